@@ -1,0 +1,222 @@
+"""Robot-versus-obstacle clearance with coal, for one configuration or a batch.
+
+A :class:`CollisionWorld` adds the obstacles to a copy of the robot's Pinocchio geometry
+model and registers robot-obstacle pairs only (the robot never tests itself). Distances are
+signed: negative values are penetration depths. The clearance of a group is the smallest
+distance between any of its geometries and any obstacle.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import ArrayLike, NDArray
+
+from cpr_kin.errors import CprKinError
+from cpr_kin.obstacles import Obstacle
+from cpr_kin.robot import GROUPS, Robot
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+
+@dataclass(frozen=True)
+class PairDistance:
+    """Signed distance of one robot geometry to one obstacle.
+
+    Attributes:
+        robot_geometry: robot geometry name (e.g. ``"arm"``).
+        obstacle: obstacle name.
+        group: collision group of the robot geometry.
+        distance_m: signed distance [m]; negative when they overlap.
+        point_on_robot: closest point on the robot geometry, world frame [m].
+        point_on_obstacle: closest point on the obstacle, world frame [m].
+    """
+
+    robot_geometry: str
+    obstacle: str
+    group: str
+    distance_m: float
+    point_on_robot: FloatArray
+    point_on_obstacle: FloatArray
+
+
+@dataclass(frozen=True)
+class Clearance:
+    """Clearance of one configuration.
+
+    Attributes:
+        q: the configuration [rad, m].
+        pairs: every robot-obstacle pair with its distance and closest points.
+        group_clearance_m: smallest distance per group, keyed by group name [m]
+            (``inf`` without obstacles).
+    """
+
+    q: FloatArray
+    pairs: tuple[PairDistance, ...]
+    group_clearance_m: dict[str, float]
+
+    @property
+    def min_clearance_m(self) -> float:
+        """Smallest distance over every pair [m]."""
+        return min(self.group_clearance_m.values())
+
+    @property
+    def closest(self) -> PairDistance | None:
+        """The closest robot-obstacle pair, or ``None`` without obstacles."""
+        return min(self.pairs, key=lambda p: p.distance_m) if self.pairs else None
+
+    def violating_groups(self, margin_m: float) -> tuple[str, ...]:
+        """Groups closer than ``margin_m`` [m] to an obstacle, in :data:`GROUPS` order."""
+        return tuple(g for g in GROUPS if self.group_clearance_m[g] < margin_m)
+
+
+@dataclass(frozen=True)
+class BatchClearance:
+    """Per-group clearance of many configurations.
+
+    Attributes:
+        clearance_m: ``(N, 2)`` smallest distance per group [m], columns in :data:`GROUPS`
+            order (``effector``, ``links``).
+        closest_pair: ``(N, 2)`` index into :attr:`CollisionWorld.pairs` of the closest pair
+            per group (``-1`` without obstacles).
+    """
+
+    clearance_m: FloatArray
+    closest_pair: IntArray
+
+    @property
+    def min_clearance_m(self) -> FloatArray:
+        """``(N,)`` smallest distance over both groups [m]."""
+        return np.asarray(self.clearance_m.min(axis=1))
+
+
+class CollisionWorld:
+    """The robot among static obstacles, ready for repeated distance queries.
+
+    Args:
+        robot: the robot (its collision geometry model is copied, never modified).
+        obstacles: the obstacles; their names must be unique.
+        num_threads: threads for :meth:`margin_violated` (default: up to 2).
+    """
+
+    def __init__(self, robot: Robot, obstacles: Sequence[Obstacle], num_threads: int | None = None) -> None:
+        names = [o.name for o in obstacles]
+        duplicated = sorted({n for n in names if names.count(n) > 1})
+        if duplicated:
+            raise CprKinError(f"obstacle names must be unique; {duplicated} appear more than once")
+        self.robot = robot
+        self.obstacles = tuple(obstacles)
+        self.num_threads = num_threads or min(2, os.cpu_count() or 1)
+        model = robot.collision_model.copy()
+        obstacle_ids = []
+        for obstacle in self.obstacles:
+            obj = pin.GeometryObject(f"obstacle:{obstacle.name}", 0, 0, obstacle.placement, obstacle.geometry())
+            obstacle_ids.append(model.addGeometryObject(obj))
+        pairs: list[tuple[int, int]] = []
+        for geometry in robot.geometries:
+            for k, oid in enumerate(obstacle_ids):
+                model.addCollisionPair(pin.CollisionPair(geometry.index, oid))
+                pairs.append((geometry.index, k))
+        self.geometry_model = model
+        self._pairs = pairs
+        self._pair_group = np.array([GROUPS.index(robot.geometries[g].group) for g, _ in pairs], dtype=np.int64)
+        self._data = robot.model.createData()
+        self._all = model.createData()
+        self._groups = []
+        for group_index in range(len(GROUPS)):
+            gdata = model.createData()
+            for p, pair_group in enumerate(self._pair_group):
+                if pair_group == group_index:
+                    gdata.activateCollisionPair(p)
+                else:
+                    gdata.deactivateCollisionPair(p)
+            self._groups.append(gdata)
+        self._group_has_pairs = [bool(np.any(self._pair_group == g)) for g in range(len(GROUPS))]
+        self._pool: Any = None
+        self._pool_margin: float | None = None
+
+    @property
+    def pairs(self) -> tuple[tuple[str, str, str], ...]:
+        """``(robot geometry, obstacle, group)`` of every pair, in query order."""
+        geoms = self.robot.geometries
+        return tuple((geoms[g].name, self.obstacles[k].name, geoms[g].group) for g, k in self._pairs)
+
+    def clearance(self, q: ArrayLike) -> Clearance:
+        """Signed distance of every robot-obstacle pair at configuration ``q`` [rad, m]."""
+        q_arr = self.robot.configuration(q, check_limits=False)
+        pin.computeDistances(self.robot.model, self._data, self.geometry_model, self._all, q_arr)
+        pairs = []
+        group_min = {g: float("inf") for g in GROUPS}
+        for (g, k), result in zip(self._pairs, self._all.distanceResults, strict=True):
+            geometry = self.robot.geometries[g]
+            distance = float(result.min_distance)
+            pairs.append(
+                PairDistance(
+                    robot_geometry=geometry.name,
+                    obstacle=self.obstacles[k].name,
+                    group=geometry.group,
+                    distance_m=distance,
+                    point_on_robot=np.array(result.getNearestPoint1()),
+                    point_on_obstacle=np.array(result.getNearestPoint2()),
+                )
+            )
+            group_min[geometry.group] = min(group_min[geometry.group], distance)
+        return Clearance(q=q_arr, pairs=tuple(pairs), group_clearance_m=group_min)
+
+    def clearance_batch(self, q: ArrayLike) -> BatchClearance:
+        """Per-group clearance of configurations ``q`` of shape ``(N, nq)`` [rad, m].
+
+        One coal query per group and configuration, each returning its closest pair; joint
+        limits are not checked (callers sampling a curve pass in-range values).
+        """
+        batch = np.asarray(q, dtype=float)
+        if batch.ndim != 2 or batch.shape[1] != self.robot.nq:
+            raise CprKinError(f"configurations of shape {batch.shape}; expected (N, {self.robot.nq})")
+        if not np.all(np.isfinite(batch)):
+            raise CprKinError("configurations contain NaN or inf")
+        n = len(batch)
+        clearance = np.full((n, len(GROUPS)), np.inf)
+        closest = np.full((n, len(GROUPS)), -1, dtype=np.int64)
+        model, data, gmodel = self.robot.model, self._data, self.geometry_model
+        compute = pin.computeDistances
+        for group_index, gdata in enumerate(self._groups):
+            if not self._group_has_pairs[group_index]:
+                continue
+            results = gdata.distanceResults
+            column = clearance[:, group_index]
+            index_column = closest[:, group_index]
+            for k in range(n):
+                pair = compute(model, data, gmodel, gdata, batch[k])
+                column[k] = results[pair].min_distance
+                index_column[k] = pair
+        return BatchClearance(clearance_m=clearance, closest_pair=closest)
+
+    def margin_violated(self, q: ArrayLike, margin_m: float) -> NDArray[np.bool_]:
+        """``(N,)`` whether any robot geometry is closer than ``margin_m`` [m] to an obstacle.
+
+        A yes/no check run by coal's collision test with ``margin_m`` as security margin, in
+        parallel over :attr:`num_threads` threads (Pinocchio's ``GeometryPool``); several
+        times faster than :meth:`clearance_batch` when distances are not needed.
+        """
+        batch = np.asarray(q, dtype=float)
+        if batch.ndim != 2 or batch.shape[1] != self.robot.nq:
+            raise CprKinError(f"configurations of shape {batch.shape}; expected (N, {self.robot.nq})")
+        if not (np.isfinite(margin_m) and margin_m >= 0.0):
+            raise CprKinError(f"safety margin {margin_m} m must be a finite number >= 0")
+        if not self._pairs:
+            return np.zeros(len(batch), dtype=bool)
+        if self._pool is None:
+            self._pool = pin.GeometryPool(self.robot.model, self.geometry_model, self.num_threads)
+        if self._pool_margin != margin_m:
+            margins = np.full((self.geometry_model.ngeoms,) * 2, float(margin_m))
+            for gdata in self._pool.getGeometryDatas():
+                gdata.setSecurityMargins(self.geometry_model, margins, True, True)
+            self._pool_margin = margin_m
+        result = pin.computeCollisionsInParallel(self.num_threads, self._pool, np.asfortranarray(batch.T))
+        return np.asarray(result, dtype=bool)

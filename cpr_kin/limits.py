@@ -1,0 +1,132 @@
+"""Joint limits of a serial robot: position range, velocity, acceleration and jerk."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import yaml
+from numpy.typing import NDArray
+
+from cpr_kin.errors import CprKinError, UrdfError
+
+FloatArray = NDArray[np.float64]
+
+_KINDS = ("velocity", "acceleration", "jerk")
+
+
+@dataclass(frozen=True)
+class JointLimits:
+    """Per-joint kinematic limits, in joint order.
+
+    Attributes:
+        names: joint names.
+        lower: lower position limit [rad or m].
+        upper: upper position limit [rad or m].
+        velocity: maximum absolute velocity [rad/s or m/s].
+        acceleration: maximum absolute acceleration [rad/s^2 or m/s^2].
+        jerk: maximum absolute jerk [rad/s^3 or m/s^3].
+    """
+
+    names: tuple[str, ...]
+    lower: FloatArray
+    upper: FloatArray
+    velocity: FloatArray
+    acceleration: FloatArray
+    jerk: FloatArray
+
+    def __post_init__(self) -> None:
+        n = len(self.names)
+        for field in ("lower", "upper", *_KINDS):
+            value = np.array(getattr(self, field), dtype=float)
+            if value.shape != (n,):
+                raise CprKinError(
+                    f"joint limits '{field}' has shape {value.shape}; expected ({n},), "
+                    f"one value per joint {list(self.names)}"
+                )
+            if not np.all(np.isfinite(value)):
+                raise CprKinError(f"joint limits '{field}' = {value.tolist()} must be finite")
+            value.setflags(write=False)
+            object.__setattr__(self, field, value)
+        for i, name in enumerate(self.names):
+            if not self.lower[i] <= self.upper[i]:
+                raise CprKinError(
+                    f"joint '{name}': lower limit {self.lower[i]} exceeds upper limit "
+                    f"{self.upper[i]}"
+                )
+            for kind in _KINDS:
+                if not getattr(self, kind)[i] > 0.0:
+                    raise CprKinError(
+                        f"joint '{name}': {kind} limit {getattr(self, kind)[i]} must be > 0"
+                    )
+
+    @property
+    def range(self) -> FloatArray:
+        """Width of each joint's position range [rad or m]."""
+        return self.upper - self.lower
+
+    def index(self, name: str) -> int:
+        """Index of joint ``name``; raises :class:`CprKinError` naming the known joints."""
+        try:
+            return self.names.index(name)
+        except ValueError:
+            raise CprKinError(
+                f"unknown joint '{name}'; the robot's joints are {list(self.names)}"
+            ) from None
+
+
+def read_dynamic_limits(
+    path: Path, names: tuple[str, ...], urdf_velocity: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """Read acceleration and jerk limits from a ``cpr_limits.yaml``-style file.
+
+    The file maps each joint name to ``{velocity, acceleration, jerk}``; ``velocity`` is
+    optional and, when given, must agree with the URDF's.
+
+    Returns:
+        (acceleration, jerk) arrays in the order of ``names``.
+    """
+    try:
+        raw = yaml.safe_load(path.read_text())
+    except OSError as exc:
+        raise UrdfError(f"cannot read joint limits file '{path}': {exc.strerror}") from None
+    except yaml.YAMLError as exc:
+        raise UrdfError(f"joint limits file '{path}' is not valid YAML: {exc}") from None
+    if not isinstance(raw, dict):
+        raise UrdfError(f"joint limits file '{path}' must map joint names to limits")
+    unknown = sorted(set(map(str, raw)) - set(names))
+    if unknown:
+        raise UrdfError(
+            f"joint limits file '{path}' names unknown joint(s) {unknown}; "
+            f"the robot's joints are {list(names)}"
+        )
+    acc = np.empty(len(names))
+    jerk = np.empty(len(names))
+    for i, name in enumerate(names):
+        entry = raw.get(name)
+        if not isinstance(entry, dict) or {"acceleration", "jerk"} - set(entry):
+            raise UrdfError(
+                f"joint limits file '{path}': joint '{name}' needs "
+                "{acceleration: ..., jerk: ...}"
+            )
+        extra = sorted(set(entry) - set(_KINDS))
+        if extra:
+            raise UrdfError(
+                f"joint limits file '{path}': joint '{name}' has unknown key(s) {extra}; "
+                f"allowed: {list(_KINDS)}"
+            )
+        try:
+            acc[i] = float(entry["acceleration"])
+            jerk[i] = float(entry["jerk"])
+            vel = float(entry.get("velocity", urdf_velocity[i]))
+        except (TypeError, ValueError):
+            raise UrdfError(
+                f"joint limits file '{path}': joint '{name}' limits {entry} must be numbers"
+            ) from None
+        if not np.isclose(vel, urdf_velocity[i]):
+            raise UrdfError(
+                f"joint limits file '{path}': joint '{name}' velocity {vel} disagrees with "
+                f"the URDF's {urdf_velocity[i]}; edit one so that they match"
+            )
+    return acc, jerk

@@ -1,0 +1,1 @@
+"""planning: firefly waypoint search, septic smoothing spline and the planner pipeline."""
