@@ -35,9 +35,7 @@ def _wrap(angle: float) -> float:
     return math.atan2(math.sin(angle), math.cos(angle))
 
 
-def tcp_ik(
-    robot: Robot, tcp_in_world: ArrayLike, theta4: float = 0.0, theta5: float = 0.0
-) -> FloatArray:
+def tcp_ik(robot: Robot, tcp_in_world: ArrayLike, theta4: float = 0.0, theta5: float = 0.0) -> FloatArray:
     """Joint vector that puts the TCP at ``tcp_in_world`` with the given wrist angles.
 
     Args:
@@ -53,13 +51,16 @@ def tcp_ik(
         UnreachableError: the target needs a joint outside its limits; the message names
             the joint, the value it would need and its range.
         CprKinError: the target is not three finite numbers.
+
     """
     try:
         target = np.asarray(tcp_in_world, dtype=float)
     except (TypeError, ValueError):
         raise CprKinError(f"TCP target {tcp_in_world!r} must be three numbers (x, y, z) [m]") from None
     if target.shape != (3,) or not np.all(np.isfinite(target)):
-        raise CprKinError(f"TCP target {np.asarray(tcp_in_world).tolist()} must be three finite numbers (x, y, z) [m]")
+        raise CprKinError(
+            f"TCP target {np.asarray(tcp_in_world).tolist()} must be three finite numbers (x, y, z) [m]"
+        )
     for name, value in (("theta4", theta4), ("theta5", theta5)):
         robot.check_joint(name, value)
 

@@ -31,6 +31,7 @@ def frame_poses(robot: Robot, q: ArrayLike, frame: str = TCP_FRAME) -> FloatArra
 
     Returns:
         ``(4, 4)`` for one configuration, ``(N, 4, 4)`` for a batch.
+
     """
     fid = robot.frame_id(frame)
     batch, single = _as_batch(robot, q)

@@ -27,6 +27,7 @@ class JointLimits:
         velocity: maximum absolute velocity [rad/s or m/s].
         acceleration: maximum absolute acceleration [rad/s^2 or m/s^2].
         jerk: maximum absolute jerk [rad/s^3 or m/s^3].
+
     """
 
     names: tuple[str, ...]
@@ -52,14 +53,11 @@ class JointLimits:
         for i, name in enumerate(self.names):
             if not self.lower[i] <= self.upper[i]:
                 raise CprKinError(
-                    f"joint '{name}': lower limit {self.lower[i]} exceeds upper limit "
-                    f"{self.upper[i]}"
+                    f"joint '{name}': lower limit {self.lower[i]} exceeds upper limit {self.upper[i]}"
                 )
             for kind in _KINDS:
                 if not getattr(self, kind)[i] > 0.0:
-                    raise CprKinError(
-                        f"joint '{name}': {kind} limit {getattr(self, kind)[i]} must be > 0"
-                    )
+                    raise CprKinError(f"joint '{name}': {kind} limit {getattr(self, kind)[i]} must be > 0")
 
     @property
     def range(self) -> FloatArray:
@@ -71,9 +69,7 @@ class JointLimits:
         try:
             return self.names.index(name)
         except ValueError:
-            raise CprKinError(
-                f"unknown joint '{name}'; the robot's joints are {list(self.names)}"
-            ) from None
+            raise CprKinError(f"unknown joint '{name}'; the robot's joints are {list(self.names)}") from None
 
 
 def read_dynamic_limits(
@@ -86,6 +82,7 @@ def read_dynamic_limits(
 
     Returns:
         (acceleration, jerk) arrays in the order of ``names``.
+
     """
     try:
         raw = yaml.safe_load(path.read_text())
@@ -107,8 +104,7 @@ def read_dynamic_limits(
         entry = raw.get(name)
         if not isinstance(entry, dict) or {"acceleration", "jerk"} - set(entry):
             raise UrdfError(
-                f"joint limits file '{path}': joint '{name}' needs "
-                "{acceleration: ..., jerk: ...}"
+                f"joint limits file '{path}': joint '{name}' needs {{acceleration: ..., jerk: ...}}"
             )
         extra = sorted(set(entry) - set(_KINDS))
         if extra:

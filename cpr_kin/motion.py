@@ -102,6 +102,7 @@ class CurveCheck:
         worst_group: group of the smallest sampled clearance.
         worst_pair: ``(robot geometry, obstacle)`` closest at :attr:`worst_time`.
         violating_groups: groups whose certified clearance falls below the margin.
+
     """
 
     accepted: bool
@@ -136,6 +137,7 @@ def check_curve(
         speed_bound: ``(nq,)`` bounds on ``|dq_j/dt|`` over the interval [rad/s, m/s].
         margin_m: required clearance [m].
         step_m: largest robot motion between two checks [m].
+
     """
     speed = np.asarray(speed_bound, dtype=float)
     if speed.shape != (world.robot.nq,) or not np.all(np.isfinite(speed)) or np.any(speed < 0):
@@ -147,14 +149,12 @@ def check_curve(
     point_speed = float(motion_radii(world.robot) @ speed)
     duration = t1 - t0
     count = int(np.ceil(duration * point_speed / (2.0 * step_m))) + 1 if point_speed > 0 else 1
-    times = np.linspace(t0, t1, max(count, 2))
+    times = np.linspace(t0, t1, max(count, 2))  # at least both ends
     dt = times[1] - times[0]
     batch = world.clearance_batch(curve(times))
     per_group = batch.clearance_m
-    if len(times) > 1:
-        certified = 0.5 * (per_group[:-1] + per_group[1:] - point_speed * dt)
-    else:
-        certified = per_group
+    # lower bound between neighbouring samples: distances change no faster than V
+    certified = 0.5 * (per_group[:-1] + per_group[1:] - point_speed * dt)
     group_bound = certified.min(axis=0)
     sample_min = per_group.min(axis=1)
     worst = int(np.argmin(sample_min))
@@ -177,7 +177,9 @@ def check_curve(
     )
 
 
-def check_segment(world: CollisionWorld, q_start: ArrayLike, q_goal: ArrayLike, margin_m: float, step_m: float = 0.005) -> CurveCheck:
+def check_segment(
+    world: CollisionWorld, q_start: ArrayLike, q_goal: ArrayLike, margin_m: float, step_m: float = 0.005
+) -> CurveCheck:
     """Continuous check of the straight joint-space segment from ``q_start`` to ``q_goal``.
 
     The segment is parametrised by ``s`` in [0, 1] (reported as :attr:`CurveCheck.times`).

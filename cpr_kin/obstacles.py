@@ -27,7 +27,9 @@ def _vector(value: ArrayLike, what: str, n: int) -> FloatArray:
     except (TypeError, ValueError):
         raise ObstacleError(f"{what} = {value!r} must be {n} numbers") from None
     if arr.shape != (n,):
-        raise ObstacleError(f"{what} = {np.asarray(value).tolist()} must have {n} values, not shape {arr.shape}")
+        raise ObstacleError(
+            f"{what} = {np.asarray(value).tolist()} must have {n} values, not shape {arr.shape}"
+        )
     if not np.all(np.isfinite(arr)):
         raise ObstacleError(f"{what} = {arr.tolist()} must be finite numbers (no NaN or inf)")
     arr.setflags(write=False)
@@ -68,6 +70,7 @@ class Obstacle:
         xyz: position of the shape's centre in the world [m].
         rpy: orientation as roll, pitch, yaw about fixed x, y, z axes [rad].
         name: a name for messages and displays.
+
     """
 
     shape: Shape
@@ -83,13 +86,17 @@ class Obstacle:
 
     def __post_init__(self) -> None:
         if self.shape not in SHAPES:
-            raise ObstacleError(f"obstacle '{self.name}': unknown shape {self.shape!r}; allowed: {list(SHAPES)}")
+            raise ObstacleError(
+                f"obstacle '{self.name}': unknown shape {self.shape!r}; allowed: {list(SHAPES)}"
+            )
         object.__setattr__(self, "xyz", _vector(self.xyz, f"obstacle '{self.name}' xyz", 3))
         object.__setattr__(self, "rpy", _vector(self.rpy, f"obstacle '{self.name}' rpy", 3))
         if self.shape == "box":
             size = _vector(self.size if self.size is not None else [], f"obstacle '{self.name}' size", 3)
             if not np.all(size > 0):
-                raise ObstacleError(f"obstacle '{self.name}' size = {size.tolist()} must be > 0 in every axis [m]")
+                raise ObstacleError(
+                    f"obstacle '{self.name}' size = {size.tolist()} must be > 0 in every axis [m]"
+                )
             object.__setattr__(self, "size", size)
         if self.shape in ("sphere", "cylinder", "capsule"):
             object.__setattr__(self, "radius", _positive(self.radius, f"obstacle '{self.name}' radius"))
@@ -104,7 +111,13 @@ class Obstacle:
     @classmethod
     def box(cls, size: ArrayLike, xyz: ArrayLike, rpy: ArrayLike = (0, 0, 0), name: str = "box") -> Obstacle:
         """A box of full side lengths ``size`` [m] centred at ``xyz``."""
-        return cls(shape="box", size=np.asarray(size, dtype=float), xyz=np.asarray(xyz), rpy=np.asarray(rpy), name=name)
+        return cls(
+            shape="box",
+            size=np.asarray(size, dtype=float),
+            xyz=np.asarray(xyz),
+            rpy=np.asarray(rpy),
+            name=name,
+        )
 
     @classmethod
     def sphere(cls, radius: float, xyz: ArrayLike, name: str = "sphere") -> Obstacle:
@@ -112,19 +125,48 @@ class Obstacle:
         return cls(shape="sphere", radius=radius, xyz=np.asarray(xyz), name=name)
 
     @classmethod
-    def cylinder(cls, radius: float, length: float, xyz: ArrayLike, rpy: ArrayLike = (0, 0, 0), name: str = "cylinder") -> Obstacle:
+    def cylinder(
+        cls, radius: float, length: float, xyz: ArrayLike, rpy: ArrayLike = (0, 0, 0), name: str = "cylinder"
+    ) -> Obstacle:
         """A cylinder of ``radius`` and ``length`` [m] along its local z, centred at ``xyz``."""
-        return cls(shape="cylinder", radius=radius, length=length, xyz=np.asarray(xyz), rpy=np.asarray(rpy), name=name)
+        return cls(
+            shape="cylinder",
+            radius=radius,
+            length=length,
+            xyz=np.asarray(xyz),
+            rpy=np.asarray(rpy),
+            name=name,
+        )
 
     @classmethod
-    def capsule(cls, radius: float, length: float, xyz: ArrayLike, rpy: ArrayLike = (0, 0, 0), name: str = "capsule") -> Obstacle:
+    def capsule(
+        cls, radius: float, length: float, xyz: ArrayLike, rpy: ArrayLike = (0, 0, 0), name: str = "capsule"
+    ) -> Obstacle:
         """A capsule: segment of ``length`` [m] along local z swept by a ball of ``radius``."""
-        return cls(shape="capsule", radius=radius, length=length, xyz=np.asarray(xyz), rpy=np.asarray(rpy), name=name)
+        return cls(
+            shape="capsule", radius=radius, length=length, xyz=np.asarray(xyz), rpy=np.asarray(rpy), name=name
+        )
 
     @classmethod
-    def from_mesh(cls, path: str | Path, xyz: ArrayLike, rpy: ArrayLike = (0, 0, 0), scale: float = 1.0, convex: bool = True, name: str = "mesh") -> Obstacle:
+    def from_mesh(
+        cls,
+        path: str | Path,
+        xyz: ArrayLike,
+        rpy: ArrayLike = (0, 0, 0),
+        scale: float = 1.0,
+        convex: bool = True,
+        name: str = "mesh",
+    ) -> Obstacle:
         """A mesh file (STL, OBJ, PLY, ... through trimesh), scaled by ``scale``."""
-        return cls(shape="mesh", mesh=Path(path), scale=scale, convex=convex, xyz=np.asarray(xyz), rpy=np.asarray(rpy), name=name)
+        return cls(
+            shape="mesh",
+            mesh=Path(path),
+            scale=scale,
+            convex=convex,
+            xyz=np.asarray(xyz),
+            rpy=np.asarray(rpy),
+            name=name,
+        )
 
     @property
     def placement(self) -> Any:
@@ -148,7 +190,7 @@ class Obstacle:
         import trimesh  # only needed for mesh obstacles
 
         try:
-            mesh = trimesh.load(str(self.mesh), force="mesh")
+            mesh: Any = trimesh.load(str(self.mesh), force="mesh")
         except Exception as exc:  # trimesh raises many types for unreadable files
             raise ObstacleError(f"obstacle '{self.name}': cannot read mesh '{self.mesh}': {exc}") from None
         if len(mesh.faces) == 0:
@@ -157,7 +199,7 @@ class Obstacle:
             mesh = mesh.convex_hull
         bvh = coal.BVHModelOBBRSS()
         bvh.beginModel(len(mesh.faces), len(mesh.vertices))
-        bvh.addVertices(np.asarray(mesh.vertices, dtype=float) * self.scale)
+        bvh.addVertices(np.asarray(mesh.vertices, dtype=np.float64) * self.scale)
         bvh.addTriangles(np.asarray(mesh.faces, dtype=np.int64))
         bvh.endModel()
         if self.convex:

@@ -48,6 +48,7 @@ class RobotGeometry:
         link: URDF link it belongs to.
         group: ``"effector"`` or ``"links"``.
         index: index in the Pinocchio geometry model.
+
     """
 
     name: str
@@ -106,6 +107,7 @@ class Robot:
         visual_model: Pinocchio geometry model of the visual shapes.
         limits: joint limits, in configuration order.
         geometries: the robot's collision geometries with their groups.
+
     """
 
     urdf_path: Path
@@ -127,13 +129,12 @@ class Robot:
 
         Raises:
             UrdfError: the file is missing or malformed, or lacks a CPR joint or the tcp frame.
+
         """
         path = Path(urdf_path) if urdf_path is not None else cpr_urdf_path()
         urdf = _validate_urdf(path)
         try:
-            model, collision_model, visual_model = pin.buildModelsFromUrdf(
-                str(path), str(path.parent)
-            )
+            model, collision_model, visual_model = pin.buildModelsFromUrdf(str(path), str(path.parent))
         except Exception as exc:  # Pinocchio reports C++ exceptions as RuntimeError/ValueError
             raise UrdfError(f"Pinocchio cannot build a model from '{path}': {exc}") from None
 
@@ -218,6 +219,7 @@ class Robot:
         Raises:
             JointLimitError: wrong length, non-finite value, unknown joint or value outside
                 the limits; the message names the joint, the value and the range.
+
         """
         if isinstance(values, dict):
             for name in values:
@@ -251,9 +253,7 @@ class Robot:
         lo, hi = self.limits.lower[i], self.limits.upper[i]
         if not lo - tol <= value <= hi + tol:
             unit = self.joint_unit(name)
-            raise JointLimitError(
-                f"joint '{name}' = {value:.6g} {unit} is outside [{lo:g}, {hi:g}] {unit}"
-            )
+            raise JointLimitError(f"joint '{name}' = {value:.6g} {unit} is outside [{lo:g}, {hi:g}] {unit}")
 
     def joint_unit(self, name: str) -> str:
         """``"rad"`` for a revolute joint, ``"m"`` for a prismatic one."""

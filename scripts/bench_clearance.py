@@ -41,7 +41,11 @@ def main() -> None:
     world.margin_violated(single, 0.1)  # build the thread pool outside the timing
 
     rows = [
-        ("clearance(q): all pairs, closest points", median_seconds(lambda: world.clearance(batch[0]), 2000), 1),
+        (
+            "clearance(q): all pairs, closest points",
+            median_seconds(lambda: world.clearance(batch[0]), 2000),
+            1,
+        ),
         ("clearance_batch, 1 configuration", median_seconds(lambda: world.clearance_batch(single), 2000), 1),
         (
             f"clearance_batch, {args.batch} configurations",
@@ -59,7 +63,8 @@ def main() -> None:
     for label, seconds, count in rows:
         print(f"{label:55s} {seconds * 1e3:11.3f} ms {seconds / count * 1e6:15.2f} us")
     per_config = rows[2][1] / args.batch * 1e6
-    print(f"target <= 10 us per configuration in a batch: {per_config:.2f} us -> {'met' if per_config <= 10 else 'NOT met'}")
+    verdict = "met" if per_config <= 10 else "NOT met"
+    print(f"target <= 10 us per configuration in a batch: {per_config:.2f} us -> {verdict}")
 
 
 if __name__ == "__main__":

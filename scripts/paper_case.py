@@ -52,11 +52,11 @@ def main(argv: list[str] | None = None) -> int:
         closest = clearance.closest
         assert closest is not None  # the scene has an obstacle
         verdict = "clear" if clearance.min_clearance_m >= PAPER_MARGIN_M else "VIOLATES the margin"
+        groups = clearance.group_clearance_m
         print(
-            f"{label:5s} tcp {tcp} -> q = {np.array2string(q, precision=4)}  "
-            f"(FK error {error:.1e} m)\n      clearance effector {clearance.group_clearance_m['effector']:.3f} m, "
-            f"links {clearance.group_clearance_m['links']:.3f} m, closest {closest.robot_geometry}-"
-            f"{closest.obstacle}: {verdict}"
+            f"{label:5s} tcp {tcp} -> q = {np.array2string(q, precision=4)}  (FK error {error:.1e} m)\n"
+            f"      clearance effector {groups['effector']:.3f} m, links {groups['links']:.3f} m, "
+            f"closest {closest.robot_geometry}-{closest.obstacle}: {verdict}"
         )
 
     check = ck.check_segment(world, configurations["start"], configurations["goal"], PAPER_MARGIN_M)

@@ -1,0 +1,205 @@
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from scipy.optimize import minimize
+
+import cpr_kin as ck
+
+from .conftest import PAPER_GOAL_TCP, PAPER_START_TCP, random_configurations
+
+
+def pair(clearance: ck.Clearance, geometry: str) -> ck.PairDistance:
+    return next(p for p in clearance.pairs if p.robot_geometry == geometry)
+
+
+def test_arm_beam_straight_above_a_box(robot: ck.Robot) -> None:
+    # theta1 = 0, d2 = 0.5 (arm axis z_c = 0.75), d3 = 0.5 (beam spans x in [0.1, 0.8]);
+    # a 0.1 x 0.1 x 0.2 block under the beam's middle, top at z = 0.6:
+    # gap = 0.75 - 0.025 - 0.6; every other link is farther away
+    world = ck.CollisionWorld(robot, [ck.Obstacle.box((0.1, 0.1, 0.2), (0.45, 0.0, 0.5), name="block")])
+    clearance = world.clearance([0.0, 0.5, 0.5, 0.0, 0.0])
+    arm = pair(clearance, "arm")
+    assert arm.distance_m == pytest.approx(0.125, abs=1e-9)
+    assert arm.point_on_robot[2] == pytest.approx(0.725, abs=1e-9)
+    assert arm.point_on_obstacle[2] == pytest.approx(0.6, abs=1e-9)
+    assert clearance.group_clearance_m["links"] == pytest.approx(0.125, abs=1e-9)
+    assert clearance.closest is not None and clearance.closest.robot_geometry == "arm"
+
+
+def test_tool_beside_a_sphere(robot: ck.Robot) -> None:
+    # theta1 = 0, d3 = 0.2 -> tool spans x in [0.48, 0.52]; sphere r = 0.05 whose surface is
+    # 0.1 m beyond the tool's front face, level with the tool's middle
+    q = [0.0, 0.3, 0.2, 0.0, 0.0]
+    z_mid = 0.25 + 0.3 - 0.075
+    world = ck.CollisionWorld(robot, [ck.Obstacle.sphere(0.05, (0.52 + 0.1 + 0.05, 0.0, z_mid), name="ball")])
+    clearance = world.clearance(q)
+    assert pair(clearance, "tool").distance_m == pytest.approx(0.1, abs=1e-9)
+    assert clearance.group_clearance_m["effector"] == pytest.approx(0.1, abs=1e-9)
+    assert clearance.violating_groups(0.1 + 1e-6) == ("effector",)
+    assert clearance.violating_groups(0.1 - 1e-6) == ()
+
+
+def test_obstacle_behind_a_retracted_arm_is_hit_only_by_the_rear_end(robot: ck.Robot) -> None:
+    # theta1 = 0, d3 = 0: the beam spans x in [-0.40, 0.30] at z_c; a 0.1 m cube centred at
+    # x = -0.35 on the arm axis swallows the rear end
+    z_c = 0.25 + 0.3
+    world = ck.CollisionWorld(robot, [ck.Obstacle.box((0.1, 0.1, 0.1), (-0.35, 0.0, z_c), name="shelf")])
+    retracted = world.clearance([0.0, 0.3, 0.0, 0.0, 0.0])
+    # smallest escape of the 0.05 x 0.05 beam from the 0.1 cube: 0.075 sideways or vertically
+    assert pair(retracted, "arm").distance_m == pytest.approx(-0.075, abs=1e-6)
+    assert retracted.violating_groups(0.1) == ("links",)
+    # the wrist (radius 0.035 about the flange at x = 0.30) is 0.265 + 0.30 from the cube
+    assert retracted.group_clearance_m["effector"] == pytest.approx(0.565, abs=1e-9)
+    for geometry in ("carriage", "column", "base"):
+        assert pair(retracted, geometry).distance_m > 0.1
+    # extended by 0.3 m, the rear end sits at x = -0.1: 0.2 m from the cube's face
+    extended = world.clearance([0.0, 0.3, 0.3, 0.0, 0.0])
+    assert pair(extended, "arm").distance_m == pytest.approx(0.2, abs=1e-9)
+
+
+def test_paper_start_goal_clear_and_swing_collides(robot: ck.Robot, paper_world: ck.CollisionWorld) -> None:
+    start, goal = ck.tcp_ik(robot, PAPER_START_TCP), ck.tcp_ik(robot, PAPER_GOAL_TCP)
+    assert paper_world.clearance(start).min_clearance_m > 0.1
+    assert paper_world.clearance(goal).min_clearance_m > 0.1
+    # constant-height swing: theta1 sweeps from start to goal, d2 and d3 held
+    swing = np.linspace(start, goal, 101)
+    batch = paper_world.clearance_batch(swing)
+    assert batch.min_clearance_m.min() < 0.0  # the tool passes through the crate
+    # mid-swing the tool tip is inside the crate and the beam (bottom at z = 0.4 - 0.025)
+    # passes 0.075 m above the crate's top (z = 0.3)
+    middle = paper_world.clearance(swing[50])
+    assert middle.group_clearance_m["effector"] < 0.0
+    assert middle.group_clearance_m["links"] == pytest.approx(0.075, abs=1e-6)
+    assert middle.violating_groups(0.1) == ("effector", "links")
+
+
+def test_batch_agrees_with_single(
+    robot: ck.Robot, paper_world: ck.CollisionWorld, rng: np.random.Generator
+) -> None:
+    configurations = random_configurations(robot, rng, 100)
+    batch = paper_world.clearance_batch(configurations)
+    pairs = paper_world.pairs
+    for k, q in enumerate(configurations):
+        single = paper_world.clearance(q)
+        for g, group in enumerate(ck.GROUPS):
+            assert batch.clearance_m[k, g] == pytest.approx(single.group_clearance_m[group], abs=1e-6)
+            assert pairs[batch.closest_pair[k, g]][2] == group
+
+
+def test_margin_violated_agrees_with_distances(
+    robot: ck.Robot, paper_world: ck.CollisionWorld, rng: np.random.Generator
+) -> None:
+    configurations = random_configurations(robot, rng, 1000)
+    distances = paper_world.clearance_batch(configurations).min_clearance_m
+    for margin in (0.0, 0.1, 0.25):
+        violated = paper_world.margin_violated(configurations, margin)
+        ambiguous = np.abs(distances - margin) < 1e-6
+        np.testing.assert_array_equal(violated[~ambiguous], distances[~ambiguous] < margin)
+        assert 0 < violated.sum() < len(configurations)
+
+
+def test_world_without_obstacles(robot: ck.Robot) -> None:
+    world = ck.CollisionWorld(robot, [])
+    assert world.clearance(np.zeros(5)).min_clearance_m == np.inf
+    assert np.all(world.clearance_batch(np.zeros((3, 5))).clearance_m == np.inf)
+    assert not world.margin_violated(np.zeros((3, 5)), 0.1).any()
+
+
+def test_duplicate_obstacle_names(robot: ck.Robot) -> None:
+    box = ck.Obstacle.box((0.1, 0.1, 0.1), (1, 1, 1), name="crate")
+    with pytest.raises(ck.CprKinError, match=r"\['crate'\] appear more than once"):
+        ck.CollisionWorld(robot, [box, box])
+
+
+def test_bad_batch(paper_world: ck.CollisionWorld) -> None:
+    with pytest.raises(ck.CprKinError, match=r"expected \(N, 5\)"):
+        paper_world.clearance_batch(np.zeros((4, 3)))
+    with pytest.raises(ck.CprKinError, match="NaN"):
+        paper_world.clearance_batch(np.full((2, 5), np.nan))
+    with pytest.raises(ck.CprKinError, match="safety margin -1"):
+        paper_world.margin_violated(np.zeros((2, 5)), -1.0)
+
+
+# --- independent oracle: the separating-axis dual with analytic support functions ---------
+# For disjoint convex sets A and B, dist(A, B) = max over unit n of -h_A(-n) - h_B(n), where
+# h_X(d) = max over x in X of d.x. Exact for the primitives below (no faceting) and unrelated
+# to coal's GJK/EPA.
+
+
+def support(geometry: Any, placement: Any) -> Callable[[np.ndarray], float]:
+    centre, rotation = np.asarray(placement.translation), np.asarray(placement.rotation)
+    axis = rotation[:, 2]
+    kind = type(geometry).__name__
+    if kind == "Box":
+        half = np.asarray(geometry.halfSide)
+        return lambda d: float(centre @ d + np.abs(rotation.T @ d) @ half)
+    if kind == "Sphere":
+        return lambda d: float(centre @ d + geometry.radius * np.linalg.norm(d))
+    if kind == "Cylinder":
+        r, h = geometry.radius, geometry.halfLength
+        return lambda d: float(centre @ d + h * abs(axis @ d) + r * np.linalg.norm(d - (axis @ d) * axis))
+    if kind == "Capsule":
+        r, h = geometry.radius, geometry.halfLength
+        return lambda d: float(centre @ d + h * abs(axis @ d) + r * np.linalg.norm(d))
+    raise AssertionError(kind)
+
+
+def separating_distance(
+    h_a: Callable[[np.ndarray], float],
+    h_b: Callable[[np.ndarray], float],
+    start: np.ndarray,
+    rng: np.random.Generator,
+) -> float:
+    def negative_gap(n: np.ndarray) -> float:
+        n = n / np.linalg.norm(n)
+        return h_a(-n) + h_b(n)
+
+    options = {"xatol": 1e-12, "fatol": 1e-14, "maxiter": 4000}
+    starts = [start, *rng.normal(size=(2, 3))]
+    best = min(
+        (minimize(negative_gap, s, method="Nelder-Mead", options=options) for s in starts),
+        key=lambda r: r.fun,
+    )
+    polished = minimize(negative_gap, best.x / np.linalg.norm(best.x), method="Nelder-Mead", options=options)
+    return -float(min(best.fun, polished.fun))
+
+
+def random_obstacle(shape: str, rng: np.random.Generator) -> ck.Obstacle:
+    xyz = rng.uniform([-0.8, -0.8, 0.0], [0.8, 0.8, 1.0])
+    rpy = rng.uniform(-np.pi, np.pi, 3)
+    if shape == "box":
+        return ck.Obstacle.box(rng.uniform(0.05, 0.3, 3), xyz, rpy)
+    if shape == "sphere":
+        return ck.Obstacle.sphere(rng.uniform(0.03, 0.2), xyz)
+    make = ck.Obstacle.cylinder if shape == "cylinder" else ck.Obstacle.capsule
+    return make(rng.uniform(0.03, 0.15), rng.uniform(0.1, 0.5), xyz, rpy)
+
+
+def test_distances_against_independent_oracle(robot: ck.Robot, rng: np.random.Generator) -> None:
+    checked = 0
+    data = robot.model.createData()
+    gdata = robot.collision_model.createData()
+    for trial in range(16):
+        shape = ("box", "sphere", "cylinder", "capsule")[trial % 4]
+        obstacle = random_obstacle(shape, rng)
+        world = ck.CollisionWorld(robot, [obstacle])
+        q = random_configurations(robot, rng, 1)[0]
+        clearance = world.clearance(q)
+        pin.updateGeometryPlacements(robot.model, data, robot.collision_model, gdata, q)
+        h_b = support(obstacle.geometry(), obstacle.placement)
+        for g in robot.geometries:
+            found = pair(clearance, g.name)
+            if found.distance_m < 1e-3:
+                continue
+            placement = gdata.oMg[g.index]
+            h_a = support(robot.collision_model.geometryObjects[g.index].geometry, placement)
+            expected = separating_distance(h_a, h_b, found.point_on_obstacle - found.point_on_robot, rng)
+            # coal's GJK stops at its default tolerance of 1e-6 (relative to the distance)
+            assert found.distance_m == pytest.approx(expected, abs=2e-6), (shape, g.name)
+            checked += 1
+    assert checked >= 60

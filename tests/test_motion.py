@@ -1,0 +1,137 @@
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pinocchio as pin
+import pytest
+import trimesh
+
+import cpr_kin as ck
+
+from .conftest import PAPER_GOAL_TCP, PAPER_START_TCP, random_configurations
+
+
+@pytest.fixture(scope="module")
+def surface_points(robot: ck.Robot) -> list[np.ndarray]:
+    """Points on each collision geometry's surface, in its own frame."""
+    points = []
+    for g in robot.geometries:
+        shape = robot.collision_model.geometryObjects[g.index].geometry
+        if type(shape).__name__ == "Box":
+            mesh = trimesh.creation.box(extents=2 * np.asarray(shape.halfSide))
+        else:
+            mesh = trimesh.creation.cylinder(radius=shape.radius, height=2 * shape.halfLength, sections=64)
+        points.append(np.asarray(mesh.vertices))
+    return points
+
+
+def world_points(robot: ck.Robot, q: np.ndarray, surface_points: list[np.ndarray]) -> np.ndarray:
+    data = robot.model.createData()
+    gdata = robot.collision_model.createData()
+    pin.updateGeometryPlacements(robot.model, data, robot.collision_model, gdata, q)
+    placements = [gdata.oMg[g.index] for g in robot.geometries]
+    return np.vstack(
+        [p @ m.rotation.T + m.translation for m, p in zip(placements, surface_points, strict=True)]
+    )
+
+
+def test_radii_values(robot: ck.Robot) -> None:
+    radii = ck.motion_radii(robot)
+    np.testing.assert_array_equal(radii[1:3], [1.0, 1.0])
+    # theta1 carries the tool, pitched horizontal at full reach: 0.8 + 0.15 (+ corner)
+    assert 0.95 < radii[0] < 0.97
+    # the wrist joints carry the 0.15 m tool
+    assert 0.15 < radii[3] < 0.16 and 0.15 < radii[4] < 0.16
+
+
+def test_radii_bound_every_point_motion(
+    robot: ck.Robot, rng: np.random.Generator, surface_points: list[np.ndarray]
+) -> None:
+    radii = ck.motion_radii(robot)
+    worst_ratio = 0.0
+    for q in random_configurations(robot, rng, 300):
+        dq = rng.normal(size=robot.nq) * rng.uniform(1e-4, 0.05)
+        q2 = np.clip(q + dq, robot.limits.lower, robot.limits.upper)
+        moved = np.linalg.norm(
+            world_points(robot, q2, surface_points) - world_points(robot, q, surface_points), axis=1
+        ).max()
+        bound = radii @ np.abs(q2 - q)
+        assert moved <= bound + 1e-12
+        worst_ratio = max(worst_ratio, moved / bound)
+    # single-joint motions show the bound is tight, not merely valid
+    q = np.array([0.0, 0.3, 0.5, 0.0, -1.6])  # tool pitched outward, horizontal
+    step = np.array([1e-3, 0, 0, 0, 0])
+    moved = np.linalg.norm(
+        world_points(robot, q + step, surface_points) - world_points(robot, q, surface_points), axis=1
+    ).max()
+    assert moved / (radii @ step) > 0.99
+
+
+def test_paper_swing_rejected(robot: ck.Robot, paper_world: ck.CollisionWorld) -> None:
+    start, goal = ck.tcp_ik(robot, PAPER_START_TCP), ck.tcp_ik(robot, PAPER_GOAL_TCP)
+    check = ck.check_segment(paper_world, start, goal, margin_m=0.1)
+    assert not check.accepted
+    assert check.worst_pair == ("tool", "crate")
+    assert check.worst_group == "effector"
+    assert set(check.violating_groups) == {"effector", "links"}
+    assert check.certified_min_m <= check.sampled_min_m
+
+
+def test_lifted_swing_accepted(robot: ck.Robot, paper_world: ck.CollisionWorld) -> None:
+    # the same swing with the carriage at the top clears the crate by far
+    start = ck.tcp_ik(robot, (0.5, 0.45, 0.65))
+    goal = ck.tcp_ik(robot, (-0.5, 0.45, 0.65))
+    check = ck.check_segment(paper_world, start, goal, margin_m=0.1)
+    assert check.accepted
+    assert check.violating_groups == ()
+    assert 0.1 < check.certified_min_m <= check.sampled_min_m
+
+
+@pytest.mark.parametrize("step_m", [0.002, 0.01, 0.05])
+def test_samples_respect_the_motion_bound(
+    robot: ck.Robot, paper_world: ck.CollisionWorld, step_m: float
+) -> None:
+    start, goal = ck.tcp_ik(robot, PAPER_START_TCP), ck.tcp_ik(robot, PAPER_GOAL_TCP)
+    check = ck.check_segment(paper_world, start, goal, margin_m=0.1, step_m=step_m)
+    ds = np.diff(check.times)
+    motion_between_checks = ck.motion_radii(robot) @ np.abs(goal - start) * ds
+    assert motion_between_checks.max() <= 2 * step_m * (1 + 1e-12)
+    assert check.sampled_min_m - check.certified_min_m <= step_m + 1e-12
+
+
+def test_certified_bound_is_sound(robot: ck.Robot, rng: np.random.Generator) -> None:
+    # certified minimum never exceeds what a 50x denser sampling finds
+    world = ck.CollisionWorld(robot, [ck.Obstacle.sphere(0.1, (0.2, 0.6, 0.4), name="ball")])
+    for _ in range(10):
+        a, b = random_configurations(robot, rng, 2)
+        check = ck.check_segment(world, a, b, margin_m=0.1, step_m=0.02)
+        dense = world.clearance_batch(np.linspace(a, b, 50 * len(check.times))).min_clearance_m.min()
+        assert check.certified_min_m <= dense + 1e-9
+
+
+def test_thin_plate_between_samples_is_caught(robot: ck.Robot) -> None:
+    # a 2 mm plate crossed by the tool; with coarse checks every sample may miss it, but the
+    # certified bound cannot
+    plate = ck.Obstacle.box((0.002, 0.6, 0.6), (0.0, 0.6, 0.3), name="plate")
+    world = ck.CollisionWorld(robot, [plate])
+    start, goal = ck.tcp_ik(robot, PAPER_START_TCP), ck.tcp_ik(robot, PAPER_GOAL_TCP)
+    check = ck.check_segment(world, start, goal, margin_m=0.0, step_m=0.1)
+    assert not check.accepted
+    assert check.certified_min_m < 0.0
+
+
+def test_curve_interface_and_errors(robot: ck.Robot, paper_world: ck.CollisionWorld) -> None:
+    q0 = ck.tcp_ik(robot, (0.5, 0.45, 0.65))
+
+    def hold(t: np.ndarray) -> np.ndarray:
+        return np.tile(q0, (len(t), 1))
+
+    still = ck.check_curve(paper_world, hold, 0.0, 2.0, np.zeros(5), margin_m=0.1)
+    assert still.accepted and len(still.times) == 2
+    with pytest.raises(ck.CprKinError, match="speed bound"):
+        ck.check_curve(paper_world, hold, 0.0, 1.0, -np.ones(5), margin_m=0.1)
+    with pytest.raises(ck.CprKinError, match=re.escape("motion step 0.0 m")):
+        ck.check_curve(paper_world, hold, 0.0, 1.0, np.ones(5), margin_m=0.1, step_m=0.0)
+    with pytest.raises(ck.CprKinError, match=r"time interval \[1.0, 0.0\]"):
+        ck.check_curve(paper_world, hold, 1.0, 0.0, np.ones(5), margin_m=0.1)

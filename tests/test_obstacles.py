@@ -1,0 +1,84 @@
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+
+import cpr_kin as ck
+
+
+@pytest.mark.parametrize(
+    ("make", "pattern"),
+    [
+        (
+            lambda: ck.Obstacle.box((0.3, -0.1, 0.3), (0, 0, 0), name="crate"),
+            r"'crate' size = \[0\.3, -0\.1, 0\.3\] must be > 0",
+        ),
+        (lambda: ck.Obstacle.box((0.3, 0.3), (0, 0, 0)), r"size = \[0\.3, 0\.3\] must have 3 values"),
+        (
+            lambda: ck.Obstacle.sphere(0.1, (0, math.nan, 0), name="ball"),
+            r"'ball' xyz = \[0\.0, nan, 0\.0\] must be finite",
+        ),
+        (
+            lambda: ck.Obstacle.sphere(-0.1, (0, 0, 0), name="ball"),
+            r"'ball' radius = -0\.1 must be a finite number > 0",
+        ),
+        (
+            lambda: ck.Obstacle.cylinder(0.1, 0.0, (0, 0, 0), name="pipe"),
+            r"'pipe' length = 0\.0 must be a finite number > 0",
+        ),
+        (
+            lambda: ck.Obstacle.capsule(0.1, 0.2, (0, 0, 0), rpy=(0, math.inf, 0)),
+            r"rpy = \[0\.0, inf, 0\.0\] must be finite",
+        ),
+        (
+            lambda: ck.Obstacle(shape="cone", xyz=np.zeros(3)),  # type: ignore[arg-type]
+            r"unknown shape 'cone'; allowed: \['box', 'sphere', 'cylinder', 'capsule', 'mesh'\]",
+        ),
+        (
+            lambda: ck.Obstacle.from_mesh("/no/such/file.stl", (0, 0, 0)),
+            r"mesh file '/no/such/file\.stl' does not exist",
+        ),
+    ],
+)
+def test_invalid_obstacles(make: object, pattern: str) -> None:
+    with pytest.raises(ck.ObstacleError, match=pattern):
+        make()  # type: ignore[operator]
+
+
+def test_unreadable_mesh(tmp_path: Path) -> None:
+    path = tmp_path / "junk.stl"
+    path.write_text("this is not a mesh")
+    with pytest.raises(ck.ObstacleError, match=re.escape("junk.stl")):
+        ck.Obstacle.from_mesh(path, (0, 0, 0)).geometry()
+
+
+def test_placement_from_rpy() -> None:
+    obstacle = ck.Obstacle.box((1, 2, 3), (0.1, 0.2, 0.3), rpy=(0.0, 0.0, math.pi / 2))
+    placement = obstacle.placement
+    np.testing.assert_allclose(placement.translation, [0.1, 0.2, 0.3])
+    np.testing.assert_allclose(placement.rotation @ [1, 0, 0], [0, 1, 0], atol=1e-15)
+
+
+@pytest.mark.parametrize("convex", [True, False])
+def test_mesh_box_matches_primitive_box(
+    robot: ck.Robot, rng: np.random.Generator, tmp_path: Path, convex: bool
+) -> None:
+    path = tmp_path / "crate.stl"
+    trimesh.creation.box(extents=(0.15, 0.15, 0.15)).export(path)
+    kwargs = {"xyz": (0.0, 0.6, 0.15), "rpy": (0.1, 0.0, 0.3)}
+    primitive = ck.CollisionWorld(robot, [ck.Obstacle.box((0.3, 0.3, 0.3), name="crate", **kwargs)])
+    mesh = ck.CollisionWorld(
+        robot, [ck.Obstacle.from_mesh(path, scale=2.0, convex=convex, name="crate", **kwargs)]
+    )
+    configurations = rng.uniform(robot.limits.lower, robot.limits.upper, (200, robot.nq))
+    a = primitive.clearance_batch(configurations).clearance_m
+    b = mesh.clearance_batch(configurations).clearance_m
+    separated = a > 1e-3
+    assert separated.sum() > 300
+    # coal stops GJK at a tolerance of about 1e-6 m on triangle meshes
+    np.testing.assert_allclose(b[separated], a[separated], atol=1e-5)

@@ -1,0 +1,142 @@
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import cpr_kin as ck
+
+URDF_TEXT = ck.cpr_urdf_path().read_text()
+
+
+def test_joints_and_limits_match_design(robot: ck.Robot) -> None:
+    assert robot.joint_names == ("theta1", "d2", "d3", "theta4", "theta5")
+    lim = robot.limits
+    np.testing.assert_array_equal(lim.lower, [-2.9, 0.0, 0.0, -3.1, -1.6])
+    np.testing.assert_array_equal(lim.upper, [2.9, 0.6, 0.5, 3.1, 1.6])
+    np.testing.assert_array_equal(lim.velocity, [1.5, 0.5, 0.5, 2.0, 2.0])
+    np.testing.assert_array_equal(lim.acceleration, [3.0, 2.0, 2.0, 4.0, 4.0])
+    np.testing.assert_array_equal(lim.jerk, [15.0, 10.0, 10.0, 20.0, 20.0])
+    assert [robot.joint_unit(n) for n in robot.joint_names] == ["rad", "m", "m", "rad", "rad"]
+
+
+def test_collision_groups(robot: ck.Robot) -> None:
+    groups = {g.name: g.group for g in robot.geometries}
+    assert groups == {
+        "base": "links",
+        "column": "links",
+        "carriage": "links",
+        "arm": "links",
+        "wrist": "effector",
+        "tool": "effector",
+    }
+    assert [g.name for g in robot.group_geometries("effector")] == ["wrist", "tool"]
+    with pytest.raises(ck.CprKinError, match="unknown collision group 'hand'"):
+        robot.group_geometries("hand")
+
+
+def test_missing_urdf(tmp_path: Path) -> None:
+    missing = tmp_path / "nope.urdf"
+    with pytest.raises(ck.UrdfError, match=r"nope\.urdf' does not exist"):
+        ck.load_cpr(missing)
+
+
+def test_malformed_xml(tmp_path: Path) -> None:
+    path = tmp_path / "broken.urdf"
+    path.write_text(URDF_TEXT[: len(URDF_TEXT) // 2])
+    with pytest.raises(ck.UrdfError, match=re.escape("broken.urdf' is not well-formed XML")):
+        ck.load_cpr(path)
+
+
+def test_urdf_with_dangling_joint_is_invalid(tmp_path: Path) -> None:
+    path = tmp_path / "dangling.urdf"
+    path.write_text(URDF_TEXT.replace('<child link="tcp"/>', '<child link="no_such_link"/>'))
+    with pytest.raises(ck.UrdfError, match=re.escape("dangling.urdf")):
+        ck.load_cpr(path)
+
+
+def test_urdf_without_a_cpr_joint(tmp_path: Path) -> None:
+    path = tmp_path / "renamed.urdf"
+    path.write_text(URDF_TEXT.replace('joint name="d3"', 'joint name="slide"'))
+    with pytest.raises(ck.UrdfError, match=r"missing \['d3'\]"):
+        ck.load_cpr(path)
+
+
+def test_urdf_without_tcp(tmp_path: Path) -> None:
+    path = tmp_path / "notcp.urdf"
+    path.write_text(
+        URDF_TEXT.replace('<link name="tcp"/>', '<link name="tip"/>').replace(
+            '<child link="tcp"/>', '<child link="tip"/>'
+        )
+    )
+    with pytest.raises(ck.UrdfError, match="no link or frame named 'tcp'"):
+        ck.load_cpr(path)
+
+
+def test_limits_file_disagreeing_velocity(tmp_path: Path) -> None:
+    (tmp_path / "cpr.urdf").write_text(URDF_TEXT)
+    text = (
+        ck.cpr_limits_path()
+        .read_text()
+        .replace(
+            "velocity: 0.5, acceleration: 2.0, jerk: 10.0}",
+            "velocity: 0.7, acceleration: 2.0, jerk: 10.0}",
+            1,
+        )
+    )
+    (tmp_path / "cpr_limits.yaml").write_text(text)
+    with pytest.raises(
+        ck.UrdfError, match=re.escape("joint 'd2' velocity 0.7 disagrees with the URDF's 0.5")
+    ):
+        ck.load_cpr(tmp_path / "cpr.urdf")
+
+
+def test_limits_file_unknown_joint(tmp_path: Path) -> None:
+    (tmp_path / "cpr.urdf").write_text(URDF_TEXT)
+    (tmp_path / "cpr_limits.yaml").write_text(
+        ck.cpr_limits_path().read_text() + "elbow: {acceleration: 1, jerk: 1}\n"
+    )
+    with pytest.raises(ck.UrdfError, match=r"unknown joint\(s\) \['elbow'\]"):
+        ck.load_cpr(tmp_path / "cpr.urdf")
+
+
+@pytest.mark.parametrize(
+    ("values", "pattern"),
+    [
+        ([0.0, 0.75, 0.1, 0.0, 0.0], r"joint 'd2' = 0\.75 m is outside \[0, 0\.6\] m"),
+        ([3.0, 0.1, 0.1, 0.0, 0.0], r"joint 'theta1' = 3 rad is outside \[-2\.9, 2\.9\] rad"),
+        ([0.0, 0.1, math.nan, 0.0, 0.0], r"joint 'd3' = nan is not a finite number"),
+        ([0.0, 0.1, 0.1], r"expected 5 values"),
+        ({"theta1": 0.0, "elbow": 1.0}, r"unknown joint 'elbow'"),
+        ({"theta1": 0.0, "d2": 0.1}, r"lack joint\(s\) \['d3', 'theta4', 'theta5'\]"),
+        ("abc", r"must be 5 numbers"),
+    ],
+)
+def test_bad_configurations(robot: ck.Robot, values: object, pattern: str) -> None:
+    with pytest.raises(ck.CprKinError, match=pattern):
+        robot.configuration(values)  # type: ignore[arg-type]
+
+
+def test_configuration_from_mapping(robot: ck.Robot) -> None:
+    q = robot.configuration({"theta5": 0.5, "theta4": 0.4, "d3": 0.3, "d2": 0.2, "theta1": 0.1})
+    np.testing.assert_array_equal(q, [0.1, 0.2, 0.3, 0.4, 0.5])
+
+
+def test_unknown_frame(robot: ck.Robot) -> None:
+    with pytest.raises(ck.CprKinError, match="unknown frame 'gripper'"):
+        robot.frame_id("gripper")
+
+
+def test_bad_limits_dataclass() -> None:
+    with pytest.raises(ck.CprKinError, match=re.escape("jerk limit 0.0 must be > 0")):
+        ck.JointLimits(
+            names=("a",),
+            lower=np.zeros(1),
+            upper=np.ones(1),
+            velocity=np.ones(1),
+            acceleration=np.ones(1),
+            jerk=np.zeros(1),
+        )
