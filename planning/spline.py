@@ -1,0 +1,364 @@
+"""Septic smoothing spline after Simon (2004), the paper's eq. 8-19.
+
+For every joint, the node values ``y, y', y'', y'''`` at the knots ``t_0 .. t_N`` minimise
+
+    J = sum_i p_i (y_i - f_i)^2 + int a1 y'^2 + a2 y''^2 + a3 y'''^2 dt
+
+over degree-7 Hermite segments (:mod:`planning.hermite`), so that position, velocity,
+acceleration and jerk are continuous. On a segment of duration ``h`` the r-th derivative is
+``h^-r`` times the derivative in the normalised time ``tau`` and ``dt = h dtau``: the ``a_r``
+term carries ``h^(1 - 2r)``. J is quadratic in the ``4 (N + 1)`` unknowns; ordered node by
+node, segment ``i`` touches unknowns ``4i .. 4i + 7``, so the normal equations are symmetric,
+banded (half-bandwidth 7) and positive definite once some ``a_r > 0``. Values that are not
+free are eliminated before the solve, never approximated by a huge weight:
+
+- nodes with ``p_i = inf`` (exact interpolation), and the first and last node unless
+  ``exact_ends = False`` (a robot leaves from where it stands and arrives where it is sent);
+- with ``ends = "rest"``, velocity and acceleration at both ends (zero).
+
+With ``ends = "natural"`` nothing more is imposed: the optimum's own boundary conditions
+(``y''' = y'''' = 0`` at the ends under jerk-only smoothing) are the paper's.
+All joints share the matrix: :class:`SepticSplineSolver` factorises it once (LAPACK banded
+Cholesky) and solves every joint, or every candidate of an optimiser, as columns of one
+right-hand side.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy import sparse
+from scipy.linalg import lapack
+
+from planning.errors import SplineError
+from planning.hermite import CONTINUITY, ENERGY, HERMITE_INV, node_scaling
+from planning.trajectory import Trajectory
+
+FloatArray = NDArray[np.float64]
+
+Ends = Literal["natural", "rest"]
+_PER_NODE = CONTINUITY + 1  # unknowns per node: y, y', y'', y'''
+_BAND = 2 * _PER_NODE - 1  # half-bandwidth of the normal equations
+
+
+@dataclass(frozen=True)
+class SplineSettings:
+    """Settings of the septic smoothing spline; validated on construction.
+
+    Attributes:
+        p: node weight ``p_i`` (> 0; ``inf`` interpolates exactly), one value for every node
+            or one per node. The paper: 1e6.
+        a: ``(a1, a2, a3)`` weights (>= 0, not all zero) of the squared velocity,
+            acceleration and jerk integrals. The paper: ``(0, 0, 1)``.
+        ends: ``"natural"`` (the paper) or ``"rest"`` (zero velocity and acceleration at
+            both ends).
+        exact_ends: meet the first and last node exactly whatever ``p`` (default ``True``).
+
+    """
+
+    p: float | tuple[float, ...] = 1e6
+    a: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    ends: Ends = "natural"
+    exact_ends: bool = True
+
+    def __post_init__(self) -> None:
+        p = np.atleast_1d(np.asarray(self.p, dtype=float))
+        if p.ndim != 1 or np.any(np.isnan(p)) or np.any(p <= 0):
+            raise SplineError(f"spline weight p = {np.asarray(self.p).tolist()} must be > 0 (inf: exact)")
+        object.__setattr__(self, "p", float(p[0]) if np.ndim(self.p) == 0 else tuple(float(x) for x in p))
+        a = np.asarray(self.a, dtype=float)
+        if a.shape != (3,) or not np.all(np.isfinite(a)) or np.any(a < 0):
+            raise SplineError(
+                f"spline weights a = {np.asarray(self.a).tolist()} must be three finite numbers >= 0"
+            )
+        if not np.any(a > 0):
+            raise SplineError(
+                "spline weights a = [0, 0, 0] leave the spline undetermined (singular system); "
+                "give a velocity, acceleration or jerk weight > 0, e.g. a = [0, 0, 1]"
+            )
+        object.__setattr__(self, "a", (float(a[0]), float(a[1]), float(a[2])))
+        if self.ends not in ("natural", "rest"):
+            raise SplineError(f"spline ends = {self.ends!r}; allowed: 'natural', 'rest'")
+
+    def scaled_for_time(self, scale: float) -> SplineSettings:
+        """Settings that, on knots stretched by ``scale``, give the same node values.
+
+        The ``a_r`` term carries ``h^(1 - 2r)``, so ``a_r`` scales by ``scale^(2r - 1)``.
+        """
+        a1, a2, a3 = self.a
+        return SplineSettings(
+            p=self.p, a=(a1 * scale, a2 * scale**3, a3 * scale**5), ends=self.ends, exact_ends=self.exact_ends
+        )
+
+
+@dataclass(frozen=True)
+class SplineFit:
+    """A solved septic smoothing spline.
+
+    Attributes:
+        trajectory: the spline as a piecewise polynomial in local seconds.
+        targets: ``(N + 1, nj)`` the node values ``f_i`` it was asked to pass near.
+        nodes: ``(N + 1, nj, 4)`` the solved ``y, y', y'', y'''`` at the knots.
+        settings: the settings used.
+
+    """
+
+    trajectory: Trajectory
+    targets: FloatArray
+    nodes: FloatArray
+    settings: SplineSettings
+
+    @property
+    def node_deviation(self) -> FloatArray:
+        """``(N + 1, nj)`` signed deviation ``y_i - f_i`` [rad, m]."""
+        return np.asarray(self.nodes[:, :, 0] - self.targets)
+
+    @property
+    def max_node_deviation(self) -> float:
+        """Largest absolute node deviation over all nodes and joints [rad, m]."""
+        return float(np.abs(self.node_deviation).max())
+
+
+def _lowest_weighted_order(settings: SplineSettings) -> int:
+    return 1 + next(r for r, coef in enumerate(settings.a) if coef > 0)
+
+
+_D, _C = np.meshgrid(np.arange(_BAND + 1), np.arange(2 * _PER_NODE), indexing="ij")
+_BAND_MASK = (_C + _D < 2 * _PER_NODE).astype(float)
+_BAND_ROWS = np.minimum(_C + _D, 2 * _PER_NODE - 1)
+_BAND_COLS = _C
+_OFFSETS = np.arange(-_BAND, _BAND + 1)
+_ABS_OFFSETS = np.abs(_OFFSETS)
+_DIAGONALS = np.arange(1, _BAND + 1)
+
+
+def _assemble(h: FloatArray, a: tuple[float, float, float], n_nodes: int) -> FloatArray:
+    """Lower banded storage ``(8, 4 (N + 1))`` of the integral term of the normal equations.
+
+    Segment ``i`` adds ``D_h E D_h`` (E: the weighted derivative energies in normalised
+    time, D_h: node-derivative scaling) on unknowns ``4i .. 4i + 7``, i.e. on nodes ``i``
+    and ``i + 1``; the blocks are added node by node, without a scatter.
+    """
+    energy = sum(
+        coef * h[:, None, None] ** (1 - 2 * r) * ENERGY[r]
+        for r, coef in zip((1, 2, 3), a, strict=True)
+        if coef
+    )
+    scale = node_scaling(h)
+    blocks = np.asarray(energy) * scale[:, :, None] * scale[:, None, :]
+    segment_band = blocks[:, _BAND_ROWS, _BAND_COLS] * _BAND_MASK  # [i, d, c] = B_i[c + d, c]
+    band = np.zeros((_BAND + 1, n_nodes, _PER_NODE))
+    halves = segment_band.reshape(len(h), _BAND + 1, 2, _PER_NODE)
+    band[:, :-1] += halves[:, :, 0].transpose(1, 0, 2)
+    band[:, 1:] += halves[:, :, 1].transpose(1, 0, 2)
+    return band.reshape(_BAND + 1, -1)
+
+
+@dataclass(frozen=True)
+class _Structure:
+    """Index arrays that depend only on the node count and which values are fixed."""
+
+    weighted: NDArray[np.intp]  # nodes with a finite weight p_i
+    pinned: NDArray[np.intp]  # nodes met exactly
+    fixed: NDArray[np.intp]  # fixed unknowns (pinned values, rest-end derivatives)
+    zero_diagonal: NDArray[np.intp]  # band entries (diagonal, column) in the fixed unknowns' rows
+    zero_column: NDArray[np.intp]
+    coupling_rows: NDArray[np.intp]  # free rows of the pinned unknowns' columns ...
+    coupling_nodes: NDArray[np.intp]  # ... the pinned node each belongs to ...
+    coupling_diagonal: NDArray[np.intp]  # ... and where the matrix entry sits in the band
+    coupling_column: NDArray[np.intp]
+
+
+@lru_cache(maxsize=64)
+def _structure(n_nodes: int, exact_key: bytes, rest: bool) -> _Structure:
+    exact = np.frombuffer(exact_key, dtype=bool)
+    n = _PER_NODE * n_nodes
+    fixed = np.zeros(n, dtype=bool)
+    fixed[_PER_NODE * np.flatnonzero(exact)] = True
+    if rest:
+        for node in (0, n_nodes - 1):
+            fixed[_PER_NODE * node + 1 : _PER_NODE * node + 3] = True  # y' = y'' = 0
+    fixed_index = np.flatnonzero(fixed)
+    row_cols = fixed_index[None, :] - _DIAGONALS[:, None]  # fixed rows, left of the diagonal
+    inside = row_cols >= 0
+    pinned = np.flatnonzero(exact)
+    k = _PER_NODE * pinned[:, None]
+    rows = k + _OFFSETS  # (m, 15): the band of each pinned unknown's column
+    band_cols = np.where(_OFFSETS >= 0, k, k + _OFFSETS)
+    valid = (rows >= 0) & (rows < n) & (band_cols >= 0) & (_OFFSETS != 0)
+    valid[valid] = ~fixed[rows[valid]]
+    which, offset = np.nonzero(valid)
+    return _Structure(
+        weighted=np.flatnonzero(~exact),
+        pinned=pinned,
+        fixed=fixed_index,
+        zero_diagonal=np.broadcast_to(_DIAGONALS[:, None], row_cols.shape)[inside],
+        zero_column=row_cols[inside],
+        coupling_rows=rows[which, offset],
+        coupling_nodes=pinned[which],
+        coupling_diagonal=_ABS_OFFSETS[offset],
+        coupling_column=band_cols[which, offset],
+    )
+
+
+class SepticSplineSolver:
+    """The septic smoothing spline for fixed knots and settings, factorised once.
+
+    Building it assembles and factorises the banded system; :meth:`solve` then fits any
+    node values, and :meth:`solve_batch` many sets at once (columns of one right-hand
+    side), which is what an optimiser evaluating many candidates needs.
+
+    Args:
+        knots: ``(N + 1,)`` strictly increasing node times [s] (non-uniform allowed).
+        settings: weights and end conditions (default: the paper's).
+
+    Raises:
+        SplineError: non-finite or non-increasing knots, too few nodes, or a ``p`` of the
+            wrong length.
+
+    """
+
+    def __init__(self, knots: ArrayLike, settings: SplineSettings | None = None) -> None:
+        self.settings = settings = settings or SplineSettings()
+        t = np.array(knots, dtype=float)
+        if t.ndim != 1:
+            raise SplineError(f"knots of shape {t.shape}; expected (N + 1,) node times [s]")
+        if not np.all(np.isfinite(t)):
+            raise SplineError(f"knots {t.tolist()} must be finite numbers (no NaN or inf)")
+        steps = np.diff(t)
+        if np.any(steps <= 0):
+            bad = int(np.argmax(steps <= 0))
+            raise SplineError(
+                f"knots must increase strictly; t[{bad}] = {t[bad]} >= t[{bad + 1}] = {t[bad + 1]}"
+            )
+        order = _lowest_weighted_order(settings)
+        if len(t) < max(2, order):
+            raise SplineError(
+                f"{len(t)} node(s) given; a spline whose lowest weighted derivative is order {order} "
+                f"needs at least {max(2, order)}"
+            )
+        p = np.asarray(settings.p, dtype=float)
+        if p.ndim == 1 and len(p) != len(t):
+            raise SplineError(f"{len(p)} node weights p for {len(t)} nodes; give one value or one per node")
+        t.setflags(write=False)
+        self.knots = t
+        n_nodes = len(t)
+        p = np.full(n_nodes, float(p)) if p.ndim == 0 else p
+
+        band = _assemble(steps, settings.a, n_nodes)
+        exact = ~np.isfinite(p)
+        if settings.exact_ends:
+            exact[[0, -1]] = True
+        structure = _structure(n_nodes, exact.tobytes(), settings.ends == "rest")
+        weighted = structure.weighted
+        band[0, _PER_NODE * weighted] += p[weighted]
+        self._coupling = self._coupling_matrix(band, structure, p)
+        # fixed unknowns become identity rows and columns: an exact elimination that keeps
+        # the band and the positive definiteness
+        band[:, structure.fixed] = 0.0
+        band[structure.zero_diagonal, structure.zero_column] = 0.0
+        band[0, structure.fixed] = 1.0
+        factor, info = lapack.dpbtrf(band, lower=1)
+        if info != 0:
+            raise SplineError(
+                f"the spline system is singular for a = {list(settings.a)}, ends = '{settings.ends}' and "
+                f"{n_nodes} nodes; add nodes or a lower-order weight"
+            )
+        self._factor = factor
+        # Hermite data of both ends of a segment -> power coefficients in local seconds
+        seconds = steps[:, None] ** -np.arange(HERMITE_INV.shape[0], dtype=float)
+        self._to_coefficients = seconds[:, :, None] * HERMITE_INV[None] * node_scaling(steps)[:, None, :]
+
+    @staticmethod
+    def _coupling_matrix(band: FloatArray, structure: _Structure, p: FloatArray) -> Any:
+        """``W`` with right-hand side ``W @ f`` for node values ``f``.
+
+        Weighted node ``i`` contributes ``p_i f_i`` to its value row. A pinned node's value
+        is its own (identity) row, and its column of the matrix, times ``f_i``, moves to the
+        right-hand side of the free rows. Every (row, node) pair occurs once.
+        """
+        n, n_nodes = band.shape[1], len(p)
+        weighted, pinned = structure.weighted, structure.pinned
+        r = np.concatenate([_PER_NODE * weighted, _PER_NODE * pinned, structure.coupling_rows])
+        c = np.concatenate([weighted, pinned, structure.coupling_nodes])
+        v = np.concatenate(
+            [p[weighted], np.ones(pinned.size), -band[structure.coupling_diagonal, structure.coupling_column]]
+        )
+        if n * n_nodes <= 200_000:
+            dense = np.zeros((n, n_nodes))
+            dense[r, c] = v
+            return dense
+        return sparse.csr_array((v, (r, c)), shape=(n, n_nodes))
+
+    @property
+    def n_nodes(self) -> int:
+        """Number of nodes N + 1."""
+        return len(self.knots)
+
+    def _solve_nodes(self, values: FloatArray) -> FloatArray:
+        solution, info = lapack.dpbtrs(self._factor, self._coupling @ values, lower=1)
+        if info != 0:  # pragma: no cover - dpbtrs fails only on malformed arguments
+            raise SplineError(f"LAPACK dpbtrs failed with info = {info}")
+        return np.asarray(solution)
+
+    def _coefficients(self, solution: FloatArray) -> FloatArray:
+        nodes = solution.reshape(self.n_nodes, _PER_NODE, -1)
+        hermite = np.concatenate([nodes[:-1], nodes[1:]], axis=1)  # (N, 8, m): both ends
+        return np.asarray(np.matmul(self._to_coefficients, hermite).transpose(0, 2, 1))
+
+    def _check_values(self, values: ArrayLike) -> FloatArray:
+        f = np.asarray(values, dtype=float)
+        if f.ndim == 1:
+            f = f[:, None]
+        if f.ndim != 2 or len(f) != self.n_nodes:
+            raise SplineError(
+                f"node values of shape {np.shape(values)} do not match the {self.n_nodes} knots; "
+                "expected (N + 1,) or (N + 1, joints)"
+            )
+        if not np.all(np.isfinite(f)):
+            raise SplineError("node values must be finite numbers (no NaN or inf)")
+        return f
+
+    def solve(self, targets: ArrayLike) -> SplineFit:
+        """Fit node values ``targets``: ``(N + 1,)`` or ``(N + 1, nj)`` [rad, m]."""
+        f = self._check_values(targets)
+        solution = self._solve_nodes(f)
+        nodes = solution.reshape(self.n_nodes, _PER_NODE, f.shape[1]).transpose(0, 2, 1)
+        trajectory = Trajectory(knots=self.knots, coefficients=self._coefficients(solution))
+        return SplineFit(trajectory=trajectory, targets=f, nodes=nodes, settings=self.settings)
+
+    def solve_batch(self, targets: ArrayLike) -> FloatArray:
+        """Power coefficients ``(N, m, 8)`` in local seconds for ``(N + 1, m)`` node values.
+
+        The fast path for many candidates at once: no :class:`SplineFit` objects.
+        """
+        return self._coefficients(self._solve_nodes(self._check_values(targets)))
+
+
+def fit_septic_spline(
+    knots: ArrayLike, targets: ArrayLike, settings: SplineSettings | None = None
+) -> SplineFit:
+    """Solve the septic smoothing spline through ``targets`` at ``knots``.
+
+    Args:
+        knots: ``(N + 1,)`` strictly increasing node times [s] (non-uniform allowed).
+        targets: ``(N + 1,)`` or ``(N + 1, nj)`` node values ``f_i`` [rad, m], all joints at once.
+        settings: weights and end conditions (default: the paper's, ``p = 1e6``,
+            ``a = (0, 0, 1)``, natural ends).
+
+    Raises:
+        SplineError: NaN input, non-increasing knots, too few nodes, bad settings.
+
+    """
+    return SepticSplineSolver(knots, settings).solve(targets)
+
+
+def uniform_knots(n_segments: int, duration: float) -> FloatArray:
+    """``n_segments + 1`` evenly spaced knots over ``[0, duration]`` [s]."""
+    if n_segments < 1 or not (np.isfinite(duration) and duration > 0):
+        raise SplineError(f"{n_segments} segments over {duration} s: need >= 1 segment and a duration > 0")
+    return np.linspace(0.0, duration, n_segments + 1)

@@ -1,0 +1,248 @@
+"""Piecewise-polynomial joint trajectories: evaluation, exact extrema, time scaling.
+
+Segment ``i`` covers ``knots[i] <= t <= knots[i + 1]`` and joint ``j`` follows
+``q_j(t) = sum_k coefficients[i, j, k] (t - knots[i])^k`` (local seconds, the layout of the
+``cpr-trajectory/1`` file).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from planning.errors import PlanningError
+
+FloatArray = NDArray[np.float64]
+
+DERIVATIVE_NAMES = ("position", "velocity", "acceleration", "jerk", "snap")
+
+
+def _derivative_coefficients(coefficients: FloatArray, r: int) -> FloatArray:
+    """Power coefficients of the r-th derivative, same layout, zero-padded at the top."""
+    order = coefficients.shape[-1]
+    k = np.arange(order)
+    factor = np.ones(order)
+    for m in range(r):
+        factor = factor * (k - m)
+    out = np.zeros_like(coefficients)
+    out[..., : order - r] = (coefficients * factor)[..., r:]
+    return out
+
+
+def _real_roots_in(coefficients: FloatArray, upper: FloatArray) -> list[FloatArray]:
+    """Real roots in ``(0, upper)`` of each polynomial ``sum_k c[m, k] x^k``.
+
+    Polynomials are grouped by their effective degree (leading coefficients below a relative
+    tolerance are dropped) and the eigenvalues of their companion matrices computed in
+    stacks, so many small polynomials cost few NumPy calls.
+    """
+    m_count, order = coefficients.shape
+    scale = np.abs(coefficients).max(axis=1, keepdims=True)
+    significant = np.abs(coefficients) > 1e-13 * np.where(scale > 0, scale, 1.0)
+    degree = np.where(significant.any(axis=1), order - 1 - np.argmax(significant[:, ::-1], axis=1), 0)
+    roots: list[FloatArray] = [np.empty(0)] * m_count
+    for d in range(1, order):
+        rows = np.flatnonzero(degree == d)
+        if rows.size == 0:
+            continue
+        c = coefficients[rows, : d + 1]
+        companion = np.zeros((rows.size, d, d))
+        companion[:, 1:, :-1] = np.eye(d - 1)
+        companion[:, :, -1] = -c[:, :d] / c[:, d : d + 1]
+        eigenvalues = np.linalg.eigvals(companion)
+        for n, row in enumerate(rows):
+            z = eigenvalues[n]
+            real = z.real[np.abs(z.imag) <= 1e-9 * (1.0 + np.abs(z.real))]
+            roots[row] = real[(real > 0.0) & (real < upper[row])]
+    return roots
+
+
+@dataclass(frozen=True)
+class Extrema:
+    """Exact extrema of one derivative of every joint over the whole trajectory.
+
+    Attributes:
+        derivative: derivative order (1 velocity, 2 acceleration, 3 jerk).
+        minimum: ``(nj,)`` smallest value per joint.
+        maximum: ``(nj,)`` largest value per joint.
+        time_of_minimum: ``(nj,)`` [s].
+        time_of_maximum: ``(nj,)`` [s].
+
+    """
+
+    derivative: int
+    minimum: FloatArray
+    maximum: FloatArray
+    time_of_minimum: FloatArray
+    time_of_maximum: FloatArray
+
+    @property
+    def peak(self) -> FloatArray:
+        """``(nj,)`` largest absolute value per joint."""
+        return np.asarray(np.maximum(np.abs(self.minimum), np.abs(self.maximum)))
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """A piecewise-polynomial joint trajectory, immutable.
+
+    Attributes:
+        knots: ``(N + 1,)`` increasing segment boundaries [s].
+        coefficients: ``(N, nj, order)`` power coefficients in local seconds.
+
+    """
+
+    knots: FloatArray
+    coefficients: FloatArray
+    _derivatives: dict[int, FloatArray] = field(default_factory=dict, init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        knots = np.array(self.knots, dtype=float)
+        coefficients = np.array(self.coefficients, dtype=float)
+        if knots.ndim != 1 or len(knots) < 2 or not (knots[1:] > knots[:-1]).all():
+            raise PlanningError(
+                f"trajectory knots {knots.tolist()} must be at least two increasing times [s]"
+            )
+        if coefficients.ndim != 3 or coefficients.shape[0] != len(knots) - 1:
+            raise PlanningError(
+                f"trajectory coefficients of shape {coefficients.shape}; expected "
+                f"({len(knots) - 1}, joints, order)"
+            )
+        for array in (knots, coefficients):
+            array.setflags(write=False)
+        object.__setattr__(self, "knots", knots)
+        object.__setattr__(self, "coefficients", coefficients)
+
+    @property
+    def duration(self) -> float:
+        """Total duration [s]."""
+        return float(self.knots[-1] - self.knots[0])
+
+    @property
+    def n_joints(self) -> int:
+        """Number of joints."""
+        return int(self.coefficients.shape[1])
+
+    @property
+    def n_segments(self) -> int:
+        """Number of polynomial segments N."""
+        return int(self.coefficients.shape[0])
+
+    def _coefficients(self, derivative: int) -> FloatArray:
+        if derivative not in self._derivatives:
+            self._derivatives[derivative] = _derivative_coefficients(self.coefficients, derivative)
+        return self._derivatives[derivative]
+
+    def __call__(self, t: ArrayLike, derivative: int = 0) -> FloatArray:
+        """Evaluate the ``derivative``-th derivative at times ``t`` [s].
+
+        Returns ``(nj,)`` for a scalar time, ``(K, nj)`` for ``K`` times. Times outside the
+        knots are clamped to the ends.
+        """
+        if derivative < 0 or derivative >= self.coefficients.shape[2]:
+            raise PlanningError(
+                f"derivative order {derivative} must be in [0, {self.coefficients.shape[2] - 1}]"
+            )
+        times = np.asarray(t, dtype=float)
+        flat = np.clip(np.atleast_1d(times), self.knots[0], self.knots[-1])
+        segment = np.clip(np.searchsorted(self.knots, flat, side="right") - 1, 0, self.n_segments - 1)
+        local = (flat - self.knots[segment])[:, None]
+        c = self._coefficients(derivative)[segment]  # (K, nj, order)
+        value = c[:, :, -1]
+        for k in range(c.shape[2] - 2, -1, -1):
+            value = value * local + c[:, :, k]
+        return np.asarray(value[0] if times.ndim == 0 else value)
+
+    def position(self, t: ArrayLike) -> FloatArray:
+        """Joint positions [rad, m] at ``t`` [s]."""
+        return self(t, 0)
+
+    def velocity(self, t: ArrayLike) -> FloatArray:
+        """Joint velocities [rad/s, m/s] at ``t`` [s]."""
+        return self(t, 1)
+
+    def acceleration(self, t: ArrayLike) -> FloatArray:
+        """Joint accelerations [rad/s^2, m/s^2] at ``t`` [s]."""
+        return self(t, 2)
+
+    def jerk(self, t: ArrayLike) -> FloatArray:
+        """Joint jerks [rad/s^3, m/s^3] at ``t`` [s]."""
+        return self(t, 3)
+
+    def snap(self, t: ArrayLike) -> FloatArray:
+        """Joint snaps [rad/s^4, m/s^4] at ``t`` [s] (discontinuous at the knots)."""
+        return self(t, 4)
+
+    def extrema(self, derivative: int) -> Extrema:
+        """Exact extrema of the ``derivative``-th derivative per joint.
+
+        Candidates are the segment ends and the real roots of the next derivative inside
+        each segment; no sampling is involved.
+        """
+        n, nj, order = self.coefficients.shape
+        h = np.diff(self.knots)
+        value = self._coefficients(derivative)
+        slope = self._coefficients(derivative + 1).reshape(n * nj, order)
+        roots = _real_roots_in(slope, np.repeat(h, nj))
+        minimum = np.full(nj, np.inf)
+        maximum = np.full(nj, -np.inf)
+        t_min = np.zeros(nj)
+        t_max = np.zeros(nj)
+        for i in range(n):
+            for j in range(nj):
+                local = np.concatenate(([0.0, h[i]], roots[i * nj + j]))
+                v = np.polynomial.polynomial.polyval(local, value[i, j])
+                k_lo, k_hi = int(np.argmin(v)), int(np.argmax(v))
+                if v[k_lo] < minimum[j]:
+                    minimum[j], t_min[j] = v[k_lo], self.knots[i] + local[k_lo]
+                if v[k_hi] > maximum[j]:
+                    maximum[j], t_max[j] = v[k_hi], self.knots[i] + local[k_hi]
+        return Extrema(derivative, minimum, maximum, t_min, t_max)
+
+    @cached_property
+    def integrated_squared_jerk(self) -> FloatArray:
+        """``(nj,)`` integral of the squared jerk over the trajectory [rad^2/s^5, m^2/s^5]."""
+        jerk = self._coefficients(3)
+        n, nj, order = jerk.shape
+        square = np.zeros((n, nj, 2 * order - 1))
+        for k in range(order):
+            square[..., k : k + order] += jerk[..., k : k + 1] * jerk
+        powers = np.arange(square.shape[2]) + 1
+        h = np.diff(self.knots)[:, None, None]
+        integral = (square * h**powers / powers).sum(axis=2)
+        return np.asarray(integral.sum(axis=0))
+
+    def time_scaled(self, scale: float) -> Trajectory:
+        """The same path run ``scale`` times slower: ``q'(t) = q(t0 + (t - t0) / scale)``.
+
+        Knots stretch by ``scale`` and the r-th derivative shrinks by ``scale^-r``.
+        """
+        if not (np.isfinite(scale) and scale > 0):
+            raise PlanningError(f"time scale {scale} must be a finite number > 0")
+        powers = float(scale) ** -np.arange(self.coefficients.shape[2])
+        knots = self.knots[0] + (self.knots - self.knots[0]) * scale
+        return Trajectory(knots=knots, coefficients=self.coefficients * powers)
+
+    def time_scale_for_limits(
+        self, velocity: ArrayLike, acceleration: ArrayLike | None = None, jerk: ArrayLike | None = None
+    ) -> float:
+        """Smallest uniform time scale ``s`` that keeps every joint within the given limits.
+
+        ``time_scaled(s)`` then reaches a limit exactly (``s < 1`` speeds a slow trajectory
+        up). Limits are per joint [rad/s^r, m/s^r]; ``None`` skips that order.
+        """
+        scale = 0.0
+        for r, limit in enumerate((velocity, acceleration, jerk), start=1):
+            if limit is None:
+                continue
+            bound = np.broadcast_to(np.asarray(limit, dtype=float), (self.n_joints,))
+            if not np.all(np.isfinite(bound) & (bound > 0)):
+                raise PlanningError(f"{DERIVATIVE_NAMES[r]} limits {bound.tolist()} must be finite and > 0")
+            ratio = float(np.max(self.extrema(r).peak / bound))
+            scale = max(scale, ratio ** (1.0 / r))
+        if scale == 0.0:
+            raise PlanningError("the trajectory does not move: no time scale reaches a limit")
+        return scale
