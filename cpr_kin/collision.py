@@ -184,11 +184,7 @@ class CollisionWorld:
         One coal query per group and configuration, each returning its closest pair; joint
         limits are not checked (callers sampling a curve pass in-range values).
         """
-        batch = np.asarray(q, dtype=float)
-        if batch.ndim != 2 or batch.shape[1] != self.robot.nq:
-            raise CprKinError(f"configurations of shape {batch.shape}; expected (N, {self.robot.nq})")
-        if not np.all(np.isfinite(batch)):
-            raise CprKinError("configurations contain NaN or inf")
+        batch = self._check_batch(q)
         n = len(batch)
         clearance = np.full((n, len(GROUPS)), np.inf)
         closest = np.full((n, len(GROUPS)), -1, dtype=np.int64)
@@ -206,6 +202,34 @@ class CollisionWorld:
                 index_column[k] = pair
         return BatchClearance(clearance_m=clearance, closest_pair=closest)
 
+    def min_clearance_batch(self, q: ArrayLike) -> tuple[FloatArray, IntArray]:
+        """Smallest distance over every pair [m] and the index of that pair, ``(N,)`` each.
+
+        One coal query per configuration (half the cost of :meth:`clearance_batch`) when
+        the groups need not be told apart.
+        """
+        batch = self._check_batch(q)
+        n = len(batch)
+        clearance = np.full(n, np.inf)
+        closest = np.full(n, -1, dtype=np.int64)
+        if self._pairs:
+            model, data, gmodel, gdata = self.robot.model, self._data, self.geometry_model, self._all
+            results = gdata.distanceResults
+            compute = pin.computeDistances
+            for k in range(n):
+                pair = compute(model, data, gmodel, gdata, batch[k])
+                clearance[k] = results[pair].min_distance
+                closest[k] = pair
+        return clearance, closest
+
+    def _check_batch(self, q: ArrayLike) -> FloatArray:
+        batch = np.asarray(q, dtype=float)
+        if batch.ndim != 2 or batch.shape[1] != self.robot.nq:
+            raise CprKinError(f"configurations of shape {batch.shape}; expected (N, {self.robot.nq})")
+        if not np.all(np.isfinite(batch)):
+            raise CprKinError("configurations contain NaN or inf")
+        return batch
+
     def margin_violated(self, q: ArrayLike, margin_m: float) -> NDArray[np.bool_]:
         """``(N,)`` whether any robot geometry is closer than ``margin_m`` [m] to an obstacle.
 
@@ -213,9 +237,7 @@ class CollisionWorld:
         parallel over :attr:`num_threads` threads (Pinocchio's ``GeometryPool``); several
         times faster than :meth:`clearance_batch` when distances are not needed.
         """
-        batch = np.asarray(q, dtype=float)
-        if batch.ndim != 2 or batch.shape[1] != self.robot.nq:
-            raise CprKinError(f"configurations of shape {batch.shape}; expected (N, {self.robot.nq})")
+        batch = self._check_batch(q)
         if not (np.isfinite(margin_m) and margin_m >= 0.0):
             raise CprKinError(f"safety margin {margin_m} m must be a finite number >= 0")
         if not self._pairs:

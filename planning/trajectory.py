@@ -20,8 +20,8 @@ FloatArray = NDArray[np.float64]
 DERIVATIVE_NAMES = ("position", "velocity", "acceleration", "jerk", "snap")
 
 
-def _derivative_coefficients(coefficients: FloatArray, r: int) -> FloatArray:
-    """Power coefficients of the r-th derivative, same layout, zero-padded at the top."""
+def derivative_coefficients(coefficients: FloatArray, r: int) -> FloatArray:
+    """Power coefficients ``(..., order)`` of the r-th derivative, zero-padded at the top."""
     order = coefficients.shape[-1]
     k = np.arange(order)
     factor = np.ones(order)
@@ -133,7 +133,7 @@ class Trajectory:
 
     def _coefficients(self, derivative: int) -> FloatArray:
         if derivative not in self._derivatives:
-            self._derivatives[derivative] = _derivative_coefficients(self.coefficients, derivative)
+            self._derivatives[derivative] = derivative_coefficients(self.coefficients, derivative)
         return self._derivatives[derivative]
 
     def __call__(self, t: ArrayLike, derivative: int = 0) -> FloatArray:

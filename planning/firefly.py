@@ -1,0 +1,215 @@
+"""Firefly algorithm (Yang 2010; paper eq. 1-2) for batch objectives over box bounds.
+
+The search runs in normalised coordinates ``u in [0, 1]^d`` mapped to the bounds before
+every evaluation, so distances and ``gamma`` mean the same whatever the units of the
+variables. A firefly ``i`` moves towards a brighter (lower objective) firefly ``j`` by
+
+    u_i += beta0 exp(-gamma r_ij^2) (u_j - u_i) + alpha (eps - 0.5),   eps ~ U[0, 1)^d,
+
+(the paper prints eq. 2 with a sign typo and without gamma) and is clipped to the bounds.
+``alpha`` decays geometrically, ``alpha <- theta alpha``, at the start of every iteration.
+
+Two modes:
+
+- ``sweep`` (Yang's reference code): brightness and attractor positions are taken at the
+  start of the sweep, every firefly accumulates its moves towards all brighter ones, then
+  all are evaluated in one batch call: ``n (T + 1)`` evaluations. The brightest does not
+  move, so the best value never gets worse.
+- ``sequential`` (NiaPy's ``FireflyAlgorithm``): for every pair with ``f_i >= f_j``,
+  including ``i = j``, firefly ``i`` moves and is re-evaluated at once; same random
+  draws, same order, same results as NiaPy for the same seed. About ``n^2 T / 2``
+  evaluations, one candidate per call.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from planning.errors import PlanningError
+
+FloatArray = NDArray[np.float64]
+BatchObjective = Callable[[FloatArray], FloatArray]
+"""Objective over a batch: ``(S, d)`` points in the problem's units -> ``(S,)`` values."""
+
+Mode = Literal["sweep", "sequential"]
+
+
+@dataclass(frozen=True)
+class FireflySettings:
+    """Parameters of the firefly algorithm; validated on construction.
+
+    Attributes:
+        fireflies: population size n (>= 2). The paper: 50.
+        iterations: number of iterations T (>= 0). The paper: 50.
+        alpha: initial randomisation strength, in normalised units (>= 0). The paper: 1.
+        beta0: attractiveness at distance 0 (>= 0). The paper: 0.5.
+        gamma: light absorption, in normalised units (>= 0).
+        theta: per-iteration decay of alpha, in (0, 1].
+        mode: ``"sweep"`` or ``"sequential"`` (see the module docstring).
+    """
+
+    fireflies: int = 50
+    iterations: int = 50
+    alpha: float = 1.0
+    beta0: float = 0.5
+    gamma: float = 1.0
+    theta: float = 0.97
+    mode: Mode = "sweep"
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.fireflies, int | np.integer) and self.fireflies >= 2):
+            raise PlanningError(f"fireflies = {self.fireflies!r} must be an integer >= 2")
+        if not (isinstance(self.iterations, int | np.integer) and self.iterations >= 0):
+            raise PlanningError(f"iterations = {self.iterations!r} must be an integer >= 0")
+        for name in ("alpha", "beta0", "gamma"):
+            value = getattr(self, name)
+            if not (isinstance(value, int | float) and np.isfinite(value) and value >= 0):
+                raise PlanningError(f"{name} = {value!r} must be a finite number >= 0")
+        if not (isinstance(self.theta, int | float) and 0 < self.theta <= 1):
+            raise PlanningError(f"theta = {self.theta!r} must be in (0, 1]")
+        if self.mode not in ("sweep", "sequential"):
+            raise PlanningError(f"mode = {self.mode!r}; allowed: 'sweep', 'sequential'")
+
+
+@dataclass(frozen=True)
+class FireflyProgress:
+    """What the optional callback receives after each iteration (0: the initial population)."""
+
+    iteration: int
+    iterations: int
+    best: float
+    mean: float
+    evaluations: int
+
+
+@dataclass(frozen=True)
+class FireflyResult:
+    """Outcome of a firefly run.
+
+    Attributes:
+        x: best point found, in the problem's units.
+        fitness: its objective value.
+        evaluations: objective evaluations (candidates, not calls).
+        best_history: ``(T + 1,)`` best value after each iteration (0: initial population).
+        mean_history: ``(T + 1,)`` population mean after each iteration.
+        evaluation_history: ``(T + 1,)`` cumulative evaluations after each iteration.
+        population: ``(n, d)`` final positions, in the problem's units.
+        population_fitness: ``(n,)`` their values.
+        settings: the settings used.
+    """
+
+    x: FloatArray
+    fitness: float
+    evaluations: int
+    best_history: FloatArray
+    mean_history: FloatArray
+    evaluation_history: NDArray[np.int64]
+    population: FloatArray
+    population_fitness: FloatArray
+    settings: FireflySettings = field(repr=False)
+
+
+def firefly_minimize(
+    objective: BatchObjective,
+    lower: ArrayLike,
+    upper: ArrayLike,
+    settings: FireflySettings | None = None,
+    rng: np.random.Generator | int | None = 0,
+    callback: Callable[[FireflyProgress], None] | None = None,
+) -> FireflyResult:
+    """Minimise ``objective`` over the box ``[lower, upper]`` with the firefly algorithm.
+
+    Args:
+        objective: batch objective ``(S, d) -> (S,)``; every point passed lies in the box.
+        lower: ``(d,)`` lower bounds.
+        upper: ``(d,)`` upper bounds, each > the lower one.
+        settings: algorithm parameters (default: the paper's, sweep mode).
+        rng: a ``numpy.random.Generator`` or a seed; the same seed gives the same run.
+        callback: called with a :class:`FireflyProgress` after every iteration.
+    """
+    settings = settings or FireflySettings()
+    lo = np.asarray(lower, dtype=float)
+    hi = np.asarray(upper, dtype=float)
+    if lo.ndim != 1 or lo.shape != hi.shape or lo.size == 0:
+        raise PlanningError(f"bounds of shapes {lo.shape} and {hi.shape}; expected two (d,) arrays, d >= 1")
+    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi)) and np.all(hi > lo)):
+        raise PlanningError(f"bounds [{lo.tolist()}, {hi.tolist()}] must be finite with upper > lower")
+    generator = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
+    span = hi - lo
+    n, d = settings.fireflies, lo.size
+
+    def evaluate(u: FloatArray) -> FloatArray:
+        values = np.asarray(objective(lo + u * span), dtype=float)
+        if values.shape != (len(u),):
+            raise PlanningError(
+                f"objective returned shape {values.shape} for {len(u)} candidates; expected ({len(u)},)"
+            )
+        return values
+
+    # NiaPy draws the initial population as uniform(lower, upper) in its (here: unit) box
+    u = generator.uniform(np.zeros(d), np.ones(d), (n, d))
+    f = evaluate(u)
+    best_u, best_f = u[int(np.argmin(f))].copy(), float(np.min(f))
+    evaluations = n
+    best_history, mean_history, evaluation_history = [best_f], [float(np.mean(f))], [evaluations]
+    if callback is not None:
+        callback(FireflyProgress(0, settings.iterations, best_f, mean_history[0], evaluations))
+    alpha = settings.alpha
+    for iteration in range(1, settings.iterations + 1):
+        alpha *= settings.theta
+        if settings.mode == "sweep":
+            u = _sweep(u, f, alpha, settings, generator)
+            f = evaluate(u)
+            evaluations += n
+            k = int(np.argmin(f))
+            if f[k] <= best_f:
+                best_u, best_f = u[k].copy(), float(f[k])
+        else:
+            for i in range(n):
+                for j in range(n):
+                    if f[i] >= f[j]:
+                        r = np.sqrt(np.sum((u[i] - u[j]) ** 2))
+                        beta = settings.beta0 * np.exp(-settings.gamma * r**2)
+                        steps = alpha * (generator.random(d) - 0.5)
+                        u[i] += beta * (u[j] - u[i]) + steps
+                        u[i] = np.clip(u[i], 0.0, 1.0)
+                        f[i] = evaluate(u[i : i + 1])[0]
+                        evaluations += 1
+                        if f[i] <= best_f:
+                            best_u, best_f = u[i].copy(), float(f[i])
+        best_history.append(best_f)
+        mean_history.append(float(np.mean(f)))
+        evaluation_history.append(evaluations)
+        if callback is not None:
+            callback(FireflyProgress(iteration, settings.iterations, best_f, mean_history[-1], evaluations))
+    return FireflyResult(
+        x=lo + best_u * span,
+        fitness=best_f,
+        evaluations=evaluations,
+        best_history=np.array(best_history),
+        mean_history=np.array(mean_history),
+        evaluation_history=np.array(evaluation_history, dtype=np.int64),
+        population=lo + u * span,
+        population_fitness=f.copy(),
+        settings=settings,
+    )
+
+
+def _sweep(
+    u: FloatArray, f: FloatArray, alpha: float, settings: FireflySettings, rng: np.random.Generator
+) -> FloatArray:
+    """One synchronous sweep: every firefly moves towards each brighter one, in order."""
+    n, d = u.shape
+    kicks = alpha * (rng.random((n, n, d)) - 0.5)  # one (n, d) draw per attractor, for everyone
+    dimmer = f[None, :] > f[:, None]  # dimmer[j, i]: firefly i moves towards j
+    moved = u.copy()
+    for j in np.flatnonzero(dimmer.any(axis=1)):
+        delta = u[j] - moved  # attractors stay where the sweep found them
+        beta = settings.beta0 * np.exp(-settings.gamma * np.einsum("ij,ij->i", delta, delta))
+        moved += dimmer[j][:, None] * (beta[:, None] * delta + kicks[j])
+    return np.asarray(np.clip(moved, 0.0, 1.0))

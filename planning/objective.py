@@ -1,0 +1,284 @@
+"""The waypoint objective after Severin & Rossmann (2012), paper eq. 3-7.
+
+A candidate is ``p`` intermediate waypoints of the moving joints (paper eq. 3), visited
+between the fixed start and goal. Its terms:
+
+- ``t_sol``: time of the point-to-point motion through start, waypoints and goal, each
+  segment a synchronised rest-to-rest trapezoidal move under the joints' v/a limits;
+- ``w_sol``: the joint motion accumulated over the IPO interpolation steps of the executed
+  path (eq. 7), each joint normalised by its range;
+- ``t_max``, ``w_max``: the same for the longest possible solution (every segment crossing
+  every moving joint's full range); ``t_max`` includes one IPO so that every feasible value
+  ``t_sol + (w_sol / w_max) IPO`` stays at or below it.
+
+Fitness (lower is better), with the margin checked by coal on the executed path (the septic
+spline through the nodes, or the paper's straight PTP lines), at ``fitness_samples``
+configurations and against ``margin + verify_step_m``:
+
+- ``paper``: feasible ``F = t_sol + (w_sol / w_max) IPO`` (eq. 4); effector only violates:
+  ``2 t_max - F`` (eq. 5); links violate ("shoulder", with or without the effector), or a
+  joint leaves its range: ``2 t_max + F`` (our reading of eq. 6).
+- ``clearance`` (default): feasible as eq. 4; infeasible ``2 t_max + t_max (depth / required
+  + excess)``, with ``depth`` the mean violation of the required clearance over the samples
+  [m] and ``excess`` the sum of the other violations below, each relative to its bound.
+  Feasible always ranks ahead of infeasible.
+
+Beyond the margin, a feasible candidate's spline must stay within the joint ranges, deviate
+from its nodes by at most ``max_node_deviation`` and, when the scene fixes the duration,
+keep velocity, acceleration and jerk within the limits at that duration (checked at the IPO
+samples; the final timing uses exact extrema). The paper fitness ranks these violations
+with eq. 6.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+import cpr_kin as ck
+from planning.ptp import ptp_time, trapezoid_time
+from planning.scene import PlannerSettings
+from planning.spline import SepticSplineSolver
+from planning.trajectory import derivative_coefficients
+
+FloatArray = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
+
+
+@dataclass(frozen=True)
+class Breakdown:
+    """The fitness of a batch of candidates, term by term (all ``(S,)``).
+
+    Attributes:
+        fitness: the objective value.
+        t_sol: PTP time through the candidate's nodes [s].
+        w_sol: normalised accumulated joint motion of the executed path.
+        feasible: no margin violation and no joint beyond its limits.
+        effector_violates: the wrist or tool comes closer than the required clearance (with
+            the ``clearance`` fitness: is the closest group at a violating sample).
+        links_violate: base, column, carriage or arm comes closer than the required
+            clearance (likewise).
+        depth_m: mean violation of the required clearance over the samples [m].
+        overshoot: largest excursion beyond a joint limit, as a fraction of its range.
+        limit_excess: largest |velocity|, |acceleration| or |jerk| over its limit, minus 1
+            (0 when within limits or when the duration is free).
+        node_deviation: largest spline node deviation [rad or m].
+        min_clearance_m: smallest sampled clearance (``inf`` where every sample is clear of
+            the required clearance: distances are computed only where it is violated).
+    """
+
+    fitness: FloatArray
+    t_sol: FloatArray
+    w_sol: FloatArray
+    feasible: BoolArray
+    effector_violates: BoolArray
+    links_violate: BoolArray
+    depth_m: FloatArray
+    overshoot: FloatArray
+    limit_excess: FloatArray
+    node_deviation: FloatArray
+    min_clearance_m: FloatArray
+
+
+class _Sampler:
+    """Evaluates piecewise polynomials at fixed times with one matrix product per segment."""
+
+    def __init__(self, knots: FloatArray, times: FloatArray, order: int) -> None:
+        segment = np.clip(np.searchsorted(knots, times, side="right") - 1, 0, len(knots) - 2)
+        local = times - knots[segment]
+        self.groups = [
+            (np.flatnonzero(segment == i), local[segment == i][:, None] ** np.arange(order))
+            for i in range(len(knots) - 1)
+        ]
+        self.count = len(times)
+
+    def __call__(self, coefficients: FloatArray) -> FloatArray:
+        """``(K, M)`` values of ``(N, M, order)`` coefficients at the sampler's times."""
+        out = np.empty((self.count, coefficients.shape[1]))
+        for i, (rows, powers) in enumerate(self.groups):
+            out[rows] = powers @ coefficients[i].T
+        return out
+
+
+class WaypointObjective:
+    """Batch fitness of waypoint candidates for one scene.
+
+    Args:
+        world: robot and obstacles.
+        q_start: start configuration [rad, m].
+        q_goal: goal configuration [rad, m].
+        moving: indices of the joints the waypoints move.
+        margin_m: safety margin [m].
+        settings: planner settings (fitness kind, path kind, IPO, samples, buffer).
+        solver: the septic spline solver on the trajectory's knots (``N = p + 1`` segments).
+        timed: the knots are the final timing (the scene fixes the duration), so velocity,
+            acceleration and jerk limits apply to candidates.
+    """
+
+    def __init__(
+        self,
+        world: ck.CollisionWorld,
+        q_start: FloatArray,
+        q_goal: FloatArray,
+        moving: NDArray[np.intp],
+        margin_m: float,
+        settings: PlannerSettings,
+        solver: SepticSplineSolver,
+        timed: bool = False,
+    ) -> None:
+        robot = world.robot
+        self.world = world
+        self.q_start, self.q_goal = np.asarray(q_start, dtype=float), np.asarray(q_goal, dtype=float)
+        self.moving = np.asarray(moving, dtype=np.intp)
+        self.settings = settings
+        self.solver = solver
+        self.n_waypoints = settings.waypoints
+        self.required_m = margin_m + settings.verify_step_m
+        limits = robot.limits
+        self.lower_q, self.upper_q, self.range_q = limits.lower, limits.upper, limits.range
+        self.v_max, self.a_max = limits.velocity, limits.acceleration
+        self.timed = timed
+        self._derivative_limits = (limits.velocity, limits.acceleration, limits.jerk)
+        segments = self.n_waypoints + 1
+        self.lower = np.tile(limits.lower[self.moving], self.n_waypoints)
+        self.upper = np.tile(limits.upper[self.moving], self.n_waypoints)
+        longest = float(
+            trapezoid_time(self.range_q[self.moving], self.v_max[self.moving], self.a_max[self.moving]).max()
+        )
+        self.t_max = segments * longest + settings.ipo
+        self.w_max = float(segments * self.moving.size)
+        knots = solver.knots
+        self._check_times = np.linspace(knots[0], knots[-1], settings.fitness_samples)
+        self._check = _Sampler(knots, self._check_times, 8)
+        self._last_step_powers = (knots[-1] - knots[-2]) ** np.arange(8.0)
+        ipo_times = np.append(np.arange(knots[0], knots[-1], settings.ipo), knots[-1])
+        self._ipo = _Sampler(knots, ipo_times, 8)
+        self._pair_group = np.array([ck.GROUPS.index(group) for _, _, group in world.pairs], dtype=np.intp)
+
+    @property
+    def dimension(self) -> int:
+        """Length of a decision vector: waypoints x moving joints."""
+        return int(self.lower.size)
+
+    def nodes(self, x: FloatArray) -> FloatArray:
+        """``(S, p + 2, nq)`` start, waypoints and goal of candidates ``x`` ``(S, p k)``."""
+        x = np.atleast_2d(np.asarray(x, dtype=float))
+        s = len(x)
+        nodes = np.empty((s, self.n_waypoints + 2, self.q_start.size))
+        nodes[:, 0], nodes[:, -1] = self.q_start, self.q_goal
+        nodes[:, 1:-1] = self.q_start  # held joints keep the start's values
+        nodes[:, 1:-1, self.moving] = x.reshape(s, self.n_waypoints, self.moving.size)
+        return nodes
+
+    def __call__(self, x: FloatArray) -> FloatArray:
+        """``(S,)`` fitness of candidates ``x`` ``(S, p k)`` in joint units."""
+        return self.breakdown(x).fitness
+
+    def _paths(self, nodes: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
+        """Check samples ``(S, K, nq)`` of the executed paths and their ``(S,)`` terms.
+
+        Returns the samples, w_sol, overshoot, limit excess and node deviation.
+        """
+        s, n_nodes, nq = nodes.shape
+        zeros = np.zeros(s)
+        if self.settings.path == "ptp":
+            fraction = np.linspace(0.0, 1.0, max(2, self.settings.fitness_samples // (n_nodes - 1)))
+            steps = np.diff(nodes, axis=1)
+            samples = nodes[:, :-1, None, :] + fraction[None, None, :, None] * steps[:, :, None, :]
+            w_sol = (np.abs(steps) / self.range_q).sum(axis=(1, 2))
+            return samples.reshape(s, -1, nq), w_sol, zeros, zeros, zeros
+        columns = nodes.transpose(1, 0, 2).reshape(n_nodes, s * nq)  # every joint of every candidate
+        coefficients = self.solver.solve_batch(columns)
+        samples = self._check(coefficients).reshape(-1, s, nq).transpose(1, 0, 2)
+        range_q, lower_q, upper_q = (np.tile(v, s) for v in (self.range_q, self.lower_q, self.upper_q))
+        dense = self._ipo(coefficients)  # (IPO steps, S nq): reduce over time first
+        w_sol = (np.abs(np.diff(dense, axis=0)).sum(axis=0) / range_q).reshape(s, nq).sum(axis=1)
+        beyond = np.maximum(dense.max(axis=0) - upper_q, lower_q - dense.min(axis=0)) / range_q
+        overshoot = np.maximum(beyond.reshape(s, nq).max(axis=1), 0.0)
+        last = coefficients[-1] @ self._last_step_powers  # value at the end of the last segment
+        node_values = np.concatenate([coefficients[:, :, 0], last[None]])
+        deviation = np.abs(node_values - columns).max(axis=0).reshape(s, nq).max(axis=1)
+        excess = zeros
+        if self.timed:
+            utilisation = zeros
+            for r, limit in enumerate(self._derivative_limits, start=1):
+                values = self._ipo(derivative_coefficients(coefficients, r))
+                peak = np.maximum(values.max(axis=0), -values.min(axis=0)) / np.tile(limit, s)
+                utilisation = np.maximum(utilisation, peak.reshape(s, nq).max(axis=1))
+            excess = np.maximum(utilisation - 1.0, 0.0)
+        return samples, w_sol, overshoot, excess, deviation
+
+    def _clearance(self, samples: FloatArray) -> FloatArray:
+        """``(S, K, 2)`` per-group clearance where it falls short of the required clearance.
+
+        ``inf`` where a sample keeps the required clearance, ``nan`` where it was not checked.
+        Staged: every 4th sample first; only candidates clear there are checked at the
+        others, so an infeasible candidate costs a quarter (its depth is then the mean over
+        the coarse samples). Where coal's parallel yes/no test flags a sample, its distance
+        is computed.
+        """
+        s, k, _ = samples.shape
+        clearance = np.full((s, k, 2), np.nan)
+        coarse = np.zeros(k, dtype=bool)
+        coarse[::4] = True
+        coarse[-1] = True
+        self._fill(clearance, samples, np.arange(s), coarse)
+        still_clear = np.flatnonzero(~(clearance[:, coarse] < self.required_m).any(axis=(1, 2)))
+        self._fill(clearance, samples, still_clear, ~coarse)
+        return clearance
+
+    def _fill(
+        self, clearance: FloatArray, samples: FloatArray, candidates: NDArray[np.intp], columns: BoolArray
+    ) -> None:
+        """Check ``samples[candidates][:, columns]`` and write the result into ``clearance``."""
+        if candidates.size == 0 or not columns.any():
+            return
+        flat = samples[candidates][:, columns].reshape(-1, samples.shape[2])
+        values = np.full((len(flat), 2), np.inf)
+        flagged = np.flatnonzero(self.world.margin_violated(flat, self.required_m))
+        if flagged.size:
+            if self.settings.fitness == "paper":
+                values[flagged] = self.world.clearance_batch(flat[flagged]).clearance_m
+            else:  # one query per sample; the violation goes to the closest pair's group
+                distance, pair = self.world.min_clearance_batch(flat[flagged])
+                values[flagged, self._pair_group[pair]] = distance
+        block = clearance[candidates]
+        block[:, columns] = values.reshape(len(candidates), -1, 2)
+        clearance[candidates] = block
+
+    def breakdown(self, x: FloatArray) -> Breakdown:
+        """The fitness of candidates ``x`` ``(S, p k)`` with all its terms."""
+        nodes = self.nodes(x)
+        t_sol = ptp_time(nodes, self.v_max, self.a_max)
+        samples, w_sol, overshoot, excess, deviation = self._paths(nodes)
+        deviation_excess = np.maximum(deviation / self.settings.max_node_deviation - 1.0, 0.0)
+        other = overshoot + excess + deviation_excess
+        clearance = self._clearance(np.clip(samples, self.lower_q, self.upper_q))
+        shortfall = np.maximum(self.required_m - clearance, 0.0)
+        effector = np.asarray((clearance[:, :, 0] < self.required_m).any(axis=1))
+        links = np.asarray((clearance[:, :, 1] < self.required_m).any(axis=1))
+        depth = np.nanmean(shortfall.max(axis=2), axis=1)
+        feasible = ~(effector | links) & (other <= 0.0)
+        base = t_sol + np.minimum(w_sol / self.w_max, 1.0) * self.settings.ipo
+        if self.settings.fitness == "paper":
+            fitness = np.where(
+                feasible, base, np.where(links | (other > 0), 2 * self.t_max + base, 2 * self.t_max - base)
+            )
+        else:
+            penalty = self.t_max * (depth / max(self.required_m, 1e-3) + other)
+            fitness = np.where(feasible, base, 2 * self.t_max + penalty)
+        return Breakdown(
+            fitness=fitness,
+            t_sol=t_sol,
+            w_sol=w_sol,
+            feasible=feasible,
+            effector_violates=effector,
+            links_violate=links,
+            depth_m=depth,
+            overshoot=overshoot,
+            limit_excess=excess,
+            node_deviation=deviation,
+            min_clearance_m=np.nanmin(clearance, axis=(1, 2)),
+        )

@@ -1,0 +1,285 @@
+"""The planner: scene -> firefly waypoints -> septic spline -> timing -> verified trajectory."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+import cpr_kin as ck
+from planning.errors import PlanningError
+from planning.firefly import FireflyProgress, FireflyResult, firefly_minimize
+from planning.objective import Breakdown, WaypointObjective
+from planning.scene import Scene
+from planning.spline import SepticSplineSolver, SplineFit, uniform_knots
+from planning.trajectory import Trajectory
+
+FloatArray = NDArray[np.float64]
+
+WRIST_JOINTS = ("theta4", "theta5")
+
+
+class NoTrajectoryFoundError(PlanningError):
+    """No candidate of the final population passed the verification.
+
+    Attributes:
+        certified_clearance_m: certified clearance of the best candidate [m].
+        worst_time: when it comes closest [s].
+        worst_pair: ``(robot geometry, obstacle)`` closest then.
+        worst_group: the violating group.
+    """
+
+    def __init__(self, message: str, check: ck.CurveCheck) -> None:
+        super().__init__(message)
+        self.certified_clearance_m = check.certified_min_m
+        self.worst_time = check.worst_time
+        self.worst_pair = check.worst_pair
+        self.worst_group = check.worst_group
+
+
+@dataclass(frozen=True)
+class Metrics:
+    """Figures of a planned trajectory.
+
+    Attributes:
+        duration: trajectory duration [s].
+        fitness: objective value of the chosen waypoints.
+        t_sol: PTP time through the chosen nodes (the paper's objective value) [s].
+        w_sol: normalised accumulated joint motion of the executed path.
+        min_clearance: certified lower bound of the clearance along the trajectory [m].
+        sampled_min_clearance: smallest clearance at the verification samples [m].
+        max_node_deviation: largest |y_i - f_i| of the spline [rad or m].
+        jerk_min: per joint, smallest jerk [rad/s^3 or m/s^3].
+        jerk_max: per joint, largest jerk.
+        limit_utilisation: largest |velocity|, |acceleration|, |jerk| over the limit, per order.
+        integrated_squared_jerk: per joint [rad^2/s^5 or m^2/s^5].
+        planning_time_s: wall time of :func:`plan` [s].
+        optimiser_time_s: wall time of the firefly search [s].
+        evaluations: objective evaluations.
+        candidates_verified: candidates that went through the final verification.
+        duration_stretched: the requested duration broke a limit and was stretched.
+    """
+
+    duration: float
+    fitness: float
+    t_sol: float
+    w_sol: float
+    min_clearance: float
+    sampled_min_clearance: float
+    max_node_deviation: float
+    jerk_min: dict[str, float]
+    jerk_max: dict[str, float]
+    limit_utilisation: dict[str, float]
+    integrated_squared_jerk: dict[str, float]
+    planning_time_s: float
+    optimiser_time_s: float
+    evaluations: int
+    candidates_verified: int
+    duration_stretched: bool
+
+
+@dataclass(frozen=True)
+class PlanResult:
+    """A planned, verified trajectory with everything that produced it.
+
+    Attributes:
+        scene: the scene planned.
+        robot: the robot used.
+        joint_names: joint order of every array.
+        waypoints: ``(p + 2, nq)`` start, intermediate waypoints, goal [rad, m].
+        trajectory: the timed septic spline.
+        spline: the spline fit (on the nominal knots, before timing).
+        time_scale: factor from the nominal knots to the trajectory's.
+        metrics: figures of the result.
+        breakdown: the chosen candidate's fitness terms.
+        optimiser: the firefly run (history, population).
+        verification: the certified continuous check of the trajectory.
+    """
+
+    scene: Scene
+    robot: ck.Robot = field(repr=False)
+    joint_names: tuple[str, ...]
+    waypoints: FloatArray
+    trajectory: Trajectory
+    spline: SplineFit = field(repr=False)
+    time_scale: float
+    metrics: Metrics
+    breakdown: Breakdown = field(repr=False)
+    optimiser: FireflyResult = field(repr=False)
+    verification: ck.CurveCheck = field(repr=False)
+
+
+def _moving_joints(
+    robot: ck.Robot, scene: Scene, q_start: FloatArray, q_goal: FloatArray
+) -> NDArray[np.intp]:
+    names = scene.planner.moving_joints
+    if names is None:
+        names = tuple(
+            n
+            for i, n in enumerate(robot.joint_names)
+            if n not in WRIST_JOINTS or not np.isclose(q_start[i], q_goal[i])
+        )
+    if not names:
+        raise PlanningError("moving_joints is empty; name at least one joint the waypoints may move")
+    return np.array([robot.limits.index(n) for n in names], dtype=np.intp)
+
+
+def _endpoint(robot: ck.Robot, world: ck.CollisionWorld, scene: Scene, label: str) -> FloatArray:
+    target = scene.start if label == "start" else scene.goal
+    try:
+        q = target.configuration(robot)
+    except ck.CprKinError as exc:
+        raise PlanningError(f"{label} is not reachable: {exc}") from None
+    clearance = world.clearance(q)
+    closest = clearance.closest
+    if closest is not None and clearance.min_clearance_m < scene.safety_margin:
+        raise PlanningError(
+            f"{label} q = {np.round(q, 4).tolist()} is inside the safety margin: {closest.robot_geometry} "
+            f"is {clearance.min_clearance_m:.3f} m from obstacle '{closest.obstacle}' "
+            f"(margin {scene.safety_margin} m)"
+        )
+    return q
+
+
+def plan(
+    scene: Scene,
+    robot: ck.Robot | None = None,
+    progress: Callable[[FireflyProgress], None] | None = None,
+) -> PlanResult:
+    """Plan a collision-free, jerk-continuous trajectory for ``scene``.
+
+    Steps: inverse kinematics of start and goal (reachable, clear of the margin); firefly
+    search of the waypoints on the objective of :mod:`planning.objective`; septic spline
+    through start, waypoints and goal on ``p + 1`` uniform segments; timing (the scene's
+    duration, stretched if it breaks a velocity, acceleration or jerk limit, or the fastest
+    uniform timing within them); certified continuous verification of the whole
+    trajectory against the margin. If the best candidate fails the verification the next
+    ones of the final population are tried in order of fitness.
+
+    Args:
+        scene: the problem and its settings.
+        robot: a loaded robot (default: load ``scene.robot`` or the bundled CPR).
+        progress: called after every firefly iteration.
+
+    Raises:
+        PlanningError: unreachable start or goal, or one inside the margin; bad settings.
+        NoTrajectoryFoundError: no candidate passes the verification.
+    """
+    started = time.perf_counter()
+    robot = robot or ck.load_cpr(scene.robot)
+    world = ck.CollisionWorld(robot, scene.obstacles)
+    q_start = _endpoint(robot, world, scene, "start")
+    q_goal = _endpoint(robot, world, scene, "goal")
+    settings = scene.planner
+    moving = _moving_joints(robot, scene, q_start, q_goal)
+    segments = settings.waypoints + 1
+    nominal_duration = scene.duration if scene.duration is not None else float(segments)
+    solver = SepticSplineSolver(uniform_knots(segments, nominal_duration), scene.spline)
+    objective = WaypointObjective(
+        world,
+        q_start,
+        q_goal,
+        moving,
+        scene.safety_margin,
+        settings,
+        solver,
+        timed=scene.duration is not None,
+    )
+
+    search_started = time.perf_counter()
+    result = firefly_minimize(
+        objective,
+        objective.lower,
+        objective.upper,
+        settings.firefly(),
+        np.random.default_rng(settings.seed),
+        progress,
+    )
+    optimiser_time = time.perf_counter() - search_started
+
+    limits = robot.limits
+    order = np.argsort(result.population_fitness, kind="stable")
+    candidates = [result.x] + [result.population[k] for k in order]
+    first_check: ck.CurveCheck | None = None
+    tried = 0
+    for x in candidates:
+        tried += 1
+        nodes = objective.nodes(x[None])[0]
+        fit = solver.solve(nodes)
+        nominal = fit.trajectory
+        scale = nominal.time_scale_for_limits(limits.velocity, limits.acceleration, limits.jerk)
+        stretched = scene.duration is not None and scale > 1.0
+        if scene.duration is not None:
+            scale = max(scale, 1.0)
+        trajectory = nominal.time_scaled(scale)
+        speed = trajectory.extrema(1).peak
+        check = ck.check_curve(
+            world,
+            trajectory.position,
+            trajectory.knots[0],
+            trajectory.knots[-1],
+            speed,
+            scene.safety_margin,
+            settings.verify_step_m,
+        )
+        first_check = first_check or check
+        if (
+            check.accepted
+            and np.all(trajectory.extrema(0).minimum >= limits.lower - 1e-9)
+            and np.all(trajectory.extrema(0).maximum <= limits.upper + 1e-9)
+        ):
+            break
+    else:
+        assert first_check is not None  # candidates is never empty
+        raise NoTrajectoryFoundError(
+            f"no collision-free trajectory found: the best candidate's certified clearance is "
+            f"{first_check.certified_min_m:.3f} m (margin {scene.safety_margin} m), closest at t = "
+            f"{first_check.worst_time:.2f} s between {first_check.worst_pair} ({first_check.worst_group}); "
+            f"{len(candidates)} candidates verified",
+            first_check,
+        )
+
+    breakdown = objective.breakdown(x[None])
+    names = robot.joint_names
+    jerk = trajectory.extrema(3)
+    utilisation = {
+        kind: float(np.max(trajectory.extrema(r).peak / limit))
+        for r, (kind, limit) in enumerate(
+            (("velocity", limits.velocity), ("acceleration", limits.acceleration), ("jerk", limits.jerk)),
+            start=1,
+        )
+    }
+    metrics = Metrics(
+        duration=trajectory.duration,
+        fitness=float(breakdown.fitness[0]),
+        t_sol=float(breakdown.t_sol[0]),
+        w_sol=float(breakdown.w_sol[0]),
+        min_clearance=check.certified_min_m,
+        sampled_min_clearance=check.sampled_min_m,
+        max_node_deviation=fit.max_node_deviation,
+        jerk_min=dict(zip(names, map(float, jerk.minimum), strict=True)),
+        jerk_max=dict(zip(names, map(float, jerk.maximum), strict=True)),
+        limit_utilisation=utilisation,
+        integrated_squared_jerk=dict(zip(names, map(float, trajectory.integrated_squared_jerk), strict=True)),
+        planning_time_s=time.perf_counter() - started,
+        optimiser_time_s=optimiser_time,
+        evaluations=result.evaluations,
+        candidates_verified=tried,
+        duration_stretched=bool(stretched),
+    )
+    return PlanResult(
+        scene=scene,
+        robot=robot,
+        joint_names=names,
+        waypoints=nodes,
+        trajectory=trajectory,
+        spline=fit,
+        time_scale=float(scale),
+        metrics=metrics,
+        breakdown=breakdown,
+        optimiser=result,
+        verification=check,
+    )
