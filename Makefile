@@ -34,6 +34,7 @@ format: $(STAMP)
 bench: $(STAMP)
 	$(PY) scripts/bench_clearance.py
 	$(PY) scripts/bench_spline.py
+	$(PY) scripts/bench_planner.py
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache .mypy_cache .ruff_cache

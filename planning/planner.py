@@ -144,6 +144,39 @@ def _endpoint(robot: ck.Robot, world: ck.CollisionWorld, scene: Scene, label: st
     return q
 
 
+def _verify(
+    robot: ck.Robot, world: ck.CollisionWorld, scene: Scene, trajectory: Trajectory, fit: SplineFit
+) -> tuple[ck.CurveCheck, list[str]]:
+    """Certified clearance, joint ranges and node deviation of a timed trajectory."""
+    speed = trajectory.extrema(1).peak
+    start, end = trajectory.knots[0], trajectory.knots[-1]
+    step = scene.planner.verify_step_m
+    check = ck.check_curve(world, trajectory.position, start, end, speed, scene.safety_margin, step)
+    problems = []
+    if not check.accepted:
+        problems.append(
+            f"comes within {check.certified_min_m:.3f} m (certified) of an obstacle, "
+            f"margin {scene.safety_margin} m: closest at t = {check.worst_time:.2f} s "
+            f"between {check.worst_pair} ({check.worst_group})"
+        )
+    positions = trajectory.extrema(0)
+    limits = robot.limits
+    for i, name in enumerate(robot.joint_names):
+        low, high = positions.minimum[i], positions.maximum[i]
+        if low < limits.lower[i] - 1e-9 or high > limits.upper[i] + 1e-9:
+            unit = robot.joint_unit(name)
+            problems.append(
+                f"moves joint '{name}' over [{low:.4g}, {high:.4g}] {unit}, outside its range "
+                f"[{limits.lower[i]:g}, {limits.upper[i]:g}] {unit}"
+            )
+    if fit.max_node_deviation > scene.planner.max_node_deviation:
+        problems.append(
+            f"deviates {fit.max_node_deviation:.3g} from its nodes, more than max_node_deviation = "
+            f"{scene.planner.max_node_deviation:g}"
+        )
+    return check, problems
+
+
 def plan(
     scene: Scene,
     robot: ck.Robot | None = None,
@@ -203,7 +236,7 @@ def plan(
     limits = robot.limits
     order = np.argsort(result.population_fitness, kind="stable")
     candidates = [result.x] + [result.population[k] for k in order]
-    first_check: ck.CurveCheck | None = None
+    first: tuple[ck.CurveCheck, list[str]] | None = None
     tried = 0
     for x in candidates:
         tried += 1
@@ -215,31 +248,17 @@ def plan(
         if scene.duration is not None:
             scale = max(scale, 1.0)
         trajectory = nominal.time_scaled(scale)
-        speed = trajectory.extrema(1).peak
-        check = ck.check_curve(
-            world,
-            trajectory.position,
-            trajectory.knots[0],
-            trajectory.knots[-1],
-            speed,
-            scene.safety_margin,
-            settings.verify_step_m,
-        )
-        first_check = first_check or check
-        if (
-            check.accepted
-            and np.all(trajectory.extrema(0).minimum >= limits.lower - 1e-9)
-            and np.all(trajectory.extrema(0).maximum <= limits.upper + 1e-9)
-        ):
+        check, problems = _verify(robot, world, scene, trajectory, fit)
+        first = first or (check, problems)
+        if not problems:
             break
     else:
-        assert first_check is not None  # candidates is never empty
+        assert first is not None  # candidates is never empty
+        check, problems = first
         raise NoTrajectoryFoundError(
-            f"no collision-free trajectory found: the best candidate's certified clearance is "
-            f"{first_check.certified_min_m:.3f} m (margin {scene.safety_margin} m), closest at t = "
-            f"{first_check.worst_time:.2f} s between {first_check.worst_pair} ({first_check.worst_group}); "
-            f"{len(candidates)} candidates verified",
-            first_check,
+            f"no collision-free trajectory found: the best candidate {'; '.join(problems)} "
+            f"({len(candidates)} candidates verified)",
+            check,
         )
 
     breakdown = objective.breakdown(x[None])

@@ -178,15 +178,15 @@ def paper_scene(seed: int = 0, **planner_overrides: object) -> Scene:
     (0, 0.6, 0.15), margin 0.1 m; n = 50, alpha = 1, beta0 = 0.5, 50 iterations, 3
     waypoints; spline N = 4, h = 1 s (4 s), p = 1e6, jerk only, natural ends.
     """
-    planner = PlannerSettings(
-        fireflies=50,
-        iterations=50,
-        alpha=1.0,
-        beta0=0.5,
-        waypoints=3,
-        seed=seed,
-        **planner_overrides,  # type: ignore[arg-type]
-    )
+    parameters: dict[str, object] = {
+        "fireflies": 50,
+        "iterations": 50,
+        "alpha": 1.0,
+        "beta0": 0.5,
+        "waypoints": 3,
+    }
+    parameters.update(planner_overrides, seed=seed)
+    planner = PlannerSettings(**parameters)  # type: ignore[arg-type]
     return Scene(
         name="paper",
         start=Target(tcp=PAPER_START_TCP),

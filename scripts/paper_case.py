@@ -1,70 +1,96 @@
-"""The paper case (DESIGN.md section 4), as far as the project goes today.
+"""The paper case (DESIGN.md section 4), planned and reported beside the paper's figures.
 
-Loads the CPR, prints its joints and limits, solves the inverse kinematics of the paper's
-start and goal TCP points, checks them against forward kinematics, and reports their
-clearance to the paper's crate, then certifies (or refutes) the direct constant-height
-swing between them with the continuous check. The firefly planner replaces the last step
-once it exists.
+Plans the scene with the paper's parameters (n = 50, alpha = 1, beta0 = 0.5, 50 iterations,
+3 waypoints; septic spline N = 4, h = 1 s, p = 1e6), verifies the trajectory, prints the
+paper's figures beside ours, writes ``trajectory.json`` (cpr-trajectory/1), ``samples.csv``
+and ``report.md`` into ``--out``, and plans seeds ``0 .. --seeds - 1`` to report how many
+succeed.
 """
 
 from __future__ import annotations
 
 import argparse
+import statistics
 import sys
-
-import numpy as np
+from pathlib import Path
 
 import cpr_kin as ck
+from planning.errors import PlanningError
+from planning.planner import PlanResult, plan
+from planning.report import markdown_table, paper_rows, text_table
+from planning.scene import paper_scene
+from planning.trajectory_io import atomic_write_text, write_samples, write_trajectory
 
-PAPER_START_TCP = (0.5, 0.45, 0.25)
-PAPER_GOAL_TCP = (-0.5, 0.45, 0.25)
-PAPER_CRATE = ck.Obstacle.box(size=(0.3, 0.3, 0.3), xyz=(0.0, 0.6, 0.15), name="crate")
-PAPER_MARGIN_M = 0.1
+
+def seed_summary(robot: ck.Robot, seeds: int) -> tuple[list[tuple[int, str]], list[PlanResult]]:
+    """Plan seeds 0 .. seeds - 1: per seed a verdict line, and the successful results."""
+    lines, results = [], []
+    for seed in range(seeds):
+        try:
+            result = plan(paper_scene(seed), robot)
+        except PlanningError as exc:
+            lines.append((seed, f"failed: {exc}"))
+            continue
+        m = result.metrics
+        ok = m.min_clearance >= 0.1 and m.max_node_deviation < 20e-6
+        lines.append(
+            (
+                seed,
+                f"{'ok' if ok else 'NOT ok'}: t_sol {m.t_sol:.3f} s, clearance {m.min_clearance:.4f} m, "
+                f"deviation {m.max_node_deviation * 1e6:.2f} um, {m.planning_time_s:.3f} s",
+            )
+        )
+        if ok:
+            results.append(result)
+    return lines, results
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--urdf", default=None, help="URDF of the CPR (default: the bundled one)")
-    args = parser.parse_args(argv)
-    try:
-        robot = ck.load_cpr(args.urdf)
-    except ck.CprKinError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-
-    print(f"CPR loaded from {robot.urdf_path}")
-    print(f"{'joint':8s} {'unit':4s} {'lower':>7s} {'upper':>7s} {'v max':>6s} {'a max':>6s} {'j max':>6s}")
-    lim = robot.limits
-    for i, name in enumerate(robot.joint_names):
-        print(
-            f"{name:8s} {robot.joint_unit(name):4s} {lim.lower[i]:7.2f} {lim.upper[i]:7.2f} "
-            f"{lim.velocity[i]:6.2f} {lim.acceleration[i]:6.2f} {lim.jerk[i]:6.1f}"
-        )
-
-    world = ck.CollisionWorld(robot, [PAPER_CRATE])
-    print(f"\nscene: crate 0.3 m cube at (0, 0.6, 0.15), safety margin {PAPER_MARGIN_M} m")
-    configurations = {}
-    for label, tcp in (("start", PAPER_START_TCP), ("goal", PAPER_GOAL_TCP)):
-        q = ck.tcp_ik(robot, tcp)
-        configurations[label] = q
-        error = np.linalg.norm(ck.frame_positions(robot, q) - np.asarray(tcp))
-        clearance = world.clearance(q)
-        closest = clearance.closest
-        assert closest is not None  # the scene has an obstacle
-        verdict = "clear" if clearance.min_clearance_m >= PAPER_MARGIN_M else "VIOLATES the margin"
-        groups = clearance.group_clearance_m
-        print(
-            f"{label:5s} tcp {tcp} -> q = {np.array2string(q, precision=4)}  (FK error {error:.1e} m)\n"
-            f"      clearance effector {groups['effector']:.3f} m, links {groups['links']:.3f} m, "
-            f"closest {closest.robot_geometry}-{closest.obstacle}: {verdict}"
-        )
-
-    check = ck.check_segment(world, configurations["start"], configurations["goal"], PAPER_MARGIN_M)
-    print(
-        f"\ndirect constant-height swing: certified clearance {check.certified_min_m:.3f} m "
-        f"({len(check.times)} checks, <= {check.step_m * 1000:.0f} mm robot motion apart): "
-        + ("accepted" if check.accepted else f"rejected, {check.worst_pair} in group '{check.worst_group}'")
+    parser.add_argument(
+        "--out", type=Path, default=Path("out/paper"), help="output folder (default: out/paper)"
     )
+    parser.add_argument("--seed", type=int, default=0, help="seed of the reported run (default: 0)")
+    parser.add_argument("--seeds", type=int, default=10, help="seeds 0..N-1 to count successes (default: 10)")
+    args = parser.parse_args(argv)
+    robot = ck.load_cpr()
+    try:
+        result = plan(paper_scene(args.seed), robot)
+    except PlanningError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 3
+    rows = paper_rows(result)
+    clearance = result.metrics.min_clearance
+    print(f"Paper case, seed {args.seed}: trajectory verified, certified clearance {clearance:.4f} m\n")
+    print(text_table(rows))
+
+    lines, successes = seed_summary(robot, args.seeds)
+    count = f"{len(successes)}/{args.seeds}"
+    print(f"\nseeds 0..{args.seeds - 1}: {count} verified with clearance >= 0.1 m and deviation < 20 um")
+    for seed, line in lines:
+        print(f"  seed {seed}: {line}")
+    times = [r.metrics.planning_time_s for r in successes]
+    if times:
+        print(f"  median planning time {statistics.median(times):.3f} s")
+
+    args.out.mkdir(parents=True, exist_ok=True)
+    write_trajectory(result, args.out / "trajectory.json")
+    write_samples(result, args.out / "samples.csv")
+    report = [
+        "# Paper case",
+        "",
+        f"Seed {args.seed}; scene and method of DESIGN.md section 4. Trajectory: `trajectory.json`, "
+        "samples every IPO period: `samples.csv`.",
+        "",
+        markdown_table(rows),
+        "",
+        f"Seeds 0..{args.seeds - 1}: {len(successes)}/{args.seeds} verified.",
+        "",
+        *[f"- seed {seed}: {line}" for seed, line in lines],
+        "",
+    ]
+    atomic_write_text(args.out / "report.md", "\n".join(report))
+    print(f"\nwrote {args.out / 'trajectory.json'}, {args.out / 'samples.csv'}, {args.out / 'report.md'}")
     return 0
 
 

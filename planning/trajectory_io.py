@@ -1,0 +1,196 @@
+"""Files users exchange: the ``cpr-trajectory/1`` JSON (DESIGN.md section 6) and CSV samples.
+
+Every file is written atomically: to a temporary file in the target folder, then renamed,
+so a reader never sees half a file and a failure leaves nothing behind.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+import cpr_kin as ck
+from planning.errors import PlanningError
+from planning.planner import PlanResult
+from planning.scene import Scene, Target
+from planning.trajectory import DERIVATIVE_NAMES, Trajectory
+
+FloatArray = NDArray[np.float64]
+FORMAT = "cpr-trajectory/1"
+
+
+def atomic_write_text(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` through a temporary file and a rename."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    try:
+        with os.fdopen(handle, "w", encoding="utf-8", newline="") as stream:
+            stream.write(text)
+        os.replace(temporary, path)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+
+
+def obstacle_to_dict(obstacle: ck.Obstacle) -> dict[str, Any]:
+    """An obstacle in the scene file's form (DESIGN.md section 6)."""
+    entry: dict[str, Any] = {"name": obstacle.name, "shape": obstacle.shape}
+    if obstacle.shape == "box":
+        entry["size"] = np.asarray(obstacle.size).tolist()
+    if obstacle.shape in ("sphere", "cylinder", "capsule"):
+        entry["radius"] = obstacle.radius
+    if obstacle.shape in ("cylinder", "capsule"):
+        entry["length"] = obstacle.length
+    if obstacle.shape == "mesh":
+        entry.update(mesh=str(obstacle.mesh), scale=obstacle.scale, convex=obstacle.convex)
+    entry.update(xyz=obstacle.xyz.tolist(), rpy=obstacle.rpy.tolist())
+    return entry
+
+
+def target_to_dict(target: Target) -> dict[str, Any]:
+    """A start or goal in the scene file's form."""
+    if target.q is not None:
+        return {"q": [float(v) for v in target.q]}
+    entry: dict[str, Any] = {"tcp": [float(v) for v in target.tcp or ()]}
+    if target.theta4 or target.theta5:
+        entry.update(theta4=target.theta4, theta5=target.theta5)
+    return entry
+
+
+def scene_to_dict(scene: Scene) -> dict[str, Any]:
+    """The scene as planned: obstacles, safety margin, start, goal (and duration)."""
+    return {
+        "name": scene.name,
+        "safety_margin": scene.safety_margin,
+        "start": target_to_dict(scene.start),
+        "goal": target_to_dict(scene.goal),
+        "duration": scene.duration,
+        "obstacles": [obstacle_to_dict(o) for o in scene.obstacles],
+    }
+
+
+def trajectory_document(result: PlanResult) -> dict[str, Any]:
+    """The ``cpr-trajectory/1`` document of a plan, as plain JSON types."""
+    trajectory = result.trajectory
+    metrics = result.metrics
+    segments = [
+        {"t0": float(t0), "t1": float(t1), "coeffs": trajectory.coefficients[i].tolist()}
+        for i, (t0, t1) in enumerate(zip(trajectory.knots[:-1], trajectory.knots[1:], strict=True))
+    ]
+    return {
+        "format": FORMAT,
+        "joint_names": list(result.joint_names),
+        "robot": str(result.robot.urdf_path),
+        "scene": scene_to_dict(result.scene),
+        "waypoints": result.waypoints.tolist(),
+        "knots": trajectory.knots.tolist(),
+        "segments": segments,
+        "metrics": {
+            "duration": metrics.duration,
+            "min_clearance": metrics.min_clearance,
+            "sampled_min_clearance": metrics.sampled_min_clearance,
+            "max_node_deviation": metrics.max_node_deviation,
+            "jerk_min": metrics.jerk_min,
+            "jerk_max": metrics.jerk_max,
+            "limit_utilisation": metrics.limit_utilisation,
+            "integrated_squared_jerk": metrics.integrated_squared_jerk,
+            "fitness": metrics.fitness,
+            "t_sol": metrics.t_sol,
+            "w_sol": metrics.w_sol,
+            "planning_time_s": metrics.planning_time_s,
+            "optimiser_time_s": metrics.optimiser_time_s,
+            "evaluations": metrics.evaluations,
+            "candidates_verified": metrics.candidates_verified,
+            "duration_stretched": metrics.duration_stretched,
+            "seed": result.scene.planner.seed,
+            "fitness_kind": result.scene.planner.fitness,
+        },
+    }
+
+
+def write_trajectory(result: PlanResult, path: Path) -> None:
+    """Write the plan as a ``cpr-trajectory/1`` JSON file, atomically."""
+    atomic_write_text(Path(path), json.dumps(trajectory_document(result), indent=1) + "\n")
+
+
+def samples_csv(trajectory: Trajectory, joint_names: tuple[str, ...], period: float) -> str:
+    """CSV text of position, velocity, acceleration and jerk every ``period`` seconds."""
+    times = np.append(np.arange(trajectory.knots[0], trajectory.knots[-1], period), trajectory.knots[-1])
+    columns = [trajectory(times, r) for r in range(4)]
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    header = ["t"]
+    for r in range(4):
+        suffix = "" if r == 0 else f"_{DERIVATIVE_NAMES[r]}"
+        header += [f"{name}{suffix}" for name in joint_names]
+    writer.writerow(header)
+    for k, t in enumerate(times):
+        writer.writerow([f"{t:.6f}"] + [f"{v:.12g}" for column in columns for v in column[k]])
+    return buffer.getvalue()
+
+
+def write_samples(result: PlanResult, path: Path) -> None:
+    """Write the trajectory sampled at the planner's IPO period as CSV, atomically."""
+    atomic_write_text(
+        Path(path), samples_csv(result.trajectory, result.joint_names, result.scene.planner.ipo)
+    )
+
+
+@dataclass(frozen=True)
+class TrajectoryFile:
+    """A ``cpr-trajectory/1`` file read back.
+
+    Attributes:
+        trajectory: the piecewise polynomial.
+        joint_names: joint order.
+        waypoints: ``(P, nq)`` start, waypoints, goal.
+        robot: URDF path recorded in the file.
+        scene: the scene section as written.
+        metrics: the metrics section as written.
+    """
+
+    trajectory: Trajectory
+    joint_names: tuple[str, ...]
+    waypoints: FloatArray
+    robot: str
+    scene: dict[str, Any]
+    metrics: dict[str, Any]
+
+
+def read_trajectory(path: Path) -> TrajectoryFile:
+    """Read a ``cpr-trajectory/1`` file; raises :class:`PlanningError` naming what is wrong."""
+    path = Path(path)
+    try:
+        document = json.loads(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise PlanningError(f"cannot read trajectory file '{path}': {exc.strerror}") from None
+    except json.JSONDecodeError as exc:
+        raise PlanningError(f"trajectory file '{path}' is not valid JSON: {exc}") from None
+    if not isinstance(document, dict) or document.get("format") != FORMAT:
+        found = document.get("format") if isinstance(document, dict) else type(document).__name__
+        raise PlanningError(f"trajectory file '{path}' has format {found!r}; expected '{FORMAT}'")
+    try:
+        segments = document["segments"]
+        knots = np.array(document["knots"], dtype=float)
+        coefficients = np.array([s["coeffs"] for s in segments], dtype=float)
+        trajectory = Trajectory(knots=knots, coefficients=coefficients)
+        return TrajectoryFile(
+            trajectory=trajectory,
+            joint_names=tuple(document["joint_names"]),
+            waypoints=np.array(document["waypoints"], dtype=float),
+            robot=str(document["robot"]),
+            scene=dict(document["scene"]),
+            metrics=dict(document.get("metrics", {})),
+        )
+    except (KeyError, TypeError, ValueError) as exc:
+        raise PlanningError(f"trajectory file '{path}' is malformed: {exc!r}") from None

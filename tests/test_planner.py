@@ -1,0 +1,130 @@
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+
+import numpy as np
+import pytest
+
+import cpr_kin as ck
+from planning.errors import PlanningError
+from planning.planner import NoTrajectoryFoundError, PlanResult, plan
+from planning.scene import PAPER_GOAL_TCP, PAPER_START_TCP, PlannerSettings, Scene, Target, paper_scene
+
+
+@pytest.fixture(scope="module")
+def paper_results(robot: ck.Robot) -> list[PlanResult]:
+    results = []
+    for seed in range(10):
+        with contextlib.suppress(NoTrajectoryFoundError):  # counted by the test below
+            results.append(plan(paper_scene(seed), robot))
+    return results
+
+
+def test_paper_case_succeeds_for_seeds_0_to_9(paper_results: list[PlanResult]) -> None:
+    print(f"\npaper case: {len(paper_results)}/10 seeds planned and verified")
+    assert len(paper_results) == 10
+
+
+def test_paper_case_trajectories(
+    robot: ck.Robot, paper_results: list[PlanResult], crate: ck.Obstacle
+) -> None:
+    world = ck.CollisionWorld(robot, [crate])
+    for result in paper_results:
+        trajectory, m = result.trajectory, result.metrics
+        assert result.verification.accepted and m.min_clearance >= 0.1
+        assert m.max_node_deviation < 20e-6
+        assert m.duration == pytest.approx(4.0) and not m.duration_stretched
+        assert max(m.limit_utilisation.values()) <= 1.0 + 1e-9
+        # starts and ends exactly at the requested TCP points
+        np.testing.assert_allclose(ck.frame_positions(robot, trajectory(0.0)), PAPER_START_TCP, atol=1e-12)
+        np.testing.assert_allclose(
+            ck.frame_positions(robot, trajectory(trajectory.duration)), PAPER_GOAL_TCP, atol=1e-12
+        )
+        # C3: position to jerk continuous at the knots
+        for t in trajectory.knots[1:-1]:
+            for r in range(4):
+                np.testing.assert_allclose(trajectory(t - 1e-9, r), trajectory(t + 1e-9, r), atol=1e-6)
+        # an independent, 5x denser re-check of the clearance
+        dense = np.linspace(0.0, trajectory.duration, 5 * len(result.verification.times))
+        assert world.clearance_batch(trajectory(dense)).min_clearance_m.min() >= 0.1
+
+
+def test_result_is_immutable_and_inspectable(paper_results: list[PlanResult]) -> None:
+    result = paper_results[0]
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        result.time_scale = 2.0  # type: ignore[misc]
+    assert result.waypoints.shape == (5, 5)
+    assert len(result.optimiser.best_history) == 51
+    assert result.metrics.evaluations == 50 * 51
+    assert result.breakdown.feasible[0]
+
+
+def test_same_seed_same_plan(robot: ck.Robot, paper_results: list[PlanResult]) -> None:
+    again = plan(paper_scene(0), robot)
+    np.testing.assert_array_equal(again.trajectory.coefficients, paper_results[0].trajectory.coefficients)
+
+
+@pytest.mark.parametrize(
+    "overrides",
+    [
+        {"fitness": "paper"},
+        {"path": "ptp"},
+        {"mode": "sequential", "fireflies": 16, "iterations": 8, "alpha": 0.1},
+    ],
+)
+def test_variants_plan_the_paper_case(robot: ck.Robot, overrides: dict[str, object]) -> None:
+    result = plan(paper_scene(1, **overrides), robot)
+    assert result.verification.accepted
+    assert result.metrics.min_clearance >= 0.1
+
+
+def test_free_duration_gives_the_fastest_timing(robot: ck.Robot) -> None:
+    scene = dataclasses.replace(paper_scene(2), duration=None)
+    result = plan(scene, robot)
+    assert max(result.metrics.limit_utilisation.values()) == pytest.approx(1.0, abs=1e-9)
+    assert result.verification.accepted
+
+
+def test_unreachable_goal(robot: ck.Robot) -> None:
+    scene = dataclasses.replace(paper_scene(), goal=Target(tcp=(1.5, 0.0, 0.3)))
+    with pytest.raises(
+        PlanningError, match=r"goal is not reachable: .*joint 'd3' = 1\.2 m is outside \[0, 0\.5\] m"
+    ):
+        plan(scene, robot)
+
+
+def test_start_inside_the_margin(robot: ck.Robot) -> None:
+    scene = dataclasses.replace(paper_scene(), start=Target(tcp=(0.1, 0.5, 0.35)))
+    with pytest.raises(
+        PlanningError,
+        match=r"start q = .* is inside the safety margin: tool is 0\.0\d+ m from obstacle 'crate'",
+    ):
+        plan(scene, robot)
+
+
+def test_infeasible_scene_raises_with_the_best_clearance(robot: ck.Robot) -> None:
+    # a wall taller than the robot across the only way round
+    wall = ck.Obstacle.box((0.05, 1.3, 2.0), (0.0, 0.95, 1.0), name="wall")  # y from 0.3 to 1.6
+    scene = Scene(
+        start=Target(tcp=PAPER_START_TCP),
+        goal=Target(tcp=PAPER_GOAL_TCP),
+        obstacles=(wall,),
+        duration=4.0,
+        planner=PlannerSettings(fireflies=10, iterations=5),
+    )
+    with pytest.raises(NoTrajectoryFoundError, match=r"no collision-free trajectory found: .*wall") as info:
+        plan(scene, robot)
+    assert info.value.certified_clearance_m < 0.1
+    assert info.value.worst_pair is not None and info.value.worst_pair[1] == "wall"
+
+
+def test_bad_planner_settings() -> None:
+    with pytest.raises(PlanningError, match="waypoints = 0 must be an integer >= 1"):
+        PlannerSettings(waypoints=0)
+    with pytest.raises(PlanningError, match="fitness = 'fast'; allowed: 'clearance', 'paper'"):
+        PlannerSettings(fitness="fast")  # type: ignore[arg-type]
+    with pytest.raises(PlanningError, match="fireflies = 0 must be an integer >= 2"):
+        PlannerSettings(fireflies=0)
+    with pytest.raises(PlanningError, match="exactly one of 'tcp'"):
+        Target()

@@ -1,0 +1,114 @@
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import cpr_kin as ck
+from planning.errors import PlanningError
+from planning.planner import PlanResult, plan
+from planning.scene import paper_scene
+from planning.trajectory_io import atomic_write_text, read_trajectory, write_samples, write_trajectory
+
+
+@pytest.fixture(scope="module")
+def result(robot: ck.Robot) -> PlanResult:
+    return plan(paper_scene(0), robot)
+
+
+def test_document_follows_the_design(result: PlanResult, tmp_path: Path) -> None:
+    path = tmp_path / "trajectory.json"
+    write_trajectory(result, path)
+    document = json.loads(path.read_text())
+    assert document["format"] == "cpr-trajectory/1"
+    assert document["joint_names"] == ["theta1", "d2", "d3", "theta4", "theta5"]
+    assert set(document) >= {
+        "format",
+        "joint_names",
+        "robot",
+        "scene",
+        "waypoints",
+        "knots",
+        "segments",
+        "metrics",
+    }
+    assert set(document["scene"]) >= {"obstacles", "safety_margin", "start", "goal"}
+    assert document["scene"]["obstacles"][0] == {
+        "name": "crate",
+        "shape": "box",
+        "size": [0.3, 0.3, 0.3],
+        "xyz": [0.0, 0.6, 0.15],
+        "rpy": [0.0, 0.0, 0.0],
+    }
+    metrics = document["metrics"]
+    for key in (
+        "duration",
+        "min_clearance",
+        "max_node_deviation",
+        "jerk_min",
+        "jerk_max",
+        "fitness",
+        "planning_time_s",
+        "evaluations",
+    ):
+        assert key in metrics
+    # coeffs[j][k] is a_k of joint j: q_j(t) = sum_k a_k (t - t0)^k, evaluated by hand
+    for segment in document["segments"]:
+        t = 0.5 * (segment["t0"] + segment["t1"])
+        by_hand = [sum(a * (t - segment["t0"]) ** k for k, a in enumerate(row)) for row in segment["coeffs"]]
+        np.testing.assert_allclose(by_hand, result.trajectory(t), atol=1e-12)
+    assert len(document["segments"]) == len(document["knots"]) - 1 == 4
+
+
+def test_round_trip(result: PlanResult, tmp_path: Path) -> None:
+    path = tmp_path / "trajectory.json"
+    write_trajectory(result, path)
+    back = read_trajectory(path)
+    np.testing.assert_array_equal(back.trajectory.coefficients, result.trajectory.coefficients)
+    np.testing.assert_array_equal(back.waypoints, result.waypoints)
+    assert back.joint_names == result.joint_names
+    assert back.metrics["min_clearance"] == result.metrics.min_clearance
+
+
+def test_samples_csv(result: PlanResult, tmp_path: Path) -> None:
+    path = tmp_path / "samples.csv"
+    write_samples(result, path)
+    lines = path.read_text().splitlines()
+    header = lines[0].split(",")
+    assert header[:6] == ["t", "theta1", "d2", "d3", "theta4", "theta5"]
+    assert header[-1] == "theta5_jerk" and len(header) == 21
+    data = np.loadtxt(path, delimiter=",", skiprows=1)
+    assert len(data) == int(np.ceil(4.0 / 0.012)) + 1
+    np.testing.assert_allclose(np.diff(data[:-1, 0]), 0.012, atol=1e-6)
+    np.testing.assert_allclose(data[:, 1:6], result.trajectory(data[:, 0]), atol=1e-9)
+    np.testing.assert_allclose(data[:, 16:21], result.trajectory(data[:, 0], 3), atol=1e-9)
+
+
+def test_atomic_write_leaves_nothing_on_failure(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    def refuse(*_: object) -> None:
+        raise OSError("disk full")
+
+    monkeypatch.setattr(os, "replace", refuse)
+    with pytest.raises(OSError, match="disk full"):
+        atomic_write_text(tmp_path / "out.json", "{}")
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    ("content", "pattern"),
+    [
+        ("{not json", "is not valid JSON"),
+        ('{"format": "other/2"}', "has format 'other/2'; expected 'cpr-trajectory/1'"),
+        ('{"format": "cpr-trajectory/1", "knots": [0, 1]}', "is malformed"),
+    ],
+)
+def test_bad_trajectory_files(tmp_path: Path, content: str, pattern: str) -> None:
+    path = tmp_path / "bad.json"
+    path.write_text(content)
+    with pytest.raises(PlanningError, match=pattern):
+        read_trajectory(path)
+    with pytest.raises(PlanningError, match="cannot read trajectory file"):
+        read_trajectory(tmp_path / "missing.json")
