@@ -48,7 +48,7 @@ def _positive(value: float | None, what: str) -> float:
     return x
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Obstacle:
     """A static obstacle: a shape, its dimensions and its pose in the world frame.
 
@@ -107,6 +107,29 @@ class Obstacle:
                 raise ObstacleError(f"obstacle '{self.name}': mesh file '{self.mesh}' does not exist")
             object.__setattr__(self, "mesh", Path(self.mesh))
             object.__setattr__(self, "scale", _positive(self.scale, f"obstacle '{self.name}' scale"))
+
+    def _key(self) -> tuple[object, ...]:
+        size = None if self.size is None else tuple(np.asarray(self.size).tolist())
+        return (
+            self.shape,
+            self.name,
+            tuple(self.xyz.tolist()),
+            tuple(self.rpy.tolist()),
+            size,
+            self.radius,
+            self.length,
+            None if self.mesh is None else str(self.mesh),
+            self.scale,
+            self.convex,
+        )
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Obstacle):
+            return NotImplemented
+        return self._key() == other._key()
+
+    def __hash__(self) -> int:
+        return hash(self._key())
 
     @classmethod
     def box(cls, size: ArrayLike, xyz: ArrayLike, rpy: ArrayLike = (0, 0, 0), name: str = "box") -> Obstacle:

@@ -24,7 +24,7 @@ configurations and against ``margin + verify_step_m``:
   Feasible always ranks ahead of infeasible.
 
 Beyond the margin, a feasible candidate's spline must stay within the joint ranges, deviate
-from its nodes by at most ``max_node_deviation`` and, when the scene fixes the duration,
+from its nodes by at most ``max_node_deviation`` (when set) and, when the scene fixes the duration,
 keep velocity, acceleration and jerk within the limits at that duration (checked at the IPO
 samples; the final timing uses exact extrema). The paper fitness ranks these violations
 with eq. 6.
@@ -253,7 +253,10 @@ class WaypointObjective:
         nodes = self.nodes(x)
         t_sol = ptp_time(nodes, self.v_max, self.a_max)
         samples, w_sol, overshoot, excess, deviation = self._paths(nodes)
-        deviation_excess = np.maximum(deviation / self.settings.max_node_deviation - 1.0, 0.0)
+        bound = self.settings.max_node_deviation
+        deviation_excess = (
+            np.zeros_like(deviation) if bound is None else np.maximum(deviation / bound - 1.0, 0.0)
+        )
         other = overshoot + excess + deviation_excess
         clearance = self._clearance(np.clip(samples, self.lower_q, self.upper_q))
         shortfall = np.maximum(self.required_m - clearance, 0.0)

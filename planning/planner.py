@@ -169,10 +169,10 @@ def _verify(
                 f"moves joint '{name}' over [{low:.4g}, {high:.4g}] {unit}, outside its range "
                 f"[{limits.lower[i]:g}, {limits.upper[i]:g}] {unit}"
             )
-    if fit.max_node_deviation > scene.planner.max_node_deviation:
+    bound = scene.planner.max_node_deviation
+    if bound is not None and fit.max_node_deviation > bound:
         problems.append(
-            f"deviates {fit.max_node_deviation:.3g} from its nodes, more than max_node_deviation = "
-            f"{scene.planner.max_node_deviation:g}"
+            f"deviates {fit.max_node_deviation:.3g} from its nodes, more than max_node_deviation = {bound:g}"
         )
     return check, problems
 

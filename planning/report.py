@@ -53,7 +53,7 @@ def paper_rows(result: PlanResult) -> list[tuple[str, str, str]]:
         ),
         ("duration", "4 s", f"{m.duration:.3f} s"),
         (
-            "peak |v|, |a|, |jerk| / limit",
+            "peak velocity, acceleration, jerk / limit",
             "-",
             ", ".join(f"{v:.2f}" for v in m.limit_utilisation.values()),
         ),

@@ -69,8 +69,8 @@ class PlannerSettings:
         fitness_samples: configurations checked per candidate path in the fitness.
         verify_step_m: robot motion between two checks in the final verification [m];
             the fitness requires this much clearance beyond the margin.
-        max_node_deviation: largest spline node deviation a candidate may have [rad or m]
-            (the paper's 20 um).
+        max_node_deviation: largest spline node deviation a candidate may have [rad or m];
+            ``None`` (default): no bound. The paper case requires 20e-6.
         moving_joints: joints the waypoints move; default: theta1, d2, d3, and a wrist
             joint when start and goal differ in it.
     """
@@ -89,7 +89,7 @@ class PlannerSettings:
     ipo: float = 0.012
     fitness_samples: int = 64
     verify_step_m: float = 0.005
-    max_node_deviation: float = 20e-6
+    max_node_deviation: float | None = None
     moving_joints: tuple[str, ...] | None = None
 
     def __post_init__(self) -> None:
@@ -106,7 +106,9 @@ class PlannerSettings:
             raise PlanningError(f"ipo = {self.ipo!r} s must be a finite number > 0")
         if not (isinstance(self.fitness_samples, int) and self.fitness_samples >= 2):
             raise PlanningError(f"fitness_samples = {self.fitness_samples!r} must be an integer >= 2")
-        if not (math.isfinite(self.max_node_deviation) and self.max_node_deviation > 0):
+        if self.max_node_deviation is not None and not (
+            math.isfinite(self.max_node_deviation) and self.max_node_deviation > 0
+        ):
             raise PlanningError(
                 f"max_node_deviation = {self.max_node_deviation!r} must be a finite number > 0"
             )
@@ -176,7 +178,8 @@ def paper_scene(seed: int = 0, **planner_overrides: object) -> Scene:
 
     Start TCP (0.5, 0.45, 0.25), goal (-0.5, 0.45, 0.25), a 0.3 m cube centred at
     (0, 0.6, 0.15), margin 0.1 m; n = 50, alpha = 1, beta0 = 0.5, 50 iterations, 3
-    waypoints; spline N = 4, h = 1 s (4 s), p = 1e6, jerk only, natural ends.
+    waypoints, node deviation at most 20 um; spline N = 4, h = 1 s (4 s), p = 1e6, jerk
+    only, natural ends.
     """
     parameters: dict[str, object] = {
         "fireflies": 50,
@@ -184,6 +187,7 @@ def paper_scene(seed: int = 0, **planner_overrides: object) -> Scene:
         "alpha": 1.0,
         "beta0": 0.5,
         "waypoints": 3,
+        "max_node_deviation": 20e-6,
     }
     parameters.update(planner_overrides, seed=seed)
     planner = PlannerSettings(**parameters)  # type: ignore[arg-type]

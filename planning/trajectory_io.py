@@ -79,8 +79,12 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
     }
 
 
-def trajectory_document(result: PlanResult) -> dict[str, Any]:
-    """The ``cpr-trajectory/1`` document of a plan, as plain JSON types."""
+def trajectory_document(result: PlanResult, timings: bool = False) -> dict[str, Any]:
+    """The ``cpr-trajectory/1`` document of a plan, as plain JSON types.
+
+    Wall times (``planning_time_s``, ``optimiser_time_s``) are ``null`` unless ``timings``:
+    the same scene and seed then give the same file, byte for byte.
+    """
     trajectory = result.trajectory
     metrics = result.metrics
     segments = [
@@ -107,8 +111,8 @@ def trajectory_document(result: PlanResult) -> dict[str, Any]:
             "fitness": metrics.fitness,
             "t_sol": metrics.t_sol,
             "w_sol": metrics.w_sol,
-            "planning_time_s": metrics.planning_time_s,
-            "optimiser_time_s": metrics.optimiser_time_s,
+            "planning_time_s": metrics.planning_time_s if timings else None,
+            "optimiser_time_s": metrics.optimiser_time_s if timings else None,
             "evaluations": metrics.evaluations,
             "candidates_verified": metrics.candidates_verified,
             "duration_stretched": metrics.duration_stretched,
@@ -118,9 +122,9 @@ def trajectory_document(result: PlanResult) -> dict[str, Any]:
     }
 
 
-def write_trajectory(result: PlanResult, path: Path) -> None:
-    """Write the plan as a ``cpr-trajectory/1`` JSON file, atomically."""
-    atomic_write_text(Path(path), json.dumps(trajectory_document(result), indent=1) + "\n")
+def write_trajectory(result: PlanResult, path: Path, timings: bool = False) -> None:
+    """Write the plan as a ``cpr-trajectory/1`` JSON file, atomically (see :func:`trajectory_document`)."""
+    atomic_write_text(Path(path), json.dumps(trajectory_document(result, timings), indent=1) + "\n")
 
 
 def samples_csv(trajectory: Trajectory, joint_names: tuple[str, ...], period: float) -> str:

@@ -1,0 +1,352 @@
+"""``cpr-plan``: plan, check and report trajectories from the command line.
+
+Exit codes: 0 success; 2 invalid input (missing file, broken YAML, schema error, start or
+goal unreachable or inside the margin, bad parameters, unwritable output); 3 no
+collision-free trajectory found (``plan``, ``paper``) or a trajectory that fails the scene
+(``check``). Errors are one line on stderr, never a traceback; on failure nothing is written.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import os
+import shutil
+import sys
+import tempfile
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import cpr_kin as ck
+from planning.errors import PlanningError
+from planning.firefly import FireflyProgress
+from planning.planner import NoTrajectoryFoundError, PlanResult, plan
+from planning.report import markdown_table, paper_rows, text_table
+from planning.scene import Scene
+from planning.scene_file import load_scene, paper_scene_path
+from planning.trajectory_io import read_trajectory, samples_csv, trajectory_document
+
+EXIT_OK, EXIT_INVALID, EXIT_NO_TRAJECTORY = 0, 2, 3
+
+
+class _CommandError(Exception):
+    """A failure with its exit code and one-line message."""
+
+    def __init__(self, code: int, message: str) -> None:
+        super().__init__(message)
+        self.code = code
+
+
+def write_outputs(folder: Path, files: dict[str, str]) -> list[Path]:
+    """Write every file, or none: all go to temporary names first, then are renamed."""
+    folder.mkdir(parents=True, exist_ok=True)
+    temporary: list[tuple[str, Path]] = []
+    try:
+        for name, text in files.items():
+            handle, temporary_name = tempfile.mkstemp(prefix=f".{name}.", dir=folder)
+            with os.fdopen(handle, "w", encoding="utf-8", newline="") as stream:
+                stream.write(text)
+            temporary.append((name, Path(temporary_name)))
+        for name, written in temporary:
+            os.replace(written, folder / name)
+    finally:
+        for _, leftover in temporary:
+            leftover.unlink(missing_ok=True)
+    return [folder / name for name in files]
+
+
+def _progress(enabled: bool) -> tuple[Callable[[FireflyProgress], None] | None, Callable[[], None]]:
+    """A tqdm bar over the firefly iterations when enabled (stdout is a terminal)."""
+    if not enabled:
+        return None, lambda: None
+    from tqdm import tqdm
+
+    bar: Any = None
+
+    def update(progress: FireflyProgress) -> None:
+        nonlocal bar
+        if bar is None:
+            # a terminal that reports a size of 0 (a bare pty) makes tqdm draw nothing
+            size = shutil.get_terminal_size((80, 24))
+            bar = tqdm(
+                total=progress.iterations,
+                desc="firefly",
+                unit="it",
+                leave=False,
+                ncols=size.columns,
+                nrows=size.lines,
+            )
+        else:
+            bar.update(1)
+        bar.set_postfix(best=f"{progress.best:.4g}")
+
+    def close() -> None:
+        if bar is not None:
+            bar.close()
+
+    return update, close
+
+
+def _summary(result: PlanResult, outputs: list[Path]) -> dict[str, Any]:
+    m = result.metrics
+    return {
+        "status": "ok",
+        "scene": result.scene.name,
+        "seed": result.scene.planner.seed,
+        "fitness_kind": result.scene.planner.fitness,
+        "duration_s": m.duration,
+        "min_clearance_m": m.min_clearance,
+        "safety_margin_m": result.scene.safety_margin,
+        "max_node_deviation": m.max_node_deviation,
+        "t_sol_s": m.t_sol,
+        "fitness": m.fitness,
+        "evaluations": m.evaluations,
+        "planning_time_s": m.planning_time_s,
+        "limit_utilisation": m.limit_utilisation,
+        "outputs": [str(p) for p in outputs],
+    }
+
+
+def _report(result: PlanResult, paper: bool) -> str:
+    m = result.metrics
+    names = result.joint_names
+    rows = [
+        ("duration", f"{m.duration:.3f} s"),
+        ("certified min clearance", f"{m.min_clearance:.4f} m (margin {result.scene.safety_margin} m)"),
+        ("PTP time t_sol (objective)", f"{m.t_sol:.3f} s"),
+        ("fitness", f"{m.fitness:.4f}"),
+        ("max node deviation", f"{m.max_node_deviation:.3g}"),
+        (
+            "peak velocity, acceleration, jerk / limit",
+            ", ".join(f"{v:.2f}" for v in m.limit_utilisation.values()),
+        ),
+        ("evaluations", str(m.evaluations)),
+        ("planning time", f"{m.planning_time_s:.3f} s"),
+    ]
+    lines = [
+        f"# Plan: {result.scene.name}",
+        "",
+        f"Seed {result.scene.planner.seed}, fitness `{result.scene.planner.fitness}`, "
+        f"{len(result.scene.obstacles)} obstacle(s). Files: `trajectory.json` (cpr-trajectory/1), "
+        "`samples.csv` (every IPO period).",
+        "",
+        "| figure | value |",
+        "|---|---|",
+        *[f"| {a} | {b} |" for a, b in rows],
+        "",
+        "| joint | jerk min | jerk max |",
+        "|---|---|---|",
+        *[f"| {n} | {m.jerk_min[n]:.4g} | {m.jerk_max[n]:.4g} |" for n in names],
+        "",
+        "Waypoints (start, intermediate, goal):",
+        "",
+        *[f"- {np.round(w, 5).tolist()}" for w in result.waypoints],
+        "",
+    ]
+    if paper:
+        lines += ["## Beside the paper", "", markdown_table(paper_rows(result)), ""]
+    return "\n".join(lines)
+
+
+def _plan_and_write(scene: Scene, out: Path, args: argparse.Namespace, paper: bool) -> int:
+    planner = scene.planner
+    overrides = {
+        k: getattr(args, k)
+        for k in ("seed", "fitness", "fireflies", "iterations")
+        if getattr(args, k, None) is not None
+    }
+    if overrides:
+        try:
+            scene = dataclasses.replace(scene, planner=dataclasses.replace(planner, **overrides))
+        except PlanningError as exc:
+            raise _CommandError(EXIT_INVALID, str(exc)) from None
+    update, close = _progress(sys.stdout.isatty() and not args.json)
+    try:
+        result = plan(scene, progress=update)
+    except NoTrajectoryFoundError as exc:
+        raise _CommandError(EXIT_NO_TRAJECTORY, str(exc)) from None
+    except (PlanningError, ck.CprKinError) as exc:
+        raise _CommandError(EXIT_INVALID, str(exc)) from None
+    finally:
+        close()
+    document = trajectory_document(result, timings=args.timings)
+    files = {
+        "trajectory.json": json.dumps(document, indent=1) + "\n",
+        "samples.csv": samples_csv(result.trajectory, result.joint_names, scene.planner.ipo),
+        "report.md": _report(result, paper),
+    }
+    try:
+        outputs = write_outputs(out, files)
+    except OSError as exc:
+        raise _CommandError(EXIT_INVALID, f"cannot write to '{out}': {exc.strerror or exc}") from None
+    summary = _summary(result, outputs)
+    if args.json:
+        print(json.dumps(summary, indent=1))
+    else:
+        m = result.metrics
+        print(
+            f"{result.scene.name}: verified trajectory of {m.duration:.3f} s, certified clearance "
+            f"{m.min_clearance:.4f} m (margin {scene.safety_margin} m), "
+            f"node deviation {m.max_node_deviation:.3g}, "
+            f"planned in {m.planning_time_s:.3f} s ({m.evaluations} evaluations)"
+        )
+        if paper:
+            print(text_table(paper_rows(result)))
+        print("wrote " + ", ".join(str(p) for p in outputs))
+    return EXIT_OK
+
+
+def _load(path: Path) -> Scene:
+    try:
+        return load_scene(path)
+    except PlanningError as exc:
+        raise _CommandError(EXIT_INVALID, str(exc)) from None
+
+
+def _cmd_plan(args: argparse.Namespace) -> int:
+    return _plan_and_write(_load(args.scene), args.out, args, paper=False)
+
+
+def _cmd_paper(args: argparse.Namespace) -> int:
+    return _plan_and_write(_load(paper_scene_path()), args.out, args, paper=True)
+
+
+def _cmd_check(args: argparse.Namespace) -> int:
+    scene = _load(args.scene)
+    try:
+        document = read_trajectory(args.trajectory)
+        robot = ck.load_cpr(scene.robot)
+        world = ck.CollisionWorld(robot, scene.obstacles)
+        q_start, q_goal = scene.start.configuration(robot), scene.goal.configuration(robot)
+    except (PlanningError, ck.CprKinError) as exc:
+        raise _CommandError(EXIT_INVALID, str(exc)) from None
+    if document.joint_names != robot.joint_names:
+        raise _CommandError(
+            EXIT_INVALID,
+            f"trajectory joints {list(document.joint_names)} are not the robot's {list(robot.joint_names)}",
+        )
+    trajectory = document.trajectory
+    problems = []
+    for label, q, t in (("start", q_start, trajectory.knots[0]), ("goal", q_goal, trajectory.knots[-1])):
+        gap = float(np.abs(trajectory(t) - q).max())
+        if gap > 1e-6:
+            problems.append(f"the trajectory's {label} is {gap:.3g} away from the scene's {label}")
+    check = ck.check_curve(
+        world,
+        trajectory.position,
+        trajectory.knots[0],
+        trajectory.knots[-1],
+        trajectory.extrema(1).peak,
+        scene.safety_margin,
+        scene.planner.verify_step_m,
+    )
+    if not check.accepted:
+        problems.append(
+            f"certified clearance {check.certified_min_m:.4f} m is below the margin {scene.safety_margin} m: "
+            f"closest at t = {check.worst_time:.2f} s between {check.worst_pair} ({check.worst_group})"
+        )
+    limits = robot.limits
+    positions = trajectory.extrema(0)
+    for i, name in enumerate(robot.joint_names):
+        if positions.minimum[i] < limits.lower[i] - 1e-9 or positions.maximum[i] > limits.upper[i] + 1e-9:
+            problems.append(f"joint '{name}' leaves its range [{limits.lower[i]:g}, {limits.upper[i]:g}]")
+    for r, (kind, limit) in enumerate(
+        (("velocity", limits.velocity), ("acceleration", limits.acceleration), ("jerk", limits.jerk)), start=1
+    ):
+        ratio = trajectory.extrema(r).peak / limit
+        if ratio.max() > 1 + 1e-9:
+            j = int(np.argmax(ratio))
+            problems.append(
+                f"{kind} of joint '{robot.joint_names[j]}' reaches {ratio[j]:.3f} x its limit {limit[j]:g}"
+            )
+    verdict = {
+        "status": "ok" if not problems else "failed",
+        "certified_min_clearance_m": check.certified_min_m,
+        "safety_margin_m": scene.safety_margin,
+        "checks": len(check.times),
+        "problems": problems,
+    }
+    if args.json:
+        print(json.dumps(verdict, indent=1))
+    elif problems:
+        print(f"{args.trajectory}: FAILS {args.scene}:\n  " + "\n  ".join(problems))
+    else:
+        print(
+            f"{args.trajectory}: verified against {args.scene}: "
+            f"certified clearance {check.certified_min_m:.4f} m "
+            f">= {scene.safety_margin} m over {len(check.times)} checks, joints within range and limits"
+        )
+    return EXIT_OK if not problems else EXIT_NO_TRAJECTORY
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="cpr-plan", description="Collision-free, jerk-continuous trajectories for the CPR."
+    )
+    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    def planning_options(sub: argparse.ArgumentParser) -> None:
+        sub.add_argument(
+            "--out", type=Path, required=True, help="output folder (trajectory.json, samples.csv, report.md)"
+        )
+        sub.add_argument("--seed", type=int, help="seed of the firefly search (default: the scene's)")
+        sub.add_argument("--fitness", choices=("clearance", "paper"), help="fitness (default: the scene's)")
+        sub.add_argument("--fireflies", type=int, help="population size (default: the scene's)")
+        sub.add_argument("--iterations", type=int, help="firefly iterations (default: the scene's)")
+        sub.add_argument("--json", action="store_true", help="print the summary as JSON")
+        sub.add_argument(
+            "--timings",
+            action="store_true",
+            help="record wall times in trajectory.json (then it is not reproducible byte for byte)",
+        )
+
+    sub = commands.add_parser(
+        "plan",
+        help="plan a scene file",
+        description="Plan SCENE and write trajectory.json, samples.csv and report.md into --out.",
+    )
+    sub.add_argument("scene", type=Path, help="scene file (YAML)")
+    planning_options(sub)
+    sub.set_defaults(run=_cmd_plan)
+
+    sub = commands.add_parser(
+        "paper",
+        help="plan the paper case",
+        description="Plan the bundled paper scene and report it beside the paper's figures.",
+    )
+    planning_options(sub)
+    sub.set_defaults(run=_cmd_paper)
+
+    sub = commands.add_parser(
+        "check",
+        help="re-verify a trajectory file against a scene",
+        description="Re-verify TRAJECTORY against SCENE: start and goal, certified clearance, "
+        "joint ranges and limits.",
+    )
+    sub.add_argument("scene", type=Path, help="scene file (YAML)")
+    sub.add_argument("trajectory", type=Path, help="trajectory file (cpr-trajectory/1 JSON)")
+    sub.add_argument("--json", action="store_true", help="print the verdict as JSON")
+    sub.set_defaults(run=_cmd_check)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``cpr-plan``; returns the exit code."""
+    args = _parser().parse_args(argv)
+    try:
+        code: int = args.run(args)
+    except _CommandError as failure:
+        print(f"cpr-plan {args.command}: error: {failure}", file=sys.stderr)
+        return failure.code
+    except KeyboardInterrupt:
+        print(f"cpr-plan {args.command}: interrupted", file=sys.stderr)
+        return 130
+    return code
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,206 @@
+from __future__ import annotations
+
+import json
+import math
+import os
+import pty
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+
+from planning.cli import main
+
+SCENE: dict[str, Any] = {
+    "name": "swing",
+    "safety_margin": 0.1,
+    "start": {"tcp": [0.5, 0.45, 0.25]},
+    "goal": {"tcp": [-0.5, 0.45, 0.25]},
+    "duration": 4.0,
+    "obstacles": [{"name": "crate", "shape": "box", "size": [0.3, 0.3, 0.3], "xyz": [0.0, 0.6, 0.15]}],
+    "planner": {"seed": 1},
+    "spline": {"ends": "natural"},
+}
+
+
+def write_scene(folder: Path, document: Any, name: str = "scene.yaml") -> Path:
+    path = folder / name
+    path.write_text(document if isinstance(document, str) else yaml.safe_dump(document))
+    return path
+
+
+def run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+    code = main(args)
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def with_changes(**changes: Any) -> dict[str, Any]:
+    document: dict[str, Any] = json.loads(json.dumps(SCENE))
+    for dotted, value in changes.items():
+        target = document
+        *parents, last = dotted.split("__")
+        for key in parents:
+            target = target[int(key)] if isinstance(target, list) else target[key]
+        target[last] = value
+    return document
+
+
+BAD_INPUTS = [
+    ("broken YAML", "start: {tcp: [0.5, 0.45\n", "is not valid YAML"),
+    ("not a mapping", "- start\n- goal\n", "must be a mapping of keys"),
+    ("misspelt key", with_changes(safty_margin=0.1), "safty_margin: unknown key"),
+    ("negative size", with_changes(obstacles__0__size=[0.3, -0.3, 0.3]), "obstacles[0].size[1] = -0.3"),
+    ("negative margin", with_changes(safety_margin=-0.1), "safety_margin = -0.1"),
+    ("NaN", with_changes(obstacles__0__xyz=[0.0, float("nan"), 0.15]), "obstacles[0].xyz[1] = nan"),
+    ("unknown shape", with_changes(obstacles__0__shape="pyramid"), "obstacles[0].shape = 'pyramid'"),
+    ("short joint vector", with_changes(start={"q": [0.7, 0.15, 0.37]}), "start.q = [0.7, 0.15, 0.37]"),
+    (
+        "joint outside limits",
+        with_changes(start={"q": [0.7, 0.9, 0.37, 0, 0]}),
+        "joint 'd2' = 0.9 m is outside [0, 0.6] m",
+    ),
+    (
+        "unreachable TCP",
+        with_changes(goal={"tcp": [1.2, 0.0, 0.3]}),
+        "joint 'd3' = 0.9 m is outside [0, 0.5] m",
+    ),
+    ("goal inside margin", with_changes(goal={"tcp": [0.0, 0.45, 0.4]}), "goal q = "),
+    ("zero fireflies", with_changes(planner__fireflies=0), "planner.fireflies = 0"),
+    (
+        "all spline weights zero",
+        with_changes(spline__a=[0, 0, 0]),
+        "a = [0, 0, 0] leaves the spline undetermined",
+    ),
+]
+
+
+@pytest.mark.parametrize(("label", "document", "message"), BAD_INPUTS, ids=[b[0] for b in BAD_INPUTS])
+def test_bad_input_exits_2_naming_the_value(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], label: str, document: Any, message: str
+) -> None:
+    scene = write_scene(tmp_path, document)
+    out = tmp_path / "out"
+    code, stdout, stderr = run(["plan", str(scene), "--out", str(out)], capsys)
+    assert code == 2, label
+    assert message in stderr
+    assert "Traceback" not in stderr and stdout == ""
+    assert len(stderr.strip().splitlines()) == 1
+    assert not out.exists()
+
+
+def test_missing_scene_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, stderr = run(["plan", str(tmp_path / "nope.yaml"), "--out", str(tmp_path / "out")], capsys)
+    assert code == 2 and "nope.yaml' does not exist" in stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_infeasible_scene_exits_3_writing_nothing(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    wall = {"name": "wall", "shape": "box", "size": [0.05, 1.3, 2.0], "xyz": [0.0, 0.95, 1.0]}
+    scene = write_scene(tmp_path, with_changes(obstacles=[wall], planner={"fireflies": 10, "iterations": 5}))
+    out = tmp_path / "out"
+    code, _, stderr = run(["plan", str(scene), "--out", str(out)], capsys)
+    assert code == 3
+    assert "no collision-free trajectory found" in stderr and "wall" in stderr
+    assert not out.exists()
+
+
+def test_plan_check_and_reproducibility(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    scene = write_scene(tmp_path, SCENE)
+    first, second = tmp_path / "a", tmp_path / "b"
+    code, stdout, _ = run(["plan", str(scene), "--out", str(first)], capsys)
+    assert code == 0 and "verified trajectory" in stdout
+    assert sorted(p.name for p in first.iterdir()) == ["report.md", "samples.csv", "trajectory.json"]
+    code, stdout, _ = run(["plan", str(scene), "--out", str(second), "--json"], capsys)
+    assert code == 0
+    summary = json.loads(stdout)
+    assert summary["status"] == "ok" and summary["min_clearance_m"] >= 0.1
+    assert (first / "trajectory.json").read_bytes() == (second / "trajectory.json").read_bytes()
+    # another seed gives another trajectory
+    code, _, _ = run(["plan", str(scene), "--out", str(tmp_path / "c"), "--seed", "7"], capsys)
+    assert code == 0
+    assert (tmp_path / "c" / "trajectory.json").read_bytes() != (first / "trajectory.json").read_bytes()
+    # the trajectory passes its own scene, and fails one with an obstacle in its way
+    code, stdout, _ = run(["check", str(scene), str(first / "trajectory.json")], capsys)
+    assert code == 0 and "verified against" in stdout
+    document = json.loads((first / "trajectory.json").read_text())
+    middle = document["waypoints"][2]
+    # a ball on the arm's way at the middle waypoint
+    xyz = [0.55 * math.cos(middle[0]), 0.55 * math.sin(middle[0]), 0.25 + middle[1]]
+    blocker = {"name": "post", "shape": "sphere", "radius": 0.1, "xyz": xyz}
+    other = write_scene(tmp_path, with_changes(obstacles=[*SCENE["obstacles"], blocker]), "other.yaml")
+    code, stdout, _ = run(["check", str(other), str(first / "trajectory.json"), "--json"], capsys)
+    assert code == 3
+    verdict = json.loads(stdout)
+    assert verdict["status"] == "failed" and any("post" in p for p in verdict["problems"])
+
+
+def test_timings_flag(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    scene = write_scene(tmp_path, SCENE)
+    run(["plan", str(scene), "--out", str(tmp_path / "t"), "--timings"], capsys)
+    metrics = json.loads((tmp_path / "t" / "trajectory.json").read_text())["metrics"]
+    assert metrics["planning_time_s"] > 0
+    run(["plan", str(scene), "--out", str(tmp_path / "u")], capsys)
+    assert json.loads((tmp_path / "u" / "trajectory.json").read_text())["metrics"]["planning_time_s"] is None
+
+
+def test_paper_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code, stdout, _ = run(["paper", "--out", str(tmp_path / "paper")], capsys)
+    assert code == 0
+    assert "FMA processing time" in stdout and "53 s" in stdout
+    assert "Beside the paper" in (tmp_path / "paper" / "report.md").read_text()
+
+
+@pytest.mark.parametrize("command", [[], ["plan"], ["paper"], ["check"]])
+def test_help_everywhere(command: list[str]) -> None:
+    completed = subprocess.run(
+        [sys.executable, "-m", "planning.cli", *command, "--help"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert completed.returncode == 0
+    assert "usage: cpr-plan" in completed.stdout
+
+
+def test_installed_console_script() -> None:
+    script = Path(sys.executable).parent / "cpr-plan"
+    assert script.exists(), "the project installs the cpr-plan command"
+    completed = subprocess.run([str(script), "check", "--help"], capture_output=True, text=True, check=False)
+    assert completed.returncode == 0 and "TRAJECTORY" in completed.stdout
+
+
+def test_usage_error_exits_2_without_traceback() -> None:
+    completed = subprocess.run(
+        [sys.executable, "-m", "planning.cli", "plan"], capture_output=True, text=True, check=False
+    )
+    assert completed.returncode == 2
+    assert "the following arguments are required" in completed.stderr and "Traceback" not in completed.stderr
+
+
+def test_progress_bar_only_on_a_terminal(tmp_path: Path) -> None:
+    scene = write_scene(tmp_path, SCENE)
+    command = [sys.executable, "-m", "planning.cli", "plan", str(scene), "--out"]
+    piped = subprocess.run([*command, str(tmp_path / "piped")], capture_output=True, text=True, check=False)
+    assert piped.returncode == 0 and "firefly" not in piped.stdout + piped.stderr
+    leader, follower = pty.openpty()
+    process = subprocess.Popen(
+        [*command, str(tmp_path / "tty")], stdout=follower, stderr=follower, close_fds=True
+    )
+    os.close(follower)
+    output = b""
+    while True:
+        try:
+            chunk = os.read(leader, 4096)
+        except OSError:  # the terminal closes when the process exits
+            break
+        if not chunk:
+            break
+        output += chunk
+    assert process.wait(timeout=60) == 0
+    os.close(leader)
+    assert b"firefly" in output
+    assert b"it/s" in output or b"s/it" in output

@@ -1,0 +1,191 @@
+from __future__ import annotations
+
+import contextlib
+import math
+from pathlib import Path
+from typing import Any
+
+import pytest
+import trimesh
+import yaml
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import cpr_kin as ck
+from planning.scene import PlannerSettings, paper_scene
+from planning.scene_file import SceneError, load_scene, paper_scene_path, parse_scene
+from planning.spline import SplineSettings
+
+MINIMAL = {"start": {"tcp": [0.5, 0.45, 0.25]}, "goal": {"tcp": [-0.5, 0.45, 0.25]}}
+
+
+def test_bundled_paper_scene_is_the_paper_case() -> None:
+    assert load_scene(paper_scene_path()) == paper_scene()
+
+
+def test_documented_defaults() -> None:
+    scene = parse_scene(MINIMAL)
+    assert scene.safety_margin == 0.1
+    assert scene.duration is None and scene.robot is None and scene.obstacles == ()
+    assert scene.planner == PlannerSettings()
+    assert scene.spline == SplineSettings(p=1e6, a=(0.0, 0.0, 1.0), ends="rest")
+
+
+def test_every_shape_and_relative_mesh_path(tmp_path: Path) -> None:
+    trimesh.creation.box(extents=(0.1, 0.1, 0.1)).export(tmp_path / "part.stl")
+    (tmp_path / "scene.yaml").write_text(
+        yaml.safe_dump(
+            {
+                **MINIMAL,
+                "obstacles": [
+                    {"shape": "box", "size": [0.1, 0.2, 0.3], "xyz": [1, 1, 1]},
+                    {"shape": "sphere", "radius": 0.1, "xyz": [1, -1, 1]},
+                    {"shape": "cylinder", "radius": 0.1, "length": 0.5, "xyz": [-1, -1, 1], "rpy": [0, 1, 0]},
+                    {"shape": "capsule", "radius": 0.1, "length": 0.5, "xyz": [-1, 1, 1]},
+                    {"name": "part", "shape": "mesh", "mesh": "part.stl", "scale": 2.0, "xyz": [1, 0, 1.5]},
+                ],
+            }
+        )
+    )
+    scene = load_scene(tmp_path / "scene.yaml")
+    assert [o.shape for o in scene.obstacles] == ["box", "sphere", "cylinder", "capsule", "mesh"]
+    assert [o.name for o in scene.obstacles][:2] == ["box_0", "sphere_1"]
+    assert scene.obstacles[4].mesh == tmp_path / "part.stl"
+    ck.CollisionWorld(ck.load_cpr(), scene.obstacles)  # every shape builds a coal geometry
+
+
+@pytest.mark.parametrize(
+    ("change", "pattern"),
+    [
+        ({"safety_margn": 0.1}, "safety_margn: unknown key; allowed here: name, robot, safety_margin"),
+        (
+            {"obstacles": [{"shape": "box", "size": [0.1, 0.1], "xyz": [0, 0, 0]}]},
+            "obstacles[0].size = [0.1, 0.1]",
+        ),
+        (
+            {"obstacles": [{"shape": "box", "size": [0.1, 0.1, 0.1]}]},
+            "obstacles[0].xyz: required key is missing",
+        ),
+        ({"start": {"tcp": [0.5, 0.45, 0.25], "q": [0, 0, 0, 0, 0]}}, "start = "),
+        ({"goal": {"q": [0, 0, 0, 0, 0], "theta4": 1.0}}, "theta4 and theta5 go with 'tcp'"),
+        ({"planner": {"mode": "parallel"}}, "planner.mode = 'parallel'"),
+        ({"planner": {"moving_joints": ["elbow"]}}, "planner.moving_joints[0] = 'elbow'"),
+        ({"spline": {"ends": "clamped"}}, "spline.ends = 'clamped'"),
+        ({"duration": 0}, "duration = 0: Input should be greater than 0"),
+        (
+            {"obstacles": [{"name": "a", "shape": "sphere", "radius": 1, "xyz": [0, 0, 3]}] * 2},
+            "names ['a'] appear more than once",
+        ),
+        (
+            {"obstacles": [{"shape": "mesh", "mesh": "none.stl", "xyz": [0, 0, 0]}]},
+            "obstacles[0]: obstacle 'mesh_0': mesh file",
+        ),
+    ],
+)
+def test_schema_errors_name_path_and_value(change: dict[str, Any], pattern: str) -> None:
+    with pytest.raises(SceneError) as info:
+        parse_scene({**MINIMAL, **change}, source="s.yaml")
+    assert pattern in str(info.value)
+    assert str(info.value).startswith("s.yaml: ")
+
+
+def test_file_errors(tmp_path: Path) -> None:
+    with pytest.raises(SceneError, match=r"missing\.yaml' does not exist"):
+        load_scene(tmp_path / "missing.yaml")
+    (tmp_path / "broken.yaml").write_text("start: {tcp: [0.5, 0.45\n")
+    with pytest.raises(SceneError, match="is not valid YAML"):
+        load_scene(tmp_path / "broken.yaml")
+    (tmp_path / "list.yaml").write_text("- 1\n- 2\n")
+    with pytest.raises(SceneError, match=r"must be a mapping of keys .* not list"):
+        load_scene(tmp_path / "list.yaml")
+
+
+# --- property tests: any input loads or raises SceneError, never anything else ---------------
+
+scalars = st.one_of(
+    st.none(),
+    st.booleans(),
+    st.integers(-(10**6), 10**6),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.text(max_size=8),
+)
+values = st.recursive(
+    scalars,
+    lambda inner: st.lists(inner, max_size=4) | st.dictionaries(st.text(max_size=8), inner, max_size=4),
+    max_leaves=12,
+)
+numbers = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True), st.integers(-5, 5), st.text(max_size=3), st.none()
+)
+vectors = st.lists(numbers, min_size=0, max_size=6)
+obstacles = st.fixed_dictionaries(
+    {"shape": st.sampled_from(["box", "sphere", "cylinder", "capsule", "mesh", "cone", 3])},
+    optional={
+        "size": vectors,
+        "radius": numbers,
+        "length": numbers,
+        "xyz": vectors,
+        "rpy": vectors,
+        "name": st.text(max_size=4),
+        "mesh": st.text(max_size=4),
+        "extra": values,
+    },
+)
+targets = st.one_of(
+    st.fixed_dictionaries({}, optional={"tcp": vectors, "q": vectors, "theta4": numbers, "theta5": numbers}),
+    values,
+)
+scenes = st.fixed_dictionaries(
+    {"start": targets, "goal": targets},
+    optional={
+        "safety_margin": numbers,
+        "duration": numbers,
+        "obstacles": st.lists(obstacles, max_size=3),
+        "planner": st.dictionaries(
+            st.sampled_from(
+                ["fireflies", "iterations", "alpha", "theta", "mode", "seed", "waypoints", "fitness", "typo"]
+            ),
+            numbers,
+            max_size=4,
+        ),
+        "spline": st.dictionaries(
+            st.sampled_from(["p", "a", "ends", "typo"]), st.one_of(numbers, vectors), max_size=3
+        ),
+        "robot": st.one_of(st.text(max_size=5), numbers),
+    },
+)
+
+
+def _loads_or_scene_error(document: Any) -> None:
+    try:
+        parse_scene(document)
+    except SceneError as exc:
+        assert str(exc)
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(scenes)
+def test_structured_inputs_load_or_raise_scene_error(document: dict[str, Any]) -> None:
+    _loads_or_scene_error(document)
+
+
+@settings(max_examples=300, deadline=None)
+@given(values)
+def test_arbitrary_inputs_load_or_raise_scene_error(document: Any) -> None:
+    _loads_or_scene_error(document)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.text(max_size=60))
+def test_arbitrary_text_files_load_or_raise_scene_error(
+    tmp_path_factory: pytest.TempPathFactory, text: str
+) -> None:
+    path = tmp_path_factory.mktemp("scene") / "scene.yaml"
+    path.write_text(text, encoding="utf-8")
+    with contextlib.suppress(SceneError):  # anything but a SceneError fails the test
+        load_scene(path)
+
+
+def test_valid_scene_loads_with_finite_values() -> None:
+    scene = parse_scene({**MINIMAL, "safety_margin": 0.05, "duration": 3.0})
+    assert math.isclose(scene.safety_margin, 0.05) and scene.duration == 3.0
