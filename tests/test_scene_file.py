@@ -189,3 +189,8 @@ def test_arbitrary_text_files_load_or_raise_scene_error(
 def test_valid_scene_loads_with_finite_values() -> None:
     scene = parse_scene({**MINIMAL, "safety_margin": 0.05, "duration": 3.0})
     assert math.isclose(scene.safety_margin, 0.05) and scene.duration == 3.0
+
+
+def test_bundled_example_scene_loads() -> None:
+    scene = load_scene(paper_scene_path().parent / "shelf.yaml")
+    assert sorted(o.shape for o in scene.obstacles) == ["box", "cylinder", "sphere"]
