@@ -13,8 +13,10 @@ import dataclasses
 import json
 import os
 import shutil
+import signal
 import sys
 import tempfile
+import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -22,12 +24,13 @@ from typing import Any
 import numpy as np
 
 import cpr_kin as ck
+from planning import artifacts
 from planning.errors import PlanningError
 from planning.firefly import FireflyProgress
 from planning.planner import NoTrajectoryFoundError, PlanResult, plan
 from planning.report import markdown_table, paper_rows, text_table
 from planning.scene import Scene
-from planning.scene_file import load_scene, paper_scene_path
+from planning.scene_file import load_scene, paper_scene_path, parse_scene
 from planning.trajectory_io import read_trajectory, samples_csv, trajectory_document
 
 EXIT_OK, EXIT_INVALID, EXIT_NO_TRAJECTORY = 0, 2, 3
@@ -41,15 +44,15 @@ class _CommandError(Exception):
         self.code = code
 
 
-def write_outputs(folder: Path, files: dict[str, str]) -> list[Path]:
+def write_outputs(folder: Path, files: dict[str, str | bytes]) -> list[Path]:
     """Write every file, or none: all go to temporary names first, then are renamed."""
     folder.mkdir(parents=True, exist_ok=True)
     temporary: list[tuple[str, Path]] = []
     try:
         for name, text in files.items():
             handle, temporary_name = tempfile.mkstemp(prefix=f".{name}.", dir=folder)
-            with os.fdopen(handle, "w", encoding="utf-8", newline="") as stream:
-                stream.write(text)
+            with os.fdopen(handle, "wb") as stream:
+                stream.write(text.encode("utf-8") if isinstance(text, str) else text)
             temporary.append((name, Path(temporary_name)))
         for name, written in temporary:
             os.replace(written, folder / name)
@@ -174,11 +177,21 @@ def _plan_and_write(scene: Scene, out: Path, args: argparse.Namespace, paper: bo
     finally:
         close()
     document = trajectory_document(result, timings=args.timings)
-    files = {
+    files: dict[str, str | bytes] = {
         "trajectory.json": json.dumps(document, indent=1) + "\n",
         "samples.csv": samples_csv(result.trajectory, result.joint_names, scene.planner.ipo),
         "report.md": _report(result, paper),
     }
+    if paper or args.plots:
+        files.update(artifacts.plot_files(result))
+    if paper or args.html:
+        files["viewer.html"] = artifacts.viewer_html(
+            result.robot,
+            result.scene.obstacles,
+            result.scene.safety_margin,
+            result.trajectory,
+            result.waypoints,
+        )
     try:
         outputs = write_outputs(out, files)
     except OSError as exc:
@@ -283,6 +296,48 @@ def _cmd_check(args: argparse.Namespace) -> int:
     return EXIT_OK if not problems else EXIT_NO_TRAJECTORY
 
 
+def _cmd_show(args: argparse.Namespace) -> int:
+    try:
+        document = read_trajectory(args.trajectory)
+        scene = parse_scene(document.scene, source=f"{args.trajectory} (scene)")
+        robot = ck.load_cpr(document.robot if Path(document.robot).is_file() else None)
+    except (PlanningError, ck.CprKinError) as exc:
+        raise _CommandError(EXIT_INVALID, str(exc)) from None
+    if args.html is not None:
+        html = artifacts.viewer_html(
+            robot,
+            scene.obstacles,
+            scene.safety_margin,
+            document.trajectory,
+            document.waypoints,
+            args.collision,
+        )
+        try:
+            written = write_outputs(args.html.parent, {args.html.name: html})
+        except OSError as exc:
+            raise _CommandError(EXIT_INVALID, f"cannot write '{args.html}': {exc.strerror or exc}") from None
+        print(f"wrote {written[0]} (self-contained; open it in a browser)")
+        return EXIT_OK
+    from planning.viewer import Viewer
+
+    def stop(signum: int, _frame: object) -> None:
+        raise KeyboardInterrupt(signal.Signals(signum).name)
+
+    for signum in (signal.SIGINT, signal.SIGTERM):  # also when started with SIGINT ignored
+        signal.signal(signum, stop)
+    with Viewer(robot, scene.obstacles, scene.safety_margin) as viewer:
+        viewer.show_geometry(visual=not args.collision, collision=args.collision)
+        viewer.show_plan(document.trajectory, document.waypoints)
+        viewer.animate(document.trajectory)
+        print(f"meshcat viewer at {viewer.url}  (127.0.0.1 only; Ctrl-C to stop)", flush=True)
+        try:
+            while True:
+                time.sleep(3600)
+        except KeyboardInterrupt:
+            print("viewer stopped", flush=True)
+    return EXIT_OK
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="cpr-plan", description="Collision-free, jerk-continuous trajectories for the CPR."
@@ -298,6 +353,14 @@ def _parser() -> argparse.ArgumentParser:
         sub.add_argument("--fireflies", type=int, help="population size (default: the scene's)")
         sub.add_argument("--iterations", type=int, help="firefly iterations (default: the scene's)")
         sub.add_argument("--json", action="store_true", help="print the summary as JSON")
+        sub.add_argument(
+            "--plots",
+            action="store_true",
+            help="also write joints.png, tcp_path.png, clearance.png, convergence.png",
+        )
+        sub.add_argument(
+            "--html", action="store_true", help="also write viewer.html (meshcat, animated, self-contained)"
+        )
         sub.add_argument(
             "--timings",
             action="store_true",
@@ -331,6 +394,21 @@ def _parser() -> argparse.ArgumentParser:
     sub.add_argument("trajectory", type=Path, help="trajectory file (cpr-trajectory/1 JSON)")
     sub.add_argument("--json", action="store_true", help="print the verdict as JSON")
     sub.set_defaults(run=_cmd_check)
+
+    sub = commands.add_parser(
+        "show",
+        help="show a trajectory file in meshcat",
+        description="Show TRAJECTORY with its scene in a live meshcat viewer (printing its URL), or write a "
+        "self-contained HTML page with --html.",
+    )
+    sub.add_argument("trajectory", type=Path, help="trajectory file (cpr-trajectory/1 JSON)")
+    sub.add_argument(
+        "--html", type=Path, metavar="OUT.html", help="write a self-contained HTML page instead of serving"
+    )
+    sub.add_argument(
+        "--collision", action="store_true", help="show the collision geometry instead of the visual one"
+    )
+    sub.set_defaults(run=_cmd_show)
     return parser
 
 

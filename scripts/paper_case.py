@@ -3,7 +3,7 @@
 Plans the scene with the paper's parameters (n = 50, alpha = 1, beta0 = 0.5, 50 iterations,
 3 waypoints; septic spline N = 4, h = 1 s, p = 1e6), verifies the trajectory, prints the
 paper's figures beside ours, writes ``trajectory.json`` (cpr-trajectory/1), ``samples.csv``
-and ``report.md`` into ``--out``, and plans seeds ``0 .. --seeds - 1`` to report how many
+and ``report.md``, ``viewer.html`` (meshcat, animated) and the plots into ``--out``, and plans seeds ``0 .. --seeds - 1`` to report how many
 succeed.
 """
 
@@ -15,6 +15,7 @@ import sys
 from pathlib import Path
 
 import cpr_kin as ck
+from planning import artifacts
 from planning.errors import PlanningError
 from planning.planner import PlanResult, plan
 from planning.report import markdown_table, paper_rows, text_table
@@ -76,6 +77,13 @@ def main(argv: list[str] | None = None) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     write_trajectory(result, args.out / "trajectory.json")
     write_samples(result, args.out / "samples.csv")
+    for name, data in artifacts.plot_files(result).items():
+        (args.out / name).write_bytes(data)
+    scene = result.scene
+    html = artifacts.viewer_html(
+        robot, scene.obstacles, scene.safety_margin, result.trajectory, result.waypoints
+    )
+    atomic_write_text(args.out / "viewer.html", html)
     report = [
         "# Paper case",
         "",
@@ -90,7 +98,10 @@ def main(argv: list[str] | None = None) -> int:
         "",
     ]
     atomic_write_text(args.out / "report.md", "\n".join(report))
-    print(f"\nwrote {args.out / 'trajectory.json'}, {args.out / 'samples.csv'}, {args.out / 'report.md'}")
+    print(
+        f"\nwrote into {args.out}: trajectory.json, samples.csv, report.md, viewer.html (open it in a browser),"
+    )
+    print(f"  {', '.join(artifacts.PLOT_FILES)}")
     return 0
 
 

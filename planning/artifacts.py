@@ -1,0 +1,55 @@
+"""Files that show a plan: PNG plots and the self-contained meshcat HTML page.
+
+The drawing libraries (matplotlib, meshcat) are imported here only when these are made.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+import cpr_kin as ck
+from planning.planner import PlanResult
+from planning.trajectory import Trajectory
+
+PLOT_FILES = ("joints.png", "tcp_path.png", "clearance.png", "convergence.png")
+
+
+def plot_files(result: PlanResult) -> dict[str, bytes]:
+    """PNG bytes of the joint, TCP-path, clearance and convergence plots, by file name."""
+    from planning import plots
+
+    robot = result.robot
+    units = tuple(robot.joint_unit(n) for n in robot.joint_names)
+    world = ck.CollisionWorld(robot, result.scene.obstacles)
+    figures = (
+        plots.joint_figure(result.trajectory, robot.joint_names, units),
+        plots.tcp_path_figure(
+            robot, result.trajectory, result.waypoints, result.scene.obstacles, result.scene.safety_margin
+        ),
+        plots.clearance_figure(world, result.trajectory, result.scene.safety_margin),
+        plots.convergence_figure(result.optimiser),
+    )
+    return {name: plots.png_bytes(figure) for name, figure in zip(PLOT_FILES, figures, strict=True)}
+
+
+def viewer_html(
+    robot: ck.Robot,
+    obstacles: tuple[ck.Obstacle, ...],
+    margin_m: float,
+    trajectory: Trajectory,
+    waypoints: NDArray[np.float64],
+    collision: bool = False,
+) -> str:
+    """One self-contained HTML page of the plan, animated.
+
+    It shows the robot, obstacles, margin, waypoints, TCP path and the trajectory; a loopback
+    meshcat server runs while it is made.
+    """
+    from planning.viewer import Viewer
+
+    with Viewer(robot, obstacles, margin_m) as viewer:
+        viewer.show_geometry(visual=not collision, collision=collision)
+        viewer.show_plan(trajectory, waypoints)
+        viewer.animate(trajectory)
+        return viewer.static_html()

@@ -1,0 +1,174 @@
+"""Plots of a planned trajectory as PNG files (matplotlib, Agg backend).
+
+Imported only when plots are asked for: ``import planning`` never loads matplotlib.
+
+- :func:`joint_figure`: position, velocity, acceleration and jerk of the moving joints
+  against time, waypoints marked (the paper's fig. 4). The curves are sampled on a fine grid
+  plus the knots and the exact extremum instants, so their extrema are the metrics'.
+- :func:`tcp_path_figure`: the 3-D TCP path with the obstacles and margin (fig. 3).
+- :func:`clearance_figure`: clearance against time with the margin line.
+- :func:`convergence_figure`: the firefly's best and mean fitness per iteration.
+"""
+
+from __future__ import annotations
+
+import io
+import itertools
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.figure import Figure
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+from numpy.typing import NDArray
+
+import cpr_kin as ck
+from planning.firefly import FireflyResult
+from planning.trajectory import DERIVATIVE_NAMES, Trajectory
+
+FloatArray = NDArray[np.float64]
+UNITS = {"rad": ("rad", "rad/s", "rad/s$^2$", "rad/s$^3$"), "m": ("m", "m/s", "m/s$^2$", "m/s$^3$")}
+
+
+def sample_times(trajectory: Trajectory, count: int = 1000) -> FloatArray:
+    """A fine time grid with the knots and every exact extremum instant of orders 0 to 3."""
+    extra = [trajectory.knots]
+    for r in range(4):
+        extrema = trajectory.extrema(r)
+        extra += [extrema.time_of_minimum, extrema.time_of_maximum]
+    return np.unique(np.concatenate([np.linspace(trajectory.knots[0], trajectory.knots[-1], count), *extra]))
+
+
+def _moving(trajectory: Trajectory, tolerance: float = 1e-12) -> list[int]:
+    extrema = trajectory.extrema(0)
+    return [j for j in range(trajectory.n_joints) if extrema.maximum[j] - extrema.minimum[j] > tolerance]
+
+
+def joint_figure(trajectory: Trajectory, joint_names: tuple[str, ...], units: tuple[str, ...]) -> Figure:
+    """Position, velocity, acceleration and jerk of the moving joints, knots marked."""
+    times = sample_times(trajectory)
+    moving = _moving(trajectory) or list(range(trajectory.n_joints))
+    figure, axes = plt.subplots(4, len(moving), figsize=(3.2 * len(moving), 9), sharex=True, squeeze=False)
+    for column, j in enumerate(moving):
+        for r in range(4):
+            ax = axes[r, column]
+            ax.plot(
+                times, trajectory(times, r)[:, j], color="C0", label=f"{joint_names[j]} {DERIVATIVE_NAMES[r]}"
+            )
+            ax.plot(
+                trajectory.knots,
+                trajectory(trajectory.knots, r)[:, j],
+                "o",
+                color="C1",
+                markersize=4,
+                label="nodes",
+            )
+            ax.set_ylabel(f"{DERIVATIVE_NAMES[r]} [{UNITS[units[j]][r]}]")
+            ax.grid(alpha=0.3)
+        axes[0, column].set_title(joint_names[j])
+        axes[-1, column].set_xlabel("t [s]")
+    figure.suptitle("Joint trajectories: position, velocity, acceleration, jerk (nodes marked)")
+    figure.tight_layout()
+    return figure
+
+
+def _box_faces(obstacle: ck.Obstacle, grow: float) -> list[FloatArray]:
+    half = (
+        (np.asarray(obstacle.size) / 2 + grow)
+        if obstacle.shape == "box"
+        else np.full(3, (obstacle.radius or 0.1) + grow)
+    )
+    if obstacle.shape in ("cylinder", "capsule"):
+        half[2] = (
+            (obstacle.length or 0.0) / 2
+            + grow
+            + ((obstacle.radius or 0.0) if obstacle.shape == "capsule" else 0.0)
+        )
+    corners = np.array(list(itertools.product(*[(-h, h) for h in half])))
+    placement = obstacle.placement
+    world = corners @ np.asarray(placement.rotation).T + np.asarray(placement.translation)
+    faces = [[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5]]
+    return [world[f] for f in faces]
+
+
+def tcp_path_figure(
+    robot: ck.Robot,
+    trajectory: Trajectory,
+    waypoints: FloatArray,
+    obstacles: tuple[ck.Obstacle, ...],
+    margin_m: float,
+) -> Figure:
+    """The TCP path in 3-D with the obstacles and the margin as translucent shells.
+
+    Obstacles are drawn as boxes (round shapes as their bounding boxes).
+    """
+    times = np.linspace(trajectory.knots[0], trajectory.knots[-1], 400)
+    tcp = ck.frame_positions(robot, trajectory(times))
+    nodes = ck.frame_positions(robot, waypoints)
+    figure = plt.figure(figsize=(7, 6))
+    ax: Any = figure.add_subplot(projection="3d")
+    ax.plot(*tcp.T, color="C0", label="TCP path")
+    ax.scatter(*nodes.T, color="C1", s=25, label="waypoints", depthshade=False)
+    for obstacle in obstacles:
+        ax.add_collection3d(
+            Poly3DCollection(_box_faces(obstacle, 0.0), facecolor="#d9534f", alpha=0.7, edgecolor="k")
+        )
+        if margin_m > 0:
+            ax.add_collection3d(
+                Poly3DCollection(_box_faces(obstacle, margin_m), facecolor="#d9534f", alpha=0.12)
+            )
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_zlabel("z [m]")
+    ax.set_xlim(-0.9, 0.9)
+    ax.set_ylim(-0.9, 0.9)
+    ax.set_zlim(0.0, 1.0)
+    ax.legend(loc="upper left")
+    ax.set_title("TCP path, obstacles and safety margin")
+    return figure
+
+
+def clearance_figure(world: ck.CollisionWorld, trajectory: Trajectory, margin_m: float) -> Figure:
+    """Clearance of each collision group against time, with the margin line."""
+    times = np.linspace(trajectory.knots[0], trajectory.knots[-1], 600)
+    clearance = world.clearance_batch(trajectory(times)).clearance_m
+    figure, ax = plt.subplots(figsize=(8, 4))
+    for g, group in enumerate(ck.GROUPS):
+        ax.plot(times, clearance[:, g], label=f"{group} clearance")
+    ax.axhline(margin_m, color="k", linestyle="--", label=f"safety margin {margin_m} m")
+    ax.set_ylim(bottom=min(0.0, float(np.nanmin(clearance))))
+    ax.set_xlabel("t [s]")
+    ax.set_ylabel("clearance [m]")
+    ax.grid(alpha=0.3)
+    ax.legend()
+    ax.set_title("Clearance to the obstacles")
+    figure.tight_layout()
+    return figure
+
+
+def convergence_figure(result: FireflyResult) -> Figure:
+    """Best and mean fitness of the firefly population per iteration."""
+    figure, ax = plt.subplots(figsize=(7, 4))
+    iterations = np.arange(len(result.best_history))
+    ax.plot(iterations, result.best_history, label="best")
+    ax.plot(iterations, result.mean_history, label="population mean", alpha=0.7)
+    ax.set_yscale("log")
+    ax.set_xlabel("iteration")
+    ax.set_ylabel("fitness")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend()
+    ax.set_title(f"Firefly convergence ({result.evaluations} evaluations)")
+    figure.tight_layout()
+    return figure
+
+
+def png_bytes(figure: Figure) -> bytes:
+    """The figure as PNG bytes; the figure is closed."""
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=100)
+    plt.close(figure)
+    return buffer.getvalue()
