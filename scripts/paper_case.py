@@ -2,9 +2,9 @@
 
 Plans the scene with the paper's parameters (n = 50, alpha = 1, beta0 = 0.5, 50 iterations,
 3 waypoints; septic spline N = 4, h = 1 s, p = 1e6), verifies the trajectory, prints the
-paper's figures beside ours, writes ``trajectory.json`` (cpr-trajectory/1), ``samples.csv``
-and ``report.md``, ``viewer.html`` (meshcat, animated) and the plots into ``--out``, and plans seeds ``0 .. --seeds - 1`` to report how many
-succeed.
+paper's figures beside ours, and writes into ``--out``: ``trajectory.json``
+(cpr-trajectory/1), ``samples.csv``, ``report.md``, ``viewer.html`` (meshcat, animated) and
+the plots. Then plans seeds ``0 .. --seeds - 1`` to report how many succeed.
 """
 
 from __future__ import annotations
@@ -99,7 +99,7 @@ def main(argv: list[str] | None = None) -> int:
     ]
     atomic_write_text(args.out / "report.md", "\n".join(report))
     print(
-        f"\nwrote into {args.out}: trajectory.json, samples.csv, report.md, viewer.html (open it in a browser),"
+        f"\nwrote into {args.out}: trajectory.json, samples.csv, report.md, viewer.html (open in a browser),"
     )
     print(f"  {', '.join(artifacts.PLOT_FILES)}")
     return 0
