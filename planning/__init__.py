@@ -14,6 +14,7 @@ from planning.scene import PlannerSettings, Scene, Target, paper_scene
 from planning.spline import SepticSplineSolver, SplineFit, SplineSettings, fit_septic_spline, uniform_knots
 from planning.trajectory import Extrema, Trajectory
 from planning.trajectory_io import read_trajectory, write_samples, write_trajectory
+from planning.verification import Verification, verify_trajectory
 
 __all__ = [
     "Breakdown",
@@ -33,6 +34,7 @@ __all__ = [
     "SplineSettings",
     "Target",
     "Trajectory",
+    "Verification",
     "WaypointObjective",
     "firefly_minimize",
     "fit_septic_spline",
@@ -42,6 +44,7 @@ __all__ = [
     "read_trajectory",
     "trapezoid_time",
     "uniform_knots",
+    "verify_trajectory",
     "write_samples",
     "write_trajectory",
 ]

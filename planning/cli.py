@@ -32,6 +32,7 @@ from planning.report import markdown_table, paper_rows, text_table
 from planning.scene import Scene
 from planning.scene_file import load_scene, paper_scene_path, parse_scene
 from planning.trajectory_io import read_trajectory, samples_csv, trajectory_document
+from planning.verification import verify_trajectory
 
 EXIT_OK, EXIT_INVALID, EXIT_NO_TRAJECTORY = 0, 2, 3
 
@@ -242,40 +243,10 @@ def _cmd_check(args: argparse.Namespace) -> int:
             EXIT_INVALID,
             f"trajectory joints {list(document.joint_names)} are not the robot's {list(robot.joint_names)}",
         )
-    trajectory = document.trajectory
-    problems = []
-    for label, q, t in (("start", q_start, trajectory.knots[0]), ("goal", q_goal, trajectory.knots[-1])):
-        gap = float(np.abs(trajectory(t) - q).max())
-        if gap > 1e-6:
-            problems.append(f"the trajectory's {label} is {gap:.3g} away from the scene's {label}")
-    check = ck.check_curve(
-        world,
-        trajectory.position,
-        trajectory.knots[0],
-        trajectory.knots[-1],
-        trajectory.extrema(1).peak,
-        scene.safety_margin,
-        scene.planner.verify_step_m,
+    verification = verify_trajectory(
+        world, document.trajectory, scene.safety_margin, scene.planner.verify_step_m, (q_start, q_goal)
     )
-    if not check.accepted:
-        problems.append(
-            f"certified clearance {check.certified_min_m:.4f} m is below the margin {scene.safety_margin} m: "
-            f"closest at t = {check.worst_time:.2f} s between {check.worst_pair} ({check.worst_group})"
-        )
-    limits = robot.limits
-    positions = trajectory.extrema(0)
-    for i, name in enumerate(robot.joint_names):
-        if positions.minimum[i] < limits.lower[i] - 1e-9 or positions.maximum[i] > limits.upper[i] + 1e-9:
-            problems.append(f"joint '{name}' leaves its range [{limits.lower[i]:g}, {limits.upper[i]:g}]")
-    for r, (kind, limit) in enumerate(
-        (("velocity", limits.velocity), ("acceleration", limits.acceleration), ("jerk", limits.jerk)), start=1
-    ):
-        ratio = trajectory.extrema(r).peak / limit
-        if ratio.max() > 1 + 1e-9:
-            j = int(np.argmax(ratio))
-            problems.append(
-                f"{kind} of joint '{robot.joint_names[j]}' reaches {ratio[j]:.3f} x its limit {limit[j]:g}"
-            )
+    check, problems = verification.check, list(verification.problems)
     verdict = {
         "status": "ok" if not problems else "failed",
         "certified_min_clearance_m": check.certified_min_m,

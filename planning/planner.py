@@ -16,6 +16,7 @@ from planning.objective import Breakdown, WaypointObjective
 from planning.scene import Scene
 from planning.spline import SepticSplineSolver, SplineFit, uniform_knots
 from planning.trajectory import Trajectory
+from planning.verification import Verification, verify_trajectory
 
 FloatArray = NDArray[np.float64]
 
@@ -144,37 +145,16 @@ def _endpoint(robot: ck.Robot, world: ck.CollisionWorld, scene: Scene, label: st
     return q
 
 
-def _verify(
-    robot: ck.Robot, world: ck.CollisionWorld, scene: Scene, trajectory: Trajectory, fit: SplineFit
-) -> tuple[ck.CurveCheck, list[str]]:
-    """Certified clearance, joint ranges and node deviation of a timed trajectory."""
-    speed = trajectory.extrema(1).peak
-    start, end = trajectory.knots[0], trajectory.knots[-1]
-    step = scene.planner.verify_step_m
-    check = ck.check_curve(world, trajectory.position, start, end, speed, scene.safety_margin, step)
-    problems = []
-    if not check.accepted:
-        problems.append(
-            f"comes within {check.certified_min_m:.3f} m (certified) of an obstacle, "
-            f"margin {scene.safety_margin} m: closest at t = {check.worst_time:.2f} s "
-            f"between {check.worst_pair} ({check.worst_group})"
-        )
-    positions = trajectory.extrema(0)
-    limits = robot.limits
-    for i, name in enumerate(robot.joint_names):
-        low, high = positions.minimum[i], positions.maximum[i]
-        if low < limits.lower[i] - 1e-9 or high > limits.upper[i] + 1e-9:
-            unit = robot.joint_unit(name)
-            problems.append(
-                f"moves joint '{name}' over [{low:.4g}, {high:.4g}] {unit}, outside its range "
-                f"[{limits.lower[i]:g}, {limits.upper[i]:g}] {unit}"
-            )
+def _verify(world: ck.CollisionWorld, scene: Scene, trajectory: Trajectory, fit: SplineFit) -> Verification:
+    """The scene's verification, plus the node-deviation bound of the planner settings."""
+    verification = verify_trajectory(world, trajectory, scene.safety_margin, scene.planner.verify_step_m)
     bound = scene.planner.max_node_deviation
     if bound is not None and fit.max_node_deviation > bound:
-        problems.append(
+        problem = (
             f"deviates {fit.max_node_deviation:.3g} from its nodes, more than max_node_deviation = {bound:g}"
         )
-    return check, problems
+        verification = Verification(verification.check, (*verification.problems, problem))
+    return verification
 
 
 def plan(
@@ -236,7 +216,7 @@ def plan(
     limits = robot.limits
     order = np.argsort(result.population_fitness, kind="stable")
     candidates = [result.x] + [result.population[k] for k in order]
-    first: tuple[ck.CurveCheck, list[str]] | None = None
+    first: Verification | None = None
     tried = 0
     for x in candidates:
         tried += 1
@@ -248,18 +228,18 @@ def plan(
         if scene.duration is not None:
             scale = max(scale, 1.0)
         trajectory = nominal.time_scaled(scale)
-        check, problems = _verify(robot, world, scene, trajectory, fit)
-        first = first or (check, problems)
-        if not problems:
+        verification = _verify(world, scene, trajectory, fit)
+        first = first or verification
+        if verification.accepted:
             break
     else:
         assert first is not None  # candidates is never empty
-        check, problems = first
         raise NoTrajectoryFoundError(
-            f"no collision-free trajectory found: the best candidate {'; '.join(problems)} "
+            f"no collision-free trajectory found: the best candidate {'; '.join(first.problems)} "
             f"({len(candidates)} candidates verified)",
-            check,
+            first.check,
         )
+    check = verification.check
 
     breakdown = objective.breakdown(x[None])
     names = robot.joint_names

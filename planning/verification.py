@@ -1,0 +1,88 @@
+"""Verification of a timed trajectory against a scene.
+
+What the planner accepts is what ``cpr-plan check`` re-checks: one function serves both.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+import cpr_kin as ck
+from planning.trajectory import Trajectory
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Verification:
+    """Outcome of :func:`verify_trajectory`.
+
+    Attributes:
+        check: the certified continuous clearance check.
+        problems: one sentence per failed condition (empty when accepted).
+    """
+
+    check: ck.CurveCheck
+    problems: tuple[str, ...]
+
+    @property
+    def accepted(self) -> bool:
+        """Every condition holds."""
+        return not self.problems
+
+
+def verify_trajectory(
+    world: ck.CollisionWorld,
+    trajectory: Trajectory,
+    margin_m: float,
+    step_m: float,
+    endpoints: tuple[FloatArray, FloatArray] | None = None,
+    tolerance: float = 1e-9,
+) -> Verification:
+    """Check a timed trajectory for everything a robot needs of it.
+
+    - the certified clearance (:func:`cpr_kin.check_curve`, robot motion between checks at
+      most ``step_m``) is at least ``margin_m`` [m];
+    - every joint stays within its range, and within its velocity, acceleration and jerk
+      limits (exact extrema);
+    - with ``endpoints = (q_start, q_goal)``: it starts and ends there (within 1e-6).
+    """
+    robot = world.robot
+    limits = robot.limits
+    start, end = trajectory.knots[0], trajectory.knots[-1]
+    check = ck.check_curve(
+        world, trajectory.position, start, end, trajectory.extrema(1).peak, margin_m, step_m
+    )
+    problems = []
+    if endpoints is not None:
+        for label, q, t in (("start", endpoints[0], start), ("goal", endpoints[1], end)):
+            gap = float(np.abs(trajectory(t) - q).max())
+            if gap > 1e-6:
+                problems.append(f"its {label} is {gap:.3g} away from the scene's {label}")
+    if not check.accepted:
+        problems.append(
+            f"comes within {check.certified_min_m:.4f} m (certified) of an obstacle, margin {margin_m} m: "
+            f"closest at t = {check.worst_time:.2f} s between {check.worst_pair} ({check.worst_group})"
+        )
+    positions = trajectory.extrema(0)
+    for i, name in enumerate(robot.joint_names):
+        low, high = positions.minimum[i], positions.maximum[i]
+        if low < limits.lower[i] - tolerance or high > limits.upper[i] + tolerance:
+            unit = robot.joint_unit(name)
+            problems.append(
+                f"moves joint '{name}' over [{low:.4g}, {high:.4g}] {unit}, outside its range "
+                f"[{limits.lower[i]:g}, {limits.upper[i]:g}] {unit}"
+            )
+    for r, (kind, limit) in enumerate(
+        (("velocity", limits.velocity), ("acceleration", limits.acceleration), ("jerk", limits.jerk)), start=1
+    ):
+        ratio = trajectory.extrema(r).peak / limit
+        if ratio.max() > 1 + tolerance:
+            j = int(np.argmax(ratio))
+            problems.append(
+                f"drives the {kind} of joint '{robot.joint_names[j]}' to {ratio[j]:.3f} x its limit"
+            )
+    return Verification(check=check, problems=tuple(problems))
