@@ -11,27 +11,24 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
-import os
 import shutil
 import signal
 import sys
-import tempfile
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 import cpr_kin as ck
 from planning import artifacts
 from planning.errors import PlanningError
 from planning.firefly import FireflyProgress
-from planning.planner import NoTrajectoryFoundError, PlanResult, plan
-from planning.report import markdown_table, paper_rows, text_table
+from planning.outputs import plan_files, summary, write_files
+from planning.planner import NoTrajectoryFoundError, plan
+from planning.report import paper_rows, text_table
 from planning.scene import Scene
 from planning.scene_file import load_scene, paper_scene_path, parse_scene
-from planning.trajectory_io import read_trajectory, samples_csv, trajectory_document
+from planning.trajectory_io import read_trajectory
 from planning.verification import verify_trajectory
 
 EXIT_OK, EXIT_INVALID, EXIT_NO_TRAJECTORY = 0, 2, 3
@@ -43,24 +40,6 @@ class _CommandError(Exception):
     def __init__(self, code: int, message: str) -> None:
         super().__init__(message)
         self.code = code
-
-
-def write_outputs(folder: Path, files: dict[str, str | bytes]) -> list[Path]:
-    """Write every file, or none: all go to temporary names first, then are renamed."""
-    folder.mkdir(parents=True, exist_ok=True)
-    temporary: list[tuple[str, Path]] = []
-    try:
-        for name, text in files.items():
-            handle, temporary_name = tempfile.mkstemp(prefix=f".{name}.", dir=folder)
-            with os.fdopen(handle, "wb") as stream:
-                stream.write(text.encode("utf-8") if isinstance(text, str) else text)
-            temporary.append((name, Path(temporary_name)))
-        for name, written in temporary:
-            os.replace(written, folder / name)
-    finally:
-        for _, leftover in temporary:
-            leftover.unlink(missing_ok=True)
-    return [folder / name for name in files]
 
 
 def _progress(enabled: bool) -> tuple[Callable[[FireflyProgress], None] | None, Callable[[], None]]:
@@ -95,67 +74,6 @@ def _progress(enabled: bool) -> tuple[Callable[[FireflyProgress], None] | None, 
     return update, close
 
 
-def _summary(result: PlanResult, outputs: list[Path]) -> dict[str, Any]:
-    m = result.metrics
-    return {
-        "status": "ok",
-        "scene": result.scene.name,
-        "seed": result.scene.planner.seed,
-        "fitness_kind": result.scene.planner.fitness,
-        "duration_s": m.duration,
-        "min_clearance_m": m.min_clearance,
-        "safety_margin_m": result.scene.safety_margin,
-        "max_node_deviation": m.max_node_deviation,
-        "t_sol_s": m.t_sol,
-        "fitness": m.fitness,
-        "evaluations": m.evaluations,
-        "planning_time_s": m.planning_time_s,
-        "limit_utilisation": m.limit_utilisation,
-        "outputs": [str(p) for p in outputs],
-    }
-
-
-def _report(result: PlanResult, paper: bool) -> str:
-    m = result.metrics
-    names = result.joint_names
-    rows = [
-        ("duration", f"{m.duration:.3f} s"),
-        ("certified min clearance", f"{m.min_clearance:.4f} m (margin {result.scene.safety_margin} m)"),
-        ("PTP time t_sol (objective)", f"{m.t_sol:.3f} s"),
-        ("fitness", f"{m.fitness:.4f}"),
-        ("max node deviation", f"{m.max_node_deviation:.3g}"),
-        (
-            "peak velocity, acceleration, jerk / limit",
-            ", ".join(f"{v:.2f}" for v in m.limit_utilisation.values()),
-        ),
-        ("evaluations", str(m.evaluations)),
-        ("planning time", f"{m.planning_time_s:.3f} s"),
-    ]
-    lines = [
-        f"# Plan: {result.scene.name}",
-        "",
-        f"Seed {result.scene.planner.seed}, fitness `{result.scene.planner.fitness}`, "
-        f"{len(result.scene.obstacles)} obstacle(s). Files: `trajectory.json` (cpr-trajectory/1), "
-        "`samples.csv` (every IPO period).",
-        "",
-        "| figure | value |",
-        "|---|---|",
-        *[f"| {a} | {b} |" for a, b in rows],
-        "",
-        "| joint | jerk min | jerk max |",
-        "|---|---|---|",
-        *[f"| {n} | {m.jerk_min[n]:.4g} | {m.jerk_max[n]:.4g} |" for n in names],
-        "",
-        "Waypoints (start, intermediate, goal):",
-        "",
-        *[f"- {np.round(w, 5).tolist()}" for w in result.waypoints],
-        "",
-    ]
-    if paper:
-        lines += ["## Beside the paper", "", markdown_table(paper_rows(result)), ""]
-    return "\n".join(lines)
-
-
 def _plan_and_write(scene: Scene, out: Path, args: argparse.Namespace, paper: bool) -> int:
     planner = scene.planner
     overrides = {
@@ -177,29 +95,14 @@ def _plan_and_write(scene: Scene, out: Path, args: argparse.Namespace, paper: bo
         raise _CommandError(EXIT_INVALID, str(exc)) from None
     finally:
         close()
-    document = trajectory_document(result, timings=args.timings)
-    files: dict[str, str | bytes] = {
-        "trajectory.json": json.dumps(document, indent=1) + "\n",
-        "samples.csv": samples_csv(result.trajectory, result.joint_names, scene.planner.ipo),
-        "report.md": _report(result, paper),
-    }
-    if paper or args.plots:
-        files.update(artifacts.plot_files(result))
-    if paper or args.html:
-        files["viewer.html"] = artifacts.viewer_html(
-            result.robot,
-            result.scene.obstacles,
-            result.scene.safety_margin,
-            result.trajectory,
-            result.waypoints,
-        )
+    extras = {"plots": paper or args.plots, "html": paper or args.html}
+    files = plan_files(result, paper=paper, timings=args.timings, **extras)
     try:
-        outputs = write_outputs(out, files)
+        outputs = write_files(out, files)
     except OSError as exc:
         raise _CommandError(EXIT_INVALID, f"cannot write to '{out}': {exc.strerror or exc}") from None
-    summary = _summary(result, outputs)
     if args.json:
-        print(json.dumps(summary, indent=1))
+        print(json.dumps({**summary(result), "outputs": [str(p) for p in outputs]}, indent=1))
     else:
         m = result.metrics
         print(
@@ -284,7 +187,7 @@ def _cmd_show(args: argparse.Namespace) -> int:
             args.collision,
         )
         try:
-            written = write_outputs(args.html.parent, {args.html.name: html})
+            written = write_files(args.html.parent, {args.html.name: html})
         except OSError as exc:
             raise _CommandError(EXIT_INVALID, f"cannot write '{args.html}': {exc.strerror or exc}") from None
         print(f"wrote {written[0]} (self-contained; open it in a browser)")
