@@ -212,6 +212,66 @@ def _cmd_show(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _cmd_batch(args: argparse.Namespace) -> int:
+    from planning import batch
+
+    try:
+        paths = batch.scene_files(args.scenes)
+    except PlanningError as exc:
+        raise _CommandError(EXIT_INVALID, str(exc)) from None
+    bar: Any = None
+    if sys.stdout.isatty() and not args.json:
+        from tqdm import tqdm
+
+        size = shutil.get_terminal_size((80, 24))
+        bar = tqdm(total=len(paths), desc="scenes", unit="scene", ncols=size.columns, nrows=size.lines)
+    try:
+        tick = None if bar is None else (lambda _item: bar.update(1))
+        items = batch.plan_batch(paths, args.out, args.workers, args.scheduler, tick)
+    except PlanningError as exc:
+        raise _CommandError(EXIT_INVALID, str(exc)) from None
+    finally:
+        if bar is not None:
+            bar.close()
+    write_files(args.out, {"summary.csv": batch.summary_csv(items)})
+    failed = [i for i in items if i.status != "ok"]
+    if args.json:
+        print(
+            json.dumps(
+                {
+                    "scenes": len(items),
+                    "ok": len(items) - len(failed),
+                    "items": [dataclasses.asdict(i) for i in items],
+                },
+                indent=1,
+            )
+        )
+    else:
+        rows = [
+            (
+                i.scene,
+                i.status,
+                str(i.exit_class),
+                "-" if i.duration_s is None else f"{i.duration_s:.2f} s",
+                "-" if i.min_clearance_m is None else f"{i.min_clearance_m:.3f} m",
+                f"{i.planning_time_s:.2f} s",
+            )
+            for i in items
+        ]
+        print(_table(("scene", "status", "exit", "duration", "clearance", "time"), rows))
+        print(f"{len(items) - len(failed)}/{len(items)} scenes planned; summary: {args.out / 'summary.csv'}")
+        for item in failed:
+            print(f"  {item.scene} (exit class {item.exit_class}): {item.message}")
+    return EXIT_OK if not failed else EXIT_NO_TRAJECTORY
+
+
+def _table(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
+    widths = [max(len(str(r[i])) for r in [headers, *rows]) for i in range(len(headers))]
+    lines = ["  ".join(str(c).ljust(w) for c, w in zip(row, widths, strict=True)) for row in [headers, *rows]]
+    lines.insert(1, "  ".join("-" * w for w in widths))
+    return "\n".join(lines)
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="cpr-plan", description="Collision-free, jerk-continuous trajectories for the CPR."
@@ -283,6 +343,22 @@ def _parser() -> argparse.ArgumentParser:
         "--collision", action="store_true", help="show the collision geometry instead of the visual one"
     )
     sub.set_defaults(run=_cmd_show)
+
+    sub = commands.add_parser(
+        "batch",
+        help="plan every scene of a folder in parallel",
+        description="Plan every *.yaml scene of SCENES_DIR in parallel (local processes, or a Dask cluster), "
+        "writing DIR/<scene>/ outputs and DIR/summary.csv. A failing scene never stops the others. Exit 0 "
+        "when every scene planned, 3 when any failed, 2 for an invalid folder or scheduler.",
+    )
+    sub.add_argument("scenes", type=Path, metavar="SCENES_DIR", help="folder of scene files")
+    sub.add_argument("--out", type=Path, required=True, help="output folder")
+    sub.add_argument("--workers", type=int, help="parallel tasks (default: all cores, or the cluster's)")
+    sub.add_argument(
+        "--scheduler", metavar="ADDRESS", help="dask.distributed scheduler, e.g. tcp://127.0.0.1:8786"
+    )
+    sub.add_argument("--json", action="store_true", help="print the results as JSON")
+    sub.set_defaults(run=_cmd_batch)
     return parser
 
 

@@ -161,6 +161,7 @@ def plan(
     scene: Scene,
     robot: ck.Robot | None = None,
     progress: Callable[[FireflyProgress], None] | None = None,
+    threads: int | None = None,
 ) -> PlanResult:
     """Plan a collision-free, jerk-continuous trajectory for ``scene``.
 
@@ -176,6 +177,8 @@ def plan(
         scene: the problem and its settings.
         robot: a loaded robot (default: load ``scene.robot`` or the bundled CPR).
         progress: called after every firefly iteration.
+        threads: threads of the parallel collision checks (default: up to 2); a batch that
+            plans scenes in parallel processes gives each 1.
 
     Raises:
         PlanningError: unreachable start or goal, or one inside the margin; bad settings.
@@ -183,7 +186,7 @@ def plan(
     """
     started = time.perf_counter()
     robot = robot or ck.load_cpr(scene.robot)
-    world = ck.CollisionWorld(robot, scene.obstacles)
+    world = ck.CollisionWorld(robot, scene.obstacles, num_threads=threads)
     q_start = _endpoint(robot, world, scene, "start")
     q_goal = _endpoint(robot, world, scene, "goal")
     settings = scene.planner
