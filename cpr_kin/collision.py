@@ -14,12 +14,14 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
+import coal
 import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import CprKinError
 from cpr_kin.obstacles import Obstacle
+from cpr_kin.reach import geometry_reach
 from cpr_kin.robot import GROUPS, Robot
 
 FloatArray = NDArray[np.float64]
@@ -149,6 +151,38 @@ class CollisionWorld:
         self._group_has_pairs = [bool(np.any(self._pair_group == g)) for g in range(len(GROUPS))]
         self._pool: Any = None
         self._pool_margin: float | None = None
+        self._reach_distance = self._pair_reach_distances()
+
+    def _pair_reach_distances(self) -> FloatArray:
+        """Per pair, a lower bound of its distance over every configuration [m].
+
+        Each robot geometry stays inside a capsule around the first joint's axis
+        (:mod:`cpr_kin.reach`); the distance from that capsule to the obstacle bounds the
+        pair's distance from below, whatever the joints do.
+        """
+        robot = self.robot
+        reach = geometry_reach(robot.model, robot.collision_model, robot.limits.lower, robot.limits.upper)
+        request, distances = coal.DistanceRequest(), []
+        for g, k in self._pairs:
+            bound = reach[robot.geometries[g].index]
+            low, high = bound.points.min(axis=0), bound.points.max(axis=0)
+            centre = (low + high) / 2
+            half = float(np.linalg.norm(high - low)) / 2
+            axis = (high - low) / (2 * half) if half > 0 else np.array([0.0, 0.0, 1.0])
+            rotation = pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), axis).matrix()
+            capsule = coal.Capsule(bound.ball, 2 * half)
+            obstacle = self.obstacles[k]
+            result = coal.DistanceResult()
+            coal.distance(
+                capsule,
+                coal.Transform3s(rotation, centre),
+                obstacle.geometry(),
+                coal.Transform3s(obstacle.placement.rotation, obstacle.placement.translation),
+                request,
+                result,
+            )
+            distances.append(result.min_distance)
+        return np.array(distances)
 
     @property
     def pairs(self) -> tuple[tuple[str, str, str], ...]:
@@ -235,7 +269,9 @@ class CollisionWorld:
 
         A yes/no check run by coal's collision test with ``margin_m`` as security margin, in
         parallel over :attr:`num_threads` threads (Pinocchio's ``GeometryPool``); several
-        times faster than :meth:`clearance_batch` when distances are not needed.
+        times faster than :meth:`clearance_batch` when distances are not needed. Pairs that
+        cannot come within the margin in any configuration (their reach capsule is farther,
+        see :mod:`cpr_kin.reach`) are not tested.
         """
         batch = self._check_batch(q)
         if not (np.isfinite(margin_m) and margin_m >= 0.0):
@@ -248,6 +284,12 @@ class CollisionWorld:
             margins = np.full((self.geometry_model.ngeoms,) * 2, float(margin_m))
             for gdata in self._pool.getGeometryDatas():
                 gdata.setSecurityMargins(self.geometry_model, margins, True, True)
+                # pairs that stay farther than the margin in every configuration need no test
+                for p, far in enumerate(self._reach_distance > margin_m):
+                    if far:
+                        gdata.deactivateCollisionPair(p)
+                    else:
+                        gdata.activateCollisionPair(p)
             self._pool_margin = margin_m
         result = pin.computeCollisionsInParallel(self.num_threads, self._pool, np.asfortranarray(batch.T))
         return np.asarray(result, dtype=bool)

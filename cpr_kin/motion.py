@@ -17,73 +17,26 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.collision import CollisionWorld
 from cpr_kin.errors import CprKinError
+from cpr_kin.reach import geometry_reach
 from cpr_kin.robot import GROUPS, Robot
 
 FloatArray = NDArray[np.float64]
-
-
-def _joint_axis(joint: Any) -> tuple[bool, FloatArray]:
-    """(is prismatic, unit axis in the joint frame) of a one-degree-of-freedom joint."""
-    jdata = joint.createData()
-    joint.calc(jdata, np.zeros(joint.nq))
-    subspace = np.asarray(jdata.S).ravel()
-    linear, angular = subspace[:3], subspace[3:]
-    prismatic = bool(np.linalg.norm(linear) > np.linalg.norm(angular))
-    axis = linear if prismatic else angular
-    return prismatic, axis / np.linalg.norm(axis)
-
-
-def _distance_from_axis(points: FloatArray, axis: FloatArray) -> FloatArray:
-    """Distances [m] of ``points`` ``(K, 3)`` from the line through the origin along ``axis``."""
-    along = points @ axis
-    return np.asarray(np.linalg.norm(points - np.outer(along, axis), axis=1))
 
 
 def motion_radii(robot: Robot) -> FloatArray:
     """Per-joint motion radius ``R_j``: [m/rad] for revolute, 1 [m/m] for prismatic joints.
 
     A displacement ``dq`` of the joints moves no point of any collision geometry by more
-    than ``sum_j R_j |dq_j|`` [m], whatever the configuration.
-
-    Each geometry is bounded by the convex hull of a few points plus a ball, carried up the
-    kinematic tree: a prismatic joint sweeps the points over its travel, a revolute joint
-    (whose angle is free) folds them onto its axis and adds their largest distance from the
-    axis to the ball. At each revolute joint the largest distance of the set from its axis
-    is that joint's radius.
+    than ``sum_j R_j |dq_j|`` [m], whatever the configuration (see :mod:`cpr_kin.reach`).
     """
-    model = robot.model
-    axes = [_joint_axis(model.joints[k]) for k in range(1, model.njoints)]
-    lower, upper = robot.limits.lower, robot.limits.upper
-    radii = np.zeros(robot.nq)
-    for geometry in robot.geometries:
-        obj = robot.collision_model.geometryObjects[geometry.index]
-        shape = obj.geometry
-        shape.computeLocalAABB()
-        points = np.atleast_2d(obj.placement.act(np.asarray(shape.aabb_center, dtype=float)))
-        ball = float(shape.aabb_radius)
-        joint = obj.parentJoint
-        while joint > 0:
-            i = joint - 1
-            prismatic, axis = axes[i]
-            if prismatic:
-                radii[i] = 1.0
-                points = np.vstack([points + lower[i] * axis, points + upper[i] * axis])
-            else:
-                distance = _distance_from_axis(points, axis)
-                radii[i] = max(radii[i], float(distance.max()) + ball)
-                ball += float(distance.max())
-                points = np.outer(points @ axis, axis)
-            placement = model.jointPlacements[joint]
-            points = points @ np.asarray(placement.rotation).T + np.asarray(placement.translation)
-            joint = model.parents[joint]
-    return radii
+    reach = geometry_reach(robot.model, robot.collision_model, robot.limits.lower, robot.limits.upper)
+    return np.asarray(np.max([r.radii for r in reach], axis=0))
 
 
 @dataclass(frozen=True)

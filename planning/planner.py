@@ -170,8 +170,8 @@ def plan(
     through start, waypoints and goal on ``p + 1`` uniform segments; timing (the scene's
     duration, stretched if it breaks a velocity, acceleration or jerk limit, or the fastest
     uniform timing within them); certified continuous verification of the whole
-    trajectory against the margin. If the best candidate fails the verification the next
-    ones of the final population are tried in order of fitness.
+    trajectory against the margin. If the best candidate fails the verification, the final
+    population's other feasible candidates are tried in order of fitness.
 
     Args:
         scene: the problem and its settings.
@@ -217,8 +217,11 @@ def plan(
     optimiser_time = time.perf_counter() - search_started
 
     limits = robot.limits
+    # the best, then the final population's candidates the fitness found feasible (an
+    # infeasible one will not pass the verification), best first
     order = np.argsort(result.population_fitness, kind="stable")
-    candidates = [result.x] + [result.population[k] for k in order]
+    feasible = objective.breakdown(result.population).feasible
+    candidates = [result.x] + [result.population[k] for k in order if feasible[k]]
     first: Verification | None = None
     tried = 0
     for x in candidates:

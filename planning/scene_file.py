@@ -322,3 +322,37 @@ def load_scene(path: str | Path) -> Scene:
 def paper_scene_path() -> Path:
     """The bundled paper scene, ``planning/scenes/paper.yaml``."""
     return Path(str(resources.files("planning") / "scenes" / "paper.yaml"))
+
+
+def scene_document(scene: Scene) -> dict[str, Any]:
+    """The scene file's document for ``scene`` (the inverse of :func:`parse_scene`)."""
+    from dataclasses import asdict
+
+    from planning.trajectory_io import obstacle_to_dict, target_to_dict
+
+    planner = asdict(scene.planner)
+    if planner["moving_joints"] is not None:
+        planner["moving_joints"] = list(planner["moving_joints"])
+    document: dict[str, Any] = {
+        "name": scene.name,
+        "safety_margin": scene.safety_margin,
+        "start": target_to_dict(scene.start),
+        "goal": target_to_dict(scene.goal),
+        "obstacles": [obstacle_to_dict(o) for o in scene.obstacles],
+        "planner": planner,
+        "spline": {"p": scene.spline.p, "a": list(scene.spline.a), "ends": scene.spline.ends},
+    }
+    if scene.duration is not None:
+        document["duration"] = scene.duration
+    if scene.robot is not None:
+        document["robot"] = str(scene.robot)
+    return document
+
+
+def dump_scene(scene: Scene, path: Path) -> None:
+    """Write ``scene`` as a scene file, atomically."""
+    from planning.trajectory_io import atomic_write_text
+
+    atomic_write_text(
+        Path(path), yaml.safe_dump(scene_document(scene), sort_keys=False, default_flow_style=None)
+    )

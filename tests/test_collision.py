@@ -203,3 +203,22 @@ def test_distances_against_independent_oracle(robot: ck.Robot, rng: np.random.Ge
             assert found.distance_m == pytest.approx(expected, abs=2e-6), (shape, g.name)
             checked += 1
     assert checked >= 60
+
+
+def test_reach_distance_bounds_every_pair_from_below(robot: ck.Robot, rng: np.random.Generator) -> None:
+    obstacles = [random_obstacle(shape, rng) for shape in ("box", "sphere", "cylinder", "capsule", "box")]
+    obstacles = [ck.Obstacle(**{**o.__dict__, "name": f"o{k}"}) for k, o in enumerate(obstacles)]
+    world = ck.CollisionWorld(robot, obstacles)
+    bound = world._reach_distance
+    assert np.sum(bound > 0.05) >= 3  # some pairs can be left out of the yes/no test
+    configurations = random_configurations(robot, rng, 300)
+    for q in configurations:
+        actual = np.array([p.distance_m for p in world.clearance(q).pairs])
+        assert np.all(actual >= bound - 1e-9)
+    # and the culled yes/no check still agrees with the distances
+    distances = world.clearance_batch(configurations).min_clearance_m
+    for margin in (0.02, 0.1, 0.3):
+        ambiguous = np.abs(distances - margin) < 1e-6
+        np.testing.assert_array_equal(
+            world.margin_violated(configurations, margin)[~ambiguous], (distances < margin)[~ambiguous]
+        )

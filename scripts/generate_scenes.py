@@ -1,0 +1,24 @@
+"""Write seeded random scenes as scene files (for ``cpr-plan batch`` and the benchmarks)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from planning.scene_file import dump_scene
+from planning.scene_generator import generate_scenes
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--count", type=int, default=100, help="number of scenes (default: 100)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the generator (default: 0)")
+    parser.add_argument("--out", type=Path, required=True, help="folder for the scene files")
+    args = parser.parse_args()
+    for scene in generate_scenes(args.count, args.seed):
+        dump_scene(scene, args.out / f"{scene.name}.yaml")
+    print(f"wrote {args.count} scenes into {args.out}")
+
+
+if __name__ == "__main__":
+    main()
