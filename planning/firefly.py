@@ -100,7 +100,8 @@ class FireflyResult:
         evaluation_history: ``(T + 1,)`` cumulative evaluations after each iteration.
         population: ``(n, d)`` final positions, in the problem's units.
         population_fitness: ``(n,)`` their values.
-        settings: the settings used.
+        settings: the settings used (``None`` for the baseline optimisers of
+            :mod:`planning.baselines`, which return this type too).
     """
 
     x: FloatArray
@@ -111,7 +112,7 @@ class FireflyResult:
     evaluation_history: NDArray[np.int64]
     population: FloatArray
     population_fitness: FloatArray
-    settings: FireflySettings = field(repr=False)
+    settings: FireflySettings | None = field(default=None, repr=False)
 
 
 def firefly_minimize(

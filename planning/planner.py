@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
+from planning.baselines import Optimizer
 from planning.errors import PlanningError
 from planning.firefly import FireflyProgress, FireflyResult, firefly_minimize
 from planning.objective import Breakdown, WaypointObjective
@@ -113,9 +114,12 @@ class PlanResult:
     verification: ck.CurveCheck = field(repr=False)
 
 
-def _moving_joints(
-    robot: ck.Robot, scene: Scene, q_start: FloatArray, q_goal: FloatArray
-) -> NDArray[np.intp]:
+def moving_joints(robot: ck.Robot, scene: Scene, q_start: FloatArray, q_goal: FloatArray) -> NDArray[np.intp]:
+    """Indices of the joints a plan moves.
+
+    ``scene.planner.moving_joints``, or theta1, d2, d3 and each wrist joint whose start and
+    goal values differ.
+    """
     names = scene.planner.moving_joints
     if names is None:
         names = tuple(
@@ -128,7 +132,8 @@ def _moving_joints(
     return np.array([robot.limits.index(n) for n in names], dtype=np.intp)
 
 
-def _endpoint(robot: ck.Robot, world: ck.CollisionWorld, scene: Scene, label: str) -> FloatArray:
+def endpoint(robot: ck.Robot, world: ck.CollisionWorld, scene: Scene, label: str) -> FloatArray:
+    """The configuration of the scene's start or goal; refused if unreachable or inside the margin."""
     target = scene.start if label == "start" else scene.goal
     try:
         q = target.configuration(robot)
@@ -162,6 +167,7 @@ def plan(
     robot: ck.Robot | None = None,
     progress: Callable[[FireflyProgress], None] | None = None,
     threads: int | None = None,
+    optimizer: Optimizer | None = None,
 ) -> PlanResult:
     """Plan a collision-free, jerk-continuous trajectory for ``scene``.
 
@@ -179,6 +185,8 @@ def plan(
         progress: called after every firefly iteration.
         threads: threads of the parallel collision checks (default: up to 2); a batch that
             plans scenes in parallel processes gives each 1.
+        optimizer: another optimiser of :mod:`planning.baselines` on the same objective and
+            evaluation budget (``fireflies x (iterations + 1)``); default: the firefly.
 
     Raises:
         PlanningError: unreachable start or goal, or one inside the margin; bad settings.
@@ -187,10 +195,10 @@ def plan(
     started = time.perf_counter()
     robot = robot or ck.load_cpr(scene.robot)
     world = ck.CollisionWorld(robot, scene.obstacles, num_threads=threads)
-    q_start = _endpoint(robot, world, scene, "start")
-    q_goal = _endpoint(robot, world, scene, "goal")
+    q_start = endpoint(robot, world, scene, "start")
+    q_goal = endpoint(robot, world, scene, "goal")
     settings = scene.planner
-    moving = _moving_joints(robot, scene, q_start, q_goal)
+    moving = moving_joints(robot, scene, q_start, q_goal)
     segments = settings.waypoints + 1
     nominal_duration = scene.duration if scene.duration is not None else float(segments)
     solver = SepticSplineSolver(uniform_knots(segments, nominal_duration), scene.spline)
@@ -206,14 +214,14 @@ def plan(
     )
 
     search_started = time.perf_counter()
-    result = firefly_minimize(
-        objective,
-        objective.lower,
-        objective.upper,
-        settings.firefly(),
-        np.random.default_rng(settings.seed),
-        progress,
-    )
+    rng = np.random.default_rng(settings.seed)
+    if optimizer is None:
+        result = firefly_minimize(
+            objective, objective.lower, objective.upper, settings.firefly(), rng, progress
+        )
+    else:
+        budget = settings.fireflies * (settings.iterations + 1)
+        result = optimizer(objective, objective.lower, objective.upper, budget, rng)
     optimiser_time = time.perf_counter() - search_started
 
     limits = robot.limits

@@ -73,9 +73,9 @@ def text_table(
 
 
 def markdown_table(
-    rows: Sequence[tuple[str, str, str]], headers: tuple[str, str, str] = ("figure", "paper", "ours")
+    rows: Sequence[Sequence[str]], headers: Sequence[str] = ("figure", "paper", "ours")
 ) -> str:
-    """A Markdown table."""
+    """A Markdown table of any number of columns."""
     lines = ["| " + " | ".join(headers) + " |", "|" + "---|" * len(headers)]
     lines += ["| " + " | ".join(row) + " |" for row in rows]
     return "\n".join(lines)

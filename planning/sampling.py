@@ -1,0 +1,161 @@
+"""A sampling-planner baseline: OMPL's RRT-Connect, path simplification, TOPP-RA timing.
+
+The same scene, URDF, collision world and limits as the firefly planner: RRT-Connect
+(``ompl``) searches the moving joints with our coal margin check as state validity,
+OMPL simplifies the path, TOPP-RA (``toppra``) times a cubic spline through it under the
+joints' velocity and acceleration limits (it has no jerk limit), and the same certified
+continuous check verifies the result. ``ompl`` and ``toppra`` are optional peers
+(``pip install '.[bench]'``).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+import cpr_kin as ck
+from planning.planner import endpoint, moving_joints
+from planning.scene import Scene
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class SamplingResult:
+    """Outcome of the RRT-Connect pipeline on one scene.
+
+    Attributes:
+        success: a path was found, timed and verified.
+        reason: why not, when it failed.
+        waypoints: ``(K, nq)`` the simplified path's vertices.
+        duration: trajectory duration [s].
+        min_clearance: certified clearance of the timed trajectory [m].
+        path_length: length of the path in joint space, each joint scaled by its range.
+        max_abs_jerk: largest |jerk| of any joint, from the timed spline (its acceleration
+            jumps at the spline's knots, so this samples its finite pieces).
+        planning_time_s: wall time of search, simplification, timing and verification [s].
+    """
+
+    success: bool
+    reason: str
+    waypoints: FloatArray
+    duration: float
+    min_clearance: float
+    path_length: float
+    max_abs_jerk: float
+    planning_time_s: float
+
+
+def plan_rrt_connect(
+    scene: Scene, robot: ck.Robot | None = None, time_limit_s: float = 2.0, seed: int = 0
+) -> SamplingResult:
+    """Plan ``scene`` with RRT-Connect + simplification + TOPP-RA, then verify."""
+    import toppra
+    import toppra.algorithm
+    import toppra.constraint
+    from ompl import base as ob
+    from ompl import geometric as og
+    from ompl import util as ou
+
+    started = time.perf_counter()
+    robot = robot or ck.load_cpr(scene.robot)
+    world = ck.CollisionWorld(robot, scene.obstacles)
+    q_start, q_goal = endpoint(robot, world, scene, "start"), endpoint(robot, world, scene, "goal")
+    moving = moving_joints(robot, scene, q_start, q_goal)
+    limits = robot.limits
+    empty = np.empty((0, robot.nq))
+
+    def failed(reason: str) -> SamplingResult:
+        return SamplingResult(
+            False, reason, empty, np.nan, np.nan, np.nan, np.nan, time.perf_counter() - started
+        )
+
+    ou.setLogLevel(ou.LogLevel.LOG_NONE)
+    ou.RNG.setSeed(seed + 1)  # OMPL refuses seed 0
+    space = ob.RealVectorStateSpace(int(moving.size))
+    bounds = ob.RealVectorBounds(int(moving.size))
+    for i, j in enumerate(moving):
+        bounds.setLow(i, float(limits.lower[j]))
+        bounds.setHigh(i, float(limits.upper[j]))
+    space.setBounds(bounds)
+    information = ob.SpaceInformation(space)
+
+    def full(state: object) -> FloatArray:
+        q = q_start.copy()
+        q[moving] = [state[i] for i in range(moving.size)]  # type: ignore[index]
+        return q
+
+    def valid(state: object) -> bool:
+        return not bool(world.margin_violated(full(state)[None], scene.safety_margin)[0])
+
+    information.setStateValidityChecker(valid)
+    information.setStateValidityCheckingResolution(0.002)  # of the space's extent, ~1.2 cm in theta1
+    information.setup()
+    start_state, goal_state = space.allocState(), space.allocState()
+    for i, j in enumerate(moving):
+        start_state[i], goal_state[i] = float(q_start[j]), float(q_goal[j])
+    setup = og.SimpleSetup(information)
+    setup.setStartAndGoalStates(start_state, goal_state)
+    setup.setPlanner(og.RRTConnect(information))
+    if not setup.solve(time_limit_s) or not setup.haveExactSolutionPath():
+        return failed(f"RRT-Connect found no path in {time_limit_s} s")
+    setup.simplifySolution()
+    path = setup.getSolutionPath()
+    waypoints = np.array([full(path.getState(i)) for i in range(path.getStateCount())])
+
+    steps = np.linalg.norm(np.diff(waypoints / limits.range, axis=0), axis=1)
+    keep = np.concatenate([[True], steps > 1e-9])
+    waypoints = waypoints[keep]
+    s_grid = np.concatenate([[0.0], np.cumsum(steps[steps > 1e-9])])
+    if len(waypoints) < 2:
+        return failed("the simplified path is a single point")
+    geometric = toppra.SplineInterpolator(s_grid / s_grid[-1], waypoints, bc_type="clamped")
+    constraints = [
+        toppra.constraint.JointVelocityConstraint(np.column_stack([-limits.velocity, limits.velocity])),
+        toppra.constraint.JointAccelerationConstraint(
+            np.column_stack([-limits.acceleration, limits.acceleration])
+        ),
+    ]
+    timed = toppra.algorithm.TOPPRA(
+        constraints, geometric, gridpoints=np.linspace(0, 1, 401)
+    ).compute_trajectory(0, 0)
+    if timed is None:
+        return failed("TOPP-RA found no timing")
+    duration = float(timed.duration)
+    dense = np.linspace(0.0, duration, 4001)
+    positions = np.asarray(timed(dense))
+    speeds = np.abs(np.asarray(timed(dense, 1))).max(axis=0) * 1.05 + 1e-9  # sampled, with 5 % slack
+    check = ck.check_curve(
+        world,
+        lambda t: np.asarray(timed(np.asarray(t))),
+        0.0,
+        duration,
+        speeds,
+        scene.safety_margin,
+        scene.planner.verify_step_m,
+    )
+    jerk = np.diff(np.asarray(timed(dense, 2)), axis=0) / np.diff(dense)[:, None]
+    length = float(np.linalg.norm(np.diff(positions / limits.range, axis=0), axis=1).sum())
+    inside = bool(np.all(positions >= limits.lower - 1e-9) and np.all(positions <= limits.upper + 1e-9))
+    reason = (
+        ""
+        if check.accepted and inside
+        else (
+            f"certified clearance {check.certified_min_m:.4f} m below the margin"
+            if not check.accepted
+            else "leaves a joint range"
+        )
+    )
+    return SamplingResult(
+        success=check.accepted and inside,
+        reason=reason,
+        waypoints=waypoints,
+        duration=duration,
+        min_clearance=check.certified_min_m,
+        path_length=length,
+        max_abs_jerk=float(np.abs(jerk).max()),
+        planning_time_s=time.perf_counter() - started,
+    )

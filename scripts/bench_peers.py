@@ -1,0 +1,231 @@
+"""Benchmark against peers: the same objective, budget and scenes, side by side in one run.
+
+1. Optimisers on the paper case's objective and budget (n = 50, 2550 evaluations), seeds
+   0..9: our firefly (sweep) against NiaPy's FireflyAlgorithm, PSO, harmony search, SciPy's
+   differential evolution and CMA-ES. Target: ours >= 10x faster than NiaPy's FA with an
+   equal or better median fitness.
+2. Planners on ``--scenes`` generated scenes (seeded): the firefly planner, the same
+   pipeline with each baseline optimiser, and OMPL's RRT-Connect + simplification + TOPP-RA.
+   Every result is verified by the same certified continuous check. Target: our success
+   rate >= RRT-Connect's.
+
+Prints the tables and writes them as Markdown to ``--out``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+from collections.abc import Callable
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+import cpr_kin as ck
+from planning import baselines
+from planning.errors import PlanningError
+from planning.objective import WaypointObjective
+from planning.planner import endpoint, moving_joints, plan
+from planning.report import markdown_table
+from planning.scene import Scene, paper_scene
+from planning.scene_generator import generate_scenes
+from planning.spline import SepticSplineSolver, uniform_knots
+
+
+def optimisers(scene: Scene) -> dict[str, baselines.Optimizer]:
+    settings = scene.planner.firefly()
+    found: dict[str, baselines.Optimizer] = {
+        "firefly (ours)": baselines.firefly(settings),
+        "PSO": baselines.particle_swarm(),
+        "harmony search": baselines.harmony_search(),
+        "differential evolution (scipy)": baselines.differential_evolution(),
+    }
+    peers: list[tuple[str, str, Callable[[], baselines.Optimizer]]] = [
+        ("CMA-ES (cma)", "cma", baselines.cma_es),
+        ("NiaPy FireflyAlgorithm", "niapy", lambda: baselines.niapy_firefly(settings)),
+    ]
+    for name, module, make in peers:
+        try:
+            __import__(module)
+        except ImportError:
+            print(f"  ({name}: not installed, skipped)")
+            continue
+        found[name] = make()
+    return found
+
+
+def paper_objective(robot: ck.Robot, scene: Scene) -> WaypointObjective:
+    world = ck.CollisionWorld(robot, scene.obstacles)
+    q_start, q_goal = endpoint(robot, world, scene, "start"), endpoint(robot, world, scene, "goal")
+    solver = SepticSplineSolver(
+        uniform_knots(scene.planner.waypoints + 1, scene.duration or 4.0), scene.spline
+    )
+    moving = moving_joints(robot, scene, q_start, q_goal)
+    return WaypointObjective(
+        world, q_start, q_goal, moving, scene.safety_margin, scene.planner, solver, timed=True
+    )
+
+
+def percentile(values: list[float], q: float) -> float:
+    return float(np.percentile(values, q)) if values else float("nan")
+
+
+def optimiser_table(robot: ck.Robot, seeds: int) -> tuple[list[list[str]], dict[str, float]]:
+    scene = paper_scene()
+    objective = paper_objective(robot, scene)
+    budget = scene.planner.fireflies * (scene.planner.iterations + 1)
+    times: dict[str, list[float]] = {}
+    fitness: dict[str, list[float]] = {}
+    for name, optimiser in optimisers(scene).items():
+        for seed in range(seeds):
+            started = time.perf_counter()
+            result = optimiser(
+                objective, objective.lower, objective.upper, budget, np.random.default_rng(seed)
+            )
+            times.setdefault(name, []).append(time.perf_counter() - started)
+            fitness.setdefault(name, []).append(result.fitness)
+    ours = statistics.median(times["firefly (ours)"])
+    rows = [
+        [
+            name,
+            f"{statistics.median(times[name]):.3f} s",
+            f"{statistics.median(times[name]) / ours:.1f}",
+            f"{statistics.median(fitness[name]):.4f}",
+            f"{sum(f <= objective.t_max for f in fitness[name])}/{seeds}",
+        ]
+        for name in times
+    ]
+    medians = {name: statistics.median(times[name]) for name in times}
+    return rows, medians
+
+
+def planner_rows(robot: ck.Robot, scenes: list[Scene], time_limit_s: float) -> list[list[str]]:
+    methods: dict[str, Callable[[Scene], dict[str, float] | None]] = {}
+
+    def pipeline(optimiser: baselines.Optimizer | None) -> Callable[[Scene], dict[str, float] | None]:
+        def run(scene: Scene) -> dict[str, float] | None:
+            try:
+                result = plan(scene, robot, optimizer=optimiser)
+            except PlanningError:
+                return None
+            trajectory = result.trajectory
+            dense = trajectory(np.linspace(0, trajectory.duration, 2001))
+            length = float(np.linalg.norm(np.diff(dense / robot.limits.range, axis=0), axis=1).sum())
+            jerk = max(
+                float(np.max(np.abs(trajectory.extrema(3).minimum))),
+                float(np.max(trajectory.extrema(3).maximum)),
+            )
+            return {
+                "time": result.metrics.planning_time_s,
+                "duration": result.metrics.duration,
+                "length": length,
+                "jerk": jerk,
+                "clearance": result.metrics.min_clearance,
+            }
+
+        return run
+
+    sample = scenes[0]
+    for name, optimiser in optimisers(sample).items():
+        methods[f"{name} + septic spline"] = pipeline(None if name == "firefly (ours)" else optimiser)
+    try:
+        from planning.sampling import plan_rrt_connect
+
+        __import__("ompl")
+        __import__("toppra")
+
+        def rrt(scene: Scene) -> dict[str, float] | None:
+            result = plan_rrt_connect(scene, robot, time_limit_s=time_limit_s, seed=scene.planner.seed)
+            if not result.success:
+                return None
+            return {
+                "time": result.planning_time_s,
+                "duration": result.duration,
+                "length": result.path_length,
+                "jerk": result.max_abs_jerk,
+                "clearance": result.min_clearance,
+            }
+
+        methods["RRT-Connect (OMPL) + TOPP-RA"] = rrt
+    except ImportError:
+        print("  (OMPL or TOPP-RA not installed: RRT-Connect skipped)")
+
+    results: dict[str, list[dict[str, float] | None]] = {name: [] for name in methods}
+    for scene in scenes:
+        for name, method in methods.items():
+            results[name].append(method(scene))
+    ours = statistics.median([r["time"] for r in results[next(iter(results))] if r] or [float("nan")])
+    rows: list[list[str]] = []
+    for name, outcomes in results.items():
+        ok = [r for r in outcomes if r is not None]
+
+        def med(key: str, ok: list[dict[str, float]] = ok) -> float:
+            return statistics.median([r[key] for r in ok]) if ok else float("nan")
+
+        times = [r["time"] for r in ok]
+        rows.append(
+            [
+                name,
+                f"{len(ok)}/{len(outcomes)}",
+                f"{med('time'):.3f} / {percentile(times, 90):.3f} s",
+                f"{med('time') / ours:.2f}",
+                f"{med('duration'):.2f} s",
+                f"{med('length'):.3f}",
+                f"{med('jerk'):.3g}",
+                f"{med('clearance'):.3f} m",
+            ]
+        )
+    return rows
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--scenes", type=int, default=50, help="generated scenes (default: 50)")
+    parser.add_argument(
+        "--seeds", type=int, default=10, help="seeds of the optimiser comparison (default: 10)"
+    )
+    parser.add_argument("--scene-seed", type=int, default=0, help="seed of the scene generator (default: 0)")
+    parser.add_argument("--rrt-time", type=float, default=2.0, help="RRT-Connect time limit [s] (default: 2)")
+    parser.add_argument("--out", type=Path, default=Path("out/bench_peers.md"), help="Markdown report")
+    args = parser.parse_args()
+    robot = ck.load_cpr()
+
+    print(f"1. Optimisers on the paper case's objective, budget 2550 evaluations, seeds 0..{args.seeds - 1}")
+    rows, medians = optimiser_table(robot, args.seeds)
+    headers1 = ("optimiser", "median time", "time / ours", "median fitness", "feasible")
+    print(markdown_table(rows, headers1))
+    if "NiaPy FireflyAlgorithm" in medians:
+        ratio = medians["NiaPy FireflyAlgorithm"] / medians["firefly (ours)"]
+        print(f"ours vs NiaPy's FA: {ratio:.1f}x faster (target >= 10x)")
+
+    print(f"\n2. Planners on {args.scenes} generated scenes (generator seed {args.scene_seed}), all verified")
+    scenes = [
+        replace(s, planner=replace(s.planner)) for s in generate_scenes(args.scenes, args.scene_seed, robot)
+    ]
+    headers2 = (
+        "method",
+        "success",
+        "median / p90 time",
+        "time / ours",
+        "duration",
+        "path length",
+        "max abs jerk",
+        "min clearance",
+    )
+    rows2 = planner_rows(robot, scenes, args.rrt_time)
+    print(markdown_table(rows2, headers2))
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(
+        "# Benchmark against peers\n\n## Optimisers (paper case objective)\n\n"
+        + markdown_table(rows, headers1)
+        + f"\n\n## Planners ({args.scenes} generated scenes)\n\n"
+        + markdown_table(rows2, headers2)
+        + "\n"
+    )
+    print(f"\nwrote {args.out}")
+
+
+if __name__ == "__main__":
+    main()
