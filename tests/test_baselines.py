@@ -60,11 +60,12 @@ def test_budget_bounds_and_progress(name: str, factory: object) -> None:
 
 @pytest.mark.parametrize("name", ["pso", "harmony", "de"])
 def test_baselines_plan_the_paper_case(robot: ck.Robot, name: str) -> None:
-    optimiser = {
+    factories: dict[str, Callable[[], baselines.Optimizer]] = {
         "pso": baselines.particle_swarm,
         "harmony": baselines.harmony_search,
         "de": baselines.differential_evolution,
-    }[name]()
+    }
+    optimiser = factories[name]()
     result = plan(paper_scene(1), robot, optimizer=optimiser)
     assert result.verification.accepted and result.metrics.min_clearance >= 0.1
     assert result.metrics.evaluations <= 2550
