@@ -1,14 +1,15 @@
 # The two commands of the README:
 #   make demo   set up .venv and run the paper case
 #   make test   set up .venv and run the test suite
-# `make lint` runs ruff and mypy; `make bench` the benchmarks.
+# `make lint` runs ruff and mypy; `make bench` the benchmarks; `make bench-peers` the
+# comparison with peer optimisers and planners (several minutes).
 
 PYTHON ?= python3
 VENV ?= .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test lint format bench clean
+.PHONY: demo test lint format bench bench-peers clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -35,6 +36,9 @@ bench: $(STAMP)
 	$(PY) scripts/bench_clearance.py
 	$(PY) scripts/bench_spline.py
 	$(PY) scripts/bench_planner.py
+
+bench-peers: $(STAMP)
+	$(PY) scripts/bench_peers.py --scenes 50 --out out/bench_peers.md
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache .mypy_cache .ruff_cache
