@@ -75,14 +75,15 @@ class PlannerSettings:
             joint when start and goal differ in it.
     """
 
-    fireflies: int = 50
-    iterations: int = 50
-    alpha: float = 1.0
-    beta0: float = 0.5
-    gamma: float = 1.0
-    theta: float = 0.97
+    # the firefly's parameters and their defaults are FireflySettings'
+    fireflies: int = FireflySettings.fireflies
+    iterations: int = FireflySettings.iterations
+    alpha: float = FireflySettings.alpha
+    beta0: float = FireflySettings.beta0
+    gamma: float = FireflySettings.gamma
+    theta: float = FireflySettings.theta
     waypoints: int = 3
-    mode: Mode = "sweep"
+    mode: Mode = FireflySettings.mode
     fitness: Fitness = "clearance"
     seed: int = 0
     path: PathKind = "spline"

@@ -112,24 +112,27 @@ class TargetSpec(_Strict):
         return self
 
 
-class PlannerSpec(_Strict):
-    """The ``planner:`` block; see :class:`planning.scene.PlannerSettings`."""
+_P = PlannerSettings  # the defaults are the settings' own
 
-    fireflies: Annotated[int, Field(ge=2)] = 50
-    iterations: Annotated[int, Field(ge=0)] = 50
-    alpha: NonNegative = 1.0
-    beta0: NonNegative = 0.5
-    gamma: NonNegative = 1.0
-    theta: Annotated[float, Field(gt=0, le=1)] = 0.97
-    waypoints: Annotated[int, Field(ge=1)] = 3
-    mode: Literal["sweep", "sequential"] = "sweep"
-    fitness: Literal["clearance", "paper"] = "clearance"
-    seed: Annotated[int, Field(ge=0)] = 0
-    path: Literal["spline", "ptp"] = "spline"
-    ipo: Positive = 0.012
-    fitness_samples: Annotated[int, Field(ge=2)] = 64
-    verify_step_m: Positive = 0.005
-    max_node_deviation: Positive | None = None
+
+class PlannerSpec(_Strict):
+    """The ``planner:`` block; see :class:`planning.scene.PlannerSettings` (same defaults)."""
+
+    fireflies: Annotated[int, Field(ge=2)] = _P.fireflies
+    iterations: Annotated[int, Field(ge=0)] = _P.iterations
+    alpha: NonNegative = _P.alpha
+    beta0: NonNegative = _P.beta0
+    gamma: NonNegative = _P.gamma
+    theta: Annotated[float, Field(gt=0, le=1)] = _P.theta
+    waypoints: Annotated[int, Field(ge=1)] = _P.waypoints
+    mode: Literal["sweep", "sequential"] = _P.mode
+    fitness: Literal["clearance", "paper"] = _P.fitness
+    seed: Annotated[int, Field(ge=0)] = _P.seed
+    path: Literal["spline", "ptp"] = _P.path
+    ipo: Positive = _P.ipo
+    fitness_samples: Annotated[int, Field(ge=2)] = _P.fitness_samples
+    verify_step_m: Positive = _P.verify_step_m
+    max_node_deviation: Positive | None = _P.max_node_deviation
     moving_joints: list[Literal["theta1", "d2", "d3", "theta4", "theta5"]] | None = None
 
 
