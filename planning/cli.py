@@ -174,7 +174,13 @@ def _cmd_show(args: argparse.Namespace) -> int:
     try:
         document = read_trajectory(args.trajectory)
         scene = parse_scene(document.scene, source=f"{args.trajectory} (scene)")
-        robot = ck.load_cpr(document.robot if Path(document.robot).is_file() else None)
+        recorded = Path(document.robot)
+        if not recorded.is_file():
+            print(
+                f"cpr-plan show: note: the recorded URDF '{recorded}' is not here; using the bundled CPR",
+                file=sys.stderr,
+            )
+        robot = ck.load_cpr(recorded if recorded.is_file() else None)
     except (PlanningError, ck.CprKinError) as exc:
         raise _CommandError(EXIT_INVALID, str(exc)) from None
     if args.html is not None:
