@@ -228,7 +228,7 @@ def plan(
     # the best, then the final population's candidates the fitness found feasible (an
     # infeasible one will not pass the verification), best first
     order = np.argsort(result.population_fitness, kind="stable")
-    feasible = objective.breakdown(result.population).feasible
+    feasible = result.population_fitness <= objective.t_max  # both fitnesses rank feasible at or below t_max
     candidates = [result.x] + [result.population[k] for k in order if feasible[k]]
     first: Verification | None = None
     tried = 0

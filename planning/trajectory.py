@@ -98,6 +98,7 @@ class Trajectory:
     knots: FloatArray
     coefficients: FloatArray
     _derivatives: dict[int, FloatArray] = field(default_factory=dict, init=False, repr=False, compare=False)
+    _extrema: dict[int, Extrema] = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         knots = np.array(self.knots, dtype=float)
@@ -180,8 +181,11 @@ class Trajectory:
         """Exact extrema of the ``derivative``-th derivative per joint.
 
         Candidates are the segment ends and the real roots of the next derivative inside
-        each segment; no sampling is involved.
+        each segment; no sampling is involved. Computed once per order (the trajectory is
+        immutable).
         """
+        if derivative in self._extrema:
+            return self._extrema[derivative]
         n, nj, order = self.coefficients.shape
         h = np.diff(self.knots)
         value = self._coefficients(derivative)
@@ -200,7 +204,10 @@ class Trajectory:
                     minimum[j], t_min[j] = v[k_lo], self.knots[i] + local[k_lo]
                 if v[k_hi] > maximum[j]:
                     maximum[j], t_max[j] = v[k_hi], self.knots[i] + local[k_hi]
-        return Extrema(derivative, minimum, maximum, t_min, t_max)
+        for array in (minimum, maximum, t_min, t_max):
+            array.setflags(write=False)
+        self._extrema[derivative] = Extrema(derivative, minimum, maximum, t_min, t_max)
+        return self._extrema[derivative]
 
     @cached_property
     def integrated_squared_jerk(self) -> FloatArray:
