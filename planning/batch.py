@@ -21,9 +21,10 @@ import joblib
 
 import cpr_kin as ck
 from planning.errors import PlanningError
-from planning.outputs import plan_files, write_files
+from planning.outputs import plan_files
 from planning.planner import NoTrajectoryFoundError, plan
 from planning.scene_file import load_scene
+from planning.trajectory_io import write_files
 
 STATUS_EXIT = {"ok": 0, "invalid": 2, "no_trajectory": 3}
 SUMMARY_FIELDS = (

@@ -23,12 +23,12 @@ import cpr_kin as ck
 from planning import artifacts
 from planning.errors import PlanningError
 from planning.firefly import FireflyProgress
-from planning.outputs import plan_files, summary, write_files
+from planning.outputs import plan_files, summary
 from planning.planner import NoTrajectoryFoundError, plan
 from planning.report import paper_rows, text_table
 from planning.scene import Scene
 from planning.scene_file import load_scene, paper_scene_path, parse_scene
-from planning.trajectory_io import read_trajectory
+from planning.trajectory_io import read_trajectory, write_files
 from planning.verification import verify_trajectory
 
 EXIT_OK, EXIT_INVALID, EXIT_NO_TRAJECTORY = 0, 2, 3
@@ -42,27 +42,27 @@ class _CommandError(Exception):
         self.code = code
 
 
+def _terminal_bar(total: int, desc: str, unit: str, leave: bool = True) -> Any:
+    """A tqdm bar sized to the terminal.
+
+    A terminal that reports a size of 0 (a bare pty) would make tqdm draw nothing.
+    """
+    from tqdm import tqdm
+
+    size = shutil.get_terminal_size((80, 24))
+    return tqdm(total=total, desc=desc, unit=unit, leave=leave, ncols=size.columns, nrows=size.lines)
+
+
 def _progress(enabled: bool) -> tuple[Callable[[FireflyProgress], None] | None, Callable[[], None]]:
     """A tqdm bar over the firefly iterations when enabled (stdout is a terminal)."""
     if not enabled:
         return None, lambda: None
-    from tqdm import tqdm
-
     bar: Any = None
 
     def update(progress: FireflyProgress) -> None:
         nonlocal bar
         if bar is None:
-            # a terminal that reports a size of 0 (a bare pty) makes tqdm draw nothing
-            size = shutil.get_terminal_size((80, 24))
-            bar = tqdm(
-                total=progress.iterations,
-                desc="firefly",
-                unit="it",
-                leave=False,
-                ncols=size.columns,
-                nrows=size.lines,
-            )
+            bar = _terminal_bar(progress.iterations, "firefly", "it", leave=False)
         else:
             bar.update(1)
         bar.set_postfix(best=f"{progress.best:.4g}")
@@ -227,10 +227,7 @@ def _cmd_batch(args: argparse.Namespace) -> int:
         raise _CommandError(EXIT_INVALID, str(exc)) from None
     bar: Any = None
     if sys.stdout.isatty() and not args.json:
-        from tqdm import tqdm
-
-        size = shutil.get_terminal_size((80, 24))
-        bar = tqdm(total=len(paths), desc="scenes", unit="scene", ncols=size.columns, nrows=size.lines)
+        bar = _terminal_bar(len(paths), "scenes", "scene")
     try:
         tick = None if bar is None else (lambda _item: bar.update(1))
         items = batch.plan_batch(paths, args.out, args.workers, args.scheduler, tick)
@@ -264,18 +261,11 @@ def _cmd_batch(args: argparse.Namespace) -> int:
             )
             for i in items
         ]
-        print(_table(("scene", "status", "exit", "duration", "clearance", "time"), rows))
+        print(text_table(rows, ("scene", "status", "exit", "duration", "clearance", "time")))
         print(f"{len(items) - len(failed)}/{len(items)} scenes planned; summary: {args.out / 'summary.csv'}")
         for item in failed:
             print(f"  {item.scene} (exit class {item.exit_class}): {item.message}")
     return EXIT_OK if not failed else EXIT_NO_TRAJECTORY
-
-
-def _table(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
-    widths = [max(len(str(r[i])) for r in [headers, *rows]) for i in range(len(headers))]
-    lines = ["  ".join(str(c).ljust(w) for c, w in zip(row, widths, strict=True)) for row in [headers, *rows]]
-    lines.insert(1, "  ".join("-" * w for w in widths))
-    return "\n".join(lines)
 
 
 def _parser() -> argparse.ArgumentParser:

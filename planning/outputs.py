@@ -1,11 +1,11 @@
-"""The files a plan produces, rendered in memory and written all at once, or not at all."""
+"""The files a plan produces, rendered in memory.
+
+:func:`planning.trajectory_io.write_files` then writes them all at once, or none.
+"""
 
 from __future__ import annotations
 
 import json
-import os
-import tempfile
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -13,24 +13,6 @@ import numpy as np
 from planning.planner import PlanResult
 from planning.report import markdown_table, paper_rows
 from planning.trajectory_io import samples_csv, trajectory_document
-
-
-def write_files(folder: Path, files: dict[str, str | bytes]) -> list[Path]:
-    """Write every file into ``folder``, or none: all go to temporary names first, then are renamed."""
-    folder.mkdir(parents=True, exist_ok=True)
-    temporary: list[tuple[str, Path]] = []
-    try:
-        for name, content in files.items():
-            handle, temporary_name = tempfile.mkstemp(prefix=f".{name}.", dir=folder)
-            with os.fdopen(handle, "wb") as stream:
-                stream.write(content.encode("utf-8") if isinstance(content, str) else content)
-            temporary.append((name, Path(temporary_name)))
-        for name, written in temporary:
-            os.replace(written, folder / name)
-    finally:
-        for _, leftover in temporary:
-            leftover.unlink(missing_ok=True)
-    return [folder / name for name in files]
 
 
 def report_markdown(result: PlanResult, paper: bool = False) -> str:

@@ -61,14 +61,11 @@ def paper_rows(result: PlanResult) -> list[tuple[str, str, str]]:
     return rows
 
 
-def text_table(
-    rows: Sequence[tuple[str, str, str]], headers: tuple[str, str, str] = ("figure", "paper", "ours")
-) -> str:
-    """A fixed-width table."""
-    widths = [max(len(r[i]) for r in [headers, *rows]) for i in range(3)]
-    lines = ["  ".join(h.ljust(w) for h, w in zip(headers, widths, strict=True))]
-    lines.append("  ".join("-" * w for w in widths))
-    lines += ["  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)) for row in rows]
+def text_table(rows: Sequence[Sequence[str]], headers: Sequence[str] = ("figure", "paper", "ours")) -> str:
+    """A fixed-width table of any number of columns."""
+    widths = [max(len(str(r[i])) for r in [headers, *rows]) for i in range(len(headers))]
+    lines = ["  ".join(str(c).ljust(w) for c, w in zip(row, widths, strict=True)) for row in [headers, *rows]]
+    lines.insert(1, "  ".join("-" * w for w in widths))
     return "\n".join(lines)
 
 

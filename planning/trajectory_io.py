@@ -28,18 +28,28 @@ FloatArray = NDArray[np.float64]
 FORMAT = "cpr-trajectory/1"
 
 
+def write_files(folder: Path, files: dict[str, str | bytes]) -> list[Path]:
+    """Write every file into ``folder``, or none: all go to temporary names first, then are renamed."""
+    folder.mkdir(parents=True, exist_ok=True)
+    temporary: list[tuple[str, Path]] = []
+    try:
+        for name, content in files.items():
+            handle, temporary_name = tempfile.mkstemp(prefix=f".{name}.", dir=folder)
+            with os.fdopen(handle, "wb") as stream:
+                stream.write(content.encode("utf-8") if isinstance(content, str) else content)
+            temporary.append((name, Path(temporary_name)))
+        for name, written in temporary:
+            os.replace(written, folder / name)
+    finally:
+        for _, leftover in temporary:
+            leftover.unlink(missing_ok=True)
+    return [folder / name for name in files]
+
+
 def atomic_write_text(path: Path, text: str) -> None:
     """Write ``text`` to ``path`` through a temporary file and a rename."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    try:
-        with os.fdopen(handle, "w", encoding="utf-8", newline="") as stream:
-            stream.write(text)
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
+    write_files(path.parent, {path.name: text})
 
 
 def obstacle_to_dict(obstacle: ck.Obstacle) -> dict[str, Any]:

@@ -17,10 +17,11 @@ from pathlib import Path
 import cpr_kin as ck
 from planning import artifacts
 from planning.errors import PlanningError
+from planning.outputs import plan_files
 from planning.planner import PlanResult, plan
-from planning.report import markdown_table, paper_rows, text_table
+from planning.report import paper_rows, text_table
 from planning.scene import paper_scene
-from planning.trajectory_io import atomic_write_text, write_samples, write_trajectory
+from planning.trajectory_io import write_files
 
 
 def seed_summary(robot: ck.Robot, seeds: int) -> tuple[list[tuple[int, str]], list[PlanResult]]:
@@ -74,30 +75,15 @@ def main(argv: list[str] | None = None) -> int:
     if times:
         print(f"  median planning time {statistics.median(times):.3f} s")
 
-    args.out.mkdir(parents=True, exist_ok=True)
-    write_trajectory(result, args.out / "trajectory.json")
-    write_samples(result, args.out / "samples.csv")
-    for name, data in artifacts.plot_files(result).items():
-        (args.out / name).write_bytes(data)
-    scene = result.scene
-    html = artifacts.viewer_html(
-        robot, scene.obstacles, scene.safety_margin, result.trajectory, result.waypoints
-    )
-    atomic_write_text(args.out / "viewer.html", html)
-    report = [
-        "# Paper case",
-        "",
-        f"Seed {args.seed}; scene and method of DESIGN.md section 4. Trajectory: `trajectory.json`, "
-        "samples every IPO period: `samples.csv`.",
-        "",
-        markdown_table(rows),
-        "",
-        f"Seeds 0..{args.seeds - 1}: {len(successes)}/{args.seeds} verified.",
+    files = plan_files(result, paper=True, plots=True, html=True)
+    seeds = [
+        f"## Seeds 0..{args.seeds - 1}: {count} verified",
         "",
         *[f"- seed {seed}: {line}" for seed, line in lines],
         "",
     ]
-    atomic_write_text(args.out / "report.md", "\n".join(report))
+    files["report.md"] = str(files["report.md"]) + "\n" + "\n".join(seeds)
+    write_files(args.out, files)
     print(
         f"\nwrote into {args.out}: trajectory.json, samples.csv, report.md, viewer.html (open in a browser),"
     )
