@@ -152,6 +152,7 @@ class CollisionWorld:
         self._pool: Any = None
         self._pool_margin: float | None = None
         self._reach_distance = self._pair_reach_distances()
+        self._culled_data: dict[tuple[bool, ...], Any] = {}
 
     def _pair_reach_distances(self) -> FloatArray:
         """Per pair, a lower bound of its distance over every configuration [m].
@@ -164,24 +165,23 @@ class CollisionWorld:
         reach = geometry_reach(robot.model, robot.collision_model, robot.limits.lower, robot.limits.upper)
         request, distances = coal.DistanceRequest(), []
         for g, k in self._pairs:
-            bound = reach[robot.geometries[g].index]
-            low, high = bound.points.min(axis=0), bound.points.max(axis=0)
-            centre = (low + high) / 2
-            half = float(np.linalg.norm(high - low)) / 2
-            axis = (high - low) / (2 * half) if half > 0 else np.array([0.0, 0.0, 1.0])
-            rotation = pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), axis).matrix()
-            capsule = coal.Capsule(bound.ball, 2 * half)
             obstacle = self.obstacles[k]
-            result = coal.DistanceResult()
-            coal.distance(
-                capsule,
-                coal.Transform3s(rotation, centre),
-                obstacle.geometry(),
-                coal.Transform3s(obstacle.placement.rotation, obstacle.placement.translation),
-                request,
-                result,
-            )
-            distances.append(result.min_distance)
+            placement = coal.Transform3s(obstacle.placement.rotation, obstacle.placement.translation)
+            bound = -np.inf  # every hull gives a lower bound: keep the largest
+            for hull in reach[robot.geometries[g].index].hulls:
+                centre, axis, half, radius = hull.capsule()
+                rotation = pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), axis).matrix()
+                result = coal.DistanceResult()
+                coal.distance(
+                    coal.Capsule(radius, 2 * half),
+                    coal.Transform3s(rotation, centre),
+                    obstacle.geometry(),
+                    placement,
+                    request,
+                    result,
+                )
+                bound = max(bound, result.min_distance)
+            distances.append(bound)
         return np.array(distances)
 
     @property
@@ -236,18 +236,22 @@ class CollisionWorld:
                 index_column[k] = pair
         return BatchClearance(clearance_m=clearance, closest_pair=closest)
 
-    def min_clearance_batch(self, q: ArrayLike) -> tuple[FloatArray, IntArray]:
+    def min_clearance_batch(self, q: ArrayLike, below_m: float | None = None) -> tuple[FloatArray, IntArray]:
         """Smallest distance over every pair [m] and the index of that pair, ``(N,)`` each.
 
         One coal query per configuration (half the cost of :meth:`clearance_batch`) when
-        the groups need not be told apart.
+        the groups need not be told apart. With ``below_m`` [m], pairs that stay at least
+        that far apart in every configuration (their reach, see :mod:`cpr_kin.reach`) are
+        skipped: a distance below ``below_m`` is exact, a larger one may be reported as
+        ``inf`` with pair ``-1`` (what a caller wants who asks only where a margin is violated).
         """
         batch = self._check_batch(q)
         n = len(batch)
         clearance = np.full(n, np.inf)
         closest = np.full(n, -1, dtype=np.int64)
-        if self._pairs:
-            model, data, gmodel, gdata = self.robot.model, self._data, self.geometry_model, self._all
+        gdata = self._all if below_m is None else self._culled(below_m)
+        if gdata is not None:
+            model, data, gmodel = self.robot.model, self._data, self.geometry_model
             results = gdata.distanceResults
             compute = pin.computeDistances
             for k in range(n):
@@ -255,6 +259,24 @@ class CollisionWorld:
                 clearance[k] = results[pair].min_distance
                 closest[k] = pair
         return clearance, closest
+
+    def _culled(self, below_m: float) -> Any:
+        """Geometry data with only the pairs that can come closer than ``below_m`` [m] active.
+
+        ``None`` when no pair can.
+        """
+        if not np.isfinite(below_m):
+            raise CprKinError(f"distance bound {below_m} m must be finite")
+        near = self._reach_distance <= below_m
+        if not near.any():
+            return None
+        key = tuple(near.tolist())
+        if key not in self._culled_data:
+            gdata = self.geometry_model.createData()
+            for p, active in enumerate(near):
+                (gdata.activateCollisionPair if active else gdata.deactivateCollisionPair)(p)
+            self._culled_data[key] = gdata
+        return self._culled_data[key]
 
     def _check_batch(self, q: ArrayLike) -> FloatArray:
         batch = np.asarray(q, dtype=float)
@@ -291,5 +313,10 @@ class CollisionWorld:
                     else:
                         gdata.activateCollisionPair(p)
             self._pool_margin = margin_m
-        result = pin.computeCollisionsInParallel(self.num_threads, self._pool, np.asfortranarray(batch.T))
+        result = pin.computeCollisionsInParallel(
+            self.num_threads,
+            self._pool,
+            np.asfortranarray(batch.T),
+            True,  # stop at a configuration's first hit
+        )
         return np.asarray(result, dtype=bool)

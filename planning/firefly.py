@@ -204,13 +204,23 @@ def firefly_minimize(
 def _sweep(
     u: FloatArray, f: FloatArray, alpha: float, settings: FireflySettings, rng: np.random.Generator
 ) -> FloatArray:
-    """One synchronous sweep: every firefly moves towards each brighter one, in order."""
+    """One synchronous sweep: every firefly moves towards each brighter one, in order.
+
+    Each firefly's path depends only on its own position and the attractors' snapshot, so
+    the loop runs over attractors and moves every firefly at once.
+    """
     n, d = u.shape
-    kicks = alpha * (rng.random((n, n, d)) - 0.5)  # one (n, d) draw per attractor, for everyone
     dimmer = f[None, :] > f[:, None]  # dimmer[j, i]: firefly i moves towards j
+    kicks = rng.random((n, n, d))  # one (n, d) draw per attractor, for everyone
+    kicks -= 0.5
+    kicks *= alpha * dimmer[:, :, None]  # no kick towards a dimmer firefly
+    attraction = settings.beta0 * dimmer
+    minus_gamma = -settings.gamma
     moved = u.copy()
     for j in np.flatnonzero(dimmer.any(axis=1)):
-        delta = u[j] - moved  # attractors stay where the sweep found them
-        beta = settings.beta0 * np.exp(-settings.gamma * np.einsum("ij,ij->i", delta, delta))
-        moved += dimmer[j][:, None] * (beta[:, None] * delta + kicks[j])
-    return np.asarray(np.clip(moved, 0.0, 1.0))
+        step = u[j] - moved  # attractors stay where the sweep found them
+        beta = attraction[j] * np.exp(minus_gamma * np.einsum("ij,ij->i", step, step))
+        step *= beta[:, None]
+        step += kicks[j]
+        moved += step
+    return np.clip(moved, 0.0, 1.0, out=moved)

@@ -38,10 +38,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
+from planning.piecewise_sampler import PiecewiseSampler
 from planning.ptp import ptp_time, trapezoid_time
 from planning.scene import PlannerSettings
 from planning.spline import SepticSplineSolver
-from planning.trajectory import derivative_coefficients
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
@@ -80,26 +80,6 @@ class Breakdown:
     limit_excess: FloatArray
     node_deviation: FloatArray
     min_clearance_m: FloatArray
-
-
-class _Sampler:
-    """Evaluates piecewise polynomials at fixed times with one matrix product per segment."""
-
-    def __init__(self, knots: FloatArray, times: FloatArray, order: int) -> None:
-        segment = np.clip(np.searchsorted(knots, times, side="right") - 1, 0, len(knots) - 2)
-        local = times - knots[segment]
-        self.groups = [
-            (np.flatnonzero(segment == i), local[segment == i][:, None] ** np.arange(order))
-            for i in range(len(knots) - 1)
-        ]
-        self.count = len(times)
-
-    def __call__(self, coefficients: FloatArray) -> FloatArray:
-        """``(K, M)`` values of ``(N, M, order)`` coefficients at the sampler's times."""
-        out = np.empty((self.count, coefficients.shape[1]))
-        for i, (rows, powers) in enumerate(self.groups):
-            out[rows] = powers @ coefficients[i].T
-        return out
 
 
 class WaypointObjective:
@@ -150,11 +130,13 @@ class WaypointObjective:
         self.t_max = segments * longest + settings.ipo
         self.w_max = float(segments * self.moving.size)
         knots = solver.knots
-        self._check_times = np.linspace(knots[0], knots[-1], settings.fitness_samples)
-        self._check = _Sampler(knots, self._check_times, 8)
+        check_times = np.linspace(knots[0], knots[-1], settings.fitness_samples)
+        self._check = PiecewiseSampler(knots, check_times, 8)
         self._last_step_powers = (knots[-1] - knots[-2]) ** np.arange(8.0)
         ipo_times = np.append(np.arange(knots[0], knots[-1], settings.ipo), knots[-1])
-        self._ipo = _Sampler(knots, ipo_times, 8)
+        self._ipo = PiecewiseSampler(knots, ipo_times, 8, derivatives=3 if timed else 0)
+        self._steps = np.empty((len(ipo_times) - 1, 0))  # reused buffer of IPO steps
+        self._tiled: dict[int, tuple[FloatArray, ...]] = {}
         self._pair_group = np.array([ck.GROUPS.index(group) for _, _, group in world.pairs], dtype=np.intp)
 
     @property
@@ -191,24 +173,32 @@ class WaypointObjective:
             return samples.reshape(s, -1, nq), w_sol, zeros, zeros, zeros
         columns = nodes.transpose(1, 0, 2).reshape(n_nodes, s * nq)  # every joint of every candidate
         coefficients = self.solver.solve_batch(columns)
-        samples = self._check(coefficients).reshape(-1, s, nq).transpose(1, 0, 2)
-        range_q, lower_q, upper_q = (np.tile(v, s) for v in (self.range_q, self.lower_q, self.upper_q))
-        dense = self._ipo(coefficients)  # (IPO steps, S nq): reduce over time first
-        w_sol = (np.abs(np.diff(dense, axis=0)).sum(axis=0) / range_q).reshape(s, nq).sum(axis=1)
-        beyond = np.maximum(dense.max(axis=0) - upper_q, lower_q - dense.min(axis=0)) / range_q
+        samples = self._check(coefficients)[0].reshape(-1, s, nq).transpose(1, 0, 2)
+        range_q, lower_q, upper_q, limits = self._tiles(s)
+        dense = self._ipo(coefficients)  # (orders, IPO steps, S nq): reduce over time first
+        if self._steps.shape != (dense.shape[1] - 1, s * nq):
+            self._steps = np.empty((dense.shape[1] - 1, s * nq))
+        steps = np.subtract(dense[0, 1:], dense[0, :-1], out=self._steps)
+        w_sol = (np.abs(steps, out=steps).sum(axis=0) / range_q).reshape(s, nq).sum(axis=1)
+        beyond = np.maximum(dense[0].max(axis=0) - upper_q, lower_q - dense[0].min(axis=0)) / range_q
         overshoot = np.maximum(beyond.reshape(s, nq).max(axis=1), 0.0)
         last = coefficients[-1] @ self._last_step_powers  # value at the end of the last segment
         node_values = np.concatenate([coefficients[:, :, 0], last[None]])
         deviation = np.abs(node_values - columns).max(axis=0).reshape(s, nq).max(axis=1)
         excess = zeros
-        if self.timed:
-            utilisation = zeros
-            for r, limit in enumerate(self._derivative_limits, start=1):
-                values = self._ipo(derivative_coefficients(coefficients, r))
-                peak = np.maximum(values.max(axis=0), -values.min(axis=0)) / np.tile(limit, s)
-                utilisation = np.maximum(utilisation, peak.reshape(s, nq).max(axis=1))
+        if self.timed:  # largest |velocity|, |acceleration|, |jerk| relative to its limit
+            derivatives = np.abs(dense[1:], out=dense[1:])
+            utilisation = (derivatives.max(axis=1) / limits).reshape(-1, s, nq).max(axis=(0, 2))
             excess = np.maximum(utilisation - 1.0, 0.0)
         return samples, w_sol, overshoot, excess, deviation
+
+    def _tiles(self, s: int) -> tuple[FloatArray, ...]:
+        """Joint ranges, bounds and ``(3, S nq)`` v/a/j limits repeated for ``s`` candidates."""
+        if s not in self._tiled:
+            per_joint = (self.range_q, self.lower_q, self.upper_q)
+            limits = np.stack([np.tile(limit, s) for limit in self._derivative_limits])
+            self._tiled[s] = (*(np.tile(v, s) for v in per_joint), limits)
+        return self._tiled[s]
 
     def _clearance(self, samples: FloatArray) -> FloatArray:
         """``(S, K, 2)`` per-group clearance where it falls short of the required clearance.
@@ -242,7 +232,7 @@ class WaypointObjective:
             if self.settings.fitness == "paper":
                 values[flagged] = self.world.clearance_batch(flat[flagged]).clearance_m
             else:  # one query per sample; the violation goes to the closest pair's group
-                distance, pair = self.world.min_clearance_batch(flat[flagged])
+                distance, pair = self.world.min_clearance_batch(flat[flagged], below_m=self.required_m)
                 values[flagged, self._pair_group[pair]] = distance
         block = clearance[candidates]
         block[:, columns] = values.reshape(len(candidates), -1, 2)
@@ -262,7 +252,9 @@ class WaypointObjective:
         shortfall = np.maximum(self.required_m - clearance, 0.0)
         effector = np.asarray((clearance[:, :, 0] < self.required_m).any(axis=1))
         links = np.asarray((clearance[:, :, 1] < self.required_m).any(axis=1))
-        depth = np.nanmean(shortfall.max(axis=2), axis=1)
+        worst = np.maximum(shortfall[:, :, 0], shortfall[:, :, 1])  # nan where a sample was not checked
+        checked = ~np.isnan(worst)
+        depth = np.where(checked, worst, 0.0).sum(axis=1) / checked.sum(axis=1)
         feasible = ~(effector | links) & (other <= 0.0)
         base = t_sol + np.minimum(w_sol / self.w_max, 1.0) * self.settings.ipo
         if self.settings.fitness == "paper":

@@ -222,3 +222,12 @@ def test_reach_distance_bounds_every_pair_from_below(robot: ck.Robot, rng: np.ra
         np.testing.assert_array_equal(
             world.margin_violated(configurations, margin)[~ambiguous], (distances < margin)[~ambiguous]
         )
+
+
+def test_reach_distance_of_the_turning_column_is_exact(robot: ck.Robot) -> None:
+    # the 0.12 m square column turns about z: its corners sweep a cylinder of radius 0.06 sqrt(2);
+    # a crate whose near face is 0.45 m from the axis, below the column's top, is that much closer
+    crate = ck.Obstacle(shape="box", xyz=np.array([0.0, 0.6, 0.15]), size=np.array([0.3, 0.3, 0.3]), name="c")
+    world = ck.CollisionWorld(robot, [crate])
+    column = [p for p, (geometry, _, _) in enumerate(world.pairs) if geometry == "column"]
+    assert world._reach_distance[column[0]] == pytest.approx(0.45 - 0.06 * np.sqrt(2), abs=1e-6)
