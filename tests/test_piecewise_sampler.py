@@ -1,0 +1,52 @@
+"""The piecewise sampler against the trajectory's own evaluation (Horner per segment)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from planning.errors import PlanningError
+from planning.piecewise_sampler import PiecewiseSampler, derivative_powers
+from planning.trajectory import Trajectory
+
+
+@pytest.mark.parametrize("derivatives", [0, 3])
+def test_matches_trajectory_evaluation(derivatives: int) -> None:
+    rng = np.random.default_rng(3)
+    knots = np.cumsum(np.r_[0.5, rng.uniform(0.2, 1.5, 5)])
+    coefficients = rng.normal(size=(5, 7, 8))
+    times = np.sort(np.r_[knots, rng.uniform(knots[0], knots[-1], 200)])
+    sampler = PiecewiseSampler(knots, times, 8, derivatives=derivatives)
+    values = sampler(coefficients)
+    assert values.shape == (derivatives + 1, len(times), 7)
+    trajectory = Trajectory(knots, coefficients)
+    for r in range(derivatives + 1):
+        np.testing.assert_allclose(values[r], trajectory(times, derivative=r), rtol=1e-12, atol=1e-9)
+
+
+def test_derivative_powers_differentiate_a_monomial() -> None:
+    t = np.array([0.0, 0.5, 2.0])
+    # d^3/dt^3 t^5 = 60 t^2, and lower powers vanish
+    powers = derivative_powers(t, 8, 3)
+    np.testing.assert_allclose(powers[:, 5], 60 * t**2)
+    np.testing.assert_array_equal(powers[:, :3], 0.0)
+
+
+def test_buffer_is_reused_and_resized() -> None:
+    sampler = PiecewiseSampler([0.0, 1.0, 2.0], np.linspace(0, 2, 9), 4)
+    first = sampler(np.ones((2, 3, 4)))
+    assert sampler(np.ones((2, 3, 4))) is first  # same buffer, overwritten
+    assert sampler(np.ones((2, 5, 4))).shape == (1, 9, 5)
+
+
+@pytest.mark.parametrize(
+    ("knots", "times", "pattern"),
+    [
+        ([0.0, 1.0], [0.5, 0.2], "non-decreasing"),
+        ([0.0, 1.0], [0.5, 1.5], r"leave the knots \[0.0, 1.0\]"),
+        ([1.0, 0.0], [0.5], "increasing times"),
+    ],
+)
+def test_bad_input(knots: list[float], times: list[float], pattern: str) -> None:
+    with pytest.raises(PlanningError, match=pattern):
+        PiecewiseSampler(knots, times, 8)
