@@ -219,7 +219,7 @@ def _sweep(
     moved = u.copy()
     for j in np.flatnonzero(dimmer.any(axis=1)):
         step = u[j] - moved  # attractors stay where the sweep found them
-        beta = attraction[j] * np.exp(minus_gamma * np.einsum("ij,ij->i", step, step))
+        beta = attraction[j] * np.exp(minus_gamma * np.vecdot(step, step))
         step *= beta[:, None]
         step += kicks[j]
         moved += step

@@ -21,6 +21,8 @@ configurations and against ``margin + verify_step_m``:
 - ``clearance`` (default): feasible as eq. 4; infeasible ``2 t_max + t_max (depth / required
   + excess)``, with ``depth`` the mean violation of the required clearance over the samples
   [m] and ``excess`` the sum of the other violations below, each relative to its bound.
+  The margin is checked at every 4th sample first; the rest only where it can still make the
+  candidate feasible (no violation so far); depth is the mean over the samples checked.
   Feasible always ranks ahead of infeasible.
 
 Beyond the margin, a feasible candidate's spline must stay within the joint ranges, deviate
@@ -200,14 +202,15 @@ class WaypointObjective:
             self._tiled[s] = (*(np.tile(v, s) for v in per_joint), limits)
         return self._tiled[s]
 
-    def _clearance(self, samples: FloatArray) -> FloatArray:
+    def _clearance(self, samples: FloatArray, may_be_feasible: BoolArray) -> FloatArray:
         """``(S, K, 2)`` per-group clearance where it falls short of the required clearance.
 
         ``inf`` where a sample keeps the required clearance, ``nan`` where it was not checked.
-        Staged: every 4th sample first; only candidates clear there are checked at the
-        others, so an infeasible candidate costs a quarter (its depth is then the mean over
-        the coarse samples). Where coal's parallel yes/no test flags a sample, its distance
-        is computed.
+        Staged: every 4th sample first, for every candidate; the others only for candidates
+        clear there that ``may_be_feasible`` (no other violation), the only ones whose
+        feasibility the remaining samples decide. An infeasible candidate so costs a
+        quarter, its depth the mean over the coarse samples. Where coal's parallel yes/no
+        test flags a sample, its distance is computed.
         """
         s, k, _ = samples.shape
         clearance = np.full((s, k, 2), np.nan)
@@ -215,8 +218,8 @@ class WaypointObjective:
         coarse[::4] = True
         coarse[-1] = True
         self._fill(clearance, samples, np.arange(s), coarse)
-        still_clear = np.flatnonzero(~(clearance[:, coarse] < self.required_m).any(axis=(1, 2)))
-        self._fill(clearance, samples, still_clear, ~coarse)
+        still_clear = ~(clearance[:, coarse] < self.required_m).any(axis=(1, 2))
+        self._fill(clearance, samples, np.flatnonzero(still_clear & may_be_feasible), ~coarse)
         return clearance
 
     def _fill(
@@ -248,7 +251,7 @@ class WaypointObjective:
             np.zeros_like(deviation) if bound is None else np.maximum(deviation / bound - 1.0, 0.0)
         )
         other = overshoot + excess + deviation_excess
-        clearance = self._clearance(np.clip(samples, self.lower_q, self.upper_q))
+        clearance = self._clearance(np.clip(samples, self.lower_q, self.upper_q), other <= 0.0)
         shortfall = np.maximum(self.required_m - clearance, 0.0)
         effector = np.asarray((clearance[:, :, 0] < self.required_m).any(axis=1))
         links = np.asarray((clearance[:, :, 1] < self.required_m).any(axis=1))
