@@ -15,6 +15,9 @@ $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e ".[dev,bench]"
+	# pyroboplan pins pin, matplotlib and toppra to exact versions and needs drake for its
+	# trajectory optimisation; its RRT needs none of that: install it without its pins
+	$(PY) -m pip install --quiet --no-deps "pyroboplan>=1.3.1"
 	touch $(STAMP)
 
 demo: $(STAMP)

@@ -62,7 +62,7 @@ class Breakdown:
             the ``clearance`` fitness: is the closest group at a violating sample).
         links_violate: base, column, carriage or arm comes closer than the required
             clearance (likewise).
-        depth_m: mean violation of the required clearance over the samples [m].
+        depth_m: mean violation of the required clearance over the samples checked [m].
         overshoot: largest excursion beyond a joint limit, as a fraction of its range.
         limit_excess: largest |velocity|, |acceleration| or |jerk| over its limit, minus 1
             (0 when within limits or when the duration is free).

@@ -1,11 +1,13 @@
-"""A sampling-planner baseline: OMPL's RRT-Connect, path simplification, TOPP-RA timing.
+"""Sampling-planner baselines: RRT-Connect, path simplification, TOPP-RA timing.
 
 The same scene, URDF, collision world and limits as the firefly planner: RRT-Connect
-(``ompl``) searches the moving joints with our coal margin check as state validity,
-OMPL simplifies the path, TOPP-RA (``toppra``) times a cubic spline through it under the
-joints' velocity and acceleration limits (it has no jerk limit), and the same certified
-continuous check verifies the result. ``ompl`` and ``toppra`` are optional peers
-(``pip install '.[bench]'``).
+searches the moving joints with our coal margin check as state validity (margin plus the
+verification step, the clearance the firefly's fitness asks of its samples), the path is
+simplified, TOPP-RA (``toppra``) times a cubic spline through it under the joints' velocity
+and acceleration limits (it has no jerk limit), and the same certified continuous check
+verifies the result (:func:`time_and_verify`, shared by every sampling baseline). This
+module holds OMPL's RRT-Connect; :mod:`planning.pyroboplan_rrt` holds pyroboplan's. The
+peers are optional (``pip install '.[bench]'``).
 """
 
 from __future__ import annotations
@@ -48,14 +50,17 @@ class SamplingResult:
     max_abs_jerk: float
     planning_time_s: float
 
+    @classmethod
+    def failure(cls, reason: str, nq: int, started: float) -> SamplingResult:
+        """A failed run: ``reason``, no path, figures NaN; ``started`` is its ``perf_counter()``."""
+        nan = float("nan")
+        return cls(False, reason, np.empty((0, nq)), nan, nan, nan, nan, time.perf_counter() - started)
+
 
 def plan_rrt_connect(
     scene: Scene, robot: ck.Robot | None = None, time_limit_s: float = 2.0, seed: int = 0
 ) -> SamplingResult:
     """Plan ``scene`` with RRT-Connect + simplification + TOPP-RA, then verify."""
-    import toppra
-    import toppra.algorithm
-    import toppra.constraint
     from ompl import base as ob
     from ompl import geometric as og
     from ompl import util as ou
@@ -66,12 +71,6 @@ def plan_rrt_connect(
     q_start, q_goal = endpoint(robot, world, scene, "start"), endpoint(robot, world, scene, "goal")
     moving = moving_joints(robot, scene, q_start, q_goal)
     limits = robot.limits
-    empty = np.empty((0, robot.nq))
-
-    def failed(reason: str) -> SamplingResult:
-        return SamplingResult(
-            False, reason, empty, np.nan, np.nan, np.nan, np.nan, time.perf_counter() - started
-        )
 
     ou.setLogLevel(ou.LogLevel.LOG_NONE)
     ou.RNG.setSeed(seed + 1)  # OMPL refuses seed 0
@@ -89,7 +88,7 @@ def plan_rrt_connect(
         return q
 
     def valid(state: object) -> bool:
-        return not bool(world.margin_violated(full(state)[None], scene.safety_margin)[0])
+        return not bool(world.margin_violated(full(state)[None], planning_clearance_m(scene))[0])
 
     information.setStateValidityChecker(valid)
     information.setStateValidityCheckingResolution(0.002)  # of the space's extent, ~1.2 cm in theta1
@@ -101,17 +100,44 @@ def plan_rrt_connect(
     setup.setStartAndGoalStates(start_state, goal_state)
     setup.setPlanner(og.RRTConnect(information))
     if not setup.solve(time_limit_s) or not setup.haveExactSolutionPath():
-        return failed(f"RRT-Connect found no path in {time_limit_s} s")
+        return SamplingResult.failure(f"RRT-Connect found no path in {time_limit_s} s", robot.nq, started)
     setup.simplifySolution()
     path = setup.getSolutionPath()
     waypoints = np.array([full(path.getState(i)) for i in range(path.getStateCount())])
 
+    return time_and_verify(robot, world, scene, waypoints, started)
+
+
+def planning_clearance_m(scene: Scene) -> float:
+    """Clearance a sampling planner's states and segments keep [m].
+
+    The margin plus the verification step, as the firefly's fitness requires at its samples:
+    the timed spline strays a little from the straight segments between the path's vertices.
+    """
+    return scene.safety_margin + scene.planner.verify_step_m
+
+
+def time_and_verify(
+    robot: ck.Robot, world: ck.CollisionWorld, scene: Scene, waypoints: FloatArray, started: float
+) -> SamplingResult:
+    """Time a path of joint-space ``waypoints`` ``(K, nq)`` with TOPP-RA, then verify it.
+
+    A clamped cubic spline through the waypoints (parametrised by their range-scaled joint
+    distance) is timed under the velocity and acceleration limits and verified by the
+    certified continuous check against the scene's margin; ``started`` is the
+    ``time.perf_counter()`` of the planner's start.
+    """
+    import toppra
+    import toppra.algorithm
+    import toppra.constraint
+
+    limits = robot.limits
     steps = np.linalg.norm(np.diff(waypoints / limits.range, axis=0), axis=1)
     keep = np.concatenate([[True], steps > 1e-9])
     waypoints = waypoints[keep]
     s_grid = np.concatenate([[0.0], np.cumsum(steps[steps > 1e-9])])
     if len(waypoints) < 2:
-        return failed("the simplified path is a single point")
+        return SamplingResult.failure("the simplified path is a single point", robot.nq, started)
     geometric = toppra.SplineInterpolator(s_grid / s_grid[-1], waypoints, bc_type="clamped")
     constraints = [
         toppra.constraint.JointVelocityConstraint(np.column_stack([-limits.velocity, limits.velocity])),
@@ -123,7 +149,7 @@ def plan_rrt_connect(
         constraints, geometric, gridpoints=np.linspace(0, 1, 401)
     ).compute_trajectory(0, 0)
     if timed is None:
-        return failed("TOPP-RA found no timing")
+        return SamplingResult.failure("TOPP-RA found no timing", robot.nq, started)
     duration = float(timed.duration)
     dense = np.linspace(0.0, duration, 4001)
     positions = np.asarray(timed(dense))

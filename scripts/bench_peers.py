@@ -5,7 +5,8 @@
    differential evolution and CMA-ES. Target: ours >= 10x faster than NiaPy's FA with an
    equal or better median fitness.
 2. Planners on ``--scenes`` generated scenes (seeded): the firefly planner, the same
-   pipeline with each baseline optimiser, and OMPL's RRT-Connect + simplification + TOPP-RA.
+   pipeline with each baseline optimiser, OMPL's RRT-Connect + simplification + TOPP-RA and
+   pyroboplan's RRT-Connect + shortcutting + TOPP-RA.
    Every result is verified by the same certified continuous check. Target: our success
    rate >= RRT-Connect's.
 
@@ -101,6 +102,33 @@ def optimiser_table(robot: ck.Robot, seeds: int) -> tuple[list[list[str]], dict[
     return rows, medians
 
 
+def sampling_method(
+    robot: ck.Robot, module: str, time_limit_s: float
+) -> Callable[[Scene], dict[str, float] | None]:
+    """One of the sampling pipelines (``planning.sampling`` or ``planning.pyroboplan_rrt``)."""
+    import importlib
+
+    planner = {
+        "planning.sampling": "plan_rrt_connect",
+        "planning.pyroboplan_rrt": "plan_pyroboplan_rrt_connect",
+    }[module]
+    function = getattr(importlib.import_module(module), planner)
+
+    def run(scene: Scene) -> dict[str, float] | None:
+        result = function(scene, robot, time_limit_s=time_limit_s, seed=scene.planner.seed)
+        if not result.success:
+            return None
+        return {
+            "time": result.planning_time_s,
+            "duration": result.duration,
+            "length": result.path_length,
+            "jerk": result.max_abs_jerk,
+            "clearance": result.min_clearance,
+        }
+
+    return run
+
+
 def planner_rows(robot: ck.Robot, scenes: list[Scene], time_limit_s: float) -> list[list[str]]:
     methods: dict[str, Callable[[Scene], dict[str, float] | None]] = {}
 
@@ -130,27 +158,17 @@ def planner_rows(robot: ck.Robot, scenes: list[Scene], time_limit_s: float) -> l
     sample = scenes[0]
     for name, optimiser in optimisers(sample).items():
         methods[f"{name} + septic spline"] = pipeline(None if name == "firefly (ours)" else optimiser)
-    try:
-        from planning.sampling import plan_rrt_connect
-
-        __import__("ompl")
-        __import__("toppra")
-
-        def rrt(scene: Scene) -> dict[str, float] | None:
-            result = plan_rrt_connect(scene, robot, time_limit_s=time_limit_s, seed=scene.planner.seed)
-            if not result.success:
-                return None
-            return {
-                "time": result.planning_time_s,
-                "duration": result.duration,
-                "length": result.path_length,
-                "jerk": result.max_abs_jerk,
-                "clearance": result.min_clearance,
-            }
-
-        methods["RRT-Connect (OMPL) + TOPP-RA"] = rrt
-    except ImportError:
-        print("  (OMPL or TOPP-RA not installed: RRT-Connect skipped)")
+    for label, module, needs in (
+        ("RRT-Connect (OMPL) + TOPP-RA", "planning.sampling", ("ompl", "toppra")),
+        ("RRT-Connect (pyroboplan) + TOPP-RA", "planning.pyroboplan_rrt", ("pyroboplan", "toppra")),
+    ):
+        try:
+            for name in needs:
+                __import__(name)
+        except ImportError:
+            print(f"  ({' or '.join(needs)} not installed: {label} skipped)")
+            continue
+        methods[label] = sampling_method(robot, module, time_limit_s)
 
     results: dict[str, list[dict[str, float] | None]] = {name: [] for name in methods}
     for scene in scenes:

@@ -1,5 +1,6 @@
 from __future__ import annotations
 
+import itertools
 import subprocess
 import sys
 from collections.abc import Callable
@@ -71,12 +72,20 @@ def test_baselines_plan_the_paper_case(robot: ck.Robot, name: str) -> None:
     assert result.metrics.evaluations <= 2550
 
 
-def test_rrt_connect_pipeline(robot: ck.Robot) -> None:
-    pytest.importorskip("ompl")
+@pytest.mark.parametrize("peer", ["ompl", "pyroboplan"])
+def test_rrt_connect_pipelines(robot: ck.Robot, peer: str) -> None:
+    pytest.importorskip(peer)
     pytest.importorskip("toppra")
-    from planning.sampling import plan_rrt_connect
+    if peer == "ompl":
+        from planning.sampling import plan_rrt_connect as planner
+    else:
+        from planning.pyroboplan_rrt import plan_pyroboplan_rrt_connect as planner
 
-    result = plan_rrt_connect(paper_scene(), robot, seed=0)
+    state = np.random.get_state()
+    result = planner(paper_scene(), robot, seed=0)
+    after = np.random.random(8)  # the global generator is left where it was
+    np.random.set_state(state)
+    np.testing.assert_array_equal(after, np.random.random(8))
     assert result.success, result.reason
     assert result.min_clearance >= 0.1
     np.testing.assert_allclose(result.waypoints[0], ck.tcp_ik(robot, (0.5, 0.45, 0.25)), atol=1e-9)
@@ -105,3 +114,46 @@ def test_benchmark_script_runs(tmp_path: Path) -> None:
     assert completed.returncode == 0, completed.stderr[-2000:]
     report = out.read_text()
     assert "firefly (ours) + septic spline" in report and "| method | success |" in report
+
+
+def test_shortcut_path_keeps_ends_and_checks_every_new_segment() -> None:
+    from planning.pyroboplan_rrt import shortcut_path
+
+    def clear(a: np.ndarray, b: np.ndarray) -> bool:
+        """A wall at x = 0.5 blocks |y| < 0.2: is the segment a-b free of it?"""
+        if (a[0] - 0.5) * (b[0] - 0.5) > 0:
+            return True  # both on one side of the wall
+        y = a[1] + (0.5 - a[0]) / (b[0] - a[0]) * (b[1] - a[1])
+        return bool(abs(y) >= 0.2)
+
+    checked: list[tuple[tuple[float, ...], tuple[float, ...]]] = []
+
+    def recorded(a: np.ndarray, b: np.ndarray) -> bool:
+        checked.append((tuple(a), tuple(b)))
+        return clear(a, b)
+
+    # a clear zigzag over the wall; the straight line from start to goal is blocked
+    zigzag = np.array([[0.0, 0.0], [0.2, 0.6], [0.35, 0.1], [0.5, 0.6], [0.65, 0.1], [0.8, 0.6], [1.0, 0.0]])
+    assert all(clear(a, b) for a, b in itertools.pairwise(zigzag))
+    assert not clear(zigzag[0], zigzag[-1])
+
+    path = shortcut_path(zigzag, recorded, np.random.default_rng(0), attempts=200)
+    np.testing.assert_array_equal(path[0], zigzag[0])
+    np.testing.assert_array_equal(path[-1], zigzag[-1])
+
+    def length(polyline: np.ndarray) -> float:
+        return float(np.linalg.norm(np.diff(polyline, axis=0), axis=1).sum())
+
+    assert length(path) < 0.6 * length(zigzag)
+    assert length(path) >= 2 * np.hypot(0.5, 0.2) - 1e-12  # no shorter way around the wall
+    # every segment of the result lies on one of the input's or on one that was checked clear
+    known = [(np.asarray(a), np.asarray(b)) for a, b in itertools.pairwise(zigzag)]
+    known += [(np.array(a), np.array(b)) for a, b in checked if clear(np.array(a), np.array(b))]
+
+    def within(point: np.ndarray, a: np.ndarray, b: np.ndarray) -> bool:
+        s = float(np.clip((point - a) @ (b - a) / ((b - a) @ (b - a)), 0.0, 1.0))
+        return bool(np.linalg.norm(a + s * (b - a) - point) < 1e-9)
+
+    for p, q in itertools.pairwise(path):
+        assert any(within(p, a, b) and within(q, a, b) for a, b in known)
+        assert clear(p, q)
