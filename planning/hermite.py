@@ -28,10 +28,10 @@ def _falling(k: int, r: int) -> int:
     return factorial(k) // factorial(k - r) if k >= r else 0
 
 
-def derivative_matrix(r: int) -> FloatArray:
-    """``(8, 8)`` matrix ``M`` with ``a^(r) = M @ a``: power coefficients of the r-th derivative."""
-    m = np.zeros((ORDER, ORDER))
-    for k in range(r, ORDER):
+def derivative_matrix(r: int, order: int = ORDER) -> FloatArray:
+    """``(order, order)`` matrix ``M`` with ``a^(r) = M @ a``: power coefficients of the r-th derivative."""
+    m = np.zeros((order, order))
+    for k in range(r, order):
         m[k - r, k] = _falling(k, r)
     return m
 

@@ -30,6 +30,11 @@ from its nodes by at most ``max_node_deviation`` (when set) and, when the scene 
 keep velocity, acceleration and jerk within the limits at that duration (checked at the IPO
 samples; the final timing uses exact extrema). The paper fitness ranks these violations
 with eq. 6.
+
+Only the moving joints are fitted and sampled: the held ones keep their start value, which is
+also their goal value. A joint whose velocity, acceleration and jerk are certainly within
+their limits by a Bernstein bound (:mod:`planning.polynomial_bounds`) contributes no excess
+and is not sampled for them: the bound is at least the sampled maximum.
 """
 
 from __future__ import annotations
@@ -41,6 +46,7 @@ from numpy.typing import NDArray
 
 import cpr_kin as ck
 from planning.piecewise_sampler import PiecewiseSampler
+from planning.polynomial_bounds import DerivativeBounds
 from planning.ptp import ptp_time, trapezoid_time
 from planning.scene import PlannerSettings
 from planning.spline import SepticSplineSolver
@@ -136,7 +142,9 @@ class WaypointObjective:
         self._check = PiecewiseSampler(knots, check_times, 8)
         self._last_step_powers = (knots[-1] - knots[-2]) ** np.arange(8.0)
         ipo_times = np.append(np.arange(knots[0], knots[-1], settings.ipo), knots[-1])
-        self._ipo = PiecewiseSampler(knots, ipo_times, 8, derivatives=3 if timed else 0)
+        self._ipo = PiecewiseSampler(knots, ipo_times, 8)
+        self._ipo_derivatives = PiecewiseSampler(knots, ipo_times, 8, derivatives=3, first=1)
+        self._derivative_bounds = DerivativeBounds(knots, 8, (1, 2, 3))
         self._steps = np.empty((len(ipo_times) - 1, 0))  # reused buffer of IPO steps
         self._tiled: dict[int, tuple[FloatArray, ...]] = {}
         self._pair_group = np.array([ck.GROUPS.index(group) for _, _, group in world.pairs], dtype=np.intp)
@@ -173,33 +181,39 @@ class WaypointObjective:
             samples = nodes[:, :-1, None, :] + fraction[None, None, :, None] * steps[:, :, None, :]
             w_sol = (np.abs(steps) / self.range_q).sum(axis=(1, 2))
             return samples.reshape(s, -1, nq), w_sol, zeros, zeros, zeros
-        columns = nodes.transpose(1, 0, 2).reshape(n_nodes, s * nq)  # every joint of every candidate
+        k = self.moving.size
+        columns = nodes[:, :, self.moving].transpose(1, 0, 2).reshape(n_nodes, s * k)  # (nodes, S k)
         coefficients = self.solver.solve_batch(columns)
-        samples = self._check(coefficients)[0].reshape(-1, s, nq).transpose(1, 0, 2)
+        samples = np.empty((s, self._check.count, nq))
+        samples[...] = self.q_start  # held joints stay where they start (and end)
+        samples[:, :, self.moving] = self._check(coefficients)[0].reshape(-1, s, k).transpose(1, 0, 2)
         range_q, lower_q, upper_q, limits = self._tiles(s)
-        dense = self._ipo(coefficients)  # (orders, IPO steps, S nq): reduce over time first
-        if self._steps.shape != (dense.shape[1] - 1, s * nq):
-            self._steps = np.empty((dense.shape[1] - 1, s * nq))
-        steps = np.subtract(dense[0, 1:], dense[0, :-1], out=self._steps)
-        w_sol = (np.abs(steps, out=steps).sum(axis=0) / range_q).reshape(s, nq).sum(axis=1)
-        beyond = np.maximum(dense[0].max(axis=0) - upper_q, lower_q - dense[0].min(axis=0)) / range_q
-        overshoot = np.maximum(beyond.reshape(s, nq).max(axis=1), 0.0)
+        positions = self._ipo(coefficients)[0]  # (IPO steps, S k): reduce over time first
+        if self._steps.shape != (positions.shape[0] - 1, s * k):
+            self._steps = np.empty((positions.shape[0] - 1, s * k))
+        steps = np.subtract(positions[1:], positions[:-1], out=self._steps)
+        w_sol = (np.abs(steps, out=steps).sum(axis=0) / range_q).reshape(s, k).sum(axis=1)
+        beyond = np.maximum(positions.max(axis=0) - upper_q, lower_q - positions.min(axis=0)) / range_q
+        overshoot = np.maximum(beyond.reshape(s, k).max(axis=1), 0.0)
         last = coefficients[-1] @ self._last_step_powers  # value at the end of the last segment
         node_values = np.concatenate([coefficients[:, :, 0], last[None]])
-        deviation = np.abs(node_values - columns).max(axis=0).reshape(s, nq).max(axis=1)
+        deviation = np.abs(node_values - columns).max(axis=0).reshape(s, k).max(axis=1)
         excess = zeros
         if self.timed:  # largest |velocity|, |acceleration|, |jerk| relative to its limit
-            derivatives = np.abs(dense[1:], out=dense[1:])
-            utilisation = (derivatives.max(axis=1) / limits).reshape(-1, s, nq).max(axis=(0, 2))
-            excess = np.maximum(utilisation - 1.0, 0.0)
+            utilisation = np.zeros(s * k)
+            unsure = np.flatnonzero((self._derivative_bounds(coefficients) > limits).any(axis=0))
+            if unsure.size:  # the others are within their limits: they add no excess
+                derivatives = np.abs(self._ipo_derivatives(coefficients[:, unsure]))
+                utilisation[unsure] = (derivatives.max(axis=1) / limits[:, unsure]).max(axis=0)
+            excess = np.maximum(utilisation.reshape(s, k).max(axis=1) - 1.0, 0.0)
         return samples, w_sol, overshoot, excess, deviation
 
     def _tiles(self, s: int) -> tuple[FloatArray, ...]:
-        """Joint ranges, bounds and ``(3, S nq)`` v/a/j limits repeated for ``s`` candidates."""
+        """Moving joints' ranges, bounds and ``(3, S k)`` v/a/j limits, repeated for ``s`` candidates."""
         if s not in self._tiled:
             per_joint = (self.range_q, self.lower_q, self.upper_q)
-            limits = np.stack([np.tile(limit, s) for limit in self._derivative_limits])
-            self._tiled[s] = (*(np.tile(v, s) for v in per_joint), limits)
+            limits = np.stack([np.tile(limit[self.moving], s) for limit in self._derivative_limits])
+            self._tiled[s] = (*(np.tile(v[self.moving], s) for v in per_joint), limits)
         return self._tiled[s]
 
     def _clearance(self, samples: FloatArray, may_be_feasible: BoolArray) -> FloatArray:

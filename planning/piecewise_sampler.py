@@ -38,14 +38,18 @@ class PiecewiseSampler:
         knots: ``(N + 1,)`` increasing segment boundaries [s].
         times: ``(K,)`` non-decreasing evaluation times [s] within the knots.
         order: number of power coefficients per segment (8 for septic).
-        derivatives: highest derivative order evaluated besides the values.
+        derivatives: highest derivative order evaluated.
+        first: lowest derivative order evaluated (0: the values).
 
     Calling it with coefficients ``(N, M, order)`` (``M`` columns, e.g. every joint of every
-    candidate) returns ``(derivatives + 1, K, M)``: values, then each derivative. The array
-    is the sampler's own buffer, overwritten by its next call: copy what must outlive it.
+    candidate) returns ``(derivatives - first + 1, K, M)``: derivative orders ``first`` to
+    ``derivatives``. The array is the sampler's own buffer, overwritten by its next call:
+    copy what must outlive it.
     """
 
-    def __init__(self, knots: ArrayLike, times: ArrayLike, order: int, derivatives: int = 0) -> None:
+    def __init__(
+        self, knots: ArrayLike, times: ArrayLike, order: int, derivatives: int = 0, first: int = 0
+    ) -> None:
         knots = np.asarray(knots, dtype=float)
         times = np.asarray(times, dtype=float)
         if knots.ndim != 1 or len(knots) < 2 or not (np.diff(knots) > 0).all():
@@ -58,21 +62,24 @@ class PiecewiseSampler:
             )
         if not 0 <= derivatives < order:
             raise PlanningError(f"derivatives = {derivatives} must lie in [0, {order - 1}]")
+        if not 0 <= first <= derivatives:
+            raise PlanningError(f"first = {first} must lie in [0, derivatives = {derivatives}]")
         segment = np.clip(np.searchsorted(knots, times, side="right") - 1, 0, len(knots) - 2)
         local = times - knots[segment]
         self.order = order
         self.derivatives = derivatives
+        self.first = first
         self.count = len(times)
         self._blocks: list[tuple[int, slice, list[FloatArray]]] = []
         for i in np.unique(segment):
             rows = np.flatnonzero(segment == i)  # contiguous: the times are sorted
-            powers = [derivative_powers(local[rows], order, r) for r in range(derivatives + 1)]
+            powers = [derivative_powers(local[rows], order, r) for r in range(first, derivatives + 1)]
             self._blocks.append((int(i), slice(int(rows[0]), int(rows[-1]) + 1), powers))
-        self._out = np.empty((derivatives + 1, self.count, 0))
+        self._out = np.empty((derivatives - first + 1, self.count, 0))
 
     def __call__(self, coefficients: FloatArray) -> FloatArray:
-        """``(derivatives + 1, K, M)`` values and derivatives of ``(N, M, order)`` coefficients."""
-        shape = (self.derivatives + 1, self.count, coefficients.shape[1])
+        """``(derivatives - first + 1, K, M)`` derivatives of ``(N, M, order)`` coefficients."""
+        shape = (self.derivatives - self.first + 1, self.count, coefficients.shape[1])
         if self._out.shape != shape:
             self._out = np.empty(shape)
         out = self._out

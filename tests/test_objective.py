@@ -109,3 +109,28 @@ def test_w_sol_of_the_spline_is_at_least_the_ptp_one(
     ptp = (np.abs(np.diff(nodes, axis=1)) / paper_objective.range_q).sum(axis=(1, 2))
     spline = paper_objective.breakdown(x).w_sol
     assert np.all(spline >= ptp - 1e-6)
+
+
+def test_limit_excess_and_w_sol_match_the_fitted_trajectories(
+    paper_objective: WaypointObjective, rng: np.random.Generator
+) -> None:
+    from planning.spline import fit_septic_spline
+
+    objective = paper_objective
+    centre = np.tile((objective.q_start[:3] + objective.q_goal[:3]) / 2, 3)
+    spread = rng.normal(0.0, 0.08, (40, 9)) * (objective.upper - objective.lower)
+    x = np.clip(centre + spread, objective.lower, objective.upper)
+    breakdown = objective.breakdown(x)
+    limits = objective.world.robot.limits
+    knots = objective.solver.knots
+    ipo_times = np.append(np.arange(knots[0], knots[-1], objective.settings.ipo), knots[-1])
+    for candidate, nodes in enumerate(objective.nodes(x)):
+        trajectory = fit_septic_spline(knots, nodes, paper_scene().spline).trajectory
+        utilisation = max(
+            float((np.abs(trajectory(ipo_times, r)).max(axis=0) / limit).max())
+            for r, limit in ((1, limits.velocity), (2, limits.acceleration), (3, limits.jerk))
+        )
+        assert breakdown.limit_excess[candidate] == pytest.approx(max(utilisation - 1.0, 0.0), abs=1e-9)
+        w_sol = (np.abs(np.diff(trajectory(ipo_times), axis=0)) / limits.range).sum()
+        assert breakdown.w_sol[candidate] == pytest.approx(w_sol, rel=1e-9)
+    assert (breakdown.limit_excess == 0).any() and (breakdown.limit_excess > 0).any()

@@ -24,6 +24,19 @@ def test_matches_trajectory_evaluation(derivatives: int) -> None:
         np.testing.assert_allclose(values[r], trajectory(times, derivative=r), rtol=1e-12, atol=1e-9)
 
 
+def test_first_order_skips_the_lower_ones() -> None:
+    rng = np.random.default_rng(4)
+    knots = np.array([0.0, 0.8, 2.0])
+    coefficients = rng.normal(size=(2, 3, 8))
+    times = np.linspace(0.0, 2.0, 17)
+    full = PiecewiseSampler(knots, times, 8, derivatives=3)(coefficients).copy()
+    upper = PiecewiseSampler(knots, times, 8, derivatives=3, first=1)(coefficients)
+    assert upper.shape == (3, 17, 3)
+    np.testing.assert_array_equal(upper, full[1:])
+    with pytest.raises(PlanningError, match=r"first = 4 must lie in \[0, derivatives = 3\]"):
+        PiecewiseSampler(knots, times, 8, derivatives=3, first=4)
+
+
 def test_derivative_powers_differentiate_a_monomial() -> None:
     t = np.array([0.0, 0.5, 2.0])
     # d^3/dt^3 t^5 = 60 t^2, and lower powers vanish
