@@ -65,20 +65,22 @@ class DerivativeBounds:
             raise PlanningError(f"derivatives {list(derivatives)} must be orders in [0, {order - 1}]")
         self.order = order
         self.derivatives = tuple(int(r) for r in derivatives)
-        # per segment: all derivatives' Bernstein coefficients in one product, (R order, order)
-        self._matrices = [
-            np.vstack([bernstein_matrix(order, h) @ derivative_matrix(r, order) for r in self.derivatives])
-            for h in np.diff(knots)
-        ]
+        # per segment: all derivatives' Bernstein coefficients in one product, (N, R order, order)
+        self._matrices = np.stack(
+            [
+                np.vstack(
+                    [bernstein_matrix(order, h) @ derivative_matrix(r, order) for r in self.derivatives]
+                )
+                for h in np.diff(knots)
+            ]
+        )
 
     def __call__(self, coefficients: FloatArray) -> FloatArray:
         """``(len(derivatives), M)`` bounds for ``(N, M, order)`` coefficients."""
-        if coefficients.ndim != 3 or coefficients.shape[0] != len(self._matrices):
-            expected = f"({len(self._matrices)}, M, {self.order})"
+        n = len(self._matrices)
+        if coefficients.ndim != 3 or coefficients.shape[0] != n or coefficients.shape[2] != self.order:
+            expected = f"({n}, M, {self.order})"
             raise PlanningError(f"coefficients of shape {coefficients.shape}; expected {expected}")
-        m = coefficients.shape[1]
-        bound = np.zeros((m, len(self.derivatives)))
-        for segment, matrix in zip(coefficients, self._matrices, strict=True):
-            hull = np.abs(segment @ matrix.T).reshape(m, len(self.derivatives), self.order)
-            np.maximum(bound, hull.max(axis=2), out=bound)
-        return np.ascontiguousarray(bound.T)
+        # columns last, so that the largest |coefficient| is taken across contiguous rows
+        hull = np.abs(np.matmul(self._matrices, coefficients.transpose(0, 2, 1)))
+        return np.asarray(hull.reshape(n, len(self.derivatives), self.order, -1).max(axis=(0, 2)))
