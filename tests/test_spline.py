@@ -9,7 +9,13 @@ from scipy.interpolate import BSpline, make_interp_spline
 
 import cpr_kin as ck
 from planning.errors import SplineError
-from planning.spline import SepticSplineSolver, SplineSettings, fit_septic_spline, uniform_knots
+from planning.spline import (
+    DENSE_MAP_NODES,
+    SepticSplineSolver,
+    SplineSettings,
+    fit_septic_spline,
+    uniform_knots,
+)
 
 from .conftest import PAPER_GOAL_TCP, PAPER_START_TCP
 
@@ -271,9 +277,11 @@ def test_single_joint_vector_input(rng: np.random.Generator) -> None:
     assert fit.trajectory.n_joints == 1
 
 
-def test_prepared_solver_reuse_and_batch(rng: np.random.Generator) -> None:
-    t, f = knots_and_values(rng, 5, uniform=False, joints=4)
-    settings = SplineSettings(p=(INF, 10.0, 1e3, INF, 5.0, 1.0), a=(0.1, 0.0, 1.0), ends="rest")
+@pytest.mark.parametrize("segments", [5, DENSE_MAP_NODES + 3])  # dense map, then banded solves
+def test_prepared_solver_reuse_and_batch(rng: np.random.Generator, segments: int) -> None:
+    t, f = knots_and_values(rng, segments, uniform=False, joints=4)
+    p = np.tile([INF, 10.0, 1e3, INF, 5.0, 1.0], segments)[: segments + 1]
+    settings = SplineSettings(p=tuple(p), a=(0.1, 0.0, 1.0), ends="rest")
     solver = SepticSplineSolver(t, settings)
     candidates = [rng.normal(size=f.shape) for _ in range(3)]
     for values in candidates:
@@ -286,6 +294,10 @@ def test_prepared_solver_reuse_and_batch(rng: np.random.Generator) -> None:
         np.testing.assert_allclose(
             batch[:, 4 * m : 4 * m + 4], solver.solve(values).trajectory.coefficients, atol=1e-12
         )
+    # pinned nodes (p = inf, and the first) are met exactly, at rest at the start
+    for i in np.flatnonzero(~np.isfinite(p[:-1])):
+        np.testing.assert_array_equal(batch[i, :, 0], stacked[i])
+    np.testing.assert_array_equal(batch[0, :, 1:3], 0.0)
 
 
 def test_large_problem_uses_the_sparse_path(rng: np.random.Generator) -> None:
