@@ -357,7 +357,7 @@ class SepticSplineSolver:
         """
         f = self._check_values(targets)
         if self.n_nodes <= DENSE_MAP_NODES:
-            return np.matmul(self.coefficient_map, f).transpose(0, 2, 1)
+            return np.asarray(np.matmul(self.coefficient_map, f).transpose(0, 2, 1))
         return self._coefficients(self._solve_nodes(f))
 
 
