@@ -217,10 +217,14 @@ def _sweep(
     attraction = settings.beta0 * dimmer
     minus_gamma = -settings.gamma
     moved = u.copy()
+    step, beta = np.empty_like(u), np.empty(n)  # reused: at this size allocations cost more than the maths
     for j in np.flatnonzero(dimmer.any(axis=1)):
-        step = u[j] - moved  # attractors stay where the sweep found them
-        beta = attraction[j] * np.exp(minus_gamma * np.vecdot(step, step))
-        step *= beta[:, None]
+        np.subtract(u[j], moved, out=step)  # attractors stay where the sweep found them
+        np.vecdot(step, step, out=beta)
+        np.multiply(beta, minus_gamma, out=beta)
+        np.exp(beta, out=beta)
+        np.multiply(beta, attraction[j], out=beta)  # beta0 exp(-gamma r^2), 0 towards a dimmer one
+        np.multiply(step, beta[:, None], out=step)
         step += kicks[j]
         moved += step
     return np.clip(moved, 0.0, 1.0, out=moved)
