@@ -31,10 +31,12 @@ keep velocity, acceleration and jerk within the limits at that duration (checked
 samples; the final timing uses exact extrema). The paper fitness ranks these violations
 with eq. 6.
 
-Only the moving joints are fitted and sampled: the held ones keep their start value, which is
-also their goal value. A joint whose velocity, acceleration and jerk are certainly within
-their limits by a Bernstein bound (:mod:`planning.polynomial_bounds`) contributes no excess
-and is not sampled for them: the bound is at least the sampled maximum.
+Only joints that move are fitted and sampled: the waypoint joints, and any other joint whose
+goal differs from its start (it moves in the last segment). The rest keep their start value,
+exactly, as the spline through constant nodes does. A joint whose velocity, acceleration
+and jerk are certainly within their limits by a Bernstein bound
+(:mod:`planning.polynomial_bounds`) contributes no excess and is not sampled for them: the
+bound is at least the sampled maximum.
 """
 
 from __future__ import annotations
@@ -120,6 +122,8 @@ class WaypointObjective:
         self.world = world
         self.q_start, self.q_goal = np.asarray(q_start, dtype=float), np.asarray(q_goal, dtype=float)
         self.moving = np.asarray(moving, dtype=np.intp)
+        # joints the spline moves; the others stay at their start (= goal) value throughout
+        self._fitted = np.union1d(self.moving, np.flatnonzero(self.q_start != self.q_goal))
         self.settings = settings
         self.solver = solver
         self.n_waypoints = settings.waypoints
@@ -181,12 +185,12 @@ class WaypointObjective:
             samples = nodes[:, :-1, None, :] + fraction[None, None, :, None] * steps[:, :, None, :]
             w_sol = (np.abs(steps) / self.range_q).sum(axis=(1, 2))
             return samples.reshape(s, -1, nq), w_sol, zeros, zeros, zeros
-        k = self.moving.size
-        columns = nodes[:, :, self.moving].transpose(1, 0, 2).reshape(n_nodes, s * k)  # (nodes, S k)
+        fitted, k = self._fitted, self._fitted.size
+        columns = nodes[:, :, fitted].transpose(1, 0, 2).reshape(n_nodes, s * k)  # (nodes, S k)
         coefficients = self.solver.solve_batch(columns)
         samples = np.empty((s, self._check.count, nq))
         samples[...] = self.q_start  # held joints stay where they start (and end)
-        samples[:, :, self.moving] = self._check(coefficients)[0].reshape(-1, s, k).transpose(1, 0, 2)
+        samples[:, :, fitted] = self._check(coefficients)[0].reshape(-1, s, k).transpose(1, 0, 2)
         range_q, lower_q, upper_q, limits = self._tiles(s)
         positions = self._ipo(coefficients)[0]  # (IPO steps, S k): reduce over time first
         if self._steps.shape != (positions.shape[0] - 1, s * k):
@@ -209,11 +213,11 @@ class WaypointObjective:
         return samples, w_sol, overshoot, excess, deviation
 
     def _tiles(self, s: int) -> tuple[FloatArray, ...]:
-        """Moving joints' ranges, bounds and ``(3, S k)`` v/a/j limits, repeated for ``s`` candidates."""
+        """Fitted joints' ranges, bounds and ``(3, S k)`` v/a/j limits, repeated for ``s`` candidates."""
         if s not in self._tiled:
             per_joint = (self.range_q, self.lower_q, self.upper_q)
-            limits = np.stack([np.tile(limit[self.moving], s) for limit in self._derivative_limits])
-            self._tiled[s] = (*(np.tile(v[self.moving], s) for v in per_joint), limits)
+            limits = np.stack([np.tile(limit[self._fitted], s) for limit in self._derivative_limits])
+            self._tiled[s] = (*(np.tile(v[self._fitted], s) for v in per_joint), limits)
         return self._tiled[s]
 
     def _clearance(self, samples: FloatArray, may_be_feasible: BoolArray) -> FloatArray:

@@ -111,12 +111,16 @@ def test_w_sol_of_the_spline_is_at_least_the_ptp_one(
     assert np.all(spline >= ptp - 1e-6)
 
 
+@pytest.mark.parametrize("theta4_goal", [0.0, 0.6])  # held; not a waypoint joint, yet it moves
 def test_limit_excess_and_w_sol_match_the_fitted_trajectories(
-    paper_objective: WaypointObjective, rng: np.random.Generator
+    robot: ck.Robot, crate: ck.Obstacle, rng: np.random.Generator, theta4_goal: float
 ) -> None:
     from planning.spline import fit_septic_spline
 
-    objective = paper_objective
+    scene = paper_scene()
+    q_goal = scene.goal.configuration(robot)
+    q_goal[3] = theta4_goal
+    objective = make_objective(robot, [crate], scene.start.configuration(robot), q_goal)
     centre = np.tile((objective.q_start[:3] + objective.q_goal[:3]) / 2, 3)
     spread = rng.normal(0.0, 0.08, (40, 9)) * (objective.upper - objective.lower)
     x = np.clip(centre + spread, objective.lower, objective.upper)
@@ -133,4 +137,6 @@ def test_limit_excess_and_w_sol_match_the_fitted_trajectories(
         assert breakdown.limit_excess[candidate] == pytest.approx(max(utilisation - 1.0, 0.0), abs=1e-9)
         w_sol = (np.abs(np.diff(trajectory(ipo_times), axis=0)) / limits.range).sum()
         assert breakdown.w_sol[candidate] == pytest.approx(w_sol, rel=1e-9)
+        deviation = np.abs(trajectory(knots) - nodes).max()
+        assert breakdown.node_deviation[candidate] == pytest.approx(deviation, rel=1e-6, abs=1e-12)
     assert (breakdown.limit_excess == 0).any() and (breakdown.limit_excess > 0).any()
