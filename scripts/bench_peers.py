@@ -29,7 +29,9 @@ from planning import baselines
 from planning.errors import PlanningError
 from planning.objective import WaypointObjective
 from planning.planner import endpoint, moving_joints, plan
+from planning.pyroboplan_rrt import plan_pyroboplan_rrt_connect
 from planning.report import markdown_table
+from planning.sampling import SamplingResult, plan_rrt_connect
 from planning.scene import Scene, paper_scene
 from planning.scene_generator import generate_scenes
 from planning.spline import SepticSplineSolver, uniform_knots
@@ -108,19 +110,12 @@ def optimiser_table(robot: ck.Robot, seeds: int) -> tuple[list[list[str]], dict[
 
 
 def sampling_method(
-    robot: ck.Robot, module: str, time_limit_s: float
+    robot: ck.Robot, planner: Callable[..., SamplingResult], time_limit_s: float
 ) -> Callable[[Scene], dict[str, float] | None]:
-    """One of the sampling pipelines (``planning.sampling`` or ``planning.pyroboplan_rrt``)."""
-    import importlib
-
-    planner = {
-        "planning.sampling": "plan_rrt_connect",
-        "planning.pyroboplan_rrt": "plan_pyroboplan_rrt_connect",
-    }[module]
-    function = getattr(importlib.import_module(module), planner)
+    """One of the sampling pipelines (OMPL's or pyroboplan's RRT-Connect) as a benchmark method."""
 
     def run(scene: Scene) -> dict[str, float] | None:
-        result = function(scene, robot, time_limit_s=time_limit_s, seed=scene.planner.seed)
+        result = planner(scene, robot, time_limit_s=time_limit_s, seed=scene.planner.seed)
         if not result.success:
             return None
         return {
@@ -163,9 +158,10 @@ def planner_rows(robot: ck.Robot, scenes: list[Scene], time_limit_s: float) -> l
     sample = scenes[0]
     for name, optimiser in optimisers(sample).items():
         methods[f"{name} + septic spline"] = pipeline(None if name == "firefly (ours)" else optimiser)
-    for label, module, needs in (
-        ("RRT-Connect (OMPL) + TOPP-RA", "planning.sampling", ("ompl", "toppra")),
-        ("RRT-Connect (pyroboplan) + TOPP-RA", "planning.pyroboplan_rrt", ("pyroboplan", "toppra")),
+    # the planners import their peers when called: check that the peers are there first
+    for label, planner, needs in (
+        ("RRT-Connect (OMPL) + TOPP-RA", plan_rrt_connect, ("ompl", "toppra")),
+        ("RRT-Connect (pyroboplan) + TOPP-RA", plan_pyroboplan_rrt_connect, ("pyroboplan", "toppra")),
     ):
         try:
             for name in needs:
@@ -173,7 +169,7 @@ def planner_rows(robot: ck.Robot, scenes: list[Scene], time_limit_s: float) -> l
         except ImportError:
             print(f"  ({' or '.join(needs)} not installed: {label} skipped)")
             continue
-        methods[label] = sampling_method(robot, module, time_limit_s)
+        methods[label] = sampling_method(robot, planner, time_limit_s)
 
     results: dict[str, list[dict[str, float] | None]] = {name: [] for name in methods}
     for scene in scenes:
