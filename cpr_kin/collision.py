@@ -21,11 +21,16 @@ from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import CprKinError
 from cpr_kin.obstacles import Obstacle
+from cpr_kin.pair_bounds import PairBounds
 from cpr_kin.reach import geometry_reach
 from cpr_kin.robot import GROUPS, Robot
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
+
+BOUND_TOLERANCE_M = 1e-6
+"""A configuration goes to coal unless its pair bounds clear the margin by this much [m]
+(coal's distances are accurate to about 1e-6 of their size)."""
 
 
 @dataclass(frozen=True)
@@ -153,6 +158,7 @@ class CollisionWorld:
         self._pool_margin: float | None = None
         self._reach_distance = self._pair_reach_distances()
         self._culled_data: dict[tuple[bool, ...], Any] = {}
+        self._pair_bounds: dict[tuple[bool, ...], PairBounds] = {}
 
     def _pair_reach_distances(self) -> FloatArray:
         """Per pair, a lower bound of its distance over every configuration [m].
@@ -293,13 +299,18 @@ class CollisionWorld:
         parallel over :attr:`num_threads` threads (Pinocchio's ``GeometryPool``); several
         times faster than :meth:`clearance_batch` when distances are not needed. Pairs that
         cannot come within the margin in any configuration (their reach capsule is farther,
-        see :mod:`cpr_kin.reach`) are not tested.
+        see :mod:`cpr_kin.reach`) are not tested, and configurations whose every pair is
+        certainly farther than the margin by a cheap bound (:mod:`cpr_kin.pair_bounds`,
+        computed for the whole batch at once) are not sent to coal. Distances within
+        :data:`BOUND_TOLERANCE_M` of the margin always go to coal.
         """
         batch = self._check_batch(q)
         if not (np.isfinite(margin_m) and margin_m >= 0.0):
             raise CprKinError(f"safety margin {margin_m} m must be a finite number >= 0")
-        if not self._pairs:
-            return np.zeros(len(batch), dtype=bool)
+        violated = np.zeros(len(batch), dtype=bool)
+        near = self._reach_distance <= margin_m
+        if not near.any() or not len(batch):
+            return violated
         if self._pool is None:
             self._pool = pin.GeometryPool(self.robot.model, self.geometry_model, self.num_threads)
         if self._pool_margin != margin_m:
@@ -307,16 +318,29 @@ class CollisionWorld:
             for gdata in self._pool.getGeometryDatas():
                 gdata.setSecurityMargins(self.geometry_model, margins, True, True)
                 # pairs that stay farther than the margin in every configuration need no test
-                for p, far in enumerate(self._reach_distance > margin_m):
-                    if far:
-                        gdata.deactivateCollisionPair(p)
-                    else:
-                        gdata.activateCollisionPair(p)
+                for p, active in enumerate(near):
+                    (gdata.activateCollisionPair if active else gdata.deactivateCollisionPair)(p)
             self._pool_margin = margin_m
-        result = pin.computeCollisionsInParallel(
-            self.num_threads,
-            self._pool,
-            np.asfortranarray(batch.T),
-            True,  # stop at a configuration's first hit
-        )
-        return np.asarray(result, dtype=bool)
+        bounds = self._bounds(tuple(near.tolist()))(batch)
+        uncertain = np.flatnonzero((bounds <= margin_m + BOUND_TOLERANCE_M).any(axis=1))
+        if uncertain.size:
+            result = pin.computeCollisionsInParallel(
+                self.num_threads,
+                self._pool,
+                np.asfortranarray(batch[uncertain].T),
+                True,  # stop at a configuration's first hit
+            )
+            violated[uncertain] = np.asarray(result, dtype=bool)
+        return violated
+
+    def _bounds(self, active: tuple[bool, ...]) -> PairBounds:
+        """The pair bounds of the ``active`` pairs, built once per set of pairs."""
+        if active not in self._pair_bounds:
+            pairs = [
+                (self.robot.geometries[g].index, k)
+                for (g, k), on in zip(self._pairs, active, strict=True)
+                if on
+            ]
+            model = self.robot
+            self._pair_bounds[active] = PairBounds(model.model, model.collision_model, self.obstacles, pairs)
+        return self._pair_bounds[active]

@@ -60,7 +60,7 @@ class GeometryReach:
     hulls: tuple[Hull, ...]
 
 
-def _joint_axis(joint: Any) -> tuple[bool, FloatArray]:
+def joint_axis(joint: Any) -> tuple[bool, FloatArray]:
     """(is prismatic, unit axis in the joint frame) of a one-degree-of-freedom joint."""
     jdata = joint.createData()
     joint.calc(jdata, np.zeros(joint.nq))
@@ -81,7 +81,7 @@ def geometry_reach(
     model: Any, collision_model: Any, lower: FloatArray, upper: FloatArray
 ) -> list[GeometryReach]:
     """The bounds of every collision geometry of a Pinocchio model (one-DOF joints)."""
-    axes = [_joint_axis(model.joints[k]) for k in range(1, model.njoints)]
+    axes = [joint_axis(model.joints[k]) for k in range(1, model.njoints)]
     bounds = []
     for obj in collision_model.geometryObjects:
         shape = obj.geometry

@@ -1,0 +1,112 @@
+from __future__ import annotations
+
+from pathlib import Path
+
+import coal
+import numpy as np
+import pinocchio as pin
+import pytest
+import trimesh
+
+import cpr_kin as ck
+from cpr_kin.pair_bounds import PairBounds, bounding_capsule
+
+from .conftest import random_configurations
+from .test_collision import random_obstacle
+
+SHAPES = ("box", "sphere", "cylinder", "capsule")
+
+
+def all_pairs(robot: ck.Robot, obstacles: list[ck.Obstacle]) -> list[tuple[int, int]]:
+    return [(g.index, k) for g in robot.geometries for k in range(len(obstacles))]
+
+
+def coal_distances(robot: ck.Robot, world: ck.CollisionWorld, q: np.ndarray) -> np.ndarray:
+    return np.array([[p.distance_m for p in world.clearance(qk).pairs] for qk in q])
+
+
+@pytest.mark.parametrize(
+    ("geometry", "inside"),
+    [
+        (coal.Box(0.7, 0.05, 0.05), [[0.35, 0.025, 0.025], [-0.35, -0.025, 0.025], [0.0, 0.0, -0.025]]),
+        (coal.Cylinder(0.035, 0.08), [[0.035, 0.0, 0.04], [0.0, -0.035, -0.04]]),
+        (coal.Capsule(0.02, 0.3), [[0.0, 0.0, 0.17], [0.02, 0.0, -0.15]]),
+        (coal.Sphere(0.1), [[0.1, 0.0, 0.0], [0.0, 0.0, -0.1]]),
+    ],
+)
+def test_bounding_capsule_contains_the_shape(geometry: object, inside: list[list[float]]) -> None:
+    ends, radius = bounding_capsule(geometry)
+    for point in np.array(inside):
+        d = ends[1] - ends[0]
+        t = np.clip((point - ends[0]) @ d / max(d @ d, 1e-300), 0.0, 1.0)
+        assert np.linalg.norm(point - ends[0] - t * d) <= radius + 1e-12
+
+
+def test_bounds_never_exceed_coal_distances(robot: ck.Robot, rng: np.random.Generator) -> None:
+    obstacles = [random_obstacle(shape, rng) for shape in SHAPES for _ in range(3)]
+    obstacles = [ck.Obstacle(**{**o.__dict__, "name": f"o{k}"}) for k, o in enumerate(obstacles)]
+    world = ck.CollisionWorld(robot, obstacles)
+    configurations = random_configurations(robot, rng, 150)
+    bounds = PairBounds(robot.model, robot.collision_model, obstacles, all_pairs(robot, obstacles))(
+        configurations
+    )
+    exact = coal_distances(robot, world, configurations)
+    positive = bounds > 0.0
+    # a positive bound is a distance lower bound, up to coal's GJK tolerance (about 1e-6)
+    assert np.all(bounds[positive] <= exact[positive] + 2e-6)
+    overlapping = exact < 0.0
+    assert overlapping.any() and np.all(bounds[overlapping] <= 0.0)
+    # and they are useful: most pairs that keep 10 cm are certified to keep 5 cm
+    far = exact > 0.1
+    assert np.mean(bounds[far] > 0.05) > 0.8
+
+
+def test_mesh_obstacle_is_bounded_by_its_bounding_box(
+    robot: ck.Robot, rng: np.random.Generator, tmp_path: Path
+) -> None:
+    path = tmp_path / "tetra.stl"
+    trimesh.Trimesh(
+        vertices=[[0.0, 0.0, 0.0], [0.3, 0.0, 0.0], [0.0, 0.2, 0.0], [0.1, 0.1, 0.25]],
+        faces=[[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
+    ).export(path)
+    mesh = ck.Obstacle.from_mesh(path, xyz=(0.2, 0.45, 0.3), rpy=(0.3, -0.2, 0.5), name="tetra")
+    world = ck.CollisionWorld(robot, [mesh])
+    configurations = random_configurations(robot, rng, 300)
+    bounds = PairBounds(robot.model, robot.collision_model, [mesh], all_pairs(robot, [mesh]))(configurations)
+    exact = coal_distances(robot, world, configurations)
+    positive = bounds > 0.0
+    assert positive.mean() > 0.5
+    assert np.all(bounds[positive] <= exact[positive] + 2e-6)
+
+
+def test_sphere_bound_is_exact_beside_a_cylinder_side(robot: ck.Robot) -> None:
+    # the wrist is a horizontal cylinder (radius 0.035 m), bounded by a capsule of the same
+    # radius and axis: straight above its centre, both are 0.3 - 0.035 - 0.05 m from a ball
+    q = np.array([0.0, 0.3, 0.2, 0.0, 0.0])
+    wrist = next(g for g in robot.geometries if g.name == "wrist")
+    gdata = robot.collision_model.createData()
+    pin.forwardKinematics(robot.model, robot.data, q)
+    pin.updateGeometryPlacements(robot.model, robot.data, robot.collision_model, gdata)
+    placement = gdata.oMg[wrist.index]
+    assert abs(placement.rotation[2, 2]) < 1e-12  # the cylinder's axis is horizontal
+    ball = ck.Obstacle.sphere(0.05, placement.translation + np.array([0.0, 0.0, 0.3]), name="ball")
+    bound = PairBounds(robot.model, robot.collision_model, [ball], [(wrist.index, 0)])(q[None])[0, 0]
+    exact = coal_distances(robot, ck.CollisionWorld(robot, [ball]), q[None])[0, wrist.index]
+    assert exact == pytest.approx(0.3 - 0.035 - 0.05, abs=1e-9)
+    assert bound == pytest.approx(exact, abs=1e-9)
+
+
+def test_margin_check_with_bounds_agrees_with_distances_for_every_shape(
+    robot: ck.Robot, rng: np.random.Generator
+) -> None:
+    for shape in SHAPES:
+        obstacles = [
+            ck.Obstacle(**{**random_obstacle(shape, rng).__dict__, "name": f"o{k}"}) for k in range(3)
+        ]
+        world = ck.CollisionWorld(robot, obstacles)
+        configurations = random_configurations(robot, rng, 400)
+        distances = world.clearance_batch(configurations).min_clearance_m
+        for margin in (0.0, 0.05, 0.2):
+            violated = world.margin_violated(configurations, margin)
+            ambiguous = np.abs(distances - margin) < 1e-6
+            np.testing.assert_array_equal(violated[~ambiguous], (distances < margin)[~ambiguous])
