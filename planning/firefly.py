@@ -30,6 +30,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from cpr_kin.compiled import njit
 from planning.errors import PlanningError
 
 FloatArray = NDArray[np.float64]
@@ -206,25 +207,47 @@ def _sweep(
 ) -> FloatArray:
     """One synchronous sweep: every firefly moves towards each brighter one, in order.
 
-    Each firefly's path depends only on its own position and the attractors' snapshot, so
-    the loop runs over attractors and moves every firefly at once.
+    The kicks are drawn here, one ``(n, d)`` block per attractor for everyone (draws for
+    a dimmer attractor are discarded), so a seed gives the same run whatever computes the
+    moves; the O(n^2 d) moves themselves run compiled (:func:`_move`).
     """
     n, d = u.shape
-    dimmer = f[None, :] > f[:, None]  # dimmer[j, i]: firefly i moves towards j
-    kicks = rng.random((n, n, d))  # one (n, d) draw per attractor, for everyone
-    kicks -= 0.5
-    kicks *= alpha * dimmer[:, :, None]  # no kick towards a dimmer firefly
-    attraction = settings.beta0 * dimmer
-    minus_gamma = -settings.gamma
-    moved = u.copy()
-    step, beta = np.empty_like(u), np.empty(n)  # reused: at this size allocations cost more than the maths
-    for j in np.flatnonzero(dimmer.any(axis=1)):
-        np.subtract(u[j], moved, out=step)  # attractors stay where the sweep found them
-        np.vecdot(step, step, out=beta)
-        np.multiply(beta, minus_gamma, out=beta)
-        np.exp(beta, out=beta)
-        np.multiply(beta, attraction[j], out=beta)  # beta0 exp(-gamma r^2), 0 towards a dimmer one
-        np.multiply(step, beta[:, None], out=step)
-        step += kicks[j]
-        moved += step
-    return np.clip(moved, 0.0, 1.0, out=moved)
+    kicks = rng.random((n, n, d))
+    moved = np.empty_like(u)
+    _move(u, f, kicks, alpha, settings.beta0, settings.gamma, moved)
+    return moved
+
+
+@njit
+def _move(
+    u: FloatArray,
+    f: FloatArray,
+    kicks: FloatArray,
+    alpha: float,
+    beta0: float,
+    gamma: float,
+    moved: FloatArray,
+) -> None:
+    """Write the swept positions of fireflies ``u`` ``(n, d)`` with values ``f`` into ``moved``.
+
+    Attractors stay where the sweep found them (``u``); firefly ``i`` moves towards every
+    ``j`` with ``f[j] < f[i]`` in the order of ``j``, by ``beta0 exp(-gamma r^2)`` of the way
+    plus ``alpha (kicks[j, i] - 0.5)``, and ends clipped to ``[0, 1]``.
+    """
+    n, d = u.shape
+    for i in range(n):
+        for k in range(d):
+            moved[i, k] = u[i, k]
+    for j in range(n):
+        for i in range(n):
+            if f[j] < f[i]:
+                distance2 = 0.0
+                for k in range(d):
+                    step = u[j, k] - moved[i, k]
+                    distance2 += step * step
+                beta = beta0 * np.exp(-gamma * distance2)
+                for k in range(d):
+                    moved[i, k] += (u[j, k] - moved[i, k]) * beta + (kicks[j, i, k] - 0.5) * alpha
+    for i in range(n):
+        for k in range(d):
+            moved[i, k] = min(max(moved[i, k], 0.0), 1.0)

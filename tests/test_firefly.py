@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from planning.errors import PlanningError
-from planning.firefly import FireflyProgress, FireflySettings, firefly_minimize
+from planning.firefly import FireflyProgress, FireflySettings, _sweep, firefly_minimize
 
 
 def sphere(x: np.ndarray) -> np.ndarray:
@@ -86,6 +86,28 @@ def test_sweep_keeps_the_brightest_in_place() -> None:
     brightest = int(np.argmin(sphere(initial)))
     np.testing.assert_array_equal(after[brightest], initial[brightest])
     assert not np.array_equal(np.delete(after, brightest, 0), np.delete(initial, brightest, 0))
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_compiled_sweep_matches_a_plain_loop(seed: int) -> None:
+    # Yang's sweep written out pair by pair: attractors where the sweep found them, every
+    # firefly moving in turn towards each brighter one, with the same kicks
+    rng = np.random.default_rng(seed)
+    n, d = 9, 4
+    u, f = rng.random((n, d)), rng.random(n)
+    f[3] = f[5]  # a tie: neither moves towards the other
+    settings = FireflySettings(fireflies=n, beta0=0.8, gamma=2.0)
+    kicks = np.random.default_rng(seed + 100).random((n, n, d))
+    expected = u.copy()
+    for j in range(n):
+        for i in range(n):
+            if f[j] < f[i]:
+                step = u[j] - expected[i]
+                expected[i] += 0.8 * np.exp(-2.0 * step @ step) * step + 0.3 * (kicks[j, i] - 0.5)
+    expected = np.clip(expected, 0.0, 1.0)
+    moved = _sweep(u.copy(), f, 0.3, settings, np.random.default_rng(seed + 100))
+    np.testing.assert_allclose(moved, expected, rtol=0, atol=1e-14)
+    np.testing.assert_array_equal(moved[np.argmin(f)], u[np.argmin(f)])  # the brightest stays
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
