@@ -33,10 +33,9 @@ with eq. 6.
 
 Only joints that move are fitted and sampled: the waypoint joints, and any other joint whose
 goal differs from its start (it moves in the last segment). The rest keep their start value,
-exactly, as the spline through constant nodes does. A joint whose velocity, acceleration
-and jerk are certainly within their limits by a Bernstein bound
-(:mod:`planning.polynomial_bounds`) contributes no excess and is not sampled for them: the
-bound is at least the sampled maximum.
+exactly, as the spline through constant nodes does. A joint's velocity, acceleration or
+jerk that is certainly within its limit by a Bernstein bound (:mod:`planning.polynomial_bounds`)
+contributes no excess and is not sampled: the bound is at least the sampled maximum.
 """
 
 from __future__ import annotations
@@ -147,7 +146,9 @@ class WaypointObjective:
         self._last_step_powers = (knots[-1] - knots[-2]) ** np.arange(8.0)
         ipo_times = np.append(np.arange(knots[0], knots[-1], settings.ipo), knots[-1])
         self._ipo = PiecewiseSampler(knots, ipo_times, 8)
-        self._ipo_derivatives = PiecewiseSampler(knots, ipo_times, 8, derivatives=3, first=1)
+        self._ipo_derivatives = tuple(
+            PiecewiseSampler(knots, ipo_times, 8, derivatives=r, first=r) for r in (1, 2, 3)
+        )
         self._derivative_bounds = DerivativeBounds(knots, 8, (1, 2, 3))
         self._steps = np.empty((len(ipo_times) - 1, 0))  # reused buffer of IPO steps
         self._tiled: dict[int, tuple[FloatArray, ...]] = {}
@@ -205,10 +206,13 @@ class WaypointObjective:
         excess = zeros
         if self.timed:  # largest |velocity|, |acceleration|, |jerk| relative to its limit
             utilisation = np.zeros(s * k)
-            unsure = np.flatnonzero((self._derivative_bounds(coefficients) > limits).any(axis=0))
-            if unsure.size:  # the others are within their limits: they add no excess
-                derivatives = np.abs(self._ipo_derivatives(coefficients[:, unsure]))
-                utilisation[unsure] = (derivatives.max(axis=1) / limits[:, unsure]).max(axis=0)
+            may_exceed = self._derivative_bounds(coefficients) > limits  # (3, S k)
+            for r, sampler in enumerate(self._ipo_derivatives):
+                unsure = np.flatnonzero(may_exceed[r])
+                if unsure.size:  # the others stay within this limit: they add no excess
+                    values = sampler(coefficients[:, unsure])[0]
+                    peak = np.abs(values, out=values).max(axis=0) / limits[r, unsure]
+                    utilisation[unsure] = np.maximum(utilisation[unsure], peak)
             excess = np.maximum(utilisation.reshape(s, k).max(axis=1) - 1.0, 0.0)
         return samples, w_sol, overshoot, excess, deviation
 

@@ -75,14 +75,15 @@ class PiecewiseSampler:
             rows = np.flatnonzero(segment == i)  # contiguous: the times are sorted
             powers = [derivative_powers(local[rows], order, r) for r in range(first, derivatives + 1)]
             self._blocks.append((int(i), slice(int(rows[0]), int(rows[-1]) + 1), powers))
-        self._out = np.empty((derivatives - first + 1, self.count, 0))
+        self._buffer = np.empty(0)  # grows to the largest call's size, reused below it
 
     def __call__(self, coefficients: FloatArray) -> FloatArray:
         """``(derivatives - first + 1, K, M)`` derivatives of ``(N, M, order)`` coefficients."""
         shape = (self.derivatives - self.first + 1, self.count, coefficients.shape[1])
-        if self._out.shape != shape:
-            self._out = np.empty(shape)
-        out = self._out
+        size = shape[0] * shape[1] * shape[2]
+        if self._buffer.size < size:
+            self._buffer = np.empty(size)
+        out = self._buffer[:size].reshape(shape)
         for segment, rows, powers in self._blocks:
             columns = coefficients[segment].T  # (order, M)
             for r, matrix in enumerate(powers):

@@ -48,8 +48,16 @@ def test_derivative_powers_differentiate_a_monomial() -> None:
 def test_buffer_is_reused_and_resized() -> None:
     sampler = PiecewiseSampler([0.0, 1.0, 2.0], np.linspace(0, 2, 9), 4)
     first = sampler(np.ones((2, 3, 4)))
-    assert sampler(np.ones((2, 3, 4))) is first  # same buffer, overwritten
-    assert sampler(np.ones((2, 5, 4))).shape == (1, 9, 5)
+    second = sampler(2 * np.ones((2, 3, 4)))
+    assert np.shares_memory(first, second)  # same buffer, overwritten
+    np.testing.assert_array_equal(first, second)
+    larger = sampler(np.ones((2, 5, 4)))
+    assert larger.shape == (1, 9, 5) and not np.shares_memory(larger, first)  # grown
+    smaller = sampler(np.ones((2, 2, 4)))
+    assert smaller.shape == (1, 9, 2) and np.shares_memory(smaller, larger)  # kept: large enough
+    assert smaller.flags.c_contiguous
+    expected = smaller[0, :, 0].copy()
+    np.testing.assert_array_equal(sampler(np.ones((2, 1, 4)))[0, :, 0], expected)
 
 
 @pytest.mark.parametrize(
