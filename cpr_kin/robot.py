@@ -12,17 +12,19 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
-import yourdfpy
 from lxml import etree
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import CprKinError, JointLimitError, UrdfError
 from cpr_kin.limits import JointLimits, read_dynamic_limits
 from cpr_kin.resources import cpr_limits_path, cpr_urdf_path
+
+if TYPE_CHECKING:
+    import yourdfpy
 
 FloatArray = NDArray[np.float64]
 
@@ -58,7 +60,13 @@ class RobotGeometry:
 
 
 def _validate_urdf(path: Path) -> yourdfpy.URDF:
-    """Parse ``path`` strictly and validate it with yourdfpy; raise :class:`UrdfError`."""
+    """Parse ``path`` strictly and validate it with yourdfpy; raise :class:`UrdfError`.
+
+    yourdfpy is imported here, not with the package: it imports trimesh, about a second,
+    which a process that never loads a robot (the batch's parent process) need not pay.
+    """
+    import yourdfpy
+
     if not path.is_file():
         raise UrdfError(f"URDF file '{path}' does not exist; pass the path of a .urdf file")
     try:

@@ -140,3 +140,14 @@ def test_bad_limits_dataclass() -> None:
             acceleration=np.ones(1),
             jerk=np.zeros(1),
         )
+
+
+def test_importing_the_packages_does_not_import_trimesh() -> None:
+    # yourdfpy (and with it trimesh, about a second) is imported only when a robot is loaded:
+    # the batch's parent process never pays for it
+    import subprocess
+    import sys
+
+    code = "import sys, cpr_kin, planning.batch; print('trimesh' in sys.modules, 'yourdfpy' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.split() == ["False", "False"]
