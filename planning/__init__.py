@@ -8,7 +8,7 @@ optimiser's history and the verification. Write it with :func:`write_trajectory`
 from planning.errors import PlanningError, SplineError
 from planning.firefly import FireflyProgress, FireflyResult, FireflySettings, firefly_minimize
 from planning.objective import Breakdown, WaypointObjective
-from planning.planner import Metrics, NoTrajectoryFoundError, PlanResult, plan
+from planning.planner import Metrics, NoTrajectoryFoundError, PlanResult, plan, warm_up
 from planning.ptp import ptp_time, trapezoid_time
 from planning.scene import PlannerSettings, Scene, Target, paper_scene
 from planning.spline import SepticSplineSolver, SplineFit, SplineSettings, fit_septic_spline, uniform_knots
@@ -45,6 +45,7 @@ __all__ = [
     "trapezoid_time",
     "uniform_knots",
     "verify_trajectory",
+    "warm_up",
     "write_samples",
     "write_trajectory",
 ]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -14,7 +15,7 @@ from planning.baselines import Optimizer
 from planning.errors import PlanningError
 from planning.firefly import FireflyProgress, FireflyResult, firefly_minimize
 from planning.objective import Breakdown, WaypointObjective
-from planning.scene import Scene
+from planning.scene import Scene, paper_scene
 from planning.spline import SepticSplineSolver, SplineFit, uniform_knots
 from planning.trajectory import Trajectory
 from planning.verification import Verification, verify_trajectory
@@ -296,3 +297,16 @@ def plan(
         optimiser=result,
         verification=check,
     )
+
+
+def warm_up(robot: ck.Robot | None = None) -> float:
+    """Compile the numba kernels, or load them from their on-disk cache; seconds spent.
+
+    Planning does it anyway on its first call; this moves the one-time cost (several
+    seconds on a new machine, a fraction of a second per process afterwards) out of a plan
+    that is timed. It plans the paper case with two fireflies for one iteration.
+    """
+    started = time.perf_counter()
+    with contextlib.suppress(PlanningError):  # a search this small may find nothing: the kernels ran
+        plan(paper_scene(fireflies=2, iterations=1), robot, threads=1)
+    return time.perf_counter() - started

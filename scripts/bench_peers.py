@@ -28,7 +28,7 @@ import cpr_kin as ck
 from planning import baselines
 from planning.errors import PlanningError
 from planning.objective import WaypointObjective
-from planning.planner import endpoint, moving_joints, plan
+from planning.planner import endpoint, moving_joints, plan, warm_up
 from planning.pyroboplan_rrt import plan_pyroboplan_rrt_connect
 from planning.report import markdown_table
 from planning.sampling import SamplingResult, plan_rrt_connect
@@ -210,6 +210,7 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=Path("out/bench_peers.md"), help="Markdown report")
     args = parser.parse_args()
     robot = ck.load_cpr()
+    print(f"compiled (or loaded) the numba kernels in {warm_up(robot):.1f} s; not part of any timing\n")
 
     print(f"1. Optimisers on the paper case's objective, budget 2550 evaluations, seeds 0..{args.seeds - 1}")
     rows, ratios = optimiser_table(robot, args.seeds)

@@ -8,7 +8,7 @@ import pytest
 
 import cpr_kin as ck
 from planning.errors import PlanningError
-from planning.planner import NoTrajectoryFoundError, PlanResult, plan
+from planning.planner import NoTrajectoryFoundError, PlanResult, plan, warm_up
 from planning.scene import PAPER_GOAL_TCP, PAPER_START_TCP, PlannerSettings, Scene, Target, paper_scene
 
 
@@ -128,3 +128,12 @@ def test_bad_planner_settings() -> None:
         PlannerSettings(fireflies=0)
     with pytest.raises(PlanningError, match="exactly one of 'tcp'"):
         Target()
+
+
+def test_warm_up_compiles_the_kernels_and_returns_its_time(robot: ck.Robot) -> None:
+    from cpr_kin.pair_bounds import _bounds
+    from planning.firefly import _move
+
+    seconds = warm_up(robot)
+    assert 0.0 < seconds < 120.0
+    assert _move.signatures and _bounds.signatures  # compiled (or loaded from the cache)
