@@ -2,6 +2,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+from typing import Any
 
 import numpy as np
 import pytest
@@ -136,4 +137,5 @@ def test_warm_up_compiles_the_kernels_and_returns_its_time(robot: ck.Robot) -> N
 
     seconds = warm_up(robot)
     assert 0.0 < seconds < 120.0
-    assert _move.signatures and _bounds.signatures  # compiled (or loaded from the cache)
+    compiled: list[Any] = [_move, _bounds]
+    assert all(kernel.signatures for kernel in compiled)  # compiled (or loaded from the cache)
