@@ -143,10 +143,6 @@ class PairBounds:
         _bounds(batch, out, *self._arguments)
         return out
 
-    def clear_of(self, q: FloatArray, margin_m: float) -> NDArray[np.bool_]:
-        """``(N,)`` whether every pair's bound exceeds ``margin_m`` [m] (then the configuration keeps it)."""
-        return np.asarray((self(q) > margin_m).all(axis=1))
-
 
 def _obstacle_bound(obstacle: Obstacle) -> tuple[int, FloatArray, FloatArray, float, FloatArray]:
     """Kind, rotation, centre [m], radius [m] and half sides (z: half length) [m] of a bound.
