@@ -21,30 +21,28 @@ from cpr_kin.reach import joint_axis
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
+BoolArray = NDArray[np.bool_]
+ChainArrays = tuple[IntArray, IntArray, BoolArray, FloatArray, FloatArray, FloatArray, BoolArray]
+"""A :class:`KinematicChain`'s arrays, in its field order, as compiled code takes them."""
 
 
 @njit
 def place_joints(
     q: FloatArray,
-    parents: IntArray,
-    index_q: IntArray,
-    prismatic: NDArray[np.bool_],
-    axes: FloatArray,
-    rotations: FloatArray,
-    translations: FloatArray,
-    aligned: NDArray[np.bool_],
+    chain: ChainArrays,
     rotation_out: FloatArray,
     translation_out: FloatArray,
     local: FloatArray,
 ) -> None:
     """Write every joint's ``joint_in_world`` at one configuration ``q`` ``(nq,)``.
 
-    The chain's arrays are those of :class:`KinematicChain`; ``rotation_out`` ``(J, 3, 3)``
+    ``chain`` is :attr:`KinematicChain.arrays`; ``rotation_out`` ``(J, 3, 3)``
     and ``translation_out`` ``(J, 3)`` receive the placements, in joint order. ``local`` is
     a ``(4, 3)`` work array (allocating per call would cost more than the arithmetic).
     Written with scalars and explicit indices (array views cost reference counting), and
     skipping products with the identity where a placement has no rotation (``aligned``).
     """
+    parents, index_q, prismatic, axes, rotations, translations, aligned = chain
     for j in range(len(parents)):
         value = q[index_q[j]]
         x, y, z = axes[j, 0], axes[j, 1], axes[j, 2]
@@ -153,8 +151,8 @@ class KinematicChain:
         )
 
     @property
-    def arrays(self) -> tuple[Any, ...]:
-        """The arrays in :func:`place_joints`'s argument order."""
+    def arrays(self) -> ChainArrays:
+        """The arrays, in field order: :func:`place_joints`'s ``chain``."""
         return (
             self.parents,
             self.index_q,
@@ -174,43 +172,19 @@ class KinematicChain:
         batch = np.ascontiguousarray(q, dtype=float)
         n, joints = len(batch), len(self.parents)
         rotations, translations = np.empty((n, joints, 3, 3)), np.empty((n, joints, 3))
-        _place_batch(batch, rotations, translations, *self.arrays)
+        _place_batch(batch, self.arrays, rotations, translations)
         return rotations, translations
 
 
 @njit
 def _place_batch(
-    q: FloatArray,
-    rotation_out: FloatArray,
-    translation_out: FloatArray,
-    parents: IntArray,
-    index_q: IntArray,
-    prismatic: NDArray[np.bool_],
-    axes: FloatArray,
-    rotations: FloatArray,
-    translations: FloatArray,
-    aligned: NDArray[np.bool_],
+    q: FloatArray, chain: ChainArrays, rotation_out: FloatArray, translation_out: FloatArray
 ) -> None:
-    rotation, translation, local = (
-        np.empty((len(parents), 3, 3)),
-        np.empty((len(parents), 3)),
-        np.empty((4, 3)),
-    )
+    joints = len(chain[0])
+    rotation, translation, local = np.empty((joints, 3, 3)), np.empty((joints, 3)), np.empty((4, 3))
     for k in range(len(q)):
-        place_joints(
-            q[k],
-            parents,
-            index_q,
-            prismatic,
-            axes,
-            rotations,
-            translations,
-            aligned,
-            rotation,
-            translation,
-            local,
-        )
-        for j in range(len(parents)):  # element by element: a slice assignment allocates
+        place_joints(q[k], chain, rotation, translation, local)
+        for j in range(joints):  # element by element: a slice assignment allocates
             for r in range(3):
                 translation_out[k, j, r] = translation[j, r]
                 for c in range(3):

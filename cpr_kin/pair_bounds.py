@@ -32,7 +32,7 @@ import coal
 import numpy as np
 from numpy.typing import NDArray
 
-from cpr_kin.batch_kinematics import KinematicChain, place_joints
+from cpr_kin.batch_kinematics import ChainArrays, KinematicChain, place_joints
 from cpr_kin.compiled import njit
 from cpr_kin.obstacles import Obstacle
 
@@ -125,7 +125,7 @@ class PairBounds:
         )
         # the compiled kernel's arguments after the configurations and the output
         self._arguments: tuple[Any, ...] = (
-            *self._chain.arrays,
+            self._chain.arrays,
             *self._capsules,
             *self._pairs,
             *self._obstacles,
@@ -183,13 +183,7 @@ def _gap(low: float, high: float, half: float) -> float:
 def _bounds(
     q: FloatArray,
     out: FloatArray,
-    parents: IntArray,
-    index_q: IntArray,
-    prismatic: NDArray[np.bool_],
-    axes: FloatArray,
-    rotations: FloatArray,
-    translations: FloatArray,
-    aligned: NDArray[np.bool_],
+    chain: ChainArrays,
     capsule_joint: IntArray,
     capsule_ends: FloatArray,
     capsule_radius: FloatArray,
@@ -201,24 +195,12 @@ def _bounds(
     obstacle_radius: FloatArray,
     obstacle_half: FloatArray,
 ) -> None:
-    joints = len(parents)
+    joints = len(chain[0])
     rotation, translation = np.empty((joints, 3, 3)), np.empty((joints, 3))
     world = np.empty((len(capsule_joint), 2, 3))
     local, scratch = np.empty((2, 3)), np.empty((4, 3))
     for n in range(len(q)):
-        place_joints(
-            q[n],
-            parents,
-            index_q,
-            prismatic,
-            axes,
-            rotations,
-            translations,
-            aligned,
-            rotation,
-            translation,
-            scratch,
-        )
+        place_joints(q[n], chain, rotation, translation, scratch)
         for c in range(len(capsule_joint)):
             j = capsule_joint[c]
             for e in range(2):
