@@ -39,6 +39,7 @@ bench: $(STAMP)
 	$(PY) scripts/bench_clearance.py
 	$(PY) scripts/bench_spline.py
 	$(PY) scripts/bench_planner.py
+	$(PY) scripts/bench_batch.py
 
 bench-peers: $(STAMP)
 	$(PY) scripts/bench_peers.py --scenes 50 --out out/bench_peers.md

@@ -1,0 +1,91 @@
+"""Time ``cpr-plan batch`` on generated scenes, as a user runs it: a new process each time.
+
+Writes ``--scenes`` seeded scenes (``scripts/generate_scenes.py``'s generator) into a
+temporary folder, then runs ``cpr-plan batch --workers N`` on them ``--runs`` times and prints
+every wall time, their median and the scenes planned. Process start-up (imports, loading the
+URDF, loading the compiled kernels in every worker) is part of the figure.
+
+With ``--compare DIR`` (another checkout of the project, e.g. ``git worktree add /tmp/old
+<commit>``), that checkout's code is timed too, alternating run by run with this one, so that
+the machine's drift hits both alike. Target (issue 7): 100 scenes in <= 20 s on 2 cores.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from planning.scene_file import dump_scene
+from planning.scene_generator import generate_scenes
+
+TARGET_S = 20.0
+
+
+def run_batch(code: Path, scenes: Path, out: Path, workers: int) -> tuple[float, int]:
+    """Wall time [s] of one ``cpr-plan batch`` with ``code`` first on the path, and scenes planned."""
+    env = {**os.environ, "PYTHONPATH": str(code)}  # and a neutral working folder: it comes first on the path
+    command = [sys.executable, "-c", "import sys; from planning.cli import main; sys.exit(main())"]
+    started = time.perf_counter()
+    done = subprocess.run(
+        [*command, "batch", str(scenes), "--out", str(out), "--workers", str(workers)],
+        env=env,
+        cwd=scenes.parent,
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    elapsed = time.perf_counter() - started
+    if done.returncode not in (0, 3):  # 3: some scenes have no trajectory, which is an outcome
+        raise SystemExit(f"cpr-plan batch failed with exit code {done.returncode}:\n{done.stderr}")
+    with (out / "summary.csv").open() as summary:
+        planned = sum(row["status"] == "ok" for row in csv.DictReader(summary))
+    return elapsed, planned
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--scenes", type=int, default=100, help="generated scenes (default: 100)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the scene generator (default: 0)")
+    parser.add_argument("--workers", type=int, default=2, help="worker processes (default: 2)")
+    parser.add_argument("--runs", type=int, default=3, help="timed runs (default: 3)")
+    parser.add_argument("--compare", type=Path, help="another checkout to time beside this one")
+    args = parser.parse_args()
+    here = Path(__file__).resolve().parents[1]
+    codes = {"this checkout": here}
+    if args.compare is not None:
+        if not (args.compare / "planning" / "cli.py").is_file():
+            raise SystemExit(f"--compare {args.compare}: not a checkout of this project (no planning/cli.py)")
+        codes[f"compare ({args.compare})"] = args.compare.resolve()
+    with tempfile.TemporaryDirectory() as tmp:
+        scenes = Path(tmp) / "scenes"
+        for scene in generate_scenes(args.scenes, args.seed):
+            dump_scene(scene, scenes / f"{scene.name}.yaml")
+        # one untimed run per checkout: compiles the numba kernels if this machine never has
+        for code in codes.values():
+            run_batch(code, scenes, Path(tmp) / "warm-up", args.workers)
+        times: dict[str, list[float]] = {name: [] for name in codes}
+        planned: dict[str, int] = {}
+        for run in range(args.runs):
+            for k, (name, code) in enumerate(codes.items()):
+                out = Path(tmp) / f"out-{k}-{run}"
+                elapsed, planned[name] = run_batch(code, scenes, out, args.workers)
+                times[name].append(elapsed)
+                print(f"run {run + 1}, {name}: {elapsed:.1f} s, {planned[name]}/{args.scenes} planned")
+    print(f"\n{args.scenes} scenes, --workers {args.workers}, {args.runs} runs each")
+    for name, values in times.items():
+        spread = ", ".join(f"{v:.1f}" for v in values)
+        print(f"  {name}: median {statistics.median(values):.1f} s ({spread}), {planned[name]} planned")
+    median = statistics.median(times["this checkout"])
+    verdict = "met" if median <= TARGET_S else "NOT met"
+    print(f"target <= {TARGET_S:.0f} s for 100 scenes on 2 cores: {median:.1f} s -> {verdict}")
+
+
+if __name__ == "__main__":
+    main()
