@@ -337,10 +337,8 @@ class CollisionWorld:
         """The pair bounds of the ``active`` pairs, built once per set of pairs."""
         if active not in self._pair_bounds:
             pairs = [
-                (self.robot.geometries[g].index, k)
-                for (g, k), on in zip(self._pairs, active, strict=True)
-                if on
-            ]
-            model = self.robot
-            self._pair_bounds[active] = PairBounds(model.model, model.collision_model, self.obstacles, pairs)
+                pair for pair, on in zip(self._pairs, active, strict=True) if on
+            ]  # (geometry index, obstacle)
+            robot = self.robot
+            self._pair_bounds[active] = PairBounds(robot.model, robot.collision_model, self.obstacles, pairs)
         return self._pair_bounds[active]
