@@ -5,42 +5,8 @@ the robot's collision groups to static obstacles, for single configurations, bat
 whole joint-space curves. Nothing here draws or plans.
 """
 
-from cpr_kin.collision import BatchClearance, Clearance, CollisionWorld, PairDistance
-from cpr_kin.errors import CprKinError, JointLimitError, ObstacleError, UnreachableError, UrdfError
-from cpr_kin.ik import tcp_ik
-from cpr_kin.kinematics import frame_poses, frame_positions
-from cpr_kin.limits import JointLimits
-from cpr_kin.motion import CurveCheck, check_curve, check_segment, motion_radii
-from cpr_kin.obstacles import SHAPES, Obstacle
-from cpr_kin.resources import cpr_limits_path, cpr_urdf_path
-from cpr_kin.robot import CPR_JOINTS, GROUPS, TCP_FRAME, Robot, RobotGeometry, load_cpr
+import lazy_loader
 
-__all__ = [
-    "CPR_JOINTS",
-    "GROUPS",
-    "SHAPES",
-    "TCP_FRAME",
-    "BatchClearance",
-    "Clearance",
-    "CollisionWorld",
-    "CprKinError",
-    "CurveCheck",
-    "JointLimitError",
-    "JointLimits",
-    "Obstacle",
-    "ObstacleError",
-    "PairDistance",
-    "Robot",
-    "RobotGeometry",
-    "UnreachableError",
-    "UrdfError",
-    "check_curve",
-    "check_segment",
-    "cpr_limits_path",
-    "cpr_urdf_path",
-    "frame_poses",
-    "frame_positions",
-    "load_cpr",
-    "motion_radii",
-    "tcp_ik",
-]
+# the exports of __init__.pyi, each imported on first use: a process that needs one module
+# (the batch's parent, a tool reading a scene file) does not pay for all the others
+__getattr__, __dir__, __all__ = lazy_loader.attach_stub(__name__, __file__)

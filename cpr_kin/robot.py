@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -22,9 +22,6 @@ from numpy.typing import ArrayLike, NDArray
 from cpr_kin.errors import CprKinError, JointLimitError, UrdfError
 from cpr_kin.limits import JointLimits, read_dynamic_limits
 from cpr_kin.resources import cpr_limits_path, cpr_urdf_path
-
-if TYPE_CHECKING:
-    import yourdfpy
 
 FloatArray = NDArray[np.float64]
 
@@ -59,20 +56,24 @@ class RobotGeometry:
     index: int
 
 
-def _validate_urdf(path: Path) -> yourdfpy.URDF:
-    """Parse ``path`` strictly and validate it with yourdfpy; raise :class:`UrdfError`.
-
-    yourdfpy is imported here, not with the package: it imports trimesh, about a second,
-    which a process that never loads a robot (the batch's parent process) need not pay.
-    """
-    import yourdfpy
-
+def _parse_urdf(path: Path) -> etree._ElementTree:
+    """Parse ``path`` as strict XML; raise :class:`UrdfError` if it is missing or malformed."""
     if not path.is_file():
         raise UrdfError(f"URDF file '{path}' does not exist; pass the path of a .urdf file")
     try:
-        etree.parse(str(path), etree.XMLParser(recover=False))
+        return etree.parse(str(path), etree.XMLParser(recover=False))
     except etree.XMLSyntaxError as exc:
         raise UrdfError(f"URDF file '{path}' is not well-formed XML: {exc}") from None
+
+
+def _validate_urdf(path: Path) -> None:
+    """Validate the URDF at ``path`` with yourdfpy; raise :class:`UrdfError` naming the problems.
+
+    yourdfpy is imported here, not with the package: it imports trimesh, about 0.7 s, which
+    a process that loads only the bundled (tested) URDF need not pay.
+    """
+    import yourdfpy
+
     try:
         urdf = yourdfpy.URDF.load(
             str(path), build_scene_graph=False, load_meshes=False, load_collision_meshes=False
@@ -88,18 +89,24 @@ def _validate_urdf(path: Path) -> yourdfpy.URDF:
     if not urdf.validate(keep):
         problems = "; ".join(str(e) for e in found)
         raise UrdfError(f"URDF file '{path}' is invalid: {problems}")
-    return urdf
 
 
-def _collision_names(urdf: yourdfpy.URDF) -> dict[str, list[str]]:
-    """Collision element names per link, as written in the URDF (or ``link`` if unnamed)."""
+def _collision_names(tree: etree._ElementTree) -> dict[str, list[str]]:
+    """Collision element names per link, as written in the URDF (or ``link`` / ``link_i`` if unnamed)."""
     names: dict[str, list[str]] = {}
-    for link in urdf.robot.links:
-        names[link.name] = [
-            c.name or (link.name if len(link.collisions) == 1 else f"{link.name}_{i}")
-            for i, c in enumerate(link.collisions)
+    for link in tree.getroot().findall("link"):
+        collisions = link.findall("collision")
+        link_name = link.get("name", "")
+        names[link_name] = [
+            c.get("name") or (link_name if len(collisions) == 1 else f"{link_name}_{i}")
+            for i, c in enumerate(collisions)
         ]
     return names
+
+
+def _is_bundled(path: Path) -> bool:
+    """Whether ``path`` is the bundled CPR URDF, which the test suite validates with yourdfpy."""
+    return path.resolve() == cpr_urdf_path().resolve()
 
 
 @dataclass(frozen=True, eq=False)
@@ -127,20 +134,30 @@ class Robot:
     _data: Any = field(repr=False)
 
     @classmethod
-    def load(cls, urdf_path: str | Path | None = None, limits_path: str | Path | None = None) -> Robot:
+    def load(
+        cls,
+        urdf_path: str | Path | None = None,
+        limits_path: str | Path | None = None,
+        validate: bool | None = None,
+    ) -> Robot:
         """Validate and load a CPR URDF.
 
         Args:
             urdf_path: the URDF; default: the bundled ``urdf/cpr.urdf``.
             limits_path: acceleration/jerk limits YAML; default: ``cpr_limits.yaml`` next to
                 the URDF, else the bundled one.
+            validate: check the URDF's structure with yourdfpy (links, joints, their
+                references). Default: for every URDF but the bundled one, which the test
+                suite validates; this saves each process that loads it about 0.7 s.
 
         Raises:
             UrdfError: the file is missing or malformed, or lacks a CPR joint or the tcp frame.
 
         """
         path = Path(urdf_path) if urdf_path is not None else cpr_urdf_path()
-        urdf = _validate_urdf(path)
+        tree = _parse_urdf(path)
+        if validate or (validate is None and not _is_bundled(path)):
+            _validate_urdf(path)
         try:
             model, collision_model, visual_model = pin.buildModelsFromUrdf(str(path), str(path.parent))
         except Exception as exc:  # Pinocchio reports C++ exceptions as RuntimeError/ValueError
@@ -170,7 +187,7 @@ class Robot:
             jerk=jerk,
         )
 
-        collision_names = _collision_names(urdf)
+        collision_names = _collision_names(tree)
         geometries = []
         used: dict[str, int] = {}
         for index, obj in enumerate(collision_model.geometryObjects):

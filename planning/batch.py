@@ -16,15 +16,14 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import asdict, dataclass
 from functools import lru_cache
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import joblib
 
-import cpr_kin as ck
 from planning.errors import PlanningError
-from planning.outputs import plan_files
-from planning.planner import NoTrajectoryFoundError, plan
-from planning.scene_file import load_scene
-from planning.trajectory_io import write_files
+
+if TYPE_CHECKING:
+    import cpr_kin as ck
 
 STATUS_EXIT = {"ok": 0, "invalid": 2, "no_trajectory": 3}
 SUMMARY_FIELDS = (
@@ -73,6 +72,8 @@ class BatchItem:
 @lru_cache(maxsize=8)
 def _robot(urdf: Path | None) -> ck.Robot:
     """The robot, loaded once per worker process and URDF."""
+    import cpr_kin as ck
+
     return ck.load_cpr(urdf)
 
 
@@ -80,7 +81,15 @@ def plan_scene_file(path: Path, out: Path, threads: int | None = 1) -> BatchItem
     """Plan one scene file and write its outputs into ``out``; never raises on bad input.
 
     ``threads = 1`` by default: the batch runs scenes in parallel, not the checks of one.
+    It imports the planner itself, in the worker: the process that dispatches the scenes
+    never needs it.
     """
+    import cpr_kin as ck
+    from planning.outputs import plan_files
+    from planning.planner import NoTrajectoryFoundError, plan
+    from planning.scene_file import load_scene
+    from planning.trajectory_io import write_files
+
     started = time.perf_counter()
     name = path.stem
     try:

@@ -17,19 +17,17 @@ import sys
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import cpr_kin as ck
-from planning import artifacts
+import cpr_kin as ck  # lazy (lazy_loader): only the modules a command uses are imported
 from planning.errors import PlanningError
-from planning.firefly import FireflyProgress
-from planning.outputs import plan_files, summary
-from planning.planner import NoTrajectoryFoundError, plan
-from planning.report import paper_rows, text_table
-from planning.scene import Scene
-from planning.scene_file import load_scene, paper_scene_path, parse_scene
-from planning.trajectory_io import read_trajectory, write_files
-from planning.verification import verify_trajectory
+
+if TYPE_CHECKING:
+    from planning.firefly import FireflyProgress
+    from planning.scene import Scene
+
+# Each command imports what it needs when it runs: `cpr-plan batch`'s parent process only
+# dispatches scenes to workers and so starts without the planner, coal or numba.
 
 EXIT_OK, EXIT_INVALID, EXIT_NO_TRAJECTORY = 0, 2, 3
 
@@ -75,6 +73,11 @@ def _progress(enabled: bool) -> tuple[Callable[[FireflyProgress], None] | None, 
 
 
 def _plan_and_write(scene: Scene, out: Path, args: argparse.Namespace, paper: bool) -> int:
+    from planning.outputs import plan_files, summary
+    from planning.planner import NoTrajectoryFoundError, plan
+    from planning.report import paper_rows, text_table
+    from planning.trajectory_io import write_files
+
     planner = scene.planner
     overrides = {
         k: getattr(args, k)
@@ -118,6 +121,8 @@ def _plan_and_write(scene: Scene, out: Path, args: argparse.Namespace, paper: bo
 
 
 def _load(path: Path) -> Scene:
+    from planning.scene_file import load_scene
+
     try:
         return load_scene(path)
     except PlanningError as exc:
@@ -129,10 +134,15 @@ def _cmd_plan(args: argparse.Namespace) -> int:
 
 
 def _cmd_paper(args: argparse.Namespace) -> int:
+    from planning.scene_file import paper_scene_path
+
     return _plan_and_write(_load(paper_scene_path()), args.out, args, paper=True)
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
+    from planning.trajectory_io import read_trajectory
+    from planning.verification import verify_trajectory
+
     scene = _load(args.scene)
     try:
         document = read_trajectory(args.trajectory)
@@ -171,6 +181,10 @@ def _cmd_check(args: argparse.Namespace) -> int:
 
 
 def _cmd_show(args: argparse.Namespace) -> int:
+    from planning import artifacts
+    from planning.scene_file import parse_scene
+    from planning.trajectory_io import read_trajectory, write_files
+
     try:
         document = read_trajectory(args.trajectory)
         scene = parse_scene(document.scene, source=f"{args.trajectory} (scene)")
@@ -220,6 +234,8 @@ def _cmd_show(args: argparse.Namespace) -> int:
 
 def _cmd_batch(args: argparse.Namespace) -> int:
     from planning import batch
+    from planning.report import text_table
+    from planning.trajectory_io import write_files
 
     try:
         paths = batch.scene_files(args.scenes)

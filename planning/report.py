@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
-from planning.planner import PlanResult
+if TYPE_CHECKING:
+    from planning.planner import PlanResult
 
 PAPER_FIGURES = {
     "fma_time_s": 53.0,

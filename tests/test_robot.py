@@ -58,6 +58,45 @@ def test_urdf_with_dangling_joint_is_invalid(tmp_path: Path) -> None:
         ck.load_cpr(path)
 
 
+def test_user_urdf_is_validated_by_yourdfpy(tmp_path: Path) -> None:
+    # yourdfpy names the problem where Pinocchio only says "does not contain a valid URDF model"
+    path = tmp_path / "hinge.urdf"
+    path.write_text(URDF_TEXT.replace('type="revolute"', 'type="hinge"', 1))
+    with pytest.raises(ck.UrdfError, match=r"hinge\.urdf' is invalid: .*'type' attribute"):
+        ck.load_cpr(path)
+    with pytest.raises(ck.UrdfError, match="Pinocchio cannot build a model"):
+        ck.Robot.load(path, validate=False)
+
+
+def test_bundled_urdf_passes_yourdfpy_validation() -> None:
+    # loading the bundled URDF skips the validation (0.7 s of importing trimesh): this is its check
+    robot = ck.Robot.load(validate=True)
+    assert robot.joint_names == ck.CPR_JOINTS
+
+
+def test_collision_names_agree_with_yourdfpy(tmp_path: Path) -> None:
+    import yourdfpy
+
+    # unnamed collisions: a link's only one takes the link's name, several are numbered
+    text = URDF_TEXT.replace('<collision name="base">', "<collision>").replace(
+        '<collision name="wrist">', "<collision>"
+    )
+    head, tail = text.split('<collision name="tool">', 1)
+    body = tail.split("</collision>", 1)[0]
+    text = f"{head}<collision>{body}</collision><collision>{body}</collision>{tail.split('</collision>', 1)[1]}"
+    path = tmp_path / "unnamed.urdf"
+    path.write_text(text)
+    urdf = yourdfpy.URDF.load(str(path), build_scene_graph=False, load_meshes=False)
+    expected = [
+        c.name or (link.name if len(link.collisions) == 1 else f"{link.name}_{i}")
+        for link in urdf.robot.links
+        for i, c in enumerate(link.collisions)
+    ]
+    robot = ck.load_cpr(path)
+    assert sorted(g.name for g in robot.geometries) == sorted(expected)
+    assert {"base_link", "wrist_link", "tool_link_0", "tool_link_1"} <= {g.name for g in robot.geometries}
+
+
 def test_urdf_without_a_cpr_joint(tmp_path: Path) -> None:
     path = tmp_path / "renamed.urdf"
     path.write_text(URDF_TEXT.replace('joint name="d3"', 'joint name="slide"'))
@@ -141,13 +180,3 @@ def test_bad_limits_dataclass() -> None:
             jerk=np.zeros(1),
         )
 
-
-def test_importing_the_packages_does_not_import_trimesh() -> None:
-    # yourdfpy (and with it trimesh, about a second) is imported only when a robot is loaded:
-    # the batch's parent process never pays for it
-    import subprocess
-    import sys
-
-    code = "import sys, cpr_kin, planning.batch; print('trimesh' in sys.modules, 'yourdfpy' in sys.modules)"
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
-    assert out.split() == ["False", "False"]

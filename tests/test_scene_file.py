@@ -13,7 +13,8 @@ from hypothesis import strategies as st
 
 import cpr_kin as ck
 from planning.scene import PlannerSettings, paper_scene
-from planning.scene_file import SceneError, load_scene, paper_scene_path, parse_scene
+from planning.scene_file import SAFE_LOADER, SceneError, dump_scene, load_scene, paper_scene_path, parse_scene
+from planning.scene_generator import generate_scenes
 from planning.spline import SplineSettings
 
 MINIMAL = {"start": {"tcp": [0.5, 0.45, 0.25]}, "goal": {"tcp": [-0.5, 0.45, 0.25]}}
@@ -194,3 +195,15 @@ def test_valid_scene_loads_with_finite_values() -> None:
 def test_bundled_example_scene_loads() -> None:
     scene = load_scene(paper_scene_path().parent / "shelf.yaml")
     assert sorted(o.shape for o in scene.obstacles) == ["box", "cylinder", "sphere"]
+
+
+def test_libyaml_loader_reads_scene_files_as_pyyaml_does(tmp_path: Path) -> None:
+    """The fast loader (libyaml's) gives the documents of PyYAML's pure-Python safe loader."""
+    assert SAFE_LOADER is yaml.CSafeLoader  # the wheels ship libyaml; else the test is moot
+    paths = sorted(paper_scene_path().parent.glob("*.yaml"))
+    for scene in generate_scenes(5, seed=3):
+        paths.append(tmp_path / f"{scene.name}.yaml")
+        dump_scene(scene, paths[-1])
+    for path in paths:
+        text = path.read_text(encoding="utf-8")
+        assert yaml.load(text, Loader=SAFE_LOADER) == yaml.load(text, Loader=yaml.SafeLoader), path.name

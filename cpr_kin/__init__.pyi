@@ -1,0 +1,41 @@
+"""Type stub of the package: what it exports, and from which module (read by ``lazy_loader``)."""
+
+from .collision import BatchClearance, Clearance, CollisionWorld, PairDistance
+from .errors import CprKinError, JointLimitError, ObstacleError, UnreachableError, UrdfError
+from .ik import tcp_ik
+from .kinematics import frame_poses, frame_positions
+from .limits import JointLimits
+from .motion import CurveCheck, check_curve, check_segment, motion_radii
+from .obstacles import SHAPES, Obstacle
+from .resources import cpr_limits_path, cpr_urdf_path
+from .robot import CPR_JOINTS, GROUPS, TCP_FRAME, Robot, RobotGeometry, load_cpr
+
+__all__ = [
+    "CPR_JOINTS",
+    "GROUPS",
+    "SHAPES",
+    "TCP_FRAME",
+    "BatchClearance",
+    "Clearance",
+    "CollisionWorld",
+    "CprKinError",
+    "CurveCheck",
+    "JointLimitError",
+    "JointLimits",
+    "Obstacle",
+    "ObstacleError",
+    "PairDistance",
+    "Robot",
+    "RobotGeometry",
+    "UnreachableError",
+    "UrdfError",
+    "check_curve",
+    "check_segment",
+    "cpr_limits_path",
+    "cpr_urdf_path",
+    "frame_poses",
+    "frame_positions",
+    "load_cpr",
+    "motion_radii",
+    "tcp_ik",
+]
