@@ -34,7 +34,8 @@ def test_the_batch_parent_imports_no_planner_robot_or_compiler() -> None:
     # modules (numba, coal, Pinocchio, SciPy, trimesh: about 1.2 s), which each worker imports
     heavy = ["numba", "coal", "pinocchio", "scipy", "trimesh", "yourdfpy", "planning.planner"]
     code = (
-        "import sys, cpr_kin, planning, planning.cli, planning.batch, planning.report, planning.trajectory_io; "
+        "import sys, cpr_kin, planning, planning.cli, planning.batch, planning.report, "
+        "planning.trajectory_io; "
         f"print(*[m in sys.modules for m in {heavy!r}])"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout

@@ -82,8 +82,8 @@ def test_collision_names_agree_with_yourdfpy(tmp_path: Path) -> None:
         '<collision name="wrist">', "<collision>"
     )
     head, tail = text.split('<collision name="tool">', 1)
-    body = tail.split("</collision>", 1)[0]
-    text = f"{head}<collision>{body}</collision><collision>{body}</collision>{tail.split('</collision>', 1)[1]}"
+    body, rest = tail.split("</collision>", 1)
+    text = f"{head}<collision>{body}</collision><collision>{body}</collision>{rest}"
     path = tmp_path / "unnamed.urdf"
     path.write_text(text)
     urdf = yourdfpy.URDF.load(str(path), build_scene_graph=False, load_meshes=False)
