@@ -179,4 +179,3 @@ def test_bad_limits_dataclass() -> None:
             acceleration=np.ones(1),
             jerk=np.zeros(1),
         )
-
