@@ -321,8 +321,9 @@ class CollisionWorld:
                 for p, active in enumerate(near):
                     (gdata.activateCollisionPair if active else gdata.deactivateCollisionPair)(p)
             self._pool_margin = margin_m
-        bounds = self._bounds(tuple(near.tolist()))(batch)
-        uncertain = np.flatnonzero((bounds <= margin_m + BOUND_TOLERANCE_M).any(axis=1))
+        uncertain = np.flatnonzero(
+            self._bounds(tuple(near.tolist())).any_below(batch, margin_m + BOUND_TOLERANCE_M)
+        )
         if uncertain.size:
             result = pin.computeCollisionsInParallel(
                 self.num_threads,

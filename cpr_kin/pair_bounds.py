@@ -8,7 +8,9 @@ a few lines of arithmetic. Compiled code places the capsules with the kinematic 
 about 0.45 us per pair. A positive bound is at most coal's
 distance (shapes that overlap get a bound <= 0), so a configuration whose bounds all exceed
 a margin keeps it for certain: :meth:`cpr_kin.CollisionWorld.margin_violated` sends coal only
-the others.
+the others. That check asks :meth:`PairBounds.any_below`, which first compares the bounding
+spheres of each capsule and obstacle (most pairs are far apart) and stops at a
+configuration's first uncertain pair.
 
 Obstacle bounds, in the obstacle's frame, for the robot's segment (before subtracting the
 robot capsule's radius):
@@ -39,6 +41,7 @@ from cpr_kin.obstacles import Obstacle
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
+BoolArray = NDArray[np.bool_]
 
 SPHERE, CYLINDER, CAPSULE, BOX = 0, 1, 2, 3
 """Obstacle bound kinds, as the compiled code reads them."""
@@ -105,11 +108,14 @@ class PairBounds:
             np.array(ends, dtype=float).reshape(-1, 2, 3),
             np.array(radii, dtype=float),
         )
+        segments = self._capsules[1]
+        # radius of each capsule's bounding sphere about its segment's middle
+        capsule_reach = np.linalg.norm(segments[:, 1] - segments[:, 0], axis=1) / 2 + self._capsules[2]
         self._pairs = (
             np.array([slot[g] for g, _ in pairs], dtype=np.int64),
             np.array([k for _, k in pairs], dtype=np.int64),
         )
-        kinds, rotations, origins, radii_o, halves = [], [], [], [], []
+        kinds, rotations, origins, radii_o, halves, reaches = [], [], [], [], [], []
         for obstacle in obstacles:
             kind, rotation, origin, radius, half = _obstacle_bound(obstacle)
             kinds.append(kind)
@@ -117,6 +123,7 @@ class PairBounds:
             origins.append(origin)
             radii_o.append(radius)
             halves.append(half)
+            reaches.append(_obstacle_reach(kind, radius, half))
         self._obstacles = (
             np.array(kinds, dtype=np.int64),
             np.array(rotations, dtype=float).reshape(-1, 3, 3),
@@ -124,12 +131,23 @@ class PairBounds:
             np.array(radii_o, dtype=float),
             np.array(halves, dtype=float).reshape(-1, 3),
         )
-        # the compiled kernel's arguments after the configurations and the output
+        # the compiled kernels' arguments after the configurations (and threshold) and the output
         self._arguments: tuple[Any, ...] = (
             self._chain.arrays,
             *self._capsules,
             *self._pairs,
             *self._obstacles,
+        )
+        c_joint, c_ends, c_radius = self._capsules
+        self._any_arguments: tuple[Any, ...] = (
+            self._chain.arrays,
+            c_joint,
+            c_ends,
+            c_radius,
+            capsule_reach,
+            *self._pairs,
+            *self._obstacles,
+            np.array(reaches, dtype=float),
         )
 
     @property
@@ -142,6 +160,20 @@ class PairBounds:
         batch = np.ascontiguousarray(q, dtype=float)
         out = np.empty((len(batch), self.n_pairs))
         _bounds(batch, out, *self._arguments)
+        return out
+
+    def any_below(self, q: FloatArray, threshold_m: float) -> BoolArray:
+        """``(N,)`` whether some pair may be within ``threshold_m`` [m] at configurations ``q``.
+
+        False only where every pair is certainly farther: by its bound of :meth:`__call__`
+        or by the bounding spheres of the robot capsule and the obstacle, whichever is
+        tested first. So it is at most ``(self(q) <= threshold_m).any(axis=1)``, and faster:
+        far pairs cost only the spheres' test, and a configuration stops at its first
+        uncertain pair.
+        """
+        batch = np.ascontiguousarray(q, dtype=float)
+        out = np.empty(len(batch), dtype=np.bool_)
+        _any_below(batch, float(threshold_m), out, *self._any_arguments)
         return out
 
 
@@ -161,6 +193,15 @@ def _obstacle_bound(obstacle: Obstacle) -> tuple[int, FloatArray, FloatArray, fl
         return kind, rotation, origin, float(obstacle.radius or 0.0), half
     centre, half = _local_box(obstacle.geometry())  # a box, or a mesh's bounding box
     return BOX, rotation, origin + rotation @ centre, float(np.linalg.norm(half)), half
+
+
+def _obstacle_reach(kind: int, radius: float, half: FloatArray) -> float:
+    """Radius [m] of the obstacle's bounding sphere about its bound's centre."""
+    if kind == CYLINDER:
+        return float(np.hypot(radius, half[2]))
+    if kind == CAPSULE:
+        return radius + float(half[2])
+    return radius  # a sphere's radius, a box's half diagonal
 
 
 @njit
@@ -246,3 +287,83 @@ def _bounds(
                 else:
                     bound = np.sqrt(axis_distance * axis_distance + gap * gap) - radius
             out[n, p] = bound - capsule_radius[c]
+
+
+@njit
+def _any_below(
+    q: FloatArray,
+    threshold: float,
+    out: BoolArray,
+    chain: ChainArrays,
+    capsule_joint: IntArray,
+    capsule_ends: FloatArray,
+    capsule_radius: FloatArray,
+    capsule_reach: FloatArray,
+    pair_capsule: IntArray,
+    pair_obstacle: IntArray,
+    kind: IntArray,
+    obstacle_rotation: FloatArray,
+    obstacle_origin: FloatArray,
+    obstacle_radius: FloatArray,
+    obstacle_half: FloatArray,
+    obstacle_reach: FloatArray,
+) -> None:
+    joints = len(chain[0])
+    rotation, translation = np.empty((joints, 3, 3)), np.empty((joints, 3))
+    world = np.empty((len(capsule_joint), 2, 3))
+    local, scratch = np.empty((2, 3)), np.empty((4, 3))
+    for n in range(len(q)):
+        place_joints(q[n], chain, rotation, translation, scratch)
+        for c in range(len(capsule_joint)):
+            j = capsule_joint[c]
+            for e in range(2):
+                for r in range(3):
+                    if j < 0:
+                        world[c, e, r] = capsule_ends[c, e, r]
+                    else:
+                        world[c, e, r] = (
+                            translation[j, r]
+                            + rotation[j, r, 0] * capsule_ends[c, e, 0]
+                            + rotation[j, r, 1] * capsule_ends[c, e, 1]
+                            + rotation[j, r, 2] * capsule_ends[c, e, 2]
+                        )
+        out[n] = False
+        for p in range(len(pair_capsule)):
+            c, o = pair_capsule[p], pair_obstacle[p]
+            x = 0.5 * (world[c, 0, 0] + world[c, 1, 0]) - obstacle_origin[o, 0]
+            y = 0.5 * (world[c, 0, 1] + world[c, 1, 1]) - obstacle_origin[o, 1]
+            z = 0.5 * (world[c, 0, 2] + world[c, 1, 2]) - obstacle_origin[o, 2]
+            apart = threshold + capsule_reach[c] + obstacle_reach[o]
+            if x * x + y * y + z * z > apart * apart:
+                continue
+            for e in range(2):  # the capsule's end points in the obstacle's frame
+                for r in range(3):
+                    local[e, r] = (
+                        obstacle_rotation[o, 0, r] * (world[c, e, 0] - obstacle_origin[o, 0])
+                        + obstacle_rotation[o, 1, r] * (world[c, e, 1] - obstacle_origin[o, 1])
+                        + obstacle_rotation[o, 2, r] * (world[c, e, 2] - obstacle_origin[o, 2])
+                    )
+            ax, ay, az = local[0, 0], local[0, 1], local[0, 2]
+            dx, dy, dz = local[1, 0] - ax, local[1, 1] - ay, local[1, 2] - az
+            radius = obstacle_radius[o]  # (no array views here: each costs reference counting)
+            if kind[o] == SPHERE:
+                bound = _point_segment(ax, ay, az, dx, dy, dz) - radius
+            elif kind[o] == BOX:
+                gap2 = 0.0
+                for r in range(3):
+                    g = _gap(
+                        min(local[0, r], local[1, r]), max(local[0, r], local[1, r]), obstacle_half[o, r]
+                    )
+                    gap2 += g * g
+                bound = max(np.sqrt(gap2), _point_segment(ax, ay, az, dx, dy, dz) - radius)
+            else:
+                axis_distance = _point_segment(ax, ay, 0.0, dx, dy, 0.0)
+                gap = _gap(min(local[0, 2], local[1, 2]), max(local[0, 2], local[1, 2]), obstacle_half[o, 2])
+                if kind[o] == CYLINDER:
+                    radial = max(axis_distance - radius, 0.0)
+                    bound = np.sqrt(radial * radial + gap * gap)
+                else:
+                    bound = np.sqrt(axis_distance * axis_distance + gap * gap) - radius
+            if bound - capsule_radius[c] <= threshold:
+                out[n] = True
+                break

@@ -61,6 +61,22 @@ def test_bounds_never_exceed_coal_distances(robot: ck.Robot, rng: np.random.Gene
     assert np.mean(bounds[far] > 0.05) > 0.8
 
 
+def test_any_below_is_sound_and_at_most_the_bounds_answer(robot: ck.Robot, rng: np.random.Generator) -> None:
+    obstacles = [random_obstacle(shape, rng) for shape in SHAPES]
+    obstacles = [ck.Obstacle(**{**o.__dict__, "name": f"o{k}"}) for k, o in enumerate(obstacles)]
+    bounds = PairBounds(robot.model, robot.collision_model, obstacles, all_pairs(robot, obstacles))
+    configurations = random_configurations(robot, rng, 300)
+    exact = coal_distances(robot, ck.CollisionWorld(robot, obstacles), configurations).min(axis=1)
+    per_pair = bounds(configurations)
+    for threshold in (0.0, 0.05, 0.1):
+        uncertain = bounds.any_below(configurations, threshold)
+        # sound: every configuration within the threshold is flagged (up to coal's tolerance)
+        assert np.all(uncertain[exact <= threshold - 2e-6])
+        # the spheres' test only ever clears more: never flags what the bounds clear
+        assert not np.any(uncertain & ~(per_pair <= threshold).any(axis=1))
+        assert uncertain.any() and not uncertain.all()
+
+
 def test_mesh_obstacle_is_bounded_by_its_bounding_box(
     robot: ck.Robot, rng: np.random.Generator, tmp_path: Path
 ) -> None:
