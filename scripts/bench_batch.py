@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import csv
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -28,10 +29,15 @@ from planning.scene_generator import generate_scenes
 TARGET_S = 20.0
 
 
-def run_batch(code: Path, scenes: Path, out: Path, workers: int) -> tuple[float, int]:
-    """Wall time [s] of one ``cpr-plan batch`` with ``code`` first on the path, and scenes planned."""
+def run_batch(code: Path, scenes: Path, out: Path, workers: int) -> tuple[float, float, int]:
+    """One ``cpr-plan batch`` with ``code`` first on the path: wall time [s], CPU time [s], scenes planned.
+
+    The CPU time is that of the process and its workers (user + system). On a shared machine
+    it varies less than the wall time, which also counts the time other guests hold the cores.
+    """
     env = {**os.environ, "PYTHONPATH": str(code)}  # and a neutral working folder: it comes first on the path
     command = [sys.executable, "-c", "import sys; from planning.cli import main; sys.exit(main())"]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.perf_counter()
     done = subprocess.run(
         [*command, "batch", str(scenes), "--out", str(out), "--workers", str(workers)],
@@ -42,11 +48,13 @@ def run_batch(code: Path, scenes: Path, out: Path, workers: int) -> tuple[float,
         check=False,
     )
     elapsed = time.perf_counter() - started
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     if done.returncode not in (0, 3):  # 3: some scenes have no trajectory, which is an outcome
         raise SystemExit(f"cpr-plan batch failed with exit code {done.returncode}:\n{done.stderr}")
     with (out / "summary.csv").open() as summary:
         planned = sum(row["status"] == "ok" for row in csv.DictReader(summary))
-    return elapsed, planned
+    return elapsed, cpu, planned
 
 
 def main() -> None:
@@ -71,17 +79,34 @@ def main() -> None:
         for code in codes.values():
             run_batch(code, scenes, Path(tmp) / "warm-up", args.workers)
         times: dict[str, list[float]] = {name: [] for name in codes}
+        cpu_times: dict[str, list[float]] = {name: [] for name in codes}
         planned: dict[str, int] = {}
         for run in range(args.runs):
             for k, (name, code) in enumerate(codes.items()):
                 out = Path(tmp) / f"out-{k}-{run}"
-                elapsed, planned[name] = run_batch(code, scenes, out, args.workers)
+                elapsed, cpu, planned[name] = run_batch(code, scenes, out, args.workers)
                 times[name].append(elapsed)
-                print(f"run {run + 1}, {name}: {elapsed:.1f} s, {planned[name]}/{args.scenes} planned")
+                cpu_times[name].append(cpu)
+                print(
+                    f"run {run + 1}, {name}: {elapsed:.1f} s wall, {cpu:.1f} s CPU, "
+                    f"{planned[name]}/{args.scenes} planned"
+                )
     print(f"\n{args.scenes} scenes, --workers {args.workers}, {args.runs} runs each")
     for name, values in times.items():
         spread = ", ".join(f"{v:.1f}" for v in values)
-        print(f"  {name}: median {statistics.median(values):.1f} s ({spread}), {planned[name]} planned")
+        print(
+            f"  {name}: median {statistics.median(values):.1f} s wall ({spread}), "
+            f"{statistics.median(cpu_times[name]):.1f} s CPU, {planned[name]} planned"
+        )
+    if len(codes) == 2:
+        mine, other = times.values()
+        ratios = [a / b for a, b in zip(mine, other, strict=True)]
+        mine_cpu, other_cpu = cpu_times.values()
+        cpu_ratios = [a / b for a, b in zip(mine_cpu, other_cpu, strict=True)]
+        print(
+            f"  this / compare, median of the runs' ratios: {statistics.median(ratios):.2f} wall, "
+            f"{statistics.median(cpu_ratios):.2f} CPU"
+        )
     median = statistics.median(times["this checkout"])
     verdict = "met" if median <= TARGET_S else "NOT met"
     print(f"target <= {TARGET_S:.0f} s for 100 scenes on 2 cores: {median:.1f} s -> {verdict}")
