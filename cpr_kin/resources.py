@@ -15,7 +15,8 @@ def bundled_urdf_dir() -> Path:
     checkout = Path(__file__).resolve().parent.parent / "urdf"
     if (checkout / "cpr.urdf").is_file():
         return checkout
-    return Path(str(resources.files("cpr_kin.urdf")))
+    # ``cpr_kin.urdf`` has no ``__init__.py``: ask its parent package, whose files() is a plain path
+    return Path(str(resources.files("cpr_kin") / "urdf"))
 
 
 def cpr_urdf_path() -> Path:

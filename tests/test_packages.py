@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import ast
 import importlib
+import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -49,3 +51,33 @@ def test_loading_a_robot_imports_what_it_needs() -> None:
     code = f"import sys, cpr_kin as ck; ck.load_cpr(); print(*[m in sys.modules for m in {modules!r}])"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.split() == ["True", "True", "False", "False"]
+
+
+def test_an_installed_wheel_carries_its_data_and_stubs(tmp_path: Path) -> None:
+    # the wheel, not the checkout: the URDF, limits and scenes as package data, and the
+    # __init__.pyi stubs that the lazy exports are read from
+    root = Path(__file__).resolve().parents[1]
+    source = tmp_path / "source"
+    shutil.copytree(
+        root, source, ignore=shutil.ignore_patterns(".*", "build", "out", "*.egg-info", "__pycache__")
+    )
+    pip = [sys.executable, "-m", "pip", "--disable-pip-version-check", "--quiet"]
+    subprocess.run([*pip, "wheel", str(source), "--no-deps", "-w", str(tmp_path / "dist")], check=True)
+    wheel = next((tmp_path / "dist").glob("cpr_firefly-*.whl"))
+    site = tmp_path / "site"
+    subprocess.run([*pip, "install", "--no-deps", "--target", str(site), str(wheel)], check=True)
+    code = (
+        "import cpr_kin, planning; from planning.scene_file import load_scene, paper_scene_path; "
+        "robot = cpr_kin.load_cpr(); scene = load_scene(paper_scene_path()); "
+        "print(cpr_kin.__file__, robot.urdf_path, scene.name, planning.plan.__module__, sep='\\n')"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code],
+        env={**os.environ, "PYTHONPATH": str(site)},  # before the checkout's editable install
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout.split("\n")
+    assert out[0].startswith(str(site)) and out[1].startswith(str(site))
+    assert out[1].endswith("cpr.urdf") and out[2:4] == ["paper", "planning.planner"]
