@@ -289,6 +289,8 @@ def _bounds(
             out[n, p] = bound - capsule_radius[c]
 
 
+# The kernel below repeats the capsule placement and pair bound of ``_bounds``. Factored into
+# compiled helpers (even with Numba's inline="always"), both kernels measured 1.4-4x slower.
 @njit
 def _any_below(
     q: FloatArray,
