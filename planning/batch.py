@@ -16,14 +16,10 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import asdict, dataclass
 from functools import lru_cache
 from pathlib import Path
-from typing import TYPE_CHECKING
-
 import joblib
 
+import cpr_kin as ck  # lazy (lazy_loader): its modules load in the workers, where they are used
 from planning.errors import PlanningError
-
-if TYPE_CHECKING:
-    import cpr_kin as ck
 
 STATUS_EXIT = {"ok": 0, "invalid": 2, "no_trajectory": 3}
 SUMMARY_FIELDS = (
@@ -72,8 +68,6 @@ class BatchItem:
 @lru_cache(maxsize=8)
 def _robot(urdf: Path | None) -> ck.Robot:
     """The robot, loaded once per worker process and URDF."""
-    import cpr_kin as ck
-
     return ck.load_cpr(urdf)
 
 
@@ -84,7 +78,6 @@ def plan_scene_file(path: Path, out: Path, threads: int | None = 1) -> BatchItem
     It imports the planner itself, in the worker: the process that dispatches the scenes
     never needs it.
     """
-    import cpr_kin as ck
     from planning.outputs import plan_files
     from planning.planner import NoTrajectoryFoundError, plan
     from planning.scene_file import load_scene
