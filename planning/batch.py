@@ -16,6 +16,7 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import asdict, dataclass
 from functools import lru_cache
 from pathlib import Path
+
 import joblib
 
 import cpr_kin as ck  # lazy (lazy_loader): its modules load in the workers, where they are used
