@@ -103,34 +103,24 @@ class PairBounds:
             ends.append(local @ np.asarray(placement.rotation).T + np.asarray(placement.translation))
             radii.append(radius)
             joints.append(int(obj.parentJoint) - 1)  # -1: fixed to the world
-        self._capsules = (
-            np.array(joints, dtype=np.int64),
-            np.array(ends, dtype=float).reshape(-1, 2, 3),
-            np.array(radii, dtype=float),
-        )
-        segments = self._capsules[1]
+        capsule_ends = np.array(ends, dtype=float).reshape(-1, 2, 3)
+        capsule_radius = np.array(radii, dtype=float)
+        self._capsules = (np.array(joints, dtype=np.int64), capsule_ends, capsule_radius)
         # radius of each capsule's bounding sphere about its segment's middle
-        capsule_reach = np.linalg.norm(segments[:, 1] - segments[:, 0], axis=1) / 2 + self._capsules[2]
+        capsule_reach = np.linalg.norm(capsule_ends[:, 1] - capsule_ends[:, 0], axis=1) / 2 + capsule_radius
         self._pairs = (
             np.array([slot[g] for g, _ in pairs], dtype=np.int64),
             np.array([k for _, k in pairs], dtype=np.int64),
         )
-        kinds, rotations, origins, radii_o, halves, reaches = [], [], [], [], [], []
-        for obstacle in obstacles:
-            kind, rotation, origin, radius, half = _obstacle_bound(obstacle)
-            kinds.append(kind)
-            rotations.append(rotation)
-            origins.append(origin)
-            radii_o.append(radius)
-            halves.append(half)
-            reaches.append(_obstacle_reach(kind, radius, half))
+        bounds = [_obstacle_bound(obstacle) for obstacle in obstacles]
         self._obstacles = (
-            np.array(kinds, dtype=np.int64),
-            np.array(rotations, dtype=float).reshape(-1, 3, 3),
-            np.array(origins, dtype=float).reshape(-1, 3),
-            np.array(radii_o, dtype=float),
-            np.array(halves, dtype=float).reshape(-1, 3),
+            np.array([b[0] for b in bounds], dtype=np.int64),
+            np.array([b[1] for b in bounds], dtype=float).reshape(-1, 3, 3),
+            np.array([b[2] for b in bounds], dtype=float).reshape(-1, 3),
+            np.array([b[3] for b in bounds], dtype=float),
+            np.array([b[4] for b in bounds], dtype=float).reshape(-1, 3),
         )
+        obstacle_reach = np.array([b[5] for b in bounds], dtype=float)
         # the compiled kernels' arguments after the configurations (and threshold) and the output
         self._arguments: tuple[Any, ...] = (
             self._chain.arrays,
@@ -138,16 +128,13 @@ class PairBounds:
             *self._pairs,
             *self._obstacles,
         )
-        c_joint, c_ends, c_radius = self._capsules
         self._any_arguments: tuple[Any, ...] = (
             self._chain.arrays,
-            c_joint,
-            c_ends,
-            c_radius,
+            *self._capsules,
             capsule_reach,
             *self._pairs,
             *self._obstacles,
-            np.array(reaches, dtype=float),
+            obstacle_reach,
         )
 
     @property
@@ -177,31 +164,27 @@ class PairBounds:
         return out
 
 
-def _obstacle_bound(obstacle: Obstacle) -> tuple[int, FloatArray, FloatArray, float, FloatArray]:
-    """Kind, rotation, centre [m], radius [m] and half sides (z: half length) [m] of a bound.
+def _obstacle_bound(obstacle: Obstacle) -> tuple[int, FloatArray, FloatArray, float, FloatArray, float]:
+    """Kind, rotation, centre [m], radius [m], half sides (z: half length) [m] and reach [m] of a bound.
 
-    A box's radius is its half diagonal (the radius of its bounding sphere).
+    A box's radius is its half diagonal (the radius of its bounding sphere); the reach is
+    the radius of the obstacle's bounding sphere about the centre.
     """
     placement = obstacle.placement
     rotation = np.asarray(placement.rotation, dtype=float)
     origin = np.asarray(placement.translation, dtype=float)
+    radius = float(obstacle.radius or 0.0)
     if obstacle.shape == "sphere":
-        return SPHERE, rotation, origin, float(obstacle.radius or 0.0), np.zeros(3)
+        return SPHERE, rotation, origin, radius, np.zeros(3), radius
     if obstacle.shape in ("cylinder", "capsule"):
-        half = np.array([0.0, 0.0, float(obstacle.length or 0.0) / 2])
-        kind = CYLINDER if obstacle.shape == "cylinder" else CAPSULE
-        return kind, rotation, origin, float(obstacle.radius or 0.0), half
+        half_length = float(obstacle.length or 0.0) / 2
+        half = np.array([0.0, 0.0, half_length])
+        if obstacle.shape == "cylinder":
+            return CYLINDER, rotation, origin, radius, half, float(np.hypot(radius, half_length))
+        return CAPSULE, rotation, origin, radius, half, radius + half_length
     centre, half = _local_box(obstacle.geometry())  # a box, or a mesh's bounding box
-    return BOX, rotation, origin + rotation @ centre, float(np.linalg.norm(half)), half
-
-
-def _obstacle_reach(kind: int, radius: float, half: FloatArray) -> float:
-    """Radius [m] of the obstacle's bounding sphere about its bound's centre."""
-    if kind == CYLINDER:
-        return float(np.hypot(radius, half[2]))
-    if kind == CAPSULE:
-        return radius + float(half[2])
-    return radius  # a sphere's radius, a box's half diagonal
+    diagonal = float(np.linalg.norm(half))
+    return BOX, rotation, origin + rotation @ centre, diagonal, half, diagonal
 
 
 @njit
