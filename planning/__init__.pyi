@@ -1,14 +1,14 @@
 """Type stub of the package: what it exports, and from which module (read by ``lazy_loader``)."""
 
+from .curves.ptp import ptp_time, trapezoid_time
+from .curves.spline import SepticSplineSolver, SplineFit, SplineSettings, fit_septic_spline, uniform_knots
+from .curves.trajectory import Extrema, Trajectory
 from .errors import PlanningError, SplineError
-from .firefly import FireflyProgress, FireflyResult, FireflySettings, firefly_minimize
+from .io.trajectory_io import read_trajectory, write_samples, write_trajectory
 from .objective import Breakdown, WaypointObjective
 from .planner import Metrics, NoTrajectoryFoundError, PlanResult, plan, warm_up
-from .ptp import ptp_time, trapezoid_time
 from .scene import PlannerSettings, Scene, Target, paper_scene
-from .spline import SepticSplineSolver, SplineFit, SplineSettings, fit_septic_spline, uniform_knots
-from .trajectory import Extrema, Trajectory
-from .trajectory_io import read_trajectory, write_samples, write_trajectory
+from .search.firefly import FireflyProgress, FireflyResult, FireflySettings, firefly_minimize
 from .verification import Verification, verify_trajectory
 
 __all__ = [

@@ -79,10 +79,10 @@ def plan_scene_file(path: Path, out: Path, threads: int | None = 1) -> BatchItem
     It imports the planner itself, in the worker: the process that dispatches the scenes
     never needs it.
     """
-    from planning.outputs import plan_files
+    from planning.io.outputs import plan_files
+    from planning.io.scene_file import load_scene
+    from planning.io.trajectory_io import write_files
     from planning.planner import NoTrajectoryFoundError, plan
-    from planning.scene_file import load_scene
-    from planning.trajectory_io import write_files
 
     started = time.perf_counter()
     name = path.stem

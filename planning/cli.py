@@ -23,8 +23,8 @@ import cpr_kin as ck  # lazy (lazy_loader): only the modules a command uses are 
 from planning.errors import PlanningError
 
 if TYPE_CHECKING:
-    from planning.firefly import FireflyProgress
     from planning.scene import Scene
+    from planning.search.firefly import FireflyProgress
 
 # Each command imports what it needs when it runs: `cpr-plan batch`'s parent process only
 # dispatches scenes to workers and so starts without the planner, coal or numba.
@@ -73,10 +73,10 @@ def _progress(enabled: bool) -> tuple[Callable[[FireflyProgress], None] | None, 
 
 
 def _plan_and_write(scene: Scene, out: Path, args: argparse.Namespace, paper: bool) -> int:
-    from planning.outputs import plan_files, summary
+    from planning.io.outputs import plan_files, summary
+    from planning.io.report import paper_rows, text_table
+    from planning.io.trajectory_io import write_files
     from planning.planner import NoTrajectoryFoundError, plan
-    from planning.report import paper_rows, text_table
-    from planning.trajectory_io import write_files
 
     planner = scene.planner
     overrides = {
@@ -121,7 +121,7 @@ def _plan_and_write(scene: Scene, out: Path, args: argparse.Namespace, paper: bo
 
 
 def _load(path: Path) -> Scene:
-    from planning.scene_file import load_scene
+    from planning.io.scene_file import load_scene
 
     try:
         return load_scene(path)
@@ -134,13 +134,13 @@ def _cmd_plan(args: argparse.Namespace) -> int:
 
 
 def _cmd_paper(args: argparse.Namespace) -> int:
-    from planning.scene_file import paper_scene_path
+    from planning.io.scene_file import paper_scene_path
 
     return _plan_and_write(_load(paper_scene_path()), args.out, args, paper=True)
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
-    from planning.trajectory_io import read_trajectory
+    from planning.io.trajectory_io import read_trajectory
     from planning.verification import verify_trajectory
 
     scene = _load(args.scene)
@@ -181,9 +181,9 @@ def _cmd_check(args: argparse.Namespace) -> int:
 
 
 def _cmd_show(args: argparse.Namespace) -> int:
-    from planning import artifacts
-    from planning.scene_file import parse_scene
-    from planning.trajectory_io import read_trajectory, write_files
+    from planning.io.scene_file import parse_scene
+    from planning.io.trajectory_io import read_trajectory, write_files
+    from planning.viz import artifacts
 
     try:
         document = read_trajectory(args.trajectory)
@@ -212,7 +212,7 @@ def _cmd_show(args: argparse.Namespace) -> int:
             raise _CommandError(EXIT_INVALID, f"cannot write '{args.html}': {exc.strerror or exc}") from None
         print(f"wrote {written[0]} (self-contained; open it in a browser)")
         return EXIT_OK
-    from planning.viewer import Viewer
+    from planning.viz.viewer import Viewer
 
     def stop(signum: int, _frame: object) -> None:
         raise KeyboardInterrupt(signal.Signals(signum).name)
@@ -234,8 +234,8 @@ def _cmd_show(args: argparse.Namespace) -> int:
 
 def _cmd_batch(args: argparse.Namespace) -> int:
     from planning import batch
-    from planning.report import text_table
-    from planning.trajectory_io import write_files
+    from planning.io.report import text_table
+    from planning.io.trajectory_io import write_files
 
     try:
         paths = batch.scene_files(args.scenes)

@@ -34,7 +34,7 @@ with eq. 6.
 Only joints that move are fitted and sampled: the waypoint joints, and any other joint whose
 goal differs from its start (it moves in the last segment). The rest keep their start value,
 exactly, as the spline through constant nodes does. A joint's velocity, acceleration or
-jerk that is certainly within its limit by a Bernstein bound (:mod:`planning.polynomial_bounds`)
+jerk that is certainly within its limit by a Bernstein bound (:mod:`planning.curves.polynomial_bounds`)
 contributes no excess and is not sampled: the bound is at least the sampled maximum.
 """
 
@@ -46,11 +46,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from planning.piecewise_sampler import PiecewiseSampler
-from planning.polynomial_bounds import DerivativeBounds
-from planning.ptp import ptp_time, trapezoid_time
+from planning.curves.piecewise_sampler import PiecewiseSampler
+from planning.curves.polynomial_bounds import DerivativeBounds
+from planning.curves.ptp import ptp_time, trapezoid_time
+from planning.curves.spline import SepticSplineSolver
 from planning.scene import PlannerSettings
-from planning.spline import SepticSplineSolver
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]

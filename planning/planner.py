@@ -11,13 +11,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from planning.baselines import Optimizer
+from planning.curves.spline import SepticSplineSolver, SplineFit, uniform_knots
+from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
-from planning.firefly import FireflyProgress, FireflyResult, firefly_minimize
 from planning.objective import Breakdown, WaypointObjective
 from planning.scene import Scene, paper_scene
-from planning.spline import SepticSplineSolver, SplineFit, uniform_knots
-from planning.trajectory import Trajectory
+from planning.search.baselines import Optimizer
+from planning.search.firefly import FireflyProgress, FireflyResult, firefly_minimize
 from planning.verification import Verification, verify_trajectory
 
 FloatArray = NDArray[np.float64]
@@ -186,7 +186,7 @@ def plan(
         progress: called after every firefly iteration.
         threads: threads of the parallel collision checks (default: up to 2); a batch that
             plans scenes in parallel processes gives each 1.
-        optimizer: another optimiser of :mod:`planning.baselines` on the same objective and
+        optimizer: another optimiser of :mod:`planning.search.baselines` on the same objective and
             evaluation budget (``fireflies x (iterations + 1)``); default: the firefly.
 
     Raises:

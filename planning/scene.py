@@ -11,9 +11,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
+from planning.curves.spline import SplineSettings
 from planning.errors import PlanningError
-from planning.firefly import FireflySettings, Mode
-from planning.spline import SplineSettings
+from planning.search.firefly import FireflySettings, Mode
 
 FloatArray = NDArray[np.float64]
 Fitness = Literal["clearance", "paper"]

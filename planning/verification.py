@@ -11,7 +11,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from planning.trajectory import Trajectory
+from planning.curves.trajectory import Trajectory
 
 FloatArray = NDArray[np.float64]
 

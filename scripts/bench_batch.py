@@ -23,8 +23,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from planning.scene_file import dump_scene
-from planning.scene_generator import generate_scenes
+from planning.io.scene_file import dump_scene
+from planning.io.scene_generator import generate_scenes
 
 TARGET_S = 20.0
 

@@ -25,16 +25,16 @@ from pathlib import Path
 import numpy as np
 
 import cpr_kin as ck
-from planning import baselines
+from planning.curves.spline import SepticSplineSolver, uniform_knots
 from planning.errors import PlanningError
+from planning.io.report import markdown_table
+from planning.io.scene_generator import generate_scenes
 from planning.objective import WaypointObjective
+from planning.peers.ompl_rrt import SamplingResult, plan_rrt_connect
+from planning.peers.pyroboplan_rrt import plan_pyroboplan_rrt_connect
 from planning.planner import endpoint, moving_joints, plan, warm_up
-from planning.pyroboplan_rrt import plan_pyroboplan_rrt_connect
-from planning.report import markdown_table
-from planning.sampling import SamplingResult, plan_rrt_connect
 from planning.scene import Scene, paper_scene
-from planning.scene_generator import generate_scenes
-from planning.spline import SepticSplineSolver, uniform_knots
+from planning.search import baselines
 
 
 def optimisers(scene: Scene) -> dict[str, baselines.Optimizer]:

@@ -20,8 +20,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from planning import spline
-from planning.spline import SepticSplineSolver, SplineSettings, fit_septic_spline
+from planning.curves import spline
+from planning.curves.spline import SepticSplineSolver, SplineSettings, fit_septic_spline
 
 
 def median_seconds(

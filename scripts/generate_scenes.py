@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from planning.scene_file import dump_scene
-from planning.scene_generator import generate_scenes
+from planning.io.scene_file import dump_scene
+from planning.io.scene_generator import generate_scenes
 
 
 def main() -> None:

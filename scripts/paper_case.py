@@ -15,13 +15,13 @@ import sys
 from pathlib import Path
 
 import cpr_kin as ck
-from planning import artifacts
 from planning.errors import PlanningError
-from planning.outputs import plan_files
+from planning.io.outputs import plan_files
+from planning.io.report import paper_rows, text_table
+from planning.io.trajectory_io import write_files
 from planning.planner import PlanResult, plan, warm_up
-from planning.report import paper_rows, text_table
 from planning.scene import paper_scene
-from planning.trajectory_io import write_files
+from planning.viz import artifacts
 
 
 def seed_summary(robot: ck.Robot, seeds: int) -> tuple[list[tuple[int, str]], list[PlanResult]]:

@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
-from planning import baselines
-from planning.firefly import FireflySettings
 from planning.planner import plan
 from planning.scene import paper_scene
+from planning.search import baselines
+from planning.search.firefly import FireflySettings
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -77,9 +77,9 @@ def test_rrt_connect_pipelines(robot: ck.Robot, peer: str) -> None:
     pytest.importorskip(peer)
     pytest.importorskip("toppra")
     if peer == "ompl":
-        from planning.sampling import plan_rrt_connect as planner
+        from planning.peers.ompl_rrt import plan_rrt_connect as planner
     else:
-        from planning.pyroboplan_rrt import plan_pyroboplan_rrt_connect as planner
+        from planning.peers.pyroboplan_rrt import plan_pyroboplan_rrt_connect as planner
 
     state = np.random.get_state()
     result = planner(paper_scene(), robot, seed=0)
@@ -117,7 +117,7 @@ def test_benchmark_script_runs(tmp_path: Path) -> None:
 
 
 def test_shortcut_path_keeps_ends_and_checks_every_new_segment() -> None:
-    from planning.pyroboplan_rrt import shortcut_path
+    from planning.peers.pyroboplan_rrt import shortcut_path
 
     def clear(a: np.ndarray, b: np.ndarray) -> bool:
         """A wall at x = 0.5 blocks |y| < 0.2: is the segment a-b free of it?"""

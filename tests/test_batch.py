@@ -9,7 +9,7 @@ import pytest
 from planning.batch import plan_batch, scene_files, summary_csv
 from planning.cli import main
 from planning.errors import PlanningError
-from planning.scene_file import paper_scene_path
+from planning.io.scene_file import paper_scene_path
 
 
 @pytest.fixture(scope="module")

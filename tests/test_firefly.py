@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from planning.errors import PlanningError
-from planning.firefly import FireflyProgress, FireflySettings, _sweep, firefly_minimize
+from planning.search.firefly import FireflyProgress, FireflySettings, _sweep, firefly_minimize
 
 
 def sphere(x: np.ndarray) -> np.ndarray:

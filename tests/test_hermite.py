@@ -3,7 +3,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.interpolate import BPoly
 
-from planning.hermite import ENERGY, HERMITE, HERMITE_INV, derivative_matrix
+from planning.curves.hermite import ENERGY, HERMITE, HERMITE_INV, derivative_matrix
 
 
 def test_hermite_step_matches_scipy_bpoly(rng: np.random.Generator) -> None:

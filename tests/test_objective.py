@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
+from planning.curves.spline import SepticSplineSolver, uniform_knots
 from planning.objective import WaypointObjective
 from planning.scene import PlannerSettings, paper_scene
-from planning.spline import SepticSplineSolver, uniform_knots
 
 
 def make_objective(
@@ -115,7 +115,7 @@ def test_w_sol_of_the_spline_is_at_least_the_ptp_one(
 def test_limit_excess_and_w_sol_match_the_fitted_trajectories(
     robot: ck.Robot, crate: ck.Obstacle, rng: np.random.Generator, theta4_goal: float
 ) -> None:
-    from planning.spline import fit_septic_spline
+    from planning.curves.spline import fit_septic_spline
 
     scene = paper_scene()
     q_goal = scene.goal.configuration(robot)

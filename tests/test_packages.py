@@ -36,8 +36,8 @@ def test_the_batch_parent_imports_no_planner_robot_or_compiler() -> None:
     # modules (numba, coal, Pinocchio, SciPy, trimesh: about 1.2 s), which each worker imports
     heavy = ["numba", "coal", "pinocchio", "scipy", "trimesh", "yourdfpy", "planning.planner"]
     code = (
-        "import sys, cpr_kin, planning, planning.cli, planning.batch, planning.report, "
-        "planning.trajectory_io; "
+        "import sys, cpr_kin, planning, planning.cli, planning.batch, planning.io.report, "
+        "planning.io.trajectory_io; "
         f"print(*[m in sys.modules for m in {heavy!r}])"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
@@ -67,7 +67,7 @@ def test_an_installed_wheel_carries_its_data_and_stubs(tmp_path: Path) -> None:
     site = tmp_path / "site"
     subprocess.run([*pip, "install", "--no-deps", "--target", str(site), str(wheel)], check=True)
     code = (
-        "import cpr_kin, planning; from planning.scene_file import load_scene, paper_scene_path; "
+        "import cpr_kin, planning; from planning.io.scene_file import load_scene, paper_scene_path; "
         "robot = cpr_kin.load_cpr(); scene = load_scene(paper_scene_path()); "
         "print(cpr_kin.__file__, robot.urdf_path, scene.name, planning.plan.__module__, sep='\\n')"
     )

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from planning.curves.piecewise_sampler import PiecewiseSampler, derivative_powers
+from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
-from planning.piecewise_sampler import PiecewiseSampler, derivative_powers
-from planning.trajectory import Trajectory
 
 
 @pytest.mark.parametrize("derivatives", [0, 3])

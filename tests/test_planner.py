@@ -133,7 +133,7 @@ def test_bad_planner_settings() -> None:
 
 def test_warm_up_compiles_the_kernels_and_returns_its_time(robot: ck.Robot) -> None:
     from cpr_kin.pair_bounds import _bounds
-    from planning.firefly import _move
+    from planning.search.firefly import _move
 
     seconds = warm_up(robot)
     assert 0.0 < seconds < 120.0

@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
-from planning import plots
-from planning.artifacts import PLOT_FILES, plot_files
 from planning.planner import PlanResult, plan
 from planning.scene import paper_scene
+from planning.viz import plots
+from planning.viz.artifacts import PLOT_FILES, plot_files
 
 
 @pytest.fixture(scope="module")

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from scipy.interpolate import BPoly, PPoly
 
+from planning.curves.polynomial_bounds import DerivativeBounds, bernstein_matrix
+from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
-from planning.polynomial_bounds import DerivativeBounds, bernstein_matrix
-from planning.trajectory import Trajectory
 
 
 def test_bernstein_coefficients_match_scipy() -> None:

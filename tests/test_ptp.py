@@ -3,7 +3,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from planning.ptp import ptp_time, trapezoid_time
+from planning.curves.ptp import ptp_time, trapezoid_time
 
 
 def test_trapezoid_by_hand() -> None:

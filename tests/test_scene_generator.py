@@ -3,8 +3,8 @@ from __future__ import annotations
 import numpy as np
 
 import cpr_kin as ck
-from planning.scene_file import parse_scene, scene_document
-from planning.scene_generator import generate_scenes
+from planning.io.scene_file import parse_scene, scene_document
+from planning.io.scene_generator import generate_scenes
 
 
 def test_generated_scenes_are_reproducible_and_valid(robot: ck.Robot) -> None:

@@ -8,14 +8,14 @@ import pytest
 from scipy.interpolate import BSpline, make_interp_spline
 
 import cpr_kin as ck
-from planning.errors import SplineError
-from planning.spline import (
+from planning.curves.spline import (
     DENSE_MAP_NODES,
     SepticSplineSolver,
     SplineSettings,
     fit_septic_spline,
     uniform_knots,
 )
+from planning.errors import SplineError
 
 from .conftest import PAPER_GOAL_TCP, PAPER_START_TCP
 

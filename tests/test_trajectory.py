@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
+from planning.curves.spline import SplineSettings, fit_septic_spline
+from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
-from planning.spline import SplineSettings, fit_septic_spline
-from planning.trajectory import Trajectory
 
 
 @pytest.fixture()

@@ -9,9 +9,9 @@ import pytest
 
 import cpr_kin as ck
 from planning.errors import PlanningError
+from planning.io.trajectory_io import atomic_write_text, read_trajectory, write_samples, write_trajectory
 from planning.planner import PlanResult, plan
 from planning.scene import paper_scene
-from planning.trajectory_io import atomic_write_text, read_trajectory, write_samples, write_trajectory
 
 
 @pytest.fixture(scope="module")

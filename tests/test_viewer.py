@@ -16,12 +16,12 @@ import psutil
 import pytest
 
 import cpr_kin as ck
-from planning.artifacts import viewer_html
+from planning.io.trajectory_io import write_trajectory
 from planning.planner import PlanResult, plan
 from planning.scene import paper_scene
-from planning.trajectory_io import write_trajectory
-from planning.viewer import Viewer
-from planning.viewer_server import start_server
+from planning.viz.artifacts import viewer_html
+from planning.viz.viewer import Viewer
+from planning.viz.viewer_server import start_server
 
 CHROMIUM_FLAGS = [
     "--headless",
@@ -176,7 +176,7 @@ def alive(pid: int) -> bool:
 def test_orphaned_server_exits(tmp_path: Path) -> None:
     # a parent that starts a server and dies without closing it: the server follows it
     script = (
-        "from planning.viewer_server import start_server; import os; "
+        "from planning.viz.viewer_server import start_server; import os; "
         "s = start_server(); print(s.process.pid, flush=True); os._exit(0)"
     )
     completed = subprocess.run(

@@ -4,7 +4,7 @@ For every joint, the node values ``y, y', y'', y'''`` at the knots ``t_0 .. t_N`
 
     J = sum_i p_i (y_i - f_i)^2 + int a1 y'^2 + a2 y''^2 + a3 y'''^2 dt
 
-over degree-7 Hermite segments (:mod:`planning.hermite`), so that position, velocity,
+over degree-7 Hermite segments (:mod:`planning.curves.hermite`), so that position, velocity,
 acceleration and jerk are continuous. On a segment of duration ``h`` the r-th derivative is
 ``h^-r`` times the derivative in the normalised time ``tau`` and ``dt = h dtau``: the ``a_r``
 term carries ``h^(1 - 2r)``. J is quadratic in the ``4 (N + 1)`` unknowns; ordered node by
@@ -34,9 +34,9 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import sparse
 from scipy.linalg import lapack
 
+from planning.curves.hermite import CONTINUITY, ENERGY, HERMITE_INV, node_scaling
+from planning.curves.trajectory import Trajectory
 from planning.errors import SplineError
-from planning.hermite import CONTINUITY, ENERGY, HERMITE_INV, node_scaling
-from planning.trajectory import Trajectory
 
 FloatArray = NDArray[np.float64]
 

@@ -102,7 +102,7 @@ class FireflyResult:
         population: ``(n, d)`` final positions, in the problem's units.
         population_fitness: ``(n,)`` their values.
         settings: the settings used (``None`` for the baseline optimisers of
-            :mod:`planning.baselines`, which return this type too).
+            :mod:`planning.search.baselines`, which return this type too).
     """
 
     x: FloatArray

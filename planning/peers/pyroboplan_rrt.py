@@ -4,10 +4,10 @@ pyroboplan (``pip install --no-deps pyroboplan``, see the README) plans on a Pin
 and collision model. It gets the CPR reduced to the moving joints
 (``pinocchio.buildReducedModel`` locks the others at their start values) and our collision
 world's geometry, robot-obstacle pairs only, with the planning clearance
-(:func:`planning.sampling.planning_clearance_m`) as its distance padding.
+(:func:`planning.peers.ompl_rrt.planning_clearance_m`) as its distance padding.
 Its own shortcutting checks collisions without that padding, so the path is shortcut here,
 against that clearance; TOPP-RA timing and the certified verification are those of
-:func:`planning.sampling.time_and_verify`.
+:func:`planning.peers.ompl_rrt.time_and_verify`.
 """
 
 from __future__ import annotations
@@ -22,8 +22,8 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 import cpr_kin as ck
+from planning.peers.ompl_rrt import SamplingResult, planning_clearance_m, time_and_verify
 from planning.planner import endpoint, moving_joints
-from planning.sampling import SamplingResult, planning_clearance_m, time_and_verify
 from planning.scene import Scene
 
 FloatArray = NDArray[np.float64]

@@ -1,7 +1,7 @@
 """meshcat display of the CPR, its obstacles, the safety margin and a trajectory.
 
 Imported only when a display is asked for: ``import planning`` never loads meshcat. The
-viewer talks to a loopback-only meshcat server (:mod:`planning.viewer_server`) that it
+viewer talks to a loopback-only meshcat server (:mod:`planning.viz.viewer_server`) that it
 starts, and can export everything, animation included, as one self-contained HTML file.
 
 Scene tree: ``/cpr`` (the robot, visual and collision geometry, the latter hidden by
@@ -30,8 +30,8 @@ from numpy.typing import NDArray
 from pinocchio.visualize import MeshcatVisualizer
 
 import cpr_kin as ck
-from planning.trajectory import Trajectory
-from planning.viewer_server import ServerProcess, start_server
+from planning.curves.trajectory import Trajectory
+from planning.viz.viewer_server import ServerProcess, start_server
 
 FloatArray = NDArray[np.float64]
 

@@ -2,7 +2,7 @@
 
 Every optimiser has the signature of :data:`Optimizer`: a batch objective, box bounds, an
 evaluation budget and a ``numpy.random.Generator``; it returns a
-:class:`~planning.firefly.FireflyResult` (best point, history, final population), so the
+:class:`~planning.search.firefly.FireflyResult` (best point, history, final population), so the
 planner can use any of them (``plan(scene, optimizer=...)``) on the same objective and
 budget. They all search normalised coordinates, like the firefly.
 
@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from planning.firefly import BatchObjective, FireflyResult, FireflySettings, firefly_minimize
+from planning.search.firefly import BatchObjective, FireflyResult, FireflySettings, firefly_minimize
 
 FloatArray = NDArray[np.float64]
 Optimizer = Callable[[BatchObjective, FloatArray, FloatArray, int, np.random.Generator], FireflyResult]

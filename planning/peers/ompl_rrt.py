@@ -6,7 +6,7 @@ verification step, the clearance the firefly's fitness asks of its samples), the
 simplified, TOPP-RA (``toppra``) times a cubic spline through it under the joints' velocity
 and acceleration limits (it has no jerk limit), and the same certified continuous check
 verifies the result (:func:`time_and_verify`, shared by every sampling baseline). This
-module holds OMPL's RRT-Connect; :mod:`planning.pyroboplan_rrt` holds pyroboplan's. The
+module holds OMPL's RRT-Connect; :mod:`planning.peers.pyroboplan_rrt` holds pyroboplan's. The
 peers are optional (``pip install '.[bench]'``).
 """
 

@@ -24,9 +24,9 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 import cpr_kin as ck
+from planning.curves.spline import SplineSettings
 from planning.errors import PlanningError
 from planning.scene import PlannerSettings, Scene, Target
-from planning.spline import SplineSettings
 
 # libyaml's safe loader where PyYAML was built with it: it parses a scene file about 7x faster
 SAFE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
@@ -140,7 +140,7 @@ class PlannerSpec(_Strict):
 
 
 class SplineSpec(_Strict):
-    """The ``spline:`` block; see :class:`planning.spline.SplineSettings`."""
+    """The ``spline:`` block; see :class:`planning.curves.spline.SplineSettings`."""
 
     p: Annotated[float, Field(gt=0)] = 1e6
     a: Annotated[list[NonNegative], Field(min_length=3, max_length=3)] = Field(
@@ -334,7 +334,7 @@ def scene_document(scene: Scene) -> dict[str, Any]:
     """The scene file's document for ``scene`` (the inverse of :func:`parse_scene`)."""
     from dataclasses import asdict
 
-    from planning.trajectory_io import obstacle_to_dict, target_to_dict
+    from planning.io.trajectory_io import obstacle_to_dict, target_to_dict
 
     planner = asdict(scene.planner)
     if planner["moving_joints"] is not None:
@@ -357,7 +357,7 @@ def scene_document(scene: Scene) -> dict[str, Any]:
 
 def dump_scene(scene: Scene, path: Path) -> None:
     """Write ``scene`` as a scene file, atomically."""
-    from planning.trajectory_io import atomic_write_text
+    from planning.io.trajectory_io import atomic_write_text
 
     atomic_write_text(
         Path(path), yaml.safe_dump(scene_document(scene), sort_keys=False, default_flow_style=None)

@@ -9,15 +9,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
+from planning.curves.trajectory import Trajectory
 from planning.planner import PlanResult
-from planning.trajectory import Trajectory
 
 PLOT_FILES = ("joints.png", "tcp_path.png", "clearance.png", "convergence.png")
 
 
 def plot_files(result: PlanResult) -> dict[str, bytes]:
     """PNG bytes of the joint, TCP-path, clearance and convergence plots, by file name."""
-    from planning import plots
+    from planning.viz import plots
 
     robot = result.robot
     units = tuple(robot.joint_unit(n) for n in robot.joint_names)
@@ -46,7 +46,7 @@ def viewer_html(
     It shows the robot, obstacles, margin, waypoints, TCP path and the trajectory; a loopback
     meshcat server runs while it is made.
     """
-    from planning.viewer import Viewer
+    from planning.viz.viewer import Viewer
 
     with Viewer(robot, obstacles, margin_m) as viewer:
         viewer.show_geometry(visual=not collision, collision=collision)

@@ -18,8 +18,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from planning.curves.trajectory import DERIVATIVE_NAMES, Trajectory
 from planning.errors import PlanningError
-from planning.trajectory import DERIVATIVE_NAMES, Trajectory
 
 if TYPE_CHECKING:  # types only: writing files needs neither the planner nor the robot
     import cpr_kin as ck

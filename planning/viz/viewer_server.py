@@ -5,7 +5,7 @@ every interface. This module runs the same bridge with the web server on 127.0.0
 speaks the same protocol on stdout (``zmq_url=...`` and ``web_url=...`` lines), so
 ``meshcat.Visualizer(zmq_url=...)`` connects to it unchanged.
 
-Run it as ``python -m planning.viewer_server``; :func:`start_server` does that for you. It
+Run it as ``python -m planning.viz.viewer_server``; :func:`start_server` does that for you. It
 exits when it is terminated or when the process that started it is gone.
 """
 
@@ -51,7 +51,7 @@ class ServerProcess:
 def start_server(timeout_s: float = 30.0) -> ServerProcess:
     """Start the loopback meshcat server in a subprocess and return its URLs."""
     process = subprocess.Popen(
-        [sys.executable, "-u", "-m", "planning.viewer_server"],
+        [sys.executable, "-u", "-m", "planning.viz.viewer_server"],
         stdout=subprocess.PIPE,
         stderr=subprocess.DEVNULL,
         text=True,

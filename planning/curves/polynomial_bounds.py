@@ -24,8 +24,8 @@ from math import comb
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from planning.curves.hermite import derivative_matrix
 from planning.errors import PlanningError
-from planning.hermite import derivative_matrix
 
 FloatArray = NDArray[np.float64]
 
@@ -53,7 +53,7 @@ class DerivativeBounds:
         derivatives: the derivative orders ``r`` to bound (e.g. ``(1, 2, 3)``).
 
     Calling it with coefficients ``(N, M, order)`` (local time per segment, the layout of
-    :class:`~planning.trajectory.Trajectory`) returns ``(len(derivatives), M)`` bounds, each
+    :class:`~planning.curves.trajectory.Trajectory`) returns ``(len(derivatives), M)`` bounds, each
     at least the true largest |value| of that derivative over all segments.
     """
 

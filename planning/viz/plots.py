@@ -27,8 +27,8 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from planning.firefly import FireflyResult
-from planning.trajectory import DERIVATIVE_NAMES, Trajectory
+from planning.curves.trajectory import DERIVATIVE_NAMES, Trajectory
+from planning.search.firefly import FireflyResult
 
 FloatArray = NDArray[np.float64]
 UNITS = {"rad": ("rad", "rad/s", "rad/s$^2$", "rad/s$^3$"), "m": ("m", "m/s", "m/s$^2$", "m/s$^3$")}

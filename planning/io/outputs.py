@@ -1,6 +1,6 @@
 """The files a plan produces, rendered in memory.
 
-:func:`planning.trajectory_io.write_files` then writes them all at once, or none.
+:func:`planning.io.trajectory_io.write_files` then writes them all at once, or none.
 """
 
 from __future__ import annotations
@@ -10,9 +10,9 @@ from typing import Any
 
 import numpy as np
 
+from planning.io.report import markdown_table, paper_rows
+from planning.io.trajectory_io import samples_csv, trajectory_document
 from planning.planner import PlanResult
-from planning.report import markdown_table, paper_rows
-from planning.trajectory_io import samples_csv, trajectory_document
 
 
 def report_markdown(result: PlanResult, paper: bool = False) -> str:
@@ -67,11 +67,11 @@ def plan_files(
         "report.md": report_markdown(result, paper),
     }
     if plots:
-        from planning.artifacts import plot_files
+        from planning.viz.artifacts import plot_files
 
         files.update(plot_files(result))
     if html:
-        from planning.artifacts import viewer_html
+        from planning.viz.artifacts import viewer_html
 
         scene = result.scene
         files["viewer.html"] = viewer_html(
