@@ -3,26 +3,37 @@
 from .curves.ptp import ptp_time, trapezoid_time
 from .curves.spline import SepticSplineSolver, SplineFit, SplineSettings, fit_septic_spline, uniform_knots
 from .curves.trajectory import Extrema, Trajectory
-from .errors import PlanningError, SplineError
+from .errors import NoSolutionError, NoTrajectoryFoundError, PlanningError, SceneError, SplineError
+from .io.bundled import paper_scene
+from .io.scene_file import dump_scene, load_scene
 from .io.trajectory_io import read_trajectory, write_samples, write_trajectory
+from .metrics import Metrics
 from .objective import Breakdown, WaypointObjective
-from .planner import Metrics, NoTrajectoryFoundError, PlanResult, plan, warm_up
-from .scene import PlannerSettings, Scene, Target, paper_scene
-from .search.firefly import FireflyProgress, FireflyResult, FireflySettings, firefly_minimize
+from .planner import PlanResult, plan, solve, warm_up
+from .problem import Problem, build_problem
+from .scene import DEFAULT_SAFETY_MARGIN_M, DEFAULT_SPLINE, PlannerSettings, Scene, Target
+from .search.firefly import FireflyProgress, FireflySettings, firefly_minimize
+from .search.optimizer import Optimizer, SearchResult
 from .verification import Verification, verify_trajectory
 
 __all__ = [
+    "DEFAULT_SAFETY_MARGIN_M",
+    "DEFAULT_SPLINE",
     "Breakdown",
     "Extrema",
     "FireflyProgress",
-    "FireflyResult",
     "FireflySettings",
     "Metrics",
+    "NoSolutionError",
     "NoTrajectoryFoundError",
+    "Optimizer",
     "PlanResult",
     "PlannerSettings",
     "PlanningError",
+    "Problem",
     "Scene",
+    "SceneError",
+    "SearchResult",
     "SepticSplineSolver",
     "SplineError",
     "SplineFit",
@@ -31,12 +42,16 @@ __all__ = [
     "Trajectory",
     "Verification",
     "WaypointObjective",
+    "build_problem",
+    "dump_scene",
     "firefly_minimize",
     "fit_septic_spline",
+    "load_scene",
     "paper_scene",
     "plan",
     "ptp_time",
     "read_trajectory",
+    "solve",
     "trapezoid_time",
     "uniform_knots",
     "verify_trajectory",

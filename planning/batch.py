@@ -16,25 +16,17 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import asdict, dataclass
 from functools import lru_cache
 from pathlib import Path
+from typing import Any
 
 import joblib
 
 import cpr_kin as ck  # lazy (lazy_loader): its modules load in the workers, where they are used
-from planning.errors import PlanningError
+from planning.errors import NoSolutionError, PlanningError
 
 STATUS_EXIT = {"ok": 0, "invalid": 2, "no_trajectory": 3}
-SUMMARY_FIELDS = (
-    "scene",
-    "status",
-    "exit_class",
-    "duration_s",
-    "min_clearance_m",
-    "t_sol_s",
-    "fitness",
-    "evaluations",
-    "planning_time_s",
-    "message",
-)
+RECORD_FIELDS = ("duration", "min_clearance", "t_sol", "fitness", "evaluations", "planning_time_s")
+"""The plan record's fields (:func:`planning.io.report.plan_record`) that ``summary.csv`` shows."""
+SUMMARY_FIELDS = ("scene", "status", "exit_class", *RECORD_FIELDS, "task_time_s", "message")
 
 
 @dataclass(frozen=True)
@@ -46,24 +38,17 @@ class BatchItem:
         status: ``ok``, ``invalid`` (bad scene) or ``no_trajectory``.
         exit_class: the exit code ``cpr-plan plan`` would give: 0, 2 or 3.
         message: the error for a failed scene, empty otherwise.
-        duration_s: trajectory duration [s] (ok only).
-        min_clearance_m: certified clearance [m] (ok only).
-        t_sol_s: PTP time of the waypoints [s] (ok only).
-        fitness: objective value (ok only).
-        evaluations: objective evaluations (ok only).
-        planning_time_s: wall time of the task [s].
+        record: the plan's record (:func:`planning.io.report.plan_record`, the trajectory
+            file's metrics), ``None`` for a failed scene.
+        task_time_s: wall time of the task: loading, planning and writing [s].
     """
 
     scene: str
     status: str
     exit_class: int
     message: str = ""
-    duration_s: float | None = None
-    min_clearance_m: float | None = None
-    t_sol_s: float | None = None
-    fitness: float | None = None
-    evaluations: int | None = None
-    planning_time_s: float = 0.0
+    record: dict[str, Any] | None = None
+    task_time_s: float = 0.0
 
 
 @lru_cache(maxsize=8)
@@ -80,37 +65,27 @@ def plan_scene_file(path: Path, out: Path, threads: int | None = 1) -> BatchItem
     never needs it.
     """
     from planning.io.outputs import plan_files
+    from planning.io.report import plan_record
     from planning.io.scene_file import load_scene
     from planning.io.trajectory_io import write_files
-    from planning.planner import NoTrajectoryFoundError, plan
+    from planning.planner import plan
 
     started = time.perf_counter()
     name = path.stem
     try:
         scene = load_scene(path)
         result = plan(scene, _robot(scene.robot), threads=threads)
-    except NoTrajectoryFoundError as exc:
-        return BatchItem(name, "no_trajectory", 3, str(exc), planning_time_s=time.perf_counter() - started)
+    except NoSolutionError as exc:
+        return BatchItem(name, "no_trajectory", 3, str(exc), task_time_s=time.perf_counter() - started)
     except (PlanningError, ck.CprKinError) as exc:
-        return BatchItem(name, "invalid", 2, str(exc), planning_time_s=time.perf_counter() - started)
+        return BatchItem(name, "invalid", 2, str(exc), task_time_s=time.perf_counter() - started)
     try:
         write_files(out, plan_files(result))
     except OSError as exc:
         return BatchItem(
-            name, "invalid", 2, f"cannot write '{out}': {exc}", planning_time_s=time.perf_counter() - started
+            name, "invalid", 2, f"cannot write '{out}': {exc}", task_time_s=time.perf_counter() - started
         )
-    m = result.metrics
-    return BatchItem(
-        scene=name,
-        status="ok",
-        exit_class=0,
-        duration_s=m.duration,
-        min_clearance_m=m.min_clearance,
-        t_sol_s=m.t_sol,
-        fitness=m.fitness,
-        evaluations=m.evaluations,
-        planning_time_s=time.perf_counter() - started,
-    )
+    return BatchItem(name, "ok", 0, record=plan_record(result), task_time_s=time.perf_counter() - started)
 
 
 def scene_files(folder: Path) -> list[Path]:
@@ -176,10 +151,12 @@ def plan_batch(
 
 
 def summary_csv(items: Sequence[BatchItem]) -> str:
-    """``summary.csv``: one row per scene, the fields of :class:`BatchItem`."""
+    """``summary.csv``: one row per scene: its status, the record's :data:`RECORD_FIELDS`, its message."""
     buffer = io.StringIO()
     writer = csv.DictWriter(buffer, fieldnames=SUMMARY_FIELDS, lineterminator="\n")
     writer.writeheader()
     for item in items:
-        writer.writerow({k: ("" if v is None else v) for k, v in asdict(item).items()})
+        record = item.record or {}
+        row = {k: v for k, v in asdict(item).items() if k != "record"}
+        writer.writerow({**row, **{k: record.get(k, "") for k in RECORD_FIELDS}})
     return buffer.getvalue()

@@ -1,10 +1,22 @@
-"""Exceptions of :mod:`planning`.
+"""Exceptions of :mod:`planning`, with two roots because callers treat them differently.
 
-Every error caused by user input (settings, waypoints, knots, scenes) is a
-:class:`PlanningError`, whose message names the offending value and what is allowed.
+- :class:`PlanningError` (a ``ValueError``): the input is wrong (settings, waypoints, knots,
+  a scene or a file). Its message names the offending value and what is allowed: fix the
+  input. The CLI exits with code 2.
+- :class:`NoSolutionError` (a ``RuntimeError``): the input is valid, but the planner found
+  no trajectory that passes the verification: search longer, try another seed, or loosen
+  the scene. The CLI exits with code 3.
+
+Bad robot input (a URDF, a joint vector, an obstacle) raises :class:`cpr_kin.CprKinError`,
+also a ``ValueError``, which the planner lets through.
 """
 
 from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import cpr_kin as ck
 
 
 class PlanningError(ValueError):
@@ -13,3 +25,29 @@ class PlanningError(ValueError):
 
 class SplineError(PlanningError):
     """Invalid spline settings, knots or node values."""
+
+
+class SceneError(PlanningError):
+    """A scene file is missing, not YAML, or does not follow the schema."""
+
+
+class NoSolutionError(RuntimeError):
+    """Base class of the outcomes where valid input has no solution that was found."""
+
+
+class NoTrajectoryFoundError(NoSolutionError):
+    """No candidate of the final population passed the verification.
+
+    Attributes:
+        certified_clearance_m: certified clearance of the best candidate [m].
+        worst_time_s: when it comes closest [s].
+        worst_pair: ``(robot geometry, obstacle)`` closest then.
+        worst_group: the violating group.
+    """
+
+    def __init__(self, message: str, check: ck.CurveCheck) -> None:
+        super().__init__(message)
+        self.certified_clearance_m = check.certified_min_m
+        self.worst_time_s = check.worst_time
+        self.worst_pair = check.worst_pair
+        self.worst_group = check.worst_group

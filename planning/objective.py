@@ -62,7 +62,7 @@ class Breakdown:
 
     Attributes:
         fitness: the objective value.
-        t_sol: PTP time through the candidate's nodes [s].
+        t_sol_s: PTP time through the candidate's nodes [s].
         w_sol: normalised accumulated joint motion of the executed path.
         feasible: no margin violation and no joint beyond its limits.
         effector_violates: the wrist or tool comes closer than the required clearance (with
@@ -79,7 +79,7 @@ class Breakdown:
     """
 
     fitness: FloatArray
-    t_sol: FloatArray
+    t_sol_s: FloatArray
     w_sol: FloatArray
     feasible: BoolArray
     effector_violates: BoolArray
@@ -291,7 +291,7 @@ class WaypointObjective:
             fitness = np.where(feasible, base, 2 * self.t_max + penalty)
         return Breakdown(
             fitness=fitness,
-            t_sol=t_sol,
+            t_sol_s=t_sol,
             w_sol=w_sol,
             feasible=feasible,
             effector_violates=effector,

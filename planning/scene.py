@@ -1,11 +1,19 @@
-"""What to plan: the robot, the obstacles, the start and goal, the margin and the settings."""
+"""What to plan: the robot, the obstacles, the start and goal, the margin and the settings.
+
+Every default lives here once: :data:`DEFAULT_SAFETY_MARGIN_M`, :data:`DEFAULT_SPLINE` and
+the fields of :class:`PlannerSettings` (with its nested
+:class:`~planning.search.firefly.FireflySettings`). The scene file's schema
+(:mod:`planning.io.scene_schema`) reads its defaults from them.
+"""
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -13,11 +21,21 @@ from numpy.typing import NDArray
 import cpr_kin as ck
 from planning.curves.spline import SplineSettings
 from planning.errors import PlanningError
-from planning.search.firefly import FireflySettings, Mode
+from planning.search.firefly import FireflySettings
 
 FloatArray = NDArray[np.float64]
 Fitness = Literal["clearance", "paper"]
 PathKind = Literal["spline", "ptp"]
+
+DEFAULT_SAFETY_MARGIN_M = 0.1
+"""Clearance every robot geometry keeps from every obstacle unless a scene says otherwise [m]
+(the paper's value)."""
+
+DEFAULT_SPLINE = SplineSettings(p=1e6, a=(0.0, 0.0, 1.0), ends="rest")
+"""The spline of a scene unless it says otherwise: the paper's weights, but at rest at both
+ends, which a real robot needs (the paper case itself uses natural ends)."""
+
+_FIREFLY_FIELDS = frozenset(f.name for f in dataclasses.fields(FireflySettings))
 
 
 @dataclass(frozen=True)
@@ -49,17 +67,11 @@ class Target:
 
 @dataclass(frozen=True)
 class PlannerSettings:
-    """Settings of the firefly waypoint planner; validated on construction.
+    """Settings of the waypoint planner; validated on construction.
 
     Attributes:
-        fireflies: population size. The paper: 50.
-        iterations: firefly iterations. The paper: 50.
-        alpha: initial randomisation (normalised units). The paper: 1.
-        beta0: attractiveness at distance 0. The paper: 0.5.
-        gamma: light absorption (normalised units).
-        theta: per-iteration decay of alpha.
+        firefly: the firefly algorithm's parameters (the paper's by default).
         waypoints: number of intermediate waypoints p. The paper: 3.
-        mode: ``"sweep"`` (vectorised) or ``"sequential"`` (NiaPy's semantics).
         fitness: ``"clearance"`` (feasible first, infeasible ranked by coal's violation
             depth) or ``"paper"`` (eq. 4-6).
         seed: seed of the random generator.
@@ -75,15 +87,8 @@ class PlannerSettings:
             joint when start and goal differ in it.
     """
 
-    # the firefly's parameters and their defaults are FireflySettings'
-    fireflies: int = FireflySettings.fireflies
-    iterations: int = FireflySettings.iterations
-    alpha: float = FireflySettings.alpha
-    beta0: float = FireflySettings.beta0
-    gamma: float = FireflySettings.gamma
-    theta: float = FireflySettings.theta
+    firefly: FireflySettings = field(default_factory=FireflySettings)
     waypoints: int = 3
-    mode: Mode = FireflySettings.mode
     fitness: Fitness = "clearance"
     seed: int = 0
     path: PathKind = "spline"
@@ -94,7 +99,8 @@ class PlannerSettings:
     moving_joints: tuple[str, ...] | None = None
 
     def __post_init__(self) -> None:
-        self.firefly()  # validates the firefly parameters
+        if not isinstance(self.firefly, FireflySettings):
+            raise PlanningError(f"firefly = {self.firefly!r} must be a FireflySettings")
         if not (isinstance(self.waypoints, int) and self.waypoints >= 1):
             raise PlanningError(f"waypoints = {self.waypoints!r} must be an integer >= 1")
         if self.fitness not in ("clearance", "paper"):
@@ -116,17 +122,36 @@ class PlannerSettings:
         if not (math.isfinite(self.verify_step_m) and self.verify_step_m > 0):
             raise PlanningError(f"verify_step_m = {self.verify_step_m!r} m must be a finite number > 0")
 
-    def firefly(self) -> FireflySettings:
-        """The firefly algorithm's part of these settings."""
-        return FireflySettings(
-            fireflies=self.fireflies,
-            iterations=self.iterations,
-            alpha=self.alpha,
-            beta0=self.beta0,
-            gamma=self.gamma,
-            theta=self.theta,
-            mode=self.mode,
+    @classmethod
+    def from_flat(cls, values: Mapping[str, Any]) -> PlannerSettings:
+        """Settings from the scene file's flat ``planner:`` block (firefly keys included)."""
+        return cls().updated(**values)
+
+    def updated(self, **changes: Any) -> PlannerSettings:
+        """A copy with ``changes``; the firefly's keys (``fireflies``, ``alpha``, ...) go to :attr:`firefly`.
+
+        Raises:
+            PlanningError: an unknown key, or a value the settings refuse.
+        """
+        own = {f.name for f in dataclasses.fields(self)} - {"firefly"}
+        unknown = sorted(set(changes) - own - _FIREFLY_FIELDS)
+        if unknown:
+            raise PlanningError(
+                f"unknown planner setting(s) {unknown}; allowed: {sorted(own | _FIREFLY_FIELDS)}"
+            )
+        firefly = {k: v for k, v in changes.items() if k in _FIREFLY_FIELDS}
+        rest = {k: v for k, v in changes.items() if k in own}
+        if firefly:
+            rest["firefly"] = dataclasses.replace(self.firefly, **firefly)
+        return dataclasses.replace(self, **rest)
+
+    def flat(self) -> dict[str, Any]:
+        """The scene file's flat ``planner:`` block: firefly keys first, then the planner's."""
+        values = dataclasses.asdict(self.firefly)
+        values.update(
+            {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name != "firefly"}
         )
+        return values
 
 
 @dataclass(frozen=True)
@@ -138,24 +163,22 @@ class Scene:
         goal: where it must go.
         obstacles: static obstacles, unique names.
         safety_margin: required clearance between every robot geometry and every obstacle [m].
-        duration: trajectory duration [s]; ``None``: the fastest uniform timing within the
-            joints' velocity, acceleration and jerk limits.
+        duration: trajectory duration [s]; ``None``: the fastest timing within the joints'
+            velocity, acceleration and jerk limits.
         robot: URDF of the robot; ``None``: the bundled CPR.
         planner: planner settings.
-        spline: spline settings (default: p = 1e6, jerk only, rest-to-rest ends).
+        spline: spline settings (default :data:`DEFAULT_SPLINE`).
         name: a name for reports.
     """
 
     start: Target
     goal: Target
     obstacles: tuple[ck.Obstacle, ...] = ()
-    safety_margin: float = 0.1
+    safety_margin: float = DEFAULT_SAFETY_MARGIN_M
     duration: float | None = None
     robot: Path | None = None
     planner: PlannerSettings = field(default_factory=PlannerSettings)
-    spline: SplineSettings = field(
-        default_factory=lambda: SplineSettings(p=1e6, a=(0.0, 0.0, 1.0), ends="rest")
-    )
+    spline: SplineSettings = DEFAULT_SPLINE
     name: str = "scene"
 
     def __post_init__(self) -> None:
@@ -168,37 +191,3 @@ class Scene:
         if self.duration is not None and not (math.isfinite(self.duration) and self.duration > 0):
             raise PlanningError(f"duration = {self.duration!r} s must be a finite number > 0 (or omitted)")
         object.__setattr__(self, "obstacles", tuple(self.obstacles))
-
-
-PAPER_START_TCP = (0.5, 0.45, 0.25)
-PAPER_GOAL_TCP = (-0.5, 0.45, 0.25)
-
-
-def paper_scene(seed: int = 0, **planner_overrides: object) -> Scene:
-    """The paper case (DESIGN.md section 4) with the paper's parameters.
-
-    Start TCP (0.5, 0.45, 0.25), goal (-0.5, 0.45, 0.25), a 0.3 m cube centred at
-    (0, 0.6, 0.15), margin 0.1 m; n = 50, alpha = 1, beta0 = 0.5, 50 iterations, 3
-    waypoints, node deviation at most 20 um; spline N = 4, h = 1 s (4 s), p = 1e6, jerk
-    only, natural ends.
-    """
-    parameters: dict[str, object] = {
-        "fireflies": 50,
-        "iterations": 50,
-        "alpha": 1.0,
-        "beta0": 0.5,
-        "waypoints": 3,
-        "max_node_deviation": 20e-6,
-    }
-    parameters.update(planner_overrides, seed=seed)
-    planner = PlannerSettings(**parameters)  # type: ignore[arg-type]
-    return Scene(
-        name="paper",
-        start=Target(tcp=PAPER_START_TCP),
-        goal=Target(tcp=PAPER_GOAL_TCP),
-        obstacles=(ck.Obstacle.box((0.3, 0.3, 0.3), (0.0, 0.6, 0.15), name="crate"),),
-        safety_margin=0.1,
-        duration=4.0,
-        planner=planner,
-        spline=SplineSettings(p=1e6, a=(0.0, 0.0, 1.0), ends="natural"),
-    )

@@ -6,6 +6,7 @@ What the planner accepts is what ``cpr-plan check`` re-checks: one function serv
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -32,6 +33,16 @@ class Verification:
     def accepted(self) -> bool:
         """Every condition holds."""
         return not self.problems
+
+    def to_record(self) -> dict[str, Any]:
+        """The verdict as plain JSON types (``cpr-plan check --json`` prints it)."""
+        return {
+            "status": "ok" if self.accepted else "failed",
+            "certified_min_clearance_m": self.check.certified_min_m,
+            "safety_margin_m": self.check.margin_m,
+            "checks": len(self.check.times),
+            "problems": list(self.problems),
+        }
 
 
 def verify_trajectory(

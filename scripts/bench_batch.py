@@ -68,8 +68,10 @@ def main() -> None:
     here = Path(__file__).resolve().parents[1]
     codes = {"this checkout": here}
     if args.compare is not None:
-        if not (args.compare / "planning" / "cli.py").is_file():
-            raise SystemExit(f"--compare {args.compare}: not a checkout of this project (no planning/cli.py)")
+        if not (args.compare / "planning").is_dir():
+            raise SystemExit(
+                f"--compare {args.compare}: not a checkout of this project (no planning/ package)"
+            )
         codes[f"compare ({args.compare})"] = args.compare.resolve()
     with tempfile.TemporaryDirectory() as tmp:
         scenes = Path(tmp) / "scenes"

@@ -25,27 +25,30 @@ from pathlib import Path
 import numpy as np
 
 import cpr_kin as ck
-from planning.curves.spline import SepticSplineSolver, uniform_knots
-from planning.errors import PlanningError
+from planning.errors import NoSolutionError, PlanningError
+from planning.io.bundled import paper_scene
 from planning.io.report import markdown_table
 from planning.io.scene_generator import generate_scenes
 from planning.objective import WaypointObjective
-from planning.peers.ompl_rrt import SamplingResult, plan_rrt_connect
+from planning.peers.ompl_rrt import plan_rrt_connect
 from planning.peers.pyroboplan_rrt import plan_pyroboplan_rrt_connect
-from planning.planner import endpoint, moving_joints, plan, warm_up
-from planning.scene import Scene, paper_scene
+from planning.peers.toppra_timing import SamplingResult
+from planning.planner import plan, warm_up
+from planning.problem import build_problem
+from planning.scene import Scene
 from planning.search import baselines
+from planning.search.optimizer import Optimizer
 
 
-def optimisers(scene: Scene) -> dict[str, baselines.Optimizer]:
-    settings = scene.planner.firefly()
-    found: dict[str, baselines.Optimizer] = {
+def optimisers(scene: Scene) -> dict[str, Optimizer]:
+    settings = scene.planner.firefly
+    found: dict[str, Optimizer] = {
         "firefly (ours)": baselines.firefly(settings),
         "PSO": baselines.particle_swarm(),
         "harmony search": baselines.harmony_search(),
         "differential evolution (scipy)": baselines.differential_evolution(),
     }
-    peers: list[tuple[str, str, Callable[[], baselines.Optimizer]]] = [
+    peers: list[tuple[str, str, Callable[[], Optimizer]]] = [
         ("CMA-ES (cma)", "cma", baselines.cma_es),
         ("NiaPy FireflyAlgorithm", "niapy", lambda: baselines.niapy_firefly(settings)),
     ]
@@ -60,15 +63,7 @@ def optimisers(scene: Scene) -> dict[str, baselines.Optimizer]:
 
 
 def paper_objective(robot: ck.Robot, scene: Scene) -> WaypointObjective:
-    world = ck.CollisionWorld(robot, scene.obstacles)
-    q_start, q_goal = endpoint(robot, world, scene, "start"), endpoint(robot, world, scene, "goal")
-    solver = SepticSplineSolver(
-        uniform_knots(scene.planner.waypoints + 1, scene.duration or 4.0), scene.spline
-    )
-    moving = moving_joints(robot, scene, q_start, q_goal)
-    return WaypointObjective(
-        world, q_start, q_goal, moving, scene.safety_margin, scene.planner, solver, timed=True
-    )
+    return build_problem(scene, robot).objective
 
 
 def percentile(values: list[float], q: float) -> float:
@@ -79,7 +74,7 @@ def optimiser_table(robot: ck.Robot, seeds: int) -> tuple[list[list[str]], dict[
     """Rows of the optimiser table, and each optimiser's median time ratio to ours."""
     scene = paper_scene()
     objective = paper_objective(robot, scene)
-    budget = scene.planner.fireflies * (scene.planner.iterations + 1)
+    budget = scene.planner.firefly.fireflies * (scene.planner.firefly.iterations + 1)
     times: dict[str, list[float]] = {}
     fitness: dict[str, list[float]] = {}
     methods = optimisers(scene)
@@ -132,11 +127,11 @@ def sampling_method(
 def planner_rows(robot: ck.Robot, scenes: list[Scene], time_limit_s: float) -> list[list[str]]:
     methods: dict[str, Callable[[Scene], dict[str, float] | None]] = {}
 
-    def pipeline(optimiser: baselines.Optimizer | None) -> Callable[[Scene], dict[str, float] | None]:
+    def pipeline(optimiser: Optimizer | None) -> Callable[[Scene], dict[str, float] | None]:
         def run(scene: Scene) -> dict[str, float] | None:
             try:
                 result = plan(scene, robot, optimizer=optimiser)
-            except PlanningError:
+            except (PlanningError, NoSolutionError):
                 return None
             trajectory = result.trajectory
             dense = trajectory(np.linspace(0, trajectory.duration, 2001))
@@ -147,10 +142,10 @@ def planner_rows(robot: ck.Robot, scenes: list[Scene], time_limit_s: float) -> l
             )
             return {
                 "time": result.metrics.planning_time_s,
-                "duration": result.metrics.duration,
+                "duration": result.metrics.duration_s,
                 "length": length,
                 "jerk": jerk,
-                "clearance": result.metrics.min_clearance,
+                "clearance": result.metrics.min_clearance_m,
             }
 
         return run

@@ -11,8 +11,8 @@ import argparse
 import statistics
 
 import cpr_kin as ck
+from planning.io.bundled import paper_scene
 from planning.planner import plan
-from planning.scene import paper_scene
 
 
 def main() -> None:

@@ -15,12 +15,12 @@ import sys
 from pathlib import Path
 
 import cpr_kin as ck
-from planning.errors import PlanningError
+from planning.errors import NoSolutionError, PlanningError
+from planning.io.bundled import paper_scene
 from planning.io.outputs import plan_files
 from planning.io.report import paper_rows, text_table
 from planning.io.trajectory_io import write_files
 from planning.planner import PlanResult, plan, warm_up
-from planning.scene import paper_scene
 from planning.viz import artifacts
 
 
@@ -30,15 +30,15 @@ def seed_summary(robot: ck.Robot, seeds: int) -> tuple[list[tuple[int, str]], li
     for seed in range(seeds):
         try:
             result = plan(paper_scene(seed), robot)
-        except PlanningError as exc:
+        except (PlanningError, NoSolutionError) as exc:
             lines.append((seed, f"failed: {exc}"))
             continue
         m = result.metrics
-        ok = m.min_clearance >= 0.1 and m.max_node_deviation < 20e-6
+        ok = m.min_clearance_m >= 0.1 and m.max_node_deviation < 20e-6
         lines.append(
             (
                 seed,
-                f"{'ok' if ok else 'NOT ok'}: t_sol {m.t_sol:.3f} s, clearance {m.min_clearance:.4f} m, "
+                f"{'ok' if ok else 'NOT ok'}: t_sol {m.t_sol_s:.3f} s, clearance {m.min_clearance_m:.4f} m, "
                 f"deviation {m.max_node_deviation * 1e6:.2f} um, {m.planning_time_s:.3f} s",
             )
         )
@@ -61,11 +61,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f"compiled the numba kernels in {compile_s:.1f} s (once per machine: they are cached)\n")
     try:
         result = plan(paper_scene(args.seed), robot)
-    except PlanningError as exc:
+    except (PlanningError, NoSolutionError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 3
     rows = paper_rows(result)
-    clearance = result.metrics.min_clearance
+    clearance = result.metrics.min_clearance_m
     print(f"Paper case, seed {args.seed}: trajectory verified, certified clearance {clearance:.4f} m\n")
     print(text_table(rows))
 

@@ -10,10 +10,11 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
+from planning.io.bundled import paper_scene
 from planning.planner import plan
-from planning.scene import paper_scene
 from planning.search import baselines
 from planning.search.firefly import FireflySettings
+from planning.search.optimizer import Optimizer
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -61,14 +62,14 @@ def test_budget_bounds_and_progress(name: str, factory: object) -> None:
 
 @pytest.mark.parametrize("name", ["pso", "harmony", "de"])
 def test_baselines_plan_the_paper_case(robot: ck.Robot, name: str) -> None:
-    factories: dict[str, Callable[[], baselines.Optimizer]] = {
+    factories: dict[str, Callable[[], Optimizer]] = {
         "pso": baselines.particle_swarm,
         "harmony": baselines.harmony_search,
         "de": baselines.differential_evolution,
     }
     optimiser = factories[name]()
     result = plan(paper_scene(1), robot, optimizer=optimiser)
-    assert result.verification.accepted and result.metrics.min_clearance >= 0.1
+    assert result.verification.accepted and result.metrics.min_clearance_m >= 0.1
     assert result.metrics.evaluations <= 2550
 
 

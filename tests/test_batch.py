@@ -9,7 +9,7 @@ import pytest
 from planning.batch import plan_batch, scene_files, summary_csv
 from planning.cli import main
 from planning.errors import PlanningError
-from planning.io.scene_file import paper_scene_path
+from planning.io.bundled import paper_scene_path
 
 
 @pytest.fixture(scope="module")
@@ -29,7 +29,7 @@ def test_batch_local_processes(scenes: Path, tmp_path: Path) -> None:
     broken = items[0]
     assert broken.status == "invalid" and broken.exit_class == 2 and "not reachable" in broken.message
     for item in items[1:]:
-        assert item.status == "ok" and item.min_clearance_m is not None and item.min_clearance_m >= 0.1
+        assert item.status == "ok" and item.record is not None and item.record["min_clearance"] >= 0.1
         assert sorted(p.name for p in (tmp_path / item.scene).iterdir()) == [
             "report.md",
             "samples.csv",
@@ -51,7 +51,11 @@ def test_dask_cluster_gives_the_same_results(scenes: Path, tmp_path: Path) -> No
         remote = plan_batch(paths, tmp_path / "dask", scheduler=cluster.scheduler_address)
     assert [i.scene for i in remote] == [i.scene for i in local]
     for a, b in zip(local, remote, strict=True):
-        assert (a.status, a.fitness, a.min_clearance_m) == (b.status, b.fitness, b.min_clearance_m)
+        assert a.status == b.status == "ok" and a.record is not None and b.record is not None
+        wall_times = ("planning_time_s", "optimiser_time_s")
+        assert {k: v for k, v in a.record.items() if k not in wall_times} == {
+            k: v for k, v in b.record.items() if k not in wall_times
+        }
         assert (tmp_path / "local" / a.scene / "trajectory.json").read_bytes() == (
             tmp_path / "dask" / b.scene / "trajectory.json"
         ).read_bytes()

@@ -1,7 +1,6 @@
 from __future__ import annotations
 
 import json
-import math
 import os
 import pty
 import subprocess
@@ -9,10 +8,13 @@ import sys
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 import yaml
 
+import cpr_kin as ck
 from planning.cli import main
+from planning.io.trajectory_io import read_trajectory
 
 SCENE: dict[str, Any] = {
     "name": "swing",
@@ -117,8 +119,14 @@ def test_plan_check_and_reproducibility(tmp_path: Path, capsys: pytest.CaptureFi
     code, stdout, _ = run(["plan", str(scene), "--out", str(second), "--json"], capsys)
     assert code == 0
     summary = json.loads(stdout)
-    assert summary["status"] == "ok" and summary["min_clearance_m"] >= 0.1
+    assert summary["status"] == "ok" and summary["min_clearance"] >= 0.1
     assert (first / "trajectory.json").read_bytes() == (second / "trajectory.json").read_bytes()
+    # one serialisation: the summary carries the file's metrics, under the same keys
+    recorded = json.loads((second / "trajectory.json").read_text())["metrics"]
+    wall_times = {"planning_time_s", "optimiser_time_s"}
+    assert {k: summary[k] for k in recorded if k not in wall_times} == {
+        k: v for k, v in recorded.items() if k not in wall_times
+    }
     # another seed gives another trajectory
     code, _, _ = run(["plan", str(scene), "--out", str(tmp_path / "c"), "--seed", "7"], capsys)
     assert code == 0
@@ -126,14 +134,20 @@ def test_plan_check_and_reproducibility(tmp_path: Path, capsys: pytest.CaptureFi
     # the trajectory passes its own scene, and fails one with an obstacle in its way
     code, stdout, _ = run(["check", str(scene), str(first / "trajectory.json")], capsys)
     assert code == 0 and "verified against" in stdout
-    document = json.loads((first / "trajectory.json").read_text())
-    middle = document["waypoints"][2]
-    # a ball on the arm's way at the middle waypoint
-    xyz = [0.55 * math.cos(middle[0]), 0.55 * math.sin(middle[0]), 0.25 + middle[1]]
-    blocker = {"name": "post", "shape": "sphere", "radius": 0.1, "xyz": xyz}
+    trajectory = read_trajectory(first / "trajectory.json").trajectory
+    # a ball around the tool tip where it is farthest from the robot at start and goal: the
+    # scene stays valid, but the trajectory runs into the ball
+    robot = ck.load_cpr()
+    q = trajectory(np.linspace(0.0, trajectory.duration, 41))
+    ends = q[[0, -1]]
+    balls = [ck.Obstacle.sphere(0.05, p) for p in ck.frame_positions(robot, q)]
+    farthest = max(
+        balls, key=lambda b: ck.CollisionWorld(robot, [b]).clearance_batch(ends).min_clearance_m.min()
+    )
+    blocker = {"name": "post", "shape": "sphere", "radius": 0.05, "xyz": farthest.xyz.tolist()}
     other = write_scene(tmp_path, with_changes(obstacles=[*SCENE["obstacles"], blocker]), "other.yaml")
-    code, stdout, _ = run(["check", str(other), str(first / "trajectory.json"), "--json"], capsys)
-    assert code == 3
+    code, stdout, err = run(["check", str(other), str(first / "trajectory.json"), "--json"], capsys)
+    assert code == 3, err
     verdict = json.loads(stdout)
     assert verdict["status"] == "failed" and any("post" in p for p in verdict["problems"])
 

@@ -5,8 +5,9 @@ import pytest
 
 import cpr_kin as ck
 from planning.curves.spline import SepticSplineSolver, uniform_knots
+from planning.io.bundled import paper_scene
 from planning.objective import WaypointObjective
-from planning.scene import PlannerSettings, paper_scene
+from planning.scene import PlannerSettings
 
 
 def make_objective(
@@ -63,7 +64,7 @@ def test_every_feasible_candidate_ranks_ahead_of_every_infeasible_one(
     assert b.fitness[b.feasible].max() < b.fitness[~b.feasible].min()
     assert np.all(b.fitness[b.feasible] <= objective.t_max)
     np.testing.assert_allclose(
-        b.fitness[b.feasible], (b.t_sol + b.w_sol / objective.w_max * 0.012)[b.feasible]
+        b.fitness[b.feasible], (b.t_sol_s + b.w_sol / objective.w_max * 0.012)[b.feasible]
     )
 
 
@@ -76,7 +77,7 @@ def test_paper_branches_follow_the_colliding_group(robot: ck.Robot, crate: ck.Ob
     objective = make_objective(robot, [crate], start, goal, fitness="paper", path="ptp")
     b = objective.breakdown(over[None])
     assert b.effector_violates[0] and not b.links_violate[0]
-    base = b.t_sol[0] + b.w_sol[0] / objective.w_max * 0.012
+    base = b.t_sol_s[0] + b.w_sol[0] / objective.w_max * 0.012
     assert b.fitness[0] == pytest.approx(2 * objective.t_max - base)  # eq. 5
 
     # links only: the retracted arm's rear end sweeps through a block behind the column
@@ -86,7 +87,7 @@ def test_paper_branches_follow_the_colliding_group(robot: ck.Robot, crate: ck.Ob
     objective = make_objective(robot, [block], start, goal, fitness="paper", path="ptp")
     b = objective.breakdown(through[None])
     assert b.links_violate[0] and not b.effector_violates[0]
-    base = b.t_sol[0] + b.w_sol[0] / objective.w_max * 0.012
+    base = b.t_sol_s[0] + b.w_sol[0] / objective.w_max * 0.012
     assert b.fitness[0] == pytest.approx(2 * objective.t_max + base)  # eq. 6, our reading
 
 

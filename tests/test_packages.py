@@ -67,8 +67,8 @@ def test_an_installed_wheel_carries_its_data_and_stubs(tmp_path: Path) -> None:
     site = tmp_path / "site"
     subprocess.run([*pip, "install", "--no-deps", "--target", str(site), str(wheel)], check=True)
     code = (
-        "import cpr_kin, planning; from planning.io.scene_file import load_scene, paper_scene_path; "
-        "robot = cpr_kin.load_cpr(); scene = load_scene(paper_scene_path()); "
+        "import cpr_kin, planning; from planning.io.bundled import paper_scene; "
+        "robot = cpr_kin.load_cpr(); scene = paper_scene(); "
         "print(cpr_kin.__file__, robot.urdf_path, scene.name, planning.plan.__module__, sep='\\n')"
     )
     out = subprocess.run(

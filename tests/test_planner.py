@@ -8,9 +8,13 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
-from planning.errors import PlanningError
-from planning.planner import NoTrajectoryFoundError, PlanResult, plan, warm_up
-from planning.scene import PAPER_GOAL_TCP, PAPER_START_TCP, PlannerSettings, Scene, Target, paper_scene
+from planning.errors import NoTrajectoryFoundError, PlanningError
+from planning.io.bundled import paper_scene
+from planning.planner import PlanResult, plan, warm_up
+from planning.scene import PlannerSettings, Scene, Target
+from planning.search.firefly import FireflySettings
+
+from .conftest import PAPER_GOAL_TCP, PAPER_START_TCP
 
 
 @pytest.fixture(scope="module")
@@ -33,9 +37,9 @@ def test_paper_case_trajectories(
     world = ck.CollisionWorld(robot, [crate])
     for result in paper_results:
         trajectory, m = result.trajectory, result.metrics
-        assert result.verification.accepted and m.min_clearance >= 0.1
+        assert result.verification.accepted and m.min_clearance_m >= 0.1
         assert m.max_node_deviation < 20e-6
-        assert m.duration == pytest.approx(4.0) and not m.duration_stretched
+        assert m.duration_s == pytest.approx(4.0) and not m.duration_stretched
         assert max(m.limit_utilisation.values()) <= 1.0 + 1e-9
         # starts and ends exactly at the requested TCP points
         np.testing.assert_allclose(ck.frame_positions(robot, trajectory(0.0)), PAPER_START_TCP, atol=1e-12)
@@ -77,7 +81,7 @@ def test_same_seed_same_plan(robot: ck.Robot, paper_results: list[PlanResult]) -
 def test_variants_plan_the_paper_case(robot: ck.Robot, overrides: dict[str, object]) -> None:
     result = plan(paper_scene(1, **overrides), robot)
     assert result.verification.accepted
-    assert result.metrics.min_clearance >= 0.1
+    assert result.metrics.min_clearance_m >= 0.1
 
 
 def test_free_duration_gives_the_fastest_timing(robot: ck.Robot) -> None:
@@ -112,7 +116,7 @@ def test_infeasible_scene_raises_with_the_best_clearance(robot: ck.Robot) -> Non
         goal=Target(tcp=PAPER_GOAL_TCP),
         obstacles=(wall,),
         duration=4.0,
-        planner=PlannerSettings(fireflies=10, iterations=5),
+        planner=PlannerSettings(firefly=FireflySettings(fireflies=10, iterations=5)),
     )
     with pytest.raises(NoTrajectoryFoundError, match=r"no collision-free trajectory found: .*wall") as info:
         plan(scene, robot)
@@ -126,7 +130,9 @@ def test_bad_planner_settings() -> None:
     with pytest.raises(PlanningError, match="fitness = 'fast'; allowed: 'clearance', 'paper'"):
         PlannerSettings(fitness="fast")  # type: ignore[arg-type]
     with pytest.raises(PlanningError, match="fireflies = 0 must be an integer >= 2"):
-        PlannerSettings(fireflies=0)
+        PlannerSettings().updated(fireflies=0)
+    with pytest.raises(PlanningError, match=r"unknown planner setting\(s\) \['fire_flies'\]"):
+        PlannerSettings().updated(fire_flies=10)
     with pytest.raises(PlanningError, match="exactly one of 'tcp'"):
         Target()
 

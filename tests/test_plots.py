@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
+from planning.io.bundled import paper_scene
 from planning.planner import PlanResult, plan
-from planning.scene import paper_scene
 from planning.viz import plots
 from planning.viz.artifacts import PLOT_FILES, plot_files
 
@@ -54,7 +54,7 @@ def test_clearance_and_convergence_curves(result: PlanResult, robot: ck.Robot) -
     figure = plots.clearance_figure(world, result.trajectory, 0.1)
     lines = figure.axes[0].lines
     lowest = min(float(np.min(line.get_ydata())) for line in lines[:2])
-    assert lowest >= result.metrics.min_clearance - 1e-9  # the certified bound is below any sample
+    assert lowest >= result.metrics.min_clearance_m - 1e-9  # the certified bound is below any sample
     assert np.asarray(lines[2].get_ydata())[0] == 0.1  # the margin line
     plt.close(figure)
     figure = plots.convergence_figure(result.optimiser)

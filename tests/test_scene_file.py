@@ -13,16 +13,16 @@ from hypothesis import strategies as st
 
 import cpr_kin as ck
 from planning.curves.spline import SplineSettings
+from planning.errors import SceneError
+from planning.io.bundled import paper_scene, paper_scene_path
 from planning.io.scene_file import (
     SAFE_LOADER,
-    SceneError,
     dump_scene,
     load_scene,
-    paper_scene_path,
     parse_scene,
 )
 from planning.io.scene_generator import generate_scenes
-from planning.scene import PlannerSettings, paper_scene
+from planning.scene import PlannerSettings
 
 MINIMAL = {"start": {"tcp": [0.5, 0.45, 0.25]}, "goal": {"tcp": [-0.5, 0.45, 0.25]}}
 

@@ -9,9 +9,9 @@ import pytest
 
 import cpr_kin as ck
 from planning.errors import PlanningError
+from planning.io.bundled import paper_scene
 from planning.io.trajectory_io import atomic_write_text, read_trajectory, write_samples, write_trajectory
 from planning.planner import PlanResult, plan
-from planning.scene import paper_scene
 
 
 @pytest.fixture(scope="module")
@@ -70,7 +70,7 @@ def test_round_trip(result: PlanResult, tmp_path: Path) -> None:
     np.testing.assert_array_equal(back.trajectory.coefficients, result.trajectory.coefficients)
     np.testing.assert_array_equal(back.waypoints, result.waypoints)
     assert back.joint_names == result.joint_names
-    assert back.metrics["min_clearance"] == result.metrics.min_clearance
+    assert back.metrics["min_clearance"] == result.metrics.min_clearance_m
 
 
 def test_samples_csv(result: PlanResult, tmp_path: Path) -> None:

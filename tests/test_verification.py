@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
+from planning.io.bundled import paper_scene
 from planning.planner import PlanResult, plan
-from planning.scene import paper_scene
 from planning.verification import verify_trajectory
 
 
@@ -18,7 +18,7 @@ def test_planned_trajectory_is_accepted(result: PlanResult, paper_world: ck.Coll
     ends = (result.waypoints[0], result.waypoints[-1])
     verification = verify_trajectory(paper_world, result.trajectory, 0.1, 0.005, ends)
     assert verification.accepted and verification.problems == ()
-    assert verification.check.certified_min_m == pytest.approx(result.metrics.min_clearance)
+    assert verification.check.certified_min_m == pytest.approx(result.metrics.min_clearance_m)
 
 
 def test_each_violation_is_named(result: PlanResult, paper_world: ck.CollisionWorld) -> None:

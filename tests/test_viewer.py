@@ -16,9 +16,9 @@ import psutil
 import pytest
 
 import cpr_kin as ck
+from planning.io.bundled import paper_scene
 from planning.io.trajectory_io import write_trajectory
 from planning.planner import PlanResult, plan
-from planning.scene import paper_scene
 from planning.viz.artifacts import viewer_html
 from planning.viz.viewer import Viewer
 from planning.viz.viewer_server import start_server
@@ -79,7 +79,7 @@ def test_exported_html_draws_robot_and_obstacle_in_chromium(
     scene = result.scene
     page = tmp_path / "viewer.html"
     page.write_text(
-        viewer_html(robot, scene.obstacles, scene.safety_margin, result.trajectory, result.waypoints)
+        viewer_html(result.problem.world, scene.safety_margin, result.trajectory, result.waypoints)
     )
     text = page.read_text()
     assert "<script" in text and "http://" not in text.split("<script", 1)[1][:200]  # scripts are inline
@@ -89,14 +89,15 @@ def test_exported_html_draws_robot_and_obstacle_in_chromium(
     assert carriage_orange(image) > 50
     # control: the same page without obstacles shows the robot but no obstacle red
     empty = tmp_path / "empty.html"
-    empty.write_text(viewer_html(robot, (), scene.safety_margin, result.trajectory, result.waypoints))
+    empty_world = ck.CollisionWorld(robot, ())
+    empty.write_text(viewer_html(empty_world, scene.safety_margin, result.trajectory, result.waypoints))
     control = screenshot(empty, tmp_path / "control.png", tmp_path / "profile2")
     assert obstacle_red(control) < 20
     assert carriage_orange(control) > 50
 
 
 def test_viewer_scene_contents(robot: ck.Robot, result: PlanResult) -> None:
-    with Viewer(robot, result.scene.obstacles, result.scene.safety_margin) as viewer:
+    with Viewer(result.problem.world, result.scene.safety_margin) as viewer:
         drawn = viewer.show_plan(result.trajectory, result.waypoints)
         frames = viewer.animate(result.trajectory, fps=25)
         html = viewer.static_html()

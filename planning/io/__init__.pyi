@@ -1,22 +1,28 @@
 """Type stub of the package: what it exports, and from which module (read by ``lazy_loader``)."""
 
+from .bundled import bundled_scene_paths, paper_scene, paper_scene_path
 from .outputs import plan_files
-from .scene_file import SceneError, dump_scene, load_scene, paper_scene_path, parse_scene, scene_document
+from .report import plan_record, report_markdown, summary
+from .scene_file import dump_scene, load_scene, parse_scene, scene_document
 from .scene_generator import generate_scenes, random_scene
 from .trajectory_io import TrajectoryFile, read_trajectory, write_files, write_samples, write_trajectory
 
 __all__ = [
-    "SceneError",
     "TrajectoryFile",
+    "bundled_scene_paths",
     "dump_scene",
     "generate_scenes",
     "load_scene",
+    "paper_scene",
     "paper_scene_path",
     "parse_scene",
     "plan_files",
+    "plan_record",
     "random_scene",
     "read_trajectory",
+    "report_markdown",
     "scene_document",
+    "summary",
     "write_files",
     "write_samples",
     "write_trajectory",

@@ -1,11 +1,18 @@
-"""Reports: the paper's figures beside ours, as text tables and Markdown."""
+"""Reports of a plan: ``report.md``, the CLI's summary, and the paper's figures beside ours.
+
+Every figure comes from the plan's one record (:func:`plan_record`, whose metrics are
+:meth:`planning.metrics.Metrics.to_record`): the trajectory file, the batch summary and the
+reports cannot disagree.
+"""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
-if TYPE_CHECKING:
+import numpy as np
+
+if TYPE_CHECKING:  # types only: a batch's parent formats tables without the planner
     from planning.planner import PlanResult
 
 PAPER_FIGURES = {
@@ -18,24 +25,51 @@ PAPER_FIGURES = {
 """The paper's reported figures (DESIGN.md section 4)."""
 
 
+def plan_record(result: PlanResult, timings: bool = True) -> dict[str, Any]:
+    """The trajectory file's ``metrics`` section: the metrics' record, the seed and the fitness kind."""
+    settings = result.scene.planner
+    return {**result.metrics.to_record(timings), "seed": settings.seed, "fitness_kind": settings.fitness}
+
+
+def summary(result: PlanResult) -> dict[str, Any]:
+    """The CLI's JSON summary of a plan: the scene, its margin and the record, wall times included."""
+    return {
+        "status": "ok",
+        "scene": result.scene.name,
+        "safety_margin": result.scene.safety_margin,
+        **plan_record(result),
+    }
+
+
+def summary_line(result: PlanResult) -> str:
+    """The CLI's one-line summary of a plan."""
+    r = plan_record(result)
+    return (
+        f"{result.scene.name}: verified trajectory of {r['duration']:.3f} s, certified clearance "
+        f"{r['min_clearance']:.4f} m (margin {result.scene.safety_margin} m), "
+        f"node deviation {r['max_node_deviation']:.3g}, "
+        f"planned in {r['planning_time_s']:.3f} s ({r['evaluations']} evaluations)"
+    )
+
+
 def paper_rows(result: PlanResult) -> list[tuple[str, str, str]]:
     """``(figure, paper, ours)`` rows for the paper case."""
-    m = result.metrics
-    settings = result.scene.planner
+    r = plan_record(result)
+    firefly = result.scene.planner.firefly
     rows = [
         (
-            f"FMA processing time (n={settings.fireflies}, {settings.iterations} iterations)",
+            f"FMA processing time (n={firefly.fireflies}, {firefly.iterations} iterations)",
             f"{PAPER_FIGURES['fma_time_s']:.0f} s",
-            f"{m.optimiser_time_s:.3f} s",
+            f"{r['optimiser_time_s']:.3f} s",
         ),
-        ("planning time, end to end", "-", f"{m.planning_time_s:.3f} s"),
-        ("objective evaluations", "-", f"{m.evaluations}"),
-        ("objective value: PTP time t_sol", f"{PAPER_FIGURES['objective_s']} s", f"{m.t_sol:.3f} s"),
-        ("fitness (eq. 4)", "-", f"{m.fitness:.4f}"),
+        ("planning time, end to end", "-", f"{r['planning_time_s']:.3f} s"),
+        ("objective evaluations", "-", f"{r['evaluations']}"),
+        ("objective value: PTP time t_sol", f"{PAPER_FIGURES['objective_s']} s", f"{r['t_sol']:.3f} s"),
+        ("fitness (eq. 4)", "-", f"{r['fitness']:.4f}"),
         (
             "max node deviation (p=1e6, h=1 s)",
             f"{PAPER_FIGURES['node_deviation_um']} um (limit 20 um)",
-            f"{m.max_node_deviation * 1e6:.2f} um",
+            f"{r['max_node_deviation'] * 1e6:.2f} um",
         ),
     ]
     for joint, (low, high) in PAPER_FIGURES["jerk"].items():  # type: ignore[attr-defined]
@@ -44,23 +78,65 @@ def paper_rows(result: PlanResult) -> list[tuple[str, str, str]]:
             (
                 f"jerk {joint} min / max",
                 f"{low} / {high} {unit}",
-                f"{m.jerk_min[joint]:.4f} / {m.jerk_max[joint]:.4f} {unit}",
+                f"{r['jerk_min'][joint]:.4f} / {r['jerk_max'][joint]:.4f} {unit}",
             )
         )
     rows += [
         (
             "min clearance (certified)",
             f">= {result.scene.safety_margin} m (margin)",
-            f"{m.min_clearance:.4f} m",
+            f"{r['min_clearance']:.4f} m",
         ),
-        ("duration", "4 s", f"{m.duration:.3f} s"),
+        ("duration", "4 s", f"{r['duration']:.3f} s"),
         (
             "peak velocity, acceleration, jerk / limit",
             "-",
-            ", ".join(f"{v:.2f}" for v in m.limit_utilisation.values()),
+            ", ".join(f"{v:.2f}" for v in r["limit_utilisation"].values()),
         ),
     ]
     return rows
+
+
+def report_markdown(result: PlanResult, paper: bool = False) -> str:
+    """``report.md``: the figures of the plan, its jerk extrema and waypoints (and the paper's)."""
+    r = plan_record(result)
+    scene = result.scene
+    rows = [
+        ("duration", f"{r['duration']:.3f} s"),
+        ("certified min clearance", f"{r['min_clearance']:.4f} m (margin {scene.safety_margin} m)"),
+        ("PTP time t_sol (objective)", f"{r['t_sol']:.3f} s"),
+        ("fitness", f"{r['fitness']:.4f}"),
+        ("max node deviation", f"{r['max_node_deviation']:.3g}"),
+        (
+            "peak velocity, acceleration, jerk / limit",
+            ", ".join(f"{v:.2f}" for v in r["limit_utilisation"].values()),
+        ),
+        ("evaluations", str(r["evaluations"])),
+        ("planning time", f"{r['planning_time_s']:.3f} s"),
+    ]
+    lines = [
+        f"# Plan: {scene.name}",
+        "",
+        f"Seed {r['seed']}, fitness `{r['fitness_kind']}`, "
+        f"{len(scene.obstacles)} obstacle(s). Files: `trajectory.json` (cpr-trajectory/1), "
+        "`samples.csv` (every IPO period).",
+        "",
+        "| figure | value |",
+        "|---|---|",
+        *[f"| {a} | {b} |" for a, b in rows],
+        "",
+        "| joint | jerk min | jerk max |",
+        "|---|---|---|",
+        *[f"| {n} | {r['jerk_min'][n]:.4g} | {r['jerk_max'][n]:.4g} |" for n in result.joint_names],
+        "",
+        "Waypoints (start, intermediate, goal):",
+        "",
+        *[f"- {np.round(w, 5).tolist()}" for w in result.waypoints],
+        "",
+    ]
+    if paper:
+        lines += ["## Beside the paper", "", markdown_table(paper_rows(result)), ""]
+    return "\n".join(lines)
 
 
 def text_table(rows: Sequence[Sequence[str]], headers: Sequence[str] = ("figure", "paper", "ours")) -> str:

@@ -97,8 +97,9 @@ def trajectory_document(result: PlanResult, timings: bool = False) -> dict[str, 
     Wall times (``planning_time_s``, ``optimiser_time_s``) are ``null`` unless ``timings``:
     the same scene and seed then give the same file, byte for byte.
     """
+    from planning.io.report import plan_record
+
     trajectory = result.trajectory
-    metrics = result.metrics
     segments = [
         {"t0": float(t0), "t1": float(t1), "coeffs": trajectory.coefficients[i].tolist()}
         for i, (t0, t1) in enumerate(zip(trajectory.knots[:-1], trajectory.knots[1:], strict=True))
@@ -111,26 +112,7 @@ def trajectory_document(result: PlanResult, timings: bool = False) -> dict[str, 
         "waypoints": result.waypoints.tolist(),
         "knots": trajectory.knots.tolist(),
         "segments": segments,
-        "metrics": {
-            "duration": metrics.duration,
-            "min_clearance": metrics.min_clearance,
-            "sampled_min_clearance": metrics.sampled_min_clearance,
-            "max_node_deviation": metrics.max_node_deviation,
-            "jerk_min": metrics.jerk_min,
-            "jerk_max": metrics.jerk_max,
-            "limit_utilisation": metrics.limit_utilisation,
-            "integrated_squared_jerk": metrics.integrated_squared_jerk,
-            "fitness": metrics.fitness,
-            "t_sol": metrics.t_sol,
-            "w_sol": metrics.w_sol,
-            "planning_time_s": metrics.planning_time_s if timings else None,
-            "optimiser_time_s": metrics.optimiser_time_s if timings else None,
-            "evaluations": metrics.evaluations,
-            "candidates_verified": metrics.candidates_verified,
-            "duration_stretched": metrics.duration_stretched,
-            "seed": result.scene.planner.seed,
-            "fitness_kind": result.scene.planner.fitness,
-        },
+        "metrics": plan_record(result, timings),
     }
 
 

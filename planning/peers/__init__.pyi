@@ -1,10 +1,14 @@
 """Type stub of the package: what it exports, and from which module (read by ``lazy_loader``)."""
 
-from .ompl_rrt import SamplingResult, plan_rrt_connect
-from .pyroboplan_rrt import plan_pyroboplan_rrt_connect
+from .ompl_rrt import plan_rrt_connect
+from .pyroboplan_rrt import plan_pyroboplan_rrt_connect, shortcut_path
+from .toppra_timing import SamplingResult, planning_clearance_m, time_and_verify
 
 __all__ = [
     "SamplingResult",
     "plan_pyroboplan_rrt_connect",
     "plan_rrt_connect",
+    "planning_clearance_m",
+    "shortcut_path",
+    "time_and_verify",
 ]

@@ -4,10 +4,10 @@ pyroboplan (``pip install --no-deps pyroboplan``, see the README) plans on a Pin
 and collision model. It gets the CPR reduced to the moving joints
 (``pinocchio.buildReducedModel`` locks the others at their start values) and our collision
 world's geometry, robot-obstacle pairs only, with the planning clearance
-(:func:`planning.peers.ompl_rrt.planning_clearance_m`) as its distance padding.
+(:func:`planning.peers.toppra_timing.planning_clearance_m`) as its distance padding.
 Its own shortcutting checks collisions without that padding, so the path is shortcut here,
 against that clearance; TOPP-RA timing and the certified verification are those of
-:func:`planning.peers.ompl_rrt.time_and_verify`.
+:func:`planning.peers.toppra_timing.time_and_verify`.
 """
 
 from __future__ import annotations
@@ -22,8 +22,8 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from planning.peers.ompl_rrt import SamplingResult, planning_clearance_m, time_and_verify
-from planning.planner import endpoint, moving_joints
+from planning.peers.toppra_timing import SamplingResult, planning_clearance_m, time_and_verify
+from planning.problem import build_problem
 from planning.scene import Scene
 
 FloatArray = NDArray[np.float64]
@@ -42,10 +42,9 @@ def plan_pyroboplan_rrt_connect(
     from pyroboplan.planning.rrt import RRTPlanner, RRTPlannerOptions
 
     started = time.perf_counter()
-    robot = robot or ck.load_cpr(scene.robot)
-    world = ck.CollisionWorld(robot, scene.obstacles)
-    q_start, q_goal = endpoint(robot, world, scene, "start"), endpoint(robot, world, scene, "goal")
-    moving = moving_joints(robot, scene, q_start, q_goal)
+    problem = build_problem(scene, robot)
+    robot, world, moving = problem.robot, problem.world, problem.moving
+    q_start, q_goal = problem.q_start, problem.q_goal
     locked = [robot.model.getJointId(name) for i, name in enumerate(robot.joint_names) if i not in moving]
     model, geometry = pin.buildReducedModel(robot.model, world.geometry_model, locked, q_start)
     clearance_m = planning_clearance_m(scene)

@@ -1,15 +1,15 @@
 """Type stub of the package: what it exports, and from which module (read by ``lazy_loader``)."""
 
 from . import baselines
-from .baselines import Optimizer
-from .firefly import BatchObjective, FireflyProgress, FireflyResult, FireflySettings, firefly_minimize
+from .firefly import FireflyProgress, FireflySettings, firefly_minimize
+from .optimizer import BatchObjective, Optimizer, SearchResult
 
 __all__ = [
     "BatchObjective",
     "FireflyProgress",
-    "FireflyResult",
     "FireflySettings",
     "Optimizer",
+    "SearchResult",
     "baselines",
     "firefly_minimize",
 ]

@@ -1,8 +1,8 @@
 """Baseline optimisers behind the firefly's batch interface, for benchmarks.
 
-Every optimiser has the signature of :data:`Optimizer`: a batch objective, box bounds, an
+Every optimiser is an :class:`~planning.search.optimizer.Optimizer`: a batch objective, box bounds, an
 evaluation budget and a ``numpy.random.Generator``; it returns a
-:class:`~planning.search.firefly.FireflyResult` (best point, history, final population), so the
+:class:`~planning.search.optimizer.SearchResult` (best point, history, final population), so the
 planner can use any of them (``plan(scene, optimizer=...)``) on the same objective and
 budget. They all search normalised coordinates, like the firefly.
 
@@ -17,16 +17,15 @@ budget. They all search normalised coordinates, like the firefly.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from planning.search.firefly import BatchObjective, FireflyResult, FireflySettings, firefly_minimize
+from planning.search.firefly import FireflySettings, firefly_minimize
+from planning.search.optimizer import BatchObjective, Optimizer, SearchResult
 
 FloatArray = NDArray[np.float64]
-Optimizer = Callable[[BatchObjective, FloatArray, FloatArray, int, np.random.Generator], FireflyResult]
 
 
 class _Tracker:
@@ -59,8 +58,8 @@ class _Tracker:
         self.evaluation_history.append(self.evaluations)
         return f
 
-    def result(self, population: FloatArray, fitness: FloatArray) -> FireflyResult:
-        return FireflyResult(
+    def result(self, population: FloatArray, fitness: FloatArray) -> SearchResult:
+        return SearchResult(
             x=self.lower + self.best_u * self.span,
             fitness=self.best_f,
             evaluations=self.evaluations,
@@ -69,7 +68,6 @@ class _Tracker:
             evaluation_history=np.array(self.evaluation_history, dtype=np.int64),
             population=self.lower + np.atleast_2d(population) * self.span,
             population_fitness=np.asarray(fitness, dtype=float),
-            settings=None,
         )
 
 
@@ -78,7 +76,7 @@ def firefly(settings: FireflySettings) -> Optimizer:
 
     def run(
         objective: BatchObjective, lower: FloatArray, upper: FloatArray, budget: int, rng: np.random.Generator
-    ) -> FireflyResult:
+    ) -> SearchResult:
         iterations = max(budget // settings.fireflies - 1, 0)
         adjusted = FireflySettings(**{**settings.__dict__, "iterations": iterations})
         return firefly_minimize(objective, lower, upper, adjusted, rng)
@@ -93,7 +91,7 @@ def particle_swarm(
 
     def run(
         objective: BatchObjective, lower: FloatArray, upper: FloatArray, budget: int, rng: np.random.Generator
-    ) -> FireflyResult:
+    ) -> SearchResult:
         track = _Tracker(objective, lower, upper, budget)
         d = lower.size
         x = rng.random((particles, d))
@@ -124,7 +122,7 @@ def harmony_search(
 
     def run(
         objective: BatchObjective, lower: FloatArray, upper: FloatArray, budget: int, rng: np.random.Generator
-    ) -> FireflyResult:
+    ) -> SearchResult:
         track = _Tracker(objective, lower, upper, budget)
         d = lower.size
         harmonies = rng.random((memory, d))
@@ -150,7 +148,7 @@ def differential_evolution(population: int = 50) -> Optimizer:
 
     def run(
         objective: BatchObjective, lower: FloatArray, upper: FloatArray, budget: int, rng: np.random.Generator
-    ) -> FireflyResult:
+    ) -> SearchResult:
         from scipy.optimize import differential_evolution as scipy_de
 
         track = _Tracker(objective, lower, upper, budget)
@@ -187,7 +185,7 @@ def cma_es(population: int = 50, sigma0: float = 0.25) -> Optimizer:
 
     def run(
         objective: BatchObjective, lower: FloatArray, upper: FloatArray, budget: int, rng: np.random.Generator
-    ) -> FireflyResult:
+    ) -> SearchResult:
         import cma
 
         track = _Tracker(objective, lower, upper, budget)
@@ -218,7 +216,7 @@ def niapy_firefly(settings: FireflySettings) -> Optimizer:
 
     def run(
         objective: BatchObjective, lower: FloatArray, upper: FloatArray, budget: int, rng: np.random.Generator
-    ) -> FireflyResult:
+    ) -> SearchResult:
         from niapy.algorithms.basic import FireflyAlgorithm
         from niapy.problems import Problem
         from niapy.task import Task

@@ -24,7 +24,7 @@ Two modes:
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
@@ -32,11 +32,9 @@ from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.compiled import njit
 from planning.errors import PlanningError
+from planning.search.optimizer import BatchObjective, SearchResult
 
 FloatArray = NDArray[np.float64]
-BatchObjective = Callable[[FloatArray], FloatArray]
-"""Objective over a batch: ``(S, d)`` points in the problem's units -> ``(S,)`` values."""
-
 Mode = Literal["sweep", "sequential"]
 
 
@@ -88,34 +86,6 @@ class FireflyProgress:
     evaluations: int
 
 
-@dataclass(frozen=True)
-class FireflyResult:
-    """Outcome of a firefly run.
-
-    Attributes:
-        x: best point found, in the problem's units.
-        fitness: its objective value.
-        evaluations: objective evaluations (candidates, not calls).
-        best_history: ``(T + 1,)`` best value after each iteration (0: initial population).
-        mean_history: ``(T + 1,)`` population mean after each iteration.
-        evaluation_history: ``(T + 1,)`` cumulative evaluations after each iteration.
-        population: ``(n, d)`` final positions, in the problem's units.
-        population_fitness: ``(n,)`` their values.
-        settings: the settings used (``None`` for the baseline optimisers of
-            :mod:`planning.search.baselines`, which return this type too).
-    """
-
-    x: FloatArray
-    fitness: float
-    evaluations: int
-    best_history: FloatArray
-    mean_history: FloatArray
-    evaluation_history: NDArray[np.int64]
-    population: FloatArray
-    population_fitness: FloatArray
-    settings: FireflySettings | None = field(default=None, repr=False)
-
-
 def firefly_minimize(
     objective: BatchObjective,
     lower: ArrayLike,
@@ -123,7 +93,7 @@ def firefly_minimize(
     settings: FireflySettings | None = None,
     rng: np.random.Generator | int | None = 0,
     callback: Callable[[FireflyProgress], None] | None = None,
-) -> FireflyResult:
+) -> SearchResult:
     """Minimise ``objective`` over the box ``[lower, upper]`` with the firefly algorithm.
 
     Args:
@@ -189,7 +159,7 @@ def firefly_minimize(
         evaluation_history.append(evaluations)
         if callback is not None:
             callback(FireflyProgress(iteration, settings.iterations, best_f, mean_history[-1], evaluations))
-    return FireflyResult(
+    return SearchResult(
         x=lo + best_u * span,
         fitness=best_f,
         evaluations=evaluations,
@@ -198,7 +168,6 @@ def firefly_minimize(
         evaluation_history=np.array(evaluation_history, dtype=np.int64),
         population=lo + u * span,
         population_fitness=f.copy(),
-        settings=settings,
     )
 
 

@@ -21,7 +21,7 @@ def plot_files(result: PlanResult) -> dict[str, bytes]:
 
     robot = result.robot
     units = tuple(robot.joint_unit(n) for n in robot.joint_names)
-    world = ck.CollisionWorld(robot, result.scene.obstacles)
+    world = result.problem.world
     figures = (
         plots.joint_figure(result.trajectory, robot.joint_names, units),
         plots.tcp_path_figure(
@@ -34,8 +34,7 @@ def plot_files(result: PlanResult) -> dict[str, bytes]:
 
 
 def viewer_html(
-    robot: ck.Robot,
-    obstacles: tuple[ck.Obstacle, ...],
+    world: ck.CollisionWorld,
     margin_m: float,
     trajectory: Trajectory,
     waypoints: NDArray[np.float64],
@@ -43,12 +42,12 @@ def viewer_html(
 ) -> str:
     """One self-contained HTML page of the plan, animated.
 
-    It shows the robot, obstacles, margin, waypoints, TCP path and the trajectory; a loopback
+    It shows the world's robot and obstacles, the margin, waypoints, TCP path and the trajectory; a loopback
     meshcat server runs while it is made.
     """
     from planning.viz.viewer import Viewer
 
-    with Viewer(robot, obstacles, margin_m) as viewer:
+    with Viewer(world, margin_m) as viewer:
         viewer.show_geometry(visual=not collision, collision=collision)
         viewer.show_plan(trajectory, waypoints)
         viewer.animate(trajectory)

@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 
 import cpr_kin as ck
 from planning.curves.trajectory import DERIVATIVE_NAMES, Trajectory
-from planning.search.firefly import FireflyResult
+from planning.search.optimizer import SearchResult
 
 FloatArray = NDArray[np.float64]
 UNITS = {"rad": ("rad", "rad/s", "rad/s$^2$", "rad/s$^3$"), "m": ("m", "m/s", "m/s$^2$", "m/s$^3$")}
@@ -150,7 +150,7 @@ def clearance_figure(world: ck.CollisionWorld, trajectory: Trajectory, margin_m:
     return figure
 
 
-def convergence_figure(result: FireflyResult) -> Figure:
+def convergence_figure(result: SearchResult) -> Figure:
     """Best and mean fitness of the firefly population per iteration."""
     figure, ax = plt.subplots(figsize=(7, 4))
     iterations = np.arange(len(result.best_history))

@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import contextlib
 import io
-from collections.abc import Sequence
 from typing import Any
 
 import meshcat
@@ -80,21 +79,17 @@ class Viewer:
     """The CPR among its obstacles in meshcat.
 
     Args:
-        robot: the robot.
-        obstacles: the obstacles.
+        world: the robot among its obstacles (its clearance colours the TCP path).
         margin_m: safety margin drawn as translucent shells [m].
         server: a running server (default: start a loopback one, closed by :meth:`close`).
     """
 
     def __init__(
-        self,
-        robot: ck.Robot,
-        obstacles: Sequence[ck.Obstacle],
-        margin_m: float,
-        server: ServerProcess | None = None,
+        self, world: ck.CollisionWorld, margin_m: float, server: ServerProcess | None = None
     ) -> None:
+        robot, obstacles = world.robot, world.obstacles
         self.robot = robot
-        self.world = ck.CollisionWorld(robot, obstacles)
+        self.world = world
         self.margin_m = margin_m
         self._own_server = server is None
         self.server = server or start_server()

@@ -1,0 +1,80 @@
+"""``cpr-plan plan`` and ``cpr-plan paper``: plan a scene and write its files."""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import cpr_kin as ck  # lazy (lazy_loader): only the modules a command uses are imported
+from planning.cli.failure import EXIT_INVALID, EXIT_NO_TRAJECTORY, EXIT_OK, CommandError
+from planning.cli.terminal import firefly_progress
+from planning.errors import NoSolutionError, PlanningError
+
+if TYPE_CHECKING:
+    from planning.scene import Scene
+
+OVERRIDES = ("seed", "fitness", "fireflies", "iterations")
+"""Planner settings the command line may change, by their scene-file keys."""
+
+
+def load(path: Path) -> Scene:
+    """The scene file at ``path``, or a :class:`CommandError` (exit 2) naming what is wrong."""
+    from planning.io.scene_file import load_scene
+
+    try:
+        return load_scene(path)
+    except PlanningError as exc:
+        raise CommandError(EXIT_INVALID, str(exc)) from None
+
+
+def _plan_and_write(scene: Scene, out: Path, args: argparse.Namespace, paper: bool) -> int:
+    from planning.io.outputs import plan_files
+    from planning.io.report import paper_rows, summary, summary_line, text_table
+    from planning.io.trajectory_io import write_files
+    from planning.planner import plan
+
+    overrides = {k: getattr(args, k) for k in OVERRIDES if getattr(args, k, None) is not None}
+    if overrides:
+        try:
+            scene = dataclasses.replace(scene, planner=scene.planner.updated(**overrides))
+        except PlanningError as exc:
+            raise CommandError(EXIT_INVALID, str(exc)) from None
+    update, close = firefly_progress(sys.stdout.isatty() and not args.json)
+    try:
+        result = plan(scene, progress=update)
+    except NoSolutionError as exc:
+        raise CommandError(EXIT_NO_TRAJECTORY, str(exc)) from None
+    except (PlanningError, ck.CprKinError) as exc:
+        raise CommandError(EXIT_INVALID, str(exc)) from None
+    finally:
+        close()
+    extras = {"plots": paper or args.plots, "html": paper or args.html}
+    files = plan_files(result, paper=paper, timings=args.timings, **extras)
+    try:
+        outputs = write_files(out, files)
+    except OSError as exc:
+        raise CommandError(EXIT_INVALID, f"cannot write to '{out}': {exc.strerror or exc}") from None
+    if args.json:
+        print(json.dumps({**summary(result), "outputs": [str(p) for p in outputs]}, indent=1))
+    else:
+        print(summary_line(result))
+        if paper:
+            print(text_table(paper_rows(result)))
+        print("wrote " + ", ".join(str(p) for p in outputs))
+    return EXIT_OK
+
+
+def cmd_plan(args: argparse.Namespace) -> int:
+    """Plan a scene file."""
+    return _plan_and_write(load(args.scene), args.out, args, paper=False)
+
+
+def cmd_paper(args: argparse.Namespace) -> int:
+    """Plan the bundled paper scene, beside the paper's figures."""
+    from planning.io.bundled import paper_scene_path
+
+    return _plan_and_write(load(paper_scene_path()), args.out, args, paper=True)

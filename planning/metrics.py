@@ -1,0 +1,139 @@
+"""The figures of a planned trajectory, and their one serialisation.
+
+:meth:`Metrics.to_record` gives them under the keys of the trajectory file's ``metrics``
+section (DESIGN.md section 6); the trajectory file, ``report.md``, the batch's
+``summary.csv`` and the CLI's summary all take them from there.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+import cpr_kin as ck
+from planning.curves.trajectory import Trajectory
+from planning.objective import Breakdown
+from planning.search.optimizer import SearchResult
+
+
+@dataclass(frozen=True)
+class Metrics:
+    """Figures of a planned trajectory.
+
+    Attributes:
+        duration_s: trajectory duration [s].
+        fitness: objective value of the chosen waypoints.
+        t_sol_s: PTP time through the chosen nodes (the paper's objective value) [s].
+        w_sol: normalised accumulated joint motion of the executed path.
+        min_clearance_m: certified lower bound of the clearance along the trajectory [m].
+        sampled_min_clearance_m: smallest clearance at the verification samples [m].
+        max_node_deviation: largest |y_i - f_i| of the spline [rad or m].
+        jerk_min: per joint, smallest jerk [rad/s^3 or m/s^3].
+        jerk_max: per joint, largest jerk.
+        limit_utilisation: largest |velocity|, |acceleration|, |jerk| over the limit, per order.
+        integrated_squared_jerk: per joint [rad^2/s^5 or m^2/s^5].
+        planning_time_s: wall time of the plan, building the problem included [s].
+        optimiser_time_s: wall time of the search [s].
+        evaluations: objective evaluations.
+        candidates_verified: candidates that went through the final verification.
+        duration_stretched: the requested duration broke a limit and was stretched.
+    """
+
+    duration_s: float
+    fitness: float
+    t_sol_s: float
+    w_sol: float
+    min_clearance_m: float
+    sampled_min_clearance_m: float
+    max_node_deviation: float
+    jerk_min: dict[str, float]
+    jerk_max: dict[str, float]
+    limit_utilisation: dict[str, float]
+    integrated_squared_jerk: dict[str, float]
+    planning_time_s: float
+    optimiser_time_s: float
+    evaluations: int
+    candidates_verified: int
+    duration_stretched: bool
+
+    def to_record(self, timings: bool = True) -> dict[str, Any]:
+        """The metrics as plain JSON types, under the trajectory file's keys.
+
+        Wall times (``planning_time_s``, ``optimiser_time_s``) are ``None`` unless
+        ``timings``: a file that records none is the same, byte for byte, for the same scene
+        and seed.
+        """
+        return {
+            "duration": self.duration_s,
+            "min_clearance": self.min_clearance_m,
+            "sampled_min_clearance": self.sampled_min_clearance_m,
+            "max_node_deviation": self.max_node_deviation,
+            "jerk_min": self.jerk_min,
+            "jerk_max": self.jerk_max,
+            "limit_utilisation": self.limit_utilisation,
+            "integrated_squared_jerk": self.integrated_squared_jerk,
+            "fitness": self.fitness,
+            "t_sol": self.t_sol_s,
+            "w_sol": self.w_sol,
+            "planning_time_s": self.planning_time_s if timings else None,
+            "optimiser_time_s": self.optimiser_time_s if timings else None,
+            "evaluations": self.evaluations,
+            "candidates_verified": self.candidates_verified,
+            "duration_stretched": self.duration_stretched,
+        }
+
+
+def measure(
+    robot: ck.Robot,
+    trajectory: Trajectory,
+    check: ck.CurveCheck,
+    max_node_deviation: float,
+    breakdown: Breakdown,
+    search: SearchResult,
+    times_s: tuple[float, float],
+    candidates_verified: int,
+    duration_stretched: bool,
+) -> Metrics:
+    """The metrics of a verified trajectory.
+
+    Args:
+        robot: the robot (joint names, limits).
+        trajectory: the timed trajectory.
+        check: its certified clearance check.
+        max_node_deviation: the spline's largest node deviation [rad or m].
+        breakdown: the chosen candidate's fitness terms (one candidate).
+        search: the optimiser's run.
+        times_s: ``(planning, search)`` wall times [s].
+        candidates_verified: candidates that went through the final verification.
+        duration_stretched: the scene's duration was stretched to meet a limit.
+    """
+    limits = robot.limits
+    names = robot.joint_names
+    jerk = trajectory.extrema(3)
+    utilisation = {
+        kind: float(np.max(trajectory.extrema(r).peak / limit))
+        for r, (kind, limit) in enumerate(
+            (("velocity", limits.velocity), ("acceleration", limits.acceleration), ("jerk", limits.jerk)),
+            start=1,
+        )
+    }
+    return Metrics(
+        duration_s=trajectory.duration,
+        fitness=float(breakdown.fitness[0]),
+        t_sol_s=float(breakdown.t_sol_s[0]),
+        w_sol=float(breakdown.w_sol[0]),
+        min_clearance_m=check.certified_min_m,
+        sampled_min_clearance_m=check.sampled_min_m,
+        max_node_deviation=max_node_deviation,
+        jerk_min=dict(zip(names, map(float, jerk.minimum), strict=True)),
+        jerk_max=dict(zip(names, map(float, jerk.maximum), strict=True)),
+        limit_utilisation=utilisation,
+        integrated_squared_jerk=dict(zip(names, map(float, trajectory.integrated_squared_jerk), strict=True)),
+        planning_time_s=times_s[0],
+        optimiser_time_s=times_s[1],
+        evaluations=search.evaluations,
+        candidates_verified=candidates_verified,
+        duration_stretched=duration_stretched,
+    )

@@ -1,0 +1,130 @@
+"""TOPP-RA timing and verification of a sampling planner's path, shared by the peers.
+
+A clamped cubic spline through the path's vertices is timed by TOPP-RA (``toppra``) under
+the joints' velocity and acceleration limits (it has no jerk limit) and verified by the same
+certified continuous check as the firefly planner's trajectories.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+import cpr_kin as ck
+from planning.scene import Scene
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class SamplingResult:
+    """Outcome of the RRT-Connect pipeline on one scene.
+
+    Attributes:
+        success: a path was found, timed and verified.
+        reason: why not, when it failed.
+        waypoints: ``(K, nq)`` the simplified path's vertices.
+        duration: trajectory duration [s].
+        min_clearance: certified clearance of the timed trajectory [m].
+        path_length: length of the path in joint space, each joint scaled by its range.
+        max_abs_jerk: largest |jerk| of any joint, from the timed spline (its acceleration
+            jumps at the spline's knots, so this samples its finite pieces).
+        planning_time_s: wall time of search, simplification, timing and verification [s].
+    """
+
+    success: bool
+    reason: str
+    waypoints: FloatArray
+    duration: float
+    min_clearance: float
+    path_length: float
+    max_abs_jerk: float
+    planning_time_s: float
+
+    @classmethod
+    def failure(cls, reason: str, nq: int, started: float) -> SamplingResult:
+        """A failed run: ``reason``, no path, figures NaN; ``started`` is its ``perf_counter()``."""
+        nan = float("nan")
+        return cls(False, reason, np.empty((0, nq)), nan, nan, nan, nan, time.perf_counter() - started)
+
+
+def planning_clearance_m(scene: Scene) -> float:
+    """Clearance a sampling planner's states and segments keep [m].
+
+    The margin plus the verification step, as the firefly's fitness requires at its samples:
+    the timed spline strays a little from the straight segments between the path's vertices.
+    """
+    return scene.safety_margin + scene.planner.verify_step_m
+
+
+def time_and_verify(
+    robot: ck.Robot, world: ck.CollisionWorld, scene: Scene, waypoints: FloatArray, started: float
+) -> SamplingResult:
+    """Time a path of joint-space ``waypoints`` ``(K, nq)`` with TOPP-RA, then verify it.
+
+    A clamped cubic spline through the waypoints (parametrised by their range-scaled joint
+    distance) is timed under the velocity and acceleration limits and verified by the
+    certified continuous check against the scene's margin; ``started`` is the
+    ``time.perf_counter()`` of the planner's start.
+    """
+    import toppra
+    import toppra.algorithm
+    import toppra.constraint
+
+    limits = robot.limits
+    steps = np.linalg.norm(np.diff(waypoints / limits.range, axis=0), axis=1)
+    keep = np.concatenate([[True], steps > 1e-9])
+    waypoints = waypoints[keep]
+    s_grid = np.concatenate([[0.0], np.cumsum(steps[steps > 1e-9])])
+    if len(waypoints) < 2:
+        return SamplingResult.failure("the simplified path is a single point", robot.nq, started)
+    geometric = toppra.SplineInterpolator(s_grid / s_grid[-1], waypoints, bc_type="clamped")
+    constraints = [
+        toppra.constraint.JointVelocityConstraint(np.column_stack([-limits.velocity, limits.velocity])),
+        toppra.constraint.JointAccelerationConstraint(
+            np.column_stack([-limits.acceleration, limits.acceleration])
+        ),
+    ]
+    timed = toppra.algorithm.TOPPRA(
+        constraints, geometric, gridpoints=np.linspace(0, 1, 401)
+    ).compute_trajectory(0, 0)
+    if timed is None:
+        return SamplingResult.failure("TOPP-RA found no timing", robot.nq, started)
+    duration = float(timed.duration)
+    dense = np.linspace(0.0, duration, 4001)
+    positions = np.asarray(timed(dense))
+    speeds = np.abs(np.asarray(timed(dense, 1))).max(axis=0) * 1.05 + 1e-9  # sampled, with 5 % slack
+    check = ck.check_curve(
+        world,
+        lambda t: np.asarray(timed(np.asarray(t))),
+        0.0,
+        duration,
+        speeds,
+        scene.safety_margin,
+        scene.planner.verify_step_m,
+    )
+    jerk = np.diff(np.asarray(timed(dense, 2)), axis=0) / np.diff(dense)[:, None]
+    length = float(np.linalg.norm(np.diff(positions / limits.range, axis=0), axis=1).sum())
+    inside = bool(np.all(positions >= limits.lower - 1e-9) and np.all(positions <= limits.upper + 1e-9))
+    reason = (
+        ""
+        if check.accepted and inside
+        else (
+            f"certified clearance {check.certified_min_m:.4f} m below the margin"
+            if not check.accepted
+            else "leaves a joint range"
+        )
+    )
+    return SamplingResult(
+        success=check.accepted and inside,
+        reason=reason,
+        waypoints=waypoints,
+        duration=duration,
+        min_clearance=check.certified_min_m,
+        path_length=length,
+        max_abs_jerk=float(np.abs(jerk).max()),
+        planning_time_s=time.perf_counter() - started,
+    )

@@ -1,0 +1,62 @@
+"""What every optimiser of :mod:`planning.search` shares: its interface and its result.
+
+An optimiser minimises a *batch objective* (``(S, d)`` candidates in -> ``(S,)`` values
+out, lower is better) over a box, within an evaluation budget, drawing randomness only from
+the ``numpy.random.Generator`` it is given. The planner calls any :class:`Optimizer` the
+same way (``plan(scene, optimizer=...)``), so the firefly and its baselines are compared on
+one objective and one budget.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+FloatArray = NDArray[np.float64]
+
+BatchObjective = Callable[[FloatArray], FloatArray]
+"""Objective over a batch: ``(S, d)`` points in the problem's units -> ``(S,)`` values."""
+
+
+@dataclass(frozen=True)
+class SearchResult:
+    """Outcome of an optimiser run.
+
+    Attributes:
+        x: best point found, in the problem's units.
+        fitness: its objective value.
+        evaluations: objective evaluations (candidates, not calls).
+        best_history: ``(T + 1,)`` best value after each iteration (0: initial population).
+        mean_history: ``(T + 1,)`` population mean after each iteration.
+        evaluation_history: ``(T + 1,)`` cumulative evaluations after each iteration.
+        population: ``(n, d)`` final positions, in the problem's units.
+        population_fitness: ``(n,)`` their values.
+    """
+
+    x: FloatArray
+    fitness: float
+    evaluations: int
+    best_history: FloatArray
+    mean_history: FloatArray
+    evaluation_history: NDArray[np.int64]
+    population: FloatArray
+    population_fitness: FloatArray
+
+
+class Optimizer(Protocol):
+    """A box-constrained batch optimiser with an evaluation budget."""
+
+    def __call__(
+        self,
+        objective: BatchObjective,
+        lower: FloatArray,
+        upper: FloatArray,
+        budget: int,
+        rng: np.random.Generator,
+    ) -> SearchResult:
+        """Minimise ``objective`` over ``[lower, upper]`` in at most ``budget`` evaluations."""
+        ...
