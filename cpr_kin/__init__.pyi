@@ -1,6 +1,7 @@
 """Type stub of the package: what it exports, and from which module (read by ``lazy_loader``)."""
 
-from .collision import BatchClearance, Clearance, CollisionWorld, PairDistance
+from .clearance import BatchClearance, Clearance, PairDistance
+from .collision import CollisionWorld
 from .errors import CprKinError, JointLimitError, ObstacleError, UnreachableError, UrdfError
 from .ik import tcp_ik
 from .kinematics import frame_poses, frame_positions

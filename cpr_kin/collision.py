@@ -11,18 +11,17 @@ from __future__ import annotations
 
 import os
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
-import coal
 import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
+from cpr_kin.clearance import BatchClearance, Clearance, PairDistance
 from cpr_kin.errors import CprKinError
 from cpr_kin.obstacles import Obstacle
 from cpr_kin.pair_bounds import PairBounds
-from cpr_kin.reach import geometry_reach
+from cpr_kin.reach import pair_reach_distances
 from cpr_kin.robot import GROUPS, Robot
 
 FloatArray = NDArray[np.float64]
@@ -31,80 +30,6 @@ IntArray = NDArray[np.int64]
 BOUND_TOLERANCE_M = 1e-6
 """A configuration goes to coal unless its pair bounds clear the margin by this much [m]
 (coal's distances are accurate to about 1e-6 of their size)."""
-
-
-@dataclass(frozen=True)
-class PairDistance:
-    """Signed distance of one robot geometry to one obstacle.
-
-    Attributes:
-        robot_geometry: robot geometry name (e.g. ``"arm"``).
-        obstacle: obstacle name.
-        group: collision group of the robot geometry.
-        distance_m: signed distance [m]; negative when they overlap.
-        point_on_robot: closest point on the robot geometry, world frame [m].
-        point_on_obstacle: closest point on the obstacle, world frame [m].
-
-    """
-
-    robot_geometry: str
-    obstacle: str
-    group: str
-    distance_m: float
-    point_on_robot: FloatArray
-    point_on_obstacle: FloatArray
-
-
-@dataclass(frozen=True)
-class Clearance:
-    """Clearance of one configuration.
-
-    Attributes:
-        q: the configuration [rad, m].
-        pairs: every robot-obstacle pair with its distance and closest points.
-        group_clearance_m: smallest distance per group, keyed by group name [m]
-            (``inf`` without obstacles).
-
-    """
-
-    q: FloatArray
-    pairs: tuple[PairDistance, ...]
-    group_clearance_m: dict[str, float]
-
-    @property
-    def min_clearance_m(self) -> float:
-        """Smallest distance over every pair [m]."""
-        return min(self.group_clearance_m.values())
-
-    @property
-    def closest(self) -> PairDistance | None:
-        """The closest robot-obstacle pair, or ``None`` without obstacles."""
-        return min(self.pairs, key=lambda p: p.distance_m) if self.pairs else None
-
-    def violating_groups(self, margin_m: float) -> tuple[str, ...]:
-        """Groups closer than ``margin_m`` [m] to an obstacle, in :data:`GROUPS` order."""
-        return tuple(g for g in GROUPS if self.group_clearance_m[g] < margin_m)
-
-
-@dataclass(frozen=True)
-class BatchClearance:
-    """Per-group clearance of many configurations.
-
-    Attributes:
-        clearance_m: ``(N, 2)`` smallest distance per group [m], columns in :data:`GROUPS`
-            order (``effector``, ``links``).
-        closest_pair: ``(N, 2)`` index into :attr:`CollisionWorld.pairs` of the closest pair
-            per group (``-1`` without obstacles).
-
-    """
-
-    clearance_m: FloatArray
-    closest_pair: IntArray
-
-    @property
-    def min_clearance_m(self) -> FloatArray:
-        """``(N,)`` smallest distance over both groups [m]."""
-        return np.asarray(self.clearance_m.min(axis=1))
 
 
 class CollisionWorld:
@@ -156,39 +81,9 @@ class CollisionWorld:
         self._group_has_pairs = [bool(np.any(self._pair_group == g)) for g in range(len(GROUPS))]
         self._pool: Any = None
         self._pool_margin: float | None = None
-        self._reach_distance = self._pair_reach_distances()
+        self._reach_distance = pair_reach_distances(robot, self.obstacles, self._pairs)
         self._culled_data: dict[tuple[bool, ...], Any] = {}
         self._pair_bounds: dict[tuple[bool, ...], PairBounds] = {}
-
-    def _pair_reach_distances(self) -> FloatArray:
-        """Per pair, a lower bound of its distance over every configuration [m].
-
-        Each robot geometry stays inside a capsule around the first joint's axis
-        (:mod:`cpr_kin.reach`); the distance from that capsule to the obstacle bounds the
-        pair's distance from below, whatever the joints do.
-        """
-        robot = self.robot
-        reach = geometry_reach(robot.model, robot.collision_model, robot.limits.lower, robot.limits.upper)
-        request, distances = coal.DistanceRequest(), []
-        for g, k in self._pairs:
-            obstacle = self.obstacles[k]
-            placement = coal.Transform3s(obstacle.placement.rotation, obstacle.placement.translation)
-            bound = -np.inf  # every hull gives a lower bound: keep the largest
-            for hull in reach[robot.geometries[g].index].hulls:
-                centre, axis, half, radius = hull.capsule()
-                rotation = pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), axis).matrix()
-                result = coal.DistanceResult()
-                coal.distance(
-                    coal.Capsule(radius, 2 * half),
-                    coal.Transform3s(rotation, centre),
-                    obstacle.geometry(),
-                    placement,
-                    request,
-                    result,
-                )
-                bound = max(bound, result.min_distance)
-            distances.append(bound)
-        return np.array(distances)
 
     @property
     def pairs(self) -> tuple[tuple[str, str, str], ...]:

@@ -12,11 +12,16 @@ geometry in every configuration.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+if TYPE_CHECKING:
+    from cpr_kin.obstacles import Obstacle
+    from cpr_kin.robot import Robot
 
 FloatArray = NDArray[np.float64]
 
@@ -131,3 +136,38 @@ def _carry(
         points = points @ np.asarray(placement.rotation).T + np.asarray(placement.translation)
         joint = model.parents[joint]
     return radii, Hull(points=points, ball=ball)
+
+
+def pair_reach_distances(
+    robot: Robot, obstacles: Sequence[Obstacle], pairs: Sequence[tuple[int, int]]
+) -> FloatArray:
+    """Per ``(geometry index, obstacle index)`` pair, a lower bound of its distance in any configuration [m].
+
+    Each robot geometry stays inside a capsule around the first joint's axis
+    (:func:`geometry_reach`); the distance from that capsule to the obstacle, by coal,
+    bounds the pair's distance from below, whatever the joints do.
+    """
+    import coal
+    import pinocchio as pin
+
+    reach = geometry_reach(robot.model, robot.collision_model, robot.limits.lower, robot.limits.upper)
+    request, distances = coal.DistanceRequest(), []
+    for g, k in pairs:
+        obstacle = obstacles[k]
+        placement = coal.Transform3s(obstacle.placement.rotation, obstacle.placement.translation)
+        bound = -np.inf  # every hull gives a lower bound: keep the largest
+        for hull in reach[robot.geometries[g].index].hulls:
+            centre, axis, half, radius = hull.capsule()
+            rotation = pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), axis).matrix()
+            result = coal.DistanceResult()
+            coal.distance(
+                coal.Capsule(radius, 2 * half),
+                coal.Transform3s(rotation, centre),
+                obstacle.geometry(),
+                placement,
+                request,
+                result,
+            )
+            bound = max(bound, result.min_distance)
+        distances.append(bound)
+    return np.array(distances)

@@ -46,10 +46,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from planning.curves.piecewise_sampler import PiecewiseSampler
-from planning.curves.polynomial_bounds import DerivativeBounds
 from planning.curves.ptp import ptp_time, trapezoid_time
 from planning.curves.spline import SepticSplineSolver
+from planning.path_terms import ExecutedPaths
 from planning.scene import PlannerSettings
 
 FloatArray = NDArray[np.float64]
@@ -121,37 +120,23 @@ class WaypointObjective:
         self.world = world
         self.q_start, self.q_goal = np.asarray(q_start, dtype=float), np.asarray(q_goal, dtype=float)
         self.moving = np.asarray(moving, dtype=np.intp)
-        # joints the spline moves; the others stay at their start (= goal) value throughout
-        self._fitted = np.union1d(self.moving, np.flatnonzero(self.q_start != self.q_goal))
         self.settings = settings
         self.solver = solver
         self.n_waypoints = settings.waypoints
         self.required_m = margin_m + settings.verify_step_m
         limits = robot.limits
-        self.lower_q, self.upper_q, self.range_q = limits.lower, limits.upper, limits.range
+        self.lower_q, self.upper_q = limits.lower, limits.upper
         self.v_max, self.a_max = limits.velocity, limits.acceleration
         self.timed = timed
-        self._derivative_limits = (limits.velocity, limits.acceleration, limits.jerk)
+        self.paths = ExecutedPaths(limits, self.q_start, self.q_goal, self.moving, settings, solver, timed)
         segments = self.n_waypoints + 1
         self.lower = np.tile(limits.lower[self.moving], self.n_waypoints)
         self.upper = np.tile(limits.upper[self.moving], self.n_waypoints)
         longest = float(
-            trapezoid_time(self.range_q[self.moving], self.v_max[self.moving], self.a_max[self.moving]).max()
+            trapezoid_time(limits.range[self.moving], self.v_max[self.moving], self.a_max[self.moving]).max()
         )
         self.t_max = segments * longest + settings.ipo
         self.w_max = float(segments * self.moving.size)
-        knots = solver.knots
-        check_times = np.linspace(knots[0], knots[-1], settings.fitness_samples)
-        self._check = PiecewiseSampler(knots, check_times, 8)
-        self._last_step_powers = (knots[-1] - knots[-2]) ** np.arange(8.0)
-        ipo_times = np.append(np.arange(knots[0], knots[-1], settings.ipo), knots[-1])
-        self._ipo = PiecewiseSampler(knots, ipo_times, 8)
-        self._ipo_derivatives = tuple(
-            PiecewiseSampler(knots, ipo_times, 8, derivatives=r, first=r) for r in (1, 2, 3)
-        )
-        self._derivative_bounds = DerivativeBounds(knots, 8, (1, 2, 3))
-        self._steps = np.empty((len(ipo_times) - 1, 0))  # reused buffer of IPO steps
-        self._tiled: dict[int, tuple[FloatArray, ...]] = {}
         self._pair_group = np.array([ck.GROUPS.index(group) for _, _, group in world.pairs], dtype=np.intp)
 
     @property
@@ -172,57 +157,6 @@ class WaypointObjective:
     def __call__(self, x: FloatArray) -> FloatArray:
         """``(S,)`` fitness of candidates ``x`` ``(S, p k)`` in joint units."""
         return self.breakdown(x).fitness
-
-    def _paths(self, nodes: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
-        """Check samples ``(S, K, nq)`` of the executed paths and their ``(S,)`` terms.
-
-        Returns the samples, w_sol, overshoot, limit excess and node deviation.
-        """
-        s, n_nodes, nq = nodes.shape
-        zeros = np.zeros(s)
-        if self.settings.path == "ptp":
-            fraction = np.linspace(0.0, 1.0, max(2, self.settings.fitness_samples // (n_nodes - 1)))
-            steps = np.diff(nodes, axis=1)
-            samples = nodes[:, :-1, None, :] + fraction[None, None, :, None] * steps[:, :, None, :]
-            w_sol = (np.abs(steps) / self.range_q).sum(axis=(1, 2))
-            return samples.reshape(s, -1, nq), w_sol, zeros, zeros, zeros
-        fitted, k = self._fitted, self._fitted.size
-        columns = nodes[:, :, fitted].transpose(1, 0, 2).reshape(n_nodes, s * k)  # (nodes, S k)
-        coefficients = self.solver.solve_batch(columns)
-        samples = np.empty((s, self._check.count, nq))
-        samples[...] = self.q_start  # held joints stay where they start (and end)
-        samples[:, :, fitted] = self._check(coefficients)[0].reshape(-1, s, k).transpose(1, 0, 2)
-        range_q, lower_q, upper_q, limits = self._tiles(s)
-        positions = self._ipo(coefficients)[0]  # (IPO steps, S k): reduce over time first
-        if self._steps.shape != (positions.shape[0] - 1, s * k):
-            self._steps = np.empty((positions.shape[0] - 1, s * k))
-        steps = np.subtract(positions[1:], positions[:-1], out=self._steps)
-        w_sol = (np.abs(steps, out=steps).sum(axis=0) / range_q).reshape(s, k).sum(axis=1)
-        beyond = np.maximum(positions.max(axis=0) - upper_q, lower_q - positions.min(axis=0)) / range_q
-        overshoot = np.maximum(beyond.reshape(s, k).max(axis=1), 0.0)
-        last = coefficients[-1] @ self._last_step_powers  # value at the end of the last segment
-        node_values = np.concatenate([coefficients[:, :, 0], last[None]])
-        deviation = np.abs(node_values - columns).max(axis=0).reshape(s, k).max(axis=1)
-        excess = zeros
-        if self.timed:  # largest |velocity|, |acceleration|, |jerk| relative to its limit
-            utilisation = np.zeros(s * k)
-            may_exceed = self._derivative_bounds(coefficients) > limits  # (3, S k)
-            for r, sampler in enumerate(self._ipo_derivatives):
-                unsure = np.flatnonzero(may_exceed[r])
-                if unsure.size:  # the others stay within this limit: they add no excess
-                    values = sampler(coefficients[:, unsure])[0]
-                    peak = np.abs(values, out=values).max(axis=0) / limits[r, unsure]
-                    utilisation[unsure] = np.maximum(utilisation[unsure], peak)
-            excess = np.maximum(utilisation.reshape(s, k).max(axis=1) - 1.0, 0.0)
-        return samples, w_sol, overshoot, excess, deviation
-
-    def _tiles(self, s: int) -> tuple[FloatArray, ...]:
-        """Fitted joints' ranges, bounds and ``(3, S k)`` v/a/j limits, repeated for ``s`` candidates."""
-        if s not in self._tiled:
-            per_joint = (self.range_q, self.lower_q, self.upper_q)
-            limits = np.stack([np.tile(limit[self._fitted], s) for limit in self._derivative_limits])
-            self._tiled[s] = (*(np.tile(v[self._fitted], s) for v in per_joint), limits)
-        return self._tiled[s]
 
     def _clearance(self, samples: FloatArray, may_be_feasible: BoolArray) -> FloatArray:
         """``(S, K, 2)`` per-group clearance where it falls short of the required clearance.
@@ -267,13 +201,14 @@ class WaypointObjective:
         """The fitness of candidates ``x`` ``(S, p k)`` with all its terms."""
         nodes = self.nodes(x)
         t_sol = ptp_time(nodes, self.v_max, self.a_max)
-        samples, w_sol, overshoot, excess, deviation = self._paths(nodes)
+        paths = self.paths(nodes)
+        w_sol, excess, deviation = paths.w_sol, paths.limit_excess, paths.node_deviation
         bound = self.settings.max_node_deviation
         deviation_excess = (
             np.zeros_like(deviation) if bound is None else np.maximum(deviation / bound - 1.0, 0.0)
         )
-        other = overshoot + excess + deviation_excess
-        clearance = self._clearance(np.clip(samples, self.lower_q, self.upper_q), other <= 0.0)
+        other = paths.overshoot + excess + deviation_excess
+        clearance = self._clearance(np.clip(paths.samples, self.lower_q, self.upper_q), other <= 0.0)
         shortfall = np.maximum(self.required_m - clearance, 0.0)
         effector = np.asarray((clearance[:, :, 0] < self.required_m).any(axis=1))
         links = np.asarray((clearance[:, :, 1] < self.required_m).any(axis=1))
@@ -297,7 +232,7 @@ class WaypointObjective:
             effector_violates=effector,
             links_violate=links,
             depth_m=depth,
-            overshoot=overshoot,
+            overshoot=paths.overshoot,
             limit_excess=excess,
             node_deviation=deviation,
             min_clearance_m=np.nanmin(clearance, axis=(1, 2)),

@@ -20,7 +20,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from planning.curves import spline
+from planning.curves import banded_system
 from planning.curves.spline import SepticSplineSolver, SplineSettings, fit_septic_spline
 
 
@@ -54,7 +54,7 @@ def measure(
         ("one-shot fit", median_seconds(one_shot, repeats), 1.0),
         (
             "one-shot fit, structure cache cold",
-            median_seconds(one_shot, repeats, spline._structure.cache_clear),
+            median_seconds(one_shot, repeats, banded_system.structure.cache_clear),
             None,
         ),
         ("prepared solver: solve", median_seconds(lambda: solver.solve(values), repeats), None),

@@ -107,7 +107,7 @@ def test_w_sol_of_the_spline_is_at_least_the_ptp_one(
 ) -> None:
     x = rng.uniform(paper_objective.lower, paper_objective.upper, (20, 9))
     nodes = paper_objective.nodes(x)
-    ptp = (np.abs(np.diff(nodes, axis=1)) / paper_objective.range_q).sum(axis=(1, 2))
+    ptp = (np.abs(np.diff(nodes, axis=1)) / paper_objective.paths.range_q).sum(axis=(1, 2))
     spline = paper_objective.breakdown(x).w_sol
     assert np.all(spline >= ptp - 1e-6)
 

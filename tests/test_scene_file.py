@@ -22,13 +22,24 @@ from planning.io.scene_file import (
     parse_scene,
 )
 from planning.io.scene_generator import generate_scenes
-from planning.scene import PlannerSettings
+from planning.scene import PlannerSettings, Target
 
 MINIMAL = {"start": {"tcp": [0.5, 0.45, 0.25]}, "goal": {"tcp": [-0.5, 0.45, 0.25]}}
 
 
-def test_bundled_paper_scene_is_the_paper_case() -> None:
-    assert load_scene(paper_scene_path()) == paper_scene()
+def test_bundled_paper_scene_is_the_paper_case_of_the_design() -> None:
+    # DESIGN.md section 4, value by value
+    scene = paper_scene()
+    assert scene.name == "paper" and scene.safety_margin == 0.1 and scene.duration == 4.0
+    assert scene.start == Target(tcp=(0.5, 0.45, 0.25)) and scene.goal == Target(tcp=(-0.5, 0.45, 0.25))
+    assert scene.obstacles == (ck.Obstacle.box((0.3, 0.3, 0.3), (0.0, 0.6, 0.15), name="crate"),)
+    firefly = scene.planner.firefly
+    assert (firefly.fireflies, firefly.alpha, firefly.beta0, firefly.iterations) == (50, 1.0, 0.5, 50)
+    assert scene.planner.waypoints == 3 and scene.planner.max_node_deviation == 20e-6
+    assert scene.spline == SplineSettings(p=1e6, a=(0.0, 0.0, 1.0), ends="natural")
+    # the planner changes and the seed apply on top of the file, which holds seed 0
+    assert load_scene(paper_scene_path()) == paper_scene(0)
+    assert paper_scene(3, fireflies=10).planner == scene.planner.updated(seed=3, fireflies=10)
 
 
 def test_documented_defaults() -> None:

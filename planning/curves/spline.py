@@ -26,23 +26,21 @@ right-hand side.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property, lru_cache
-from typing import Any, Literal
+from functools import cached_property
+from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import sparse
 from scipy.linalg import lapack
 
-from planning.curves.hermite import CONTINUITY, ENERGY, HERMITE_INV, node_scaling
+from planning.curves.banded_system import PER_NODE, factorised_system
+from planning.curves.hermite import HERMITE_INV, node_scaling
 from planning.curves.trajectory import Trajectory
 from planning.errors import SplineError
 
 FloatArray = NDArray[np.float64]
 
 Ends = Literal["natural", "rest"]
-_PER_NODE = CONTINUITY + 1  # unknowns per node: y, y', y'', y'''
-_BAND = 2 * _PER_NODE - 1  # half-bandwidth of the normal equations
 DENSE_MAP_NODES = 16
 """Up to this many nodes, :meth:`SepticSplineSolver.solve_batch` applies the dense map."""
 
@@ -129,84 +127,6 @@ def _lowest_weighted_order(settings: SplineSettings) -> int:
     return 1 + next(r for r, coef in enumerate(settings.a) if coef > 0)
 
 
-_D, _C = np.meshgrid(np.arange(_BAND + 1), np.arange(2 * _PER_NODE), indexing="ij")
-_BAND_MASK = (_C + _D < 2 * _PER_NODE).astype(float)
-_BAND_ROWS = np.minimum(_C + _D, 2 * _PER_NODE - 1)
-_BAND_COLS = _C
-_OFFSETS = np.arange(-_BAND, _BAND + 1)
-_ABS_OFFSETS = np.abs(_OFFSETS)
-_DIAGONALS = np.arange(1, _BAND + 1)
-
-
-def _assemble(h: FloatArray, a: tuple[float, float, float], n_nodes: int) -> FloatArray:
-    """Lower banded storage ``(8, 4 (N + 1))`` of the integral term of the normal equations.
-
-    Segment ``i`` adds ``D_h E D_h`` (E: the weighted derivative energies in normalised
-    time, D_h: node-derivative scaling) on unknowns ``4i .. 4i + 7``, i.e. on nodes ``i``
-    and ``i + 1``; the blocks are added node by node, without a scatter.
-    """
-    energy = sum(
-        coef * h[:, None, None] ** (1 - 2 * r) * ENERGY[r]
-        for r, coef in zip((1, 2, 3), a, strict=True)
-        if coef
-    )
-    scale = node_scaling(h)
-    blocks = np.asarray(energy) * scale[:, :, None] * scale[:, None, :]
-    segment_band = blocks[:, _BAND_ROWS, _BAND_COLS] * _BAND_MASK  # [i, d, c] = B_i[c + d, c]
-    band = np.zeros((_BAND + 1, n_nodes, _PER_NODE))
-    halves = segment_band.reshape(len(h), _BAND + 1, 2, _PER_NODE)
-    band[:, :-1] += halves[:, :, 0].transpose(1, 0, 2)
-    band[:, 1:] += halves[:, :, 1].transpose(1, 0, 2)
-    return band.reshape(_BAND + 1, -1)
-
-
-@dataclass(frozen=True)
-class _Structure:
-    """Index arrays that depend only on the node count and which values are fixed."""
-
-    weighted: NDArray[np.intp]  # nodes with a finite weight p_i
-    pinned: NDArray[np.intp]  # nodes met exactly
-    fixed: NDArray[np.intp]  # fixed unknowns (pinned values, rest-end derivatives)
-    zero_diagonal: NDArray[np.intp]  # band entries (diagonal, column) in the fixed unknowns' rows
-    zero_column: NDArray[np.intp]
-    coupling_rows: NDArray[np.intp]  # free rows of the pinned unknowns' columns ...
-    coupling_nodes: NDArray[np.intp]  # ... the pinned node each belongs to ...
-    coupling_diagonal: NDArray[np.intp]  # ... and where the matrix entry sits in the band
-    coupling_column: NDArray[np.intp]
-
-
-@lru_cache(maxsize=64)
-def _structure(n_nodes: int, exact_key: bytes, rest: bool) -> _Structure:
-    exact = np.frombuffer(exact_key, dtype=bool)
-    n = _PER_NODE * n_nodes
-    fixed = np.zeros(n, dtype=bool)
-    fixed[_PER_NODE * np.flatnonzero(exact)] = True
-    if rest:
-        for node in (0, n_nodes - 1):
-            fixed[_PER_NODE * node + 1 : _PER_NODE * node + 3] = True  # y' = y'' = 0
-    fixed_index = np.flatnonzero(fixed)
-    row_cols = fixed_index[None, :] - _DIAGONALS[:, None]  # fixed rows, left of the diagonal
-    inside = row_cols >= 0
-    pinned = np.flatnonzero(exact)
-    k = _PER_NODE * pinned[:, None]
-    rows = k + _OFFSETS  # (m, 15): the band of each pinned unknown's column
-    band_cols = np.where(_OFFSETS >= 0, k, k + _OFFSETS)
-    valid = (rows >= 0) & (rows < n) & (band_cols >= 0) & (_OFFSETS != 0)
-    valid[valid] = ~fixed[rows[valid]]
-    which, offset = np.nonzero(valid)
-    return _Structure(
-        weighted=np.flatnonzero(~exact),
-        pinned=pinned,
-        fixed=fixed_index,
-        zero_diagonal=np.broadcast_to(_DIAGONALS[:, None], row_cols.shape)[inside],
-        zero_column=row_cols[inside],
-        coupling_rows=rows[which, offset],
-        coupling_nodes=pinned[which],
-        coupling_diagonal=_ABS_OFFSETS[offset],
-        coupling_column=band_cols[which, offset],
-    )
-
-
 class SepticSplineSolver:
     """The septic smoothing spline for fixed knots and settings, factorised once.
 
@@ -254,50 +174,13 @@ class SepticSplineSolver:
         n_nodes = len(t)
         p = np.full(n_nodes, float(p)) if p.ndim == 0 else p
 
-        band = _assemble(steps, settings.a, n_nodes)
         exact = ~np.isfinite(p)
         if settings.exact_ends:
             exact[[0, -1]] = True
-        structure = _structure(n_nodes, exact.tobytes(), settings.ends == "rest")
-        weighted = structure.weighted
-        band[0, _PER_NODE * weighted] += p[weighted]
-        self._coupling = self._coupling_matrix(band, structure, p)
-        # fixed unknowns become identity rows and columns: an exact elimination that keeps
-        # the band and the positive definiteness
-        band[:, structure.fixed] = 0.0
-        band[structure.zero_diagonal, structure.zero_column] = 0.0
-        band[0, structure.fixed] = 1.0
-        factor, info = lapack.dpbtrf(band, lower=1)
-        if info != 0:
-            raise SplineError(
-                f"the spline system is singular for a = {list(settings.a)}, ends = '{settings.ends}' and "
-                f"{n_nodes} nodes; add nodes or a lower-order weight"
-            )
-        self._factor = factor
+        self._factor, self._coupling = factorised_system(steps, settings.a, p, exact, settings.ends)
         # Hermite data of both ends of a segment -> power coefficients in local seconds
         seconds = steps[:, None] ** -np.arange(HERMITE_INV.shape[0], dtype=float)
         self._to_coefficients = seconds[:, :, None] * HERMITE_INV[None] * node_scaling(steps)[:, None, :]
-
-    @staticmethod
-    def _coupling_matrix(band: FloatArray, structure: _Structure, p: FloatArray) -> Any:
-        """``W`` with right-hand side ``W @ f`` for node values ``f``.
-
-        Weighted node ``i`` contributes ``p_i f_i`` to its value row. A pinned node's value
-        is its own (identity) row, and its column of the matrix, times ``f_i``, moves to the
-        right-hand side of the free rows. Every (row, node) pair occurs once.
-        """
-        n, n_nodes = band.shape[1], len(p)
-        weighted, pinned = structure.weighted, structure.pinned
-        r = np.concatenate([_PER_NODE * weighted, _PER_NODE * pinned, structure.coupling_rows])
-        c = np.concatenate([weighted, pinned, structure.coupling_nodes])
-        v = np.concatenate(
-            [p[weighted], np.ones(pinned.size), -band[structure.coupling_diagonal, structure.coupling_column]]
-        )
-        if n * n_nodes <= 200_000:
-            dense = np.zeros((n, n_nodes))
-            dense[r, c] = v
-            return dense
-        return sparse.csr_array((v, (r, c)), shape=(n, n_nodes))
 
     @property
     def n_nodes(self) -> int:
@@ -311,7 +194,7 @@ class SepticSplineSolver:
         return np.asarray(solution)
 
     def _coefficients(self, solution: FloatArray) -> FloatArray:
-        nodes = solution.reshape(self.n_nodes, _PER_NODE, -1)
+        nodes = solution.reshape(self.n_nodes, PER_NODE, -1)
         hermite = np.concatenate([nodes[:-1], nodes[1:]], axis=1)  # (N, 8, m): both ends
         return np.asarray(np.matmul(self._to_coefficients, hermite).transpose(0, 2, 1))
 
@@ -332,7 +215,7 @@ class SepticSplineSolver:
         """Fit node values ``targets``: ``(N + 1,)`` or ``(N + 1, nj)`` [rad, m]."""
         f = self._check_values(targets)
         solution = self._solve_nodes(f)
-        nodes = solution.reshape(self.n_nodes, _PER_NODE, f.shape[1]).transpose(0, 2, 1)
+        nodes = solution.reshape(self.n_nodes, PER_NODE, f.shape[1]).transpose(0, 2, 1)
         trajectory = Trajectory(knots=self.knots, coefficients=self._coefficients(solution))
         return SplineFit(trajectory=trajectory, targets=f, nodes=nodes, settings=self.settings)
 

@@ -1,0 +1,145 @@
+"""The paths that candidate nodes make the robot execute: samples and their non-clearance terms.
+
+For a batch of candidates' nodes (start, waypoints, goal), :class:`ExecutedPaths` fits the
+executed path (the septic spline through the nodes, or the paper's straight PTP lines), and
+returns the configurations the fitness checks for clearance and the terms that need no
+collision query:
+
+- ``w_sol``: the joint motion accumulated over the IPO steps, each joint normalised by its
+  range (paper eq. 7);
+- ``overshoot``: the largest excursion beyond a joint range, as a fraction of the range;
+- ``limit_excess``: when the knots are the final timing, the largest |velocity|,
+  |acceleration| or |jerk| over its limit, minus 1 (sampled every IPO period, only for the
+  joints and orders a Bernstein bound, :mod:`planning.curves.polynomial_bounds`, cannot
+  certify);
+- ``node_deviation``: the spline's largest |y_i - f_i|.
+
+Only joints that move are fitted and sampled: the waypoint joints, and any other joint whose
+goal differs from its start (it moves in the last segment). The rest keep their start value,
+exactly, as the spline through constant nodes does.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+import cpr_kin as ck
+from planning.curves.piecewise_sampler import PiecewiseSampler
+from planning.curves.polynomial_bounds import DerivativeBounds
+from planning.curves.spline import SepticSplineSolver
+from planning.scene import PlannerSettings
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class PathTerms:
+    """The executed paths of ``S`` candidates.
+
+    Attributes:
+        samples: ``(S, K, nq)`` configurations to check for clearance [rad, m].
+        w_sol: ``(S,)`` normalised accumulated joint motion.
+        overshoot: ``(S,)`` largest excursion beyond a joint range, relative to the range.
+        limit_excess: ``(S,)`` largest |v|, |a| or |j| over its limit, minus 1 (0 within).
+        node_deviation: ``(S,)`` largest spline node deviation [rad or m].
+    """
+
+    samples: FloatArray
+    w_sol: FloatArray
+    overshoot: FloatArray
+    limit_excess: FloatArray
+    node_deviation: FloatArray
+
+
+class ExecutedPaths:
+    """Samples and terms of the executed paths of candidates' nodes.
+
+    Args:
+        limits: the robot's joint limits.
+        q_start: start configuration [rad, m] (held joints keep its values).
+        q_goal: goal configuration [rad, m].
+        moving: indices of the joints the waypoints move.
+        settings: planner settings (path kind, IPO, samples).
+        solver: the septic spline solver on the trajectory's knots.
+        timed: the knots are the final timing, so velocity, acceleration and jerk limits apply.
+    """
+
+    def __init__(
+        self,
+        limits: ck.JointLimits,
+        q_start: FloatArray,
+        q_goal: FloatArray,
+        moving: NDArray[np.intp],
+        settings: PlannerSettings,
+        solver: SepticSplineSolver,
+        timed: bool,
+    ) -> None:
+        self.q_start = q_start
+        # joints the spline moves; the others stay at their start (= goal) value throughout
+        self.fitted = np.union1d(moving, np.flatnonzero(q_start != q_goal))
+        self.settings, self.solver, self.timed = settings, solver, timed
+        self.lower_q, self.upper_q, self.range_q = limits.lower, limits.upper, limits.range
+        self._derivative_limits = (limits.velocity, limits.acceleration, limits.jerk)
+        knots = solver.knots
+        check_times = np.linspace(knots[0], knots[-1], settings.fitness_samples)
+        self._check = PiecewiseSampler(knots, check_times, 8)
+        self._last_step_powers = (knots[-1] - knots[-2]) ** np.arange(8.0)
+        ipo_times = np.append(np.arange(knots[0], knots[-1], settings.ipo), knots[-1])
+        self._ipo = PiecewiseSampler(knots, ipo_times, 8)
+        self._ipo_derivatives = tuple(
+            PiecewiseSampler(knots, ipo_times, 8, derivatives=r, first=r) for r in (1, 2, 3)
+        )
+        self._derivative_bounds = DerivativeBounds(knots, 8, (1, 2, 3))
+        self._steps = np.empty((len(ipo_times) - 1, 0))  # reused buffer of IPO steps
+        self._tiled: dict[int, tuple[FloatArray, ...]] = {}
+
+    def __call__(self, nodes: FloatArray) -> PathTerms:
+        """The executed paths through ``nodes`` ``(S, p + 2, nq)``."""
+        s, n_nodes, nq = nodes.shape
+        zeros = np.zeros(s)
+        if self.settings.path == "ptp":
+            fraction = np.linspace(0.0, 1.0, max(2, self.settings.fitness_samples // (n_nodes - 1)))
+            steps = np.diff(nodes, axis=1)
+            samples = nodes[:, :-1, None, :] + fraction[None, None, :, None] * steps[:, :, None, :]
+            w_sol = (np.abs(steps) / self.range_q).sum(axis=(1, 2))
+            return PathTerms(samples.reshape(s, -1, nq), w_sol, zeros, zeros, zeros)
+        fitted, k = self.fitted, self.fitted.size
+        columns = nodes[:, :, fitted].transpose(1, 0, 2).reshape(n_nodes, s * k)  # (nodes, S k)
+        coefficients = self.solver.solve_batch(columns)
+        samples = np.empty((s, self._check.count, nq))
+        samples[...] = self.q_start  # held joints stay where they start (and end)
+        samples[:, :, fitted] = self._check(coefficients)[0].reshape(-1, s, k).transpose(1, 0, 2)
+        range_q, lower_q, upper_q, limits = self._tiles(s)
+        positions = self._ipo(coefficients)[0]  # (IPO steps, S k): reduce over time first
+        if self._steps.shape != (positions.shape[0] - 1, s * k):
+            self._steps = np.empty((positions.shape[0] - 1, s * k))
+        steps = np.subtract(positions[1:], positions[:-1], out=self._steps)
+        w_sol = (np.abs(steps, out=steps).sum(axis=0) / range_q).reshape(s, k).sum(axis=1)
+        beyond = np.maximum(positions.max(axis=0) - upper_q, lower_q - positions.min(axis=0)) / range_q
+        overshoot = np.maximum(beyond.reshape(s, k).max(axis=1), 0.0)
+        last = coefficients[-1] @ self._last_step_powers  # value at the end of the last segment
+        node_values = np.concatenate([coefficients[:, :, 0], last[None]])
+        deviation = np.abs(node_values - columns).max(axis=0).reshape(s, k).max(axis=1)
+        excess = zeros
+        if self.timed:  # largest |velocity|, |acceleration|, |jerk| relative to its limit
+            utilisation = np.zeros(s * k)
+            may_exceed = self._derivative_bounds(coefficients) > limits  # (3, S k)
+            for r, sampler in enumerate(self._ipo_derivatives):
+                unsure = np.flatnonzero(may_exceed[r])
+                if unsure.size:  # the others stay within this limit: they add no excess
+                    values = sampler(coefficients[:, unsure])[0]
+                    peak = np.abs(values, out=values).max(axis=0) / limits[r, unsure]
+                    utilisation[unsure] = np.maximum(utilisation[unsure], peak)
+            excess = np.maximum(utilisation.reshape(s, k).max(axis=1) - 1.0, 0.0)
+        return PathTerms(samples, w_sol, overshoot, excess, deviation)
+
+    def _tiles(self, s: int) -> tuple[FloatArray, ...]:
+        """Fitted joints' ranges, bounds and ``(3, S k)`` v/a/j limits, repeated for ``s`` candidates."""
+        if s not in self._tiled:
+            per_joint = (self.range_q, self.lower_q, self.upper_q)
+            limits = np.stack([np.tile(limit[self.fitted], s) for limit in self._derivative_limits])
+            self._tiled[s] = (*(np.tile(v[self.fitted], s) for v in per_joint), limits)
+        return self._tiled[s]

@@ -1,0 +1,122 @@
+"""The package layout holds: small modules, and imports that follow the layers.
+
+Layers (README, "How it fits together"): ``planning.curves`` is pure mathematics (no robot),
+``planning.search`` knows only objectives over boxes, the core (the top-level modules and
+``planning.io``) never imports a peer, and drawing libraries are imported only by
+``planning.viz`` (lazily elsewhere). The import graph is read from the source, every
+``import`` statement counted, including those inside functions.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGES = ("cpr_kin", "planning")
+MAX_LINES = 300
+
+
+def modules() -> dict[str, Path]:
+    """Every module of the packages, by dotted name."""
+    found = {}
+    for package in PACKAGES:
+        for path in sorted((ROOT / package).rglob("*.py")):
+            parts = path.relative_to(ROOT).with_suffix("").parts
+            name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+            found[name] = path
+    return found
+
+
+def imports(name: str, path: Path) -> list[tuple[str, bool]]:
+    """``(imported module, at module level)`` of every import statement of a module."""
+    tree = ast.parse(path.read_text())
+    top_level = {id(node) for node in tree.body}
+    top_level |= {  # imports under `if TYPE_CHECKING:` run only for the type checker
+        id(child) for node in tree.body if isinstance(node, ast.If) for child in node.body
+    }
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found += [(alias.name, id(node) in top_level) for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                anchor = package.split(".")[: len(package.split(".")) - node.level + 1]
+                base = ".".join([*anchor, base] if base else anchor)
+            found += [(base, id(node) in top_level)]
+            found += [(f"{base}.{alias.name}", id(node) in top_level) for alias in node.names]
+    return found
+
+
+def typing_only(path: Path) -> set[str]:
+    """Modules imported only under ``if TYPE_CHECKING:``."""
+    tree = ast.parse(path.read_text())
+    names = set()
+    for node in tree.body:
+        if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
+            for child in ast.walk(node):
+                if isinstance(child, ast.ImportFrom) and child.module:
+                    names.add(child.module)
+    return names
+
+
+def within(module: str, prefix: str) -> bool:
+    return module == prefix or module.startswith(prefix + ".")
+
+
+@pytest.mark.parametrize("name", sorted(modules()))
+def test_modules_are_small(name: str) -> None:
+    lines = len(modules()[name].read_text().splitlines())
+    assert lines <= MAX_LINES, f"{name} has {lines} lines; split it by concept (at most {MAX_LINES})"
+
+
+def test_the_core_never_imports_a_peer() -> None:
+    offenders = [
+        (name, imported)
+        for name, path in modules().items()
+        if not within(name, "planning.peers")
+        for imported, _ in imports(name, path)
+        if within(imported, "planning.peers")
+    ]
+    assert offenders == []
+
+
+def test_curves_are_pure_mathematics_and_search_knows_no_robot() -> None:
+    allowed = {
+        "planning.curves": ("planning.curves", "planning.errors"),
+        "planning.search": ("planning.search", "planning.errors", "cpr_kin.compiled"),
+    }
+    offenders = []
+    for name, path in modules().items():
+        for layer, permitted in allowed.items():
+            if not within(name, layer):
+                continue
+            for imported, _ in imports(name, path):
+                ours = within(imported, "planning") or within(imported, "cpr_kin")
+                if ours and not any(within(imported, p) for p in permitted):
+                    offenders.append((name, imported))
+    assert offenders == []
+
+
+def test_drawing_libraries_load_only_with_the_viewer_or_plots() -> None:
+    drawing = ("meshcat", "matplotlib", "planning.viz")
+    offenders = [
+        (name, imported)
+        for name, path in modules().items()
+        if not within(name, "planning.viz")
+        for imported, module_level in imports(name, path)
+        if module_level and any(within(imported, d) for d in drawing) and imported not in typing_only(path)
+    ]
+    assert offenders == []
+
+
+def test_the_checker_sees_what_it_checks() -> None:
+    # the graph reader resolves relative imports and finds function-level imports
+    found = imports("planning.cli.plan_commands", modules()["planning.cli.plan_commands"])
+    assert ("planning.planner", False) in found and ("planning.cli.failure", True) in found
+    stub_reader = imports("planning.curves", ROOT / "planning" / "curves" / "__init__.py")
+    assert ("lazy_loader", True) in stub_reader
