@@ -1,6 +1,6 @@
 # The two commands of the README:
 #   make demo   set up .venv and run the paper case
-#   make test   set up .venv and run the test suite
+#   make test   set up .venv (and Chromium, for the viewer test) and run the test suite
 # `make lint` runs ruff and mypy; `make bench` the benchmarks; `make bench-peers` the
 # comparison with peer optimisers and planners (several minutes).
 
@@ -24,6 +24,7 @@ demo: $(STAMP)
 	$(PY) scripts/paper_case.py
 
 test: $(STAMP)
+	@sh scripts/ensure_chromium.sh
 	$(PY) -m pytest
 
 lint: $(STAMP)
