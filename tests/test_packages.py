@@ -13,12 +13,23 @@ from pathlib import Path
 import pytest
 
 
-@pytest.mark.parametrize("package", ["cpr_kin", "planning"])
+@pytest.mark.parametrize(
+    "package",
+    [
+        "cpr_kin",
+        "planning",
+        "planning.curves",
+        "planning.search",
+        "planning.io",
+        "planning.viz",
+        "planning.peers",
+    ],
+)
 def test_every_export_resolves_to_its_module_object(package: str) -> None:
     module = importlib.import_module(package)
     stub = Path(module.__file__ or "").with_suffix(".pyi")
-    imported = {
-        alias.name: f"{package}.{node.module}"
+    imported = {  # name -> the module it comes from (`from . import x`: the submodule x itself)
+        alias.name: f"{package}.{node.module}" if node.module else f"{package}.{alias.name}"
         for node in ast.walk(ast.parse(stub.read_text()))
         if isinstance(node, ast.ImportFrom)
         for alias in node.names
@@ -26,7 +37,10 @@ def test_every_export_resolves_to_its_module_object(package: str) -> None:
     assert sorted(module.__all__) == sorted(imported)  # the stub's __all__ lists what it imports
     assert set(imported) <= set(dir(module))
     for name, source in imported.items():
-        assert getattr(module, name) is getattr(importlib.import_module(source), name), name
+        expected = importlib.import_module(source)
+        if not source.endswith(f".{name}"):
+            expected = getattr(expected, name)
+        assert getattr(module, name) is expected, name
     with pytest.raises(AttributeError, match="no_such_name"):
         _ = module.no_such_name
 
@@ -67,9 +81,10 @@ def test_an_installed_wheel_carries_its_data_and_stubs(tmp_path: Path) -> None:
     site = tmp_path / "site"
     subprocess.run([*pip, "install", "--no-deps", "--target", str(site), str(wheel)], check=True)
     code = (
-        "import cpr_kin, planning; from planning.io.bundled import paper_scene; "
-        "robot = cpr_kin.load_cpr(); scene = paper_scene(); "
-        "print(cpr_kin.__file__, robot.urdf_path, scene.name, planning.plan.__module__, sep='\\n')"
+        "import cpr_kin, planning, planning.curves, planning.io; "
+        "robot = cpr_kin.load_cpr(); scene = planning.io.paper_scene(); "
+        "print(cpr_kin.__file__, robot.urdf_path, scene.name, planning.plan.__module__, "
+        "planning.curves.SepticSplineSolver.__module__, sep='\\n')"
     )
     out = subprocess.run(
         [sys.executable, "-c", code],
@@ -80,4 +95,6 @@ def test_an_installed_wheel_carries_its_data_and_stubs(tmp_path: Path) -> None:
         check=True,
     ).stdout.split("\n")
     assert out[0].startswith(str(site)) and out[1].startswith(str(site))
-    assert out[1].endswith("cpr.urdf") and out[2:4] == ["paper", "planning.planner"]
+    assert out[1].endswith("cpr.urdf") and out[2:5] == ["paper", "planning.planner", "planning.curves.spline"]
+    for package in ("cpr_kin", "planning"):  # PEP 561: the packages carry their own types
+        assert (site / package / "py.typed").is_file()
