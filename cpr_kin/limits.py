@@ -6,14 +6,16 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import yaml
 from numpy.typing import NDArray
 
 from cpr_kin.errors import CprKinError, UrdfError
+from cpr_kin.safe_yaml import YamlError, load_yaml
 
 FloatArray = NDArray[np.float64]
 
 _KINDS = ("velocity", "acceleration", "jerk")
+MAX_LIMITS_BYTES = 100_000
+"""Largest joint limits file [bytes] (the CPR's takes 300)."""
 
 
 @dataclass(frozen=True)
@@ -85,18 +87,17 @@ def read_dynamic_limits(
 
     """
     try:
-        raw = yaml.safe_load(path.read_text())
-    except OSError as exc:
-        raise UrdfError(f"cannot read joint limits file '{path}': {exc.strerror}") from None
-    except yaml.YAMLError as exc:
-        raise UrdfError(f"joint limits file '{path}' is not valid YAML: {exc}") from None
+        raw = load_yaml(path, MAX_LIMITS_BYTES, "joint limits file")
+    except YamlError as exc:
+        raise UrdfError(str(exc)) from None
     if not isinstance(raw, dict):
         raise UrdfError(f"joint limits file '{path}' must map joint names to limits")
     unknown = sorted(set(map(str, raw)) - set(names))
     if unknown:
+        listed = ", ".join(repr(n)[:40] for n in unknown[:3]) + (", ..." if len(unknown) > 3 else "")
+        known = list(names)
         raise UrdfError(
-            f"joint limits file '{path}' names unknown joint(s) {unknown}; "
-            f"the robot's joints are {list(names)}"
+            f"joint limits file '{path}' names unknown joint(s) [{listed}]; the robot's are {known}"
         )
     acc = np.empty(len(names))
     jerk = np.empty(len(names))
@@ -112,14 +113,14 @@ def read_dynamic_limits(
                 f"joint limits file '{path}': joint '{name}' has unknown key(s) {extra}; "
                 f"allowed: {list(_KINDS)}"
             )
-        try:
-            acc[i] = float(entry["acceleration"])
-            jerk[i] = float(entry["jerk"])
-            vel = float(entry.get("velocity", urdf_velocity[i]))
-        except (TypeError, ValueError):
-            raise UrdfError(
-                f"joint limits file '{path}': joint '{name}' limits {entry} must be numbers"
-            ) from None
+        values = {kind: entry.get(kind, urdf_velocity[i] if kind == "velocity" else None) for kind in _KINDS}
+        for kind, value in values.items():
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                shown = repr(value) if len(repr(value)) <= 40 else repr(value)[:37] + "..."
+                raise UrdfError(
+                    f"joint limits file '{path}': joint '{name}' {kind} = {shown} must be a number"
+                )
+        acc[i], jerk[i], vel = float(values["acceleration"]), float(values["jerk"]), float(values["velocity"])
         if not np.isclose(vel, urdf_velocity[i]):
             raise UrdfError(
                 f"joint limits file '{path}': joint '{name}' velocity {vel} disagrees with "

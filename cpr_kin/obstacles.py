@@ -21,31 +21,72 @@ SHAPES: tuple[str, ...] = ("box", "sphere", "cylinder", "capsule", "mesh")
 """Supported obstacle shapes."""
 
 
-def _vector(value: ArrayLike, what: str, n: int) -> FloatArray:
+MAX_COORDINATE_M = 100.0
+"""Largest |coordinate| of an obstacle's centre [m]. The CPR reaches about 1.3 m; far out
+the distance arithmetic loses its meaning (at 1e200 m it overflows)."""
+SIZE_RANGE_M = (1e-4, 100.0)
+"""Allowed box sides, radii and lengths [m]."""
+MAX_ANGLE_RAD = 100.0
+"""Largest |roll|, |pitch|, |yaw| [rad]."""
+SCALE_RANGE = (1e-6, 1e3)
+"""Allowed scale factors of a mesh file."""
+MAX_MESH_BYTES = 50_000_000
+"""Largest mesh file [bytes]."""
+MAX_MESH_VERTICES = 1_000_000
+"""Most vertices of a mesh (coal's bounding-volume tree of a million vertices takes ~1 GB)."""
+MAX_NAME_CHARS = 100
+"""Longest obstacle name (names appear in every message about the obstacle)."""
+
+
+def _shown(value: object) -> str:
+    """``repr`` of a value (a list for an array), cut to 40 characters."""
+    text = repr(value.tolist() if isinstance(value, np.ndarray) else value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def _vector(value: ArrayLike, what: str, n: int, low: float, high: float, unit: str) -> FloatArray:
     try:
+        if np.asarray(value).dtype == np.bool_:
+            raise TypeError("booleans are not coordinates")
         arr = np.array(value, dtype=float)
     except (TypeError, ValueError):
-        raise ObstacleError(f"{what} = {value!r} must be {n} numbers") from None
+        raise ObstacleError(f"{what} = {_shown(value)} must be {n} numbers") from None
     if arr.shape != (n,):
+        raise ObstacleError(f"{what} = {_shown(value)} must have {n} values, not shape {arr.shape}")
+    if not np.all(np.isfinite(arr) & (arr >= low) & (arr <= high)):
         raise ObstacleError(
-            f"{what} = {np.asarray(value).tolist()} must have {n} values, not shape {arr.shape}"
+            f"{what} = {_shown(arr.tolist())} must be finite numbers in [{low:g}, {high:g}] {unit}"
         )
-    if not np.all(np.isfinite(arr)):
-        raise ObstacleError(f"{what} = {arr.tolist()} must be finite numbers (no NaN or inf)")
     arr.setflags(write=False)
     return arr
 
 
-def _positive(value: float | None, what: str) -> float:
+def _number(value: float | None, what: str, low: float, high: float, unit: str) -> float:
     if value is None:
         raise ObstacleError(f"{what} is required")
+    if isinstance(value, bool | np.bool_):  # Python's True is 1, but not a size
+        raise ObstacleError(f"{what} = {value} must be a number in [{low:g}, {high:g}] {unit}".rstrip())
     try:
         x = float(value)
     except (TypeError, ValueError):
-        raise ObstacleError(f"{what} = {value!r} must be a number > 0 [m]") from None
-    if not (math.isfinite(x) and x > 0.0):
-        raise ObstacleError(f"{what} = {x} must be a finite number > 0 [m]")
+        raise ObstacleError(
+            f"{what} = {_shown(value)} must be a number in [{low:g}, {high:g}] {unit}".rstrip()
+        ) from None
+    if not (math.isfinite(x) and low <= x <= high):
+        raise ObstacleError(f"{what} = {x:g} must be a number in [{low:g}, {high:g}] {unit}".rstrip())
     return x
+
+
+def _regular_file(path: Path, what: str) -> Path:
+    """``path`` if it is a regular file of at most :data:`MAX_MESH_BYTES`; an ObstacleError otherwise."""
+    if not path.exists():
+        raise ObstacleError(f"{what} '{path}' does not exist")
+    if not path.is_file():
+        raise ObstacleError(f"{what} '{path}' is not a regular file (a folder or a device); give a mesh file")
+    size = path.stat().st_size
+    if size > MAX_MESH_BYTES:
+        raise ObstacleError(f"{what} '{path}' has {size} bytes; at most {MAX_MESH_BYTES}")
+    return path
 
 
 @dataclass(frozen=True, eq=False)
@@ -89,24 +130,26 @@ class Obstacle:
             raise ObstacleError(
                 f"obstacle '{self.name}': unknown shape {self.shape!r}; allowed: {list(SHAPES)}"
             )
-        object.__setattr__(self, "xyz", _vector(self.xyz, f"obstacle '{self.name}' xyz", 3))
-        object.__setattr__(self, "rpy", _vector(self.rpy, f"obstacle '{self.name}' rpy", 3))
+        if not isinstance(self.name, str) or not 0 < len(self.name) <= MAX_NAME_CHARS:
+            raise ObstacleError(f"obstacle name {_shown(self.name)} must be 1 to {MAX_NAME_CHARS} characters")
+        what = f"obstacle '{self.name}'"
+        bound = MAX_COORDINATE_M
+        object.__setattr__(self, "xyz", _vector(self.xyz, f"{what} xyz", 3, -bound, bound, "m"))
+        object.__setattr__(
+            self, "rpy", _vector(self.rpy, f"{what} rpy", 3, -MAX_ANGLE_RAD, MAX_ANGLE_RAD, "rad")
+        )
         if self.shape == "box":
-            size = _vector(self.size if self.size is not None else [], f"obstacle '{self.name}' size", 3)
-            if not np.all(size > 0):
-                raise ObstacleError(
-                    f"obstacle '{self.name}' size = {size.tolist()} must be > 0 in every axis [m]"
-                )
-            object.__setattr__(self, "size", size)
+            size = [] if self.size is None else self.size
+            object.__setattr__(self, "size", _vector(size, f"{what} size", 3, *SIZE_RANGE_M, "m"))
         if self.shape in ("sphere", "cylinder", "capsule"):
-            object.__setattr__(self, "radius", _positive(self.radius, f"obstacle '{self.name}' radius"))
+            object.__setattr__(self, "radius", _number(self.radius, f"{what} radius", *SIZE_RANGE_M, "m"))
         if self.shape in ("cylinder", "capsule"):
-            object.__setattr__(self, "length", _positive(self.length, f"obstacle '{self.name}' length"))
+            object.__setattr__(self, "length", _number(self.length, f"{what} length", *SIZE_RANGE_M, "m"))
         if self.shape == "mesh":
-            if self.mesh is None or not Path(self.mesh).is_file():
-                raise ObstacleError(f"obstacle '{self.name}': mesh file '{self.mesh}' does not exist")
-            object.__setattr__(self, "mesh", Path(self.mesh))
-            object.__setattr__(self, "scale", _positive(self.scale, f"obstacle '{self.name}' scale"))
+            if self.mesh is None:
+                raise ObstacleError(f"{what}: a mesh obstacle needs a mesh file")
+            object.__setattr__(self, "mesh", _regular_file(Path(self.mesh), f"{what}: mesh file"))
+            object.__setattr__(self, "scale", _number(self.scale, f"{what} scale", *SCALE_RANGE, ""))
 
     def _key(self) -> tuple[object, ...]:
         size = None if self.size is None else tuple(np.asarray(self.size).tolist())
@@ -212,18 +255,39 @@ class Obstacle:
     def _mesh_geometry(self) -> Any:
         import trimesh  # only needed for mesh obstacles
 
+        what = f"obstacle '{self.name}': mesh '{self.mesh}'"
         try:
             mesh: Any = trimesh.load(str(self.mesh), force="mesh")
         except Exception as exc:  # trimesh raises many types for unreadable files
-            raise ObstacleError(f"obstacle '{self.name}': cannot read mesh '{self.mesh}': {exc}") from None
-        if len(mesh.faces) == 0:
-            raise ObstacleError(f"obstacle '{self.name}': mesh '{self.mesh}' has no triangles")
+            raise ObstacleError(f"{what} cannot be read: {_shown(str(exc))}") from None
+        vertices = np.asarray(getattr(mesh, "vertices", np.empty((0, 3))), dtype=np.float64)
+        faces = np.asarray(getattr(mesh, "faces", np.empty((0, 3))), dtype=np.int64)
+        if len(faces) == 0:
+            raise ObstacleError(f"{what} has no triangles")
+        if len(vertices) > MAX_MESH_VERTICES:
+            raise ObstacleError(f"{what} has {len(vertices)} vertices; at most {MAX_MESH_VERTICES}")
+        if not np.all(np.isfinite(vertices)) or np.abs(vertices * self.scale).max() > MAX_COORDINATE_M:
+            raise ObstacleError(f"{what} has vertices that are not finite or beyond {MAX_COORDINATE_M:g} m")
         if self.convex:
-            mesh = mesh.convex_hull
+            # the hull of a flat (or line-like) mesh has no volume: Qhull refuses it
+            spread = np.linalg.svd(vertices - vertices.mean(axis=0), compute_uv=False)
+            if len(vertices) < 4 or spread[-1] <= 1e-9 * max(spread[0], 1e-300):
+                raise ObstacleError(
+                    f"{what} is flat (its vertices span no volume), so it has no convex hull; "
+                    "give a solid mesh, or convex: false to use its surface"
+                )
+            try:
+                hull = mesh.convex_hull
+            except Exception as exc:  # Qhull's errors for degenerate input
+                raise ObstacleError(f"{what} has no convex hull: {_shown(str(exc))}") from None
+            vertices, faces = (
+                np.asarray(hull.vertices, dtype=np.float64),
+                np.asarray(hull.faces, dtype=np.int64),
+            )
         bvh = coal.BVHModelOBBRSS()
-        bvh.beginModel(len(mesh.faces), len(mesh.vertices))
-        bvh.addVertices(np.asarray(mesh.vertices, dtype=np.float64) * self.scale)
-        bvh.addTriangles(np.asarray(mesh.faces, dtype=np.int64))
+        bvh.beginModel(len(faces), len(vertices))
+        bvh.addVertices(vertices * self.scale)
+        bvh.addTriangles(faces)
         bvh.endModel()
         if self.convex:
             bvh.buildConvexRepresentation(False)

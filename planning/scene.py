@@ -9,7 +9,6 @@ the fields of :class:`PlannerSettings` (with its nested
 from __future__ import annotations
 
 import dataclasses
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -22,6 +21,7 @@ import cpr_kin as ck
 from planning.curves.spline import SplineSettings
 from planning.errors import PlanningError
 from planning.search.firefly import FireflySettings
+from planning.validation import integer_in, number_in, shown
 
 FloatArray = NDArray[np.float64]
 Fitness = Literal["clearance", "paper"]
@@ -34,6 +34,33 @@ DEFAULT_SAFETY_MARGIN_M = 0.1
 DEFAULT_SPLINE = SplineSettings(p=1e6, a=(0.0, 0.0, 1.0), ends="rest")
 """The spline of a scene unless it says otherwise: the paper's weights, but at rest at both
 ends, which a real robot needs (the paper case itself uses natural ends)."""
+
+MAX_WAYPOINTS = 20
+"""Most intermediate waypoints (the search's dimension is waypoints x moving joints)."""
+MAX_FITNESS_SAMPLES = 4096
+"""Most configurations checked per candidate path: with 1000 fireflies, 4096 x 5 x 8 bytes
+per candidate is 160 MB of samples."""
+IPO_RANGE_S = (1e-3, 1.0)
+"""Allowed controller interpolation periods [s]."""
+VERIFY_STEP_RANGE_M = (1e-4, 0.1)
+"""Allowed robot motion between two verification checks [m]: below 0.1 mm the check of a
+long trajectory takes minutes, above 0.1 m it is no check."""
+MAX_SAFETY_MARGIN_M = 1.0
+"""Largest safety margin [m]: the CPR reaches about 1.3 m."""
+DURATION_RANGE_S = (0.01, 600.0)
+"""Allowed fixed durations [s]."""
+MAX_IPO_SAMPLES = 100_000
+"""Most IPO samples of a fixed duration, ``duration / ipo``: the fitness samples every
+candidate's path at each (about 100,000 x 150 columns x 8 bytes = 120 MB per array)."""
+MAX_OBSTACLES = 500
+"""Most obstacles in a scene (each adds six robot-obstacle pairs to every check)."""
+SPLINE_P_RANGE = (1e-6, 1e12)
+"""Allowed finite node weights ``p`` of a scene's spline (``inf`` also: exact interpolation);
+beyond them the banded system loses the digits that the node deviation is measured in."""
+SPLINE_A_RANGE = (1e-6, 1e6)
+"""Allowed non-zero velocity, acceleration and jerk weights ``a_r`` of a scene's spline."""
+MAX_SEED = 2**63 - 1
+"""Largest seed (it is stored in the trajectory file as a JSON integer)."""
 
 _FIREFLY_FIELDS = frozenset(f.name for f in dataclasses.fields(FireflySettings))
 
@@ -71,16 +98,19 @@ class PlannerSettings:
 
     Attributes:
         firefly: the firefly algorithm's parameters (the paper's by default).
-        waypoints: number of intermediate waypoints p. The paper: 3.
+        waypoints: number of intermediate waypoints p, at most :data:`MAX_WAYPOINTS`. The
+            paper: 3.
         fitness: ``"clearance"`` (feasible first, infeasible ranked by coal's violation
             depth) or ``"paper"`` (eq. 4-6).
         seed: seed of the random generator.
         path: what the fitness checks: the executed ``"spline"`` (default) or the
             paper's straight joint-space ``"ptp"`` moves.
-        ipo: controller interpolation period [s] for w_sol.
-        fitness_samples: configurations checked per candidate path in the fitness.
-        verify_step_m: robot motion between two checks in the final verification [m];
-            the fitness requires this much clearance beyond the margin.
+        ipo: controller interpolation period [s] for w_sol, in :data:`IPO_RANGE_S`.
+        fitness_samples: configurations checked per candidate path in the fitness, at most
+            :data:`MAX_FITNESS_SAMPLES`.
+        verify_step_m: robot motion between two checks in the final verification [m], in
+            :data:`VERIFY_STEP_RANGE_M`; the fitness requires this much clearance beyond the
+            margin.
         max_node_deviation: largest spline node deviation a candidate may have [rad or m];
             ``None`` (default): no bound. The paper case requires 20e-6.
         moving_joints: joints the waypoints move; default: theta1, d2, d3, and a wrist
@@ -100,27 +130,22 @@ class PlannerSettings:
 
     def __post_init__(self) -> None:
         if not isinstance(self.firefly, FireflySettings):
-            raise PlanningError(f"firefly = {self.firefly!r} must be a FireflySettings")
-        if not (isinstance(self.waypoints, int) and self.waypoints >= 1):
-            raise PlanningError(f"waypoints = {self.waypoints!r} must be an integer >= 1")
+            raise PlanningError(f"firefly = {shown(self.firefly)} must be a FireflySettings")
+        integer_in("waypoints", self.waypoints, 1, MAX_WAYPOINTS)
         if self.fitness not in ("clearance", "paper"):
-            raise PlanningError(f"fitness = {self.fitness!r}; allowed: 'clearance', 'paper'")
+            raise PlanningError(f"fitness = {shown(self.fitness)}; allowed: 'clearance', 'paper'")
         if self.path not in ("spline", "ptp"):
-            raise PlanningError(f"path = {self.path!r}; allowed: 'spline', 'ptp'")
-        if not (isinstance(self.seed, int) and self.seed >= 0):
-            raise PlanningError(f"seed = {self.seed!r} must be an integer >= 0")
-        if not (math.isfinite(self.ipo) and self.ipo > 0):
-            raise PlanningError(f"ipo = {self.ipo!r} s must be a finite number > 0")
-        if not (isinstance(self.fitness_samples, int) and self.fitness_samples >= 2):
-            raise PlanningError(f"fitness_samples = {self.fitness_samples!r} must be an integer >= 2")
-        if self.max_node_deviation is not None and not (
-            math.isfinite(self.max_node_deviation) and self.max_node_deviation > 0
-        ):
-            raise PlanningError(
-                f"max_node_deviation = {self.max_node_deviation!r} must be a finite number > 0"
-            )
-        if not (math.isfinite(self.verify_step_m) and self.verify_step_m > 0):
-            raise PlanningError(f"verify_step_m = {self.verify_step_m!r} m must be a finite number > 0")
+            raise PlanningError(f"path = {shown(self.path)}; allowed: 'spline', 'ptp'")
+        integer_in("seed", self.seed, 0, MAX_SEED)
+        number_in("ipo", self.ipo, *IPO_RANGE_S, unit="s")
+        integer_in("fitness_samples", self.fitness_samples, 2, MAX_FITNESS_SAMPLES)
+        if self.max_node_deviation is not None:
+            number_in("max_node_deviation", self.max_node_deviation, 0.0, 1.0, low_open=True)
+        number_in("verify_step_m", self.verify_step_m, *VERIFY_STEP_RANGE_M, unit="m")
+        if self.moving_joints is not None:
+            names = list(self.moving_joints)
+            if len(set(names)) != len(names):
+                raise PlanningError(f"moving_joints = {shown(names)} names a joint twice")
 
     @classmethod
     def from_flat(cls, values: Mapping[str, Any]) -> PlannerSettings:
@@ -161,13 +186,16 @@ class Scene:
     Attributes:
         start: where the robot stands.
         goal: where it must go.
-        obstacles: static obstacles, unique names.
-        safety_margin: required clearance between every robot geometry and every obstacle [m].
-        duration: trajectory duration [s]; ``None``: the fastest timing within the joints'
-            velocity, acceleration and jerk limits.
+        obstacles: static obstacles, unique names, at most :data:`MAX_OBSTACLES`.
+        safety_margin: required clearance between every robot geometry and every obstacle
+            [m], at most :data:`MAX_SAFETY_MARGIN_M`.
+        duration: trajectory duration [s], in :data:`DURATION_RANGE_S` and at most
+            :data:`MAX_IPO_SAMPLES` IPO periods; ``None``: the fastest timing within the
+            joints' velocity, acceleration and jerk limits.
         robot: URDF of the robot; ``None``: the bundled CPR.
         planner: planner settings.
-        spline: spline settings (default :data:`DEFAULT_SPLINE`).
+        spline: spline settings (default :data:`DEFAULT_SPLINE`); finite weights ``p`` in
+            :data:`SPLINE_P_RANGE`, non-zero ``a_r`` in :data:`SPLINE_A_RANGE`.
         name: a name for reports.
     """
 
@@ -182,12 +210,21 @@ class Scene:
     name: str = "scene"
 
     def __post_init__(self) -> None:
-        if not (
-            isinstance(self.safety_margin, int | float)
-            and math.isfinite(self.safety_margin)
-            and self.safety_margin >= 0
-        ):
-            raise PlanningError(f"safety_margin = {self.safety_margin!r} m must be a finite number >= 0")
-        if self.duration is not None and not (math.isfinite(self.duration) and self.duration > 0):
-            raise PlanningError(f"duration = {self.duration!r} s must be a finite number > 0 (or omitted)")
+        number_in("safety_margin", self.safety_margin, 0.0, MAX_SAFETY_MARGIN_M, unit="m")
         object.__setattr__(self, "obstacles", tuple(self.obstacles))
+        if len(self.obstacles) > MAX_OBSTACLES:
+            raise PlanningError(f"{len(self.obstacles)} obstacles; at most {MAX_OBSTACLES}")
+        for k, p in enumerate(np.atleast_1d(self.spline.p)):
+            if np.isfinite(p):
+                number_in(f"spline.p[{k}]" if np.ndim(self.spline.p) else "spline.p", p, *SPLINE_P_RANGE)
+        for r, a in enumerate(self.spline.a):
+            if a != 0.0:
+                number_in(f"spline.a[{r}]", a, *SPLINE_A_RANGE)
+        if self.duration is not None:
+            number_in("duration", self.duration, *DURATION_RANGE_S, unit="s")
+            samples = self.duration / self.planner.ipo
+            if samples > MAX_IPO_SAMPLES:
+                raise PlanningError(
+                    f"duration / planner.ipo = {samples:.0f} IPO samples; at most {MAX_IPO_SAMPLES}: "
+                    "lengthen ipo or shorten the duration"
+                )

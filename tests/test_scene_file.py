@@ -2,6 +2,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+import re
 from pathlib import Path
 from typing import Any
 
@@ -12,11 +13,11 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import cpr_kin as ck
+from cpr_kin.safe_yaml import StrictLoader
 from planning.curves.spline import SplineSettings
 from planning.errors import SceneError
 from planning.io.bundled import paper_scene, paper_scene_path
 from planning.io.scene_file import (
-    SAFE_LOADER,
     dump_scene,
     load_scene,
     parse_scene,
@@ -215,13 +216,29 @@ def test_bundled_example_scene_loads() -> None:
     assert sorted(o.shape for o in scene.obstacles) == ["box", "cylinder", "sphere"]
 
 
-def test_libyaml_loader_reads_scene_files_as_pyyaml_does(tmp_path: Path) -> None:
-    """The fast loader (libyaml's) gives the documents of PyYAML's pure-Python safe loader."""
-    assert SAFE_LOADER is yaml.CSafeLoader  # the wheels ship libyaml; else the test is moot
+def yaml12_floats(document: Any) -> Any:
+    """``document`` with the strings PyYAML's YAML 1.1 resolver leaves as text (1.0e6) as floats."""
+    if isinstance(document, dict):
+        return {k: yaml12_floats(v) for k, v in document.items()}
+    if isinstance(document, list):
+        return [yaml12_floats(v) for v in document]
+    if isinstance(document, str) and re.fullmatch(r"[-+]?[0-9][0-9_]*(\.[0-9_]*)?[eE][-+]?[0-9]+", document):
+        return float(document)
+    return document
+
+
+def test_strict_loader_reads_scene_files_as_pyyaml_does(tmp_path: Path) -> None:
+    """The strict loader (libyaml's parser) gives the documents of PyYAML's pure-Python safe loader.
+
+    Except for one intended difference: ``1.0e6`` is a float (YAML 1.2), where PyYAML's
+    YAML 1.1 resolver leaves it a string (which the strict schema would refuse).
+    """
+    assert issubclass(StrictLoader, yaml.CSafeLoader)  # the wheels ship libyaml; else the test is moot
     paths = sorted(paper_scene_path().parent.glob("*.yaml"))
     for scene in generate_scenes(5, seed=3):
         paths.append(tmp_path / f"{scene.name}.yaml")
         dump_scene(scene, paths[-1])
     for path in paths:
         text = path.read_text(encoding="utf-8")
-        assert yaml.load(text, Loader=SAFE_LOADER) == yaml.load(text, Loader=yaml.SafeLoader), path.name
+        expected = yaml12_floats(yaml.load(text, Loader=yaml.SafeLoader))
+        assert yaml.load(text, Loader=StrictLoader) == expected, path.name
