@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -113,7 +114,9 @@ def read_dynamic_limits(
                 f"joint limits file '{path}': joint '{name}' has unknown key(s) {extra}; "
                 f"allowed: {list(_KINDS)}"
             )
-        values = {kind: entry.get(kind, urdf_velocity[i] if kind == "velocity" else None) for kind in _KINDS}
+        values: dict[str, Any] = {
+            kind: entry.get(kind, urdf_velocity[i] if kind == "velocity" else None) for kind in _KINDS
+        }
         for kind, value in values.items():
             if isinstance(value, bool) or not isinstance(value, int | float):
                 shown = repr(value) if len(repr(value)) <= 40 else repr(value)[:37] + "..."

@@ -139,7 +139,7 @@ class Obstacle:
             self, "rpy", _vector(self.rpy, f"{what} rpy", 3, -MAX_ANGLE_RAD, MAX_ANGLE_RAD, "rad")
         )
         if self.shape == "box":
-            size = [] if self.size is None else self.size
+            size: ArrayLike = [] if self.size is None else self.size
             object.__setattr__(self, "size", _vector(size, f"{what} size", 3, *SIZE_RANGE_M, "m"))
         if self.shape in ("sphere", "cylinder", "capsule"):
             object.__setattr__(self, "radius", _number(self.radius, f"{what} radius", *SIZE_RANGE_M, "m"))

@@ -142,10 +142,14 @@ def test_sequential_mode_matches_niapy(seed: int) -> None:
 @pytest.mark.parametrize(
     ("kwargs", "pattern"),
     [
-        ({"fireflies": 0}, "fireflies = 0 must be an integer >= 2"),
-        ({"iterations": -1}, "iterations = -1 must be an integer >= 0"),
-        ({"alpha": float("nan")}, "alpha = nan must be a finite number >= 0"),
-        ({"theta": 1.5}, r"theta = 1.5 must be in \(0, 1\]"),
+        ({"fireflies": 0}, r"fireflies = 0 must be an integer in \[2, 1000\]"),
+        ({"fireflies": True}, r"fireflies = True must be an integer in \[2, 1000\]"),
+        ({"fireflies": 10**9}, r"fireflies = 1000000000 must be an integer in \[2, 1000\]"),
+        ({"iterations": -1}, r"iterations = -1 must be an integer in \[0, 10000\]"),
+        ({"fireflies": 1000, "iterations": 5000}, r"fireflies x \(iterations \+ 1\) = 5001000 evaluations"),
+        ({"alpha": float("nan")}, r"alpha = nan must be a number in \[0, 10\]"),
+        ({"alpha": 1e300}, r"alpha = 1e\+300 must be a number in \[0, 10\]"),
+        ({"theta": 1.5}, r"theta = 1.5 must be a number in \(0, 1\]"),
         ({"mode": "parallel"}, "mode = 'parallel'; allowed: 'sweep', 'sequential'"),
     ],
 )

@@ -40,7 +40,7 @@ import cpr_kin as ck
             r"'far' xyz = \[1e\+200, 0\.0, 0\.0\] must be finite numbers in \[-100, 100\] m",
         ),
         (
-            lambda: ck.Obstacle.sphere(True, (0, 0, 0), name="flag"),  # type: ignore[arg-type]
+            lambda: ck.Obstacle.sphere(True, (0, 0, 0), name="flag"),
             r"'flag' radius = True must be a number in \[0\.0001, 100\] m",
         ),
         (

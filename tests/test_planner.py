@@ -125,11 +125,11 @@ def test_infeasible_scene_raises_with_the_best_clearance(robot: ck.Robot) -> Non
 
 
 def test_bad_planner_settings() -> None:
-    with pytest.raises(PlanningError, match="waypoints = 0 must be an integer >= 1"):
+    with pytest.raises(PlanningError, match=r"waypoints = 0 must be an integer in \[1, 20\]"):
         PlannerSettings(waypoints=0)
     with pytest.raises(PlanningError, match="fitness = 'fast'; allowed: 'clearance', 'paper'"):
         PlannerSettings(fitness="fast")  # type: ignore[arg-type]
-    with pytest.raises(PlanningError, match="fireflies = 0 must be an integer >= 2"):
+    with pytest.raises(PlanningError, match=r"fireflies = 0 must be an integer in \[2, 1000\]"):
         PlannerSettings().updated(fireflies=0)
     with pytest.raises(PlanningError, match=r"unknown planner setting\(s\) \['fire_flies'\]"):
         PlannerSettings().updated(fire_flies=10)

@@ -22,9 +22,8 @@ from typing import Any
 import yaml
 from pydantic import ValidationError
 
-from cpr_kin.safe_yaml import YamlError, load_yaml
-
 import cpr_kin as ck
+from cpr_kin.safe_yaml import YamlError, load_yaml
 from planning.curves.spline import SplineSettings
 from planning.errors import PlanningError, SceneError
 from planning.io.scene_schema import (

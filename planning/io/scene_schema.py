@@ -13,61 +13,88 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from planning.scene import DEFAULT_SAFETY_MARGIN_M, DEFAULT_SPLINE, PlannerSettings
-from planning.search.firefly import FireflySettings
+from cpr_kin.obstacles import MAX_ANGLE_RAD, MAX_COORDINATE_M, MAX_NAME_CHARS, SCALE_RANGE, SIZE_RANGE_M
+from planning.scene import (
+    DEFAULT_SAFETY_MARGIN_M,
+    DEFAULT_SPLINE,
+    DURATION_RANGE_S,
+    IPO_RANGE_S,
+    MAX_FITNESS_SAMPLES,
+    MAX_OBSTACLES,
+    MAX_SAFETY_MARGIN_M,
+    MAX_SEED,
+    MAX_WAYPOINTS,
+    SPLINE_A_RANGE,
+    SPLINE_P_RANGE,
+    VERIFY_STEP_RANGE_M,
+    PlannerSettings,
+)
+from planning.search.firefly import MAX_FIREFLIES, MAX_GAMMA, MAX_ITERATIONS, MAX_STEP, FireflySettings
+from planning.validation import shown
 
-Finite = Annotated[float, Field(allow_inf_nan=False)]
-Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
-NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
-Vector3 = Annotated[list[Finite], Field(min_length=3, max_length=3)]
+
+def _between(low: float, high: float) -> Any:
+    return Field(ge=low, le=high, allow_inf_nan=False)
+
+
+Coordinate = Annotated[float, _between(-MAX_COORDINATE_M, MAX_COORDINATE_M)]
+Angle = Annotated[float, _between(-MAX_ANGLE_RAD, MAX_ANGLE_RAD)]
+Size = Annotated[float, _between(*SIZE_RANGE_M)]
+Point = Annotated[list[Coordinate], Field(min_length=3, max_length=3)]
+Turn = Annotated[list[Angle], Field(min_length=3, max_length=3)]
+Name = Annotated[str, Field(min_length=1, max_length=MAX_NAME_CHARS)]
+FilePath = Annotated[str, Field(min_length=1, max_length=4096)]
+JointName = Literal["theta1", "d2", "d3", "theta4", "theta5"]
+Weight = Annotated[float, _between(0.0, SPLINE_A_RANGE[1])]
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    # strict: a number must be a number (not true, not "0.1"), a list a list
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True)
 
 
 class _Placed(_Strict):
-    name: str | None = None
-    xyz: Vector3
-    rpy: Vector3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    name: Name | None = None
+    xyz: Point
+    rpy: Turn = Field(default_factory=lambda: [0.0, 0.0, 0.0])
 
 
 class BoxSpec(_Placed):
     """``{shape: box, size: [x, y, z], xyz, rpy}``: full side lengths [m]."""
 
     shape: Literal["box"]
-    size: Annotated[list[Positive], Field(min_length=3, max_length=3)]
+    size: Annotated[list[Size], Field(min_length=3, max_length=3)]
 
 
 class SphereSpec(_Placed):
     """``{shape: sphere, radius, xyz}`` [m]."""
 
     shape: Literal["sphere"]
-    radius: Positive
+    radius: Size
 
 
 class CylinderSpec(_Placed):
     """``{shape: cylinder, radius, length, xyz, rpy}``: axis along the local z [m]."""
 
     shape: Literal["cylinder"]
-    radius: Positive
-    length: Positive
+    radius: Size
+    length: Size
 
 
 class CapsuleSpec(_Placed):
     """``{shape: capsule, radius, length, xyz, rpy}``: segment along the local z [m]."""
 
     shape: Literal["capsule"]
-    radius: Positive
-    length: Positive
+    radius: Size
+    length: Size
 
 
 class MeshSpec(_Placed):
     """``{shape: mesh, mesh: FILE, scale, convex, xyz, rpy}``; FILE relative to the scene."""
 
     shape: Literal["mesh"]
-    mesh: str
-    scale: Positive = 1.0
+    mesh: FilePath
+    scale: Annotated[float, _between(*SCALE_RANGE)] = 1.0
     convex: bool = True
 
 
@@ -79,10 +106,10 @@ ObstacleSpec = Annotated[
 class TargetSpec(_Strict):
     """``{tcp: [x, y, z]}`` (with optional ``theta4``, ``theta5``) or ``{q: [5 joint values]}``."""
 
-    tcp: Vector3 | None = None
-    q: Annotated[list[Finite], Field(min_length=5, max_length=5)] | None = None
-    theta4: Finite = 0.0
-    theta5: Finite = 0.0
+    tcp: Point | None = None
+    q: Annotated[list[Angle], Field(min_length=5, max_length=5)] | None = None
+    theta4: Angle = 0.0
+    theta5: Angle = 0.0
 
     @model_validator(mode="after")
     def _one_of(self) -> TargetSpec:
@@ -101,31 +128,33 @@ _F, _P = FireflySettings, PlannerSettings  # the defaults are the settings' own
 class PlannerSpec(_Strict):
     """The flat ``planner:`` block; see :class:`~planning.scene.PlannerSettings` (same defaults)."""
 
-    fireflies: Annotated[int, Field(ge=2)] = _F.fireflies
-    iterations: Annotated[int, Field(ge=0)] = _F.iterations
-    alpha: NonNegative = _F.alpha
-    beta0: NonNegative = _F.beta0
-    gamma: NonNegative = _F.gamma
+    fireflies: Annotated[int, Field(ge=2, le=MAX_FIREFLIES)] = _F.fireflies
+    iterations: Annotated[int, Field(ge=0, le=MAX_ITERATIONS)] = _F.iterations
+    alpha: Annotated[float, _between(0.0, MAX_STEP)] = _F.alpha
+    beta0: Annotated[float, _between(0.0, MAX_STEP)] = _F.beta0
+    gamma: Annotated[float, _between(0.0, MAX_GAMMA)] = _F.gamma
     theta: Annotated[float, Field(gt=0, le=1)] = _F.theta
     mode: Literal["sweep", "sequential"] = _F.mode
-    waypoints: Annotated[int, Field(ge=1)] = _P.waypoints
+    waypoints: Annotated[int, Field(ge=1, le=MAX_WAYPOINTS)] = _P.waypoints
     fitness: Literal["clearance", "paper"] = _P.fitness
-    seed: Annotated[int, Field(ge=0)] = _P.seed
+    seed: Annotated[int, Field(ge=0, le=MAX_SEED)] = _P.seed
     path: Literal["spline", "ptp"] = _P.path
-    ipo: Positive = _P.ipo
-    fitness_samples: Annotated[int, Field(ge=2)] = _P.fitness_samples
-    verify_step_m: Positive = _P.verify_step_m
-    max_node_deviation: Positive | None = _P.max_node_deviation
-    moving_joints: list[Literal["theta1", "d2", "d3", "theta4", "theta5"]] | None = None
+    ipo: Annotated[float, _between(*IPO_RANGE_S)] = _P.ipo
+    fitness_samples: Annotated[int, Field(ge=2, le=MAX_FITNESS_SAMPLES)] = _P.fitness_samples
+    verify_step_m: Annotated[float, _between(*VERIFY_STEP_RANGE_M)] = _P.verify_step_m
+    max_node_deviation: Annotated[float, Field(gt=0, le=1)] | None = _P.max_node_deviation
+    moving_joints: (
+        Annotated[list[Literal["theta1", "d2", "d3", "theta4", "theta5"]], Field(max_length=5)] | None
+    ) = None
 
 
 class SplineSpec(_Strict):
     """The ``spline:`` block; see :class:`~planning.curves.spline.SplineSettings`."""
 
-    p: Annotated[float, Field(gt=0)] = float(DEFAULT_SPLINE.p)  # type: ignore[arg-type]
-    a: Annotated[list[NonNegative], Field(min_length=3, max_length=3)] = Field(
-        default_factory=lambda: list(DEFAULT_SPLINE.a)
-    )
+    p: Annotated[float, Field(ge=SPLINE_P_RANGE[0])] = float(DEFAULT_SPLINE.p)  # type: ignore[arg-type]
+    a: Annotated[
+        list[Annotated[float, _between(0.0, SPLINE_A_RANGE[1])]], Field(min_length=3, max_length=3)
+    ] = Field(default_factory=lambda: list(DEFAULT_SPLINE.a))
     ends: Literal["natural", "rest"] = DEFAULT_SPLINE.ends
 
     @model_validator(mode="after")
@@ -134,21 +163,24 @@ class SplineSpec(_Strict):
             raise ValueError(
                 "a = [0, 0, 0] leaves the spline undetermined; give a weight > 0, e.g. a: [0, 0, 1]"
             )
-        if math.isnan(self.p):
-            raise ValueError("p must be a number > 0 (.inf interpolates exactly)")
+        if math.isnan(self.p) or (math.isfinite(self.p) and self.p > SPLINE_P_RANGE[1]):
+            low, high = SPLINE_P_RANGE
+            raise ValueError(f"p = {self.p!r} must be in [{low:g}, {high:g}] or .inf (exact interpolation)")
+        if any(0 < a < SPLINE_A_RANGE[0] for a in self.a):
+            raise ValueError(f"a weight other than 0 must be at least {SPLINE_A_RANGE[0]:g}")
         return self
 
 
 class SceneSpec(_Strict):
     """A whole scene file."""
 
-    name: str | None = None
-    robot: str | None = None
-    safety_margin: NonNegative = DEFAULT_SAFETY_MARGIN_M
+    name: Annotated[str, Field(min_length=1, max_length=200)] | None = None
+    robot: FilePath | None = None
+    safety_margin: Annotated[float, _between(0.0, MAX_SAFETY_MARGIN_M)] = DEFAULT_SAFETY_MARGIN_M
     start: TargetSpec
     goal: TargetSpec
-    duration: Positive | None = None
-    obstacles: list[ObstacleSpec] = Field(default_factory=list)
+    duration: Annotated[float, _between(*DURATION_RANGE_S)] | None = None
+    obstacles: Annotated[list[ObstacleSpec], Field(max_length=MAX_OBSTACLES)] = Field(default_factory=list)
     planner: PlannerSpec = Field(default_factory=PlannerSpec)
     spline: SplineSpec = Field(default_factory=SplineSpec)
 
@@ -176,7 +208,8 @@ def _path(location: tuple[int | str, ...]) -> str:
         elif part in _SHAPE_SPECS:
             continue  # the discriminator's branch, not a key of the file
         else:
-            text += f".{part}" if text else str(part)
+            key = str(part) if len(str(part)) <= 40 else str(part)[:37] + "..."  # a key may be hostile too
+            text += f".{key}" if text else key
     return text or "(top level)"
 
 
@@ -201,11 +234,19 @@ def _describe(error: dict[str, Any]) -> str:
         return f"{where}: required key is missing"
     if error["type"] in ("union_tag_invalid", "union_tag_not_found") and isinstance(value, dict):
         allowed = ", ".join(_SHAPE_SPECS)
-        return f"{where}.shape = {value.get('shape')!r}: unknown or missing shape; allowed: {allowed}"
+        return f"{where}.shape = {shown(value.get('shape'))}: unknown or missing shape; allowed: {allowed}"
     message = error["msg"].removeprefix("Value error, ")
-    return f"{where} = {value!r}: {message}"
+    if isinstance(value, dict):  # a block (a model's input): its keys tell more than its repr
+        return f"{where}: {message}"
+    return f"{where} = {shown(value)}: {message}"
+
+
+MAX_PROBLEMS = 3
+"""Most problems one message lists (the rest are counted)."""
 
 
 def describe_errors(error: ValidationError) -> str:
-    """One ``; ``-separated line naming every problem of a failed validation."""
-    return "; ".join(_describe(dict(e)) for e in error.errors())
+    """One ``; ``-separated line naming the first problems of a failed validation."""
+    problems = [_describe(dict(e)) for e in error.errors()]
+    more = len(problems) - MAX_PROBLEMS
+    return "; ".join(problems[:MAX_PROBLEMS]) + (f"; and {more} more" if more > 0 else "")
