@@ -16,12 +16,12 @@ from typing import Any
 
 import numpy as np
 import pinocchio as pin
-from lxml import etree
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import CprKinError, JointLimitError, UrdfError
 from cpr_kin.limits import JointLimits, read_dynamic_limits
 from cpr_kin.resources import cpr_limits_path, cpr_urdf_path
+from cpr_kin.urdf_file import collision_names, is_bundled, parse_urdf, validate_urdf
 
 FloatArray = NDArray[np.float64]
 
@@ -54,59 +54,6 @@ class RobotGeometry:
     link: str
     group: str
     index: int
-
-
-def _parse_urdf(path: Path) -> etree._ElementTree:
-    """Parse ``path`` as strict XML; raise :class:`UrdfError` if it is missing or malformed."""
-    if not path.is_file():
-        raise UrdfError(f"URDF file '{path}' does not exist; pass the path of a .urdf file")
-    try:
-        return etree.parse(str(path), etree.XMLParser(recover=False))
-    except etree.XMLSyntaxError as exc:
-        raise UrdfError(f"URDF file '{path}' is not well-formed XML: {exc}") from None
-
-
-def _validate_urdf(path: Path) -> None:
-    """Validate the URDF at ``path`` with yourdfpy; raise :class:`UrdfError` naming the problems.
-
-    yourdfpy is imported here, not with the package: it imports trimesh, about 0.7 s, which
-    a process that loads only the bundled (tested) URDF need not pay.
-    """
-    import yourdfpy
-
-    try:
-        urdf = yourdfpy.URDF.load(
-            str(path), build_scene_graph=False, load_meshes=False, load_collision_meshes=False
-        )
-    except Exception as exc:  # yourdfpy raises bare exceptions on structural problems
-        raise UrdfError(f"URDF file '{path}' cannot be read: {exc}") from None
-    found: list[Any] = []
-
-    def keep(errors: list[Any]) -> bool:
-        found.extend(errors)
-        return not errors
-
-    if not urdf.validate(keep):
-        problems = "; ".join(str(e) for e in found)
-        raise UrdfError(f"URDF file '{path}' is invalid: {problems}")
-
-
-def _collision_names(tree: etree._ElementTree) -> dict[str, list[str]]:
-    """Collision element names per link, as written in the URDF (or ``link`` / ``link_i`` if unnamed)."""
-    names: dict[str, list[str]] = {}
-    for link in tree.getroot().findall("link"):
-        collisions = link.findall("collision")
-        link_name = link.get("name", "")
-        names[link_name] = [
-            c.get("name") or (link_name if len(collisions) == 1 else f"{link_name}_{i}")
-            for i, c in enumerate(collisions)
-        ]
-    return names
-
-
-def _is_bundled(path: Path) -> bool:
-    """Whether ``path`` is the bundled CPR URDF, which the test suite validates with yourdfpy."""
-    return path.resolve() == cpr_urdf_path().resolve()
 
 
 @dataclass(frozen=True, eq=False)
@@ -155,9 +102,9 @@ class Robot:
 
         """
         path = Path(urdf_path) if urdf_path is not None else cpr_urdf_path()
-        tree = _parse_urdf(path)
-        if validate or (validate is None and not _is_bundled(path)):
-            _validate_urdf(path)
+        tree = parse_urdf(path)
+        if validate or (validate is None and not is_bundled(path)):
+            validate_urdf(path)
         try:
             model, collision_model, visual_model = pin.buildModelsFromUrdf(str(path), str(path.parent))
         except Exception as exc:  # Pinocchio reports C++ exceptions as RuntimeError/ValueError
@@ -187,14 +134,14 @@ class Robot:
             jerk=jerk,
         )
 
-        collision_names = _collision_names(tree)
+        names_by_link = collision_names(tree)
         geometries = []
         used: dict[str, int] = {}
         for index, obj in enumerate(collision_model.geometryObjects):
             link = model.frames[obj.parentFrame].name
             k = used.get(link, 0)
             used[link] = k + 1
-            name = collision_names[link][k]
+            name = names_by_link[link][k]
             obj.name = name
             group = "effector" if link in EFFECTOR_LINKS else "links"
             geometries.append(RobotGeometry(name=name, link=link, group=group, index=index))

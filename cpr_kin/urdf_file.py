@@ -1,0 +1,83 @@
+"""Reading a URDF file: strict, bounded XML, and yourdfpy's structural validation.
+
+Pinocchio builds the models from the file (:meth:`cpr_kin.Robot.load`); this module makes
+sure first that the file is one: a regular file of bounded size, well-formed XML parsed
+without entity expansion or network access, and (for a user's URDF) a structure yourdfpy
+accepts, so that a broken file gets a message naming the problem.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from lxml import etree
+
+from cpr_kin.errors import UrdfError
+from cpr_kin.resources import cpr_urdf_path
+
+MAX_URDF_BYTES = 10_000_000
+"""Largest URDF file [bytes] (the CPR's takes 6 kB)."""
+
+
+def parse_urdf(path: Path) -> etree._ElementTree:
+    """Parse ``path`` as strict XML; raise :class:`UrdfError` if it is missing or malformed.
+
+    Entities are not expanded and nothing is fetched from the network: a URDF that defines
+    entities (an "XML bomb", or a reference to a local file) is parsed as written.
+    """
+    if not path.exists():
+        raise UrdfError(f"URDF file '{path}' does not exist; pass the path of a .urdf file")
+    if not path.is_file():
+        raise UrdfError(f"URDF file '{path}' is not a regular file (a folder or a device)")
+    if path.stat().st_size > MAX_URDF_BYTES:
+        raise UrdfError(f"URDF file '{path}' has {path.stat().st_size} bytes; at most {MAX_URDF_BYTES}")
+    parser = etree.XMLParser(recover=False, resolve_entities=False, no_network=True, huge_tree=False)
+    try:
+        return etree.parse(str(path), parser)
+    except etree.XMLSyntaxError as exc:
+        message = str(exc) if len(str(exc)) <= 120 else str(exc)[:117] + "..."
+        raise UrdfError(f"URDF file '{path}' is not well-formed XML: {message}") from None
+
+
+def validate_urdf(path: Path) -> None:
+    """Validate the URDF at ``path`` with yourdfpy; raise :class:`UrdfError` naming the problems.
+
+    yourdfpy is imported here, not with the package: it imports trimesh, about 0.7 s, which
+    a process that loads only the bundled (tested) URDF need not pay.
+    """
+    import yourdfpy
+
+    try:
+        urdf = yourdfpy.URDF.load(
+            str(path), build_scene_graph=False, load_meshes=False, load_collision_meshes=False
+        )
+    except Exception as exc:  # yourdfpy raises bare exceptions on structural problems
+        raise UrdfError(f"URDF file '{path}' cannot be read: {exc}") from None
+    found: list[Any] = []
+
+    def keep(errors: list[Any]) -> bool:
+        found.extend(errors)
+        return not errors
+
+    if not urdf.validate(keep):
+        problems = "; ".join(str(e) for e in found)
+        raise UrdfError(f"URDF file '{path}' is invalid: {problems}")
+
+
+def collision_names(tree: etree._ElementTree) -> dict[str, list[str]]:
+    """Collision element names per link, as written in the URDF (or ``link`` / ``link_i`` if unnamed)."""
+    names: dict[str, list[str]] = {}
+    for link in tree.getroot().findall("link"):
+        collisions = link.findall("collision")
+        link_name = link.get("name", "")
+        names[link_name] = [
+            c.get("name") or (link_name if len(collisions) == 1 else f"{link_name}_{i}")
+            for i, c in enumerate(collisions)
+        ]
+    return names
+
+
+def is_bundled(path: Path) -> bool:
+    """Whether ``path`` is the bundled CPR URDF, which the test suite validates with yourdfpy."""
+    return path.resolve() == cpr_urdf_path().resolve()
