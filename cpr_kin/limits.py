@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cpr_kin.errors import CprKinError, UrdfError
-from cpr_kin.safe_yaml import YamlError, load_yaml
+from cpr_kin.user_files import UserFileError, load_yaml
 
 FloatArray = NDArray[np.float64]
 
@@ -89,7 +89,7 @@ def read_dynamic_limits(
     """
     try:
         raw = load_yaml(path, MAX_LIMITS_BYTES, "joint limits file")
-    except YamlError as exc:
+    except UserFileError as exc:
         raise UrdfError(str(exc)) from None
     if not isinstance(raw, dict):
         raise UrdfError(f"joint limits file '{path}' must map joint names to limits")

@@ -13,6 +13,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import ObstacleError
+from cpr_kin.user_files import UserFileError, read_bytes
 
 FloatArray = NDArray[np.float64]
 
@@ -77,18 +78,6 @@ def _number(value: float | None, what: str, low: float, high: float, unit: str) 
     return x
 
 
-def _regular_file(path: Path, what: str) -> Path:
-    """``path`` if it is a regular file of at most :data:`MAX_MESH_BYTES`; an ObstacleError otherwise."""
-    if not path.exists():
-        raise ObstacleError(f"{what} '{path}' does not exist")
-    if not path.is_file():
-        raise ObstacleError(f"{what} '{path}' is not a regular file (a folder or a device); give a mesh file")
-    size = path.stat().st_size
-    if size > MAX_MESH_BYTES:
-        raise ObstacleError(f"{what} '{path}' has {size} bytes; at most {MAX_MESH_BYTES}")
-    return path
-
-
 @dataclass(frozen=True, eq=False)
 class Obstacle:
     """A static obstacle: a shape, its dimensions and its pose in the world frame.
@@ -148,7 +137,13 @@ class Obstacle:
         if self.shape == "mesh":
             if self.mesh is None:
                 raise ObstacleError(f"{what}: a mesh obstacle needs a mesh file")
-            object.__setattr__(self, "mesh", _regular_file(Path(self.mesh), f"{what}: mesh file"))
+            mesh = Path(self.mesh)
+            if not mesh.is_file() or mesh.stat().st_size > MAX_MESH_BYTES:
+                try:  # the same words as for every other file a user gives
+                    read_bytes(mesh, MAX_MESH_BYTES, f"{what}: mesh file")
+                except UserFileError as exc:
+                    raise ObstacleError(str(exc)) from None
+            object.__setattr__(self, "mesh", mesh)
             object.__setattr__(self, "scale", _number(self.scale, f"{what} scale", *SCALE_RANGE, ""))
 
     def _key(self) -> tuple[object, ...]:

@@ -13,7 +13,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import cpr_kin as ck
-from cpr_kin.safe_yaml import StrictLoader
+from cpr_kin.user_files import StrictLoader
 from planning.curves.spline import SplineSettings
 from planning.errors import SceneError
 from planning.io.bundled import paper_scene, paper_scene_path

@@ -23,7 +23,7 @@ import yaml
 from pydantic import ValidationError
 
 import cpr_kin as ck
-from cpr_kin.safe_yaml import YamlError, load_yaml
+from cpr_kin.user_files import UserFileError, load_yaml
 from planning.curves.spline import SplineSettings
 from planning.errors import PlanningError, SceneError
 from planning.io.scene_schema import (
@@ -122,13 +122,13 @@ def _target(spec: TargetSpec) -> Target:
 def load_scene(path: str | Path) -> Scene:
     """Read and validate a scene file; raises :class:`SceneError` naming what is wrong.
 
-    The file is read by :func:`cpr_kin.safe_yaml.load_yaml`: at most
+    The file is read by :func:`cpr_kin.user_files.load_yaml`: at most
     :data:`MAX_SCENE_BYTES`, no anchors or aliases, no duplicate keys, bounded nesting.
     """
     path = Path(path)
     try:
         data = load_yaml(path, MAX_SCENE_BYTES, "scene file")
-    except YamlError as exc:
+    except UserFileError as exc:
         raise SceneError(str(exc)) from None
     return parse_scene(data, source=str(path), base=path.parent)
 

@@ -1,6 +1,9 @@
-"""Reading YAML that a user (or an attacker) wrote: bounded, unambiguous, never recursive.
+"""Reading files that a user (or an attacker) wrote: bounded, and YAML unambiguous, never recursive.
 
-PyYAML's safe loader is safe from code execution, not from the rest:
+:func:`read_bytes` and :func:`read_text` read a regular file of bounded size (a folder, a
+device such as ``/dev/zero`` or a file too large is refused before anything is read into
+memory beyond the bound). :func:`load_yaml` parses YAML safely. PyYAML's safe loader is
+safe from code execution, not from the rest:
 
 - *aliases* expand without limit: 517 bytes of nested aliases make gigabytes ("billion
   laughs");
@@ -12,7 +15,7 @@ PyYAML's safe loader is safe from code execution, not from the rest:
 :func:`load_yaml` reads at most ``max_bytes`` of a regular file, then walks the parser's
 event stream (iterative, in C) refusing anchors, aliases, nesting deeper than
 :data:`MAX_DEPTH` and more than :data:`MAX_NODES` nodes, and only then builds the document
-with a loader that refuses duplicate keys. Every refusal is a :class:`YamlError` naming the
+with a loader that refuses duplicate keys. Every refusal is a :class:`UserFileError` naming the
 line. Numbers in exponent form without a dot (``1e6``) are floats, as in YAML 1.2.
 """
 
@@ -34,8 +37,8 @@ MAX_NODES = 100_000
 _BASE = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's parser: about 7x faster
 
 
-class YamlError(CprKinError):
-    """A YAML file is unreadable, too large, malformed, or uses what these files refuse."""
+class UserFileError(CprKinError):
+    """A user's file is missing, not a regular file, too large, not UTF-8, or malformed YAML."""
 
 
 class StrictLoader(_BASE):  # type: ignore[misc, valid-type]
@@ -88,44 +91,59 @@ def _scan(text: str, source: str) -> None:
     depth = nodes = 0
     for event in yaml.parse(text, Loader=_BASE):
         if isinstance(event, yaml.AliasEvent):
-            raise YamlError(f"{source}: {_line(event)}: aliases (*name) are not allowed; write the value out")
+            raise UserFileError(
+                f"{source}: {_line(event)}: aliases (*name) are not allowed; write the value out"
+            )
         if getattr(event, "anchor", None) is not None:
-            raise YamlError(f"{source}: {_line(event)}: anchors (&name) are not allowed; write the value out")
+            raise UserFileError(
+                f"{source}: {_line(event)}: anchors (&name) are not allowed; write the value out"
+            )
         if isinstance(event, yaml.ScalarEvent | yaml.SequenceStartEvent | yaml.MappingStartEvent):
             nodes += 1
             if nodes > MAX_NODES:
-                raise YamlError(f"{source}: more than {MAX_NODES} values; this is not a file of this kind")
+                raise UserFileError(
+                    f"{source}: more than {MAX_NODES} values; this is not a file of this kind"
+                )
         if isinstance(event, yaml.SequenceStartEvent | yaml.MappingStartEvent):
             depth += 1
             if depth > MAX_DEPTH:
-                raise YamlError(f"{source}: {_line(event)}: nested more than {MAX_DEPTH} levels deep")
+                raise UserFileError(f"{source}: {_line(event)}: nested more than {MAX_DEPTH} levels deep")
         elif isinstance(event, yaml.SequenceEndEvent | yaml.MappingEndEvent):
             depth -= 1
+
+
+def read_bytes(path: Path, max_bytes: int, what: str) -> bytes:
+    """The content of the regular file ``path``, at most ``max_bytes`` long.
+
+    Raises:
+        UserFileError: missing, not a regular file, or larger than ``max_bytes``.
+    """
+    if not path.exists():
+        raise UserFileError(f"{what} '{path}' does not exist")
+    if not path.is_file():
+        raise UserFileError(f"{what} '{path}' is not a regular file (a folder or a device)")
+    try:
+        with path.open("rb") as stream:
+            data = stream.read(max_bytes + 1)  # st_size can lie (a pipe, /proc): read, then count
+    except OSError as exc:
+        raise UserFileError(f"cannot read {what} '{path}': {exc.strerror or exc}") from None
+    if len(data) > max_bytes:
+        raise UserFileError(f"{what} '{path}' is larger than {max_bytes} bytes")
+    return data
 
 
 def read_text(path: Path, max_bytes: int, what: str) -> str:
     """The UTF-8 text of the regular file ``path``, at most ``max_bytes`` long.
 
     Raises:
-        YamlError: missing, not a regular file, larger than ``max_bytes``, or not UTF-8.
+        UserFileError: missing, not a regular file, larger than ``max_bytes``, or not UTF-8.
     """
-    if not path.exists():
-        raise YamlError(f"{what} '{path}' does not exist")
-    if not path.is_file():
-        raise YamlError(f"{what} '{path}' is not a regular file (a folder or a device)")
-    try:
-        with path.open("rb") as stream:
-            data = stream.read(max_bytes + 1)  # st_size can lie (a pipe, /proc): read, then count
-    except OSError as exc:
-        raise YamlError(f"cannot read {what} '{path}': {exc.strerror or exc}") from None
-    if len(data) > max_bytes:
-        raise YamlError(f"{what} '{path}' is larger than {max_bytes} bytes")
+    data = read_bytes(path, max_bytes, what)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
-        raise YamlError(
-            f"{what} '{path}' is not UTF-8 text (byte {exc.start} is 0x{data[exc.start]:02x})"
-        ) from None
+        byte = f"byte {exc.start} is 0x{data[exc.start]:02x}"
+        raise UserFileError(f"{what} '{path}' is not UTF-8 text ({byte})") from None
 
 
 def load_yaml(path: Path, max_bytes: int, what: str = "YAML file") -> Any:
@@ -137,7 +155,7 @@ def load_yaml(path: Path, max_bytes: int, what: str = "YAML file") -> Any:
         what: what the file is, for messages (e.g. ``"scene file"``).
 
     Raises:
-        YamlError: the file is unreadable, too large, not YAML, or refused; one line.
+        UserFileError: the file is unreadable, too large, not YAML, or refused; one line.
     """
     text = read_text(Path(path), max_bytes, what)
     source = f"{what} '{path}'"
@@ -148,4 +166,4 @@ def load_yaml(path: Path, max_bytes: int, what: str = "YAML file") -> Any:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
         problem = getattr(exc, "problem", None) or " ".join(str(exc).split())
-        raise YamlError(f"{source} is not valid YAML{where}: {_cut(str(problem), 120)}") from None
+        raise UserFileError(f"{source} is not valid YAML{where}: {_cut(str(problem), 120)}") from None
