@@ -6,7 +6,8 @@ from .curves.trajectory import Extrema, Trajectory
 from .errors import NoSolutionError, NoTrajectoryFoundError, PlanningError, SceneError, SplineError
 from .io.bundled import paper_scene
 from .io.scene_file import dump_scene, load_scene
-from .io.trajectory_io import read_trajectory, write_samples, write_trajectory
+from .io.trajectory_io import write_samples, write_trajectory
+from .io.trajectory_reader import TrajectoryFileError, read_trajectory
 from .metrics import Metrics
 from .objective import Breakdown, WaypointObjective
 from .planner import PlanResult, plan, solve, warm_up
@@ -40,6 +41,7 @@ __all__ = [
     "SplineSettings",
     "Target",
     "Trajectory",
+    "TrajectoryFileError",
     "Verification",
     "WaypointObjective",
     "build_problem",

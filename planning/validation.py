@@ -8,10 +8,12 @@ Python counts ``True`` as 1: ``fireflies = True`` is a mistake, not a population
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Sequence
 from numbers import Real
 from typing import Any
 
 import numpy as np
+from pydantic import BaseModel, ValidationError
 
 from planning.errors import PlanningError
 
@@ -60,3 +62,65 @@ def number_in(
         given = f"{shown(value)}{suffix if number else ''}"
         raise PlanningError(f"{name} = {given} must be a number in {bracket}{low:g}, {high:g}]{suffix}")
     return float(value)
+
+
+MAX_PROBLEMS = 3
+"""Most problems one message lists (the rest are counted)."""
+
+Location = tuple[int | str, ...]
+
+
+def field_path(location: Location, hidden: Sequence[str] = ()) -> str:
+    """``obstacles[1].size[2]`` for pydantic's location ``("obstacles", 1, "size", 2)``.
+
+    Parts in ``hidden`` (a tagged union's branch names) are not keys of the file and are left
+    out; a hostile key is shortened like a value.
+    """
+    text = ""
+    for part in location:
+        if isinstance(part, int):
+            text += f"[{part}]"
+        elif part not in hidden:
+            key = str(part) if len(str(part)) <= MAX_VALUE_CHARS else str(part)[: MAX_VALUE_CHARS - 3] + "..."
+            text += f".{key}" if text else key
+    return text or "(top level)"
+
+
+def describe_validation(
+    error: ValidationError,
+    model_at: Callable[[Location], type[BaseModel] | None] = lambda _: None,
+    hidden: Sequence[str] = (),
+    tag: tuple[str, Sequence[str]] | None = None,
+) -> str:
+    """One line naming the first :data:`MAX_PROBLEMS` problems of a pydantic validation.
+
+    Args:
+        error: the validation error.
+        model_at: the model owning a location, to list the keys allowed where one is unknown.
+        hidden: location parts that are not keys of the file (see :func:`field_path`).
+        tag: a tagged union's tag and its allowed values, e.g. ``("shape", ("box", ...))``.
+    """
+    problems = []
+    for item in error.errors():
+        location = tuple(item["loc"])
+        where = field_path(location, hidden)
+        value = item.get("input")
+        if item["type"] == "extra_forbidden":
+            model = model_at(location)
+            allowed = ", ".join(model.model_fields) if model is not None else ""
+            problems.append(f"{where}: unknown key; allowed here: {allowed}")
+        elif item["type"] == "missing":
+            problems.append(f"{where}: required key is missing")
+        elif item["type"] in ("union_tag_invalid", "union_tag_not_found") and tag and isinstance(value, dict):
+            key, allowed = tag[0], ", ".join(tag[1])
+            problems.append(
+                f"{where}.{key} = {shown(value.get(key))}: unknown or missing {key}; allowed: {allowed}"
+            )
+        else:
+            message = item["msg"].removeprefix("Value error, ")
+            if isinstance(value, dict):  # a block (a model's input): its keys tell more than its repr
+                problems.append(f"{where}: {message}")
+            else:
+                problems.append(f"{where} = {shown(value)}: {message}")
+    more = len(problems) - MAX_PROBLEMS
+    return "; ".join(problems[:MAX_PROBLEMS]) + (f"; and {more} more" if more > 0 else "")

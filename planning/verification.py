@@ -12,7 +12,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from planning.curves.trajectory import Trajectory
+from planning.curves.hermite import CONTINUITY
+from planning.curves.trajectory import DERIVATIVE_NAMES, Trajectory
 
 FloatArray = NDArray[np.float64]
 
@@ -45,6 +46,26 @@ class Verification:
         }
 
 
+CONTINUITY_TOLERANCE = 1e-6
+"""Largest relative jump of position, velocity, acceleration or jerk at a knot
+(:meth:`~planning.curves.trajectory.Trajectory.knot_jumps`) of a C3 trajectory."""
+
+
+def _discontinuity(trajectory: Trajectory, robot: ck.Robot) -> str | None:
+    """The worst jump at a knot beyond :data:`CONTINUITY_TOLERANCE`, as a sentence, if any."""
+    jump, relative = trajectory.knot_jumps(CONTINUITY + 1)
+    if relative.size == 0 or relative.max() <= CONTINUITY_TOLERANCE:
+        return None
+    knot, joint, r = np.unravel_index(int(np.argmax(relative)), relative.shape)
+    name = robot.joint_names[joint]
+    unit = robot.joint_unit(name) + ("" if r == 0 else "/s" if r == 1 else f"/s^{r}")
+    where = f"t = {trajectory.knots[knot + 1]:.4g} s (knot {knot + 1})"
+    return (
+        f"is not continuous (C3) at {where}: the {DERIVATIVE_NAMES[r]} of joint '{name}' "
+        f"jumps by {jump[knot, joint, r]:.3g} {unit}"
+    )
+
+
 def verify_trajectory(
     world: ck.CollisionWorld,
     trajectory: Trajectory,
@@ -55,6 +76,7 @@ def verify_trajectory(
 ) -> Verification:
     """Check a timed trajectory for everything a robot needs of it.
 
+    - position, velocity, acceleration and jerk are continuous at every knot (C3);
     - the certified clearance (:func:`cpr_kin.check_curve`, robot motion between checks at
       most ``step_m``) is at least ``margin_m`` [m];
     - every joint stays within its range, and within its velocity, acceleration and jerk
@@ -68,6 +90,9 @@ def verify_trajectory(
         world, trajectory.position, start, end, trajectory.extrema(1).peak, margin_m, step_m
     )
     problems = []
+    jumps = _discontinuity(trajectory, robot)
+    if jumps is not None:
+        problems.append(jumps)
     if endpoints is not None:
         for label, q, t in (("start", endpoints[0], start), ("goal", endpoints[1], end)):
             gap = float(np.abs(trajectory(t) - q).max())

@@ -14,7 +14,7 @@ import yaml
 
 import cpr_kin as ck
 from planning.cli import main
-from planning.io.trajectory_io import read_trajectory
+from planning.io.trajectory_reader import read_trajectory
 
 SCENE: dict[str, Any] = {
     "name": "swing",

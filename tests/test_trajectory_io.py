@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
-from planning.errors import PlanningError
 from planning.io.bundled import paper_scene
-from planning.io.trajectory_io import atomic_write_text, read_trajectory, write_samples, write_trajectory
+from planning.io.trajectory_io import atomic_write_text, write_samples, write_trajectory
+from planning.io.trajectory_reader import read_trajectory
 from planning.planner import PlanResult, plan
 
 
@@ -95,20 +95,3 @@ def test_atomic_write_leaves_nothing_on_failure(tmp_path: Path, monkeypatch: pyt
     with pytest.raises(OSError, match="disk full"):
         atomic_write_text(tmp_path / "out.json", "{}")
     assert list(tmp_path.iterdir()) == []
-
-
-@pytest.mark.parametrize(
-    ("content", "pattern"),
-    [
-        ("{not json", "is not valid JSON"),
-        ('{"format": "other/2"}', "has format 'other/2'; expected 'cpr-trajectory/1'"),
-        ('{"format": "cpr-trajectory/1", "knots": [0, 1]}', "is malformed"),
-    ],
-)
-def test_bad_trajectory_files(tmp_path: Path, content: str, pattern: str) -> None:
-    path = tmp_path / "bad.json"
-    path.write_text(content)
-    with pytest.raises(PlanningError, match=pattern):
-        read_trajectory(path)
-    with pytest.raises(PlanningError, match="cannot read trajectory file"):
-        read_trajectory(tmp_path / "missing.json")

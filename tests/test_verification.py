@@ -1,9 +1,12 @@
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
 import cpr_kin as ck
+from planning.curves.trajectory import Trajectory
 from planning.io.bundled import paper_scene
 from planning.planner import PlanResult, plan
 from planning.verification import verify_trajectory
@@ -30,3 +33,32 @@ def test_each_violation_is_named(result: PlanResult, paper_world: ck.CollisionWo
     assert "its start is 0.1 away from the scene's start" in text
     assert "certified) of an obstacle, margin 0.2 m" in text
     assert "drives the velocity of joint" in text and "drives the jerk of joint" in text
+
+
+@pytest.mark.parametrize(("order", "unit"), [(0, "rad"), (1, "rad/s"), (2, "rad/s^2"), (3, "rad/s^3")])
+def test_a_jump_at_a_knot_is_named(
+    result: PlanResult, paper_world: ck.CollisionWorld, order: int, unit: str
+) -> None:
+    # shift one coefficient of the last segment's theta1: its value, or a derivative, jumps
+    # at the segment's start (knot 3) and nowhere else
+    coefficients = result.trajectory.coefficients.copy()
+    coefficients[3, 0, order] += 0.3 / math.factorial(order)
+    broken = Trajectory(result.trajectory.knots, coefficients)
+    problems = verify_trajectory(paper_world, broken, 0.1, 0.005).problems
+    name = ("position", "velocity", "acceleration", "jerk")[order]
+    assert (
+        f"is not continuous (C3) at t = 3 s (knot 3): the {name} of joint 'theta1' jumps by 0.3 {unit}"
+        in problems
+    )
+
+
+def test_knot_jumps_agree_with_evaluation_and_vanish_for_the_planned_spline(result: PlanResult) -> None:
+    trajectory = result.trajectory
+    jump, relative = trajectory.knot_jumps(4)
+    assert relative.max() < 1e-11  # a C3 spline: rounding only
+    coefficients = trajectory.coefficients.copy()
+    coefficients[1, 2, 1] += 0.25  # d2's velocity at the start of segment 1
+    jump, _ = Trajectory(trajectory.knots, coefficients).knot_jumps(4)
+    t = trajectory.knots[1]
+    left, right = trajectory(t - 1e-12, 1), Trajectory(trajectory.knots, coefficients)(t, 1)
+    assert jump[0, 2, 1] == pytest.approx(abs(left[2] - right[2]), abs=1e-9) == pytest.approx(0.25)

@@ -17,7 +17,7 @@ from planning.errors import PlanningError
 
 def cmd_check(args: argparse.Namespace) -> int:
     """Re-verify a trajectory file against a scene; exit 3 when it fails."""
-    from planning.io.trajectory_io import read_trajectory
+    from planning.io.trajectory_reader import read_trajectory
     from planning.problem import build_problem
     from planning.verification import verify_trajectory
 
@@ -57,7 +57,8 @@ def cmd_check(args: argparse.Namespace) -> int:
 def cmd_show(args: argparse.Namespace) -> int:
     """Show a trajectory file in a live meshcat viewer, or write it as one HTML page."""
     from planning.io.scene_file import parse_scene
-    from planning.io.trajectory_io import read_trajectory, write_files
+    from planning.io.trajectory_io import write_files
+    from planning.io.trajectory_reader import read_trajectory
     from planning.viz import artifacts
 
     try:

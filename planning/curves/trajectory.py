@@ -209,6 +209,34 @@ class Trajectory:
         self._extrema[derivative] = Extrema(derivative, minimum, maximum, t_min, t_max)
         return self._extrema[derivative]
 
+    def knot_jumps(self, orders: int = 4) -> tuple[FloatArray, FloatArray]:
+        """Jumps of the derivatives ``0 .. orders - 1`` at the interior knots.
+
+        Returns ``(jump, relative)``, each ``(N - 1, nj, orders)``: ``jump`` is
+        ``|left - right|``, the end of segment ``i`` minus the start of segment ``i + 1``
+        [rad/s^r or m/s^r]; ``relative`` is it over the largest magnitude summed to evaluate
+        either side (rounding alone gives about 1e-15; a C3 spline's are that small).
+        """
+        n, nj, order = self.coefficients.shape
+        if n < 2:
+            empty = np.zeros((0, nj, orders))
+            return empty, empty
+        h = np.diff(self.knots)[:-1, None, None]  # (N - 1, 1, 1)
+        k = np.arange(order)
+        jump = np.zeros((n - 1, nj, orders))
+        relative = np.zeros((n - 1, nj, orders))
+        for r in range(orders):
+            factor = np.ones(order)
+            for m in range(r):
+                factor = factor * (k - m)
+            terms = self.coefficients[:-1] * factor * h ** np.maximum(k - r, 0)  # (N - 1, nj, order)
+            left = terms.sum(axis=2)
+            right = self.coefficients[1:, :, r] * factor[r]
+            scale = np.maximum(np.abs(terms).max(axis=2), np.abs(right))
+            jump[:, :, r] = np.abs(left - right)
+            relative[:, :, r] = np.where(scale > 0, jump[:, :, r] / np.where(scale > 0, scale, 1.0), 0.0)
+        return jump, relative
+
     @cached_property
     def integrated_squared_jerk(self) -> FloatArray:
         """``(nj,)`` integral of the squared jerk over the trajectory [rad^2/s^5, m^2/s^5]."""

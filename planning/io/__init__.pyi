@@ -5,10 +5,12 @@ from .outputs import plan_files
 from .report import plan_record, report_markdown, summary
 from .scene_file import dump_scene, load_scene, parse_scene, scene_document
 from .scene_generator import generate_scenes, random_scene
-from .trajectory_io import TrajectoryFile, read_trajectory, write_files, write_samples, write_trajectory
+from .trajectory_io import write_files, write_samples, write_trajectory
+from .trajectory_reader import TrajectoryFile, TrajectoryFileError, parse_trajectory, read_trajectory
 
 __all__ = [
     "TrajectoryFile",
+    "TrajectoryFileError",
     "bundled_scene_paths",
     "dump_scene",
     "generate_scenes",
@@ -16,6 +18,7 @@ __all__ = [
     "paper_scene",
     "paper_scene_path",
     "parse_scene",
+    "parse_trajectory",
     "plan_files",
     "plan_record",
     "random_scene",

@@ -30,7 +30,7 @@ from planning.scene import (
     PlannerSettings,
 )
 from planning.search.firefly import MAX_FIREFLIES, MAX_GAMMA, MAX_ITERATIONS, MAX_STEP, FireflySettings
-from planning.validation import shown
+from planning.validation import describe_validation
 
 
 def _between(low: float, high: float) -> Any:
@@ -200,19 +200,6 @@ _BLOCK_SPECS: dict[str, type[BaseModel]] = {
 }
 
 
-def _path(location: tuple[int | str, ...]) -> str:
-    text = ""
-    for part in location:
-        if isinstance(part, int):
-            text += f"[{part}]"
-        elif part in _SHAPE_SPECS:
-            continue  # the discriminator's branch, not a key of the file
-        else:
-            key = str(part) if len(str(part)) <= 40 else str(part)[:37] + "..."  # a key may be hostile too
-            text += f".{key}" if text else key
-    return text or "(top level)"
-
-
 def _model_at(location: tuple[int | str, ...]) -> type[BaseModel] | None:
     """The schema model that owns the key at ``location`` (to list the allowed keys)."""
     if len(location) == 1:
@@ -222,31 +209,7 @@ def _model_at(location: tuple[int | str, ...]) -> type[BaseModel] | None:
     return _BLOCK_SPECS.get(str(location[0]))
 
 
-def _describe(error: dict[str, Any]) -> str:
-    location = tuple(error["loc"])
-    where = _path(location)
-    value = error.get("input")
-    if error["type"] == "extra_forbidden":
-        model = _model_at(location)
-        allowed = ", ".join(model.model_fields) if model is not None else ""
-        return f"{where}: unknown key; allowed here: {allowed}"
-    if error["type"] == "missing":
-        return f"{where}: required key is missing"
-    if error["type"] in ("union_tag_invalid", "union_tag_not_found") and isinstance(value, dict):
-        allowed = ", ".join(_SHAPE_SPECS)
-        return f"{where}.shape = {shown(value.get('shape'))}: unknown or missing shape; allowed: {allowed}"
-    message = error["msg"].removeprefix("Value error, ")
-    if isinstance(value, dict):  # a block (a model's input): its keys tell more than its repr
-        return f"{where}: {message}"
-    return f"{where} = {shown(value)}: {message}"
-
-
-MAX_PROBLEMS = 3
-"""Most problems one message lists (the rest are counted)."""
-
-
 def describe_errors(error: ValidationError) -> str:
-    """One ``; ``-separated line naming the first problems of a failed validation."""
-    problems = [_describe(dict(e)) for e in error.errors()]
-    more = len(problems) - MAX_PROBLEMS
-    return "; ".join(problems[:MAX_PROBLEMS]) + (f"; and {more} more" if more > 0 else "")
+    """One line naming the first problems of a failed scene validation (field path, value, rule)."""
+    shapes = tuple(_SHAPE_SPECS)
+    return describe_validation(error, _model_at, hidden=shapes, tag=("shape", shapes))

@@ -11,7 +11,6 @@ import io
 import json
 import os
 import tempfile
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -19,7 +18,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from planning.curves.trajectory import DERIVATIVE_NAMES, Trajectory
-from planning.errors import PlanningError
 
 if TYPE_CHECKING:  # types only: writing files needs neither the planner nor the robot
     import cpr_kin as ck
@@ -143,53 +141,3 @@ def write_samples(result: PlanResult, path: Path) -> None:
     atomic_write_text(
         Path(path), samples_csv(result.trajectory, result.joint_names, result.scene.planner.ipo)
     )
-
-
-@dataclass(frozen=True)
-class TrajectoryFile:
-    """A ``cpr-trajectory/1`` file read back.
-
-    Attributes:
-        trajectory: the piecewise polynomial.
-        joint_names: joint order.
-        waypoints: ``(P, nq)`` start, waypoints, goal.
-        robot: URDF path recorded in the file.
-        scene: the scene section as written.
-        metrics: the metrics section as written.
-    """
-
-    trajectory: Trajectory
-    joint_names: tuple[str, ...]
-    waypoints: FloatArray
-    robot: str
-    scene: dict[str, Any]
-    metrics: dict[str, Any]
-
-
-def read_trajectory(path: Path) -> TrajectoryFile:
-    """Read a ``cpr-trajectory/1`` file; raises :class:`PlanningError` naming what is wrong."""
-    path = Path(path)
-    try:
-        document = json.loads(path.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise PlanningError(f"cannot read trajectory file '{path}': {exc.strerror}") from None
-    except json.JSONDecodeError as exc:
-        raise PlanningError(f"trajectory file '{path}' is not valid JSON: {exc}") from None
-    if not isinstance(document, dict) or document.get("format") != FORMAT:
-        found = document.get("format") if isinstance(document, dict) else type(document).__name__
-        raise PlanningError(f"trajectory file '{path}' has format {found!r}; expected '{FORMAT}'")
-    try:
-        segments = document["segments"]
-        knots = np.array(document["knots"], dtype=float)
-        coefficients = np.array([s["coeffs"] for s in segments], dtype=float)
-        trajectory = Trajectory(knots=knots, coefficients=coefficients)
-        return TrajectoryFile(
-            trajectory=trajectory,
-            joint_names=tuple(document["joint_names"]),
-            waypoints=np.array(document["waypoints"], dtype=float),
-            robot=str(document["robot"]),
-            scene=dict(document["scene"]),
-            metrics=dict(document.get("metrics", {})),
-        )
-    except (KeyError, TypeError, ValueError) as exc:
-        raise PlanningError(f"trajectory file '{path}' is malformed: {exc!r}") from None
