@@ -28,6 +28,9 @@ from cpr_kin.robot import GROUPS, Robot
 
 FloatArray = NDArray[np.float64]
 
+MAX_CURVE_CHECKS = 1_000_000
+"""Most configurations one continuous check queries (about 10 to 20 s of coal on 2 cores)."""
+
 
 def motion_radii(robot: Robot) -> FloatArray:
     """Per-joint motion radius ``R_j``: [m/rad] for revolute, 1 [m/m] for prismatic joints.
@@ -91,6 +94,9 @@ def check_curve(
         margin_m: required clearance [m].
         step_m: largest robot motion between two checks [m].
 
+    Raises:
+        CprKinError: bad arguments, or more than :data:`MAX_CURVE_CHECKS` samples needed.
+
     """
     speed = np.asarray(speed_bound, dtype=float)
     if speed.shape != (world.robot.nq,) or not np.all(np.isfinite(speed)) or np.any(speed < 0):
@@ -102,6 +108,11 @@ def check_curve(
     point_speed = float(motion_radii(world.robot) @ speed)
     duration = t1 - t0
     count = int(np.ceil(duration * point_speed / (2.0 * step_m))) + 1 if point_speed > 0 else 1
+    if count > MAX_CURVE_CHECKS:
+        raise CprKinError(
+            f"the continuous check needs {count} samples ({duration:.4g} s of motion at up to "
+            f"{point_speed:.3g} m/s, step {step_m:g} m); at most {MAX_CURVE_CHECKS}: use a larger step"
+        )
     times = np.linspace(t0, t1, max(count, 2))  # at least both ends
     dt = times[1] - times[0]
     batch = world.clearance_batch(curve(times))

@@ -135,3 +135,12 @@ def test_curve_interface_and_errors(robot: ck.Robot, paper_world: ck.CollisionWo
         ck.check_curve(paper_world, hold, 0.0, 1.0, np.ones(5), margin_m=0.1, step_m=0.0)
     with pytest.raises(ck.CprKinError, match=r"time interval \[1.0, 0.0\]"):
         ck.check_curve(paper_world, hold, 1.0, 0.0, np.ones(5), margin_m=0.1)
+
+
+def test_a_check_that_would_take_minutes_is_refused(paper_world: ck.CollisionWorld) -> None:
+    def still(t: np.ndarray) -> np.ndarray:
+        return np.tile(ck.tcp_ik(paper_world.robot, (0.5, 0.45, 0.25)), (len(t), 1))
+
+    speeds = paper_world.robot.limits.velocity  # a bound, however still the curve
+    with pytest.raises(ck.CprKinError, match=r"the continuous check needs \d+ samples .* at most 1000000"):
+        ck.check_curve(paper_world, still, 0.0, 600.0, speeds, 0.1, step_m=1e-4)
