@@ -1,10 +1,18 @@
-"""Planning many scenes in parallel: joblib processes locally, or a Dask cluster.
+"""Planning many scene files: one isolated task per scene, and the summary of their outcomes.
 
-:func:`plan_batch` plans every scene file in its own task; each writes its outputs into
-``out/<scene file stem>/`` and returns a :class:`BatchItem`, so one failing scene never
-stops the others. Parallelism is joblib's: local processes (``loky``) by default, or a
-``dask.distributed`` cluster through joblib's Dask backend when a scheduler address is
-given. Results come back in the order of the scene files whatever the backend.
+:func:`plan_scene_file` plans one scene and publishes its outputs into ``out/<scene stem>/``;
+it never raises: every outcome, an unexpected exception included, becomes a
+:class:`BatchItem`. :mod:`planning.batch_pool` runs the tasks in parallel and turns a worker
+that dies (a crash in a native library) into the row of the scene that killed it.
+:func:`summary_csv` writes one row per scene.
+
+Statuses and their exit classes (the batch exits with the worst one):
+
+- ``ok`` (0): planned, verified, written;
+- ``invalid`` (2): bad input (scene file, robot, settings) or an unwritable output folder;
+- ``no_trajectory`` (3): valid input, but no verified trajectory found;
+- ``error`` (4): an unexpected exception while planning (a bug: please report it);
+- ``crashed`` (4): the worker process died while planning this scene.
 """
 
 from __future__ import annotations
@@ -12,21 +20,21 @@ from __future__ import annotations
 import csv
 import io
 import time
-from collections.abc import Callable, Iterator, Sequence
 from dataclasses import asdict, dataclass
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
-import joblib
-
 import cpr_kin as ck  # lazy (lazy_loader): its modules load in the workers, where they are used
 from planning.errors import NoSolutionError, PlanningError
+from planning.validation import shown
 
-STATUS_EXIT = {"ok": 0, "invalid": 2, "no_trajectory": 3}
+STATUS_EXIT = {"ok": 0, "invalid": 2, "no_trajectory": 3, "error": 4, "crashed": 4}
 RECORD_FIELDS = ("duration", "min_clearance", "t_sol", "fitness", "evaluations", "planning_time_s")
 """The plan record's fields (:func:`planning.io.report.plan_record`) that ``summary.csv`` shows."""
 SUMMARY_FIELDS = ("scene", "status", "exit_class", *RECORD_FIELDS, "task_time_s", "message")
+MAX_MESSAGE_CHARS = 300
+"""Longest message of a row (a hostile scene must not flood the summary)."""
 
 
 @dataclass(frozen=True)
@@ -35,9 +43,10 @@ class BatchItem:
 
     Attributes:
         scene: the scene file's stem (its output folder's name).
-        status: ``ok``, ``invalid`` (bad scene) or ``no_trajectory``.
-        exit_class: the exit code ``cpr-plan plan`` would give: 0, 2 or 3.
-        message: the error for a failed scene, empty otherwise.
+        status: ``ok``, ``invalid``, ``no_trajectory``, ``error`` or ``crashed`` (see the
+            module docstring).
+        exit_class: the status's exit code, :data:`STATUS_EXIT`.
+        message: what went wrong, empty when ok (at most :data:`MAX_MESSAGE_CHARS`).
         record: the plan's record (:func:`planning.io.report.plan_record`, the trajectory
             file's metrics), ``None`` for a failed scene.
         task_time_s: wall time of the task: loading, planning and writing [s].
@@ -50,6 +59,15 @@ class BatchItem:
     record: dict[str, Any] | None = None
     task_time_s: float = 0.0
 
+    @classmethod
+    def failed(cls, scene: str, status: str, message: str, started: float | None = None) -> BatchItem:
+        """A failed scene's row; ``started`` is the task's ``time.perf_counter()`` at its start."""
+        message = " ".join(message.split())
+        if len(message) > MAX_MESSAGE_CHARS:
+            message = message[: MAX_MESSAGE_CHARS - 3] + "..."
+        elapsed = 0.0 if started is None else time.perf_counter() - started
+        return cls(scene, status, STATUS_EXIT[status], message, None, elapsed)
+
 
 @lru_cache(maxsize=8)
 def _robot(urdf: Path | None) -> ck.Robot:
@@ -58,33 +76,33 @@ def _robot(urdf: Path | None) -> ck.Robot:
 
 
 def plan_scene_file(path: Path, out: Path, threads: int | None = 1) -> BatchItem:
-    """Plan one scene file and write its outputs into ``out``; never raises on bad input.
+    """Plan one scene file and publish its outputs into ``out``; never raises.
 
     ``threads = 1`` by default: the batch runs scenes in parallel, not the checks of one.
     It imports the planner itself, in the worker: the process that dispatches the scenes
     never needs it.
     """
     from planning.io.outputs import plan_files
+    from planning.io.publish import OutputFolder
     from planning.io.report import plan_record
     from planning.io.scene_file import load_scene
-    from planning.io.trajectory_io import write_files
     from planning.planner import plan
 
     started = time.perf_counter()
     name = path.stem
     try:
         scene = load_scene(path)
-        result = plan(scene, _robot(scene.robot), threads=threads)
+        with OutputFolder(out) as folder:
+            result = plan(scene, _robot(scene.robot), threads=threads)
+            folder.publish(plan_files(result))
     except NoSolutionError as exc:
-        return BatchItem(name, "no_trajectory", 3, str(exc), task_time_s=time.perf_counter() - started)
+        return BatchItem.failed(name, "no_trajectory", str(exc), started)
     except (PlanningError, ck.CprKinError) as exc:
-        return BatchItem(name, "invalid", 2, str(exc), task_time_s=time.perf_counter() - started)
-    try:
-        write_files(out, plan_files(result))
+        return BatchItem.failed(name, "invalid", str(exc), started)
     except OSError as exc:
-        return BatchItem(
-            name, "invalid", 2, f"cannot write '{out}': {exc}", task_time_s=time.perf_counter() - started
-        )
+        return BatchItem.failed(name, "invalid", f"cannot write '{out}': {exc.strerror or exc}", started)
+    except Exception as exc:  # a bug: this scene's row says so, the batch goes on
+        return BatchItem.failed(name, "error", f"{type(exc).__name__}: {shown(str(exc))}", started)
     return BatchItem(name, "ok", 0, record=plan_record(result), task_time_s=time.perf_counter() - started)
 
 
@@ -98,59 +116,11 @@ def scene_files(folder: Path) -> list[Path]:
     stems = [p.stem for p in files]
     clashing = sorted({s for s in stems if stems.count(s) > 1})
     if clashing:
-        raise PlanningError(f"scene files {clashing} share a stem (and so an output folder); rename one")
+        raise PlanningError(f"scene files {clashing[:5]} share a stem (and so an output folder); rename one")
     return files
 
 
-def plan_batch(
-    paths: Sequence[Path],
-    out: Path,
-    workers: int | None = None,
-    scheduler: str | None = None,
-    progress: Callable[[BatchItem], None] | None = None,
-) -> list[BatchItem]:
-    """Plan every scene file in parallel; outputs go to ``out/<stem>/``.
-
-    Args:
-        paths: scene files.
-        out: output folder.
-        workers: parallel tasks (default: every core locally; the cluster's size on Dask).
-        scheduler: address of a ``dask.distributed`` scheduler, e.g. ``tcp://127.0.0.1:8786``.
-        progress: called with each item as it completes.
-    """
-    tasks = (joblib.delayed(plan_scene_file)(path, out / path.stem) for path in paths)
-
-    def run(backend_jobs: int) -> Iterator[BatchItem]:
-        runner = joblib.Parallel(n_jobs=backend_jobs, return_as="generator")
-        yield from runner(tasks)
-
-    items: list[BatchItem] = []
-    if scheduler is None:
-        results = run(workers or -1)
-        for item in results:
-            items.append(item)
-            if progress is not None:
-                progress(item)
-        return items
-    try:
-        from dask.distributed import Client
-    except ImportError:
-        raise PlanningError(
-            "a Dask scheduler needs dask.distributed: pip install 'dask[distributed]'"
-        ) from None
-    try:
-        client = Client(scheduler, timeout=10)  # type: ignore[no-untyped-call]
-    except (OSError, TimeoutError) as exc:
-        raise PlanningError(f"cannot reach the Dask scheduler at '{scheduler}': {exc}") from None
-    with client, joblib.parallel_config(backend="dask"):
-        for item in run(workers or -1):
-            items.append(item)
-            if progress is not None:
-                progress(item)
-    return items
-
-
-def summary_csv(items: Sequence[BatchItem]) -> str:
+def summary_csv(items: list[BatchItem]) -> str:
     """``summary.csv``: one row per scene: its status, the record's :data:`RECORD_FIELDS`, its message."""
     buffer = io.StringIO()
     writer = csv.DictWriter(buffer, fieldnames=SUMMARY_FIELDS, lineterminator="\n")

@@ -7,6 +7,8 @@ checkout's code and then with ``--compare DIR`` (another checkout, e.g. ``git wo
 ``samples.csv``, ``report.md``). The one expected difference, the checkout's own folder in
 the recorded URDF path, is replaced by ``<checkout>``, and the wall times in ``report.md``'s
 time rows are masked, before comparing (``trajectory.json`` records no wall time).
+``manifest.json`` is left out: it lists the other files' hashes, and older checkouts do not
+write it.
 
 A refactoring must print ``identical`` for every file; a change that means to alter results
 (a new timing, say) shows here which files and scenes it alters. Exit code 0 when all are
@@ -60,7 +62,7 @@ def outputs(code: Path, scenes: list[Path], seeds: int, work: Path) -> dict[str,
         code_returned = run(code, [*arguments, "--out", str(out)], work)
         files[f"{label}/exit"] = str(code_returned).encode()
         for path in sorted(out.glob("*")) if out.is_dir() else []:
-            if path.suffix in (".json", ".csv", ".md"):
+            if path.suffix in (".json", ".csv", ".md") and path.name != "manifest.json":
                 files[f"{label}/{path.name}"] = normalised(path.read_bytes(), code.resolve(), path.name)
     return files
 

@@ -12,14 +12,13 @@ from __future__ import annotations
 import argparse
 import statistics
 import sys
-from pathlib import Path
 
 import cpr_kin as ck
 from planning.errors import NoSolutionError, PlanningError
 from planning.io.bundled import paper_scene
 from planning.io.outputs import plan_files
+from planning.io.publish import OutputFolder
 from planning.io.report import paper_rows, text_table
-from planning.io.trajectory_io import write_files
 from planning.planner import PlanResult, plan, warm_up
 from planning.viz import artifacts
 
@@ -49,9 +48,7 @@ def seed_summary(robot: ck.Robot, seeds: int) -> tuple[list[tuple[int, str]], li
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument(
-        "--out", type=Path, default=Path("out/paper"), help="output folder (default: out/paper)"
-    )
+    parser.add_argument("--out", default="out/paper", help="output folder (default: out/paper)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the reported run (default: 0)")
     parser.add_argument("--seeds", type=int, default=10, help="seeds 0..N-1 to count successes (default: 10)")
     args = parser.parse_args(argv)
@@ -86,7 +83,8 @@ def main(argv: list[str] | None = None) -> int:
         "",
     ]
     files["report.md"] = str(files["report.md"]) + "\n" + "\n".join(seeds)
-    write_files(args.out, files)
+    with OutputFolder(args.out) as folder:
+        folder.publish(files)
     print(
         f"\nwrote into {args.out}: trajectory.json, samples.csv, report.md, viewer.html (open in a browser),"
     )

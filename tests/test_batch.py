@@ -2,14 +2,18 @@ from __future__ import annotations
 
 import csv
 import json
+import os
+import signal
 from pathlib import Path
 
 import pytest
 
-from planning.batch import plan_batch, scene_files, summary_csv
+from planning.batch import BatchItem, plan_scene_file, scene_files, summary_csv
+from planning.batch_pool import run_batch
 from planning.cli import main
 from planning.errors import PlanningError
 from planning.io.bundled import paper_scene_path
+from planning.io.publish import complete_set
 
 
 @pytest.fixture(scope="module")
@@ -24,13 +28,17 @@ def scenes(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def test_batch_local_processes(scenes: Path, tmp_path: Path) -> None:
-    items = plan_batch(scene_files(scenes), tmp_path, workers=2)
+    run = run_batch(scene_files(scenes), tmp_path, workers=2)
+    items = run.items
+    assert not run.interrupted
     assert [i.scene for i in items] == ["broken", "paper_0", "paper_1", "paper_2", "paper_3"]
     broken = items[0]
     assert broken.status == "invalid" and broken.exit_class == 2 and "not reachable" in broken.message
     for item in items[1:]:
         assert item.status == "ok" and item.record is not None and item.record["min_clearance"] >= 0.1
+        assert complete_set(tmp_path / item.scene)
         assert sorted(p.name for p in (tmp_path / item.scene).iterdir()) == [
+            "manifest.json",
             "report.md",
             "samples.csv",
             "trajectory.json",
@@ -40,15 +48,79 @@ def test_batch_local_processes(scenes: Path, tmp_path: Path) -> None:
     assert [r["status"] for r in rows] == ["invalid", "ok", "ok", "ok", "ok"]
 
 
+def die_on_doomed(path: Path, out: Path) -> BatchItem:
+    """A scene task whose worker dies (as in a segfault) on the scene named 'doomed'."""
+    if path.stem == "doomed":
+        os.kill(os.getpid(), signal.SIGKILL)
+    return plan_scene_file(path, out)
+
+
+def raise_on_doomed(path: Path, out: Path) -> BatchItem:
+    """A scene task that fails outside plan_scene_file's own handling (a bug in the pool's path)."""
+    if path.stem == "doomed":
+        raise MemoryError("out of memory while planning")
+    return plan_scene_file(path, out)
+
+
+def test_a_worker_that_dies_sinks_only_its_scene(scenes: Path, tmp_path: Path) -> None:
+    folder = tmp_path / "scenes"
+    folder.mkdir()
+    for path in scene_files(scenes)[1:4]:
+        (folder / path.name).write_bytes(path.read_bytes())
+    (folder / "doomed.yaml").write_bytes((scenes / "paper_0.yaml").read_bytes())
+    run = run_batch(scene_files(folder), tmp_path / "out", workers=2, task=die_on_doomed)
+    statuses = {item.scene: (item.status, item.exit_class) for item in run.items}
+    assert statuses == {
+        "doomed": ("crashed", 4),
+        "paper_0": ("ok", 0),
+        "paper_1": ("ok", 0),
+        "paper_2": ("ok", 0),
+    }
+    rows = {r["scene"]: r for r in csv.DictReader(summary_csv(run.items).splitlines())}
+    assert rows["doomed"]["status"] == "crashed" and "worker process died" in rows["doomed"]["message"]
+    assert all(complete_set(tmp_path / "out" / name) for name in ("paper_0", "paper_1", "paper_2"))
+    # an exception outside the task's own handling is that scene's row too
+    run = run_batch(scene_files(folder), tmp_path / "again", workers=2, task=raise_on_doomed)
+    doomed = next(i for i in run.items if i.scene == "doomed")
+    assert (doomed.status, doomed.message) == ("error", "MemoryError: 'out of memory while planning'")
+    assert sum(i.status == "ok" for i in run.items) == 3
+
+
+def test_an_unexpected_exception_in_a_scene_is_its_row(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import planning.planner
+
+    def broken_plan(*args: object, **kwargs: object) -> None:
+        raise IndexError("index 7 is out of bounds for axis 0 with size 5")
+
+    monkeypatch.setattr(planning.planner, "plan", broken_plan)
+    item = plan_scene_file(paper_scene_path(), tmp_path / "paper")
+    assert (item.status, item.exit_class) == ("error", 4)
+    assert item.message == "IndexError: 'index 7 is out of bounds for axis 0 ..." and item.record is None
+    assert not (tmp_path / "paper").exists()
+
+
+def test_a_scene_never_replaces_a_folder_that_is_not_ours(tmp_path: Path) -> None:
+    scene = tmp_path / "odd.yaml"
+    scene.write_text((paper_scene_path()).read_text())
+    out = tmp_path / "odd"
+    out.mkdir()
+    (out / "keep.txt").write_text("the user's file")  # a folder that is not ours: refused, not replaced
+    item = plan_scene_file(scene, out)
+    assert item.status == "invalid" and "holds files a plan does not write (keep.txt)" in item.message
+    assert (out / "keep.txt").read_text() == "the user's file"
+
+
 def test_dask_cluster_gives_the_same_results(scenes: Path, tmp_path: Path) -> None:
     distributed = pytest.importorskip("distributed")
     paths = scene_files(scenes)[1:3]
-    local = plan_batch(paths, tmp_path / "local", workers=2)
+    local = run_batch(paths, tmp_path / "local", workers=2).items
     with distributed.LocalCluster(
         n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
     ) as cluster:
         assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")
-        remote = plan_batch(paths, tmp_path / "dask", scheduler=cluster.scheduler_address)
+        remote = run_batch(paths, tmp_path / "dask", scheduler=cluster.scheduler_address).items
     assert [i.scene for i in remote] == [i.scene for i in local]
     for a, b in zip(local, remote, strict=True):
         assert a.status == b.status == "ok" and a.record is not None and b.record is not None
@@ -68,17 +140,20 @@ def test_bad_folders(tmp_path: Path) -> None:
         scene_files(tmp_path)
     with pytest.raises(PlanningError, match="cannot reach the Dask scheduler"):
         (tmp_path / "a.yaml").write_text("{}")
-        plan_batch(scene_files(tmp_path), tmp_path / "out", scheduler="tcp://127.0.0.1:9")
+        run_batch(scene_files(tmp_path), tmp_path / "out", scheduler="tcp://127.0.0.1:9")
 
 
 def test_batch_command(scenes: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    code = main(["batch", str(scenes), "--out", str(tmp_path), "--workers", "2"])
+    code = main(["batch", str(scenes), "--out", str(tmp_path / "b"), "--workers", "2"])
     out = capsys.readouterr().out
-    assert code == 3  # one scene failed, the others were planned
+    assert code == 2  # the worst class: one scene was invalid, the others were planned
     assert "4/5 scenes planned" in out and "broken (exit class 2)" in out
-    assert (tmp_path / "summary.csv").exists()
+    assert (tmp_path / "b" / "summary.csv").exists()
     code = main(["batch", str(scenes), "--out", str(tmp_path / "j"), "--workers", "2", "--json"])
     result = json.loads(capsys.readouterr().out)
-    assert code == 3 and result["ok"] == 4 and result["scenes"] == 5
+    assert code == 2 and result["ok"] == 4 and result["scenes"] == 5 and not result["interrupted"]
     code = main(["batch", str(tmp_path / "missing"), "--out", str(tmp_path / "x")])
     assert code == 2 and "does not exist" in capsys.readouterr().err
+    (tmp_path / "file").write_text("")
+    code = main(["batch", str(scenes), "--out", str(tmp_path / "file")])
+    assert code == 2 and "output folder" in capsys.readouterr().err and (tmp_path / "file").read_text() == ""

@@ -115,7 +115,12 @@ def test_plan_check_and_reproducibility(tmp_path: Path, capsys: pytest.CaptureFi
     first, second = tmp_path / "a", tmp_path / "b"
     code, stdout, _ = run(["plan", str(scene), "--out", str(first)], capsys)
     assert code == 0 and "verified trajectory" in stdout
-    assert sorted(p.name for p in first.iterdir()) == ["report.md", "samples.csv", "trajectory.json"]
+    assert sorted(p.name for p in first.iterdir()) == [
+        "manifest.json",
+        "report.md",
+        "samples.csv",
+        "trajectory.json",
+    ]
     code, stdout, _ = run(["plan", str(scene), "--out", str(second), "--json"], capsys)
     assert code == 0
     summary = json.loads(stdout)

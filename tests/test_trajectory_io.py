@@ -1,7 +1,6 @@
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 
 import numpy as np
@@ -9,7 +8,7 @@ import pytest
 
 import cpr_kin as ck
 from planning.io.bundled import paper_scene
-from planning.io.trajectory_io import atomic_write_text, write_samples, write_trajectory
+from planning.io.trajectory_io import write_samples, write_trajectory
 from planning.io.trajectory_reader import read_trajectory
 from planning.planner import PlanResult, plan
 
@@ -85,13 +84,3 @@ def test_samples_csv(result: PlanResult, tmp_path: Path) -> None:
     np.testing.assert_allclose(np.diff(data[:-1, 0]), 0.012, atol=1e-6)
     np.testing.assert_allclose(data[:, 1:6], result.trajectory(data[:, 0]), atol=1e-9)
     np.testing.assert_allclose(data[:, 16:21], result.trajectory(data[:, 0], 3), atol=1e-9)
-
-
-def test_atomic_write_leaves_nothing_on_failure(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    def refuse(*_: object) -> None:
-        raise OSError("disk full")
-
-    monkeypatch.setattr(os, "replace", refuse)
-    with pytest.raises(OSError, match="disk full"):
-        atomic_write_text(tmp_path / "out.json", "{}")
-    assert list(tmp_path.iterdir()) == []

@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import argparse
+import os
+import signal
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 
 from planning.cli.batch_command import cmd_batch
-from planning.cli.failure import CommandError
+from planning.cli.failure import EXIT_INTERNAL, EXIT_INTERRUPTED, CommandError
 from planning.cli.file_commands import cmd_check, cmd_show
 from planning.cli.plan_commands import cmd_paper, cmd_plan
 
@@ -22,7 +24,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     def planning_options(sub: argparse.ArgumentParser) -> None:
         sub.add_argument(
-            "--out", type=Path, required=True, help="output folder (trajectory.json, samples.csv, report.md)"
+            "--out",
+            required=True,
+            help="output folder, new, empty or a previous plan's (trajectory.json, samples.csv, report.md)",
         )
         sub.add_argument("--seed", type=int, help="seed of the firefly search (default: the scene's)")
         sub.add_argument("--fitness", choices=("clearance", "paper"), help="fitness (default: the scene's)")
@@ -94,7 +98,7 @@ def build_parser() -> argparse.ArgumentParser:
         "when every scene planned, 3 when any failed, 2 for an invalid folder or scheduler.",
     )
     sub.add_argument("scenes", type=Path, metavar="SCENES_DIR", help="folder of scene files")
-    sub.add_argument("--out", type=Path, required=True, help="output folder")
+    sub.add_argument("--out", required=True, help="output folder (a subfolder per scene, and summary.csv)")
     sub.add_argument("--workers", type=int, help="parallel tasks (default: all cores, or the cluster's)")
     sub.add_argument(
         "--scheduler", metavar="ADDRESS", help="dask.distributed scheduler, e.g. tcp://127.0.0.1:8786"
@@ -104,15 +108,44 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+MAX_ERROR_CHARS = 300
+"""Longest error line the CLI prints (a hostile input must not flood the terminal)."""
+
+
+def _one_line(text: str) -> str:
+    text = " ".join(text.split())
+    return text if len(text) <= MAX_ERROR_CHARS else text[: MAX_ERROR_CHARS - 3] + "..."
+
+
+def _stop(signum: int, _frame: object) -> None:
+    raise KeyboardInterrupt(signal.Signals(signum).name)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of ``cpr-plan``; returns the exit code."""
+    """Entry point of ``cpr-plan``; returns the exit code.
+
+    ``SIGINT`` and ``SIGTERM`` stop any command cleanly (exit 130; nothing half-written),
+    also when the shell started it with ``SIGINT`` ignored (``cpr-plan batch ... &``). An
+    unexpected exception is a bug: one line and exit 4; ``CPR_PLAN_TRACEBACK=1`` shows it whole.
+    """
     args = build_parser().parse_args(argv)
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, _stop)
     try:
         code: int = args.run(args)
     except CommandError as failure:
-        print(f"cpr-plan {args.command}: error: {failure}", file=sys.stderr)
+        print(f"cpr-plan {args.command}: error: {_one_line(str(failure))}", file=sys.stderr)
         return failure.code
     except KeyboardInterrupt:
-        print(f"cpr-plan {args.command}: interrupted", file=sys.stderr)
-        return 130
+        print(f"cpr-plan {args.command}: interrupted; nothing written", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except Exception as exc:
+        if os.environ.get("CPR_PLAN_TRACEBACK"):
+            raise
+        problem = _one_line(f"{type(exc).__name__}: {exc}")
+        print(
+            f"cpr-plan {args.command}: internal error (a bug; please report it with the input): {problem}",
+            file=sys.stderr,
+        )
+        return EXIT_INTERNAL
     return code

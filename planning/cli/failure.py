@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
-EXIT_OK, EXIT_INVALID, EXIT_NO_TRAJECTORY = 0, 2, 3
+EXIT_OK, EXIT_INVALID, EXIT_NO_TRAJECTORY, EXIT_INTERNAL = 0, 2, 3, 4
+"""Success; invalid input; no trajectory found (or, for ``check``, one that fails); an
+unexpected error (a bug, or a crashed batch worker)."""
+EXIT_INTERRUPTED = 130
+"""Stopped by ``Ctrl-C`` or ``SIGTERM`` (128 + SIGINT, as shells report it)."""
 
 
 class CommandError(Exception):

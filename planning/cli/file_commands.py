@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import signal
 import sys
 import time
 from pathlib import Path
@@ -56,8 +55,8 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 def cmd_show(args: argparse.Namespace) -> int:
     """Show a trajectory file in a live meshcat viewer, or write it as one HTML page."""
+    from planning.io.publish import write_file
     from planning.io.scene_file import parse_scene
-    from planning.io.trajectory_io import write_files
     from planning.io.trajectory_reader import read_trajectory
     from planning.viz import artifacts
 
@@ -79,18 +78,15 @@ def cmd_show(args: argparse.Namespace) -> int:
             world, scene.safety_margin, document.trajectory, document.waypoints, args.collision
         )
         try:
-            written = write_files(args.html.parent, {args.html.name: html})
+            written = write_file(args.html, html)
+        except PlanningError as exc:
+            raise CommandError(EXIT_INVALID, str(exc)) from None
         except OSError as exc:
             raise CommandError(EXIT_INVALID, f"cannot write '{args.html}': {exc.strerror or exc}") from None
-        print(f"wrote {written[0]} (self-contained; open it in a browser)")
+        print(f"wrote {written} (self-contained; open it in a browser)")
         return EXIT_OK
     from planning.viz.viewer import Viewer
 
-    def stop(signum: int, _frame: object) -> None:
-        raise KeyboardInterrupt(signal.Signals(signum).name)
-
-    for signum in (signal.SIGINT, signal.SIGTERM):  # also when started with SIGINT ignored
-        signal.signal(signum, stop)
     with Viewer(world, scene.safety_margin) as viewer:
         viewer.show_geometry(visual=not args.collision, collision=args.collision)
         viewer.show_plan(document.trajectory, document.waypoints)

@@ -31,33 +31,30 @@ def load(path: Path) -> Scene:
         raise CommandError(EXIT_INVALID, str(exc)) from None
 
 
-def _plan_and_write(scene: Scene, out: Path, args: argparse.Namespace, paper: bool) -> int:
+def _plan_and_write(scene: Scene, out: str, args: argparse.Namespace, paper: bool) -> int:
     from planning.io.outputs import plan_files
+    from planning.io.publish import OutputFolder
     from planning.io.report import paper_rows, summary, summary_line, text_table
-    from planning.io.trajectory_io import write_files
     from planning.planner import plan
 
     overrides = {k: getattr(args, k) for k in OVERRIDES if getattr(args, k, None) is not None}
-    if overrides:
-        try:
-            scene = dataclasses.replace(scene, planner=scene.planner.updated(**overrides))
-        except PlanningError as exc:
-            raise CommandError(EXIT_INVALID, str(exc)) from None
     update, close = firefly_progress(sys.stdout.isatty() and not args.json)
     try:
-        result = plan(scene, progress=update)
+        if overrides:
+            scene = dataclasses.replace(scene, planner=scene.planner.updated(**overrides))
+        with OutputFolder(out) as folder:  # locked from here: a second writer is refused at once
+            result = plan(scene, progress=update)
+            close()
+            extras = {"plots": paper or args.plots, "html": paper or args.html}
+            outputs = folder.publish(plan_files(result, paper=paper, timings=args.timings, **extras))
     except NoSolutionError as exc:
         raise CommandError(EXIT_NO_TRAJECTORY, str(exc)) from None
     except (PlanningError, ck.CprKinError) as exc:
         raise CommandError(EXIT_INVALID, str(exc)) from None
-    finally:
-        close()
-    extras = {"plots": paper or args.plots, "html": paper or args.html}
-    files = plan_files(result, paper=paper, timings=args.timings, **extras)
-    try:
-        outputs = write_files(out, files)
     except OSError as exc:
         raise CommandError(EXIT_INVALID, f"cannot write to '{out}': {exc.strerror or exc}") from None
+    finally:
+        close()
     if args.json:
         print(json.dumps({**summary(result), "outputs": [str(p) for p in outputs]}, indent=1))
     else:

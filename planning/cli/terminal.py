@@ -35,8 +35,10 @@ def firefly_progress(enabled: bool) -> tuple[Callable[[FireflyProgress], None] |
             bar.update(1)
         bar.set_postfix(best=f"{progress.best:.4g}")
 
-    def close() -> None:
+    def close() -> None:  # idempotent: a command may close it early, and again on the way out
+        nonlocal bar
         if bar is not None:
             bar.close()
+            bar = None
 
     return update, close

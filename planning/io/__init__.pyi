@@ -2,13 +2,17 @@
 
 from .bundled import bundled_scene_paths, paper_scene, paper_scene_path
 from .outputs import plan_files
+from .publish import FolderLock, OutputError, OutputFolder, write_file
 from .report import plan_record, report_markdown, summary
 from .scene_file import dump_scene, load_scene, parse_scene, scene_document
 from .scene_generator import generate_scenes, random_scene
-from .trajectory_io import write_files, write_samples, write_trajectory
+from .trajectory_io import write_samples, write_trajectory
 from .trajectory_reader import TrajectoryFile, TrajectoryFileError, parse_trajectory, read_trajectory
 
 __all__ = [
+    "FolderLock",
+    "OutputError",
+    "OutputFolder",
     "TrajectoryFile",
     "TrajectoryFileError",
     "bundled_scene_paths",
@@ -26,7 +30,7 @@ __all__ = [
     "report_markdown",
     "scene_document",
     "summary",
-    "write_files",
+    "write_file",
     "write_samples",
     "write_trajectory",
 ]

@@ -1,6 +1,6 @@
 """The files a plan produces, rendered in memory.
 
-:func:`planning.io.trajectory_io.write_files` then writes them all at once, or none.
+:meth:`planning.io.publish.OutputFolder.publish` then publishes them as one set, or none.
 """
 
 from __future__ import annotations

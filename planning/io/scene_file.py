@@ -19,6 +19,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import yaml
 from pydantic import ValidationError
 
@@ -26,6 +27,7 @@ import cpr_kin as ck
 from cpr_kin.user_files import UserFileError, load_yaml
 from planning.curves.spline import SplineSettings
 from planning.errors import PlanningError, SceneError
+from planning.io.publish import write_file
 from planning.io.scene_schema import (
     BoxSpec,
     CapsuleSpec,
@@ -133,24 +135,53 @@ def load_scene(path: str | Path) -> Scene:
     return parse_scene(data, source=str(path), base=path.parent)
 
 
-def scene_document(scene: Scene) -> dict[str, Any]:
-    """The scene file's document for ``scene`` (the inverse of :func:`parse_scene`)."""
-    from planning.io.trajectory_io import obstacle_to_dict, target_to_dict
+def obstacle_to_dict(obstacle: ck.Obstacle) -> dict[str, Any]:
+    """An obstacle in the scene file's form (DESIGN.md section 6)."""
+    entry: dict[str, Any] = {"name": obstacle.name, "shape": obstacle.shape}
+    if obstacle.shape == "box":
+        entry["size"] = np.asarray(obstacle.size).tolist()
+    if obstacle.shape in ("sphere", "cylinder", "capsule"):
+        entry["radius"] = obstacle.radius
+    if obstacle.shape in ("cylinder", "capsule"):
+        entry["length"] = obstacle.length
+    if obstacle.shape == "mesh":
+        entry.update(mesh=str(obstacle.mesh), scale=obstacle.scale, convex=obstacle.convex)
+    entry.update(xyz=obstacle.xyz.tolist(), rpy=obstacle.rpy.tolist())
+    return entry
 
-    planner = scene.planner.flat()
-    if planner["moving_joints"] is not None:
-        planner["moving_joints"] = list(planner["moving_joints"])
-    document: dict[str, Any] = {
+
+def target_to_dict(target: Target) -> dict[str, Any]:
+    """A start or goal in the scene file's form."""
+    if target.q is not None:
+        return {"q": [float(v) for v in target.q]}
+    entry: dict[str, Any] = {"tcp": [float(v) for v in target.tcp or ()]}
+    if target.theta4 or target.theta5:
+        entry.update(theta4=target.theta4, theta5=target.theta5)
+    return entry
+
+
+def scene_to_dict(scene: Scene) -> dict[str, Any]:
+    """The scene as planned: obstacles, safety margin, start, goal (and duration)."""
+    return {
         "name": scene.name,
         "safety_margin": scene.safety_margin,
         "start": target_to_dict(scene.start),
         "goal": target_to_dict(scene.goal),
+        "duration": scene.duration,
         "obstacles": [obstacle_to_dict(o) for o in scene.obstacles],
-        "planner": planner,
-        "spline": {"p": scene.spline.p, "a": list(scene.spline.a), "ends": scene.spline.ends},
     }
-    if scene.duration is not None:
-        document["duration"] = scene.duration
+
+
+def scene_document(scene: Scene) -> dict[str, Any]:
+    """The scene file's document for ``scene`` (the inverse of :func:`parse_scene`)."""
+    planner = scene.planner.flat()
+    if planner["moving_joints"] is not None:
+        planner["moving_joints"] = list(planner["moving_joints"])
+    document = scene_to_dict(scene)
+    if document["duration"] is None:
+        del document["duration"]
+    document["planner"] = planner
+    document["spline"] = {"p": scene.spline.p, "a": list(scene.spline.a), "ends": scene.spline.ends}
     if scene.robot is not None:
         document["robot"] = str(scene.robot)
     return document
@@ -158,8 +189,4 @@ def scene_document(scene: Scene) -> dict[str, Any]:
 
 def dump_scene(scene: Scene, path: Path) -> None:
     """Write ``scene`` as a scene file, atomically."""
-    from planning.io.trajectory_io import atomic_write_text
-
-    atomic_write_text(
-        Path(path), yaml.safe_dump(scene_document(scene), sort_keys=False, default_flow_style=None)
-    )
+    write_file(Path(path), yaml.safe_dump(scene_document(scene), sort_keys=False, default_flow_style=None))
