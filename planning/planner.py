@@ -28,6 +28,9 @@ from planning.verification import Verification, verify_trajectory
 
 FloatArray = NDArray[np.float64]
 
+SAME_POSE_TOLERANCE = 1e-9
+"""Start and goal closer than this in every joint [rad or m] are one pose: the plan stands still."""
+
 
 @dataclass(frozen=True)
 class PlanResult:
@@ -112,6 +115,8 @@ def solve(
         NoTrajectoryFoundError: no candidate passes the verification.
     """
     started = time.perf_counter()
+    if np.allclose(problem.q_start, problem.q_goal, rtol=0.0, atol=SAME_POSE_TOLERANCE):
+        return _stay_put(problem, started)
     scene, objective, solver = problem.scene, problem.objective, problem.solver
     settings = scene.planner
     rng = np.random.default_rng(settings.seed)
@@ -174,6 +179,62 @@ def solve(
         metrics=metrics,
         breakdown=breakdown,
         optimiser=result,
+        verification=verification.check,
+    )
+
+
+def _stay_put(problem: Problem, started: float) -> PlanResult:
+    """The trajectory of a scene whose goal is its start: standing still, verified.
+
+    It lasts the scene's duration, or one IPO period when the duration is free (a trajectory
+    needs a time interval; a controller executes nothing shorter).
+    """
+    scene, objective = problem.scene, problem.objective
+    x = np.tile(problem.q_start[problem.moving], scene.planner.waypoints)
+    fit = problem.solver.solve(objective.nodes(x[None])[0])
+    duration = scene.duration if scene.duration is not None else scene.planner.ipo
+    scale = duration / fit.trajectory.duration
+    coefficients = np.zeros((1, problem.robot.nq, fit.trajectory.coefficients.shape[2]))
+    coefficients[0, :, 0] = problem.q_start  # exactly still (the spline through equal nodes is, to 1e-9)
+    trajectory = Trajectory(knots=np.array([0.0, duration]), coefficients=coefficients)
+    verification = _verify(problem, trajectory, fit)
+    if not verification.accepted:  # pragma: no cover - the start was checked clear of the margin
+        raise NoTrajectoryFoundError(
+            f"standing still fails: {'; '.join(verification.problems)}", verification.check
+        )
+    breakdown = objective.breakdown(x[None])
+    fitness = float(breakdown.fitness[0])
+    search = SearchResult(
+        x=x,
+        fitness=fitness,
+        evaluations=1,
+        best_history=np.array([fitness]),
+        mean_history=np.array([fitness]),
+        evaluation_history=np.array([1], dtype=np.int64),
+        population=x[None],
+        population_fitness=np.array([fitness]),
+    )
+    elapsed = problem.build_time_s + time.perf_counter() - started
+    metrics = measure(
+        problem.robot,
+        trajectory,
+        verification.check,
+        fit.max_node_deviation,
+        breakdown,
+        search,
+        (elapsed, 0.0),
+        1,
+        False,
+    )
+    return PlanResult(
+        problem=problem,
+        waypoints=objective.nodes(x[None])[0],
+        trajectory=trajectory,
+        spline=fit,
+        time_scale=float(scale),
+        metrics=metrics,
+        breakdown=breakdown,
+        optimiser=search,
         verification=verification.check,
     )
 

@@ -47,13 +47,16 @@ class Verification:
 
 
 CONTINUITY_TOLERANCE = 1e-6
-"""Largest relative jump of position, velocity, acceleration or jerk at a knot
-(:meth:`~planning.curves.trajectory.Trajectory.knot_jumps`) of a C3 trajectory."""
+"""Largest jump of position, velocity, acceleration or jerk at a knot of a C3 trajectory
+(:meth:`~planning.curves.trajectory.Trajectory.knot_jumps`): relative to the magnitudes
+summed, or absolute [rad/s^r or m/s^r], whichever is larger (rounding in another tool's file
+must not count)."""
 
 
 def _discontinuity(trajectory: Trajectory, robot: ck.Robot) -> str | None:
     """The worst jump at a knot beyond :data:`CONTINUITY_TOLERANCE`, as a sentence, if any."""
     jump, relative = trajectory.knot_jumps(CONTINUITY + 1)
+    relative = np.where(jump > CONTINUITY_TOLERANCE, relative, 0.0)
     if relative.size == 0 or relative.max() <= CONTINUITY_TOLERANCE:
         return None
     knot, joint, r = np.unravel_index(int(np.argmax(relative)), relative.shape)

@@ -145,3 +145,18 @@ def test_warm_up_compiles_the_kernels_and_returns_its_time(robot: ck.Robot) -> N
     assert 0.0 < seconds < 120.0
     compiled: list[Any] = [_move, any_below]  # what planning runs
     assert all(kernel.signatures for kernel in compiled)  # compiled (or loaded from the cache)
+
+
+@pytest.mark.parametrize("duration", [None, 2.5])
+def test_a_goal_at_the_start_gives_the_trajectory_that_stands_still(
+    robot: ck.Robot, duration: float | None
+) -> None:
+    scene = Scene(start=Target(tcp=PAPER_START_TCP), goal=Target(tcp=PAPER_START_TCP), duration=duration)
+    result = plan(scene, robot)
+    trajectory = result.trajectory
+    assert trajectory.duration == pytest.approx(duration or scene.planner.ipo)
+    times = np.linspace(0.0, trajectory.duration, 7)
+    np.testing.assert_array_equal(trajectory(times), np.tile(result.problem.q_start, (7, 1)))
+    for r in (1, 2, 3):
+        assert not np.any(trajectory(times, r))
+    assert result.metrics.evaluations == 1 and result.verification.accepted
