@@ -7,9 +7,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
-import coal
 import numpy as np
-import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import ObstacleError
@@ -232,11 +230,15 @@ class Obstacle:
     @property
     def placement(self) -> Any:
         """Pose ``obstacle_in_world`` as a ``pinocchio.SE3``."""
+        import pinocchio as pin  # imported when geometry is built: reading a scene needs neither
+
         rotation = pin.rpy.rpyToMatrix(*self.rpy)
         return pin.SE3(rotation, np.array(self.xyz))
 
     def geometry(self) -> Any:
         """A new coal collision geometry of this obstacle in its local frame."""
+        import coal  # imported when geometry is built: reading a scene needs neither
+
         if self.shape == "box":
             return coal.Box(*(float(x) for x in np.asarray(self.size)))
         if self.shape == "sphere":
@@ -248,9 +250,10 @@ class Obstacle:
         return self._mesh_geometry()
 
     def _mesh_geometry(self) -> Any:
+        import coal
         import trimesh  # only needed for mesh obstacles
 
-        what = f"obstacle '{self.name}': mesh '{self.mesh}'"
+        what = f"obstacle '{self.name}': mesh '{Path(str(self.mesh)).name}'"
         try:
             mesh: Any = trimesh.load(str(self.mesh), force="mesh")
         except Exception as exc:  # trimesh raises many types for unreadable files

@@ -1,7 +1,8 @@
 """Type stub of the package: what it exports, and from which module (read by ``lazy_loader``)."""
 
 from .curves.ptp import ptp_time, trapezoid_time
-from .curves.spline import SepticSplineSolver, SplineFit, SplineSettings, fit_septic_spline, uniform_knots
+from .curves.spline import SepticSplineSolver, SplineFit, fit_septic_spline, uniform_knots
+from .curves.spline_settings import SplineSettings
 from .curves.trajectory import Extrema, Trajectory
 from .errors import NoSolutionError, NoTrajectoryFoundError, PlanningError, SceneError, SplineError
 from .io.bundled import paper_scene
@@ -13,7 +14,8 @@ from .objective import Breakdown, WaypointObjective
 from .planner import PlanResult, plan, solve, warm_up
 from .problem import Problem, build_problem
 from .scene import DEFAULT_SAFETY_MARGIN_M, DEFAULT_SPLINE, PlannerSettings, Scene, Target
-from .search.firefly import FireflyProgress, FireflySettings, firefly_minimize
+from .search.firefly import FireflyProgress, firefly_minimize
+from .search.firefly_settings import FireflySettings
 from .search.optimizer import Optimizer, SearchResult
 from .verification import Verification, verify_trajectory
 

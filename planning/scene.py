@@ -18,9 +18,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from planning.curves.spline import SplineSettings
+from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError
-from planning.search.firefly import FireflySettings
+from planning.search.firefly_settings import FireflySettings
 from planning.validation import integer_in, number_in, shown
 
 FloatArray = NDArray[np.float64]

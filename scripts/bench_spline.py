@@ -21,7 +21,8 @@ from collections.abc import Callable
 import numpy as np
 
 from planning.curves import banded_system
-from planning.curves.spline import SepticSplineSolver, SplineSettings, fit_septic_spline
+from planning.curves.spline import SepticSplineSolver, fit_septic_spline
+from planning.curves.spline_settings import SplineSettings
 
 
 def median_seconds(

@@ -13,7 +13,7 @@ import cpr_kin as ck
 from planning.io.bundled import paper_scene
 from planning.planner import plan
 from planning.search import baselines
-from planning.search.firefly import FireflySettings
+from planning.search.firefly_settings import FireflySettings
 from planning.search.optimizer import Optimizer
 
 ROOT = Path(__file__).resolve().parent.parent

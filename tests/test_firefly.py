@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from planning.errors import PlanningError
-from planning.search.firefly import FireflyProgress, FireflySettings, _sweep, firefly_minimize
+from planning.search.firefly import FireflyProgress, _sweep, firefly_minimize
+from planning.search.firefly_settings import FireflySettings
 
 
 def sphere(x: np.ndarray) -> np.ndarray:

@@ -12,7 +12,7 @@ from planning.errors import NoTrajectoryFoundError, PlanningError
 from planning.io.bundled import paper_scene
 from planning.planner import PlanResult, plan, warm_up
 from planning.scene import PlannerSettings, Scene, Target
-from planning.search.firefly import FireflySettings
+from planning.search.firefly_settings import FireflySettings
 
 from .conftest import PAPER_GOAL_TCP, PAPER_START_TCP
 

@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 
 import cpr_kin as ck
 from cpr_kin.user_files import StrictLoader
-from planning.curves.spline import SplineSettings
+from planning.curves.spline_settings import SplineSettings
 from planning.errors import SceneError
 from planning.io.bundled import paper_scene, paper_scene_path
 from planning.io.scene_file import (

@@ -11,10 +11,10 @@ import cpr_kin as ck
 from planning.curves.spline import (
     DENSE_MAP_NODES,
     SepticSplineSolver,
-    SplineSettings,
     fit_septic_spline,
     uniform_knots,
 )
+from planning.curves.spline_settings import SplineSettings
 from planning.errors import SplineError
 
 from .conftest import PAPER_GOAL_TCP, PAPER_START_TCP

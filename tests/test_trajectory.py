@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from planning.curves.spline import SplineSettings, fit_septic_spline
+from planning.curves.spline import fit_septic_spline
+from planning.curves.spline_settings import SplineSettings
 from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
 

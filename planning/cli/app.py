@@ -134,7 +134,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         code: int = args.run(args)
     except CommandError as failure:
-        print(f"cpr-plan {args.command}: error: {_one_line(str(failure))}", file=sys.stderr)
+        print(_one_line(f"cpr-plan {args.command}: error: {failure}"), file=sys.stderr)
         return failure.code
     except KeyboardInterrupt:
         print(f"cpr-plan {args.command}: interrupted; nothing written", file=sys.stderr)
@@ -142,10 +142,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except Exception as exc:
         if os.environ.get("CPR_PLAN_TRACEBACK"):
             raise
-        problem = _one_line(f"{type(exc).__name__}: {exc}")
-        print(
-            f"cpr-plan {args.command}: internal error (a bug; please report it with the input): {problem}",
-            file=sys.stderr,
-        )
+        bug = f"cpr-plan {args.command}: internal error (a bug; please report it with the input)"
+        print(_one_line(f"{bug}: {type(exc).__name__}: {exc}"), file=sys.stderr)
         return EXIT_INTERNAL
     return code

@@ -7,10 +7,10 @@ from .spline import (
     DENSE_MAP_NODES,
     SepticSplineSolver,
     SplineFit,
-    SplineSettings,
     fit_septic_spline,
     uniform_knots,
 )
+from .spline_settings import SplineSettings
 from .trajectory import DERIVATIVE_NAMES, Extrema, Trajectory
 
 __all__ = [

@@ -25,7 +25,7 @@ from pydantic import ValidationError
 
 import cpr_kin as ck
 from cpr_kin.user_files import UserFileError, load_yaml
-from planning.curves.spline import SplineSettings
+from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError, SceneError
 from planning.io.publish import write_file
 from planning.io.scene_schema import (

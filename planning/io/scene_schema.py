@@ -29,7 +29,13 @@ from planning.scene import (
     VERIFY_STEP_RANGE_M,
     PlannerSettings,
 )
-from planning.search.firefly import MAX_FIREFLIES, MAX_GAMMA, MAX_ITERATIONS, MAX_STEP, FireflySettings
+from planning.search.firefly_settings import (
+    MAX_FIREFLIES,
+    MAX_GAMMA,
+    MAX_ITERATIONS,
+    MAX_STEP,
+    FireflySettings,
+)
 from planning.validation import describe_validation
 
 

@@ -1,7 +1,8 @@
 """Type stub of the package: what it exports, and from which module (read by ``lazy_loader``)."""
 
 from . import baselines
-from .firefly import FireflyProgress, FireflySettings, firefly_minimize
+from .firefly import FireflyProgress, firefly_minimize
+from .firefly_settings import FireflySettings
 from .optimizer import BatchObjective, Optimizer, SearchResult
 
 __all__ = [

@@ -22,7 +22,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from planning.search.firefly import FireflySettings, firefly_minimize
+from planning.search.firefly import firefly_minimize
+from planning.search.firefly_settings import FireflySettings
 from planning.search.optimizer import BatchObjective, Optimizer, SearchResult
 
 FloatArray = NDArray[np.float64]
