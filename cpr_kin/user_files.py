@@ -21,6 +21,7 @@ line. Numbers in exponent form without a dot (``1e6``) are floats, as in YAML 1.
 
 from __future__ import annotations
 
+import contextlib
 import re
 from pathlib import Path
 from typing import Any
@@ -159,9 +160,18 @@ def load_yaml(path: Path, max_bytes: int, what: str = "YAML file") -> Any:
     """
     text = read_text(Path(path), max_bytes, what)
     source = f"{what} '{path}'"
-    try:
+    # the scan raises UserFileError itself (a ValueError, not a constructor's); a syntax error
+    # it meets is reported by the load below, with its line
+    with contextlib.suppress(yaml.YAMLError):
         _scan(text, source)
+    try:
         return yaml.load(text, Loader=StrictLoader)
+    except RecursionError:  # pragma: no cover - the depth is bounded by the scan
+        raise UserFileError(f"{source}: nested too deeply") from None
+    except (ValueError, TypeError, IndexError, OverflowError) as exc:  # a constructor's own error
+        raise UserFileError(
+            f"{source} is not valid YAML: {_cut(f'{type(exc).__name__}: {exc}', 120)}"
+        ) from None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""

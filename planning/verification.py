@@ -69,6 +69,23 @@ def _discontinuity(trajectory: Trajectory, robot: ck.Robot) -> str | None:
     )
 
 
+def _unchecked(margin_m: float, step_m: float) -> ck.CurveCheck:
+    """The record of a continuous check that could not be run: nothing certified."""
+    return ck.CurveCheck(
+        accepted=False,
+        margin_m=margin_m,
+        step_m=step_m,
+        times=np.empty(0),
+        clearance_m=np.empty((0, len(ck.GROUPS))),
+        certified_min_m=-np.inf,
+        sampled_min_m=np.nan,
+        worst_time=np.nan,
+        worst_group="",
+        worst_pair=None,
+        violating_groups=ck.GROUPS,
+    )
+
+
 def verify_trajectory(
     world: ck.CollisionWorld,
     trajectory: Trajectory,
@@ -89,10 +106,14 @@ def verify_trajectory(
     robot = world.robot
     limits = robot.limits
     start, end = trajectory.knots[0], trajectory.knots[-1]
-    check = ck.check_curve(
-        world, trajectory.position, start, end, trajectory.extrema(1).peak, margin_m, step_m
-    )
     problems = []
+    try:
+        check = ck.check_curve(
+            world, trajectory.position, start, end, trajectory.extrema(1).peak, margin_m, step_m
+        )
+    except ck.CprKinError as exc:  # too fast to certify: a verdict, not a crash
+        problems.append(f"cannot be certified clear of obstacles: {exc}")
+        check = _unchecked(margin_m, step_m)
     jumps = _discontinuity(trajectory, robot)
     if jumps is not None:
         problems.append(jumps)
@@ -101,7 +122,7 @@ def verify_trajectory(
             gap = float(np.abs(trajectory(t) - q).max())
             if gap > 1e-6:
                 problems.append(f"its {label} is {gap:.3g} away from the scene's {label}")
-    if not check.accepted:
+    if not check.accepted and check.times.size:
         problems.append(
             f"comes within {check.certified_min_m:.4f} m (certified) of an obstacle, margin {margin_m} m: "
             f"closest at t = {check.worst_time:.2f} s between {check.worst_pair} ({check.worst_group})"

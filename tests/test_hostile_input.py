@@ -16,6 +16,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import trimesh
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from planning.cli import main
 
@@ -269,3 +271,29 @@ def test_check_accepts_the_file_a_plan_wrote(
     assert code == 0 and "verified against" in stdout
     values = np.array(json.loads(good.read_text())["segments"][0]["coeffs"])
     assert np.all(np.isfinite(values))
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(
+    segment=st.integers(0, 3),
+    joint=st.integers(0, 4),
+    k=st.integers(0, 7),
+    value=st.one_of(st.floats(-10.0, 10.0), st.sampled_from([0.0, 1e-9, 1e5, -1e5])),
+)
+def test_check_of_any_changed_coefficient_ends_in_a_verdict(
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    trajectory_file: tuple[Path, Path],
+    segment: int,
+    joint: int,
+    k: int,
+    value: float,
+) -> None:
+    scene, good = trajectory_file
+
+    def edit(document: dict[str, object]) -> None:
+        document["segments"][segment]["coeffs"][joint][k] = value  # type: ignore[index]
+
+    bad = changed(good, edit, tmp_path / "fuzzed.json")
+    code, _, stderr, _ = run(["check", str(scene), str(bad)], capsys)
+    assert code in (0, 2, 3) and "Traceback" not in stderr and stderr.count("\n") <= 1

@@ -242,3 +242,49 @@ def test_strict_loader_reads_scene_files_as_pyyaml_does(tmp_path: Path) -> None:
         text = path.read_text(encoding="utf-8")
         expected = yaml12_floats(yaml.load(text, Loader=yaml.SafeLoader))
         assert yaml.load(text, Loader=StrictLoader) == expected, path.name
+
+
+yaml_pieces = st.lists(
+    st.sampled_from(
+        [
+            "start: ",
+            "goal: ",
+            "{tcp: [0.5, 0.45, 0.25]}",
+            "&a ",
+            "*a",
+            "[",
+            "]",
+            "{",
+            "}",
+            ", ",
+            "\n",
+            "  ",
+            "obstacles: ",
+            "- ",
+            "1e6",
+            "true",
+            "'x'",
+            "? ",
+            ": ",
+            "!!float ",
+            "<<: *a",
+            "---\n",
+            "\t",
+            "#",
+        ]
+    ),
+    max_size=30,
+)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.one_of(st.binary(max_size=120), yaml_pieces.map(lambda pieces: "".join(pieces).encode())))
+def test_arbitrary_bytes_and_yaml_features_load_or_raise_one_short_scene_error(
+    tmp_path_factory: pytest.TempPathFactory, data: bytes
+) -> None:
+    path = tmp_path_factory.mktemp("scene") / "scene.yaml"
+    path.write_bytes(data)
+    try:
+        load_scene(path)
+    except SceneError as exc:
+        assert "\n" not in str(exc) and len(str(exc)) < 300 + len(str(path))
