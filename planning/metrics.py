@@ -16,6 +16,10 @@ import cpr_kin as ck
 from planning.curves.trajectory import Trajectory
 from planning.objective import Breakdown
 from planning.search.optimizer import SearchResult
+from planning.timing import Timing
+
+WALL_TIMES = ("planning_time_s", "optimiser_time_s", "timing_time_s")
+"""The record's wall times: ``None`` in a file written without ``timings``."""
 
 
 @dataclass(frozen=True)
@@ -39,6 +43,9 @@ class Metrics:
         evaluations: objective evaluations.
         candidates_verified: candidates that went through the final verification.
         duration_stretched: the requested duration broke a limit and was stretched.
+        timing: how the trajectory was timed: ``fixed`` (the scene's duration), ``fastest``
+            or ``uniform`` (see :mod:`planning.timing`).
+        timing_time_s: wall time of that timing [s].
     """
 
     duration_s: float
@@ -57,15 +64,16 @@ class Metrics:
     evaluations: int
     candidates_verified: int
     duration_stretched: bool
+    timing: str = "fixed"
+    timing_time_s: float = 0.0
 
     def to_record(self, timings: bool = True) -> dict[str, Any]:
         """The metrics as plain JSON types, under the trajectory file's keys.
 
-        Wall times (``planning_time_s``, ``optimiser_time_s``) are ``None`` unless
-        ``timings``: a file that records none is the same, byte for byte, for the same scene
-        and seed.
+        Wall times (:data:`WALL_TIMES`) are ``None`` unless ``timings``: a file that records
+        none is the same, byte for byte, for the same scene and seed.
         """
-        return {
+        record = {
             "duration": self.duration_s,
             "min_clearance": self.min_clearance_m,
             "sampled_min_clearance": self.sampled_min_clearance_m,
@@ -77,12 +85,15 @@ class Metrics:
             "fitness": self.fitness,
             "t_sol": self.t_sol_s,
             "w_sol": self.w_sol,
-            "planning_time_s": self.planning_time_s if timings else None,
-            "optimiser_time_s": self.optimiser_time_s if timings else None,
+            "planning_time_s": self.planning_time_s,
+            "optimiser_time_s": self.optimiser_time_s,
             "evaluations": self.evaluations,
             "candidates_verified": self.candidates_verified,
             "duration_stretched": self.duration_stretched,
+            "timing": self.timing,
+            "timing_time_s": self.timing_time_s,
         }
+        return record if timings else {**record, **dict.fromkeys(WALL_TIMES)}
 
 
 def measure(
@@ -94,7 +105,7 @@ def measure(
     search: SearchResult,
     times_s: tuple[float, float],
     candidates_verified: int,
-    duration_stretched: bool,
+    timing: Timing,
 ) -> Metrics:
     """The metrics of a verified trajectory.
 
@@ -107,7 +118,7 @@ def measure(
         search: the optimiser's run.
         times_s: ``(planning, search)`` wall times [s].
         candidates_verified: candidates that went through the final verification.
-        duration_stretched: the scene's duration was stretched to meet a limit.
+        timing: the timing that was verified.
     """
     limits = robot.limits
     names = robot.joint_names
@@ -135,5 +146,7 @@ def measure(
         optimiser_time_s=times_s[1],
         evaluations=search.evaluations,
         candidates_verified=candidates_verified,
-        duration_stretched=duration_stretched,
+        duration_stretched=timing.stretched,
+        timing=timing.method,
+        timing_time_s=timing.time_s,
     )

@@ -18,9 +18,13 @@ configurations and against ``margin + verify_step_m``:
 - ``paper``: feasible ``F = t_sol + (w_sol / w_max) IPO`` (eq. 4); effector only violates:
   ``2 t_max - F`` (eq. 5); links violate ("shoulder", with or without the effector), or a
   joint leaves its range: ``2 t_max + F`` (our reading of eq. 6).
-- ``clearance`` (default): feasible as eq. 4; infeasible ``2 t_max + t_max (depth / required
-  + excess)``, with ``depth`` the mean violation of the required clearance over the samples
-  [m] and ``excess`` the sum of the other violations below, each relative to its bound.
+- ``clearance`` (default): feasible as eq. 4, except that when the scene leaves the duration
+  free, ``t_sol`` is replaced by how fast the path itself can be run (its phase-plane time
+  plus the jerk allowance, :mod:`planning.path_terms`): the search then optimises the
+  trajectory that is executed, not the paper's proxy of stopping at every waypoint;
+  infeasible ``2 t_max + t_max (depth / required + excess)``, with ``depth`` the mean
+  violation of the required clearance over the samples [m] and ``excess`` the sum of the
+  other violations below, each relative to its bound.
   The margin is checked at every 4th sample first; the rest only where it can still make the
   candidate feasible (no violation so far); depth is the mean over the samples checked.
   Feasible always ranks ahead of infeasible.
@@ -31,11 +35,8 @@ keep velocity, acceleration and jerk within the limits at that duration (checked
 samples; the final timing uses exact extrema). The paper fitness ranks these violations
 with eq. 6.
 
-Only joints that move are fitted and sampled: the waypoint joints, and any other joint whose
-goal differs from its start (it moves in the last segment). The rest keep their start value,
-exactly, as the spline through constant nodes does. A joint's velocity, acceleration or
-jerk that is certainly within its limit by a Bernstein bound (:mod:`planning.curves.polynomial_bounds`)
-contributes no excess and is not sampled: the bound is at least the sampled maximum.
+The paths themselves (samples, ``w_sol``, range, limit and deviation terms) are those of
+:mod:`planning.path_terms`.
 """
 
 from __future__ import annotations
@@ -62,6 +63,8 @@ class Breakdown:
     Attributes:
         fitness: the objective value.
         t_sol_s: PTP time through the candidate's nodes [s].
+        duration_s: how fast the path can be run, with the duration free and the clearance
+            fitness (``nan`` otherwise) [s].
         w_sol: normalised accumulated joint motion of the executed path.
         feasible: no margin violation and no joint beyond its limits.
         effector_violates: the wrist or tool comes closer than the required clearance (with
@@ -79,6 +82,7 @@ class Breakdown:
 
     fitness: FloatArray
     t_sol_s: FloatArray
+    duration_s: FloatArray
     w_sol: FloatArray
     feasible: BoolArray
     effector_violates: BoolArray
@@ -128,7 +132,11 @@ class WaypointObjective:
         self.lower_q, self.upper_q = limits.lower, limits.upper
         self.v_max, self.a_max = limits.velocity, limits.acceleration
         self.timed = timed
-        self.paths = ExecutedPaths(limits, self.q_start, self.q_goal, self.moving, settings, solver, timed)
+        # with the duration free, the clearance fitness ranks by how fast a path can be run
+        self.estimates_duration = not timed and settings.fitness == "clearance" and settings.path == "spline"
+        self.paths = ExecutedPaths(
+            limits, self.q_start, self.q_goal, self.moving, settings, solver, timed, self.estimates_duration
+        )
         segments = self.n_waypoints + 1
         self.lower = np.tile(limits.lower[self.moving], self.n_waypoints)
         self.upper = np.tile(limits.upper[self.moving], self.n_waypoints)
@@ -153,6 +161,12 @@ class WaypointObjective:
         nodes[:, 1:-1] = self.q_start  # held joints keep the start's values
         nodes[:, 1:-1, self.moving] = x.reshape(s, self.n_waypoints, self.moving.size)
         return nodes
+
+    def straight_line(self) -> FloatArray:
+        """The decision vector whose waypoints lie evenly on the straight line from start to goal."""
+        fractions = np.arange(1, self.n_waypoints + 1) / (self.n_waypoints + 1)
+        points = self.q_start + fractions[:, None] * (self.q_goal - self.q_start)
+        return np.asarray(points[:, self.moving].ravel())
 
     def __call__(self, x: FloatArray) -> FloatArray:
         """``(S,)`` fitness of candidates ``x`` ``(S, p k)`` in joint units."""
@@ -216,7 +230,12 @@ class WaypointObjective:
         checked = ~np.isnan(worst)
         depth = np.where(checked, worst, 0.0).sum(axis=1) / checked.sum(axis=1)
         feasible = ~(effector | links) & (other <= 0.0)
-        base = t_sol + np.minimum(w_sol / self.w_max, 1.0) * self.settings.ipo
+        time_s = (
+            t_sol
+            if paths.duration_s is None
+            else np.minimum(paths.duration_s, self.t_max - self.settings.ipo)
+        )
+        base = time_s + np.minimum(w_sol / self.w_max, 1.0) * self.settings.ipo
         if self.settings.fitness == "paper":
             fitness = np.where(
                 feasible, base, np.where(links | (other > 0), 2 * self.t_max + base, 2 * self.t_max - base)
@@ -227,6 +246,7 @@ class WaypointObjective:
         return Breakdown(
             fitness=fitness,
             t_sol_s=t_sol,
+            duration_s=np.full(len(t_sol), np.nan) if paths.duration_s is None else paths.duration_s,
             w_sol=w_sol,
             feasible=feasible,
             effector_violates=effector,

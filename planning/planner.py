@@ -24,6 +24,7 @@ from planning.problem import Problem, build_problem
 from planning.scene import Scene
 from planning.search.firefly import FireflyProgress, firefly_minimize
 from planning.search.optimizer import Optimizer, SearchResult
+from planning.timing import Timing, timings
 from planning.verification import Verification, verify_trajectory
 
 FloatArray = NDArray[np.float64]
@@ -117,19 +118,21 @@ def solve(
     started = time.perf_counter()
     if np.allclose(problem.q_start, problem.q_goal, rtol=0.0, atol=SAME_POSE_TOLERANCE):
         return _stay_put(problem, started)
-    scene, objective, solver = problem.scene, problem.objective, problem.solver
+    scene, objective = problem.scene, problem.objective
     settings = scene.planner
     rng = np.random.default_rng(settings.seed)
     if optimizer is None:
+        # with a free duration, the straight line is the fastest path when it is clear: the
+        # search starts from it (the paper case, of fixed duration, keeps its random start)
+        seeds = None if scene.duration is not None else objective.straight_line()[None]
         result = firefly_minimize(
-            objective, objective.lower, objective.upper, settings.firefly, rng, progress
+            objective, objective.lower, objective.upper, settings.firefly, rng, progress, seeds
         )
     else:
         budget = settings.firefly.fireflies * (settings.firefly.iterations + 1)
         result = optimizer(objective, objective.lower, objective.upper, budget, rng)
     optimiser_time = time.perf_counter() - started
 
-    limits = problem.robot.limits
     # the best, then the final population's candidates the fitness found feasible (an
     # infeasible one will not pass the verification), best first
     order = np.argsort(result.population_fitness, kind="stable")
@@ -140,15 +143,11 @@ def solve(
     for x in candidates:
         tried += 1
         nodes = objective.nodes(x[None])[0]
-        fit = solver.solve(nodes)
-        nominal = fit.trajectory
-        scale = nominal.time_scale_for_limits(limits.velocity, limits.acceleration, limits.jerk)
-        stretched = scene.duration is not None and scale > 1.0
-        if scene.duration is not None:
-            scale = max(scale, 1.0)
-        trajectory = nominal.time_scaled(scale)
-        verification = _verify(problem, trajectory, fit)
-        first = first or verification
+        for timing in timings(problem, nodes):  # the fastest first; a fallback if it fails
+            verification = _verify(problem, timing.trajectory, timing.fit)
+            first = first or verification
+            if verification.accepted:
+                break
         if verification.accepted:
             break
     else:
@@ -158,6 +157,7 @@ def solve(
             f"({len(candidates)} candidates verified)",
             first.check,
         )
+    trajectory, fit = timing.trajectory, timing.fit
     breakdown = objective.breakdown(x[None])
     metrics = measure(
         problem.robot,
@@ -168,14 +168,14 @@ def solve(
         result,
         (problem.build_time_s + time.perf_counter() - started, optimiser_time),
         tried,
-        bool(stretched),
+        timing,
     )
     return PlanResult(
         problem=problem,
         waypoints=nodes,
         trajectory=trajectory,
         spline=fit,
-        time_scale=float(scale),
+        time_scale=trajectory.duration / fit.trajectory.duration,
         metrics=metrics,
         breakdown=breakdown,
         optimiser=result,
@@ -224,7 +224,7 @@ def _stay_put(problem: Problem, started: float) -> PlanResult:
         search,
         (elapsed, 0.0),
         1,
-        False,
+        Timing(trajectory, "fixed" if scene.duration is not None else "fastest", fit, False, 0.0),
     )
     return PlanResult(
         problem=problem,

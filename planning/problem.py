@@ -37,7 +37,8 @@ class Problem:
         q_start: start configuration [rad, m], reachable and clear of the margin.
         q_goal: goal configuration [rad, m], likewise.
         moving: indices of the joints the waypoints move.
-        solver: the septic spline solver on the search's knots.
+        solver: the septic spline solver on the search's knots: the trajectory's spline when
+            the scene fixes the duration, else the geometric path's.
         objective: the waypoint objective the search minimises.
         build_time_s: wall time of :func:`build_problem` [s].
     """
@@ -110,6 +111,8 @@ def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | No
     moving = moving_joints(robot, scene, q_start, q_goal)
     segments = scene.planner.waypoints + 1
     nominal_duration = scene.duration if scene.duration is not None else float(segments)
+    # the spline on the search's knots: the trajectory itself when the scene fixes the duration,
+    # else the geometric path that the timing runs as fast as the limits allow
     solver = SepticSplineSolver(uniform_knots(segments, nominal_duration), scene.spline)
     objective = WaypointObjective(
         world,

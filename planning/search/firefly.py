@@ -55,6 +55,7 @@ def firefly_minimize(
     settings: FireflySettings | None = None,
     rng: np.random.Generator | int | None = 0,
     callback: Callable[[FireflyProgress], None] | None = None,
+    seeds: ArrayLike | None = None,
 ) -> SearchResult:
     """Minimise ``objective`` over the box ``[lower, upper]`` with the firefly algorithm.
 
@@ -65,6 +66,8 @@ def firefly_minimize(
         settings: algorithm parameters (default: the paper's, sweep mode).
         rng: a ``numpy.random.Generator`` or a seed; the same seed gives the same run.
         callback: called with a :class:`FireflyProgress` after every iteration.
+        seeds: ``(k, d)`` points (in the box) that replace the first ``k`` fireflies of the
+            random initial population; the random draws are the same with or without them.
     """
     settings = settings or FireflySettings()
     lo = np.asarray(lower, dtype=float)
@@ -87,6 +90,13 @@ def firefly_minimize(
 
     # NiaPy draws the initial population as uniform(lower, upper) in its (here: unit) box
     u = generator.uniform(np.zeros(d), np.ones(d), (n, d))
+    if seeds is not None:
+        given = np.atleast_2d(np.asarray(seeds, dtype=float))
+        if given.shape[1:] != (d,) or len(given) > n or not np.all((given >= lo) & (given <= hi)):
+            raise PlanningError(
+                f"seeds of shape {given.shape} must be at most {n} points of the box, ({d},) each"
+            )
+        u[: len(given)] = (given - lo) / span
     f = evaluate(u)
     best_u, best_f = u[int(np.argmin(f))].copy(), float(np.min(f))
     evaluations = n

@@ -1,0 +1,188 @@
+"""Time-optimal path speed under velocity and acceleration limits (the phase-plane method).
+
+A path ``q(u)`` with derivatives ``q'(u)``, ``q''(u)`` is followed at speed ``u'(t)``; with
+``x = u'^2`` the joint velocity is ``q' sqrt(x)`` and the joint acceleration
+``q'' x + q' x' / 2`` (``x'`` the derivative along ``u``). On a grid ``u_0 .. u_G`` the
+fastest profile from rest to rest within ``|q_j'| u' <= v_j`` and ``|q_j'' u'^2 + q_j' u''| <= a_j``
+lies under the *maximum velocity curve*: the largest ``x`` at which the velocity limits hold
+and some acceleration satisfies every joint (found by bisection where curvature binds).
+
+The time is ``sum 2 du / (sqrt(x_g) + sqrt(x_g+1))``. On each step the path acceleration is
+constant and keeps the joints within their limits at the step's first grid point. As in
+TOPP-RA (Pham and Pham 2018), a backward pass first finds at every grid point the largest
+``x`` from which the end can still be reached (the controllable set); the forward pass then
+accelerates as hard as it may without leaving it, so the profile never follows a limit
+curve more steeply than the acceleration limits allow. The passes are compiled and batched
+over many paths for the planner's fitness (:func:`sampled_path_times`, on the samples of
+each candidate's path);
+:mod:`planning.curves.path_timing` turns a profile into a jerk-limited, C3 septic trajectory.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from cpr_kin.compiled import njit
+
+FloatArray = NDArray[np.float64]
+
+_TINY = 1e-12
+_HUGE = 1e12
+
+
+@njit
+def _acceleration_bounds(
+    d1: FloatArray, d2: FloatArray, g: int, x: float, a: FloatArray
+) -> tuple[float, float]:
+    """``(lowest, highest)`` path acceleration ``u''`` at grid point ``g`` and ``x = u'^2``.
+
+    ``lowest > highest`` when no acceleration keeps every joint within its limit.
+    """
+    low, high = -_HUGE, _HUGE
+    for j in range(d1.shape[1]):
+        slope, curve = d1[g, j], d2[g, j] * x
+        if abs(slope) > _TINY:
+            b1, b2 = (a[j] - curve) / slope, (-a[j] - curve) / slope
+            high = min(high, max(b1, b2))
+            low = max(low, min(b1, b2))
+        elif abs(curve) > a[j]:
+            return _HUGE, -_HUGE
+    return low, high
+
+
+@njit
+def _controllable(
+    d1: FloatArray, d2: FloatArray, g: int, du: float, a: FloatArray, top: float, ahead: float
+) -> float:
+    """The largest ``x`` at ``g``, at most ``top``, from which one step reaches ``[0, ahead]``.
+
+    A step keeps ``u''`` constant, ``x_next = x + 2 du u''``, and ``u''`` must keep every joint
+    within its acceleration limit at ``g``. The ``x`` that allow it form an interval that
+    holds 0 (``u'' = 0``); bisection finds its top.
+    """
+
+    def reaches(x: float) -> bool:
+        low, high = _acceleration_bounds(d1, d2, g, x, a)
+        low, high = max(low, -x / (2.0 * du)), min(high, (ahead - x) / (2.0 * du))
+        return low <= high
+
+    if reaches(top):
+        return top
+    below, above = 0.0, top
+    for _ in range(50):
+        middle = 0.5 * (below + above)
+        if reaches(middle):
+            below = middle
+        else:
+            above = middle
+    return below
+
+
+@njit
+def phase_plane_profile(
+    d1: FloatArray, d2: FloatArray, du: FloatArray, v: FloatArray, a: FloatArray
+) -> FloatArray:
+    """``x = u'^2`` at the grid points ``(G,)`` of the fastest rest-to-rest profile.
+
+    Args:
+        d1: ``(G, nj)`` path derivative ``q'(u)`` at the grid points.
+        d2: ``(G, nj)`` second derivative ``q''(u)``.
+        du: ``(G - 1,)`` grid steps.
+        v: ``(nj,)`` velocity limits [rad/s, m/s].
+        a: ``(nj,)`` acceleration limits.
+    """
+    n, joints = d1.shape
+    limit = np.empty(n)
+    for g in range(n):  # the maximum velocity curve
+        top = _HUGE
+        for j in range(joints):
+            if abs(d1[g, j]) > _TINY:
+                top = min(top, (v[j] / abs(d1[g, j])) ** 2)
+        low, high = _acceleration_bounds(d1, d2, g, top, a)
+        if low > high:  # curvature binds: the largest x whose acceleration interval is not empty
+            below, above = 0.0, top
+            for _ in range(50):
+                middle = 0.5 * (below + above)
+                low, high = _acceleration_bounds(d1, d2, g, middle, a)
+                if low <= high:
+                    below = middle
+                else:
+                    above = middle
+            top = below
+        limit[g] = top
+    controllable = np.zeros(n)  # backward: from where the robot can still stop at the end
+    for g in range(n - 2, -1, -1):
+        controllable[g] = _controllable(d1, d2, g, du[g], a, limit[g], controllable[g + 1])
+    x = np.zeros(n)  # forward: as fast as the limits allow without leaving the controllable set
+    for g in range(n - 1):
+        low, high = _acceleration_bounds(d1, d2, g, x[g], a)
+        x[g + 1] = max(min(controllable[g + 1], x[g] + 2.0 * du[g] * high), 0.0)
+    return x
+
+
+@njit
+def profile_time(x: FloatArray, du: FloatArray) -> float:
+    """Duration [s] of the profile ``x = u'^2`` on a grid of steps ``du`` ``(G - 1,)``."""
+    total = 0.0
+    for g in range(len(x) - 1):
+        total += 2.0 * du[g] / max(np.sqrt(x[g]) + np.sqrt(x[g + 1]), _TINY)
+    return total
+
+
+@njit
+def _sampled_derivatives(points: FloatArray, v: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Arc-length steps ``(M - 1,)`` and ``dq/ds``, ``d2q/ds2`` ``(M, nj)`` of a sampled path.
+
+    ``s`` measures each joint in seconds at its velocity limit; samples closer than ``1e-9``
+    to the one before are dropped; derivatives are the three-point formulas of a
+    non-uniform grid, taken from the neighbour at the ends.
+    """
+    count, joints = points.shape
+    kept = np.empty((count, joints))
+    kept[0] = points[0]
+    m = 1
+    for k in range(1, count):
+        step = 0.0
+        for j in range(joints):
+            step += ((points[k, j] - kept[m - 1, j]) / v[j]) ** 2
+        if np.sqrt(step) > 1e-9:
+            kept[m] = points[k]
+            m += 1
+    steps = np.empty(max(m - 1, 1))
+    steps[0] = 1.0
+    for k in range(m - 1):
+        step = 0.0
+        for j in range(joints):
+            step += ((kept[k + 1, j] - kept[k, j]) / v[j]) ** 2
+        steps[k] = np.sqrt(step)
+    d1 = np.zeros((max(m, 2), joints))
+    d2 = np.zeros((max(m, 2), joints))
+    for k in range(1, m - 1):
+        h1, h2 = steps[k - 1], steps[k]
+        for j in range(joints):
+            f0, f1, f2 = kept[k - 1, j], kept[k, j], kept[k + 1, j]
+            d1[k, j] = -h2 / (h1 * (h1 + h2)) * f0 + (h2 - h1) / (h1 * h2) * f1 + h1 / (h2 * (h1 + h2)) * f2
+            d2[k, j] = 2.0 * (f0 / (h1 * (h1 + h2)) - f1 / (h1 * h2) + f2 / (h2 * (h1 + h2)))
+    if m >= 3:
+        d1[0], d1[m - 1], d2[0], d2[m - 1] = d1[1], d1[m - 2], d2[1], d2[m - 2]
+    elif m == 2:
+        for j in range(joints):
+            d1[0, j] = d1[1, j] = (kept[1, j] - kept[0, j]) / steps[0]
+    return steps, d1[:m], d2[:m]
+
+
+@njit
+def sampled_path_times(points: FloatArray, v: FloatArray, a: FloatArray) -> FloatArray:
+    """``(S,)`` fastest rest-to-rest durations [s] along ``S`` sampled paths ``(S, M, nj)``.
+
+    The paths are taken in arc length (:func:`_sampled_derivatives`): a path that creeps
+    in its own parameter (as a rest-to-rest spline does near its ends) is not mistaken for
+    one that moves fast.
+    """
+    times = np.zeros(points.shape[0])
+    for s in range(points.shape[0]):
+        steps, d1, d2 = _sampled_derivatives(points[s], v)
+        if len(d1) >= 2:
+            times[s] = profile_time(phase_plane_profile(d1, d2, steps, v, a), steps)
+    return times
