@@ -32,10 +32,14 @@ comes within a few percent of Ruckig's time-optimal jerk-limited duration.
 
 from __future__ import annotations
 
+from itertools import pairwise
+from typing import NamedTuple
+
 import numpy as np
 from numpy.typing import NDArray
 
 from planning.curves.hermite import HERMITE_INV, node_scaling
+from planning.curves.moving_average import arc_at_times, jerk_limited_motion, scaled_duration
 from planning.curves.phase_plane import phase_plane_profile
 from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
@@ -45,107 +49,72 @@ FloatArray = NDArray[np.float64]
 GRID = 512
 """Grid points of the phase-plane profile along the path (uniform in its parameter)."""
 FINE = 2049
-"""Samples of the path's parameter from which its arc length is integrated."""
-TIME_STEP_S = 1e-3
-"""Step of the time grid on which the joints' motion is averaged [s]."""
+"""Samples of the path's parameter: its arc length is integrated on them, and positions
+along the path are interpolated between them (chords of 1/2048 of the path)."""
+STEPS_PER_RAMP = 100
+"""Steps of the time grid on which the joints' motion is averaged, per ``max_j a_j / j_j``
+(the time the jerk limit takes to ramp the acceleration limit; 2 ms for the CPR). Relative,
+so that limits scaled as time is (``v`` by ``k``, ``a`` by ``k^2``, ``j`` by ``k^3``) give the
+same motion ``k`` times faster."""
 NODE_STEP_S = 0.1
 """Spacing of the trajectory's knots [s]."""
 ROUNDS = 3
 """Most widenings of the averaging window for a jerk beyond the limit."""
 TOLERANCE = 0.02
-"""Excess of a limit left to the final uniform scaling."""
-ACCELERATION_SHARES = (1.0, 0.7, 0.5)
-"""Shares of the acceleration limit tried for the phase-plane profile. A short move switches
-from accelerating to braking at once, and the jerk of that switch is cheaper to meet with a
-gentler acceleration than with a wider average; the fastest result is kept."""
+"""Excess of the jerk limit left to the final uniform scaling."""
+FACTORS = (0.95, 0.9, 0.85, 0.8, 0.75, 0.7, 0.65, 0.6, 0.55, 0.5, 0.45, 0.4, 0.35, 0.3)
+"""Caps of the phase-plane profile's velocity tried, as shares of its uncapped peak.
+
+A move too short to cruise switches from accelerating to braking at once, and the moving
+average needs a wider window to ramp through that switch within the jerk limit. Cruising
+briefly below the peak, long enough for the acceleration to ramp down and up apart, is
+often faster; so, on curved paths, can a cap that changes where the profile brakes. The
+duration is not monotone in the cap (it jumps where the window must widen), so a grid is
+tried, refined by bisection where the widening stops. Shares of the peak rather than of
+the limit keep the search the same when a limit that does not bind is raised."""
+RAMP_FACTORS = (0.75, 0.5)
+"""Shares of the best velocity cap's acceleration ramp time tried as caps of the ramps."""
+BISECTIONS = 4
+"""Bisection steps between two neighbours of the grid, to 0.3 % of the peak."""
+MARGIN = 0.01
+"""How far below the bisection's boundary the cap is taken, as a share of the peak."""
+
+
+class _Grid(NamedTuple):
+    """A path in arc length (:func:`_arc_length_grid`)."""
+
+    dq: FloatArray
+    """``dq/ds`` at the grid points ``(G, nj)``."""
+    ddq: FloatArray
+    """``d2q/ds2`` at the grid points ``(G, nj)``."""
+    ds: FloatArray
+    """Steps between the grid points ``(G - 1,)``."""
+    length: FloatArray
+    """Arc length at the fine samples ``(FINE,)``."""
+    table: FloatArray
+    """Positions at the fine samples ``(FINE, nj)``."""
+
+
+class _Candidate(NamedTuple):
+    """The motion that one pair of caps gives."""
+
+    duration_s: float
+    """Its duration once uniformly scaled to meet every limit at its samples [s]."""
+    widened: bool
+    """The moving average needed a wider window than the accelerations' ramps."""
+    peak: float
+    """The profile's largest velocity as a share of the limit."""
+    window_s: float
+    """The moving average's width the profile's accelerations need [s]."""
+    motion: FloatArray
+    """Position, velocity, acceleration and jerk every ``step_s`` ``(4, T, nj)``."""
+    step_s: float
+    """The motion's time step [s]."""
 
 
 def jerk_allowance_s(acceleration: FloatArray, jerk: FloatArray) -> float:
     """What the moving averages add to the phase-plane time [s]: ``1.25 max_j a_j / j_j``."""
     return 1.25 * float(np.max(np.asarray(acceleration) / np.asarray(jerk)))
-
-
-def _arc_length_grid(
-    path: Trajectory, velocity: FloatArray
-) -> tuple[FloatArray, FloatArray, FloatArray, tuple[FloatArray, FloatArray]]:
-    """The path in its arc length ``s``, on a grid uniform in its own parameter ``u``.
-
-    Returns ``dq/ds`` and ``d2q/ds2`` at the grid points, the steps ``ds`` between them, and
-    the fine table ``(s, u)`` from which positions along the path are interpolated. ``s``
-    measures each joint in seconds at its velocity limit. A grid uniform in ``u`` is dense in
-    ``s`` where the path is slow in ``u``: at its ends and where it turns sharply, which is
-    where the phase plane needs resolution. The derivatives follow from the chain rule
-    exactly (``q' / s'`` and ``(q'' - dq/ds s'') / s'^2``); where ``q'`` vanishes they take
-    their neighbours' values.
-    """
-    fine = np.linspace(path.knots[0], path.knots[-1], FINE)
-    rate = np.linalg.norm(path(fine, 1) / velocity, axis=1)
-    length = np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(fine))])
-    if not length[-1] > 0:
-        raise PlanningError("the path does not move: there is nothing to time")
-    pick = np.linspace(0, FINE - 1, GRID).round().astype(int)
-    u, s = fine[pick], length[pick]
-    d1, d2 = path(u, 1), path(u, 2)
-    speed = rate[pick]
-    moving = speed > 1e-9 * speed.max()
-    dq = np.zeros_like(d1)
-    ddq = np.zeros_like(d2)
-    dq[moving] = d1[moving] / speed[moving, None]
-    bend = np.sum(d1[moving] * d2[moving] / velocity**2, axis=1) / speed[moving]  # s''(u)
-    ddq[moving] = (d2[moving] - dq[moving] * bend[:, None]) / speed[moving, None] ** 2
-    for index in np.flatnonzero(~moving):  # take the nearest moving neighbour's values
-        nearest = np.flatnonzero(moving)[np.argmin(np.abs(np.flatnonzero(moving) - index))]
-        dq[index], ddq[index] = dq[nearest], ddq[nearest]
-    steps = np.diff(s)
-    keep = np.concatenate([[True], steps > 0])  # drop repeated points (the path standing still)
-    return dq[keep], ddq[keep], np.diff(s[keep]), (length, fine)
-
-
-def _timed_positions(
-    path: Trajectory, table: tuple[FloatArray, FloatArray], ds: FloatArray, x: FloatArray
-) -> FloatArray:
-    """Positions ``(T, nj)`` every ``TIME_STEP_S`` along the profile ``x`` on the grid of steps ``ds``.
-
-    Between grid points the path acceleration ``s''`` is constant, so ``s(t)`` is exact there.
-    """
-    speed = np.sqrt(np.maximum(x, 0.0))
-    push = np.diff(x) / (2.0 * ds)  # s'' on each grid interval
-    steps = 2.0 * ds / np.maximum(speed[:-1] + speed[1:], 1e-12)
-    knot_times = np.concatenate([[0.0], np.cumsum(steps)])
-    grid = np.concatenate([[0.0], np.cumsum(ds)])
-    times = np.append(np.arange(0.0, knot_times[-1], TIME_STEP_S), knot_times[-1])
-    g = np.clip(np.searchsorted(knot_times, times, side="right") - 1, 0, len(x) - 2)
-    tau = times - knot_times[g]
-    s = np.minimum(grid[g] + speed[g] * tau + 0.5 * push[g] * tau**2, grid[-1])
-    # u(s) from the fine table: its kinks (where the interpolation's slope changes) are small
-    return path(np.interp(s, *table))
-
-
-def _average(values: FloatArray, width: int) -> FloatArray:
-    """Causal moving average over ``width`` samples along axis 0, ``width`` samples longer.
-
-    Before and after the motion the robot stands at its first and last position.
-    """
-    before = np.repeat(values[:1], width, axis=0)
-    after = np.repeat(values[-1:], width - 1, axis=0)
-    total = np.cumsum(np.concatenate([np.zeros((1, values.shape[1])), before, values, after]), axis=0)
-    return np.asarray((total[width:] - total[:-width]) / width)
-
-
-def _filtered(positions: FloatArray, window_s: float) -> list[FloatArray]:
-    """Position, velocity, acceleration and jerk of the positions averaged over ``window_s``, then a quarter.
-
-    The derivatives are those of the averaged positions themselves (central differences of a
-    smooth signal): the Hermite data of the septic must agree with each other, or the small
-    disagreements become large jerks over a short segment.
-    """
-    widths = (max(1, round(window_s / TIME_STEP_S)), max(1, round(window_s / 4 / TIME_STEP_S)))
-    for width in widths:
-        positions = _average(positions, width)
-    out = [positions]
-    for _ in range(3):
-        out.append(np.gradient(out[-1], TIME_STEP_S, axis=0))
-    return out
 
 
 def time_path(
@@ -172,38 +141,131 @@ def time_path(
         raise PlanningError(
             f"limits of shape {limits.shape} must be finite and > 0 for {path.n_joints} joints"
         )
-    dq, ddq, ds, table = _arc_length_grid(path, limits[0])
-    best: list[FloatArray] = []
-    best_time = np.inf
-    for share in ACCELERATION_SHARES:
-        x = phase_plane_profile(dq, ddq, ds, limits[0], share * limits[1])
-        positions = _timed_positions(path, table, ds, x)
-        window = share * float(np.max(limits[1] / limits[2]))
-        for _ in range(ROUNDS + 1):
-            motion = _filtered(positions, window)
-            usage = float(np.max(np.abs(motion[3]) / limits[2]))
-            if usage <= 1.0 + TOLERANCE:
-                break
-            window *= min(usage, 2.0)  # the profile switches faster than a / j: ramp it slower
-        # its duration once a uniform scaling meets every limit, to compare the shares fairly
-        usages = [float(np.max(np.abs(motion[r]) / limits[r - 1])) ** (1.0 / r) for r in (1, 2, 3)]
-        duration = len(motion[0]) * TIME_STEP_S * max(*usages, 1.0)
-        if duration < best_time:
-            best, best_time = motion, duration
-    trajectory = _septic(best, node_step_s, path(path.knots[[0, -1]]))
+    fastest = _fastest(_arc_length_grid(path, limits[0]), limits)
+    trajectory = _septic(fastest.motion, fastest.step_s, node_step_s, path(path.knots[[0, -1]]))
     return trajectory.time_scaled(trajectory.time_scale_for_limits(*limits))
 
 
-def _septic(motion: list[FloatArray], node_step_s: float, ends: FloatArray) -> Trajectory:
+def _fastest(grid: _Grid, limits: FloatArray) -> _Candidate:
+    """The fastest motion over the caps of :data:`FACTORS` and :data:`RAMP_FACTORS`.
+
+    The uncapped profile first, then velocity caps at :data:`FACTORS` of its peak (above the
+    peak a cap changes nothing); between the first pair of neighbours where the window
+    stops widening, the largest cap that needs no wider window, found by bisection and taken
+    :data:`MARGIN` lower (the jerk rises steeply past it); last, caps on the accelerations'
+    ramps at the best velocity cap.
+    """
+    tried = {1.0: _candidate(grid, limits, 1.0)}
+    peak = tried[1.0].peak
+    for share in (factor * peak for factor in FACTORS):
+        tried[share] = _candidate(grid, limits, share)
+    ordered = sorted(tried, reverse=True)
+    for high, low in pairwise(ordered):
+        if tried[high].widened and not tried[low].widened:  # the window stops widening between
+            bottom = low
+            for _ in range(BISECTIONS):
+                middle = 0.5 * (low + high)
+                if _candidate(grid, limits, middle).widened:
+                    high = middle
+                else:
+                    low = middle
+            if low - MARGIN * peak > bottom:
+                tried[low - MARGIN * peak] = _candidate(grid, limits, low - MARGIN * peak)
+            break
+    share = min(tried, key=lambda share: (tried[share].duration_s, -share))
+    best = tried[share]
+    for factor in RAMP_FACTORS:
+        found = _candidate(grid, limits, share, factor * best.window_s)
+        if found.duration_s < best.duration_s:
+            best = found
+    return best
+
+
+def _caps(limits: FloatArray, share: float, ramp_s: float) -> tuple[FloatArray, FloatArray]:
+    """Velocity and acceleration caps of the profile.
+
+    The velocity cap is ``share`` of the limit. The acceleration cap is the limit, or less
+    where the jerk limit could not reach it before the velocity cap (``a = sqrt(v j)``, as in
+    a jerk-limited profile that never holds its peak acceleration: a higher cap would only
+    widen the moving average's window), or within ``ramp_s`` [s] (``a = j ramp_s``).
+    """
+    velocity_cap = share * limits[0]
+    reachable = np.minimum(np.sqrt(velocity_cap * limits[2]), ramp_s * limits[2])
+    return velocity_cap, np.minimum(limits[1], reachable)
+
+
+def _window_s(grid: _Grid, x: FloatArray, jerk: FloatArray) -> float:
+    """The moving average's width [s]: what the jerk limits need to ramp the profile's accelerations.
+
+    Each joint's largest acceleration in the profile ``x`` (``q'' s'^2 + q' s''``) over its
+    jerk limit; the widest of them.
+    """
+    push = np.diff(x) / (2.0 * grid.ds)  # s'' on each grid interval
+    acceleration = np.abs(grid.ddq[:-1] * x[:-1, None] + grid.dq[:-1] * push[:, None])
+    return float(np.max(acceleration.max(axis=0) / jerk))
+
+
+def _candidate(grid: _Grid, limits: FloatArray, share: float, ramp_s: float = np.inf) -> _Candidate:
+    """Steps 1 and 2 with the caps of :func:`_caps`.
+
+    Positions along the path are interpolated in its table at the profile's arc lengths.
+    """
+    velocity_cap, acceleration_cap = _caps(limits, share, ramp_s)
+    x = phase_plane_profile(grid.dq, grid.ddq, grid.ds, velocity_cap, acceleration_cap)
+    window = _window_s(grid, x, limits[2])
+    peak = float(np.max(np.abs(grid.dq) * np.sqrt(np.maximum(x, 0.0))[:, None] / limits[0]))
+    step_s = float(np.max(limits[1] / limits[2])) / STEPS_PER_RAMP
+    s = arc_at_times(x, grid.ds, step_s)
+    positions = np.column_stack([np.interp(s, grid.length, column) for column in grid.table.T])
+    motion, used = jerk_limited_motion(positions, window, step_s, limits[2], ROUNDS, TOLERANCE)
+    duration_s = scaled_duration(motion, step_s, *limits)
+    return _Candidate(duration_s, used > window, peak, window, motion, step_s)
+
+
+def _arc_length_grid(path: Trajectory, velocity: FloatArray) -> _Grid:
+    """The path in its arc length ``s``, on a grid uniform in its own parameter ``u``.
+
+    ``s``
+    measures each joint in seconds at its velocity limit. A grid uniform in ``u`` is dense in
+    ``s`` where the path is slow in ``u``: at its ends and where it turns sharply, which is
+    where the phase plane needs resolution. The derivatives follow from the chain rule
+    exactly (``q' / s'`` and ``(q'' - dq/ds s'') / s'^2``); where ``q'`` vanishes they take
+    their neighbours' values.
+    """
+    fine = np.linspace(path.knots[0], path.knots[-1], FINE)
+    rate = np.linalg.norm(path(fine, 1) / velocity, axis=1)
+    length = np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(fine))])
+    if not length[-1] > 0:
+        raise PlanningError("the path does not move: there is nothing to time")
+    pick = np.linspace(0, FINE - 1, GRID).round().astype(int)
+    u, s = fine[pick], length[pick]
+    d1, d2 = path(u, 1), path(u, 2)
+    speed = rate[pick]
+    moving = speed > 1e-9 * speed.max()
+    dq = np.zeros_like(d1)
+    ddq = np.zeros_like(d2)
+    dq[moving] = d1[moving] / speed[moving, None]
+    bend = np.sum(d1[moving] * d2[moving] / velocity**2, axis=1) / speed[moving]  # s''(u)
+    ddq[moving] = (d2[moving] - dq[moving] * bend[:, None]) / speed[moving, None] ** 2
+    for index in np.flatnonzero(~moving):  # take the nearest moving neighbour's values
+        nearest = np.flatnonzero(moving)[np.argmin(np.abs(np.flatnonzero(moving) - index))]
+        dq[index], ddq[index] = dq[nearest], ddq[nearest]
+    steps = np.diff(s)
+    keep = np.concatenate([[True], steps > 0])  # drop repeated points (the path standing still)
+    return _Grid(dq[keep], ddq[keep], np.diff(s[keep]), length, path(fine))
+
+
+def _septic(motion: FloatArray, step_s: float, node_step_s: float, ends: FloatArray) -> Trajectory:
     """Septic Hermite segments whose knots take the motion's position and derivatives.
 
+    ``motion`` ``(4, T, nj)`` holds them every ``step_s`` [s].
     The first and last knots are exactly ``ends`` ``(2, nj)``, at rest.
     """
     samples = len(motion[0])
-    count = max(1, int(np.ceil((samples - 1) * TIME_STEP_S / node_step_s)))
+    count = max(1, int(np.ceil((samples - 1) * step_s / node_step_s)))
     index = np.round(np.linspace(0, samples - 1, count + 1)).astype(int)
-    knots = index * TIME_STEP_S
-    data = np.stack([values[index] for values in motion], axis=2)  # (knots, nj, 4)
+    knots = index * step_s
+    data = motion[:, index].transpose(1, 2, 0)  # (knots, nj, 4)
     data[[0, -1], :, 0] = ends
     data[[0, -1], :, 1:3] = 0.0
     steps = np.diff(knots)

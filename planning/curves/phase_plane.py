@@ -5,7 +5,7 @@ A path ``q(u)`` with derivatives ``q'(u)``, ``q''(u)`` is followed at speed ``u'
 ``q'' x + q' x' / 2`` (``x'`` the derivative along ``u``). On a grid ``u_0 .. u_G`` the
 fastest profile from rest to rest within ``|q_j'| u' <= v_j`` and ``|q_j'' u'^2 + q_j' u''| <= a_j``
 lies under the *maximum velocity curve*: the largest ``x`` at which the velocity limits hold
-and some acceleration satisfies every joint (found by bisection where curvature binds).
+and some acceleration satisfies every joint (exactly: every bound is affine in ``x``).
 
 The time is ``sum 2 du / (sqrt(x_g) + sqrt(x_g+1))``. On each step the path acceleration is
 constant and keeps the joints within their limits at the step's first grid point. As in
@@ -52,31 +52,41 @@ def _acceleration_bounds(
 
 
 @njit
-def _controllable(
-    d1: FloatArray, d2: FloatArray, g: int, du: float, a: FloatArray, top: float, ahead: float
+def _largest_x(
+    d1: FloatArray, d2: FloatArray, g: int, a: FloatArray, top: float, du: float, ahead: float
 ) -> float:
-    """The largest ``x`` at ``g``, at most ``top``, from which one step reaches ``[0, ahead]``.
+    """The largest ``x`` in ``[0, top]`` at grid point ``g`` that some path acceleration allows.
 
-    A step keeps ``u''`` constant, ``x_next = x + 2 du u''``, and ``u''`` must keep every joint
-    within its acceleration limit at ``g``. The ``x`` that allow it form an interval that
-    holds 0 (``u'' = 0``); bisection finds its top.
+    That ``u''`` must keep every joint within its acceleration limit and, if ``du > 0``,
+    one step of ``du`` (``u''`` constant, ``x_next = x + 2 du u''``) must land in
+    ``[0, ahead]``.
+
+    Every bound on ``u''`` is affine in ``x``: joint ``j`` allows ``u''`` in
+    ``(-+a_j - q_j'' x) / q_j'``, the step ``[-x, ahead - x] / (2 du)``. The bounds overlap
+    iff every lower bound is below every upper bound (intervals on a line), each pair an
+    affine inequality in ``x``: the answer is exact, the least of the pairs' limits, with
+    no bisection. ``x = 0`` (``u'' = 0``) always qualifies.
     """
-
-    def reaches(x: float) -> bool:
-        low, high = _acceleration_bounds(d1, d2, g, x, a)
-        low, high = max(low, -x / (2.0 * du)), min(high, (ahead - x) / (2.0 * du))
-        return low <= high
-
-    if reaches(top):
-        return top
-    below, above = 0.0, top
-    for _ in range(50):
-        middle = 0.5 * (below + above)
-        if reaches(middle):
-            below = middle
-        else:
-            above = middle
-    return below
+    best = top
+    joints = d1.shape[1]
+    rate = 1.0 / (2.0 * du) if du > 0.0 else 0.0
+    for i in range(joints):
+        if abs(d1[g, i]) <= _TINY:  # the joint's acceleration is the curvature term alone
+            if abs(d2[g, i]) > 0.0:
+                best = min(best, a[i] / abs(d2[g, i]))
+            continue
+        slope_i, reach_i = -d2[g, i] / d1[g, i], a[i] / abs(d1[g, i])  # bounds: slope x -+ reach
+        for k in range(joints):
+            if k != i and abs(d1[g, k]) > _TINY:  # lower of i below upper of k
+                slope_k, reach_k = -d2[g, k] / d1[g, k], a[k] / abs(d1[g, k])
+                if slope_i - slope_k > 0.0:
+                    best = min(best, (reach_i + reach_k) / (slope_i - slope_k))
+        if du > 0.0:
+            if slope_i + rate > 0.0:  # lower of i below the step's upper (ahead - x) rate
+                best = min(best, (ahead * rate + reach_i) / (slope_i + rate))
+            if -rate - slope_i > 0.0:  # the step's lower -x rate below the upper of i
+                best = min(best, reach_i / (-rate - slope_i))
+    return max(best, 0.0)
 
 
 @njit
@@ -94,29 +104,18 @@ def phase_plane_profile(
     """
     n, joints = d1.shape
     limit = np.empty(n)
-    for g in range(n):  # the maximum velocity curve
+    for g in range(n):  # the maximum velocity curve: velocity limits, then accelerations
         top = _HUGE
         for j in range(joints):
             if abs(d1[g, j]) > _TINY:
                 top = min(top, (v[j] / abs(d1[g, j])) ** 2)
-        low, high = _acceleration_bounds(d1, d2, g, top, a)
-        if low > high:  # curvature binds: the largest x whose acceleration interval is not empty
-            below, above = 0.0, top
-            for _ in range(50):
-                middle = 0.5 * (below + above)
-                low, high = _acceleration_bounds(d1, d2, g, middle, a)
-                if low <= high:
-                    below = middle
-                else:
-                    above = middle
-            top = below
-        limit[g] = top
+        limit[g] = _largest_x(d1, d2, g, a, top, 0.0, 0.0)
     controllable = np.zeros(n)  # backward: from where the robot can still stop at the end
     for g in range(n - 2, -1, -1):
-        controllable[g] = _controllable(d1, d2, g, du[g], a, limit[g], controllable[g + 1])
+        controllable[g] = _largest_x(d1, d2, g, a, limit[g], du[g], controllable[g + 1])
     x = np.zeros(n)  # forward: as fast as the limits allow without leaving the controllable set
     for g in range(n - 1):
-        low, high = _acceleration_bounds(d1, d2, g, x[g], a)
+        _, high = _acceleration_bounds(d1, d2, g, x[g], a)
         x[g + 1] = max(min(controllable[g + 1], x[g] + 2.0 * du[g] * high), 0.0)
     return x
 

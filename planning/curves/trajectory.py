@@ -32,18 +32,19 @@ def derivative_coefficients(coefficients: FloatArray, r: int) -> FloatArray:
     return out
 
 
-def _real_roots_in(coefficients: FloatArray, upper: FloatArray) -> list[FloatArray]:
-    """Real roots in ``(0, upper)`` of each polynomial ``sum_k c[m, k] x^k``.
+def _real_roots_in(coefficients: FloatArray, upper: FloatArray) -> FloatArray:
+    """Real roots in ``(0, upper)`` of each polynomial ``sum_k c[m, k] x^k``, ``(M, order - 1)``.
 
-    Polynomials are grouped by their effective degree (leading coefficients below a relative
-    tolerance are dropped) and the eigenvalues of their companion matrices computed in
-    stacks, so many small polynomials cost few NumPy calls.
+    Each row holds its polynomial's roots, ``nan`` in the places of the others. Polynomials
+    are grouped by their effective degree (leading coefficients below a relative tolerance
+    are dropped) and the eigenvalues of their companion matrices computed in stacks, so many
+    small polynomials cost few NumPy calls and no Python loop over them.
     """
     m_count, order = coefficients.shape
+    roots = np.full((m_count, order - 1), np.nan)
     scale = np.abs(coefficients).max(axis=1, keepdims=True)
     significant = np.abs(coefficients) > 1e-13 * np.where(scale > 0, scale, 1.0)
     degree = np.where(significant.any(axis=1), order - 1 - np.argmax(significant[:, ::-1], axis=1), 0)
-    roots: list[FloatArray] = [np.empty(0)] * m_count
     for d in range(1, order):
         rows = np.flatnonzero(degree == d)
         if rows.size == 0:
@@ -52,11 +53,10 @@ def _real_roots_in(coefficients: FloatArray, upper: FloatArray) -> list[FloatArr
         companion = np.zeros((rows.size, d, d))
         companion[:, 1:, :-1] = np.eye(d - 1)
         companion[:, :, -1] = -c[:, :d] / c[:, d : d + 1]
-        eigenvalues = np.linalg.eigvals(companion)
-        for n, row in enumerate(rows):
-            z = eigenvalues[n]
-            real = z.real[np.abs(z.imag) <= 1e-9 * (1.0 + np.abs(z.real))]
-            roots[row] = real[(real > 0.0) & (real < upper[row])]
+        z = np.linalg.eigvals(companion)
+        real = np.abs(z.imag) <= 1e-9 * (1.0 + np.abs(z.real))
+        inside = real & (z.real > 0.0) & (z.real < upper[rows, None])
+        roots[rows, :d] = np.where(inside, z.real, np.nan)
     return roots
 
 
@@ -188,22 +188,21 @@ class Trajectory:
             return self._extrema[derivative]
         n, nj, order = self.coefficients.shape
         h = np.diff(self.knots)
-        value = self._coefficients(derivative)
+        value = self._coefficients(derivative).reshape(n * nj, order)
         slope = self._coefficients(derivative + 1).reshape(n * nj, order)
-        roots = _real_roots_in(slope, np.repeat(h, nj))
-        minimum = np.full(nj, np.inf)
-        maximum = np.full(nj, -np.inf)
-        t_min = np.zeros(nj)
-        t_max = np.zeros(nj)
-        for i in range(n):
-            for j in range(nj):
-                local = np.concatenate(([0.0, h[i]], roots[i * nj + j]))
-                v = np.polynomial.polynomial.polyval(local, value[i, j])
-                k_lo, k_hi = int(np.argmin(v)), int(np.argmax(v))
-                if v[k_lo] < minimum[j]:
-                    minimum[j], t_min[j] = v[k_lo], self.knots[i] + local[k_lo]
-                if v[k_hi] > maximum[j]:
-                    maximum[j], t_max[j] = v[k_hi], self.knots[i] + local[k_hi]
+        # candidates of every (segment, joint): both ends and the slope's roots inside
+        ends = np.column_stack([np.zeros(n * nj), np.repeat(h, nj)])
+        local = np.concatenate([ends, _real_roots_in(slope, np.repeat(h, nj))], axis=1)  # (n nj, K)
+        values = np.zeros_like(local)
+        for k in range(order - 1, -1, -1):  # Horner, all candidates at once (nan stays nan)
+            values = values * local + value[:, k : k + 1]
+        values = values.reshape(n, nj, -1).transpose(1, 0, 2).reshape(nj, -1)  # per joint
+        times = (self.knots[:-1, None, None] + local.reshape(n, nj, -1)).transpose(1, 0, 2).reshape(nj, -1)
+        low = np.nanargmin(values, axis=1)
+        high = np.nanargmax(values, axis=1)
+        joints = np.arange(nj)
+        minimum, maximum = values[joints, low], values[joints, high]
+        t_min, t_max = times[joints, low], times[joints, high]
         for array in (minimum, maximum, t_min, t_max):
             array.setflags(write=False)
         self._extrema[derivative] = Extrema(derivative, minimum, maximum, t_min, t_max)
