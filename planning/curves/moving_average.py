@@ -143,4 +143,4 @@ def scaled_duration(motion: FloatArray, step_s: float, v: FloatArray, a: FloatAr
             usage[1] = max(usage[1], abs(motion[2, k, n]) / a[n])
             usage[2] = max(usage[2], abs(motion[3, k, n]) / j[n])
     worst = max(1.0, usage[0], np.sqrt(usage[1]), usage[2] ** (1.0 / 3.0))
-    return (motion.shape[1] - 1) * step_s * worst
+    return float((motion.shape[1] - 1) * step_s * worst)
