@@ -17,6 +17,7 @@ from planning.curves.trajectory import Trajectory
 from planning.objective import Breakdown
 from planning.search.optimizer import SearchResult
 from planning.timing import Timing
+from planning.utilisation import ORDERS, limit_usage
 
 WALL_TIMES = ("planning_time_s", "optimiser_time_s", "timing_time_s")
 """The record's wall times: ``None`` in a file written without ``timings``."""
@@ -37,6 +38,8 @@ class Metrics:
         jerk_min: per joint, smallest jerk [rad/s^3 or m/s^3].
         jerk_max: per joint, largest jerk.
         limit_utilisation: largest |velocity|, |acceleration|, |jerk| over the limit, per order.
+        mean_limit_utilisation: the same usage (largest over the joints) averaged over time,
+            per order (:mod:`planning.utilisation`).
         integrated_squared_jerk: per joint [rad^2/s^5 or m^2/s^5].
         planning_time_s: wall time of the plan, building the problem included [s].
         optimiser_time_s: wall time of the search [s].
@@ -58,6 +61,7 @@ class Metrics:
     jerk_min: dict[str, float]
     jerk_max: dict[str, float]
     limit_utilisation: dict[str, float]
+    mean_limit_utilisation: dict[str, float]
     integrated_squared_jerk: dict[str, float]
     planning_time_s: float
     optimiser_time_s: float
@@ -81,6 +85,7 @@ class Metrics:
             "jerk_min": self.jerk_min,
             "jerk_max": self.jerk_max,
             "limit_utilisation": self.limit_utilisation,
+            "mean_limit_utilisation": self.mean_limit_utilisation,
             "integrated_squared_jerk": self.integrated_squared_jerk,
             "fitness": self.fitness,
             "t_sol": self.t_sol_s,
@@ -141,6 +146,9 @@ def measure(
         jerk_min=dict(zip(names, map(float, jerk.minimum), strict=True)),
         jerk_max=dict(zip(names, map(float, jerk.maximum), strict=True)),
         limit_utilisation=utilisation,
+        mean_limit_utilisation=dict(
+            zip(ORDERS, map(float, limit_usage(trajectory, limits).mean()), strict=True)
+        ),
         integrated_squared_jerk=dict(zip(names, map(float, trajectory.integrated_squared_jerk), strict=True)),
         planning_time_s=times_s[0],
         optimiser_time_s=times_s[1],

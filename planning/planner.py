@@ -42,7 +42,8 @@ class PlanResult:
         waypoints: ``(p + 2, nq)`` start, intermediate waypoints, goal [rad, m].
         trajectory: the timed septic spline.
         spline: the spline fit (on the nominal knots, before timing).
-        time_scale: factor from the nominal knots to the trajectory's.
+        time_scale: the trajectory's duration over the spline's nominal one (the uniform
+            time scaling, unless the timing is ``fastest``).
         metrics: figures of the result.
         breakdown: the chosen candidate's fitness terms.
         optimiser: the search's run (history, population).
@@ -99,8 +100,9 @@ def solve(
 
     Steps: firefly search of the waypoints on the problem's objective
     (:mod:`planning.objective`); septic spline through start, waypoints and goal on
-    ``p + 1`` uniform segments; timing (the scene's duration, stretched if it breaks a
-    velocity, acceleration or jerk limit, or the fastest uniform timing within them);
+    ``p + 1`` uniform segments; timing (:mod:`planning.timing`: the scene's duration,
+    stretched if it breaks a velocity, acceleration or jerk limit; or, with the duration
+    free, as fast as the limits allow along the path, its uniform timing as the fallback);
     certified continuous verification of the whole trajectory against the margin. If the
     best candidate fails the verification, the final population's other feasible
     candidates are tried in order of fitness.

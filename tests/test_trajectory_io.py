@@ -78,9 +78,16 @@ def test_samples_csv(result: PlanResult, tmp_path: Path) -> None:
     lines = path.read_text().splitlines()
     header = lines[0].split(",")
     assert header[:6] == ["t", "theta1", "d2", "d3", "theta4", "theta5"]
-    assert header[-1] == "theta5_jerk" and len(header) == 21
+    assert header[20] == "theta5_jerk" and len(header) == 24
+    assert header[21:] == ["velocity_usage", "acceleration_usage", "jerk_usage"]
     data = np.loadtxt(path, delimiter=",", skiprows=1)
     assert len(data) == int(np.ceil(4.0 / 0.012)) + 1
     np.testing.assert_allclose(np.diff(data[:-1, 0]), 0.012, atol=1e-6)
     np.testing.assert_allclose(data[:, 1:6], result.trajectory(data[:, 0]), atol=1e-9)
     np.testing.assert_allclose(data[:, 16:21], result.trajectory(data[:, 0], 3), atol=1e-9)
+    limits = result.problem.robot.limits
+    for r, limit in enumerate((limits.velocity, limits.acceleration, limits.jerk), start=1):
+        columns = data[:, 1 + 5 * r : 6 + 5 * r]  # the derivative's columns, by joint
+        np.testing.assert_allclose(data[:, 20 + r], np.max(np.abs(columns) / limit, axis=1), rtol=1e-9)
+    # the usage never exceeds what the exact extrema allow
+    assert np.all(data[:, 21:] <= np.array(list(result.metrics.limit_utilisation.values())) + 1e-9)

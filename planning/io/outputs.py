@@ -8,7 +8,7 @@ from __future__ import annotations
 import json
 
 from planning.io.report import report_markdown
-from planning.io.trajectory_io import samples_csv, trajectory_document
+from planning.io.trajectory_io import plan_samples_csv, trajectory_document
 from planning.planner import PlanResult
 
 
@@ -18,7 +18,7 @@ def plan_files(
     """``trajectory.json``, ``samples.csv`` and ``report.md``; the plots and ``viewer.html`` if asked."""
     files: dict[str, str | bytes] = {
         "trajectory.json": json.dumps(trajectory_document(result, timings=timings), indent=1) + "\n",
-        "samples.csv": samples_csv(result.trajectory, result.joint_names, result.scene.planner.ipo),
+        "samples.csv": plan_samples_csv(result),
         "report.md": report_markdown(result, paper),
     }
     if plots:

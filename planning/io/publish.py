@@ -36,7 +36,7 @@ from planning.errors import PlanningError
 MANIFEST = "manifest.json"
 OUTPUT_NAMES = frozenset(
     {MANIFEST, "trajectory.json", "samples.csv", "report.md", "viewer.html"}
-    | {"joints.png", "tcp_path.png", "clearance.png", "convergence.png"}
+    | {"joints.png", "tcp_path.png", "clearance.png", "utilisation.png", "convergence.png"}
 )
 """Every file a plan may write: a folder holding only these is a previous set, which a new
 one may replace."""

@@ -129,6 +129,7 @@ def report_markdown(result: PlanResult, paper: bool = False) -> str:
         "|---|---|---|",
         *[f"| {n} | {r['jerk_min'][n]:.4g} | {r['jerk_max'][n]:.4g} |" for n in result.joint_names],
         "",
+        *usage_section(result),
         "Waypoints (start, intermediate, goal):",
         "",
         *[f"- {np.round(w, 5).tolist()}" for w in result.waypoints],
@@ -137,6 +138,37 @@ def report_markdown(result: PlanResult, paper: bool = False) -> str:
     if paper:
         lines += ["## Beside the paper", "", markdown_table(paper_rows(result)), ""]
     return "\n".join(lines)
+
+
+def usage_section(result: PlanResult) -> list[str]:
+    """``report.md``'s lines on how much of each limit the motion uses, over time."""
+    from planning.utilisation import NEAR_LIMIT, ORDERS, limit_usage
+
+    names = result.joint_names
+    usage = limit_usage(result.trajectory, result.problem.robot.limits)
+    near = usage.share_near_limit()
+    r = plan_record(result)
+    rows = [
+        (
+            f"{t0:.2f}-{t1:.2f}",
+            *(f"{u:.2f}" for u in peak),
+            f"{ORDERS[order]} of {names[joint]}",
+        )
+        for t0, t1, peak, order, joint in usage.phases()
+    ]
+    return [
+        "## Limit usage over time",
+        "",
+        f"Largest {', '.join(ORDERS)} over its limit: "
+        f"{', '.join(f'{v:.2f}' for v in r['limit_utilisation'].values())} at the peak, "
+        f"{', '.join(f'{v:.2f}' for v in r['mean_limit_utilisation'].values())} averaged over time. "
+        f"Some limit is used to {NEAR_LIMIT:.0%} or more during {near[3]:.0%} of the motion "
+        f"({', '.join(f'{order} {share:.0%}' for order, share in zip(ORDERS, near[:3], strict=True))}). "
+        "`samples.csv` has the usage at every IPO sample; `--plots` draws `utilisation.png`.",
+        "",
+        markdown_table(rows, ("time [s]", "velocity", "acceleration", "jerk", "nearest its limit")),
+        "",
+    ]
 
 
 def text_table(rows: Sequence[Sequence[str]], headers: Sequence[str] = ("figure", "paper", "ours")) -> str:

@@ -22,6 +22,7 @@ from planning.curves.trajectory import DERIVATIVE_NAMES, Trajectory
 from planning.io.publish import write_file
 
 if TYPE_CHECKING:  # types only: writing files needs neither the planner nor the robot
+    import cpr_kin as ck
     from planning.planner import PlanResult
 
 FloatArray = NDArray[np.float64]
@@ -59,18 +60,29 @@ def write_trajectory(result: PlanResult, path: Path, timings: bool = False) -> N
     write_file(Path(path), json.dumps(trajectory_document(result, timings), indent=1) + "\n")
 
 
-def samples_csv(trajectory: Trajectory, joint_names: tuple[str, ...], period: float) -> str:
-    """CSV text of position, velocity, acceleration and jerk every ``period`` seconds."""
+def samples_csv(
+    trajectory: Trajectory, joint_names: tuple[str, ...], period: float, limits: ck.JointLimits | None = None
+) -> str:
+    """CSV text of position, velocity, acceleration and jerk every ``period`` seconds.
+
+    With ``limits``, three more columns: the largest ``|velocity|``, ``|acceleration|`` and
+    ``|jerk|`` over the limit among the joints at each sample (:mod:`planning.utilisation`).
+    """
     times = np.append(np.arange(trajectory.knots[0], trajectory.knots[-1], period), trajectory.knots[-1])
     columns = [trajectory(times, r) for r in range(4)]
     header = ["t"]
     for r in range(4):
         suffix = "" if r == 0 else f"_{DERIVATIVE_NAMES[r]}"
         header += [f"{name}{suffix}" for name in joint_names]
+    if limits is not None:
+        from planning.utilisation import ORDERS, limit_usage
+
+        header += [f"{order}_usage" for order in ORDERS]
+        columns.append(limit_usage(trajectory, limits, times).usage)
     buffer = io.StringIO()
     csv.writer(buffer, lineterminator="\n").writerow(header)
     # numbers need no quoting: one %-format per row is several times faster than csv's writer
-    row = ",".join(["%.6f", *["%.12g"] * (4 * len(joint_names))]) + "\n"
+    row = ",".join(["%.6f", *["%.12g"] * (len(header) - 1)]) + "\n"
     values = np.column_stack([times, *columns]).tolist()
     buffer.write("".join([row % tuple(v) for v in values]))
     return buffer.getvalue()
@@ -78,4 +90,11 @@ def samples_csv(trajectory: Trajectory, joint_names: tuple[str, ...], period: fl
 
 def write_samples(result: PlanResult, path: Path) -> None:
     """Write the trajectory sampled at the planner's IPO period as CSV, atomically."""
-    write_file(Path(path), samples_csv(result.trajectory, result.joint_names, result.scene.planner.ipo))
+    write_file(Path(path), plan_samples_csv(result))
+
+
+def plan_samples_csv(result: PlanResult) -> str:
+    """A plan's ``samples.csv``: every IPO period, with the usage of the robot's limits."""
+    return samples_csv(
+        result.trajectory, result.joint_names, result.scene.planner.ipo, result.problem.robot.limits
+    )

@@ -12,11 +12,12 @@ import cpr_kin as ck
 from planning.curves.trajectory import Trajectory
 from planning.planner import PlanResult
 
-PLOT_FILES = ("joints.png", "tcp_path.png", "clearance.png", "convergence.png")
+PLOT_FILES = ("joints.png", "tcp_path.png", "clearance.png", "utilisation.png", "convergence.png")
 
 
 def plot_files(result: PlanResult) -> dict[str, bytes]:
-    """PNG bytes of the joint, TCP-path, clearance and convergence plots, by file name."""
+    """PNG bytes of the joint, TCP-path, clearance, limit-usage and convergence plots, by file name."""
+    from planning.utilisation import limit_usage
     from planning.viz import plots
 
     robot = result.robot
@@ -28,6 +29,7 @@ def plot_files(result: PlanResult) -> dict[str, bytes]:
             robot, result.trajectory, result.waypoints, result.scene.obstacles, result.scene.safety_margin
         ),
         plots.clearance_figure(world, result.trajectory, result.scene.safety_margin),
+        plots.utilisation_figure(limit_usage(result.trajectory, robot.limits), robot.joint_names),
         plots.convergence_figure(result.optimiser),
     )
     return {name: plots.png_bytes(figure) for name, figure in zip(PLOT_FILES, figures, strict=True)}

@@ -7,6 +7,7 @@ Imported only when plots are asked for: ``import planning`` never loads matplotl
   plus the knots and the exact extremum instants, so their extrema are the metrics'.
 - :func:`tcp_path_figure`: the 3-D TCP path with the obstacles and margin (fig. 3).
 - :func:`clearance_figure`: clearance against time with the margin line.
+- :func:`utilisation_figure`: how much of each kinematic limit the motion uses over time.
 - :func:`convergence_figure`: the firefly's best and mean fitness per iteration.
 """
 
@@ -29,6 +30,7 @@ from numpy.typing import NDArray
 import cpr_kin as ck
 from planning.curves.trajectory import DERIVATIVE_NAMES, Trajectory
 from planning.search.optimizer import SearchResult
+from planning.utilisation import ORDERS, LimitUsage
 
 FloatArray = NDArray[np.float64]
 UNITS = {"rad": ("rad", "rad/s", "rad/s$^2$", "rad/s$^3$"), "m": ("m", "m/s", "m/s$^2$", "m/s$^3$")}
@@ -146,6 +148,30 @@ def clearance_figure(world: ck.CollisionWorld, trajectory: Trajectory, margin_m:
     ax.grid(alpha=0.3)
     ax.legend()
     ax.set_title("Clearance to the obstacles")
+    figure.tight_layout()
+    return figure
+
+
+def utilisation_figure(usage: LimitUsage, joint_names: tuple[str, ...]) -> Figure:
+    """Largest |velocity|, |acceleration| and |jerk| over its limit among the joints, against time.
+
+    Where the curves stay near 1 the motion runs at its limits; where all stay low, time is
+    left on the table. The shading marks which joint holds the largest usage of each order.
+    """
+    figure, axes = plt.subplots(3, 1, figsize=(8, 6), sharex=True)
+    for r, (ax, order) in enumerate(zip(axes, ORDERS, strict=True)):
+        ax.plot(usage.times, usage.usage[:, r], color=f"C{r}")
+        ax.axhline(1.0, color="k", linestyle="--", linewidth=0.8)
+        for j, name in enumerate(joint_names):
+            held = usage.binding[:, r] == j
+            if held.any() and np.ptp(usage.times[held]) > 0:
+                ax.fill_between(usage.times, 0, 1.05, where=held, alpha=0.08, color=f"C{j + 3}", label=name)
+        ax.set_ylim(0.0, 1.05)
+        ax.set_ylabel(f"{order} / limit")
+        ax.grid(alpha=0.3)
+        ax.legend(loc="lower right", fontsize="small", ncol=len(joint_names), title="largest: joint")
+    axes[0].set_title(f"Limit usage over time (mean {', '.join(f'{m:.2f}' for m in usage.mean())})")
+    axes[-1].set_xlabel("t [s]")
     figure.tight_layout()
     return figure
 

@@ -1,0 +1,92 @@
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import cpr_kin as ck
+from planning.errors import NoSolutionError, PlanningError
+from planning.io.bundled import paper_scene
+from planning.io.scene_generator import generate_scenes
+from planning.io.trajectory_io import trajectory_document
+from planning.planner import PlanResult, build_problem, plan, solve
+from planning.timing import timings, uniform_scale
+
+
+@pytest.fixture(scope="module")
+def free_results(robot: ck.Robot) -> list[PlanResult]:
+    """Plans of generated scenes, whose duration is free: timed as fast as the limits allow."""
+    results = []
+    for scene in generate_scenes(6, 5, robot):
+        assert scene.duration is None
+        try:
+            results.append(plan(scene, robot))
+        except (PlanningError, NoSolutionError):
+            continue
+    assert len(results) >= 5
+    return results
+
+
+def test_free_durations_are_timed_within_the_limits_c3_and_certified(
+    robot: ck.Robot, free_results: list[PlanResult]
+) -> None:
+    limits = robot.limits
+    for result in free_results:
+        trajectory, metrics = result.trajectory, result.metrics
+        assert result.verification.accepted and metrics.min_clearance_m >= result.scene.safety_margin
+        used = [
+            float(np.max(trajectory.extrema(r).peak / limit))
+            for r, limit in enumerate((limits.velocity, limits.acceleration, limits.jerk), start=1)
+        ]
+        assert max(used) == pytest.approx(1.0, abs=1e-9) and all(u <= 1.0 + 1e-9 for u in used)
+        positions = trajectory.extrema(0)
+        assert np.all(positions.minimum >= limits.lower - 1e-9) and np.all(
+            positions.maximum <= limits.upper + 1e-9
+        )
+        jump, relative = trajectory.knot_jumps(4)
+        assert np.all((relative < 1e-7) | (jump < 1e-7))  # C3 at every knot (a break would be O(1))
+        np.testing.assert_allclose(
+            trajectory(trajectory.knots[[0, -1]]), [result.problem.q_start, result.problem.q_goal], atol=1e-12
+        )
+        for r in (1, 2):  # at rest at both ends
+            np.testing.assert_allclose(trajectory(trajectory.knots[[0, -1]], r), 0.0, atol=1e-9)
+
+
+def test_the_fastest_timing_is_never_longer_than_the_uniform_one(free_results: list[PlanResult]) -> None:
+    methods = []
+    for result in free_results:
+        uniform = result.spline.trajectory.time_scaled(uniform_scale(result.spline, result.problem))
+        assert result.trajectory.duration <= uniform.duration * (1 + 1e-12)
+        methods.append(result.metrics.timing)
+        if result.metrics.timing == "fastest":  # by 15-35 % on these scenes
+            assert result.trajectory.duration < 0.9 * uniform.duration
+    assert methods.count("fastest") >= len(methods) - 1
+
+
+def test_timings_are_offered_fastest_first(robot: ck.Robot, free_results: list[PlanResult]) -> None:
+    result = free_results[0]
+    offered = timings(result.problem, result.waypoints)
+    assert [t.method for t in offered] == ["fastest", "uniform"]
+    assert offered[0].trajectory.duration <= offered[1].trajectory.duration
+    fixed = build_problem(paper_scene(0), robot)
+    (only,) = timings(fixed, solve(fixed).waypoints)
+    assert only.method == "fixed" and only.trajectory.duration == pytest.approx(4.0)
+
+
+def test_the_search_ranks_candidates_by_a_bound_tight_to_the_executed_duration(
+    free_results: list[PlanResult],
+) -> None:
+    """The fitness's time term (phase plane of the sampled path plus the jerk allowance) is
+    what the executed timing takes, to within 20 %: the search optimises what is executed."""
+    for result in free_results:
+        estimate = float(result.breakdown.duration_s[0])
+        assert 0.8 * result.trajectory.duration <= estimate <= 1.05 * result.trajectory.duration
+
+
+def test_same_seed_gives_a_byte_identical_trajectory_file(
+    robot: ck.Robot, free_results: list[PlanResult]
+) -> None:
+    again = plan(free_results[0].scene, robot)
+    first = json.dumps(trajectory_document(free_results[0], timings=False))
+    assert json.dumps(trajectory_document(again, timings=False)) == first
