@@ -6,11 +6,12 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
+from planning import build_problem
 from planning.errors import NoSolutionError, PlanningError
 from planning.io.bundled import paper_scene
 from planning.io.scene_generator import generate_scenes
 from planning.io.trajectory_io import trajectory_document
-from planning.planner import PlanResult, build_problem, plan, solve
+from planning.planner import PlanResult, plan, solve
 from planning.timing import timings, uniform_scale
 
 
