@@ -32,6 +32,8 @@ class SamplingResult:
         path_length: length of the path in joint space, each joint scaled by its range.
         max_abs_jerk: largest |jerk| of any joint, from the timed spline (its acceleration
             jumps at the spline's knots, so this samples its finite pieces).
+        jerk_over_limit: the largest |jerk| / jerk limit over the joints, the same way
+            (TOPP-RA knows no jerk limit).
         planning_time_s: wall time of search, simplification, timing and verification [s].
     """
 
@@ -42,13 +44,14 @@ class SamplingResult:
     min_clearance: float
     path_length: float
     max_abs_jerk: float
+    jerk_over_limit: float
     planning_time_s: float
 
     @classmethod
     def failure(cls, reason: str, nq: int, started: float) -> SamplingResult:
         """A failed run: ``reason``, no path, figures NaN; ``started`` is its ``perf_counter()``."""
         nan = float("nan")
-        return cls(False, reason, np.empty((0, nq)), nan, nan, nan, nan, time.perf_counter() - started)
+        return cls(False, reason, np.empty((0, nq)), nan, nan, nan, nan, nan, time.perf_counter() - started)
 
 
 def planning_clearance_m(scene: Scene) -> float:
@@ -126,5 +129,6 @@ def time_and_verify(
         min_clearance=check.certified_min_m,
         path_length=length,
         max_abs_jerk=float(np.abs(jerk).max()),
+        jerk_over_limit=float(np.max(np.abs(jerk) / limits.jerk)),
         planning_time_s=time.perf_counter() - started,
     )
