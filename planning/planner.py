@@ -15,20 +15,25 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
+from planning.candidates import first_verified, verify
 from planning.curves.spline import SplineFit
 from planning.curves.trajectory import Trajectory
 from planning.errors import NoSolutionError, NoTrajectoryFoundError
 from planning.metrics import Metrics, measure
 from planning.objective import Breakdown
-from planning.problem import Problem, build_problem
-from planning.scene import Scene
+from planning.problem import Problem, build_problem, with_planner
+from planning.scene import MAX_FITNESS_SAMPLES, Scene
 from planning.search.firefly import FireflyProgress, firefly_minimize
 from planning.search.optimizer import Optimizer, SearchResult
-from planning.timing import Timing, timings
-from planning.verification import Verification, verify_trajectory
+from planning.seeding import seed_search
+from planning.timing import Timing
 
 FloatArray = NDArray[np.float64]
 
+RETRIES = 2
+"""With ``seeding: paths``, how many times a failed search is tried again: with more
+waypoints when no candidate was feasible, with twice the fitness samples when feasible ones
+failed the certified check (a violation between two samples escaped the fitness)."""
 SAME_POSE_TOLERANCE = 1e-9
 """Start and goal closer than this in every joint [rad or m] are one pose: the plan stands still."""
 
@@ -76,21 +81,6 @@ class PlanResult:
         return self.problem.robot.joint_names
 
 
-def _verify(problem: Problem, trajectory: Trajectory, fit: SplineFit) -> Verification:
-    """The scene's verification, plus the node-deviation bound of the planner settings."""
-    scene = problem.scene
-    verification = verify_trajectory(
-        problem.world, trajectory, scene.safety_margin, scene.planner.verify_step_m
-    )
-    bound = scene.planner.max_node_deviation
-    if bound is not None and fit.max_node_deviation > bound:
-        problem_text = (
-            f"deviates {fit.max_node_deviation:.3g} from its nodes, more than max_node_deviation = {bound:g}"
-        )
-        verification = Verification(verification.check, (*verification.problems, problem_text))
-    return verification
-
-
 def solve(
     problem: Problem,
     progress: Callable[[FireflyProgress], None] | None = None,
@@ -120,45 +110,31 @@ def solve(
     started = time.perf_counter()
     if np.allclose(problem.q_start, problem.q_goal, rtol=0.0, atol=SAME_POSE_TOLERANCE):
         return _stay_put(problem, started)
-    scene, objective = problem.scene, problem.objective
-    settings = scene.planner
-    rng = np.random.default_rng(settings.seed)
-    if optimizer is None:
-        # with a free duration, the straight line is the fastest path when it is clear: the
-        # search starts from it (the paper case, of fixed duration, keeps its random start)
-        seeds = None if scene.duration is not None else objective.straight_line()[None]
-        result = firefly_minimize(
-            objective, objective.lower, objective.upper, settings.firefly, rng, progress, seeds
-        )
-    else:
-        budget = settings.firefly.fireflies * (settings.firefly.iterations + 1)
-        result = optimizer(objective, objective.lower, objective.upper, budget, rng)
-    optimiser_time = time.perf_counter() - started
-
-    # the best, then the final population's candidates the fitness found feasible (an
-    # infeasible one will not pass the verification), best first
-    order = np.argsort(result.population_fitness, kind="stable")
-    feasible = result.population_fitness <= objective.t_max  # both fitnesses rank feasible at or below t_max
-    candidates = [result.x] + [result.population[k] for k in order if feasible[k]]
-    first: Verification | None = None
-    tried = 0
-    for x in candidates:
-        tried += 1
-        nodes = objective.nodes(x[None])[0]
-        for timing in timings(problem, nodes):  # the fastest first; a fallback if it fails
-            verification = _verify(problem, timing.trajectory, timing.fit)
-            first = first or verification
-            if verification.accepted:
-                break
-        if verification.accepted:
+    escalate = optimizer is None and problem.scene.planner.seeding == "paths"
+    path, widen = None, False
+    for attempt in range(1 + (RETRIES if escalate else 0)):
+        seeds = seed_search(problem, widen, path) if escalate else None
+        searched = problem if seeds is None else seeds.problem
+        path = None if seeds is None else seeds.path
+        result = _search(searched, progress, optimizer, None if seeds is None else seeds.candidates)
+        optimiser_time = time.perf_counter() - started
+        try:
+            x, nodes, timing, verification, tried = first_verified(searched, result)
             break
-    else:
-        assert first is not None  # candidates is never empty
-        raise NoTrajectoryFoundError(
-            f"no collision-free trajectory found: the best candidate {'; '.join(first.problems)} "
-            f"({len(candidates)} candidates verified)",
-            first.check,
+        except NoTrajectoryFoundError:
+            if attempt == RETRIES or not escalate:
+                raise
+        # no candidate feasible: more waypoints; feasible ones failed the certified check: a
+        # violation between two samples escaped the fitness, so check twice as many
+        widen = result.fitness > searched.objective.t_max
+        samples = searched.scene.planner.fitness_samples
+        problem = (
+            searched
+            if widen
+            else with_planner(searched, fitness_samples=min(2 * samples, MAX_FITNESS_SAMPLES))
         )
+    problem = searched
+    objective = problem.objective
     trajectory, fit = timing.trajectory, timing.fit
     breakdown = objective.breakdown(x[None])
     metrics = measure(
@@ -185,6 +161,30 @@ def solve(
     )
 
 
+def _search(
+    problem: Problem,
+    progress: Callable[[FireflyProgress], None] | None,
+    optimizer: Optimizer | None,
+    seeds: FloatArray | None,
+) -> SearchResult:
+    """The firefly (from ``seeds`` and a random population) or ``optimizer``."""
+    objective, settings = problem.objective, problem.scene.planner
+    rng = np.random.default_rng(settings.seed)
+    if optimizer is not None:
+        budget = settings.firefly.fireflies * (settings.firefly.iterations + 1)
+        return optimizer(objective, objective.lower, objective.upper, budget, rng)
+    return firefly_minimize(
+        objective,
+        objective.lower,
+        objective.upper,
+        settings.firefly,
+        rng,
+        progress,
+        seeds,
+        stall_below=objective.t_max,  # stop early only once a candidate is feasible
+    )
+
+
 def _stay_put(problem: Problem, started: float) -> PlanResult:
     """The trajectory of a scene whose goal is its start: standing still, verified.
 
@@ -199,7 +199,7 @@ def _stay_put(problem: Problem, started: float) -> PlanResult:
     coefficients = np.zeros((1, problem.robot.nq, fit.trajectory.coefficients.shape[2]))
     coefficients[0, :, 0] = problem.q_start  # exactly still (the spline through equal nodes is, to 1e-9)
     trajectory = Trajectory(knots=np.array([0.0, duration]), coefficients=coefficients)
-    verification = _verify(problem, trajectory, fit)
+    verification = verify(problem, trajectory, fit)
     if not verification.accepted:  # pragma: no cover - the start was checked clear of the margin
         raise NoTrajectoryFoundError(
             f"standing still fails: {'; '.join(verification.problems)}", verification.check

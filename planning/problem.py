@@ -9,8 +9,10 @@ waypoint objective. :func:`planning.planner.solve` then searches, times and veri
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -109,6 +111,45 @@ def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | No
     q_start = endpoint(robot, world, scene, "start")
     q_goal = endpoint(robot, world, scene, "goal")
     moving = moving_joints(robot, scene, q_start, q_goal)
+    solver, objective = _search(scene, world, q_start, q_goal, moving)
+    return Problem(
+        scene=scene,
+        robot=robot,
+        world=world,
+        q_start=q_start,
+        q_goal=q_goal,
+        moving=moving,
+        solver=solver,
+        objective=objective,
+        build_time_s=time.perf_counter() - started,
+    )
+
+
+def with_planner(problem: Problem, **changes: Any) -> Problem:
+    """``problem`` with planner settings changed (same world and endpoints), e.g. ``waypoints=5``.
+
+    Raises:
+        PlanningError: an unknown setting, or a value the settings refuse.
+    """
+    settings = problem.scene.planner.updated(**changes)
+    if settings == problem.scene.planner:
+        return problem
+    started = time.perf_counter()
+    scene = dataclasses.replace(problem.scene, planner=settings)
+    solver, objective = _search(scene, problem.world, problem.q_start, problem.q_goal, problem.moving)
+    return dataclasses.replace(
+        problem,
+        scene=scene,
+        solver=solver,
+        objective=objective,
+        build_time_s=problem.build_time_s + time.perf_counter() - started,
+    )
+
+
+def _search(
+    scene: Scene, world: ck.CollisionWorld, q_start: FloatArray, q_goal: FloatArray, moving: NDArray[np.intp]
+) -> tuple[SepticSplineSolver, WaypointObjective]:
+    """The spline solver on the search's knots and the waypoint objective."""
     segments = scene.planner.waypoints + 1
     nominal_duration = scene.duration if scene.duration is not None else float(segments)
     # the spline on the search's knots: the trajectory itself when the scene fixes the duration,
@@ -124,14 +165,4 @@ def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | No
         solver,
         timed=scene.duration is not None,
     )
-    return Problem(
-        scene=scene,
-        robot=robot,
-        world=world,
-        q_start=q_start,
-        q_goal=q_goal,
-        moving=moving,
-        solver=solver,
-        objective=objective,
-        build_time_s=time.perf_counter() - started,
-    )
+    return solver, objective

@@ -26,6 +26,7 @@ from planning.validation import integer_in, number_in, shown
 FloatArray = NDArray[np.float64]
 Fitness = Literal["clearance", "paper"]
 PathKind = Literal["spline", "ptp"]
+Seeding = Literal["paths", "none"]
 
 DEFAULT_SAFETY_MARGIN_M = 0.1
 """Clearance every robot geometry keeps from every obstacle unless a scene says otherwise [m]
@@ -34,6 +35,11 @@ DEFAULT_SAFETY_MARGIN_M = 0.1
 DEFAULT_SPLINE = SplineSettings(p=1e6, a=(0.0, 0.0, 1.0), ends="rest")
 """The spline of a scene unless it says otherwise: the paper's weights, but at rest at both
 ends, which a real robot needs (the paper case itself uses natural ends)."""
+
+DEFAULT_FIREFLY = FireflySettings(fireflies=30, iterations=50, stall_iterations=8)
+"""The planner's firefly: the paper's parameters (:class:`FireflySettings`'s defaults) with
+fewer fireflies and an early stop, backed by ``scripts/study_parameters.py``: seeded with
+paths (:mod:`planning.seeding`), a smaller population converges as well in fewer evaluations."""
 
 MAX_WAYPOINTS = 20
 """Most intermediate waypoints (the search's dimension is waypoints x moving joints)."""
@@ -97,7 +103,7 @@ class PlannerSettings:
     """Settings of the waypoint planner; validated on construction.
 
     Attributes:
-        firefly: the firefly algorithm's parameters (the paper's by default).
+        firefly: the firefly algorithm's parameters (default :data:`DEFAULT_FIREFLY`).
         waypoints: number of intermediate waypoints p, at most :data:`MAX_WAYPOINTS`. The
             paper: 3.
         fitness: ``"clearance"`` (feasible first, infeasible ranked by coal's violation
@@ -115,9 +121,13 @@ class PlannerSettings:
             ``None`` (default): no bound. The paper case requires 20e-6.
         moving_joints: joints the waypoints move; default: theta1, d2, d3, and a wrist
             joint when start and goal differ in it.
+        seeding: ``"paths"`` (default): the search starts from the straight line and, when
+            that is blocked, from a sampling planner's path, with more waypoints if the
+            path needs them (:mod:`planning.seeding`); ``"none"`` (the paper): from a
+            random population only.
     """
 
-    firefly: FireflySettings = field(default_factory=FireflySettings)
+    firefly: FireflySettings = DEFAULT_FIREFLY
     waypoints: int = 3
     fitness: Fitness = "clearance"
     seed: int = 0
@@ -127,6 +137,7 @@ class PlannerSettings:
     verify_step_m: float = 0.005
     max_node_deviation: float | None = None
     moving_joints: tuple[str, ...] | None = None
+    seeding: Seeding = "paths"
 
     def __post_init__(self) -> None:
         if not isinstance(self.firefly, FireflySettings):
@@ -134,6 +145,8 @@ class PlannerSettings:
         integer_in("waypoints", self.waypoints, 1, MAX_WAYPOINTS)
         if self.fitness not in ("clearance", "paper"):
             raise PlanningError(f"fitness = {shown(self.fitness)}; allowed: 'clearance', 'paper'")
+        if self.seeding not in ("paths", "none"):
+            raise PlanningError(f"seeding = {shown(self.seeding)}; allowed: 'paths', 'none'")
         if self.path not in ("spline", "ptp"):
             raise PlanningError(f"path = {shown(self.path)}; allowed: 'spline', 'ptp'")
         integer_in("seed", self.seed, 0, MAX_SEED)

@@ -13,9 +13,15 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--count", type=int, default=100, help="number of scenes (default: 100)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the generator (default: 0)")
+    parser.add_argument(
+        "--narrow",
+        type=int,
+        default=0,
+        help="of which narrow passages: beam, window, pillars in turn (default: 0)",
+    )
     parser.add_argument("--out", type=Path, required=True, help="folder for the scene files")
     args = parser.parse_args()
-    for scene in generate_scenes(args.count, args.seed):
+    for scene in generate_scenes(args.count, args.seed, narrow=args.narrow):
         dump_scene(scene, args.out / f"{scene.name}.yaml")
     print(f"wrote {args.count} scenes into {args.out}")
 

@@ -5,7 +5,7 @@ import pytest
 
 from planning.errors import PlanningError
 from planning.search.firefly import FireflyProgress, _sweep, firefly_minimize
-from planning.search.firefly_settings import FireflySettings
+from planning.search.firefly_settings import STALL_TOLERANCE, FireflySettings
 
 
 def sphere(x: np.ndarray) -> np.ndarray:
@@ -166,3 +166,31 @@ def test_bad_bounds_and_objective() -> None:
         firefly_minimize(
             lambda x: x[:, :1], np.zeros(2), np.ones(2), FireflySettings(fireflies=3, iterations=1)
         )
+
+
+def test_early_stop_after_stalled_iterations_is_a_prefix_of_the_full_run() -> None:
+    bounds = (-5 * np.ones(3), 5 * np.ones(3))
+    full = firefly_minimize(rastrigin, *bounds, FireflySettings(fireflies=10, iterations=200), 4)
+    early = firefly_minimize(
+        rastrigin, *bounds, FireflySettings(fireflies=10, iterations=200, stall_iterations=5), 4
+    )
+    stop = len(early.best_history)
+    assert stop < len(full.best_history)  # it stopped early ...
+    np.testing.assert_array_equal(early.best_history, full.best_history[:stop])  # ... on the same run
+    assert early.evaluations == 10 * stop
+    # the rule: the last 5 iterations improved the best by less than the tolerance of it
+    last, before = early.best_history[-1], early.best_history[-6]
+    assert last >= before - STALL_TOLERANCE * abs(before)
+    again = firefly_minimize(
+        rastrigin, *bounds, FireflySettings(fireflies=10, iterations=200, stall_iterations=5), 4
+    )
+    np.testing.assert_array_equal(again.population, early.population)
+
+
+def test_no_early_stop_while_the_best_is_above_stall_below() -> None:
+    bounds = (-5 * np.ones(3), 5 * np.ones(3))
+    settings = FireflySettings(fireflies=10, iterations=60, stall_iterations=3)
+    unreachable = firefly_minimize(lambda x: sphere(x) + 10.0, *bounds, settings, 1, stall_below=5.0)
+    assert len(unreachable.best_history) == 61
+    reached = firefly_minimize(lambda x: sphere(x) + 10.0, *bounds, settings, 1, stall_below=np.inf)
+    assert len(reached.best_history) < 61

@@ -1,8 +1,11 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 import cpr_kin as ck
+from planning.errors import PlanningError
+from planning.io.narrow_passages import KINDS, narrow_scene
 from planning.io.scene_file import parse_scene, scene_document
 from planning.io.scene_generator import generate_scenes
 
@@ -23,3 +26,38 @@ def test_generated_scenes_are_reproducible_and_valid(robot: ck.Robot) -> None:
         assert world.clearance_batch(q).min_clearance_m.min() >= scene.safety_margin
         assert abs(q[1, 0] - q[0, 0]) >= 0.9 - 1e-9
         assert parse_scene(scene_document(scene)) == scene  # the file form round-trips
+
+
+def test_narrow_passages_are_reproducible_and_block_the_straight_swing(robot: ck.Robot) -> None:
+    scenes = generate_scenes(12, seed=3, robot=robot, narrow=9)
+    assert generate_scenes(12, seed=3, robot=robot, narrow=9) == scenes
+    # the regular scenes do not depend on how many narrow ones follow
+    assert scenes[:3] == generate_scenes(3, seed=3, robot=robot)
+    narrow = scenes[3:]
+    assert [s.name for s in narrow] == [
+        f"{kind}_{i:03d}" for i, kind in zip(range(3, 12), KINDS * 3, strict=True)
+    ]
+    blocked = 0
+    for scene in narrow:
+        names = {o.name for o in scene.obstacles}
+        assert names in (
+            {"crate", "beam"},
+            {"wall_below", "wall_above", "wall_beside"},
+            {"pillar_0", "pillar_1"},
+        )
+        world = ck.CollisionWorld(robot, scene.obstacles)
+        q = np.array([scene.start.configuration(robot), scene.goal.configuration(robot)])
+        assert world.clearance_batch(q).min_clearance_m.min() >= scene.safety_margin + 0.02 - 1e-9
+        line = q[0] + np.linspace(0.0, 1.0, 200)[:, None] * (q[1] - q[0])
+        blocked += bool(world.margin_violated(line, scene.safety_margin).any())
+        assert parse_scene(scene_document(scene)) == scene
+    # a narrow passage stands in the way of the straight joint-space swing (pillars flank the
+    # goal: the straight swing may pass them)
+    assert blocked >= 6
+
+
+def test_narrow_count_is_checked(robot: ck.Robot) -> None:
+    with pytest.raises(PlanningError, match="narrow = 5"):
+        generate_scenes(3, robot=robot, narrow=5)
+    with pytest.raises(PlanningError, match="kind = 'slot'"):
+        narrow_scene(np.random.default_rng(0), robot, "slot")  # type: ignore[arg-type]

@@ -15,6 +15,7 @@ from dataclasses import replace
 import numpy as np
 
 import cpr_kin as ck
+from planning.errors import PlanningError
 from planning.scene import PlannerSettings, Scene, Target
 
 
@@ -75,12 +76,26 @@ def random_scene(
             )
 
 
-def generate_scenes(count: int, seed: int = 0, robot: ck.Robot | None = None) -> list[Scene]:
-    """``count`` random scenes from ``seed``; scene ``i`` plans with seed ``i``."""
+def generate_scenes(count: int, seed: int = 0, robot: ck.Robot | None = None, narrow: int = 0) -> list[Scene]:
+    """``count`` random scenes from ``seed``; scene ``i`` plans with seed ``i``.
+
+    The last ``narrow`` of them are narrow passages (:mod:`planning.io.narrow_passages`),
+    their kinds in turn, drawn from a stream of their own: the other scenes are the same
+    whatever ``narrow`` is.
+    """
+    from planning.io.narrow_passages import KINDS, narrow_scene
+
+    if not 0 <= narrow <= count:
+        raise PlanningError(f"narrow = {narrow} scenes; allowed: 0 to count = {count}")
     robot = robot or ck.load_cpr()
     rng = np.random.default_rng(seed)
     scenes = []
-    for index in range(count):
+    for index in range(count - narrow):
         scene = random_scene(rng, robot, name=f"scene_{index:03d}")
+        scenes.append(replace(scene, planner=replace(scene.planner, seed=index)))
+    narrow_rng = np.random.default_rng([seed, 1])
+    for index in range(count - narrow, count):
+        kind = KINDS[(index - count + narrow) % len(KINDS)]
+        scene = narrow_scene(narrow_rng, robot, kind, name=f"{kind}_{index:03d}")
         scenes.append(replace(scene, planner=replace(scene.planner, seed=index)))
     return scenes

@@ -15,6 +15,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from cpr_kin.obstacles import MAX_ANGLE_RAD, MAX_COORDINATE_M, MAX_NAME_CHARS, SCALE_RANGE, SIZE_RANGE_M
 from planning.scene import (
+    DEFAULT_FIREFLY,
     DEFAULT_SAFETY_MARGIN_M,
     DEFAULT_SPLINE,
     DURATION_RANGE_S,
@@ -34,7 +35,6 @@ from planning.search.firefly_settings import (
     MAX_GAMMA,
     MAX_ITERATIONS,
     MAX_STEP,
-    FireflySettings,
 )
 from planning.validation import describe_validation
 
@@ -128,7 +128,7 @@ class TargetSpec(_Strict):
         return self
 
 
-_F, _P = FireflySettings, PlannerSettings  # the defaults are the settings' own
+_F, _P = DEFAULT_FIREFLY, PlannerSettings  # the defaults are the settings' own
 
 
 class PlannerSpec(_Strict):
@@ -141,6 +141,7 @@ class PlannerSpec(_Strict):
     gamma: Annotated[float, _between(0.0, MAX_GAMMA)] = _F.gamma
     theta: Annotated[float, Field(gt=0, le=1)] = _F.theta
     mode: Literal["sweep", "sequential"] = _F.mode
+    stall_iterations: Annotated[int, Field(ge=0, le=MAX_ITERATIONS)] = _F.stall_iterations
     waypoints: Annotated[int, Field(ge=1, le=MAX_WAYPOINTS)] = _P.waypoints
     fitness: Literal["clearance", "paper"] = _P.fitness
     seed: Annotated[int, Field(ge=0, le=MAX_SEED)] = _P.seed
@@ -152,6 +153,7 @@ class PlannerSpec(_Strict):
     moving_joints: (
         Annotated[list[Literal["theta1", "d2", "d3", "theta4", "theta5"]], Field(max_length=5)] | None
     ) = None
+    seeding: Literal["paths", "none"] = _P.seeding
 
 
 class SplineSpec(_Strict):

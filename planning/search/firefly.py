@@ -8,6 +8,8 @@ variables. A firefly ``i`` moves towards a brighter (lower objective) firefly ``
 
 (the paper prints eq. 2 with a sign typo and without gamma) and is clipped to the bounds.
 ``alpha`` decays geometrically, ``alpha <- theta alpha``, at the start of every iteration.
+With ``stall_iterations`` set, the search ends once that many iterations in a row have
+improved the best value by less than a relative :data:`~planning.search.firefly_settings.STALL_TOLERANCE`.
 
 Two modes:
 
@@ -31,7 +33,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.compiled import njit
 from planning.errors import PlanningError
-from planning.search.firefly_settings import FireflySettings
+from planning.search.firefly_settings import STALL_TOLERANCE, FireflySettings
 from planning.search.optimizer import BatchObjective, SearchResult
 
 FloatArray = NDArray[np.float64]
@@ -56,6 +58,7 @@ def firefly_minimize(
     rng: np.random.Generator | int | None = 0,
     callback: Callable[[FireflyProgress], None] | None = None,
     seeds: ArrayLike | None = None,
+    stall_below: float = np.inf,
 ) -> SearchResult:
     """Minimise ``objective`` over the box ``[lower, upper]`` with the firefly algorithm.
 
@@ -68,6 +71,9 @@ def firefly_minimize(
         callback: called with a :class:`FireflyProgress` after every iteration.
         seeds: ``(k, d)`` points (in the box) that replace the first ``k`` fireflies of the
             random initial population; the random draws are the same with or without them.
+        stall_below: the early stop (``settings.stall_iterations``) counts an iteration as
+            stalled only while the best value is at or below this (e.g. the objective's
+            bound of feasible values: an infeasible best keeps searching).
     """
     settings = settings or FireflySettings()
     lo = np.asarray(lower, dtype=float)
@@ -104,6 +110,7 @@ def firefly_minimize(
     if callback is not None:
         callback(FireflyProgress(0, settings.iterations, best_f, mean_history[0], evaluations))
     alpha = settings.alpha
+    stalled, reference = 0, best_f
     for iteration in range(1, settings.iterations + 1):
         alpha *= settings.theta
         if settings.mode == "sweep":
@@ -131,6 +138,12 @@ def firefly_minimize(
         evaluation_history.append(evaluations)
         if callback is not None:
             callback(FireflyProgress(iteration, settings.iterations, best_f, mean_history[-1], evaluations))
+        if best_f < reference - STALL_TOLERANCE * abs(reference) or best_f > stall_below:
+            stalled, reference = 0, best_f
+        else:
+            stalled += 1
+            if stalled == settings.stall_iterations:
+                break
     return SearchResult(
         x=lo + best_u * span,
         fitness=best_f,

@@ -28,6 +28,8 @@ MAX_STEP = 10.0
 box and is clipped back, so larger values only hide a typo."""
 MAX_GAMMA = 1000.0
 """Largest light absorption: at 1000 a firefly sees no neighbour farther than 0.1."""
+STALL_TOLERANCE = 1e-3
+"""Relative improvement of the best value below which an iteration counts as stalled."""
 
 
 @dataclass(frozen=True)
@@ -43,6 +45,9 @@ class FireflySettings:
         gamma: light absorption, in normalised units, in [0, 1000].
         theta: per-iteration decay of alpha, in (0, 1].
         mode: ``"sweep"`` or ``"sequential"`` (see the module docstring).
+        stall_iterations: stop early once this many iterations in a row have improved the
+            best value by less than :data:`STALL_TOLERANCE` of it; 0 (default, the paper):
+            run every iteration. Deterministic: the same seed stops at the same iteration.
     """
 
     fireflies: int = 50
@@ -52,6 +57,7 @@ class FireflySettings:
     gamma: float = 1.0
     theta: float = 0.97
     mode: Mode = "sweep"
+    stall_iterations: int = 0
 
     def __post_init__(self) -> None:
         integer_in("fireflies", self.fireflies, 2, MAX_FIREFLIES)
@@ -66,5 +72,6 @@ class FireflySettings:
         number_in("beta0", self.beta0, 0.0, MAX_STEP)
         number_in("gamma", self.gamma, 0.0, MAX_GAMMA)
         number_in("theta", self.theta, 0.0, 1.0, low_open=True)
+        integer_in("stall_iterations", self.stall_iterations, 0, MAX_ITERATIONS)
         if self.mode not in ("sweep", "sequential"):
             raise PlanningError(f"mode = {shown(self.mode)}; allowed: 'sweep', 'sequential'")

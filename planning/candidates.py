@@ -1,0 +1,81 @@
+"""The search's candidates, timed and verified, best first: the planner's last word on a search.
+
+:func:`first_verified` takes the best candidate, then the final population's others the
+fitness found feasible, and returns the first whose timed trajectory passes the certified
+continuous check (:mod:`planning.verification`) and the planner's node-deviation bound.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from planning.curves.spline import SplineFit
+from planning.curves.trajectory import Trajectory
+from planning.errors import NoTrajectoryFoundError
+from planning.problem import Problem
+from planning.search.optimizer import SearchResult
+from planning.timing import Timing, timings
+from planning.verification import Verification, verify_trajectory
+
+FloatArray = NDArray[np.float64]
+
+PREFERRED_FIRST = 3
+"""How many candidates have their preferred timing verified before any falls back."""
+
+
+def verify(problem: Problem, trajectory: Trajectory, fit: SplineFit) -> Verification:
+    """The scene's verification, plus the node-deviation bound of the planner settings."""
+    scene = problem.scene
+    verification = verify_trajectory(
+        problem.world, trajectory, scene.safety_margin, scene.planner.verify_step_m
+    )
+    bound = scene.planner.max_node_deviation
+    if bound is not None and fit.max_node_deviation > bound:
+        problem_text = (
+            f"deviates {fit.max_node_deviation:.3g} from its nodes, more than max_node_deviation = {bound:g}"
+        )
+        verification = Verification(verification.check, (*verification.problems, problem_text))
+    return verification
+
+
+def first_verified(
+    problem: Problem, result: SearchResult
+) -> tuple[FloatArray, FloatArray, Timing, Verification, int]:
+    """The first candidate whose timed trajectory passes the verification.
+
+    Candidates: the best, then the final population's ones the fitness found feasible (an
+    infeasible one will not pass the verification), best first. The preferred (fastest)
+    timing of each of the first :data:`PREFERRED_FIRST` is tried before any fallback: a
+    nearly as good candidate run at full speed beats the best one run at the uniform
+    timing's pace. Then each candidate's remaining timings, in order. Returns the candidate,
+    its nodes, timing, verification and how many candidates were timed.
+
+    Raises:
+        NoTrajectoryFoundError: none passes.
+    """
+    objective = problem.objective
+    order = np.argsort(result.population_fitness, kind="stable")
+    feasible = result.population_fitness <= objective.t_max  # both fitnesses rank feasible at or below t_max
+    candidates = [result.x] + [result.population[k] for k in order if feasible[k]]
+    timed: list[list[Timing]] = []
+    attempts = [(k, 0) for k in range(min(PREFERRED_FIRST, len(candidates)))]
+    attempts += [(k, 1) for k in range(min(PREFERRED_FIRST, len(candidates)))]
+    attempts += [(k, m) for k in range(PREFERRED_FIRST, len(candidates)) for m in (0, 1)]
+    first: Verification | None = None
+    for k, m in attempts:
+        while len(timed) <= k:
+            timed.append(timings(problem, objective.nodes(candidates[len(timed)][None])[0]))
+        if m >= len(timed[k]):
+            continue  # a fixed duration has one timing
+        verification = verify(problem, timed[k][m].trajectory, timed[k][m].fit)
+        first = first or verification
+        if verification.accepted:
+            x = candidates[k]
+            return x, objective.nodes(x[None])[0], timed[k][m], verification, len(timed)
+    assert first is not None  # candidates is never empty
+    raise NoTrajectoryFoundError(
+        f"no collision-free trajectory found: the best candidate {'; '.join(first.problems)} "
+        f"({len(candidates)} candidates verified)",
+        first.check,
+    )

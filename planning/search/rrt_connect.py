@@ -1,0 +1,272 @@
+"""RRT-Connect (Kuffner & LaValle 2000) with shortcutting: a fast first path to seed the search.
+
+The firefly searches a few waypoints well but cannot find a narrow passage by chance: a way
+under a beam or through a window is a small region of its space. A sampling planner finds one
+in milliseconds, and its path, cut to a few waypoints, seeds the firefly's population
+(:func:`waypoints_along`).
+
+Two trees grow from start and goal: one extends a step towards a random sample, the other
+then greedily connects to the new node; they swap roles every sample. Edges are checked as
+OMPL checks its motions, at configurations a fixed robot motion apart (not certified: the
+executed spline gets the certified check), but every edge in one batched call to the
+validity check rather than one call per state, which is what makes it fast in Python.
+Distances are robot motion bounds ``sum_j R_j |dq_j|`` [m] with the joints' motion radii
+(:func:`cpr_kin.motion_radii`), so a step means the same in every joint whatever its unit.
+The path is then shortened by random shortcuts (a straight edge between two points on it
+replaces what lies between when it is valid), then by skipping vertices (from each vertex
+straight to the farthest one it sees). All randomness comes from the generator passed.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from planning.errors import PlanningError
+from planning.validation import integer_in, number_in
+
+FloatArray = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
+Validity = Callable[[FloatArray], BoolArray]
+"""``(N, d) -> (N,)``: whether each configuration is valid (clear of the margin)."""
+
+
+@dataclass(frozen=True)
+class RrtSettings:
+    """Parameters of :func:`rrt_connect`; validated on construction.
+
+    Attributes:
+        max_samples: random samples before giving up, in [1, 100000].
+        step_m: longest extension towards a sample, as a robot motion bound [m], in (0, 10].
+        resolution_m: spacing of the checked configurations along an edge [m], in
+            (0, step_m].
+        shortcuts: random shortcut attempts on the found path, in [0, 10000].
+    """
+
+    max_samples: int = 3000
+    step_m: float = 0.25
+    resolution_m: float = 0.01
+    shortcuts: int = 60
+
+    def __post_init__(self) -> None:
+        integer_in("max_samples", self.max_samples, 1, 100_000)
+        number_in("step_m", self.step_m, 0.0, 10.0, low_open=True, unit="m")
+        number_in("resolution_m", self.resolution_m, 0.0, self.step_m, low_open=True, unit="m")
+        integer_in("shortcuts", self.shortcuts, 0, 10_000)
+
+
+@dataclass(frozen=True)
+class RrtPath:
+    """A path found by :func:`rrt_connect`.
+
+    Attributes:
+        path: ``(k, d)`` vertices from start to goal, shortened [joint units].
+        samples: random samples drawn.
+        checks: configurations checked.
+    """
+
+    path: FloatArray
+    samples: int
+    checks: int
+
+
+class _Tree:
+    """Nodes and parents, grown in place (arrays doubled when full)."""
+
+    def __init__(self, root: FloatArray) -> None:
+        self.nodes = np.empty((64, root.size))
+        self.parents = np.empty(64, dtype=np.intp)
+        self.nodes[0], self.parents[0], self.size = root, -1, 1
+
+    def add(self, q: FloatArray, parent: int) -> int:
+        if self.size == len(self.nodes):
+            self.nodes = np.concatenate([self.nodes, np.empty_like(self.nodes)])
+            self.parents = np.concatenate([self.parents, np.empty_like(self.parents)])
+        self.nodes[self.size], self.parents[self.size] = q, parent
+        self.size += 1
+        return self.size - 1
+
+    def nearest(self, q: FloatArray, weights: FloatArray) -> int:
+        return int(np.argmin(np.abs(self.nodes[: self.size] - q) @ weights))
+
+    def branch(self, index: int) -> FloatArray:
+        """The nodes from ``index`` back to the root."""
+        chain = []
+        while index >= 0:
+            chain.append(self.nodes[index])
+            index = int(self.parents[index])
+        return np.array(chain)
+
+
+class _Edges:
+    """Validity of straight edges, each checked in one batch; counts the configurations checked."""
+
+    def __init__(self, valid: Validity, weights: FloatArray, resolution_m: float) -> None:
+        self.valid, self.weights, self.resolution_m, self.checks = valid, weights, resolution_m, 0
+
+    def free_fraction(self, a: FloatArray, b: FloatArray) -> float:
+        """The fraction of the edge ``a -> b`` valid from ``a`` on, in [0, 1] (``a`` assumed valid)."""
+        count = max(1, math.ceil(float(np.abs(b - a) @ self.weights) / self.resolution_m))
+        fractions = np.arange(1, count + 1) / count
+        ok = self.valid(a + fractions[:, None] * (b - a))
+        self.checks += count
+        if ok.all():
+            return 1.0
+        first_bad = int(np.argmin(ok))
+        return 0.0 if first_bad == 0 else float(fractions[first_bad - 1])
+
+
+def rrt_connect(
+    valid: Validity,
+    start: FloatArray,
+    goal: FloatArray,
+    lower: FloatArray,
+    upper: FloatArray,
+    weights: FloatArray,
+    rng: np.random.Generator,
+    settings: RrtSettings | None = None,
+) -> RrtPath | None:
+    """A valid path from ``start`` to ``goal`` in the box ``[lower, upper]``, or ``None``.
+
+    Args:
+        valid: the batched validity check (both ends must pass it).
+        start: ``(d,)`` start configuration [joint units].
+        goal: ``(d,)`` goal configuration.
+        lower: ``(d,)`` lower bounds of the samples.
+        upper: ``(d,)`` upper bounds.
+        weights: ``(d,)`` motion radius of each joint [m per joint unit], > 0.
+        rng: the source of every random draw.
+        settings: the planner's parameters (default :class:`RrtSettings`).
+    """
+    settings = settings or RrtSettings()
+    start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
+    weights = np.asarray(weights, dtype=float)
+    if not (weights.shape == start.shape == goal.shape and np.all(weights > 0)):
+        raise PlanningError(f"weights {weights.tolist()} must be positive, one per joint of start and goal")
+    edges = _Edges(valid, weights, settings.resolution_m)
+    if edges.free_fraction(start, goal) == 1.0:
+        return RrtPath(np.array([start, goal]), 0, edges.checks)
+    trees = (_Tree(start), _Tree(goal))
+    for sample in range(1, settings.max_samples + 1):
+        grow, other = trees[(sample - 1) % 2], trees[sample % 2]
+        target = rng.uniform(lower, upper)
+        near = grow.nearest(target, weights)
+        new = _extend(grow, near, target, edges, settings.step_m)
+        if new is None:
+            continue
+        joined = _connect(other, grow.nodes[new], edges, settings.step_m)
+        if joined is not None:
+            # root of grow ... new == joined ... root of other (the meeting point once)
+            path = np.concatenate([grow.branch(new)[::-1], other.branch(joined)[1:]])
+            if grow is not trees[0]:
+                path = path[::-1]
+            path = _shortcut(path, edges, rng, settings.shortcuts)
+            return RrtPath(path, sample, edges.checks)
+    return None
+
+
+def _extend(tree: _Tree, near: int, target: FloatArray, edges: _Edges, step_m: float) -> int | None:
+    """Add the farthest valid point up to one step from node ``near`` towards ``target``."""
+    origin = tree.nodes[near]
+    length = float(np.abs(target - origin) @ edges.weights)
+    if length <= 1e-12:
+        return None
+    end = origin + (target - origin) * min(1.0, step_m / length)
+    fraction = edges.free_fraction(origin, end)
+    if fraction == 0.0:
+        return None
+    return tree.add(origin + fraction * (end - origin), near)
+
+
+def _connect(tree: _Tree, target: FloatArray, edges: _Edges, step_m: float) -> int | None:
+    """Grow ``tree`` straight towards ``target``, a node every step; the node at ``target`` if reached."""
+    near = tree.nearest(target, edges.weights)
+    origin = tree.nodes[near]
+    fraction = edges.free_fraction(origin, target)
+    length = float(np.abs(target - origin) @ edges.weights)
+    nodes = max(1, math.ceil(fraction * length / step_m))
+    parent = near
+    for k in range(1, nodes + 1):
+        parent = tree.add(origin + (fraction * k / nodes) * (target - origin), parent)
+    return parent if fraction == 1.0 else None
+
+
+def _shortcut(path: FloatArray, edges: _Edges, rng: np.random.Generator, attempts: int) -> FloatArray:
+    """Shorten ``path`` by ``attempts`` random shortcuts between points on its edges."""
+    for _ in range(attempts):
+        if len(path) < 3:
+            break
+        lengths = np.abs(np.diff(path, axis=0)) @ edges.weights
+        arc = np.concatenate([[0.0], np.cumsum(lengths)])
+        s0, s1 = np.sort(rng.uniform(0.0, arc[-1], 2))
+        i, j = (int(np.searchsorted(arc, s, side="right")) - 1 for s in (s0, s1))
+        if i == j:
+            continue
+        a = path[i] + (s0 - arc[i]) / max(lengths[i], 1e-300) * (path[i + 1] - path[i])
+        b = path[j] + (s1 - arc[j]) / max(lengths[j], 1e-300) * (path[j + 1] - path[j])
+        if edges.free_fraction(a, b) == 1.0:
+            path = np.concatenate([path[: i + 1], [a, b], path[j + 1 :]])
+    return _drop_collinear(_skip_vertices(path, edges))
+
+
+def _skip_vertices(path: FloatArray, edges: _Edges) -> FloatArray:
+    """``path`` from each kept vertex straight to the farthest later vertex it sees."""
+    kept, i = [path[0]], 0
+    while i < len(path) - 1:
+        j = len(path) - 1
+        while j > i + 1 and edges.free_fraction(path[i], path[j]) < 1.0:
+            j -= 1
+        kept.append(path[j])
+        i = j
+    return np.array(kept)
+
+
+def _drop_collinear(path: FloatArray) -> FloatArray:
+    """``path`` without vertices on the straight line between their neighbours."""
+    keep = [0]
+    for k in range(1, len(path) - 1):
+        before, after = path[k] - path[keep[-1]], path[k + 1] - path[k]
+        if _sine(before, after) > 1e-9:
+            keep.append(k)
+    keep.append(len(path) - 1)
+    return path[keep]
+
+
+def _sine(u: FloatArray, v: FloatArray) -> float:
+    """``|sin|`` of the angle between ``u`` and ``v`` (0 if either is zero)."""
+    nu, nv = float(np.linalg.norm(u)), float(np.linalg.norm(v))
+    if nu == 0.0 or nv == 0.0:
+        return 0.0
+    c = float(u @ v) / (nu * nv)
+    return math.sqrt(max(0.0, 1.0 - c * c))
+
+
+def waypoints_along(path: FloatArray, count: int, weights: FloatArray) -> FloatArray:
+    """``(count, d)`` interior waypoints for a spline that follows ``path`` (its vertices kept).
+
+    The path's interior vertices are its corners and are kept when there are at most
+    ``count``; the rest are placed on the longest pieces (each split evenly), so that
+    the spline through start, waypoints and goal stays near the path. With more corners
+    than ``count``, points evenly spaced in arc length.
+    """
+    corners = path[1:-1]
+    if len(corners) > count:
+        lengths = np.abs(np.diff(path, axis=0)) @ weights
+        arc = np.concatenate([[0.0], np.cumsum(lengths)])
+        at = arc[-1] * np.arange(1, count + 1) / (count + 1)
+        return np.array([np.interp(at, arc, path[:, j]) for j in range(path.shape[1])]).T
+    pieces = len(path) - 1
+    splits = np.ones(pieces, dtype=np.intp)  # parts per piece
+    lengths = np.abs(np.diff(path, axis=0)) @ weights
+    for _ in range(count - len(corners)):
+        splits[int(np.argmax(lengths / splits))] += 1
+    points: list[FloatArray] = []
+    for k in range(pieces):
+        points.extend(path[k] + (m / splits[k]) * (path[k + 1] - path[k]) for m in range(1, splits[k]))
+        if k + 1 < pieces:
+            points.append(path[k + 1])
+    return np.array(points)

@@ -1,0 +1,144 @@
+"""Our default planner against OMPL's RRT-Connect pipeline on generated scenes, narrow passages included.
+
+Issue 17's benchmark, one run, side by side. On ``--scenes`` seeded scenes of which
+``--narrow`` are narrow passages (beam, window, pillars in turn; ``scripts/generate_scenes.py
+--narrow``), every scene is planned by
+
+- ours: :func:`planning.planner.plan` with the scene's (default) settings, warm (one process,
+  kernels loaded, robot loaded; the collision world is built in the call);
+- OMPL RRT-Connect + simplification + TOPP-RA (:mod:`planning.peers.ompl_rrt`), ``--budget``
+  seconds for RRT-Connect, warm likewise, its trajectory verified by the same certified check;
+
+the two alternating scene by scene, so that the machine's drift hits both alike. It prints
+success per class, the scenes OMPL solves and we do not, the median warm planning time of
+each and their ratio, the median duration on the scenes both solve, and, with ``--cli-runs``,
+the wall time of ``cpr-plan plan`` on one scene as a user runs it (a new process each time,
+kernels cached on disk). Targets (issue 17): success >= OMPL's on each class, warm time
+ratio <= 1, ``cpr-plan plan`` <= 1.5 s. Needs the ``bench`` extra.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+
+import cpr_kin as ck
+from planning.errors import NoSolutionError
+from planning.io.scene_file import dump_scene
+from planning.io.scene_generator import generate_scenes
+from planning.peers.ompl_rrt import plan_rrt_connect
+from planning.planner import plan, warm_up
+from planning.scene import Scene
+
+CLI_TARGET_S = 1.5
+
+
+def ours(scene: Scene, robot: ck.Robot) -> tuple[bool, float, float]:
+    """Success (a certified trajectory), warm wall time [s] and duration [s] of our planner."""
+    started = time.perf_counter()
+    try:
+        result = plan(scene, robot)
+    except NoSolutionError:
+        return False, time.perf_counter() - started, float("nan")
+    elapsed = time.perf_counter() - started
+    return result.verification.accepted, elapsed, result.trajectory.duration
+
+
+def theirs(scene: Scene, robot: ck.Robot, budget_s: float) -> tuple[bool, float, float]:
+    """The same for OMPL RRT-Connect + simplification + TOPP-RA."""
+    started = time.perf_counter()
+    result = plan_rrt_connect(scene, robot, budget_s, scene.planner.seed)
+    return result.success, time.perf_counter() - started, result.duration
+
+
+def cli_wall_times(scene: Scene, runs: int) -> list[float]:
+    """Wall time of ``cpr-plan plan SCENE --out DIR`` in a new process, ``runs`` times [s]."""
+    times = []
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "scene.yaml"
+        dump_scene(scene, path)
+        for run in range(runs):
+            started = time.perf_counter()
+            subprocess.run(
+                [sys.executable, "-m", "planning.cli", "plan", str(path), "--out", f"{folder}/out{run}"],
+                check=True,
+                capture_output=True,
+            )
+            times.append(time.perf_counter() - started)
+    return times
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument("--scenes", type=int, default=100, help="number of scenes (default: 100)")
+    parser.add_argument("--narrow", type=int, default=24, help="of which narrow passages (default: 24)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the scene generator (default: 0)")
+    parser.add_argument(
+        "--budget", type=float, default=5.0, help="RRT-Connect's time budget [s] (default: 5)"
+    )
+    parser.add_argument(
+        "--cli-runs", type=int, default=5, help="runs of `cpr-plan plan` (default: 5; 0: none)"
+    )
+    args = parser.parse_args()
+
+    robot = ck.load_cpr()
+    scenes = generate_scenes(args.scenes, args.seed, robot, narrow=args.narrow)
+    warm_up(robot)
+    plan_rrt_connect(scenes[0], robot, args.budget, 0)  # OMPL's imports and first call, untimed
+    rows = []
+    print(f"{'scene':<14}{'ours':>6}{'time s':>9}{'dur s':>8}   {'OMPL':>6}{'time s':>9}{'dur s':>8}")
+    for scene in scenes:
+        mine = ours(scene, robot)
+        peer = theirs(scene, robot, args.budget)
+        rows.append((scene.name.split("_")[0], scene.name, mine, peer))
+        print(
+            f"{scene.name:<14}{'ok' if mine[0] else 'FAIL':>6}{mine[1]:9.3f}{mine[2]:8.3f}   "
+            f"{'ok' if peer[0] else 'FAIL':>6}{peer[1]:9.3f}{peer[2]:8.3f}",
+            flush=True,
+        )
+
+    print("\nsuccess per class (ours / OMPL; target: ours >= OMPL's on each)")
+    classes: dict[str, list[tuple[bool, bool]]] = defaultdict(list)
+    for kind, _, mine, peer in rows:
+        classes["regular" if kind == "scene" else kind].append((mine[0], peer[0]))
+    for kind, outcomes in classes.items():
+        won, theirs_won = sum(m for m, _ in outcomes), sum(p for _, p in outcomes)
+        verdict = "met" if won >= theirs_won else "NOT met"
+        print(f"  {kind:<8} {won:3d} / {theirs_won:3d} of {len(outcomes):3d}   {verdict}")
+    missed = [name for _, name, mine, peer in rows if peer[0] and not mine[0]]
+    print(f"  solved by OMPL, not by us: {', '.join(missed) if missed else 'none'}")
+
+    our_time = statistics.median(mine[1] for *_, mine, _ in rows)
+    their_time = statistics.median(peer[1] for *_, peer in rows)
+    print(
+        f"\nwarm planning time, median over {len(rows)} scenes: ours {our_time:.3f} s, OMPL pipeline "
+        f"{their_time:.3f} s, ratio {our_time / their_time:.2f} (target <= 1)"
+    )
+    both = [(mine[2], peer[2]) for *_, mine, peer in rows if mine[0] and peer[0]]
+    if both:
+        mine_d, peer_d = np.median([b[0] for b in both]), np.median([b[1] for b in both])
+        print(
+            f"duration on the {len(both)} scenes both solve, median: ours {mine_d:.3f} s (jerk-limited), "
+            f"OMPL + TOPP-RA {peer_d:.3f} s (jerk unbounded), ratio {mine_d / peer_d:.3f}"
+        )
+    if args.cli_runs:
+        times = cli_wall_times(scenes[0], args.cli_runs)
+        median = statistics.median(times)
+        print(
+            f"`cpr-plan plan {scenes[0].name}` in a new process: median {median:.2f} s "
+            f"over {len(times)} runs ({', '.join(f'{t:.2f}' for t in times)}); target <= {CLI_TARGET_S} s"
+        )
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,148 @@
+"""RRT-Connect on a 2-D maze whose free space is known exactly, and the waypoints along a path."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+from numpy.typing import NDArray
+
+from planning.errors import PlanningError
+from planning.search.rrt_connect import RrtSettings, rrt_connect, waypoints_along
+
+WEIGHTS = np.ones(2)
+LOWER, UPPER = np.zeros(2), np.ones(2)
+
+
+def wall_with_slot(q: NDArray[np.float64], shrink: float = 0.0) -> NDArray[np.bool_]:
+    """Free unless in the wall ``0.45 < x < 0.55``, except for the slot ``0.45 < y < 0.5``.
+
+    ``shrink``: the wall made thinner and the slot wider by this much on each side.
+    """
+    in_wall = (q[:, 0] > 0.45 + shrink) & (q[:, 0] < 0.55 - shrink)
+    in_slot = (q[:, 1] > 0.45 - shrink) & (q[:, 1] < 0.5 + shrink)
+    return np.asarray(~in_wall | in_slot)
+
+
+def eroded(q: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """The wall shrunk by the check's resolution: an edge may clip a corner by less."""
+    return wall_with_slot(q, RrtSettings().resolution_m)
+
+
+def densely_valid(path: NDArray[np.float64], valid: object, spacing: float = 1e-3) -> bool:
+    for a, b in itertools.pairwise(path):
+        count = int(np.ceil(np.abs(b - a).sum() / spacing)) + 1
+        points = a + np.linspace(0.0, 1.0, count)[:, None] * (b - a)
+        if not valid(points).all():  # type: ignore[operator]
+            return False
+    return True
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_finds_the_slot_and_every_edge_is_valid(seed: int) -> None:
+    start, goal = np.array([0.1, 0.9]), np.array([0.9, 0.1])
+    found = rrt_connect(wall_with_slot, start, goal, LOWER, UPPER, WEIGHTS, np.random.default_rng(seed))
+    assert found is not None
+    path = found.path
+    np.testing.assert_array_equal(path[0], start)
+    np.testing.assert_array_equal(path[-1], goal)
+    # edges are checked every 0.01: between two checks they clip a corner by less than that
+    assert densely_valid(path, eroded)
+    assert found.samples >= 1 and found.checks > 0
+    # where it crosses x = 0.5 it is in the slot
+    crossings = [
+        a[1] + (0.5 - a[0]) / (b[0] - a[0]) * (b[1] - a[1])
+        for a, b in itertools.pairwise(path)
+        if (a[0] - 0.5) * (b[0] - 0.5) < 0
+    ]
+    assert crossings and all(0.44 < y < 0.51 for y in crossings)
+
+
+def test_shortcuts_make_the_path_at_most_as_long() -> None:
+    start, goal = np.array([0.1, 0.9]), np.array([0.9, 0.1])
+    lengths = []
+    for shortcuts in (0, 200):
+        found = rrt_connect(
+            wall_with_slot,
+            start,
+            goal,
+            LOWER,
+            UPPER,
+            WEIGHTS,
+            np.random.default_rng(3),
+            RrtSettings(shortcuts=shortcuts),
+        )
+        assert found is not None
+        lengths.append(float(np.abs(np.diff(found.path, axis=0)).sum()))
+    assert lengths[1] <= lengths[0] + 1e-12
+    # the shortest way through the slot, in the L1 metric, is at least |dx| + |dy| = 1.6
+    assert lengths[1] >= 1.6 - 1e-9
+
+
+def test_a_clear_line_is_the_path_with_no_sample() -> None:
+    found = rrt_connect(
+        lambda q: np.ones(len(q), dtype=bool),
+        np.zeros(2),
+        np.ones(2),
+        LOWER,
+        UPPER,
+        WEIGHTS,
+        np.random.default_rng(0),
+    )
+    assert found is not None and found.samples == 0
+    np.testing.assert_array_equal(found.path, [[0.0, 0.0], [1.0, 1.0]])
+
+
+def test_a_closed_wall_gives_none_after_the_budget() -> None:
+    def closed(q: NDArray[np.float64]) -> NDArray[np.bool_]:
+        return np.asarray(~((q[:, 0] > 0.45) & (q[:, 0] < 0.55)))
+
+    found = rrt_connect(
+        closed,
+        np.array([0.1, 0.5]),
+        np.array([0.9, 0.5]),
+        LOWER,
+        UPPER,
+        WEIGHTS,
+        np.random.default_rng(0),
+        RrtSettings(max_samples=300),
+    )
+    assert found is None
+
+
+def test_same_generator_seed_same_path() -> None:
+    def run() -> NDArray[np.float64]:
+        found = rrt_connect(
+            wall_with_slot,
+            np.array([0.1, 0.9]),
+            np.array([0.9, 0.1]),
+            LOWER,
+            UPPER,
+            WEIGHTS,
+            np.random.default_rng(11),
+        )
+        assert found is not None
+        return found.path
+
+    np.testing.assert_array_equal(run(), run())
+
+
+def test_settings_and_weights_are_validated() -> None:
+    with pytest.raises(PlanningError, match="step_m"):
+        RrtSettings(step_m=0.0)
+    with pytest.raises(PlanningError, match="resolution_m"):
+        RrtSettings(step_m=0.1, resolution_m=0.2)
+    with pytest.raises(PlanningError, match="weights"):
+        rrt_connect(wall_with_slot, LOWER, UPPER, LOWER, UPPER, -WEIGHTS, np.random.default_rng(0))
+
+
+def test_waypoints_keep_the_corners_and_split_the_longest_pieces() -> None:
+    path = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 3.0]])
+    points = waypoints_along(path, 3, WEIGHTS)
+    # the corner kept, the 3-long piece split in three
+    np.testing.assert_allclose(points, [[1.0, 0.0], [1.0, 1.0], [1.0, 2.0]])
+    # fewer waypoints than corners: evenly spaced in arc length (total 4: at 1, 2, 3)
+    zigzag = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [2.0, 1.0], [2.0, 2.0]])
+    np.testing.assert_allclose(waypoints_along(zigzag, 1, WEIGHTS), [[1.0, 1.0]])
+    assert waypoints_along(path, 1, WEIGHTS).shape == (1, 2)

@@ -1,0 +1,77 @@
+"""The search's seeds: the straight line when clear, a sampled path around what blocks it."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import cpr_kin as ck
+from planning.io.narrow_passages import narrow_scene
+from planning.problem import Problem, build_problem
+from planning.scene import PlannerSettings, Scene, Target
+from planning.seeding import SEED_SHARE, sampled_path, seed_search
+
+
+@pytest.fixture(scope="module")
+def window(robot: ck.Robot) -> Problem:
+    """A window in a wall across the swing: the straight line is blocked."""
+    scene = narrow_scene(np.random.default_rng(5), robot, "window")
+    return build_problem(scene, robot)
+
+
+def test_a_clear_straight_line_is_the_only_path_seed(robot: ck.Robot) -> None:
+    scene = Scene(start=Target(tcp=(0.5, 0.3, 0.3)), goal=Target(tcp=(0.3, 0.5, 0.4)))
+    problem = build_problem(scene, robot)
+    seeds = seed_search(problem)
+    assert seeds.straight_line_clear and seeds.path is None and seeds.problem is problem
+    np.testing.assert_array_equal(seeds.candidates[0], problem.objective.straight_line())
+    assert len(seeds.candidates) == int(SEED_SHARE * scene.planner.firefly.fireflies)
+    objective = problem.objective
+    assert np.all((seeds.candidates >= objective.lower) & (seeds.candidates <= objective.upper))
+    # the others are small moves around the seed
+    spread = np.abs(seeds.candidates[1:] - seeds.candidates[0]) / (objective.upper - objective.lower)
+    assert 0.0 < np.median(spread) < 0.05
+
+
+def test_a_blocked_line_is_seeded_with_a_clear_sampled_path(robot: ck.Robot, window: Problem) -> None:
+    seeds = seed_search(window)
+    assert not seeds.straight_line_clear and seeds.path is not None
+    moving = window.moving
+    np.testing.assert_allclose(seeds.path[0], window.q_start[moving])
+    np.testing.assert_allclose(seeds.path[-1], window.q_goal[moving])
+    # every vertex keeps the fitness's clearance, by coal's own distance
+    full = np.repeat(window.q_start[None], len(seeds.path), axis=0)
+    full[:, moving] = seeds.path
+    clearance = window.world.clearance_batch(full).min_clearance_m
+    assert clearance.min() >= window.objective.required_m - 1e-9
+    # the straight line, then the path's waypoints
+    np.testing.assert_array_equal(seeds.candidates[0], seeds.problem.objective.straight_line())
+    assert seeds.candidates.shape[1] == seeds.problem.objective.dimension
+
+
+def test_more_waypoints_follow_the_path_until_the_spline_keeps_the_clearance(window: Problem) -> None:
+    first = seed_search(window)
+    wider = seed_search(window, more_waypoints=True, path=first.path)
+    assert wider.problem.scene.planner.waypoints >= window.scene.planner.waypoints + 2
+    assert wider.problem.world is window.world  # the same world, a new objective
+    fitness = wider.problem.objective(wider.candidates[1][None])[0]
+    assert fitness <= wider.problem.objective.t_max  # this window's path seed is feasible with more
+
+
+def test_same_seed_same_seeds_and_the_sampler_has_its_own_stream(window: Problem) -> None:
+    a, b = seed_search(window), seed_search(window)
+    np.testing.assert_array_equal(a.candidates, b.candidates)
+    other = dataclasses.replace(window.scene, planner=window.scene.planner.updated(seed=1))
+    c = seed_search(build_problem(other, window.robot))
+    assert not np.array_equal(a.candidates, c.candidates)
+    # the sampled path comes from default_rng([seed, 1]), not the firefly's default_rng(seed)
+    path = sampled_path(window, np.random.default_rng([window.scene.planner.seed, 1]))
+    assert path is not None
+    np.testing.assert_array_equal(path.path, a.path)
+
+
+def test_seeding_none_is_a_setting(robot: ck.Robot) -> None:
+    assert PlannerSettings().seeding == "paths"
+    assert PlannerSettings(seeding="none").seeding == "none"
