@@ -49,8 +49,8 @@ class RrtSettings:
 
     max_samples: int = 3000
     step_m: float = 0.25
-    resolution_m: float = 0.01
-    shortcuts: int = 60
+    resolution_m: float = 0.02
+    shortcuts: int = 20
 
     def __post_init__(self) -> None:
         integer_in("max_samples", self.max_samples, 1, 100_000)
