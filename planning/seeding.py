@@ -110,8 +110,7 @@ def seed_search(problem: Problem, more_waypoints: bool = False, path: FloatArray
     started = time.perf_counter()
     straight = problem.objective.straight_line()
     clear = bool(problem.objective.breakdown(straight[None]).feasible[0])
-    import os
-    if path is None and not clear and not (os.environ.get("LAZY") and not more_waypoints):
+    if path is None and not clear:
         found = sampled_path(problem, np.random.default_rng([problem.scene.planner.seed, 1]))
         path = None if found is None else found.path
     if path is None:

@@ -16,9 +16,8 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import sparse
-from scipy.linalg import lapack
 
+from planning.curves.banded_cholesky import band_cholesky
 from planning.curves.hermite import CONTINUITY, ENERGY, node_scaling
 from planning.errors import SplineError
 
@@ -129,6 +128,8 @@ def coupling_matrix(band: FloatArray, structure: Structure, p: FloatArray) -> An
         dense = np.zeros((n, n_nodes))
         dense[r, c] = v
         return dense
+    from scipy import sparse  # only for long splines: a plan's few segments need no SciPy
+
     return sparse.csr_array((v, (r, c)), shape=(n, n_nodes))
 
 
@@ -145,7 +146,7 @@ def factorised_system(
         ends: ``"rest"`` fixes velocity and acceleration at both ends to zero.
 
     Returns:
-        The factor in LAPACK's lower band storage (``dpbtrs``'s input), and ``W`` such that
+        The factor in LAPACK's lower band storage (:func:`band_cholesky_solve`'s input), and ``W`` such that
         the right-hand side for node values ``f`` is ``W @ f`` (:func:`coupling_matrix`).
 
     Raises:
@@ -162,7 +163,7 @@ def factorised_system(
     band[:, elimination.fixed] = 0.0
     band[elimination.zero_diagonal, elimination.zero_column] = 0.0
     band[0, elimination.fixed] = 1.0
-    factor, info = lapack.dpbtrf(band, lower=1)
+    factor, info = band_cholesky(np.ascontiguousarray(band))
     if info != 0:
         raise SplineError(
             f"the spline system is singular for a = {list(a)}, ends = '{ends}' and "

@@ -30,8 +30,8 @@ from functools import cached_property
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.linalg import lapack
 
+from planning.curves.banded_cholesky import band_cholesky_solve
 from planning.curves.banded_system import PER_NODE, factorised_system
 from planning.curves.hermite import HERMITE_INV, node_scaling
 from planning.curves.spline_settings import SplineSettings
@@ -137,10 +137,9 @@ class SepticSplineSolver:
         return len(self.knots)
 
     def _solve_nodes(self, values: FloatArray) -> FloatArray:
-        solution, info = lapack.dpbtrs(self._factor, self._coupling @ values, lower=1)
-        if info != 0:  # pragma: no cover - dpbtrs fails only on malformed arguments
-            raise SplineError(f"LAPACK dpbtrs failed with info = {info}")
-        return np.asarray(solution)
+        rhs = np.asarray(self._coupling @ values, dtype=float)
+        solution = band_cholesky_solve(self._factor, np.ascontiguousarray(rhs.reshape(len(rhs), -1)))
+        return solution.reshape(rhs.shape)
 
     def _coefficients(self, solution: FloatArray) -> FloatArray:
         nodes = solution.reshape(self.n_nodes, PER_NODE, -1)
