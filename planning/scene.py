@@ -41,6 +41,11 @@ DEFAULT_FIREFLY = FireflySettings(fireflies=30, iterations=50, stall_iterations=
 fewer fireflies and an early stop, backed by ``scripts/study_parameters.py``: seeded with
 paths (:mod:`planning.seeding`), a smaller population converges as well in fewer evaluations."""
 
+PAPER_SEARCH: dict[str, Any] = {**dataclasses.asdict(FireflySettings()), "seeding": "none"}
+"""The paper's search as planner-setting changes (:meth:`PlannerSettings.updated`): its firefly
+(:class:`FireflySettings`'s defaults: n = 50, 50 iterations, alpha 1, beta0 0.5, every
+iteration) from a random population. ``cpr-plan plan --paper-search`` applies them."""
+
 MAX_WAYPOINTS = 20
 """Most intermediate waypoints (the search's dimension is waypoints x moving joints)."""
 MAX_FITNESS_SAMPLES = 4096

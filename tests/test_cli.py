@@ -224,3 +224,34 @@ def test_progress_bar_only_on_a_terminal(tmp_path: Path) -> None:
     os.close(leader)
     assert b"firefly" in output
     assert b"it/s" in output or b"s/it" in output
+
+
+def test_paper_search_flag_is_the_papers_settings_written_in_the_scene(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = write_scene(tmp_path, SCENE)
+    code, stdout, _ = run(
+        ["plan", str(scene), "--out", str(tmp_path / "f"), "--paper-search", "--json"], capsys
+    )
+    assert code == 0
+    assert json.loads(stdout)["evaluations"] == 50 * 51  # every iteration of the paper's 50 fireflies
+    paper_planner = {
+        **SCENE["planner"],
+        "fireflies": 50,
+        "iterations": 50,
+        "alpha": 1.0,
+        "beta0": 0.5,
+        "gamma": 1.0,
+        "theta": 0.97,
+        "stall_iterations": 0,
+        "seeding": "none",
+    }
+    written = write_scene(tmp_path, with_changes(planner=paper_planner), "paper_search.yaml")
+    code, _, _ = run(["plan", str(written), "--out", str(tmp_path / "w")], capsys)
+    assert code == 0
+    assert (tmp_path / "f" / "trajectory.json").read_bytes() == (
+        tmp_path / "w" / "trajectory.json"
+    ).read_bytes()
+    # without the flag, the defaults search less
+    code, stdout, _ = run(["plan", str(scene), "--out", str(tmp_path / "d"), "--json"], capsys)
+    assert code == 0 and json.loads(stdout)["evaluations"] < 50 * 51

@@ -160,3 +160,33 @@ def test_a_goal_at_the_start_gives_the_trajectory_that_stands_still(
     for r in (1, 2, 3):
         assert not np.any(trajectory(times, r))
     assert result.metrics.evaluations == 1 and result.verification.accepted
+
+
+def test_narrow_passages_are_planned_through_by_the_seeded_search(robot: ck.Robot) -> None:
+    from planning.io.scene_generator import generate_scenes
+
+    scenes = generate_scenes(6, seed=0, robot=robot, narrow=6)
+    unseeded = 0
+    for scene in scenes:
+        result = plan(scene, robot)
+        assert result.verification.accepted
+        assert result.metrics.min_clearance_m >= scene.safety_margin
+        try:
+            plan(dataclasses.replace(scene, planner=scene.planner.updated(seeding="none")), robot)
+            unseeded += 1
+        except NoTrajectoryFoundError:
+            pass
+    # the firefly alone, from a random population, misses some of them
+    assert unseeded < len(scenes)
+
+
+def test_early_stop_and_seeds_keep_a_plan_byte_identical(robot: ck.Robot) -> None:
+    from planning.io.scene_generator import generate_scenes
+
+    scene = generate_scenes(1, seed=0, robot=robot, narrow=1)[0]  # seeded by a sampled path
+    first, second = plan(scene, robot), plan(scene, robot)
+    assert first.optimiser.evaluations < scene.planner.firefly.fireflies * (
+        scene.planner.firefly.iterations + 1
+    )
+    np.testing.assert_array_equal(first.trajectory.coefficients, second.trajectory.coefficients)
+    np.testing.assert_array_equal(first.optimiser.best_history, second.optimiser.best_history)

@@ -32,6 +32,12 @@ def build_parser() -> argparse.ArgumentParser:
         sub.add_argument("--fitness", choices=("clearance", "paper"), help="fitness (default: the scene's)")
         sub.add_argument("--fireflies", type=int, help="population size (default: the scene's)")
         sub.add_argument("--iterations", type=int, help="firefly iterations (default: the scene's)")
+        sub.add_argument(
+            "--paper-search",
+            action="store_true",
+            help="search with the paper's firefly (n = 50, 50 iterations, alpha 1, beta0 0.5, every "
+            "iteration) from a random population, not the planner's seeded search with early stop",
+        )
         sub.add_argument("--json", action="store_true", help="print the summary as JSON")
         sub.add_argument(
             "--plots",

@@ -37,7 +37,11 @@ def _plan_and_write(scene: Scene, out: str, args: argparse.Namespace, paper: boo
     from planning.io.report import paper_rows, summary, summary_line, text_table
     from planning.planner import plan
 
+    from planning.scene import PAPER_SEARCH
+
     overrides = {k: getattr(args, k) for k in OVERRIDES if getattr(args, k, None) is not None}
+    if getattr(args, "paper_search", False):
+        overrides = {**PAPER_SEARCH, **overrides}  # a --fireflies or --iterations given still wins
     update, close = firefly_progress(sys.stdout.isatty() and not args.json)
     try:
         if overrides:

@@ -1,0 +1,91 @@
+"""Parameter study behind the planner's defaults: seeded, a few minutes, one run side by side.
+
+Plans ``--scenes`` generated scenes (``--narrow`` of them narrow passages) with the defaults
+and with variants of the search's settings, warm (one process, kernels and robot loaded),
+and prints per variant: scenes planned, the median warm planning time, the median
+evaluations, and the durations relative to the defaults' (geometric mean of the per-scene
+ratios on the scenes both plan, and its spread). The variants change one thing at a time
+from the defaults (:data:`planning.scene.DEFAULT_FIREFLY`, ``seeding: paths``); the first
+row is the paper's search (50 fireflies, every iteration, a random population).
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import statistics
+import time
+from typing import Any
+
+import numpy as np
+
+import cpr_kin as ck
+from planning.errors import NoSolutionError
+from planning.io.scene_generator import generate_scenes
+from planning.planner import plan, warm_up
+from planning.scene import Scene
+
+PAPER_SEARCH = {"fireflies": 50, "stall_iterations": 0, "seeding": "none"}
+VARIANTS: dict[str, dict[str, Any]] = {
+    "paper's search (n = 50, no stop, no seeds)": PAPER_SEARCH,
+    "defaults": {},
+    "n = 20": {"fireflies": 20},
+    "n = 50": {"fireflies": 50},
+    "no early stop": {"stall_iterations": 0},
+    "stall 4": {"stall_iterations": 4},
+    "stall 16": {"stall_iterations": 16},
+    "alpha 0.5": {"alpha": 0.5},
+    "alpha 0.2": {"alpha": 0.2},
+    "alpha 0.1": {"alpha": 0.1},
+    "alpha 0.2, n = 50": {"alpha": 0.2, "fireflies": 50},
+    "alpha 0.2, stall 16": {"alpha": 0.2, "stall_iterations": 16},
+    "no seeds": {"seeding": "none"},
+}
+
+
+def run(scene: Scene, robot: ck.Robot, changes: dict[str, Any]) -> tuple[bool, float, float, int]:
+    """Planned, warm wall time [s], duration [s] and evaluations of ``scene`` with ``changes``."""
+    changed = dataclasses.replace(scene, planner=scene.planner.updated(**changes))
+    started = time.perf_counter()
+    try:
+        result = plan(changed, robot)
+    except NoSolutionError:
+        return False, time.perf_counter() - started, float("nan"), 0
+    return True, time.perf_counter() - started, result.trajectory.duration, result.optimiser.evaluations
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--scenes", type=int, default=30, help="generated scenes (default: 30)")
+    parser.add_argument("--narrow", type=int, default=6, help="of which narrow passages (default: 6)")
+    parser.add_argument("--seed", type=int, default=1, help="seed of the scene generator (default: 1)")
+    args = parser.parse_args()
+    robot = ck.load_cpr()
+    warm_up(robot)
+    scenes = generate_scenes(args.scenes, args.seed, robot, narrow=args.narrow)
+    results: dict[str, list[tuple[bool, float, float, int]]] = {name: [] for name in VARIANTS}
+    for scene in scenes:  # variants interleaved scene by scene: the machine's drift hits all alike
+        for name, changes in VARIANTS.items():
+            results[name].append(run(scene, robot, changes))
+    reference = results["defaults"]
+    print(f"{len(scenes)} scenes ({args.narrow} narrow passages), generator seed {args.seed}\n")
+    print(f"{'variant':<44}{'planned':>9}{'time s':>9}{'evals':>8}{'duration / defaults':>24}")
+    for name, outcomes in results.items():
+        ratios = [
+            mine[2] / ours[2] for mine, ours in zip(outcomes, reference, strict=True) if mine[0] and ours[0]
+        ]
+        logs = np.log(ratios)
+        low, high = np.exp(np.percentile(logs, [10, 90]))
+        spread = f"{np.exp(logs.mean()):.3f} ({low:.2f}-{high:.2f})"
+        print(
+            f"{name:<44}{sum(o[0] for o in outcomes):>5}/{len(outcomes):<3}"
+            f"{statistics.median(o[1] for o in outcomes):9.3f}"
+            f"{statistics.median(o[3] for o in outcomes):8.0f}{spread:>24}"
+        )
+    print(
+        "\nduration / defaults: geometric mean of per-scene ratios (10th-90th percentile) on scenes both plan"
+    )
+
+
+if __name__ == "__main__":
+    main()
