@@ -12,16 +12,27 @@ from .io.trajectory_reader import TrajectoryFileError, read_trajectory
 from .metrics import Metrics
 from .objective import Breakdown, WaypointObjective
 from .planner import PlanResult, plan, solve, warm_up
-from .problem import Problem, build_problem
-from .scene import DEFAULT_SAFETY_MARGIN_M, DEFAULT_SPLINE, PlannerSettings, Scene, Target
+from .problem import Problem, build_problem, with_planner
+from .scene import (
+    DEFAULT_FIREFLY,
+    DEFAULT_SAFETY_MARGIN_M,
+    DEFAULT_SPLINE,
+    PAPER_SEARCH,
+    PlannerSettings,
+    Scene,
+    Target,
+)
 from .search.firefly import FireflyProgress, firefly_minimize
 from .search.firefly_settings import FireflySettings
 from .search.optimizer import Optimizer, SearchResult
+from .seeding import Seeds, seed_search
 from .verification import Verification, verify_trajectory
 
 __all__ = [
+    "DEFAULT_FIREFLY",
     "DEFAULT_SAFETY_MARGIN_M",
     "DEFAULT_SPLINE",
+    "PAPER_SEARCH",
     "Breakdown",
     "Extrema",
     "FireflyProgress",
@@ -37,6 +48,7 @@ __all__ = [
     "Scene",
     "SceneError",
     "SearchResult",
+    "Seeds",
     "SepticSplineSolver",
     "SplineError",
     "SplineFit",
@@ -55,11 +67,13 @@ __all__ = [
     "plan",
     "ptp_time",
     "read_trajectory",
+    "seed_search",
     "solve",
     "trapezoid_time",
     "uniform_knots",
     "verify_trajectory",
     "warm_up",
+    "with_planner",
     "write_samples",
     "write_trajectory",
 ]

@@ -36,7 +36,6 @@ def _plan_and_write(scene: Scene, out: str, args: argparse.Namespace, paper: boo
     from planning.io.publish import OutputFolder
     from planning.io.report import paper_rows, summary, summary_line, text_table
     from planning.planner import plan
-
     from planning.scene import PAPER_SEARCH
 
     overrides = {k: getattr(args, k) for k in OVERRIDES if getattr(args, k, None) is not None}

@@ -1,6 +1,7 @@
 """Type stub of the package: what it exports, and from which module (read by ``lazy_loader``)."""
 
 from .bundled import bundled_scene_paths, paper_scene, paper_scene_path
+from .narrow_passages import narrow_scene
 from .outputs import plan_files
 from .publish import FolderLock, OutputError, OutputFolder, write_file
 from .report import plan_record, report_markdown, summary
@@ -19,6 +20,7 @@ __all__ = [
     "dump_scene",
     "generate_scenes",
     "load_scene",
+    "narrow_scene",
     "paper_scene",
     "paper_scene_path",
     "parse_scene",

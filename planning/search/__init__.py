@@ -1,6 +1,7 @@
 """Box-constrained batch optimisers behind one interface.
 
-The firefly algorithm (Yang 2010) and the baselines it is compared with (:mod:`.baselines`).
+The firefly algorithm (Yang 2010) and the baselines it is compared with (:mod:`.baselines`);
+RRT-Connect (:func:`.rrt_connect.rrt_connect`), whose paths seed the firefly.
 """
 
 import lazy_loader

@@ -4,13 +4,17 @@ from . import baselines
 from .firefly import FireflyProgress, firefly_minimize
 from .firefly_settings import FireflySettings
 from .optimizer import BatchObjective, Optimizer, SearchResult
+from .rrt_connect import RrtPath, RrtSettings, waypoints_along
 
 __all__ = [
     "BatchObjective",
     "FireflyProgress",
     "FireflySettings",
     "Optimizer",
+    "RrtPath",
+    "RrtSettings",
     "SearchResult",
     "baselines",
     "firefly_minimize",
+    "waypoints_along",
 ]

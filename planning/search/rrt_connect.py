@@ -6,8 +6,9 @@ in milliseconds, and its path, cut to a few waypoints, seeds the firefly's popul
 (:func:`waypoints_along`).
 
 Two trees grow from start and goal: one extends a step towards a random sample, the other
-then greedily connects to the new node; they swap roles every sample. Edges are checked as
-OMPL checks its motions, at configurations a fixed robot motion apart (not certified: the
+then greedily connects to the new node; they swap roles every sample. The extension and the
+connection are checked in one call (the connection speculatively, towards the step's end).
+Edges are checked as OMPL checks its motions, at configurations a fixed robot motion apart (not certified: the
 executed spline gets the certified check), but every edge in one batched call to the
 validity check rather than one call per state, which is what makes it fast in Python.
 Distances are robot motion bounds ``sum_j R_j |dq_j|`` [m] with the joints' motion radii
@@ -110,14 +111,28 @@ class _Edges:
 
     def free_fraction(self, a: FloatArray, b: FloatArray) -> float:
         """The fraction of the edge ``a -> b`` valid from ``a`` on, in [0, 1] (``a`` assumed valid)."""
-        count = max(1, math.ceil(float(np.abs(b - a) @ self.weights) / self.resolution_m))
-        fractions = np.arange(1, count + 1) / count
-        ok = self.valid(a + fractions[:, None] * (b - a))
-        self.checks += count
-        if ok.all():
-            return 1.0
-        first_bad = int(np.argmin(ok))
-        return 0.0 if first_bad == 0 else float(fractions[first_bad - 1])
+        return self.free_fractions([(a, b)])[0]
+
+    def free_fractions(self, edges: list[tuple[FloatArray, FloatArray]]) -> list[float]:
+        """:meth:`free_fraction` of each edge, all checked in one call of the validity check."""
+        fractions = [
+            np.arange(1, count + 1) / count
+            for count in (
+                max(1, math.ceil(float(np.abs(b - a) @ self.weights) / self.resolution_m)) for a, b in edges
+            )
+        ]
+        points = np.concatenate(
+            [a + f[:, None] * (b - a) for (a, b), f in zip(edges, fractions, strict=True)]
+        )
+        ok = self.valid(points)
+        self.checks += len(points)
+        found, offset = [], 0
+        for f in fractions:
+            part = ok[offset : offset + len(f)]
+            offset += len(f)
+            first_bad = len(f) if part.all() else int(np.argmin(part))
+            found.append(1.0 if first_bad == len(f) else 0.0 if first_bad == 0 else float(f[first_bad - 1]))
+        return found
 
 
 def rrt_connect(
@@ -155,10 +170,22 @@ def rrt_connect(
         grow, other = trees[(sample - 1) % 2], trees[sample % 2]
         target = rng.uniform(lower, upper)
         near = grow.nearest(target, weights)
-        new = _extend(grow, near, target, edges, settings.step_m)
-        if new is None:
+        origin = grow.nodes[near]
+        length = float(np.abs(target - origin) @ weights)
+        if length <= 1e-12:
             continue
-        joined = _connect(other, grow.nodes[new], edges, settings.step_m)
+        end = origin + (target - origin) * min(1.0, settings.step_m / length)
+        # the extension and the other tree's connection to its end, checked in one call (the
+        # connection is wasted only when the extension stops short)
+        other_near = other.nearest(end, weights)
+        extended, connected = edges.free_fractions([(origin, end), (other.nodes[other_near], end)])
+        if extended == 0.0:
+            continue
+        new = grow.add(origin + extended * (end - origin), near)
+        if extended < 1.0:
+            other_near = other.nearest(grow.nodes[new], weights)
+            connected = edges.free_fraction(other.nodes[other_near], grow.nodes[new])
+        joined = _connect(other, other_near, grow.nodes[new], connected, settings.step_m, weights)
         if joined is not None:
             # root of grow ... new == joined ... root of other (the meeting point once)
             path = np.concatenate([grow.branch(new)[::-1], other.branch(joined)[1:]])
@@ -169,25 +196,17 @@ def rrt_connect(
     return None
 
 
-def _extend(tree: _Tree, near: int, target: FloatArray, edges: _Edges, step_m: float) -> int | None:
-    """Add the farthest valid point up to one step from node ``near`` towards ``target``."""
-    origin = tree.nodes[near]
-    length = float(np.abs(target - origin) @ edges.weights)
-    if length <= 1e-12:
-        return None
-    end = origin + (target - origin) * min(1.0, step_m / length)
-    fraction = edges.free_fraction(origin, end)
+def _connect(
+    tree: _Tree, near: int, target: FloatArray, fraction: float, step_m: float, weights: FloatArray
+) -> int | None:
+    """Grow ``tree`` from node ``near`` along the valid ``fraction`` of the way to ``target``.
+
+    A node every step; returns the node at ``target`` if reached.
+    """
     if fraction == 0.0:
         return None
-    return tree.add(origin + fraction * (end - origin), near)
-
-
-def _connect(tree: _Tree, target: FloatArray, edges: _Edges, step_m: float) -> int | None:
-    """Grow ``tree`` straight towards ``target``, a node every step; the node at ``target`` if reached."""
-    near = tree.nearest(target, edges.weights)
     origin = tree.nodes[near]
-    fraction = edges.free_fraction(origin, target)
-    length = float(np.abs(target - origin) @ edges.weights)
+    length = float(np.abs(target - origin) @ weights)
     nodes = max(1, math.ceil(fraction * length / step_m))
     parent = near
     for k in range(1, nodes + 1):
