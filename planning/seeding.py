@@ -47,6 +47,11 @@ SEED_SPREAD = 0.01
 firefly then refines around the seeds from its first iteration (a lone seed among random
 fireflies stays the best, unmoved, until the others come near). Backed by
 ``scripts/study_parameters.py``."""
+MAX_RESOLUTION_M = 0.04
+"""Largest spacing of the sampling planner's edge checks [m]: the checks cost most of its time,
+and a path that clips an obstacle between two checks is only a seed (the fitness and the
+certified check judge what is executed). It is never more than the clearance required (a
+thin obstacle with no margin is checked every centimetre)."""
 MORE_WAYPOINTS = 6
 """How many waypoints beyond the path's corners the seeding may add, two at a time, until the
 spline through them keeps the clearance (a tight passage needs the spline held close to the
@@ -85,6 +90,8 @@ def sampled_path(
         full[:, moving] = q
         return ~problem.world.margin_violated(full, objective.required_m)
 
+    if settings is None:  # edges checked at most as far apart as the clearance required, 1-4 cm
+        settings = RrtSettings(resolution_m=min(MAX_RESOLUTION_M, max(0.01, objective.required_m)))
     limits = robot.limits
     return rrt_connect(
         valid,
