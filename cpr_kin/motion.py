@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.collision import CollisionWorld
 from cpr_kin.errors import CprKinError
-from cpr_kin.reach import geometry_reach
+from cpr_kin.reach import robot_reach
 from cpr_kin.robot import GROUPS, Robot
 
 FloatArray = NDArray[np.float64]
@@ -38,8 +38,7 @@ def motion_radii(robot: Robot) -> FloatArray:
     A displacement ``dq`` of the joints moves no point of any collision geometry by more
     than ``sum_j R_j |dq_j|`` [m], whatever the configuration (see :mod:`cpr_kin.reach`).
     """
-    reach = geometry_reach(robot.model, robot.collision_model, robot.limits.lower, robot.limits.upper)
-    return np.asarray(np.max([r.radii for r in reach], axis=0))
+    return np.asarray(np.max([r.radii for r in robot_reach(robot)], axis=0))
 
 
 @dataclass(frozen=True)

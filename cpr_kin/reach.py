@@ -12,6 +12,7 @@ geometry in every configuration.
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -104,6 +105,22 @@ def geometry_reach(
     return bounds
 
 
+_ROBOT_REACH: weakref.WeakKeyDictionary[Robot, tuple[GeometryReach, ...]] = weakref.WeakKeyDictionary()
+
+
+def robot_reach(robot: Robot) -> tuple[GeometryReach, ...]:
+    """:func:`geometry_reach` of ``robot``'s collision geometries within its joint ranges.
+
+    Computed once per robot (a few milliseconds, asked for by every problem built, edge
+    checked and trajectory verified); a :class:`~cpr_kin.Robot` does not change.
+    """
+    if robot not in _ROBOT_REACH:
+        limits = robot.limits
+        reach = geometry_reach(robot.model, robot.collision_model, limits.lower, limits.upper)
+        _ROBOT_REACH[robot] = tuple(reach)
+    return _ROBOT_REACH[robot]
+
+
 def _carry(
     model: Any,
     axes: list[tuple[bool, FloatArray]],
@@ -150,7 +167,7 @@ def pair_reach_distances(
     import coal
     import pinocchio as pin
 
-    reach = geometry_reach(robot.model, robot.collision_model, robot.limits.lower, robot.limits.upper)
+    reach = robot_reach(robot)
     request, distances = coal.DistanceRequest(), []
     for g, k in pairs:
         obstacle = obstacles[k]

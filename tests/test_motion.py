@@ -45,6 +45,19 @@ def test_radii_values(robot: ck.Robot) -> None:
     assert 0.15 < radii[3] < 0.16 and 0.15 < radii[4] < 0.16
 
 
+def test_reach_is_computed_once_per_robot(robot: ck.Robot) -> None:
+    from cpr_kin.reach import geometry_reach, robot_reach
+
+    cached = robot_reach(robot)
+    assert robot_reach(robot) is cached
+    fresh = geometry_reach(robot.model, robot.collision_model, robot.limits.lower, robot.limits.upper)
+    for a, b in zip(cached, fresh, strict=True):
+        np.testing.assert_array_equal(a.radii, b.radii)
+    other = ck.load_cpr()  # another robot gets its own
+    assert robot_reach(other) is not cached
+    np.testing.assert_array_equal(ck.motion_radii(other), ck.motion_radii(robot))
+
+
 def test_radii_bound_every_point_motion(
     robot: ck.Robot, rng: np.random.Generator, surface_points: list[np.ndarray]
 ) -> None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import itertools
+import math
 
 import numpy as np
 import pytest
@@ -126,6 +127,27 @@ def test_same_generator_seed_same_path() -> None:
         return found.path
 
     np.testing.assert_array_equal(run(), run())
+
+
+@pytest.mark.parametrize("step_m", [None, 0.1])
+def test_an_extension_is_at_most_one_step(step_m: float | None) -> None:
+    """The default step is a fifth of the box's diagonal in the weighted motion bound."""
+    weights = np.array([2.0, 0.5])
+    batches: list[NDArray[np.float64]] = []
+
+    def recorded(q: NDArray[np.float64]) -> NDArray[np.bool_]:
+        batches.append(q.copy())
+        return wall_with_slot(q)
+
+    start, goal = np.array([0.1, 0.9]), np.array([0.9, 0.1])
+    settings = RrtSettings(step_m=step_m, resolution_m=0.01)
+    rrt_connect(recorded, start, goal, LOWER, UPPER, weights, np.random.default_rng(0), settings)
+    step = 0.2 * float(np.hypot(2.0, 0.5)) if step_m is None else step_m
+    # batch 0 is the straight line; batch 1 the first extension from the start (then a connection)
+    count = math.ceil(step / 0.01 - 1e-9)
+    reach = np.abs(batches[1] - start) @ weights
+    assert reach[:count].max() <= step * (1 + 1e-9)
+    assert reach[:count].max() >= step - 0.01  # the first sample lies farther than one step
 
 
 def test_settings_and_weights_are_validated() -> None:
