@@ -103,7 +103,9 @@ def test_an_interrupted_background_batch_stops_and_summarises_the_scenes_done(tm
         preexec_fn=as_a_background_job,
     )
     deadline = time.monotonic() + 120
-    while not (out / "paper_00" / "manifest.json").exists() and time.monotonic() < deadline:
+    # the second scene's files: one worker takes it only once the first scene's row is in (the
+    # first scene's files alone may be published before its result reaches the dispatcher)
+    while not (out / "paper_01" / "manifest.json").exists() and time.monotonic() < deadline:
         time.sleep(0.05)
     os.kill(batch.pid, signal.SIGINT)
     started = time.monotonic()

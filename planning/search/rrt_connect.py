@@ -9,34 +9,28 @@ Two trees grow from start and goal: one extends a step towards a random sample, 
 then greedily connects to the new node; they swap roles every sample. The step is by default
 a fifth of the sampling box's diagonal, OMPL's default range: on 200 generated scenes with a
 blocked straight line it needed 40 % fewer samples and 25 % fewer checked configurations than
-a step of 0.25 m, and seeded trajectories as fast. The extension and the
-connection are checked in one call (the connection speculatively, towards the step's end).
-Edges are checked as OMPL checks its motions, at configurations a fixed robot motion apart (not certified: the
-executed spline gets the certified check), but every edge in one batched call to the
-validity check rather than one call per state, which is what makes it fast in Python.
-Distances are robot motion bounds ``sum_j R_j |dq_j|`` [m] with the joints' motion radii
-(:func:`cpr_kin.motion_radii`), so a step means the same in every joint whatever its unit.
-The path is then shortened by random shortcuts (a straight edge between two points on it
-replaces what lies between when it is valid), then by skipping vertices (from each vertex
-straight to the farthest one it sees). All randomness comes from the generator passed.
+a step of 0.25 m, and seeded trajectories as fast. The extension and the connection are
+checked in one call (the connection speculatively, towards the step's end), edges in batches
+as :mod:`planning.search.edges` describes (not certified: the executed spline gets the
+certified check). Distances are robot motion bounds ``sum_j R_j |dq_j|`` [m] with the joints'
+motion radii (:func:`cpr_kin.motion_radii`), so a step means the same in every joint whatever
+its unit. The path found is then shortened (:func:`planning.search.edges.shortcut`). All
+randomness comes from the generator passed.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
 from planning.errors import PlanningError
+from planning.search.edges import Edges, Validity, shortcut
 from planning.validation import integer_in, number_in
 
 FloatArray = NDArray[np.float64]
-BoolArray = NDArray[np.bool_]
-Validity = Callable[[FloatArray], BoolArray]
-"""``(N, d) -> (N,)``: whether each configuration is valid (clear of the margin)."""
 
 RANGE_FRACTION = 0.2
 """Default extension step as a fraction of the sampling box's diagonal (OMPL's default range)."""
@@ -113,38 +107,6 @@ class _Tree:
         return np.array(chain)
 
 
-class _Edges:
-    """Validity of straight edges, each checked in one batch; counts the configurations checked."""
-
-    def __init__(self, valid: Validity, weights: FloatArray, resolution_m: float) -> None:
-        self.valid, self.weights, self.resolution_m, self.checks = valid, weights, resolution_m, 0
-
-    def free_fraction(self, a: FloatArray, b: FloatArray) -> float:
-        """The fraction of the edge ``a -> b`` valid from ``a`` on, in [0, 1] (``a`` assumed valid)."""
-        return self.free_fractions([(a, b)])[0]
-
-    def free_fractions(self, edges: list[tuple[FloatArray, FloatArray]]) -> list[float]:
-        """:meth:`free_fraction` of each edge, all checked in one call of the validity check."""
-        fractions = [
-            np.arange(1, count + 1) / count
-            for count in (
-                max(1, math.ceil(float(np.abs(b - a) @ self.weights) / self.resolution_m)) for a, b in edges
-            )
-        ]
-        points = np.concatenate(
-            [a + f[:, None] * (b - a) for (a, b), f in zip(edges, fractions, strict=True)]
-        )
-        ok = self.valid(points)
-        self.checks += len(points)
-        found, offset = [], 0
-        for f in fractions:
-            part = ok[offset : offset + len(f)]
-            offset += len(f)
-            first_bad = len(f) if part.all() else int(np.argmin(part))
-            found.append(1.0 if first_bad == len(f) else 0.0 if first_bad == 0 else float(f[first_bad - 1]))
-        return found
-
-
 def rrt_connect(
     valid: Validity,
     start: FloatArray,
@@ -176,7 +138,7 @@ def rrt_connect(
     if step_m is None:
         diagonal = float(np.linalg.norm(weights * (np.asarray(upper) - np.asarray(lower))))
         step_m = max(settings.resolution_m, RANGE_FRACTION * diagonal)
-    edges = _Edges(valid, weights, settings.resolution_m)
+    edges = Edges(valid, weights, settings.resolution_m)
     if edges.free_fraction(start, goal) == 1.0:
         return RrtPath(np.array([start, goal]), 0, edges.checks)
     trees = (_Tree(start), _Tree(goal))
@@ -205,7 +167,7 @@ def rrt_connect(
             path = np.concatenate([grow.branch(new)[::-1], other.branch(joined)[1:]])
             if grow is not trees[0]:
                 path = path[::-1]
-            path = _shortcut(path, edges, rng, settings.shortcuts)
+            path = shortcut(path, edges, rng, settings.shortcuts)
             return RrtPath(path, sample, edges.checks)
     return None
 
@@ -226,56 +188,6 @@ def _connect(
     for k in range(1, nodes + 1):
         parent = tree.add(origin + (fraction * k / nodes) * (target - origin), parent)
     return parent if fraction == 1.0 else None
-
-
-def _shortcut(path: FloatArray, edges: _Edges, rng: np.random.Generator, attempts: int) -> FloatArray:
-    """Shorten ``path`` by ``attempts`` random shortcuts between points on its edges."""
-    for _ in range(attempts):
-        if len(path) < 3:
-            break
-        lengths = np.abs(np.diff(path, axis=0)) @ edges.weights
-        arc = np.concatenate([[0.0], np.cumsum(lengths)])
-        s0, s1 = np.sort(rng.uniform(0.0, arc[-1], 2))
-        i, j = (int(np.searchsorted(arc, s, side="right")) - 1 for s in (s0, s1))
-        if i == j:
-            continue
-        a = path[i] + (s0 - arc[i]) / max(lengths[i], 1e-300) * (path[i + 1] - path[i])
-        b = path[j] + (s1 - arc[j]) / max(lengths[j], 1e-300) * (path[j + 1] - path[j])
-        if edges.free_fraction(a, b) == 1.0:
-            path = np.concatenate([path[: i + 1], [a, b], path[j + 1 :]])
-    return _drop_collinear(_skip_vertices(path, edges))
-
-
-def _skip_vertices(path: FloatArray, edges: _Edges) -> FloatArray:
-    """``path`` from each kept vertex straight to the farthest later vertex it sees."""
-    kept, i = [path[0]], 0
-    while i < len(path) - 1:
-        j = len(path) - 1
-        while j > i + 1 and edges.free_fraction(path[i], path[j]) < 1.0:
-            j -= 1
-        kept.append(path[j])
-        i = j
-    return np.array(kept)
-
-
-def _drop_collinear(path: FloatArray) -> FloatArray:
-    """``path`` without vertices on the straight line between their neighbours."""
-    keep = [0]
-    for k in range(1, len(path) - 1):
-        before, after = path[k] - path[keep[-1]], path[k + 1] - path[k]
-        if _sine(before, after) > 1e-9:
-            keep.append(k)
-    keep.append(len(path) - 1)
-    return path[keep]
-
-
-def _sine(u: FloatArray, v: FloatArray) -> float:
-    """``|sin|`` of the angle between ``u`` and ``v`` (0 if either is zero)."""
-    nu, nv = float(np.linalg.norm(u)), float(np.linalg.norm(v))
-    if nu == 0.0 or nv == 0.0:
-        return 0.0
-    c = float(u @ v) / (nu * nv)
-    return math.sqrt(max(0.0, 1.0 - c * c))
 
 
 def waypoints_along(path: FloatArray, count: int, weights: FloatArray) -> FloatArray:
