@@ -41,6 +41,8 @@ bench: $(STAMP)
 	$(PY) scripts/bench_spline.py
 	$(PY) scripts/bench_planner.py
 	$(PY) scripts/bench_batch.py
+	$(PY) scripts/bench_timing.py --out out/bench_timing.md
+	$(PY) scripts/bench_search.py
 
 bench-peers: $(STAMP)
 	$(PY) scripts/bench_peers.py --scenes 50 --out out/bench_peers.md
