@@ -120,22 +120,53 @@ class CollisionWorld:
         limits are not checked (callers sampling a curve pass in-range values).
         """
         batch = self._check_batch(q)
-        n = len(batch)
-        clearance = np.full((n, len(GROUPS)), np.inf)
-        closest = np.full((n, len(GROUPS)), -1, dtype=np.int64)
-        model, data, gmodel = self.robot.model, self._data, self.geometry_model
-        compute = pin.computeDistances
-        for group_index, gdata in enumerate(self._groups):
-            if not self._group_has_pairs[group_index]:
-                continue
-            results = gdata.distanceResults
-            column = clearance[:, group_index]
-            index_column = closest[:, group_index]
-            for k in range(n):
-                pair = compute(model, data, gmodel, gdata, batch[k])
-                column[k] = results[pair].min_distance
-                index_column[k] = pair
+        clearance = np.full((len(batch), len(GROUPS)), np.inf)
+        closest = np.full((len(batch), len(GROUPS)), -1, dtype=np.int64)
+        for group_index in range(len(GROUPS)):
+            clearance[:, group_index], closest[:, group_index] = self.group_clearance(batch, group_index)
         return BatchClearance(clearance_m=clearance, closest_pair=closest)
+
+    def group_clearance(self, q: ArrayLike, group_index: int) -> tuple[FloatArray, IntArray]:
+        """Clearance [m] of group ``GROUPS[group_index]`` at configurations ``q`` ``(N, nq)``, by coal.
+
+        Also the index of the closest pair per configuration; ``inf`` and ``-1`` for a group
+        with no pair.
+        """
+        batch = self._check_batch(q)
+        n = len(batch)
+        clearance = np.full(n, np.inf)
+        closest = np.full(n, -1, dtype=np.int64)
+        if not self._group_has_pairs[group_index]:
+            return clearance, closest
+        model, data, gmodel = self.robot.model, self._data, self.geometry_model
+        gdata = self._groups[group_index]
+        results = gdata.distanceResults
+        compute = pin.computeDistances
+        for k in range(n):
+            pair = compute(model, data, gmodel, gdata, batch[k])
+            clearance[k] = results[pair].min_distance
+            closest[k] = pair
+        return clearance, closest
+
+    def clearance_lower_bounds(self, q: ArrayLike) -> FloatArray:
+        """``(N, len(GROUPS))`` lower bounds [m] of each group's clearance at ``q`` ``(N, nq)``.
+
+        From the pair bounds (:mod:`cpr_kin.pair_bounds`), a fraction of coal's cost, less
+        :data:`BOUND_TOLERANCE_M` for coal's own tolerance: a positive bound is at most
+        :meth:`clearance_batch`'s value; where the geometries' bounding shapes overlap nothing
+        is known and the bound is ``-inf``. ``inf`` for a group with no pair.
+        """
+        batch = self._check_batch(q)
+        bounds = np.full((len(batch), len(GROUPS)), np.inf)
+        if not self._pairs:
+            return bounds
+        per_pair = self._bounds((True,) * len(self._pairs))(batch)
+        for group_index in range(len(GROUPS)):
+            columns = self._pair_group == group_index
+            if columns.any():
+                bounds[:, group_index] = per_pair[:, columns].min(axis=1) - BOUND_TOLERANCE_M
+        bounds[bounds <= 0.0] = -np.inf
+        return bounds
 
     def min_clearance_batch(self, q: ArrayLike, below_m: float | None = None) -> tuple[FloatArray, IntArray]:
         """Smallest distance over every pair [m] and the index of that pair, ``(N,)`` each.

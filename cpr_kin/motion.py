@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from cpr_kin.clearance import BatchClearance
 from cpr_kin.collision import CollisionWorld
 from cpr_kin.errors import CprKinError
 from cpr_kin.reach import robot_reach
@@ -50,7 +51,9 @@ class CurveCheck:
         margin_m: the required clearance [m].
         step_m: the stated bound on robot motion between two checks [m].
         times: ``(K,)`` sampled instants [s].
-        clearance_m: ``(K, 2)`` sampled clearance per group [m] (columns as :data:`GROUPS`).
+        clearance_m: ``(K, 2)`` sampled clearance per group [m] (columns as :data:`GROUPS`):
+            exact (coal) where it decides a minimum, a lower bound elsewhere
+            (see :func:`decisive_clearance`).
         certified_min_m: lower bound of the clearance over the whole curve [m].
         sampled_min_m: smallest sampled clearance [m].
         worst_time: instant of the smallest sampled clearance [s].
@@ -114,7 +117,7 @@ def check_curve(
         )
     times = np.linspace(t0, t1, max(count, 2))  # at least both ends
     dt = times[1] - times[0]
-    batch = world.clearance_batch(curve(times))
+    batch = decisive_clearance(world, curve(times), point_speed * dt)
     per_group = batch.clearance_m
     # lower bound between neighbouring samples: distances change no faster than V
     certified = 0.5 * (per_group[:-1] + per_group[1:] - point_speed * dt)
@@ -138,6 +141,57 @@ def check_curve(
         worst_pair=worst_pair,
         violating_groups=tuple(g for g, b in zip(GROUPS, group_bound, strict=True) if b < margin_m),
     )
+
+
+def decisive_clearance(world: CollisionWorld, q: FloatArray, slack_m: float) -> BatchClearance:
+    """Per-group clearance of the samples ``q`` ``(K, nq)`` of a curve, exact where it decides the check.
+
+    :func:`check_curve` needs, per group, the smallest certified value
+    ``(c_k + c_{k+1} - slack_m) / 2`` and the smallest sampled clearance, each exactly (coal).
+    Every sample starts with its cheap lower bound
+    (:meth:`~cpr_kin.CollisionWorld.clearance_lower_bounds`); coal then computes the samples
+    that could still be below the smallest exact value, in batches, until the minima are
+    exact. Values computed from lower bounds are at most the true ones, so a minimum found
+    exactly is the true minimum. Along a trajectory most samples are far from every
+    obstacle, and coal computes about a fifth of them. Elsewhere :attr:`clearance_m` holds
+    the lower bound and :attr:`closest_pair` ``-1``.
+    """
+    values = world.clearance_lower_bounds(q)
+    known = np.isinf(values) & (values > 0)  # groups without pairs: nothing to compute
+    closest = np.full(values.shape, -1, dtype=np.int64)
+    while (needed := _undecided(values, known, slack_m)).any():
+        for group_index in range(values.shape[1]):
+            rows = np.flatnonzero(needed[:, group_index])
+            if rows.size:
+                values[rows, group_index], closest[rows, group_index] = world.group_clearance(
+                    q[rows], group_index
+                )
+                known[rows, group_index] = True
+    return BatchClearance(clearance_m=values, closest_pair=closest)
+
+
+def _undecided(values: FloatArray, known: NDArray[np.bool_], slack_m: float) -> NDArray[np.bool_]:
+    """Samples not yet exact whose exact value could still lower a minimum the check reports."""
+    needed = np.zeros_like(known)
+    certified = 0.5 * (values[:-1] + values[1:] - slack_m)
+    both_known = known[:-1] & known[1:]
+    for g in range(values.shape[1]):
+        column = certified[:, g]
+        lowest = int(np.argmin(column))
+        if both_known[lowest, g]:
+            continue
+        best_exact = float(np.min(column[both_known[:, g]], initial=np.inf))
+        below = column <= best_exact if np.isfinite(best_exact) else np.arange(len(column)) == lowest
+        needed[:-1, g] |= below
+        needed[1:, g] |= below
+    lowest_sample = np.unravel_index(int(np.argmin(values)), values.shape)
+    if not known[lowest_sample]:
+        best_exact = float(np.min(values[known], initial=np.inf))
+        if np.isfinite(best_exact):
+            needed |= values <= best_exact
+        else:
+            needed[lowest_sample] = True
+    return needed & ~known
 
 
 def check_segment(

@@ -123,6 +123,55 @@ def test_certified_bound_is_sound(robot: ck.Robot, rng: np.random.Generator) -> 
         assert check.certified_min_m <= dense + 1e-9
 
 
+@pytest.fixture(scope="module")
+def cluttered_world(robot: ck.Robot) -> ck.CollisionWorld:
+    return ck.CollisionWorld(
+        robot,
+        [
+            ck.Obstacle.box((0.3, 0.3, 0.3), (0.0, 0.6, 0.15), name="crate"),
+            ck.Obstacle.sphere(0.1, (0.2, 0.6, 0.4), name="ball"),
+            ck.Obstacle.cylinder(0.05, 0.8, (-0.5, 0.3, 0.4), name="post"),
+            ck.Obstacle.capsule(0.04, 0.6, (0.4, -0.4, 0.5), (1.2, 0.0, 0.3), name="bar"),
+        ],
+    )
+
+
+def test_clearance_lower_bounds_are_below_coal(
+    robot: ck.Robot, cluttered_world: ck.CollisionWorld, rng: np.random.Generator
+) -> None:
+    q = random_configurations(robot, rng, 400)
+    bounds = cluttered_world.clearance_lower_bounds(q)
+    exact = cluttered_world.clearance_batch(q).clearance_m
+    assert np.all(bounds <= exact)
+    assert np.isneginf(bounds).any() and np.isfinite(bounds).mean() > 0.5  # informative mostly
+    alone = ck.CollisionWorld(robot, [])
+    assert np.all(alone.clearance_lower_bounds(q) == np.inf)
+
+
+@pytest.mark.parametrize("slack_m", [0.0, 0.01, 0.05])
+def test_decisive_clearance_finds_the_minima_of_the_full_evaluation(
+    robot: ck.Robot, cluttered_world: ck.CollisionWorld, rng: np.random.Generator, slack_m: float
+) -> None:
+    from cpr_kin.motion import decisive_clearance
+
+    saved = 0
+    for _ in range(8):  # random joint-space segments, sampled densely
+        a, b = random_configurations(robot, rng, 2)
+        q = np.linspace(a, b, 300)
+        full = cluttered_world.clearance_batch(q)
+        lazy = decisive_clearance(cluttered_world, q, slack_m)
+        exact = lazy.closest_pair >= 0
+        saved += int((~exact).sum())
+        # coal's distances depend slightly on the order of the queries (GJK's warm start)
+        np.testing.assert_allclose(lazy.clearance_m[exact], full.clearance_m[exact], atol=1e-6)
+        assert np.all(lazy.clearance_m <= full.clearance_m + 1e-6)
+        certified = [0.5 * (c[:-1] + c[1:] - slack_m) for c in (lazy.clearance_m, full.clearance_m)]
+        np.testing.assert_allclose(certified[0].min(axis=0), certified[1].min(axis=0), atol=1e-6)
+        worst = np.unravel_index(np.argmin(lazy.clearance_m), lazy.clearance_m.shape)
+        assert exact[worst] and lazy.clearance_m[worst] == pytest.approx(full.clearance_m.min(), abs=1e-6)
+    assert saved > 0.3 * 8 * 300 * 2  # and coal was spared most samples
+
+
 def test_thin_plate_between_samples_is_caught(robot: ck.Robot) -> None:
     # a 2 mm plate crossed by the tool; with coarse checks every sample may miss it, but the
     # certified bound cannot
