@@ -5,10 +5,8 @@
 
 from __future__ import annotations
 
-import json
-
 from planning.io.report import report_markdown
-from planning.io.trajectory_io import plan_samples_csv, trajectory_document
+from planning.io.trajectory_io import plan_samples_csv, trajectory_json
 from planning.planner import PlanResult
 
 
@@ -17,7 +15,7 @@ def plan_files(
 ) -> dict[str, str | bytes]:
     """``trajectory.json``, ``samples.csv`` and ``report.md``; the plots and ``viewer.html`` if asked."""
     files: dict[str, str | bytes] = {
-        "trajectory.json": json.dumps(trajectory_document(result, timings=timings), indent=1) + "\n",
+        "trajectory.json": trajectory_json(result, timings=timings),
         "samples.csv": plan_samples_csv(result),
         "report.md": report_markdown(result, paper),
     }

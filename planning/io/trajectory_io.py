@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import csv
 import io
-import json
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -19,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from planning.curves.trajectory import DERIVATIVE_NAMES, Trajectory
+from planning.io.json_layout import dumps
 from planning.io.publish import write_file
 
 if TYPE_CHECKING:  # types only: writing files needs neither the planner nor the robot
@@ -55,9 +55,18 @@ def trajectory_document(result: PlanResult, timings: bool = False) -> dict[str, 
     }
 
 
+def trajectory_json(result: PlanResult, timings: bool = False) -> str:
+    """The text of the plan's ``cpr-trajectory/1`` file (see :func:`trajectory_document`).
+
+    Laid out by :func:`planning.io.json_layout.dumps`: a waypoint, a knot vector or a row of
+    a segment's coefficients per line.
+    """
+    return dumps(trajectory_document(result, timings)) + "\n"
+
+
 def write_trajectory(result: PlanResult, path: Path, timings: bool = False) -> None:
-    """Write the plan as a ``cpr-trajectory/1`` JSON file, atomically (see :func:`trajectory_document`)."""
-    write_file(Path(path), json.dumps(trajectory_document(result, timings), indent=1) + "\n")
+    """Write the plan as a ``cpr-trajectory/1`` JSON file, atomically (see :func:`trajectory_json`)."""
+    write_file(Path(path), trajectory_json(result, timings))
 
 
 def samples_csv(
