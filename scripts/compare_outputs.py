@@ -6,7 +6,9 @@ checkout's code and then with ``--compare DIR`` (another checkout, e.g. ``git wo
 /tmp/base <commit>``), and compares every file written (``trajectory.json``,
 ``samples.csv``, ``report.md``). The one expected difference, the checkout's own folder in
 the recorded URDF path, is replaced by ``<checkout>``, and the wall times in ``report.md``'s
-time rows are masked, before comparing (``trajectory.json`` records no wall time).
+time rows are masked, before comparing (``trajectory.json`` records no wall time). JSON files
+are compared as documents, value for value (floats exactly), not by their layout, which
+changed when ``planning.io.json_layout`` came.
 ``manifest.json`` is left out: it lists the other files' hashes, and older checkouts do not
 write it.
 
@@ -18,6 +20,7 @@ identical, 1 otherwise.
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import re
 import subprocess
@@ -30,8 +33,13 @@ WALL_TIME = re.compile(rb"\d+\.\d+ s\b")
 
 
 def normalised(content: bytes, checkout: Path, name: str) -> bytes:
-    """``content`` with the checkout's folder and, in ``report.md``'s time rows, wall times masked."""
+    """``content`` with the checkout's folder and, in ``report.md``'s time rows, wall times masked.
+
+    A JSON file becomes its document written compactly, so that layouts compare alike.
+    """
     content = content.replace(str(checkout).encode(), b"<checkout>")
+    if name.endswith(".json"):
+        return json.dumps(json.loads(content)).encode()
     if name != "report.md":
         return content
     lines = content.split(b"\n")
