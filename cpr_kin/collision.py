@@ -132,21 +132,8 @@ class CollisionWorld:
         Also the index of the closest pair per configuration; ``inf`` and ``-1`` for a group
         with no pair.
         """
-        batch = self._check_batch(q)
-        n = len(batch)
-        clearance = np.full(n, np.inf)
-        closest = np.full(n, -1, dtype=np.int64)
-        if not self._group_has_pairs[group_index]:
-            return clearance, closest
-        model, data, gmodel = self.robot.model, self._data, self.geometry_model
-        gdata = self._groups[group_index]
-        results = gdata.distanceResults
-        compute = pin.computeDistances
-        for k in range(n):
-            pair = compute(model, data, gmodel, gdata, batch[k])
-            clearance[k] = results[pair].min_distance
-            closest[k] = pair
-        return clearance, closest
+        gdata = self._groups[group_index] if self._group_has_pairs[group_index] else None
+        return self._closest_pairs(self._check_batch(q), gdata)
 
     def clearance_lower_bounds(self, q: ArrayLike) -> FloatArray:
         """``(N, len(GROUPS))`` lower bounds [m] of each group's clearance at ``q`` ``(N, nq)``.
@@ -178,10 +165,16 @@ class CollisionWorld:
         ``inf`` with pair ``-1`` (what a caller wants who asks only where a margin is violated).
         """
         batch = self._check_batch(q)
+        return self._closest_pairs(batch, self._all if below_m is None else self._culled(below_m))
+
+    def _closest_pairs(self, batch: FloatArray, gdata: Any) -> tuple[FloatArray, IntArray]:
+        """Coal's smallest distance [m] over ``gdata``'s active pairs and that pair, per configuration.
+
+        ``inf`` and ``-1`` everywhere when ``gdata`` is ``None`` (no pair to compute).
+        """
         n = len(batch)
         clearance = np.full(n, np.inf)
         closest = np.full(n, -1, dtype=np.int64)
-        gdata = self._all if below_m is None else self._culled(below_m)
         if gdata is not None:
             model, data, gmodel = self.robot.model, self._data, self.geometry_model
             results = gdata.distanceResults
