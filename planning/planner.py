@@ -25,6 +25,7 @@ from planning.problem import Problem, build_problem, with_planner
 from planning.scene import MAX_FITNESS_SAMPLES, Scene
 from planning.search.firefly import FireflyProgress, firefly_minimize
 from planning.search.optimizer import Optimizer, SearchResult
+from planning.search.refinement import refine_search
 from planning.seeding import seed_search
 from planning.timing import Timing
 
@@ -89,13 +90,14 @@ def solve(
     """Search, time and verify a trajectory for ``problem``.
 
     Steps: firefly search of the waypoints on the problem's objective
-    (:mod:`planning.objective`); septic spline through start, waypoints and goal on
-    ``p + 1`` uniform segments; timing (:mod:`planning.timing`: the scene's duration,
-    stretched if it breaks a velocity, acceleration or jerk limit; or, with the duration
-    free, as fast as the limits allow along the path, its uniform timing as the fallback);
-    certified continuous verification of the whole trajectory against the margin. If the
-    best candidate fails the verification, the final population's other feasible
-    candidates are tried in order of fitness.
+    (:mod:`planning.objective`), its best refined by a CMA-ES (``refine: cma``); septic
+    spline through start, waypoints and goal on ``p + 1`` uniform segments; timing
+    (:mod:`planning.timing`: the scene's duration, stretched if it breaks a velocity,
+    acceleration or jerk limit; or, with the duration free, as fast as the limits allow
+    along the path, its uniform timing as the fallback); certified continuous verification
+    of the whole trajectory against the margin. If the best candidate fails the
+    verification, the refinement's earlier points and the final population's other
+    feasible candidates are tried in order of fitness.
 
     Args:
         problem: from :func:`~planning.problem.build_problem`.
@@ -167,13 +169,18 @@ def _search(
     optimizer: Optimizer | None,
     seeds: FloatArray | None,
 ) -> SearchResult:
-    """The firefly (from ``seeds`` and a random population) or ``optimizer``."""
+    """The firefly (from ``seeds`` and a random population) or ``optimizer``.
+
+    With ``refine: cma`` and a feasible best, the firefly's best is refined by a CMA-ES
+    (:func:`~planning.search.refinement.refine_search`) within the rest of the budget,
+    drawing on the same generator after the firefly.
+    """
     objective, settings = problem.objective, problem.scene.planner
     rng = np.random.default_rng(settings.seed)
     if optimizer is not None:
         budget = settings.firefly.fireflies * (settings.firefly.iterations + 1)
         return optimizer(objective, objective.lower, objective.upper, budget, rng)
-    return firefly_minimize(
+    found = firefly_minimize(
         objective,
         objective.lower,
         objective.upper,
@@ -183,6 +190,10 @@ def _search(
         seeds,
         stall_below=objective.t_max,  # stop early only once a candidate is feasible
     )
+    if settings.refine == "none" or found.fitness > objective.t_max:
+        return found
+    budget = settings.firefly.fireflies * (settings.firefly.iterations + 1) - found.evaluations
+    return refine_search(objective, objective.lower, objective.upper, found, budget, rng)
 
 
 def _stay_put(problem: Problem, started: float) -> PlanResult:

@@ -27,6 +27,7 @@ FloatArray = NDArray[np.float64]
 Fitness = Literal["clearance", "paper"]
 PathKind = Literal["spline", "ptp"]
 Seeding = Literal["paths", "none"]
+Refine = Literal["cma", "none"]
 
 DEFAULT_SAFETY_MARGIN_M = 0.1
 """Clearance every robot geometry keeps from every obstacle unless a scene says otherwise [m]
@@ -36,21 +37,27 @@ DEFAULT_SPLINE = SplineSettings(p=1e6, a=(0.0, 0.0, 1.0), ends="rest")
 """The spline of a scene unless it says otherwise: the paper's weights, but at rest at both
 ends, which a real robot needs (the paper case itself uses natural ends)."""
 
-DEFAULT_FIREFLY = FireflySettings(fireflies=30, iterations=50, alpha=0.5, stall_iterations=8)
+DEFAULT_FIREFLY = FireflySettings(fireflies=30, iterations=50, alpha=0.5, stall_iterations=4)
 """The planner's firefly: the paper's parameters (:class:`FireflySettings`'s defaults) with
 fewer fireflies, smaller random steps and an early stop, backed by
 ``scripts/study_parameters.py`` (30 scenes, 6 of them narrow passages): seeded with paths
-(:mod:`planning.seeding`), 30 fireflies stopping after 8 stalled iterations plan every scene
-in a third of the paper search's time (which misses 4 of 30). Alpha 0.5 instead of 1
-shortens the trajectories by 6 % (geometric mean) for 12 % more time; alpha 0.2 by 8 % for
-16 % more, which on 100 scenes put the median planning time 10 % above OMPL's RRT-Connect
-pipeline's (``scripts/bench_search.py``; alpha 0.5: 2 % below). 50 fireflies or no early
-stop cost more time for less."""
+(:mod:`planning.seeding`), 30 fireflies plan every scene in a fraction of the paper search's
+time (which misses 4 of 30). Alpha 0.5 instead of 1 shortens the trajectories by 6 %
+(geometric mean); smaller alphas cost more time than they give. The firefly stops after 4
+stalled iterations and hands its best to the CMA-ES refinement (``refine: cma``,
+:mod:`planning.search.refinement`), which descends further per evaluation than the
+firefly's late iterations: on 100 generated scenes (24 narrow) the pair gives 7-10 %
+shorter trajectories (geometric mean) than 8 stalled iterations and no refinement, in the
+same planning time (``scripts/bench_search.py``); in the study, the former defaults' are
+10 % longer and 4 stalled iterations without the refinement 17 % longer. 2 stalled
+iterations measured as well as 4 on the study's 30 scenes and worse on 100; 50 fireflies or
+no early stop cost more time for less."""
 
-PAPER_SEARCH: dict[str, Any] = {**dataclasses.asdict(FireflySettings()), "seeding": "none"}
+PAPER_SEARCH: dict[str, Any] = {**dataclasses.asdict(FireflySettings()), "seeding": "none", "refine": "none"}
 """The paper's search as planner-setting changes (:meth:`PlannerSettings.updated`): its firefly
 (:class:`FireflySettings`'s defaults: n = 50, 50 iterations, alpha 1, beta0 0.5, every
-iteration) from a random population. ``cpr-plan plan --paper-search`` applies them."""
+iteration) from a random population, and no refinement. ``cpr-plan plan --paper-search``
+applies them."""
 
 MAX_WAYPOINTS = 20
 """Most intermediate waypoints (the search's dimension is waypoints x moving joints)."""
@@ -136,6 +143,9 @@ class PlannerSettings:
             that is blocked, from a sampling planner's path, with more waypoints if the
             path needs them (:mod:`planning.seeding`); ``"none"`` (the paper): from a
             random population only.
+        refine: ``"cma"`` (default): once the firefly has a feasible best, a CMA-ES started
+            at it refines it within the rest of the evaluation budget
+            (:mod:`planning.search.refinement`); ``"none"`` (the paper): the firefly's best.
     """
 
     firefly: FireflySettings = DEFAULT_FIREFLY
@@ -149,6 +159,7 @@ class PlannerSettings:
     max_node_deviation: float | None = None
     moving_joints: tuple[str, ...] | None = None
     seeding: Seeding = "paths"
+    refine: Refine = "cma"
 
     def __post_init__(self) -> None:
         if not isinstance(self.firefly, FireflySettings):
@@ -158,6 +169,8 @@ class PlannerSettings:
             raise PlanningError(f"fitness = {shown(self.fitness)}; allowed: 'clearance', 'paper'")
         if self.seeding not in ("paths", "none"):
             raise PlanningError(f"seeding = {shown(self.seeding)}; allowed: 'paths', 'none'")
+        if self.refine not in ("cma", "none"):
+            raise PlanningError(f"refine = {shown(self.refine)}; allowed: 'cma', 'none'")
         if self.path not in ("spline", "ptp"):
             raise PlanningError(f"path = {shown(self.path)}; allowed: 'spline', 'ptp'")
         integer_in("seed", self.seed, 0, MAX_SEED)

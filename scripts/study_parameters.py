@@ -5,8 +5,9 @@ and with variants of the search's settings, warm (one process, kernels and robot
 and prints per variant: scenes planned, the median warm planning time, the median
 evaluations, and the durations relative to the defaults' (geometric mean of the per-scene
 ratios on the scenes both plan, and its spread). The variants change one thing at a time
-from the defaults (:data:`planning.scene.DEFAULT_FIREFLY`, ``seeding: paths``); the first
-row is the paper's search (50 fireflies, every iteration, a random population).
+from the defaults (:data:`planning.scene.DEFAULT_FIREFLY`, ``seeding: paths``, ``refine:
+cma`` with :data:`planning.search.refinement.SIGMA`); the first row is the paper's search
+(50 fireflies, every iteration, a random population, no refinement).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import dataclasses
 import statistics
 import time
 from typing import Any
+from unittest import mock
 
 import numpy as np
 
@@ -24,31 +26,38 @@ from planning.errors import NoSolutionError
 from planning.io.scene_generator import generate_scenes
 from planning.planner import plan, warm_up
 from planning.scene import Scene
+from planning.search import refinement
 
-PAPER_SEARCH = {"fireflies": 50, "stall_iterations": 0, "seeding": "none"}
+PAPER_SEARCH = {"fireflies": 50, "stall_iterations": 0, "seeding": "none", "refine": "none"}
+SIGMA = "refinement sigma"
+"""A variant's key for the refinement's initial step (a module constant, not a scene setting)."""
 VARIANTS: dict[str, dict[str, Any]] = {
     "paper's search (n = 50, no stop, no seeds)": PAPER_SEARCH,
     "defaults": {},
+    "no refinement": {"refine": "none"},
+    "no refinement, stall 8 (the former defaults)": {"refine": "none", "stall_iterations": 8},
+    "stall 2": {"stall_iterations": 2},
+    "stall 8": {"stall_iterations": 8},
+    "no early stop": {"stall_iterations": 0},
+    "refinement sigma 0.015": {SIGMA: 0.015},
+    "refinement sigma 0.06": {SIGMA: 0.06},
     "n = 20": {"fireflies": 20},
     "n = 50": {"fireflies": 50},
-    "no early stop": {"stall_iterations": 0},
-    "stall 4": {"stall_iterations": 4},
-    "stall 16": {"stall_iterations": 16},
-    "alpha 0.5": {"alpha": 0.5},
     "alpha 0.2": {"alpha": 0.2},
-    "alpha 0.1": {"alpha": 0.1},
-    "alpha 0.2, n = 50": {"alpha": 0.2, "fireflies": 50},
-    "alpha 0.2, stall 16": {"alpha": 0.2, "stall_iterations": 16},
+    "alpha 1": {"alpha": 1.0},
     "no seeds": {"seeding": "none"},
 }
 
 
 def run(scene: Scene, robot: ck.Robot, changes: dict[str, Any]) -> tuple[bool, float, float, int]:
     """Planned, warm wall time [s], duration [s] and evaluations of ``scene`` with ``changes``."""
-    changed = dataclasses.replace(scene, planner=scene.planner.updated(**changes))
+    settings = {key: value for key, value in changes.items() if key != SIGMA}
+    changed = dataclasses.replace(scene, planner=scene.planner.updated(**settings))
+    sigma = changes.get(SIGMA, refinement.SIGMA)
     started = time.perf_counter()
     try:
-        result = plan(changed, robot)
+        with mock.patch.object(refinement, "SIGMA", sigma):
+            result = plan(changed, robot)
     except NoSolutionError:
         return False, time.perf_counter() - started, float("nan"), 0
     return True, time.perf_counter() - started, result.trajectory.duration, result.optimiser.evaluations

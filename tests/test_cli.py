@@ -245,6 +245,7 @@ def test_paper_search_flag_is_the_papers_settings_written_in_the_scene(
         "theta": 0.97,
         "stall_iterations": 0,
         "seeding": "none",
+        "refine": "none",
     }
     written = write_scene(tmp_path, with_changes(planner=paper_planner), "paper_search.yaml")
     code, _, _ = run(["plan", str(written), "--out", str(tmp_path / "w")], capsys)

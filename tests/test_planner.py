@@ -190,3 +190,31 @@ def test_early_stop_and_seeds_keep_a_plan_byte_identical(robot: ck.Robot) -> Non
     )
     np.testing.assert_array_equal(first.trajectory.coefficients, second.trajectory.coefficients)
     np.testing.assert_array_equal(first.optimiser.best_history, second.optimiser.best_history)
+
+
+def test_refinement_continues_the_firefly_and_only_improves(robot: ck.Robot) -> None:
+    from planning.io.scene_generator import generate_scenes
+
+    for scene in generate_scenes(4, seed=2, robot=robot, narrow=1):
+        refined = plan(scene, robot)
+        alone = plan(dataclasses.replace(scene, planner=scene.planner.updated(refine="none")), robot)
+        assert scene.planner.refine == "cma" and refined.verification.accepted
+        # the same generator draws the firefly's moves first: the firefly's run is the same
+        firefly = alone.optimiser
+        n = len(firefly.best_history)
+        np.testing.assert_array_equal(refined.optimiser.best_history[:n], firefly.best_history)
+        assert refined.optimiser.fitness <= firefly.fitness
+        assert refined.optimiser.evaluations >= firefly.evaluations
+        assert refined.optimiser.evaluations <= scene.planner.firefly.fireflies * (
+            scene.planner.firefly.iterations + 1
+        )
+
+
+def test_the_paper_search_does_not_refine() -> None:
+    from planning.scene import PAPER_SEARCH
+
+    assert paper_scene().planner.refine == "none"
+    assert PlannerSettings().updated(**PAPER_SEARCH).refine == "none"
+    assert PlannerSettings().refine == "cma"
+    with pytest.raises(PlanningError, match="refine = 'bfgs'; allowed: 'cma', 'none'"):
+        PlannerSettings(refine="bfgs")  # type: ignore[arg-type]

@@ -89,6 +89,7 @@ def test_every_shape_and_relative_mesh_path(tmp_path: Path) -> None:
         ({"start": {"tcp": [0.5, 0.45, 0.25], "q": [0, 0, 0, 0, 0]}}, "start: give exactly one of 'tcp'"),
         ({"goal": {"q": [0, 0, 0, 0, 0], "theta4": 1.0}}, "theta4 and theta5 go with 'tcp'"),
         ({"planner": {"mode": "parallel"}}, "planner.mode = 'parallel'"),
+        ({"planner": {"refine": "bfgs"}}, "planner.refine = 'bfgs'"),
         ({"planner": {"moving_joints": ["elbow"]}}, "planner.moving_joints[0] = 'elbow'"),
         ({"spline": {"ends": "clamped"}}, "spline.ends = 'clamped'"),
         ({"duration": 0}, "duration = 0: Input should be greater than or equal to 0.01"),

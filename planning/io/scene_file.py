@@ -9,7 +9,8 @@ Defaults of the optional keys: ``robot``: the bundled CPR; ``safety_margin``: 0.
 ``duration``: none (the fastest timing within the joint limits); ``obstacles``: none;
 ``rpy``: ``[0, 0, 0]``; mesh ``scale``: 1 and ``convex``: true; ``planner``: the paper's
 firefly with 30 fireflies, alpha 0.5 and an early stop (50 iterations, beta0 0.5, gamma 1,
-theta 0.97, sweep mode, 8 stalled iterations), seeded with paths, 3 waypoints, clearance
+theta 0.97, sweep mode, 4 stalled iterations), seeded with paths, its best refined by a
+CMA-ES, 3 waypoints, clearance
 fitness, seed 0, spline path, IPO 0.012 s, 64 fitness samples, verification step 0.005 m,
 no bound on the node deviation; ``spline``: p = 1e6, a = [0, 0, 1],
 ``ends: rest``. They are read from :mod:`planning.scene`, the one place they are set.

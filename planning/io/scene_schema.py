@@ -154,6 +154,7 @@ class PlannerSpec(_Strict):
         Annotated[list[Literal["theta1", "d2", "d3", "theta4", "theta5"]], Field(max_length=5)] | None
     ) = None
     seeding: Literal["paths", "none"] = _P.seeding
+    refine: Literal["cma", "none"] = _P.refine
 
 
 class SplineSpec(_Strict):

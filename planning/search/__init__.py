@@ -1,6 +1,7 @@
 """Box-constrained batch optimisers behind one interface.
 
-The firefly algorithm (Yang 2010) and the baselines it is compared with (:mod:`.baselines`);
+The firefly algorithm (Yang 2010), the CMA-ES that refines its best (:mod:`.refinement`) and
+the baselines they are compared with (:mod:`.baselines`);
 RRT-Connect (:func:`.rrt_connect.rrt_connect`), whose paths seed the firefly.
 """
 

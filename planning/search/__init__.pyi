@@ -4,6 +4,7 @@ from . import baselines
 from .firefly import FireflyProgress, firefly_minimize
 from .firefly_settings import FireflySettings
 from .optimizer import BatchObjective, Optimizer, SearchResult
+from .refinement import cma_refine, refine_search
 from .rrt_connect import RrtPath, RrtSettings, waypoints_along
 
 __all__ = [
@@ -15,6 +16,8 @@ __all__ = [
     "RrtSettings",
     "SearchResult",
     "baselines",
+    "cma_refine",
     "firefly_minimize",
+    "refine_search",
     "waypoints_along",
 ]

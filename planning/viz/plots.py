@@ -177,17 +177,17 @@ def utilisation_figure(usage: LimitUsage, joint_names: tuple[str, ...]) -> Figur
 
 
 def convergence_figure(result: SearchResult) -> Figure:
-    """Best and mean fitness of the firefly population per iteration."""
+    """Best and mean fitness per firefly iteration, then per refinement generation (if any)."""
     figure, ax = plt.subplots(figsize=(7, 4))
     iterations = np.arange(len(result.best_history))
     ax.plot(iterations, result.best_history, label="best")
     ax.plot(iterations, result.mean_history, label="population mean", alpha=0.7)
     ax.set_yscale("log")
-    ax.set_xlabel("iteration")
+    ax.set_xlabel("firefly iteration, then CMA-ES generation")
     ax.set_ylabel("fitness")
     ax.grid(alpha=0.3, which="both")
     ax.legend()
-    ax.set_title(f"Firefly convergence ({result.evaluations} evaluations)")
+    ax.set_title(f"Search convergence ({result.evaluations} evaluations)")
     figure.tight_layout()
     return figure
 

@@ -1,0 +1,224 @@
+"""Local refinement of a search's best point: a CMA-ES started at it with a small step.
+
+The firefly explores and finds the basin; near its best point its moves are too coarse to
+descend (a sweep kicks every firefly by about ``alpha sqrt(n) / 2`` per iteration), and its
+early stop ends the search there. A covariance matrix adaptation evolution strategy
+(Hansen 2016, "The CMA Evolution Strategy: A Tutorial", default parameters) learns the
+valley's directions from a few generations and walks along them: on the planner's objectives
+the valleys run across joints (a waypoint moved in ``theta1`` wants ``d3`` moved with it),
+which an isotropic local search does not see. Measured on 100 generated scenes (24 narrow
+passages, generator seeds 0 and 1, ``scripts/bench_search.py``): after 4 stalled firefly
+iterations instead of 8, the refinement makes the trajectories 7-10 % shorter (geometric
+mean) in the same planning time. On the paper objective (``scripts/bench_peers.py``, 10
+seeds), run to the budget of 2550 evaluations, the seeded firefly and this refinement reach
+a median of 2.47, the CMA-ES peer from a random start 2.50; with the early stops, 2.82 in
+about 300 evaluations.
+
+Written here rather than taken from ``cma`` or ``cmaes``: both import ``scipy.stats``
+(0.6-0.9 s), more than a third of the 1.5 s a plan may take in a new process; the method
+itself is the textbook's, in normalised coordinates ``u in [0, 1]^d`` like the firefly.
+Samples outside the box are clipped onto it and the clipped steps enter the update
+(repair), so every evaluated point lies in the box.
+
+The refinement ends when its best value has improved by less than a relative
+:data:`~planning.search.firefly_settings.STALL_TOLERANCE` over :data:`STALL_GENERATIONS`
+generations in a row, when its step has shrunk below :data:`MIN_SIGMA`, or when the next
+generation would exceed the evaluation budget. The same generator state gives the same run.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from planning.errors import PlanningError
+from planning.search.firefly_settings import STALL_TOLERANCE
+from planning.search.optimizer import BatchObjective, SearchResult
+
+FloatArray = NDArray[np.float64]
+
+SIGMA = 0.03
+"""Initial step [share of each variable's range]: the firefly's best lies in the right basin,
+so the refinement starts local. Backed by ``scripts/study_parameters.py``."""
+STALL_GENERATIONS = 4
+"""Generations in a row without a relative improvement of ``STALL_TOLERANCE`` that end the
+refinement."""
+MIN_SIGMA = 1e-4
+"""Step below which the refinement ends [share of the range]: 1e-4 of a joint's range is
+below what the timing or the clearance can tell apart."""
+
+
+def population_size(dimension: int) -> int:
+    """CMA-ES's default population for ``dimension`` variables: ``4 + floor(3 ln d)``."""
+    return 4 + int(3 * math.log(dimension))
+
+
+def cma_refine(
+    objective: BatchObjective,
+    lower: ArrayLike,
+    upper: ArrayLike,
+    start: ArrayLike,
+    start_value: float,
+    budget: int,
+    rng: np.random.Generator,
+    sigma: float | None = None,
+    stall_generations: int | None = None,
+) -> SearchResult:
+    """Refine ``start`` (value ``start_value``) with a CMA-ES within ``budget`` evaluations.
+
+    Args:
+        objective: batch objective ``(S, d) -> (S,)``; every point passed lies in the box.
+        lower: ``(d,)`` lower bounds.
+        upper: ``(d,)`` upper bounds, each > the lower one.
+        start: ``(d,)`` point of the box to start from (the mean of the first generation).
+        start_value: its objective value (not evaluated again).
+        budget: most evaluations; fewer than one generation: no refinement.
+        rng: the generator of the samples.
+        sigma: initial step [share of each variable's range], in (0, 1]; default
+            :data:`SIGMA`.
+        stall_generations: generations in a row without a relative improvement of
+            ``STALL_TOLERANCE`` that end the refinement; 0: run out the budget (or the step);
+            default :data:`STALL_GENERATIONS`.
+
+    Returns:
+        The best of ``start`` and every evaluated point; histories per generation (entry 0:
+        the start). ``population`` and ``population_fitness`` hold the points that improved
+        on the best, newest (best) first: a caller whose own check refuses the best (it
+        went closest to a constraint) falls back along the way the refinement came.
+    """
+    lo = np.asarray(lower, dtype=float)
+    span = np.asarray(upper, dtype=float) - lo
+    x0 = np.asarray(start, dtype=float)
+    if x0.shape != lo.shape or span.shape != lo.shape or not np.all(span > 0):
+        raise PlanningError(
+            f"start of shape {x0.shape} and bounds of shapes {lo.shape}, {span.shape}; "
+            "expected (d,) each with upper > lower"
+        )
+    sigma = SIGMA if sigma is None else sigma
+    stall_generations = STALL_GENERATIONS if stall_generations is None else stall_generations
+    if not 0.0 < sigma <= 1.0:
+        raise PlanningError(f"sigma = {sigma!r} must be in (0, 1] (a share of each variable's range)")
+    d = lo.size
+    lam = population_size(d)
+    mu = lam // 2
+    weights = np.log(mu + 0.5) - np.log(np.arange(1, mu + 1))
+    weights /= weights.sum()
+    mu_eff = 1.0 / float(np.sum(weights**2))
+    c_sigma = (mu_eff + 2) / (d + mu_eff + 5)
+    d_sigma = 1 + 2 * max(0.0, math.sqrt((mu_eff - 1) / (d + 1)) - 1) + c_sigma
+    c_c = (4 + mu_eff / d) / (d + 4 + 2 * mu_eff / d)
+    c_1 = 2 / ((d + 1.3) ** 2 + mu_eff)
+    c_mu = min(1 - c_1, 2 * (mu_eff - 2 + 1 / mu_eff) / ((d + 2) ** 2 + mu_eff))
+    chi_n = math.sqrt(d) * (1 - 1 / (4 * d) + 1 / (21 * d**2))
+
+    mean = np.clip((x0 - lo) / span, 0.0, 1.0)
+    cov = np.eye(d)
+    basis, scales = np.eye(d), np.ones(d)  # cov = basis diag(scales^2) basis^T
+    p_sigma, p_c = np.zeros(d), np.zeros(d)
+    best_u, best_f = mean.copy(), float(start_value)
+    improved: list[tuple[FloatArray, float]] = []
+    best_history, mean_history, evaluation_history = [best_f], [best_f], [0]
+    evaluations, generation, stalled, reference = 0, 0, 0, best_f
+    while evaluations + lam <= budget and sigma >= MIN_SIGMA:
+        generation += 1
+        steps = rng.standard_normal((lam, d)) @ (basis * scales).T
+        population = np.clip(mean + sigma * steps, 0.0, 1.0)
+        steps = (population - mean) / sigma  # the repaired steps enter the update
+        values = np.asarray(objective(lo + population * span), dtype=float)
+        if values.shape != (lam,):
+            raise PlanningError(
+                f"objective returned shape {values.shape} for {lam} candidates; expected ({lam},)"
+            )
+        evaluations += lam
+        order = np.argsort(values, kind="stable")
+        if values[order[0]] < best_f:
+            best_u, best_f = population[order[0]].copy(), float(values[order[0]])
+            improved.append((best_u, best_f))
+        selected = steps[order[:mu]]
+        step = weights @ selected
+        mean = mean + sigma * step
+        whitened = basis @ ((basis.T @ step) / scales)  # cov^(-1/2) step
+        p_sigma = (1 - c_sigma) * p_sigma + math.sqrt(c_sigma * (2 - c_sigma) * mu_eff) * whitened
+        norm = float(np.linalg.norm(p_sigma))
+        h_sigma = norm / math.sqrt(1 - (1 - c_sigma) ** (2 * generation)) < (1.4 + 2 / (d + 1)) * chi_n
+        p_c = (1 - c_c) * p_c + h_sigma * math.sqrt(c_c * (2 - c_c) * mu_eff) * step
+        cov = (
+            (1 - c_1 - c_mu) * cov
+            + c_1 * (np.outer(p_c, p_c) + (not h_sigma) * c_c * (2 - c_c) * cov)
+            + c_mu * (selected.T * weights) @ selected
+        )
+        sigma *= math.exp(min(1.0, (c_sigma / d_sigma) * (norm / chi_n - 1)))
+        cov = (cov + cov.T) / 2
+        eigenvalues, basis = np.linalg.eigh(cov)
+        scales = np.sqrt(np.maximum(eigenvalues, 1e-20))
+        best_history.append(best_f)
+        mean_history.append(float(np.mean(values)))
+        evaluation_history.append(evaluations)
+        if best_f < reference - STALL_TOLERANCE * abs(reference):
+            stalled, reference = 0, best_f
+        else:
+            stalled += 1
+            if stalled == stall_generations:
+                break
+    return SearchResult(
+        x=lo + best_u * span,
+        fitness=best_f,
+        evaluations=evaluations,
+        best_history=np.array(best_history),
+        mean_history=np.array(mean_history),
+        evaluation_history=np.array(evaluation_history, dtype=np.int64),
+        population=lo + np.array([u for u, _ in improved[::-1]]).reshape(-1, d) * span,
+        population_fitness=np.array([f for _, f in improved[::-1]]),
+    )
+
+
+FALLBACK_SPACING = 1 / 8
+"""Least fitness between two of the refinement's points kept for the fallback, as a share of
+its whole improvement (:func:`refine_search`)."""
+
+
+def refine_search(
+    objective: BatchObjective,
+    lower: ArrayLike,
+    upper: ArrayLike,
+    searched: SearchResult,
+    budget: int,
+    rng: np.random.Generator,
+    sigma: float | None = None,
+    stall_generations: int | None = None,
+) -> SearchResult:
+    """``searched`` (a global search's result) refined by :func:`cma_refine` from its best point.
+
+    Returns one result for both phases: the refined best; ``budget`` bounds the refinement's
+    evaluations, which add to ``searched``'s; the histories run on through the refinement's
+    generations. The population is ``searched``'s with, ahead of it, some of the points that
+    improved on its best: the newest and then those at least :data:`FALLBACK_SPACING` of the
+    whole improvement apart, so that a caller whose check refuses the best (the refinement
+    goes as close to the constraints as the objective lets it) falls back to distinct,
+    less tight points before the global search's. ``sigma`` and ``stall_generations`` are
+    :func:`cma_refine`'s.
+    """
+    refined = cma_refine(
+        objective, lower, upper, searched.x, searched.fitness, budget, rng, sigma, stall_generations
+    )
+    if refined.evaluations == 0:
+        return searched
+    spacing = FALLBACK_SPACING * (searched.fitness - refined.fitness)
+    keep: list[int] = []
+    for index, value in enumerate(refined.population_fitness):  # best first
+        if not keep or value >= refined.population_fitness[keep[-1]] + spacing:
+            keep.append(index)
+    return SearchResult(
+        x=refined.x,
+        fitness=refined.fitness,
+        evaluations=searched.evaluations + refined.evaluations,
+        best_history=np.concatenate([searched.best_history, refined.best_history[1:]]),
+        mean_history=np.concatenate([searched.mean_history, refined.mean_history[1:]]),
+        evaluation_history=np.concatenate(
+            [searched.evaluation_history, searched.evaluations + refined.evaluation_history[1:]]
+        ),
+        population=np.vstack([refined.population[keep], searched.population]),
+        population_fitness=np.concatenate([refined.population_fitness[keep], searched.population_fitness]),
+    )
