@@ -178,8 +178,7 @@ def _search(
     objective, settings = problem.objective, problem.scene.planner
     rng = np.random.default_rng(settings.seed)
     if optimizer is not None:
-        budget = settings.firefly.fireflies * (settings.firefly.iterations + 1)
-        return optimizer(objective, objective.lower, objective.upper, budget, rng)
+        return optimizer(objective, objective.lower, objective.upper, settings.firefly.evaluations, rng)
     found = firefly_minimize(
         objective,
         objective.lower,
@@ -192,7 +191,7 @@ def _search(
     )
     if settings.refine == "none" or found.fitness > objective.t_max:
         return found
-    budget = settings.firefly.fireflies * (settings.firefly.iterations + 1) - found.evaluations
+    budget = settings.firefly.evaluations - found.evaluations
     return refine_search(objective, objective.lower, objective.upper, found, budget, rng)
 
 

@@ -120,7 +120,7 @@ def optimiser_table(
     """Rows of the optimiser table, each optimiser's median time ratio to ours and median fitness."""
     scene = paper_scene()
     objective = paper_objective(robot, scene)
-    budget = scene.planner.firefly.fireflies * (scene.planner.firefly.iterations + 1)
+    budget = scene.planner.firefly.evaluations
     times: dict[str, list[float]] = {}
     fitness: dict[str, list[float]] = {}
     methods = {DEFAULT_SEARCH: default_search(robot, scene), FULL_BUDGET: default_search(robot, scene, 0)}

@@ -5,7 +5,8 @@ import pytest
 
 from planning.errors import PlanningError
 from planning.search.firefly import FireflyProgress, _sweep, firefly_minimize
-from planning.search.firefly_settings import STALL_TOLERANCE, FireflySettings
+from planning.search.firefly_settings import FireflySettings
+from planning.search.optimizer import STALL_TOLERANCE
 
 
 def sphere(x: np.ndarray) -> np.ndarray:

@@ -7,7 +7,8 @@ import pytest
 
 from planning.errors import PlanningError
 from planning.search.firefly import firefly_minimize
-from planning.search.firefly_settings import STALL_TOLERANCE, FireflySettings
+from planning.search.firefly_settings import FireflySettings
+from planning.search.optimizer import STALL_TOLERANCE
 from planning.search.refinement import (
     FALLBACK_SPACING,
     STALL_GENERATIONS,

@@ -9,7 +9,7 @@ variables. A firefly ``i`` moves towards a brighter (lower objective) firefly ``
 (the paper prints eq. 2 with a sign typo and without gamma) and is clipped to the bounds.
 ``alpha`` decays geometrically, ``alpha <- theta alpha``, at the start of every iteration.
 With ``stall_iterations`` set, the search ends once that many iterations in a row have
-improved the best value by less than a relative :data:`~planning.search.firefly_settings.STALL_TOLERANCE`.
+improved the best value by less than a relative :data:`~planning.search.optimizer.STALL_TOLERANCE`.
 
 Two modes:
 
@@ -33,8 +33,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.compiled import njit
 from planning.errors import PlanningError
-from planning.search.firefly_settings import STALL_TOLERANCE, FireflySettings
-from planning.search.optimizer import BatchObjective, SearchResult
+from planning.search.firefly_settings import FireflySettings
+from planning.search.optimizer import BatchObjective, EarlyStop, SearchResult, evaluate_in_box
 
 FloatArray = NDArray[np.float64]
 
@@ -87,12 +87,7 @@ def firefly_minimize(
     n, d = settings.fireflies, lo.size
 
     def evaluate(u: FloatArray) -> FloatArray:
-        values = np.asarray(objective(lo + u * span), dtype=float)
-        if values.shape != (len(u),):
-            raise PlanningError(
-                f"objective returned shape {values.shape} for {len(u)} candidates; expected ({len(u)},)"
-            )
-        return values
+        return evaluate_in_box(objective, lo, span, u)
 
     # NiaPy draws the initial population as uniform(lower, upper) in its (here: unit) box
     u = generator.uniform(np.zeros(d), np.ones(d), (n, d))
@@ -110,7 +105,7 @@ def firefly_minimize(
     if callback is not None:
         callback(FireflyProgress(0, settings.iterations, best_f, mean_history[0], evaluations))
     alpha = settings.alpha
-    stalled, reference = 0, best_f
+    early_stop = EarlyStop(settings.stall_iterations, best_f)
     for iteration in range(1, settings.iterations + 1):
         alpha *= settings.theta
         if settings.mode == "sweep":
@@ -138,12 +133,8 @@ def firefly_minimize(
         evaluation_history.append(evaluations)
         if callback is not None:
             callback(FireflyProgress(iteration, settings.iterations, best_f, mean_history[-1], evaluations))
-        if best_f < reference - STALL_TOLERANCE * abs(reference) or best_f > stall_below:
-            stalled, reference = 0, best_f
-        else:
-            stalled += 1
-            if stalled == settings.stall_iterations:
-                break
+        if early_stop.update(best_f, counts=best_f <= stall_below):
+            break
     return SearchResult(
         x=lo + best_u * span,
         fitness=best_f,

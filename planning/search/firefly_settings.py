@@ -28,8 +28,6 @@ MAX_STEP = 10.0
 box and is clipped back, so larger values only hide a typo."""
 MAX_GAMMA = 1000.0
 """Largest light absorption: at 1000 a firefly sees no neighbour farther than 0.1."""
-STALL_TOLERANCE = 1e-3
-"""Relative improvement of the best value below which an iteration counts as stalled."""
 
 
 @dataclass(frozen=True)
@@ -46,8 +44,9 @@ class FireflySettings:
         theta: per-iteration decay of alpha, in (0, 1].
         mode: ``"sweep"`` or ``"sequential"`` (see the module docstring).
         stall_iterations: stop early once this many iterations in a row have improved the
-            best value by less than :data:`STALL_TOLERANCE` of it; 0 (default, the paper):
-            run every iteration. Deterministic: the same seed stops at the same iteration.
+            best value by less than :data:`~planning.search.optimizer.STALL_TOLERANCE` of it;
+            0 (default, the paper): run every iteration. Deterministic: the same seed stops
+            at the same iteration.
     """
 
     fireflies: int = 50
@@ -59,13 +58,17 @@ class FireflySettings:
     mode: Mode = "sweep"
     stall_iterations: int = 0
 
+    @property
+    def evaluations(self) -> int:
+        """The evaluation budget of a run to the last iteration: ``fireflies x (iterations + 1)``."""
+        return self.fireflies * (self.iterations + 1)
+
     def __post_init__(self) -> None:
         integer_in("fireflies", self.fireflies, 2, MAX_FIREFLIES)
         integer_in("iterations", self.iterations, 0, MAX_ITERATIONS)
-        evaluations = self.fireflies * (self.iterations + 1)
-        if evaluations > MAX_EVALUATIONS:
+        if self.evaluations > MAX_EVALUATIONS:
             raise PlanningError(
-                f"fireflies x (iterations + 1) = {evaluations} evaluations; at most {MAX_EVALUATIONS}: "
+                f"fireflies x (iterations + 1) = {self.evaluations} evaluations; at most {MAX_EVALUATIONS}: "
                 "lower fireflies or iterations"
             )
         number_in("alpha", self.alpha, 0.0, MAX_STEP)

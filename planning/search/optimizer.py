@@ -16,10 +16,56 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from planning.errors import PlanningError
+
 FloatArray = NDArray[np.float64]
 
 BatchObjective = Callable[[FloatArray], FloatArray]
 """Objective over a batch: ``(S, d)`` points in the problem's units -> ``(S,)`` values."""
+
+STALL_TOLERANCE = 1e-3
+"""Relative improvement of the best value below which an iteration counts as stalled."""
+
+
+def evaluate_in_box(
+    objective: BatchObjective, lower: FloatArray, span: FloatArray, u: FloatArray
+) -> FloatArray:
+    """``objective`` at the points ``lower + u span`` of the normalised ``(S, d)`` batch ``u``.
+
+    Raises:
+        PlanningError: the objective did not return ``(S,)`` values.
+    """
+    values = np.asarray(objective(lower + u * span), dtype=float)
+    if values.shape != (len(u),):
+        raise PlanningError(
+            f"objective returned shape {values.shape} for {len(u)} candidates; expected ({len(u)},)"
+        )
+    return values
+
+
+@dataclass
+class EarlyStop:
+    """The searches' early stop, deterministic: stop after ``limit`` iterations in a row.
+
+    An iteration stalls when it leaves the best value less than a relative
+    :data:`STALL_TOLERANCE` below :attr:`reference`; ``limit`` 0: never stop.
+    """
+
+    limit: int
+    reference: float
+    """The best value when the count last started."""
+    stalled: int = 0
+
+    def update(self, best: float, counts: bool = True) -> bool:
+        """Count an iteration that ended with ``best``; ``True``: stop now.
+
+        ``counts=False`` (e.g. no feasible value yet) restarts the count as an improvement does.
+        """
+        if best < self.reference - STALL_TOLERANCE * abs(self.reference) or not counts:
+            self.stalled, self.reference = 0, best
+            return False
+        self.stalled += 1
+        return self.stalled == self.limit
 
 
 @dataclass(frozen=True)

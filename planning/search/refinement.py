@@ -22,7 +22,7 @@ Samples outside the box are clipped onto it and the clipped steps enter the upda
 (repair), so every evaluated point lies in the box.
 
 The refinement ends when its best value has improved by less than a relative
-:data:`~planning.search.firefly_settings.STALL_TOLERANCE` over :data:`STALL_GENERATIONS`
+:data:`~planning.search.optimizer.STALL_TOLERANCE` over :data:`STALL_GENERATIONS`
 generations in a row, when its step has shrunk below :data:`MIN_SIGMA`, or when the next
 generation would exceed the evaluation budget. The same generator state gives the same run.
 """
@@ -35,8 +35,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from planning.errors import PlanningError
-from planning.search.firefly_settings import STALL_TOLERANCE
-from planning.search.optimizer import BatchObjective, SearchResult
+from planning.search.optimizer import BatchObjective, EarlyStop, SearchResult, evaluate_in_box
 
 FloatArray = NDArray[np.float64]
 
@@ -123,17 +122,14 @@ def cma_refine(
     best_u, best_f = mean.copy(), float(start_value)
     improved: list[tuple[FloatArray, float]] = []
     best_history, mean_history, evaluation_history = [best_f], [best_f], [0]
-    evaluations, generation, stalled, reference = 0, 0, 0, best_f
+    evaluations, generation = 0, 0
+    early_stop = EarlyStop(stall_generations, best_f)
     while evaluations + lam <= budget and sigma >= MIN_SIGMA:
         generation += 1
         steps = rng.standard_normal((lam, d)) @ (basis * scales).T
         population = np.clip(mean + sigma * steps, 0.0, 1.0)
         steps = (population - mean) / sigma  # the repaired steps enter the update
-        values = np.asarray(objective(lo + population * span), dtype=float)
-        if values.shape != (lam,):
-            raise PlanningError(
-                f"objective returned shape {values.shape} for {lam} candidates; expected ({lam},)"
-            )
+        values = evaluate_in_box(objective, lo, span, population)
         evaluations += lam
         order = np.argsort(values, kind="stable")
         if values[order[0]] < best_f:
@@ -159,12 +155,8 @@ def cma_refine(
         best_history.append(best_f)
         mean_history.append(float(np.mean(values)))
         evaluation_history.append(evaluations)
-        if best_f < reference - STALL_TOLERANCE * abs(reference):
-            stalled, reference = 0, best_f
-        else:
-            stalled += 1
-            if stalled == stall_generations:
-                break
+        if early_stop.update(best_f):
+            break
     return SearchResult(
         x=lo + best_u * span,
         fitness=best_f,
