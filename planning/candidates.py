@@ -7,6 +7,8 @@ continuous check (:mod:`planning.verification`) and the planner's node-deviation
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -15,7 +17,7 @@ from planning.curves.trajectory import Trajectory
 from planning.errors import NoTrajectoryFoundError
 from planning.problem import Problem
 from planning.search.optimizer import SearchResult
-from planning.timing import Timing, timings
+from planning.timing import NARROWED_ACCELERATION, Timing, narrowed_timing, timings
 from planning.verification import Verification, verify_trajectory
 
 FloatArray = NDArray[np.float64]
@@ -45,11 +47,19 @@ def first_verified(
     """The first candidate whose timed trajectory passes the verification.
 
     Candidates: the best, then the final population's ones the fitness found feasible (an
-    infeasible one will not pass the verification), best first. The preferred (fastest)
-    timing of each of the first :data:`PREFERRED_FIRST` is tried before any fallback: a
-    nearly as good candidate run at full speed beats the best one run at the uniform
-    timing's pace. Then each candidate's remaining timings, in order. Returns the candidate,
-    its nodes, timing, verification and how many candidates were timed.
+    infeasible one will not pass the verification), best first. In order:
+
+    1. the preferred (fastest) timing of each of the first :data:`PREFERRED_FIRST`: a nearly
+       as good candidate run at full speed beats the best one run at the uniform timing's
+       pace;
+    2. their narrowed timings (:func:`~planning.timing.narrowed_timing`), one share of
+       :data:`~planning.timing.NARROWED_ACCELERATION` after the other (each computed only
+       when the previous share failed), each share's shortest first, whichever candidate
+       they time;
+    3. their other timings (the uniform ones), shortest first;
+    4. each further candidate's timings, in order.
+
+    Returns the candidate, its nodes, timing, verification and how many candidates were timed.
 
     Raises:
         NoTrajectoryFoundError: none passes.
@@ -59,20 +69,34 @@ def first_verified(
     feasible = result.population_fitness <= objective.t_max  # both fitnesses rank feasible at or below t_max
     candidates = [result.x] + [result.population[k] for k in order if feasible[k]]
     timed: list[list[Timing]] = []
-    attempts = [(k, 0) for k in range(min(PREFERRED_FIRST, len(candidates)))]
-    attempts += [(k, 1) for k in range(min(PREFERRED_FIRST, len(candidates)))]
-    attempts += [(k, m) for k in range(PREFERRED_FIRST, len(candidates)) for m in (0, 1)]
-    first: Verification | None = None
-    for k, m in attempts:
+
+    def offered(k: int) -> list[Timing]:
         while len(timed) <= k:
             timed.append(timings(problem, objective.nodes(candidates[len(timed)][None])[0]))
-        if m >= len(timed[k]):
-            continue  # a fixed duration has one timing
-        verification = verify(problem, timed[k][m].trajectory, timed[k][m].fit)
+        return timed[k]
+
+    def shortest_first(pairs: list[tuple[int, Timing | None]]) -> list[tuple[int, Timing]]:
+        found = [(k, timing) for k, timing in pairs if timing is not None]
+        return sorted(found, key=lambda pair: pair[1].trajectory.duration)  # stable
+
+    def attempts() -> Iterator[tuple[int, Timing]]:
+        preferred = list(range(min(PREFERRED_FIRST, len(candidates))))
+        yield from ((k, offered(k)[0]) for k in preferred)
+        narrowing = preferred
+        for share in NARROWED_ACCELERATION:  # share by share: a path that passes costs no lower share
+            found = shortest_first([(k, narrowed_timing(problem, offered(k), share)) for k in narrowing])
+            yield from found
+            narrowing = [k for k, _ in found]  # a lower share is slower still
+        yield from shortest_first([(k, timing) for k in preferred for timing in offered(k)[1:]])
+        yield from ((k, timing) for k in range(PREFERRED_FIRST, len(candidates)) for timing in offered(k))
+
+    first: Verification | None = None
+    for k, timing in attempts():
+        verification = verify(problem, timing.trajectory, timing.fit)
         first = first or verification
         if verification.accepted:
             x = candidates[k]
-            return x, objective.nodes(x[None])[0], timed[k][m], verification, len(timed)
+            return x, objective.nodes(x[None])[0], timing, verification, len(timed)
     assert first is not None  # candidates is never empty
     raise NoTrajectoryFoundError(
         f"no collision-free trajectory found: the best candidate {'; '.join(first.problems)} "

@@ -46,8 +46,8 @@ class Metrics:
         evaluations: objective evaluations.
         candidates_verified: candidates that went through the final verification.
         duration_stretched: the requested duration broke a limit and was stretched.
-        timing: how the trajectory was timed: ``fixed`` (the scene's duration), ``fastest``
-            or ``uniform`` (see :mod:`planning.timing`).
+        timing: how the trajectory was timed: ``fixed`` (the scene's duration), ``fastest``,
+            ``narrowed`` or ``uniform`` (see :mod:`planning.timing`).
         timing_time_s: wall time of that timing [s].
     """
 

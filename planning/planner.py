@@ -94,10 +94,11 @@ def solve(
     spline through start, waypoints and goal on ``p + 1`` uniform segments; timing
     (:mod:`planning.timing`: the scene's duration, stretched if it breaks a velocity,
     acceleration or jerk limit; or, with the duration free, as fast as the limits allow
-    along the path, its uniform timing as the fallback); certified continuous verification
-    of the whole trajectory against the margin. If the best candidate fails the
-    verification, the refinement's earlier points and the final population's other
-    feasible candidates are tried in order of fitness.
+    along the path, with narrowed and uniform timings as the fallbacks); certified
+    continuous verification of the whole trajectory against the margin. If the best
+    candidate fails the verification, the refinement's earlier points and the final
+    population's other feasible candidates are tried
+    (:func:`~planning.candidates.first_verified` says in which order).
 
     Args:
         problem: from :func:`~planning.problem.build_problem`.

@@ -11,7 +11,9 @@ Issue 17's benchmark, one run, side by side. On ``--scenes`` seeded scenes of wh
 
 the two alternating scene by scene, so that the machine's drift hits both alike. It prints
 success per class, the scenes OMPL solves and we do not, the median warm planning time of
-each and their ratio, the median duration on the scenes both solve, and, with ``--cli-runs``,
+each and their ratio, the median duration on the scenes both solve (beside the median of
+Ruckig's jerk-limited bound on them, which no jerk-limited planner's median can go below),
+and, with ``--cli-runs``,
 the wall time of ``cpr-plan plan`` on one scene as a user runs it (a new process each time,
 kernels cached on disk). Targets (issue 17): success >= OMPL's on each class, warm time
 ratio <= 1, ``cpr-plan plan`` <= 1.5 s. Needs the ``bench`` extra.
@@ -35,7 +37,9 @@ from planning.errors import NoSolutionError
 from planning.io.scene_file import dump_scene
 from planning.io.scene_generator import generate_scenes
 from planning.peers.ompl_rrt import plan_rrt_connect
+from planning.peers.ruckig_bound import ruckig_duration
 from planning.planner import plan, warm_up
+from planning.problem import build_problem
 from planning.scene import Scene
 
 CLI_TARGET_S = 1.5
@@ -57,6 +61,16 @@ def theirs(scene: Scene, robot: ck.Robot, budget_s: float) -> tuple[bool, float,
     started = time.perf_counter()
     result = plan_rrt_connect(scene, robot, budget_s, scene.planner.seed)
     return result.success, time.perf_counter() - started, result.duration
+
+
+def free_space_bound(scene: Scene, robot: ck.Robot) -> float:
+    """Ruckig's time-optimal jerk-limited duration from start to goal with no obstacle [s].
+
+    No jerk-limited trajectory of the scene is shorter, so no median of them is below theirs.
+    """
+    problem, limits = build_problem(scene, robot), robot.limits
+    q_start, q_goal = problem.q_start, problem.q_goal
+    return ruckig_duration(q_start, q_goal, limits.velocity, limits.acceleration, limits.jerk)
 
 
 def cli_wall_times(scene: Scene, runs: int) -> list[float]:
@@ -124,12 +138,21 @@ def main() -> None:
         f"\nwarm planning time, median over {len(rows)} scenes: ours {our_time:.3f} s, OMPL pipeline "
         f"{their_time:.3f} s, ratio {our_time / their_time:.2f} (target <= 1)"
     )
-    both = [(mine[2], peer[2]) for *_, mine, peer in rows if mine[0] and peer[0]]
+    both = [
+        (scene, mine[2], peer[2])
+        for scene, (_, _, mine, peer) in zip(scenes, rows, strict=True)
+        if mine[0] and peer[0]
+    ]
     if both:
-        mine_d, peer_d = np.median([b[0] for b in both]), np.median([b[1] for b in both])
+        mine_d, peer_d = np.median([b[1] for b in both]), np.median([b[2] for b in both])
+        bounds = [free_space_bound(scene, robot) for scene, *_ in both]
+        bound_d = np.median(bounds)
+        beaten = sum(b[2] < bound for b, bound in zip(both, bounds, strict=True))
         print(
             f"duration on the {len(both)} scenes both solve, median: ours {mine_d:.3f} s (jerk-limited), "
-            f"OMPL + TOPP-RA {peer_d:.3f} s (jerk unbounded), ratio {mine_d / peer_d:.3f}"
+            f"OMPL + TOPP-RA {peer_d:.3f} s (jerk unbounded), ratio {mine_d / peer_d:.3f}\n"
+            f"  Ruckig's jerk-limited bound there, median: {bound_d:.3f} s (ratio to OMPL + TOPP-RA "
+            f"{bound_d / peer_d:.3f}); OMPL + TOPP-RA beats the bound on {beaten} of {len(both)} scenes"
         )
     if args.cli_runs:
         times = cli_wall_times(scenes[0], args.cli_runs)

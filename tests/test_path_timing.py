@@ -8,6 +8,7 @@ from planning.curves.path_timing import NODE_STEP_S, time_path
 from planning.curves.spline import SepticSplineSolver, uniform_knots
 from planning.curves.spline_settings import SplineSettings
 from planning.curves.trajectory import Trajectory
+from planning.peers.ruckig_bound import ruckig_duration
 
 from .conftest import PAPER_GOAL_TCP, PAPER_START_TCP
 
@@ -32,17 +33,6 @@ def usage(trajectory: Trajectory, limits: tuple[np.ndarray, ...]) -> list[float]
     return [float(np.max(trajectory.extrema(r).peak / limits[r - 1])) for r in (1, 2, 3)]
 
 
-def ruckig_duration(q0: np.ndarray, q1: np.ndarray, limits: tuple[np.ndarray, ...]) -> float:
-    ruckig = pytest.importorskip("ruckig")
-    n = len(q0)
-    request = ruckig.InputParameter(n)
-    request.current_position, request.target_position = list(q0), list(q1)
-    request.max_velocity, request.max_acceleration, request.max_jerk = (list(x) for x in limits)
-    trajectory = ruckig.Trajectory(n)
-    assert ruckig.Ruckig(n).calculate(request, trajectory) == ruckig.Result.Working
-    return float(trajectory.duration)
-
-
 @pytest.fixture(scope="module")
 def lines(robot: ck.Robot) -> list[tuple[np.ndarray, np.ndarray]]:
     rng = np.random.default_rng(11)
@@ -62,7 +52,7 @@ def test_a_straight_line_comes_within_ten_percent_of_ruckigs_optimum(
     ratios = []
     for q0, q1 in lines:
         trajectory = time_path(spline_path(np.linspace(q0, q1, 5)), *limits)
-        optimum = ruckig_duration(q0, q1, limits)  # time-optimal and jerk-limited: a lower bound
+        optimum = ruckig_duration(q0, q1, *limits)  # time-optimal and jerk-limited: a lower bound
         assert trajectory.duration >= optimum * (1 - 1e-6)
         ratios.append(trajectory.duration / optimum)
     assert np.median(ratios) <= 1.06 and max(ratios) <= 1.15

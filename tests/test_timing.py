@@ -7,12 +7,13 @@ import pytest
 
 import cpr_kin as ck
 from planning import build_problem
+from planning.candidates import verify
 from planning.errors import NoSolutionError, PlanningError
 from planning.io.bundled import paper_scene
 from planning.io.scene_generator import generate_scenes
 from planning.io.trajectory_io import trajectory_document
 from planning.planner import PlanResult, plan, solve
-from planning.timing import timings, uniform_scale
+from planning.timing import NARROWED_ACCELERATION, narrowed_timings, timings, uniform_scale
 
 
 @pytest.fixture(scope="module")
@@ -73,6 +74,49 @@ def test_timings_are_offered_fastest_first(robot: ck.Robot, free_results: list[P
     fixed = build_problem(paper_scene(0), robot)
     (only,) = timings(fixed, solve(fixed).waypoints)
     assert only.method == "fixed" and only.trajectory.duration == pytest.approx(4.0)
+
+
+def test_narrowed_timings_meet_the_lowered_acceleration_and_beat_the_uniform_one(
+    robot: ck.Robot, free_results: list[PlanResult]
+) -> None:
+    limits = robot.limits
+    result = free_results[0]
+    offered = timings(result.problem, result.waypoints)
+    uniform = next(t for t in offered if t.method == "uniform").trajectory
+    narrowed = narrowed_timings(result.problem, offered)
+    assert narrowed, "a share of 0.7 costs well under the uniform timing's 15-35 %"
+    durations = [timing.trajectory.duration for timing in narrowed]
+    assert durations == sorted(durations) and durations[-1] < uniform.duration
+    for share, timing in zip(NARROWED_ACCELERATION, narrowed, strict=False):
+        trajectory = timing.trajectory
+        assert timing.method == "narrowed" and timing.fit is offered[0].fit
+        used = [
+            float(np.max(trajectory.extrema(r).peak / limit))
+            for r, limit in enumerate((limits.velocity, share * limits.acceleration, limits.jerk), start=1)
+        ]
+        assert max(used) == pytest.approx(1.0, abs=1e-9) and all(u <= 1.0 + 1e-9 for u in used)
+        np.testing.assert_allclose(
+            trajectory(trajectory.knots[[0, -1]]), [result.problem.q_start, result.problem.q_goal], atol=1e-12
+        )
+    fixed = build_problem(paper_scene(0), robot)
+    assert narrowed_timings(fixed, timings(fixed, solve(fixed).waypoints)) == []
+
+
+def test_a_path_whose_fastest_timing_cuts_into_the_margin_runs_narrowed(robot: ck.Robot) -> None:
+    """Generated scene 30 (seed 0): the fastest timings of the three best candidates come within
+    0.046-0.047 m of an obstacle (margin 0.05 m); a narrowed one passes, 25 % shorter than the
+    uniform timing the planner fell back to before."""
+    scene = generate_scenes(31, 0, robot)[30]
+    result = plan(scene, robot)
+    uniform = result.spline.trajectory.time_scaled(uniform_scale(result.spline, result.problem))
+    assert result.metrics.timing == "narrowed" and result.verification.accepted
+    fastest = timings(result.problem, result.waypoints)[0]
+    assert fastest.method == "fastest"
+    assert not verify(result.problem, fastest.trajectory, fastest.fit).accepted
+    assert result.metrics.min_clearance_m >= scene.safety_margin
+    assert result.trajectory.duration < 0.8 * uniform.duration
+    jump, relative = result.trajectory.knot_jumps(4)
+    assert np.all((relative < 1e-7) | (jump < 1e-7))
 
 
 def test_the_search_ranks_candidates_by_a_bound_tight_to_the_executed_duration(

@@ -1,4 +1,7 @@
-"""Peer planners for the benchmarks: OMPL's and pyroboplan's RRT-Connect with TOPP-RA timing.
+"""Peers for the benchmarks: RRT-Connect pipelines and Ruckig's jerk-limited bound.
+
+OMPL's and pyroboplan's RRT-Connect with TOPP-RA timing; Ruckig's time-optimal jerk-limited
+duration, the lower bound of the timing benchmarks.
 
 Optional (``pip install '.[bench]'``); the core never imports this package.
 """

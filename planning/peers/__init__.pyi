@@ -2,6 +2,7 @@
 
 from .ompl_rrt import plan_rrt_connect
 from .pyroboplan_rrt import plan_pyroboplan_rrt_connect, shortcut_path
+from .ruckig_bound import ruckig_duration
 from .toppra_timing import SamplingResult, planning_clearance_m, time_and_verify
 
 __all__ = [
@@ -9,6 +10,7 @@ __all__ = [
     "plan_pyroboplan_rrt_connect",
     "plan_rrt_connect",
     "planning_clearance_m",
+    "ruckig_duration",
     "shortcut_path",
     "time_and_verify",
 ]
