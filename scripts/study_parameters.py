@@ -6,8 +6,9 @@ and prints per variant: scenes planned, the median warm planning time, the media
 evaluations, and the durations relative to the defaults' (geometric mean of the per-scene
 ratios on the scenes both plan, and its spread). The variants change one thing at a time
 from the defaults (:data:`planning.scene.DEFAULT_FIREFLY`, ``seeding: paths``, ``refine:
-cma`` with :data:`planning.search.refinement.SIGMA`); the first row is the paper's search
-(50 fireflies, every iteration, a random population, no refinement).
+cma`` with :data:`planning.search.refinement.SIGMA` and ``STALL_GENERATIONS``); the first
+row is the paper's search (50 fireflies, every iteration, a random population, no
+refinement).
 """
 
 from __future__ import annotations
@@ -31,6 +32,10 @@ from planning.search import refinement
 PAPER_SEARCH = {"fireflies": 50, "stall_iterations": 0, "seeding": "none", "refine": "none"}
 SIGMA = "refinement sigma"
 """A variant's key for the refinement's initial step (a module constant, not a scene setting)."""
+STALL = "refinement stall"
+"""A variant's key for the refinement's stalled generations (a module constant likewise)."""
+CONSTANTS = {SIGMA: "SIGMA", STALL: "STALL_GENERATIONS"}
+"""Variant keys that patch a constant of :mod:`planning.search.refinement`, and its name."""
 VARIANTS: dict[str, dict[str, Any]] = {
     "paper's search (n = 50, no stop, no seeds)": PAPER_SEARCH,
     "defaults": {},
@@ -41,6 +46,8 @@ VARIANTS: dict[str, dict[str, Any]] = {
     "no early stop": {"stall_iterations": 0},
     "refinement sigma 0.015": {SIGMA: 0.015},
     "refinement sigma 0.06": {SIGMA: 0.06},
+    "refinement stall 8": {STALL: 8},
+    "refinement stall 20": {STALL: 20},
     "n = 20": {"fireflies": 20},
     "n = 50": {"fireflies": 50},
     "alpha 0.2": {"alpha": 0.2},
@@ -51,12 +58,12 @@ VARIANTS: dict[str, dict[str, Any]] = {
 
 def run(scene: Scene, robot: ck.Robot, changes: dict[str, Any]) -> tuple[bool, float, float, int]:
     """Planned, warm wall time [s], duration [s] and evaluations of ``scene`` with ``changes``."""
-    settings = {key: value for key, value in changes.items() if key != SIGMA}
+    settings = {key: value for key, value in changes.items() if key not in CONSTANTS}
     changed = dataclasses.replace(scene, planner=scene.planner.updated(**settings))
-    sigma = changes.get(SIGMA, refinement.SIGMA)
+    constants = {name: changes.get(key, getattr(refinement, name)) for key, name in CONSTANTS.items()}
     started = time.perf_counter()
     try:
-        with mock.patch.object(refinement, "SIGMA", sigma):
+        with mock.patch.multiple(refinement, **constants):
             result = plan(changed, robot)
     except NoSolutionError:
         return False, time.perf_counter() - started, float("nan"), 0
