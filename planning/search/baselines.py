@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 from planning.search.firefly import firefly_minimize
 from planning.search.firefly_settings import FireflySettings
-from planning.search.optimizer import BatchObjective, Optimizer, SearchResult
+from planning.search.optimizer import BatchObjective, History, Optimizer, SearchResult
 
 FloatArray = NDArray[np.float64]
 
@@ -37,9 +37,7 @@ class _Tracker:
         self.evaluations = 0
         self.best_u: FloatArray = np.full(lower.size, 0.5)
         self.best_f = np.inf
-        self.best_history: list[float] = []
-        self.mean_history: list[float] = []
-        self.evaluation_history: list[int] = []
+        self.history = History()
 
     @property
     def left(self) -> int:
@@ -54,21 +52,12 @@ class _Tracker:
         k = int(np.argmin(f))
         if f[k] < self.best_f:
             self.best_u, self.best_f = u[k].copy(), float(f[k])
-        self.best_history.append(self.best_f)
-        self.mean_history.append(float(np.mean(f)))
-        self.evaluation_history.append(self.evaluations)
+        self.history.record(self.best_f, float(np.mean(f)), self.evaluations)
         return f
 
     def result(self, population: FloatArray, fitness: FloatArray) -> SearchResult:
-        return SearchResult(
-            x=self.lower + self.best_u * self.span,
-            fitness=self.best_f,
-            evaluations=self.evaluations,
-            best_history=np.array(self.best_history),
-            mean_history=np.array(self.mean_history),
-            evaluation_history=np.array(self.evaluation_history, dtype=np.int64),
-            population=self.lower + np.atleast_2d(population) * self.span,
-            population_fitness=np.asarray(fitness, dtype=float),
+        return self.history.result(
+            self.lower, self.span, self.best_u, self.best_f, np.atleast_2d(population), fitness
         )
 
 

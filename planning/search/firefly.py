@@ -34,7 +34,7 @@ from numpy.typing import ArrayLike, NDArray
 from cpr_kin.compiled import njit
 from planning.errors import PlanningError
 from planning.search.firefly_settings import FireflySettings
-from planning.search.optimizer import BatchObjective, EarlyStop, SearchResult, evaluate_in_box
+from planning.search.optimizer import BatchObjective, EarlyStop, History, SearchResult, evaluate_in_box
 
 FloatArray = NDArray[np.float64]
 
@@ -101,9 +101,10 @@ def firefly_minimize(
     f = evaluate(u)
     best_u, best_f = u[int(np.argmin(f))].copy(), float(np.min(f))
     evaluations = n
-    best_history, mean_history, evaluation_history = [best_f], [float(np.mean(f))], [evaluations]
+    history = History()
+    history.record(best_f, float(np.mean(f)), evaluations)
     if callback is not None:
-        callback(FireflyProgress(0, settings.iterations, best_f, mean_history[0], evaluations))
+        callback(FireflyProgress(0, settings.iterations, best_f, history.mean[0], evaluations))
     alpha = settings.alpha
     early_stop = EarlyStop(settings.stall_iterations, best_f)
     for iteration in range(1, settings.iterations + 1):
@@ -128,23 +129,12 @@ def firefly_minimize(
                         evaluations += 1
                         if f[i] <= best_f:
                             best_u, best_f = u[i].copy(), float(f[i])
-        best_history.append(best_f)
-        mean_history.append(float(np.mean(f)))
-        evaluation_history.append(evaluations)
+        history.record(best_f, float(np.mean(f)), evaluations)
         if callback is not None:
-            callback(FireflyProgress(iteration, settings.iterations, best_f, mean_history[-1], evaluations))
+            callback(FireflyProgress(iteration, settings.iterations, best_f, history.mean[-1], evaluations))
         if early_stop.update(best_f, counts=best_f <= stall_below):
             break
-    return SearchResult(
-        x=lo + best_u * span,
-        fitness=best_f,
-        evaluations=evaluations,
-        best_history=np.array(best_history),
-        mean_history=np.array(mean_history),
-        evaluation_history=np.array(evaluation_history, dtype=np.int64),
-        population=lo + u * span,
-        population_fitness=f.copy(),
-    )
+    return history.result(lo, span, best_u, best_f, u, f.copy())
 
 
 def _sweep(

@@ -10,7 +10,7 @@ one objective and one budget.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
@@ -91,6 +91,50 @@ class SearchResult:
     evaluation_history: NDArray[np.int64]
     population: FloatArray
     population_fitness: FloatArray
+
+
+@dataclass
+class History:
+    """A search's record after each iteration (or batch), in the unit box ``[0, 1]^d``.
+
+    One entry per :meth:`record`: the best value so far, the mean of the values just
+    evaluated, and the evaluations so far; :meth:`result` turns it into a
+    :class:`SearchResult` in the problem's units.
+    """
+
+    best: list[float] = field(default_factory=list)
+    mean: list[float] = field(default_factory=list)
+    evaluations: list[int] = field(default_factory=list)
+
+    def record(self, best: float, mean: float, evaluations: int) -> None:
+        """Append one iteration's best value, mean value and evaluations so far."""
+        self.best.append(best)
+        self.mean.append(mean)
+        self.evaluations.append(evaluations)
+
+    def result(
+        self,
+        lower: FloatArray,
+        span: FloatArray,
+        best_u: FloatArray,
+        best_f: float,
+        population_u: FloatArray,
+        population_f: FloatArray,
+    ) -> SearchResult:
+        """The search's result: best point ``lower + best_u span``, the final population likewise.
+
+        Its evaluations are the last recorded count (0 if nothing was recorded).
+        """
+        return SearchResult(
+            x=lower + best_u * span,
+            fitness=best_f,
+            evaluations=self.evaluations[-1] if self.evaluations else 0,
+            best_history=np.array(self.best),
+            mean_history=np.array(self.mean),
+            evaluation_history=np.array(self.evaluations, dtype=np.int64),
+            population=lower + population_u * span,
+            population_fitness=np.asarray(population_f, dtype=float),
+        )
 
 
 class Optimizer(Protocol):

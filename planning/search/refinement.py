@@ -35,7 +35,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from planning.errors import PlanningError
-from planning.search.optimizer import BatchObjective, EarlyStop, SearchResult, evaluate_in_box
+from planning.search.optimizer import BatchObjective, EarlyStop, History, SearchResult, evaluate_in_box
 
 FloatArray = NDArray[np.float64]
 
@@ -125,7 +125,8 @@ def cma_refine(
     p_sigma, p_c = np.zeros(d), np.zeros(d)
     best_u, best_f = mean.copy(), float(start_value)
     improved: list[tuple[FloatArray, float]] = []
-    best_history, mean_history, evaluation_history = [best_f], [best_f], [0]
+    history = History()
+    history.record(best_f, best_f, 0)
     evaluations, generation = 0, 0
     early_stop = EarlyStop(stall_generations, best_f)
     while evaluations + lam <= budget and sigma >= MIN_SIGMA:
@@ -156,21 +157,12 @@ def cma_refine(
         cov = (cov + cov.T) / 2
         eigenvalues, basis = np.linalg.eigh(cov)
         scales = np.sqrt(np.maximum(eigenvalues, 1e-20))
-        best_history.append(best_f)
-        mean_history.append(float(np.mean(values)))
-        evaluation_history.append(evaluations)
+        history.record(best_f, float(np.mean(values)), evaluations)
         if early_stop.update(best_f):
             break
-    return SearchResult(
-        x=lo + best_u * span,
-        fitness=best_f,
-        evaluations=evaluations,
-        best_history=np.array(best_history),
-        mean_history=np.array(mean_history),
-        evaluation_history=np.array(evaluation_history, dtype=np.int64),
-        population=lo + np.array([u for u, _ in improved[::-1]]).reshape(-1, d) * span,
-        population_fitness=np.array([f for _, f in improved[::-1]]),
-    )
+    newest_first = improved[::-1]
+    population = np.array([u for u, _ in newest_first]).reshape(-1, d)
+    return history.result(lo, span, best_u, best_f, population, np.array([f for _, f in newest_first]))
 
 
 FALLBACK_SPACING = 1 / 8
