@@ -5,8 +5,9 @@ and with variants of the search's settings, warm (one process, kernels and robot
 and prints per variant: scenes planned, the median warm planning time, the median
 evaluations, and the durations relative to the defaults' (geometric mean of the per-scene
 ratios on the scenes both plan, and its spread). The variants change one thing at a time
-from the defaults (:data:`planning.scene.DEFAULT_FIREFLY`, ``seeding: paths``, ``refine:
-cma`` with :data:`planning.search.refinement.SIGMA` and ``STALL_GENERATIONS``); the first
+from the defaults (:data:`planning.scene.DEFAULT_FIREFLY`, ``seeding: paths`` with
+:data:`planning.seeding.PATH_ATTEMPTS`, ``refine: cma`` with
+:data:`planning.search.refinement.SIGMA` and ``STALL_GENERATIONS``); the first
 row is the paper's search (50 fireflies, every iteration, a random population, no
 refinement).
 """
@@ -14,6 +15,7 @@ refinement).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import statistics
 import time
@@ -23,6 +25,7 @@ from unittest import mock
 import numpy as np
 
 import cpr_kin as ck
+from planning import seeding
 from planning.errors import NoSolutionError
 from planning.io.scene_generator import generate_scenes
 from planning.planner import plan, warm_up
@@ -34,8 +37,14 @@ SIGMA = "refinement sigma"
 """A variant's key for the refinement's initial step (a module constant, not a scene setting)."""
 STALL = "refinement stall"
 """A variant's key for the refinement's stalled generations (a module constant likewise)."""
-CONSTANTS = {SIGMA: "SIGMA", STALL: "STALL_GENERATIONS"}
-"""Variant keys that patch a constant of :mod:`planning.search.refinement`, and its name."""
+PATHS = "path attempts"
+"""A variant's key for the seeding's most RRT-Connect paths (a module constant likewise)."""
+CONSTANTS: dict[str, tuple[Any, str]] = {
+    SIGMA: (refinement, "SIGMA"),
+    STALL: (refinement, "STALL_GENERATIONS"),
+    PATHS: (seeding, "PATH_ATTEMPTS"),
+}
+"""Variant keys that patch a module constant: the module and the constant's name."""
 VARIANTS: dict[str, dict[str, Any]] = {
     "paper's search (n = 50, no stop, no seeds)": PAPER_SEARCH,
     "defaults": {},
@@ -48,6 +57,9 @@ VARIANTS: dict[str, dict[str, Any]] = {
     "refinement sigma 0.06": {SIGMA: 0.06},
     "refinement stall 8": {STALL: 8},
     "refinement stall 20": {STALL: 20},
+    "1 path attempt": {PATHS: 1},
+    "2 path attempts": {PATHS: 2},
+    "5 path attempts": {PATHS: 5},
     "n = 20": {"fireflies": 20},
     "n = 50": {"fireflies": 50},
     "alpha 0.2": {"alpha": 0.2},
@@ -60,10 +72,13 @@ def run(scene: Scene, robot: ck.Robot, changes: dict[str, Any]) -> tuple[bool, f
     """Planned, warm wall time [s], duration [s] and evaluations of ``scene`` with ``changes``."""
     settings = {key: value for key, value in changes.items() if key not in CONSTANTS}
     changed = dataclasses.replace(scene, planner=scene.planner.updated(**settings))
-    constants = {name: changes.get(key, getattr(refinement, name)) for key, name in CONSTANTS.items()}
     started = time.perf_counter()
     try:
-        with mock.patch.multiple(refinement, **constants):
+        with contextlib.ExitStack() as patches:
+            for key, value in changes.items():
+                if key in CONSTANTS:
+                    module, name = CONSTANTS[key]
+                    patches.enter_context(mock.patch.object(module, name, value))
             result = plan(changed, robot)
     except NoSolutionError:
         return False, time.perf_counter() - started, float("nan"), 0

@@ -3,15 +3,18 @@
 from __future__ import annotations
 
 import dataclasses
+from unittest import mock
 
 import numpy as np
 import pytest
 
 import cpr_kin as ck
+from planning import seeding
 from planning.io.narrow_passages import narrow_scene
 from planning.problem import Problem, build_problem
 from planning.scene import PlannerSettings, Scene, Target
-from planning.seeding import SEED_SHARE, sampled_path, seed_search
+from planning.search.rrt_connect import waypoints_along
+from planning.seeding import PATH_ATTEMPTS, SEED_SHARE, sampled_path, seed_search
 
 
 @pytest.fixture(scope="module")
@@ -70,6 +73,40 @@ def test_same_seed_same_seeds_and_the_sampler_has_its_own_stream(window: Problem
     path = sampled_path(window, np.random.default_rng([window.scene.planner.seed, 1]))
     assert path is not None
     np.testing.assert_array_equal(path.path, a.path)
+
+
+def drawn_paths(problem: Problem) -> list[tuple[np.ndarray, float]]:
+    """The paths the seeding may draw, in order, each with the fitness of its waypoints' seed."""
+    rng = np.random.default_rng([problem.scene.planner.seed, 1])
+    weights = ck.motion_radii(problem.robot)[problem.moving]
+    drawn = []
+    for _ in range(PATH_ATTEMPTS):
+        found = sampled_path(problem, rng)
+        assert found is not None
+        seed = waypoints_along(found.path, problem.scene.planner.waypoints, weights).ravel()
+        drawn.append((found.path, float(problem.objective(seed[None])[0])))
+    return drawn
+
+
+def test_a_path_whose_spline_violates_the_clearance_is_drawn_again(robot: ck.Robot) -> None:
+    """A beam: the spline through the first path's waypoints cuts into the margin, the second's not."""
+    problem = build_problem(narrow_scene(np.random.default_rng(6), robot, "beam"), robot)
+    drawn = drawn_paths(problem)
+    (first, first_fitness), (second, second_fitness) = drawn[:2]
+    assert first_fitness > problem.objective.t_max >= second_fitness
+    seeds = seed_search(problem)
+    np.testing.assert_array_equal(seeds.path, second)
+    assert seeds.problem is problem  # a feasible seed with the scene's waypoints: no more needed
+    with mock.patch.object(seeding, "PATH_ATTEMPTS", 1):  # one attempt keeps the first path
+        np.testing.assert_array_equal(seed_search(problem).path, first)
+
+
+def test_when_no_path_seed_is_feasible_the_best_ranked_is_kept(robot: ck.Robot) -> None:
+    problem = build_problem(narrow_scene(np.random.default_rng(3), robot, "pillars"), robot)
+    drawn = drawn_paths(problem)
+    fitness = [value for _, value in drawn]
+    assert min(fitness) > problem.objective.t_max and int(np.argmin(fitness)) > 0
+    np.testing.assert_array_equal(seed_search(problem).path, drawn[int(np.argmin(fitness))][0])
 
 
 def test_seeding_none_is_a_setting(robot: ck.Robot) -> None:
