@@ -66,6 +66,10 @@ def number_in(
 
 MAX_PROBLEMS = 3
 """Most problems one message lists (the rest are counted)."""
+MAX_PROBLEM_CHARS = 200
+"""Most characters of the problems one message lists: a further problem that would pass it
+is counted instead (the first is always listed), so that a message stays one short line
+whatever the values."""
 
 Location = tuple[int | str, ...]
 
@@ -93,6 +97,8 @@ def describe_validation(
     tag: tuple[str, Sequence[str]] | None = None,
 ) -> str:
     """One line naming the first :data:`MAX_PROBLEMS` problems of a pydantic validation.
+
+    Fewer when they would take more than :data:`MAX_PROBLEM_CHARS`; the others are counted.
 
     Args:
         error: the validation error.
@@ -122,5 +128,10 @@ def describe_validation(
                 problems.append(f"{where}: {message}")
             else:
                 problems.append(f"{where} = {shown(value)}: {message}")
-    more = len(problems) - MAX_PROBLEMS
-    return "; ".join(problems[:MAX_PROBLEMS]) + (f"; and {more} more" if more > 0 else "")
+    listed = problems[:1]
+    for problem in problems[1:MAX_PROBLEMS]:
+        if len("; ".join([*listed, problem])) > MAX_PROBLEM_CHARS:
+            break
+        listed.append(problem)
+    more = len(problems) - len(listed)
+    return "; ".join(listed) + (f"; and {more} more" if more > 0 else "")

@@ -72,6 +72,16 @@ def test_a_malformed_document_is_refused_naming_the_place(
     assert message in str(info.value) and len(str(info.value)) < 300
 
 
+def test_long_values_in_many_places_keep_the_message_one_short_line(document: dict[str, Any]) -> None:
+    """Hypothesis found it: three values of 36 characters once made a message of 300."""
+    value = "0000\x1f\x1f\U00018cd6\U0001dab0"
+    with pytest.raises(TrajectoryFileError) as info:
+        parse_trajectory(changed(document, "segments.0.coeffs.1", [value] * 3))
+    text = str(info.value)
+    assert len(text) < 250 and "\n" not in text
+    assert "segments[0].coeffs[1][0] = " in text and text.endswith("; and 1 more")
+
+
 def test_a_missing_key_and_a_non_document() -> None:
     with pytest.raises(TrajectoryFileError, match=r"robot: required key is missing; .* and 1 more"):
         parse_trajectory(b'{"format": "cpr-trajectory/1", "joint_names": ["a"], "knots": [0, 1]}')
