@@ -55,6 +55,7 @@ VARIANTS: dict[str, dict[str, Any]] = {
     "no early stop": {"stall_iterations": 0},
     "refinement sigma 0.015": {SIGMA: 0.015},
     "refinement sigma 0.06": {SIGMA: 0.06},
+    "refinement stall 6": {STALL: 6},
     "refinement stall 8": {STALL: 8},
     "refinement stall 20": {STALL: 20},
     "1 path attempt": {PATHS: 1},

@@ -49,8 +49,10 @@ STALL_GENERATIONS = 4
 refinement. Longer refinements give shorter trajectories for more planning time
 (``scripts/study_parameters.py``): 8 generations, 5 % shorter for 12 % more time on its 30
 scenes, and 1.3 % and 7 % shorter for 24 % and 40 % more time on 50 scenes of generator
-seeds 0 and 2; 20 generations, 1.6 % shorter for twice the time. The planning time is the
-figure held against OMPL's (issue 17), so the default stays short."""
+seeds 0 and 2; 20 generations, 1.6 % shorter for twice the time. On 100 scenes (24 narrow)
+of seeds 0 and 1, with the faster timing: 6 generations 1-2 % shorter for 5-12 % more time,
+8 generations 2-3 % for 27 %. The planning time is the figure held against OMPL's
+(issue 17), so the default stays short."""
 MIN_SIGMA = 1e-4
 """Step below which the refinement ends [share of the range]: 1e-4 of a joint's range is
 below what the timing or the clearance can tell apart."""
