@@ -70,6 +70,9 @@ MORE_WAYPOINTS = 6
 spline through them keeps the clearance (a tight passage needs the spline held close to the
 path)."""
 
+PathSeed = tuple[float, Problem, FloatArray]
+"""A path's seed: its fitness, the problem it seeds (the waypoints it has) and the decision vector."""
+
 
 @dataclass(frozen=True)
 class Seeds:
@@ -130,52 +133,66 @@ def seed_search(problem: Problem, more_waypoints: bool = False, path: FloatArray
     started = time.perf_counter()
     straight = problem.objective.straight_line()
     clear = bool(problem.objective.breakdown(straight[None]).feasible[0])
+    weights = ck.motion_radii(problem.robot)[problem.moving]
+    seeded: PathSeed | None = None
     if path is None and not clear:
-        path = _followable_path(problem)
+        path, seeded = _followable_path(problem, weights)
     if path is None:
         return Seeds(problem, _around(problem, straight[None]), None, clear, time.perf_counter() - started)
-    weights = ck.motion_radii(problem.robot)[problem.moving]
-    first = problem.scene.planner.waypoints
-    counts = [first]
     if more_waypoints:
-        first = min(max(first + 2, len(path) - 2), MAX_WAYPOINTS)
-        counts = list(range(first, min(first + MORE_WAYPOINTS, MAX_WAYPOINTS) + 1, 2))
-    best: tuple[float, Problem, FloatArray] | None = None
-    for count in counts:
-        candidate_problem = with_planner(problem, waypoints=count)
-        along = waypoints_along(path, count, weights).ravel()
-        fitness = float(candidate_problem.objective(along[None])[0])
-        if best is None or fitness < best[0]:
-            best = (fitness, candidate_problem, along)
-        if fitness <= candidate_problem.objective.t_max:  # feasible: the fewest waypoints that follow
-            break
-    assert best is not None  # counts is never empty
-    _, problem, along = best
+        seeded = _fewest_waypoints(problem, path, weights)
+    elif seeded is None:
+        seeded = _path_seed(problem, path, problem.scene.planner.waypoints, weights)
+    _, problem, along = seeded
     candidates = np.array([problem.objective.straight_line(), along])
     return Seeds(problem, _around(problem, candidates), path, clear, time.perf_counter() - started)
 
 
-def _followable_path(problem: Problem) -> FloatArray | None:
-    """RRT-Connect's path whose waypoints seed ``problem`` best (module docstring, step 2).
+def _path_seed(problem: Problem, path: FloatArray, count: int, weights: FloatArray) -> PathSeed:
+    """The seed of ``path`` with ``count`` waypoints along it: its fitness, problem and decision vector."""
+    counted = with_planner(problem, waypoints=count)
+    along = waypoints_along(path, count, weights).ravel()
+    return float(counted.objective(along[None])[0]), counted, along
+
+
+def _followable_path(problem: Problem, weights: FloatArray) -> tuple[FloatArray | None, PathSeed | None]:
+    """RRT-Connect's path whose waypoints seed ``problem`` best (module docstring, step 2), and its seed.
 
     Up to :data:`PATH_ATTEMPTS` paths, all drawn from the stream ``default_rng([seed, 1])``;
     the first whose seed is feasible, else the one of the best fitness; ``None`` when
     RRT-Connect finds none (a further draw is not tried: a failed one has used up its samples).
     """
     rng = np.random.default_rng([problem.scene.planner.seed, 1])
-    weights = ck.motion_radii(problem.robot)[problem.moving]
-    objective, count = problem.objective, problem.scene.planner.waypoints
-    best: tuple[float, FloatArray] | None = None
+    best: tuple[FloatArray, PathSeed] | None = None
     for _ in range(PATH_ATTEMPTS):
         found = sampled_path(problem, rng)
         if found is None:
             break
-        fitness = float(objective(waypoints_along(found.path, count, weights).ravel()[None])[0])
-        if best is None or fitness < best[0]:
-            best = (fitness, found.path)
-        if fitness <= objective.t_max:
+        seeded = _path_seed(problem, found.path, problem.scene.planner.waypoints, weights)
+        if best is None or seeded[0] < best[1][0]:
+            best = (found.path, seeded)
+        if seeded[0] <= problem.objective.t_max:
             break
-    return None if best is None else best[1]
+    return (None, None) if best is None else best
+
+
+def _fewest_waypoints(problem: Problem, path: FloatArray, weights: FloatArray) -> PathSeed:
+    """The seed of ``path`` with the fewest waypoints beyond ``problem``'s that keeps the clearance.
+
+    Two or more beyond them, the path's corners at least, then two more at a time up to
+    :data:`MORE_WAYPOINTS` more (and :data:`~planning.scene.MAX_WAYPOINTS`); if none keeps
+    it, the count whose seed ranks best.
+    """
+    first = min(max(problem.scene.planner.waypoints + 2, len(path) - 2), MAX_WAYPOINTS)
+    best: PathSeed | None = None
+    for count in range(first, min(first + MORE_WAYPOINTS, MAX_WAYPOINTS) + 1, 2):
+        seeded = _path_seed(problem, path, count, weights)
+        if best is None or seeded[0] < best[0]:
+            best = seeded
+        if seeded[0] <= seeded[1].objective.t_max:  # feasible: the fewest waypoints that follow
+            break
+    assert best is not None  # the range is never empty
+    return best
 
 
 def _around(problem: Problem, seeds: FloatArray) -> FloatArray:
