@@ -37,7 +37,7 @@ from planning.errors import NoSolutionError
 from planning.io.scene_file import dump_scene
 from planning.io.scene_generator import generate_scenes
 from planning.peers.ompl_rrt import plan_rrt_connect
-from planning.peers.ruckig_bound import ruckig_duration
+from planning.peers.ruckig_bound import free_space_bound
 from planning.planner import plan, warm_up
 from planning.problem import build_problem
 from planning.scene import Scene
@@ -61,16 +61,6 @@ def theirs(scene: Scene, robot: ck.Robot, budget_s: float) -> tuple[bool, float,
     started = time.perf_counter()
     result = plan_rrt_connect(scene, robot, budget_s, scene.planner.seed)
     return result.success, time.perf_counter() - started, result.duration
-
-
-def free_space_bound(scene: Scene, robot: ck.Robot) -> float:
-    """Ruckig's time-optimal jerk-limited duration from start to goal with no obstacle [s].
-
-    No jerk-limited trajectory of the scene is shorter, so no median of them is below theirs.
-    """
-    problem, limits = build_problem(scene, robot), robot.limits
-    q_start, q_goal = problem.q_start, problem.q_goal
-    return ruckig_duration(q_start, q_goal, limits.velocity, limits.acceleration, limits.jerk)
 
 
 def cli_wall_times(scene: Scene, runs: int) -> list[float]:
@@ -145,7 +135,7 @@ def main() -> None:
     ]
     if both:
         mine_d, peer_d = np.median([b[1] for b in both]), np.median([b[2] for b in both])
-        bounds = [free_space_bound(scene, robot) for scene, *_ in both]
+        bounds = [free_space_bound(build_problem(scene, robot)) for scene, *_ in both]
         bound_d = np.median(bounds)
         beaten = sum(b[2] < bound for b, bound in zip(both, bounds, strict=True))
         print(

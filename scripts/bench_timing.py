@@ -46,7 +46,7 @@ from planning.io.report import markdown_table, text_table
 from planning.io.scene_file import load_scene
 from planning.io.scene_generator import generate_scenes
 from planning.peers.ompl_rrt import plan_rrt_connect
-from planning.peers.ruckig_bound import ruckig_duration
+from planning.peers.ruckig_bound import free_space_bound
 from planning.planner import plan, warm_up
 from planning.problem import build_problem
 from planning.scene import Scene
@@ -86,10 +86,7 @@ def line_is_clear(scene: Scene, robot: ck.Robot) -> bool:
 
 def measure(scene: Scene, robot: ck.Robot, rrt_time_s: float) -> Row:
     problem = build_problem(scene, robot)
-    limits = robot.limits
-    bound = ruckig_duration(
-        problem.q_start, problem.q_goal, limits.velocity, limits.acceleration, limits.jerk
-    )
+    bound = free_space_bound(problem)
     clear = line_is_clear(scene, robot)
     nan = float("nan")
     ours = uniform = timing_ms = nan

@@ -2,11 +2,16 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
+import cpr_kin as ck
 from planning.errors import PlanningError
-from planning.peers.ruckig_bound import ruckig_duration
+from planning.io.bundled import paper_scene
+from planning.peers.ruckig_bound import free_space_bound, ruckig_duration
+from planning.planner import plan
 
 
 def test_a_long_single_joint_move_takes_the_closed_form_time() -> None:
@@ -37,3 +42,13 @@ def test_joints_are_synchronised_to_the_slowest() -> None:
 def test_bad_input_is_refused_with_the_reason(start: list[float], limit: list[float], match: str) -> None:
     with pytest.raises(PlanningError, match=match):
         ruckig_duration(start, [1.0], limit, [1.0], [1.0])
+
+
+def test_a_planned_trajectory_is_never_shorter_than_its_problems_free_space_bound(robot: ck.Robot) -> None:
+    result = plan(replace(paper_scene(), duration=None), robot)
+    problem, limits = result.problem, robot.limits
+    bound = free_space_bound(problem)
+    assert bound == ruckig_duration(
+        problem.q_start, problem.q_goal, limits.velocity, limits.acceleration, limits.jerk
+    )
+    assert bound <= result.trajectory.duration

@@ -2,11 +2,12 @@
 
 from .ompl_rrt import plan_rrt_connect
 from .pyroboplan_rrt import plan_pyroboplan_rrt_connect, shortcut_path
-from .ruckig_bound import ruckig_duration
+from .ruckig_bound import free_space_bound, ruckig_duration
 from .toppra_timing import SamplingResult, planning_clearance_m, time_and_verify
 
 __all__ = [
     "SamplingResult",
+    "free_space_bound",
     "plan_pyroboplan_rrt_connect",
     "plan_rrt_connect",
     "planning_clearance_m",

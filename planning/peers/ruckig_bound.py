@@ -13,6 +13,7 @@ import ruckig
 from numpy.typing import ArrayLike
 
 from planning.errors import PlanningError
+from planning.problem import Problem
 
 
 def ruckig_duration(
@@ -48,3 +49,12 @@ def ruckig_duration(
     if result != ruckig.Result.Working:
         raise PlanningError(f"Ruckig found no trajectory ({result})")
     return float(trajectory.duration)
+
+
+def free_space_bound(problem: Problem) -> float:
+    """:func:`ruckig_duration` from ``problem``'s start to its goal under its robot's limits [s].
+
+    No trajectory of the problem, whatever its obstacles, is shorter.
+    """
+    limits = problem.robot.limits
+    return ruckig_duration(problem.q_start, problem.q_goal, limits.velocity, limits.acceleration, limits.jerk)
