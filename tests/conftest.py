@@ -1,4 +1,4 @@
-"""Shared fixtures: the bundled CPR and the paper's scene."""
+"""Shared fixtures: the bundled CPR, the paper's scene and geometric paths to time."""
 
 from __future__ import annotations
 
@@ -6,9 +6,27 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
+from planning.curves.spline import SepticSplineSolver, uniform_knots
+from planning.curves.spline_settings import SplineSettings
+from planning.curves.trajectory import Trajectory
 
 PAPER_START_TCP = (0.5, 0.45, 0.25)
 PAPER_GOAL_TCP = (-0.5, 0.45, 0.25)
+
+REST = SplineSettings(p=1e6, a=(0.0, 0.0, 1.0), ends="rest")
+LIFT = np.array([0.4, 0.25, -0.1, 0.0, 0.0])
+"""An offset of the middle waypoints: the path lifts over something, a curved path."""
+
+
+def spline_path(nodes: np.ndarray) -> Trajectory:
+    """The planner's geometric path: the rest-to-rest spline through nodes on uniform knots."""
+    return (
+        SepticSplineSolver(uniform_knots(len(nodes) - 1, float(len(nodes) - 1)), REST).solve(nodes).trajectory
+    )
+
+
+def limits_of(robot: ck.Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    return robot.limits.velocity, robot.limits.acceleration, robot.limits.jerk
 
 
 @pytest.fixture(scope="session")
@@ -33,3 +51,16 @@ def rng() -> np.random.Generator:
 
 def random_configurations(robot: ck.Robot, rng: np.random.Generator, n: int) -> np.ndarray:
     return rng.uniform(robot.limits.lower, robot.limits.upper, (n, robot.nq))
+
+
+@pytest.fixture(scope="session")
+def lines(robot: ck.Robot) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Start and goal pairs: the paper's, then 8 random ones in the moving joints."""
+    rng = np.random.default_rng(11)
+    pairs = [(ck.tcp_ik(robot, PAPER_START_TCP), ck.tcp_ik(robot, PAPER_GOAL_TCP))]
+    lower, upper = robot.limits.lower, robot.limits.upper
+    for _ in range(8):
+        a, b = rng.uniform(lower, upper), rng.uniform(lower, upper)
+        a[3:] = b[3:] = 0.0
+        pairs.append((a, b))
+    return pairs

@@ -1,53 +1,19 @@
 from __future__ import annotations
 
-from itertools import pairwise
-from unittest import mock
-
 import numpy as np
 import pytest
 
 import cpr_kin as ck
-from planning.curves import path_timing
 from planning.curves.path_timing import NODE_STEP_S, time_path
-from planning.curves.phase_plane import profile_time
-from planning.curves.spline import SepticSplineSolver, uniform_knots
-from planning.curves.spline_settings import SplineSettings
 from planning.curves.trajectory import Trajectory
 from planning.peers.ruckig_bound import ruckig_duration
 
-from .conftest import PAPER_GOAL_TCP, PAPER_START_TCP
-
-REST = SplineSettings(p=1e6, a=(0.0, 0.0, 1.0), ends="rest")
-LIFT = np.array([0.4, 0.25, -0.1, 0.0, 0.0])
-"""An offset of the middle waypoints: the path lifts over something, a curved path."""
-
-
-def spline_path(nodes: np.ndarray) -> Trajectory:
-    """The planner's geometric path: the rest-to-rest spline through nodes on uniform knots."""
-    return (
-        SepticSplineSolver(uniform_knots(len(nodes) - 1, float(len(nodes) - 1)), REST).solve(nodes).trajectory
-    )
-
-
-def limits_of(robot: ck.Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    return robot.limits.velocity, robot.limits.acceleration, robot.limits.jerk
+from .conftest import LIFT, PAPER_GOAL_TCP, PAPER_START_TCP, limits_of, spline_path
 
 
 def usage(trajectory: Trajectory, limits: tuple[np.ndarray, ...]) -> list[float]:
     """Largest |derivative| / limit by the exact extrema, for velocity, acceleration and jerk."""
     return [float(np.max(trajectory.extrema(r).peak / limits[r - 1])) for r in (1, 2, 3)]
-
-
-@pytest.fixture(scope="module")
-def lines(robot: ck.Robot) -> list[tuple[np.ndarray, np.ndarray]]:
-    rng = np.random.default_rng(11)
-    pairs = [(ck.tcp_ik(robot, PAPER_START_TCP), ck.tcp_ik(robot, PAPER_GOAL_TCP))]
-    lower, upper = robot.limits.lower, robot.limits.upper
-    for _ in range(8):
-        a, b = rng.uniform(lower, upper), rng.uniform(lower, upper)
-        a[3:] = b[3:] = 0.0
-        pairs.append((a, b))
-    return pairs
 
 
 def test_a_straight_line_comes_within_ten_percent_of_ruckigs_optimum(
@@ -123,57 +89,3 @@ def test_limits_and_knots_scaled_as_time_give_the_same_motion_faster(robot: ck.R
         scaled = time_path(path, velocity * k, acceleration * k**2, jerk * k**3, node_step_s=NODE_STEP_S / k)
         assert scaled.duration == pytest.approx(base.duration / k, rel=1e-9)
         np.testing.assert_allclose(scaled(base.knots / k), base(base.knots), rtol=0, atol=1e-9)
-
-
-def every_cap(grid: path_timing._Grid, limits: np.ndarray) -> path_timing._Candidate:
-    """The cap search with no early stop: every cap of the grid, as first written."""
-    tried = {1.0: path_timing._candidate(grid, limits, 1.0)}
-    peak = tried[1.0].peak
-    for share in (factor * peak for factor in path_timing.FACTORS):
-        tried[share] = path_timing._candidate(grid, limits, share)
-    for high, low in pairwise(sorted(tried, reverse=True)):
-        if tried[high].widened and not tried[low].widened:
-            path_timing._bisect(grid, limits, tried, high, low, peak)
-            break
-    share = min(tried, key=lambda share: (tried[share].duration_s, -share))
-    best = tried[share]
-    for factor in path_timing.RAMP_FACTORS:
-        found = path_timing._candidate(grid, limits, share, factor * best.window_s)
-        if found.duration_s < best.duration_s:
-            best = found
-    return best
-
-
-def test_the_cap_search_stops_early_with_what_every_cap_gives(
-    robot: ck.Robot, lines: list[tuple[np.ndarray, np.ndarray]]
-) -> None:
-    limits = np.stack(limits_of(robot))
-    paths = [spline_path(np.linspace(q0, q1, 5)) for q0, q1 in lines]
-    paths += [spline_path(np.array([q0, q0 + LIFT, q1 + LIFT * [-1, 1, 1, 1, 1], q1])) for q0, q1 in lines]
-    calls = {"stopped": 0, "every": 0}
-    for path in paths:
-        for factor in (1.0, 0.35):  # the planner's limits and its narrowed ones
-            narrowed = limits * np.array([[1.0], [factor], [1.0]])
-            grid = path_timing._arc_length_grid(path, narrowed[0])
-            for name, search in (("stopped", path_timing._fastest), ("every", every_cap)):
-                with mock.patch.object(path_timing, "_candidate", wraps=path_timing._candidate) as spy:
-                    found = search(grid, narrowed)
-                calls[name] += spy.call_count
-                if name == "stopped":
-                    stopped = found
-            assert stopped.duration_s == found.duration_s and stopped.step_s == found.step_s
-            np.testing.assert_array_equal(stopped.motion, found.motion)
-    assert calls["stopped"] < 0.7 * calls["every"]
-
-
-def test_a_lower_velocity_cap_never_shortens_the_phase_plane_time(robot: ck.Robot) -> None:
-    """What the early stop of the cap search rests on: the profile's time grows as its cap falls."""
-    limits = np.stack(limits_of(robot))
-    q0, q1 = ck.tcp_ik(robot, PAPER_START_TCP), ck.tcp_ik(robot, PAPER_GOAL_TCP)
-    for nodes in (np.linspace(q0, q1, 5), np.array([q0, q0 + LIFT, q1 + LIFT * [-1, 1, 1, 1, 1], q1])):
-        grid = path_timing._arc_length_grid(spline_path(nodes), limits[0])
-        times = [
-            profile_time(path_timing._profile(grid, limits, share), grid.ds)
-            for share in np.linspace(1, 0.1, 60)
-        ]
-        assert np.all(np.diff(times) >= -1e-12 * times[0])

@@ -1,0 +1,67 @@
+from __future__ import annotations
+
+from itertools import pairwise
+from unittest import mock
+
+import numpy as np
+
+import cpr_kin as ck
+from planning.curves import velocity_caps
+from planning.curves.arc_length import ArcLengthPath, arc_length_path
+from planning.curves.phase_plane import profile_time
+from planning.curves.velocity_caps import CappedMotion, capped_motion, capped_profile, fastest_motion
+
+from .conftest import LIFT, PAPER_GOAL_TCP, PAPER_START_TCP, limits_of, spline_path
+
+
+def every_cap(grid: ArcLengthPath, limits: np.ndarray) -> CappedMotion:
+    """The cap search with no early stop: every cap of the grid, as first written."""
+    tried = {1.0: velocity_caps.capped_motion(grid, limits, 1.0)}
+    peak = tried[1.0].peak
+    for share in (factor * peak for factor in velocity_caps.FACTORS):
+        tried[share] = velocity_caps.capped_motion(grid, limits, share)
+    for high, low in pairwise(sorted(tried, reverse=True)):
+        if tried[high].widened and not tried[low].widened:
+            velocity_caps.bisect_widening(grid, limits, tried, high, low, peak)
+            break
+    share = min(tried, key=lambda share: (tried[share].duration_s, -share))
+    best = tried[share]
+    for factor in velocity_caps.RAMP_FACTORS:
+        found = velocity_caps.capped_motion(grid, limits, share, factor * best.window_s)
+        if found.duration_s < best.duration_s:
+            best = found
+    return best
+
+
+def test_the_cap_search_stops_early_with_what_every_cap_gives(
+    robot: ck.Robot, lines: list[tuple[np.ndarray, np.ndarray]]
+) -> None:
+    limits = np.stack(limits_of(robot))
+    paths = [spline_path(np.linspace(q0, q1, 5)) for q0, q1 in lines]
+    paths += [spline_path(np.array([q0, q0 + LIFT, q1 + LIFT * [-1, 1, 1, 1, 1], q1])) for q0, q1 in lines]
+    calls = {"stopped": 0, "every": 0}
+    for path in paths:
+        for factor in (1.0, 0.35):  # the planner's limits and its narrowed ones
+            narrowed = limits * np.array([[1.0], [factor], [1.0]])
+            grid = arc_length_path(path, narrowed[0])
+            for name, search in (("stopped", fastest_motion), ("every", every_cap)):
+                with mock.patch.object(velocity_caps, "capped_motion", wraps=capped_motion) as spy:
+                    found = search(grid, narrowed)
+                calls[name] += spy.call_count
+                if name == "stopped":
+                    stopped = found
+            assert stopped.duration_s == found.duration_s and stopped.step_s == found.step_s
+            np.testing.assert_array_equal(stopped.motion, found.motion)
+    assert calls["stopped"] < 0.7 * calls["every"]
+
+
+def test_a_lower_velocity_cap_never_shortens_the_phase_plane_time(robot: ck.Robot) -> None:
+    """What the early stop of the cap search rests on: the profile's time grows as its cap falls."""
+    limits = np.stack(limits_of(robot))
+    q0, q1 = ck.tcp_ik(robot, PAPER_START_TCP), ck.tcp_ik(robot, PAPER_GOAL_TCP)
+    for nodes in (np.linspace(q0, q1, 5), np.array([q0, q0 + LIFT, q1 + LIFT * [-1, 1, 1, 1, 1], q1])):
+        grid = arc_length_path(spline_path(nodes), limits[0])
+        times = [
+            profile_time(capped_profile(grid, limits, share), grid.ds) for share in np.linspace(1, 0.1, 60)
+        ]
+        assert np.all(np.diff(times) >= -1e-12 * times[0])
