@@ -115,6 +115,7 @@ def test_benchmark_script_runs(tmp_path: Path) -> None:
     assert completed.returncode == 0, completed.stderr[-2000:]
     report = out.read_text()
     assert "firefly (ours) + septic spline" in report and "| method | success |" in report
+    assert "## Optimisers at equal budgets" in report and "| 2550 evaluations |" in report
 
 
 def test_shortcut_path_keeps_ends_and_checks_every_new_segment() -> None:
