@@ -174,7 +174,8 @@ def _search(
 
     With ``refine: cma`` and a feasible best, the firefly's best is refined by a CMA-ES
     (:func:`~planning.search.refinement.refine_search`) within the rest of the budget,
-    drawing on the same generator after the firefly.
+    drawing on the same generator after the firefly, until ``refine_stall`` generations
+    in a row have stalled (0: to the budget).
     """
     objective, settings = problem.objective, problem.scene.planner
     rng = np.random.default_rng(settings.seed)
@@ -193,7 +194,15 @@ def _search(
     if settings.refine == "none" or found.fitness > objective.t_max:
         return found
     budget = settings.firefly.evaluations - found.evaluations
-    return refine_search(objective, objective.lower, objective.upper, found, budget, rng)
+    return refine_search(
+        objective,
+        objective.lower,
+        objective.upper,
+        found,
+        budget,
+        rng,
+        stall_generations=settings.refine_stall,
+    )
 
 
 def _stay_put(problem: Problem, started: float) -> PlanResult:

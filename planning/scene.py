@@ -20,7 +20,8 @@ from numpy.typing import NDArray
 import cpr_kin as ck
 from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError
-from planning.search.firefly_settings import FireflySettings
+from planning.search.firefly_settings import MAX_ITERATIONS, FireflySettings
+from planning.search.refinement import STALL_GENERATIONS
 from planning.validation import integer_in, number_in, shown
 
 FloatArray = NDArray[np.float64]
@@ -146,6 +147,10 @@ class PlannerSettings:
         refine: ``"cma"`` (default): once the firefly has a feasible best, a CMA-ES started
             at it refines it within the rest of the evaluation budget
             (:mod:`planning.search.refinement`); ``"none"`` (the paper): the firefly's best.
+        refine_stall: generations in a row without a relative improvement of 0.1 % that end
+            the refinement, in [0, ``MAX_ITERATIONS``]; 0: run it to the evaluation budget
+            (better fitness for more planning time, ``scripts/bench_peers.py``); default
+            :data:`~planning.search.refinement.STALL_GENERATIONS`.
     """
 
     firefly: FireflySettings = DEFAULT_FIREFLY
@@ -160,6 +165,7 @@ class PlannerSettings:
     moving_joints: tuple[str, ...] | None = None
     seeding: Seeding = "paths"
     refine: Refine = "cma"
+    refine_stall: int = STALL_GENERATIONS
 
     def __post_init__(self) -> None:
         if not isinstance(self.firefly, FireflySettings):
@@ -171,6 +177,7 @@ class PlannerSettings:
             raise PlanningError(f"seeding = {shown(self.seeding)}; allowed: 'paths', 'none'")
         if self.refine not in ("cma", "none"):
             raise PlanningError(f"refine = {shown(self.refine)}; allowed: 'cma', 'none'")
+        integer_in("refine_stall", self.refine_stall, 0, MAX_ITERATIONS)
         if self.path not in ("spline", "ptp"):
             raise PlanningError(f"path = {shown(self.path)}; allowed: 'spline', 'ptp'")
         integer_in("seed", self.seed, 0, MAX_SEED)

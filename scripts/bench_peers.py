@@ -49,7 +49,7 @@ from planning.seeding import seed_search
 
 FloatArray = NDArray[np.float64]
 DEFAULT_SEARCH = "firefly (our defaults: seeded, n = 30, early stop, CMA-ES refinement)"
-FULL_BUDGET = "the same, its refinement run to the budget (no early stop)"
+FULL_BUDGET = "the same with refine_stall: 0 (its refinement run to the budget)"
 
 
 def optimisers(scene: Scene) -> dict[str, Optimizer]:
@@ -82,7 +82,8 @@ def default_search(robot: ck.Robot, scene: Scene, refine_stall: int | None = Non
     around them), then :data:`~planning.scene.DEFAULT_FIREFLY` with as many iterations as the
     budget allows and its early stop, then (from a feasible best) the CMA-ES refinement of
     :mod:`planning.search.refinement` within the rest of the budget, as the planner does
-    (``refine_stall``: the refinement's stall generations, 0 to run it to the budget).
+    (``refine_stall``: the refinement's stall generations, as the planner setting of that
+    name; 0 to run it to the budget).
     The seeding's streams get a seed drawn from ``rng``.
     """
     problem = build_problem(replace(scene, planner=scene.planner.updated(seeding="paths")), robot)

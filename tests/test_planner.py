@@ -210,6 +210,24 @@ def test_refinement_continues_the_firefly_and_only_improves(robot: ck.Robot) -> 
         )
 
 
+def test_refine_stall_zero_runs_the_same_refinement_on_to_the_budget(robot: ck.Robot) -> None:
+    """The early stop only cuts the refinement short: without it, the same run goes on."""
+    from planning.io.scene_generator import generate_scenes
+
+    for scene in generate_scenes(3, seed=2, robot=robot, narrow=1):
+        stopped = plan(scene, robot).optimiser
+        budget = scene.planner.firefly.evaluations
+        full = plan(
+            dataclasses.replace(scene, planner=scene.planner.updated(refine_stall=0)), robot
+        ).optimiser
+        n = len(stopped.best_history)
+        np.testing.assert_array_equal(full.best_history[:n], stopped.best_history)
+        assert full.fitness <= stopped.fitness
+        assert stopped.evaluations < full.evaluations <= budget
+    with pytest.raises(PlanningError, match=r"refine_stall = -1 .*\[0, 10000\]"):
+        PlannerSettings(refine_stall=-1)
+
+
 def test_the_paper_search_does_not_refine() -> None:
     from planning.scene import PAPER_SEARCH
 

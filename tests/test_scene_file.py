@@ -49,6 +49,7 @@ def test_documented_defaults() -> None:
     assert scene.duration is None and scene.robot is None and scene.obstacles == ()
     assert scene.planner == PlannerSettings()
     assert scene.spline == SplineSettings(p=1e6, a=(0.0, 0.0, 1.0), ends="rest")
+    assert parse_scene({**MINIMAL, "planner": {"refine_stall": 0}}).planner.refine_stall == 0
 
 
 def test_every_shape_and_relative_mesh_path(tmp_path: Path) -> None:
@@ -90,6 +91,7 @@ def test_every_shape_and_relative_mesh_path(tmp_path: Path) -> None:
         ({"goal": {"q": [0, 0, 0, 0, 0], "theta4": 1.0}}, "theta4 and theta5 go with 'tcp'"),
         ({"planner": {"mode": "parallel"}}, "planner.mode = 'parallel'"),
         ({"planner": {"refine": "bfgs"}}, "planner.refine = 'bfgs'"),
+        ({"planner": {"refine_stall": -1}}, "planner.refine_stall = -1"),
         ({"planner": {"moving_joints": ["elbow"]}}, "planner.moving_joints[0] = 'elbow'"),
         ({"spline": {"ends": "clamped"}}, "spline.ends = 'clamped'"),
         ({"duration": 0}, "duration = 0: Input should be greater than or equal to 0.01"),

@@ -155,6 +155,7 @@ class PlannerSpec(_Strict):
     ) = None
     seeding: Literal["paths", "none"] = _P.seeding
     refine: Literal["cma", "none"] = _P.refine
+    refine_stall: Annotated[int, Field(ge=0, le=MAX_ITERATIONS)] = _P.refine_stall
 
 
 class SplineSpec(_Strict):
