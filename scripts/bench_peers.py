@@ -335,12 +335,24 @@ def main() -> None:
         ]
         print(f"{label}: at least as good as every peer at {len(wins)} of {len(budgets)} budgets {wins}")
 
-    if not args.scenes:
-        return
-    print(f"\n2. Planners on {args.scenes} generated scenes (generator seed {args.scene_seed}), all verified")
-    scenes = [
-        replace(s, planner=replace(s.planner)) for s in generate_scenes(args.scenes, args.scene_seed, robot)
-    ]
+    report = (
+        "# Benchmark against peers\n\n## Optimisers (paper case objective)\n\n"
+        + markdown_table(rows, headers1)
+        + "\n\n## Optimisers at equal budgets (median fitness)\n\n"
+        + markdown_table(rows1b, headers1b)
+        + "\n"
+    )
+    if args.scenes:
+        report += planners_section(robot, args.scenes, args.scene_seed, args.rrt_time)
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(report)
+    print(f"\nwrote {args.out}")
+
+
+def planners_section(robot: ck.Robot, count: int, scene_seed: int, rrt_time_s: float) -> str:
+    """Part 2: prints the planner table and returns it as a Markdown section."""
+    print(f"\n2. Planners on {count} generated scenes (generator seed {scene_seed}), all verified")
+    scenes = generate_scenes(count, scene_seed, robot)
     headers2 = (
         "method",
         "success",
@@ -351,19 +363,9 @@ def main() -> None:
         "max abs jerk",
         "min clearance",
     )
-    rows2 = planner_rows(robot, scenes, args.rrt_time)
+    rows2 = planner_rows(robot, scenes, rrt_time_s)
     print(markdown_table(rows2, headers2))
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(
-        "# Benchmark against peers\n\n## Optimisers (paper case objective)\n\n"
-        + markdown_table(rows, headers1)
-        + "\n\n## Optimisers at equal budgets (median fitness)\n\n"
-        + markdown_table(rows1b, headers1b)
-        + f"\n\n## Planners ({args.scenes} generated scenes)\n\n"
-        + markdown_table(rows2, headers2)
-        + "\n"
-    )
-    print(f"\nwrote {args.out}")
+    return f"\n## Planners ({count} generated scenes)\n\n" + markdown_table(rows2, headers2) + "\n"
 
 
 if __name__ == "__main__":

@@ -94,14 +94,16 @@ def test_rrt_connect_pipelines(robot: ck.Robot, peer: str) -> None:
     assert result.duration > 0 and result.path_length > 0
 
 
-def test_benchmark_script_runs(tmp_path: Path) -> None:
+@pytest.mark.parametrize("scenes", [1, 0])
+def test_benchmark_script_runs(tmp_path: Path, scenes: int) -> None:
+    """The script writes its report, with the planners' table unless ``--scenes 0``."""
     out = tmp_path / "bench.md"
     completed = subprocess.run(
         [
             sys.executable,
             str(ROOT / "scripts" / "bench_peers.py"),
             "--scenes",
-            "1",
+            str(scenes),
             "--seeds",
             "1",
             "--out",
@@ -114,8 +116,9 @@ def test_benchmark_script_runs(tmp_path: Path) -> None:
     )
     assert completed.returncode == 0, completed.stderr[-2000:]
     report = out.read_text()
-    assert "firefly (ours) + septic spline" in report and "| method | success |" in report
     assert "## Optimisers at equal budgets" in report and "| 2550 evaluations |" in report
+    planners = "firefly (ours) + septic spline" in report and "| method | success |" in report
+    assert planners == bool(scenes)
 
 
 def test_shortcut_path_keeps_ends_and_checks_every_new_segment() -> None:
