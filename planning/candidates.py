@@ -41,21 +41,34 @@ def verify(problem: Problem, trajectory: Trajectory, fit: SplineFit) -> Verifica
     return verification
 
 
+def distinct(points: list[FloatArray]) -> list[FloatArray]:
+    """``points`` without repeats, in order.
+
+    The best is also the first of a refined population: a point refused once would be timed
+    and verified again.
+    """
+    kept: list[FloatArray] = []
+    for point in points:
+        if not any(np.array_equal(point, other) for other in kept):
+            kept.append(point)
+    return kept
+
+
 def first_verified(
     problem: Problem, result: SearchResult
 ) -> tuple[FloatArray, FloatArray, Timing, Verification, int]:
     """The first candidate whose timed trajectory passes the verification.
 
     Candidates: the best, then the final population's ones the fitness found feasible (an
-    infeasible one will not pass the verification), best first. In order:
+    infeasible one will not pass the verification), best first, each once. In order:
 
-    1. the preferred (fastest) timing of each of the first :data:`PREFERRED_FIRST`: a nearly
-       as good candidate run at full speed beats the best one run at the uniform timing's
-       pace;
-    2. their narrowed timings (:func:`~planning.timing.narrowed_timing`), one share of
-       :data:`~planning.timing.NARROWED_ACCELERATION` after the other (each computed only
-       when the previous share failed), each share's shortest first, whichever candidate
-       they time;
+    1. the best's preferred (fastest) timing;
+    2. the narrowed timings (:func:`~planning.timing.narrowed_timing`) of the first
+       :data:`PREFERRED_FIRST`, one share of :data:`~planning.timing.NARROWED_ACCELERATION`
+       after the other (each computed only when the previous share failed), each share's
+       shortest first, whichever candidate they time; the first share's go with the other
+       two's preferred timings: a nearly as good candidate run at full speed beats the best
+       one run slower, and a worse one run at full speed does not;
     3. their other timings (the uniform ones), shortest first;
     4. each further candidate's timings, in order.
 
@@ -67,7 +80,7 @@ def first_verified(
     objective = problem.objective
     order = np.argsort(result.population_fitness, kind="stable")
     feasible = result.population_fitness <= objective.t_max  # both fitnesses rank feasible at or below t_max
-    candidates = [result.x] + [result.population[k] for k in order if feasible[k]]
+    candidates = distinct([result.x] + [result.population[k] for k in order if feasible[k]])
     timed: list[list[Timing]] = []
 
     def offered(k: int) -> list[Timing]:
@@ -81,12 +94,14 @@ def first_verified(
 
     def attempts() -> Iterator[tuple[int, Timing]]:
         preferred = list(range(min(PREFERRED_FIRST, len(candidates))))
-        yield from ((k, offered(k)[0]) for k in preferred)
+        yield 0, offered(0)[0]  # most plans end here, after one timing
+        others: list[tuple[int, Timing | None]] = [(k, offered(k)[0]) for k in preferred[1:]]
         narrowing = preferred
         for share in NARROWED_ACCELERATION:  # share by share: a path that passes costs no lower share
-            found = shortest_first([(k, narrowed_timing(problem, offered(k), share)) for k in narrowing])
-            yield from found
-            narrowing = [k for k, _ in found]  # a lower share is slower still
+            found = [(k, narrowed_timing(problem, offered(k), share)) for k in narrowing]
+            yield from shortest_first(others + found)
+            others = []
+            narrowing = [k for k, timing in found if timing is not None]  # a lower share is slower still
         yield from shortest_first([(k, timing) for k in preferred for timing in offered(k)[1:]])
         yield from ((k, timing) for k in range(PREFERRED_FIRST, len(candidates)) for timing in offered(k))
 

@@ -41,7 +41,11 @@ def test_free_durations_are_timed_within_the_limits_c3_and_certified(
             float(np.max(trajectory.extrema(r).peak / limit))
             for r, limit in enumerate((limits.velocity, limits.acceleration, limits.jerk), start=1)
         ]
-        assert max(used) == pytest.approx(1.0, abs=1e-9) and all(u <= 1.0 + 1e-9 for u in used)
+        assert all(u <= 1.0 + 1e-9 for u in used)
+        # a limit is reached: the acceleration's own, or its share for a narrowed timing
+        shares = NARROWED_ACCELERATION if metrics.timing == "narrowed" else (1.0,)
+        reached = [max(used[0], used[1] / share, used[2]) for share in shares]
+        assert any(peak == pytest.approx(1.0, abs=1e-9) for peak in reached)
         positions = trajectory.extrema(0)
         assert np.all(positions.minimum >= limits.lower - 1e-9) and np.all(
             positions.maximum <= limits.upper + 1e-9
@@ -103,9 +107,9 @@ def test_narrowed_timings_meet_the_lowered_acceleration_and_beat_the_uniform_one
 
 
 def test_a_path_whose_fastest_timing_cuts_into_the_margin_runs_narrowed(robot: ck.Robot) -> None:
-    """Generated scene 30 (seed 0): the fastest timings of the three best candidates come within
-    0.046-0.047 m of an obstacle (margin 0.05 m); a narrowed one passes, 25 % shorter than the
-    uniform timing the planner fell back to before."""
+    """Generated scene 30 (seed 0): the fastest timings of its best candidates cut into the
+    margin; a narrowed one passes, 34 % shorter than the uniform timing the planner fell back
+    to before."""
     scene = generate_scenes(31, 0, robot)[30]
     result = plan(scene, robot)
     uniform = result.spline.trajectory.time_scaled(uniform_scale(result.spline, result.problem))
