@@ -7,7 +7,7 @@ evaluations, and the durations relative to the defaults' (geometric mean of the 
 ratios on the scenes both plan, and its spread). The variants change one thing at a time
 from the defaults (:data:`planning.scene.DEFAULT_FIREFLY`, ``seeding: paths`` with
 :data:`planning.seeding.PATH_ATTEMPTS`, ``refine: cma`` with
-:data:`planning.search.refinement.SIGMA` and ``refine_stall``); the first
+:data:`planning.search.refinement.SIGMA`, ``ACTIVE_UPDATE`` and ``refine_stall``); the first
 row is the paper's search (50 fireflies, every iteration, a random population, no
 refinement).
 """
@@ -35,10 +35,13 @@ from planning.search import refinement
 PAPER_SEARCH = {"fireflies": 50, "stall_iterations": 0, "seeding": "none", "refine": "none"}
 SIGMA = "refinement sigma"
 """A variant's key for the refinement's initial step (a module constant, not a scene setting)."""
+ACTIVE = "active update"
+"""A variant's key for the refinement's active covariance update (a module constant likewise)."""
 PATHS = "path attempts"
 """A variant's key for the seeding's most RRT-Connect paths (a module constant likewise)."""
 CONSTANTS: dict[str, tuple[Any, str]] = {
     SIGMA: (refinement, "SIGMA"),
+    ACTIVE: (refinement, "ACTIVE_UPDATE"),
     PATHS: (seeding, "PATH_ATTEMPTS"),
 }
 """Variant keys that patch a module constant: the module and the constant's name."""
@@ -55,6 +58,7 @@ VARIANTS: dict[str, dict[str, Any]] = {
     "refinement stall 6": {"refine_stall": 6},
     "refinement stall 8": {"refine_stall": 8},
     "refinement stall 20": {"refine_stall": 20},
+    "refinement with the active update": {ACTIVE: True},
     "1 path attempt": {PATHS: 1},
     "2 path attempts": {PATHS: 2},
     "5 path attempts": {PATHS: 5},

@@ -12,6 +12,7 @@ from planning.search.optimizer import STALL_TOLERANCE
 from planning.search.refinement import (
     FALLBACK_SPACING,
     STALL_GENERATIONS,
+    LearningRates,
     cma_refine,
     population_size,
     refine_search,
@@ -44,6 +45,48 @@ def start_of(objective: Callable[[np.ndarray], np.ndarray], x0: np.ndarray) -> t
 
 def test_population_size_is_cma_es_default() -> None:
     assert [population_size(d) for d in (1, 2, 5, 10, 15, 100)] == [4, 6, 8, 10, 12, 17]
+
+
+@pytest.mark.parametrize("dimension", [2, 5, 10, 15, 20, 40])
+def test_learning_rates_are_the_tutorials(dimension: int) -> None:
+    rates = LearningRates.of(dimension)
+    lam = population_size(dimension)
+    mu = lam // 2
+    assert rates.weights.shape == (mu,) and rates.negative_weights.shape == (lam - mu,)
+    assert rates.weights.sum() == pytest.approx(1.0)
+    assert np.all(np.diff(rates.weights) < 0) and np.all(rates.weights > 0)
+    assert rates.mu_eff == pytest.approx(rates.weights.sum() ** 2 / np.sum(rates.weights**2))
+    assert np.all(rates.negative_weights <= 0) and np.all(np.diff(rates.negative_weights) < 0)
+    # the worse half's mass keeps the covariance positive definite: the decay left after
+    # the positive updates covers the negative one at its largest (every step at norm sqrt(d))
+    mass = -rates.negative_weights.sum()
+    assert rates.c_mu * mass * dimension <= 1 - rates.c_1 - rates.c_mu + 1e-12
+    assert mass <= 1 + rates.c_1 / rates.c_mu + 1e-12
+    classic = LearningRates.of(dimension, active=False)
+    np.testing.assert_array_equal(classic.negative_weights, 0.0)
+    np.testing.assert_array_equal(classic.weights, rates.weights)
+
+
+def band(x: np.ndarray) -> np.ndarray:
+    """Minimise ``-(x0 + x1)`` within ``|x0 - x1| <= 0.01``, a thin band along the diagonal;
+    outside it, a penalty above every feasible value."""
+    off = np.abs(x[:, 0] - x[:, 1])
+    return np.asarray(np.where(off <= 0.01, -(x[:, 0] + x[:, 1]), 10 + off))
+
+
+def test_active_update_walks_along_a_constraint() -> None:
+    # the worse half lands across the band: unlearning those steps narrows the search to it
+    x0 = np.array([0.1, 0.1, 0.5, 0.5, 0.5, 0.5])
+    f0 = float(band(x0[None])[0])
+    gains = {}
+    for active in (True, False):
+        runs = [
+            cma_refine(band, np.zeros(6), np.ones(6), x0, f0, 300, np.random.default_rng(s), 0.03, 0, active)
+            for s in range(20)
+        ]
+        assert all(-2.0 <= run.fitness <= f0 for run in runs)
+        gains[active] = f0 - float(np.median([run.fitness for run in runs]))
+    assert gains[True] > 2 * gains[False] > 0
 
 
 def test_learns_a_rotated_ill_conditioned_quadratic() -> None:
@@ -147,7 +190,7 @@ def test_refine_search_continues_a_firefly_run() -> None:
     rng = np.random.default_rng(4)
     searched = firefly_minimize(mild, lower, upper, settings, rng)
     budget = settings.fireflies * (settings.iterations + 1) - searched.evaluations
-    result = refine_search(mild, lower, upper, searched, budget, rng)
+    result = refine_search(mild, lower, upper, searched, budget, rng, stall_generations=0)
     assert result.fitness < 0.1 * searched.fitness
     assert result.evaluations <= settings.fireflies * (settings.iterations + 1)
     # the histories run on from the firefly's

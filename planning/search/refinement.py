@@ -3,17 +3,17 @@
 The firefly explores and finds the basin; near its best point its moves are too coarse to
 descend (a sweep kicks every firefly by about ``alpha sqrt(n) / 2`` per iteration), and its
 early stop ends the search there. A covariance matrix adaptation evolution strategy
-(Hansen 2016, "The CMA Evolution Strategy: A Tutorial", default parameters) learns the
-valley's directions from a few generations and walks along them, also where the valley does
-not follow the variables' axes (the tests: a rotated quadratic of condition number 1000,
-where a search that adapts only its step length needs about that many times more
-evaluations). Measured on 100 generated scenes (24 narrow
+(Hansen 2016, "The CMA Evolution Strategy: A Tutorial", default parameters, with its
+active covariance update) learns the valley's directions from a few generations and walks
+along them, also where the valley does not follow the variables' axes (the tests: a
+rotated quadratic of condition number 1000, where a search that adapts only its step
+length needs about that many times more evaluations). Measured on 100 generated scenes (24 narrow
 passages, generator seeds 0 and 1, ``scripts/bench_search.py``): after 4 stalled firefly
 iterations instead of 8, the refinement makes the trajectories 7-10 % shorter (geometric
 mean) in the same planning time. On the paper objective (``scripts/bench_peers.py``, 10
 seeds), run to the budget of 2550 evaluations, the seeded firefly and this refinement reach
-a median of 2.47, the CMA-ES peer from a random start 2.50; with the early stops, 2.82 in
-about 300 evaluations.
+a median of 2.48 (2.22 with :data:`ACTIVE_UPDATE`), the CMA-ES peer from a random start
+2.50; with the early stops, 2.81 in about 230 evaluations.
 
 Written here rather than taken from ``cma`` or ``cmaes``: both import ``scipy.stats``
 (0.6-0.9 s), more than a third of the 1.5 s a plan may take in a new process; the method
@@ -30,6 +30,7 @@ generation would exceed the evaluation budget. The same generator state gives th
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -53,6 +54,17 @@ seeds 0 and 2; 20 generations, 1.6 % shorter for twice the time. On 100 scenes (
 of seeds 0 and 1, with the faster timing: 6 generations 1-2 % shorter for 5-12 % more time,
 8 generations 2-3 % for 27 %. The planning time is the figure held against OMPL's
 (issue 17), so the default stays short."""
+ACTIVE_UPDATE = False
+"""Whether the covariance also learns from the worse half of each generation (the active
+CMA-ES of the tutorial): it shrinks the variance along the directions that failed, such as
+a constraint's normal, so that a long refinement walks along the clearance constraint
+instead of sampling across it. On the paper objective run to its budget
+(``refine_stall: 0``, ``scripts/bench_peers.py``, 10 seeds) it reaches a median of 2.22
+against 2.48 without. Off by default: on 100 generated scenes (24 narrow, generator seed 1,
+``scripts/study_parameters.py``) its trajectories are as long (1.002) and its planning
+time 8-10 % longer, because its best candidates come closer to the clearance and the
+certified check refuses twice as many (20 against 10 of 100), each a fallback timed and
+verified again."""
 MIN_SIGMA = 1e-4
 """Step below which the refinement ends [share of the range]: 1e-4 of a joint's range is
 below what the timing or the clearance can tell apart."""
@@ -61,6 +73,45 @@ below what the timing or the clearance can tell apart."""
 def population_size(dimension: int) -> int:
     """CMA-ES's default population for ``dimension`` variables: ``4 + floor(3 ln d)``."""
     return 4 + int(3 * math.log(dimension))
+
+
+@dataclass(frozen=True)
+class LearningRates:
+    """The CMA-ES's recombination weights and covariance learning rates (Hansen 2016, sec. A).
+
+    The best half of a generation moves the mean and teaches the covariance its steps
+    (``weights``, summing to 1); with the active update, the worse half unteaches theirs
+    (``negative_weights``, summing to ``-min(1 + c_1 / c_mu, 1 + 2 mu_eff^- / (mu_eff + 2),
+    (1 - c_1 - c_mu) / (d c_mu))``, the last bound keeping the covariance positive definite).
+    """
+
+    weights: FloatArray
+    """``(mu,)`` positive weights of the best half, best first."""
+    negative_weights: FloatArray
+    """``(lambda - mu,)`` weights (<= 0) of the worse half, best first; zeros without the
+    active update."""
+    mu_eff: float
+    """Variance-effective selection mass of the positive weights."""
+    c_1: float
+    """Rank-one learning rate."""
+    c_mu: float
+    """Rank-mu learning rate."""
+
+    @classmethod
+    def of(cls, dimension: int, active: bool = True) -> LearningRates:
+        """The default rates for ``dimension`` variables and :func:`population_size`."""
+        d, lam = dimension, population_size(dimension)
+        mu = lam // 2
+        raw = math.log((lam + 1) / 2) - np.log(np.arange(1, lam + 1))  # > 0 for the best mu
+        weights = raw[:mu] / raw[:mu].sum()
+        mu_eff = 1.0 / float(np.sum(weights**2))
+        c_1 = 2 / ((d + 1.3) ** 2 + mu_eff)
+        c_mu = min(1 - c_1, 2 * (mu_eff - 2 + 1 / mu_eff) / ((d + 2) ** 2 + mu_eff))
+        worse = raw[mu:]
+        mu_eff_negative = float(worse.sum() ** 2 / np.sum(worse**2))
+        mass = min(1 + c_1 / c_mu, 1 + 2 * mu_eff_negative / (mu_eff + 2), (1 - c_1 - c_mu) / (d * c_mu))
+        negative = mass * worse / np.abs(worse).sum() if active else np.zeros(lam - mu)
+        return cls(weights, negative, mu_eff, c_1, c_mu)
 
 
 def cma_refine(
@@ -73,6 +124,7 @@ def cma_refine(
     rng: np.random.Generator,
     sigma: float | None = None,
     stall_generations: int | None = None,
+    active: bool | None = None,
 ) -> SearchResult:
     """Refine ``start`` (value ``start_value``) with a CMA-ES within ``budget`` evaluations.
 
@@ -89,6 +141,8 @@ def cma_refine(
         stall_generations: generations in a row without a relative improvement of
             ``STALL_TOLERANCE`` that end the refinement; 0: run out the budget (or the step);
             default :data:`STALL_GENERATIONS`.
+        active: the active covariance update (:class:`LearningRates`); default
+            :data:`ACTIVE_UPDATE`.
 
     Returns:
         The best of ``start`` and every evaluated point; histories per generation (entry 0:
@@ -111,14 +165,12 @@ def cma_refine(
     d = lo.size
     lam = population_size(d)
     mu = lam // 2
-    weights = np.log(mu + 0.5) - np.log(np.arange(1, mu + 1))
-    weights /= weights.sum()
-    mu_eff = 1.0 / float(np.sum(weights**2))
+    rates = LearningRates.of(d, ACTIVE_UPDATE if active is None else active)
+    weights, negative = rates.weights, rates.negative_weights
+    mu_eff, c_1, c_mu = rates.mu_eff, rates.c_1, rates.c_mu
     c_sigma = (mu_eff + 2) / (d + mu_eff + 5)
     d_sigma = 1 + 2 * max(0.0, math.sqrt((mu_eff - 1) / (d + 1)) - 1) + c_sigma
     c_c = (4 + mu_eff / d) / (d + 4 + 2 * mu_eff / d)
-    c_1 = 2 / ((d + 1.3) ** 2 + mu_eff)
-    c_mu = min(1 - c_1, 2 * (mu_eff - 2 + 1 / mu_eff) / ((d + 2) ** 2 + mu_eff))
     chi_n = math.sqrt(d) * (1 - 1 / (4 * d) + 1 / (21 * d**2))
 
     mean = np.clip((x0 - lo) / span, 0.0, 1.0)
@@ -150,10 +202,16 @@ def cma_refine(
         norm = float(np.linalg.norm(p_sigma))
         h_sigma = norm / math.sqrt(1 - (1 - c_sigma) ** (2 * generation)) < (1.4 + 2 / (d + 1)) * chi_n
         p_c = (1 - c_c) * p_c + h_sigma * math.sqrt(c_c * (2 - c_c) * mu_eff) * step
+        # active update: the worst steps, rescaled to the Mahalanobis norm sqrt(d), shrink
+        # the covariance along them (a constraint's normal, where the worst land)
+        worst = steps[order[mu:]]
+        worst_norms = np.sum((worst @ basis / scales) ** 2, axis=1)
+        worst_weights = negative * d / np.maximum(worst_norms, 1e-20)
         cov = (
-            (1 - c_1 - c_mu) * cov
+            (1 - c_1 - c_mu * (1 + negative.sum())) * cov
             + c_1 * (np.outer(p_c, p_c) + (not h_sigma) * c_c * (2 - c_c) * cov)
             + c_mu * (selected.T * weights) @ selected
+            + c_mu * (worst.T * worst_weights) @ worst
         )
         sigma *= math.exp(min(1.0, (c_sigma / d_sigma) * (norm / chi_n - 1)))
         cov = (cov + cov.T) / 2
