@@ -164,9 +164,10 @@ def cma_refine(
         raise PlanningError(f"sigma = {sigma!r} must be in (0, 1] (a share of each variable's range)")
     d = lo.size
     lam = population_size(d)
-    mu = lam // 2
-    rates = LearningRates.of(d, ACTIVE_UPDATE if active is None else active)
+    active = ACTIVE_UPDATE if active is None else active
+    rates = LearningRates.of(d, active)
     weights, negative = rates.weights, rates.negative_weights
+    mu = weights.size
     mu_eff, c_1, c_mu = rates.mu_eff, rates.c_1, rates.c_mu
     c_sigma = (mu_eff + 2) / (d + mu_eff + 5)
     d_sigma = 1 + 2 * max(0.0, math.sqrt((mu_eff - 1) / (d + 1)) - 1) + c_sigma
@@ -202,17 +203,16 @@ def cma_refine(
         norm = float(np.linalg.norm(p_sigma))
         h_sigma = norm / math.sqrt(1 - (1 - c_sigma) ** (2 * generation)) < (1.4 + 2 / (d + 1)) * chi_n
         p_c = (1 - c_c) * p_c + h_sigma * math.sqrt(c_c * (2 - c_c) * mu_eff) * step
-        # active update: the worst steps, rescaled to the Mahalanobis norm sqrt(d), shrink
-        # the covariance along them (a constraint's normal, where the worst land)
-        worst = steps[order[mu:]]
-        worst_norms = np.sum((worst @ basis / scales) ** 2, axis=1)
-        worst_weights = negative * d / np.maximum(worst_norms, 1e-20)
         cov = (
             (1 - c_1 - c_mu * (1 + negative.sum())) * cov
             + c_1 * (np.outer(p_c, p_c) + (not h_sigma) * c_c * (2 - c_c) * cov)
             + c_mu * (selected.T * weights) @ selected
-            + c_mu * (worst.T * worst_weights) @ worst
         )
+        if active:  # the worst steps, rescaled to the Mahalanobis norm sqrt(d), shrink the
+            # covariance along them (a constraint's normal, where the worst land)
+            worst = steps[order[mu:]]
+            worst_norms = np.sum((worst @ basis / scales) ** 2, axis=1)
+            cov = cov + c_mu * (worst.T * (negative * d / np.maximum(worst_norms, 1e-20))) @ worst
         sigma *= math.exp(min(1.0, (c_sigma / d_sigma) * (norm / chi_n - 1)))
         cov = (cov + cov.T) / 2
         eigenvalues, basis = np.linalg.eigh(cov)
