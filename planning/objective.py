@@ -20,7 +20,7 @@ configurations and against ``margin + verify_step_m``:
   joint leaves its range: ``2 t_max + F`` (our reading of eq. 6).
 - ``clearance`` (default): feasible as eq. 4, except that when the scene leaves the duration
   free, ``t_sol`` is replaced by how fast the path itself can be run (its phase-plane time
-  plus the jerk allowance, :mod:`planning.path_terms`): the search then optimises the
+  plus what the jerk limit adds, :mod:`planning.curves.jerk_window`): the search then optimises the
   trajectory that is executed, not the paper's proxy of stopping at every waypoint;
   infeasible ``2 t_max + t_max (depth / required + excess)``, with ``depth`` the mean
   violation of the required clearance over the samples [m] and ``excess`` the sum of the
@@ -64,7 +64,8 @@ class Breakdown:
         fitness: the objective value.
         t_sol_s: PTP time through the candidate's nodes [s].
         duration_s: how fast the path can be run, with the duration free and the clearance
-            fitness (``nan`` otherwise) [s].
+            fitness, for a feasible candidate (``nan`` otherwise: an infeasible candidate's
+            fitness does not count it, so it is not estimated) [s].
         w_sol: normalised accumulated joint motion of the executed path.
         feasible: no margin violation and no joint beyond its limits.
         effector_violates: the wrist or tool comes closer than the required clearance (with
@@ -134,9 +135,7 @@ class WaypointObjective:
         self.timed = timed
         # with the duration free, the clearance fitness ranks by how fast a path can be run
         self.estimates_duration = not timed and settings.fitness == "clearance" and settings.path == "spline"
-        self.paths = ExecutedPaths(
-            limits, self.q_start, self.q_goal, self.moving, settings, solver, timed, self.estimates_duration
-        )
+        self.paths = ExecutedPaths(limits, self.q_start, self.q_goal, self.moving, settings, solver, timed)
         segments = self.n_waypoints + 1
         self.lower = np.tile(limits.lower[self.moving], self.n_waypoints)
         self.upper = np.tile(limits.upper[self.moving], self.n_waypoints)
@@ -230,11 +229,11 @@ class WaypointObjective:
         checked = ~np.isnan(worst)
         depth = np.where(checked, worst, 0.0).sum(axis=1) / checked.sum(axis=1)
         feasible = ~(effector | links) & (other <= 0.0)
-        time_s = (
-            t_sol
-            if paths.duration_s is None
-            else np.minimum(paths.duration_s, self.t_max - self.settings.ipo)
-        )
+        duration = np.full(len(t_sol), np.nan)
+        time_s = t_sol
+        if self.estimates_duration:  # only a feasible candidate's fitness counts its duration
+            duration[feasible] = self.paths.durations(paths.samples[feasible])
+            time_s = np.minimum(duration, self.t_max - self.settings.ipo)
         base = time_s + np.minimum(w_sol / self.w_max, 1.0) * self.settings.ipo
         if self.settings.fitness == "paper":
             fitness = np.where(
@@ -246,7 +245,7 @@ class WaypointObjective:
         return Breakdown(
             fitness=fitness,
             t_sol_s=t_sol,
-            duration_s=np.full(len(t_sol), np.nan) if paths.duration_s is None else paths.duration_s,
+            duration_s=duration,
             w_sol=w_sol,
             feasible=feasible,
             effector_violates=effector,

@@ -13,10 +13,11 @@ collision query:
   joints and orders a Bernstein bound, :mod:`planning.curves.polynomial_bounds`, cannot
   certify);
 - ``node_deviation``: the spline's largest |y_i - f_i|;
-- ``duration_s``, when the duration is free: how fast the path can be run, the phase-plane
-  time under the velocity and acceleration limits (:mod:`planning.curves.phase_plane`, on
-  the check samples) plus the jerk allowance of :func:`planning.curves.path_timing.time_path`;
-  the final timing comes within a few percent of it.
+
+and, on request (:meth:`ExecutedPaths.durations`, for the candidates whose duration counts),
+how fast each path can be run: the phase-plane time under the velocity and acceleration
+limits on the check samples plus what the jerk limit adds
+(:mod:`planning.curves.jerk_window`); the final timing comes within a few percent of it.
 
 Only joints that move are fitted and sampled: the waypoint joints, and any other joint whose
 goal differs from its start (it moves in the last segment). The rest keep their start value,
@@ -31,11 +32,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from planning.curves.path_timing import jerk_allowance_s
-from planning.curves.phase_plane import sampled_path_times
+from planning.curves.jerk_window import sampled_path_durations
 from planning.curves.piecewise_sampler import PiecewiseSampler
 from planning.curves.polynomial_bounds import DerivativeBounds
 from planning.curves.spline import SepticSplineSolver
+from planning.curves.velocity_caps import ROUNDS, TOLERANCE
 from planning.scene import PlannerSettings
 
 FloatArray = NDArray[np.float64]
@@ -51,7 +52,6 @@ class PathTerms:
         overshoot: ``(S,)`` largest excursion beyond a joint range, relative to the range.
         limit_excess: ``(S,)`` largest |v|, |a| or |j| over its limit, minus 1 (0 within).
         node_deviation: ``(S,)`` largest spline node deviation [rad or m].
-        duration_s: ``(S,)`` how fast each path can be run [s], when estimated.
     """
 
     samples: FloatArray
@@ -59,7 +59,6 @@ class PathTerms:
     overshoot: FloatArray
     limit_excess: FloatArray
     node_deviation: FloatArray
-    duration_s: FloatArray | None = None
 
 
 class ExecutedPaths:
@@ -73,7 +72,6 @@ class ExecutedPaths:
         settings: planner settings (path kind, IPO, samples).
         solver: the septic spline solver on the trajectory's knots.
         timed: the knots are the final timing, so velocity, acceleration and jerk limits apply.
-        estimate_duration: estimate how fast each path can be run (the duration is free).
     """
 
     def __init__(
@@ -85,7 +83,6 @@ class ExecutedPaths:
         settings: PlannerSettings,
         solver: SepticSplineSolver,
         timed: bool,
-        estimate_duration: bool = False,
     ) -> None:
         self.q_start = q_start
         # joints the spline moves; the others stay at their start (= goal) value throughout
@@ -103,9 +100,12 @@ class ExecutedPaths:
             PiecewiseSampler(knots, ipo_times, 8, derivatives=r, first=r) for r in (1, 2, 3)
         )
         self._derivative_bounds = DerivativeBounds(knots, 8, (1, 2, 3))
-        self.estimate_duration = estimate_duration
-        self._fitted_limits = (limits.velocity[self.fitted].copy(), limits.acceleration[self.fitted].copy())
-        self._jerk_allowance_s = jerk_allowance_s(limits.acceleration, limits.jerk)
+        self._fitted_limits = (
+            limits.velocity[self.fitted].copy(),
+            limits.acceleration[self.fitted].copy(),
+            limits.jerk[self.fitted].copy(),
+        )
+        self._window_s = float(np.max(limits.acceleration / limits.jerk))
         self._steps = np.empty((len(ipo_times) - 1, 0))  # reused buffer of IPO steps
         self._tiled: dict[int, tuple[FloatArray, ...]] = {}
 
@@ -147,11 +147,18 @@ class ExecutedPaths:
                     peak = np.abs(values, out=values).max(axis=0) / limits[r, unsure]
                     utilisation[unsure] = np.maximum(utilisation[unsure], peak)
             excess = np.maximum(utilisation.reshape(s, k).max(axis=1) - 1.0, 0.0)
-        duration = None
-        if self.estimate_duration:
-            points = np.ascontiguousarray(samples[:, :, fitted])
-            duration = sampled_path_times(points, *self._fitted_limits) + self._jerk_allowance_s
-        return PathTerms(samples, w_sol, overshoot, excess, deviation, duration)
+        return PathTerms(samples, w_sol, overshoot, excess, deviation)
+
+    def durations(self, samples: FloatArray) -> FloatArray:
+        """``(S,)`` how fast the paths of :attr:`PathTerms.samples` ``(S, K, nq)`` can be run [s].
+
+        The jerk-limited phase-plane estimate of
+        :func:`~planning.curves.jerk_window.sampled_path_durations` with the timing's window
+        widenings (:data:`~planning.curves.velocity_caps.ROUNDS`,
+        :data:`~planning.curves.velocity_caps.TOLERANCE`).
+        """
+        points = np.ascontiguousarray(samples[:, :, self.fitted])
+        return sampled_path_durations(points, *self._fitted_limits, self._window_s, ROUNDS, TOLERANCE)
 
     def _tiles(self, s: int) -> tuple[FloatArray, ...]:
         """Fitted joints' ranges, bounds and ``(3, S k)`` v/a/j limits, repeated for ``s`` candidates."""

@@ -107,10 +107,10 @@ def test_narrowed_timings_meet_the_lowered_acceleration_and_beat_the_uniform_one
 
 
 def test_a_path_whose_fastest_timing_cuts_into_the_margin_runs_narrowed(robot: ck.Robot) -> None:
-    """Generated scene 30 (seed 0): the fastest timings of its best candidates cut into the
-    margin; a narrowed one passes, 34 % shorter than the uniform timing the planner fell back
-    to before."""
-    scene = generate_scenes(31, 0, robot)[30]
+    """Generated scene 4 (seed 2; the only one of 180 of seeds 0-2): the fastest timings of
+    its best candidates cut into the margin; a narrowed one passes, 11 % shorter than the
+    uniform timing the planner fell back to before."""
+    scene = generate_scenes(5, 2, robot)[4]
     result = plan(scene, robot)
     uniform = result.spline.trajectory.time_scaled(uniform_scale(result.spline, result.problem))
     assert result.metrics.timing == "narrowed" and result.verification.accepted
@@ -118,7 +118,7 @@ def test_a_path_whose_fastest_timing_cuts_into_the_margin_runs_narrowed(robot: c
     assert fastest.method == "fastest"
     assert not verify(result.problem, fastest.trajectory, fastest.fit).accepted
     assert result.metrics.min_clearance_m >= scene.safety_margin
-    assert result.trajectory.duration < 0.8 * uniform.duration
+    assert result.trajectory.duration < 0.9 * uniform.duration
     jump, relative = result.trajectory.knot_jumps(4)
     assert np.all((relative < 1e-7) | (jump < 1e-7))
 
@@ -126,11 +126,14 @@ def test_a_path_whose_fastest_timing_cuts_into_the_margin_runs_narrowed(robot: c
 def test_the_search_ranks_candidates_by_a_bound_tight_to_the_executed_duration(
     free_results: list[PlanResult],
 ) -> None:
-    """The fitness's time term (phase plane of the sampled path plus the jerk allowance) is
-    what the executed timing takes, to within 20 %: the search optimises what is executed."""
-    for result in free_results:
-        estimate = float(result.breakdown.duration_s[0])
-        assert 0.8 * result.trajectory.duration <= estimate <= 1.05 * result.trajectory.duration
+    """The fitness's time term (phase plane of the sampled path plus the jerk window's tail,
+    :mod:`planning.curves.jerk_window`) is what the executed timing takes: within 5 % below
+    it (the check samples are coarser than the timing's grid), the median within 2 % (a
+    constant allowance of ``1.25 a / j`` is 4 % short in the median), and at most 20 % above
+    (where the timing's velocity caps find a faster motion than the widened window)."""
+    ratios = [float(result.breakdown.duration_s[0]) / result.trajectory.duration for result in free_results]
+    assert all(0.95 <= ratio <= 1.2 for ratio in ratios), ratios
+    assert abs(float(np.median(ratios)) - 1.0) < 0.02, ratios
 
 
 def test_same_seed_gives_a_byte_identical_trajectory_file(

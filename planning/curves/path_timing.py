@@ -50,11 +50,6 @@ NODE_STEP_S = 0.1
 """Spacing of the trajectory's knots [s]."""
 
 
-def jerk_allowance_s(acceleration: FloatArray, jerk: FloatArray) -> float:
-    """What the moving averages add to the phase-plane time [s]: ``1.25 max_j a_j / j_j``."""
-    return 1.25 * float(np.max(np.asarray(acceleration) / np.asarray(jerk)))
-
-
 def time_path(
     path: Trajectory,
     velocity: FloatArray,

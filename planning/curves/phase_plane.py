@@ -130,7 +130,7 @@ def profile_time(x: FloatArray, du: FloatArray) -> float:
 
 
 @njit
-def _sampled_derivatives(points: FloatArray, v: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+def sampled_derivatives(points: FloatArray, v: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Arc-length steps ``(M - 1,)`` and ``dq/ds``, ``d2q/ds2`` ``(M, nj)`` of a sampled path.
 
     ``s`` measures each joint in seconds at its velocity limit; samples closer than ``1e-9``
@@ -175,13 +175,13 @@ def _sampled_derivatives(points: FloatArray, v: FloatArray) -> tuple[FloatArray,
 def sampled_path_times(points: FloatArray, v: FloatArray, a: FloatArray) -> FloatArray:
     """``(S,)`` fastest rest-to-rest durations [s] along ``S`` sampled paths ``(S, M, nj)``.
 
-    The paths are taken in arc length (:func:`_sampled_derivatives`): a path that creeps
+    The paths are taken in arc length (:func:`sampled_derivatives`): a path that creeps
     in its own parameter (as a rest-to-rest spline does near its ends) is not mistaken for
     one that moves fast.
     """
     times = np.zeros(points.shape[0])
     for s in range(points.shape[0]):
-        steps, d1, d2 = _sampled_derivatives(points[s], v)
+        steps, d1, d2 = sampled_derivatives(points[s], v)
         if len(d1) >= 2:
             times[s] = profile_time(phase_plane_profile(d1, d2, steps, v, a), steps)
     return times

@@ -1,0 +1,127 @@
+"""How long a phase-plane profile takes once its jerk is limited: the fitness's duration estimate.
+
+:func:`~planning.curves.path_timing.time_path` runs each joint's motion along the
+phase-plane profile through two moving averages, of widths ``w`` and ``w / 4``, starting at
+``w = max_j a_j / j_j``, and widens ``w`` while the averaged jerk exceeds its limit
+(:func:`~planning.curves.moving_average.jerk_limited_motion`); the motion lasts the
+profile's time plus ``1.25 w``. Where a joint switches from accelerating to braking at once
+(a move too short to cruise), its acceleration swings by ``2 a`` and the window doubles, so
+the constant allowance ``1.25 a / j`` of the narrowest window underestimates such paths by
+``1.25 a / j`` (0.25 s for the CPR, a tenth of a typical move).
+
+This module repeats the widening on the profile itself. The two averages' jerk is a
+difference of the joint's velocity ``v`` at four instants (the averages of an acceleration
+are differences of its integral)::
+
+    jerk(t) = (v(t) - v(t - w/4) - v(t - w) + v(t - 5w/4)) / (w^2 / 4)
+
+With ``v`` linear between the profile's grid points, its extrema lie where one of the four
+instants meets a grid point, so a few hundred evaluations give it exactly, without the
+timing's fine time grid. :func:`sampled_path_durations` is the batch the fitness calls;
+measured on the 40 paths planned on generated scenes of seed 0, it comes within 1.2 %
+(standard deviation) of the uncapped motion's duration, where the constant allowance is
+4.5 % off (median 4 % short). Not modelled: the timing's velocity caps, which sometimes
+trade a wider window for a short cruise (:mod:`planning.curves.velocity_caps`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from cpr_kin.compiled import njit
+from planning.curves.phase_plane import phase_plane_profile, sampled_derivatives
+
+FloatArray = NDArray[np.float64]
+
+TERMS = ((0.0, 1.0), (0.25, -1.0), (1.0, -1.0), (1.25, 1.0))
+"""The four velocities of the averaged jerk: each one's delay, as a share of the window, and sign."""
+TAIL = 1.25
+"""What the two averages add to the motion's duration, as a share of the window."""
+
+
+@njit
+def averaged_jerk_usage(times: FloatArray, velocity: FloatArray, jerk: FloatArray, window_s: float) -> float:
+    """Largest ``|jerk| / limit`` of the two averages of width ``window_s`` and a quarter of it.
+
+    Args:
+        times: ``(G,)`` increasing instants of the profile's grid [s], from rest to rest.
+        velocity: ``(G, nj)`` joint velocities there [rad/s, m/s].
+        jerk: ``(nj,)`` jerk limits.
+        window_s: the first average's width [s], > 0.
+    """
+    count, joints = velocity.shape
+    scale = 4.0 / window_s**2
+    averaged = np.zeros((count, joints))
+    usage = 0.0
+    for breakpoint, _ in TERMS:  # the instants where one of the four velocities meets a grid point
+        averaged[:] = 0.0
+        for delay, sign in TERMS:
+            offset = (breakpoint - delay) * window_s
+            k = 0  # the grid interval of times[g] + offset, increasing with g
+            for g in range(count):
+                t = times[g] + offset
+                if t <= times[0] or t >= times[-1]:
+                    continue  # at rest before the start and after the end
+                while times[k + 1] < t:
+                    k += 1
+                share = (t - times[k]) / max(times[k + 1] - times[k], 1e-300)
+                for j in range(joints):
+                    averaged[g, j] += sign * (velocity[k, j] + share * (velocity[k + 1, j] - velocity[k, j]))
+        for g in range(count):
+            for j in range(joints):
+                usage = max(usage, abs(averaged[g, j]) * scale / jerk[j])
+    return usage
+
+
+@njit
+def needed_window(
+    times: FloatArray, velocity: FloatArray, jerk: FloatArray, window_s: float, rounds: int, tolerance: float
+) -> tuple[float, float]:
+    """The window the timing ends with, and its jerk usage (the widenings of ``jerk_limited_motion``).
+
+    Each of at most ``rounds`` widenings multiplies the window by the usage (at most 2) while
+    the usage exceeds ``1 + tolerance``.
+    """
+    usage = averaged_jerk_usage(times, velocity, jerk, window_s)
+    for _ in range(rounds):
+        if usage <= 1.0 + tolerance:
+            break
+        window_s *= min(usage, 2.0)
+        usage = averaged_jerk_usage(times, velocity, jerk, window_s)
+    return window_s, usage
+
+
+@njit
+def sampled_path_durations(
+    points: FloatArray,
+    v: FloatArray,
+    a: FloatArray,
+    j: FloatArray,
+    window_s: float,
+    rounds: int,
+    tolerance: float,
+) -> FloatArray:
+    """``(S,)`` durations [s] of the jerk-limited motions along ``S`` sampled paths ``(S, M, nj)``.
+
+    The phase-plane time under the velocity and acceleration limits ``v``, ``a``
+    (:func:`~planning.curves.phase_plane.sampled_path_times`), plus :data:`TAIL` times the
+    window :func:`needed_window` widens to for the jerk limits ``j`` from ``window_s`` (the
+    timing's ``max a / j`` over all the robot's joints) [s], stretched by ``usage^(1/3)``
+    where the last window still exceeds the jerk limit (as the timing's final uniform
+    scaling does).
+    """
+    durations = np.zeros(points.shape[0])
+    for s in range(points.shape[0]):
+        steps, d1, d2 = sampled_derivatives(points[s], v)
+        if len(d1) < 2:
+            continue
+        x = phase_plane_profile(d1, d2, steps, v, a)
+        speed = np.sqrt(np.maximum(x, 0.0))
+        times = np.zeros(x.size)
+        for g in range(x.size - 1):
+            times[g + 1] = times[g] + 2.0 * steps[g] / max(speed[g] + speed[g + 1], 1e-12)
+        velocity = d1 * speed[:, None]
+        window, usage = needed_window(times, velocity, j, window_s, rounds, tolerance)
+        durations[s] = (times[-1] + TAIL * window) * max(1.0, usage ** (1.0 / 3.0))
+    return durations
