@@ -34,7 +34,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cpr_kin.compiled import njit
-from planning.curves.phase_plane import phase_plane_profile, sampled_derivatives
+from planning.curves.phase_plane import phase_plane_profile, profile_instants, sampled_derivatives
 
 FloatArray = NDArray[np.float64]
 
@@ -121,11 +121,8 @@ def sampled_path_durations(
         if len(d1) < 2:
             continue
         x = phase_plane_profile(d1, d2, steps, v, a)
-        speed = np.sqrt(np.maximum(x, 0.0))
-        times = np.zeros(x.size)
-        for g in range(x.size - 1):
-            times[g + 1] = times[g] + 2.0 * steps[g] / max(speed[g] + speed[g + 1], 1e-12)
-        velocity = d1 * speed[:, None]
+        times = profile_instants(x, steps)
+        velocity = d1 * np.sqrt(np.maximum(x, 0.0))[:, None]
         window, usage = needed_window(times, velocity, j, window_s, rounds, tolerance)
         durations[s] = (times[-1] + TAIL * window) * max(1.0, usage ** (1.0 / 3.0))
     return durations

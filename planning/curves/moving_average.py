@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cpr_kin.compiled import njit
+from planning.curves.phase_plane import profile_instants
 
 FloatArray = NDArray[np.float64]
 
@@ -34,9 +35,7 @@ def arc_at_times(x: FloatArray, ds: FloatArray, step_s: float) -> FloatArray:
     """
     count = len(x)
     speed = np.sqrt(np.maximum(x, 0.0))
-    starts = np.zeros(count)  # time at each grid point
-    for g in range(count - 1):
-        starts[g + 1] = starts[g] + 2.0 * ds[g] / max(speed[g] + speed[g + 1], 1e-12)
+    starts = profile_instants(x, ds)  # time at each grid point
     total = starts[-1]
     samples = int(np.ceil(total / step_s - 1e-12)) + 1
     s = np.empty(samples)

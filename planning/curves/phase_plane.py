@@ -121,12 +121,21 @@ def phase_plane_profile(
 
 
 @njit
+def profile_instants(x: FloatArray, du: FloatArray) -> FloatArray:
+    """``(G,)`` instants [s] at which the profile ``x = u'^2`` reaches its grid points (steps ``du``).
+
+    The path acceleration is constant on each step, so a step takes ``2 du / (u'_g + u'_g+1)``.
+    """
+    instants = np.zeros(len(x))
+    for g in range(len(x) - 1):
+        instants[g + 1] = instants[g] + 2.0 * du[g] / max(np.sqrt(x[g]) + np.sqrt(x[g + 1]), _TINY)
+    return instants
+
+
+@njit
 def profile_time(x: FloatArray, du: FloatArray) -> float:
     """Duration [s] of the profile ``x = u'^2`` on a grid of steps ``du`` ``(G - 1,)``."""
-    total = 0.0
-    for g in range(len(x) - 1):
-        total += 2.0 * du[g] / max(np.sqrt(x[g]) + np.sqrt(x[g + 1]), _TINY)
-    return total
+    return float(profile_instants(x, du)[-1])
 
 
 @njit
