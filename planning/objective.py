@@ -42,6 +42,7 @@ The paths themselves (samples, ``w_sol``, range, limit and deviation terms) are 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import NDArray
@@ -166,6 +167,23 @@ class WaypointObjective:
         fractions = np.arange(1, self.n_waypoints + 1) / (self.n_waypoints + 1)
         points = self.q_start + fractions[:, None] * (self.q_goal - self.q_start)
         return np.asarray(points[:, self.moving].ravel())
+
+    @cached_property
+    def lower_bound(self) -> float:
+        """About the least value a feasible candidate can have, obstacles ignored [s].
+
+        With the duration estimated, the straight line's estimate: every path moves each
+        joint at least as far, and the straight line comes within a few percent of the
+        time-optimal motion. Otherwise the direct point-to-point time from start to goal:
+        a segment's trapezoid time is subadditive in its length, so stopping at waypoints
+        never takes less. The refinement's early stop counts only near it
+        (:data:`~planning.search.refinement.NEAR_BOUND`).
+        """
+        if self.estimates_duration:
+            samples = self.paths(self.nodes(self.straight_line())).samples
+            return float(self.paths.durations(samples)[0])
+        direct = np.stack([self.q_start, self.q_goal])
+        return float(ptp_time(direct, self.v_max, self.a_max))
 
     def __call__(self, x: FloatArray) -> FloatArray:
         """``(S,)`` fitness of candidates ``x`` ``(S, p k)`` in joint units."""

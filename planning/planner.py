@@ -175,7 +175,8 @@ def _search(
     With ``refine: cma`` and a feasible best, the firefly's best is refined by a CMA-ES
     (:func:`~planning.search.refinement.refine_search`) within the rest of the budget,
     drawing on the same generator after the firefly, until ``refine_stall`` generations
-    in a row have stalled (0: to the budget).
+    in a row have stalled within :data:`~planning.search.refinement.NEAR_BOUND` times the
+    objective's lower bound (0: to the budget).
     """
     objective, settings = problem.objective, problem.scene.planner
     rng = np.random.default_rng(settings.seed)
@@ -202,6 +203,7 @@ def _search(
         budget,
         rng,
         stall_generations=settings.refine_stall,
+        lower_bound=objective.lower_bound,
     )
 
 

@@ -148,8 +148,10 @@ class PlannerSettings:
             at it refines it within the rest of the evaluation budget
             (:mod:`planning.search.refinement`); ``"none"`` (the paper): the firefly's best.
         refine_stall: generations in a row without a relative improvement of 0.1 % that end
-            the refinement, in [0, ``MAX_ITERATIONS``]; 0: run it to the evaluation budget
-            (better fitness for more planning time, ``scripts/bench_peers.py``); default
+            the refinement, counted once its best is within
+            :data:`~planning.search.refinement.NEAR_BOUND` times the objective's lower bound,
+            in [0, ``MAX_ITERATIONS``]; 0: run it to the evaluation budget (better fitness
+            for more planning time, ``scripts/bench_peers.py``); default
             :data:`~planning.search.refinement.STALL_GENERATIONS`.
     """
 

@@ -83,7 +83,8 @@ def default_search(robot: ck.Robot, scene: Scene, refine_stall: int | None = Non
     budget allows and its early stop, then (from a feasible best) the CMA-ES refinement of
     :mod:`planning.search.refinement` within the rest of the budget, as the planner does
     (``refine_stall``: the refinement's stall generations, as the planner setting of that
-    name; 0 to run it to the budget).
+    name; 0 to run it to the budget), its stalls counted only near the objective's lower
+    bound (:data:`~planning.search.refinement.NEAR_BOUND`).
     The seeding's streams get a seed drawn from ``rng``.
     """
     problem = build_problem(replace(scene, planner=scene.planner.updated(seeding="paths")), robot)
@@ -99,7 +100,10 @@ def default_search(robot: ck.Robot, scene: Scene, refine_stall: int | None = Non
         if found.fitness > bound:
             return found
         left = budget - found.evaluations
-        return refine_search(objective, lower, upper, found, left, rng, stall_generations=refine_stall)
+        floor = getattr(objective, "lower_bound", None)  # a waypoint objective's (the planner passes it)
+        return refine_search(
+            objective, lower, upper, found, left, rng, stall_generations=refine_stall, lower_bound=floor
+        )
 
     return run
 

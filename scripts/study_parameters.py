@@ -7,9 +7,9 @@ evaluations, and the durations relative to the defaults' (geometric mean of the 
 ratios on the scenes both plan, and its spread). The variants change one thing at a time
 from the defaults (:data:`planning.scene.DEFAULT_FIREFLY`, ``seeding: paths`` with
 :data:`planning.seeding.PATH_ATTEMPTS`, ``refine: cma`` with
-:data:`planning.search.refinement.SIGMA`, ``ACTIVE_UPDATE`` and ``refine_stall``); the first
-row is the paper's search (50 fireflies, every iteration, a random population, no
-refinement).
+:data:`planning.search.refinement.SIGMA`, ``ACTIVE_UPDATE``, ``NEAR_BOUND`` and
+``refine_stall``); the first row is the paper's search (50 fireflies, every iteration, a
+random population, no refinement).
 """
 
 from __future__ import annotations
@@ -37,11 +37,15 @@ SIGMA = "refinement sigma"
 """A variant's key for the refinement's initial step (a module constant, not a scene setting)."""
 ACTIVE = "active update"
 """A variant's key for the refinement's active covariance update (a module constant likewise)."""
+NEAR = "near bound"
+"""A variant's key for the ratio to the objective's lower bound within which the refinement's
+stalls count (a module constant likewise)."""
 PATHS = "path attempts"
 """A variant's key for the seeding's most RRT-Connect paths (a module constant likewise)."""
 CONSTANTS: dict[str, tuple[Any, str]] = {
     SIGMA: (refinement, "SIGMA"),
     ACTIVE: (refinement, "ACTIVE_UPDATE"),
+    NEAR: (refinement, "NEAR_BOUND"),
     PATHS: (seeding, "PATH_ATTEMPTS"),
 }
 """Variant keys that patch a module constant: the module and the constant's name."""
@@ -59,6 +63,8 @@ VARIANTS: dict[str, dict[str, Any]] = {
     "refinement stall 8": {"refine_stall": 8},
     "refinement stall 20": {"refine_stall": 20},
     "refinement with the active update": {ACTIVE: True},
+    "refinement stalls counted anywhere": {NEAR: float("inf")},
+    "refinement stalls counted within 1.2x": {NEAR: 1.2},
     "1 path attempt": {PATHS: 1},
     "2 path attempts": {PATHS: 2},
     "5 path attempts": {PATHS: 5},

@@ -1,5 +1,7 @@
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -141,3 +143,33 @@ def test_limit_excess_and_w_sol_match_the_fitted_trajectories(
         deviation = np.abs(trajectory(knots) - nodes).max()
         assert breakdown.node_deviation[candidate] == pytest.approx(deviation, rel=1e-6, abs=1e-12)
     assert (breakdown.limit_excess == 0).any() and (breakdown.limit_excess > 0).any()
+
+
+def test_lower_bound_of_the_ptp_time_is_the_direct_move(
+    paper_objective: WaypointObjective, rng: np.random.Generator
+) -> None:
+    # the slowest joint's trapezoid (or triangle) time from start to goal, written out
+    limits = paper_objective.world.robot.limits
+    distance = np.abs(paper_objective.q_goal - paper_objective.q_start)
+    v, a = limits.velocity, limits.acceleration
+    cruise = distance >= v**2 / a
+    times = np.where(cruise, distance / v + v / a, 2 * np.sqrt(distance / a))
+    assert paper_objective.lower_bound == pytest.approx(times.max(), rel=1e-12)
+    # stopping at waypoints never takes less: the trapezoid time is subadditive
+    x = rng.uniform(paper_objective.lower, paper_objective.upper, (500, 9))
+    assert paper_objective.breakdown(x).t_sol_s.min() >= paper_objective.lower_bound
+
+
+def test_lower_bound_of_the_duration_estimate_is_the_straight_lines(robot: ck.Robot) -> None:
+    from planning.peers.ruckig_bound import free_space_bound
+    from planning.planner import plan
+
+    result = plan(dataclasses.replace(paper_scene(), duration=None, obstacles=()), robot)
+    objective = result.problem.objective
+    assert objective.estimates_duration
+    # with no obstacle the straight line is feasible: the bound is its estimate
+    straight = objective.breakdown(objective.straight_line()[None])
+    assert straight.feasible[0]
+    assert objective.lower_bound == pytest.approx(float(straight.duration_s[0]), rel=1e-12)
+    # within a few percent above Ruckig's time-optimal jerk-limited motion (no path is faster)
+    assert 1.0 <= objective.lower_bound / free_space_bound(result.problem) <= 1.1

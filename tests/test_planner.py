@@ -226,6 +226,32 @@ def test_refine_stall_zero_runs_the_same_refinement_on_to_the_budget(robot: ck.R
         PlannerSettings(refine_stall=-1)
 
 
+def test_the_refinement_stops_early_only_near_the_objectives_lower_bound(robot: ck.Robot) -> None:
+    """Far above the bound the refinement runs on: the same run as counting every stall, longer."""
+    from unittest import mock
+
+    from planning.io.scene_generator import generate_scenes
+    from planning.search import refinement
+
+    scenes = generate_scenes(8, seed=2, robot=robot, narrow=2)
+    went_on = 0
+    for scene in (scenes[0], scenes[5], scenes[7]):
+        with mock.patch.object(refinement, "NEAR_BOUND", np.inf):  # every stall counts
+            counted = plan(scene, robot)
+        result = plan(scene, robot)
+        bound = result.problem.objective.lower_bound
+        assert 0 < bound <= result.trajectory.duration
+        n = len(counted.optimiser.best_history)
+        np.testing.assert_array_equal(result.optimiser.best_history[:n], counted.optimiser.best_history)
+        if counted.optimiser.fitness <= refinement.NEAR_BOUND * bound:  # stopped near it: the same stop
+            assert result.optimiser.evaluations == counted.optimiser.evaluations
+        else:
+            went_on += 1
+            assert result.optimiser.evaluations > counted.optimiser.evaluations
+            assert result.optimiser.fitness < counted.optimiser.fitness
+    assert went_on == 2
+
+
 def test_the_paper_search_does_not_refine() -> None:
     from planning.scene import PAPER_SEARCH
 

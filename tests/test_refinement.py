@@ -6,15 +6,15 @@ import numpy as np
 import pytest
 
 from planning.errors import PlanningError
+from planning.search.cma_rates import LearningRates, population_size
 from planning.search.firefly import firefly_minimize
 from planning.search.firefly_settings import FireflySettings
-from planning.search.optimizer import STALL_TOLERANCE
+from planning.search.optimizer import STALL_TOLERANCE, SearchResult
 from planning.search.refinement import (
     FALLBACK_SPACING,
+    NEAR_BOUND,
     STALL_GENERATIONS,
-    LearningRates,
     cma_refine,
-    population_size,
     refine_search,
 )
 
@@ -215,3 +215,38 @@ def test_refine_search_without_budget_returns_the_search() -> None:
     assert (
         refine_search(ellipsoid, -np.ones(D), np.ones(D), searched, 5, np.random.default_rng(0)) is searched
     )
+
+
+def offset_bowl(x: np.ndarray) -> np.ndarray:
+    """A quadratic bowl whose least value is 1 (at CENTRE's first four coordinates)."""
+    return 1.0 + np.asarray(np.sum((x - CENTRE[:4]) ** 2, axis=1))
+
+
+def test_stalls_count_only_near_the_lower_bound() -> None:
+    x0, f0 = start_of(offset_bowl, np.full(4, 0.9))
+    lam = population_size(4)
+
+    def run(lower_bound: float | None) -> SearchResult:
+        return cma_refine(
+            offset_bowl, np.zeros(4), np.ones(4), x0, f0, 3000, np.random.default_rng(3), 0.05, 2,
+            lower_bound=lower_bound,
+        )  # fmt: skip
+
+    always, near, far = run(None), run(1.0), run(0.5)
+    # the bound 1 is the least value: the stop comes once within NEAR_BOUND of it, as before
+    assert near.fitness <= NEAR_BOUND * 1.0
+    assert near.evaluations < 3000 - lam
+    # counting only from there never stops sooner than counting every stall
+    assert near.evaluations >= always.evaluations
+    # a bound the objective cannot come near: no stall counts, the run ends at the budget or
+    # when its step collapses, and finds the minimum
+    assert far.evaluations > near.evaluations
+    assert far.fitness == pytest.approx(1.0, abs=1e-6)
+
+
+def test_a_lower_bound_must_be_finite() -> None:
+    x0, f0 = start_of(offset_bowl, np.full(4, 0.9))
+    with pytest.raises(PlanningError, match="lower_bound = nan must be a finite number"):
+        cma_refine(
+            offset_bowl, np.zeros(4), np.ones(4), x0, f0, 100, np.random.default_rng(0), lower_bound=np.nan
+        )
