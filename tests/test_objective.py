@@ -162,14 +162,14 @@ def test_lower_bound_of_the_ptp_time_is_the_direct_move(
 
 def test_lower_bound_of_the_duration_estimate_is_the_straight_lines(robot: ck.Robot) -> None:
     from planning.peers.ruckig_bound import free_space_bound
-    from planning.planner import plan
+    from planning.problem import build_problem
 
-    result = plan(dataclasses.replace(paper_scene(), duration=None, obstacles=()), robot)
-    objective = result.problem.objective
+    problem = build_problem(dataclasses.replace(paper_scene(), duration=None, obstacles=()), robot)
+    objective = problem.objective
     assert objective.estimates_duration
     # with no obstacle the straight line is feasible: the bound is its estimate
     straight = objective.breakdown(objective.straight_line()[None])
     assert straight.feasible[0]
     assert objective.lower_bound == pytest.approx(float(straight.duration_s[0]), rel=1e-12)
     # within a few percent above Ruckig's time-optimal jerk-limited motion (no path is faster)
-    assert 1.0 <= objective.lower_bound / free_space_bound(result.problem) <= 1.1
+    assert 1.0 <= objective.lower_bound / free_space_bound(problem) <= 1.1

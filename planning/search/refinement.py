@@ -2,20 +2,20 @@
 
 The firefly explores and finds the basin; near its best point its moves are too coarse to
 descend (a sweep kicks every firefly by about ``alpha sqrt(n) / 2`` per iteration), and its
-early stop ends the search there. A covariance matrix adaptation evolution strategy
-(Hansen 2016, "The CMA Evolution Strategy: A Tutorial", default parameters, with its
-active covariance update) learns the valley's directions from a few generations and walks
-along them, also where the valley does not follow the variables' axes (the tests: a
-rotated quadratic of condition number 1000, where a search that adapts only its step
-length needs about that many times more evaluations). Measured on 100 generated scenes (24 narrow
-passages, generator seeds 0 and 1, ``scripts/bench_search.py``): after 4 stalled firefly
-iterations instead of 8, the refinement makes the trajectories 7-10 % shorter (geometric
-mean) in the same planning time. On the paper objective (``scripts/bench_peers.py``, 10
-seeds), run to the budget of 2550 evaluations, the seeded firefly and this refinement reach
-a median of 2.48 (2.22 with :data:`ACTIVE_UPDATE`), the CMA-ES peer from a random start
-2.50. The default early stop runs as far there: its best stays more than :data:`NEAR_BOUND`
-times the objective's lower bound (when every stall counted, it stopped at 2.81 after about
-230 evaluations).
+early stop ends the search there. A covariance matrix adaptation evolution strategy (Hansen
+2016, "The CMA Evolution Strategy: A Tutorial", default parameters; its active covariance
+update is optional, :data:`ACTIVE_UPDATE`) learns the valley's directions from a few
+generations and walks along them, also where the valley does not follow the variables' axes
+(the tests: a rotated quadratic of condition number 1000, where a search that adapts only
+its step length needs about that many times more evaluations). Measured on 100 generated
+scenes (24 narrow passages, generator seeds 0 and 1, ``scripts/bench_search.py``): after 4
+stalled firefly iterations instead of 8, the refinement makes the trajectories 7-10 %
+shorter (geometric mean) in the same planning time. On the paper objective
+(``scripts/bench_peers.py``, 10 seeds), run to the budget of 2550 evaluations, the seeded
+firefly and this refinement reach a median of 2.48 (2.22 with :data:`ACTIVE_UPDATE`), the
+CMA-ES peer from a random start 2.50. The default early stop runs as far there: its best
+stays more than :data:`NEAR_BOUND` times the objective's lower bound (when every stall
+counted, it stopped at 2.81 after about 230 evaluations).
 
 Written here rather than taken from ``cma`` or ``cmaes``: both import ``scipy.stats``
 (0.6-0.9 s), more than a third of the 1.5 s a plan may take in a new process; the method
