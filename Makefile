@@ -1,23 +1,31 @@
 # The two commands of the README:
 #   make demo   set up .venv and run the paper case
 #   make test   set up .venv (and Chromium, for the viewer test) and run the test suite
-# `make lint` runs ruff and mypy; `make bench` the benchmarks; `make bench-peers` the
-# comparison with peer optimisers and planners (several minutes).
+# Both install the exact versions of requirements/constraints.txt (tested together); the
+# minimum versions a library user needs stay in pyproject.toml.
+#   make lint          ruff and mypy
+#   make wheel-check   build the wheel, install it into a fresh venv, run the CLI and the paper case there
+#   make test-latest   the tests against the newest releases (.venv-latest), and which versions moved
+#   make lock          rewrite requirements/constraints.txt from the newest releases
+#   make bench         the benchmarks; make bench-peers the comparison with peers (minutes)
 
 PYTHON ?= python3
 VENV ?= .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
+CONSTRAINTS := requirements/constraints.txt
+EXTRAS := dev,bench
+# pyroboplan pins pin, matplotlib and toppra to exact versions and needs drake for its
+# trajectory optimisation; its RRT needs none of that: it is installed without its pins
+PYROBOPLAN := pyroboplan>=1.3.1
 
-.PHONY: demo test lint format bench bench-peers clean
+.PHONY: demo test test-fast lint format wheel-check test-latest lock bench bench-peers clean
 
-$(STAMP): pyproject.toml
+$(STAMP): pyproject.toml $(CONSTRAINTS)
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e ".[dev,bench]"
-	# pyroboplan pins pin, matplotlib and toppra to exact versions and needs drake for its
-	# trajectory optimisation; its RRT needs none of that: install it without its pins
-	$(PY) -m pip install --quiet --no-deps "pyroboplan>=1.3.1"
+	$(PY) -m pip install --quiet -c $(CONSTRAINTS) -e ".[$(EXTRAS)]"
+	$(PY) -m pip install --quiet --no-deps -c $(CONSTRAINTS) "$(PYROBOPLAN)"
 	touch $(STAMP)
 
 demo: $(STAMP)
@@ -27,6 +35,9 @@ test: $(STAMP)
 	@sh scripts/ensure_chromium.sh
 	$(PY) -m pytest
 
+test-fast: $(STAMP)
+	$(PY) -m pytest -m "not slow"
+
 lint: $(STAMP)
 	$(PY) -m ruff check .
 	$(PY) -m ruff format --check .
@@ -35,6 +46,28 @@ lint: $(STAMP)
 format: $(STAMP)
 	$(PY) -m ruff format .
 	$(PY) -m ruff check --fix .
+
+# a user's install: the wheel (not the checkout) in a new venv, run from another folder
+wheel-check: $(STAMP)
+	rm -rf build/wheel-check && mkdir -p build/wheel-check/run
+	$(PY) -m pip wheel --quiet --no-deps -w build/wheel-check/dist .
+	$(PYTHON) -m venv build/wheel-check/venv
+	build/wheel-check/venv/bin/python -m pip install --quiet -c $(CONSTRAINTS) build/wheel-check/dist/*.whl
+	cd build/wheel-check/run && ../venv/bin/cpr-plan --help > /dev/null
+	cd build/wheel-check/run && ../venv/bin/cpr-plan paper --out paper
+	cd build/wheel-check/run && ../venv/bin/cpr-plan check "$$(../venv/bin/python -c 'import planning.io.bundled as b; print(b.paper_scene_path())')" paper/trajectory.json
+
+test-latest:
+	rm -rf .venv-latest
+	$(PYTHON) -m venv .venv-latest
+	.venv-latest/bin/python -m pip install --quiet --upgrade pip
+	.venv-latest/bin/python -m pip install --quiet --upgrade -e ".[$(EXTRAS)]"
+	.venv-latest/bin/python -m pip install --quiet --no-deps --upgrade "$(PYROBOPLAN)"
+	.venv-latest/bin/python scripts/dependency_drift.py $(CONSTRAINTS)
+	.venv-latest/bin/python -m pytest
+
+lock: test-latest
+	.venv-latest/bin/python scripts/dependency_drift.py $(CONSTRAINTS) --write
 
 bench: $(STAMP)
 	$(PY) scripts/bench_clearance.py
@@ -48,4 +81,4 @@ bench-peers: $(STAMP)
 	$(PY) scripts/bench_peers.py --scenes 50 --out out/bench_peers.md
 
 clean:
-	rm -rf $(VENV) build *.egg-info .pytest_cache .mypy_cache .ruff_cache
+	rm -rf $(VENV) .venv-latest build *.egg-info .pytest_cache .mypy_cache .ruff_cache

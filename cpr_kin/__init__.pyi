@@ -2,6 +2,7 @@
 
 from .clearance import BatchClearance, Clearance, PairDistance
 from .collision import CollisionWorld
+from .cpr import CPR_JOINTS, TCP_FRAME, load_cpr
 from .errors import CprKinError, JointLimitError, ObstacleError, UnreachableError, UrdfError
 from .ik import tcp_ik
 from .kinematics import frame_poses, frame_positions
@@ -9,7 +10,7 @@ from .limits import JointLimits
 from .motion import CurveCheck, check_curve, check_segment, motion_radii
 from .obstacles import SHAPES, Obstacle
 from .resources import cpr_limits_path, cpr_urdf_path
-from .robot import CPR_JOINTS, GROUPS, TCP_FRAME, Robot, RobotGeometry, load_cpr
+from .robot import GROUPS, Robot, RobotGeometry, load_robot
 
 __all__ = [
     "CPR_JOINTS",
@@ -37,6 +38,7 @@ __all__ = [
     "frame_poses",
     "frame_positions",
     "load_cpr",
+    "load_robot",
     "motion_radii",
     "tcp_ik",
 ]

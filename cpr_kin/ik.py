@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import CprKinError, JointLimitError, UnreachableError
 from cpr_kin.kinematics import frame_positions
-from cpr_kin.robot import TCP_FRAME, Robot
+from cpr_kin.robot import Robot
 
 FloatArray = NDArray[np.float64]
 
@@ -64,7 +64,7 @@ def tcp_ik(robot: Robot, tcp_in_world: ArrayLike, theta4: float = 0.0, theta5: f
     for name, value in (("theta4", theta4), ("theta5", theta5)):
         robot.check_joint(name, value)
 
-    a, b, c = frame_positions(robot, [0.0, 0.0, 0.0, theta4, theta5], TCP_FRAME)
+    a, b, c = frame_positions(robot, [0.0, 0.0, 0.0, theta4, theta5])
     x, y, z = target
     rho_sq = x * x + y * y
     if rho_sq < b * b:

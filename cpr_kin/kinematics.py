@@ -6,7 +6,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
-from cpr_kin.robot import TCP_FRAME, Robot
+from cpr_kin.robot import Robot
 
 FloatArray = NDArray[np.float64]
 
@@ -21,19 +21,20 @@ def _as_batch(robot: Robot, q: ArrayLike) -> tuple[FloatArray, bool]:
     return batch, single
 
 
-def frame_poses(robot: Robot, q: ArrayLike, frame: str = TCP_FRAME) -> FloatArray:
+def frame_poses(robot: Robot, q: ArrayLike, frame: str | None = None) -> FloatArray:
     """Homogeneous transforms ``frame_in_world`` of ``frame`` at configuration(s) ``q``.
 
     Args:
         robot: the robot.
         q: one configuration ``(nq,)`` or a batch ``(N, nq)`` [rad, m].
-        frame: any frame of the model (a link name, ``tcp``, a joint name).
+        frame: any frame of the model (a link name, a joint name); default: the robot's
+            tool-centre point, :attr:`Robot.tcp_frame`.
 
     Returns:
         ``(4, 4)`` for one configuration, ``(N, 4, 4)`` for a batch.
 
     """
-    fid = robot.frame_id(frame)
+    fid = robot.frame_id(robot.tcp_frame if frame is None else frame)
     batch, single = _as_batch(robot, q)
     model, data = robot.model, robot.data
     out = np.empty((len(batch), 4, 4))
@@ -43,7 +44,7 @@ def frame_poses(robot: Robot, q: ArrayLike, frame: str = TCP_FRAME) -> FloatArra
     return out[0] if single else out
 
 
-def frame_positions(robot: Robot, q: ArrayLike, frame: str = TCP_FRAME) -> FloatArray:
+def frame_positions(robot: Robot, q: ArrayLike, frame: str | None = None) -> FloatArray:
     """Positions ``frame_in_world`` [m] of ``frame``: ``(3,)`` or ``(N, 3)``."""
     poses = frame_poses(robot, q, frame)
     return poses[..., :3, 3]

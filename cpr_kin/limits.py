@@ -75,10 +75,39 @@ class JointLimits:
             raise CprKinError(f"unknown joint '{name}'; the robot's joints are {list(self.names)}") from None
 
 
+LIMITS_NAMES = ("{stem}_limits.yaml", "limits.yaml")
+"""Names of the limits file looked for beside a URDF, in order (``{stem}``: the URDF's name
+without ``.urdf``)."""
+
+
+def find_limits_file(
+    urdf_path: Path, default: Path | None = None, names: tuple[str, ...] = LIMITS_NAMES
+) -> Path:
+    """The acceleration and jerk limits file of the URDF at ``urdf_path``.
+
+    The first of ``names`` (default :data:`LIMITS_NAMES`) that exists beside the URDF, else
+    ``default``.
+
+    Raises:
+        UrdfError: none exists and there is no default; the message names every path looked for.
+    """
+    candidates = [urdf_path.parent / name.format(stem=urdf_path.stem) for name in names]
+    for candidate in candidates:
+        if candidate.is_file():
+            return candidate
+    if default is not None:
+        return default
+    looked = ", ".join(f"'{c}'" for c in candidates)
+    raise UrdfError(
+        f"no acceleration and jerk limits for URDF '{urdf_path}': looked for {looked}; write one "
+        "(joint: {velocity, acceleration, jerk}, the format of cpr_kin/urdf/cpr_limits.yaml) or pass its path"
+    )
+
+
 def read_dynamic_limits(
     path: Path, names: tuple[str, ...], urdf_velocity: FloatArray
 ) -> tuple[FloatArray, FloatArray]:
-    """Read acceleration and jerk limits from a ``cpr_limits.yaml``-style file.
+    """Read acceleration and jerk limits from a limits file (the format of ``cpr_limits.yaml``).
 
     The file maps each joint name to ``{velocity, acceleration, jerk}``; ``velocity`` is
     optional and, when given, must agree with the URDF's.

@@ -11,6 +11,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import ObstacleError
+from cpr_kin.names import unprintable
 from cpr_kin.user_files import UserFileError, read_bytes
 
 FloatArray = NDArray[np.float64]
@@ -119,6 +120,11 @@ class Obstacle:
             )
         if not isinstance(self.name, str) or not 0 < len(self.name) <= MAX_NAME_CHARS:
             raise ObstacleError(f"obstacle name {_shown(self.name)} must be 1 to {MAX_NAME_CHARS} characters")
+        character = unprintable(self.name)
+        if character is not None:
+            raise ObstacleError(
+                f"obstacle name {_shown(self.name)} holds {character}; names must be printable text"
+            )
         what = f"obstacle '{self.name}'"
         bound = MAX_COORDINATE_M
         object.__setattr__(self, "xyz", _vector(self.xyz, f"{what} xyz", 3, -bound, bound, "m"))

@@ -1,22 +1,17 @@
 """Paths of the files bundled with the project: the CPR's URDF and its limits.
 
-In a source checkout (and an editable install) they are the repository's ``urdf/`` folder;
-an installed wheel carries the same folder as the package data ``cpr_kin.urdf``.
+They are the package data ``cpr_kin/urdf/``, the same folder in a checkout, an editable
+install and an installed wheel.
 """
 
 from __future__ import annotations
 
-from importlib import resources
 from pathlib import Path
 
 
 def bundled_urdf_dir() -> Path:
     """Folder that holds ``cpr.urdf`` and ``cpr_limits.yaml``."""
-    checkout = Path(__file__).resolve().parent.parent / "urdf"
-    if (checkout / "cpr.urdf").is_file():
-        return checkout
-    # ``cpr_kin.urdf`` has no ``__init__.py``: ask its parent package, whose files() is a plain path
-    return Path(str(resources.files("cpr_kin") / "urdf"))
+    return Path(__file__).resolve().parent / "urdf"
 
 
 def cpr_urdf_path() -> Path:

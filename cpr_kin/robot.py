@@ -1,10 +1,15 @@
-"""The CPR robot: URDF validation and Pinocchio models, built once and reused.
+"""A serial robot from its URDF: Pinocchio models, joint limits and collision groups, built once.
 
-A :class:`Robot` holds the Pinocchio kinematic model, its collision geometry model, the
-joint limits and the two collision groups of DESIGN.md section 3:
+:func:`load_robot` reads a URDF (strict XML, validated by yourdfpy), checks that the planner
+supports it (:mod:`cpr_kin.supported`: joint types, ranges, limits, printable names), builds
+Pinocchio's kinematic, collision and visual models, reads the acceleration and jerk limits
+(:mod:`cpr_kin.limits`) and sorts the collision geometry into two groups:
 
-- ``effector``: the wrist and the tool;
-- ``links``: everything else (base, column, carriage, arm beam).
+- ``effector``: the links named as the effector (wrist and tool);
+- ``links``: everything else.
+
+A robot's preset (:mod:`cpr_kin.cpr` for the CPR) names those links, its tool frame and the
+joints it holds unless asked to move them.
 """
 
 from __future__ import annotations
@@ -19,20 +24,11 @@ import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import CprKinError, JointLimitError, UrdfError
-from cpr_kin.limits import JointLimits, read_dynamic_limits
-from cpr_kin.resources import cpr_limits_path, cpr_urdf_path
+from cpr_kin.limits import JointLimits, find_limits_file, read_dynamic_limits
+from cpr_kin.supported import check_joints, check_limits, check_names
 from cpr_kin.urdf_file import collision_names, is_bundled, parse_urdf, validate_urdf
 
 FloatArray = NDArray[np.float64]
-
-CPR_JOINTS = ("theta1", "d2", "d3", "theta4", "theta5")
-"""Joint names of the CPR, in configuration order."""
-
-TCP_FRAME = "tcp"
-"""Name of the tool-centre-point frame."""
-
-EFFECTOR_LINKS = ("wrist_link", "tool_link")
-"""Links whose collision geometry forms the ``effector`` group; the rest form ``links``."""
 
 GROUPS = ("effector", "links")
 """Collision group names, in the order used by every per-group array."""
@@ -58,9 +54,9 @@ class RobotGeometry:
 
 @dataclass(frozen=True, eq=False)
 class Robot:
-    """The CPR's Pinocchio models, limits and collision groups.
+    """A robot's Pinocchio models, limits and collision groups.
 
-    Build it with :meth:`Robot.load` (or :func:`load_cpr` for the bundled robot).
+    Build it with :func:`load_robot` (or a preset such as :func:`cpr_kin.load_cpr`).
 
     Attributes:
         urdf_path: the URDF it was built from.
@@ -69,6 +65,9 @@ class Robot:
         visual_model: Pinocchio geometry model of the visual shapes.
         limits: joint limits, in configuration order.
         geometries: the robot's collision geometries with their groups.
+        tcp_frame: the tool-centre-point frame (the default frame of the kinematics).
+        wrist_joints: joints a plan holds unless its start and goal differ in them.
+        limits_path: the file the acceleration and jerk limits were read from.
 
     """
 
@@ -79,84 +78,9 @@ class Robot:
     limits: JointLimits
     geometries: tuple[RobotGeometry, ...]
     _data: Any = field(repr=False)
-
-    @classmethod
-    def load(
-        cls,
-        urdf_path: str | Path | None = None,
-        limits_path: str | Path | None = None,
-        validate: bool | None = None,
-    ) -> Robot:
-        """Validate and load a CPR URDF.
-
-        Args:
-            urdf_path: the URDF; default: the bundled ``urdf/cpr.urdf``.
-            limits_path: acceleration/jerk limits YAML; default: ``cpr_limits.yaml`` next to
-                the URDF, else the bundled one.
-            validate: check the URDF's structure with yourdfpy (links, joints, their
-                references). Default: for every URDF but the bundled one, which the test
-                suite validates; this saves each process that loads it about 0.7 s.
-
-        Raises:
-            UrdfError: the file is missing or malformed, or lacks a CPR joint or the tcp frame.
-
-        """
-        path = Path(urdf_path) if urdf_path is not None else cpr_urdf_path()
-        tree = parse_urdf(path)
-        if validate or (validate is None and not is_bundled(path)):
-            validate_urdf(path)
-        try:
-            model, collision_model, visual_model = pin.buildModelsFromUrdf(str(path), str(path.parent))
-        except Exception as exc:  # Pinocchio reports C++ exceptions as RuntimeError/ValueError
-            raise UrdfError(f"Pinocchio cannot build a model from '{path}': {exc}") from None
-
-        names = tuple(model.names[1:])
-        if names != CPR_JOINTS or model.nq != len(CPR_JOINTS):
-            missing = [j for j in CPR_JOINTS if j not in names]
-            raise UrdfError(
-                f"URDF '{path}' has joints {list(names)}; the CPR needs exactly "
-                f"{list(CPR_JOINTS)} in this order" + (f" (missing {missing})" if missing else "")
-            )
-        if not model.existFrame(TCP_FRAME):
-            raise UrdfError(f"URDF '{path}' has no link or frame named '{TCP_FRAME}' (the tool tip)")
-
-        if limits_path is None:
-            beside = path.parent / "cpr_limits.yaml"
-            limits_path = beside if beside.is_file() else cpr_limits_path()
-        velocity = np.array(model.velocityLimit, dtype=float)
-        acceleration, jerk = read_dynamic_limits(Path(limits_path), names, velocity)
-        limits = JointLimits(
-            names=names,
-            lower=np.array(model.lowerPositionLimit, dtype=float),
-            upper=np.array(model.upperPositionLimit, dtype=float),
-            velocity=velocity,
-            acceleration=acceleration,
-            jerk=jerk,
-        )
-
-        names_by_link = collision_names(tree)
-        geometries = []
-        used: dict[str, int] = {}
-        for index, obj in enumerate(collision_model.geometryObjects):
-            link = model.frames[obj.parentFrame].name
-            k = used.get(link, 0)
-            used[link] = k + 1
-            name = names_by_link[link][k]
-            obj.name = name
-            group = "effector" if link in EFFECTOR_LINKS else "links"
-            geometries.append(RobotGeometry(name=name, link=link, group=group, index=index))
-        for group in GROUPS:
-            if not any(g.group == group for g in geometries):
-                raise UrdfError(f"URDF '{path}' has no collision geometry in group '{group}'")
-        return cls(
-            urdf_path=path,
-            model=model,
-            collision_model=collision_model,
-            visual_model=visual_model,
-            limits=limits,
-            geometries=tuple(geometries),
-            _data=model.createData(),
-        )
+    tcp_frame: str = "tcp"
+    wrist_joints: tuple[str, ...] = ()
+    limits_path: Path | None = None
 
     @property
     def joint_names(self) -> tuple[str, ...]:
@@ -239,6 +163,108 @@ class Robot:
         return [g for g in self.geometries if g.group == group]
 
 
-def load_cpr(urdf_path: str | Path | None = None) -> Robot:
-    """Load the CPR (default: the bundled URDF). See :meth:`Robot.load`."""
-    return Robot.load(urdf_path)
+def load_robot(
+    urdf_path: str | Path,
+    limits_path: str | Path | None = None,
+    *,
+    joints: Sequence[str] | None = None,
+    effector_links: Sequence[str] = (),
+    tcp_frame: str = "tcp",
+    wrist_joints: Sequence[str] = (),
+    default_limits: Path | None = None,
+    validate: bool | None = None,
+) -> Robot:
+    """Validate and load the serial robot of a URDF.
+
+    Args:
+        urdf_path: the URDF.
+        limits_path: its acceleration and jerk limits (YAML); default: the file
+            :func:`~cpr_kin.limits.find_limits_file` finds beside the URDF, else
+            ``default_limits``.
+        joints: the joint names the URDF must have, in configuration order (a preset's);
+            default: any.
+        effector_links: links whose collision geometry forms the ``effector`` group.
+        tcp_frame: the tool-centre-point frame, which must exist.
+        wrist_joints: joints a plan holds unless its start and goal differ in them.
+        default_limits: the limits file used when none is given or found beside the URDF.
+        validate: check the URDF's structure with yourdfpy (links, joints, their
+            references). Default: for every URDF but the bundled CPR's, which the test suite
+            validates; this saves each process that loads it about 0.7 s.
+
+    Raises:
+        UrdfError: the file is missing or malformed, a joint or limit the planner does not
+            support, no limits file, or a group or frame missing.
+
+    """
+    path = Path(urdf_path)
+    tree = parse_urdf(path)
+    if validate or (validate is None and not is_bundled(path)):
+        validate_urdf(path)
+    check_names(tree, path)
+    check_joints(tree, path)
+    try:
+        model, collision_model, visual_model = pin.buildModelsFromUrdf(str(path), str(path.parent))
+    except Exception as exc:  # Pinocchio reports C++ exceptions as RuntimeError/ValueError
+        raise UrdfError(f"Pinocchio cannot build a model from '{path}': {exc}") from None
+    if not model.existFrame(tcp_frame):
+        raise UrdfError(f"URDF '{path}' has no link or frame named '{tcp_frame}' (the tool tip)")
+    names = tuple(model.names[1:])
+    if joints is not None and names != tuple(joints):
+        missing = [j for j in joints if j not in names]
+        raise UrdfError(
+            f"URDF '{path}' has joints {list(names)}; this robot needs exactly "
+            f"{list(joints)} in this order" + (f" (missing {missing})" if missing else "")
+        )
+    limits_file = Path(limits_path) if limits_path is not None else find_limits_file(path, default_limits)
+    velocity = np.array(model.velocityLimit, dtype=float)
+    acceleration, jerk = read_dynamic_limits(limits_file, names, velocity)
+    limits = JointLimits(
+        names=names,
+        lower=np.array(model.lowerPositionLimit, dtype=float),
+        upper=np.array(model.upperPositionLimit, dtype=float),
+        velocity=velocity,
+        acceleration=acceleration,
+        jerk=jerk,
+    )
+    check_limits(limits, _units(model), path)
+    geometries = _geometries(model, collision_model, collision_names(tree), set(effector_links))
+    for group in GROUPS:
+        if not any(g.group == group for g in geometries):
+            raise UrdfError(f"URDF '{path}' has no collision geometry in group '{group}'")
+    return Robot(
+        urdf_path=path,
+        model=model,
+        collision_model=collision_model,
+        visual_model=visual_model,
+        limits=limits,
+        geometries=geometries,
+        _data=model.createData(),
+        tcp_frame=tcp_frame,
+        wrist_joints=tuple(wrist_joints),
+        limits_path=limits_file,
+    )
+
+
+def _units(model: Any) -> tuple[str, ...]:
+    """``"rad"`` or ``"m"`` per joint of ``model``."""
+    return tuple(
+        "m" if joint.shortname().removeprefix("JointModel").startswith("P") else "rad"
+        for joint in model.joints[1:]
+    )
+
+
+def _geometries(
+    model: Any, collision_model: Any, names_by_link: dict[str, list[str]], effector: set[str]
+) -> tuple[RobotGeometry, ...]:
+    """The collision geometries, named as in the URDF and sorted into their groups."""
+    geometries = []
+    used: dict[str, int] = {}
+    for index, obj in enumerate(collision_model.geometryObjects):
+        link = model.frames[obj.parentFrame].name
+        k = used.get(link, 0)
+        used[link] = k + 1
+        name = names_by_link[link][k]
+        obj.name = name
+        group = "effector" if link in effector else "links"
+        geometries.append(RobotGeometry(name=name, link=link, group=group, index=index))
+    return tuple(geometries)

@@ -6,13 +6,18 @@ it never raises: every outcome, an unexpected exception included, becomes a
 that dies (a crash in a native library) into the row of the scene that killed it.
 :func:`summary_csv` writes one row per scene.
 
-Statuses and their exit classes (the batch exits with the worst one):
+Statuses and their exit classes are those of :mod:`planning.outcome` (the batch exits with
+the worst one):
 
 - ``ok`` (0): planned, verified, written;
 - ``invalid`` (2): bad input (scene file, robot, settings) or an unwritable output folder;
 - ``no_trajectory`` (3): valid input, but no verified trajectory found;
 - ``error`` (4): an unexpected exception while planning (a bug: please report it);
 - ``crashed`` (4): the worker process died while planning this scene.
+
+A task gets absolute paths (:func:`scene_files`, and the caller's output folder): a worker of
+a Dask cluster runs in a folder of its own, and the scene's own relative paths (``robot:``,
+meshes) are resolved against the scene file.
 """
 
 from __future__ import annotations
@@ -26,10 +31,10 @@ from pathlib import Path
 from typing import Any
 
 import cpr_kin as ck  # lazy (lazy_loader): its modules load in the workers, where they are used
-from planning.errors import NoSolutionError, PlanningError
-from planning.validation import shown
+from cpr_kin.names import escaped
+from planning.errors import PlanningError
+from planning.outcome import STATUS_EXIT, classify
 
-STATUS_EXIT = {"ok": 0, "invalid": 2, "no_trajectory": 3, "error": 4, "crashed": 4}
 RECORD_FIELDS = ("duration", "min_clearance", "t_sol", "fitness", "evaluations", "planning_time_s")
 """The plan record's fields (:func:`planning.io.report.plan_record`) that ``summary.csv`` shows."""
 SUMMARY_FIELDS = ("scene", "status", "exit_class", *RECORD_FIELDS, "task_time_s", "message")
@@ -62,11 +67,11 @@ class BatchItem:
     @classmethod
     def failed(cls, scene: str, status: str, message: str, started: float | None = None) -> BatchItem:
         """A failed scene's row; ``started`` is the task's ``time.perf_counter()`` at its start."""
-        message = " ".join(message.split())
+        message = escaped(" ".join(message.split()))
         if len(message) > MAX_MESSAGE_CHARS:
             message = message[: MAX_MESSAGE_CHARS - 3] + "..."
         elapsed = 0.0 if started is None else time.perf_counter() - started
-        return cls(scene, status, STATUS_EXIT[status], message, None, elapsed)
+        return cls(escaped(scene), status, STATUS_EXIT[status], message, None, elapsed)
 
 
 @lru_cache(maxsize=8)
@@ -95,19 +100,17 @@ def plan_scene_file(path: Path, out: Path, threads: int | None = 1) -> BatchItem
         with OutputFolder(out) as folder:
             result = plan(scene, _robot(scene.robot), threads=threads)
             folder.publish(plan_files(result))
-    except NoSolutionError as exc:
-        return BatchItem.failed(name, "no_trajectory", str(exc), started)
-    except (PlanningError, ck.CprKinError) as exc:
-        return BatchItem.failed(name, "invalid", str(exc), started)
-    except OSError as exc:
-        return BatchItem.failed(name, "invalid", f"cannot write '{out}': {exc.strerror or exc}", started)
-    except Exception as exc:  # a bug: this scene's row says so, the batch goes on
-        return BatchItem.failed(name, "error", f"{type(exc).__name__}: {shown(str(exc))}", started)
-    return BatchItem(name, "ok", 0, record=plan_record(result), task_time_s=time.perf_counter() - started)
+    except Exception as exc:  # every outcome is a row (a bug's too): the batch goes on
+        outcome = classify(exc)
+        return BatchItem.failed(name, outcome.status, outcome.message, started)
+    return BatchItem(
+        escaped(name), "ok", 0, record=plan_record(result), task_time_s=time.perf_counter() - started
+    )
 
 
 def scene_files(folder: Path) -> list[Path]:
-    """The scene files (``*.yaml``, ``*.yml``) of ``folder``, sorted by name."""
+    """The scene files (``*.yaml``, ``*.yml``) of ``folder``, sorted by name, as absolute paths."""
+    folder = folder.absolute()
     if not folder.is_dir():
         raise PlanningError(f"scene folder '{folder}' does not exist or is not a folder")
     files = sorted(p for p in folder.iterdir() if p.suffix in (".yaml", ".yml") and p.is_file())

@@ -10,11 +10,13 @@ scene is a future of its own; the scheduler retries a task whose worker died and
 ``KilledWorker`` when it keeps killing them.
 
 ``Ctrl-C`` (or ``SIGTERM``, which the CLI turns into the same) stops the pool at once,
-killing its workers; :func:`run_batch` then returns the scenes done, ``interrupted``.
+killing its workers; :func:`run_batch` then returns every scene that finished (also those
+whose result had not yet been collected), ``interrupted``.
 """
 
 from __future__ import annotations
 
+import ipaddress
 import time
 from collections import deque
 from collections.abc import Callable, Sequence
@@ -22,6 +24,7 @@ from concurrent.futures import FIRST_COMPLETED, Future, wait
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+from urllib.parse import urlsplit
 
 from planning.batch import BatchItem, plan_scene_file
 from planning.errors import PlanningError
@@ -82,8 +85,21 @@ def _run_local(
                     done(index, _alone(task, tasks[index]))
                 executor = get_reusable_executor(max_workers=workers)
     except BaseException:
+        _harvest({future: index for future, index in in_flight.items() if future.done()}, tasks, done)
         executor.shutdown(wait=False, kill_workers=True)
         raise
+
+
+def _harvest(
+    finished: dict[Any, int], tasks: Sequence[tuple[Path, Path]], done: Callable[[int, BatchItem], None]
+) -> None:
+    """Record the scenes of ``finished`` futures that completed, when a batch is interrupted."""
+    for future, index in finished.items():
+        try:
+            item = future.result(timeout=1)
+        except BaseException:  # cancelled, failed or still running: not a finished scene
+            continue
+        done(index, item)
 
 
 def _alone(task: Task, arguments: tuple[Path, Path]) -> BatchItem:
@@ -117,9 +133,11 @@ def _run_dask(
         futures: dict[Any, int] = {
             client.submit(task, *arguments, pure=False): index for index, arguments in enumerate(tasks)
         }
+        recorded: set[int] = set()
         try:
             for future in as_completed(futures):  # type: ignore[no-untyped-call]
                 index, name = futures[future], tasks[futures[future]][0].stem
+                recorded.add(index)
                 try:
                     item = future.result()
                 except KilledWorker:
@@ -130,8 +148,44 @@ def _run_dask(
                     item = BatchItem.failed(name, "error", f"{type(exc).__name__}: {shown(str(exc))}")
                 done(index, item)
         except BaseException:
+            finished = {f: i for f, i in futures.items() if i not in recorded and f.status == "finished"}
+            _harvest(finished, tasks, done)
             client.cancel(list(futures))  # type: ignore[no-untyped-call]
             raise
+
+
+SCHEDULER_PROTOCOLS = ("tcp", "tls", "ws", "wss", "inproc", "ucx")
+"""Protocols of a ``dask.distributed`` scheduler address."""
+
+
+def check_scheduler(address: str) -> None:
+    """Refuse a scheduler address that is not ``PROTOCOL://HOST[:PORT]`` at once (no connection tried).
+
+    Raises:
+        PlanningError: an unknown protocol, no host, an invalid IP address or a port outside
+            1-65535.
+    """
+    protocols = ", ".join(SCHEDULER_PROTOCOLS)
+    expected = f"expected PROTOCOL://HOST:PORT, e.g. tcp://127.0.0.1:8786 (PROTOCOL: {protocols})"
+    parts = urlsplit(address)
+    if parts.scheme not in SCHEDULER_PROTOCOLS or not parts.hostname:
+        raise PlanningError(f"--scheduler = {shown(address)} is not a scheduler address; {expected}")
+    try:
+        port = parts.port
+    except ValueError:
+        port = -1
+    if port is not None and not 1 <= port <= 65535:
+        raise PlanningError(f"--scheduler = {shown(address)}: the port must be in [1, 65535]; {expected}")
+    host = parts.hostname
+    if all(c.isdigit() or c == "." for c in host) or ":" in host:
+        try:
+            ipaddress.ip_address(host)
+        except ValueError:
+            raise PlanningError(f"--scheduler = {shown(address)}: '{host}' is not an IP address") from None
+    elif not all(
+        label and len(label) <= 63 and label.replace("-", "").isalnum() for label in host.split(".")
+    ):
+        raise PlanningError(f"--scheduler = {shown(address)}: {shown(host)} is not a host name")
 
 
 def run_batch(

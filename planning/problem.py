@@ -25,8 +25,6 @@ from planning.scene import Scene
 
 FloatArray = NDArray[np.float64]
 
-WRIST_JOINTS = ("theta4", "theta5")
-
 
 @dataclass(frozen=True)
 class Problem:
@@ -59,15 +57,16 @@ class Problem:
 def moving_joints(robot: ck.Robot, scene: Scene, q_start: FloatArray, q_goal: FloatArray) -> NDArray[np.intp]:
     """Indices of the joints a plan moves.
 
-    ``scene.planner.moving_joints``, or theta1, d2, d3 and each wrist joint whose start and
-    goal values differ.
+    ``scene.planner.moving_joints``, or every joint but the robot's wrist joints
+    (:attr:`cpr_kin.Robot.wrist_joints`; the CPR's theta4 and theta5) whose start and goal
+    values agree.
     """
     names = scene.planner.moving_joints
     if names is None:
         names = tuple(
             n
             for i, n in enumerate(robot.joint_names)
-            if n not in WRIST_JOINTS or not np.isclose(q_start[i], q_goal[i])
+            if n not in robot.wrist_joints or not np.isclose(q_start[i], q_goal[i])
         )
     if not names:
         raise PlanningError("moving_joints is empty; name at least one joint the waypoints may move")

@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
+from cpr_kin.names import unprintable
 from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError
 from planning.search.firefly_settings import MAX_ITERATIONS, FireflySettings
@@ -256,6 +257,13 @@ class Scene:
     name: str = "scene"
 
     def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name:
+            raise PlanningError(f"scene name {shown(self.name)} must be a non-empty text")
+        character = unprintable(self.name)
+        if character is not None:
+            raise PlanningError(
+                f"scene name {shown(self.name)} holds {character}; names must be printable text"
+            )
         number_in("safety_margin", self.safety_margin, 0.0, MAX_SAFETY_MARGIN_M, unit="m")
         object.__setattr__(self, "obstacles", tuple(self.obstacles))
         if len(self.obstacles) > MAX_OBSTACLES:

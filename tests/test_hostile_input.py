@@ -9,6 +9,7 @@ took (``scripts/bench_hostile.py`` prints the actual times).
 from __future__ import annotations
 
 import json
+import re
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -32,6 +33,7 @@ BOMB = (  # 9 levels of 9 aliases: 9^9 = 387 million strings once expanded
     + GOOD
 )
 TIME_BOUND_S = 5.0
+NESTING = re.compile(r"scene file '.*scene\.yaml'.* line 1\b.*nest")
 
 
 def flat_mesh(folder: Path) -> str:
@@ -41,15 +43,14 @@ def flat_mesh(folder: Path) -> str:
     return GOOD + "obstacles: [{shape: mesh, mesh: flat.stl, xyz: [0.3, 0.3, 0.4]}]\n"
 
 
-CASES: list[tuple[str, Callable[[Path], str], str]] = [
+CASES: list[tuple[str, Callable[[Path], str], str | re.Pattern[str]]] = [
     ("alias bomb", lambda _: BOMB, "line 1: anchors (&name) are not allowed"),
     ("alias", lambda _: GOOD + "x: &m 0.1\nsafety_margin: *m\n", "anchors (&name) are not allowed"),
-    (
-        "deep nesting",
-        lambda _: "a: " + "[" * 100_000 + "]" * 100_000 + "\n",
-        "nested more than 16 levels deep",
-    ),
-    ("nesting 2000", lambda _: "a: " + "[" * 2_000 + "]" * 2_000 + "\n", "nested more than 16 levels deep"),
+    # our scan stops nesting beyond 16 levels; a newer PyYAML's scanner may stop it first (at
+    # 1000), in its own words: either way exit 2 with the file and the line named
+    ("deep nesting", lambda _: "a: " + "[" * 100_000 + "]" * 100_000 + "\n", NESTING),
+    ("nesting 2000", lambda _: "a: " + "[" * 2_000 + "]" * 2_000 + "\n", NESTING),
+    ("nesting 17", lambda _: GOOD + "x: " + "[" * 17 + "]" * 17 + "\n", "line 3: nested more than 16 levels"),
     (
         "duplicate key",
         lambda _: GOOD + CRATE + "obstacles: []\n",
@@ -168,13 +169,17 @@ def run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, 
 
 @pytest.mark.parametrize(("label", "make", "message"), CASES, ids=[c[0] for c in CASES])
 def test_a_hostile_scene_exits_2_at_once_naming_the_field(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str], label: str, make: Callable[[Path], str], message: str
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    label: str,
+    make: Callable[[Path], str],
+    message: str | re.Pattern[str],
 ) -> None:
     scene = write(tmp_path, make(tmp_path))
     out = tmp_path / "out"
     code, stdout, stderr, elapsed = run(["plan", str(scene), "--out", str(out)], capsys)
     assert code == 2, label
-    assert message in stderr, stderr
+    assert message.search(stderr) if isinstance(message, re.Pattern) else message in stderr, stderr
     assert stderr.count("\n") == 1 and len(stderr) < 300 and "Traceback" not in stderr and stdout == ""
     assert not out.exists() and elapsed < TIME_BOUND_S
 

@@ -64,13 +64,13 @@ def test_user_urdf_is_validated_by_yourdfpy(tmp_path: Path) -> None:
     path.write_text(URDF_TEXT.replace('type="revolute"', 'type="hinge"', 1))
     with pytest.raises(ck.UrdfError, match=r"hinge\.urdf' is invalid: .*'type' attribute"):
         ck.load_cpr(path)
-    with pytest.raises(ck.UrdfError, match="Pinocchio cannot build a model"):
-        ck.Robot.load(path, validate=False)
+    with pytest.raises(ck.UrdfError, match="joint 'theta1' is of type 'hinge'; supported"):
+        ck.load_cpr(path, validate=False)
 
 
 def test_bundled_urdf_passes_yourdfpy_validation() -> None:
     # loading the bundled URDF skips the validation (0.7 s of importing trimesh): this is its check
-    robot = ck.Robot.load(validate=True)
+    robot = ck.load_cpr(validate=True)
     assert robot.joint_names == ck.CPR_JOINTS
 
 

@@ -2,6 +2,6 @@
 
 import sys
 
-from planning.cli.app import main
+from planning.cli.app import console_main
 
-sys.exit(main())
+sys.exit(console_main())

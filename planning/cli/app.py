@@ -4,15 +4,16 @@ from __future__ import annotations
 
 import argparse
 import os
-import signal
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 
+from cpr_kin.names import escaped
 from planning.cli.batch_command import cmd_batch
-from planning.cli.failure import EXIT_INTERNAL, EXIT_INTERRUPTED, CommandError
 from planning.cli.file_commands import cmd_check, cmd_show
 from planning.cli.plan_commands import cmd_paper, cmd_plan
+from planning.cli.signals import interrupts
+from planning.outcome import EXIT_INTERRUPTED, Interrupted, classify
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -94,14 +95,20 @@ def build_parser() -> argparse.ArgumentParser:
     sub.add_argument(
         "--collision", action="store_true", help="show the collision geometry instead of the visual one"
     )
+    sub.add_argument(
+        "--urdf",
+        type=Path,
+        help="the robot's URDF when the one the file records is not here ('cpr': the bundled CPR)",
+    )
     sub.set_defaults(run=cmd_show)
 
     sub = commands.add_parser(
         "batch",
         help="plan every scene of a folder in parallel",
         description="Plan every *.yaml scene of SCENES_DIR in parallel (local processes, or a Dask cluster), "
-        "writing DIR/<scene>/ outputs and DIR/summary.csv. A failing scene never stops the others. Exit 0 "
-        "when every scene planned, 3 when any failed, 2 for an invalid folder or scheduler.",
+        "writing DIR/<scene>/ outputs and DIR/summary.csv. A failing scene never stops the others. Exits "
+        "with the worst scene's code (0 all planned, 2 invalid, 3 no trajectory, 4 a bug or a crashed "
+        "worker), 2 for an invalid folder or scheduler, 130 when interrupted.",
     )
     sub.add_argument("scenes", type=Path, metavar="SCENES_DIR", help="folder of scene files")
     sub.add_argument("--out", required=True, help="output folder (a subfolder per scene, and summary.csv)")
@@ -119,36 +126,44 @@ MAX_ERROR_CHARS = 300
 
 
 def _one_line(text: str) -> str:
-    text = " ".join(text.split())
+    text = escaped(" ".join(text.split()))
     return text if len(text) <= MAX_ERROR_CHARS else text[: MAX_ERROR_CHARS - 3] + "..."
 
 
-def _stop(signum: int, _frame: object) -> None:
-    raise KeyboardInterrupt(signal.Signals(signum).name)
-
-
-def main(argv: Sequence[str] | None = None) -> int:
+def main(argv: Sequence[str] | None = None, *, restore_signals: bool = True) -> int:
     """Entry point of ``cpr-plan``; returns the exit code.
 
-    ``SIGINT`` and ``SIGTERM`` stop any command cleanly (exit 130; nothing half-written),
-    also when the shell started it with ``SIGINT`` ignored (``cpr-plan batch ... &``). An
-    unexpected exception is a bug: one line and exit 4; ``CPR_PLAN_TRACEBACK=1`` shows it whole.
+    Every failure is classified once (:func:`planning.outcome.classify`): exit 2 for invalid
+    input, 3 for no trajectory, 130 when ``SIGINT`` or ``SIGTERM`` stopped the command (also
+    inside compiled code, and when a shell started it with ``SIGINT`` ignored), 4 for an
+    unexpected exception, a bug (``CPR_PLAN_TRACEBACK=1`` shows it whole). One line on
+    stderr, never a traceback. ``restore_signals=False`` (the installed command) ignores a
+    signal that comes once the command is over.
     """
     args = build_parser().parse_args(argv)
-    for signum in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(signum, _stop)
-    try:
-        code: int = args.run(args)
-    except CommandError as failure:
-        print(_one_line(f"cpr-plan {args.command}: error: {failure}"), file=sys.stderr)
-        return failure.code
-    except KeyboardInterrupt:
-        print(f"cpr-plan {args.command}: interrupted; nothing written", file=sys.stderr)
-        return EXIT_INTERRUPTED
-    except Exception as exc:
-        if os.environ.get("CPR_PLAN_TRACEBACK"):
+    label = f"cpr-plan {args.command}"
+    with interrupts(restore=restore_signals) as signalled:
+        try:
+            code: int = args.run(args)
+        except SystemExit:
             raise
-        bug = f"cpr-plan {args.command}: internal error (a bug; please report it with the input)"
-        print(_one_line(f"{bug}: {type(exc).__name__}: {exc}"), file=sys.stderr)
-        return EXIT_INTERNAL
+        except BaseException as exc:
+            outcome = classify(exc)
+            if outcome.status == "interrupted" or signalled():
+                said = str(exc) if isinstance(exc, Interrupted) else "interrupted; nothing written"
+                print(_one_line(f"{label}: {said}"), file=sys.stderr)
+                return EXIT_INTERRUPTED
+            if outcome.status == "error":
+                if os.environ.get("CPR_PLAN_TRACEBACK"):
+                    raise
+                bug = f"{label}: internal error (a bug; please report it with the input)"
+                print(_one_line(f"{bug}: {outcome.message}"), file=sys.stderr)
+            else:
+                print(_one_line(f"{label}: error: {outcome.message}"), file=sys.stderr)
+            return outcome.exit_code
     return code
+
+
+def console_main() -> int:
+    """The installed ``cpr-plan`` (and ``python -m planning.cli``): :func:`main`, late signals ignored."""
+    return main(restore_signals=False)

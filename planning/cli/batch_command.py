@@ -9,49 +9,43 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from planning.cli.failure import EXIT_INTERRUPTED, EXIT_INVALID, CommandError
+from cpr_kin.names import escaped
 from planning.cli.terminal import terminal_bar
-from planning.errors import PlanningError
+from planning.outcome import EXIT_INTERRUPTED
 
 
 def cmd_batch(args: argparse.Namespace) -> int:
     """Plan every scene of a folder; ``summary.csv`` lists each scene's outcome.
 
-    The exit code is the worst scene's class (0, 2, 3 or 4; see :mod:`planning.batch`), or
-    130 when interrupted; ``summary.csv`` is written in every case, for the scenes done.
+    Every path (the scene folder, ``--out``) is made absolute here, before any work is sent:
+    a worker of a Dask cluster runs in a folder of its own. The exit code is the worst
+    scene's (0, 2, 3 or 4; :mod:`planning.outcome`), or 130 when interrupted;
+    ``summary.csv`` is written in every case, for the scenes done.
     """
     from planning import batch
-    from planning.batch_pool import run_batch
+    from planning.batch_pool import check_scheduler, run_batch
     from planning.io.publish import FolderLock, write_file
     from planning.io.report import text_table
 
-    out = Path(args.out) if str(args.out).strip() else args.out
-    bar: Any = None
-    try:
-        paths = batch.scene_files(args.scenes)
-        with FolderLock(out):
-            if sys.stdout.isatty() and not args.json:
-                bar = terminal_bar(len(paths), "scenes", "scene")
-            tick = None if bar is None else (lambda _item: bar.update(1))
-            run = run_batch(paths, Path(out), args.workers, args.scheduler, tick)
-            if bar is not None:
-                bar.close()
-            write_file(Path(out) / "summary.csv", batch.summary_csv(run.items))
-    except PlanningError as exc:
-        raise CommandError(EXIT_INVALID, str(exc)) from None
-    except OSError as exc:
-        raise CommandError(EXIT_INVALID, f"cannot write to '{out}': {exc.strerror or exc}") from None
+    if args.scheduler is not None:
+        check_scheduler(args.scheduler)
+    paths = batch.scene_files(args.scenes)
+    with FolderLock(args.out) as lock:
+        out = lock.target  # absolute: the workers write there, wherever they run
+        bar: Any = None
+        if sys.stdout.isatty() and not args.json:
+            bar = terminal_bar(len(paths), "scenes", "scene")
+        tick = None if bar is None else (lambda _item: bar.update(1))
+        run = run_batch(paths, out, args.workers, args.scheduler, tick)
+        if bar is not None:
+            bar.close()
+        write_file(out / "summary.csv", batch.summary_csv(run.items))
     items = run.items
     failed = [i for i in items if i.status != "ok"]
     if args.json:
+        summary = {"scenes": len(paths), "done": len(items), "ok": len(items) - len(failed)}
         items_json = [dataclasses.asdict(i) for i in items]
-        summary = {
-            "scenes": len(paths),
-            "done": len(items),
-            "ok": len(items) - len(failed),
-            "items": items_json,
-        }
-        print(json.dumps({**summary, "interrupted": run.interrupted}, indent=1))
+        print(json.dumps({**summary, "items": items_json, "interrupted": run.interrupted}, indent=1))
     else:
         rows = []
         for item in items:
@@ -69,7 +63,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
             )
         print(text_table(rows, ("scene", "status", "exit", "duration", "clearance", "time")))
         planned = f"{len(items) - len(failed)}/{len(paths)} scenes planned"
-        print(f"{planned}; summary: {Path(out) / 'summary.csv'}")
+        print(escaped(f"{planned}; summary: {Path(args.out) / 'summary.csv'}"))
         for item in failed:
             print(f"  {item.scene} (exit class {item.exit_class}): {item.message}")
     if run.interrupted:

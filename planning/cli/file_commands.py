@@ -4,14 +4,14 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 import time
 from pathlib import Path
 
 import cpr_kin as ck  # lazy (lazy_loader): only the modules a command uses are imported
-from planning.cli.failure import EXIT_INVALID, EXIT_NO_TRAJECTORY, EXIT_OK, CommandError
+from cpr_kin.names import escaped
 from planning.cli.plan_commands import load
 from planning.errors import PlanningError
+from planning.outcome import EXIT_NO_TRAJECTORY, EXIT_OK
 
 
 def cmd_check(args: argparse.Namespace) -> int:
@@ -21,16 +21,12 @@ def cmd_check(args: argparse.Namespace) -> int:
     from planning.verification import verify_trajectory
 
     scene = load(args.scene)
-    try:
-        document = read_trajectory(args.trajectory)
-        problem = build_problem(scene)
-    except (PlanningError, ck.CprKinError) as exc:
-        raise CommandError(EXIT_INVALID, str(exc)) from None
+    document = read_trajectory(args.trajectory)
+    problem = build_problem(scene)
     robot = problem.robot
     if document.joint_names != robot.joint_names:
-        raise CommandError(
-            EXIT_INVALID,
-            f"trajectory joints {list(document.joint_names)} are not the robot's {list(robot.joint_names)}",
+        raise PlanningError(
+            f"trajectory joints {list(document.joint_names)} are not the robot's {list(robot.joint_names)}"
         )
     verification = verify_trajectory(
         problem.world,
@@ -43,14 +39,31 @@ def cmd_check(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(verification.to_record(), indent=1))
     elif problems:
-        print(f"{args.trajectory}: FAILS {args.scene}:\n  " + "\n  ".join(problems))
+        print(escaped(f"{args.trajectory}: FAILS {args.scene}:\n  " + "\n  ".join(problems)))
     else:
         print(
-            f"{args.trajectory}: verified against {args.scene}: "
-            f"certified clearance {check.certified_min_m:.4f} m "
-            f">= {scene.safety_margin} m over {len(check.times)} checks, joints within range and limits"
+            escaped(
+                f"{args.trajectory}: verified against {args.scene}: "
+                f"certified clearance {check.certified_min_m:.4f} m "
+                f">= {scene.safety_margin} m over {len(check.times)} checks, joints within range and limits"
+            )
         )
     return EXIT_OK if not problems else EXIT_NO_TRAJECTORY
+
+
+def shown_robot(recorded: str, urdf: Path | None) -> ck.Robot:
+    """The robot to draw: ``urdf`` if given, else the URDF the trajectory file records.
+
+    Raises:
+        PlanningError: the recorded URDF is not on this machine (and no ``urdf`` given).
+    """
+    path = urdf if urdf is not None else Path(recorded)
+    if urdf is None and not path.is_file():
+        raise PlanningError(
+            f"the trajectory's robot URDF '{recorded}' is not on this machine; "
+            "pass the robot with --urdf PATH (the bundled CPR: --urdf cpr)"
+        )
+    return ck.load_cpr(None if str(path) == "cpr" else path)
 
 
 def cmd_show(args: argparse.Namespace) -> int:
@@ -60,30 +73,20 @@ def cmd_show(args: argparse.Namespace) -> int:
     from planning.io.trajectory_reader import read_trajectory
     from planning.viz import artifacts
 
-    try:
-        document = read_trajectory(args.trajectory)
-        scene = parse_scene(document.scene, source=f"{args.trajectory} (scene)")
-        recorded = Path(document.robot)
-        if not recorded.is_file():
-            print(
-                f"cpr-plan show: note: the recorded URDF '{recorded}' is not here; using the bundled CPR",
-                file=sys.stderr,
-            )
-        robot = ck.load_cpr(recorded if recorded.is_file() else None)
-        world = ck.CollisionWorld(robot, scene.obstacles)
-    except (PlanningError, ck.CprKinError) as exc:
-        raise CommandError(EXIT_INVALID, str(exc)) from None
+    document = read_trajectory(args.trajectory)
+    scene = parse_scene(document.scene, source=f"{args.trajectory} (scene)")
+    robot = shown_robot(document.robot, args.urdf)
+    if robot.joint_names != document.joint_names:
+        raise PlanningError(
+            f"trajectory joints {list(document.joint_names)} are not the robot's {list(robot.joint_names)}"
+        )
+    world = ck.CollisionWorld(robot, scene.obstacles)
     if args.html is not None:
         html = artifacts.viewer_html(
             world, scene.safety_margin, document.trajectory, document.waypoints, args.collision
         )
-        try:
-            written = write_file(args.html, html)
-        except PlanningError as exc:
-            raise CommandError(EXIT_INVALID, str(exc)) from None
-        except OSError as exc:
-            raise CommandError(EXIT_INVALID, f"cannot write '{args.html}': {exc.strerror or exc}") from None
-        print(f"wrote {written} (self-contained; open it in a browser)")
+        written = write_file(args.html, html)
+        print(escaped(f"wrote {written} (self-contained; open it in a browser)"))
         return EXIT_OK
     from planning.viz.viewer import Viewer
 

@@ -9,10 +9,9 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import cpr_kin as ck  # lazy (lazy_loader): only the modules a command uses are imported
-from planning.cli.failure import EXIT_INVALID, EXIT_NO_TRAJECTORY, EXIT_OK, CommandError
+from cpr_kin.names import escaped
 from planning.cli.terminal import firefly_progress
-from planning.errors import NoSolutionError, PlanningError
+from planning.outcome import EXIT_OK, Interrupted, interruption
 
 if TYPE_CHECKING:
     from planning.scene import Scene
@@ -22,13 +21,10 @@ OVERRIDES = ("seed", "fitness", "fireflies", "iterations")
 
 
 def load(path: Path) -> Scene:
-    """The scene file at ``path``, or a :class:`CommandError` (exit 2) naming what is wrong."""
+    """The scene file at ``path`` (a :class:`~planning.errors.SceneError` names what is wrong)."""
     from planning.io.scene_file import load_scene
 
-    try:
-        return load_scene(path)
-    except PlanningError as exc:
-        raise CommandError(EXIT_INVALID, str(exc)) from None
+    return load_scene(path)
 
 
 def _plan_and_write(scene: Scene, out: str, args: argparse.Namespace, paper: bool) -> int:
@@ -41,30 +37,28 @@ def _plan_and_write(scene: Scene, out: str, args: argparse.Namespace, paper: boo
     overrides = {k: getattr(args, k) for k in OVERRIDES if getattr(args, k, None) is not None}
     if getattr(args, "paper_search", False):
         overrides = {**PAPER_SEARCH, **overrides}  # a --fireflies or --iterations given still wins
+    if overrides:
+        scene = dataclasses.replace(scene, planner=scene.planner.updated(**overrides))
     update, close = firefly_progress(sys.stdout.isatty() and not args.json)
-    try:
-        if overrides:
-            scene = dataclasses.replace(scene, planner=scene.planner.updated(**overrides))
-        with OutputFolder(out) as folder:  # locked from here: a second writer is refused at once
+    with OutputFolder(out) as folder:  # locked from here: a second writer is refused at once
+        try:
             result = plan(scene, progress=update)
             close()
             extras = {"plots": paper or args.plots, "html": paper or args.html}
             outputs = folder.publish(plan_files(result, paper=paper, timings=args.timings, **extras))
-    except NoSolutionError as exc:
-        raise CommandError(EXIT_NO_TRAJECTORY, str(exc)) from None
-    except (PlanningError, ck.CprKinError) as exc:
-        raise CommandError(EXIT_INVALID, str(exc)) from None
-    except OSError as exc:
-        raise CommandError(EXIT_INVALID, f"cannot write to '{out}': {exc.strerror or exc}") from None
-    finally:
-        close()
-    if args.json:
-        print(json.dumps({**summary(result), "outputs": [str(p) for p in outputs]}, indent=1))
-    else:
-        print(summary_line(result))
-        if paper:
-            print(text_table(paper_rows(result)))
-        print("wrote " + ", ".join(str(p) for p in outputs))
+            if args.json:
+                print(json.dumps({**summary(result), "outputs": [str(p) for p in outputs]}, indent=1))
+            else:
+                print(summary_line(result))
+                if paper:
+                    print(text_table(paper_rows(result)))
+                print(escaped("wrote " + ", ".join(str(p) for p in outputs)))
+        except BaseException as exc:
+            if folder.published and interruption(exc) is not None:
+                raise Interrupted(f"interrupted; the new set in '{out}' is complete") from None
+            raise
+        finally:
+            close()
     return EXIT_OK
 
 

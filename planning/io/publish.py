@@ -7,8 +7,11 @@ A plan's files are *published as a whole* (:class:`OutputFolder`):
    one's process. The kernel releases the lock when its process ends, even killed.
 2. The files go into a new hidden folder beside the target, each flushed to disk, with
    ``manifest.json`` listing every file and its SHA-256.
-3. Two renames put it in place: the previous set (if any) aside, the new set in. Only
-   between them is the target missing: a reader sees nothing then, never half a set.
+3. Two renames put it in place: the previous set (if any) aside, the new set in; then the
+   previous set is removed. Only between the renames is the target missing: a reader sees
+   nothing then, never half a set. ``SIGINT`` and ``SIGTERM`` wait for the end of this step
+   (:mod:`planning.io.uninterrupted`), so that an interrupted command leaves either its new
+   set in place, tidied, or the previous one (:attr:`OutputFolder.published` tells which).
 4. What a killed writer left (``.<name>.new-*``, ``.<name>.old-*``) is rolled back or removed
    by the next writer, under the lock: a previous set put aside returns if no new one took
    its place.
@@ -32,6 +35,7 @@ from types import TracebackType
 from typing import Any
 
 from planning.errors import PlanningError
+from planning.io.uninterrupted import uninterrupted
 
 MANIFEST = "manifest.json"
 OUTPUT_NAMES = frozenset(
@@ -168,6 +172,9 @@ class OutputFolder(FolderLock):
             set of outputs, or another writer holding the lock.
     """
 
+    published = False
+    """Whether :meth:`publish` has put a new, complete set in place."""
+
     def __enter__(self) -> OutputFolder:
         super().__enter__()
         try:
@@ -210,18 +217,20 @@ class OutputFolder(FolderLock):
             )
         target, token = self.target, f"{os.getpid()}-{os.urandom(4).hex()}"
         new = target.parent / f".{target.name}.new-{token}"
-        new.mkdir()
         try:
+            new.mkdir()
             for name, content in {**files, MANIFEST: _manifest(files)}.items():
                 _write(new / name, content)
-            old = target.parent / f".{target.name}.old-{token}"
-            if target.exists():
-                os.rename(target, old)
-            os.rename(new, target)
         except BaseException:
             shutil.rmtree(new, ignore_errors=True)
             raise
-        shutil.rmtree(old, ignore_errors=True)
+        old = target.parent / f".{target.name}.old-{token}"
+        with uninterrupted():  # a signal waits: the swap and the tidying are one step
+            if target.exists():
+                os.rename(target, old)
+            os.rename(new, target)
+            self.published = True
+            shutil.rmtree(old, ignore_errors=True)
         return [self.path / name for name in [*files, MANIFEST]]
 
 

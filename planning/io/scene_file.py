@@ -51,7 +51,8 @@ def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> S
     Args:
         data: the parsed document (must be a mapping).
         source: name of the file for messages.
-        base: folder that relative paths (robot, meshes) are resolved against.
+        base: folder that relative paths (robot, meshes) are resolved against (default: the
+            current folder); the scene holds them as absolute paths.
 
     Raises:
         SceneError: anything wrong, with the field path, the value and what is allowed.
@@ -81,7 +82,7 @@ def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> S
             elif isinstance(item, CapsuleSpec):
                 obstacles.append(ck.Obstacle.capsule(item.radius, item.length, item.xyz, item.rpy, name=name))
             else:
-                mesh = Path(item.mesh) if Path(item.mesh).is_absolute() else base / item.mesh
+                mesh = (base / item.mesh).resolve()  # absolute: the scene may be planned elsewhere
                 obstacle = ck.Obstacle.from_mesh(mesh, item.xyz, item.rpy, item.scale, item.convex, name=name)
                 obstacle.geometry()  # read the file now: a broken mesh is a scene error
                 obstacles.append(obstacle)
@@ -96,11 +97,7 @@ def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> S
     planner = spec.planner.model_dump()
     if planner["moving_joints"] is not None:
         planner["moving_joints"] = tuple(planner["moving_joints"])
-    robot = (
-        None
-        if spec.robot is None
-        else (Path(spec.robot) if Path(spec.robot).is_absolute() else base / spec.robot)
-    )
+    robot = None if spec.robot is None else (base / spec.robot).resolve()
     try:
         return Scene(
             name=spec.name or source,

@@ -11,8 +11,9 @@ from __future__ import annotations
 import math
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError, model_validator
 
+from cpr_kin.names import unprintable
 from cpr_kin.obstacles import MAX_ANGLE_RAD, MAX_COORDINATE_M, MAX_NAME_CHARS, SCALE_RANGE, SIZE_RANGE_M
 from planning.scene import (
     DEFAULT_FIREFLY,
@@ -48,7 +49,16 @@ Angle = Annotated[float, _between(-MAX_ANGLE_RAD, MAX_ANGLE_RAD)]
 Size = Annotated[float, _between(*SIZE_RANGE_M)]
 Point = Annotated[list[Coordinate], Field(min_length=3, max_length=3)]
 Turn = Annotated[list[Angle], Field(min_length=3, max_length=3)]
-Name = Annotated[str, Field(min_length=1, max_length=MAX_NAME_CHARS)]
+
+
+def _printable(text: str) -> str:
+    character = unprintable(text)
+    if character is not None:
+        raise ValueError(f"holds {character}; names must be printable text")
+    return text
+
+
+Name = Annotated[str, Field(min_length=1, max_length=MAX_NAME_CHARS), AfterValidator(_printable)]
 FilePath = Annotated[str, Field(min_length=1, max_length=4096)]
 JointName = Literal["theta1", "d2", "d3", "theta4", "theta5"]
 Weight = Annotated[float, _between(0.0, SPLINE_A_RANGE[1])]
@@ -184,7 +194,7 @@ class SplineSpec(_Strict):
 class SceneSpec(_Strict):
     """A whole scene file."""
 
-    name: Annotated[str, Field(min_length=1, max_length=200)] | None = None
+    name: Annotated[str, Field(min_length=1, max_length=200), AfterValidator(_printable)] | None = None
     robot: FilePath | None = None
     safety_margin: Annotated[float, _between(0.0, MAX_SAFETY_MARGIN_M)] = DEFAULT_SAFETY_MARGIN_M
     start: TargetSpec

@@ -1,0 +1,53 @@
+"""The CPR preset: the bundled 5-DOF cylindrical arm (R-P-P:R-R) as a :class:`~cpr_kin.robot.Robot`.
+
+What makes a URDF the CPR: joints ``theta1 d2 d3 theta4 theta5`` in this order, a ``tcp``
+frame at the tool tip, and the wrist and tool links that form the ``effector`` group. A CPR
+variant (other lengths, ranges or limits) is a URDF with the same names. Its acceleration
+and jerk limits: the file :func:`~cpr_kin.limits.find_limits_file` finds beside the URDF,
+then ``cpr_limits.yaml`` beside it, else the bundled CPR's.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from cpr_kin.limits import LIMITS_NAMES, find_limits_file
+from cpr_kin.resources import cpr_limits_path, cpr_urdf_path
+from cpr_kin.robot import Robot, load_robot
+
+CPR_JOINTS = ("theta1", "d2", "d3", "theta4", "theta5")
+"""Joint names of the CPR, in configuration order."""
+TCP_FRAME = "tcp"
+"""Name of the tool-centre-point frame."""
+EFFECTOR_LINKS = ("wrist_link", "tool_link")
+"""Links whose collision geometry forms the ``effector`` group; the rest form ``links``."""
+WRIST_JOINTS = ("theta4", "theta5")
+"""Joints a plan holds unless its start and goal differ in them (the paper holds both at 0)."""
+
+
+def load_cpr(
+    urdf_path: str | Path | None = None, limits_path: str | Path | None = None, validate: bool | None = None
+) -> Robot:
+    """Load the CPR: the bundled URDF, or a variant of it with the same joint names.
+
+    Args:
+        urdf_path: the URDF; default: the bundled ``cpr_kin/urdf/cpr.urdf``.
+        limits_path: acceleration and jerk limits; default: see the module docstring.
+        validate: as :func:`~cpr_kin.robot.load_robot`'s.
+
+    Raises:
+        UrdfError: the file is missing, malformed or unsupported, or lacks a CPR joint or
+            the ``tcp`` frame.
+    """
+    path = Path(urdf_path) if urdf_path is not None else cpr_urdf_path()
+    if limits_path is None:
+        limits_path = find_limits_file(path, cpr_limits_path(), (*LIMITS_NAMES, "cpr_limits.yaml"))
+    return load_robot(
+        path,
+        limits_path,
+        joints=CPR_JOINTS,
+        effector_links=EFFECTOR_LINKS,
+        tcp_frame=TCP_FRAME,
+        wrist_joints=WRIST_JOINTS,
+        validate=validate,
+    )

@@ -1,0 +1,47 @@
+r"""Names and text from a user's files, made safe to print: no control or bidirectional characters.
+
+A name (a joint, link or collision element of a URDF, an obstacle, a scene) reaches
+terminals, reports and CSV files. A control character (``\x1b[2J`` clears a terminal) or a
+bidirectional override (U+202E turns ``exe.txt`` around) would make what is printed lie
+about what is there, so a name holding one is refused (:func:`unprintable`), and text that
+cannot be refused (a file's own path) is printed with such characters escaped
+(:func:`escaped`).
+
+Refused: Unicode's control (Cc), format (Cf: the bidirectional controls, zero-width
+joiners), surrogate (Cs), private-use (Co) and unassigned (Cn) characters, and the line and
+paragraph separators (Zl, Zp).
+"""
+
+from __future__ import annotations
+
+import unicodedata
+
+UNPRINTABLE_CATEGORIES = frozenset({"Cc", "Cf", "Cs", "Co", "Cn", "Zl", "Zp"})
+"""Unicode general categories that are never printed as they are."""
+
+
+def _unprintable(character: str) -> bool:
+    return unicodedata.category(character) in UNPRINTABLE_CATEGORIES
+
+
+def describe(character: str) -> str:
+    """``U+202E (RIGHT-TO-LEFT OVERRIDE)``: a character as a message names it."""
+    name = unicodedata.name(character, "")
+    return f"U+{ord(character):04X}" + (f" ({name})" if name else "")
+
+
+def unprintable(text: str) -> str | None:
+    """The first control or bidirectional character of ``text``, described, or ``None``."""
+    for character in text:
+        if _unprintable(character):
+            return describe(character)
+    return None
+
+
+def escaped(text: str) -> str:
+    r"""``text`` with every character :func:`unprintable` refuses written as ``\u202e`` (``\n`` stays)."""
+    if not any(_unprintable(c) for c in text):
+        return text
+    return "".join(
+        c if c == "\n" or not _unprintable(c) else c.encode("unicode_escape").decode("ascii") for c in text
+    )

@@ -1,0 +1,101 @@
+"""Fingerprints of the planner's output: a SHA-256 per planned scene, for same-seed comparisons.
+
+Plans, warm and in one process, the bundled scenes (seeds 0-2), the paper case (with the
+planner's default search) and the shelf with each of the planner's modes (the paper's search,
+the ``paper`` fitness, the ``ptp`` path, no refinement, no seeding), fixed and free durations,
+a goal at the start and ``--generated`` generated scenes (a quarter of them narrow
+passages), and prints the SHA-256 of each plan's ``cpr-trajectory/1`` file (without wall
+times; the recorded URDF path replaced by its name) and one digest of them all. Run it on
+two checkouts: a refactoring that means to change no result must print the same digest.
+A scene with no trajectory prints the failure's class instead of a hash.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import hashlib
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import cpr_kin as ck
+from planning import NoSolutionError, Optimizer, PlannerSettings, Scene, load_scene, plan, warm_up
+from planning.io.bundled import bundled_scene_paths, paper_scene_path
+from planning.io.scene_generator import generate_scenes
+from planning.io.trajectory_io import trajectory_json
+from planning.search import baselines
+
+MODES: dict[str, dict[str, Any]] = {
+    "paper search": {
+        "fireflies": 50,
+        "alpha": 1.0,
+        "stall_iterations": 0,
+        "seeding": "none",
+        "refine": "none",
+    },
+    "paper fitness": {"fitness": "paper"},
+    "ptp path": {"path": "ptp", "fireflies": 20, "iterations": 20},
+    "no refinement": {"refine": "none"},
+    "no seeding": {"seeding": "none"},
+}
+"""Planner-setting changes applied to the paper case, one plan each."""
+
+
+def scenes(generated: int, robot: ck.Robot) -> Iterator[tuple[str, Scene]]:
+    """``(label, scene)`` of every scene fingerprinted (with the planner's own search)."""
+    for path in bundled_scene_paths():
+        scene = load_scene(path)
+        for seed in range(3):
+            yield f"{path.stem} seed {seed}", _changed(scene, seed=seed)
+    paper = load_scene(paper_scene_path())
+    default_search = dataclasses.replace(paper, planner=PlannerSettings(max_node_deviation=20e-6))
+    shelf = load_scene(bundled_scene_paths()[-1])
+    for mode, changes in MODES.items():
+        yield f"paper, {mode}", _changed(default_search, **changes)
+        yield f"shelf, {mode}", _changed(shelf, **changes)
+    yield "paper, free duration", dataclasses.replace(paper, duration=None)
+    yield "shelf, 3 s", dataclasses.replace(shelf, duration=3.0)
+    yield "paper, goal at start", dataclasses.replace(paper, goal=paper.start)
+    for scene in generate_scenes(generated, seed=5, robot=robot, narrow=generated // 4):
+        yield scene.name, scene
+
+
+def _changed(scene: Scene, **changes: Any) -> Scene:
+    return dataclasses.replace(scene, planner=scene.planner.updated(**changes))
+
+
+def fingerprint(scene: Scene, robot: ck.Robot, optimizer: Optimizer | None = None) -> str:
+    """SHA-256 of the plan's trajectory file, or the failure's class."""
+    try:
+        result = plan(scene, robot, optimizer=optimizer)
+    except NoSolutionError as exc:
+        return type(exc).__name__
+    text = trajectory_json(result).replace(str(robot.urdf_path), Path(robot.urdf_path).name)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--generated", type=int, default=20, help="generated scenes (default: 20)")
+    args = parser.parse_args()
+    robot = ck.load_cpr()
+    warm_up(robot)
+    total = hashlib.sha256()
+    for label, scene in scenes(args.generated, robot):
+        digest = fingerprint(scene, robot)
+        total.update(f"{label} {digest}\n".encode())
+        print(f"{label:<36} {digest}", flush=True)
+    shelf = load_scene(bundled_scene_paths()[-1])
+    for label, optimizer in (
+        ("shelf, PSO", baselines.particle_swarm()),
+        ("shelf, harmony", baselines.harmony_search()),
+    ):
+        digest = fingerprint(shelf, robot, optimizer)
+        total.update(f"{label} {digest}\n".encode())
+        print(f"{label:<36} {digest}", flush=True)
+    print(f"{'all':<36} {total.hexdigest()}")
+
+
+if __name__ == "__main__":
+    main()
