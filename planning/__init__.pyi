@@ -9,24 +9,21 @@ from .io.bundled import paper_scene
 from .io.scene_file import dump_scene, load_scene
 from .io.trajectory_io import write_samples, write_trajectory
 from .io.trajectory_reader import TrajectoryFileError, read_trajectory
-from .metrics import Metrics
-from .objective import Breakdown, WaypointObjective
-from .planner import PlanResult, plan, solve, warm_up
-from .problem import Problem, build_problem, with_planner
-from .scene import (
-    DEFAULT_FIREFLY,
-    DEFAULT_SAFETY_MARGIN_M,
-    DEFAULT_SPLINE,
-    PAPER_SEARCH,
-    PlannerSettings,
-    Scene,
-    Target,
-)
+from .pipeline.metrics import Metrics
+from .pipeline.objective import Breakdown, WaypointObjective
+from .pipeline.planner import plan, solve, warm_up
+from .pipeline.problem import Problem, build_problem, with_planner
+from .pipeline.result import PlanResult
+from .pipeline.scene import DEFAULT_SAFETY_MARGIN_M, DEFAULT_SPLINE, Scene, Target
+from .pipeline.seeding import Seeds, seed_search
+from .pipeline.settings import DEFAULT_FIREFLY, PAPER_SEARCH, PlannerSettings
+from .pipeline.tuning import SearchTuning, SeedingTuning
+from .pipeline.verification import Verification, verify_trajectory
 from .search.firefly import FireflyProgress, firefly_minimize
 from .search.firefly_settings import FireflySettings
 from .search.optimizer import Optimizer, SearchResult
-from .seeding import Seeds, seed_search
-from .verification import Verification, verify_trajectory
+from .search.refined_firefly import RefinedFirefly
+from .search.refinement_settings import RefinementSettings
 
 __all__ = [
     "DEFAULT_FIREFLY",
@@ -45,9 +42,13 @@ __all__ = [
     "PlannerSettings",
     "PlanningError",
     "Problem",
+    "RefinedFirefly",
+    "RefinementSettings",
     "Scene",
     "SceneError",
     "SearchResult",
+    "SearchTuning",
+    "SeedingTuning",
     "Seeds",
     "SepticSplineSolver",
     "SplineError",

@@ -91,7 +91,7 @@ def plan_scene_file(path: Path, out: Path, threads: int | None = 1) -> BatchItem
     from planning.io.publish import OutputFolder
     from planning.io.report import plan_record
     from planning.io.scene_file import load_scene
-    from planning.planner import plan
+    from planning.pipeline.planner import plan
 
     started = time.perf_counter()
     name = path.stem

@@ -20,6 +20,7 @@ Prints the tables and writes them as Markdown to ``--out``.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import statistics
 import time
 from collections.abc import Callable
@@ -34,18 +35,18 @@ from planning.errors import NoSolutionError, PlanningError
 from planning.io.bundled import paper_scene
 from planning.io.report import markdown_table
 from planning.io.scene_generator import generate_scenes
-from planning.objective import WaypointObjective
 from planning.peers.ompl_rrt import plan_rrt_connect
 from planning.peers.pyroboplan_rrt import plan_pyroboplan_rrt_connect
 from planning.peers.toppra_timing import SamplingResult
-from planning.planner import plan, warm_up
-from planning.problem import build_problem, with_planner
-from planning.scene import DEFAULT_FIREFLY, Scene
+from planning.pipeline.objective import WaypointObjective
+from planning.pipeline.planner import plan, warm_up
+from planning.pipeline.problem import build_problem, with_planner
+from planning.pipeline.scene import Scene
+from planning.pipeline.search import planner_search
+from planning.pipeline.seeding import Attempt, seed_search
+from planning.pipeline.settings import DEFAULT_FIREFLY
 from planning.search import baselines
-from planning.search.firefly import firefly_minimize
 from planning.search.optimizer import BatchObjective, Optimizer, SearchResult
-from planning.search.refinement import refine_search
-from planning.seeding import seed_search
 
 FloatArray = NDArray[np.float64]
 DEFAULT_SEARCH = "firefly (our defaults: seeded, n = 30, early stop, CMA-ES refinement)"
@@ -75,42 +76,28 @@ def optimisers(scene: Scene) -> dict[str, Optimizer]:
 
 
 def default_search(robot: ck.Robot, scene: Scene, refine_stall: int | None = None) -> Optimizer:
-    """Our default search on ``scene``'s objective: the planner's seeds and firefly settings.
+    """Our default search on ``scene``'s objective: the planner's own, through its entry point.
 
-    The seeds of :func:`planning.seeding.seed_search` (the straight line and, when it is
-    blocked, RRT-Connect's path; :data:`~planning.seeding.SEED_SHARE` of the population
-    around them), then :data:`~planning.scene.DEFAULT_FIREFLY` with as many iterations as the
-    budget allows and its early stop, then (from a feasible best) the CMA-ES refinement of
-    :mod:`planning.search.refinement` within the rest of the budget, as the planner does
-    (``refine_stall``: the refinement's stall generations, as the planner setting of that
-    name; 0 to run it to the budget), its stalls counted only near the objective's lower
-    bound (:data:`~planning.search.refinement.NEAR_BOUND`).
-    The seeding's streams get a seed drawn from ``rng``.
+    The scene with the planner's default search settings (:data:`DEFAULT_FIREFLY`, seeded
+    with paths, CMA-ES refinement; ``refine_stall`` as that planner setting, 0 to run the
+    refinement to the budget); each run seeds the search as the planner does
+    (:func:`~planning.pipeline.seeding.seed_search`, its streams seeded from ``rng``) and
+    runs :func:`~planning.pipeline.search.planner_search`'s optimiser on the objective given.
     """
-    problem = build_problem(replace(scene, planner=scene.planner.updated(seeding="paths")), robot)
+    changes = {**dataclasses.asdict(DEFAULT_FIREFLY), "seeding": "paths", "refine": "cma"}
+    if refine_stall is not None:
+        changes["refine_stall"] = refine_stall
+    problem = build_problem(replace(scene, planner=scene.planner.updated(**changes)), robot)
 
     def run(
         objective: BatchObjective, lower: FloatArray, upper: FloatArray, budget: int, rng: np.random.Generator
     ) -> SearchResult:
         seeded = with_planner(problem, seed=int(rng.integers(2**31)))
-        seeds = seed_search(seeded).candidates
-        settings = replace(DEFAULT_FIREFLY, iterations=budget // DEFAULT_FIREFLY.fireflies - 1)
-        bound = objective_bound(objective)
-        found = firefly_minimize(objective, lower, upper, settings, rng, None, seeds, bound)
-        if found.fitness > bound:
-            return found
-        left = budget - found.evaluations
-        floor = getattr(objective, "lower_bound", None)  # a waypoint objective's (the planner passes it)
-        return refine_search(
-            objective, lower, upper, found, left, rng, stall_generations=refine_stall, lower_bound=floor
-        )
+        seeds = seed_search(seeded)
+        search = planner_search(seeds.problem, Attempt(seeds.problem, seeds.candidates))
+        return search(objective, lower, upper, budget, rng)
 
     return run
-
-
-def objective_bound(objective: BatchObjective) -> float:
-    """The bound of feasible values of a waypoint objective (the firefly's early stop counts below it)."""
-    return float(getattr(objective, "t_max", np.inf))
 
 
 def paper_objective(robot: ck.Robot, scene: Scene) -> WaypointObjective:
@@ -166,10 +153,12 @@ def run_optimisers(
     return runs
 
 
-def optimiser_table(runs: Runs, t_max: float) -> tuple[list[list[str]], dict[str, float], dict[str, float]]:
+def optimiser_table(
+    runs: Runs, objective: WaypointObjective
+) -> tuple[list[list[str]], dict[str, float], dict[str, float]]:
     """Rows of the optimiser table; each optimiser's median time ratio to ours and evaluations.
 
-    ``t_max``: the objective's bound of feasible values.
+    ``objective``: the objective run (its feasibility rule counts the feasible runs).
     """
     times = runs.times
     ours = times["firefly (ours)"]  # the paper's parameters: the figure the NiaPy target is about
@@ -184,7 +173,7 @@ def optimiser_table(runs: Runs, t_max: float) -> tuple[list[list[str]], dict[str
             f"{ratios[name]:.1f}",
             f"{statistics.median(runs.fitness[name]):.4f}",
             f"{statistics.median(runs.spent[name]):.0f}",
-            f"{sum(f <= t_max for f in runs.fitness[name])}/{len(ours)}",
+            f"{int(objective.feasible(np.array(runs.fitness[name])).sum())}/{len(ours)}",
         ]
         for name in times
     ]
@@ -316,7 +305,7 @@ def main() -> None:
         f"1. Optimisers on the paper case's objective, budget {budget} evaluations, seeds 0..{args.seeds - 1}"
     )
     full = run_optimisers(methods, objective, budget, args.seeds)
-    rows, ratios, spent = optimiser_table(full, objective.t_max)
+    rows, ratios, spent = optimiser_table(full, objective)
     medians = full.medians()
     headers1 = (
         "optimiser",

@@ -1,7 +1,7 @@
 """Benchmark of the paper case end to end (issue: firefly planner).
 
 Plans the paper case (n = 50, 50 iterations, sweep mode) for several seeds and prints the
-median wall time of the whole :func:`planning.planner.plan` call and of its firefly search,
+median wall time of the whole :func:`planning.pipeline.planner.plan` call and of its firefly search,
 with the evaluation count. Target: <= 0.5 s end to end on 2 cores; goal: <= 0.1 s.
 """
 
@@ -12,7 +12,7 @@ import statistics
 
 import cpr_kin as ck
 from planning.io.bundled import paper_scene
-from planning.planner import plan
+from planning.pipeline.planner import plan
 
 
 def main() -> None:

@@ -4,7 +4,7 @@ Issue 17's benchmark, one run, side by side. On ``--scenes`` seeded scenes of wh
 ``--narrow`` are narrow passages (beam, window, pillars in turn; ``scripts/generate_scenes.py
 --narrow``), every scene is planned by
 
-- ours: :func:`planning.planner.plan` with the scene's (default) settings, warm (one process,
+- ours: :func:`planning.pipeline.planner.plan` with the scene's (default) settings, warm (one process,
   kernels loaded, robot loaded; the collision world is built in the call);
 - OMPL RRT-Connect + simplification + TOPP-RA (:mod:`planning.peers.ompl_rrt`), ``--budget``
   seconds for RRT-Connect, warm likewise, its trajectory verified by the same certified check;
@@ -38,9 +38,9 @@ from planning.io.scene_file import dump_scene
 from planning.io.scene_generator import generate_scenes
 from planning.peers.ompl_rrt import plan_rrt_connect
 from planning.peers.ruckig_bound import free_space_bound
-from planning.planner import plan, warm_up
-from planning.problem import build_problem
-from planning.scene import Scene
+from planning.pipeline.planner import plan, warm_up
+from planning.pipeline.problem import build_problem
+from planning.pipeline.scene import Scene
 
 CLI_TARGET_S = 1.5
 

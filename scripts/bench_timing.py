@@ -47,10 +47,10 @@ from planning.io.scene_file import load_scene
 from planning.io.scene_generator import generate_scenes
 from planning.peers.ompl_rrt import plan_rrt_connect
 from planning.peers.ruckig_bound import free_space_bound
-from planning.planner import plan, warm_up
-from planning.problem import build_problem
-from planning.scene import Scene
-from planning.timing import narrowed_timings, timings, uniform_scale
+from planning.pipeline.planner import plan, warm_up
+from planning.pipeline.problem import build_problem
+from planning.pipeline.scene import Scene
+from planning.pipeline.timing import narrowed_timings, uniform_scale
 
 
 @dataclass(frozen=True)
@@ -94,9 +94,11 @@ def measure(scene: Scene, robot: ck.Robot, rrt_time_s: float) -> Row:
     try:
         result = plan(scene, robot)
         ours, method = result.trajectory.duration, result.metrics.timing
-        uniform = result.spline.trajectory.time_scaled(uniform_scale(result.spline, result.problem)).duration
+        uniform = result.spline.trajectory.time_scaled(
+            uniform_scale(result.spline, result.problem.robot.limits)
+        ).duration
         started = time.perf_counter()
-        offered = timings(result.problem, result.waypoints)  # the step again, alone
+        offered = result.problem.duration.timings(result.problem, result.waypoints)  # the step again, alone
         if method != "fastest":  # the fastest timing failed the check: the fallbacks were computed
             narrowed_timings(result.problem, offered)
         timing_ms = 1e3 * (time.perf_counter() - started)

@@ -19,7 +19,8 @@ from planning.io.bundled import paper_scene
 from planning.io.outputs import plan_files
 from planning.io.publish import OutputFolder
 from planning.io.report import paper_rows, text_table
-from planning.planner import PlanResult, plan, warm_up
+from planning.pipeline.planner import plan, warm_up
+from planning.pipeline.result import PlanResult
 from planning.viz import artifacts
 
 

@@ -11,7 +11,7 @@ import pytest
 
 import cpr_kin as ck
 from planning.io.bundled import paper_scene
-from planning.planner import plan
+from planning.pipeline.planner import plan
 from planning.search import baselines
 from planning.search.firefly_settings import FireflySettings
 from planning.search.optimizer import Optimizer

@@ -14,7 +14,7 @@ from planning.cli import main
 from planning.errors import PlanningError
 from planning.io.bundled import paper_scene_path
 from planning.io.publish import complete_set
-from planning.metrics import WALL_TIMES
+from planning.pipeline.metrics import WALL_TIMES
 
 
 @pytest.fixture(scope="module")
@@ -90,12 +90,12 @@ def test_a_worker_that_dies_sinks_only_its_scene(scenes: Path, tmp_path: Path) -
 def test_an_unexpected_exception_in_a_scene_is_its_row(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    import planning.planner
+    import planning.pipeline.planner
 
     def broken_plan(*args: object, **kwargs: object) -> None:
         raise IndexError("index 7 is out of bounds for axis 0 with size 5")
 
-    monkeypatch.setattr(planning.planner, "plan", broken_plan)
+    monkeypatch.setattr(planning.pipeline.planner, "plan", broken_plan)
     item = plan_scene_file(paper_scene_path(), tmp_path / "paper")
     assert (item.status, item.exit_class) == ("error", 4)
     assert item.message == "IndexError: index 7 is out of bounds for axis 0 with size 5"

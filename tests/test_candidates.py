@@ -1,21 +1,37 @@
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pytest
 
 import cpr_kin as ck
 from planning import build_problem
-from planning import candidates as candidates_module
-from planning.candidates import PREFERRED_FIRST, distinct, first_verified, verify
 from planning.curves.trajectory import Trajectory
 from planning.io.bundled import paper_scene
 from planning.io.scene_generator import generate_scenes
-from planning.planner import solve
+from planning.pipeline import choose as choose_module
+from planning.pipeline.choose import Choice, choose, distinct, verify
+from planning.pipeline.planner import solve
+from planning.pipeline.problem import Problem
+from planning.pipeline.timing import FixedDuration, Timing
+from planning.pipeline.tuning import SearchTuning
+from planning.pipeline.verification import Verification
 from planning.search.optimizer import SearchResult
-from planning.timing import NARROWED_ACCELERATION, Timing, narrowed_timing, timings
-from planning.verification import Verification
+
+PREFERRED_FIRST = SearchTuning().preferred_first
+NARROWED_ACCELERATION = SearchTuning().narrowed_acceleration
+
+
+@dataclass(frozen=True)
+class CountingDuration(FixedDuration):
+    """The paper case's duration rule, recording every path it times."""
+
+    timed: list[np.ndarray] = field(default_factory=list)
+
+    def timings(self, problem: Problem, nodes: np.ndarray) -> list[Timing]:
+        self.timed.append(nodes)
+        return super().timings(problem, nodes)
 
 
 def test_distinct_keeps_the_first_of_each_point_in_order() -> None:
@@ -26,12 +42,12 @@ def test_distinct_keeps_the_first_of_each_point_in_order() -> None:
     assert distinct([]) == []
 
 
-def test_a_refused_point_is_timed_and_verified_once(robot: ck.Robot, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_refused_point_is_timed_and_verified_once(robot: ck.Robot) -> None:
     # after a refinement the best is also its population's first: refused once, it is not
     # timed and verified again before the next distinct candidate
     problem = build_problem(paper_scene(0), robot)
     blocked = problem.objective.straight_line()  # the paper case's straight swing hits the crate
-    fixed = timings(problem, problem.objective.nodes(blocked[None])[0])[0]
+    fixed = problem.duration.timings(problem, problem.objective.nodes(blocked[None])[0])[0]
     assert not verify(problem, fixed.trajectory, fixed.fit).accepted
     found = solve(problem).optimiser.x
     result = SearchResult(
@@ -44,17 +60,12 @@ def test_a_refused_point_is_timed_and_verified_once(robot: ck.Robot, monkeypatch
         population=np.stack([blocked, blocked.copy(), found]),
         population_fitness=np.array([1.0, 1.0, 2.0]),
     )
-    timed: list[np.ndarray] = []
-
-    def counting(problem_: object, nodes: np.ndarray) -> list:  # type: ignore[type-arg]
-        timed.append(nodes)
-        return timings(problem, nodes)
-
-    monkeypatch.setattr(candidates_module, "timings", counting)
-    x, _, _, verification, tried = first_verified(problem, result)
-    np.testing.assert_array_equal(x, found)
-    assert verification.accepted
-    assert tried == len(timed) == 2
+    counting = CountingDuration(4.0)  # the paper case's duration
+    chosen = choose(replace(problem, duration=counting), result)
+    assert isinstance(chosen, Choice)
+    np.testing.assert_array_equal(chosen.x, found)
+    assert chosen.verification.accepted
+    assert chosen.candidates_timed == len(counting.timed) == 2
 
 
 def test_once_the_best_is_refused_the_shortest_passing_timing_wins(
@@ -70,7 +81,7 @@ def test_once_the_best_is_refused_the_shortest_passing_timing_wins(
         population=np.stack(points),
         population_fitness=np.arange(1.0, len(points) + 1),
     )
-    offered = [timings(problem, problem.objective.nodes(x[None])[0]) for x in points]
+    offered = [problem.duration.timings(problem, problem.objective.nodes(x[None])[0]) for x in points]
     refused = offered[0][0].trajectory.duration  # the best's fastest timing
 
     def refusing(problem_: object, trajectory: Trajectory, fit: object) -> Verification:
@@ -80,14 +91,14 @@ def test_once_the_best_is_refused_the_shortest_passing_timing_wins(
         return checked
 
     options: list[Timing | None] = [timing[0] for timing in offered[1:]]
-    options += [narrowed_timing(problem, timing, NARROWED_ACCELERATION[0]) for timing in offered]
+    options += [problem.duration.narrowed(problem, timing, NARROWED_ACCELERATION[0]) for timing in offered]
     passing = [
         t.trajectory.duration
         for t in options
         if t is not None and verify(problem, t.trajectory, t.fit).accepted
     ]
     assert passing
-    monkeypatch.setattr(candidates_module, "verify", refusing)
-    _, _, timing, verification, _ = first_verified(problem, result)
-    assert verification.accepted
-    assert timing.trajectory.duration == min(passing)
+    monkeypatch.setattr(choose_module, "verify", refusing)
+    chosen = choose(problem, result)
+    assert isinstance(chosen, Choice) and chosen.verification.accepted
+    assert chosen.timing.trajectory.duration == min(passing)

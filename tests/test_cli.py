@@ -15,7 +15,7 @@ import yaml
 import cpr_kin as ck
 from planning.cli import main
 from planning.io.trajectory_reader import read_trajectory
-from planning.metrics import WALL_TIMES
+from planning.pipeline.metrics import WALL_TIMES
 
 SCENE: dict[str, Any] = {
     "name": "swing",

@@ -10,7 +10,7 @@ import cpr_kin as ck
 from planning.io.bundled import paper_scene
 from planning.io.json_layout import dumps
 from planning.io.trajectory_io import trajectory_document, trajectory_json
-from planning.planner import plan
+from planning.pipeline.planner import plan
 
 
 def random_document(rng: np.random.Generator, depth: int = 0) -> object:

@@ -8,8 +8,10 @@ import pytest
 import cpr_kin as ck
 from planning.curves.spline import SepticSplineSolver, uniform_knots
 from planning.io.bundled import paper_scene
-from planning.objective import WaypointObjective
-from planning.scene import PlannerSettings
+from planning.pipeline.motion import Motion
+from planning.pipeline.objective import WaypointObjective
+from planning.pipeline.settings import PlannerSettings
+from planning.pipeline.timing import FixedDuration
 
 
 def make_objective(
@@ -23,7 +25,8 @@ def make_objective(
     settings = PlannerSettings(**{**scene.planner.__dict__, **overrides})
     solver = SepticSplineSolver(uniform_knots(settings.waypoints + 1, 4.0), scene.spline)
     world = ck.CollisionWorld(robot, obstacles)
-    return WaypointObjective(world, q_start, q_goal, np.array([0, 1, 2]), 0.1, settings, solver, timed=True)
+    motion = Motion(q_start, q_goal, np.array([0, 1, 2]))
+    return WaypointObjective(world, motion, 0.1, settings, solver, FixedDuration(4.0))
 
 
 @pytest.fixture(scope="module")
@@ -65,6 +68,8 @@ def test_every_feasible_candidate_ranks_ahead_of_every_infeasible_one(
     assert 10 < b.feasible.sum() < 190
     assert b.fitness[b.feasible].max() < b.fitness[~b.feasible].min()
     assert np.all(b.fitness[b.feasible] <= objective.t_max)
+    # the one rule: a fitness says whether its candidate is feasible
+    np.testing.assert_array_equal(objective.feasible(b.fitness), b.feasible)
     np.testing.assert_allclose(
         b.fitness[b.feasible], (b.t_sol_s + b.w_sol / objective.w_max * 0.012)[b.feasible]
     )
@@ -162,7 +167,7 @@ def test_lower_bound_of_the_ptp_time_is_the_direct_move(
 
 def test_lower_bound_of_the_duration_estimate_is_the_straight_lines(robot: ck.Robot) -> None:
     from planning.peers.ruckig_bound import free_space_bound
-    from planning.problem import build_problem
+    from planning.pipeline.problem import build_problem
 
     problem = build_problem(dataclasses.replace(paper_scene(), duration=None, obstacles=()), robot)
     objective = problem.objective

@@ -49,7 +49,7 @@ def test_every_export_resolves_to_its_module_object(package: str) -> None:
 def test_the_batch_parent_imports_no_planner_robot_or_compiler() -> None:
     # `cpr-plan batch` dispatches scenes to workers: its process needs none of the heavy
     # modules (numba, coal, Pinocchio, SciPy, trimesh: about 1.2 s), which each worker imports
-    heavy = ["numba", "coal", "pinocchio", "scipy", "trimesh", "yourdfpy", "planning.planner"]
+    heavy = ["numba", "coal", "pinocchio", "scipy", "trimesh", "yourdfpy", "planning.pipeline.planner"]
     code = (
         "import sys, cpr_kin, planning, planning.cli, planning.batch, planning.io.report, "
         "planning.io.trajectory_io; "
@@ -105,6 +105,10 @@ def test_an_installed_wheel_carries_its_data_and_stubs(tmp_path: Path) -> None:
         check=True,
     ).stdout.split("\n")
     assert out[0].startswith(str(site)) and out[1].startswith(str(site))
-    assert out[1].endswith("cpr.urdf") and out[2:5] == ["paper", "planning.planner", "planning.curves.spline"]
+    assert out[1].endswith("cpr.urdf") and out[2:5] == [
+        "paper",
+        "planning.pipeline.planner",
+        "planning.curves.spline",
+    ]
     for package in ("cpr_kin", "planning"):  # PEP 561: the packages carry their own types
         assert (site / package / "py.typed").is_file()

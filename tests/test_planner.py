@@ -10,9 +10,13 @@ import pytest
 import cpr_kin as ck
 from planning.errors import NoTrajectoryFoundError, PlanningError
 from planning.io.bundled import paper_scene
-from planning.planner import PlanResult, plan, warm_up
-from planning.scene import PlannerSettings, Scene, Target
+from planning.pipeline.planner import plan, warm_up
+from planning.pipeline.result import PlanResult
+from planning.pipeline.scene import Scene, Target
+from planning.pipeline.settings import PlannerSettings
+from planning.pipeline.tuning import SearchTuning
 from planning.search.firefly_settings import FireflySettings
+from planning.search.refinement_settings import RefinementSettings
 
 from .conftest import PAPER_GOAL_TCP, PAPER_START_TCP
 
@@ -228,22 +232,20 @@ def test_refine_stall_zero_runs_the_same_refinement_on_to_the_budget(robot: ck.R
 
 def test_the_refinement_stops_early_only_near_the_objectives_lower_bound(robot: ck.Robot) -> None:
     """Far above the bound the refinement runs on: the same run as counting every stall, longer."""
-    from unittest import mock
-
     from planning.io.scene_generator import generate_scenes
-    from planning.search import refinement
 
     scenes = generate_scenes(8, seed=2, robot=robot, narrow=2)
+    everywhere = SearchTuning(refinement=RefinementSettings(near_bound=np.inf))  # every stall counts
+    near_bound = RefinementSettings().near_bound
     went_on = 0
     for scene in (scenes[0], scenes[5], scenes[7]):
-        with mock.patch.object(refinement, "NEAR_BOUND", np.inf):  # every stall counts
-            counted = plan(scene, robot)
+        counted = plan(dataclasses.replace(scene, planner=scene.planner.updated(tuning=everywhere)), robot)
         result = plan(scene, robot)
         bound = result.problem.objective.lower_bound
         assert 0 < bound <= result.trajectory.duration
         n = len(counted.optimiser.best_history)
         np.testing.assert_array_equal(result.optimiser.best_history[:n], counted.optimiser.best_history)
-        if counted.optimiser.fitness <= refinement.NEAR_BOUND * bound:  # stopped near it: the same stop
+        if counted.optimiser.fitness <= near_bound * bound:  # stopped near it: the same stop
             assert result.optimiser.evaluations == counted.optimiser.evaluations
         else:
             went_on += 1
@@ -253,7 +255,7 @@ def test_the_refinement_stops_early_only_near_the_objectives_lower_bound(robot: 
 
 
 def test_the_paper_search_does_not_refine() -> None:
-    from planning.scene import PAPER_SEARCH
+    from planning.pipeline.settings import PAPER_SEARCH
 
     assert paper_scene().planner.refine == "none"
     assert PlannerSettings().updated(**PAPER_SEARCH).refine == "none"

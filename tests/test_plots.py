@@ -8,7 +8,8 @@ import pytest
 
 import cpr_kin as ck
 from planning.io.bundled import paper_scene
-from planning.planner import PlanResult, plan
+from planning.pipeline.planner import plan
+from planning.pipeline.result import PlanResult
 from planning.viz import plots
 from planning.viz.artifacts import PLOT_FILES, plot_files
 

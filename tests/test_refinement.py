@@ -10,13 +10,12 @@ from planning.search.cma_rates import LearningRates, population_size
 from planning.search.firefly import firefly_minimize
 from planning.search.firefly_settings import FireflySettings
 from planning.search.optimizer import STALL_TOLERANCE, SearchResult
-from planning.search.refinement import (
-    FALLBACK_SPACING,
-    NEAR_BOUND,
-    STALL_GENERATIONS,
-    cma_refine,
-    refine_search,
-)
+from planning.search.refinement import cma_refine, refine_search
+from planning.search.refinement_settings import STALL_GENERATIONS
+from planning.search.refinement_settings import RefinementSettings as R
+
+FALLBACK_SPACING = R().fallback_spacing
+NEAR_BOUND = R().near_bound
 
 D = 10
 ROTATION = np.linalg.qr(np.random.default_rng(1).standard_normal((D, D)))[0]
@@ -81,7 +80,17 @@ def test_active_update_walks_along_a_constraint() -> None:
     gains = {}
     for active in (True, False):
         runs = [
-            cma_refine(band, np.zeros(6), np.ones(6), x0, f0, 300, np.random.default_rng(s), 0.03, 0, active)
+            cma_refine(
+                band,
+                np.zeros(6),
+                np.ones(6),
+                x0,
+                f0,
+                300,
+                np.random.default_rng(s),
+                R(0.03, active),
+                stall_generations=0,
+            )
             for s in range(20)
         ]
         assert all(-2.0 <= run.fitness <= f0 for run in runs)
@@ -93,7 +102,7 @@ def test_learns_a_rotated_ill_conditioned_quadratic() -> None:
     # a step-size-only search needs ~condition-number times more evaluations on it
     x0, f0 = start_of(ellipsoid, np.full(D, 0.7))
     rng = np.random.default_rng(0)
-    result = cma_refine(ellipsoid, np.zeros(D), np.ones(D), x0, f0, 4000, rng, 0.1, stall_generations=0)
+    result = cma_refine(ellipsoid, np.zeros(D), np.ones(D), x0, f0, 4000, rng, R(0.1), stall_generations=0)
     assert result.fitness < 1e-6 * f0
     np.testing.assert_allclose(result.x, CENTRE, atol=1e-3)
     assert result.evaluations <= 4000
@@ -102,7 +111,9 @@ def test_learns_a_rotated_ill_conditioned_quadratic() -> None:
 def test_solves_rosenbrock_in_a_box() -> None:
     x0, f0 = start_of(rosenbrock, np.zeros(5))
     rng = np.random.default_rng(3)
-    result = cma_refine(rosenbrock, -2 * np.ones(5), 2 * np.ones(5), x0, f0, 20_000, rng, 0.1, 0)
+    result = cma_refine(
+        rosenbrock, -2 * np.ones(5), 2 * np.ones(5), x0, f0, 20_000, rng, R(0.1), stall_generations=0
+    )
     assert result.fitness < 1e-6
     np.testing.assert_allclose(result.x, np.ones(5), atol=1e-2)
 
@@ -119,7 +130,17 @@ def test_optimum_on_the_boundary_is_reached_from_inside() -> None:
         seen.append(x.copy())
         return shifted(x)
 
-    result = cma_refine(recording, np.zeros(3), np.ones(3), x0, f0, 3000, np.random.default_rng(0), 0.2, 0)
+    result = cma_refine(
+        recording,
+        np.zeros(3),
+        np.ones(3),
+        x0,
+        f0,
+        3000,
+        np.random.default_rng(0),
+        R(0.2),
+        stall_generations=0,
+    )
     assert np.all(np.concatenate(seen) >= 0.0) and np.all(np.concatenate(seen) <= 1.0)
     np.testing.assert_allclose(result.x, np.ones(3), atol=1e-4)
 
@@ -168,7 +189,17 @@ def test_too_small_a_budget_evaluates_nothing() -> None:
 def test_same_generator_state_same_run() -> None:
     x0, f0 = start_of(rosenbrock, np.full(6, 0.3))
     runs = [
-        cma_refine(rosenbrock, -np.ones(6), np.ones(6), x0, f0, 600, np.random.default_rng(7), 0.05, 0)
+        cma_refine(
+            rosenbrock,
+            -np.ones(6),
+            np.ones(6),
+            x0,
+            f0,
+            600,
+            np.random.default_rng(7),
+            R(0.05),
+            stall_generations=0,
+        )
         for _ in range(2)
     ]
     np.testing.assert_array_equal(runs[0].x, runs[1].x)
@@ -181,7 +212,7 @@ def test_same_generator_state_same_run() -> None:
 )
 def test_bad_arguments_name_the_value(start: np.ndarray, sigma: float, message: str) -> None:
     with pytest.raises(PlanningError, match=message):
-        cma_refine(rosenbrock, np.zeros(4), np.ones(4), start, 1.0, 100, np.random.default_rng(0), sigma)
+        cma_refine(rosenbrock, np.zeros(4), np.ones(4), start, 1.0, 100, np.random.default_rng(0), R(sigma))
 
 
 def test_refine_search_continues_a_firefly_run() -> None:
@@ -227,8 +258,9 @@ def test_stalls_count_only_near_the_lower_bound() -> None:
     lam = population_size(4)
 
     def run(lower_bound: float | None) -> SearchResult:
+        rng = np.random.default_rng(3)
         return cma_refine(
-            offset_bowl, np.zeros(4), np.ones(4), x0, f0, 3000, np.random.default_rng(3), 0.05, 2,
+            offset_bowl, np.zeros(4), np.ones(4), x0, f0, 3000, rng, R(0.05), stall_generations=2,
             lower_bound=lower_bound,
         )  # fmt: skip
 

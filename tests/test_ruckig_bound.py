@@ -11,7 +11,7 @@ import cpr_kin as ck
 from planning.errors import PlanningError
 from planning.io.bundled import paper_scene
 from planning.peers.ruckig_bound import free_space_bound, ruckig_duration
-from planning.planner import plan
+from planning.pipeline.planner import plan
 
 
 def test_a_long_single_joint_move_takes_the_closed_form_time() -> None:

@@ -23,7 +23,8 @@ from planning.io.scene_file import (
     parse_scene,
 )
 from planning.io.scene_generator import generate_scenes
-from planning.scene import PlannerSettings, Target
+from planning.pipeline.scene import Target
+from planning.pipeline.settings import PlannerSettings
 
 MINIMAL = {"start": {"tcp": [0.5, 0.45, 0.25]}, "goal": {"tcp": [-0.5, 0.45, 0.25]}}
 

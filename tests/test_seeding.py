@@ -3,18 +3,18 @@
 from __future__ import annotations
 
 import dataclasses
-from unittest import mock
 
 import numpy as np
 import pytest
 
 import cpr_kin as ck
-from planning import seeding
 from planning.io.narrow_passages import narrow_scene
-from planning.problem import Problem, build_problem
-from planning.scene import PlannerSettings, Scene, Target
+from planning.pipeline.problem import Problem, build_problem, with_planner
+from planning.pipeline.scene import Scene, Target
+from planning.pipeline.seeding import sampled_path, seed_search
+from planning.pipeline.settings import PlannerSettings
+from planning.pipeline.tuning import SearchTuning, SeedingTuning
 from planning.search.rrt_connect import waypoints_along
-from planning.seeding import PATH_ATTEMPTS, SEED_SHARE, sampled_path, seed_search
 
 
 @pytest.fixture(scope="module")
@@ -30,7 +30,7 @@ def test_a_clear_straight_line_is_the_only_path_seed(robot: ck.Robot) -> None:
     seeds = seed_search(problem)
     assert seeds.straight_line_clear and seeds.path is None and seeds.problem is problem
     np.testing.assert_array_equal(seeds.candidates[0], problem.objective.straight_line())
-    assert len(seeds.candidates) == int(SEED_SHARE * scene.planner.firefly.fireflies)
+    assert len(seeds.candidates) == int(SeedingTuning().share * scene.planner.firefly.fireflies)
     objective = problem.objective
     assert np.all((seeds.candidates >= objective.lower) & (seeds.candidates <= objective.upper))
     # the others are small moves around the seed
@@ -80,7 +80,7 @@ def drawn_paths(problem: Problem) -> list[tuple[np.ndarray, float]]:
     rng = np.random.default_rng([problem.scene.planner.seed, 1])
     weights = ck.motion_radii(problem.robot)[problem.moving]
     drawn = []
-    for _ in range(PATH_ATTEMPTS):
+    for _ in range(problem.scene.planner.tuning.seeding.path_attempts):
         found = sampled_path(problem, rng)
         assert found is not None
         seed = waypoints_along(found.path, problem.scene.planner.waypoints, weights).ravel()
@@ -97,8 +97,8 @@ def test_a_path_whose_spline_violates_the_clearance_is_drawn_again(robot: ck.Rob
     seeds = seed_search(problem)
     np.testing.assert_array_equal(seeds.path, second)
     assert seeds.problem is problem  # a feasible seed with the scene's waypoints: no more needed
-    with mock.patch.object(seeding, "PATH_ATTEMPTS", 1):  # one attempt keeps the first path
-        np.testing.assert_array_equal(seed_search(problem).path, first)
+    one_attempt = SearchTuning(seeding=SeedingTuning(path_attempts=1))  # keeps the first path
+    np.testing.assert_array_equal(seed_search(with_planner(problem, tuning=one_attempt)).path, first)
 
 
 def test_when_no_path_seed_is_feasible_the_best_ranked_is_kept(robot: ck.Robot) -> None:

@@ -7,13 +7,17 @@ import pytest
 
 import cpr_kin as ck
 from planning import build_problem
-from planning.candidates import verify
 from planning.errors import NoSolutionError, PlanningError
 from planning.io.bundled import paper_scene
 from planning.io.scene_generator import generate_scenes
 from planning.io.trajectory_io import trajectory_document
-from planning.planner import PlanResult, plan, solve
-from planning.timing import NARROWED_ACCELERATION, narrowed_timings, timings, uniform_scale
+from planning.pipeline.choose import verify
+from planning.pipeline.planner import plan, solve
+from planning.pipeline.result import PlanResult
+from planning.pipeline.timing import narrowed_timings, uniform_scale
+from planning.pipeline.tuning import SearchTuning
+
+NARROWED_ACCELERATION = SearchTuning().narrowed_acceleration
 
 
 @pytest.fixture(scope="module")
@@ -62,7 +66,9 @@ def test_free_durations_are_timed_within_the_limits_c3_and_certified(
 def test_the_fastest_timing_is_never_longer_than_the_uniform_one(free_results: list[PlanResult]) -> None:
     methods = []
     for result in free_results:
-        uniform = result.spline.trajectory.time_scaled(uniform_scale(result.spline, result.problem))
+        uniform = result.spline.trajectory.time_scaled(
+            uniform_scale(result.spline, result.problem.robot.limits)
+        )
         assert result.trajectory.duration <= uniform.duration * (1 + 1e-12)
         methods.append(result.metrics.timing)
         if result.metrics.timing == "fastest":  # by 15-35 % on these scenes
@@ -72,11 +78,11 @@ def test_the_fastest_timing_is_never_longer_than_the_uniform_one(free_results: l
 
 def test_timings_are_offered_fastest_first(robot: ck.Robot, free_results: list[PlanResult]) -> None:
     result = free_results[0]
-    offered = timings(result.problem, result.waypoints)
+    offered = result.problem.duration.timings(result.problem, result.waypoints)
     assert [t.method for t in offered] == ["fastest", "uniform"]
     assert offered[0].trajectory.duration <= offered[1].trajectory.duration
     fixed = build_problem(paper_scene(0), robot)
-    (only,) = timings(fixed, solve(fixed).waypoints)
+    (only,) = fixed.duration.timings(fixed, solve(fixed).waypoints)
     assert only.method == "fixed" and only.trajectory.duration == pytest.approx(4.0)
 
 
@@ -85,7 +91,7 @@ def test_narrowed_timings_meet_the_lowered_acceleration_and_beat_the_uniform_one
 ) -> None:
     limits = robot.limits
     result = free_results[0]
-    offered = timings(result.problem, result.waypoints)
+    offered = result.problem.duration.timings(result.problem, result.waypoints)
     uniform = next(t for t in offered if t.method == "uniform").trajectory
     narrowed = narrowed_timings(result.problem, offered)
     assert narrowed, "a share of 0.7 costs well under the uniform timing's 15-35 %"
@@ -103,7 +109,7 @@ def test_narrowed_timings_meet_the_lowered_acceleration_and_beat_the_uniform_one
             trajectory(trajectory.knots[[0, -1]]), [result.problem.q_start, result.problem.q_goal], atol=1e-12
         )
     fixed = build_problem(paper_scene(0), robot)
-    assert narrowed_timings(fixed, timings(fixed, solve(fixed).waypoints)) == []
+    assert narrowed_timings(fixed, fixed.duration.timings(fixed, solve(fixed).waypoints)) == []
 
 
 def test_a_path_whose_fastest_timing_cuts_into_the_margin_runs_narrowed(robot: ck.Robot) -> None:
@@ -112,9 +118,9 @@ def test_a_path_whose_fastest_timing_cuts_into_the_margin_runs_narrowed(robot: c
     timing the planner fell back to before."""
     scene = generate_scenes(5, 2, robot)[4]
     result = plan(scene, robot)
-    uniform = result.spline.trajectory.time_scaled(uniform_scale(result.spline, result.problem))
+    uniform = result.spline.trajectory.time_scaled(uniform_scale(result.spline, result.problem.robot.limits))
     assert result.metrics.timing == "narrowed" and result.verification.accepted
-    fastest = timings(result.problem, result.waypoints)[0]
+    fastest = result.problem.duration.timings(result.problem, result.waypoints)[0]
     assert fastest.method == "fastest"
     assert not verify(result.problem, fastest.trajectory, fastest.fit).accepted
     assert result.metrics.min_clearance_m >= scene.safety_margin
@@ -134,7 +140,7 @@ def test_the_search_ranks_candidates_by_a_bound_tight_to_the_executed_duration(
     window)."""
     ratios = []
     for result in free_results:
-        fastest = timings(result.problem, result.waypoints)[0]
+        fastest = result.problem.duration.timings(result.problem, result.waypoints)[0]
         assert fastest.method == "fastest"
         ratios.append(float(result.breakdown.duration_s[0]) / fastest.trajectory.duration)
     assert all(0.95 <= ratio <= 1.2 for ratio in ratios), ratios

@@ -10,7 +10,8 @@ import cpr_kin as ck
 from planning.io.bundled import paper_scene
 from planning.io.trajectory_io import write_samples, write_trajectory
 from planning.io.trajectory_reader import read_trajectory
-from planning.planner import PlanResult, plan
+from planning.pipeline.planner import plan
+from planning.pipeline.result import PlanResult
 
 
 @pytest.fixture(scope="module")

@@ -19,7 +19,7 @@ from planning.io.trajectory_reader import (
     parse_trajectory,
     read_trajectory,
 )
-from planning.planner import plan
+from planning.pipeline.planner import plan
 
 
 @pytest.fixture(scope="module")

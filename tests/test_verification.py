@@ -8,8 +8,9 @@ import pytest
 import cpr_kin as ck
 from planning.curves.trajectory import Trajectory
 from planning.io.bundled import paper_scene
-from planning.planner import PlanResult, plan
-from planning.verification import verify_trajectory
+from planning.pipeline.planner import plan
+from planning.pipeline.result import PlanResult
+from planning.pipeline.verification import verify_trajectory
 
 
 @pytest.fixture(scope="module")

@@ -18,7 +18,8 @@ import pytest
 import cpr_kin as ck
 from planning.io.bundled import paper_scene
 from planning.io.trajectory_io import write_trajectory
-from planning.planner import PlanResult, plan
+from planning.pipeline.planner import plan
+from planning.pipeline.result import PlanResult
 from planning.viz.artifacts import viewer_html
 from planning.viz.viewer import Viewer
 from planning.viz.viewer_server import start_server

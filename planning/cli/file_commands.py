@@ -17,8 +17,8 @@ from planning.outcome import EXIT_NO_TRAJECTORY, EXIT_OK
 def cmd_check(args: argparse.Namespace) -> int:
     """Re-verify a trajectory file against a scene; exit 3 when it fails."""
     from planning.io.trajectory_reader import read_trajectory
-    from planning.problem import build_problem
-    from planning.verification import verify_trajectory
+    from planning.pipeline.problem import build_problem
+    from planning.pipeline.verification import verify_trajectory
 
     scene = load(args.scene)
     document = read_trajectory(args.trajectory)

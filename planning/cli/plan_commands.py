@@ -14,7 +14,7 @@ from planning.cli.terminal import firefly_progress
 from planning.outcome import EXIT_OK, Interrupted, interruption
 
 if TYPE_CHECKING:
-    from planning.scene import Scene
+    from planning.pipeline.scene import Scene
 
 OVERRIDES = ("seed", "fitness", "fireflies", "iterations")
 """Planner settings the command line may change, by their scene-file keys."""
@@ -31,8 +31,8 @@ def _plan_and_write(scene: Scene, out: str, args: argparse.Namespace, paper: boo
     from planning.io.outputs import plan_files
     from planning.io.publish import OutputFolder
     from planning.io.report import paper_rows, summary, summary_line, text_table
-    from planning.planner import plan
-    from planning.scene import PAPER_SEARCH
+    from planning.pipeline.planner import plan
+    from planning.pipeline.settings import PAPER_SEARCH
 
     overrides = {k: getattr(args, k) for k in OVERRIDES if getattr(args, k, None) is not None}
     if getattr(args, "paper_search", False):

@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from planning.io.scene_file import load_scene
-from planning.scene import Scene
+from planning.pipeline.scene import Scene
 
 
 def bundled_scene_paths() -> list[Path]:
@@ -36,7 +36,7 @@ def paper_scene(seed: int = 0, **planner_changes: Any) -> Scene:
     Args:
         seed: seed of the search.
         planner_changes: other planner settings, by their scene-file keys
-            (:meth:`~planning.scene.PlannerSettings.updated`), e.g. ``fireflies=10``.
+            (:meth:`~planning.pipeline.settings.PlannerSettings.updated`), e.g. ``fireflies=10``.
     """
     scene = load_scene(paper_scene_path())
     return dataclasses.replace(scene, planner=scene.planner.updated(seed=seed, **planner_changes))

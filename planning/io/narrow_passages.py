@@ -28,7 +28,8 @@ import numpy as np
 
 import cpr_kin as ck
 from planning.errors import PlanningError
-from planning.scene import PlannerSettings, Scene, Target
+from planning.pipeline.scene import Scene, Target
+from planning.pipeline.settings import PlannerSettings
 
 Kind = Literal["beam", "window", "pillars"]
 KINDS: tuple[Kind, ...] = ("beam", "window", "pillars")

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from planning.io.report import report_markdown
 from planning.io.trajectory_io import plan_samples_csv, trajectory_json
-from planning.planner import PlanResult
+from planning.pipeline.result import PlanResult
 
 
 def plan_files(

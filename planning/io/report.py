@@ -1,7 +1,7 @@
 """Reports of a plan: ``report.md``, the CLI's summary, and the paper's figures beside ours.
 
 Every figure comes from the plan's one record (:func:`plan_record`, whose metrics are
-:meth:`planning.metrics.Metrics.to_record`): the trajectory file, the batch summary and the
+:meth:`planning.pipeline.metrics.Metrics.to_record`): the trajectory file, the batch summary and the
 reports cannot disagree.
 """
 
@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 if TYPE_CHECKING:  # types only: a batch's parent formats tables without the planner
-    from planning.planner import PlanResult
+    from planning.pipeline.result import PlanResult
 
 PAPER_FIGURES = {
     "fma_time_s": 53.0,

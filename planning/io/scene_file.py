@@ -13,7 +13,7 @@ theta 0.97, sweep mode, 4 stalled iterations), seeded with paths, its best refin
 CMA-ES, 3 waypoints, clearance
 fitness, seed 0, spline path, IPO 0.012 s, 64 fitness samples, verification step 0.005 m,
 no bound on the node deviation; ``spline``: p = 1e6, a = [0, 0, 1],
-``ends: rest``. They are read from :mod:`planning.scene`, the one place they are set.
+``ends: rest``. They are read from :mod:`planning.pipeline.scene`, the one place they are set.
 """
 
 from __future__ import annotations
@@ -39,7 +39,8 @@ from planning.io.scene_schema import (
     TargetSpec,
     describe_errors,
 )
-from planning.scene import PlannerSettings, Scene, Target
+from planning.pipeline.scene import Scene, Target
+from planning.pipeline.settings import PlannerSettings
 
 MAX_SCENE_BYTES = 1_000_000
 """Largest scene file [bytes]: the largest valid scene (500 obstacles) takes about 60 kB."""

@@ -16,7 +16,8 @@ import numpy as np
 
 import cpr_kin as ck
 from planning.errors import PlanningError
-from planning.scene import PlannerSettings, Scene, Target
+from planning.pipeline.scene import Scene, Target
+from planning.pipeline.settings import PlannerSettings
 
 
 def _tcp(theta1: float, radius: float, height: float) -> tuple[float, float, float]:

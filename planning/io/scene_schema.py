@@ -1,7 +1,7 @@
 """The scene file's schema (DESIGN.md section 6) as pydantic models, and its error messages.
 
 Unknown keys are errors; every optional key has the default of the setting it fills
-(:mod:`planning.scene`), so the file and the library cannot disagree. A validation error
+(:mod:`planning.pipeline.scene`), so the file and the library cannot disagree. A validation error
 becomes one line per problem naming the field path (``obstacles[1].size[2]``), the value
 and what is allowed (:func:`describe_errors`).
 """
@@ -15,19 +15,21 @@ from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationErr
 
 from cpr_kin.names import unprintable
 from cpr_kin.obstacles import MAX_ANGLE_RAD, MAX_COORDINATE_M, MAX_NAME_CHARS, SCALE_RANGE, SIZE_RANGE_M
-from planning.scene import (
-    DEFAULT_FIREFLY,
+from planning.pipeline.scene import (
     DEFAULT_SAFETY_MARGIN_M,
     DEFAULT_SPLINE,
     DURATION_RANGE_S,
-    IPO_RANGE_S,
-    MAX_FITNESS_SAMPLES,
     MAX_OBSTACLES,
     MAX_SAFETY_MARGIN_M,
-    MAX_SEED,
-    MAX_WAYPOINTS,
     SPLINE_A_RANGE,
     SPLINE_P_RANGE,
+)
+from planning.pipeline.settings import (
+    DEFAULT_FIREFLY,
+    IPO_RANGE_S,
+    MAX_FITNESS_SAMPLES,
+    MAX_SEED,
+    MAX_WAYPOINTS,
     VERIFY_STEP_RANGE_M,
     PlannerSettings,
 )
@@ -142,7 +144,7 @@ _F, _P = DEFAULT_FIREFLY, PlannerSettings  # the defaults are the settings' own
 
 
 class PlannerSpec(_Strict):
-    """The flat ``planner:`` block; see :class:`~planning.scene.PlannerSettings` (same defaults)."""
+    """The flat ``planner:`` block; see :class:`~planning.pipeline.settings.PlannerSettings`."""
 
     fireflies: Annotated[int, Field(ge=2, le=MAX_FIREFLIES)] = _F.fireflies
     iterations: Annotated[int, Field(ge=0, le=MAX_ITERATIONS)] = _F.iterations

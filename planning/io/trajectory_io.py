@@ -23,7 +23,7 @@ from planning.io.publish import write_file
 
 if TYPE_CHECKING:  # types only: writing files needs neither the planner nor the robot
     import cpr_kin as ck
-    from planning.planner import PlanResult
+    from planning.pipeline.result import PlanResult
 
 FloatArray = NDArray[np.float64]
 FORMAT = "cpr-trajectory/1"

@@ -5,7 +5,7 @@ types (pydantic, with field paths in the messages), finite numbers, one segment 
 interval whose own ``t0`` and ``t1`` are those knots, eight coefficients per joint, and
 values of a sane size. Anything else is a :class:`TrajectoryFileError` (the CLI's exit 2)
 naming the key or the segment. Whether the trajectory is continuous (C3) at its knots and
-keeps the margin is then for :func:`planning.verification.verify_trajectory` (exit 3).
+keeps the margin is then for :func:`planning.pipeline.verification.verify_trajectory` (exit 3).
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ from cpr_kin.user_files import UserFileError, read_bytes
 from planning.curves.hermite import ORDER
 from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
-from planning.scene import DURATION_RANGE_S
+from planning.pipeline.scene import DURATION_RANGE_S
 
 FloatArray = NDArray[np.float64]
 FORMAT = "cpr-trajectory/1"

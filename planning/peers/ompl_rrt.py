@@ -1,7 +1,7 @@
 """OMPL's RRT-Connect with path simplification and TOPP-RA timing, a sampling-planner peer.
 
 The same scene, URDF, collision world and limits as the firefly planner
-(:func:`planning.problem.build_problem`): RRT-Connect searches the moving joints with our
+(:func:`planning.pipeline.problem.build_problem`): RRT-Connect searches the moving joints with our
 coal margin check as state validity (margin plus the verification step, the clearance the
 firefly's fitness asks of its samples), the path is simplified, and
 :func:`planning.peers.toppra_timing.time_and_verify` times and verifies it. The peer is
@@ -17,8 +17,8 @@ from numpy.typing import NDArray
 
 import cpr_kin as ck
 from planning.peers.toppra_timing import SamplingResult, planning_clearance_m, time_and_verify
-from planning.problem import build_problem
-from planning.scene import Scene
+from planning.pipeline.problem import build_problem
+from planning.pipeline.scene import Scene
 
 FloatArray = NDArray[np.float64]
 

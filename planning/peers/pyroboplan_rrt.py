@@ -23,8 +23,8 @@ from numpy.typing import NDArray
 
 import cpr_kin as ck
 from planning.peers.toppra_timing import SamplingResult, planning_clearance_m, time_and_verify
-from planning.problem import build_problem
-from planning.scene import Scene
+from planning.pipeline.problem import build_problem
+from planning.pipeline.scene import Scene
 
 FloatArray = NDArray[np.float64]
 

@@ -13,7 +13,7 @@ import ruckig
 from numpy.typing import ArrayLike
 
 from planning.errors import PlanningError
-from planning.problem import Problem
+from planning.pipeline.problem import Problem
 
 
 def ruckig_duration(

@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from planning.scene import Scene
+from planning.pipeline.scene import Scene
 
 FloatArray = NDArray[np.float64]
 

@@ -3,31 +3,25 @@
 The firefly explores and finds the basin; near its best point its moves are too coarse to
 descend (a sweep kicks every firefly by about ``alpha sqrt(n) / 2`` per iteration), and its
 early stop ends the search there. A covariance matrix adaptation evolution strategy (Hansen
-2016, "The CMA Evolution Strategy: A Tutorial", default parameters; its active covariance
-update is optional, :data:`ACTIVE_UPDATE`) learns the valley's directions from a few
+2016, "The CMA Evolution Strategy: A Tutorial", default parameters, :mod:`cma_rates`; its
+active covariance update is optional) learns the valley's directions from a few
 generations and walks along them, also where the valley does not follow the variables' axes
 (the tests: a rotated quadratic of condition number 1000, where a search that adapts only
-its step length needs about that many times more evaluations). Measured on 100 generated
-scenes (24 narrow passages, generator seeds 0 and 1, ``scripts/bench_search.py``): after 4
-stalled firefly iterations instead of 8, the refinement makes the trajectories 7-10 %
-shorter (geometric mean) in the same planning time. On the paper objective
-(``scripts/bench_peers.py``, 10 seeds), run to the budget of 2550 evaluations, the seeded
-firefly and this refinement reach a median of 2.48 (2.22 with :data:`ACTIVE_UPDATE`), the
-CMA-ES peer from a random start 2.50. The default early stop runs as far there: its best
-stays more than :data:`NEAR_BOUND` times the objective's lower bound (when every stall
-counted, it stopped at 2.81 after about 230 evaluations).
+its step length needs about that many times more evaluations). What it gains on planning
+scenes and the paper objective: ``docs/tuning.md``.
 
-Written here rather than taken from ``cma`` or ``cmaes``: both import ``scipy.stats``
-(0.6-0.9 s), more than a third of the 1.5 s a plan may take in a new process; the method
-itself is the textbook's, in normalised coordinates ``u in [0, 1]^d`` like the firefly.
-Samples outside the box are clipped onto it and the clipped steps enter the update
-(repair), so every evaluated point lies in the box.
+Written here rather than taken from ``cma`` or ``cmaes``: both import ``scipy.stats``, a large
+part of the time a plan may take in a new process; the method itself is the textbook's, in
+normalised coordinates ``u in [0, 1]^d`` like the firefly. Samples outside the box are
+clipped onto it and the clipped steps enter the update (repair), so every evaluated point
+lies in the box.
 
 The refinement ends when its best value has improved by less than a relative
-:data:`~planning.search.optimizer.STALL_TOLERANCE` over :data:`STALL_GENERATIONS`
-generations in a row while within :data:`NEAR_BOUND` times the objective's lower bound
-(when one is given), when its step has shrunk below :data:`MIN_SIGMA`, or when the next
-generation would exceed the evaluation budget. The same generator state gives the same run.
+:data:`~planning.search.optimizer.STALL_TOLERANCE` over ``stall_generations`` generations
+in a row while within :attr:`RefinementSettings.near_bound` times the objective's lower
+bound (when one is given), when its step has shrunk below
+:attr:`RefinementSettings.min_sigma`, or when the next generation would exceed the
+evaluation budget. The same generator state gives the same run.
 """
 
 from __future__ import annotations
@@ -40,47 +34,9 @@ from numpy.typing import ArrayLike, NDArray
 from planning.errors import PlanningError
 from planning.search.cma_rates import LearningRates, population_size
 from planning.search.optimizer import BatchObjective, EarlyStop, History, SearchResult, evaluate_in_box
+from planning.search.refinement_settings import STALL_GENERATIONS, RefinementSettings
 
 FloatArray = NDArray[np.float64]
-
-SIGMA = 0.03
-"""Initial step [share of each variable's range]: the firefly's best lies in the right basin,
-so the refinement starts local. ``scripts/study_parameters.py`` (30 scenes): 0.06 gives 5 %
-longer trajectories, 0.015 1.4 % shorter ones for 7 % more planning time and more
-candidates refused by the certified check (they end closer to the clearance)."""
-STALL_GENERATIONS = 4
-"""Generations in a row without a relative improvement of ``STALL_TOLERANCE`` that end the
-refinement. Longer refinements give shorter trajectories for more planning time
-(``scripts/study_parameters.py``): 8 generations, 5 % shorter for 12 % more time on its 30
-scenes, and 1.3 % and 7 % shorter for 24 % and 40 % more time on 50 scenes of generator
-seeds 0 and 2; 20 generations, 1.6 % shorter for twice the time. On 100 scenes (24 narrow)
-of seeds 0 and 1, with the faster timing: 6 generations 1-2 % shorter for 5-12 % more time,
-8 generations 2-3 % for 27 %. The planning time is the figure held against OMPL's
-(issue 17), so the default stays short; where the best is still far above the objective's
-lower bound, :data:`NEAR_BOUND` lets the refinement run on instead."""
-ACTIVE_UPDATE = False
-"""Whether the covariance also learns from the worse half of each generation (the active
-CMA-ES of the tutorial): it shrinks the variance along the directions that failed, such as
-a constraint's normal, so that a long refinement walks along the clearance constraint
-instead of sampling across it. On the paper objective run to its budget
-(``refine_stall: 0``, ``scripts/bench_peers.py``, 10 seeds) it reaches a median of 2.22
-against 2.48 without. Off by default: on 100 generated scenes (24 narrow, generator seed 1,
-``scripts/study_parameters.py``) its trajectories are as long (1.002) and its planning
-time 8-10 % longer, because its best candidates come closer to the clearance and the
-certified check refuses twice as many (20 against 10 of 100), each a fallback timed and
-verified again."""
-NEAR_BOUND = 1.3
-"""How close to the objective's lower bound (a ratio) the best must be before stalled
-generations count towards the early stop. Farther, the refinement runs on until its step
-collapses or the budget ends: a best 30 % above what the obstacle-free motion takes has room
-to improve, and there the refinement's improvements come rarely but large (several percent,
-after up to 15 generations without one). On 100 generated scenes each of generator seeds 0
-and 1 (24 narrow passages), against counting every stall: trajectories 4.3 % and 2.0 %
-shorter (geometric mean; the ten most improved 27 % and 15 %), for 10 % and 2.5 % more
-median planning time; 1.2: 5.7 % and 2.7 % shorter for 20 % and 13 % more time."""
-MIN_SIGMA = 1e-4
-"""Step below which the refinement ends [share of the range]: 1e-4 of a joint's range is
-below what the timing or the clearance can tell apart."""
 
 
 def cma_refine(
@@ -91,9 +47,9 @@ def cma_refine(
     start_value: float,
     budget: int,
     rng: np.random.Generator,
-    sigma: float | None = None,
-    stall_generations: int | None = None,
-    active: bool | None = None,
+    settings: RefinementSettings | None = None,
+    *,
+    stall_generations: int = STALL_GENERATIONS,
     lower_bound: float | None = None,
 ) -> SearchResult:
     """Refine ``start`` (value ``start_value``) with a CMA-ES within ``budget`` evaluations.
@@ -106,16 +62,13 @@ def cma_refine(
         start_value: its objective value (not evaluated again).
         budget: most evaluations; fewer than one generation: no refinement.
         rng: the generator of the samples.
-        sigma: initial step [share of each variable's range], in (0, 1]; default
-            :data:`SIGMA`.
+        settings: step, covariance update and stopping rules (default:
+            :class:`RefinementSettings`'s).
         stall_generations: generations in a row without a relative improvement of
-            ``STALL_TOLERANCE`` that end the refinement; 0: run out the budget (or the step);
-            default :data:`STALL_GENERATIONS`.
-        active: the active covariance update (:class:`LearningRates`); default
-            :data:`ACTIVE_UPDATE`.
-        lower_bound: about the least value the objective can take (e.g.
-            :attr:`planning.objective.WaypointObjective.lower_bound`); stalled generations
-            count only while the best is within :data:`NEAR_BOUND` times it. ``None``: always.
+            ``STALL_TOLERANCE`` that end the refinement; 0: run out the budget (or the step).
+        lower_bound: about the least value the objective can take (e.g. a waypoint
+            objective's ``lower_bound``); stalled generations count only while the best is
+            within ``settings.near_bound`` times it. ``None``: always.
 
     Returns:
         The best of ``start`` and every evaluated point; histories per generation (entry 0:
@@ -131,16 +84,13 @@ def cma_refine(
             f"start of shape {x0.shape} and bounds of shapes {lo.shape}, {span.shape}; "
             "expected (d,) each with upper > lower"
         )
-    sigma = SIGMA if sigma is None else sigma
-    stall_generations = STALL_GENERATIONS if stall_generations is None else stall_generations
-    if not 0.0 < sigma <= 1.0:
-        raise PlanningError(f"sigma = {sigma!r} must be in (0, 1] (a share of each variable's range)")
+    settings = settings or RefinementSettings()
+    sigma, active = settings.sigma, settings.active
     if lower_bound is not None and not math.isfinite(lower_bound):
         raise PlanningError(f"lower_bound = {lower_bound!r} must be a finite number (or None)")
-    near = math.inf if lower_bound is None else NEAR_BOUND * lower_bound
+    near = math.inf if lower_bound is None else settings.near_bound * lower_bound
     d = lo.size
     lam = population_size(d)
-    active = ACTIVE_UPDATE if active is None else active
     rates = LearningRates.of(d, active)
     weights, negative = rates.weights, rates.negative_weights
     mu = weights.size
@@ -160,7 +110,7 @@ def cma_refine(
     history.record(best_f, best_f, 0)
     evaluations, generation = 0, 0
     early_stop = EarlyStop(stall_generations, best_f)
-    while evaluations + lam <= budget and sigma >= MIN_SIGMA:
+    while evaluations + lam <= budget and sigma >= settings.min_sigma:
         generation += 1
         steps = rng.standard_normal((lam, d)) @ (basis * scales).T
         population = np.clip(mean + sigma * steps, 0.0, 1.0)
@@ -201,11 +151,6 @@ def cma_refine(
     return history.result(lo, span, best_u, best_f, population, np.array([f for _, f in newest_first]))
 
 
-FALLBACK_SPACING = 1 / 8
-"""Least fitness between two of the refinement's points kept for the fallback, as a share of
-its whole improvement (:func:`refine_search`)."""
-
-
 def refine_search(
     objective: BatchObjective,
     lower: ArrayLike,
@@ -213,8 +158,9 @@ def refine_search(
     searched: SearchResult,
     budget: int,
     rng: np.random.Generator,
-    sigma: float | None = None,
-    stall_generations: int | None = None,
+    settings: RefinementSettings | None = None,
+    *,
+    stall_generations: int = STALL_GENERATIONS,
     lower_bound: float | None = None,
 ) -> SearchResult:
     """``searched`` (a global search's result) refined by :func:`cma_refine` from its best point.
@@ -222,12 +168,13 @@ def refine_search(
     Returns one result for both phases: the refined best; ``budget`` bounds the refinement's
     evaluations, which add to ``searched``'s; the histories run on through the refinement's
     generations. The population is ``searched``'s with, ahead of it, some of the points that
-    improved on its best: the newest and then those at least :data:`FALLBACK_SPACING` of the
-    whole improvement apart, so that a caller whose check refuses the best (the refinement
-    goes as close to the constraints as the objective lets it) falls back to distinct,
-    less tight points before the global search's. ``sigma``, ``stall_generations`` and
-    ``lower_bound`` are :func:`cma_refine`'s.
+    improved on its best: the newest and then those at least ``settings.fallback_spacing`` of
+    the whole improvement apart, so that a caller whose check refuses the best (the
+    refinement goes as close to the constraints as the objective lets it) falls back to
+    distinct, less tight points before the global search's. ``settings``,
+    ``stall_generations`` and ``lower_bound`` are :func:`cma_refine`'s.
     """
+    settings = settings or RefinementSettings()
     refined = cma_refine(
         objective,
         lower,
@@ -236,13 +183,13 @@ def refine_search(
         searched.fitness,
         budget,
         rng,
-        sigma,
-        stall_generations,
+        settings,
+        stall_generations=stall_generations,
         lower_bound=lower_bound,
     )
     if refined.evaluations == 0:
         return searched
-    spacing = FALLBACK_SPACING * (searched.fitness - refined.fitness)
+    spacing = settings.fallback_spacing * (searched.fitness - refined.fitness)
     keep: list[int] = []
     for index, value in enumerate(refined.population_fitness):  # best first
         if not keep or value >= refined.population_fitness[keep[-1]] + spacing:

@@ -10,7 +10,7 @@ from numpy.typing import NDArray
 
 import cpr_kin as ck
 from planning.curves.trajectory import Trajectory
-from planning.planner import PlanResult
+from planning.pipeline.result import PlanResult
 
 PLOT_FILES = ("joints.png", "tcp_path.png", "clearance.png", "utilisation.png", "convergence.png")
 

@@ -1,9 +1,10 @@
-"""Build a planning problem from a scene: robot, collision world, endpoints, objective.
+"""Build a planning problem from a scene: robot, collision world, motion, duration rule, objective.
 
 :func:`build_problem` does everything that depends only on the scene, and refuses bad input
 before any search starts: it loads the robot, builds the collision world, solves and
-checks the start and goal, picks the moving joints and prepares the spline solver and the
-waypoint objective. :func:`planning.planner.solve` then searches, times and verifies;
+checks the start and goal, picks the moving joints, chooses the duration rule (fixed or
+free, :mod:`planning.pipeline.timing`) and prepares the spline solver and the waypoint
+objective. :func:`planning.pipeline.planner.solve` then searches, times and verifies;
 ``cpr-plan check`` and the peer planners use the same problem.
 """
 
@@ -20,10 +21,15 @@ from numpy.typing import NDArray
 import cpr_kin as ck
 from planning.curves.spline import SepticSplineSolver, uniform_knots
 from planning.errors import PlanningError
-from planning.objective import WaypointObjective
-from planning.scene import Scene
+from planning.pipeline.motion import Motion
+from planning.pipeline.objective import WaypointObjective
+from planning.pipeline.scene import Scene
+from planning.pipeline.timing import FixedDuration, FreeDuration, duration_rule
 
 FloatArray = NDArray[np.float64]
+
+SAME_POSE_TOLERANCE = 1e-9
+"""Start and goal closer than this in every joint [rad or m] are one pose: the plan stands still."""
 
 
 @dataclass(frozen=True)
@@ -34,9 +40,8 @@ class Problem:
         scene: the scene.
         robot: the robot it plans for.
         world: the robot among the scene's obstacles.
-        q_start: start configuration [rad, m], reachable and clear of the margin.
-        q_goal: goal configuration [rad, m], likewise.
-        moving: indices of the joints the waypoints move.
+        motion: start and goal (reachable, clear of the margin) and the moving joints.
+        duration: the scene's duration rule (fixed or free).
         solver: the septic spline solver on the search's knots: the trajectory's spline when
             the scene fixes the duration, else the geometric path's.
         objective: the waypoint objective the search minimises.
@@ -46,12 +51,31 @@ class Problem:
     scene: Scene
     robot: ck.Robot = field(repr=False)
     world: ck.CollisionWorld = field(repr=False)
-    q_start: FloatArray
-    q_goal: FloatArray
-    moving: NDArray[np.intp]
+    motion: Motion
+    duration: FixedDuration | FreeDuration
     solver: SepticSplineSolver = field(repr=False)
     objective: WaypointObjective = field(repr=False)
     build_time_s: float = 0.0
+
+    @property
+    def q_start(self) -> FloatArray:
+        """Start configuration [rad, m]."""
+        return self.motion.q_start
+
+    @property
+    def q_goal(self) -> FloatArray:
+        """Goal configuration [rad, m]."""
+        return self.motion.q_goal
+
+    @property
+    def moving(self) -> NDArray[np.intp]:
+        """Indices of the joints the waypoints move."""
+        return self.motion.moving
+
+    @property
+    def stands_still(self) -> bool:
+        """The goal is the start (within :data:`SAME_POSE_TOLERANCE` in every joint)."""
+        return bool(np.allclose(self.q_start, self.q_goal, rtol=0.0, atol=SAME_POSE_TOLERANCE))
 
 
 def moving_joints(robot: ck.Robot, scene: Scene, q_start: FloatArray, q_goal: FloatArray) -> NDArray[np.intp]:
@@ -101,7 +125,8 @@ def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | No
             plans scenes in parallel processes gives each 1.
 
     Raises:
-        PlanningError: unreachable start or goal, or one inside the margin; bad settings.
+        PlanningError: unreachable start or goal, or one inside the margin; a fixed duration
+            shorter than the limits allow; bad settings.
         cpr_kin.CprKinError: the robot's URDF or an obstacle is invalid.
     """
     started = time.perf_counter()
@@ -109,15 +134,17 @@ def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | No
     world = ck.CollisionWorld(robot, scene.obstacles, num_threads=threads)
     q_start = endpoint(robot, world, scene, "start")
     q_goal = endpoint(robot, world, scene, "goal")
-    moving = moving_joints(robot, scene, q_start, q_goal)
-    solver, objective = _search(scene, world, q_start, q_goal, moving)
+    motion = Motion(q_start, q_goal, moving_joints(robot, scene, q_start, q_goal))
+    duration = duration_rule(scene.duration)
+    if isinstance(duration, FixedDuration):
+        duration.check_reachable(robot, q_start, q_goal, rest_ends=scene.spline.ends == "rest")
+    solver, objective = _search_space(scene, world, motion, duration)
     return Problem(
         scene=scene,
         robot=robot,
         world=world,
-        q_start=q_start,
-        q_goal=q_goal,
-        moving=moving,
+        motion=motion,
+        duration=duration,
         solver=solver,
         objective=objective,
         build_time_s=time.perf_counter() - started,
@@ -135,7 +162,7 @@ def with_planner(problem: Problem, **changes: Any) -> Problem:
         return problem
     started = time.perf_counter()
     scene = dataclasses.replace(problem.scene, planner=settings)
-    solver, objective = _search(scene, problem.world, problem.q_start, problem.q_goal, problem.moving)
+    solver, objective = _search_space(scene, problem.world, problem.motion, problem.duration)
     return dataclasses.replace(
         problem,
         scene=scene,
@@ -145,23 +172,13 @@ def with_planner(problem: Problem, **changes: Any) -> Problem:
     )
 
 
-def _search(
-    scene: Scene, world: ck.CollisionWorld, q_start: FloatArray, q_goal: FloatArray, moving: NDArray[np.intp]
+def _search_space(
+    scene: Scene, world: ck.CollisionWorld, motion: Motion, duration: FixedDuration | FreeDuration
 ) -> tuple[SepticSplineSolver, WaypointObjective]:
     """The spline solver on the search's knots and the waypoint objective."""
     segments = scene.planner.waypoints + 1
-    nominal_duration = scene.duration if scene.duration is not None else float(segments)
     # the spline on the search's knots: the trajectory itself when the scene fixes the duration,
     # else the geometric path that the timing runs as fast as the limits allow
-    solver = SepticSplineSolver(uniform_knots(segments, nominal_duration), scene.spline)
-    objective = WaypointObjective(
-        world,
-        q_start,
-        q_goal,
-        moving,
-        scene.safety_margin,
-        scene.planner,
-        solver,
-        timed=scene.duration is not None,
-    )
+    solver = SepticSplineSolver(uniform_knots(segments, duration.nominal_duration(segments)), scene.spline)
+    objective = WaypointObjective(world, motion, scene.safety_margin, scene.planner, solver, duration)
     return solver, objective

@@ -1,22 +1,21 @@
 """The figures of a planned trajectory, and their one serialisation.
 
 :meth:`Metrics.to_record` gives them under the keys of the trajectory file's ``metrics``
-section (DESIGN.md section 6); the trajectory file, ``report.md``, the batch's
+section (``docs/formats.md``); the trajectory file, ``report.md``, the batch's
 ``summary.csv`` and the CLI's summary all take them from there.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
 import cpr_kin as ck
-from planning.curves.trajectory import Trajectory
-from planning.objective import Breakdown
+from planning.pipeline.choose import Choice
+from planning.pipeline.objective import Breakdown
 from planning.search.optimizer import SearchResult
-from planning.timing import Timing
 from planning.utilisation import ORDERS, limit_usage
 
 WALL_TIMES = ("planning_time_s", "optimiser_time_s", "timing_time_s")
@@ -47,7 +46,7 @@ class Metrics:
         candidates_verified: candidates that went through the final verification.
         duration_stretched: the requested duration broke a limit and was stretched.
         timing: how the trajectory was timed: ``fixed`` (the scene's duration), ``fastest``,
-            ``narrowed`` or ``uniform`` (see :mod:`planning.timing`).
+            ``narrowed`` or ``uniform`` (see :mod:`planning.pipeline.timing`).
         timing_time_s: wall time of that timing [s].
     """
 
@@ -101,30 +100,32 @@ class Metrics:
         return record if timings else {**record, **dict.fromkeys(WALL_TIMES)}
 
 
+class Elapsed(NamedTuple):
+    """Wall times of a plan [s].
+
+    Attributes:
+        planning_s: the whole plan, building the problem included.
+        search_s: from the start of solving to the end of the last search.
+    """
+
+    planning_s: float
+    search_s: float
+
+
 def measure(
-    robot: ck.Robot,
-    trajectory: Trajectory,
-    check: ck.CurveCheck,
-    max_node_deviation: float,
-    breakdown: Breakdown,
-    search: SearchResult,
-    times_s: tuple[float, float],
-    candidates_verified: int,
-    timing: Timing,
+    robot: ck.Robot, choice: Choice, breakdown: Breakdown, searched: SearchResult, elapsed: Elapsed
 ) -> Metrics:
     """The metrics of a verified trajectory.
 
     Args:
         robot: the robot (joint names, limits).
-        trajectory: the timed trajectory.
-        check: its certified clearance check.
-        max_node_deviation: the spline's largest node deviation [rad or m].
+        choice: the verified candidate, its timing and its check.
         breakdown: the chosen candidate's fitness terms (one candidate).
-        search: the optimiser's run.
-        times_s: ``(planning, search)`` wall times [s].
-        candidates_verified: candidates that went through the final verification.
-        timing: the timing that was verified.
+        searched: the optimiser's run.
+        elapsed: wall times of the plan.
     """
+    timing, check = choice.timing, choice.verification.check
+    trajectory = timing.trajectory
     limits = robot.limits
     names = robot.joint_names
     jerk = trajectory.extrema(3)
@@ -142,7 +143,7 @@ def measure(
         w_sol=float(breakdown.w_sol[0]),
         min_clearance_m=check.certified_min_m,
         sampled_min_clearance_m=check.sampled_min_m,
-        max_node_deviation=max_node_deviation,
+        max_node_deviation=timing.fit.max_node_deviation,
         jerk_min=dict(zip(names, map(float, jerk.minimum), strict=True)),
         jerk_max=dict(zip(names, map(float, jerk.maximum), strict=True)),
         limit_utilisation=utilisation,
@@ -150,10 +151,10 @@ def measure(
             zip(ORDERS, map(float, limit_usage(trajectory, limits).mean()), strict=True)
         ),
         integrated_squared_jerk=dict(zip(names, map(float, trajectory.integrated_squared_jerk), strict=True)),
-        planning_time_s=times_s[0],
-        optimiser_time_s=times_s[1],
-        evaluations=search.evaluations,
-        candidates_verified=candidates_verified,
+        planning_time_s=elapsed.planning_s,
+        optimiser_time_s=elapsed.search_s,
+        evaluations=searched.evaluations,
+        candidates_verified=choice.candidates_timed,
         duration_stretched=timing.stretched,
         timing=timing.method,
         timing_time_s=timing.time_s,

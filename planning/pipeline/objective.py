@@ -11,32 +11,18 @@ between the fixed start and goal. Its terms:
   every moving joint's full range); ``t_max`` includes one IPO so that every feasible value
   ``t_sol + (w_sol / w_max) IPO`` stays at or below it.
 
-Fitness (lower is better), with the margin checked by coal on the executed path (the septic
-spline through the nodes, or the paper's straight PTP lines), at ``fitness_samples``
-configurations and against ``margin + verify_step_m``:
+**Feasible** (:meth:`WaypointObjective.feasible`, the one place the rule is written): the
+fitness is at most ``t_max``, which holds exactly when the executed path keeps
+``margin + verify_step_m`` from every obstacle at the ``fitness_samples`` samples (coal),
+stays within the joint ranges, deviates from its nodes by at most ``max_node_deviation``
+(when set) and, when the scene fixes the duration, keeps velocity, acceleration and jerk
+within the limits at that duration (checked at the IPO samples; the final timing uses exact
+extrema). How the terms become the fitness, feasible or not, is the fitness rule's
+(:mod:`planning.pipeline.fitness`); the paths themselves are those of
+:mod:`planning.pipeline.path_terms`.
 
-- ``paper``: feasible ``F = t_sol + (w_sol / w_max) IPO`` (eq. 4); effector only violates:
-  ``2 t_max - F`` (eq. 5); links violate ("shoulder", with or without the effector), or a
-  joint leaves its range: ``2 t_max + F`` (our reading of eq. 6).
-- ``clearance`` (default): feasible as eq. 4, except that when the scene leaves the duration
-  free, ``t_sol`` is replaced by how fast the path itself can be run (its phase-plane time
-  plus what the jerk limit adds, :mod:`planning.curves.jerk_window`): the search then optimises the
-  trajectory that is executed, not the paper's proxy of stopping at every waypoint;
-  infeasible ``2 t_max + t_max (depth / required + excess)``, with ``depth`` the mean
-  violation of the required clearance over the samples [m] and ``excess`` the sum of the
-  other violations below, each relative to its bound.
-  The margin is checked at every 4th sample first; the rest only where it can still make the
-  candidate feasible (no violation so far); depth is the mean over the samples checked.
-  Feasible always ranks ahead of infeasible.
-
-Beyond the margin, a feasible candidate's spline must stay within the joint ranges, deviate
-from its nodes by at most ``max_node_deviation`` (when set) and, when the scene fixes the duration,
-keep velocity, acceleration and jerk within the limits at that duration (checked at the IPO
-samples; the final timing uses exact extrema). The paper fitness ranks these violations
-with eq. 6.
-
-The paths themselves (samples, ``w_sol``, range, limit and deviation terms) are those of
-:mod:`planning.path_terms`.
+The margin is checked at every 4th sample first; the rest only where it can still make the
+candidate feasible (no violation so far); depth is the mean over the samples checked.
 """
 
 from __future__ import annotations
@@ -50,8 +36,11 @@ from numpy.typing import NDArray
 import cpr_kin as ck
 from planning.curves.ptp import ptp_time, trapezoid_time
 from planning.curves.spline import SepticSplineSolver
-from planning.path_terms import ExecutedPaths
-from planning.scene import PlannerSettings
+from planning.pipeline.fitness import FITNESS_RULES, Terms
+from planning.pipeline.motion import Motion
+from planning.pipeline.path_terms import executed_paths
+from planning.pipeline.settings import PlannerSettings
+from planning.pipeline.timing import DurationRule
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
@@ -101,31 +90,26 @@ class WaypointObjective:
 
     Args:
         world: robot and obstacles.
-        q_start: start configuration [rad, m].
-        q_goal: goal configuration [rad, m].
-        moving: indices of the joints the waypoints move.
+        motion: start, goal and the joints the waypoints move.
         margin_m: safety margin [m].
-        settings: planner settings (fitness kind, path kind, IPO, samples, buffer).
-        solver: the septic spline solver on the trajectory's knots (``N = p + 1`` segments).
-        timed: the knots are the final timing (the scene fixes the duration), so velocity,
-            acceleration and jerk limits apply to candidates.
+        settings: planner settings (fitness rule, path kind, IPO, samples, verification step).
+        solver: the septic spline solver on the search's knots (``N = p + 1`` segments).
+        duration: the scene's duration rule: with a fixed duration the knots are the final
+            timing, so velocity, acceleration and jerk limits apply to candidates.
     """
 
     def __init__(
         self,
         world: ck.CollisionWorld,
-        q_start: FloatArray,
-        q_goal: FloatArray,
-        moving: NDArray[np.intp],
+        motion: Motion,
         margin_m: float,
         settings: PlannerSettings,
         solver: SepticSplineSolver,
-        timed: bool = False,
+        duration: DurationRule,
     ) -> None:
         robot = world.robot
-        self.world = world
-        self.q_start, self.q_goal = np.asarray(q_start, dtype=float), np.asarray(q_goal, dtype=float)
-        self.moving = np.asarray(moving, dtype=np.intp)
+        self.world, self.motion = world, motion
+        self.q_start, self.q_goal, self.moving = motion.q_start, motion.q_goal, motion.moving
         self.settings = settings
         self.solver = solver
         self.n_waypoints = settings.waypoints
@@ -133,10 +117,11 @@ class WaypointObjective:
         limits = robot.limits
         self.lower_q, self.upper_q = limits.lower, limits.upper
         self.v_max, self.a_max = limits.velocity, limits.acceleration
-        self.timed = timed
+        self.rule = FITNESS_RULES[settings.fitness]
+        timed = duration.limits_bind_candidates
+        self.paths = executed_paths(limits, motion, settings, solver, timed)
         # with the duration free, the clearance fitness ranks by how fast a path can be run
-        self.estimates_duration = not timed and settings.fitness == "clearance" and settings.path == "spline"
-        self.paths = ExecutedPaths(limits, self.q_start, self.q_goal, self.moving, settings, solver, timed)
+        self.estimates_duration = not timed and self.rule.ranks_by_duration and self.paths.estimates_duration
         segments = self.n_waypoints + 1
         self.lower = np.tile(limits.lower[self.moving], self.n_waypoints)
         self.upper = np.tile(limits.upper[self.moving], self.n_waypoints)
@@ -148,25 +133,26 @@ class WaypointObjective:
         self._pair_group = np.array([ck.GROUPS.index(group) for _, _, group in world.pairs], dtype=np.intp)
 
     @property
+    def feasible_below(self) -> float:
+        """The bound of feasible values: a candidate is feasible iff its fitness is at most this."""
+        return self.t_max
+
+    def feasible(self, fitness: FloatArray | float) -> BoolArray:
+        """Whether fitness values belong to feasible candidates (the one rule: at most ``t_max``)."""
+        return np.asarray(np.asarray(fitness) <= self.t_max)
+
+    @property
     def dimension(self) -> int:
         """Length of a decision vector: waypoints x moving joints."""
         return int(self.lower.size)
 
     def nodes(self, x: FloatArray) -> FloatArray:
         """``(S, p + 2, nq)`` start, waypoints and goal of candidates ``x`` ``(S, p k)``."""
-        x = np.atleast_2d(np.asarray(x, dtype=float))
-        s = len(x)
-        nodes = np.empty((s, self.n_waypoints + 2, self.q_start.size))
-        nodes[:, 0], nodes[:, -1] = self.q_start, self.q_goal
-        nodes[:, 1:-1] = self.q_start  # held joints keep the start's values
-        nodes[:, 1:-1, self.moving] = x.reshape(s, self.n_waypoints, self.moving.size)
-        return nodes
+        return self.motion.nodes(x, self.n_waypoints)
 
     def straight_line(self) -> FloatArray:
         """The decision vector whose waypoints lie evenly on the straight line from start to goal."""
-        fractions = np.arange(1, self.n_waypoints + 1) / (self.n_waypoints + 1)
-        points = self.q_start + fractions[:, None] * (self.q_goal - self.q_start)
-        return np.asarray(points[:, self.moving].ravel())
+        return self.motion.straight_line(self.n_waypoints)
 
     @cached_property
     def lower_bound(self) -> float:
@@ -219,11 +205,9 @@ class WaypointObjective:
         values = np.full((len(flat), 2), np.inf)
         flagged = np.flatnonzero(self.world.margin_violated(flat, self.required_m))
         if flagged.size:
-            if self.settings.fitness == "paper":
-                values[flagged] = self.world.clearance_batch(flat[flagged]).clearance_m
-            else:  # one query per sample; the violation goes to the closest pair's group
-                distance, pair = self.world.min_clearance_batch(flat[flagged], below_m=self.required_m)
-                values[flagged, self._pair_group[pair]] = distance
+            values[flagged] = self.rule.shortfall_distances(
+                self.world, flat[flagged], self.required_m, self._pair_group
+            )
         block = clearance[candidates]
         block[:, columns] = values.reshape(len(candidates), -1, 2)
         clearance[candidates] = block
@@ -253,13 +237,7 @@ class WaypointObjective:
             duration[feasible] = self.paths.durations(paths.samples[feasible])
             time_s = np.minimum(duration, self.t_max - self.settings.ipo)
         base = time_s + np.minimum(w_sol / self.w_max, 1.0) * self.settings.ipo
-        if self.settings.fitness == "paper":
-            fitness = np.where(
-                feasible, base, np.where(links | (other > 0), 2 * self.t_max + base, 2 * self.t_max - base)
-            )
-        else:
-            penalty = self.t_max * (depth / max(self.required_m, 1e-3) + other)
-            fitness = np.where(feasible, base, 2 * self.t_max + penalty)
+        fitness = self.rule.fitness(Terms(base, feasible, links, depth, other, self.t_max, self.required_m))
         return Breakdown(
             fitness=fitness,
             t_sol_s=t_sol,

@@ -1,9 +1,10 @@
 """The paths that candidate nodes make the robot execute: samples and their non-clearance terms.
 
-For a batch of candidates' nodes (start, waypoints, goal), :class:`ExecutedPaths` fits the
-executed path (the septic spline through the nodes, or the paper's straight PTP lines), and
-returns the configurations the fitness checks for clearance and the terms that need no
-collision query:
+For a batch of candidates' nodes (start, waypoints, goal), an executed-path rule fits the
+path the robot runs, :class:`SplinePaths` (the septic spline through the nodes, the default)
+or :class:`PtpPaths` (the paper's straight point-to-point lines; ``planner.path``, chosen
+once by :func:`executed_paths`), and returns the configurations the fitness checks for
+clearance and the terms that need no collision query:
 
 - ``w_sol``: the joint motion accumulated over the IPO steps, each joint normalised by its
   range (paper eq. 7);
@@ -37,7 +38,8 @@ from planning.curves.piecewise_sampler import PiecewiseSampler
 from planning.curves.polynomial_bounds import DerivativeBounds
 from planning.curves.spline import SepticSplineSolver
 from planning.curves.velocity_caps import ROUNDS, TOLERANCE
-from planning.scene import PlannerSettings
+from planning.pipeline.motion import Motion
+from planning.pipeline.settings import PlannerSettings
 
 FloatArray = NDArray[np.float64]
 
@@ -61,32 +63,62 @@ class PathTerms:
     node_deviation: FloatArray
 
 
-class ExecutedPaths:
-    """Samples and terms of the executed paths of candidates' nodes.
+class PtpPaths:
+    """The paper's executed path: straight joint-space lines from node to node.
+
+    Its samples are evenly spaced on each segment; ``w_sol`` is the lines' joint motion. It
+    has no overshoot, limit or deviation terms, and no duration estimate.
 
     Args:
         limits: the robot's joint limits.
-        q_start: start configuration [rad, m] (held joints keep its values).
-        q_goal: goal configuration [rad, m].
-        moving: indices of the joints the waypoints move.
-        settings: planner settings (path kind, IPO, samples).
-        solver: the septic spline solver on the trajectory's knots.
+        settings: planner settings (fitness samples).
+    """
+
+    estimates_duration = False
+
+    def __init__(self, limits: ck.JointLimits, settings: PlannerSettings) -> None:
+        self.range_q, self.samples = limits.range, settings.fitness_samples
+
+    def __call__(self, nodes: FloatArray) -> PathTerms:
+        """The executed paths through ``nodes`` ``(S, p + 2, nq)``."""
+        s, n_nodes, nq = nodes.shape
+        zeros = np.zeros(s)
+        fraction = np.linspace(0.0, 1.0, max(2, self.samples // (n_nodes - 1)))
+        steps = np.diff(nodes, axis=1)
+        samples = nodes[:, :-1, None, :] + fraction[None, None, :, None] * steps[:, :, None, :]
+        w_sol = (np.abs(steps) / self.range_q).sum(axis=(1, 2))
+        return PathTerms(samples.reshape(s, -1, nq), w_sol, zeros, zeros, zeros)
+
+    def durations(self, samples: FloatArray) -> FloatArray:
+        """Not estimated for straight lines: the fitness ranks by the point-to-point time."""
+        raise NotImplementedError("PtpPaths gives no duration estimate")
+
+
+class SplinePaths:
+    """Samples and terms of the septic splines through candidates' nodes.
+
+    Args:
+        limits: the robot's joint limits.
+        motion: start, goal and moving joints (held joints keep the start's values).
+        settings: planner settings (IPO, fitness samples).
+        solver: the septic spline solver on the search's knots.
         timed: the knots are the final timing, so velocity, acceleration and jerk limits apply.
     """
+
+    estimates_duration = True
 
     def __init__(
         self,
         limits: ck.JointLimits,
-        q_start: FloatArray,
-        q_goal: FloatArray,
-        moving: NDArray[np.intp],
+        motion: Motion,
         settings: PlannerSettings,
         solver: SepticSplineSolver,
         timed: bool,
     ) -> None:
+        q_start, q_goal = motion.q_start, motion.q_goal
         self.q_start = q_start
         # joints the spline moves; the others stay at their start (= goal) value throughout
-        self.fitted = np.union1d(moving, np.flatnonzero(q_start != q_goal))
+        self.fitted = np.union1d(motion.moving, np.flatnonzero(q_start != q_goal))
         self.settings, self.solver, self.timed = settings, solver, timed
         self.lower_q, self.upper_q, self.range_q = limits.lower, limits.upper, limits.range
         self._derivative_limits = (limits.velocity, limits.acceleration, limits.jerk)
@@ -113,12 +145,6 @@ class ExecutedPaths:
         """The executed paths through ``nodes`` ``(S, p + 2, nq)``."""
         s, n_nodes, nq = nodes.shape
         zeros = np.zeros(s)
-        if self.settings.path == "ptp":
-            fraction = np.linspace(0.0, 1.0, max(2, self.settings.fitness_samples // (n_nodes - 1)))
-            steps = np.diff(nodes, axis=1)
-            samples = nodes[:, :-1, None, :] + fraction[None, None, :, None] * steps[:, :, None, :]
-            w_sol = (np.abs(steps) / self.range_q).sum(axis=(1, 2))
-            return PathTerms(samples.reshape(s, -1, nq), w_sol, zeros, zeros, zeros)
         fitted, k = self.fitted, self.fitted.size
         columns = nodes[:, :, fitted].transpose(1, 0, 2).reshape(n_nodes, s * k)  # (nodes, S k)
         coefficients = self.solver.solve_batch(columns)
@@ -167,3 +193,15 @@ class ExecutedPaths:
             limits = np.stack([np.tile(limit[self.fitted], s) for limit in self._derivative_limits])
             self._tiled[s] = (*(np.tile(v[self.fitted], s) for v in per_joint), limits)
         return self._tiled[s]
+
+
+ExecutedPaths = PtpPaths | SplinePaths
+
+
+def executed_paths(
+    limits: ck.JointLimits, motion: Motion, settings: PlannerSettings, solver: SepticSplineSolver, timed: bool
+) -> ExecutedPaths:
+    """The executed-path rule of ``settings.path``: ``spline`` (default) or ``ptp``."""
+    if settings.path == "ptp":
+        return PtpPaths(limits, settings)
+    return SplinePaths(limits, motion, settings, solver, timed)

@@ -1,0 +1,177 @@
+"""The choice stage: the search's candidates, timed and verified, best first; the first that passes.
+
+:func:`choose` takes the best candidate, then the final population's others the fitness
+found feasible (an infeasible one will not pass the verification), best first, each once,
+and returns the first whose timed trajectory passes the certified continuous check
+(:mod:`planning.pipeline.verification`) and the planner's node-deviation bound, as a
+:class:`Choice`; or a :class:`Refusal` saying why the best one failed. In order:
+
+1. the best's preferred (fastest) timing;
+2. the narrowed timings (:meth:`~planning.pipeline.timing.FreeDuration.narrowed`) of the
+   first ``preferred_first``, one share of ``narrowed_acceleration`` after the other (each
+   computed only when the previous share failed), each share's shortest first, whichever
+   candidate they time; the first share's go with the other preferred candidates' own
+   timings: a nearly as good candidate run at full speed beats the best one run slower, and
+   a worse one run at full speed does not;
+3. their other timings (the uniform ones), shortest first;
+4. each further candidate's timings, in order.
+
+Each candidate is timed once, however often the search returns it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+import cpr_kin as ck
+from planning.curves.spline import SplineFit
+from planning.curves.trajectory import Trajectory
+from planning.errors import NoTrajectoryFoundError
+from planning.pipeline.objective import Breakdown
+from planning.pipeline.problem import Problem
+from planning.pipeline.timing import Timing
+from planning.pipeline.verification import Verification, verify_trajectory
+from planning.search.optimizer import SearchResult
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Choice:
+    """The candidate whose timed trajectory passed the verification.
+
+    Attributes:
+        x: its decision vector.
+        nodes: ``(p + 2, nq)`` start, waypoints and goal [rad, m].
+        timing: the timing that passed.
+        verification: its verification (accepted).
+        candidates_timed: how many candidates were timed to find it.
+    """
+
+    x: FloatArray
+    nodes: FloatArray
+    timing: Timing
+    verification: Verification
+    candidates_timed: int
+
+    accepted = True
+
+
+@dataclass(frozen=True)
+class Refusal:
+    """No candidate passed: why the best one failed.
+
+    Attributes:
+        message: one sentence for the user.
+        check: the best candidate's certified continuous check.
+    """
+
+    message: str
+    check: ck.CurveCheck
+
+    accepted = False
+
+    def error(self) -> NoTrajectoryFoundError:
+        """The error a planner raises when this was its last word."""
+        return NoTrajectoryFoundError(self.message, self.check)
+
+
+def verify(problem: Problem, trajectory: Trajectory, fit: SplineFit) -> Verification:
+    """The scene's verification, plus the node-deviation bound of the planner settings."""
+    scene = problem.scene
+    verification = verify_trajectory(
+        problem.world, trajectory, scene.safety_margin, scene.planner.verify_step_m
+    )
+    bound = scene.planner.max_node_deviation
+    if bound is not None and fit.max_node_deviation > bound:
+        problem_text = (
+            f"deviates {fit.max_node_deviation:.3g} from its nodes, more than max_node_deviation = {bound:g}"
+        )
+        verification = Verification(verification.check, (*verification.problems, problem_text))
+    return verification
+
+
+def distinct(points: list[FloatArray]) -> list[FloatArray]:
+    """``points`` without repeats, in order.
+
+    The best is also the first of a refined population: a point refused once would be timed
+    and verified again.
+    """
+    kept: list[FloatArray] = []
+    for point in points:
+        if not any(np.array_equal(point, other) for other in kept):
+            kept.append(point)
+    return kept
+
+
+def infeasibility(breakdown: Breakdown, problem: Problem) -> str:
+    """Why a candidate is infeasible, from its terms (one candidate), in a few words."""
+    reasons = []
+    if breakdown.limit_excess[0] > 0:
+        excess, seconds = breakdown.limit_excess[0], problem.scene.duration
+        reasons.append(
+            f"limits exceeded by {excess:.0%} in {seconds:g} s (lengthen duration or leave it out)"
+        )
+    if breakdown.depth_m[0] > 0:
+        reasons.append(f"{breakdown.depth_m[0]:.3g} m inside the clearance")
+    if breakdown.overshoot[0] > 0:
+        reasons.append(f"{breakdown.overshoot[0]:.0%} beyond a joint range")
+    bound = problem.scene.planner.max_node_deviation
+    if bound is not None and breakdown.node_deviation[0] > bound:
+        reasons.append(f"node deviation {breakdown.node_deviation[0]:.3g} > {bound:g}")
+    return ", ".join(reasons) or "infeasible"
+
+
+def choose(problem: Problem, searched: SearchResult) -> Choice | Refusal:
+    """The first candidate whose timed trajectory passes the verification (module docstring)."""
+    objective = problem.objective
+    order = np.argsort(searched.population_fitness, kind="stable")
+    feasible = objective.feasible(searched.population_fitness)
+    candidates = distinct([searched.x] + [searched.population[k] for k in order if feasible[k]])
+    timed: list[list[Timing]] = []
+    first: Verification | None = None
+    for k, timing in _attempts(problem, candidates, timed):
+        verification = verify(problem, timing.trajectory, timing.fit)
+        first = first or verification
+        if verification.accepted:
+            x = candidates[k]
+            return Choice(x, objective.nodes(x[None])[0], timing, verification, len(timed))
+    assert first is not None  # candidates is never empty
+    found = f"the best candidate {'; '.join(first.problems)}"
+    if not objective.feasible(searched.fitness):  # the cause comes first
+        why = infeasibility(objective.breakdown(searched.x[None]), problem)
+        found = f"no candidate was feasible (the best: {why}); timed, it {'; '.join(first.problems)}"
+    message = f"no collision-free trajectory found ({len(candidates)} candidates verified): {found}"
+    return Refusal(message, first.check)
+
+
+def _attempts(
+    problem: Problem, candidates: list[FloatArray], timed: list[list[Timing]]
+) -> Iterator[tuple[int, Timing]]:
+    """``(candidate, timing)`` in the module docstring's order; ``timed`` fills as they are timed."""
+    tuning, duration, objective = problem.scene.planner.tuning, problem.duration, problem.objective
+
+    def offered(k: int) -> list[Timing]:
+        while len(timed) <= k:
+            timed.append(duration.timings(problem, objective.nodes(candidates[len(timed)][None])[0]))
+        return timed[k]
+
+    def shortest_first(pairs: list[tuple[int, Timing | None]]) -> list[tuple[int, Timing]]:
+        found = [(k, timing) for k, timing in pairs if timing is not None]
+        return sorted(found, key=lambda pair: pair[1].trajectory.duration)  # stable
+
+    preferred = list(range(min(tuning.preferred_first, len(candidates))))
+    yield 0, offered(0)[0]  # most plans end here, after one timing
+    others: list[tuple[int, Timing | None]] = [(k, offered(k)[0]) for k in preferred[1:]]
+    narrowing = preferred
+    for share in tuning.narrowed_acceleration:  # share by share: a path that passes costs no lower share
+        found = [(k, duration.narrowed(problem, offered(k), share)) for k in narrowing]
+        yield from shortest_first(others + found)
+        others = []
+        narrowing = [k for k, timing in found if timing is not None]  # a lower share is slower still
+    yield from shortest_first([(k, timing) for k in preferred for timing in offered(k)[1:]])
+    yield from ((k, timing) for k in range(len(preferred), len(candidates)) for timing in offered(k))

@@ -1,0 +1,133 @@
+"""The planner: scene -> problem -> (attempt -> search -> choose) -> result.
+
+``plan(scene)`` is ``solve(build_problem(scene))``. :func:`solve` reads as the pipeline:
+each attempt (the seeding rule decides the first and the next,
+:mod:`planning.pipeline.seeding`) is searched (:mod:`planning.pipeline.search`), its
+candidates are timed and verified best first (:mod:`planning.pipeline.choose`), and the
+first that passes becomes the :class:`~planning.pipeline.result.PlanResult`.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+import cpr_kin as ck
+from planning.curves.trajectory import Trajectory
+from planning.errors import NoSolutionError
+from planning.pipeline.choose import Choice, Refusal, choose, verify
+from planning.pipeline.metrics import Elapsed
+from planning.pipeline.problem import Problem, build_problem
+from planning.pipeline.result import PlanResult, assemble
+from planning.pipeline.scene import Scene
+from planning.pipeline.search import search
+from planning.pipeline.seeding import SEEDINGS, NoSeeding
+from planning.pipeline.timing import Timing
+from planning.search.firefly import FireflyProgress
+from planning.search.optimizer import Optimizer, SearchResult
+
+
+def solve(
+    problem: Problem,
+    progress: Callable[[FireflyProgress], None] | None = None,
+    optimizer: Optimizer | None = None,
+) -> PlanResult:
+    """Search, time and verify a trajectory for ``problem``.
+
+    Args:
+        problem: from :func:`~planning.pipeline.problem.build_problem`.
+        progress: called after every firefly iteration.
+        optimizer: another :class:`~planning.search.optimizer.Optimizer` on the same
+            objective and evaluation budget (``fireflies x (iterations + 1)``), searched
+            once from a random population; default: the planner's seeded search.
+
+    Raises:
+        NoTrajectoryFoundError: no candidate passes the verification.
+    """
+    started = time.perf_counter()
+    if problem.stands_still:
+        return stand_still(problem, started)
+    seeding = SEEDINGS[problem.scene.planner.seeding] if optimizer is None else NoSeeding()
+    attempt = seeding.first(problem)
+    while True:
+        searched = search(attempt, progress, optimizer)
+        search_s = time.perf_counter() - started
+        chosen = choose(attempt.problem, searched)
+        if isinstance(chosen, Choice):
+            elapsed = Elapsed(attempt.problem.build_time_s + time.perf_counter() - started, search_s)
+            return assemble(attempt.problem, searched, chosen, elapsed)
+        following = seeding.after(attempt, searched)
+        if following is None:
+            raise chosen.error()
+        attempt = following
+
+
+def stand_still(problem: Problem, started: float) -> PlanResult:
+    """The trajectory of a scene whose goal is its start: standing still, verified.
+
+    It lasts the scene's duration, or one IPO period when the duration is free (a trajectory
+    needs a time interval; a controller executes nothing shorter).
+    """
+    scene, objective = problem.scene, problem.objective
+    x = np.tile(problem.q_start[problem.moving], scene.planner.waypoints)
+    fit = problem.solver.solve(objective.nodes(x[None])[0])
+    duration = problem.duration.still_duration(scene.planner.ipo)
+    coefficients = np.zeros((1, problem.robot.nq, fit.trajectory.coefficients.shape[2]))
+    coefficients[0, :, 0] = problem.q_start  # exactly still (the spline through equal nodes is, to 1e-9)
+    trajectory = Trajectory(knots=np.array([0.0, duration]), coefficients=coefficients)
+    verification = verify(problem, trajectory, fit)
+    if not verification.accepted:  # pragma: no cover - the start was checked clear of the margin
+        raise Refusal(f"standing still fails: {'; '.join(verification.problems)}", verification.check).error()
+    fitness = float(objective(x[None])[0])
+    searched = SearchResult(
+        x=x,
+        fitness=fitness,
+        evaluations=1,
+        best_history=np.array([fitness]),
+        mean_history=np.array([fitness]),
+        evaluation_history=np.array([1], dtype=np.int64),
+        population=x[None],
+        population_fitness=np.array([fitness]),
+    )
+    timing = Timing(trajectory, problem.duration.still_method, fit, False, 0.0)
+    choice = Choice(x, objective.nodes(x[None])[0], timing, verification, 1)
+    elapsed = Elapsed(problem.build_time_s + time.perf_counter() - started, 0.0)
+    return assemble(problem, searched, choice, elapsed)
+
+
+def plan(
+    scene: Scene,
+    robot: ck.Robot | None = None,
+    progress: Callable[[FireflyProgress], None] | None = None,
+    threads: int | None = None,
+    optimizer: Optimizer | None = None,
+) -> PlanResult:
+    """Plan a collision-free, jerk-continuous trajectory for ``scene``.
+
+    ``solve(build_problem(scene, robot, threads), progress, optimizer)``: see
+    :func:`~planning.pipeline.problem.build_problem` and :func:`solve`.
+
+    Raises:
+        PlanningError: unreachable start or goal, or one inside the margin; bad settings.
+        cpr_kin.CprKinError: the robot's URDF or an obstacle is invalid.
+        NoTrajectoryFoundError: no candidate passes the verification.
+    """
+    return solve(build_problem(scene, robot, threads), progress, optimizer)
+
+
+def warm_up(robot: ck.Robot | None = None) -> float:
+    """Compile the numba kernels, or load them from their on-disk cache; seconds spent.
+
+    Planning does it anyway on its first call; this moves the one-time cost (several
+    seconds on a new machine, a fraction of a second per process afterwards) out of a plan
+    that is timed. It plans the paper case with two fireflies for one iteration.
+    """
+    from planning.io.bundled import paper_scene
+
+    started = time.perf_counter()
+    with contextlib.suppress(NoSolutionError):  # a search this small may find nothing: the kernels ran
+        plan(paper_scene(fireflies=2, iterations=1), robot, threads=1)
+    return time.perf_counter() - started

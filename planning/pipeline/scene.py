@@ -1,0 +1,131 @@
+"""What to plan: the robot, the obstacles, the start and goal, the margin and the settings.
+
+A :class:`Scene` is the pipeline's input (``scene.yaml`` is its file form,
+:mod:`planning.io.scene_file`). Its defaults live here once: :data:`DEFAULT_SAFETY_MARGIN_M`,
+:data:`DEFAULT_SPLINE`, and the planner's in :mod:`planning.pipeline.settings`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+import cpr_kin as ck
+from cpr_kin.names import unprintable
+from planning.curves.spline_settings import SplineSettings
+from planning.errors import PlanningError
+from planning.pipeline.settings import PlannerSettings
+from planning.validation import number_in, shown
+
+FloatArray = NDArray[np.float64]
+
+DEFAULT_SAFETY_MARGIN_M = 0.1
+"""Clearance every robot geometry keeps from every obstacle unless a scene says otherwise [m]
+(the paper's value)."""
+
+DEFAULT_SPLINE = SplineSettings(p=1e6, a=(0.0, 0.0, 1.0), ends="rest")
+"""The spline of a scene unless it says otherwise: the paper's weights, but at rest at both
+ends, which a real robot needs (the paper case itself uses natural ends)."""
+
+MAX_SAFETY_MARGIN_M = 1.0
+"""Largest safety margin [m]: the CPR reaches about 1.3 m."""
+DURATION_RANGE_S = (0.01, 600.0)
+"""Allowed fixed durations [s]."""
+MAX_IPO_SAMPLES = 100_000
+"""Most IPO samples of a fixed duration, ``duration / ipo``: the fitness samples every
+candidate's path at each (about 100,000 x 150 columns x 8 bytes = 120 MB per array)."""
+MAX_OBSTACLES = 500
+"""Most obstacles in a scene (each adds six robot-obstacle pairs to every check)."""
+SPLINE_P_RANGE = (1e-6, 1e12)
+"""Allowed finite node weights ``p`` of a scene's spline (``inf`` also: exact interpolation);
+beyond them the banded system loses the digits that the node deviation is measured in."""
+SPLINE_A_RANGE = (1e-6, 1e6)
+"""Allowed non-zero velocity, acceleration and jerk weights ``a_r`` of a scene's spline."""
+
+
+@dataclass(frozen=True)
+class Target:
+    """A start or goal: a TCP position (wrist angles held) or a full joint vector.
+
+    Attributes:
+        tcp: ``(x, y, z)`` of the TCP [m], solved with the analytic IK, or ``None``.
+        q: ``(theta1, d2, d3, theta4, theta5)`` [rad, m], or ``None``.
+        theta4: wrist roll used with ``tcp`` [rad].
+        theta5: tool pitch used with ``tcp`` [rad].
+    """
+
+    tcp: tuple[float, float, float] | None = None
+    q: tuple[float, ...] | None = None
+    theta4: float = 0.0
+    theta5: float = 0.0
+
+    def __post_init__(self) -> None:
+        if (self.tcp is None) == (self.q is None):
+            raise PlanningError("a start or goal needs exactly one of 'tcp' (x, y, z) or 'q' (joint vector)")
+
+    def configuration(self, robot: ck.Robot) -> FloatArray:
+        """The joint vector [rad, m]; raises :class:`cpr_kin.CprKinError` if unreachable."""
+        if self.tcp is not None:
+            return ck.tcp_ik(robot, self.tcp, self.theta4, self.theta5)
+        return robot.configuration(np.asarray(self.q, dtype=float))
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A planning problem.
+
+    Attributes:
+        start: where the robot stands.
+        goal: where it must go.
+        obstacles: static obstacles, unique names, at most :data:`MAX_OBSTACLES`.
+        safety_margin: required clearance between every robot geometry and every obstacle
+            [m], at most :data:`MAX_SAFETY_MARGIN_M`.
+        duration: trajectory duration [s], in :data:`DURATION_RANGE_S` and at most
+            :data:`MAX_IPO_SAMPLES` IPO periods; ``None``: the fastest timing within the
+            joints' velocity, acceleration and jerk limits.
+        robot: URDF of the robot; ``None``: the bundled CPR.
+        planner: planner settings.
+        spline: spline settings (default :data:`DEFAULT_SPLINE`); finite weights ``p`` in
+            :data:`SPLINE_P_RANGE`, non-zero ``a_r`` in :data:`SPLINE_A_RANGE`.
+        name: a name for reports.
+    """
+
+    start: Target
+    goal: Target
+    obstacles: tuple[ck.Obstacle, ...] = ()
+    safety_margin: float = DEFAULT_SAFETY_MARGIN_M
+    duration: float | None = None
+    robot: Path | None = None
+    planner: PlannerSettings = field(default_factory=PlannerSettings)
+    spline: SplineSettings = DEFAULT_SPLINE
+    name: str = "scene"
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name:
+            raise PlanningError(f"scene name {shown(self.name)} must be a non-empty text")
+        character = unprintable(self.name)
+        if character is not None:
+            raise PlanningError(
+                f"scene name {shown(self.name)} holds {character}; names must be printable text"
+            )
+        number_in("safety_margin", self.safety_margin, 0.0, MAX_SAFETY_MARGIN_M, unit="m")
+        object.__setattr__(self, "obstacles", tuple(self.obstacles))
+        if len(self.obstacles) > MAX_OBSTACLES:
+            raise PlanningError(f"{len(self.obstacles)} obstacles; at most {MAX_OBSTACLES}")
+        for k, p in enumerate(np.atleast_1d(self.spline.p)):
+            if np.isfinite(p):
+                number_in(f"spline.p[{k}]" if np.ndim(self.spline.p) else "spline.p", p, *SPLINE_P_RANGE)
+        for r, a in enumerate(self.spline.a):
+            if a != 0.0:
+                number_in(f"spline.a[{r}]", a, *SPLINE_A_RANGE)
+        if self.duration is not None:
+            number_in("duration", self.duration, *DURATION_RANGE_S, unit="s")
+            samples = self.duration / self.planner.ipo
+            if samples > MAX_IPO_SAMPLES:
+                raise PlanningError(
+                    f"duration / planner.ipo = {samples:.0f} IPO samples; at most {MAX_IPO_SAMPLES}: "
+                    "lengthen ipo or shorten the duration"
+                )

@@ -1,0 +1,261 @@
+"""Where the waypoint search starts, and what it tries next when a search fails.
+
+The firefly refines well but explores by chance: a passage under a beam or through a window
+is a small part of its space, rarely met by a random population. So, with the planner's
+``seeding: paths`` (the default, :class:`PathSeeding`):
+
+1. the straight line from start to goal (its waypoints evenly on it) is a seed: with the
+   duration free it is the fastest path when it is clear, and a good start when it is
+   nearly clear;
+2. if the spline through it violates the margin, RRT-Connect
+   (:mod:`planning.search.rrt_connect`) looks for a path in the moving joints, clear of
+   the clearance the fitness requires (margin plus verification step), and its waypoints
+   (:func:`~planning.search.rrt_connect.waypoints_along`) are the second seed. A path is
+   clear, but the spline through its few waypoints cuts its corners and may not be: then
+   RRT-Connect draws another path, up to ``path_attempts`` in all, and the first whose
+   seed is feasible (else the one whose seed ranks best) is taken;
+3. if a search with the scene's waypoints fails, the next attempt (:meth:`PathSeeding.after`)
+   asks for more waypoints when no candidate was feasible (as many as the spline needs to
+   follow the path: at least two more and the path's corners, then two more at a time, up
+   to ``more_waypoints`` more and :data:`~planning.pipeline.settings.MAX_WAYPOINTS`, until the
+   spline through them keeps the clearance), or for twice the fitness samples when feasible
+   candidates failed the certified check (a violation between two samples escaped the
+   fitness); ``retries`` times at most.
+
+The seeds and ``spread``-sized moves around them make up ``share`` of the initial
+population (:class:`~planning.pipeline.tuning.SeedingTuning`). The sampling planner and the
+moves draw from their own streams, ``default_rng([seed, 1])`` and ``[seed, 2]``: the
+firefly's draws are the same with or without them. ``seeding: none`` (the paper,
+:class:`NoSeeding`) searches once, from a random population.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import NamedTuple, Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+import cpr_kin as ck
+from planning.pipeline.problem import Problem, with_planner
+from planning.pipeline.settings import MAX_FITNESS_SAMPLES, MAX_WAYPOINTS
+from planning.search.optimizer import SearchResult
+from planning.search.rrt_connect import RrtPath, RrtSettings, rrt_connect, waypoints_along
+
+FloatArray = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
+
+
+class PathSeed(NamedTuple):
+    """A path's seed.
+
+    Attributes:
+        fitness: its fitness on ``problem``'s objective.
+        problem: the problem it seeds (with the waypoints it has).
+        x: its decision vector.
+    """
+
+    fitness: float
+    problem: Problem
+    x: FloatArray
+
+
+@dataclass(frozen=True)
+class Seeds:
+    """The search's starting points.
+
+    Attributes:
+        problem: the problem to search (the one given, or it with more waypoints).
+        candidates: ``(k, d)`` decision vectors of the problem's objective.
+        path: the sampling planner's path in the moving joints, or ``None`` when the
+            straight line was clear or no path was found [joint units].
+        straight_line_clear: the straight line's candidate is feasible.
+        time_s: wall time of the seeding [s].
+    """
+
+    problem: Problem
+    candidates: FloatArray
+    path: FloatArray | None
+    straight_line_clear: bool
+    time_s: float
+
+
+@dataclass(frozen=True)
+class Attempt:
+    """One search of a plan: the problem searched and where the search starts.
+
+    Attributes:
+        problem: the problem to search.
+        seeds: ``(k, d)`` starting points, or ``None`` (a random population).
+        path: the sampling planner's path the seeds follow, reused by the next attempt.
+        number: 0 for the first attempt, then 1, 2, ...
+    """
+
+    problem: Problem
+    seeds: FloatArray | None = None
+    path: FloatArray | None = None
+    number: int = 0
+
+
+class Seeding(Protocol):
+    """How a plan's attempts begin and follow one another (module docstring)."""
+
+    def first(self, problem: Problem) -> Attempt:
+        """The first attempt."""
+        ...
+
+    def after(self, attempt: Attempt, searched: SearchResult) -> Attempt | None:
+        """The attempt after ``attempt``, whose search ``searched`` gave no verified trajectory."""
+        ...
+
+
+class NoSeeding:
+    """One search from a random population (the paper's; also a caller's own optimiser)."""
+
+    def first(self, problem: Problem) -> Attempt:  # noqa: D102 - the protocol's
+        return Attempt(problem)
+
+    def after(self, attempt: Attempt, searched: SearchResult) -> Attempt | None:  # noqa: D102
+        return None
+
+
+class PathSeeding:
+    """The straight line and a sampling planner's path as seeds, escalated on failure (module docstring)."""
+
+    def first(self, problem: Problem) -> Attempt:  # noqa: D102 - the protocol's
+        seeds = seed_search(problem)
+        return Attempt(seeds.problem, seeds.candidates, seeds.path, 0)
+
+    def after(self, attempt: Attempt, searched: SearchResult) -> Attempt | None:  # noqa: D102
+        problem = attempt.problem
+        if attempt.number >= problem.scene.planner.tuning.retries:
+            return None
+        widen = not problem.objective.feasible(searched.fitness)  # nothing feasible: more waypoints
+        if not widen:  # feasible ones failed the certified check: check twice as many samples
+            samples = problem.scene.planner.fitness_samples
+            problem = with_planner(problem, fitness_samples=min(2 * samples, MAX_FITNESS_SAMPLES))
+        seeds = seed_search(problem, widen, attempt.path)
+        return Attempt(seeds.problem, seeds.candidates, seeds.path, attempt.number + 1)
+
+
+SEEDINGS: dict[str, Seeding] = {"paths": PathSeeding(), "none": NoSeeding()}
+"""The seeding rules by the scene file's name (``planner.seeding``)."""
+
+
+def sampled_path(
+    problem: Problem, rng: np.random.Generator, settings: RrtSettings | None = None
+) -> RrtPath | None:
+    """RRT-Connect's path in the moving joints of ``problem``, clear of the fitness's clearance."""
+    robot, moving, objective = problem.robot, problem.moving, problem.objective
+    held = problem.q_start
+
+    def valid(q: FloatArray) -> BoolArray:
+        full = np.repeat(held[None], len(q), axis=0)
+        full[:, moving] = q
+        return ~problem.world.margin_violated(full, objective.required_m)
+
+    if settings is None:  # edges checked at most as far apart as the clearance required, 1-4 cm
+        largest = problem.scene.planner.tuning.seeding.max_resolution_m
+        settings = RrtSettings(resolution_m=min(largest, max(0.01, objective.required_m)))
+    limits = robot.limits
+    return rrt_connect(
+        valid,
+        problem.q_start[moving],
+        problem.q_goal[moving],
+        limits.lower[moving],
+        limits.upper[moving],
+        ck.motion_radii(robot)[moving],
+        rng,
+        settings,
+    )
+
+
+def seed_search(problem: Problem, more_waypoints: bool = False, path: FloatArray | None = None) -> Seeds:
+    """The seeds of ``problem``'s search (module docstring).
+
+    Args:
+        problem: the problem; searched with its own waypoints unless ``more_waypoints``.
+        more_waypoints: a search with the problem's waypoints failed: give the search two or
+            more waypoints beyond them, as many as the spline needs to follow the path.
+        path: the path an earlier call found (saves finding it again).
+    """
+    started = time.perf_counter()
+    straight = problem.objective.straight_line()
+    clear = bool(problem.objective.breakdown(straight[None]).feasible[0])
+    weights = ck.motion_radii(problem.robot)[problem.moving]
+    seeded: PathSeed | None = None
+    if path is None and not clear:
+        path, seeded = _followable_path(problem, weights)
+    if path is None:
+        return Seeds(problem, _around(problem, straight[None]), None, clear, time.perf_counter() - started)
+    if more_waypoints:
+        seeded = _fewest_waypoints(problem, path, weights)
+    elif seeded is None:
+        seeded = _path_seed(problem, path, problem.scene.planner.waypoints, weights)
+    problem = seeded.problem
+    candidates = np.array([problem.objective.straight_line(), seeded.x])
+    return Seeds(problem, _around(problem, candidates), path, clear, time.perf_counter() - started)
+
+
+def _path_seed(problem: Problem, path: FloatArray, count: int, weights: FloatArray) -> PathSeed:
+    """The seed of ``path`` with ``count`` waypoints along it."""
+    counted = with_planner(problem, waypoints=count)
+    along = waypoints_along(path, count, weights).ravel()
+    return PathSeed(float(counted.objective(along[None])[0]), counted, along)
+
+
+def _followable_path(problem: Problem, weights: FloatArray) -> tuple[FloatArray | None, PathSeed | None]:
+    """RRT-Connect's path whose waypoints seed ``problem`` best (module docstring, step 2), and its seed.
+
+    Up to ``path_attempts`` paths, all drawn from the stream ``default_rng([seed, 1])``;
+    the first whose seed is feasible, else the one of the best fitness; ``None`` when
+    RRT-Connect finds none (a further draw is not tried: a failed one has used up its samples).
+    """
+    settings = problem.scene.planner
+    rng = np.random.default_rng([settings.seed, 1])
+    best: tuple[FloatArray, PathSeed] | None = None
+    for _ in range(settings.tuning.seeding.path_attempts):
+        found = sampled_path(problem, rng)
+        if found is None:
+            break
+        seeded = _path_seed(problem, found.path, settings.waypoints, weights)
+        if best is None or seeded.fitness < best[1].fitness:
+            best = (found.path, seeded)
+        if problem.objective.feasible(seeded.fitness):
+            break
+    return (None, None) if best is None else best
+
+
+def _fewest_waypoints(problem: Problem, path: FloatArray, weights: FloatArray) -> PathSeed:
+    """The seed of ``path`` with the fewest waypoints beyond ``problem``'s that keeps the clearance.
+
+    Two or more beyond them, the path's corners at least, then two more at a time up to
+    ``more_waypoints`` more (and :data:`~planning.pipeline.settings.MAX_WAYPOINTS`); if none
+    keeps it, the count whose seed ranks best.
+    """
+    settings = problem.scene.planner
+    first = min(max(settings.waypoints + 2, len(path) - 2), MAX_WAYPOINTS)
+    last = min(first + settings.tuning.seeding.more_waypoints, MAX_WAYPOINTS)
+    best: PathSeed | None = None
+    for count in range(first, last + 1, 2):
+        seeded = _path_seed(problem, path, count, weights)
+        if best is None or seeded.fitness < best.fitness:
+            best = seeded
+        if seeded.problem.objective.feasible(seeded.fitness):  # the fewest waypoints that follow
+            break
+    assert best is not None  # the range is never empty
+    return best
+
+
+def _around(problem: Problem, seeds: FloatArray) -> FloatArray:
+    """``seeds``, then copies of them moved at random: ``share`` of the population."""
+    objective, settings = problem.objective, problem.scene.planner
+    tuning = settings.tuning.seeding
+    count = max(len(seeds), int(tuning.share * settings.firefly.fireflies))
+    rng = np.random.default_rng([settings.seed, 2])
+    picks = seeds[np.arange(count - len(seeds)) % len(seeds)]
+    span = objective.upper - objective.lower
+    moved = picks + tuning.spread * span * rng.standard_normal(picks.shape)
+    return np.concatenate([seeds, np.clip(moved, objective.lower, objective.upper)])

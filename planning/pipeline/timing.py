@@ -1,0 +1,219 @@
+"""Timing the search's chosen path: the scene's fixed duration, or as fast as the limits allow.
+
+A scene either fixes the duration or leaves it free; the choice is made once, when the
+problem is built (:func:`duration_rule`), and the rule object answers every question that
+depends on it:
+
+- :class:`FixedDuration` (the paper case): the spline on the scene's knots is the
+  trajectory; its velocity, acceleration and jerk limits bind every candidate in the search,
+  and the chosen one is stretched uniformly (and reported) only if its exact extrema still
+  break a limit. A duration shorter than the least time the joint limits allow from start to
+  goal is refused up front (:meth:`FixedDuration.check_reachable`).
+- :class:`FreeDuration`: two timings of the geometric path (the spline through the
+  candidate's nodes that the fitness checked), the shorter offered first:
+
+  - *fastest*: :func:`planning.curves.path_timing.time_path`;
+  - *uniform*: the spline on its nominal knots scaled until its worst peak meets a limit.
+
+  The planner verifies them in that order, so a trajectory is never longer than the uniform
+  timing of its path. Once a fastest timing has failed the certified check, *narrowed*
+  timings (:meth:`FreeDuration.narrowed`) try the fastest timing under lowered acceleration
+  limits: the jerk filter's window is ``a / j``, a lower acceleration narrows it, and the
+  corners it cuts shrink with it, while the velocity limit still holds the cruise.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Literal, Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from planning.curves.path_timing import time_path
+from planning.curves.ptp import trapezoid_time
+from planning.curves.spline import SplineFit
+from planning.curves.trajectory import Trajectory
+from planning.errors import PlanningError
+
+if TYPE_CHECKING:
+    import cpr_kin as ck
+    from planning.pipeline.problem import Problem
+
+FloatArray = NDArray[np.float64]
+Method = Literal["fixed", "fastest", "narrowed", "uniform"]
+
+
+@dataclass(frozen=True)
+class Timing:
+    """One timing of a candidate's path.
+
+    Attributes:
+        trajectory: the timed trajectory.
+        method: ``fixed`` (the scene's duration), ``fastest``, ``narrowed`` or ``uniform``
+            (module docstring).
+        fit: the spline through the nodes that was timed (before timing).
+        stretched: a fixed duration broke a limit and was stretched.
+        time_s: wall time of computing it [s].
+    """
+
+    trajectory: Trajectory
+    method: Method
+    fit: SplineFit
+    stretched: bool
+    time_s: float
+
+
+def uniform_scale(fit: SplineFit, limits: ck.JointLimits) -> float:
+    """The factor that stretches ``fit`` uniformly until its worst peak meets a limit."""
+    return fit.trajectory.time_scale_for_limits(limits.velocity, limits.acceleration, limits.jerk)
+
+
+class DurationRule(Protocol):
+    """What depends on whether the scene fixes the duration (module docstring)."""
+
+    @property
+    def limits_bind_candidates(self) -> bool:
+        """The search's knots are the trajectory's: the limits apply to every candidate."""
+        ...
+
+    @property
+    def still_method(self) -> Method:
+        """How a trajectory that stands still is reported."""
+        ...
+
+    def nominal_duration(self, segments: int) -> float:
+        """Duration of the search's spline on ``segments`` uniform segments [s]."""
+        ...
+
+    def still_duration(self, ipo_s: float) -> float:
+        """Duration of a trajectory that stands still [s]."""
+        ...
+
+    def timings(self, problem: Problem, nodes: FloatArray) -> list[Timing]:
+        """The timings of a candidate's ``nodes`` ``(p + 2, nq)`` to verify, in order of preference."""
+        ...
+
+    def narrowed(self, problem: Problem, offered: list[Timing], share: float) -> Timing | None:
+        """The path of ``offered`` timed under ``share`` of the acceleration limits, if that helps."""
+        ...
+
+
+@dataclass(frozen=True)
+class FixedDuration:
+    """The scene's duration: the search's knots are the trajectory's (module docstring).
+
+    Attributes:
+        seconds: the duration [s].
+    """
+
+    seconds: float
+    limits_bind_candidates: bool = True
+    still_method: Method = "fixed"
+
+    def nominal_duration(self, segments: int) -> float:  # noqa: D102 - the protocol's
+        return self.seconds
+
+    def still_duration(self, ipo_s: float) -> float:  # noqa: D102
+        return self.seconds
+
+    def check_reachable(
+        self, robot: ck.Robot, q_start: FloatArray, q_goal: FloatArray, rest_ends: bool
+    ) -> None:
+        """Refuse a duration shorter than the least time the limits allow from start to goal.
+
+        At rest at both ends, a joint that moves ``d`` needs at least the trapezoid time
+        under its velocity and acceleration limits; with free end velocities (natural
+        ends), at least ``d / v``. Every path through waypoints takes at least as long.
+
+        Raises:
+            PlanningError: naming the duration, the least time and the joint that needs it.
+        """
+        limits = robot.limits
+        distance = np.abs(q_goal - q_start)
+        if rest_ends:
+            least = trapezoid_time(distance, limits.velocity, limits.acceleration)
+        else:
+            least = distance / limits.velocity
+        j = int(np.argmax(least))
+        if self.seconds < least[j]:
+            name = limits.names[j]
+            how = "at rest at both ends" if rest_ends else "at its velocity limit"
+            raise PlanningError(
+                f"duration = {self.seconds:g} s is shorter than the least time the joint limits allow from "
+                f"start to goal: {least[j]:.3g} s (joint '{name}' moves {distance[j]:.3g} "
+                f"{robot.joint_unit(name)} {how}); give at least {least[j]:.3g} s, or leave duration out "
+                "for the fastest timing"
+            )
+
+    def timings(self, problem: Problem, nodes: FloatArray) -> list[Timing]:  # noqa: D102
+        started = time.perf_counter()
+        fit = problem.solver.solve(nodes)
+        scale = uniform_scale(fit, problem.robot.limits)
+        trajectory = fit.trajectory.time_scaled(max(scale, 1.0))
+        return [Timing(trajectory, "fixed", fit, scale > 1.0, time.perf_counter() - started)]
+
+    def narrowed(self, problem: Problem, offered: list[Timing], share: float) -> Timing | None:  # noqa: D102
+        return None
+
+
+@dataclass(frozen=True)
+class FreeDuration:
+    """As fast as the limits allow along the path (module docstring)."""
+
+    limits_bind_candidates: bool = False
+    still_method: Method = "fastest"
+
+    def nominal_duration(self, segments: int) -> float:  # noqa: D102 - the protocol's
+        return float(segments)
+
+    def still_duration(self, ipo_s: float) -> float:  # noqa: D102
+        return ipo_s  # a trajectory needs a time interval; a controller executes nothing shorter
+
+    def timings(self, problem: Problem, nodes: FloatArray) -> list[Timing]:  # noqa: D102
+        limits = problem.robot.limits
+        started = time.perf_counter()
+        fit = problem.solver.solve(nodes)
+        fastest = time_path(fit.trajectory, limits.velocity, limits.acceleration, limits.jerk)
+        middle = time.perf_counter()
+        uniform = fit.trajectory.time_scaled(uniform_scale(fit, limits))
+        found = [
+            Timing(fastest, "fastest", fit, False, middle - started),
+            Timing(uniform, "uniform", fit, False, time.perf_counter() - middle),
+        ]
+        return sorted(found, key=lambda timing: timing.trajectory.duration)
+
+    def narrowed(self, problem: Problem, offered: list[Timing], share: float) -> Timing | None:
+        """The path of ``offered`` timed under ``share`` of the acceleration limits.
+
+        ``None`` when it is not shorter than the path's uniform timing.
+        """
+        uniform = next(timing for timing in offered if timing.method == "uniform")
+        limits, fit = problem.robot.limits, uniform.fit
+        started = time.perf_counter()
+        trajectory = time_path(fit.trajectory, limits.velocity, share * limits.acceleration, limits.jerk)
+        if trajectory.duration >= uniform.trajectory.duration:
+            return None
+        return Timing(trajectory, "narrowed", fit, False, time.perf_counter() - started)
+
+
+def duration_rule(duration_s: float | None) -> FixedDuration | FreeDuration:
+    """The rule of a scene's ``duration``: fixed when given, free when ``None``."""
+    return FreeDuration() if duration_s is None else FixedDuration(duration_s)
+
+
+def narrowed_timings(problem: Problem, offered: list[Timing]) -> list[Timing]:
+    """The narrowed timings of the path of ``offered`` at each share of ``narrowed_acceleration``.
+
+    Those shorter than its uniform timing: the shares down to the first that is not (a lower
+    share is slower still, as the timing is monotone in the limits to a few per cent);
+    none for a fixed duration.
+    """
+    found = []
+    for share in problem.scene.planner.tuning.narrowed_acceleration:
+        timing = problem.duration.narrowed(problem, offered, share)
+        if timing is None:
+            break
+        found.append(timing)
+    return found

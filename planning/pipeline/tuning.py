@@ -1,0 +1,82 @@
+"""The search's tuning knobs, in one frozen dataclass: :class:`SearchTuning`.
+
+The planner settings (:class:`~planning.pipeline.settings.PlannerSettings`) hold what a
+scene file may set; the knobs below are the planner's internals, set from Python
+(``PlannerSettings(tuning=SearchTuning(...))``), as ``scripts/study_parameters.py`` does to
+measure them. Why each default is what it is: ``docs/tuning.md``.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+
+from planning.errors import PlanningError
+from planning.search.refinement_settings import RefinementSettings
+from planning.validation import integer_in, number_in
+
+
+@dataclass(frozen=True)
+class SeedingTuning:
+    """Where the search starts (:mod:`planning.pipeline.seeding`).
+
+    Attributes:
+        share: share of the population that starts at or around the seeds, in (0, 1].
+        spread: standard deviation of the moves around a seed [share of each variable's
+            range], in [0, 1].
+        max_resolution_m: largest spacing of the sampling planner's edge checks [m], in
+            (0, 1]; never more than the clearance the fitness requires (at least 1 cm).
+        path_attempts: most RRT-Connect paths drawn while the spline through a path's
+            waypoints violates the clearance, in [1, 20].
+        more_waypoints: how many waypoints beyond the path's corners the seeding may add,
+            two at a time, in [0, 20].
+    """
+
+    share: float = 0.6
+    spread: float = 0.01
+    max_resolution_m: float = 0.04
+    path_attempts: int = 3
+    more_waypoints: int = 6
+
+    def __post_init__(self) -> None:
+        number_in("share", self.share, 0.0, 1.0, low_open=True)
+        number_in("spread", self.spread, 0.0, 1.0)
+        number_in("max_resolution_m", self.max_resolution_m, 0.0, 1.0, unit="m", low_open=True)
+        integer_in("path_attempts", self.path_attempts, 1, 20)
+        integer_in("more_waypoints", self.more_waypoints, 0, 20)
+
+
+@dataclass(frozen=True)
+class SearchTuning:
+    """The planner's internal knobs, each with its measured default.
+
+    Attributes:
+        seeding: where the search starts.
+        refinement: the CMA-ES refinement's step and stopping rules (its run length is the
+            planner setting ``refine_stall``).
+        retries: with ``seeding: paths``, how many times a failed search is tried again
+            (with more waypoints, or twice the fitness samples), in [0, 10].
+        preferred_first: how many candidates have their preferred timing verified before
+            any falls back to a slower one, in [1, 100].
+        narrowed_acceleration: shares of the acceleration limits of the narrowed timings,
+            tried in turn once a fastest timing fails the certified check; each in (0, 1),
+            decreasing.
+    """
+
+    seeding: SeedingTuning = field(default_factory=SeedingTuning)
+    refinement: RefinementSettings = field(default_factory=RefinementSettings)
+    retries: int = 2
+    preferred_first: int = 3
+    narrowed_acceleration: tuple[float, ...] = (0.7, 0.5, 0.35)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.seeding, SeedingTuning) or not isinstance(self.refinement, RefinementSettings):
+            raise PlanningError("seeding and refinement must be a SeedingTuning and a RefinementSettings")
+        integer_in("retries", self.retries, 0, 10)
+        integer_in("preferred_first", self.preferred_first, 1, 100)
+        shares = tuple(self.narrowed_acceleration)
+        for k, share in enumerate(shares):
+            number_in(f"narrowed_acceleration[{k}]", share, 0.0, 1.0, low_open=True)
+        if any(later >= earlier for earlier, later in itertools.pairwise(shares)) or 1.0 in shares:
+            raise PlanningError(f"narrowed_acceleration = {list(shares)} must decrease, each share below 1")
+        object.__setattr__(self, "narrowed_acceleration", shares)

@@ -1,0 +1,83 @@
+"""The planner's search as one :class:`~planning.search.optimizer.Optimizer`: firefly, then CMA-ES.
+
+The firefly (:mod:`planning.search.firefly`) explores from its seeds and a random population
+until its early stop; from a feasible best, the CMA-ES refinement
+(:mod:`planning.search.refinement`) descends within the rest of the evaluation budget, on
+the same generator. The planner runs it on its waypoint objective, and the benchmark of peer
+optimisers (``scripts/bench_peers.py``) runs the same object beside the peers, so both
+measure one search.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from planning.search.firefly import FireflyProgress, firefly_minimize
+from planning.search.firefly_settings import FireflySettings
+from planning.search.optimizer import BatchObjective, SearchResult
+from planning.search.refinement import refine_search
+from planning.search.refinement_settings import STALL_GENERATIONS, RefinementSettings
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class RefinedFirefly:
+    """The firefly and, from a feasible best, its CMA-ES refinement, as one optimiser.
+
+    Attributes:
+        firefly: the firefly's parameters; its iterations follow from the budget
+            (``budget // fireflies - 1``).
+        refinement: the refinement's settings; ``None``: the firefly's best as it is.
+        stall_generations: the refinement's stalled generations that end it (0: to the budget).
+        seeds: ``(k, d)`` points that replace the first fireflies of the initial population.
+        feasible_below: the objective's bound of feasible values: the firefly's early stop
+            counts only once its best is at or below it, and only a feasible best is refined.
+        lower_bound: about the least value the objective can take (the refinement counts
+            stalls only near it); ``None``: unknown.
+        progress: called after every firefly iteration.
+    """
+
+    firefly: FireflySettings
+    refinement: RefinementSettings | None = field(default_factory=RefinementSettings)
+    stall_generations: int = STALL_GENERATIONS
+    seeds: FloatArray | None = None
+    feasible_below: float = math.inf
+    lower_bound: float | None = None
+    progress: Callable[[FireflyProgress], None] | None = None
+
+    def __call__(
+        self,
+        objective: BatchObjective,
+        lower: FloatArray,
+        upper: FloatArray,
+        budget: int,
+        rng: np.random.Generator,
+    ) -> SearchResult:
+        """Minimise ``objective`` over ``[lower, upper]`` in at most ``budget`` evaluations."""
+        settings = self.firefly
+        iterations = max(budget // settings.fireflies - 1, 0)
+        if iterations != settings.iterations:
+            settings = dataclasses.replace(settings, iterations=iterations)
+        found = firefly_minimize(
+            objective, lower, upper, settings, rng, self.progress, self.seeds, stall_below=self.feasible_below
+        )
+        if self.refinement is None or found.fitness > self.feasible_below:
+            return found
+        return refine_search(
+            objective,
+            lower,
+            upper,
+            found,
+            budget - found.evaluations,
+            rng,
+            self.refinement,
+            stall_generations=self.stall_generations,
+            lower_bound=self.lower_bound,
+        )
