@@ -144,8 +144,15 @@ def choose(problem: Problem, searched: SearchResult) -> Choice | Refusal:
     found = f"the best candidate {'; '.join(first.problems)}"
     if not objective.feasible(searched.fitness):  # the cause comes first
         why = infeasibility(objective.breakdown(searched.x[None]), problem)
-        found = f"no candidate was feasible (the best: {why}); timed, it {'; '.join(first.problems)}"
-    message = f"no collision-free trajectory found ({len(candidates)} candidates verified): {found}"
+        check = first.check
+        closest = (
+            "" if check.worst_pair is None else f"; closest: {check.worst_pair[0]} to '{check.worst_pair[1]}'"
+        )
+        found = (
+            f"no candidate was feasible (the best: {why}{closest}, {check.certified_min_m:.3f} m certified)"
+        )
+    verified = f"{len(candidates)} candidate{'' if len(candidates) == 1 else 's'} verified"
+    message = f"no collision-free trajectory found ({verified}): {found}"
     return Refusal(message, first.check)
 
 
