@@ -26,7 +26,7 @@ from numpy.typing import ArrayLike, NDArray
 from cpr_kin.errors import CprKinError, JointLimitError, UrdfError
 from cpr_kin.limits import JointLimits, find_limits_file, read_dynamic_limits
 from cpr_kin.supported import check_joints, check_limits, check_names
-from cpr_kin.urdf_file import collision_names, is_bundled, parse_urdf, validate_urdf
+from cpr_kin.urdf_file import captured_stderr, collision_names, is_bundled, parse_urdf, validate_urdf
 
 FloatArray = NDArray[np.float64]
 
@@ -203,9 +203,11 @@ def load_robot(
     check_names(tree, path)
     check_joints(tree, path)
     try:
-        model, collision_model, visual_model = pin.buildModelsFromUrdf(str(path), str(path.parent))
+        with captured_stderr() as complaints:  # urdfdom prints to fd 2; a model that builds needs none
+            model, collision_model, visual_model = pin.buildModelsFromUrdf(str(path), str(path.parent))
     except Exception as exc:  # Pinocchio reports C++ exceptions as RuntimeError/ValueError
-        raise UrdfError(f"Pinocchio cannot build a model from '{path}': {exc}") from None
+        said = " ".join(line.strip() for line in complaints[:2])
+        raise UrdfError(f"Pinocchio cannot build a model from '{path}': {exc} {said}".strip()) from None
     if not model.existFrame(tcp_frame):
         raise UrdfError(f"URDF '{path}' has no link or frame named '{tcp_frame}' (the tool tip)")
     names = tuple(model.names[1:])

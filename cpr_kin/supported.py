@@ -9,7 +9,7 @@ the joint, the value and what is supported:
 
 - joint types: ``revolute``, ``prismatic`` and ``fixed`` (a ``continuous`` joint must be
   given a range as a ``revolute`` one; ``floating`` and ``planar`` joints, and ``mimic``
-  joints, are not planned);
+  joints, are not planned), each moving joint with an axis that is a direction;
 - position limits within :data:`MAX_REVOLUTE_RAD` (one turn either way) for a revolute
   joint and :data:`MAX_PRISMATIC_M` for a prismatic one, with ``lower < upper``;
 - crossing a joint's whole range, at rest at both ends, within its velocity, acceleration
@@ -74,6 +74,18 @@ def check_joints(tree: etree._ElementTree, path: Path) -> None:
             )
         if joint.find("mimic") is not None:
             raise UrdfError(f"URDF '{path}': joint '{name}' mimics another; mimic joints are not supported")
+        axis = joint.find("axis")
+        if kind != "fixed" and axis is not None:
+            text = axis.get("xyz", "1 0 0")
+            try:
+                vector = [float(v) for v in text.split()]
+            except ValueError:
+                vector = []
+            if len(vector) != 3 or not all(map(math.isfinite, vector)) or math.hypot(*vector) < 1e-9:
+                raise UrdfError(
+                    f"URDF '{path}': joint '{name}' axis xyz = '{escaped(text[:40])}' is not a direction; "
+                    "give three finite numbers, not all zero (e.g. '0 0 1')"
+                )
 
 
 def crossing_time(width: float, velocity: float, acceleration: float, jerk: float) -> float:

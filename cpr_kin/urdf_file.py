@@ -8,6 +8,11 @@ accepts, so that a broken file gets a message naming the problem.
 
 from __future__ import annotations
 
+import contextlib
+import os
+import sys
+import tempfile
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -63,6 +68,29 @@ def validate_urdf(path: Path) -> None:
     if not urdf.validate(keep):
         problems = "; ".join(str(e) for e in found)
         raise UrdfError(f"URDF file '{path}' is invalid: {problems}")
+
+
+@contextlib.contextmanager
+def captured_stderr() -> Iterator[list[str]]:
+    """Capture what native code writes to the process's standard error (file descriptor 2).
+
+    Pinocchio's URDF parser (urdfdom) prints its complaints there, e.g. "Error: Material
+    [grey] color has no rgba", about details the planner does not use. Within the context
+    they go to a temporary file instead of the user's terminal; the yielded list holds its
+    lines once the context ends, for a caller that wants to report them in its own words.
+    """
+    lines: list[str] = []
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile() as sink:
+        os.dup2(sink.fileno(), 2)
+        try:
+            yield lines
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            sink.seek(0)
+            lines.extend(sink.read(10_000).decode("utf-8", errors="replace").splitlines())
 
 
 def collision_names(tree: etree._ElementTree) -> dict[str, list[str]]:

@@ -94,6 +94,7 @@ def test_rrt_connect_pipelines(robot: ck.Robot, peer: str) -> None:
     assert result.duration > 0 and result.path_length > 0
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("scenes", [1, 0])
 def test_benchmark_script_runs(tmp_path: Path, scenes: int) -> None:
     """The script writes its report, with the planners' table unless ``--scenes 0``."""

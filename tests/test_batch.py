@@ -8,8 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from planning.batch import BatchItem, plan_scene_file, scene_files, summary_csv
-from planning.batch_pool import run_batch
+from planning.batch import BatchItem, plan_scene_file, run_batch, scene_files, summary_csv
 from planning.cli import main
 from planning.errors import PlanningError
 from planning.io.bundled import paper_scene_path
@@ -28,6 +27,7 @@ def scenes(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return folder
 
 
+@pytest.mark.slow
 def test_batch_local_processes(scenes: Path, tmp_path: Path) -> None:
     run = run_batch(scene_files(scenes), tmp_path, workers=2)
     items = run.items
@@ -63,6 +63,7 @@ def raise_on_doomed(path: Path, out: Path) -> BatchItem:
     return plan_scene_file(path, out)
 
 
+@pytest.mark.slow
 def test_a_worker_that_dies_sinks_only_its_scene(scenes: Path, tmp_path: Path) -> None:
     folder = tmp_path / "scenes"
     folder.mkdir()
@@ -114,6 +115,7 @@ def test_a_scene_never_replaces_a_folder_that_is_not_ours(tmp_path: Path) -> Non
     assert (out / "keep.txt").read_text() == "the user's file"
 
 
+@pytest.mark.slow
 def test_dask_cluster_gives_the_same_results(scenes: Path, tmp_path: Path) -> None:
     distributed = pytest.importorskip("distributed")
     paths = scene_files(scenes)[1:3]
@@ -135,6 +137,7 @@ def test_dask_cluster_gives_the_same_results(scenes: Path, tmp_path: Path) -> No
         ).read_bytes()
 
 
+@pytest.mark.slow
 def test_bad_folders(tmp_path: Path) -> None:
     with pytest.raises(PlanningError, match="does not exist"):
         scene_files(tmp_path / "nowhere")
@@ -145,6 +148,7 @@ def test_bad_folders(tmp_path: Path) -> None:
         run_batch(scene_files(tmp_path), tmp_path / "out", scheduler="tcp://127.0.0.1:9")
 
 
+@pytest.mark.slow
 def test_batch_command(scenes: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     code = main(["batch", str(scenes), "--out", str(tmp_path / "b"), "--workers", "2"])
     out = capsys.readouterr().out

@@ -174,6 +174,7 @@ def test_paper_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> No
     assert "Beside the paper" in (tmp_path / "paper" / "report.md").read_text()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("command", [[], ["plan"], ["paper"], ["check"]])
 def test_help_everywhere(command: list[str]) -> None:
     completed = subprocess.run(
@@ -186,6 +187,7 @@ def test_help_everywhere(command: list[str]) -> None:
     assert "usage: cpr-plan" in completed.stdout
 
 
+@pytest.mark.slow
 def test_installed_console_script() -> None:
     script = Path(sys.executable).parent / "cpr-plan"
     assert script.exists(), "the project installs the cpr-plan command"
@@ -193,6 +195,7 @@ def test_installed_console_script() -> None:
     assert completed.returncode == 0 and "TRAJECTORY" in completed.stdout
 
 
+@pytest.mark.slow
 def test_usage_error_exits_2_without_traceback() -> None:
     completed = subprocess.run(
         [sys.executable, "-m", "planning.cli", "plan"], capture_output=True, text=True, check=False
@@ -201,6 +204,7 @@ def test_usage_error_exits_2_without_traceback() -> None:
     assert "the following arguments are required" in completed.stderr and "Traceback" not in completed.stderr
 
 
+@pytest.mark.slow
 def test_progress_bar_only_on_a_terminal(tmp_path: Path) -> None:
     scene = write_scene(tmp_path, SCENE)
     command = [sys.executable, "-m", "planning.cli", "plan", str(scene), "--out"]
@@ -256,3 +260,74 @@ def test_paper_search_flag_is_the_papers_settings_written_in_the_scene(
     # without the flag, the defaults search less
     code, stdout, _ = run(["plan", str(scene), "--out", str(tmp_path / "d"), "--json"], capsys)
     assert code == 0 and json.loads(stdout)["evaluations"] < 50 * 51
+
+
+def test_show_refuses_a_trajectory_whose_robot_is_not_here(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = write_scene(tmp_path, SCENE)
+    assert run(["plan", str(scene), "--out", str(tmp_path / "out")], capsys)[0] == 0
+    document = json.loads((tmp_path / "out" / "trajectory.json").read_text())
+    document["robot"] = "/elsewhere/robots/cpr.urdf"  # planned on another machine
+    moved = tmp_path / "moved.json"
+    moved.write_text(json.dumps(document))
+    code, _, stderr = run(["show", str(moved), "--html", str(tmp_path / "v.html")], capsys)
+    assert code == 2 and not (tmp_path / "v.html").exists()
+    assert (
+        "robot URDF '/elsewhere/robots/cpr.urdf' is not on this machine; pass the robot with --urdf" in stderr
+    )
+    # given the robot, it draws
+    code, stdout, _ = run(["show", str(moved), "--html", str(tmp_path / "v.html"), "--urdf", "cpr"], capsys)
+    assert code == 0 and "wrote" in stdout and (tmp_path / "v.html").stat().st_size > 0
+
+
+@pytest.mark.slow
+def test_a_plan_prints_no_third_party_warning(tmp_path: Path) -> None:
+    # a URDF urdfdom complains about (a material without a colour), every warning shown
+    grey = '<material name="base_grey"><color rgba="0.35 0.35 0.38 1"/></material>'
+    (tmp_path / "robot.urdf").write_text(
+        ck.cpr_urdf_path().read_text().replace(grey, '<material name="base_grey"></material>')
+    )
+    scene = write_scene(
+        tmp_path, {**with_changes(planner={"seed": 1, "fireflies": 10}), "robot": "robot.urdf"}
+    )
+    done = subprocess.run(
+        [sys.executable, "-m", "planning.cli", "plan", str(scene), "--out", str(tmp_path / "out")],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "PYTHONWARNINGS": "default"},
+        check=False,
+    )
+    assert done.returncode == 0 and done.stderr == ""
+
+
+@pytest.mark.parametrize(
+    ("duration", "ends", "least"),
+    [(0.05, "rest", "1.62 s"), (1.0, "rest", "1.62 s"), (0.5, "natural", "1.12 s")],
+)
+def test_a_duration_too_short_for_the_limits_exits_2_naming_the_least(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], duration: float, ends: str, least: str
+) -> None:
+    scene = write_scene(tmp_path, with_changes(duration=duration, spline={"ends": ends}))
+    code, _, stderr = run(["plan", str(scene), "--out", str(tmp_path / "out")], capsys)
+    assert code == 2 and not (tmp_path / "out").exists()
+    assert f"duration = {duration:g} s is shorter than the least time the joint limits allow" in stderr
+    assert f"{least} (joint 'theta1' moves 1.68 rad" in stderr and f"give at least {least}" in stderr
+
+
+def test_names_a_terminal_would_obey_are_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    document = with_changes(name="evil\u202etxt", obstacles__0__name="crate\x1b[2J")
+    scene = write_scene(tmp_path, yaml.safe_dump(document, allow_unicode=True))
+    code, _, stderr = run(["plan", str(scene), "--out", str(tmp_path / "out")], capsys)
+    assert code == 2 and stderr.count("\n") == 1
+    assert "name = 'evil\\u202etxt': holds U+202E (RIGHT-TO-LEFT OVERRIDE)" in stderr
+    assert "obstacles[0].name = 'crate\\x1b[2J': holds U+001B" in stderr
+    assert "\u202e" not in stderr and "\x1b" not in stderr
+
+
+def test_a_file_name_a_terminal_would_obey_is_printed_escaped(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = write_scene(tmp_path, "start: [", name="odd\u202eyaml.yaml")
+    code, _, stderr = run(["plan", str(scene), "--out", str(tmp_path / "out")], capsys)
+    assert code == 2 and "odd\\u202eyaml.yaml" in stderr and "\u202e" not in stderr

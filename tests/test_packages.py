@@ -46,6 +46,7 @@ def test_every_export_resolves_to_its_module_object(package: str) -> None:
         _ = module.no_such_name
 
 
+@pytest.mark.slow
 def test_the_batch_parent_imports_no_planner_robot_or_compiler() -> None:
     # `cpr-plan batch` dispatches scenes to workers: its process needs none of the heavy
     # modules (numba, coal, Pinocchio, SciPy, trimesh: about 1.2 s), which each worker imports
@@ -59,6 +60,7 @@ def test_the_batch_parent_imports_no_planner_robot_or_compiler() -> None:
     assert dict(zip(heavy, out.split(), strict=True)) == dict.fromkeys(heavy, "False")
 
 
+@pytest.mark.slow
 def test_loading_a_robot_imports_what_it_needs() -> None:
     # attribute access imports the module behind it; the bundled URDF, which the tests
     # validate, loads without yourdfpy (and trimesh)

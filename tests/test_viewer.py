@@ -24,6 +24,8 @@ from planning.viz.artifacts import viewer_html
 from planning.viz.viewer import Viewer
 from planning.viz.viewer_server import start_server
 
+pytestmark = pytest.mark.slow  # every test here starts processes
+
 CHROMIUM_FLAGS = [
     "--headless",
     "--no-sandbox",

@@ -22,14 +22,13 @@ def cmd_batch(args: argparse.Namespace) -> int:
     scene's (0, 2, 3 or 4; :mod:`planning.outcome`), or 130 when interrupted;
     ``summary.csv`` is written in every case, for the scenes done.
     """
-    from planning import batch
-    from planning.batch_pool import check_scheduler, run_batch
+    from planning.batch import check_scheduler, run_batch, scene_files, summary_csv
     from planning.io.publish import FolderLock, write_file
     from planning.io.report import text_table
 
     if args.scheduler is not None:
         check_scheduler(args.scheduler)
-    paths = batch.scene_files(args.scenes)
+    paths = scene_files(args.scenes)
     with FolderLock(args.out) as lock:
         out = lock.target  # absolute: the workers write there, wherever they run
         bar: Any = None
@@ -39,7 +38,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
         run = run_batch(paths, out, args.workers, args.scheduler, tick)
         if bar is not None:
             bar.close()
-        write_file(out / "summary.csv", batch.summary_csv(run.items))
+        write_file(out / "summary.csv", summary_csv(run.items))
     items = run.items
     failed = [i for i in items if i.status != "ok"]
     if args.json:

@@ -17,14 +17,19 @@ from __future__ import annotations
 
 import contextlib
 import io
+import warnings
 from typing import Any
 
-import meshcat
-import meshcat.geometry as g
-import meshcat.transformations as tf
 import numpy as np
 import pinocchio as pin
-from meshcat.animation import Animation
+
+with warnings.catch_warnings():  # meshcat 0.3 imports pyzmq's deprecated ioloop module
+    warnings.simplefilter("ignore", DeprecationWarning)
+    import meshcat
+    import meshcat.geometry as g
+    import meshcat.transformations as tf
+    import meshcat.visualizer
+    from meshcat.animation import Animation
 from numpy.typing import NDArray
 from pinocchio.visualize import MeshcatVisualizer
 
@@ -75,6 +80,20 @@ def _clearance_colors(clearance: FloatArray, margin_m: float) -> FloatArray:
     return np.vstack([np.where(s < 0.5, 1.0, 2 * (1 - s)), np.where(s < 0.5, 2 * s, 1.0), np.zeros_like(s)])
 
 
+class _Window(meshcat.visualizer.ViewerWindow):  # type: ignore[misc]
+    """meshcat's window, closing the socket it replaces when it connects again.
+
+    meshcat 0.3 connects twice while it starts (to ask for the page's URL) and leaves the
+    first socket open until the garbage collector finds it.
+    """
+
+    def connect_zmq(self) -> None:
+        previous = getattr(self, "zmq_socket", None)
+        if previous is not None:
+            previous.close(linger=0)
+        super().connect_zmq()
+
+
 class Viewer:
     """The CPR among its obstacles in meshcat.
 
@@ -94,7 +113,8 @@ class Viewer:
         self._own_server = server is None
         self.server = server or start_server()
         with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints the URL; callers decide
-            self.vis = meshcat.Visualizer(zmq_url=self.server.zmq_url)
+            window = _Window(zmq_url=self.server.zmq_url, start_server=False, server_args=[])
+            self.vis = meshcat.Visualizer(window=window)
         self._robot_view = MeshcatVisualizer(robot.model, robot.collision_model, robot.visual_model)
         self._robot_view.initViewer(viewer=self.vis, open=False)
         self._robot_view.loadViewerModel(rootNodeName="cpr")

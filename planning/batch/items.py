@@ -2,7 +2,7 @@
 
 :func:`plan_scene_file` plans one scene and publishes its outputs into ``out/<scene stem>/``;
 it never raises: every outcome, an unexpected exception included, becomes a
-:class:`BatchItem`. :mod:`planning.batch_pool` runs the tasks in parallel and turns a worker
+:class:`BatchItem`. :mod:`planning.batch.pool` runs the tasks in parallel and turns a worker
 that dies (a crash in a native library) into the row of the scene that killed it.
 :func:`summary_csv` writes one row per scene.
 
@@ -22,13 +22,16 @@ meshes) are resolved against the scene file.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import time
+from collections.abc import Iterator
+from contextlib import AbstractContextManager
 from dataclasses import asdict, dataclass
 from functools import lru_cache
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import cpr_kin as ck  # lazy (lazy_loader): its modules load in the workers, where they are used
 from cpr_kin.names import escaped
@@ -80,12 +83,27 @@ def _robot(urdf: Path | None) -> ck.Robot:
     return ck.load_cpr(urdf)
 
 
-def plan_scene_file(path: Path, out: Path, threads: int | None = 1) -> BatchItem:
+class Gate(Protocol):
+    """What lets a task publish its files (a cluster's :class:`~planning.batch.cluster.PublishGate`)."""
+
+    def __call__(self, item: BatchItem) -> AbstractContextManager[bool]:
+        """A context that yields whether the scene of ``item`` may publish now."""
+        ...
+
+
+@contextlib.contextmanager
+def _open(item: BatchItem) -> Iterator[bool]:
+    """The gate of a local batch: always open (an interrupt kills the local workers)."""
+    yield True
+
+
+def plan_scene_file(path: Path, out: Path, threads: int | None = 1, gate: Gate = _open) -> BatchItem:
     """Plan one scene file and publish its outputs into ``out``; never raises.
 
     ``threads = 1`` by default: the batch runs scenes in parallel, not the checks of one.
-    It imports the planner itself, in the worker: the process that dispatches the scenes
-    never needs it.
+    The files are published within ``gate``; a closed gate (an interrupted cluster batch)
+    makes the row ``interrupted`` and writes nothing. It imports the planner itself, in the
+    worker: the process that dispatches the scenes never needs it.
     """
     from planning.io.outputs import plan_files
     from planning.io.publish import OutputFolder
@@ -99,13 +117,29 @@ def plan_scene_file(path: Path, out: Path, threads: int | None = 1) -> BatchItem
         scene = load_scene(path)
         with OutputFolder(out) as folder:
             result = plan(scene, _robot(scene.robot), threads=threads)
-            folder.publish(plan_files(result))
+            files = plan_files(result)
+            item = BatchItem(
+                escaped(name), "ok", 0, record=plan_record(result), task_time_s=time.perf_counter() - started
+            )
+            with gate(item) as open_:
+                if not open_:
+                    stopped = "the batch was interrupted before this scene's files were written"
+                    return BatchItem.failed(name, "interrupted", stopped, started)
+                folder.publish(files)
     except Exception as exc:  # every outcome is a row (a bug's too): the batch goes on
         outcome = classify(exc)
         return BatchItem.failed(name, outcome.status, outcome.message, started)
-    return BatchItem(
-        escaped(name), "ok", 0, record=plan_record(result), task_time_s=time.perf_counter() - started
-    )
+    return item
+
+
+def finished_items(futures: dict[Any, int]) -> Iterator[tuple[int, BatchItem]]:
+    """``(index, item)`` of the futures (``{future: index}``) that completed with an item."""
+    for future, index in futures.items():
+        try:
+            item = future.result(timeout=1)
+        except BaseException:  # cancelled, failed or still running: not a finished scene
+            continue
+        yield index, item
 
 
 def scene_files(folder: Path) -> list[Path]:

@@ -1,0 +1,28 @@
+from __future__ import annotations
+
+import pytest
+
+from cpr_kin.names import escaped, unprintable
+
+
+@pytest.mark.parametrize(
+    ("text", "found"),
+    [
+        ("crate", None),
+        ("Kiste-Ä_01 (links)", None),
+        ("evil\u202etxt.exe", "U+202E (RIGHT-TO-LEFT OVERRIDE)"),
+        ("clear\x1b[2J", "U+001B"),
+        ("zero\u200bwidth", "U+200B (ZERO WIDTH SPACE)"),
+        ("line\u2028break", "U+2028 (LINE SEPARATOR)"),
+        ("tab\there", "U+0009"),
+    ],
+)
+def test_unprintable_names_the_first_offending_character(text: str, found: str | None) -> None:
+    assert unprintable(text) == found
+
+
+def test_escaped_shows_every_unprintable_character_and_keeps_the_rest() -> None:
+    assert escaped("plain text, ünïcode") == "plain text, ünïcode"
+    assert escaped("a\u202eb\x1bc\nd") == "a\\u202eb\\x1bc\nd"  # newlines stay: they separate lines
+    for text in ("x\u202ey", "\x07bell", "a\u2066b\u2069"):
+        assert unprintable(escaped(text)) is None
