@@ -126,8 +126,8 @@ def pair_bounds(
             out[n, p] = bound - capsule_radius[c]
 
 
-# The kernel below repeats the capsule placement and pair bound of ``pair_bounds``. Factored into
-# compiled helpers (even with Numba's inline="always"), both kernels measured 1.4-4x slower.
+# The kernel below repeats the capsule placement and pair bound of ``pair_bounds``: factored into
+# compiled helpers (even with Numba's inline="always"), both kernels ran slower (docs/tuning.md).
 @njit
 def any_below(
     q: FloatArray,

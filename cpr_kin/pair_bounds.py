@@ -3,9 +3,8 @@
 Each robot geometry is enclosed in a capsule (a segment grown by a radius) fixed to its
 joint; each obstacle is bounded in its own frame by a shape whose distance to a segment is
 a few lines of arithmetic. Compiled code places the capsules with the kinematic chain
-(:mod:`cpr_kin.batch_kinematics`) and bounds every pair: on the 2-core test machine about
-0.3 us per configuration for the chain plus 0.05 us per pair, where coal's yes/no test costs
-about 0.45 us per pair. A positive bound is at most coal's
+(:mod:`cpr_kin.batch_kinematics`) and bounds every pair, several times faster than coal's
+yes/no test (``docs/benchmarks.md``). A positive bound is at most coal's
 distance (shapes that overlap get a bound <= 0), so a configuration whose bounds all exceed
 a margin keeps it for certain: :meth:`cpr_kin.CollisionWorld.margin_violated` sends coal only
 the others. That check asks :meth:`PairBounds.any_below`, which first compares the bounding

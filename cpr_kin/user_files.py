@@ -35,7 +35,7 @@ MAX_DEPTH = 16
 MAX_NODES = 100_000
 """Most nodes (scalars, sequences, mappings) in one file."""
 
-_BASE = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's parser: about 7x faster
+_BASE = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's parser, in C, where installed
 
 
 class UserFileError(CprKinError):

@@ -4,7 +4,14 @@ from .curves.ptp import ptp_time, trapezoid_time
 from .curves.spline import SepticSplineSolver, SplineFit, fit_septic_spline, uniform_knots
 from .curves.spline_settings import SplineSettings
 from .curves.trajectory import Extrema, Trajectory
-from .errors import NoSolutionError, NoTrajectoryFoundError, PlanningError, SceneError, SplineError
+from .errors import (
+    CprPlanError,
+    NoSolutionError,
+    NoTrajectoryFoundError,
+    PlanningError,
+    SceneError,
+    SplineError,
+)
 from .io.bundled import paper_scene
 from .io.scene_file import dump_scene, load_scene
 from .io.trajectory_io import write_samples, write_trajectory
@@ -31,6 +38,7 @@ __all__ = [
     "DEFAULT_SPLINE",
     "PAPER_SEARCH",
     "Breakdown",
+    "CprPlanError",
     "Extrema",
     "FireflyProgress",
     "FireflySettings",

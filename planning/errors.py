@@ -1,4 +1,6 @@
-"""Exceptions of :mod:`planning`, with two roots because callers treat them differently.
+"""Exceptions of :mod:`planning`: one base class, :class:`CprPlanError`, and two kinds below it.
+
+Callers treat the two kinds differently:
 
 - :class:`PlanningError` (a ``ValueError``): the input is wrong (settings, waypoints, knots,
   a scene or a file). Its message names the offending value and what is allowed: fix the
@@ -19,7 +21,11 @@ if TYPE_CHECKING:
     import cpr_kin as ck
 
 
-class PlanningError(ValueError):
+class CprPlanError(Exception):
+    """Base class of every exception :mod:`planning` raises."""
+
+
+class PlanningError(CprPlanError, ValueError):
     """Base class of every error raised by :mod:`planning` on bad input."""
 
 
@@ -31,7 +37,7 @@ class SceneError(PlanningError):
     """A scene file is missing, not YAML, or does not follow the schema."""
 
 
-class NoSolutionError(RuntimeError):
+class NoSolutionError(CprPlanError, RuntimeError):
     """Base class of the outcomes where valid input has no solution that was found."""
 
 

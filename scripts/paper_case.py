@@ -1,4 +1,4 @@
-"""The paper case (DESIGN.md section 4), planned and reported beside the paper's figures.
+"""The paper case (docs/paper_case.md), planned and reported beside the paper's figures.
 
 Plans the scene with the paper's parameters (n = 50, alpha = 1, beta0 = 0.5, 50 iterations,
 3 waypoints; septic spline N = 4, h = 1 s, p = 1e6), verifies the trajectory, prints the

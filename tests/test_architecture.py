@@ -102,6 +102,39 @@ def test_curves_are_pure_mathematics_and_search_knows_no_robot() -> None:
     assert offenders == []
 
 
+def test_the_pipeline_knows_no_file_command_line_or_drawing() -> None:
+    # scene -> problem -> search -> choose -> result: what reads and writes files, the command
+    # line, the batch and the viewer are built on it, never under it
+    outside = ("planning.io", "planning.cli", "planning.batch", "planning.viz", "planning.peers")
+    offenders = [
+        (name, imported)
+        for name, path in modules().items()
+        if within(name, "planning.pipeline")
+        for imported, module_level in imports(name, path)
+        if module_level and any(within(imported, o) for o in outside)
+    ]
+    assert offenders == []
+
+
+MAX_PARAMETERS = 6
+"""Most parameters of a pipeline function (``self`` not counted): stages hand over named values."""
+
+
+def test_pipeline_functions_take_named_values_not_long_argument_lists() -> None:
+    offenders = []
+    for name, path in modules().items():
+        if not within(name, "planning.pipeline"):
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.FunctionDef):
+                arguments = node.args
+                count = len(arguments.posonlyargs) + len(arguments.args) + len(arguments.kwonlyargs)
+                count -= bool(arguments.args) and arguments.args[0].arg in ("self", "cls")
+                if count > MAX_PARAMETERS:
+                    offenders.append(f"{name}.{node.name} ({count})")
+    assert offenders == []
+
+
 def test_drawing_libraries_load_only_with_the_viewer_or_plots() -> None:
     drawing = ("meshcat", "matplotlib", "planning.viz")
     offenders = [

@@ -28,7 +28,7 @@ def test_pinocchio_agrees_with_yourdfpy(
 
 
 def test_tcp_matches_design_formula(robot: ck.Robot, rng: np.random.Generator) -> None:
-    # DESIGN section 3: with theta4 = theta5 = 0, tcp = (r_f cos t1, r_f sin t1, z_c - 0.15)
+    # docs/robot.md: with theta4 = theta5 = 0, tcp = (r_f cos t1, r_f sin t1, z_c - 0.15)
     configurations = random_configurations(robot, rng, 200)
     configurations[:, 3:] = 0.0
     theta1, d2, d3 = configurations[:, 0], configurations[:, 1], configurations[:, 2]

@@ -1,7 +1,8 @@
-"""The README's Python snippets run, in order, in one namespace (as newer mink's do).
+"""The README's and the docs' Python snippets run, and the README's scene is the example file.
 
-Each ```python block builds on the ones before it, as a reader would type them. They run in
-a temporary working folder, so the files they write land there.
+Each ```python block of a file builds on the ones before it, as a reader would type them,
+in one namespace per file (as newer mink's do). They run in a temporary working folder, so
+the files they write land there.
 """
 
 from __future__ import annotations
@@ -12,24 +13,60 @@ from pathlib import Path
 
 import pytest
 
-README = Path(__file__).resolve().parents[1] / "README.md"
+ROOT = Path(__file__).resolve().parents[1]
+README = ROOT / "README.md"
+DOCS = sorted((ROOT / "docs").glob("*.md"))
 
 
-def snippets() -> list[str]:
-    return re.findall(r"^```python\n(.*?)^```", README.read_text(), flags=re.MULTILINE | re.DOTALL)
+def blocks(path: Path, language: str) -> list[str]:
+    return re.findall(rf"^```{language}\n(.*?)^```", path.read_text(), flags=re.MULTILINE | re.DOTALL)
+
+
+def run_snippets(path: Path) -> None:
+    namespace: dict[str, object] = {"__name__": "readme"}
+    for number, code in enumerate(blocks(path, "python"), start=1):
+        try:
+            exec(compile(code, f"{path.name} snippet {number}", "exec"), namespace)
+        except Exception as exc:  # name the snippet that broke
+            raise AssertionError(f"{path.name} snippet {number} fails: {exc!r}\n{code}") from exc
 
 
 def test_the_readme_has_snippets() -> None:
-    assert len(snippets()) >= 3
+    assert len(blocks(README, "python")) >= 3
 
 
 def test_readme_snippets_run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.chdir(tmp_path)
-    namespace: dict[str, object] = {"__name__": "readme"}
-    for number, code in enumerate(snippets(), start=1):
-        try:
-            exec(compile(code, f"README.md snippet {number}", "exec"), namespace)
-        except Exception as exc:  # name the snippet that broke
-            raise AssertionError(f"README snippet {number} fails: {exc!r}\n{code}") from exc
+    run_snippets(README)
     assert (tmp_path / "out" / "trajectory.json").is_file()
     assert os.listdir(tmp_path)  # what the snippets write stays in the temporary folder
+
+
+@pytest.mark.parametrize("page", [p for p in DOCS if blocks(p, "python")], ids=lambda p: p.name)
+def test_docs_snippets_run(page: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    run_snippets(page)
+
+
+def test_the_readmes_scene_is_the_example_file_and_plans_from_where_it_lies(tmp_path: Path) -> None:
+    from planning import load_scene
+
+    (scene,) = blocks(README, "yaml")
+    example = ROOT / "examples" / "scenes" / "shelf.yaml"
+    assert scene == example.read_text()
+    loaded = load_scene(example)  # robot: resolves relative to the scene file, from any folder
+    assert loaded.robot == (ROOT / "cpr_kin" / "urdf" / "cpr.urdf").resolve()
+
+
+def test_nothing_points_outside_the_repository() -> None:
+    texts = [README, *DOCS, *ROOT.glob("planning/**/*.py"), *ROOT.glob("cpr_kin/**/*.py")]
+    offenders = [
+        str(p.relative_to(ROOT)) for p in texts if re.search(r"DESIGN\.md|\.\./shared", p.read_text())
+    ]
+    assert offenders == []
+
+
+def test_every_docs_page_the_readme_links_exists() -> None:
+    linked = re.findall(r"\]\((docs/[^)#]+)", README.read_text())
+    assert linked and all((ROOT / link).is_file() for link in linked)
+    assert {f"docs/{p.name}" for p in DOCS} - {"docs/index.md"} <= set(linked)

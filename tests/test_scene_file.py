@@ -30,7 +30,7 @@ MINIMAL = {"start": {"tcp": [0.5, 0.45, 0.25]}, "goal": {"tcp": [-0.5, 0.45, 0.2
 
 
 def test_bundled_paper_scene_is_the_paper_case_of_the_design() -> None:
-    # DESIGN.md section 4, value by value
+    # docs/paper_case.md, value by value
     scene = paper_scene()
     assert scene.name == "paper" and scene.safety_margin == 0.1 and scene.duration == 4.0
     assert scene.start == Target(tcp=(0.5, 0.45, 0.25)) and scene.goal == Target(tcp=(-0.5, 0.45, 0.25))

@@ -7,7 +7,7 @@ phase-plane profile through two moving averages, of widths ``w`` and ``w / 4``, 
 profile's time plus ``1.25 w``. Where a joint switches from accelerating to braking at once
 (a move too short to cruise), its acceleration swings by ``2 a`` and the window doubles, so
 the constant allowance ``1.25 a / j`` of the narrowest window underestimates such paths by
-``1.25 a / j`` (0.25 s for the CPR, a tenth of a typical move).
+``1.25 a / j``.
 
 This module repeats the widening on the profile itself. The two averages' jerk is a
 difference of the joint's velocity ``v`` at four instants (the averages of an acceleration
@@ -17,15 +17,10 @@ are differences of its integral)::
 
 With ``v`` linear between the profile's grid points, its extrema lie where one of the four
 instants meets a grid point, so a few hundred evaluations give it exactly, without the
-timing's fine time grid. :func:`sampled_path_durations` is the batch the fitness calls;
-measured on the 40 paths planned on generated scenes of seed 0, it comes within 1.2 %
-(standard deviation) of the uncapped motion's duration, where the constant allowance is
-4.5 % off (median 4 % short). Not modelled: the timing's velocity caps, which sometimes
-trade a wider window for a short cruise (:mod:`planning.curves.velocity_caps`); there the
-estimate is up to 17 % above the timing. Trying two of them (0.95 and 0.8 of the peak) where
-the window widens brought the estimate within 1.6 % of the timing on those 40 paths, but on
-100 generated scenes (seed 1) the trajectories came out as long (geometric mean 1.000) for
-7 % more planning time, so it is left out.
+timing's fine time grid. :func:`sampled_path_durations` is the batch the fitness calls.
+Not modelled: the timing's velocity caps, which sometimes trade a wider window for a short
+cruise (:mod:`planning.curves.velocity_caps`); there the estimate lies above the timing.
+How close the estimate comes, and why the caps are left out: ``docs/tuning.md``.
 """
 
 from __future__ import annotations

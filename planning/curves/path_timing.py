@@ -29,8 +29,8 @@ touching one of them (no time left on the table). Steps:
 
 Why not uniform scaling alone (what the planner did before): a polynomial shape's velocity
 is a bell whose peak is about twice its mean, so most of the motion runs far below the
-limits (2.3x Ruckig's free-space bound on generated scenes). On a straight line this method
-comes within a few percent of Ruckig's time-optimal jerk-limited duration.
+limits. How close this method comes to Ruckig's time-optimal jerk-limited duration:
+``docs/benchmarks.md`` (``scripts/bench_timing.py``).
 """
 
 from __future__ import annotations

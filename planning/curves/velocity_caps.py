@@ -27,7 +27,7 @@ FloatArray = NDArray[np.float64]
 
 STEPS_PER_RAMP = 100
 """Steps of the time grid on which the joints' motion is averaged, per ``max_j a_j / j_j``
-(the time the jerk limit takes to ramp the acceleration limit; 2 ms for the CPR). Relative,
+(the time the jerk limit takes to ramp the acceleration limit). Relative,
 so that limits scaled as time is (``v`` by ``k``, ``a`` by ``k^2``, ``j`` by ``k^3``) give the
 same motion ``k`` times faster."""
 ROUNDS = 3
@@ -43,7 +43,7 @@ the limit keep the search the same when a limit that does not bind is raised."""
 RAMP_FACTORS = (0.75, 0.5)
 """Shares of the best velocity cap's acceleration ramp time tried as caps of the ramps."""
 BISECTIONS = 4
-"""Bisection steps between two neighbours of the grid, to 0.3 % of the peak."""
+"""Bisection steps between two neighbours of the grid (each halves the interval)."""
 MARGIN = 0.01
 """How far below the bisection's boundary the cap is taken, as a share of the peak."""
 
@@ -77,9 +77,7 @@ def fastest_motion(path: ArcLengthPath, limits: FloatArray) -> CappedMotion:
 
     The grid stops at the first cap whose phase-plane time exceeds the best duration so far:
     a lower cap only slows the profile, and the averages add to it, so no cap below can win.
-    The result is the whole grid's (the tests compare; identical on 1000 timings of 200
-    planned paths), and :func:`~planning.curves.path_timing.time_path` takes 9.1 ms instead
-    of 13.9 ms per path there.
+    The result is the whole grid's (the tests compare), in less time (``docs/tuning.md``).
     """
     tried = {1.0: capped_motion(path, limits, 1.0)}
     peak = tried[1.0].peak

@@ -1,6 +1,6 @@
 """The scenes that ship with the package (``planning/scenes/*.yaml``), the paper case first.
 
-The paper case (DESIGN.md section 4) exists once, as ``planning/scenes/paper.yaml``:
+The paper case (docs/paper_case.md) exists once, as ``planning/scenes/paper.yaml``:
 :func:`paper_scene` loads it, ``cpr-plan paper`` plans it.
 """
 

@@ -2,10 +2,10 @@
 
 ``json.dumps(document, indent=1)`` puts every number of a trajectory on a line of its own
 (thousands of lines for a few segments), and any ``indent`` makes :mod:`json` fall back to
-its pure-Python encoder, about 8 ms per trajectory file. :func:`dumps` indents objects and
-lists that hold objects or lists, and writes every other value (numbers, strings, lists of
-them) with the C encoder on one line: a waypoint or a row of spline coefficients is one
-line, and the text is written several times faster. It parses to the same document as
+its pure-Python encoder. :func:`dumps` indents objects and lists that hold objects or
+lists, and writes every other value (numbers, strings, lists of them) with the C encoder on
+one line: a waypoint or a row of spline coefficients is one line, and the text is written
+faster. It parses to the same document as
 :func:`json.dumps` gives, float for float (both print ``repr``).
 """
 

@@ -1,7 +1,7 @@
 """Random scenes whose only way from start to goal is a narrow passage: seeded, reproducible.
 
-Three kinds, each placed across the swing of ``theta1`` between start and goal (DESIGN.md
-section 3: the arm is a 0.05 m beam at height ``z_c = 0.25 + d2`` whose flange, at radius
+Three kinds, each placed across the swing of ``theta1`` between start and goal (``docs/robot.md``:
+the arm is a 0.05 m beam at height ``z_c = 0.25 + d2`` whose flange, at radius
 ``0.30 + d3``, carries a tool that hangs 0.15 m down):
 
 - ``beam``: a crate on the floor and a beam above it, both spanning the arm's radial range

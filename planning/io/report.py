@@ -22,7 +22,7 @@ PAPER_FIGURES = {
     "node_deviation_limit_um": 20.0,
     "jerk": {"theta1": (-0.071, 0.2026), "d2": (-0.518, 0.673), "d3": (-0.292, 0.265)},
 }
-"""The paper's reported figures (DESIGN.md section 4)."""
+"""The paper's reported figures (docs/paper_case.md)."""
 
 
 def plan_record(result: PlanResult, timings: bool = True) -> dict[str, Any]:

@@ -1,4 +1,4 @@
-"""Scene files (YAML, DESIGN.md section 6): loading, validation and writing.
+"""Scene files (YAML, docs/formats.md): loading, validation and writing.
 
 Every key is checked against the schema (:mod:`planning.io.scene_schema`): unknown keys,
 wrong types, values out of range and inconsistent combinations are reported as one
@@ -136,7 +136,7 @@ def load_scene(path: str | Path) -> Scene:
 
 
 def obstacle_to_dict(obstacle: ck.Obstacle) -> dict[str, Any]:
-    """An obstacle in the scene file's form (DESIGN.md section 6)."""
+    """An obstacle in the scene file's form (docs/formats.md)."""
     entry: dict[str, Any] = {"name": obstacle.name, "shape": obstacle.shape}
     if obstacle.shape == "box":
         entry["size"] = np.asarray(obstacle.size).tolist()

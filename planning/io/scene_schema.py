@@ -1,4 +1,4 @@
-"""The scene file's schema (DESIGN.md section 6) as pydantic models, and its error messages.
+"""The scene file's schema (docs/formats.md) as pydantic models, and its error messages.
 
 Unknown keys are errors; every optional key has the default of the setting it fills
 (:mod:`planning.pipeline.scene`), so the file and the library cannot disagree. A validation error

@@ -1,6 +1,6 @@
 """Writing the files users exchange: ``cpr-trajectory/1`` JSON and CSV samples.
 
-The trajectory file follows DESIGN.md section 6; the samples are position, velocity,
+The trajectory file follows docs/formats.md; the samples are position, velocity,
 acceleration and jerk every IPO period. Each file is written atomically
 (:func:`planning.io.publish.write_file`); a plan's whole set is published by
 :class:`planning.io.publish.OutputFolder`. Reading a trajectory file back is

@@ -1,4 +1,4 @@
-"""Reading a ``cpr-trajectory/1`` file (DESIGN.md section 6) that anyone may have written.
+"""Reading a ``cpr-trajectory/1`` file (docs/formats.md) that anyone may have written.
 
 A file is read only if it is one: a bounded JSON document whose keys have the documented
 types (pydantic, with field paths in the messages), finite numbers, one segment per knot

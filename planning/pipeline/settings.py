@@ -82,11 +82,11 @@ class PlannerSettings:
         refine: ``"cma"`` (default): once the firefly has a feasible best, a CMA-ES started
             at it refines it within the rest of the evaluation budget
             (:mod:`planning.search.refinement`); ``"none"`` (the paper): the firefly's best.
-        refine_stall: generations in a row without a relative improvement of 0.1 % that end
-            the refinement, counted once its best is within
-            :data:`~planning.search.refinement.NEAR_BOUND` times the objective's lower bound,
-            in [0, ``MAX_ITERATIONS``]; 0: run it to the evaluation budget (better fitness
-            for more planning time, ``scripts/bench_peers.py``); default
+        refine_stall: generations in a row without a relative improvement of
+            :data:`~planning.search.optimizer.STALL_TOLERANCE` that end the refinement,
+            counted once its best is within ``tuning.refinement.near_bound`` times the
+            objective's lower bound, in [0, ``MAX_ITERATIONS``]; 0: run it to the evaluation
+            budget (better fitness for more planning time); default
             :data:`~planning.search.refinement_settings.STALL_GENERATIONS`.
         tuning: the search's internal knobs (:class:`~planning.pipeline.tuning.SearchTuning`),
             set from Python only: a scene file does not hold them.

@@ -21,8 +21,8 @@ MAX_FIREFLIES = 1000
 MAX_ITERATIONS = 10_000
 """Most iterations."""
 MAX_EVALUATIONS = 1_000_000
-"""Most evaluations, ``fireflies x (iterations + 1)``: about 1 to 2 minutes of search on two
-cores at the planner's ~100 us per evaluation, which bounds how long a scene can ask to run."""
+"""Most evaluations, ``fireflies x (iterations + 1)``: it bounds how long a scene can ask the
+search to run (minutes on two cores, ``docs/benchmarks.md``)."""
 MAX_STEP = 10.0
 """Largest ``alpha`` and ``beta0`` [normalised units]: beyond 1 every move already leaves the
 box and is clipped back, so larger values only hide a typo."""

@@ -7,15 +7,13 @@ in milliseconds, and its path, cut to a few waypoints, seeds the firefly's popul
 
 Two trees grow from start and goal: one extends a step towards a random sample, the other
 then greedily connects to the new node; they swap roles every sample. The step is by default
-a fifth of the sampling box's diagonal, OMPL's default range: on 200 generated scenes with a
-blocked straight line it needed 40 % fewer samples and 25 % fewer checked configurations than
-a step of 0.25 m, and seeded trajectories as fast. The extension and the connection are
-checked in one call (the connection speculatively, towards the step's end), edges in batches
-as :mod:`planning.search.edges` describes (not certified: the executed spline gets the
-certified check). Distances are robot motion bounds ``sum_j R_j |dq_j|`` [m] with the joints'
-motion radii (:func:`cpr_kin.motion_radii`), so a step means the same in every joint whatever
-its unit. The path found is then shortened (:func:`planning.search.edges.shortcut`). All
-randomness comes from the generator passed.
+a fifth of the sampling box's diagonal, OMPL's default range (``docs/tuning.md``). The
+extension and the connection are checked in one call (the connection speculatively, towards
+the step's end), edges in batches as :mod:`planning.search.edges` describes (not certified:
+the executed spline gets the certified check). Distances are robot motion bounds ``sum_j R_j
+|dq_j|`` [m] with the joints' motion radii (:func:`cpr_kin.motion_radii`), so a step means
+the same in every joint whatever its unit. The path found is then shortened
+(:func:`planning.search.edges.shortcut`). All randomness comes from the generator passed.
 """
 
 from __future__ import annotations

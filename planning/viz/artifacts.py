@@ -5,6 +5,9 @@ The drawing libraries (matplotlib, meshcat) are imported here only when these ar
 
 from __future__ import annotations
 
+import html
+from typing import Any
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -54,3 +57,21 @@ def viewer_html(
         viewer.show_plan(trajectory, waypoints)
         viewer.animate(trajectory)
         return viewer.static_html()
+
+
+def notebook_viewer(result: PlanResult, height_px: int = 480, collision: bool = False) -> Any:
+    """The plan's animated meshcat viewer for a Jupyter cell: an ``IPython.display.HTML``.
+
+    The self-contained page of :func:`viewer_html` in an iframe (``srcdoc``), so it needs no
+    server once drawn and survives in the saved notebook. ``height_px``: the frame's height.
+    """
+    from IPython.display import HTML
+
+    page = viewer_html(
+        result.problem.world, result.scene.safety_margin, result.trajectory, result.waypoints, collision
+    )
+    source = html.escape(page, quote=True)
+    return HTML(  # type: ignore[no-untyped-call]
+        f'<div style="height: {int(height_px)}px; width: 100%; resize: both; overflow: hidden">'
+        f'<iframe srcdoc="{source}" style="width: 100%; height: 100%; border: none"></iframe></div>'
+    )
