@@ -167,6 +167,10 @@ def test_an_interrupted_cluster_batch_lists_every_scene_that_finished(cluster: s
         ("http://127.0.0.1:8786", "is not a scheduler address"),
         ("tcp://:8786", "is not a scheduler address"),
         ("tcp://bad_host!:8786", "is not a host name"),
+        ("tcp://-bad:8786", "'-bad' is not a host name"),
+        ("tcp://[::1", "is not a scheduler address"),
+        ("tcp://127.0.0.1:8786/path", "is not a scheduler address"),
+        ("tcp://user@127.0.0.1:8786", "is not a scheduler address"),
     ],
 )
 def test_a_malformed_scheduler_address_is_refused_at_once(address: str, message: str) -> None:

@@ -43,8 +43,15 @@ def check_scheduler(address: str) -> None:
     """
     protocols = ", ".join(SCHEDULER_PROTOCOLS)
     expected = f"expected PROTOCOL://HOST:PORT, e.g. tcp://127.0.0.1:8786 (PROTOCOL: {protocols})"
-    parts = urlsplit(address)
-    if parts.scheme not in SCHEDULER_PROTOCOLS or not parts.hostname:
+    try:
+        parts = urlsplit(address)
+        hostname = parts.hostname
+    except ValueError:  # e.g. an unclosed IPv6 bracket
+        raise PlanningError(
+            f"--scheduler = {shown(address)} is not a scheduler address; {expected}"
+        ) from None
+    extra = parts.path or parts.query or parts.fragment or parts.username or parts.password
+    if parts.scheme not in SCHEDULER_PROTOCOLS or not hostname or extra:
         raise PlanningError(f"--scheduler = {shown(address)} is not a scheduler address; {expected}")
     try:
         port = parts.port
@@ -52,14 +59,24 @@ def check_scheduler(address: str) -> None:
         port = -1
     if port is not None and not 1 <= port <= 65535:
         raise PlanningError(f"--scheduler = {shown(address)}: the port must be in [1, 65535]; {expected}")
-    host = parts.hostname
+    host = hostname
     if all(c.isdigit() or c == "." for c in host) or ":" in host:
         try:
             ipaddress.ip_address(host)
         except ValueError:
             raise PlanningError(f"--scheduler = {shown(address)}: '{host}' is not an IP address") from None
-    elif not all(0 < len(part) <= 63 and part.replace("-", "").isalnum() for part in host.split(".")):
+    elif not all(_label(part) for part in host.split(".")):
         raise PlanningError(f"--scheduler = {shown(address)}: {shown(host)} is not a host name")
+
+
+def _label(part: str) -> bool:
+    """Whether ``part`` is a host name's label: 1-63 letters, digits and inner hyphens."""
+    return (
+        0 < len(part) <= 63
+        and part.replace("-", "").isalnum()
+        and not part.startswith("-")
+        and not part.endswith("-")
+    )
 
 
 @dataclass(frozen=True)
@@ -131,8 +148,8 @@ def run_on_cluster(
         ) from None
     try:
         client = Client(scheduler, timeout=10)
-    except (OSError, TimeoutError) as exc:
-        raise PlanningError(f"cannot reach the Dask scheduler at '{shown(scheduler)}': {exc}") from None
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise PlanningError(f"cannot reach the Dask scheduler at {shown(scheduler)}: {exc}") from None
     gate = PublishGate.new()
     recorded: set[int] = set()
 
