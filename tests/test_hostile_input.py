@@ -1,16 +1,15 @@
 """Hostile and careless input: one short line, the right exit code, nothing written, no hang.
 
 Every case runs through ``cpr-plan`` as a user meets it. Each asserts the exit code, one line
-on stderr under 300 characters that names the field, no traceback, no output folder, and a
-time bound generous enough for a slow machine but far below the minutes the unguarded code
-took (``scripts/bench_hostile.py`` prints the actual times).
+on stderr under 300 characters that names the field, no traceback, no output folder, and
+that the refusal comes before any search starts (the unguarded code searched for minutes;
+``scripts/bench_hostile.py`` prints the actual times).
 """
 
 from __future__ import annotations
 
 import json
 import re
-import time
 from collections.abc import Callable
 from pathlib import Path
 
@@ -32,7 +31,6 @@ BOMB = (  # 9 levels of 9 aliases: 9^9 = 387 million strings once expanded
     )
     + GOOD
 )
-TIME_BOUND_S = 5.0
 NESTING = re.compile(r"scene file '.*scene\.yaml'.* line 1\b.*nest")
 
 
@@ -159,15 +157,25 @@ def write(folder: Path, text: str) -> Path:
     return path
 
 
-def run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str, float]:
-    started = time.perf_counter()
+def run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
     code = main(args)
-    elapsed = time.perf_counter() - started
     captured = capsys.readouterr()
-    return code, captured.out, captured.err, elapsed
+    return code, captured.out, captured.err
+
+
+@pytest.fixture()
+def no_search(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A search that fails the command (exit 4): hostile input must be refused before one starts."""
+    import planning.pipeline.planner
+
+    def refused(*_: object, **__: object) -> None:
+        raise AssertionError("the input reached the search")
+
+    monkeypatch.setattr(planning.pipeline.planner, "search", refused)
 
 
 @pytest.mark.parametrize(("label", "make", "message"), CASES, ids=[c[0] for c in CASES])
+@pytest.mark.usefixtures("no_search")
 def test_a_hostile_scene_exits_2_at_once_naming_the_field(
     tmp_path: Path,
     capsys: pytest.CaptureFixture[str],
@@ -177,11 +185,11 @@ def test_a_hostile_scene_exits_2_at_once_naming_the_field(
 ) -> None:
     scene = write(tmp_path, make(tmp_path))
     out = tmp_path / "out"
-    code, stdout, stderr, elapsed = run(["plan", str(scene), "--out", str(out)], capsys)
+    code, stdout, stderr = run(["plan", str(scene), "--out", str(out)], capsys)
     assert code == 2, label
     assert message.search(stderr) if isinstance(message, re.Pattern) else message in stderr, stderr
     assert stderr.count("\n") == 1 and len(stderr) < 300 and "Traceback" not in stderr and stdout == ""
-    assert not out.exists() and elapsed < TIME_BOUND_S
+    assert not out.exists()
 
 
 def test_a_limits_file_that_is_not_utf8_beside_a_urdf(
@@ -192,7 +200,7 @@ def test_a_limits_file_that_is_not_utf8_beside_a_urdf(
     (tmp_path / "robot.urdf").write_bytes(cpr_urdf_path().read_bytes())
     (tmp_path / "cpr_limits.yaml").write_bytes(b"theta1: {acceleration: \xff}\n")
     scene = write(tmp_path, GOOD + "robot: robot.urdf\n")
-    code, _, stderr, _ = run(["plan", str(scene), "--out", str(tmp_path / "out")], capsys)
+    code, _, stderr = run(["plan", str(scene), "--out", str(tmp_path / "out")], capsys)
     assert code == 2 and "cpr_limits.yaml' is not UTF-8 text (byte 23 is 0xff)" in stderr
     assert stderr.count("\n") == 1 and "Traceback" not in stderr
 
@@ -203,7 +211,7 @@ def test_unusable_output_folders_are_refused(
 ) -> None:
     monkeypatch.chdir(tmp_path)
     write(tmp_path, GOOD)
-    code, _, stderr, _ = run(["plan", "scene.yaml", "--out", out], capsys)
+    code, _, stderr = run(["plan", "scene.yaml", "--out", out], capsys)
     assert code == 2 and "output folder" in stderr and stderr.count("\n") == 1
     assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.yaml"]
 
@@ -260,11 +268,11 @@ def test_check_verifies_the_file_as_a_trajectory(
 ) -> None:
     scene, good = trajectory_file
     bad = changed(good, edit, tmp_path / "bad.json")
-    returned, stdout, stderr, elapsed = run(["check", str(scene), str(bad)], capsys)
+    returned, stdout, stderr = run(["check", str(scene), str(bad)], capsys)
     assert returned == code and message in stdout + stderr, stdout + stderr
-    assert "Traceback" not in stderr and elapsed < TIME_BOUND_S
+    assert "Traceback" not in stderr
     if code == 2:  # a malformed file cannot be shown either
-        returned, _, stderr, _ = run(["show", str(bad), "--html", str(tmp_path / "v.html")], capsys)
+        returned, _, stderr = run(["show", str(bad), "--html", str(tmp_path / "v.html")], capsys)
         assert returned == 2 and message in stderr and not (tmp_path / "v.html").exists()
 
 
@@ -272,7 +280,7 @@ def test_check_accepts_the_file_a_plan_wrote(
     trajectory_file: tuple[Path, Path], capsys: pytest.CaptureFixture[str]
 ) -> None:
     scene, good = trajectory_file
-    code, stdout, _, _ = run(["check", str(scene), str(good)], capsys)
+    code, stdout, _ = run(["check", str(scene), str(good)], capsys)
     assert code == 0 and "verified against" in stdout
     values = np.array(json.loads(good.read_text())["segments"][0]["coeffs"])
     assert np.all(np.isfinite(values))
@@ -300,5 +308,5 @@ def test_check_of_any_changed_coefficient_ends_in_a_verdict(
         document["segments"][segment]["coeffs"][joint][k] = value  # type: ignore[index]
 
     bad = changed(good, edit, tmp_path / "fuzzed.json")
-    code, _, stderr, _ = run(["check", str(scene), str(bad)], capsys)
+    code, _, stderr = run(["check", str(scene), str(bad)], capsys)
     assert code in (0, 2, 3) and "Traceback" not in stderr and stderr.count("\n") <= 1
