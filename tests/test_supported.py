@@ -126,3 +126,20 @@ def test_a_urdf_pinocchio_refuses_names_its_words(tmp_path: Path) -> None:
     broken = variant(tmp_path, lambda t: t.replace('<robot name="cpr">', "<robot>"))
     with pytest.raises(ck.UrdfError, match=re.escape(str(broken))):
         ck.load_cpr(broken, validate=False)
+
+
+def test_the_limits_file_rule_names_every_path_it_looked_for(tmp_path: Path) -> None:
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_text(URDF)
+    with pytest.raises(ck.UrdfError) as refused:
+        ck.load_robot(urdf, effector_links=("wrist_link", "tool_link"))
+    looked = [tmp_path / "arm_limits.yaml", tmp_path / "limits.yaml"]
+    assert all(f"'{path}'" in str(refused.value) for path in looked)
+    # found beside the URDF by the first name, then the second; the CPR preset falls back
+    for name in ("limits.yaml", "arm_limits.yaml"):
+        (tmp_path / name).write_bytes(ck.cpr_limits_path().read_bytes())
+        assert ck.load_robot(urdf, effector_links=("wrist_link", "tool_link")).limits_path == tmp_path / name
+    alone = tmp_path / "alone"
+    alone.mkdir()
+    (alone / "cpr_variant.urdf").write_text(URDF)
+    assert ck.load_cpr(alone / "cpr_variant.urdf").limits_path == ck.cpr_limits_path()
