@@ -14,7 +14,7 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 CONSTRAINTS := requirements/constraints.txt
-EXTRAS := dev,bench
+EXTRAS := dev,bench,robots
 # pyroboplan pins pin, matplotlib and toppra to exact versions and needs drake for its
 # trajectory optimisation; its RRT needs none of that: it is installed without its pins
 PYROBOPLAN := pyroboplan>=1.3.1

@@ -2,15 +2,16 @@
 
 from .clearance import BatchClearance, Clearance, PairDistance
 from .collision import CollisionWorld
-from .cpr import CPR_JOINTS, TCP_FRAME, load_cpr
+from .cpr import CPR_JOINTS, TCP_FRAME, cpr_spec, load_cpr
 from .errors import CprKinError, JointLimitError, ObstacleError, UnreachableError, UrdfError
 from .ik import tcp_ik
 from .kinematics import frame_poses, frame_positions
 from .limits import JointLimits
+from .loading import RobotSpec, load_robot
 from .motion import CurveCheck, check_curve, check_segment, motion_radii
 from .obstacles import SHAPES, Obstacle
 from .resources import cpr_limits_path, cpr_urdf_path
-from .robot import GROUPS, Robot, RobotGeometry, load_robot
+from .robot import GROUPS, Robot, RobotGeometry
 
 __all__ = [
     "CPR_JOINTS",
@@ -29,11 +30,13 @@ __all__ = [
     "PairDistance",
     "Robot",
     "RobotGeometry",
+    "RobotSpec",
     "UnreachableError",
     "UrdfError",
     "check_curve",
     "check_segment",
     "cpr_limits_path",
+    "cpr_spec",
     "cpr_urdf_path",
     "frame_poses",
     "frame_positions",

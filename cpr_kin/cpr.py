@@ -11,9 +11,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from cpr_kin.limits import LIMITS_NAMES, find_limits_file
+from cpr_kin.limits import LIMITS_NAMES
+from cpr_kin.loading import RobotSpec
 from cpr_kin.resources import cpr_limits_path, cpr_urdf_path
-from cpr_kin.robot import Robot, load_robot
+from cpr_kin.robot import Robot
 
 CPR_JOINTS = ("theta1", "d2", "d3", "theta4", "theta5")
 """Joint names of the CPR, in configuration order."""
@@ -39,15 +40,21 @@ def load_cpr(
         UrdfError: the file is missing, malformed or unsupported, or lacks a CPR joint or
             the ``tcp`` frame.
     """
-    path = Path(urdf_path) if urdf_path is not None else cpr_urdf_path()
-    if limits_path is None:
-        limits_path = find_limits_file(path, cpr_limits_path(), (*LIMITS_NAMES, "cpr_limits.yaml"))
-    return load_robot(
-        path,
-        limits_path,
+    return cpr_spec(urdf_path, limits_path, validate).load()
+
+
+def cpr_spec(
+    urdf_path: str | Path | None = None, limits_path: str | Path | None = None, validate: bool | None = None
+) -> RobotSpec:
+    """The :class:`~cpr_kin.loading.RobotSpec` of the CPR preset (see :func:`load_cpr`)."""
+    return RobotSpec(
+        urdf=Path(urdf_path) if urdf_path is not None else cpr_urdf_path(),
+        limits=None if limits_path is None else Path(limits_path),
         joints=CPR_JOINTS,
+        tcp=TCP_FRAME,
         effector_links=EFFECTOR_LINKS,
-        tcp_frame=TCP_FRAME,
         wrist_joints=WRIST_JOINTS,
+        limits_names=(*LIMITS_NAMES, "cpr_limits.yaml"),
+        default_limits=cpr_limits_path(),
         validate=validate,
     )

@@ -30,6 +30,8 @@ class JointLimits:
         velocity: maximum absolute velocity [rad/s or m/s].
         acceleration: maximum absolute acceleration [rad/s^2 or m/s^2].
         jerk: maximum absolute jerk [rad/s^3 or m/s^3].
+        effort: the URDF's effort limits [N m or N], kept (not yet planned with); ``None``
+            when unknown.
 
     """
 
@@ -39,6 +41,7 @@ class JointLimits:
     velocity: FloatArray
     acceleration: FloatArray
     jerk: FloatArray
+    effort: FloatArray | None = None
 
     def __post_init__(self) -> None:
         n = len(self.names)
@@ -80,72 +83,112 @@ LIMITS_NAMES = ("{stem}_limits.yaml", "limits.yaml")
 without ``.urdf``)."""
 
 
+DEFAULT_ACCELERATION_PER_S = 2.0
+"""Where a limits file gives no acceleration: ``a = 2 v`` per second (the velocity limit
+reached in 0.5 s), below what arms' makers publish (Franka's Panda: 7-9 v)."""
+DEFAULT_JERK_PER_S = 10.0
+"""Where a limits file gives no jerk: ``j = 10 a`` per second (the acceleration limit reached
+in 0.1 s), below what arms' makers publish (Franka's Panda: 500 a)."""
+
+
+@dataclass(frozen=True)
+class DynamicLimits:
+    """Acceleration and jerk limits of the planned joints, and where they came from.
+
+    Attributes:
+        acceleration: per joint [rad/s^2 or m/s^2].
+        jerk: per joint [rad/s^3 or m/s^3].
+        source: the limits file read, or ``None`` when none was found.
+        defaulted: the joints whose acceleration or jerk is a default
+            (:data:`DEFAULT_ACCELERATION_PER_S`, :data:`DEFAULT_JERK_PER_S`).
+    """
+
+    acceleration: FloatArray
+    jerk: FloatArray
+    source: Path | None
+    defaulted: tuple[str, ...]
+
+
+def default_limits(velocity: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """The default acceleration and jerk limits of joints with ``velocity`` limits."""
+    acceleration = DEFAULT_ACCELERATION_PER_S * np.asarray(velocity, dtype=float)
+    return acceleration, DEFAULT_JERK_PER_S * acceleration
+
+
+def limits_candidates(urdf_path: Path, names: tuple[str, ...] = LIMITS_NAMES) -> list[Path]:
+    """The limits files looked for beside the URDF at ``urdf_path``, in order."""
+    return [urdf_path.parent / name.format(stem=urdf_path.stem) for name in names]
+
+
 def find_limits_file(
     urdf_path: Path, default: Path | None = None, names: tuple[str, ...] = LIMITS_NAMES
-) -> Path:
-    """The acceleration and jerk limits file of the URDF at ``urdf_path``.
+) -> Path | None:
+    """The acceleration and jerk limits file of the URDF at ``urdf_path``, if any.
 
     The first of ``names`` (default :data:`LIMITS_NAMES`) that exists beside the URDF, else
-    ``default``.
-
-    Raises:
-        UrdfError: none exists and there is no default; the message names every path looked for.
+    ``default`` (``None``: the defaults of :func:`default_limits` apply).
     """
-    candidates = [urdf_path.parent / name.format(stem=urdf_path.stem) for name in names]
-    for candidate in candidates:
+    for candidate in limits_candidates(urdf_path, names):
         if candidate.is_file():
             return candidate
-    if default is not None:
-        return default
-    looked = ", ".join(f"'{c}'" for c in candidates)
-    raise UrdfError(
-        f"no acceleration and jerk limits for URDF '{urdf_path}': looked for {looked}; write one "
-        "(joint: {velocity, acceleration, jerk}, the format of cpr_kin/urdf/cpr_limits.yaml) or pass its path"
-    )
+    return default
 
 
 def read_dynamic_limits(
-    path: Path, names: tuple[str, ...], urdf_velocity: FloatArray
-) -> tuple[FloatArray, FloatArray]:
+    path: Path | None, names: tuple[str, ...], urdf_velocity: FloatArray, known: tuple[str, ...] = ()
+) -> DynamicLimits:
     """Read acceleration and jerk limits from a limits file (the format of ``cpr_limits.yaml``).
 
-    The file maps each joint name to ``{velocity, acceleration, jerk}``; ``velocity`` is
-    optional and, when given, must agree with the URDF's.
+    The file maps joint names to ``{velocity, acceleration, jerk}``; ``velocity`` is optional
+    and, when given, must agree with the URDF's. A joint the file leaves out, or whose
+    acceleration or jerk it leaves out, gets :func:`default_limits`; with no file (``path``
+    ``None``) every joint does.
 
-    Returns:
-        (acceleration, jerk) arrays in the order of ``names``.
+    Args:
+        path: the file, or ``None``.
+        names: the planned joints, in order.
+        urdf_velocity: their velocity limits from the URDF.
+        known: every joint of the URDF (the file may name held joints too); default ``names``.
 
+    Raises:
+        UrdfError: the file is unreadable, names a joint the URDF lacks, or holds a value
+            that is not a number, or a velocity that disagrees with the URDF's.
     """
+    acc_default, jerk_default = default_limits(urdf_velocity)
+    if path is None:
+        return DynamicLimits(acc_default, jerk_default, None, tuple(names))
     try:
         raw = load_yaml(path, MAX_LIMITS_BYTES, "joint limits file")
     except UserFileError as exc:
         raise UrdfError(str(exc)) from None
     if not isinstance(raw, dict):
         raise UrdfError(f"joint limits file '{path}' must map joint names to limits")
-    unknown = sorted(set(map(str, raw)) - set(names))
+    unknown = sorted(set(map(str, raw)) - set(names) - set(known))
     if unknown:
         listed = ", ".join(repr(n)[:40] for n in unknown[:3]) + (", ..." if len(unknown) > 3 else "")
-        known = list(names)
         raise UrdfError(
-            f"joint limits file '{path}' names unknown joint(s) [{listed}]; the robot's are {known}"
+            f"joint limits file '{path}' names unknown joint(s) [{listed}]; the robot's are "
+            f"{list(dict.fromkeys((*names, *known)))}"
         )
-    acc = np.empty(len(names))
-    jerk = np.empty(len(names))
+    acc = acc_default.copy()
+    jerk = jerk_default.copy()
+    defaulted = []
     for i, name in enumerate(names):
-        entry = raw.get(name)
-        if not isinstance(entry, dict) or {"acceleration", "jerk"} - set(entry):
+        entry = raw.get(name, {})
+        if not isinstance(entry, dict):
             raise UrdfError(
-                f"joint limits file '{path}': joint '{name}' needs {{acceleration: ..., jerk: ...}}"
+                f"joint limits file '{path}': joint '{name}' needs a mapping {{acceleration: ..., jerk: ...}}"
             )
+        if {"acceleration", "jerk"} - set(entry):
+            defaulted.append(name)
         extra = sorted(set(entry) - set(_KINDS))
         if extra:
             raise UrdfError(
                 f"joint limits file '{path}': joint '{name}' has unknown key(s) {extra}; "
                 f"allowed: {list(_KINDS)}"
             )
-        values: dict[str, Any] = {
-            kind: entry.get(kind, urdf_velocity[i] if kind == "velocity" else None) for kind in _KINDS
-        }
+        defaults = {"velocity": urdf_velocity[i], "acceleration": acc[i], "jerk": jerk[i]}
+        values: dict[str, Any] = {kind: entry.get(kind, defaults[kind]) for kind in _KINDS}
         for kind, value in values.items():
             if isinstance(value, bool) or not isinstance(value, int | float):
                 shown = repr(value) if len(repr(value)) <= 40 else repr(value)[:37] + "..."
@@ -158,4 +201,4 @@ def read_dynamic_limits(
                 f"joint limits file '{path}': joint '{name}' velocity {vel} disagrees with "
                 f"the URDF's {urdf_velocity[i]}; edit one so that they match"
             )
-    return acc, jerk
+    return DynamicLimits(acc, jerk, path, tuple(defaulted))

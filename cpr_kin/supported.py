@@ -7,9 +7,10 @@ as long as the crossing time, and a plan runs for minutes and gigabytes. So the 
 refuses it at once (:class:`~cpr_kin.errors.UrdfError`, exit 2 on the command line), naming
 the joint, the value and what is supported:
 
-- joint types: ``revolute``, ``prismatic`` and ``fixed`` (a ``continuous`` joint must be
-  given a range as a ``revolute`` one; ``floating`` and ``planar`` joints, and ``mimic``
-  joints, are not planned), each moving joint with an axis that is a direction;
+- joint types: ``revolute``, ``prismatic``, ``continuous`` (planned within
+  :data:`~cpr_kin.urdf_file.CONTINUOUS_RANGE_RAD`) and ``fixed``; ``floating`` and
+  ``planar`` joints are not planned, and a ``mimic`` joint is held (with the joint it
+  mimics); each moving joint with an axis that is a direction;
 - position limits within :data:`MAX_REVOLUTE_RAD` (one turn either way) for a revolute
   joint and :data:`MAX_PRISMATIC_M` for a prismatic one, with ``lower < upper``;
 - crossing a joint's whole range, at rest at both ends, within its velocity, acceleration
@@ -31,7 +32,7 @@ from cpr_kin.errors import UrdfError
 from cpr_kin.limits import JointLimits
 from cpr_kin.names import escaped, unprintable
 
-SUPPORTED_TYPES = ("revolute", "prismatic", "fixed")
+SUPPORTED_TYPES = ("revolute", "prismatic", "continuous", "fixed")
 """Joint types the planner plans (``fixed`` joints join links rigidly)."""
 MAX_REVOLUTE_RAD = 2 * math.pi
 """Largest |position limit| of a revolute joint [rad]: one turn either way, as UR and xArm arms have."""
@@ -59,21 +60,13 @@ def check_names(tree: etree._ElementTree, path: Path) -> None:
 
 
 def check_joints(tree: etree._ElementTree, path: Path) -> None:
-    """Refuse joint types the planner does not plan, and mimic joints."""
+    """Refuse joint types the planner does not plan, and axes that are not directions."""
     for joint in tree.getroot().findall("joint"):
         name, kind = joint.get("name", "?"), joint.get("type", "?")
-        if kind == "continuous":
-            raise UrdfError(
-                f"URDF '{path}': joint '{name}' is continuous (it turns without end); the planner needs "
-                f'a bounded range: write it as type="revolute" with <limit lower=".." upper=".."> within '
-                f"[{-MAX_REVOLUTE_RAD:.5g}, {MAX_REVOLUTE_RAD:.5g}] rad"
-            )
         if kind not in SUPPORTED_TYPES:
             raise UrdfError(
                 f"URDF '{path}': joint '{name}' is of type '{kind}'; supported: {list(SUPPORTED_TYPES)}"
             )
-        if joint.find("mimic") is not None:
-            raise UrdfError(f"URDF '{path}': joint '{name}' mimics another; mimic joints are not supported")
         axis = joint.find("axis")
         if kind != "fixed" and axis is not None:
             text = axis.get("xyz", "1 0 0")

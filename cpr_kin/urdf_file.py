@@ -9,16 +9,19 @@ accepts, so that a broken file gets a message naming the problem.
 from __future__ import annotations
 
 import contextlib
+import copy
+import math
 import os
 import sys
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
 from lxml import etree
 
 from cpr_kin.errors import UrdfError
+from cpr_kin.packages import resolve_mesh
 from cpr_kin.resources import cpr_urdf_path
 
 MAX_URDF_BYTES = 10_000_000
@@ -104,6 +107,43 @@ def collision_names(tree: etree._ElementTree) -> dict[str, list[str]]:
             for i, c in enumerate(collisions)
         ]
     return names
+
+
+CONTINUOUS_RANGE_RAD = math.pi
+"""The range a ``continuous`` joint is planned within: ``[-pi, pi]`` rad, one turn. A
+continuous joint turns without end; a plan between two poses never needs more than a turn
+of it, and a bounded range keeps the search's box and the trajectories bounded."""
+
+
+def prepared_xml(tree: etree._ElementTree, path: Path, roots: Sequence[Path]) -> str:
+    """The URDF's text as the models are built from it.
+
+    Every ``continuous`` joint becomes a ``revolute`` one within
+    :data:`CONTINUOUS_RANGE_RAD` (its velocity and effort kept), and every mesh file name is
+    made absolute (:func:`cpr_kin.packages.resolve_mesh`), so that a missing mesh is named
+    before Pinocchio reads anything.
+
+    Raises:
+        UrdfError: a continuous joint without a velocity limit, or a mesh not found.
+    """
+    root = copy.deepcopy(tree.getroot())
+    for joint in root.findall("joint"):
+        if joint.get("type") != "continuous":
+            continue
+        joint.set("type", "revolute")
+        limit = joint.find("limit")
+        if limit is None or limit.get("velocity") is None:
+            raise UrdfError(
+                f"URDF '{path}': continuous joint '{joint.get('name')}' has no velocity limit; "
+                'give it <limit velocity=".." effort=".."/>'
+            )
+        limit.set("lower", repr(-CONTINUOUS_RANGE_RAD))
+        limit.set("upper", repr(CONTINUOUS_RANGE_RAD))
+    for mesh in root.iter("mesh"):
+        filename = mesh.get("filename")
+        if filename:
+            mesh.set("filename", str(resolve_mesh(filename, path, roots)))
+    return str(etree.tostring(root, encoding="unicode"))
 
 
 def is_bundled(path: Path) -> bool:

@@ -8,9 +8,11 @@ import re
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import cpr_kin as ck
+from cpr_kin.limits import DEFAULT_ACCELERATION_PER_S, DEFAULT_JERK_PER_S
 from cpr_kin.supported import MAX_CROSSING_S, crossing_time
 from planning import PlannerSettings, paper_scene, plan
 from planning.cli import main
@@ -42,14 +44,11 @@ REFUSED = [
     ("empty range", theta1_limit("0.5", "0.5"), r"joint 'theta1' range \[0.5, 0.5\] rad is not supported"),
     ("slow joint", theta1_limit("-2.9", "2.9", "1e-6"),
      r"joint 'theta1' needs 5.8e\+06 s to cross its range .* at most 600 s: raise the limits"),
-    ("continuous", lambda t: t.replace('name="theta1" type="revolute"', 'name="theta1" type="continuous"'),
-     r"joint 'theta1' is continuous \(it turns without end\); the planner needs a bounded range: "
-     r"write it as type=\"revolute\""),
     ("planar", lambda t: t.replace('name="d2" type="prismatic"', 'name="d2" type="planar"'),
-     r"joint 'd2' is of type 'planar'; supported: \['revolute', 'prismatic', 'fixed'\]"),
+     r"joint 'd2' is of type 'planar'; supported: \['revolute', 'prismatic', 'continuous', 'fixed'\]"),
     ("mimic", lambda t: t.replace('<joint name="theta5" type="revolute">',
                                   '<joint name="theta5" type="revolute"><mimic joint="theta4"/>'),
-     r"joint 'theta5' mimics another"),
+     r"joint\(s\) \['theta5'\] mimic another; they cannot be planned"),
     ("zero axis", lambda t: t.replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 0"/>', 1),
      r"joint 'theta1' axis xyz = '0 0 0' is not a direction"),
     ("bidirectional name", lambda t: t.replace('"d2"', '"d\u202e2"'),
@@ -65,6 +64,16 @@ def test_an_unsupported_urdf_is_refused_at_load_naming_the_joint(
 ) -> None:
     with pytest.raises(ck.UrdfError, match=message):
         ck.load_cpr(variant(tmp_path, edit))
+
+
+def test_a_continuous_joint_is_planned_within_one_turn(tmp_path: Path) -> None:
+    robot = ck.load_cpr(
+        variant(
+            tmp_path, lambda t: t.replace('name="theta1" type="revolute"', 'name="theta1" type="continuous"')
+        )
+    )
+    assert (robot.limits.lower[0], robot.limits.upper[0]) == (-math.pi, math.pi)
+    assert robot.limits.velocity[0] == 1.5 and robot.nq == 5  # one coordinate, not cos/sin
 
 
 def test_the_command_line_refuses_it_at_once_with_exit_2(
@@ -128,18 +137,42 @@ def test_a_urdf_pinocchio_refuses_names_its_words(tmp_path: Path) -> None:
         ck.load_cpr(broken, validate=False)
 
 
-def test_the_limits_file_rule_names_every_path_it_looked_for(tmp_path: Path) -> None:
+def test_the_limits_file_rule_then_the_documented_defaults(tmp_path: Path) -> None:
     urdf = tmp_path / "arm.urdf"
     urdf.write_text(URDF)
-    with pytest.raises(ck.UrdfError) as refused:
-        ck.load_robot(urdf, effector_links=("wrist_link", "tool_link"))
-    looked = [tmp_path / "arm_limits.yaml", tmp_path / "limits.yaml"]
-    assert all(f"'{path}'" in str(refused.value) for path in looked)
-    # found beside the URDF by the first name, then the second; the CPR preset falls back
+    effector = {"effector_links": ("wrist_link", "tool_link")}
+    # no file beside it: every joint gets the defaults, and the robot says so
+    robot = ck.load_robot(urdf, **effector)
+    assert robot.limits_path is None and robot.limits_defaulted == ck.CPR_JOINTS
+    np.testing.assert_allclose(robot.limits.acceleration, DEFAULT_ACCELERATION_PER_S * robot.limits.velocity)
+    np.testing.assert_allclose(robot.limits.jerk, DEFAULT_JERK_PER_S * robot.limits.acceleration)
+    # found beside the URDF: limits.yaml, then <stem>_limits.yaml before it
     for name in ("limits.yaml", "arm_limits.yaml"):
         (tmp_path / name).write_bytes(ck.cpr_limits_path().read_bytes())
-        assert ck.load_robot(urdf, effector_links=("wrist_link", "tool_link")).limits_path == tmp_path / name
+        assert ck.load_robot(urdf, **effector).limits_path == tmp_path / name
+    # a file that leaves a joint's jerk out: that joint alone is defaulted
+    (tmp_path / "arm_limits.yaml").write_text(
+        ck.cpr_limits_path()
+        .read_text()
+        .replace("jerk: 15.0", "velocity: 1.5")
+        .replace(", velocity: 1.5}", "}")
+    )
+    partial = ck.load_robot(urdf, **effector)
+    assert partial.limits_defaulted == ("theta1",) and partial.limits.jerk[1] == 10.0
+    # the CPR preset falls back to the bundled limits
     alone = tmp_path / "alone"
     alone.mkdir()
     (alone / "cpr_variant.urdf").write_text(URDF)
     assert ck.load_cpr(alone / "cpr_variant.urdf").limits_path == ck.cpr_limits_path()
+
+
+def test_the_report_states_default_limits(tmp_path: Path) -> None:
+    from planning.io.report import report_markdown
+
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_text(URDF)
+    robot = ck.load_robot(urdf, effector_links=("wrist_link", "tool_link"), wrist_joints=("theta4", "theta5"))
+    scene = dataclasses.replace(paper_scene(), duration=None, planner=PlannerSettings())
+    report = report_markdown(plan(scene, robot))
+    assert "Acceleration and jerk limits of theta1, d2, d3, theta4, theta5 are the defaults" in report
+    assert "no limits file" in report and "Held" not in report

@@ -129,6 +129,7 @@ def report_markdown(result: PlanResult, paper: bool = False) -> str:
         "|---|---|---|",
         *[f"| {n} | {r['jerk_min'][n]:.4g} | {r['jerk_max'][n]:.4g} |" for n in result.joint_names],
         "",
+        *limits_section(result),
         *usage_section(result),
         "Waypoints (start, intermediate, goal):",
         "",
@@ -138,6 +139,25 @@ def report_markdown(result: PlanResult, paper: bool = False) -> str:
     if paper:
         lines += ["## Beside the paper", "", markdown_table(paper_rows(result)), ""]
     return "\n".join(lines)
+
+
+def limits_section(result: PlanResult) -> list[str]:
+    """``report.md``'s lines on limits that are defaults, and joints held; none when neither."""
+    from cpr_kin.limits import DEFAULT_ACCELERATION_PER_S, DEFAULT_JERK_PER_S
+
+    robot, lines = result.robot, []
+    if robot.limits_defaulted:
+        source = f"`{robot.limits_path}`" if robot.limits_path is not None else "no limits file"
+        lines += [
+            f"Acceleration and jerk limits of {', '.join(robot.limits_defaulted)} are the defaults "
+            f"(a = {DEFAULT_ACCELERATION_PER_S:g} v per s, j = {DEFAULT_JERK_PER_S:g} a per s; {source}): "
+            "give the maker's in a limits file for a faster motion.",
+            "",
+        ]
+    if robot.held:
+        held = ", ".join(f"{name} = {value:g}" for name, value in robot.held.items())
+        lines += [f"Held (not planned): {held}.", ""]
+    return lines
 
 
 def usage_section(result: PlanResult) -> list[str]:

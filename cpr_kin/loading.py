@@ -1,0 +1,280 @@
+"""Any serial robot from its URDF: :class:`RobotSpec` says what to load, :func:`load_robot` loads it.
+
+Loading, in order:
+
+1. the URDF is read as strict XML, validated by yourdfpy (but the bundled CPR's, which the
+   tests validate), and checked for what the planner supports (:mod:`cpr_kin.supported`);
+2. its mesh paths (``package://NAME/...``, relative, absolute) are resolved
+   (:mod:`cpr_kin.packages`) and its ``continuous`` joints bounded
+   (:func:`~cpr_kin.urdf_file.prepared_xml`);
+3. Pinocchio builds the kinematic, collision and visual models (what its URDF parser prints
+   stays off the terminal);
+4. the joints that are not planned are held: at the value given in ``held``, a ``mimic``
+   joint at ``multiplier x leader + offset`` of its (held) leader, any other at 0 clipped into
+   its range; Pinocchio's reduced model keeps the planned joints only;
+5. velocity limits come from the URDF, acceleration and jerk limits from the limits file
+   (given, or found beside the URDF, :func:`~cpr_kin.limits.find_limits_file`), the
+   documented defaults where it gives none (:func:`~cpr_kin.limits.default_limits`, listed in
+   :attr:`Robot.limits_defaulted`);
+6. every mesh of the collision model becomes its convex hull, which contains it (a clearance
+   to the hull is at most the clearance to the mesh: safe) and gives coal signed distances;
+7. the collision geometries form two groups: ``effector`` (the links given, by default those
+   the last planned joint before the tool frame moves alone) and ``links`` (the rest).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import coal
+import numpy as np
+import pinocchio as pin
+from lxml import etree
+
+from cpr_kin.arm import ArmChain, arm_chain
+from cpr_kin.errors import UrdfError
+from cpr_kin.limits import LIMITS_NAMES, JointLimits, find_limits_file, read_dynamic_limits
+from cpr_kin.packages import package_roots
+from cpr_kin.robot import GROUPS, Robot, RobotGeometry, joint_units
+from cpr_kin.supported import check_joints, check_limits, check_names
+from cpr_kin.urdf_file import (
+    captured_stderr,
+    collision_names,
+    is_bundled,
+    parse_urdf,
+    prepared_xml,
+    validate_urdf,
+)
+
+
+@dataclass(frozen=True)
+class RobotSpec:
+    """What robot to load, from which files; hashable (a batch worker loads each spec once).
+
+    Attributes:
+        urdf: the URDF file.
+        package_dirs: folders that hold the packages its ``package://`` meshes name.
+        limits: its acceleration and jerk limits file; default: found beside the URDF by
+            ``limits_names``, else ``default_limits``, else the documented defaults.
+        joints: the planned joints, in configuration order; default: the arm's
+            (:func:`arm_chain`: from the root until the tree branches, as a hand into its
+            fingers), but mimic joints. The others are held.
+        tcp: the tool-centre-point frame (a link or joint name); default: ``tcp`` if the URDF
+            has one, else the arm's tool link (:func:`arm_chain`).
+        held: ``(joint, value)`` pairs of held joints [rad or m].
+        effector_links: links of the ``effector`` collision group; default: module docstring.
+        wrist_joints: joints a plan holds unless its start and goal differ in them.
+        limits_names: the limits file names looked for beside the URDF.
+        default_limits: the limits file used when none is found beside the URDF.
+        validate: validate the URDF with yourdfpy; default: every URDF but the bundled CPR's.
+    """
+
+    urdf: Path
+    package_dirs: tuple[Path, ...] = ()
+    limits: Path | None = None
+    joints: tuple[str, ...] | None = None
+    tcp: str | None = None
+    held: tuple[tuple[str, float], ...] = ()
+    effector_links: tuple[str, ...] | None = None
+    wrist_joints: tuple[str, ...] = ()
+    limits_names: tuple[str, ...] = LIMITS_NAMES
+    default_limits: Path | None = None
+    validate: bool | None = field(default=None, compare=False)
+
+    def load(self) -> Robot:
+        """The robot (module docstring)."""
+        path = Path(self.urdf)
+        tree = parse_urdf(path)
+        if self.validate or (self.validate is None and not is_bundled(path)):
+            validate_urdf(path)
+        check_names(tree, path)
+        check_joints(tree, path)
+        xml = prepared_xml(tree, path, package_roots(path, self.package_dirs))
+        arm = arm_chain(tree)
+        model, collision, visual = _build(xml, path)
+        planned = self._planned(model, tree, path, arm)
+        held = self._held_values(model, tree, planned, path)
+        if held:
+            lock = [model.getJointId(name) for name in held]
+            q_ref = pin.neutral(model)
+            for name, value in held.items():
+                q_ref[model.joints[model.getJointId(name)].idx_q] = value
+            model, (collision, visual) = pin.buildReducedModel(model, [collision, visual], lock, q_ref)
+        names = tuple(model.names[1:])
+        tcp = self._tcp_frame(model, path, arm)
+        velocity = np.array(model.velocityLimit, dtype=float)
+        limits_file = self.limits or find_limits_file(path, self.default_limits, self.limits_names)
+        known = tuple(j.get("name", "") for j in tree.getroot().findall("joint"))
+        dynamic = read_dynamic_limits(limits_file, names, velocity, known)
+        limits = JointLimits(
+            names=names,
+            lower=np.array(model.lowerPositionLimit, dtype=float),
+            upper=np.array(model.upperPositionLimit, dtype=float),
+            velocity=velocity,
+            acceleration=dynamic.acceleration,
+            jerk=dynamic.jerk,
+            effort=np.array(model.effortLimit, dtype=float),
+        )
+        check_limits(limits, joint_units(model), path)
+        _convex_hulls(collision)
+        effector = set(self.effector_links) if self.effector_links is not None else _carried_alone(model, tcp)
+        geometries = _geometries(model, collision, collision_names(tree), effector)
+        for group in GROUPS:
+            if not any(g.group == group for g in geometries):
+                raise UrdfError(f"URDF '{path}' has no collision geometry in group '{group}'")
+        return Robot(
+            urdf_path=path,
+            model=model,
+            collision_model=collision,
+            visual_model=visual,
+            limits=limits,
+            geometries=geometries,
+            _data=model.createData(),
+            tcp_frame=tcp,
+            wrist_joints=self.wrist_joints,
+            limits_path=dynamic.source,
+            limits_defaulted=dynamic.defaulted,
+            held=held,
+        )
+
+    def _planned(self, model: Any, tree: etree._ElementTree, path: Path, arm: ArmChain) -> tuple[str, ...]:
+        """The planned joints, checked against the URDF's."""
+        names = tuple(model.names[1:])
+        mimics = {j.get("name") for j in tree.getroot().findall("joint") if j.find("mimic") is not None}
+        if self.joints is None:
+            return tuple(n for n in names if n in arm.joints and n not in mimics)
+        unknown = [j for j in self.joints if j not in names]
+        if unknown:
+            raise UrdfError(f"URDF '{path}' has no joint(s) {unknown}; its joints are {list(names)}")
+        order = [j for j in names if j in self.joints]
+        if tuple(order) != tuple(self.joints) or len(set(self.joints)) != len(self.joints):
+            raise UrdfError(
+                f"URDF '{path}': joints = {list(self.joints)}; give each once, in the URDF's "
+                f"chain order {order}"
+            )
+        planned_mimics = sorted(mimics & set(self.joints))
+        if planned_mimics:
+            raise UrdfError(f"URDF '{path}': joint(s) {planned_mimics} mimic another; they cannot be planned")
+        return tuple(self.joints)
+
+    def _held_values(
+        self, model: Any, tree: etree._ElementTree, planned: tuple[str, ...], path: Path
+    ) -> dict[str, float]:
+        """The value of each held joint [rad or m], checked against its range."""
+        given = dict(self.held)
+        names = tuple(model.names[1:])
+        unknown = sorted(set(given) - set(names))
+        if unknown or set(given) & set(planned):
+            problem = (
+                f"no joint(s) {unknown}"
+                if unknown
+                else f"planned joint(s) {sorted(set(given) & set(planned))}"
+            )
+            raise UrdfError(f"URDF '{path}': held names {problem}; hold joints of {list(names)} not planned")
+        mimic = {
+            j.get("name"): j.find("mimic")
+            for j in tree.getroot().findall("joint")
+            if j.find("mimic") is not None
+        }
+        values: dict[str, float] = {}
+        for name in (n for n in names if n not in planned):
+            i = model.joints[model.getJointId(name)].idx_q
+            low, high = float(model.lowerPositionLimit[i]), float(model.upperPositionLimit[i])
+            if name in mimic and name not in given:
+                leader = mimic[name].get("joint", "")
+                if leader in planned:
+                    raise UrdfError(f"URDF '{path}': joint '{name}' mimics planned joint '{leader}'")
+                multiplier = float(mimic[name].get("multiplier", "1"))
+                offset = float(mimic[name].get("offset", "0"))
+                lead = given.get(leader, float(np.clip(0.0, *_range(model, leader))))
+                value = multiplier * lead + offset
+            else:
+                value = float(given.get(name, np.clip(0.0, low, high)))
+            if not low - 1e-9 <= value <= high + 1e-9:
+                raise UrdfError(
+                    f"URDF '{path}': held joint '{name}' = {value:g} is outside [{low:g}, {high:g}]"
+                )
+            values[name] = value
+        return values
+
+    def _tcp_frame(self, model: Any, path: Path, arm: ArmChain) -> str:
+        """The tool-centre-point frame (attribute ``tcp``)."""
+        if self.tcp is not None:
+            if not model.existFrame(self.tcp):
+                known = sorted({f.name for f in model.frames})
+                raise UrdfError(
+                    f"URDF '{path}' has no link or frame named '{self.tcp}'; its frames are {known}"
+                )
+            return self.tcp
+        if model.existFrame("tcp"):
+            return "tcp"
+        return arm.tool
+
+
+def _range(model: Any, joint: str) -> tuple[float, float]:
+    i = model.joints[model.getJointId(joint)].idx_q
+    return float(model.lowerPositionLimit[i]), float(model.upperPositionLimit[i])
+
+
+def _build(xml: str, path: Path) -> tuple[Any, Any, Any]:
+    """Pinocchio's kinematic, collision and visual models of the prepared URDF text."""
+    try:
+        with captured_stderr() as complaints:  # urdfdom prints to fd 2; a model that builds needs none
+            model = pin.buildModelFromXML(xml)
+            collision = pin.buildGeomFromUrdfString(model, xml, pin.GeometryType.COLLISION)
+            visual = pin.buildGeomFromUrdfString(model, xml, pin.GeometryType.VISUAL)
+    except Exception as exc:  # Pinocchio reports C++ exceptions as RuntimeError/ValueError
+        said = " ".join(line.strip() for line in complaints[:2])
+        raise UrdfError(f"Pinocchio cannot build a model from '{path}': {exc} {said}".strip()) from None
+    return model, collision, visual
+
+
+def _convex_hulls(collision: Any) -> None:
+    """Replace every mesh of ``collision`` by its convex hull (module docstring, step 6)."""
+    for obj in collision.geometryObjects:
+        geometry = obj.geometry
+        if isinstance(geometry, coal.BVHModelBase):
+            geometry.buildConvexHull(True, "Qt")
+            obj.geometry = geometry.convex
+
+
+def _carried_alone(model: Any, tcp: str) -> set[str]:
+    """The links (body frames) whose parent joint is the joint that carries ``tcp``."""
+    joint = model.frames[model.getFrameId(tcp)].parentJoint
+    return {f.name for f in model.frames if f.type == pin.FrameType.BODY and f.parentJoint == joint}
+
+
+def _geometries(
+    model: Any, collision: Any, names_by_link: Mapping[str, Sequence[str]], effector: set[str]
+) -> tuple[RobotGeometry, ...]:
+    """The collision geometries, named as in the URDF and sorted into their groups."""
+    geometries = []
+    used: dict[str, int] = {}
+    for index, obj in enumerate(collision.geometryObjects):
+        link = model.frames[obj.parentFrame].name
+        k = used.get(link, 0)
+        used[link] = k + 1
+        names = names_by_link.get(link, ())
+        name = names[k] if k < len(names) else f"{link}_{k}"
+        obj.name = name
+        group = "effector" if link in effector else "links"
+        geometries.append(RobotGeometry(name=name, link=link, group=group, index=index))
+    return tuple(geometries)
+
+
+def load_robot(urdf_path: str | Path, **options: Any) -> Robot:
+    """Load the robot of ``urdf_path``: ``RobotSpec(urdf_path, **options).load()``.
+
+    Raises:
+        UrdfError: a missing, malformed or unsupported URDF, a mesh not found, an unknown
+            planned or held joint, a limits file that does not fit.
+    """
+    for key in ("package_dirs", "joints", "effector_links", "wrist_joints", "limits_names"):
+        if key in options and options[key] is not None:
+            options[key] = tuple(options[key])
+    if isinstance(options.get("held"), Mapping):
+        options["held"] = tuple(options["held"].items())
+    return RobotSpec(Path(urdf_path), **options).load()

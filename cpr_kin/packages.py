@@ -1,0 +1,79 @@
+"""Where a URDF's mesh files are: ``package://NAME/...`` and relative paths made absolute.
+
+A URDF names its meshes as ``package://NAME/path`` (ROS packages), as a path relative to
+the URDF, or as an absolute path. :func:`resolve_mesh` finds the file, looking for the
+package ``NAME``, in order:
+
+1. the folders given (``package_dirs``): ``DIR/NAME/path``, or ``DIR/path`` when ``DIR``
+   itself is the package (its name is ``NAME``);
+2. the URDF's own folder tree: each folder from the URDF's up to the root, as ``DIR/NAME``
+   or as the package itself (a ``description`` package's ``urdf/`` and ``meshes/`` side by
+   side);
+3. the installed ``example-robot-data`` (its share folder holds ``example-robot-data/``).
+
+A mesh found nowhere is a :class:`~cpr_kin.errors.UrdfError` naming the mesh and every
+folder looked in.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Sequence
+from importlib import metadata
+from pathlib import Path
+
+from cpr_kin.errors import UrdfError
+
+PACKAGE = "package://"
+
+
+@functools.cache
+def example_robot_data_share() -> Path | None:
+    """The folder that holds the installed ``example-robot-data`` package, or ``None``."""
+    try:
+        distribution = metadata.distribution("example-robot-data")
+    except metadata.PackageNotFoundError:
+        return None
+    for file in distribution.files or ():
+        if str(file).endswith("example-robot-data/package.xml"):
+            return Path(str(file.locate())).resolve().parent.parent
+    return None
+
+
+def package_roots(urdf_path: Path, package_dirs: Sequence[Path] = ()) -> list[Path]:
+    """The folders a ``package://`` URI is looked for in, in order (module docstring)."""
+    roots = [Path(d).resolve() for d in package_dirs]
+    folder = urdf_path.resolve().parent
+    roots += [folder, *folder.parents]
+    share = example_robot_data_share()
+    if share is not None:
+        roots.append(share)
+    return list(dict.fromkeys(roots))
+
+
+def resolve_mesh(filename: str, urdf_path: Path, roots: Sequence[Path]) -> Path:
+    """The absolute path of the mesh a URDF names ``filename``.
+
+    Raises:
+        UrdfError: the file is nowhere the rule looks (module docstring).
+    """
+    if not filename.startswith(PACKAGE):
+        path = Path(filename.removeprefix("file://"))
+        path = path if path.is_absolute() else urdf_path.resolve().parent / path
+        if path.is_file():
+            return path
+        raise UrdfError(f"URDF '{urdf_path}': mesh '{filename}' does not exist (looked for '{path}')")
+    name, _, inside = filename.removeprefix(PACKAGE).partition("/")
+    candidates = []
+    for root in roots:
+        candidates.append(root / name / inside)
+        if root.name == name:
+            candidates.append(root / inside)
+    for candidate in candidates:
+        if candidate.is_file():
+            return candidate
+    looked = ", ".join(f"'{root}'" for root in roots[:6]) + (", ..." if len(roots) > 6 else "")
+    raise UrdfError(
+        f"URDF '{urdf_path}': mesh '{filename}' not found: package '{name}' is in none of {looked}; "
+        "give its folder (--package-dir, or package_dirs=...)"
+    )

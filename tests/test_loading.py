@@ -1,0 +1,119 @@
+"""Robots no one here wrote, from example-robot-data: they load, and their kinematics agree with yourdfpy.
+
+Each robot is loaded as a user would (``cpr_kin.load_robot(urdf)``: meshes by ``package://``,
+the arm's joints planned, the rest held). Forward kinematics of every link is compared with
+yourdfpy's, an independent URDF reader, at random configurations.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import yourdfpy
+
+import cpr_kin as ck
+from cpr_kin.packages import example_robot_data_share
+
+SHARE = example_robot_data_share()
+assert SHARE is not None, "example-robot-data is part of the robots extra, which make installs"
+ROBOTS = SHARE / "example-robot-data" / "robots"
+
+FINGERS = {"panda_finger_joint1": 0.0, "panda_finger_joint2": 0.0}
+ARMS = {
+    "so101": (ROBOTS / "so_arm_description/urdf/so101.urdf", 6, {}),
+    "ur5": (ROBOTS / "ur_description/urdf/ur5_robot.urdf", 6, {}),
+    "panda": (ROBOTS / "panda_description/urdf/panda.urdf", 7, FINGERS),
+    "xarm7": (ROBOTS / "xarm_description/urdf/xarm7.urdf", 7, {}),
+}
+
+
+@pytest.fixture(scope="module", params=sorted(ARMS))
+def arm(request: pytest.FixtureRequest) -> tuple[str, ck.Robot, Path]:
+    urdf, _, _ = ARMS[request.param]
+    return request.param, ck.load_robot(urdf), urdf
+
+
+def test_the_arm_is_planned_and_the_hand_held(arm: tuple[str, ck.Robot, Path]) -> None:
+    name, robot, _ = arm
+    _, dof, held = ARMS[name]
+    assert robot.nq == dof and dict(robot.held) == held
+    assert robot.limits_path is None and robot.limits_defaulted == robot.joint_names  # no limits file
+    assert robot.limits.effort is not None and np.all(robot.limits.effort > 0)  # kept for the torque issue
+    assert robot.model.existFrame(robot.tcp_frame)
+    assert {g.group for g in robot.geometries} == set(ck.GROUPS)
+
+
+def test_forward_kinematics_agrees_with_yourdfpy(arm: tuple[str, ck.Robot, Path]) -> None:
+    name, robot, urdf = arm
+    reference = yourdfpy.URDF.load(str(urdf), build_scene_graph=True, load_meshes=False)
+    links = [f.name for f in robot.model.frames if f.type.name == "BODY"]
+    rng = np.random.default_rng(7)
+    for q in rng.uniform(robot.limits.lower, robot.limits.upper, (20, robot.nq)):
+        configuration = dict(zip(robot.joint_names, q, strict=True)) | dict(robot.held)
+        reference.update_cfg({k: v for k, v in configuration.items() if k in reference.actuated_joint_names})
+        ours = ck.frame_poses(robot, np.tile(q, (1, 1)), None)  # the tool frame, batch of one
+        for link in links:
+            theirs = reference.get_transform(frame_to=link)
+            mine = ck.frame_poses(robot, q, link)
+            np.testing.assert_allclose(mine[:3, 3], theirs[:3, 3], atol=1e-9, err_msg=f"{name}: {link}")
+            np.testing.assert_allclose(mine[:3, :3], theirs[:3, :3], atol=1e-9, err_msg=f"{name}: {link}")
+        assert ours.shape == (1, 4, 4)
+
+
+def test_meshes_are_convex_hulls_that_contain_them() -> None:
+    import coal
+    import trimesh
+
+    robot = ck.load_robot(ARMS["panda"][0])
+    checked = 0
+    for obj in robot.collision_model.geometryObjects:
+        assert not isinstance(obj.geometry, coal.BVHModelBase)  # every mesh became its hull
+        if isinstance(obj.geometry, coal.Convex) and obj.meshPath:
+            mesh: Any = trimesh.load(obj.meshPath, force="mesh")
+            hull = trimesh.Trimesh(np.asarray(obj.geometry.points())).convex_hull  # coal's hull points
+            vertices = mesh.vertices * np.asarray(obj.meshScale)
+            # every vertex of the mesh is inside the hull or on it (trimesh: > 0 inside)
+            assert (hull.nearest.signed_distance(vertices) > -1e-6).all(), obj.name
+            checked += 1
+    assert checked >= 8
+
+
+def test_a_mesh_that_is_nowhere_is_named(tmp_path: Path) -> None:
+    text = ARMS["xarm7"][0].read_text().replace("xarm7/visual/link1.stl", "xarm7/visual/no_such.stl")
+    urdf = tmp_path / "xarm7.urdf"
+    urdf.write_text(text)
+    missing = "package://example-robot-data/robots/xarm_description/meshes/xarm7/visual/no_such.stl"
+    with pytest.raises(ck.UrdfError, match=f"mesh '{missing}' not found"):
+        ck.load_robot(urdf)
+
+
+def test_package_dirs_are_looked_in_first(tmp_path: Path) -> None:
+    # a copy of the xArm's description under another name, found through package_dirs
+    text = ARMS["xarm7"][0].read_text().replace("package://example-robot-data/robots/", "package://my_arms/")
+    urdf = tmp_path / "urdf" / "xarm7.urdf"
+    urdf.parent.mkdir()
+    urdf.write_text(text)
+    with pytest.raises(ck.UrdfError, match="package 'my_arms' is in none of"):
+        ck.load_robot(urdf)
+    (tmp_path / "share").mkdir()
+    (tmp_path / "share" / "my_arms").symlink_to(ROBOTS)
+    robot = ck.load_robot(urdf, package_dirs=[tmp_path / "share"])
+    assert robot.nq == 7
+
+
+def test_planned_and_held_joints_are_checked() -> None:
+    panda = ARMS["panda"][0]
+    with pytest.raises(ck.UrdfError, match=r"has no joint\(s\) \['elbow'\]"):
+        ck.load_robot(panda, joints=["elbow"])
+    with pytest.raises(ck.UrdfError, match="mimic another; they cannot be planned"):
+        ck.load_robot(panda, joints=[*(f"panda_joint{k}" for k in range(1, 8)), "panda_finger_joint2"])
+    with pytest.raises(ck.UrdfError, match=r"held joint 'panda_finger_joint1' = 0.5 is outside \[0, 0.04\]"):
+        ck.load_robot(panda, held={"panda_finger_joint1": 0.5})
+    opened = ck.load_robot(panda, held={"panda_finger_joint1": 0.04})
+    assert dict(opened.held) == {
+        "panda_finger_joint1": 0.04,
+        "panda_finger_joint2": 0.04,
+    }  # the mimic follows
