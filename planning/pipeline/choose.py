@@ -66,18 +66,23 @@ class Refusal:
     """No candidate passed: why the best one failed.
 
     Attributes:
-        message: one sentence for the user.
+        cause: why the best candidate failed, one sentence for the user.
         check: the best candidate's certified continuous check.
+        verified: how many candidates were verified, e.g. ``"3 candidates verified"``.
     """
 
-    message: str
+    cause: str
     check: ck.CurveCheck
+    verified: str = ""
 
     accepted = False
 
-    def error(self) -> NoTrajectoryFoundError:
-        """The error a planner raises when this was its last word."""
-        return NoTrajectoryFoundError(self.message, self.check)
+    def error(self, tried: str = "") -> NoTrajectoryFoundError:
+        """The error a planner raises when this was its last word; ``tried``: what else it tried."""
+        said = "; ".join(part for part in (self.verified, tried) if part)
+        return NoTrajectoryFoundError(
+            f"no collision-free trajectory found{f' ({said})' if said else ''}: {self.cause}", self.check
+        )
 
 
 def verify(problem: Problem, trajectory: Trajectory, fit: SplineFit) -> Verification:
@@ -119,7 +124,7 @@ def infeasibility(breakdown: Breakdown, problem: Problem) -> str:
     if breakdown.depth_m[0] > 0:
         reasons.append(f"{breakdown.depth_m[0]:.3g} m inside the clearance")
     if breakdown.overshoot[0] > 0:
-        reasons.append(f"{breakdown.overshoot[0]:.0%} beyond a joint range")
+        reasons.append(f"{100 * breakdown.overshoot[0]:.2g} % of a joint range beyond it")
     bound = problem.scene.planner.max_node_deviation
     if bound is not None and breakdown.node_deviation[0] > bound:
         reasons.append(f"node deviation {breakdown.node_deviation[0]:.3g} > {bound:g}")
@@ -152,8 +157,7 @@ def choose(problem: Problem, searched: SearchResult) -> Choice | Refusal:
             f"no candidate was feasible (the best: {why}{closest}, {check.certified_min_m:.3f} m certified)"
         )
     verified = f"{len(candidates)} candidate{'' if len(candidates) == 1 else 's'} verified"
-    message = f"no collision-free trajectory found ({verified}): {found}"
-    return Refusal(message, first.check)
+    return Refusal(found, first.check, verified)
 
 
 def _attempts(

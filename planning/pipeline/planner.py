@@ -61,7 +61,7 @@ def solve(
             return assemble(attempt.problem, searched, chosen, elapsed)
         following = seeding.after(attempt, searched)
         if following is None:
-            raise chosen.error()
+            raise chosen.error(attempt.tried)
         attempt = following
 
 

@@ -22,6 +22,12 @@ is a small part of its space, rarely met by a random population. So, with the pl
    candidates failed the certified check (a violation between two samples escaped the
    fitness); ``retries`` times at most.
 
+The clearance required is the margin plus the certified check's step (``verify_step_m``):
+what moves between two checks is counted against the margin. A passage narrower than that
+has no path: when RRT-Connect finds none, the first attempt asks once more with the step
+cut to ``finer_step`` of it (1 mm of the default 5 mm), which lets a path pass within a
+millimetre of the margin at the price of a denser certified check.
+
 The seeds and ``spread``-sized moves around them make up ``share`` of the initial
 population (:class:`~planning.pipeline.tuning.SeedingTuning`). The sampling planner and the
 moves draw from their own streams, ``default_rng([seed, 1])`` and ``[seed, 2]``: the
@@ -40,7 +46,7 @@ from numpy.typing import NDArray
 
 import cpr_kin as ck
 from planning.pipeline.problem import Problem, with_planner
-from planning.pipeline.settings import MAX_FITNESS_SAMPLES, MAX_WAYPOINTS
+from planning.pipeline.settings import MAX_FITNESS_SAMPLES, MAX_WAYPOINTS, VERIFY_STEP_RANGE_M
 from planning.search.optimizer import SearchResult
 from planning.search.rrt_connect import RrtPath, RrtSettings, rrt_connect, waypoints_along
 
@@ -91,12 +97,14 @@ class Attempt:
         seeds: ``(k, d)`` starting points, or ``None`` (a random population).
         path: the sampling planner's path the seeds follow, reused by the next attempt.
         number: 0 for the first attempt, then 1, 2, ...
+        tried: what the seeding tried and did not find, for a message (empty: nothing).
     """
 
     problem: Problem
     seeds: FloatArray | None = None
     path: FloatArray | None = None
     number: int = 0
+    tried: str = ""
 
 
 class Seeding(Protocol):
@@ -126,7 +134,18 @@ class PathSeeding:
 
     def first(self, problem: Problem) -> Attempt:  # noqa: D102 - the protocol's
         seeds = seed_search(problem)
-        return Attempt(seeds.problem, seeds.candidates, seeds.path, 0)
+        settings = problem.scene.planner
+        finer = max(settings.verify_step_m * settings.tuning.seeding.finer_step, VERIFY_STEP_RANGE_M[0])
+        tried = ""
+        if seeds.path is None and not seeds.straight_line_clear:
+            required = problem.objective.required_m
+            tried = f"RRT-Connect found no path keeping {required:.4g} m clear"
+            if finer < settings.verify_step_m:
+                closer = seed_search(with_planner(problem, verify_step_m=finer))
+                if closer.path is not None:  # a passage narrower than margin plus the step
+                    return Attempt(closer.problem, closer.candidates, closer.path, 0)
+                tried += f", nor {closer.problem.objective.required_m:.4g} m (a {finer:g} m certified step)"
+        return Attempt(seeds.problem, seeds.candidates, seeds.path, 0, tried)
 
     def after(self, attempt: Attempt, searched: SearchResult) -> Attempt | None:  # noqa: D102
         problem = attempt.problem
@@ -137,7 +156,7 @@ class PathSeeding:
             samples = problem.scene.planner.fitness_samples
             problem = with_planner(problem, fitness_samples=min(2 * samples, MAX_FITNESS_SAMPLES))
         seeds = seed_search(problem, widen, attempt.path)
-        return Attempt(seeds.problem, seeds.candidates, seeds.path, attempt.number + 1)
+        return Attempt(seeds.problem, seeds.candidates, seeds.path, attempt.number + 1, attempt.tried)
 
 
 SEEDINGS: dict[str, Seeding] = {"paths": PathSeeding(), "none": NoSeeding()}
@@ -157,8 +176,9 @@ def sampled_path(
         return ~problem.world.margin_violated(full, objective.required_m)
 
     if settings is None:  # edges checked at most as far apart as the clearance required, 1-4 cm
-        largest = problem.scene.planner.tuning.seeding.max_resolution_m
-        settings = RrtSettings(resolution_m=min(largest, max(0.01, objective.required_m)))
+        tuning = problem.scene.planner.tuning.seeding
+        resolution = min(tuning.max_resolution_m, max(0.01, objective.required_m))
+        settings = RrtSettings(max_samples=tuning.max_samples, resolution_m=resolution)
     limits = robot.limits
     return rrt_connect(
         valid,

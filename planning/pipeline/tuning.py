@@ -28,22 +28,33 @@ class SeedingTuning:
             (0, 1]; never more than the clearance the fitness requires (at least 1 cm).
         path_attempts: most RRT-Connect paths drawn while the spline through a path's
             waypoints violates the clearance, in [1, 20].
+        max_samples: random samples after which RRT-Connect gives up on a path, in
+            [1, 100000] (a narrow passage may need several thousand; a failed draw costs
+            about 0.15 ms a sample).
         more_waypoints: how many waypoints beyond the path's corners the seeding may add,
             two at a time, in [0, 20].
+        finer_step: when RRT-Connect finds no path keeping the margin plus the verification
+            step clear, the share of the step tried once more, in (0, 1): a finer certified
+            check lets a path pass closer to the margin (a passage narrower than the margin
+            plus the step). The verification step never goes below the smallest allowed.
     """
 
     share: float = 0.6
     spread: float = 0.01
     max_resolution_m: float = 0.04
     path_attempts: int = 3
+    max_samples: int = 10_000
     more_waypoints: int = 6
+    finer_step: float = 0.2
 
     def __post_init__(self) -> None:
         number_in("share", self.share, 0.0, 1.0, low_open=True)
         number_in("spread", self.spread, 0.0, 1.0)
         number_in("max_resolution_m", self.max_resolution_m, 0.0, 1.0, unit="m", low_open=True)
         integer_in("path_attempts", self.path_attempts, 1, 20)
+        integer_in("max_samples", self.max_samples, 1, 100_000)
         integer_in("more_waypoints", self.more_waypoints, 0, 20)
+        number_in("finer_step", self.finer_step, 0.0, 1.0, low_open=True)
 
 
 @dataclass(frozen=True)
