@@ -147,14 +147,12 @@ def choose(problem: Problem, searched: SearchResult) -> Choice | Refusal:
             return Choice(x, objective.nodes(x[None])[0], timing, verification, len(timed))
     assert first is not None  # candidates is never empty
     found = f"the best candidate {'; '.join(first.problems)}"
-    if not objective.feasible(searched.fitness):  # the cause comes first
+    if not objective.feasible(searched.fitness):  # the cause comes first, the obstacle named
         why = infeasibility(objective.breakdown(searched.x[None]), problem)
         check = first.check
-        closest = (
-            "" if check.worst_pair is None else f"; closest: {check.worst_pair[0]} to '{check.worst_pair[1]}'"
-        )
+        closest = "" if check.worst_pair is None else f" {check.worst_pair[0]} to '{check.worst_pair[1]}'"
         found = (
-            f"no candidate was feasible (the best: {why}{closest}, {check.certified_min_m:.3f} m certified)"
+            f"no candidate was feasible; the best:{closest} {check.certified_min_m:.3f} m certified, {why}"
         )
     verified = f"{len(candidates)} candidate{'' if len(candidates) == 1 else 's'} verified"
     return Refusal(found, first.check, verified)

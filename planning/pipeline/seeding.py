@@ -139,12 +139,12 @@ class PathSeeding:
         tried = ""
         if seeds.path is None and not seeds.straight_line_clear:
             required = problem.objective.required_m
-            tried = f"RRT-Connect found no path keeping {required:.4g} m clear"
+            tried = f"no RRT-Connect path keeps {required:.4g} m clear"
             if finer < settings.verify_step_m:
                 closer = seed_search(with_planner(problem, verify_step_m=finer))
                 if closer.path is not None:  # a passage narrower than margin plus the step
                     return Attempt(closer.problem, closer.candidates, closer.path, 0)
-                tried += f", nor {closer.problem.objective.required_m:.4g} m (a {finer:g} m certified step)"
+                tried += f" (nor {closer.problem.objective.required_m:.4g} m)"
         return Attempt(seeds.problem, seeds.candidates, seeds.path, 0, tried)
 
     def after(self, attempt: Attempt, searched: SearchResult) -> Attempt | None:  # noqa: D102
