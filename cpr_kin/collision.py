@@ -23,6 +23,7 @@ from cpr_kin.obstacles import Obstacle
 from cpr_kin.pair_bounds import PairBounds
 from cpr_kin.reach import pair_reach_distances
 from cpr_kin.robot import GROUPS, Robot
+from cpr_kin.self_collision import SelfCollision
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -39,10 +40,21 @@ class CollisionWorld:
         robot: the robot (its collision geometry model is copied, never modified).
         obstacles: the obstacles; their names must be unique.
         num_threads: threads for :meth:`margin_violated` (default: up to 2).
+        allowed_pairs: link pairs of the robot allowed to touch (a scene's), beyond its SRDF's.
+
+    Attributes:
+        self_collision: the robot's own pairs (:mod:`cpr_kin.self_collision`), false when
+            it has none.
 
     """
 
-    def __init__(self, robot: Robot, obstacles: Sequence[Obstacle], num_threads: int | None = None) -> None:
+    def __init__(
+        self,
+        robot: Robot,
+        obstacles: Sequence[Obstacle],
+        num_threads: int | None = None,
+        allowed_pairs: Sequence[tuple[str, str]] = (),
+    ) -> None:
         names = [o.name for o in obstacles]
         duplicated = sorted({n for n in names if names.count(n) > 1})
         if duplicated:
@@ -84,6 +96,11 @@ class CollisionWorld:
         self._reach_distance = pair_reach_distances(robot, self.obstacles, self._pairs)
         self._culled_data: dict[tuple[bool, ...], Any] = {}
         self._pair_bounds: dict[tuple[bool, ...], PairBounds] = {}
+        allowed = {frozenset(pair) for pair in allowed_pairs}
+        links = [g.link for g in robot.geometries]
+        kept = tuple((a, b) for a, b in robot.self_pairs if frozenset((links[a], links[b])) not in allowed)
+        names = [g.name for g in robot.geometries]
+        self.self_collision = SelfCollision(robot.model, robot.collision_model, kept, names)
 
     @property
     def pairs(self) -> tuple[tuple[str, str, str], ...]:

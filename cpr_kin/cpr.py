@@ -4,7 +4,9 @@ What makes a URDF the CPR: joints ``theta1 d2 d3 theta4 theta5`` in this order, 
 frame at the tool tip, and the wrist and tool links that form the ``effector`` group. A CPR
 variant (other lengths, ranges or limits) is a URDF with the same names. Its acceleration
 and jerk limits: the file :func:`~cpr_kin.limits.find_limits_file` finds beside the URDF,
-then ``cpr_limits.yaml`` beside it, else the bundled CPR's.
+then ``cpr_limits.yaml`` beside it, else the bundled CPR's. Its self-collision pairs: an
+SRDF beside it, else the bundled ``cpr.srdf`` (which disables every pair: the CPR cannot
+meet itself).
 """
 
 from __future__ import annotations
@@ -56,5 +58,6 @@ def cpr_spec(
         wrist_joints=WRIST_JOINTS,
         limits_names=(*LIMITS_NAMES, "cpr_limits.yaml"),
         default_limits=cpr_limits_path(),
+        default_srdf=cpr_limits_path().with_name("cpr.srdf"),
         validate=validate,
     )

@@ -39,6 +39,7 @@ from cpr_kin.errors import UrdfError
 from cpr_kin.limits import LIMITS_NAMES, JointLimits, find_limits_file, read_dynamic_limits
 from cpr_kin.packages import package_roots
 from cpr_kin.robot import GROUPS, Robot, RobotGeometry, joint_units
+from cpr_kin.self_collision import find_srdf, read_srdf, self_pairs
 from cpr_kin.supported import check_joints, check_limits, check_names
 from cpr_kin.urdf_file import (
     captured_stderr,
@@ -56,6 +57,9 @@ class RobotSpec:
 
     Attributes:
         urdf: the URDF file.
+        srdf: its SRDF, whose ``disable_collisions`` the self-collision checks leave out;
+            default: ``<urdf name>.srdf`` beside the URDF, or in a ``srdf`` folder beside
+            the URDF's folder (``robot_description/srdf/``), if one exists.
         package_dirs: folders that hold the packages its ``package://`` meshes name.
         limits: its acceleration and jerk limits file; default: found beside the URDF by
             ``limits_names``, else ``default_limits``, else the documented defaults.
@@ -69,10 +73,12 @@ class RobotSpec:
         wrist_joints: joints a plan holds unless its start and goal differ in them.
         limits_names: the limits file names looked for beside the URDF.
         default_limits: the limits file used when none is found beside the URDF.
+        default_srdf: the SRDF used when none is given or found (a preset's).
         validate: validate the URDF with yourdfpy; default: every URDF but the bundled CPR's.
     """
 
     urdf: Path
+    srdf: Path | None = None
     package_dirs: tuple[Path, ...] = ()
     limits: Path | None = None
     joints: tuple[str, ...] | None = None
@@ -82,6 +88,7 @@ class RobotSpec:
     wrist_joints: tuple[str, ...] = ()
     limits_names: tuple[str, ...] = LIMITS_NAMES
     default_limits: Path | None = None
+    default_srdf: Path | None = None
     validate: bool | None = field(default=None, compare=False)
 
     def load(self) -> Robot:
@@ -120,6 +127,9 @@ class RobotSpec:
         )
         check_limits(limits, joint_units(model), path)
         _convex_hulls(collision)
+        srdf = self.srdf or find_srdf(path) or self.default_srdf
+        links = {f.name for f in model.frames}
+        disabled = read_srdf(srdf, links) if srdf is not None else frozenset()
         effector = set(self.effector_links) if self.effector_links is not None else _carried_alone(model, tcp)
         geometries = _geometries(model, collision, collision_names(tree), effector)
         for group in GROUPS:
@@ -138,6 +148,8 @@ class RobotSpec:
             limits_path=dynamic.source,
             limits_defaulted=dynamic.defaulted,
             held=held,
+            srdf_path=srdf,
+            self_pairs=self_pairs(model, collision, disabled),
         )
 
     def _planned(self, model: Any, tree: etree._ElementTree, path: Path, arm: ArmChain) -> tuple[str, ...]:
@@ -272,6 +284,9 @@ def load_robot(urdf_path: str | Path, **options: Any) -> Robot:
         UrdfError: a missing, malformed or unsupported URDF, a mesh not found, an unknown
             planned or held joint, a limits file that does not fit.
     """
+    for key in ("srdf", "limits", "default_limits"):
+        if options.get(key) is not None:
+            options[key] = Path(options[key])
     for key in ("package_dirs", "joints", "effector_links", "wrist_joints", "limits_names"):
         if key in options and options[key] is not None:
             options[key] = tuple(options[key])

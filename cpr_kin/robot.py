@@ -65,6 +65,9 @@ class Robot:
             the documented defaults, :func:`cpr_kin.limits.default_limits`).
         limits_defaulted: the joints whose acceleration or jerk limit is a default.
         held: the URDF's joints that are not planned, at the values they are held at.
+        srdf_path: the SRDF whose ``disable_collisions`` were applied, if any.
+        self_pairs: indices of the collision geometry pairs checked against each other
+            (:mod:`cpr_kin.self_collision`); empty: the robot cannot meet itself.
 
     """
 
@@ -80,6 +83,8 @@ class Robot:
     limits_path: Path | None = None
     limits_defaulted: tuple[str, ...] = ()
     held: Mapping[str, float] = field(default_factory=dict)
+    srdf_path: Path | None = None
+    self_pairs: tuple[tuple[int, int], ...] = ()
 
     @property
     def joint_names(self) -> tuple[str, ...]:

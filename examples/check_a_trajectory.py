@@ -31,5 +31,6 @@ for name in ("theirs.json", "edited.json"):
         scene.safety_margin,
         scene.planner.verify_step_m,
         (problem.q_start, problem.q_goal),
+        self_margin_m=scene.self_margin,
     )
     print(f"{name}: {'verified' if verdict.accepted else 'FAILS: ' + '; '.join(verdict.problems)}")

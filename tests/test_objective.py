@@ -26,7 +26,7 @@ def make_objective(
     solver = SepticSplineSolver(uniform_knots(settings.waypoints + 1, 4.0), scene.spline)
     world = ck.CollisionWorld(robot, obstacles)
     motion = Motion(q_start, q_goal, np.array([0, 1, 2]))
-    return WaypointObjective(world, motion, 0.1, settings, solver, FixedDuration(4.0))
+    return WaypointObjective(world, motion, (0.1, 0.01), settings, solver, FixedDuration(4.0))
 
 
 @pytest.fixture(scope="module")

@@ -171,6 +171,9 @@ def test_the_report_states_default_limits(tmp_path: Path) -> None:
 
     urdf = tmp_path / "arm.urdf"
     urdf.write_text(URDF)
+    urdf.with_suffix(".srdf").write_bytes(
+        ck.cpr_urdf_path().with_suffix(".srdf").read_bytes()
+    )  # found beside
     robot = ck.load_robot(urdf, effector_links=("wrist_link", "tool_link"), wrist_joints=("theta4", "theta5"))
     scene = dataclasses.replace(paper_scene(), duration=None, planner=PlannerSettings())
     report = report_markdown(plan(scene, robot))

@@ -34,6 +34,7 @@ def cmd_check(args: argparse.Namespace) -> int:
         scene.safety_margin,
         scene.planner.verify_step_m,
         (problem.q_start, problem.q_goal),
+        self_margin_m=scene.self_margin,
     )
     check, problems = verification.check, verification.problems
     if args.json:

@@ -6,6 +6,8 @@ wrong types, values out of range and inconsistent combinations are reported as o
 (``obstacles[1].size[2]``), the value and what is allowed.
 
 Defaults of the optional keys: ``robot``: the bundled CPR; ``safety_margin``: 0.1 m;
+``self_margin``: 0.01 m (between the robot's own checked link pairs); ``allowed_collisions``:
+none;
 ``duration``: none (the fastest timing within the joint limits); ``obstacles``: none;
 ``rpy``: ``[0, 0, 0]``; mesh ``scale``: 1 and ``convex``: true; ``planner``: the paper's
 firefly with 30 fireflies, alpha 0.5 and an early stop (50 iterations, beta0 0.5, gamma 1,
@@ -39,7 +41,7 @@ from planning.io.scene_schema import (
     TargetSpec,
     describe_errors,
 )
-from planning.pipeline.scene import Scene, Target
+from planning.pipeline.scene import DEFAULT_SELF_MARGIN_M, Scene, Target
 from planning.pipeline.settings import PlannerSettings
 
 MAX_SCENE_BYTES = 1_000_000
@@ -104,6 +106,8 @@ def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> S
             name=spec.name or source,
             robot=robot,
             safety_margin=spec.safety_margin,
+            self_margin=spec.self_margin,
+            allowed_collisions=tuple((a, b) for a, b in spec.allowed_collisions),
             start=_target(spec.start),
             goal=_target(spec.goal),
             duration=spec.duration,
@@ -165,6 +169,12 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
     return {
         "name": scene.name,
         "safety_margin": scene.safety_margin,
+        **({} if scene.self_margin == DEFAULT_SELF_MARGIN_M else {"self_margin": scene.self_margin}),
+        **(
+            {"allowed_collisions": [list(p) for p in scene.allowed_collisions]}
+            if scene.allowed_collisions
+            else {}
+        ),
         "start": target_to_dict(scene.start),
         "goal": target_to_dict(scene.goal),
         "duration": scene.duration,

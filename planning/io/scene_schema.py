@@ -17,6 +17,7 @@ from cpr_kin.names import unprintable
 from cpr_kin.obstacles import MAX_ANGLE_RAD, MAX_COORDINATE_M, MAX_NAME_CHARS, SCALE_RANGE, SIZE_RANGE_M
 from planning.pipeline.scene import (
     DEFAULT_SAFETY_MARGIN_M,
+    DEFAULT_SELF_MARGIN_M,
     DEFAULT_SPLINE,
     DURATION_RANGE_S,
     MAX_OBSTACLES,
@@ -199,6 +200,10 @@ class SceneSpec(_Strict):
     name: Annotated[str, Field(min_length=1, max_length=200), AfterValidator(_printable)] | None = None
     robot: FilePath | None = None
     safety_margin: Annotated[float, _between(0.0, MAX_SAFETY_MARGIN_M)] = DEFAULT_SAFETY_MARGIN_M
+    self_margin: Annotated[float, _between(0.0, MAX_SAFETY_MARGIN_M)] = DEFAULT_SELF_MARGIN_M
+    allowed_collisions: Annotated[
+        list[Annotated[list[Name], Field(min_length=2, max_length=2)]], Field(max_length=10_000)
+    ] = Field(default_factory=list)
     start: TargetSpec
     goal: TargetSpec
     duration: Annotated[float, _between(*DURATION_RANGE_S)] | None = None

@@ -89,7 +89,11 @@ def verify(problem: Problem, trajectory: Trajectory, fit: SplineFit) -> Verifica
     """The scene's verification, plus the node-deviation bound of the planner settings."""
     scene = problem.scene
     verification = verify_trajectory(
-        problem.world, trajectory, scene.safety_margin, scene.planner.verify_step_m
+        problem.world,
+        trajectory,
+        scene.safety_margin,
+        scene.planner.verify_step_m,
+        self_margin_m=scene.self_margin,
     )
     bound = scene.planner.max_node_deviation
     if bound is not None and fit.max_node_deviation > bound:

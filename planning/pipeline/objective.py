@@ -44,6 +44,7 @@ from planning.pipeline.timing import DurationRule
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
+LINKS = ck.GROUPS.index("links")
 
 
 @dataclass(frozen=True)
@@ -91,7 +92,7 @@ class WaypointObjective:
     Args:
         world: robot and obstacles.
         motion: start, goal and the joints the waypoints move.
-        margin_m: safety margin [m].
+        margins_m: the safety margin from obstacles and the self margin [m].
         settings: planner settings (fitness rule, path kind, IPO, samples, verification step).
         solver: the septic spline solver on the search's knots (``N = p + 1`` segments).
         duration: the scene's duration rule: with a fixed duration the knots are the final
@@ -102,11 +103,12 @@ class WaypointObjective:
         self,
         world: ck.CollisionWorld,
         motion: Motion,
-        margin_m: float,
+        margins_m: tuple[float, float],
         settings: PlannerSettings,
         solver: SepticSplineSolver,
         duration: DurationRule,
     ) -> None:
+        margin_m, self_margin_m = margins_m
         robot = world.robot
         self.world, self.motion = world, motion
         self.q_start, self.q_goal, self.moving = motion.q_start, motion.q_goal, motion.moving
@@ -114,6 +116,7 @@ class WaypointObjective:
         self.solver = solver
         self.n_waypoints = settings.waypoints
         self.required_m = margin_m + settings.verify_step_m
+        self.required_self_m = self_margin_m + settings.verify_step_m
         limits = robot.limits
         self.lower_q, self.upper_q = limits.lower, limits.upper
         self.v_max, self.a_max = limits.velocity, limits.acceleration
@@ -208,6 +211,11 @@ class WaypointObjective:
             values[flagged] = self.rule.shortfall_distances(
                 self.world, flat[flagged], self.required_m, self._pair_group
             )
+        if self.world.self_collision:  # a violation of the self margin counts as the links' own
+            distance, _ = self.world.self_collision.distances(flat)
+            hit = distance < self.required_self_m
+            shifted = distance[hit] - self.required_self_m + self.required_m  # below required_m as deep
+            values[hit, LINKS] = np.minimum(values[hit, LINKS], shifted)
         block = clearance[candidates]
         block[:, columns] = values.reshape(len(candidates), -1, 2)
         clearance[candidates] = block

@@ -112,6 +112,13 @@ def endpoint(robot: ck.Robot, world: ck.CollisionWorld, scene: Scene, label: str
             f"is {clearance.min_clearance_m:.3f} m from obstacle '{closest.obstacle}' "
             f"(margin {scene.safety_margin} m)"
         )
+    distance, pair = world.self_collision.distances(q[None])
+    if distance[0] < scene.self_margin:
+        a, b = world.self_collision.pairs[int(pair[0])]
+        raise PlanningError(
+            f"{label} q = {np.round(q, 4).tolist()} is inside the self margin: {a} is {distance[0]:.3f} m "
+            f"from {b} (self_margin {scene.self_margin} m; allowed_collisions lets a pair touch)"
+        )
     return q
 
 
@@ -131,7 +138,9 @@ def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | No
     """
     started = time.perf_counter()
     robot = robot or ck.load_cpr(scene.robot)
-    world = ck.CollisionWorld(robot, scene.obstacles, num_threads=threads)
+    world = ck.CollisionWorld(
+        robot, scene.obstacles, num_threads=threads, allowed_pairs=scene.allowed_collisions
+    )
     q_start = endpoint(robot, world, scene, "start")
     q_goal = endpoint(robot, world, scene, "goal")
     motion = Motion(q_start, q_goal, moving_joints(robot, scene, q_start, q_goal))
@@ -180,5 +189,6 @@ def _search_space(
     # the spline on the search's knots: the trajectory itself when the scene fixes the duration,
     # else the geometric path that the timing runs as fast as the limits allow
     solver = SepticSplineSolver(uniform_knots(segments, duration.nominal_duration(segments)), scene.spline)
-    objective = WaypointObjective(world, motion, scene.safety_margin, scene.planner, solver, duration)
+    margins = (scene.safety_margin, scene.self_margin)
+    objective = WaypointObjective(world, motion, margins, scene.planner, solver, duration)
     return solver, objective

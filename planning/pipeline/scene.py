@@ -26,6 +26,10 @@ DEFAULT_SAFETY_MARGIN_M = 0.1
 """Clearance every robot geometry keeps from every obstacle unless a scene says otherwise [m]
 (the paper's value)."""
 
+DEFAULT_SELF_MARGIN_M = 0.01
+"""Clearance the robot keeps from itself unless a scene says otherwise [m], between the link
+pairs its SRDF leaves checked (the CPR has none)."""
+
 DEFAULT_SPLINE = SplineSettings(p=1e6, a=(0.0, 0.0, 1.0), ends="rest")
 """The spline of a scene unless it says otherwise: the paper's weights, but at rest at both
 ends, which a real robot needs (the paper case itself uses natural ends)."""
@@ -87,6 +91,10 @@ class Scene:
             :data:`MAX_IPO_SAMPLES` IPO periods; ``None``: the fastest timing within the
             joints' velocity, acceleration and jerk limits.
         robot: URDF of the robot; ``None``: the bundled CPR.
+        self_margin: required clearance between the robot's own checked link pairs [m], at
+            most :data:`MAX_SAFETY_MARGIN_M`.
+        allowed_collisions: link pairs allowed to touch, beyond the robot's SRDF (a MoveIt
+            scene's allowed-collision matrix).
         planner: planner settings.
         spline: spline settings (default :data:`DEFAULT_SPLINE`); finite weights ``p`` in
             :data:`SPLINE_P_RANGE`, non-zero ``a_r`` in :data:`SPLINE_A_RANGE`.
@@ -99,6 +107,8 @@ class Scene:
     safety_margin: float = DEFAULT_SAFETY_MARGIN_M
     duration: float | None = None
     robot: Path | None = None
+    self_margin: float = DEFAULT_SELF_MARGIN_M
+    allowed_collisions: tuple[tuple[str, str], ...] = ()
     planner: PlannerSettings = field(default_factory=PlannerSettings)
     spline: SplineSettings = DEFAULT_SPLINE
     name: str = "scene"
@@ -112,6 +122,10 @@ class Scene:
                 f"scene name {shown(self.name)} holds {character}; names must be printable text"
             )
         number_in("safety_margin", self.safety_margin, 0.0, MAX_SAFETY_MARGIN_M, unit="m")
+        number_in("self_margin", self.self_margin, 0.0, MAX_SAFETY_MARGIN_M, unit="m")
+        object.__setattr__(
+            self, "allowed_collisions", tuple((str(a), str(b)) for a, b in self.allowed_collisions)
+        )
         object.__setattr__(self, "obstacles", tuple(self.obstacles))
         if len(self.obstacles) > MAX_OBSTACLES:
             raise PlanningError(f"{len(self.obstacles)} obstacles; at most {MAX_OBSTACLES}")

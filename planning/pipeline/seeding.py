@@ -173,7 +173,10 @@ def sampled_path(
     def valid(q: FloatArray) -> BoolArray:
         full = np.repeat(held[None], len(q), axis=0)
         full[:, moving] = q
-        return ~problem.world.margin_violated(full, objective.required_m)
+        free = ~problem.world.margin_violated(full, objective.required_m)
+        if problem.world.self_collision and free.any():
+            free[free] = ~problem.world.self_collision.violated(full[free], objective.required_self_m)
+        return free
 
     if settings is None:  # edges checked at most as far apart as the clearance required, 1-4 cm
         tuning = problem.scene.planner.tuning.seeding

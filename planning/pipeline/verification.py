@@ -12,8 +12,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
+from cpr_kin.self_collision import check_self_curve
 from planning.curves.hermite import CONTINUITY
 from planning.curves.trajectory import DERIVATIVE_NAMES, Trajectory
+from planning.pipeline.scene import DEFAULT_SELF_MARGIN_M
 
 FloatArray = NDArray[np.float64]
 
@@ -46,6 +48,8 @@ class Verification:
         }
 
 
+LIMIT_TOLERANCE = 1e-9
+"""Relative excess of a joint's range or limit that still passes (rounding)."""
 CONTINUITY_TOLERANCE = 1e-6
 """Largest jump of position, velocity, acceleration or jerk at a knot of a C3 trajectory
 (:meth:`~planning.curves.trajectory.Trajectory.knot_jumps`): relative to the magnitudes
@@ -86,25 +90,49 @@ def _unchecked(margin_m: float, step_m: float) -> ck.CurveCheck:
     )
 
 
+def _self_problems(
+    world: ck.CollisionWorld, trajectory: Trajectory, margin_m: float, step_m: float
+) -> list[str]:
+    """The certified self-collision check's verdict, as problems (none for a robot without pairs)."""
+    if not world.self_collision:
+        return []
+    speed = float(ck.motion_radii(world.robot) @ trajectory.extrema(1).peak)
+    interval = (float(trajectory.knots[0]), float(trajectory.knots[-1]))
+    try:
+        check = check_self_curve(world.self_collision, trajectory.position, interval, speed, margin_m, step_m)
+    except ck.CprKinError as exc:
+        return [f"cannot be certified clear of itself: {exc}"]
+    if check.accepted:
+        return []
+    return [
+        f"comes within {check.certified_min_m:.4f} m (certified) of itself, self margin {margin_m} m: "
+        f"closest at t = {check.worst_time:.2f} s between {check.worst_pair}"
+    ]
+
+
 def verify_trajectory(
     world: ck.CollisionWorld,
     trajectory: Trajectory,
     margin_m: float,
     step_m: float,
     endpoints: tuple[FloatArray, FloatArray] | None = None,
-    tolerance: float = 1e-9,
+    *,
+    self_margin_m: float = DEFAULT_SELF_MARGIN_M,
 ) -> Verification:
     """Check a timed trajectory for everything a robot needs of it.
 
     - position, velocity, acceleration and jerk are continuous at every knot (C3);
     - the certified clearance (:func:`cpr_kin.check_curve`, robot motion between checks at
       most ``step_m``) is at least ``margin_m`` [m];
+    - the certified self-clearance of the robot's checked pairs
+      (:func:`cpr_kin.self_collision.check_self_curve`) is at least ``self_margin_m`` [m];
     - every joint stays within its range, and within its velocity, acceleration and jerk
       limits (exact extrema);
     - with ``endpoints = (q_start, q_goal)``: it starts and ends there (within 1e-6).
     """
     robot = world.robot
     limits = robot.limits
+    tolerance = LIMIT_TOLERANCE
     start, end = trajectory.knots[0], trajectory.knots[-1]
     problems = []
     try:
@@ -127,6 +155,7 @@ def verify_trajectory(
             f"comes within {check.certified_min_m:.4f} m (certified) of an obstacle, margin {margin_m} m: "
             f"closest at t = {check.worst_time:.2f} s between {check.worst_pair} ({check.worst_group})"
         )
+    problems += _self_problems(world, trajectory, self_margin_m, step_m)
     positions = trajectory.extrema(0)
     for i, name in enumerate(robot.joint_names):
         low, high = positions.minimum[i], positions.maximum[i]

@@ -1,0 +1,207 @@
+"""A robot against itself: which pairs of its links are checked, and their distances by coal.
+
+The pairs checked are those of collision geometries on links that are not adjacent (two
+links carried by the same joint, or by a joint and its parent joint, touch by design),
+minus the link pairs an SRDF's ``<disable_collisions>`` lists (MoveIt's: adjacent, always
+in contact, or never able to meet) and minus the pairs a scene allows. A robot with no such
+pair (the CPR: its SRDF disables all) costs nothing.
+
+The self-clearance required is its own, ``self_margin_m`` (a safety margin against
+obstacles is not one a robot can keep from itself: its links pass centimetres apart).
+Between two configurations both links of a pair move: their distance changes at most twice
+as fast as the fastest robot point (:func:`cpr_kin.motion_radii`), which the certified check
+of a curve counts.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+from lxml import etree
+from numpy.typing import ArrayLike, NDArray
+
+from cpr_kin.errors import CprKinError, UrdfError
+from cpr_kin.user_files import read_bytes
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+LinkPair = frozenset[str]
+
+MAX_SRDF_BYTES = 10_000_000
+"""Largest SRDF file [bytes]."""
+MAX_SELF_CHECKS = 200_000
+"""Most configurations one certified self-collision check of a curve queries."""
+
+
+def find_srdf(urdf_path: Path) -> Path | None:
+    """The SRDF of a URDF by the default rule (:attr:`cpr_kin.RobotSpec.srdf`), or ``None``."""
+    for candidate in (
+        urdf_path.with_suffix(".srdf"),
+        urdf_path.parent.parent / "srdf" / f"{urdf_path.stem}.srdf",
+    ):
+        if candidate.is_file():
+            return candidate
+    return None
+
+
+def read_srdf(path: Path, links: Iterable[str]) -> frozenset[LinkPair]:
+    """The link pairs an SRDF's ``<disable_collisions link1 link2>`` lists.
+
+    Raises:
+        UrdfError: the file is unreadable or not XML, or names a link the robot lacks.
+    """
+    parser = etree.XMLParser(recover=False, resolve_entities=False, no_network=True)
+    try:
+        root = etree.fromstring(read_bytes(path, MAX_SRDF_BYTES, "SRDF file"), parser)
+    except etree.XMLSyntaxError as exc:
+        raise UrdfError(f"SRDF file '{path}' is not well-formed XML: {str(exc)[:120]}") from None
+    except CprKinError as exc:
+        raise UrdfError(str(exc)) from None
+    known = set(links)
+    pairs = set()
+    for element in root.iter("disable_collisions"):
+        pair = (element.get("link1", ""), element.get("link2", ""))
+        unknown = [link for link in pair if link not in known]
+        if unknown:
+            raise UrdfError(f"SRDF file '{path}': disable_collisions names link(s) {unknown} the URDF lacks")
+        pairs.add(frozenset(pair))
+    return frozenset(pairs)
+
+
+def self_pairs(
+    model: Any, collision_model: Any, disabled: frozenset[LinkPair]
+) -> tuple[tuple[int, int], ...]:
+    """Geometry index pairs ``(a, b)``, ``a < b``, on non-adjacent links not ``disabled``.
+
+    Links are the frames the geometries hang on; two links are adjacent when the same joint
+    carries both, or the joint of one is the parent of the other's.
+    """
+    objects = collision_model.geometryObjects
+    found = []
+    for a in range(len(objects)):
+        for b in range(a + 1, len(objects)):
+            ja, jb = objects[a].parentJoint, objects[b].parentJoint
+            if ja == jb or model.parents[ja] == jb or model.parents[jb] == ja:
+                continue
+            link_a = model.frames[objects[a].parentFrame].name
+            link_b = model.frames[objects[b].parentFrame].name
+            if frozenset((link_a, link_b)) in disabled or link_a == link_b:
+                continue
+            found.append((a, b))
+    return tuple(found)
+
+
+class SelfCollision:
+    """Distances between a robot's own geometry pairs, for one configuration or a batch.
+
+    Args:
+        model: the robot's Pinocchio model.
+        collision_model: its collision geometry model (copied, never modified).
+        pairs: geometry index pairs to check (:func:`self_pairs`).
+        names: the geometries' names, by index.
+    """
+
+    def __init__(
+        self, model: Any, collision_model: Any, pairs: tuple[tuple[int, int], ...], names: list[str]
+    ) -> None:
+        self.model = model
+        self.geometry_model = collision_model.copy()
+        for a, b in pairs:
+            self.geometry_model.addCollisionPair(pin.CollisionPair(a, b))
+        self._pairs = pairs
+        self._names = names
+        self._data = model.createData()
+        self._gdata = self.geometry_model.createData()
+
+    @property
+    def pairs(self) -> tuple[tuple[str, str], ...]:
+        """``(geometry, geometry)`` of every pair, in query order."""
+        return tuple((self._names[a], self._names[b]) for a, b in self._pairs)
+
+    def __bool__(self) -> bool:
+        return bool(self._pairs)
+
+    def distances(self, q: ArrayLike) -> tuple[FloatArray, IntArray]:
+        """Smallest self distance [m] and its pair, ``(N,)`` each, at configurations ``q`` ``(N, nq)``.
+
+        ``inf`` and ``-1`` when there is no pair.
+        """
+        batch = np.atleast_2d(np.asarray(q, dtype=float))
+        distance = np.full(len(batch), np.inf)
+        closest = np.full(len(batch), -1, dtype=np.int64)
+        if not self._pairs:
+            return distance, closest
+        results = self._gdata.distanceResults
+        for k, qk in enumerate(batch):
+            pair = pin.computeDistances(self.model, self._data, self.geometry_model, self._gdata, qk)
+            distance[k], closest[k] = results[pair].min_distance, pair
+        return distance, closest
+
+    def violated(self, q: ArrayLike, margin_m: float) -> NDArray[np.bool_]:
+        """``(N,)`` whether any pair is closer than ``margin_m`` [m] at configurations ``q``."""
+        distance, _ = self.distances(q)
+        return np.asarray(distance < margin_m)
+
+
+@dataclass(frozen=True)
+class SelfCheck:
+    """Result of :func:`check_self_curve`.
+
+    Attributes:
+        accepted: the certified self-clearance is at least the margin everywhere.
+        margin_m: the self-clearance required [m].
+        checks: configurations checked.
+        certified_min_m: lower bound of the self-clearance over the whole curve [m]
+            (``inf`` without pairs).
+        worst_time: instant of the smallest sampled self-clearance [s].
+        worst_pair: the geometry pair closest then, or ``None``.
+    """
+
+    accepted: bool
+    margin_m: float
+    checks: int
+    certified_min_m: float
+    worst_time: float
+    worst_pair: tuple[str, str] | None
+
+
+def check_self_curve(
+    collision: SelfCollision,
+    curve: Callable[[FloatArray], FloatArray],
+    interval: tuple[float, float],
+    point_speed: float,
+    margin_m: float,
+    step_m: float,
+) -> SelfCheck:
+    """Certify that the curve ``q(t)`` over ``interval`` keeps ``margin_m`` between the robot's own pairs.
+
+    ``point_speed`` [m/s] bounds how fast any robot point moves (``motion_radii @ |q'|``);
+    two points of a pair approach at most twice as fast, so the curve is sampled every
+    ``dt = 2 step_m / (2 point_speed)`` and between samples ``k`` and ``k + 1`` the distance
+    is at least ``(c_k + c_{k+1} - 2 point_speed dt) / 2``.
+
+    Raises:
+        CprKinError: more than :data:`~cpr_kin.motion.MAX_CURVE_CHECKS` samples needed.
+    """
+    t0, t1 = interval
+    if not collision:
+        return SelfCheck(True, float(margin_m), 0, np.inf, t0, None)
+    approach = 2.0 * point_speed
+    count = int(np.ceil((t1 - t0) * approach / (2.0 * step_m))) + 1 if approach > 0 else 1
+    if count > MAX_SELF_CHECKS:
+        raise CprKinError(
+            f"the self-collision check needs {count} samples ({t1 - t0:.4g} s of motion, step {step_m:g} m); "
+            f"at most {MAX_SELF_CHECKS}: use a larger step"
+        )
+    times = np.linspace(t0, t1, max(count, 2))
+    distance, closest = collision.distances(curve(times))
+    certified = 0.5 * (distance[:-1] + distance[1:] - approach * (times[1] - times[0]))
+    worst = int(np.argmin(distance))
+    pair = collision.pairs[int(closest[worst])] if closest[worst] >= 0 else None
+    lowest = float(certified.min())
+    return SelfCheck(bool(lowest >= margin_m), float(margin_m), len(times), lowest, float(times[worst]), pair)

@@ -1,0 +1,138 @@
+"""A robot against itself: the pairs checked, the SRDF, and a certificate no denser sampling beats."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import cpr_kin as ck
+from cpr_kin.packages import example_robot_data_share
+from cpr_kin.self_collision import SelfCollision, check_self_curve, read_srdf, self_pairs
+from planning import Scene, Target, plan
+from planning.errors import PlanningError
+
+SHARE = example_robot_data_share()
+assert SHARE is not None, "example-robot-data is part of the robots extra, which make installs"
+PANDA = SHARE / "example-robot-data" / "robots" / "panda_description" / "urdf" / "panda.urdf"
+
+
+@pytest.fixture(scope="module")
+def panda() -> ck.Robot:
+    return ck.load_robot(PANDA)
+
+
+def distances(robot: ck.Robot, q: np.ndarray, pairs: tuple[tuple[int, int], ...]) -> np.ndarray:
+    names = [g.name for g in robot.geometries]
+    return SelfCollision(robot.model, robot.collision_model, pairs, names).distances(q)[0]
+
+
+def test_the_cpr_cannot_meet_itself(robot: ck.Robot) -> None:
+    assert robot.self_pairs == () and robot.srdf_path == ck.cpr_urdf_path().with_suffix(".srdf")
+    # without its SRDF: the ten non-adjacent pairs; the two it calls always touching do, and the
+    # eight it calls never meeting stay centimetres apart over many configurations
+    every = self_pairs(robot.model, robot.collision_model, frozenset())
+    links = [g.link for g in robot.geometries]
+    assert len(every) == 10
+    disabled = read_srdf(robot.srdf_path, {f.name for f in robot.model.frames})
+    assert {frozenset((links[a], links[b])) for a, b in every} == disabled
+    q = np.random.default_rng(3).uniform(robot.limits.lower, robot.limits.upper, (5000, robot.nq))
+    for a, b in every:
+        pair = frozenset((links[a], links[b]))
+        closest = distances(robot, q, ((a, b),)).min()
+        if pair in (frozenset(("column_link", "arm_link")), frozenset(("arm_link", "tool_link"))):
+            assert closest <= 0.0, pair
+        else:
+            assert closest > 0.05, pair
+
+
+def test_the_srdf_is_read_strictly(tmp_path: Path, robot: ck.Robot) -> None:
+    links = {f.name for f in robot.model.frames}
+    bad = tmp_path / "bad.srdf"
+    bad.write_text('<robot><disable_collisions link1="arm_link" link2="elbow"/></robot>')
+    with pytest.raises(ck.UrdfError, match=r"names link\(s\) \['elbow'\] the URDF lacks"):
+        read_srdf(bad, links)
+    bad.write_text("<robot><disable_collisions")
+    with pytest.raises(ck.UrdfError, match="is not well-formed XML"):
+        read_srdf(bad, links)
+
+
+def test_the_pandas_srdf_leaves_the_pairs_that_can_meet(panda: ck.Robot) -> None:
+    assert panda.srdf_path is not None and panda.srdf_path.name == "panda.srdf"
+    links = {frozenset((panda.geometries[a].link, panda.geometries[b].link)) for a, b in panda.self_pairs}
+    assert frozenset(("panda_link1", "panda_link5")) in links  # a folded arm's elbow against its base
+    assert frozenset(("panda_link6", "panda_link7")) not in links  # adjacent
+    q = np.random.default_rng(0).uniform(panda.limits.lower, panda.limits.upper, (500, panda.nq))
+    assert 0 < np.mean(ck.CollisionWorld(panda, []).self_collision.distances(q)[0] < 0) < 0.2
+
+
+def random_curves(robot: ck.Robot, count: int, seed: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    rng = np.random.default_rng(seed)
+    return [tuple(rng.uniform(robot.limits.lower, robot.limits.upper, (2, robot.nq))) for _ in range(count)]
+
+
+def test_the_certificate_is_a_lower_bound_no_denser_sampling_beats(panda: ck.Robot) -> None:
+    # straight joint-space segments and cubic curves at random: the certified minimum is at
+    # most every distance an independent sampling 20 times denser finds
+    collision = ck.CollisionWorld(panda, []).self_collision
+    radii = ck.motion_radii(panda)
+    for k, (a, b) in enumerate(random_curves(panda, 12, 5)):
+        bend = np.random.default_rng(k).normal(0.0, 0.3, panda.nq)
+
+        def curve(t: np.ndarray, a: np.ndarray = a, b: np.ndarray = b, bend: np.ndarray = bend) -> np.ndarray:
+            s = np.asarray(t)[:, None]
+            return np.asarray(a + s * (b - a) + 4 * s * (1 - s) * bend)
+
+        speed = np.abs(b - a) + 4 * np.abs(bend)  # bounds |q'(t)| on [0, 1]
+        check = check_self_curve(collision, curve, (0.0, 1.0), float(radii @ speed), 0.0, 0.01)
+        dense = np.linspace(0.0, 1.0, 20 * check.checks)
+        assert collision.distances(curve(dense))[0].min() >= check.certified_min_m - 1e-9
+
+
+def folded_through_itself(panda: ck.Robot) -> tuple[np.ndarray, np.ndarray]:
+    """Two poses clear of themselves whose straight joint-space line passes through the arm."""
+    collision = ck.CollisionWorld(panda, []).self_collision
+    rng = np.random.default_rng(11)
+    for _ in range(2000):
+        a, b = rng.uniform(panda.limits.lower, panda.limits.upper, (2, panda.nq))
+        line = a + np.linspace(0, 1, 41)[:, None] * (b - a)
+        d = collision.distances(line)[0]
+        if d[0] > 0.05 and d[-1] > 0.05 and d.min() < -0.01:
+            return a, b
+    raise AssertionError("no pair of poses found")
+
+
+def test_a_plan_goes_around_its_own_arm_and_passes_the_check(panda: ck.Robot) -> None:
+    a, b = folded_through_itself(panda)
+    scene = Scene(start=Target(q=tuple(a)), goal=Target(q=tuple(b)), self_margin=0.01)
+    result = plan(scene, panda)
+    assert result.verification.accepted
+    trajectory = result.trajectory
+    dense = trajectory(np.linspace(0.0, trajectory.duration, 4000))
+    assert result.problem.world.self_collision.distances(dense)[0].min() >= 0.01 - 1e-9
+
+
+def test_a_start_inside_itself_is_refused_unless_allowed(panda: ck.Robot) -> None:
+    collision = ck.CollisionWorld(panda, []).self_collision
+    q = np.random.default_rng(2).uniform(panda.limits.lower, panda.limits.upper, (400, panda.nq))
+    distance, pair = collision.distances(q)
+    inside = int(np.argmin(distance))
+    a, b = collision.pairs[int(pair[inside])]
+    scene = Scene(start=Target(q=tuple(q[inside])), goal=Target(q=tuple(q[inside])))
+    with pytest.raises(
+        PlanningError, match=rf"start .* is inside the self margin: {a} is -?[0-9.]+ m from {b}"
+    ):
+        plan(scene, panda)
+    links = {g.name: g.link for g in panda.geometries}
+    allowed = tuple(
+        (links[x], links[y]) for x, y in collision.pairs if collision_distance(panda, q[inside], x, y) < 0.01
+    )
+    assert plan(
+        Scene(start=scene.start, goal=scene.goal, allowed_collisions=allowed), panda
+    ).verification.accepted
+
+
+def collision_distance(robot: ck.Robot, q: np.ndarray, first: str, second: str) -> float:
+    index = {g.name: g.index for g in robot.geometries}
+    return float(distances(robot, q[None], ((index[first], index[second]),))[0])
