@@ -2,13 +2,14 @@
 
 from .clearance import BatchClearance, Clearance, PairDistance
 from .collision import CollisionWorld
-from .cpr import CPR_JOINTS, TCP_FRAME, cpr_spec, load_cpr
-from .errors import CprKinError, JointLimitError, ObstacleError, UnreachableError, UrdfError
+from .cpr import CPR_JOINTS, TCP_FRAME, cpr_spec, load_cpr, robot_spec
+from .errors import CprKinError, IkMissError, JointLimitError, ObstacleError, UnreachableError, UrdfError
 from .ik import tcp_ik
 from .kinematics import frame_poses, frame_positions
 from .limits import JointLimits
 from .loading import RobotSpec, load_robot
 from .motion import CurveCheck, check_curve, check_segment, motion_radii
+from .numerical_ik import IkSettings, IkTarget, solve_ik
 from .obstacles import SHAPES, Obstacle
 from .resources import cpr_limits_path, cpr_urdf_path
 from .robot import GROUPS, Robot, RobotGeometry
@@ -23,6 +24,9 @@ __all__ = [
     "CollisionWorld",
     "CprKinError",
     "CurveCheck",
+    "IkMissError",
+    "IkSettings",
+    "IkTarget",
     "JointLimitError",
     "JointLimits",
     "Obstacle",
@@ -43,5 +47,7 @@ __all__ = [
     "load_cpr",
     "load_robot",
     "motion_radii",
+    "robot_spec",
+    "solve_ik",
     "tcp_ik",
 ]

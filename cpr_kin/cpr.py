@@ -17,6 +17,7 @@ from cpr_kin.limits import LIMITS_NAMES
 from cpr_kin.loading import RobotSpec
 from cpr_kin.resources import cpr_limits_path, cpr_urdf_path
 from cpr_kin.robot import Robot
+from cpr_kin.urdf_file import parse_urdf
 
 CPR_JOINTS = ("theta1", "d2", "d3", "theta4", "theta5")
 """Joint names of the CPR, in configuration order."""
@@ -61,3 +62,16 @@ def cpr_spec(
         default_srdf=cpr_limits_path().with_name("cpr.srdf"),
         validate=validate,
     )
+
+
+def has_cpr_joints(urdf_path: Path) -> bool:
+    """Whether the URDF at ``urdf_path`` has exactly the CPR's joints (a CPR variant)."""
+    tree = parse_urdf(urdf_path)
+    moving = tuple(j.get("name") for j in tree.getroot().findall("joint") if j.get("type") != "fixed")
+    return moving == CPR_JOINTS
+
+
+def robot_spec(urdf_path: str | Path) -> RobotSpec:
+    """The spec of the robot of a URDF: the CPR preset for a CPR variant, else the generic rules."""
+    path = Path(urdf_path)
+    return cpr_spec(path) if path.is_file() and has_cpr_joints(path) else RobotSpec(urdf=path)

@@ -26,3 +26,7 @@ class UnreachableError(JointLimitError):
 
 class ObstacleError(CprKinError):
     """An obstacle description is invalid (shape, size, pose or mesh file)."""
+
+
+class IkMissError(UnreachableError):
+    """A numerical inverse kinematics found no configuration within the target's tolerance."""

@@ -29,7 +29,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import coal
 import numpy as np
 import pinocchio as pin
 from lxml import etree
@@ -42,13 +41,13 @@ from cpr_kin.robot import GROUPS, Robot, RobotGeometry, joint_units
 from cpr_kin.self_collision import find_srdf, read_srdf, self_pairs
 from cpr_kin.supported import check_joints, check_limits, check_names
 from cpr_kin.urdf_file import (
-    captured_stderr,
     collision_names,
     is_bundled,
     parse_urdf,
     prepared_xml,
     validate_urdf,
 )
+from cpr_kin.urdf_models import VisualModel, build_models, convex_hulls
 
 
 @dataclass(frozen=True)
@@ -58,8 +57,8 @@ class RobotSpec:
     Attributes:
         urdf: the URDF file.
         srdf: its SRDF, whose ``disable_collisions`` the self-collision checks leave out;
-            default: ``<urdf name>.srdf`` beside the URDF, or in a ``srdf`` folder beside
-            the URDF's folder (``robot_description/srdf/``), if one exists.
+            default: found by :func:`~cpr_kin.self_collision.find_srdf` (``<urdf name>.srdf``
+            or ``<robot name>.srdf`` beside the URDF or in ``robot_description/srdf/``).
         package_dirs: folders that hold the packages its ``package://`` meshes name.
         limits: its acceleration and jerk limits file; default: found beside the URDF by
             ``limits_names``, else ``default_limits``, else the documented defaults.
@@ -101,15 +100,17 @@ class RobotSpec:
         check_joints(tree, path)
         xml = prepared_xml(tree, path, package_roots(path, self.package_dirs))
         arm = arm_chain(tree)
-        model, collision, visual = _build(xml, path)
+        model, collision = build_models(xml, path)
         planned = self._planned(model, tree, path, arm)
         held = self._held_values(model, tree, planned, path)
+        visual = VisualModel(xml, path)
         if held:
             lock = [model.getJointId(name) for name in held]
             q_ref = pin.neutral(model)
             for name, value in held.items():
                 q_ref[model.joints[model.getJointId(name)].idx_q] = value
-            model, (collision, visual) = pin.buildReducedModel(model, [collision, visual], lock, q_ref)
+            model, (collision,) = pin.buildReducedModel(model, [collision], lock, q_ref)
+            visual = VisualModel(xml, path, tuple(lock), tuple(q_ref))
         names = tuple(model.names[1:])
         tcp = self._tcp_frame(model, path, arm)
         velocity = np.array(model.velocityLimit, dtype=float)
@@ -126,8 +127,8 @@ class RobotSpec:
             effort=np.array(model.effortLimit, dtype=float),
         )
         check_limits(limits, joint_units(model), path)
-        _convex_hulls(collision)
-        srdf = self.srdf or find_srdf(path) or self.default_srdf
+        convex_hulls(collision)
+        srdf = self.srdf or find_srdf(path, tree.getroot().get("name")) or self.default_srdf
         links = {f.name for f in model.frames}
         disabled = read_srdf(srdf, links) if srdf is not None else frozenset()
         effector = set(self.effector_links) if self.effector_links is not None else _carried_alone(model, tcp)
@@ -139,7 +140,7 @@ class RobotSpec:
             urdf_path=path,
             model=model,
             collision_model=collision,
-            visual_model=visual,
+            build_visual_model=visual,
             limits=limits,
             geometries=geometries,
             _data=model.createData(),
@@ -229,28 +230,6 @@ class RobotSpec:
 def _range(model: Any, joint: str) -> tuple[float, float]:
     i = model.joints[model.getJointId(joint)].idx_q
     return float(model.lowerPositionLimit[i]), float(model.upperPositionLimit[i])
-
-
-def _build(xml: str, path: Path) -> tuple[Any, Any, Any]:
-    """Pinocchio's kinematic, collision and visual models of the prepared URDF text."""
-    try:
-        with captured_stderr() as complaints:  # urdfdom prints to fd 2; a model that builds needs none
-            model = pin.buildModelFromXML(xml)
-            collision = pin.buildGeomFromUrdfString(model, xml, pin.GeometryType.COLLISION)
-            visual = pin.buildGeomFromUrdfString(model, xml, pin.GeometryType.VISUAL)
-    except Exception as exc:  # Pinocchio reports C++ exceptions as RuntimeError/ValueError
-        said = " ".join(line.strip() for line in complaints[:2])
-        raise UrdfError(f"Pinocchio cannot build a model from '{path}': {exc} {said}".strip()) from None
-    return model, collision, visual
-
-
-def _convex_hulls(collision: Any) -> None:
-    """Replace every mesh of ``collision`` by its convex hull (module docstring, step 6)."""
-    for obj in collision.geometryObjects:
-        geometry = obj.geometry
-        if isinstance(geometry, coal.BVHModelBase):
-            geometry.buildConvexHull(True, "Qt")
-            obj.geometry = geometry.convex
 
 
 def _carried_alone(model: Any, tcp: str) -> set[str]:

@@ -77,3 +77,32 @@ def resolve_mesh(filename: str, urdf_path: Path, roots: Sequence[Path]) -> Path:
         f"URDF '{urdf_path}': mesh '{filename}' not found: package '{name}' is in none of {looked}; "
         "give its folder (--package-dir, or package_dirs=...)"
     )
+
+
+EXAMPLE_ROBOTS = {
+    "panda": "panda_description/urdf/panda.urdf",
+    "ur3": "ur_description/urdf/ur3_robot.urdf",
+    "ur5": "ur_description/urdf/ur5_robot.urdf",
+    "ur10": "ur_description/urdf/ur10_robot.urdf",
+    "so100": "so_arm_description/urdf/so100.urdf",
+    "so101": "so_arm_description/urdf/so101.urdf",
+    "xarm7": "xarm_description/urdf/xarm7.urdf",
+    "z1": "z1_description/urdf/z1.urdf",
+}
+"""Arms of example-robot-data a scene may name (``robot: panda``), by their URDF in it."""
+
+
+def example_robot(name: str) -> Path:
+    """The URDF of the example-robot-data arm ``name`` (:data:`EXAMPLE_ROBOTS`).
+
+    Raises:
+        UrdfError: an unknown name, or example-robot-data not installed.
+    """
+    if name not in EXAMPLE_ROBOTS:
+        raise UrdfError(f"robot '{name}' is not one of example-robot-data's arms {sorted(EXAMPLE_ROBOTS)}")
+    share = example_robot_data_share()
+    if share is None:
+        raise UrdfError(
+            f"robot '{name}' needs example-robot-data: pip install example-robot-data (the 'robots' extra)"
+        )
+    return share / "example-robot-data" / "robots" / EXAMPLE_ROBOTS[name]

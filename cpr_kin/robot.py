@@ -11,8 +11,9 @@ wrist joints. The collision geometry forms two groups:
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -56,7 +57,8 @@ class Robot:
         urdf_path: the URDF it was built from.
         model: Pinocchio kinematic model.
         collision_model: Pinocchio geometry model of the robot's collision shapes.
-        visual_model: Pinocchio geometry model of the visual shapes.
+        visual_model: Pinocchio geometry model of the visual shapes, built on first use (only
+            a viewer needs it, and a robot's detailed meshes take a while to load).
         limits: joint limits, in configuration order.
         geometries: the robot's collision geometries with their groups.
         tcp_frame: the tool-centre-point frame (the default frame of the kinematics).
@@ -74,7 +76,7 @@ class Robot:
     urdf_path: Path
     model: Any
     collision_model: Any
-    visual_model: Any
+    build_visual_model: Callable[[], Any] = field(repr=False)
     limits: JointLimits
     geometries: tuple[RobotGeometry, ...]
     _data: Any = field(repr=False)
@@ -85,6 +87,11 @@ class Robot:
     held: Mapping[str, float] = field(default_factory=dict)
     srdf_path: Path | None = None
     self_pairs: tuple[tuple[int, int], ...] = ()
+
+    @cached_property
+    def visual_model(self) -> Any:
+        """Pinocchio geometry model of the visual shapes (class docstring)."""
+        return self.build_visual_model()
 
     @property
     def joint_names(self) -> tuple[str, ...]:
@@ -126,7 +133,10 @@ class Robot:
                 self.limits.index(name)
             missing = [n for n in self.joint_names if n not in values]
             if missing:
-                raise JointLimitError(f"joint values {values} lack joint(s) {missing}")
+                raise JointLimitError(
+                    f"joint values {values} lack joint(s) {missing}; a map names every planned joint "
+                    f"{list(self.joint_names)}"
+                )
             q = np.array([values[n] for n in self.joint_names], dtype=float)
         else:
             try:
@@ -137,8 +147,8 @@ class Robot:
                 ) from None
         if q.shape != (self.nq,):
             raise JointLimitError(
-                f"joint vector {np.asarray(values).tolist()} has shape {q.shape}; expected "
-                f"{self.nq} values for {list(self.joint_names)}"
+                f"joint vector {np.asarray(values).tolist()} has {q.size} value(s); expected {self.nq}, "
+                f"one per planned joint {list(self.joint_names)} in this order (or a {{joint: value}} map)"
             )
         for i, name in enumerate(self.joint_names):
             if not np.isfinite(q[i]):

@@ -38,14 +38,21 @@ MAX_SELF_CHECKS = 200_000
 """Most configurations one certified self-collision check of a curve queries."""
 
 
-def find_srdf(urdf_path: Path) -> Path | None:
-    """The SRDF of a URDF by the default rule (:attr:`cpr_kin.RobotSpec.srdf`), or ``None``."""
-    for candidate in (
-        urdf_path.with_suffix(".srdf"),
-        urdf_path.parent.parent / "srdf" / f"{urdf_path.stem}.srdf",
-    ):
-        if candidate.is_file():
-            return candidate
+def find_srdf(urdf_path: Path, robot_name: str | None = None) -> Path | None:
+    """The SRDF of a URDF by the default rule (:attr:`cpr_kin.RobotSpec.srdf`), or ``None``.
+
+    Looked for, in order: ``<urdf stem>.srdf`` beside the URDF, then in a ``srdf`` folder
+    beside the URDF's folder; then the same with the URDF's robot name (``<robot name=...>``,
+    MoveIt's rule: ``ur5_robot.urdf`` names robot ``ur5``, whose SRDF is ``srdf/ur5.srdf``).
+    """
+    stems = [urdf_path.stem] + ([robot_name] if robot_name and robot_name != urdf_path.stem else [])
+    for stem in stems:
+        for candidate in (
+            urdf_path.parent / f"{stem}.srdf",
+            urdf_path.parent.parent / "srdf" / f"{stem}.srdf",
+        ):
+            if candidate.is_file():
+                return candidate
     return None
 
 
@@ -117,6 +124,9 @@ class SelfCollision:
         self._names = names
         self._data = model.createData()
         self._gdata = self.geometry_model.createData()
+        for request in self._gdata.collisionRequests:
+            request.enable_contact = False
+        self._margin_m = 0.0
 
     @property
     def pairs(self) -> tuple[tuple[str, str], ...]:
@@ -143,9 +153,20 @@ class SelfCollision:
         return distance, closest
 
     def violated(self, q: ArrayLike, margin_m: float) -> NDArray[np.bool_]:
-        """``(N,)`` whether any pair is closer than ``margin_m`` [m] at configurations ``q``."""
-        distance, _ = self.distances(q)
-        return np.asarray(distance < margin_m)
+        """``(N,)`` whether any pair is closer than ``margin_m`` [m] at configurations ``q``.
+
+        coal's collision test with ``margin_m`` as its security margin, which stops at the first
+        pair closer than that: a fraction of :meth:`distances`' cost, with the same answer.
+        """
+        batch = np.atleast_2d(np.asarray(q, dtype=float))
+        if not self._pairs:
+            return np.zeros(len(batch), dtype=bool)
+        if margin_m != self._margin_m:
+            for request in self._gdata.collisionRequests:
+                request.security_margin = margin_m
+            self._margin_m = margin_m
+        model, data, geometry_model, gdata = self.model, self._data, self.geometry_model, self._gdata
+        return np.array([pin.computeCollisions(model, data, geometry_model, gdata, qk, True) for qk in batch])
 
 
 @dataclass(frozen=True)

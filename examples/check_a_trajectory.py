@@ -30,7 +30,7 @@ for name in ("theirs.json", "edited.json"):
         trajectory,
         scene.safety_margin,
         scene.planner.verify_step_m,
-        (problem.q_start, problem.q_goal),
+        (scene.start, scene.goal),  # a joint vector, or a tcp or pose checked by forward kinematics
         self_margin_m=scene.self_margin,
     )
     print(f"{name}: {'verified' if verdict.accepted else 'FAILS: ' + '; '.join(verdict.problems)}")

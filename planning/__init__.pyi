@@ -11,6 +11,7 @@ from .errors import (
     PlanningError,
     SceneError,
     SplineError,
+    TargetOutOfReachError,
 )
 from .io.bundled import paper_scene
 from .io.scene_file import dump_scene, load_scene
@@ -21,9 +22,10 @@ from .pipeline.objective import Breakdown, WaypointObjective
 from .pipeline.planner import plan, solve, warm_up
 from .pipeline.problem import Problem, build_problem, with_planner
 from .pipeline.result import PlanResult
-from .pipeline.scene import DEFAULT_SAFETY_MARGIN_M, DEFAULT_SPLINE, Scene, Target
+from .pipeline.scene import DEFAULT_SAFETY_MARGIN_M, DEFAULT_SPLINE, Scene
 from .pipeline.seeding import Seeds, seed_search
 from .pipeline.settings import DEFAULT_FIREFLY, PAPER_SEARCH, PlannerSettings
+from .pipeline.target import Target
 from .pipeline.tuning import SearchTuning, SeedingTuning
 from .pipeline.verification import Verification, verify_trajectory
 from .search.firefly import FireflyProgress, firefly_minimize
@@ -63,6 +65,7 @@ __all__ = [
     "SplineFit",
     "SplineSettings",
     "Target",
+    "TargetOutOfReachError",
     "Trajectory",
     "TrajectoryFileError",
     "Verification",

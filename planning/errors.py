@@ -41,6 +41,10 @@ class NoSolutionError(CprPlanError, RuntimeError):
     """Base class of the outcomes where valid input has no solution that was found."""
 
 
+class TargetOutOfReachError(NoSolutionError):
+    """No configuration puts the tool frame at a start or goal's ``tcp`` or ``pose`` (the IK's miss named)."""
+
+
 class NoTrajectoryFoundError(NoSolutionError):
     """No candidate of the final population passed the verification.
 

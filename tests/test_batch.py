@@ -22,7 +22,9 @@ def scenes(tmp_path_factory: pytest.TempPathFactory) -> Path:
     paper = paper_scene_path().read_text()
     for seed in range(4):
         (folder / f"paper_{seed}.yaml").write_text(paper.replace("seed: 0", f"seed: {seed}"))
-    (folder / "broken.yaml").write_text("start: {tcp: [0.5, 0.45, 0.25]}\ngoal: {tcp: [2.0, 0.0, 0.3]}\n")
+    (folder / "broken.yaml").write_text(
+        "start: {tcp: [0.5, 0.45, 0.25]}\ngoal: {q: [0.0, 0.9, 0.3, 0.0, 0.0]}\n"
+    )
     (folder / "notes.txt").write_text("not a scene")
     return folder
 
@@ -34,7 +36,11 @@ def test_batch_local_processes(scenes: Path, tmp_path: Path) -> None:
     assert not run.interrupted
     assert [i.scene for i in items] == ["broken", "paper_0", "paper_1", "paper_2", "paper_3"]
     broken = items[0]
-    assert broken.status == "invalid" and broken.exit_class == 2 and "not reachable" in broken.message
+    assert (
+        broken.status == "invalid"
+        and broken.exit_class == 2
+        and "joint 'd2' = 0.9 m is outside" in broken.message
+    )
     for item in items[1:]:
         assert item.status == "ok" and item.record is not None and item.record["min_clearance"] >= 0.1
         assert complete_set(tmp_path / item.scene)

@@ -52,6 +52,13 @@ def with_changes(**changes: Any) -> dict[str, Any]:
     return document
 
 
+PANDA: dict[str, Any] = {
+    "robot": "panda",
+    "safety_margin": 0.02,
+    "start": {"q": [0.0, -0.6, 0.0, -2.2, 0.0, 1.6, 0.8]},
+    "goal": {"pose": {"xyz": [0.45, 0.35, 0.25], "rpy": [3.14159, 0.0, 0.0]}},
+}
+
 BAD_INPUTS = [
     ("broken YAML", "start: {tcp: [0.5, 0.45\n", "is not valid YAML"),
     ("not a mapping", "- start\n- goal\n", "must be a mapping of keys"),
@@ -60,18 +67,43 @@ BAD_INPUTS = [
     ("negative margin", with_changes(safety_margin=-0.1), "safety_margin = -0.1"),
     ("NaN", with_changes(obstacles__0__xyz=[0.0, float("nan"), 0.15]), "obstacles[0].xyz[1] = nan"),
     ("unknown shape", with_changes(obstacles__0__shape="pyramid"), "obstacles[0].shape = 'pyramid'"),
-    ("short joint vector", with_changes(start={"q": [0.7, 0.15, 0.37]}), "start.q = [0.7, 0.15, 0.37]"),
+    (
+        "short joint vector",
+        with_changes(start={"q": [0.7, 0.15, 0.37]}),
+        "start.q: joint vector [0.7, 0.15, 0.37] has 3 value(s); expected 5",
+    ),
     (
         "joint outside limits",
         with_changes(start={"q": [0.7, 0.9, 0.37, 0, 0]}),
         "joint 'd2' = 0.9 m is outside [0, 0.6] m",
     ),
     (
-        "unreachable TCP",
-        with_changes(goal={"tcp": [1.2, 0.0, 0.3]}),
-        "joint 'd3' = 0.9 m is outside [0, 0.5] m",
+        "unknown moving joint",
+        with_changes(planner__moving_joints=["elbow"]),
+        "planner.moving_joints names ['elbow'], not among the robot's planned joints",
     ),
     ("goal inside margin", with_changes(goal={"tcp": [0.0, 0.45, 0.4]}), "goal q = "),
+    (
+        "panda: six values",
+        {**PANDA, "start": {"q": [0.0] * 6}},
+        "start.q: joint vector [0.0, 0.0, 0.0, 0.0, 0.0, 0.0] has 6 value(s); expected 7",
+    ),
+    (
+        "panda: unknown joint name",
+        {**PANDA, "start": {"q": {"panda_joint1": 0.0, "elbow": 1.0}}},
+        "unknown joint 'elbow'",
+    ),
+    (
+        "panda: value out of range",
+        {**PANDA, "start": {"q": [0.0, -0.6, 0.0, 0.5, 0.0, 1.6, 0.8]}},
+        "joint 'panda_joint4' = 0.5 rad is outside [-3.0718, -0.0698] rad",
+    ),
+    ("panda: wrist angles", {**PANDA, "goal": {"tcp": [0.4, 0.0, 0.4], "theta4": 1.0}}, "theta4 = 1.0"),
+    (
+        "unknown robot",
+        {**PANDA, "robot": "no_such_robot"},
+        "robot: 'no_such_robot' is neither a URDF file",
+    ),
     ("zero fireflies", with_changes(planner__fireflies=0), "planner.fireflies = 0"),
     (
         "all spline weights zero",
@@ -108,6 +140,31 @@ def test_infeasible_scene_exits_3_writing_nothing(tmp_path: Path, capsys: pytest
     code, _, stderr = run(["plan", str(scene), "--out", str(out)], capsys)
     assert code == 3
     assert "no collision-free trajectory found" in stderr and "wall" in stderr
+    assert not out.exists()
+
+
+def test_a_pose_out_of_reach_exits_3_with_the_distance(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = write_scene(
+        tmp_path, {**PANDA, "goal": {"pose": {"xyz": [1.5, 0.0, 0.4], "rpy": [3.14159, 0, 0]}}}
+    )
+    code, stdout, stderr = run(["plan", str(scene), "--out", str(tmp_path / "out")], capsys)
+    assert code == 3 and stdout == "" and len(stderr.strip().splitlines()) == 1
+    assert "goal is out of reach: no configuration puts frame 'panda_hand_tcp' at [1.5, 0.0, 0.4] m" in stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_an_unreachable_tcp_exits_3_with_the_distance(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = write_scene(tmp_path, with_changes(goal={"tcp": [1.2, 0.0, 0.3]}))
+    out = tmp_path / "out"
+    code, stdout, stderr = run(["plan", str(scene), "--out", str(out)], capsys)
+    assert code == 3 and stdout == "" and len(stderr.strip().splitlines()) == 1
+    assert "goal is out of reach: no configuration puts frame 'tcp' at [1.2, 0.0, 0.3] m" in stderr
+    assert "m from the position (tolerance 0.0001 m)" in stderr
+    assert "the analytic IK: TCP target [1.2, 0.0, 0.3] is out of reach: joint 'd3' = 0.9 m" in stderr
     assert not out.exists()
 
 

@@ -16,6 +16,7 @@ EXPECTED = {
     "plan_a_scene.py": ["shelf: ", "certified clearance", "wrote out/examples/plan/trajectory.json"],
     "inspect_clearance.py": ["certified clearance 0.1", "the straight swing: accepted False"],
     "batch_a_folder.py": ["6/6 planned"],
+    "bring_your_own_robot.py": ["tool 'panda_hand_tcp'", "goal met by forward kinematics: True"],
     "check_a_trajectory.py": [
         "theirs.json: verified",
         "edited.json: FAILS: is not continuous (C3) at t = 1 s (knot 1): the position of joint 'd2' jumps",
@@ -38,11 +39,24 @@ def test_an_example_script_runs_from_any_folder(script: str, tmp_path: Path) -> 
     assert done.stderr == ""
 
 
+def test_the_own_robots_trajectory_passes_the_cli_check(tmp_path: Path) -> None:
+    subprocess.run([sys.executable, str(EXAMPLES / "bring_your_own_robot.py")], cwd=tmp_path, check=True)
+    done = subprocess.run(
+        [sys.executable, "-m", "planning.cli", "check", "sideways.yaml", "sideways.json"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 0 and "sideways.json: verified against sideways.yaml" in done.stdout, (
+        done.stderr
+    )
+
+
 def test_the_example_scene_names_its_robot_relative_to_itself(tmp_path: Path) -> None:
     from planning import load_scene
 
     scene = load_scene(EXAMPLES / "scenes" / "shelf.yaml")
-    assert scene.robot is not None and scene.robot.is_file() and scene.robot.name == "cpr.urdf"
+    assert scene.robot is not None and scene.robot.urdf.is_file() and scene.robot.urdf.name == "cpr.urdf"
 
 
 def test_the_notebook_plans_and_shows_the_viewer_inline(tmp_path: Path) -> None:

@@ -23,7 +23,7 @@ ROBOTS = SHARE / "example-robot-data" / "robots"
 
 FINGERS = {"panda_finger_joint1": 0.0, "panda_finger_joint2": 0.0}
 ARMS = {
-    "so101": (ROBOTS / "so_arm_description/urdf/so101.urdf", 6, {}),
+    "so101": (ROBOTS / "so_arm_description/urdf/so101.urdf", 5, {"gripper": 0.0}),  # the jaw held
     "ur5": (ROBOTS / "ur_description/urdf/ur5_robot.urdf", 6, {}),
     "panda": (ROBOTS / "panda_description/urdf/panda.urdf", 7, FINGERS),
     "xarm7": (ROBOTS / "xarm_description/urdf/xarm7.urdf", 7, {}),
@@ -44,6 +44,17 @@ def test_the_arm_is_planned_and_the_hand_held(arm: tuple[str, ck.Robot, Path]) -
     assert robot.limits.effort is not None and np.all(robot.limits.effort > 0)  # kept for the torque issue
     assert robot.model.existFrame(robot.tcp_frame)
     assert {g.group for g in robot.geometries} == set(ck.GROUPS)
+
+
+TOOLS = {"so101": "gripper_frame_link", "ur5": "tool0", "panda": "panda_hand_tcp", "xarm7": "link_eef"}
+"""The tool frames the makers' URDFs define: a bare fixed leaf beside a jaw or a collision box."""
+
+
+def test_the_tool_is_the_makers_tool_frame(arm: tuple[str, ck.Robot, Path]) -> None:
+    name, robot, _ = arm
+    assert robot.tcp_frame == TOOLS[name]
+    links = {g.link for g in robot.geometries if g.group == "effector"}
+    assert links and not links & {"base_link", "shoulder_link", "panda_link1", "link1"}
 
 
 def test_forward_kinematics_agrees_with_yourdfpy(arm: tuple[str, ck.Robot, Path]) -> None:

@@ -8,12 +8,13 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
-from planning.errors import NoTrajectoryFoundError, PlanningError
+from planning.errors import NoTrajectoryFoundError, PlanningError, TargetOutOfReachError
 from planning.io.bundled import paper_scene
 from planning.pipeline.planner import plan, warm_up
 from planning.pipeline.result import PlanResult
-from planning.pipeline.scene import Scene, Target
+from planning.pipeline.scene import Scene
 from planning.pipeline.settings import PlannerSettings
+from planning.pipeline.target import Target
 from planning.pipeline.tuning import SearchTuning
 from planning.search.firefly_settings import FireflySettings
 from planning.search.refinement_settings import RefinementSettings
@@ -98,7 +99,7 @@ def test_free_duration_gives_the_fastest_timing(robot: ck.Robot) -> None:
 def test_unreachable_goal(robot: ck.Robot) -> None:
     scene = dataclasses.replace(paper_scene(), goal=Target(tcp=(1.5, 0.0, 0.3)))
     with pytest.raises(
-        PlanningError, match=r"goal is not reachable: .*joint 'd3' = 1\.2 m is outside \[0, 0\.5\] m"
+        TargetOutOfReachError, match=r"goal is out of reach: .*joint 'd3' = 1\.2 m is outside \[0, 0\.5\] m"
     ):
         plan(scene, robot)
 
@@ -137,7 +138,7 @@ def test_bad_planner_settings() -> None:
         PlannerSettings().updated(fireflies=0)
     with pytest.raises(PlanningError, match=r"unknown planner setting\(s\) \['fire_flies'\]"):
         PlannerSettings().updated(fire_flies=10)
-    with pytest.raises(PlanningError, match="exactly one of 'tcp'"):
+    with pytest.raises(PlanningError, match=r"exactly one of 'q' \(joint values\), 'tcp'"):
         Target()
 
 

@@ -51,11 +51,31 @@ def test_docs_snippets_run(page: Path, tmp_path: Path, monkeypatch: pytest.Monke
 def test_the_readmes_scene_is_the_example_file_and_plans_from_where_it_lies(tmp_path: Path) -> None:
     from planning import load_scene
 
-    (scene,) = blocks(README, "yaml")
+    scene, _ = blocks(README, "yaml")
     example = ROOT / "examples" / "scenes" / "shelf.yaml"
     assert scene == example.read_text()
     loaded = load_scene(example)  # robot: resolves relative to the scene file, from any folder
-    assert loaded.robot == (ROOT / "cpr_kin" / "urdf" / "cpr.urdf").resolve()
+    assert loaded.robot is not None
+    assert loaded.robot.urdf == (ROOT / "cpr_kin" / "urdf" / "cpr.urdf").resolve()
+
+
+def test_bring_your_own_robot_runs_as_written(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    import shlex
+
+    import yaml
+
+    from planning.cli import main
+    from planning.io.scene_file import parse_scene
+
+    _, fragment = blocks(README, "yaml")
+    own = parse_scene(yaml.safe_load(fragment))
+    assert own.robot is not None and own.robot.urdf.name == "my_arm.urdf" and own.goal.pose is not None
+    commands = [line.split("#")[0] for line in blocks(README, "sh")[-1].splitlines() if line.strip()]
+    monkeypatch.chdir(ROOT)
+    for command in commands:
+        words = shlex.split(command.replace("out/panda", str(tmp_path / "panda")))
+        assert words[0] == "cpr-plan" and main(words[1:]) == 0, command
+    assert (tmp_path / "panda" / "viewer.html").is_file()
 
 
 def test_nothing_points_outside_the_repository() -> None:

@@ -148,7 +148,7 @@ def test_limits_file_unknown_joint(tmp_path: Path) -> None:
         ([0.0, 0.75, 0.1, 0.0, 0.0], r"joint 'd2' = 0\.75 m is outside \[0, 0\.6\] m"),
         ([3.0, 0.1, 0.1, 0.0, 0.0], r"joint 'theta1' = 3 rad is outside \[-2\.9, 2\.9\] rad"),
         ([0.0, 0.1, math.nan, 0.0, 0.0], r"joint 'd3' = nan is not a finite number"),
-        ([0.0, 0.1, 0.1], r"expected 5 values"),
+        ([0.0, 0.1, 0.1], r"has 3 value\(s\); expected 5, one per planned joint"),
         ({"theta1": 0.0, "elbow": 1.0}, r"unknown joint 'elbow'"),
         ({"theta1": 0.0, "d2": 0.1}, r"lack joint\(s\) \['d3', 'theta4', 'theta5'\]"),
         ("abc", r"must be 5 numbers"),

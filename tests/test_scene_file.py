@@ -23,8 +23,8 @@ from planning.io.scene_file import (
     parse_scene,
 )
 from planning.io.scene_generator import generate_scenes
-from planning.pipeline.scene import Target
 from planning.pipeline.settings import PlannerSettings
+from planning.pipeline.target import Target
 
 MINIMAL = {"start": {"tcp": [0.5, 0.45, 0.25]}, "goal": {"tcp": [-0.5, 0.45, 0.25]}}
 
@@ -88,12 +88,17 @@ def test_every_shape_and_relative_mesh_path(tmp_path: Path) -> None:
             {"obstacles": [{"shape": "box", "size": [0.1, 0.1, 0.1]}]},
             "obstacles[0].xyz: required key is missing",
         ),
-        ({"start": {"tcp": [0.5, 0.45, 0.25], "q": [0, 0, 0, 0, 0]}}, "start: give exactly one of 'tcp'"),
-        ({"goal": {"q": [0, 0, 0, 0, 0], "theta4": 1.0}}, "theta4 and theta5 go with 'tcp'"),
+        (
+            {"start": {"tcp": [0.5, 0.45, 0.25], "q": [0, 0, 0, 0, 0]}},
+            "start: give exactly one of 'q' (joint values), 'tcp'",
+        ),
+        (
+            {"goal": {"q": [0, 0, 0, 0, 0], "theta4": 1.0}},
+            "theta4 and theta5 (the CPR's wrist angles) go with 'tcp'",
+        ),
         ({"planner": {"mode": "parallel"}}, "planner.mode = 'parallel'"),
         ({"planner": {"refine": "bfgs"}}, "planner.refine = 'bfgs'"),
         ({"planner": {"refine_stall": -1}}, "planner.refine_stall = -1"),
-        ({"planner": {"moving_joints": ["elbow"]}}, "planner.moving_joints[0] = 'elbow'"),
         ({"spline": {"ends": "clamped"}}, "spline.ends = 'clamped'"),
         ({"duration": 0}, "duration = 0: Input should be greater than or equal to 0.01"),
         (

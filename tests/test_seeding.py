@@ -10,9 +10,10 @@ import pytest
 import cpr_kin as ck
 from planning.io.narrow_passages import narrow_scene
 from planning.pipeline.problem import Problem, build_problem, with_planner
-from planning.pipeline.scene import Scene, Target
+from planning.pipeline.scene import Scene
 from planning.pipeline.seeding import sampled_path, seed_search
 from planning.pipeline.settings import PlannerSettings
+from planning.pipeline.target import Target
 from planning.pipeline.tuning import SearchTuning, SeedingTuning
 from planning.search.rrt_connect import waypoints_along
 

@@ -136,3 +136,13 @@ def test_a_start_inside_itself_is_refused_unless_allowed(panda: ck.Robot) -> Non
 def collision_distance(robot: ck.Robot, q: np.ndarray, first: str, second: str) -> float:
     index = {g.name: g.index for g in robot.geometries}
     return float(distances(robot, q[None], ((index[first], index[second]),))[0])
+
+
+@pytest.mark.parametrize("margin_m", [0.0, 0.01, 0.05])
+def test_the_fast_violation_test_agrees_with_the_distances(panda: ck.Robot, margin_m: float) -> None:
+    collision = ck.CollisionWorld(panda, []).self_collision
+    q = np.random.default_rng(4).uniform(panda.limits.lower, panda.limits.upper, (600, panda.nq))
+    distance, _ = collision.distances(q)
+    violated = collision.violated(q, margin_m)
+    assert 0 < violated.sum() < len(q)
+    np.testing.assert_array_equal(violated, distance < margin_m)

@@ -78,9 +78,9 @@ class BatchItem:
 
 
 @lru_cache(maxsize=8)
-def _robot(urdf: Path | None) -> ck.Robot:
-    """The robot, loaded once per worker process and URDF."""
-    return ck.load_cpr(urdf)
+def _robot(spec: ck.RobotSpec | None) -> ck.Robot:
+    """The robot, loaded once per worker process and spec (``None``: the bundled CPR)."""
+    return ck.load_cpr() if spec is None else spec.load()
 
 
 class Gate(Protocol):

@@ -6,12 +6,17 @@ import argparse
 import json
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import cpr_kin as ck  # lazy (lazy_loader): only the modules a command uses are imported
 from cpr_kin.names import escaped
 from planning.cli.plan_commands import load
 from planning.errors import PlanningError
 from planning.outcome import EXIT_NO_TRAJECTORY, EXIT_OK
+
+if TYPE_CHECKING:
+    from planning.io.trajectory_reader import TrajectoryFile
+    from planning.pipeline.scene import Scene
 
 
 def cmd_check(args: argparse.Namespace) -> int:
@@ -33,7 +38,7 @@ def cmd_check(args: argparse.Namespace) -> int:
         document.trajectory,
         scene.safety_margin,
         scene.planner.verify_step_m,
-        (problem.q_start, problem.q_goal),
+        (scene.start, scene.goal),
         self_margin_m=scene.self_margin,
     )
     check, problems = verification.check, verification.problems
@@ -52,19 +57,26 @@ def cmd_check(args: argparse.Namespace) -> int:
     return EXIT_OK if not problems else EXIT_NO_TRAJECTORY
 
 
-def shown_robot(recorded: str, urdf: Path | None) -> ck.Robot:
-    """The robot to draw: ``urdf`` if given, else the URDF the trajectory file records.
+def shown_robot(document: TrajectoryFile, scene: Scene, urdf: Path | None) -> ck.Robot:
+    """The robot to draw: ``urdf`` if given, else the robot the trajectory file records.
+
+    The file's scene section records the robot entry (URDF, SRDF, meshes' folders, planned
+    joints, tool) of a robot other than the bundled CPR; the file's ``robot`` key its URDF.
 
     Raises:
-        PlanningError: the recorded URDF is not on this machine (and no ``urdf`` given).
+        PlanningError: the recorded robot's files are not on this machine (and no ``urdf`` given).
     """
-    path = urdf if urdf is not None else Path(recorded)
-    if urdf is None and not path.is_file():
+    if urdf is not None:
+        return ck.load_cpr() if str(urdf) == "cpr" else ck.robot_spec(urdf).load()
+    recorded = scene.robot.urdf if scene.robot is not None else Path(document.robot)
+    if str(recorded) != "cpr" and not recorded.is_file():
         raise PlanningError(
             f"the trajectory's robot URDF '{recorded}' is not on this machine; "
             "pass the robot with --urdf PATH (the bundled CPR: --urdf cpr)"
         )
-    return ck.load_cpr(None if str(path) == "cpr" else path)
+    if scene.robot is not None:
+        return scene.robot.load()
+    return ck.load_cpr() if str(recorded) == "cpr" else ck.robot_spec(recorded).load()
 
 
 def cmd_show(args: argparse.Namespace) -> int:
@@ -76,7 +88,7 @@ def cmd_show(args: argparse.Namespace) -> int:
 
     document = read_trajectory(args.trajectory)
     scene = parse_scene(document.scene, source=f"{args.trajectory} (scene)")
-    robot = shown_robot(document.robot, args.urdf)
+    robot = shown_robot(document, scene, args.urdf)
     if robot.joint_names != document.joint_names:
         raise PlanningError(
             f"trajectory joints {list(document.joint_names)} are not the robot's {list(robot.joint_names)}"

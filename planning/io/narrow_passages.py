@@ -28,8 +28,9 @@ import numpy as np
 
 import cpr_kin as ck
 from planning.errors import PlanningError
-from planning.pipeline.scene import Scene, Target
+from planning.pipeline.scene import Scene
 from planning.pipeline.settings import PlannerSettings
+from planning.pipeline.target import Target
 
 Kind = Literal["beam", "window", "pillars"]
 KINDS: tuple[Kind, ...] = ("beam", "window", "pillars")

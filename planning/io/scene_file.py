@@ -32,16 +32,17 @@ from cpr_kin.user_files import UserFileError, load_yaml
 from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError, SceneError
 from planning.io.publish import write_file
+from planning.io.robot_entry import robot_entry, robot_spec_of
 from planning.io.scene_schema import (
     BoxSpec,
     CapsuleSpec,
     CylinderSpec,
     SceneSpec,
     SphereSpec,
-    TargetSpec,
     describe_errors,
 )
-from planning.pipeline.scene import DEFAULT_SELF_MARGIN_M, Scene, Target
+from planning.io.target_entry import target_entry
+from planning.pipeline.scene import DEFAULT_SELF_MARGIN_M, Scene
 from planning.pipeline.settings import PlannerSettings
 
 MAX_SCENE_BYTES = 1_000_000
@@ -100,7 +101,10 @@ def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> S
     planner = spec.planner.model_dump()
     if planner["moving_joints"] is not None:
         planner["moving_joints"] = tuple(planner["moving_joints"])
-    robot = None if spec.robot is None else (base / spec.robot).resolve()
+    try:
+        robot = robot_spec_of(spec.robot, base)
+    except ck.CprKinError as exc:
+        raise SceneError(f"{source}: robot: {exc}") from None
     try:
         return Scene(
             name=spec.name or source,
@@ -108,8 +112,8 @@ def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> S
             safety_margin=spec.safety_margin,
             self_margin=spec.self_margin,
             allowed_collisions=tuple((a, b) for a, b in spec.allowed_collisions),
-            start=_target(spec.start),
-            goal=_target(spec.goal),
+            start=spec.start.target(),
+            goal=spec.goal.target(),
             duration=spec.duration,
             obstacles=tuple(obstacles),
             planner=PlannerSettings.from_flat(planner),
@@ -117,12 +121,6 @@ def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> S
         )
     except PlanningError as exc:
         raise SceneError(f"{source}: {exc}") from None
-
-
-def _target(spec: TargetSpec) -> Target:
-    if spec.tcp is None:  # TargetSpec guarantees exactly one of tcp and q
-        return Target(q=tuple(spec.q or ()))
-    return Target(tcp=(spec.tcp[0], spec.tcp[1], spec.tcp[2]), theta4=spec.theta4, theta5=spec.theta5)
 
 
 def load_scene(path: str | Path) -> Scene:
@@ -154,20 +152,11 @@ def obstacle_to_dict(obstacle: ck.Obstacle) -> dict[str, Any]:
     return entry
 
 
-def target_to_dict(target: Target) -> dict[str, Any]:
-    """A start or goal in the scene file's form."""
-    if target.q is not None:
-        return {"q": [float(v) for v in target.q]}
-    entry: dict[str, Any] = {"tcp": [float(v) for v in target.tcp or ()]}
-    if target.theta4 or target.theta5:
-        entry.update(theta4=target.theta4, theta5=target.theta5)
-    return entry
-
-
 def scene_to_dict(scene: Scene) -> dict[str, Any]:
-    """The scene as planned: obstacles, safety margin, start, goal (and duration)."""
+    """The scene as planned: robot (unless the bundled CPR), obstacles, margins, start, goal, duration."""
     return {
         "name": scene.name,
+        **({} if scene.robot is None else {"robot": robot_entry(scene.robot)}),
         "safety_margin": scene.safety_margin,
         **({} if scene.self_margin == DEFAULT_SELF_MARGIN_M else {"self_margin": scene.self_margin}),
         **(
@@ -175,8 +164,8 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
             if scene.allowed_collisions
             else {}
         ),
-        "start": target_to_dict(scene.start),
-        "goal": target_to_dict(scene.goal),
+        "start": target_entry(scene.start),
+        "goal": target_entry(scene.goal),
         "duration": scene.duration,
         "obstacles": [obstacle_to_dict(o) for o in scene.obstacles],
     }
@@ -192,11 +181,9 @@ def scene_document(scene: Scene) -> dict[str, Any]:
         del document["duration"]
     document["planner"] = planner
     document["spline"] = {"p": scene.spline.p, "a": list(scene.spline.a), "ends": scene.spline.ends}
-    if scene.robot is not None:
-        document["robot"] = str(scene.robot)
     return document
 
 
-def dump_scene(scene: Scene, path: Path) -> None:
+def dump_scene(scene: Scene, path: str | Path) -> None:
     """Write ``scene`` as a scene file, atomically."""
     write_file(Path(path), yaml.safe_dump(scene_document(scene), sort_keys=False, default_flow_style=None))

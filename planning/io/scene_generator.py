@@ -16,8 +16,9 @@ import numpy as np
 
 import cpr_kin as ck
 from planning.errors import PlanningError
-from planning.pipeline.scene import Scene, Target
+from planning.pipeline.scene import Scene
 from planning.pipeline.settings import PlannerSettings
+from planning.pipeline.target import Target
 
 
 def _tcp(theta1: float, radius: float, height: float) -> tuple[float, float, float]:

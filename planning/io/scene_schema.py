@@ -9,12 +9,24 @@ and what is allowed (:func:`describe_errors`).
 from __future__ import annotations
 
 import math
-from typing import Annotated, Any, Literal
+from typing import Annotated, Literal
 
-from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import AfterValidator, BaseModel, Field, ValidationError, model_validator
 
-from cpr_kin.names import unprintable
-from cpr_kin.obstacles import MAX_ANGLE_RAD, MAX_COORDINATE_M, MAX_NAME_CHARS, SCALE_RANGE, SIZE_RANGE_M
+from cpr_kin.obstacles import SCALE_RANGE
+from planning.io.robot_entry import RobotEntry, RobotMapping
+from planning.io.schema_types import (
+    UNION_TAGS,
+    FilePath,
+    Name,
+    Point,
+    Size,
+    Strict,
+    Turn,
+    between,
+    printable,
+)
+from planning.io.target_entry import PoseSpec, TargetSpec
 from planning.pipeline.scene import (
     DEFAULT_SAFETY_MARGIN_M,
     DEFAULT_SELF_MARGIN_M,
@@ -43,36 +55,7 @@ from planning.search.firefly_settings import (
 from planning.validation import describe_validation
 
 
-def _between(low: float, high: float) -> Any:
-    return Field(ge=low, le=high, allow_inf_nan=False)
-
-
-Coordinate = Annotated[float, _between(-MAX_COORDINATE_M, MAX_COORDINATE_M)]
-Angle = Annotated[float, _between(-MAX_ANGLE_RAD, MAX_ANGLE_RAD)]
-Size = Annotated[float, _between(*SIZE_RANGE_M)]
-Point = Annotated[list[Coordinate], Field(min_length=3, max_length=3)]
-Turn = Annotated[list[Angle], Field(min_length=3, max_length=3)]
-
-
-def _printable(text: str) -> str:
-    character = unprintable(text)
-    if character is not None:
-        raise ValueError(f"holds {character}; names must be printable text")
-    return text
-
-
-Name = Annotated[str, Field(min_length=1, max_length=MAX_NAME_CHARS), AfterValidator(_printable)]
-FilePath = Annotated[str, Field(min_length=1, max_length=4096)]
-JointName = Literal["theta1", "d2", "d3", "theta4", "theta5"]
-Weight = Annotated[float, _between(0.0, SPLINE_A_RANGE[1])]
-
-
-class _Strict(BaseModel):
-    # strict: a number must be a number (not true, not "0.1"), a list a list
-    model_config = ConfigDict(extra="forbid", frozen=True, strict=True)
-
-
-class _Placed(_Strict):
+class _Placed(Strict):
     name: Name | None = None
     xyz: Point
     rpy: Turn = Field(default_factory=lambda: [0.0, 0.0, 0.0])
@@ -113,7 +96,7 @@ class MeshSpec(_Placed):
 
     shape: Literal["mesh"]
     mesh: FilePath
-    scale: Annotated[float, _between(*SCALE_RANGE)] = 1.0
+    scale: Annotated[float, between(*SCALE_RANGE)] = 1.0
     convex: bool = True
 
 
@@ -122,36 +105,17 @@ ObstacleSpec = Annotated[
 ]
 
 
-class TargetSpec(_Strict):
-    """``{tcp: [x, y, z]}`` (with optional ``theta4``, ``theta5``) or ``{q: [5 joint values]}``."""
-
-    tcp: Point | None = None
-    q: Annotated[list[Angle], Field(min_length=5, max_length=5)] | None = None
-    theta4: Angle = 0.0
-    theta5: Angle = 0.0
-
-    @model_validator(mode="after")
-    def _one_of(self) -> TargetSpec:
-        if (self.tcp is None) == (self.q is None):
-            raise ValueError(
-                "give exactly one of 'tcp' (x, y, z) [m] or 'q' (theta1, d2, d3, theta4, theta5)"
-            )
-        if self.q is not None and (self.theta4 or self.theta5):
-            raise ValueError("theta4 and theta5 go with 'tcp'; with 'q' they are part of the joint vector")
-        return self
-
-
 _F, _P = DEFAULT_FIREFLY, PlannerSettings  # the defaults are the settings' own
 
 
-class PlannerSpec(_Strict):
+class PlannerSpec(Strict):
     """The flat ``planner:`` block; see :class:`~planning.pipeline.settings.PlannerSettings`."""
 
     fireflies: Annotated[int, Field(ge=2, le=MAX_FIREFLIES)] = _F.fireflies
     iterations: Annotated[int, Field(ge=0, le=MAX_ITERATIONS)] = _F.iterations
-    alpha: Annotated[float, _between(0.0, MAX_STEP)] = _F.alpha
-    beta0: Annotated[float, _between(0.0, MAX_STEP)] = _F.beta0
-    gamma: Annotated[float, _between(0.0, MAX_GAMMA)] = _F.gamma
+    alpha: Annotated[float, between(0.0, MAX_STEP)] = _F.alpha
+    beta0: Annotated[float, between(0.0, MAX_STEP)] = _F.beta0
+    gamma: Annotated[float, between(0.0, MAX_GAMMA)] = _F.gamma
     theta: Annotated[float, Field(gt=0, le=1)] = _F.theta
     mode: Literal["sweep", "sequential"] = _F.mode
     stall_iterations: Annotated[int, Field(ge=0, le=MAX_ITERATIONS)] = _F.stall_iterations
@@ -159,24 +123,22 @@ class PlannerSpec(_Strict):
     fitness: Literal["clearance", "paper"] = _P.fitness
     seed: Annotated[int, Field(ge=0, le=MAX_SEED)] = _P.seed
     path: Literal["spline", "ptp"] = _P.path
-    ipo: Annotated[float, _between(*IPO_RANGE_S)] = _P.ipo
+    ipo: Annotated[float, between(*IPO_RANGE_S)] = _P.ipo
     fitness_samples: Annotated[int, Field(ge=2, le=MAX_FITNESS_SAMPLES)] = _P.fitness_samples
-    verify_step_m: Annotated[float, _between(*VERIFY_STEP_RANGE_M)] = _P.verify_step_m
+    verify_step_m: Annotated[float, between(*VERIFY_STEP_RANGE_M)] = _P.verify_step_m
     max_node_deviation: Annotated[float, Field(gt=0, le=1)] | None = _P.max_node_deviation
-    moving_joints: (
-        Annotated[list[Literal["theta1", "d2", "d3", "theta4", "theta5"]], Field(max_length=5)] | None
-    ) = None
+    moving_joints: Annotated[list[Name], Field(min_length=1, max_length=64)] | None = None
     seeding: Literal["paths", "none"] = _P.seeding
     refine: Literal["cma", "none"] = _P.refine
     refine_stall: Annotated[int, Field(ge=0, le=MAX_ITERATIONS)] = _P.refine_stall
 
 
-class SplineSpec(_Strict):
+class SplineSpec(Strict):
     """The ``spline:`` block; see :class:`~planning.curves.spline.SplineSettings`."""
 
     p: Annotated[float, Field(ge=SPLINE_P_RANGE[0])] = float(DEFAULT_SPLINE.p)  # type: ignore[arg-type]
     a: Annotated[
-        list[Annotated[float, _between(0.0, SPLINE_A_RANGE[1])]], Field(min_length=3, max_length=3)
+        list[Annotated[float, between(0.0, SPLINE_A_RANGE[1])]], Field(min_length=3, max_length=3)
     ] = Field(default_factory=lambda: list(DEFAULT_SPLINE.a))
     ends: Literal["natural", "rest"] = DEFAULT_SPLINE.ends
 
@@ -194,19 +156,19 @@ class SplineSpec(_Strict):
         return self
 
 
-class SceneSpec(_Strict):
+class SceneSpec(Strict):
     """A whole scene file."""
 
-    name: Annotated[str, Field(min_length=1, max_length=200), AfterValidator(_printable)] | None = None
-    robot: FilePath | None = None
-    safety_margin: Annotated[float, _between(0.0, MAX_SAFETY_MARGIN_M)] = DEFAULT_SAFETY_MARGIN_M
-    self_margin: Annotated[float, _between(0.0, MAX_SAFETY_MARGIN_M)] = DEFAULT_SELF_MARGIN_M
+    name: Annotated[str, Field(min_length=1, max_length=200), AfterValidator(printable)] | None = None
+    robot: RobotEntry | None = None
+    safety_margin: Annotated[float, between(0.0, MAX_SAFETY_MARGIN_M)] = DEFAULT_SAFETY_MARGIN_M
+    self_margin: Annotated[float, between(0.0, MAX_SAFETY_MARGIN_M)] = DEFAULT_SELF_MARGIN_M
     allowed_collisions: Annotated[
         list[Annotated[list[Name], Field(min_length=2, max_length=2)]], Field(max_length=10_000)
     ] = Field(default_factory=list)
     start: TargetSpec
     goal: TargetSpec
-    duration: Annotated[float, _between(*DURATION_RANGE_S)] | None = None
+    duration: Annotated[float, between(*DURATION_RANGE_S)] | None = None
     obstacles: Annotated[list[ObstacleSpec], Field(max_length=MAX_OBSTACLES)] = Field(default_factory=list)
     planner: PlannerSpec = Field(default_factory=PlannerSpec)
     spline: SplineSpec = Field(default_factory=SplineSpec)
@@ -233,10 +195,14 @@ def _model_at(location: tuple[int | str, ...]) -> type[BaseModel] | None:
         return SceneSpec
     if location[0] == "obstacles" and len(location) >= 4:
         return _SHAPE_SPECS.get(str(location[2]))
+    if location[0] == "robot":
+        return RobotMapping
+    if location[0] in ("start", "goal") and location[1] == "pose":
+        return PoseSpec
     return _BLOCK_SPECS.get(str(location[0]))
 
 
 def describe_errors(error: ValidationError) -> str:
     """One line naming the first problems of a failed scene validation (field path, value, rule)."""
     shapes = tuple(_SHAPE_SPECS)
-    return describe_validation(error, _model_at, hidden=shapes, tag=("shape", shapes))
+    return describe_validation(error, _model_at, hidden=(*shapes, *UNION_TAGS), tag=("shape", shapes))

@@ -64,7 +64,7 @@ def trajectory_json(result: PlanResult, timings: bool = False) -> str:
     return dumps(trajectory_document(result, timings)) + "\n"
 
 
-def write_trajectory(result: PlanResult, path: Path, timings: bool = False) -> None:
+def write_trajectory(result: PlanResult, path: str | Path, timings: bool = False) -> None:
     """Write the plan as a ``cpr-trajectory/1`` JSON file, atomically (see :func:`trajectory_json`)."""
     write_file(Path(path), trajectory_json(result, timings))
 
@@ -97,7 +97,7 @@ def samples_csv(
     return buffer.getvalue()
 
 
-def write_samples(result: PlanResult, path: Path) -> None:
+def write_samples(result: PlanResult, path: str | Path) -> None:
     """Write the trajectory sampled at the planner's IPO period as CSV, atomically."""
     write_file(Path(path), plan_samples_csv(result))
 

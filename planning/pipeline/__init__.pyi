@@ -7,10 +7,11 @@ from .objective import Breakdown, WaypointObjective
 from .planner import plan, solve, warm_up
 from .problem import Problem, build_problem, with_planner
 from .result import PlanResult
-from .scene import DEFAULT_SAFETY_MARGIN_M, DEFAULT_SPLINE, Scene, Target
+from .scene import DEFAULT_SAFETY_MARGIN_M, DEFAULT_SPLINE, Scene
 from .search import planner_search
 from .seeding import Attempt, Seeds, seed_search
 from .settings import DEFAULT_FIREFLY, PAPER_SEARCH, PlannerSettings
+from .target import Target
 from .timing import FixedDuration, FreeDuration, Timing
 from .tuning import SearchTuning, SeedingTuning
 from .verification import Verification, verify_trajectory

@@ -212,10 +212,11 @@ class WaypointObjective:
                 self.world, flat[flagged], self.required_m, self._pair_group
             )
         if self.world.self_collision:  # a violation of the self margin counts as the links' own
-            distance, _ = self.world.self_collision.distances(flat)
-            hit = distance < self.required_self_m
-            shifted = distance[hit] - self.required_self_m + self.required_m  # below required_m as deep
-            values[hit, LINKS] = np.minimum(values[hit, LINKS], shifted)
+            hit = np.flatnonzero(self.world.self_collision.violated(flat, self.required_self_m))
+            if hit.size:
+                distance, _ = self.world.self_collision.distances(flat[hit])
+                shifted = distance - self.required_self_m + self.required_m  # below required_m as deep
+                values[hit, LINKS] = np.minimum(values[hit, LINKS], shifted)
         block = clearance[candidates]
         block[:, columns] = values.reshape(len(candidates), -1, 2)
         clearance[candidates] = block

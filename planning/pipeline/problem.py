@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 
 import cpr_kin as ck
 from planning.curves.spline import SepticSplineSolver, uniform_knots
-from planning.errors import PlanningError
+from planning.errors import PlanningError, TargetOutOfReachError
 from planning.pipeline.motion import Motion
 from planning.pipeline.objective import WaypointObjective
 from planning.pipeline.scene import Scene
@@ -84,6 +84,9 @@ def moving_joints(robot: ck.Robot, scene: Scene, q_start: FloatArray, q_goal: Fl
     ``scene.planner.moving_joints``, or every joint but the robot's wrist joints
     (:attr:`cpr_kin.Robot.wrist_joints`; the CPR's theta4 and theta5) whose start and goal
     values agree.
+
+    Raises:
+        PlanningError: a named joint the robot does not plan, or none named.
     """
     names = scene.planner.moving_joints
     if names is None:
@@ -92,33 +95,60 @@ def moving_joints(robot: ck.Robot, scene: Scene, q_start: FloatArray, q_goal: Fl
             for i, n in enumerate(robot.joint_names)
             if n not in robot.wrist_joints or not np.isclose(q_start[i], q_goal[i])
         )
+    unknown = [n for n in names if n not in robot.joint_names]
+    if unknown:
+        raise PlanningError(
+            f"planner.moving_joints names {unknown}, not among the robot's planned joints "
+            f"{list(robot.joint_names)}"
+        )
     if not names:
         raise PlanningError("moving_joints is empty; name at least one joint the waypoints may move")
     return np.array([robot.limits.index(n) for n in names], dtype=np.intp)
 
 
-def endpoint(robot: ck.Robot, world: ck.CollisionWorld, scene: Scene, label: str) -> FloatArray:
-    """The configuration of the scene's start or goal; refused if unreachable or inside the margin."""
-    target = scene.start if label == "start" else scene.goal
-    try:
-        q = target.configuration(robot)
-    except ck.CprKinError as exc:
-        raise PlanningError(f"{label} is not reachable: {exc}") from None
+def margin_violation(world: ck.CollisionWorld, scene: Scene, q: FloatArray) -> str | None:
+    """What at ``q`` comes inside the scene's safety or self margin, or ``None`` if nothing does."""
     clearance = world.clearance(q)
     closest = clearance.closest
     if closest is not None and clearance.min_clearance_m < scene.safety_margin:
-        raise PlanningError(
-            f"{label} q = {np.round(q, 4).tolist()} is inside the safety margin: {closest.robot_geometry} "
-            f"is {clearance.min_clearance_m:.3f} m from obstacle '{closest.obstacle}' "
-            f"(margin {scene.safety_margin} m)"
+        return (
+            f"is inside the safety margin: {closest.robot_geometry} is {clearance.min_clearance_m:.3f} m "
+            f"from obstacle '{closest.obstacle}' (margin {scene.safety_margin} m)"
         )
     distance, pair = world.self_collision.distances(q[None])
     if distance[0] < scene.self_margin:
         a, b = world.self_collision.pairs[int(pair[0])]
-        raise PlanningError(
-            f"{label} q = {np.round(q, 4).tolist()} is inside the self margin: {a} is {distance[0]:.3f} m "
-            f"from {b} (self_margin {scene.self_margin} m; allowed_collisions lets a pair touch)"
+        return (
+            f"is inside the self margin: {a} is {distance[0]:.3f} m from {b} "
+            f"(self_margin {scene.self_margin} m; allowed_collisions lets a pair touch)"
         )
+    return None
+
+
+def endpoint(
+    robot: ck.Robot, world: ck.CollisionWorld, scene: Scene, label: str, seed_q: FloatArray | None = None
+) -> FloatArray:
+    """The configuration of the scene's start or goal, verified; refused if out of reach or inside a margin.
+
+    A ``tcp`` or ``pose`` is solved by IK (:meth:`~planning.pipeline.target.Target.configuration`):
+    the solution nearest ``seed_q`` of those clear of the margins.
+
+    Raises:
+        PlanningError: a joint vector of the wrong length, naming the wrong joints or outside
+            the ranges; a configuration inside the safety or self margin.
+        TargetOutOfReachError: no configuration reaches a ``tcp`` or ``pose`` (its distance named).
+    """
+    target = scene.start if label == "start" else scene.goal
+    try:
+        q = target.configuration(robot, seed_q, lambda x: margin_violation(world, scene, x) is None)
+    except ck.IkMissError as exc:
+        raise TargetOutOfReachError(f"{label} is out of reach: {exc}") from None
+    except ck.CprKinError as exc:
+        where = f"{label}.q" if target.q is not None else f"{label} is not reachable"
+        raise PlanningError(f"{where}: {exc}") from None
+    violation = margin_violation(world, scene, q)
+    if violation is not None:
+        raise PlanningError(f"{label} q = {np.round(q, 4).tolist()} {violation}")
     return q
 
 
@@ -127,22 +157,23 @@ def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | No
 
     Args:
         scene: the problem and its settings.
-        robot: a loaded robot (default: load ``scene.robot`` or the bundled CPR).
+        robot: a loaded robot (default: ``scene.robot`` loaded, or the bundled CPR).
         threads: threads of the parallel collision checks (default: up to 2); a batch that
             plans scenes in parallel processes gives each 1.
 
     Raises:
-        PlanningError: unreachable start or goal, or one inside the margin; a fixed duration
+        PlanningError: a bad start or goal, or one inside a margin; a fixed duration
             shorter than the limits allow; bad settings.
+        TargetOutOfReachError: a ``tcp`` or ``pose`` start or goal no configuration reaches.
         cpr_kin.CprKinError: the robot's URDF or an obstacle is invalid.
     """
     started = time.perf_counter()
-    robot = robot or ck.load_cpr(scene.robot)
+    robot = robot or (scene.robot.load() if scene.robot is not None else ck.load_cpr())
     world = ck.CollisionWorld(
         robot, scene.obstacles, num_threads=threads, allowed_pairs=scene.allowed_collisions
     )
     q_start = endpoint(robot, world, scene, "start")
-    q_goal = endpoint(robot, world, scene, "goal")
+    q_goal = endpoint(robot, world, scene, "goal", seed_q=q_start)
     motion = Motion(q_start, q_goal, moving_joints(robot, scene, q_start, q_goal))
     duration = duration_rule(scene.duration)
     if isinstance(duration, FixedDuration):

@@ -18,6 +18,7 @@ from cpr_kin.names import unprintable
 from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError
 from planning.pipeline.settings import PlannerSettings
+from planning.pipeline.target import Target
 from planning.validation import number_in, shown
 
 FloatArray = NDArray[np.float64]
@@ -51,33 +52,6 @@ SPLINE_A_RANGE = (1e-6, 1e6)
 
 
 @dataclass(frozen=True)
-class Target:
-    """A start or goal: a TCP position (wrist angles held) or a full joint vector.
-
-    Attributes:
-        tcp: ``(x, y, z)`` of the TCP [m], solved with the analytic IK, or ``None``.
-        q: ``(theta1, d2, d3, theta4, theta5)`` [rad, m], or ``None``.
-        theta4: wrist roll used with ``tcp`` [rad].
-        theta5: tool pitch used with ``tcp`` [rad].
-    """
-
-    tcp: tuple[float, float, float] | None = None
-    q: tuple[float, ...] | None = None
-    theta4: float = 0.0
-    theta5: float = 0.0
-
-    def __post_init__(self) -> None:
-        if (self.tcp is None) == (self.q is None):
-            raise PlanningError("a start or goal needs exactly one of 'tcp' (x, y, z) or 'q' (joint vector)")
-
-    def configuration(self, robot: ck.Robot) -> FloatArray:
-        """The joint vector [rad, m]; raises :class:`cpr_kin.CprKinError` if unreachable."""
-        if self.tcp is not None:
-            return ck.tcp_ik(robot, self.tcp, self.theta4, self.theta5)
-        return robot.configuration(np.asarray(self.q, dtype=float))
-
-
-@dataclass(frozen=True)
 class Scene:
     """A planning problem.
 
@@ -90,7 +64,8 @@ class Scene:
         duration: trajectory duration [s], in :data:`DURATION_RANGE_S` and at most
             :data:`MAX_IPO_SAMPLES` IPO periods; ``None``: the fastest timing within the
             joints' velocity, acceleration and jerk limits.
-        robot: URDF of the robot; ``None``: the bundled CPR.
+        robot: the robot (:class:`cpr_kin.RobotSpec`; a URDF path becomes
+            :func:`cpr_kin.robot_spec` of it); ``None``: the bundled CPR.
         self_margin: required clearance between the robot's own checked link pairs [m], at
             most :data:`MAX_SAFETY_MARGIN_M`.
         allowed_collisions: link pairs allowed to touch, beyond the robot's SRDF (a MoveIt
@@ -106,7 +81,7 @@ class Scene:
     obstacles: tuple[ck.Obstacle, ...] = ()
     safety_margin: float = DEFAULT_SAFETY_MARGIN_M
     duration: float | None = None
-    robot: Path | None = None
+    robot: ck.RobotSpec | None = None
     self_margin: float = DEFAULT_SELF_MARGIN_M
     allowed_collisions: tuple[tuple[str, str], ...] = ()
     planner: PlannerSettings = field(default_factory=PlannerSettings)
@@ -123,6 +98,8 @@ class Scene:
             )
         number_in("safety_margin", self.safety_margin, 0.0, MAX_SAFETY_MARGIN_M, unit="m")
         number_in("self_margin", self.self_margin, 0.0, MAX_SAFETY_MARGIN_M, unit="m")
+        if isinstance(self.robot, str | Path):
+            object.__setattr__(self, "robot", ck.robot_spec(self.robot))
         object.__setattr__(
             self, "allowed_collisions", tuple((str(a), str(b)) for a, b in self.allowed_collisions)
         )

@@ -16,6 +16,7 @@ from cpr_kin.self_collision import check_self_curve
 from planning.curves.hermite import CONTINUITY
 from planning.curves.trajectory import DERIVATIVE_NAMES, Trajectory
 from planning.pipeline.scene import DEFAULT_SELF_MARGIN_M
+from planning.pipeline.target import Target
 
 FloatArray = NDArray[np.float64]
 
@@ -115,7 +116,7 @@ def verify_trajectory(
     trajectory: Trajectory,
     margin_m: float,
     step_m: float,
-    endpoints: tuple[FloatArray, FloatArray] | None = None,
+    endpoints: tuple[Target, Target] | None = None,
     *,
     self_margin_m: float = DEFAULT_SELF_MARGIN_M,
 ) -> Verification:
@@ -128,7 +129,9 @@ def verify_trajectory(
       (:func:`cpr_kin.self_collision.check_self_curve`) is at least ``self_margin_m`` [m];
     - every joint stays within its range, and within its velocity, acceleration and jerk
       limits (exact extrema);
-    - with ``endpoints = (q_start, q_goal)``: it starts and ends there (within 1e-6).
+    - with ``endpoints = (start, goal)``: it starts and ends there (:meth:`Target.miss`: a
+      joint vector within 1e-6, a ``tcp`` or ``pose`` by forward kinematics within its
+      tolerance).
     """
     robot = world.robot
     limits = robot.limits
@@ -146,10 +149,10 @@ def verify_trajectory(
     if jumps is not None:
         problems.append(jumps)
     if endpoints is not None:
-        for label, q, t in (("start", endpoints[0], start), ("goal", endpoints[1], end)):
-            gap = float(np.abs(trajectory(t) - q).max())
-            if gap > 1e-6:
-                problems.append(f"its {label} is {gap:.3g} away from the scene's {label}")
+        for label, target, t in (("start", endpoints[0], start), ("goal", endpoints[1], end)):
+            miss = target.miss(robot, trajectory(t))
+            if miss is not None:
+                problems.append(f"its {label} is {miss} of the scene's {label}")
     if not check.accepted and check.times.size:
         problems.append(
             f"comes within {check.certified_min_m:.4f} m (certified) of an obstacle, margin {margin_m} m: "

@@ -1,0 +1,202 @@
+"""Inverse kinematics of any robot: damped least squares on Pinocchio's Jacobians, verified by FK.
+
+:func:`solve_ik` puts the tool frame at a position, or at a pose (position and orientation),
+within a tolerance. From the seed configuration first, then from seeded random ones
+(``restarts``), it iterates ``dq = J^T (J J^T + lambda^2 I)^-1 e`` on the frame's error ``e``
+(the position difference; for a pose, also the rotation's logarithm, in the world-aligned
+frame), each step at most ``max_step`` [rad or m] per joint and clipped into the joint
+ranges. Every solution is checked by forward kinematics against the target and its
+tolerance; of those that pass, the ones the ``accept`` test allows (collision-free, say) come
+first, then the one nearest the seed (in robot motion, ``sum_j R_j |dq_j|``). A target that
+no start reaches is an :class:`~cpr_kin.errors.IkMissError` naming the closest the solver
+came.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import ArrayLike, NDArray
+
+from cpr_kin.errors import CprKinError, IkMissError
+from cpr_kin.robot import Robot
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class IkSettings:
+    """How :func:`solve_ik` searches.
+
+    Attributes:
+        restarts: random starts after the seed.
+        iterations: steps per start.
+        damping: ``lambda`` of the damped least squares [m or rad].
+        max_step: largest change of a joint per step [rad or m].
+        seed: seed of the random starts.
+        choices: solutions found (that ``accept`` allows) before the nearest is chosen.
+    """
+
+    restarts: int = 30
+    iterations: int = 150
+    damping: float = 1e-3
+    max_step: float = 0.3
+    seed: int = 0
+    choices: int = 4
+
+    def __post_init__(self) -> None:
+        for name, low in (("restarts", 0), ("iterations", 1), ("choices", 1)):
+            value = getattr(self, name)
+            if not isinstance(value, int) or isinstance(value, bool) or not low <= value <= 100_000:
+                raise CprKinError(f"IkSettings.{name} = {value!r} must be an integer in [{low}, 100000]")
+        for name in ("damping", "max_step"):
+            value = getattr(self, name)
+            if not (isinstance(value, int | float) and 0 < value <= 10):
+                raise CprKinError(f"IkSettings.{name} = {value!r} must be a number in (0, 10]")
+
+
+@dataclass(frozen=True)
+class IkTarget:
+    """Where the tool frame must go.
+
+    Attributes:
+        position: ``(3,)`` position in the base frame [m].
+        rotation: ``(3, 3)`` orientation, or ``None`` for a position goal.
+        tolerance_m: largest position error accepted [m].
+        tolerance_rad: largest rotation error accepted [rad] (a pose goal).
+    """
+
+    position: FloatArray
+    rotation: FloatArray | None = None
+    tolerance_m: float = 1e-4
+    tolerance_rad: float = 1e-3
+
+    def __post_init__(self) -> None:
+        position = np.asarray(self.position, dtype=float)
+        if position.shape != (3,) or not np.all(np.isfinite(position)):
+            raise CprKinError(
+                f"IK target position {np.asarray(self.position).tolist()} must be three finite numbers [m]"
+            )
+        object.__setattr__(self, "position", position)
+        if self.rotation is not None:
+            rotation = np.asarray(self.rotation, dtype=float)
+            if rotation.shape != (3, 3) or not np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-6):
+                raise CprKinError("IK target rotation must be a 3 x 3 rotation matrix")
+            object.__setattr__(self, "rotation", rotation)
+        if not (self.tolerance_m > 0 and self.tolerance_rad > 0):
+            raise CprKinError(f"IK tolerances {self.tolerance_m} m, {self.tolerance_rad} rad must be > 0")
+
+    def errors(self, placement: pin.SE3) -> tuple[float, float]:
+        """Position [m] and rotation [rad] error of a frame placement."""
+        position = float(np.linalg.norm(placement.translation - self.position))
+        if self.rotation is None:
+            return position, 0.0
+        rotation = float(np.linalg.norm(pin.log3(self.rotation.T @ placement.rotation)))
+        return position, rotation
+
+    def reached(self, placement: pin.SE3) -> bool:
+        """Whether ``placement`` is within the tolerances."""
+        position, rotation = self.errors(placement)
+        return position <= self.tolerance_m and rotation <= self.tolerance_rad
+
+    def miss(self, placement: pin.SE3) -> str:
+        """How far ``placement`` is from the target, against the tolerances, in words."""
+        position, rotation = self.errors(placement)
+        text = f"{position:.4g} m from the position (tolerance {self.tolerance_m:g} m)"
+        if self.rotation is not None:
+            text += f", {rotation:.4g} rad from the orientation (tolerance {self.tolerance_rad:g} rad)"
+        return text
+
+    def excess(self, placement: pin.SE3) -> float:
+        """The larger of the position and rotation errors, each over its tolerance (<= 1: reached)."""
+        position, rotation = self.errors(placement)
+        return max(position / self.tolerance_m, rotation / self.tolerance_rad)
+
+
+def _descend(
+    robot: Robot, target: IkTarget, q: FloatArray, free: NDArray[np.bool_], settings: IkSettings
+) -> FloatArray:
+    """One start's damped least squares descent, moving the ``free`` joints; the configuration it ends at."""
+    model, data, frame = robot.model, robot.data, robot.frame_id(robot.tcp_frame)
+    lower, upper = robot.limits.lower, robot.limits.upper
+    frame_type = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+    for _ in range(settings.iterations):
+        pin.framesForwardKinematics(model, data, q)
+        placement = data.oMf[frame]
+        if target.reached(placement):
+            break
+        jacobian = pin.computeFrameJacobian(model, data, q, frame, frame_type)
+        error = target.position - placement.translation
+        if target.rotation is not None:
+            rotation_error = placement.rotation @ pin.log3(placement.rotation.T @ target.rotation)
+            error, jacobian = np.concatenate([error, rotation_error]), jacobian
+        else:
+            jacobian = jacobian[:3]
+        jacobian = jacobian * free  # a held joint's column is zero: it does not move
+        system = jacobian @ jacobian.T + settings.damping**2 * np.eye(len(error))
+        step = jacobian.T @ np.linalg.solve(system, error)
+        step = np.clip(step, -settings.max_step, settings.max_step)
+        q = np.clip(q + step, lower, upper)
+    return q
+
+
+def solve_ik(
+    robot: Robot,
+    target: IkTarget,
+    seed_q: ArrayLike | None = None,
+    accept: Callable[[FloatArray], bool] | None = None,
+    settings: IkSettings | None = None,
+    held: Sequence[str] = (),
+) -> FloatArray:
+    """A configuration that puts the robot's tool frame at ``target`` (module docstring).
+
+    Args:
+        robot: the robot.
+        target: the position or pose, with its tolerance.
+        seed_q: the configuration to start from and stay near; default: mid-range.
+        accept: a test a preferred solution passes (e.g. clear of obstacles).
+        settings: the search's parameters.
+        held: joints kept at their ``seed_q`` values (the CPR's wrist angles of a ``tcp`` goal).
+
+    Raises:
+        IkMissError: no start reaches the target within its tolerance.
+        JointLimitError: ``held`` names a joint the robot does not plan.
+    """
+    settings = settings or IkSettings()
+    lower, upper = robot.limits.lower, robot.limits.upper
+    seed = (lower + upper) / 2 if seed_q is None else np.clip(np.asarray(seed_q, dtype=float), lower, upper)
+    free = np.ones(robot.nq, dtype=bool)
+    free[[robot.limits.index(name) for name in held]] = False
+    rng = np.random.default_rng(settings.seed)
+    radii = _radii(robot)
+    found: list[FloatArray] = []
+    closest: pin.SE3 | None = None
+    frame = robot.frame_id(robot.tcp_frame)
+    for draw in [seed, *rng.uniform(lower, upper, (settings.restarts, robot.nq))]:
+        start = np.where(free, draw, seed)
+        q = _descend(robot, target, start, free, settings)
+        pin.framesForwardKinematics(robot.model, robot.data, q)
+        placement = pin.SE3(robot.data.oMf[frame])
+        if closest is None or target.excess(placement) < target.excess(closest):
+            closest = placement
+        if target.reached(placement):  # verified by forward kinematics
+            found.append(q)
+            if sum(accept is None or accept(x) for x in found) >= settings.choices:
+                break
+    if not found:
+        assert closest is not None  # the seed is always tried
+        raise IkMissError(
+            f"no configuration puts frame '{robot.tcp_frame}' at {np.round(target.position, 4).tolist()} m: "
+            f"the closest of {settings.restarts + 1} IK starts came {target.miss(closest)}"
+        )
+    preferred = [q for q in found if accept is None or accept(q)] or found
+    return min(preferred, key=lambda q: float(radii @ np.abs(q - seed)))
+
+
+def _radii(robot: Robot) -> FloatArray:
+    from cpr_kin.motion import motion_radii
+
+    return motion_radii(robot)

@@ -1,0 +1,64 @@
+"""Pinocchio's models of a prepared URDF: kinematic and collision now, the visual one on first use.
+
+Every mesh of the collision model becomes its convex hull (:func:`convex_hulls`), which
+contains it: a clearance to the hull is at most the clearance to the mesh (safe), and coal
+gives signed distances between convex shapes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import coal
+import numpy as np
+import pinocchio as pin
+
+from cpr_kin.errors import UrdfError
+from cpr_kin.urdf_file import captured_stderr
+
+
+def build_models(xml: str, path: Path, kind: Any = pin.GeometryType.COLLISION) -> tuple[Any, Any]:
+    """Pinocchio's kinematic model and the ``kind`` geometry model of the prepared URDF text."""
+    try:
+        with captured_stderr() as complaints:  # urdfdom prints to fd 2; a model that builds needs none
+            model = pin.buildModelFromXML(xml)
+            geometry = pin.buildGeomFromUrdfString(model, xml, kind)
+    except Exception as exc:  # Pinocchio reports C++ exceptions as RuntimeError/ValueError
+        said = " ".join(line.strip() for line in complaints[:2])
+        raise UrdfError(f"Pinocchio cannot build a model from '{path}': {exc} {said}".strip()) from None
+    return model, geometry
+
+
+@dataclass(frozen=True)
+class VisualModel:
+    """Builds the visual geometry model of a prepared URDF, with the held joints locked as loaded.
+
+    Attributes:
+        xml: the prepared URDF text (mesh paths resolved).
+        path: the URDF file, for messages.
+        locked: Pinocchio ids of the held joints in the full model.
+        q_ref: the full model's configuration the held joints are locked at.
+    """
+
+    xml: str
+    path: Path
+    locked: tuple[int, ...] = ()
+    q_ref: tuple[float, ...] = ()
+
+    def __call__(self) -> Any:
+        """The visual geometry model, reduced to the planned joints."""
+        model, visual = build_models(self.xml, self.path, pin.GeometryType.VISUAL)
+        if self.locked:
+            _, (visual,) = pin.buildReducedModel(model, [visual], list(self.locked), np.array(self.q_ref))
+        return visual
+
+
+def convex_hulls(collision: Any) -> None:
+    """Replace every mesh of ``collision`` by its convex hull (module docstring, step 6)."""
+    for obj in collision.geometryObjects:
+        geometry = obj.geometry
+        if isinstance(geometry, coal.BVHModelBase):
+            geometry.buildConvexHull(True, "Qt")
+            obj.geometry = geometry.convex

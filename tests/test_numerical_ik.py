@@ -1,0 +1,113 @@
+"""The numerical IK on robots no one here wrote: round trips checked by yourdfpy's forward kinematics."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yourdfpy
+
+import cpr_kin as ck
+from cpr_kin.packages import example_robot
+
+ARMS = ("so101", "ur5", "panda", "xarm7")
+
+
+@pytest.fixture(scope="module", params=ARMS)
+def arm(request: pytest.FixtureRequest) -> tuple[ck.Robot, yourdfpy.URDF]:
+    urdf: Path = example_robot(request.param)
+    return ck.load_robot(urdf), yourdfpy.URDF.load(str(urdf), build_scene_graph=True, load_meshes=False)
+
+
+def reference_tool_pose(robot: ck.Robot, reference: yourdfpy.URDF, q: np.ndarray) -> np.ndarray:
+    """The tool frame's pose by yourdfpy, an independent URDF reader."""
+    configuration = dict(zip(robot.joint_names, q, strict=True)) | dict(robot.held)
+    reference.update_cfg({k: v for k, v in configuration.items() if k in reference.actuated_joint_names})
+    return np.asarray(reference.get_transform(frame_to=robot.tcp_frame))
+
+
+def rotation_error_rad(a: np.ndarray, b: np.ndarray) -> float:
+    return float(np.arccos(np.clip((np.trace(a.T @ b) - 1.0) / 2.0, -1.0, 1.0)))
+
+
+@pytest.mark.parametrize("orientation", [True, False], ids=["pose", "position"])
+def test_random_reachable_targets_round_trip(arm: tuple[ck.Robot, yourdfpy.URDF], orientation: bool) -> None:
+    robot, reference = arm
+    rng = np.random.default_rng(21)
+    for q_true in rng.uniform(robot.limits.lower, robot.limits.upper, (6, robot.nq)):
+        wanted = reference_tool_pose(robot, reference, q_true)
+        target = ck.IkTarget(wanted[:3, 3], wanted[:3, :3] if orientation else None)
+        q = ck.solve_ik(robot, target)  # from mid-range, not from q_true
+        assert np.all(q >= robot.limits.lower) and np.all(q <= robot.limits.upper)
+        reached = reference_tool_pose(robot, reference, q)
+        assert np.linalg.norm(reached[:3, 3] - wanted[:3, 3]) <= target.tolerance_m
+        if orientation:
+            assert rotation_error_rad(reached[:3, :3], wanted[:3, :3]) <= target.tolerance_rad
+
+
+def test_the_solution_nearest_the_seed_is_chosen(arm: tuple[ck.Robot, yourdfpy.URDF]) -> None:
+    robot, reference = arm
+    q_true = np.random.default_rng(5).uniform(robot.limits.lower, robot.limits.upper, robot.nq)
+    wanted = reference_tool_pose(robot, reference, q_true)
+    q = ck.solve_ik(robot, ck.IkTarget(wanted[:3, 3], wanted[:3, :3]), seed_q=q_true)
+    np.testing.assert_allclose(q, q_true, atol=1e-9)  # the seed itself is a solution, at distance 0
+
+
+def test_accepted_solutions_come_first() -> None:
+    robot = ck.load_robot(example_robot("ur5"))
+    seed = np.array([0.0, -1.2, 1.2, -1.0, 1.0, 0.0])
+    tool = ck.frame_poses(robot, seed[None])[0]
+    target = ck.IkTarget(tool[:3, 3])  # a position goal: the wrist is free to turn
+
+    def wrist_up(q: np.ndarray) -> bool:
+        return bool(q[3] > 0.5)
+
+    assert not wrist_up(ck.solve_ik(robot, target, seed))  # the seed itself, nearest
+    q = ck.solve_ik(robot, target, seed, accept=wrist_up)
+    assert wrist_up(q)
+    assert np.linalg.norm(ck.frame_poses(robot, q[None])[0][:3, 3] - tool[:3, 3]) <= target.tolerance_m
+
+
+def test_held_joints_stay_at_the_seed(robot: ck.Robot) -> None:
+    seed = np.array([0.3, 0.2, 0.2, 0.4, -0.3])
+    goal = ck.frame_poses(robot, np.array([[-0.5, 0.3, 0.35, 0.4, -0.3]]))[0][:3, 3]
+    q = ck.solve_ik(robot, ck.IkTarget(goal), seed, held=("theta4", "theta5"))
+    np.testing.assert_array_equal(q[3:], seed[3:])
+    assert np.linalg.norm(ck.frame_poses(robot, q[None])[0][:3, 3] - goal) <= 1e-4
+
+
+def test_a_target_out_of_reach_says_how_close_the_solver_came() -> None:
+    robot = ck.load_robot(example_robot("panda"))
+    with pytest.raises(
+        ck.IkMissError,
+        match=r"no configuration puts frame 'panda_hand_tcp' at \[2\.0, 0\.0, 0\.5\] m: the closest of 31 "
+        r"IK starts came 1\.\d+ m from the position \(tolerance 0\.0001 m\)",
+    ):
+        ck.solve_ik(robot, ck.IkTarget(np.array([2.0, 0.0, 0.5])))
+
+
+@pytest.mark.parametrize(
+    ("changes", "pattern"),
+    [
+        ({"restarts": -1}, r"IkSettings\.restarts = -1 must be an integer in \[0, 100000\]"),
+        ({"iterations": 2.5}, r"IkSettings\.iterations = 2\.5 must be an integer"),
+        ({"damping": 0.0}, r"IkSettings\.damping = 0\.0 must be a number in \(0, 10\]"),
+    ],
+)
+def test_bad_settings_are_refused(changes: dict[str, float], pattern: str) -> None:
+    with pytest.raises(ck.CprKinError, match=pattern):
+        ck.IkSettings(**changes)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    ("position", "rotation", "pattern"),
+    [
+        ([0.1, 0.2], None, r"must be three finite numbers"),
+        ([0.1, np.nan, 0.2], None, r"must be three finite numbers"),
+        ([0.1, 0.2, 0.3], np.ones((3, 3)), r"must be a 3 x 3 rotation matrix"),
+    ],
+)
+def test_bad_targets_are_refused(position: list[float], rotation: np.ndarray | None, pattern: str) -> None:
+    with pytest.raises(ck.CprKinError, match=pattern):
+        ck.IkTarget(np.array(position), rotation)
