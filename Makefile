@@ -19,7 +19,7 @@ EXTRAS := dev,bench,robots
 # trajectory optimisation; its RRT needs none of that: it is installed without its pins
 PYROBOPLAN := pyroboplan>=1.3.1
 
-.PHONY: demo test test-fast lint format wheel-check test-latest lock bench bench-peers clean
+.PHONY: demo test test-fast lint format wheel-check test-latest lock bench bench-peers import-mbm clean
 
 $(STAMP): pyproject.toml $(CONSTRAINTS)
 	$(PYTHON) -m venv $(VENV)
@@ -79,6 +79,9 @@ bench: $(STAMP)
 
 bench-peers: $(STAMP)
 	$(PY) scripts/bench_peers.py --scenes 50 --out out/bench_peers.md
+
+import-mbm: $(STAMP)
+	$(PY) scripts/import_mbm.py
 
 clean:
 	rm -rf $(VENV) .venv-latest build *.egg-info .pytest_cache .mypy_cache .ruff_cache

@@ -52,6 +52,7 @@ class CollisionWorld:
         self,
         robot: Robot,
         obstacles: Sequence[Obstacle],
+        *,
         num_threads: int | None = None,
         allowed_pairs: Sequence[tuple[str, str]] = (),
     ) -> None:

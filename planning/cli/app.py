@@ -10,7 +10,8 @@ from pathlib import Path
 
 from cpr_kin.names import escaped
 from planning.cli.batch_command import cmd_batch
-from planning.cli.file_commands import cmd_check, cmd_show
+from planning.cli.file_commands import EXPORTERS, cmd_check, cmd_export, cmd_show
+from planning.cli.moveit_command import cmd_import_moveit
 from planning.cli.plan_commands import cmd_paper, cmd_plan
 from planning.cli.signals import interrupts
 from planning.outcome import EXIT_INTERRUPTED, Interrupted, classify
@@ -101,6 +102,61 @@ def build_parser() -> argparse.ArgumentParser:
         help="the robot's URDF when the one the file records is not here ('cpr': the bundled CPR)",
     )
     sub.set_defaults(run=cmd_show)
+
+    sub = commands.add_parser(
+        "import-moveit",
+        help="convert a MoveIt planning scene and request into a scene file",
+        description="Convert a MoveIt PlanningScene and MotionPlanRequest (YAML) into a scene file that "
+        "'cpr-plan plan' runs; what the conversion cannot represent is refused, naming it (docs/formats.md).",
+    )
+    sub.add_argument("scene", type=Path, metavar="PLANNING_SCENE.yaml", help="moveit_msgs/PlanningScene")
+    sub.add_argument("request", type=Path, metavar="REQUEST.yaml", help="moveit_msgs/MotionPlanRequest")
+    sub.add_argument("--urdf", type=Path, required=True, help="the robot's URDF")
+    sub.add_argument("--srdf", type=Path, help="its SRDF (planning groups, disabled collision pairs)")
+    sub.add_argument(
+        "--package-dir",
+        type=Path,
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="folder of packages (repeatable)",
+    )
+    sub.add_argument(
+        "--limits", type=Path, help="acceleration and jerk limits file (default: found, or defaults)"
+    )
+    sub.add_argument(
+        "--safety-margin",
+        type=float,
+        default=0.0,
+        metavar="M",
+        help="clearance to obstacles [m] (default 0: contact-free, as MoveIt)",
+    )
+    sub.add_argument(
+        "--self-margin",
+        type=float,
+        default=0.0,
+        metavar="M",
+        help="clearance between robot links [m] (default 0)",
+    )
+    sub.add_argument("--out", type=Path, required=True, metavar="SCENE.yaml", help="scene file to write")
+    sub.set_defaults(run=cmd_import_moveit)
+
+    sub = commands.add_parser(
+        "export",
+        help="write a trajectory file in another format",
+        description="Write TRAJECTORY in another format: "
+        + "; ".join(f"{name}: {what}" for name, what in EXPORTERS.items())
+        + ".",
+    )
+    sub.add_argument("trajectory", type=Path, help="trajectory file (cpr-trajectory/1 JSON)")
+    sub.add_argument("--format", required=True, choices=sorted(EXPORTERS), help="the format to write")
+    sub.add_argument(
+        "--rate", type=float, default=100.0, metavar="HZ", help="points per second (default 100)"
+    )
+    sub.add_argument(
+        "--out", type=Path, required=True, metavar="FILE", help="file to write (.yaml, .yml, .json)"
+    )
+    sub.set_defaults(run=cmd_export)
 
     sub = commands.add_parser(
         "batch",

@@ -1,4 +1,4 @@
-"""``cpr-plan check`` and ``cpr-plan show``: re-verify or display a trajectory file."""
+"""``cpr-plan check``, ``show`` and ``export``: re-verify, display or convert a trajectory file."""
 
 from __future__ import annotations
 
@@ -113,4 +113,23 @@ def cmd_show(args: argparse.Namespace) -> int:
                 time.sleep(3600)
         except KeyboardInterrupt:
             print("viewer stopped", flush=True)
+    return EXIT_OK
+
+
+EXPORTERS = {"joint-trajectory": "ROS trajectory_msgs/JointTrajectory (YAML or JSON by the file name)"}
+"""The formats ``export`` writes, with what each is."""
+
+
+def cmd_export(args: argparse.Namespace) -> int:
+    """Write a trajectory file in another format (:data:`EXPORTERS`)."""
+    from planning.io.joint_trajectory import joint_trajectory, write_joint_trajectory
+    from planning.io.trajectory_reader import read_trajectory
+
+    document = read_trajectory(args.trajectory)
+    exported = joint_trajectory(document.trajectory, document.joint_names, args.rate)
+    written = write_joint_trajectory(exported, args.out)
+    points = len(exported["points"])
+    print(
+        escaped(f"wrote {written}: {points} points of {len(document.joint_names)} joints at {args.rate:g} Hz")
+    )
     return EXIT_OK

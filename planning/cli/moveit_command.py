@@ -1,0 +1,42 @@
+"""``cpr-plan import-moveit``: a MoveIt planning scene and request as a scene file."""
+
+from __future__ import annotations
+
+import argparse
+
+from cpr_kin.names import escaped
+from planning.outcome import EXIT_OK
+
+
+def cmd_import_moveit(args: argparse.Namespace) -> int:
+    """Convert ``args.scene`` and ``args.request`` into the scene file ``args.out``."""
+    from planning.io.moveit_import import RobotFiles, import_moveit, read_message, write_imported
+    from planning.io.moveit_messages import MotionPlanRequest, PlanningScene
+
+    scene = read_message(args.scene, PlanningScene)
+    request = read_message(args.request, MotionPlanRequest)
+    robot = RobotFiles(
+        urdf=args.urdf.resolve(),
+        srdf=None if args.srdf is None else args.srdf.resolve(),
+        package_dirs=tuple(d.resolve() for d in args.package_dir),
+        limits=None if args.limits is None else args.limits.resolve(),
+    )
+    name = scene.name or args.scene.stem
+    imported = import_moveit(scene, request, robot, name, (args.safety_margin, args.self_margin))
+    written = write_imported(imported, args.out)
+    document = imported.document
+    goal = next(iter(document["goal"]))
+    print(
+        escaped(
+            f"wrote {written}: {len(document['obstacles'])} obstacle(s), {len(document['robot']['joints'])} "
+            f"planned joints, a '{goal}' goal, {len(document['allowed_collisions'])} allowed link pair(s)"
+        )
+    )
+    if imported.ignored:
+        print(
+            escaped(
+                "ignored (MoveIt's planner settings, or joints the URDF does not move): "
+                + "; ".join(imported.ignored)
+            )
+        )
+    return EXIT_OK

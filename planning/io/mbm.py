@@ -1,0 +1,122 @@
+"""MotionBenchMaker problems, from the ``vamp-planner`` 0.6.4 source distribution on PyPI.
+
+Its ``resources/{panda,ur5,fetch}/`` hold the robot (URDF, SRDF, meshes) and
+``problems.tar.bz2``: per class (``table_pick``, ``box``, ``cage``, ...) 100 problems, each a
+MoveIt ``sceneNNNN.yaml`` (``PlanningScene``) and ``requestNNNN.yaml`` (``MotionPlanRequest``).
+:func:`vamp_resources` downloads the archive from the package index once (its SHA-256 checked
+against the index's), into a cache folder (``$CPR_FIREFLY_CACHE``, else
+``$XDG_CACHE_HOME/cpr-firefly``, else ``~/.cache/cpr-firefly``), and unpacks what is asked.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import re
+import tarfile
+import urllib.parse
+import urllib.request
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+from planning.errors import PlanningError
+
+VERSION = "0.6.4"
+SDIST = f"vamp_planner-{VERSION}.tar.gz"
+INDEX_URL = "https://pypi.org/simple/vamp-planner/"
+CLASSES = (
+    "table_pick",
+    "table_under_pick",
+    "box",
+    "bookshelf_small",
+    "bookshelf_tall",
+    "bookshelf_thin",
+    "cage",
+)
+"""MotionBenchMaker's problem classes, in the order its papers list them."""
+ROBOTS = ("panda", "ur5", "fetch")
+
+
+def cache_folder() -> Path:
+    """Where downloads are kept (module docstring)."""
+    if os.environ.get("CPR_FIREFLY_CACHE"):
+        return Path(os.environ["CPR_FIREFLY_CACHE"])
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "cpr-firefly"
+
+
+def _download(target: Path) -> None:
+    """Fetch the source distribution from the index into ``target``, its SHA-256 checked."""
+    index = os.environ.get("PIP_INDEX_URL", "https://pypi.org/simple").rstrip("/") + "/vamp-planner/"
+    with urllib.request.urlopen(index, timeout=120) as response:
+        page = response.read().decode()
+    found = re.search(rf'href="([^"]*{re.escape(SDIST)})#sha256=([0-9a-f]{{64}})"', page)
+    if found is None:
+        raise PlanningError(f"{SDIST} is not on the package index {index}")
+    url, digest = found.groups()
+    url = urllib.parse.urljoin(index, url)
+    partial = target.with_suffix(".part")
+    with urllib.request.urlopen(url, timeout=600) as response, partial.open("wb") as out:
+        out.write(response.read())
+    if hashlib.sha256(partial.read_bytes()).hexdigest() != digest:
+        partial.unlink()
+        raise PlanningError(f"{url}: the download's SHA-256 is not the index's {digest}")
+    partial.replace(target)
+
+
+def vamp_resources(robot: str) -> Path:
+    """The folder of ``robot``'s resources (URDF, SRDF, meshes) and unpacked ``problems/``, cached."""
+    if robot not in ROBOTS:
+        raise PlanningError(f"robot '{robot}' is not one of MotionBenchMaker's {list(ROBOTS)}")
+    cache = cache_folder()
+    folder = cache / f"vamp_planner-{VERSION}" / "resources" / robot
+    if not (folder / "problems").is_dir():
+        cache.mkdir(parents=True, exist_ok=True)
+        archive = cache / SDIST
+        if not archive.is_file():
+            _download(archive)
+        prefix = f"vamp_planner-{VERSION}/resources/{robot}/"
+        with tarfile.open(archive) as sdist:
+            members = [m for m in sdist.getmembers() if m.name.startswith(prefix) and m.isfile()]
+            sdist.extractall(cache, members=members, filter="data")
+        with tarfile.open(folder / "problems.tar.bz2") as problems:
+            problems.extractall(folder, filter="data")
+    return folder
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One MotionBenchMaker problem.
+
+    Attributes:
+        robot: ``panda``, ``ur5`` or ``fetch``.
+        problem_class: its class (:data:`CLASSES`).
+        index: its number in the class, from 1.
+        scene: the ``PlanningScene`` file.
+        request: the ``MotionPlanRequest`` file.
+    """
+
+    robot: str
+    problem_class: str
+    index: int
+    scene: Path
+    request: Path
+
+    @property
+    def name(self) -> str:
+        """``<class>_<index>``, e.g. ``box_0042``."""
+        return f"{self.problem_class}_{self.index:04d}"
+
+
+def problems(robot: str, classes: tuple[str, ...] = CLASSES, limit: int | None = None) -> Iterator[Problem]:
+    """The problems of ``robot``'s ``classes``, the first ``limit`` of each (all: ``None``)."""
+    folder = vamp_resources(robot) / "problems"
+    for problem_class in classes:
+        if problem_class not in CLASSES:
+            raise PlanningError(f"class '{problem_class}' is not one of {list(CLASSES)}")
+        requests = sorted((folder / f"{problem_class}_{robot}").glob("request*.yaml"))
+        for request in requests[:limit]:
+            index = int(request.stem.removeprefix("request"))
+            scene = request.with_name(f"scene{index:04d}.yaml")
+            yield Problem(robot, problem_class, index, scene, request)

