@@ -39,17 +39,20 @@ def test_an_example_script_runs_from_any_folder(script: str, tmp_path: Path) -> 
     assert done.stderr == ""
 
 
-def test_the_own_robots_trajectory_passes_the_cli_check(tmp_path: Path) -> None:
-    subprocess.run([sys.executable, str(EXAMPLES / "bring_your_own_robot.py")], cwd=tmp_path, check=True)
+@pytest.mark.parametrize("robot", ["so101", "ur5", "panda", "xarm7"])
+def test_the_own_robot_example_runs_for_every_arm_and_passes_the_cli_check(
+    robot: str, tmp_path: Path
+) -> None:
+    script = EXAMPLES / "bring_your_own_robot.py"
+    done = subprocess.run([sys.executable, str(script), robot], cwd=tmp_path, capture_output=True, text=True)
+    assert done.returncode == 0 and "goal met by forward kinematics: True" in done.stdout, done.stderr
     done = subprocess.run(
-        [sys.executable, "-m", "planning.cli", "check", "sideways.yaml", "sideways.json"],
+        [sys.executable, "-m", "planning.cli", "check", f"{robot}_turn.yaml", f"{robot}_turn.json"],
         cwd=tmp_path,
         capture_output=True,
         text=True,
     )
-    assert done.returncode == 0 and "sideways.json: verified against sideways.yaml" in done.stdout, (
-        done.stderr
-    )
+    assert done.returncode == 0 and f"{robot}_turn.json: verified against" in done.stdout, done.stderr
 
 
 def test_the_example_scene_names_its_robot_relative_to_itself(tmp_path: Path) -> None:

@@ -29,12 +29,14 @@ def test_document_follows_the_design(result: PlanResult, tmp_path: Path) -> None
         "format",
         "joint_names",
         "robot",
+        "srdf",
         "scene",
         "waypoints",
         "knots",
         "segments",
         "metrics",
     }
+    assert document["srdf"].endswith("cpr.srdf")  # the SRDF whose pairs the checks left out
     assert set(document["scene"]) >= {"obstacles", "safety_margin", "start", "goal"}
     assert document["scene"]["obstacles"][0] == {
         "name": "crate",
