@@ -113,9 +113,9 @@ class Target:
         if analytic is None:
             return q
         seed = np.array(seed_q if seed_q is not None else (robot.limits.lower + robot.limits.upper) / 2)
-        seed[3:] = (self.theta4, self.theta5)
+        seed[_wrist(robot)] = (self.theta4, self.theta5)
         try:
-            return ck.solve_ik(robot, target, seed, accept, held=("theta4", "theta5"))
+            return ck.solve_ik(robot, target, seed, accept, held=robot.wrist_joints)
         except ck.IkMissError as exc:
             raise ck.IkMissError(f"{exc}; the analytic IK: {analytic}") from None
 
@@ -136,8 +136,12 @@ class Target:
         if not target.reached(placement):
             return f"{target.miss(placement)} of frame '{robot.tcp_frame}'"
         if self.tcp is not None and robot.joint_names == ck.CPR_JOINTS:
-            wrist = np.array([self.theta4, self.theta5])
-            gap = float(np.abs(q[3:] - wrist).max())
+            gap = float(np.abs(q[_wrist(robot)] - (self.theta4, self.theta5)).max())
             if gap > SAME_Q_TOLERANCE:
-                return f"its wrist angles theta4, theta5 are {gap:.3g} rad from the target's"
+                return f"its wrist angles {list(robot.wrist_joints)} are {gap:.3g} rad from the target's"
         return None
+
+
+def _wrist(robot: ck.Robot) -> list[int]:
+    """Indices of the CPR preset's wrist joints (:attr:`cpr_kin.Robot.wrist_joints`) in ``q``."""
+    return [robot.limits.index(name) for name in robot.wrist_joints]
