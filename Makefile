@@ -19,7 +19,7 @@ EXTRAS := dev,bench,robots
 # trajectory optimisation; its RRT needs none of that: it is installed without its pins
 PYROBOPLAN := pyroboplan>=1.3.1
 
-.PHONY: demo test test-fast lint format wheel-check test-latest lock bench bench-peers import-mbm clean
+.PHONY: demo test test-fast lint format wheel-check test-latest lock bench bench-peers import-mbm bench-mbm clean
 
 $(STAMP): pyproject.toml $(CONSTRAINTS)
 	$(PYTHON) -m venv $(VENV)
@@ -82,6 +82,9 @@ bench-peers: $(STAMP)
 
 import-mbm: $(STAMP)
 	$(PY) scripts/import_mbm.py
+
+bench-mbm: $(STAMP)
+	$(PY) scripts/bench_mbm.py --out out/bench_mbm
 
 clean:
 	rm -rf $(VENV) .venv-latest build *.egg-info .pytest_cache .mypy_cache .ruff_cache

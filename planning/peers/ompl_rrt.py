@@ -2,8 +2,9 @@
 
 The same scene, URDF, collision world and limits as the firefly planner
 (:func:`planning.pipeline.problem.build_problem`): RRT-Connect searches the moving joints with our
-coal margin check as state validity (margin plus the verification step, the clearance the
-firefly's fitness asks of its samples), the path is simplified, and
+coal margin checks as state validity (the margin, and the self margin between the robot's own
+checked pairs, each plus the verification step, the clearances the firefly's fitness asks of
+its samples), the path is simplified, and
 :func:`planning.peers.toppra_timing.time_and_verify` times and verifies it. The peer is
 optional (``pip install '.[bench]'``).
 """
@@ -52,8 +53,13 @@ def plan_rrt_connect(
         q[moving] = [state[i] for i in range(moving.size)]  # type: ignore[index]
         return q
 
+    self_clearance_m = scene.self_margin + scene.planner.verify_step_m
+
     def valid(state: object) -> bool:
-        return not bool(world.margin_violated(full(state)[None], planning_clearance_m(scene))[0])
+        q = full(state)[None]
+        if world.margin_violated(q, planning_clearance_m(scene))[0]:
+            return False
+        return not (world.self_collision and world.self_collision.violated(q, self_clearance_m)[0])
 
     information.setStateValidityChecker(valid)
     information.setStateValidityCheckingResolution(0.002)  # of the space's extent, ~1.2 cm in theta1

@@ -7,6 +7,7 @@ certified continuous check as the firefly planner's trajectories.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass
 
@@ -109,6 +110,20 @@ def time_and_verify(
         scene.safety_margin,
         scene.planner.verify_step_m,
     )
+    if check.accepted and world.self_collision:  # the robot's own pairs, certified as ours are
+        from cpr_kin.self_collision import check_self_curve
+
+        point_speed = float(ck.motion_radii(robot) @ speeds)
+        self_check = check_self_curve(
+            world.self_collision,
+            lambda t: np.asarray(timed(np.asarray(t))),
+            (0.0, duration),
+            point_speed,
+            scene.self_margin,
+            scene.planner.verify_step_m,
+        )
+        if not self_check.accepted:
+            check = dataclasses.replace(check, accepted=False, certified_min_m=self_check.certified_min_m)
     jerk = np.diff(np.asarray(timed(dense, 2)), axis=0) / np.diff(dense)[:, None]
     length = float(np.linalg.norm(np.diff(positions / limits.range, axis=0), axis=1).sum())
     inside = bool(np.all(positions >= limits.lower - 1e-9) and np.all(positions <= limits.upper + 1e-9))

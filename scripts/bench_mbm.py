@@ -1,0 +1,198 @@
+"""MotionBenchMaker: our planner beside OMPL's RRT-Connect pipeline, problem by problem, in one run.
+
+    python scripts/bench_mbm.py [--robots panda ur5] [--classes ...] [--limit N] [--timeout S] [--out DIR]
+
+Each problem goes the way a user's does (``import-moveit``, :mod:`planning.io.moveit_import`,
+margins 0 as in MoveIt), then, alternating, is planned warm by
+
+- ours: :func:`planning.pipeline.planner.plan` with the scene's default settings, in a worker
+  process (robot loaded, kernels compiled) stopped after ``--timeout`` seconds;
+- OMPL RRT-Connect + simplification + TOPP-RA (:mod:`planning.peers.ompl_rrt`) on the same
+  collision model (obstacles and self pairs), 1 s per attempt, new seeds up to ``--timeout``.
+
+Both are verified by the same certified checks. Printed per class: problems whose start and
+goal are valid in our model, solved by each, median and p95 warm planning time of each and
+the ratio of the medians, ours' median duration over Ruckig's jerk-limited bound for the
+straight line, OMPL's median jerk over the limit. Rows go to ``DIR/mbm.csv``. Needs the
+``bench`` extra; the problems are downloaded once (:mod:`planning.io.mbm`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import multiprocessing
+import statistics
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import TimeoutError as FutureTimeout
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import cpr_kin as ck
+from planning.errors import NoSolutionError
+from planning.io.mbm import CLASSES, problems, vamp_resources
+from planning.io.moveit_import import RobotFiles, import_moveit, read_message, write_imported
+from planning.io.moveit_messages import MotionPlanRequest, PlanningScene
+from planning.io.scene_file import load_scene
+from planning.pipeline.problem import margin_violation
+
+_ROBOTS: dict[str, ck.Robot] = {}
+
+
+def _robot(scene_path: str) -> tuple[Any, ck.Robot]:
+    scene = load_scene(Path(scene_path))
+    assert scene.robot is not None  # an imported scene names its robot
+    key = str(scene.robot)
+    if key not in _ROBOTS:
+        from planning.pipeline.planner import warm_up
+
+        _ROBOTS[key] = scene.robot.load()
+        warm_up(_ROBOTS[key])
+    return scene, _ROBOTS[key]
+
+
+def ours(scene_path: str) -> dict[str, Any]:
+    """Our planner on one scene file, warm (in the worker): success, time, duration over Ruckig's bound."""
+    from planning.peers.ruckig_bound import free_space_bound
+    from planning.pipeline.planner import plan
+
+    scene, robot = _robot(scene_path)
+    started = time.perf_counter()
+    try:
+        result = plan(scene, robot)
+    except NoSolutionError as exc:
+        return {"ok": False, "time_s": time.perf_counter() - started, "why": str(exc)[:100]}
+    elapsed = time.perf_counter() - started
+    bound = free_space_bound(result.problem)
+    return {
+        "ok": result.verification.accepted,
+        "time_s": elapsed,
+        "duration_s": result.trajectory.duration,
+        "over_bound": result.trajectory.duration / bound,
+    }
+
+
+def warm(scene_path: str) -> None:
+    """Load the scene's robot and compile the kernels in this process (untimed)."""
+    _robot(scene_path)
+
+
+def theirs(scene_path: str, timeout_s: float) -> dict[str, Any]:
+    """OMPL's pipeline on one scene file, warm: 1 s attempts with new seeds until ``timeout_s``."""
+    from planning.peers.ompl_rrt import plan_rrt_connect
+
+    scene, robot = _robot(scene_path)
+    started = time.perf_counter()
+    seed = 0
+    while time.perf_counter() - started < timeout_s:
+        result = plan_rrt_connect(scene, robot, min(1.0, timeout_s - (time.perf_counter() - started)), seed)
+        if result.success:
+            elapsed = time.perf_counter() - started
+            return {
+                "ok": True,
+                "time_s": elapsed,
+                "duration_s": result.duration,
+                "jerk": result.jerk_over_limit,
+            }
+        seed += 1
+    return {"ok": False, "time_s": time.perf_counter() - started}
+
+
+def valid(scene_path: Path) -> str | None:
+    """Why the scene's start or goal is not valid in our model, or ``None``."""
+    scene, robot = _robot(str(scene_path))
+    world = ck.CollisionWorld(robot, scene.obstacles, allowed_pairs=scene.allowed_collisions)
+    for label, target in (("start", scene.start), ("goal", scene.goal)):
+        violation = margin_violation(world, scene, target.configuration(robot))
+        if violation is not None:
+            return f"{label} {violation}"
+    return None
+
+
+def summary(row: dict[str, Any]) -> str:
+    """One problem's outcome for the progress line."""
+    ours_text = f"ours {row.get('ours_ok')} {row.get('ours_time_s', 0):.2f} s"
+    return f"{ours_text}, ompl {row.get('ompl_ok')} {row.get('ompl_time_s', 0):.2f} s"
+
+
+def percentile(values: list[float], q: float) -> float:
+    return float(np.percentile(values, q)) if values else float("nan")
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--robots", nargs="+", default=["panda", "ur5"], choices=["panda", "ur5", "fetch"])
+    parser.add_argument("--classes", nargs="+", default=list(CLASSES), choices=list(CLASSES))
+    parser.add_argument("--limit", type=int, help="problems per class (default: all 100)")
+    parser.add_argument("--timeout", type=float, default=10.0, help="seconds per problem and planner")
+    parser.add_argument("--out", type=Path, default=Path("out/bench_mbm"))
+    args = parser.parse_args()
+    args.out.mkdir(parents=True, exist_ok=True)
+    rows: list[dict[str, Any]] = []
+    context = multiprocessing.get_context("spawn")
+    pool = ProcessPoolExecutor(1, mp_context=context)
+    for robot_name in args.robots:
+        folder = vamp_resources(robot_name)
+        files = RobotFiles(urdf=folder / f"{robot_name}.urdf", srdf=folder / f"{robot_name}.srdf")
+        chosen = list(problems(robot_name, tuple(args.classes), args.limit))
+        for number, problem in enumerate(chosen, start=1):
+            path = args.out / "scenes" / robot_name / f"{problem.name}.yaml"
+            scene_message = read_message(problem.scene, PlanningScene)
+            request = read_message(problem.request, MotionPlanRequest)
+            write_imported(import_moveit(scene_message, request, files, problem.name, (0.0, 0.0)), path)
+            row: dict[str, Any] = {
+                "robot": robot_name,
+                "class": problem.problem_class,
+                "problem": problem.index,
+            }
+            row["invalid"] = valid(path) or ""
+            if not row["invalid"]:
+                pool.submit(warm, str(path)).result()  # loaded once per robot and worker, untimed
+                future = pool.submit(ours, str(path))
+                try:
+                    row |= {f"ours_{k}": v for k, v in future.result(timeout=args.timeout).items()}
+                except FutureTimeout:
+                    row |= {"ours_ok": False, "ours_time_s": float("inf"), "ours_why": "timeout"}
+                    for process in list(getattr(pool, "_processes", {}).values()):
+                        process.kill()
+                    pool.shutdown(wait=False, cancel_futures=True)
+                    pool = ProcessPoolExecutor(1, mp_context=context)
+                row |= {f"ompl_{k}": v for k, v in theirs(str(path), args.timeout).items()}
+            rows.append(row)
+            mark = "-" if row["invalid"] else summary(row)
+            print(f"[{number}/{len(chosen)}] {robot_name} {problem.name}: {mark}", flush=True)
+    pool.shutdown(cancel_futures=True)
+    keys = sorted({k for row in rows for k in row})
+    with (args.out / "mbm.csv").open("w", newline="") as out:
+        writer = csv.DictWriter(out, fieldnames=keys)
+        writer.writeheader()
+        writer.writerows(rows)
+    print(f"\n{'robot':6s} {'class':17s} {'valid':>5s} {'ours':>4s} {'ompl':>4s}", end="")
+    print(f"  {'ours med/p95 s':>15s}  {'ompl med/p95 s':>15s}  ratio  dur/bound  ompl jerk/lim")
+    for robot_name in args.robots:
+        for problem_class in [*args.classes, "all"]:
+            group = [r for r in rows if r["robot"] == robot_name and problem_class in ("all", r["class"])]
+            group = [r for r in group if not r["invalid"]]
+            if not group:
+                continue
+            mine = [r["ours_time_s"] for r in group if r.get("ours_ok")]
+            peer = [r["ompl_time_s"] for r in group if r.get("ompl_ok")]
+            bounds = [r["ours_over_bound"] for r in group if r.get("ours_ok")]
+            jerks = [r["ompl_jerk"] for r in group if r.get("ompl_ok")]
+            ratio = statistics.median(mine) / statistics.median(peer) if mine and peer else float("nan")
+            print(
+                f"{robot_name:6s} {problem_class:17s} {len(group):5d} {len(mine):4d} {len(peer):4d}  "
+                f"{percentile(mine, 50):6.2f} / {percentile(mine, 95):6.2f}  "
+                f"{percentile(peer, 50):6.2f} / {percentile(peer, 95):6.2f}"
+                f"  {ratio:5.2f}  {percentile(bounds, 50):9.3f}  {percentile(jerks, 50):13.1f}"
+            )
+    print(f"\nrows: {args.out / 'mbm.csv'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
