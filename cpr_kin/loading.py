@@ -38,7 +38,7 @@ from cpr_kin.errors import UrdfError
 from cpr_kin.limits import LIMITS_NAMES, JointLimits, find_limits_file, read_dynamic_limits
 from cpr_kin.packages import package_roots
 from cpr_kin.robot import GROUPS, Robot, RobotGeometry, joint_units
-from cpr_kin.self_collision import find_srdf, read_srdf, self_pairs
+from cpr_kin.self_collision import SrdfPairs, find_srdf, read_srdf, self_pairs
 from cpr_kin.supported import check_joints, check_limits, check_names
 from cpr_kin.urdf_file import (
     collision_names,
@@ -130,7 +130,7 @@ class RobotSpec:
         convex_hulls(collision)
         srdf = self.srdf or find_srdf(path, tree.getroot().get("name")) or self.default_srdf
         links = {f.name for f in model.frames}
-        disabled = read_srdf(srdf, links) if srdf is not None else frozenset()
+        srdf_pairs = read_srdf(srdf, links) if srdf is not None else SrdfPairs(frozenset())
         effector = set(self.effector_links) if self.effector_links is not None else _carried_alone(model, tcp)
         geometries = _geometries(model, collision, collision_names(tree), effector)
         for group in GROUPS:
@@ -150,7 +150,8 @@ class RobotSpec:
             limits_defaulted=dynamic.defaulted,
             held=held,
             srdf_path=srdf,
-            self_pairs=self_pairs(model, collision, disabled),
+            self_pairs=self_pairs(model, collision, srdf_pairs.disabled),
+            srdf_unknown_links=srdf_pairs.unknown_links,
         )
 
     def _planned(self, model: Any, tree: etree._ElementTree, path: Path, arm: ArmChain) -> tuple[str, ...]:

@@ -70,6 +70,7 @@ class Robot:
         srdf_path: the SRDF whose ``disable_collisions`` were applied, if any.
         self_pairs: indices of the collision geometry pairs checked against each other
             (:mod:`cpr_kin.self_collision`); empty: the robot cannot meet itself.
+        srdf_unknown_links: links the SRDF names that the URDF lacks (their entries skipped).
 
     """
 
@@ -87,6 +88,7 @@ class Robot:
     held: Mapping[str, float] = field(default_factory=dict)
     srdf_path: Path | None = None
     self_pairs: tuple[tuple[int, int], ...] = ()
+    srdf_unknown_links: tuple[str, ...] = ()
 
     @cached_property
     def visual_model(self) -> Any:

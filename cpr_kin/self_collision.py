@@ -56,11 +56,25 @@ def find_srdf(urdf_path: Path, robot_name: str | None = None) -> Path | None:
     return None
 
 
-def read_srdf(path: Path, links: Iterable[str]) -> frozenset[LinkPair]:
-    """The link pairs an SRDF's ``<disable_collisions link1 link2>`` lists.
+@dataclass(frozen=True)
+class SrdfPairs:
+    """The ``<disable_collisions>`` of an SRDF.
+
+    Attributes:
+        disabled: the link pairs it disables, both links known to the URDF.
+        unknown_links: links it names that the URDF lacks; their entries are skipped, as
+            MoveIt skips them (with a warning), and the loaded robot reports them.
+    """
+
+    disabled: frozenset[LinkPair]
+    unknown_links: tuple[str, ...] = ()
+
+
+def read_srdf(path: Path, links: Iterable[str]) -> SrdfPairs:
+    """The link pairs an SRDF's ``<disable_collisions link1 link2>`` lists (:class:`SrdfPairs`).
 
     Raises:
-        UrdfError: the file is unreadable or not XML, or names a link the robot lacks.
+        UrdfError: the file is unreadable or not XML.
     """
     parser = etree.XMLParser(recover=False, resolve_entities=False, no_network=True)
     try:
@@ -71,13 +85,14 @@ def read_srdf(path: Path, links: Iterable[str]) -> frozenset[LinkPair]:
         raise UrdfError(str(exc)) from None
     known = set(links)
     pairs = set()
+    unknown: set[str] = set()
     for element in root.iter("disable_collisions"):
         pair = (element.get("link1", ""), element.get("link2", ""))
-        unknown = [link for link in pair if link not in known]
-        if unknown:
-            raise UrdfError(f"SRDF file '{path}': disable_collisions names link(s) {unknown} the URDF lacks")
-        pairs.add(frozenset(pair))
-    return frozenset(pairs)
+        missing = {link for link in pair if link not in known}
+        unknown |= missing
+        if not missing:
+            pairs.add(frozenset(pair))
+    return SrdfPairs(frozenset(pairs), tuple(sorted(unknown)))
 
 
 def self_pairs(

@@ -67,11 +67,14 @@ def main() -> int:
                 robot if robot is not None and robot.joint_names == scene.robot.joints else scene.robot.load()
             )
             world = ck.CollisionWorld(robot, scene.obstacles, allowed_pairs=scene.allowed_collisions)
-            problems_here = [
-                f"{label} {reason(violation)}"
-                for label, target in (("start", scene.start), ("goal", scene.goal))
-                if (violation := margin_violation(world, scene, target.configuration(robot))) is not None
-            ]
+            try:
+                problems_here = [
+                    f"{label} {reason(violation)}"
+                    for label, target in (("start", scene.start), ("goal", scene.goal))
+                    if (violation := margin_violation(world, scene, target.configuration(robot))) is not None
+                ]
+            except ck.CprKinError as exc:
+                problems_here = [f"{exc}"[:100]]
             counts["valid"] += not problems_here
             for text in problems_here:
                 counts[text] += 1

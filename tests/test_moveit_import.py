@@ -103,7 +103,7 @@ def test_shapes_poses_and_the_matrix_follow_moveits_conventions(
     assert main(["import-moveit", *write(tmp_path, SCENE, REQUEST), "--out", str(out)]) == 0
     printed = capsys.readouterr().out
     assert "4 obstacle(s), 7 planned joints, a 'q' goal, 1 allowed link pair(s)" in printed
-    assert "request.planner_id; request.allowed_planning_time" in printed  # said, not dropped silently
+    assert "left out or adjusted: request.planner_id; request.allowed_planning_time" in printed  # said
     scene = load_scene(out)
     box, cylinder, sphere, cone = scene.obstacles
     assert [o.name for o in scene.obstacles] == ["post_0", "post_1", "lamp_0", "lamp_1"]
@@ -195,6 +195,17 @@ def test_a_pose_goal_becomes_a_pose_with_the_regions_tolerance(tmp_path: Path) -
         scene.goal.pose is not None and scene.goal.tolerance_m == 0.002 and scene.goal.tolerance_rad == 0.01
     )
     np.testing.assert_allclose(scene.goal.pose[1], np.diag([1.0, -1.0, -1.0]), atol=1e-12)
+
+
+def test_a_value_a_hair_beyond_its_range_is_moved_onto_it_and_said(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    request = changed(REQUEST, "start_state.joint_state.position", [2.89735, *READY[1:]])  # range +-2.8973
+    out = tmp_path / "edge.yaml"
+    assert main(["import-moveit", *write(tmp_path, SCENE, request), "--out", str(out)]) == 0
+    assert "panda_joint1 = 2.89735 moved onto its range [-2.8973, 2.8973]" in capsys.readouterr().out
+    start = load_scene(out).start.q
+    assert isinstance(start, dict) and start["panda_joint1"] == 2.8973
 
 
 def changed(document: dict[str, Any], dotted: str, value: Any) -> dict[str, Any]:

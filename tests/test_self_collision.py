@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -35,7 +36,7 @@ def test_the_cpr_cannot_meet_itself(robot: ck.Robot) -> None:
     every = self_pairs(robot.model, robot.collision_model, frozenset())
     links = [g.link for g in robot.geometries]
     assert len(every) == 10
-    disabled = read_srdf(robot.srdf_path, {f.name for f in robot.model.frames})
+    disabled = read_srdf(robot.srdf_path, {f.name for f in robot.model.frames}).disabled
     assert {frozenset((links[a], links[b])) for a, b in every} == disabled
     q = np.random.default_rng(3).uniform(robot.limits.lower, robot.limits.upper, (5000, robot.nq))
     for a, b in every:
@@ -47,12 +48,17 @@ def test_the_cpr_cannot_meet_itself(robot: ck.Robot) -> None:
             assert closest > 0.05, pair
 
 
-def test_the_srdf_is_read_strictly(tmp_path: Path, robot: ck.Robot) -> None:
+def test_the_srdf_skips_unknown_links_as_moveit_does_and_says_so(tmp_path: Path, robot: ck.Robot) -> None:
     links = {f.name for f in robot.model.frames}
     bad = tmp_path / "bad.srdf"
-    bad.write_text('<robot><disable_collisions link1="arm_link" link2="elbow"/></robot>')
-    with pytest.raises(ck.UrdfError, match=r"names link\(s\) \['elbow'\] the URDF lacks"):
-        read_srdf(bad, links)
+    bad.write_text(
+        '<robot><disable_collisions link1="arm_link" link2="elbow"/>'
+        '<disable_collisions link1="arm_link" link2="base_link"/></robot>'
+    )
+    pairs = read_srdf(bad, links)
+    assert pairs.disabled == {frozenset(("arm_link", "base_link"))} and pairs.unknown_links == ("elbow",)
+    loaded = dataclasses.replace(ck.cpr_spec(robot.urdf_path), srdf=bad).load()
+    assert loaded.srdf_unknown_links == ("elbow",) and loaded.srdf_path == bad
     bad.write_text("<robot><disable_collisions")
     with pytest.raises(ck.UrdfError, match="is not well-formed XML"):
         read_srdf(bad, links)

@@ -33,10 +33,5 @@ def cmd_import_moveit(args: argparse.Namespace) -> int:
         )
     )
     if imported.ignored:
-        print(
-            escaped(
-                "ignored (MoveIt's planner settings, or joints the URDF does not move): "
-                + "; ".join(imported.ignored)
-            )
-        )
+        print(escaped("left out or adjusted: " + "; ".join(imported.ignored)))
     return EXIT_OK

@@ -4,6 +4,8 @@
   request's ``group_name`` in the SRDF, the tool frame the link a pose goal names.
 - **Start:** the scene's robot state, with the request's start state over it; values of joints
   the URDF holds go to ``fixed``; values of joints the URDF does not move are listed as ignored.
+  Continuous joints' values are wrapped, values a hair beyond a range moved onto it and listed
+  (:mod:`planning.io.moveit_state`).
 - **Goal:** one ``Constraints``: joint constraints on every planned joint (``q``), or a position
   constraint (a sphere or box region: its centre, and its radius or smallest half side as the
   tolerance) with or without an orientation constraint on the same link (the smallest axis
@@ -36,8 +38,9 @@ from cpr_kin.srdf_groups import group_joints
 from cpr_kin.urdf_file import parse_urdf
 from cpr_kin.user_files import load_yaml
 from planning.io.moveit_goal import goal_entry
-from planning.io.moveit_messages import Constraints, MotionPlanRequest, PlanningScene, RobotState
+from planning.io.moveit_messages import Constraints, MotionPlanRequest, PlanningScene
 from planning.io.moveit_objects import MoveItImportError, convert_object
+from planning.io.moveit_state import joint_values, position_ranges, within_ranges, wrapped
 from planning.io.publish import write_file
 from planning.validation import describe_validation
 
@@ -70,7 +73,7 @@ class ImportedScene:
         document: the scene file's document (absolute paths; :func:`write_imported` makes
             them relative to the file).
         meshes: mesh files the obstacles name, by file name.
-        ignored: what the conversion left out, each in a few words.
+        ignored: what the conversion left out or adjusted, each in a few words.
     """
 
     document: dict[str, Any]
@@ -85,18 +88,6 @@ def read_message(path: Path, model: type[Model]) -> Model:
         return model.model_validate(data if data is not None else {})
     except ValidationError as exc:
         raise MoveItImportError(f"{path}: {describe_validation(exc)}") from None
-
-
-def _joint_values(*states: RobotState) -> dict[str, float]:
-    values: dict[str, float] = {}
-    for state in states:
-        joint_state = state.joint_state
-        if len(joint_state.position) != len(joint_state.name):
-            raise MoveItImportError(
-                f"joint_state has {len(joint_state.name)} names and {len(joint_state.position)} positions"
-            )
-        values.update(zip(joint_state.name, joint_state.position, strict=True))
-    return values
 
 
 def _refuse_unsupported(scene: PlanningScene, request: MotionPlanRequest) -> list[str]:
@@ -158,7 +149,13 @@ def import_moveit(
     )
     goal, tcp = goal_entry(request, planned)
     movable = {j.get("name", "") for j in tree.getroot().findall("joint") if j.get("type") != "fixed"}
-    values = _joint_values(scene.robot_state, request.start_state)
+    continuous = {j.get("name", "") for j in tree.getroot().findall("joint") if j.get("type") == "continuous"}
+    ranges = position_ranges(tree)
+    values = within_ranges(
+        wrapped(joint_values(scene.robot_state, request.start_state), continuous), ranges, ignored
+    )
+    if "q" in goal:
+        goal = {**goal, "q": within_ranges(wrapped(goal["q"], continuous), ranges, ignored)}
     missing = [j for j in planned if j not in values]
     if missing:
         raise MoveItImportError(f"the start state gives no value for the planned joint(s) {missing}")

@@ -142,7 +142,7 @@ def report_markdown(result: PlanResult, paper: bool = False) -> str:
 
 
 def limits_section(result: PlanResult) -> list[str]:
-    """``report.md``'s lines on limits that are defaults, and joints held; none when neither."""
+    """``report.md``'s lines on limits that are defaults, joints held and SRDF entries skipped; or none."""
     from cpr_kin.limits import DEFAULT_ACCELERATION_PER_S, DEFAULT_JERK_PER_S
 
     robot, lines = result.robot, []
@@ -157,6 +157,13 @@ def limits_section(result: PlanResult) -> list[str]:
     if robot.held:
         held = ", ".join(f"{name} = {value:g}" for name, value in robot.held.items())
         lines += [f"Held (not planned): {held}.", ""]
+    if robot.srdf_unknown_links:
+        lines += [
+            f"The SRDF `{robot.srdf_path}` names links the URDF lacks "
+            f"({', '.join(robot.srdf_unknown_links)}): their disable_collisions entries were skipped, "
+            "as MoveIt skips them.",
+            "",
+        ]
     return lines
 
 

@@ -1,0 +1,66 @@
+"""A MoveIt robot state's joint values as a scene file's: merged, wrapped, and onto their ranges.
+
+A continuous joint's value is turned into [-pi, pi] rad, the range it is planned in. A value
+at most :data:`BOUNDS_TOLERANCE` beyond a joint's URDF range is moved onto it and noted, as
+MoveIt's start-state bounds fixing does (which allows 0.05 rad); farther, it is left for the
+scene's own check to refuse, naming the joint.
+"""
+
+from __future__ import annotations
+
+import math
+
+from lxml import etree
+
+from planning.io.moveit_messages import RobotState
+from planning.io.moveit_objects import MoveItImportError
+
+
+def joint_values(*states: RobotState) -> dict[str, float]:
+    """The joint values of ``states``, a later state's over an earlier one's.
+
+    Raises:
+        MoveItImportError: a joint state with more names than positions, or fewer.
+    """
+    values: dict[str, float] = {}
+    for state in states:
+        joint_state = state.joint_state
+        if len(joint_state.position) != len(joint_state.name):
+            raise MoveItImportError(
+                f"joint_state has {len(joint_state.name)} names and {len(joint_state.position)} positions"
+            )
+        values.update(zip(joint_state.name, joint_state.position, strict=True))
+    return values
+
+
+def wrapped(values: dict[str, float], continuous: set[str]) -> dict[str, float]:
+    """``values`` with those of ``continuous`` joints turned into [-pi, pi] rad, where they are planned."""
+    return {j: math.remainder(v, math.tau) if j in continuous else v for j, v in values.items()}
+
+
+BOUNDS_TOLERANCE = 1e-4
+"""A joint value this far [rad or m] beyond its URDF range is moved onto it (MoveIt's start-state
+bounds fixing allows 0.05 rad); farther, it is left for the scene's check to refuse."""
+
+
+def position_ranges(tree: etree._ElementTree) -> dict[str, tuple[float, float]]:
+    """The URDF's position limits of its revolute and prismatic joints."""
+    ranges = {}
+    for joint in tree.getroot().findall("joint"):
+        limit = joint.find("limit")
+        if joint.get("type") in ("revolute", "prismatic") and limit is not None:
+            ranges[joint.get("name", "")] = (float(limit.get("lower", 0.0)), float(limit.get("upper", 0.0)))
+    return ranges
+
+
+def within_ranges(
+    values: dict[str, float], ranges: dict[str, tuple[float, float]], notes: list[str]
+) -> dict[str, float]:
+    """``values``, those within :data:`BOUNDS_TOLERANCE` beyond their range moved onto it (and noted)."""
+    moved = {}
+    for name, value in values.items():
+        low, high = ranges.get(name, (-math.inf, math.inf))
+        if low - BOUNDS_TOLERANCE <= value < low or high < value <= high + BOUNDS_TOLERANCE:
+            moved[name] = min(max(value, low), high)
+            notes.append(f"{name} = {value!r} moved onto its range [{low:g}, {high:g}]")
+    return values | moved
