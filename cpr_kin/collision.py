@@ -101,7 +101,7 @@ class CollisionWorld:
         links = [g.link for g in robot.geometries]
         kept = tuple((a, b) for a, b in robot.self_pairs if frozenset((links[a], links[b])) not in allowed)
         names = [g.name for g in robot.geometries]
-        self.self_collision = SelfCollision(robot.model, robot.collision_model, kept, names)
+        self.self_collision = SelfCollision(robot.model, robot.collision_model, kept, names, self.num_threads)
 
     @property
     def pairs(self) -> tuple[tuple[str, str, str], ...]:

@@ -130,8 +130,11 @@ def test_same_generator_seed_same_path() -> None:
 
 
 @pytest.mark.parametrize("step_m", [None, 0.1])
-def test_an_extension_is_at_most_one_step(step_m: float | None) -> None:
+def test_an_extension_is_at_most_one_step(step_m: float | None, monkeypatch: pytest.MonkeyPatch) -> None:
     """The default step is a fifth of the box's diagonal in the weighted motion bound."""
+    import planning.search.edges
+
+    monkeypatch.setattr(planning.search.edges, "COARSE_STRIDE", 1)  # one batch per call: all, in order
     weights = np.array([2.0, 0.5])
     batches: list[NDArray[np.float64]] = []
 
