@@ -26,10 +26,10 @@ def exhaustive(a: np.ndarray, b: np.ndarray, weights: np.ndarray, resolution_m: 
 def test_the_free_fractions_are_those_of_checking_every_configuration() -> None:
     rng = np.random.default_rng(3)
     weights = np.array([1.0, 2.0])
-    edges = Edges(discs, weights, 0.005)
+    edges = Edges(discs, weights, 0.002)  # long edges: hundreds of configurations, checked coarse to fine
     pairs = [(a, b) for a, b in rng.uniform(0, 1, (200, 2, 2)) if discs(a[None])[0]]
     found = edges.free_fractions(pairs)
-    assert found == [exhaustive(a, b, weights, 0.005) for a, b in pairs]
+    assert found == [exhaustive(a, b, weights, 0.002) for a, b in pairs]
     assert 0 < sum(f < 1 for f in found) < len(found)  # some edges blocked, some free
-    every = sum(max(1, math.ceil(float(np.abs(b - a) @ weights) / 0.005)) for a, b in pairs)
+    every = sum(max(1, math.ceil(float(np.abs(b - a) @ weights) / 0.002)) for a, b in pairs)
     assert edges.checks < every  # blocked edges were not checked past their obstacle

@@ -134,7 +134,7 @@ def test_an_extension_is_at_most_one_step(step_m: float | None, monkeypatch: pyt
     """The default step is a fifth of the box's diagonal in the weighted motion bound."""
     import planning.search.edges
 
-    monkeypatch.setattr(planning.search.edges, "COARSE_STRIDE", 1)  # one batch per call: all, in order
+    monkeypatch.setattr(planning.search.edges, "WHOLE_BELOW", 10**9)  # one batch per call: all, in order
     weights = np.array([2.0, 0.5])
     batches: list[NDArray[np.float64]] = []
 

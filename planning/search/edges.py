@@ -5,9 +5,10 @@ an edge is checked as OMPL checks a motion, at configurations a fixed robot moti
 (``resolution_m``, a motion bound ``sum_j R_j |dq_j|`` [m] with per-joint weights), but every
 edge of a call in batched calls to the validity check, which is what makes it fast in
 Python: a coarse pass over every edge, then the rest of each edge up to where the coarse pass
-found it blocked (OMPL stops at a motion's first invalid state in the same spirit). The same checks shorten a found path: random shortcuts (a straight edge between two
-points on it replaces what lies between when it is valid), then skipping vertices (from each
-vertex straight to the farthest one it sees), then dropping collinear vertices.
+found it blocked (OMPL stops at a motion's first invalid state in the same spirit). The same
+checks shorten a found path: random shortcuts (a straight edge between two points on it
+replaces what lies between when it is valid), then skipping vertices (from each vertex
+straight to the farthest one it sees), then dropping collinear vertices.
 """
 
 from __future__ import annotations
@@ -24,6 +25,10 @@ Validity = Callable[[FloatArray], BoolArray]
 """``(N, d) -> (N,)``: whether each configuration is valid (clear of the margin)."""
 COARSE_STRIDE = 8
 """Configurations an edge's coarse pass steps over (:meth:`Edges.free_fractions`)."""
+WHOLE_BELOW = 128
+"""Edges of fewer configurations are checked whole in the first pass: a second call of the
+validity check would cost more than it saves (a 5-joint arm's edges have 16-100; a 7-joint
+arm's, whose joints move points farther, hundreds)."""
 
 
 class Edges:
@@ -37,47 +42,53 @@ class Edges:
         return self.free_fractions([(a, b)])[0]
 
     def free_fractions(self, edges: list[tuple[FloatArray, FloatArray]]) -> list[float]:
-        """:meth:`free_fraction` of each edge, checked coarse to fine in two calls of the validity check.
+        """:meth:`free_fraction` of each edge, coarse to fine in at most two calls of the validity check.
 
-        Every :data:`COARSE_STRIDE`-th configuration of every edge first (and its end); then, of
-        each edge, the others up to its first invalid one of those: an edge that hits an
-        obstacle is not checked beyond it. The answer is that of checking every configuration.
+        Every :data:`COARSE_STRIDE`-th configuration of every edge first (and its end; an edge
+        of fewer than :data:`WHOLE_BELOW` configurations whole); then, of each edge, the others
+        up to its first invalid one of those: an edge that hits an obstacle is not checked
+        beyond it. The answer is that of checking every configuration.
         """
-        fractions = [
-            np.arange(1, count + 1) / count
-            for count in (
-                max(1, math.ceil(float(np.abs(b - a) @ self.weights) / self.resolution_m)) for a, b in edges
-            )
+        counts = [
+            max(1, math.ceil(float(np.abs(b - a) @ self.weights) / self.resolution_m)) for a, b in edges
         ]
-        coarse = [
-            np.union1d(np.arange(COARSE_STRIDE - 1, len(f), COARSE_STRIDE), [len(f) - 1]) for f in fractions
-        ]
+        fractions = [np.arange(1, count + 1) / count for count in counts]
         points = [a + f[:, None] * (b - a) for (a, b), f in zip(edges, fractions, strict=True)]
-        ok = [np.ones(len(f), dtype=bool) for f in fractions]
+        coarse = []
+        for count in counts:
+            rows = np.ones(count, dtype=bool)
+            if count >= WHOLE_BELOW:
+                rows[:] = False
+                rows[COARSE_STRIDE - 1 :: COARSE_STRIDE] = True
+                rows[-1] = True
+            coarse.append(rows)
+        ok = [np.ones(count, dtype=bool) for count in counts]
         self._check(points, coarse, ok)
         fine = []
-        for f, rows, part in zip(fractions, coarse, ok, strict=True):
-            bad = rows[~part[rows]]
-            stop = int(bad[0]) if bad.size else len(f)  # nothing past the first invalid coarse one matters
-            fine.append(np.setdiff1d(np.arange(stop), rows, assume_unique=True))
-        self._check(points, fine, ok)
+        for rows, part in zip(coarse, ok, strict=True):
+            rest = ~rows
+            if rest.any():
+                blocked = np.flatnonzero(~part)
+                if blocked.size:
+                    rest[blocked[0] :] = False  # nothing past the first invalid coarse one matters
+            fine.append(rest)
+        if any(rest.any() for rest in fine):
+            self._check(points, fine, ok)
         found = []
-        for f, part in zip(fractions, ok, strict=True):
-            first_bad = len(f) if part.all() else int(np.argmin(part))
-            found.append(1.0 if first_bad == len(f) else 0.0 if first_bad == 0 else float(f[first_bad - 1]))
+        for count, f, part in zip(counts, fractions, ok, strict=True):
+            first_bad = count if part.all() else int(np.argmin(part))
+            found.append(1.0 if first_bad == count else 0.0 if first_bad == 0 else float(f[first_bad - 1]))
         return found
 
-    def _check(self, points: list[FloatArray], rows: list[NDArray[np.intp]], ok: list[BoolArray]) -> None:
+    def _check(self, points: list[FloatArray], rows: list[BoolArray], ok: list[BoolArray]) -> None:
         """Check ``points[k][rows[k]]`` of every edge ``k`` in one call; write the answers into ``ok``."""
-        batch = [p[r] for p, r in zip(points, rows, strict=True) if r.size]
-        if not batch:
-            return
-        answers = self.valid(np.concatenate(batch))
+        answers = self.valid(np.concatenate([p[r] for p, r in zip(points, rows, strict=True)]))
         self.checks += len(answers)
         offset = 0
         for part, r in zip(ok, rows, strict=True):
-            part[r] = answers[offset : offset + r.size]
-            offset += r.size
+            size = int(np.count_nonzero(r))
+            part[r] = answers[offset : offset + size]
+            offset += size
 
 
 def shortcut(path: FloatArray, edges: Edges, rng: np.random.Generator, attempts: int) -> FloatArray:
