@@ -19,7 +19,8 @@ Loading, in order:
 6. every mesh of the collision model becomes its convex hull, which contains it (a clearance
    to the hull is at most the clearance to the mesh: safe) and gives coal signed distances;
 7. the collision geometries form two groups: ``effector`` (the links given, by default those
-   the last planned joint before the tool frame moves alone) and ``links`` (the rest).
+   the last planned joint before the tool frame moves alone, or the nearest joint above it
+   whose links have collision geometry) and ``links`` (the rest).
 """
 
 from __future__ import annotations
@@ -131,7 +132,11 @@ class RobotSpec:
         srdf = self.srdf or find_srdf(path, tree.getroot().get("name")) or self.default_srdf
         links = {f.name for f in model.frames}
         srdf_pairs = read_srdf(srdf, links) if srdf is not None else SrdfPairs(frozenset())
-        effector = set(self.effector_links) if self.effector_links is not None else _carried_alone(model, tcp)
+        effector = (
+            set(self.effector_links)
+            if self.effector_links is not None
+            else _carried_alone(model, collision, tcp)
+        )
         geometries = _geometries(model, collision, collision_names(tree), effector)
         for group in GROUPS:
             if not any(g.group == group for g in geometries):
@@ -233,9 +238,16 @@ def _range(model: Any, joint: str) -> tuple[float, float]:
     return float(model.lowerPositionLimit[i]), float(model.upperPositionLimit[i])
 
 
-def _carried_alone(model: Any, tcp: str) -> set[str]:
-    """The links (body frames) whose parent joint is the joint that carries ``tcp``."""
+def _carried_alone(model: Any, collision: Any, tcp: str) -> set[str]:
+    """The links (body frames) of the last joint up from ``tcp`` that carries collision geometry.
+
+    The joint that carries the tool frame, or, when its links have no collision geometry (a
+    gripper described only visually, as the SO-100's), the nearest joint above it that does.
+    """
     joint = model.frames[model.getFrameId(tcp)].parentJoint
+    carriers = {obj.parentJoint for obj in collision.geometryObjects}
+    while joint > 0 and joint not in carriers:
+        joint = model.parents[joint]
     return {f.name for f in model.frames if f.type == pin.FrameType.BODY and f.parentJoint == joint}
 
 

@@ -13,8 +13,9 @@ margins 0 as in MoveIt), then, alternating, is planned warm by
 Both are verified by the same certified checks. Printed per class: problems whose start and
 goal are valid in our model, solved by each, median and p95 warm planning time of each and
 the ratio of the medians, ours' median duration over Ruckig's jerk-limited bound for the
-straight line, OMPL's median jerk over the limit. Rows go to ``DIR/mbm.csv``. Needs the
-``bench`` extra; the problems are downloaded once (:mod:`planning.io.mbm`).
+straight line, OMPL's median jerk over the limit. Rows go to ``DIR/mbm.csv``, the table as
+markdown to ``DIR/mbm.md``. Needs the ``bench`` extra; the problems are downloaded once
+(:mod:`planning.io.mbm`).
 """
 
 from __future__ import annotations
@@ -173,6 +174,14 @@ def main() -> int:
         writer.writerows(rows)
     print(f"\n{'robot':6s} {'class':17s} {'valid':>5s} {'ours':>4s} {'ompl':>4s}", end="")
     print(f"  {'ours med/p95 s':>15s}  {'ompl med/p95 s':>15s}  ratio  dur/bound  ompl jerk/lim")
+    report = [
+        f"MotionBenchMaker, {args.limit or 100} problem(s) per class, timeout {args.timeout:g} s, warm "
+        "(`scripts/bench_mbm.py`)",
+        "",
+        "| robot | class | valid | solved ours | solved OMPL | ours median (p95) [s] | OMPL median (p95) [s] "
+        "| ratio | ours duration / Ruckig bound | OMPL jerk / limit |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
     for robot_name in args.robots:
         for problem_class in [*args.classes, "all"]:
             group = [r for r in rows if r["robot"] == robot_name and problem_class in ("all", r["class"])]
@@ -190,7 +199,14 @@ def main() -> int:
                 f"{percentile(peer, 50):6.2f} / {percentile(peer, 95):6.2f}"
                 f"  {ratio:5.2f}  {percentile(bounds, 50):9.3f}  {percentile(jerks, 50):13.1f}"
             )
-    print(f"\nrows: {args.out / 'mbm.csv'}")
+            report.append(
+                f"| {robot_name} | {problem_class} | {len(group)} | {len(mine)} | {len(peer)} "
+                f"| {percentile(mine, 50):.2f} ({percentile(mine, 95):.2f}) "
+                f"| {percentile(peer, 50):.2f} ({percentile(peer, 95):.2f}) | {ratio:.2f} "
+                f"| {percentile(bounds, 50):.3f} | {percentile(jerks, 50):.1f} |"
+            )
+    (args.out / "mbm.md").write_text("\n".join(report) + "\n")
+    print(f"\nrows: {args.out / 'mbm.csv'}; table: {args.out / 'mbm.md'}")
     return 0
 
 

@@ -128,3 +128,9 @@ def test_planned_and_held_joints_are_checked() -> None:
         "panda_finger_joint1": 0.04,
         "panda_finger_joint2": 0.04,
     }  # the mimic follows
+
+
+def test_a_tool_without_collision_geometry_leaves_the_effector_group_to_the_link_above() -> None:
+    so100 = ck.load_robot(ROBOTS / "so_arm_description/urdf/so100.urdf")  # gripper and jaw: visual only
+    assert {g.link for g in so100.geometries if g.group == "effector"} == {"wrist"}
+    assert {g.group for g in so100.geometries} == set(ck.GROUPS)
