@@ -22,6 +22,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import CprKinError, IkMissError
+from cpr_kin.motion import motion_radii
 from cpr_kin.robot import Robot
 
 FloatArray = NDArray[np.float64]
@@ -132,7 +133,7 @@ def _descend(
         error = target.position - placement.translation
         if target.rotation is not None:
             rotation_error = placement.rotation @ pin.log3(placement.rotation.T @ target.rotation)
-            error, jacobian = np.concatenate([error, rotation_error]), jacobian
+            error = np.concatenate([error, rotation_error])
         else:
             jacobian = jacobian[:3]
         jacobian = jacobian * free  # a held joint's column is zero: it does not move
@@ -171,8 +172,8 @@ def solve_ik(
     free = np.ones(robot.nq, dtype=bool)
     free[[robot.limits.index(name) for name in held]] = False
     rng = np.random.default_rng(settings.seed)
-    radii = _radii(robot)
     found: list[FloatArray] = []
+    accepted: list[FloatArray] = []  # ``accept`` asked once per solution
     closest: pin.SE3 | None = None
     frame = robot.frame_id(robot.tcp_frame)
     for draw in [seed, *rng.uniform(lower, upper, (settings.restarts, robot.nq))]:
@@ -184,19 +185,15 @@ def solve_ik(
             closest = placement
         if target.reached(placement):  # verified by forward kinematics
             found.append(q)
-            if sum(accept is None or accept(x) for x in found) >= settings.choices:
-                break
+            if accept is None or accept(q):
+                accepted.append(q)
+                if len(accepted) >= settings.choices:
+                    break
     if not found:
         assert closest is not None  # the seed is always tried
         raise IkMissError(
             f"no configuration puts frame '{robot.tcp_frame}' at {np.round(target.position, 4).tolist()} m: "
             f"the closest of {settings.restarts + 1} IK starts came {target.miss(closest)}"
         )
-    preferred = [q for q in found if accept is None or accept(q)] or found
-    return min(preferred, key=lambda q: float(radii @ np.abs(q - seed)))
-
-
-def _radii(robot: Robot) -> FloatArray:
-    from cpr_kin.motion import motion_radii
-
-    return motion_radii(robot)
+    radii = motion_radii(robot)
+    return min(accepted or found, key=lambda q: float(radii @ np.abs(q - seed)))

@@ -70,19 +70,28 @@ class SrdfPairs:
     unknown_links: tuple[str, ...] = ()
 
 
+def parse_srdf(path: Path) -> etree._Element:
+    """The root element of the SRDF file ``path``, parsed as strict XML (no entities, no network).
+
+    Raises:
+        UrdfError: the file is missing, too large or not well-formed XML.
+    """
+    parser = etree.XMLParser(recover=False, resolve_entities=False, no_network=True)
+    try:
+        return etree.fromstring(read_bytes(path, MAX_SRDF_BYTES, "SRDF file"), parser)
+    except etree.XMLSyntaxError as exc:
+        raise UrdfError(f"SRDF file '{path}' is not well-formed XML: {str(exc)[:120]}") from None
+    except CprKinError as exc:
+        raise UrdfError(str(exc)) from None
+
+
 def read_srdf(path: Path, links: Iterable[str]) -> SrdfPairs:
     """The link pairs an SRDF's ``<disable_collisions link1 link2>`` lists (:class:`SrdfPairs`).
 
     Raises:
         UrdfError: the file is unreadable or not XML.
     """
-    parser = etree.XMLParser(recover=False, resolve_entities=False, no_network=True)
-    try:
-        root = etree.fromstring(read_bytes(path, MAX_SRDF_BYTES, "SRDF file"), parser)
-    except etree.XMLSyntaxError as exc:
-        raise UrdfError(f"SRDF file '{path}' is not well-formed XML: {str(exc)[:120]}") from None
-    except CprKinError as exc:
-        raise UrdfError(str(exc)) from None
+    root = parse_srdf(path)
     known = set(links)
     pairs = set()
     unknown: set[str] = set()

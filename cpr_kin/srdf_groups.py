@@ -12,9 +12,8 @@ from pathlib import Path
 
 from lxml import etree
 
-from cpr_kin.errors import CprKinError, UrdfError
-from cpr_kin.self_collision import MAX_SRDF_BYTES
-from cpr_kin.user_files import read_bytes
+from cpr_kin.errors import UrdfError
+from cpr_kin.self_collision import parse_srdf
 
 
 @dataclass(frozen=True)
@@ -39,13 +38,7 @@ def group_joints(srdf: Path, group: str, urdf: etree._ElementTree) -> PlanningGr
         UrdfError: the SRDF is unreadable, has no such group (the message lists its groups), or
             names a joint or link the URDF lacks.
     """
-    parser = etree.XMLParser(recover=False, resolve_entities=False, no_network=True)
-    try:
-        root = etree.fromstring(read_bytes(srdf, MAX_SRDF_BYTES, "SRDF file"), parser)
-    except etree.XMLSyntaxError as exc:
-        raise UrdfError(f"SRDF file '{srdf}' is not well-formed XML: {str(exc)[:120]}") from None
-    except CprKinError as exc:
-        raise UrdfError(str(exc)) from None
+    root = parse_srdf(srdf)
     groups = {g.get("name", ""): g for g in root.findall("group")}
     joints = {j.get("name", ""): j for j in urdf.getroot().findall("joint")}
     above = {

@@ -127,7 +127,7 @@ class Target:
         """
         q = np.asarray(q, dtype=float)
         if self.q is not None:
-            wanted = robot.configuration(dict(self.q) if isinstance(self.q, Mapping) else self.q)
+            wanted = self.configuration(robot)
             gap = float(np.abs(q - wanted).max())
             return None if gap <= SAME_Q_TOLERANCE else f"{gap:.3g} away from its joint values"
         target = self.ik_target
