@@ -208,6 +208,41 @@ def test_a_value_a_hair_beyond_its_range_is_moved_onto_it_and_said(
     assert isinstance(start, dict) and start["panda_joint1"] == 2.8973
 
 
+def test_without_an_srdf_the_default_joints_load_with_the_package_dirs(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    robots = example_robot("xarm7").parents[2]
+    text = (
+        example_robot("xarm7")
+        .read_text()
+        .replace("package://example-robot-data/robots/", "package://my_arms/")
+    )
+    (tmp_path / "urdf").mkdir()
+    (tmp_path / "urdf" / "xarm7.urdf").write_text(text)
+    (tmp_path / "share").mkdir()
+    (tmp_path / "share" / "my_arms").symlink_to(robots)
+    joints = [f"joint{k}" for k in range(1, 8)]
+    scene = {"world": {"collision_objects": [SCENE["world"]["collision_objects"][1]]}}
+    request = {
+        "start_state": {"joint_state": {"name": joints, "position": [0.0] * 7}},
+        "goal_constraints": [{"joint_constraints": [{"joint_name": n, "position": 0.3} for n in joints]}],
+    }
+    (tmp_path / "scene.yaml").write_text(yaml.safe_dump(scene))
+    (tmp_path / "request.yaml").write_text(yaml.safe_dump(request))
+    files = [
+        str(tmp_path / "scene.yaml"),
+        str(tmp_path / "request.yaml"),
+        "--urdf",
+        str(tmp_path / "urdf" / "xarm7.urdf"),
+    ]
+    out = tmp_path / "xarm.yaml"
+    assert (
+        main(["import-moveit", *files, "--package-dir", str(tmp_path / "share"), "--out", str(out)]) == 0
+    ), capsys.readouterr().err
+    loaded = load_scene(out)
+    assert loaded.robot is not None and loaded.robot.joints == tuple(joints)
+
+
 def changed(document: dict[str, Any], dotted: str, value: Any) -> dict[str, Any]:
     document = copy.deepcopy(document)
     *parents, last = dotted.split(".")

@@ -23,7 +23,7 @@ steers MoveIt's own planner (planner id, attempts, time, workspace) is listed as
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -145,7 +145,7 @@ def import_moveit(
     planned = (
         group_joints(robot.srdf, request.group_name, tree).joints
         if robot.srdf is not None and request.group_name
-        else ck.RobotSpec(robot.urdf).load().joint_names
+        else replace(ck.robot_spec(robot.urdf), package_dirs=robot.package_dirs).load().joint_names
     )
     goal, tcp = goal_entry(request, planned)
     movable = {j.get("name", "") for j in tree.getroot().findall("joint") if j.get("type") != "fixed"}
