@@ -35,11 +35,8 @@ import numpy as np
 
 import cpr_kin as ck
 from planning.errors import NoSolutionError
-from planning.io.mbm import CLASSES, problems, vamp_resources
-from planning.io.moveit_import import RobotFiles, import_moveit, read_message, write_imported
-from planning.io.moveit_messages import MotionPlanRequest, PlanningScene
+from planning.io.mbm import CLASSES, endpoint_violations, import_problem, problems
 from planning.io.scene_file import load_scene
-from planning.pipeline.problem import margin_violation
 
 _ROBOTS: dict[str, ck.Robot] = {}
 
@@ -106,12 +103,7 @@ def theirs(scene_path: str, timeout_s: float) -> dict[str, Any]:
 def valid(scene_path: Path) -> str | None:
     """Why the scene's start or goal is not valid in our model, or ``None``."""
     scene, robot = _robot(str(scene_path))
-    world = ck.CollisionWorld(robot, scene.obstacles, allowed_pairs=scene.allowed_collisions)
-    for label, target in (("start", scene.start), ("goal", scene.goal)):
-        violation = margin_violation(world, scene, target.configuration(robot))
-        if violation is not None:
-            return f"{label} {violation}"
-    return None
+    return next(iter(endpoint_violations(scene, robot)), None)
 
 
 def summary(row: dict[str, Any]) -> str:
@@ -137,14 +129,10 @@ def main() -> int:
     context = multiprocessing.get_context("spawn")
     pool = ProcessPoolExecutor(1, mp_context=context)
     for robot_name in args.robots:
-        folder = vamp_resources(robot_name)
-        files = RobotFiles(urdf=folder / f"{robot_name}.urdf", srdf=folder / f"{robot_name}.srdf")
         chosen = list(problems(robot_name, tuple(args.classes), args.limit))
         for number, problem in enumerate(chosen, start=1):
             path = args.out / "scenes" / robot_name / f"{problem.name}.yaml"
-            scene_message = read_message(problem.scene, PlanningScene)
-            request = read_message(problem.request, MotionPlanRequest)
-            write_imported(import_moveit(scene_message, request, files, problem.name, (0.0, 0.0)), path)
+            import_problem(problem, path)
             row: dict[str, Any] = {
                 "robot": robot_name,
                 "class": problem.problem_class,

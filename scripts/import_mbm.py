@@ -23,11 +23,8 @@ from pathlib import Path
 
 import cpr_kin as ck
 from planning.errors import PlanningError
-from planning.io.mbm import CLASSES, problems, vamp_resources
-from planning.io.moveit_import import RobotFiles, import_moveit, read_message, write_imported
-from planning.io.moveit_messages import MotionPlanRequest, PlanningScene
+from planning.io.mbm import CLASSES, endpoint_violations, import_problem, problems
 from planning.io.scene_file import load_scene
-from planning.pipeline.problem import margin_violation
 
 
 def reason(text: str) -> str:
@@ -44,8 +41,6 @@ def main() -> int:
     args = parser.parse_args()
     out = args.out or Path(tempfile.mkdtemp(prefix="mbm-"))
     for robot_name in args.robots:
-        folder = vamp_resources(robot_name)
-        files = RobotFiles(urdf=folder / f"{robot_name}.urdf", srdf=folder / f"{robot_name}.srdf")
         robot: ck.Robot | None = None
         started = time.perf_counter()
         table: dict[str, collections.Counter[str]] = collections.defaultdict(collections.Counter)
@@ -53,11 +48,7 @@ def main() -> int:
             counts = table[problem.problem_class]
             counts["problems"] += 1
             try:
-                scene_message = read_message(problem.scene, PlanningScene)
-                request = read_message(problem.request, MotionPlanRequest)
-                imported = import_moveit(scene_message, request, files, problem.name, (0.0, 0.0))
-                path = write_imported(imported, out / robot_name / f"{problem.name}.yaml")
-                scene = load_scene(path)
+                scene = load_scene(import_problem(problem, out / robot_name / f"{problem.name}.yaml"))
             except (PlanningError, ck.CprKinError) as exc:
                 counts[f"not converted: {exc}"[:120]] += 1
                 continue
@@ -66,15 +57,7 @@ def main() -> int:
             robot = (
                 robot if robot is not None and robot.joint_names == scene.robot.joints else scene.robot.load()
             )
-            world = ck.CollisionWorld(robot, scene.obstacles, allowed_pairs=scene.allowed_collisions)
-            try:
-                problems_here = [
-                    f"{label} {reason(violation)}"
-                    for label, target in (("start", scene.start), ("goal", scene.goal))
-                    if (violation := margin_violation(world, scene, target.configuration(robot))) is not None
-                ]
-            except ck.CprKinError as exc:
-                problems_here = [f"{exc}"[:100]]
+            problems_here = [reason(text) for text in endpoint_violations(scene, robot)]
             counts["valid"] += not problems_here
             for text in problems_here:
                 counts[text] += 1

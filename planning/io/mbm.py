@@ -19,8 +19,13 @@ import urllib.request
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
+import cpr_kin as ck
 from planning.errors import PlanningError
+
+if TYPE_CHECKING:
+    from planning.pipeline.scene import Scene
 
 VERSION = "0.6.4"
 SDIST = f"vamp_planner-{VERSION}.tar.gz"
@@ -120,3 +125,41 @@ def problems(robot: str, classes: tuple[str, ...] = CLASSES, limit: int | None =
             index = int(request.stem.removeprefix("request"))
             scene = request.with_name(f"scene{index:04d}.yaml")
             yield Problem(robot, problem_class, index, scene, request)
+
+
+def import_problem(problem: Problem, out: Path) -> Path:
+    """Write ``problem`` as the scene file ``out`` as ``cpr-plan import-moveit`` does, margins 0 as in MoveIt.
+
+    The robot is vamp-planner's (its URDF and SRDF beside the problems).
+
+    Raises:
+        MoveItImportError: what the conversion cannot represent; SceneError, cpr_kin.UrdfError.
+    """
+    from planning.io.moveit_import import RobotFiles, import_moveit, read_message, write_imported
+    from planning.io.moveit_messages import MotionPlanRequest, PlanningScene
+
+    folder = vamp_resources(problem.robot)
+    files = RobotFiles(urdf=folder / f"{problem.robot}.urdf", srdf=folder / f"{problem.robot}.srdf")
+    scene = read_message(problem.scene, PlanningScene)
+    request = read_message(problem.request, MotionPlanRequest)
+    return write_imported(import_moveit(scene, request, files, problem.name, (0.0, 0.0)), out)
+
+
+def endpoint_violations(scene: Scene, robot: ck.Robot) -> list[str]:
+    """Why the scene's start and goal are not valid in ``robot``'s collision model (empty: both are).
+
+    Each is ``"<start|goal> <what>"``: a joint value out of range, or what comes inside the
+    safety or self margin (:func:`planning.pipeline.problem.margin_violation`).
+    """
+    from planning.pipeline.problem import margin_violation
+
+    world = ck.CollisionWorld(robot, scene.obstacles, allowed_pairs=scene.allowed_collisions)
+    found = []
+    for label, target in (("start", scene.start), ("goal", scene.goal)):
+        try:
+            violation = margin_violation(world, scene, target.configuration(robot))
+        except ck.CprKinError as exc:
+            violation = f"is refused: {exc}"
+        if violation is not None:
+            found.append(f"{label} {violation}")
+    return found
