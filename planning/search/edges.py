@@ -13,6 +13,7 @@ straight to the farthest one it sees), then dropping collinear vertices.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable
 
@@ -54,6 +55,21 @@ class Edges:
         ]
         fractions = [np.arange(1, count + 1) / count for count in counts]
         points = [a + f[:, None] * (b - a) for (a, b), f in zip(edges, fractions, strict=True)]
+        if max(counts) < WHOLE_BELOW:  # every edge whole, in one call (no masks: this is the hot path)
+            answers = self.valid(np.concatenate(points))
+            self.checks += len(answers)
+            bounds = np.cumsum([0, *counts])
+            ok = [answers[start:stop] for start, stop in itertools.pairwise(bounds)]
+        else:
+            ok = self._coarse_to_fine(points, counts)
+        found = []
+        for count, f, part in zip(counts, fractions, ok, strict=True):
+            first_bad = count if part.all() else int(np.argmin(part))
+            found.append(1.0 if first_bad == count else 0.0 if first_bad == 0 else float(f[first_bad - 1]))
+        return found
+
+    def _coarse_to_fine(self, points: list[FloatArray], counts: list[int]) -> list[BoolArray]:
+        """Each edge's validity, checked up to its first invalid configuration (module docstring)."""
         coarse = []
         for count in counts:
             rows = np.ones(count, dtype=bool)
@@ -74,11 +90,7 @@ class Edges:
             fine.append(rest)
         if any(rest.any() for rest in fine):
             self._check(points, fine, ok)
-        found = []
-        for count, f, part in zip(counts, fractions, ok, strict=True):
-            first_bad = count if part.all() else int(np.argmin(part))
-            found.append(1.0 if first_bad == count else 0.0 if first_bad == 0 else float(f[first_bad - 1]))
-        return found
+        return ok
 
     def _check(self, points: list[FloatArray], rows: list[BoolArray], ok: list[BoolArray]) -> None:
         """Check ``points[k][rows[k]]`` of every edge ``k`` in one call; write the answers into ``ok``."""
