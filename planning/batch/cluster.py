@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import contextlib
 import ipaddress
+import logging
 import uuid
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
@@ -176,6 +177,9 @@ def run_on_cluster(
                     item = BatchItem.failed(name, "error", f"{type(exc).__name__}: {shown(str(exc))}")
                 record(index, item)
         except BaseException:
+            # a Ctrl-C inside distributed's sync() leaves a loop callback that fails later on a
+            # missing future, and tornado would print its traceback over the one-line message
+            logging.getLogger("tornado.application").setLevel(logging.CRITICAL)
             client.cancel([f for f, i in futures.items() if i not in recorded])
             published = {item.scene: item for item in gate.stop(client)}
             for index, (path, _) in enumerate(tasks):
