@@ -19,7 +19,7 @@ EXTRAS := dev,bench,robots
 # trajectory optimisation; its RRT needs none of that: it is installed without its pins
 PYROBOPLAN := pyroboplan>=1.3.1
 
-.PHONY: demo test test-fast lint format wheel-check test-latest lock bench bench-peers import-mbm bench-mbm clean
+.PHONY: demo test test-fast lint format wheel-check test-latest lock bench bench-peers import-mbm bench-mbm bench-torque clean
 
 $(STAMP): pyproject.toml $(CONSTRAINTS)
 	$(PYTHON) -m venv $(VENV)
@@ -85,6 +85,9 @@ import-mbm: $(STAMP)
 
 bench-mbm: $(STAMP)
 	$(PY) scripts/bench_mbm.py --out out/bench_mbm
+
+bench-torque: $(STAMP)
+	$(PY) scripts/bench_torque.py --out out/bench_torque
 
 clean:
 	rm -rf $(VENV) .venv-latest build *.egg-info .pytest_cache .mypy_cache .ruff_cache

@@ -3,6 +3,7 @@
 from .clearance import BatchClearance, Clearance, PairDistance
 from .collision import CollisionWorld
 from .cpr import CPR_JOINTS, TCP_FRAME, cpr_spec, load_cpr, robot_spec
+from .dynamics import Dynamics, Payload, robot_dynamics
 from .errors import CprKinError, IkMissError, JointLimitError, ObstacleError, UnreachableError, UrdfError
 from .ik import tcp_ik
 from .kinematics import frame_poses, frame_positions
@@ -24,6 +25,7 @@ __all__ = [
     "CollisionWorld",
     "CprKinError",
     "CurveCheck",
+    "Dynamics",
     "IkMissError",
     "IkSettings",
     "IkTarget",
@@ -32,6 +34,7 @@ __all__ = [
     "Obstacle",
     "ObstacleError",
     "PairDistance",
+    "Payload",
     "Robot",
     "RobotGeometry",
     "RobotSpec",
@@ -47,6 +50,7 @@ __all__ = [
     "load_cpr",
     "load_robot",
     "motion_radii",
+    "robot_dynamics",
     "robot_spec",
     "solve_ik",
     "tcp_ik",

@@ -38,6 +38,7 @@ from cpr_kin.arm import ArmChain, arm_chain
 from cpr_kin.errors import UrdfError
 from cpr_kin.limits import LIMITS_NAMES, JointLimits, find_limits_file, read_dynamic_limits
 from cpr_kin.packages import package_roots
+from cpr_kin.resources import makers_limits_path
 from cpr_kin.robot import GROUPS, Robot, RobotGeometry, joint_units
 from cpr_kin.self_collision import SrdfPairs, find_srdf, read_srdf, self_pairs
 from cpr_kin.supported import check_joints, check_limits, check_names
@@ -62,7 +63,9 @@ class RobotSpec:
             or ``<robot name>.srdf`` beside the URDF or in ``robot_description/srdf/``).
         package_dirs: folders that hold the packages its ``package://`` meshes name.
         limits: its acceleration and jerk limits file; default: found beside the URDF by
-            ``limits_names``, else ``default_limits``, else the documented defaults.
+            ``limits_names``, else ``default_limits``, else a maker's file shipped for the
+            URDF's robot name (:func:`cpr_kin.resources.makers_limits_path`), else the
+            documented defaults.
         joints: the planned joints, in configuration order; default: the arm's
             (:func:`arm_chain`: from the root until the tree branches, as a hand into its
             fingers), but mimic joints. The others are held.
@@ -115,8 +118,12 @@ class RobotSpec:
         names = tuple(model.names[1:])
         tcp = self._tcp_frame(model, path, arm)
         velocity = np.array(model.velocityLimit, dtype=float)
-        limits_file = self.limits or find_limits_file(path, self.default_limits, self.limits_names)
         known = tuple(j.get("name", "") for j in tree.getroot().findall("joint"))
+        limits_file = (
+            self.limits
+            or find_limits_file(path, self.default_limits, self.limits_names)
+            or makers_limits_path(tree.getroot().get("name", ""), known)
+        )
         dynamic = read_dynamic_limits(limits_file, names, velocity, known)
         limits = JointLimits(
             names=names,

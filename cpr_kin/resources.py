@@ -6,7 +6,10 @@ install and an installed wheel.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from pathlib import Path
+
+import yaml
 
 
 def bundled_urdf_dir() -> Path:
@@ -22,3 +25,17 @@ def cpr_urdf_path() -> Path:
 def cpr_limits_path() -> Path:
     """Path of the bundled acceleration and jerk limits of the CPR."""
     return bundled_urdf_dir() / "cpr_limits.yaml"
+
+
+def makers_limits_path(robot_name: str, joints: Iterable[str]) -> Path | None:
+    """The limits file shipped for a URDF whose ``<robot name>`` is ``robot_name``, if any.
+
+    ``cpr_kin/urdf/makers/<name>_limits.yaml``: acceleration and jerk limits from an arm
+    maker's datasheet (the Panda's), used when no limits file lies beside the URDF and the
+    URDF has every joint the file names (``joints``: the URDF's).
+    """
+    path = bundled_urdf_dir() / "makers" / f"{robot_name}_limits.yaml"
+    if not robot_name or not path.is_file():
+        return None
+    named = yaml.safe_load(path.read_text(encoding="utf-8"))
+    return path if set(named) <= set(joints) else None

@@ -11,7 +11,15 @@ A second file with a segment moved by 2 cm fails, and says where.
 import json
 from pathlib import Path
 
-from planning import build_problem, paper_scene, plan, read_trajectory, verify_trajectory, write_trajectory
+from planning import (
+    Requirements,
+    build_problem,
+    paper_scene,
+    plan,
+    read_trajectory,
+    verify_trajectory,
+    write_trajectory,
+)
 
 scene = paper_scene(seed=1)
 out = Path("out/examples/check")
@@ -25,12 +33,7 @@ document["segments"][1]["coeffs"][1][0] += 0.02  # d2 of segment 1 raised by 2 c
 problem = build_problem(scene)  # the scene's robot, obstacles, start and goal
 for name in ("theirs.json", "edited.json"):
     trajectory = read_trajectory(out / name).trajectory  # refuses a malformed file, naming the key
-    verdict = verify_trajectory(
-        problem.world,
-        trajectory,
-        scene.safety_margin,
-        scene.planner.verify_step_m,
-        (scene.start, scene.goal),  # a joint vector, or a tcp or pose checked by forward kinematics
-        self_margin_m=scene.self_margin,
-    )
+    # the scene's margins, its start and goal (a tcp or pose checked by forward kinematics),
+    # and the joint torques (RNEA) within the URDF's effort limits
+    verdict = verify_trajectory(problem.world, trajectory, Requirements.of(problem, endpoints=True))
     print(f"{name}: {'verified' if verdict.accepted else 'FAILS: ' + '; '.join(verdict.problems)}")

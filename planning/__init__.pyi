@@ -8,6 +8,7 @@ from .errors import (
     CprPlanError,
     NoSolutionError,
     NoTrajectoryFoundError,
+    PayloadTooHeavyError,
     PlanningError,
     SceneError,
     SplineError,
@@ -26,8 +27,9 @@ from .pipeline.scene import DEFAULT_SAFETY_MARGIN_M, DEFAULT_SPLINE, Scene
 from .pipeline.seeding import Seeds, seed_search
 from .pipeline.settings import DEFAULT_FIREFLY, PAPER_SEARCH, PlannerSettings
 from .pipeline.target import Target
+from .pipeline.torques import TorqueProfile, torque_profile
 from .pipeline.tuning import SearchTuning, SeedingTuning
-from .pipeline.verification import Verification, verify_trajectory
+from .pipeline.verification import Requirements, Verification, verify_trajectory
 from .search.firefly import FireflyProgress, firefly_minimize
 from .search.firefly_settings import FireflySettings
 from .search.optimizer import Optimizer, SearchResult
@@ -48,12 +50,14 @@ __all__ = [
     "NoSolutionError",
     "NoTrajectoryFoundError",
     "Optimizer",
+    "PayloadTooHeavyError",
     "PlanResult",
     "PlannerSettings",
     "PlanningError",
     "Problem",
     "RefinedFirefly",
     "RefinementSettings",
+    "Requirements",
     "Scene",
     "SceneError",
     "SearchResult",
@@ -66,6 +70,7 @@ __all__ = [
     "SplineSettings",
     "Target",
     "TargetOutOfReachError",
+    "TorqueProfile",
     "Trajectory",
     "TrajectoryFileError",
     "Verification",
@@ -81,6 +86,7 @@ __all__ = [
     "read_trajectory",
     "seed_search",
     "solve",
+    "torque_profile",
     "trapezoid_time",
     "uniform_knots",
     "verify_trajectory",

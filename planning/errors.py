@@ -61,3 +61,7 @@ class NoTrajectoryFoundError(NoSolutionError):
         self.worst_time_s = check.worst_time
         self.worst_pair = check.worst_pair
         self.worst_group = check.worst_group
+
+
+class PayloadTooHeavyError(NoSolutionError):
+    """Holding the start or goal still takes more than a joint's effort limit (joint, torque, limit named)."""

@@ -1,10 +1,11 @@
-"""How much of each kinematic limit a trajectory uses, over time.
+"""How much of each limit a trajectory uses, over time: kinematic, and the joint torques.
 
 A trajectory that touches a limit once and runs far below it elsewhere leaves time on the
 table; one that runs along its limits is near time-optimal. :func:`limit_usage` samples the
 largest ``|q_j^(r)| / limit_j^(r)`` over the joints, for velocity, acceleration and jerk
 (``r = 1, 2, 3``), and which joint it is; :class:`LimitUsage` summarises it (time-averaged
-usage, share of the time near a limit, the usage phase by phase). The report, ``samples.csv``
+usage, share of the time near a limit, the usage phase by phase). Given the robot's dynamics,
+``|torque_j| / effort_j`` is a fourth order (``"torque"``). The report, ``samples.csv``
 and ``utilisation.png`` show it.
 """
 
@@ -27,6 +28,8 @@ IntArray = NDArray[np.int64]
 
 ORDERS = ("velocity", "acceleration", "jerk")
 """The limited derivatives, in order ``r = 1, 2, 3``."""
+TORQUE = "torque"
+"""The order after them when the usage includes the joint torques."""
 NEAR_LIMIT = 0.95
 """Usage from which a sample counts as running at its limit."""
 SUMMARY_SAMPLES = 1001
@@ -39,28 +42,30 @@ class LimitUsage:
 
     Attributes:
         times: ``(T,)`` sample times [s], increasing, from the start to the end.
-        usage: ``(T, 3)`` largest ``|derivative| / limit`` over the joints, per order
-            (:data:`ORDERS`).
-        binding: ``(T, 3)`` the joint (index) that has it.
+        usage: ``(T, K)`` largest ``|derivative| / limit`` over the joints, per order
+            (:attr:`orders`).
+        binding: ``(T, K)`` the joint (index) that has it.
+        orders: the orders: :data:`ORDERS`, then :data:`TORQUE` if the torques are included.
     """
 
     times: FloatArray
     usage: FloatArray
     binding: IntArray
+    orders: tuple[str, ...] = ORDERS
 
     def mean(self) -> FloatArray:
-        """``(3,)`` time-averaged usage per order (trapezoidal rule)."""
+        """``(K,)`` time-averaged usage per order (trapezoidal rule)."""
         if self.times[-1] <= self.times[0]:
             return np.asarray(self.usage.mean(axis=0))
         return np.asarray(np.trapezoid(self.usage, self.times, axis=0) / (self.times[-1] - self.times[0]))
 
     def share_near_limit(self, threshold: float = NEAR_LIMIT) -> FloatArray:
-        """``(4,)`` share of the samples at which each order, then any, is used ``>= threshold``."""
+        """``(K + 1,)`` share of the samples at which each order, then any, is used ``>= threshold``."""
         near = self.usage >= threshold
         return np.append(near.mean(axis=0), near.any(axis=1).mean())
 
     def phases(self, count: int = 10) -> list[tuple[float, float, FloatArray, int, int]]:
-        """The usage in ``count`` equal spans of time: ``(t0, t1, peak usage (3,), order, joint)``.
+        """The usage in ``count`` equal spans of time: ``(t0, t1, peak usage (K,), order, joint)``.
 
         ``order`` and ``joint`` name the limit closest to binding in the span.
         """
@@ -78,15 +83,25 @@ class LimitUsage:
 
 
 def limit_usage(
-    trajectory: Trajectory, limits: ck.JointLimits, times: FloatArray | None = None
+    trajectory: Trajectory,
+    limits: ck.JointLimits,
+    times: FloatArray | None = None,
+    dynamics: ck.Dynamics | None = None,
 ) -> LimitUsage:
     """The usage of ``limits`` by ``trajectory`` at ``times`` [s].
 
-    By default :data:`SUMMARY_SAMPLES` times evenly spaced over its duration.
+    By default :data:`SUMMARY_SAMPLES` times evenly spaced over its duration. With
+    ``dynamics`` whose efforts are known, the torques' usage too (:data:`TORQUE`).
     """
     if times is None:
         times = np.linspace(trajectory.knots[0], trajectory.knots[-1], SUMMARY_SAMPLES)
     times = np.asarray(times, dtype=float)
     bounds = (limits.velocity, limits.acceleration, limits.jerk)
-    ratios = np.stack([np.abs(trajectory(times, r)) / bounds[r - 1] for r in (1, 2, 3)], axis=1)  # (T, 3, nj)
-    return LimitUsage(times=times, usage=ratios.max(axis=2), binding=ratios.argmax(axis=2))
+    ratios = [np.abs(trajectory(times, r)) / bounds[r - 1] for r in (1, 2, 3)]
+    orders: tuple[str, ...] = ORDERS
+    if dynamics is not None and dynamics.limited:
+        torques = dynamics.torques(trajectory(times), trajectory(times, 1), trajectory(times, 2))
+        ratios.append(dynamics.utilisation(torques))
+        orders = (*ORDERS, TORQUE)
+    stacked = np.stack(ratios, axis=1)  # (T, K, nj)
+    return LimitUsage(times=times, usage=stacked.max(axis=2), binding=stacked.argmax(axis=2), orders=orders)

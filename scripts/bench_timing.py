@@ -94,9 +94,7 @@ def measure(scene: Scene, robot: ck.Robot, rrt_time_s: float) -> Row:
     try:
         result = plan(scene, robot)
         ours, method = result.trajectory.duration, result.metrics.timing
-        uniform = result.spline.trajectory.time_scaled(
-            uniform_scale(result.spline, result.problem.robot.limits)
-        ).duration
+        uniform = result.spline.trajectory.time_scaled(uniform_scale(result.spline, result.problem)).duration
         started = time.perf_counter()
         offered = result.problem.duration.timings(result.problem, result.waypoints)  # the step again, alone
         if method != "fastest":  # the fastest timing failed the check: the fallbacks were computed

@@ -16,6 +16,7 @@ import yourdfpy
 
 import cpr_kin as ck
 from cpr_kin.packages import example_robot_data_share
+from cpr_kin.resources import makers_limits_path
 
 SHARE = example_robot_data_share()
 assert SHARE is not None, "example-robot-data is part of the robots extra, which make installs"
@@ -40,7 +41,12 @@ def test_the_arm_is_planned_and_the_hand_held(arm: tuple[str, ck.Robot, Path]) -
     name, robot, _ = arm
     _, dof, held = ARMS[name]
     assert robot.nq == dof and dict(robot.held) == held
-    assert robot.limits_path is None and robot.limits_defaulted == robot.joint_names  # no limits file
+    if name == "panda":  # Franka's datasheet, shipped for a URDF named "panda"
+        assert (
+            robot.limits_path == makers_limits_path("panda", robot.joint_names) and not robot.limits_defaulted
+        )
+    else:
+        assert robot.limits_path is None and robot.limits_defaulted == robot.joint_names  # no limits file
     assert robot.limits.effort is not None and np.all(robot.limits.effort > 0)  # kept for the torque issue
     assert robot.model.existFrame(robot.tcp_frame)
     assert {g.group for g in robot.geometries} == set(ck.GROUPS)

@@ -30,7 +30,7 @@ def test_a_straight_line_takes_the_slowest_joints_trapezoid(
 ) -> None:
     delta_arr, v_arr, a_arr = np.array(delta), np.array(v), np.array(a)
     d1, d2, du = straight(delta_arr)
-    x = phase_plane_profile(d1, d2, du, v_arr, a_arr)
+    x = phase_plane_profile(d1, d2, du, v_arr, a_arr, np.zeros_like(d1))
     moving = np.abs(delta_arr) > 0
     # along a line, u'' and u' scale every joint alike: the slowest joint's trapezoid, with
     # the path limits v_j / |delta_j| and a_j / |delta_j|
@@ -50,7 +50,7 @@ def test_the_profile_keeps_every_joint_within_its_limits_on_a_bend() -> None:
     d2 = -np.column_stack([np.cos(u * np.pi / 2), np.sin(u * np.pi / 2)]) * (np.pi / 2) ** 2
     v, a = np.array([1.0, 1.0]), np.array([0.5, 0.5])
     du = np.diff(u)
-    x = phase_plane_profile(d1, d2, du, v, a)
+    x = phase_plane_profile(d1, d2, du, v, a, np.zeros_like(d1))
     push = np.diff(x) / (2.0 * du)  # u'' on each step, applied from its first point
     velocity = d1 * np.sqrt(x)[:, None]
     acceleration = d2[:-1] * x[:-1, None] + d1[:-1] * push[:, None]
@@ -69,11 +69,12 @@ def test_more_room_is_never_slower() -> None:
         q2 = np.column_stack([np.polyval(np.polyder(c[::-1], 2), u) for c in coefficients.T])
         v, a = rng.uniform(0.5, 2, 3), rng.uniform(0.5, 4, 3)
         du = np.diff(u)
-        base = profile_time(phase_plane_profile(q1, q2, du, v, a), du)
+        base = profile_time(phase_plane_profile(q1, q2, du, v, a, np.zeros_like(q1)), du)
         for which in range(2):
-            more = [v, a]
-            more[which] = more[which] * 1.3
-            assert profile_time(phase_plane_profile(q1, q2, du, *more), du) <= base * (1 + 1e-9)
+            room = [v, a]
+            room[which] = room[which] * 1.3
+            faster = phase_plane_profile(q1, q2, du, room[0], room[1], np.zeros_like(q1))
+            assert profile_time(faster, du) <= base * (1 + 1e-9)
 
 
 def test_sampled_paths_are_timed_in_arc_length() -> None:

@@ -51,12 +51,18 @@ def test_docs_snippets_run(page: Path, tmp_path: Path, monkeypatch: pytest.Monke
 def test_the_readmes_scene_is_the_example_file_and_plans_from_where_it_lies(tmp_path: Path) -> None:
     from planning import load_scene
 
-    scene, _ = blocks(README, "yaml")
+    scene, _, payload = blocks(README, "yaml")
     example = ROOT / "examples" / "scenes" / "shelf.yaml"
     assert scene == example.read_text()
     loaded = load_scene(example)  # robot: resolves relative to the scene file, from any folder
     assert loaded.robot is not None
     assert loaded.robot.urdf == (ROOT / "cpr_kin" / "urdf" / "cpr.urdf").resolve()
+    from cpr_kin.user_files import load_yaml
+    from planning.io.scene_file import parse_scene
+
+    (tmp_path / "carried.yaml").write_text(scene + payload)
+    carried = parse_scene(load_yaml(tmp_path / "carried.yaml", 100_000, "scene"), base=example.parent)
+    assert carried.payload is not None and carried.payload.mass_kg == 3.0 and carried.torque_scale == 0.9
 
 
 def test_bring_your_own_robot_runs_as_written(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
@@ -67,7 +73,7 @@ def test_bring_your_own_robot_runs_as_written(tmp_path: Path, monkeypatch: pytes
     from planning.cli import main
     from planning.io.scene_file import parse_scene
 
-    _, fragment = blocks(README, "yaml")
+    _, fragment, _ = blocks(README, "yaml")
     own = parse_scene(yaml.safe_load(fragment))
     assert own.robot is not None and own.robot.urdf.name == "my_arm.urdf" and own.goal.pose is not None
     commands = [line.split("#")[0] for line in blocks(README, "sh")[-1].splitlines() if line.strip()]

@@ -66,9 +66,7 @@ def test_free_durations_are_timed_within_the_limits_c3_and_certified(
 def test_the_fastest_timing_is_never_longer_than_the_uniform_one(free_results: list[PlanResult]) -> None:
     methods = []
     for result in free_results:
-        uniform = result.spline.trajectory.time_scaled(
-            uniform_scale(result.spline, result.problem.robot.limits)
-        )
+        uniform = result.spline.trajectory.time_scaled(uniform_scale(result.spline, result.problem))
         assert result.trajectory.duration <= uniform.duration * (1 + 1e-12)
         methods.append(result.metrics.timing)
         if result.metrics.timing == "fastest":  # by 15-35 % on these scenes
@@ -118,7 +116,7 @@ def test_a_path_whose_fastest_timing_cuts_into_the_margin_runs_narrowed(robot: c
     timing the planner fell back to before."""
     scene = generate_scenes(5, 2, robot)[4]
     result = plan(scene, robot)
-    uniform = result.spline.trajectory.time_scaled(uniform_scale(result.spline, result.problem.robot.limits))
+    uniform = result.spline.trajectory.time_scaled(uniform_scale(result.spline, result.problem))
     assert result.metrics.timing == "narrowed" and result.verification.accepted
     fastest = result.problem.duration.timings(result.problem, result.waypoints)[0]
     assert fastest.method == "fastest"

@@ -11,7 +11,7 @@ from planning.io.bundled import paper_scene
 from planning.pipeline.planner import plan
 from planning.pipeline.result import PlanResult
 from planning.pipeline.target import Target
-from planning.pipeline.verification import verify_trajectory
+from planning.pipeline.verification import Requirements, verify_trajectory
 
 
 @pytest.fixture(scope="module")
@@ -21,7 +21,7 @@ def result(robot: ck.Robot) -> PlanResult:
 
 def test_planned_trajectory_is_accepted(result: PlanResult, paper_world: ck.CollisionWorld) -> None:
     ends = (Target(q=tuple(result.waypoints[0])), Target(q=tuple(result.waypoints[-1])))
-    verification = verify_trajectory(paper_world, result.trajectory, 0.1, 0.005, ends)
+    verification = verify_trajectory(paper_world, result.trajectory, Requirements(0.1, 0.005, endpoints=ends))
     assert verification.accepted and verification.problems == ()
     assert verification.check.certified_min_m == pytest.approx(result.metrics.min_clearance_m)
 
@@ -30,7 +30,7 @@ def test_each_violation_is_named(result: PlanResult, paper_world: ck.CollisionWo
     fast = result.trajectory.time_scaled(0.3)  # velocity x 3.3, acceleration x 11, jerk x 37
     shifted = result.waypoints[0] + np.array([0.1, 0, 0, 0, 0])
     wrong_ends = (Target(q=tuple(shifted)), Target(q=tuple(result.waypoints[-1])))
-    verification = verify_trajectory(paper_world, fast, 0.2, 0.005, wrong_ends)
+    verification = verify_trajectory(paper_world, fast, Requirements(0.2, 0.005, endpoints=wrong_ends))
     text = " | ".join(verification.problems)
     assert not verification.accepted
     assert "its start is 0.1 away from its joint values of the scene's start" in text
@@ -47,7 +47,7 @@ def test_a_jump_at_a_knot_is_named(
     coefficients = result.trajectory.coefficients.copy()
     coefficients[3, 0, order] += 0.3 / math.factorial(order)
     broken = Trajectory(result.trajectory.knots, coefficients)
-    problems = verify_trajectory(paper_world, broken, 0.1, 0.005).problems
+    problems = verify_trajectory(paper_world, broken, Requirements(0.1, 0.005)).problems
     name = ("position", "velocity", "acceleration", "jerk")[order]
     assert (
         f"is not continuous (C3) at t = 3 s (knot 3): the {name} of joint 'theta1' jumps by 0.3 {unit}"

@@ -76,7 +76,7 @@ def build_parser() -> argparse.ArgumentParser:
         "check",
         help="re-verify a trajectory file against a scene",
         description="Re-verify TRAJECTORY against SCENE: start and goal, certified clearance, "
-        "joint ranges and limits.",
+        "joint ranges and limits, joint torques (with the scene's payload) within the effort limits.",
     )
     sub.add_argument("scene", type=Path, help="scene file (YAML)")
     sub.add_argument("trajectory", type=Path, help="trajectory file (cpr-trajectory/1 JSON)")

@@ -23,7 +23,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     """Re-verify a trajectory file against a scene; exit 3 when it fails."""
     from planning.io.trajectory_reader import read_trajectory
     from planning.pipeline.problem import build_problem
-    from planning.pipeline.verification import verify_trajectory
+    from planning.pipeline.verification import Requirements, verify_trajectory
 
     scene = load(args.scene)
     document = read_trajectory(args.trajectory)
@@ -33,14 +33,8 @@ def cmd_check(args: argparse.Namespace) -> int:
         raise PlanningError(
             f"trajectory joints {list(document.joint_names)} are not the robot's {list(robot.joint_names)}"
         )
-    verification = verify_trajectory(
-        problem.world,
-        document.trajectory,
-        scene.safety_margin,
-        scene.planner.verify_step_m,
-        (scene.start, scene.goal),
-        self_margin_m=scene.self_margin,
-    )
+    required = Requirements.of(problem, endpoints=True)
+    verification = verify_trajectory(problem.world, document.trajectory, required)
     check, problems = verification.check, verification.problems
     if args.json:
         print(json.dumps(verification.to_record(), indent=1))
@@ -52,6 +46,7 @@ def cmd_check(args: argparse.Namespace) -> int:
                 f"{args.trajectory}: verified against {args.scene}: "
                 f"certified clearance {check.certified_min_m:.4f} m "
                 f">= {scene.safety_margin} m over {len(check.times)} checks, joints within range and limits"
+                f"{', torques within effort limits' if problem.dynamics.limited else ''}"
             )
         )
     return EXIT_OK if not problems else EXIT_NO_TRAJECTORY

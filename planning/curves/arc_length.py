@@ -13,6 +13,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
+from planning.curves.torque_limits import TorqueRows
 from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
 
@@ -41,6 +42,11 @@ class ArcLengthPath(NamedTuple):
     """Arc length at the fine samples ``(FINE,)``."""
     table: FloatArray
     """Positions at the fine samples ``(FINE, nj)``."""
+    q: FloatArray
+    """Positions at the grid points ``(G, nj)``."""
+    torque: TorqueRows | None = None
+    """Torque constraints at the grid points, if the timing keeps any
+    (:func:`planning.curves.torque_limits.torque_rows`)."""
 
 
 def arc_length_path(path: Trajectory, velocity: FloatArray) -> ArcLengthPath:
@@ -78,4 +84,4 @@ def arc_length_path(path: Trajectory, velocity: FloatArray) -> ArcLengthPath:
         dq[index], ddq[index] = dq[nearest], ddq[nearest]
     steps = np.diff(s)
     keep = np.concatenate([[True], steps > 0])  # drop repeated points (the path standing still)
-    return ArcLengthPath(dq[keep], ddq[keep], np.diff(s[keep]), length, path(fine))
+    return ArcLengthPath(dq[keep], ddq[keep], np.diff(s[keep]), length, path(fine), path(u[keep]))

@@ -115,7 +115,7 @@ def sampled_path_durations(
         steps, d1, d2 = sampled_derivatives(points[s], v)
         if len(d1) < 2:
             continue
-        x = phase_plane_profile(d1, d2, steps, v, a)
+        x = phase_plane_profile(d1, d2, steps, v, a, np.zeros_like(d1))
         times = profile_instants(x, steps)
         velocity = d1 * np.sqrt(np.maximum(x, 0.0))[:, None]
         window, usage = needed_window(times, velocity, j, window_s, rounds, tolerance)

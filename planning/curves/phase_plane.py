@@ -33,15 +33,15 @@ _HUGE = 1e12
 
 @njit
 def _acceleration_bounds(
-    d1: FloatArray, d2: FloatArray, g: int, x: float, a: FloatArray
+    d1: FloatArray, d2: FloatArray, offset: FloatArray, g: int, x: float, a: FloatArray
 ) -> tuple[float, float]:
     """``(lowest, highest)`` path acceleration ``u''`` at grid point ``g`` and ``x = u'^2``.
 
-    ``lowest > highest`` when no acceleration keeps every joint within its limit.
+    ``lowest > highest`` when no acceleration keeps every row within its limit.
     """
     low, high = -_HUGE, _HUGE
     for j in range(d1.shape[1]):
-        slope, curve = d1[g, j], d2[g, j] * x
+        slope, curve = d1[g, j], d2[g, j] * x + offset[g, j]
         if abs(slope) > _TINY:
             b1, b2 = (a[j] - curve) / slope, (-a[j] - curve) / slope
             high = min(high, max(b1, b2))
@@ -53,69 +53,88 @@ def _acceleration_bounds(
 
 @njit
 def _largest_x(
-    d1: FloatArray, d2: FloatArray, g: int, a: FloatArray, top: float, du: float, ahead: float
+    d1: FloatArray,
+    d2: FloatArray,
+    offset: FloatArray,
+    g: int,
+    a: FloatArray,
+    top: float,
+    du: float,
+    ahead: float,
 ) -> float:
     """The largest ``x`` in ``[0, top]`` at grid point ``g`` that some path acceleration allows.
 
-    That ``u''`` must keep every joint within its acceleration limit and, if ``du > 0``,
-    one step of ``du`` (``u''`` constant, ``x_next = x + 2 du u''``) must land in
-    ``[0, ahead]``.
+    That ``u''`` must keep every row within its limit and, if ``du > 0``, one step of ``du``
+    (``u''`` constant, ``x_next = x + 2 du u''``) must land in ``[0, ahead]``.
 
-    Every bound on ``u''`` is affine in ``x``: joint ``j`` allows ``u''`` in
-    ``(-+a_j - q_j'' x) / q_j'``, the step ``[-x, ahead - x] / (2 du)``. The bounds overlap
-    iff every lower bound is below every upper bound (intervals on a line), each pair an
-    affine inequality in ``x``: the answer is exact, the least of the pairs' limits, with
-    no bisection. ``x = 0`` (``u'' = 0``) always qualifies.
+    Every bound on ``u''`` is affine in ``x``: row ``j`` allows ``u''`` in
+    ``(-+a_j - q_j'' x - o_j) / q_j'``, the step ``[-x, ahead - x] / (2 du)``. The bounds
+    overlap iff every lower bound is below every upper bound (intervals on a line), each pair
+    an affine inequality in ``x``: the answer is exact, the least of the pairs' limits, with
+    no bisection. ``x = 0`` (``u'' = 0``) qualifies when every ``|o_j| <= a_j`` (the
+    caller's condition), so the allowed ``x`` are an interval from 0.
     """
     best = top
-    joints = d1.shape[1]
+    rows = d1.shape[1]
     rate = 1.0 / (2.0 * du) if du > 0.0 else 0.0
-    for i in range(joints):
-        if abs(d1[g, i]) <= _TINY:  # the joint's acceleration is the curvature term alone
-            if abs(d2[g, i]) > 0.0:
-                best = min(best, a[i] / abs(d2[g, i]))
+    for i in range(rows):
+        if abs(d1[g, i]) <= _TINY:  # the row is the curvature term alone: |d2 x + o| <= a
+            if d2[g, i] > 0.0:
+                best = min(best, (a[i] - offset[g, i]) / d2[g, i])
+            elif d2[g, i] < 0.0:
+                best = min(best, (a[i] + offset[g, i]) / -d2[g, i])
             continue
-        slope_i, reach_i = -d2[g, i] / d1[g, i], a[i] / abs(d1[g, i])  # bounds: slope x -+ reach
-        for k in range(joints):
+        # bounds: slope x + shift -+ reach
+        slope_i, reach_i, shift_i = -d2[g, i] / d1[g, i], a[i] / abs(d1[g, i]), -offset[g, i] / d1[g, i]
+        for k in range(rows):
             if k != i and abs(d1[g, k]) > _TINY:  # lower of i below upper of k
-                slope_k, reach_k = -d2[g, k] / d1[g, k], a[k] / abs(d1[g, k])
+                slope_k, reach_k, shift_k = (
+                    -d2[g, k] / d1[g, k],
+                    a[k] / abs(d1[g, k]),
+                    -offset[g, k] / d1[g, k],
+                )
                 if slope_i - slope_k > 0.0:
-                    best = min(best, (reach_i + reach_k) / (slope_i - slope_k))
+                    best = min(best, (reach_i + reach_k + (shift_k - shift_i)) / (slope_i - slope_k))
         if du > 0.0:
             if slope_i + rate > 0.0:  # lower of i below the step's upper (ahead - x) rate
-                best = min(best, (ahead * rate + reach_i) / (slope_i + rate))
+                best = min(best, (ahead * rate + reach_i - shift_i) / (slope_i + rate))
             if -rate - slope_i > 0.0:  # the step's lower -x rate below the upper of i
-                best = min(best, reach_i / (-rate - slope_i))
+                best = min(best, (reach_i + shift_i) / (-rate - slope_i))
     return max(best, 0.0)
 
 
 @njit
 def phase_plane_profile(
-    d1: FloatArray, d2: FloatArray, du: FloatArray, v: FloatArray, a: FloatArray
+    d1: FloatArray, d2: FloatArray, du: FloatArray, v: FloatArray, a: FloatArray, offset: FloatArray
 ) -> FloatArray:
     """``x = u'^2`` at the grid points ``(G,)`` of the fastest rest-to-rest profile.
 
+    Each of the ``R`` rows (a joint's acceleration, or a torque) keeps
+    ``|d1 u'' + d2 u'^2 + offset| <= a`` and its velocity ``|d1| u' <= v``.
+
     Args:
-        d1: ``(G, nj)`` path derivative ``q'(u)`` at the grid points.
-        d2: ``(G, nj)`` second derivative ``q''(u)``.
+        d1: ``(G, R)`` path derivative ``q'(u)`` at the grid points (a torque's ``M q'``).
+        d2: ``(G, R)`` second derivative ``q''(u)`` (a torque's ``M q'' + C(q, q') q'``).
         du: ``(G - 1,)`` grid steps.
-        v: ``(nj,)`` velocity limits [rad/s, m/s].
-        a: ``(nj,)`` acceleration limits.
+        v: ``(R,)`` velocity limits [rad/s, m/s] (``inf`` for a torque).
+        a: ``(R,)`` acceleration limits (a torque's effort limit).
+        offset: ``(G, R)`` the part that does not depend on the speed (0, or gravity's
+            torque), each within its limit.
     """
-    n, joints = d1.shape
+    n, rows = d1.shape
     limit = np.empty(n)
     for g in range(n):  # the maximum velocity curve: velocity limits, then accelerations
         top = _HUGE
-        for j in range(joints):
+        for j in range(rows):
             if abs(d1[g, j]) > _TINY:
                 top = min(top, (v[j] / abs(d1[g, j])) ** 2)
-        limit[g] = _largest_x(d1, d2, g, a, top, 0.0, 0.0)
+        limit[g] = _largest_x(d1, d2, offset, g, a, top, 0.0, 0.0)
     controllable = np.zeros(n)  # backward: from where the robot can still stop at the end
     for g in range(n - 2, -1, -1):
-        controllable[g] = _largest_x(d1, d2, g, a, limit[g], du[g], controllable[g + 1])
+        controllable[g] = _largest_x(d1, d2, offset, g, a, limit[g], du[g], controllable[g + 1])
     x = np.zeros(n)  # forward: as fast as the limits allow without leaving the controllable set
     for g in range(n - 1):
-        _, high = _acceleration_bounds(d1, d2, g, x[g], a)
+        _, high = _acceleration_bounds(d1, d2, offset, g, x[g], a)
         x[g + 1] = max(min(controllable[g + 1], x[g] + 2.0 * du[g] * high), 0.0)
     return x
 
@@ -192,5 +211,5 @@ def sampled_path_times(points: FloatArray, v: FloatArray, a: FloatArray) -> Floa
     for s in range(points.shape[0]):
         steps, d1, d2 = sampled_derivatives(points[s], v)
         if len(d1) >= 2:
-            times[s] = profile_time(phase_plane_profile(d1, d2, steps, v, a), steps)
+            times[s] = profile_time(phase_plane_profile(d1, d2, steps, v, a, np.zeros_like(d1)), steps)
     return times

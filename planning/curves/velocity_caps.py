@@ -65,7 +65,9 @@ class CappedMotion(NamedTuple):
     """The motion's time step [s]."""
 
 
-def fastest_motion(path: ArcLengthPath, limits: FloatArray) -> CappedMotion:
+def fastest_motion(
+    path: ArcLengthPath, limits: FloatArray, uncapped: FloatArray | None = None
+) -> CappedMotion:
     """The fastest motion along ``path`` over the caps of :data:`FACTORS` and :data:`RAMP_FACTORS`.
 
     ``limits`` ``(3, nj)``: velocity, acceleration and jerk limits. The uncapped profile
@@ -73,13 +75,13 @@ def fastest_motion(path: ArcLengthPath, limits: FloatArray) -> CappedMotion:
     nothing); between the first pair of neighbours where the window stops widening, the
     largest cap that needs no wider window, found by bisection and taken :data:`MARGIN`
     lower (the jerk rises steeply past it); last, caps on the accelerations' ramps at the
-    best velocity cap.
+    best velocity cap. ``uncapped``: the uncapped profile, if the caller has it.
 
     The grid stops at the first cap whose phase-plane time exceeds the best duration so far:
     a lower cap only slows the profile, and the averages add to it, so no cap below can win.
     The result is the whole grid's (the tests compare), in less time (``docs/tuning.md``).
     """
-    tried = {1.0: capped_motion(path, limits, 1.0)}
+    tried = {1.0: capped_motion(path, limits, 1.0, profile=uncapped)}
     peak = tried[1.0].peak
     higher, bisected = 1.0, False
     for share in (factor * peak for factor in FACTORS):
@@ -129,9 +131,21 @@ def bisect_widening(
 def capped_profile(
     path: ArcLengthPath, limits: FloatArray, share: float, ramp_s: float = np.inf
 ) -> FloatArray:
-    """Step 1: the phase-plane profile ``s'^2`` under the caps of :func:`_caps`."""
+    """Step 1: the phase-plane profile ``s'^2`` under the caps of :func:`_caps` and the torque rows."""
     velocity_cap, acceleration_cap = _caps(limits, share, ramp_s)
-    return phase_plane_profile(path.dq, path.ddq, path.ds, velocity_cap, acceleration_cap)
+    if path.torque is None:
+        return phase_plane_profile(
+            path.dq, path.ddq, path.ds, velocity_cap, acceleration_cap, np.zeros_like(path.dq)
+        )
+    rows = path.torque
+    return phase_plane_profile(
+        np.hstack([path.dq, rows.slope]),
+        np.hstack([path.ddq, rows.curve]),
+        path.ds,
+        np.concatenate([velocity_cap, np.full(len(rows.limit), np.inf)]),
+        np.concatenate([acceleration_cap, rows.limit]),
+        np.hstack([np.zeros_like(path.dq), rows.offset]),
+    )
 
 
 def capped_motion(

@@ -168,34 +168,60 @@ def limits_section(result: PlanResult) -> list[str]:
 
 
 def usage_section(result: PlanResult) -> list[str]:
-    """``report.md``'s lines on how much of each limit the motion uses, over time."""
-    from planning.utilisation import NEAR_LIMIT, ORDERS, limit_usage
+    """``report.md``'s lines on how much of each limit (kinematic, torque) the motion uses, over time."""
+    from planning.utilisation import NEAR_LIMIT, limit_usage
 
     names = result.joint_names
-    usage = limit_usage(result.trajectory, result.problem.robot.limits)
+    usage = limit_usage(result.trajectory, result.problem.robot.limits, dynamics=result.problem.dynamics)
+    orders = usage.orders
     near = usage.share_near_limit()
-    r = plan_record(result)
+    peaks = usage.usage.max(axis=0)
     rows = [
-        (
-            f"{t0:.2f}-{t1:.2f}",
-            *(f"{u:.2f}" for u in peak),
-            f"{ORDERS[order]} of {names[joint]}",
-        )
+        (f"{t0:.2f}-{t1:.2f}", *(f"{u:.2f}" for u in peak), f"{orders[order]} of {names[joint]}")
         for t0, t1, peak, order, joint in usage.phases()
     ]
     return [
         "## Limit usage over time",
         "",
-        f"Largest {', '.join(ORDERS)} over its limit: "
-        f"{', '.join(f'{v:.2f}' for v in r['limit_utilisation'].values())} at the peak, "
-        f"{', '.join(f'{v:.2f}' for v in r['mean_limit_utilisation'].values())} averaged over time. "
-        f"Some limit is used to {NEAR_LIMIT:.0%} or more during {near[3]:.0%} of the motion "
-        f"({', '.join(f'{order} {share:.0%}' for order, share in zip(ORDERS, near[:3], strict=True))}). "
-        "`samples.csv` has the usage at every IPO sample; `--plots` draws `utilisation.png`.",
+        f"Largest {', '.join(orders)} over its limit: "
+        f"{', '.join(f'{v:.2f}' for v in peaks)} at the peak, "
+        f"{', '.join(f'{v:.2f}' for v in usage.mean())} averaged over time. "
+        f"Some limit is used to {NEAR_LIMIT:.0%} or more during {near[-1]:.0%} of the motion "
+        f"({', '.join(f'{order} {share:.0%}' for order, share in zip(orders, near[:-1], strict=True))}). "
+        "`samples.csv` has the kinematic usage at every IPO sample; `--plots` draws `utilisation.png`.",
         "",
-        markdown_table(rows, ("time [s]", "velocity", "acceleration", "jerk", "nearest its limit")),
+        markdown_table(rows, ("time [s]", *orders, "nearest its limit")),
+        "",
+        *torque_lines(result),
+    ]
+
+
+def torque_lines(result: PlanResult) -> list[str]:
+    """``report.md``'s lines on the joint torques: payload, effort limits, peak usage per joint."""
+    dynamics = result.problem.dynamics
+    utilisation = result.metrics.torque_utilisation
+    if not utilisation:
+        return ["No joint has a known effort limit in the URDF: the torques are not limited.", ""]
+    payload = dynamics.payload
+    carried = (
+        "no payload"
+        if payload is None
+        else f"a {payload.mass_kg:g} kg payload at {list(payload.com_in_frame_m)} m in "
+        f"'{payload.frame or result.robot.tcp_frame}'"
+    )
+    peaks = ", ".join(f"{name} {value:.2f}" for name, value in utilisation.items())
+    lines = [
+        f"Joint torques (RNEA every millisecond, {carried}; effort limits x torque_scale "
+        f"{dynamics.torque_scale:g}): peak |torque| / effort {peaks}.",
         "",
     ]
+    if dynamics.massless_links:
+        lines += [
+            f"Links with a shape but no `<inertial>` in the URDF, taken massless: "
+            f"{', '.join(dynamics.massless_links)}.",
+            "",
+        ]
+    return lines
 
 
 def text_table(rows: Sequence[Sequence[str]], headers: Sequence[str] = ("figure", "paper", "ours")) -> str:

@@ -106,6 +106,10 @@ def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> S
     except ck.CprKinError as exc:
         raise SceneError(f"{source}: robot: {exc}") from None
     try:
+        payload = None if spec.payload is None else spec.payload.payload()
+    except ck.CprKinError as exc:
+        raise SceneError(f"{source}: payload: {exc}") from None
+    try:
         return Scene(
             name=spec.name or source,
             robot=robot,
@@ -118,6 +122,8 @@ def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> S
             obstacles=tuple(obstacles),
             planner=PlannerSettings.from_flat(planner),
             spline=SplineSettings(p=spec.spline.p, a=tuple(spec.spline.a), ends=spec.spline.ends),  # type: ignore[arg-type]
+            payload=payload,
+            torque_scale=spec.torque_scale,
         )
     except PlanningError as exc:
         raise SceneError(f"{source}: {exc}") from None
@@ -168,7 +174,19 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
         "goal": target_entry(scene.goal),
         "duration": scene.duration,
         "obstacles": [obstacle_to_dict(o) for o in scene.obstacles],
+        **({} if scene.payload is None else {"payload": payload_to_dict(scene.payload)}),
+        **({} if scene.torque_scale == 1.0 else {"torque_scale": scene.torque_scale}),
     }
+
+
+def payload_to_dict(payload: ck.Payload) -> dict[str, Any]:
+    """A payload in the scene file's form (docs/formats.md)."""
+    entry: dict[str, Any] = {"mass_kg": payload.mass_kg, "com_in_tcp": list(payload.com_in_frame_m)}
+    if payload.inertia_kg_m2 is not None:
+        entry["inertia"] = [list(row) for row in payload.inertia_kg_m2]
+    if payload.frame is not None:
+        entry["frame"] = payload.frame
+    return entry
 
 
 def scene_document(scene: Scene) -> dict[str, Any]:

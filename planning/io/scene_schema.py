@@ -11,8 +11,11 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal
 
+import numpy as np
 from pydantic import AfterValidator, BaseModel, Field, ValidationError, model_validator
 
+import cpr_kin as ck
+from cpr_kin.dynamics import MAX_COM_OFFSET_M, MAX_PAYLOAD_KG, TORQUE_SCALE_RANGE
 from cpr_kin.obstacles import SCALE_RANGE
 from planning.io.robot_entry import RobotEntry, RobotMapping
 from planning.io.schema_types import (
@@ -156,6 +159,40 @@ class SplineSpec(Strict):
         return self
 
 
+Moment = Annotated[float, between(-1e3, 1e3)]
+
+
+class PayloadSpec(Strict):
+    """The ``payload:`` block; see :class:`cpr_kin.Payload`."""
+
+    mass_kg: Annotated[float, between(0.0, MAX_PAYLOAD_KG)]
+    com_in_tcp: Annotated[
+        list[Annotated[float, between(-MAX_COM_OFFSET_M, MAX_COM_OFFSET_M)]],
+        Field(min_length=3, max_length=3),
+    ] = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    inertia: (
+        Annotated[list[Moment], Field(min_length=3, max_length=3)]
+        | Annotated[
+            list[Annotated[list[Moment], Field(min_length=3, max_length=3)]],
+            Field(min_length=3, max_length=3),
+        ]
+        | None
+    ) = None
+    frame: Name | None = None
+
+    def payload(self) -> ck.Payload:
+        """The :class:`cpr_kin.Payload` (raises :class:`cpr_kin.CprKinError` for an unphysical inertia)."""
+        inertia = None
+        if self.inertia is not None:
+            inertia = np.diag(self.inertia) if np.ndim(self.inertia) == 1 else np.array(self.inertia)
+        return ck.Payload(
+            self.mass_kg,
+            (self.com_in_tcp[0], self.com_in_tcp[1], self.com_in_tcp[2]),
+            None if inertia is None else tuple(tuple(row) for row in inertia.tolist()),
+            self.frame,
+        )
+
+
 class SceneSpec(Strict):
     """A whole scene file."""
 
@@ -172,6 +209,8 @@ class SceneSpec(Strict):
     obstacles: Annotated[list[ObstacleSpec], Field(max_length=MAX_OBSTACLES)] = Field(default_factory=list)
     planner: PlannerSpec = Field(default_factory=PlannerSpec)
     spline: SplineSpec = Field(default_factory=SplineSpec)
+    payload: PayloadSpec | None = None
+    torque_scale: Annotated[float, between(*TORQUE_SCALE_RANGE)] = 1.0
 
 
 _SHAPE_SPECS: dict[str, type[BaseModel]] = {
@@ -186,6 +225,7 @@ _BLOCK_SPECS: dict[str, type[BaseModel]] = {
     "goal": TargetSpec,
     "planner": PlannerSpec,
     "spline": SplineSpec,
+    "payload": PayloadSpec,
 }
 
 

@@ -34,7 +34,7 @@ from planning.errors import NoTrajectoryFoundError
 from planning.pipeline.objective import Breakdown
 from planning.pipeline.problem import Problem
 from planning.pipeline.timing import Timing
-from planning.pipeline.verification import Verification, verify_trajectory
+from planning.pipeline.verification import Requirements, Verification, verify_trajectory
 from planning.search.optimizer import SearchResult
 
 FloatArray = NDArray[np.float64]
@@ -88,19 +88,15 @@ class Refusal:
 def verify(problem: Problem, trajectory: Trajectory, fit: SplineFit) -> Verification:
     """The scene's verification, plus the node-deviation bound of the planner settings."""
     scene = problem.scene
-    verification = verify_trajectory(
-        problem.world,
-        trajectory,
-        scene.safety_margin,
-        scene.planner.verify_step_m,
-        self_margin_m=scene.self_margin,
-    )
+    verification = verify_trajectory(problem.world, trajectory, Requirements.of(problem))
     bound = scene.planner.max_node_deviation
     if bound is not None and fit.max_node_deviation > bound:
         problem_text = (
             f"deviates {fit.max_node_deviation:.3g} from its nodes, more than max_node_deviation = {bound:g}"
         )
-        verification = Verification(verification.check, (*verification.problems, problem_text))
+        verification = Verification(
+            verification.check, (*verification.problems, problem_text), verification.torques
+        )
     return verification
 
 

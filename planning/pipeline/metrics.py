@@ -7,16 +7,19 @@ section (``docs/formats.md``); the trajectory file, ``report.md``, the batch's
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Any, NamedTuple
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
-import cpr_kin as ck
 from planning.pipeline.choose import Choice
 from planning.pipeline.objective import Breakdown
+from planning.pipeline.torques import torque_profile
 from planning.search.optimizer import SearchResult
 from planning.utilisation import ORDERS, limit_usage
+
+if TYPE_CHECKING:
+    from planning.pipeline.problem import Problem
 
 WALL_TIMES = ("planning_time_s", "optimiser_time_s", "timing_time_s")
 """The record's wall times: ``None`` in a file written without ``timings``."""
@@ -48,6 +51,8 @@ class Metrics:
         timing: how the trajectory was timed: ``fixed`` (the scene's duration), ``fastest``,
             ``narrowed`` or ``uniform`` (see :mod:`planning.pipeline.timing`).
         timing_time_s: wall time of that timing [s].
+        torque_utilisation: per joint with a known effort limit, the largest |torque| over
+            it (RNEA every millisecond, :mod:`planning.pipeline.torques`), the payload included.
     """
 
     duration_s: float
@@ -69,6 +74,7 @@ class Metrics:
     duration_stretched: bool
     timing: str = "fixed"
     timing_time_s: float = 0.0
+    torque_utilisation: dict[str, float] = field(default_factory=dict)
 
     def to_record(self, timings: bool = True) -> dict[str, Any]:
         """The metrics as plain JSON types, under the trajectory file's keys.
@@ -96,6 +102,7 @@ class Metrics:
             "duration_stretched": self.duration_stretched,
             "timing": self.timing,
             "timing_time_s": self.timing_time_s,
+            "torque_utilisation": self.torque_utilisation,
         }
         return record if timings else {**record, **dict.fromkeys(WALL_TIMES)}
 
@@ -113,12 +120,12 @@ class Elapsed(NamedTuple):
 
 
 def measure(
-    robot: ck.Robot, choice: Choice, breakdown: Breakdown, searched: SearchResult, elapsed: Elapsed
+    problem: Problem, choice: Choice, breakdown: Breakdown, searched: SearchResult, elapsed: Elapsed
 ) -> Metrics:
     """The metrics of a verified trajectory.
 
     Args:
-        robot: the robot (joint names, limits).
+        problem: the problem (robot, limits, dynamics).
         choice: the verified candidate, its timing and its check.
         breakdown: the chosen candidate's fitness terms (one candidate).
         searched: the optimiser's run.
@@ -126,6 +133,7 @@ def measure(
     """
     timing, check = choice.timing, choice.verification.check
     trajectory = timing.trajectory
+    robot, dynamics = problem.robot, problem.dynamics
     limits = robot.limits
     names = robot.joint_names
     jerk = trajectory.extrema(3)
@@ -158,4 +166,14 @@ def measure(
         duration_stretched=timing.stretched,
         timing=timing.method,
         timing_time_s=timing.time_s,
+        torque_utilisation={
+            name: float(peak)
+            for name, peak, limited in zip(
+                names,
+                (choice.verification.torques or torque_profile(dynamics, trajectory)).peak_utilisation,
+                np.isfinite(dynamics.effort),
+                strict=True,
+            )
+            if limited
+        },
     )

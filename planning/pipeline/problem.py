@@ -25,6 +25,7 @@ from planning.pipeline.motion import Motion
 from planning.pipeline.objective import WaypointObjective
 from planning.pipeline.scene import Scene
 from planning.pipeline.timing import FixedDuration, FreeDuration, duration_rule
+from planning.pipeline.torques import problem_dynamics
 
 FloatArray = NDArray[np.float64]
 
@@ -45,6 +46,7 @@ class Problem:
         solver: the septic spline solver on the search's knots: the trajectory's spline when
             the scene fixes the duration, else the geometric path's.
         objective: the waypoint objective the search minimises.
+        dynamics: the robot's torques with the scene's payload, and their limits.
         build_time_s: wall time of :func:`build_problem` [s].
     """
 
@@ -55,6 +57,7 @@ class Problem:
     duration: FixedDuration | FreeDuration
     solver: SepticSplineSolver = field(repr=False)
     objective: WaypointObjective = field(repr=False)
+    dynamics: ck.Dynamics = field(repr=False)
     build_time_s: float = 0.0
 
     @property
@@ -165,6 +168,7 @@ def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | No
         PlanningError: a bad start or goal, or one inside a margin; a fixed duration
             shorter than the limits allow; bad settings.
         TargetOutOfReachError: a ``tcp`` or ``pose`` start or goal no configuration reaches.
+        PayloadTooHeavyError: the motors cannot hold the start or goal still.
         cpr_kin.CprKinError: the robot's URDF or an obstacle is invalid.
     """
     started = time.perf_counter()
@@ -175,6 +179,7 @@ def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | No
     q_start = endpoint(robot, world, scene, "start")
     q_goal = endpoint(robot, world, scene, "goal", seed_q=q_start)
     motion = Motion(q_start, q_goal, moving_joints(robot, scene, q_start, q_goal))
+    dynamics = problem_dynamics(robot, scene, q_start, q_goal)
     duration = duration_rule(scene.duration)
     if isinstance(duration, FixedDuration):
         duration.check_reachable(robot, q_start, q_goal, rest_ends=scene.spline.ends == "rest")
@@ -187,6 +192,7 @@ def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | No
         duration=duration,
         solver=solver,
         objective=objective,
+        dynamics=dynamics,
         build_time_s=time.perf_counter() - started,
     )
 

@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
+from cpr_kin.dynamics import TORQUE_SCALE_RANGE
 from cpr_kin.names import unprintable
 from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError
@@ -74,6 +75,9 @@ class Scene:
         spline: spline settings (default :data:`DEFAULT_SPLINE`); finite weights ``p`` in
             :data:`SPLINE_P_RANGE`, non-zero ``a_r`` in :data:`SPLINE_A_RANGE`.
         name: a name for reports.
+        payload: a load the robot carries (:class:`cpr_kin.Payload`), part of its torques.
+        torque_scale: share of the URDF's effort limits the torques may use, in
+            :data:`cpr_kin.dynamics.TORQUE_SCALE_RANGE`.
     """
 
     start: Target
@@ -87,6 +91,8 @@ class Scene:
     planner: PlannerSettings = field(default_factory=PlannerSettings)
     spline: SplineSettings = DEFAULT_SPLINE
     name: str = "scene"
+    payload: ck.Payload | None = None
+    torque_scale: float = 1.0
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
@@ -98,6 +104,7 @@ class Scene:
             )
         number_in("safety_margin", self.safety_margin, 0.0, MAX_SAFETY_MARGIN_M, unit="m")
         number_in("self_margin", self.self_margin, 0.0, MAX_SAFETY_MARGIN_M, unit="m")
+        number_in("torque_scale", self.torque_scale, *TORQUE_SCALE_RANGE)
         if isinstance(self.robot, str | Path):
             object.__setattr__(self, "robot", ck.robot_spec(self.robot))
         object.__setattr__(

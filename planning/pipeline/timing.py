@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING, Literal, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-from planning.curves.path_timing import time_path
+from planning.curves.path_timing import limits_time_scale, time_path
 from planning.curves.ptp import trapezoid_time
 from planning.curves.spline import SplineFit
 from planning.curves.trajectory import Trajectory
@@ -65,9 +65,11 @@ class Timing:
     time_s: float
 
 
-def uniform_scale(fit: SplineFit, limits: ck.JointLimits) -> float:
-    """The factor that stretches ``fit`` uniformly until its worst peak meets a limit."""
-    return fit.trajectory.time_scale_for_limits(limits.velocity, limits.acceleration, limits.jerk)
+def uniform_scale(fit: SplineFit, problem: Problem) -> float:
+    """The factor that stretches ``fit`` uniformly until its worst peak meets a limit (torques too)."""
+    limits = problem.robot.limits
+    kinematic = np.stack([limits.velocity, limits.acceleration, limits.jerk])
+    return limits_time_scale(fit.trajectory, kinematic, problem.dynamics)
 
 
 class DurationRule(Protocol):
@@ -150,7 +152,7 @@ class FixedDuration:
     def timings(self, problem: Problem, nodes: FloatArray) -> list[Timing]:  # noqa: D102
         started = time.perf_counter()
         fit = problem.solver.solve(nodes)
-        scale = uniform_scale(fit, problem.robot.limits)
+        scale = uniform_scale(fit, problem)
         trajectory = fit.trajectory.time_scaled(max(scale, 1.0))
         return [Timing(trajectory, "fixed", fit, scale > 1.0, time.perf_counter() - started)]
 
@@ -175,9 +177,11 @@ class FreeDuration:
         limits = problem.robot.limits
         started = time.perf_counter()
         fit = problem.solver.solve(nodes)
-        fastest = time_path(fit.trajectory, limits.velocity, limits.acceleration, limits.jerk)
+        fastest = time_path(
+            fit.trajectory, limits.velocity, limits.acceleration, limits.jerk, torque=problem.dynamics
+        )
         middle = time.perf_counter()
-        uniform = fit.trajectory.time_scaled(uniform_scale(fit, limits))
+        uniform = fit.trajectory.time_scaled(uniform_scale(fit, problem))
         found = [
             Timing(fastest, "fastest", fit, False, middle - started),
             Timing(uniform, "uniform", fit, False, time.perf_counter() - middle),
@@ -192,7 +196,9 @@ class FreeDuration:
         uniform = next(timing for timing in offered if timing.method == "uniform")
         limits, fit = problem.robot.limits, uniform.fit
         started = time.perf_counter()
-        trajectory = time_path(fit.trajectory, limits.velocity, share * limits.acceleration, limits.jerk)
+        trajectory = time_path(
+            fit.trajectory, limits.velocity, share * limits.acceleration, limits.jerk, torque=problem.dynamics
+        )
         if trajectory.duration >= uniform.trajectory.duration:
             return None
         return Timing(trajectory, "narrowed", fit, False, time.perf_counter() - started)

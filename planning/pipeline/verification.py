@@ -6,7 +6,7 @@ What the planner accepts is what ``cpr-plan check`` re-checks: one function serv
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -17,6 +17,10 @@ from planning.curves.hermite import CONTINUITY
 from planning.curves.trajectory import DERIVATIVE_NAMES, Trajectory
 from planning.pipeline.scene import DEFAULT_SELF_MARGIN_M
 from planning.pipeline.target import Target
+from planning.pipeline.torques import TorqueProfile, torque_problems, torque_profile
+
+if TYPE_CHECKING:
+    from planning.pipeline.problem import Problem
 
 FloatArray = NDArray[np.float64]
 
@@ -28,10 +32,12 @@ class Verification:
     Attributes:
         check: the certified continuous clearance check.
         problems: one sentence per failed condition (empty when accepted).
+        torques: the joint torques at the check instants, if they were checked.
     """
 
     check: ck.CurveCheck
     problems: tuple[str, ...]
+    torques: TorqueProfile | None = None
 
     @property
     def accepted(self) -> bool:
@@ -111,16 +117,41 @@ def _self_problems(
     ]
 
 
+@dataclass(frozen=True)
+class Requirements:
+    """What :func:`verify_trajectory` holds a trajectory to.
+
+    Attributes:
+        margin_m: clearance from every obstacle [m].
+        step_m: largest robot motion between two checks of the certified check [m].
+        self_margin_m: clearance between the robot's checked link pairs [m].
+        endpoints: ``(start, goal)`` it must start and end at; ``None``: not checked.
+        dynamics: the robot's torques (payload included) and effort limits; ``None``: not checked.
+    """
+
+    margin_m: float
+    step_m: float
+    self_margin_m: float = DEFAULT_SELF_MARGIN_M
+    endpoints: tuple[Target, Target] | None = None
+    dynamics: ck.Dynamics | None = None
+
+    @classmethod
+    def of(cls, problem: Problem, endpoints: bool = False) -> Requirements:
+        """The scene's requirements (its start and goal too if ``endpoints``), torques included."""
+        scene = problem.scene
+        return cls(
+            margin_m=scene.safety_margin,
+            step_m=scene.planner.verify_step_m,
+            self_margin_m=scene.self_margin,
+            endpoints=(scene.start, scene.goal) if endpoints else None,
+            dynamics=problem.dynamics,
+        )
+
+
 def verify_trajectory(
-    world: ck.CollisionWorld,
-    trajectory: Trajectory,
-    margin_m: float,
-    step_m: float,
-    endpoints: tuple[Target, Target] | None = None,
-    *,
-    self_margin_m: float = DEFAULT_SELF_MARGIN_M,
+    world: ck.CollisionWorld, trajectory: Trajectory, required: Requirements
 ) -> Verification:
-    """Check a timed trajectory for everything a robot needs of it.
+    """Check a timed trajectory for everything a robot needs of it (``required``'s values).
 
     - position, velocity, acceleration and jerk are continuous at every knot (C3);
     - the certified clearance (:func:`cpr_kin.check_curve`, robot motion between checks at
@@ -131,8 +162,11 @@ def verify_trajectory(
       limits (exact extrema);
     - with ``endpoints = (start, goal)``: it starts and ends there (:meth:`Target.miss`: a
       joint vector within 1e-6, a ``tcp`` or ``pose`` by forward kinematics within its
-      tolerance).
+      tolerance);
+    - with ``dynamics``: every joint torque (RNEA, :func:`~planning.pipeline.torques.torque_profile`)
+      within its effort limit every millisecond and at every knot.
     """
+    margin_m, step_m, endpoints = required.margin_m, required.step_m, required.endpoints
     robot = world.robot
     limits = robot.limits
     tolerance = LIMIT_TOLERANCE
@@ -158,7 +192,7 @@ def verify_trajectory(
             f"comes within {check.certified_min_m:.4f} m (certified) of an obstacle, margin {margin_m} m: "
             f"closest at t = {check.worst_time:.2f} s between {check.worst_pair} ({check.worst_group})"
         )
-    problems += _self_problems(world, trajectory, self_margin_m, step_m)
+    problems += _self_problems(world, trajectory, required.self_margin_m, step_m)
     positions = trajectory.extrema(0)
     for i, name in enumerate(robot.joint_names):
         low, high = positions.minimum[i], positions.maximum[i]
@@ -177,4 +211,8 @@ def verify_trajectory(
             problems.append(
                 f"drives the {kind} of joint '{robot.joint_names[j]}' to {ratio[j]:.3f} x its limit"
             )
-    return Verification(check=check, problems=tuple(problems))
+    torques = None
+    if required.dynamics is not None:
+        torques = torque_profile(required.dynamics, trajectory)
+        problems += torque_problems(required.dynamics, torques)
+    return Verification(check=check, problems=tuple(problems), torques=torques)

@@ -32,7 +32,9 @@ def plot_files(result: PlanResult) -> dict[str, bytes]:
             robot, result.trajectory, result.waypoints, result.scene.obstacles, result.scene.safety_margin
         ),
         plots.clearance_figure(world, result.trajectory, result.scene.safety_margin),
-        plots.utilisation_figure(limit_usage(result.trajectory, robot.limits), robot.joint_names),
+        plots.utilisation_figure(
+            limit_usage(result.trajectory, robot.limits, dynamics=result.problem.dynamics), robot.joint_names
+        ),
         plots.convergence_figure(result.optimiser),
     )
     return {name: plots.png_bytes(figure) for name, figure in zip(PLOT_FILES, figures, strict=True)}

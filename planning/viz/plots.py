@@ -7,7 +7,7 @@ Imported only when plots are asked for: ``import planning`` never loads matplotl
   plus the knots and the exact extremum instants, so their extrema are the metrics'.
 - :func:`tcp_path_figure`: the 3-D TCP path with the obstacles and margin (fig. 3).
 - :func:`clearance_figure`: clearance against time with the margin line.
-- :func:`utilisation_figure`: how much of each kinematic limit the motion uses over time.
+- :func:`utilisation_figure`: how much of each limit (kinematic, and torque) the motion uses over time.
 - :func:`convergence_figure`: the firefly's best and mean fitness per iteration.
 """
 
@@ -30,7 +30,7 @@ from numpy.typing import NDArray
 import cpr_kin as ck
 from planning.curves.trajectory import DERIVATIVE_NAMES, Trajectory
 from planning.search.optimizer import SearchResult
-from planning.utilisation import ORDERS, LimitUsage
+from planning.utilisation import LimitUsage
 
 FloatArray = NDArray[np.float64]
 UNITS = {"rad": ("rad", "rad/s", "rad/s$^2$", "rad/s$^3$"), "m": ("m", "m/s", "m/s$^2$", "m/s$^3$")}
@@ -153,13 +153,14 @@ def clearance_figure(world: ck.CollisionWorld, trajectory: Trajectory, margin_m:
 
 
 def utilisation_figure(usage: LimitUsage, joint_names: tuple[str, ...]) -> Figure:
-    """Largest |velocity|, |acceleration| and |jerk| over its limit among the joints, against time.
+    """Largest |velocity|, |acceleration|, |jerk| (|torque|) over its limit among the joints, against time.
 
     Where the curves stay near 1 the motion runs at its limits; where all stay low, time is
     left on the table. The shading marks which joint holds the largest usage of each order.
     """
-    figure, axes = plt.subplots(3, 1, figsize=(8, 6), sharex=True)
-    for r, (ax, order) in enumerate(zip(axes, ORDERS, strict=True)):
+    rows = len(usage.orders)
+    figure, axes = plt.subplots(rows, 1, figsize=(8, 2 * rows), sharex=True)
+    for r, (ax, order) in enumerate(zip(axes, usage.orders, strict=True)):
         ax.plot(usage.times, usage.usage[:, r], color=f"C{r}")
         ax.axhline(1.0, color="k", linestyle="--", linewidth=0.8)
         for j, name in enumerate(joint_names):

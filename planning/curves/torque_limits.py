@@ -1,0 +1,146 @@
+"""Torque limits in the timing: the rows the phase plane keeps, and the exact uniform time scale.
+
+Along a path ``q(s)`` run at speed ``s'`` the joint torques are affine in the path
+acceleration and the squared speed: ``tau = slope s'' + curve s'^2 + offset``
+(:meth:`TorqueModel.path_terms`), the form of a joint's acceleration with an offset, gravity's
+torque. :func:`torque_rows` turns them into rows the phase plane
+(:mod:`planning.curves.phase_plane`) keeps beside the joints' accelerations, under the effort
+limits less :data:`HEADROOM`.
+
+Run uniformly ``k`` times slower, a trajectory's torques are ``d / k^2 + g``, with ``g`` the
+gravity torque and ``d`` the rest (inertia, Coriolis): :func:`torque_time_scale` gives the
+least ``k`` that keeps every sample within the limits, in closed form. This module knows no
+robot: a :class:`TorqueModel` (:class:`cpr_kin.dynamics.Dynamics`) computes the torques.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple, Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from planning.curves.trajectory import Trajectory
+
+FloatArray = NDArray[np.float64]
+
+HEADROOM = 1e-3
+"""Share of the effort limits the timing leaves unused: a check sampling other instants than
+the timing's (``cpr-plan check`` every millisecond) finds peaks between them a little higher."""
+COARSE_STEP_S = 1e-2
+"""Spacing of the samples at which :func:`torque_time_scale` first evaluates the torques [s]."""
+PRECHECK_STRIDE = 4
+"""Every how many grid points :func:`torque_rows` first looks whether the torques bind."""
+FINE_STEP_S = 2.5e-4
+"""Spacing of its samples around the coarse samples that come near the largest scale [s]."""
+UNBOUND_SHARE = 0.9
+"""Share of a limit below which a torque is taken not to bind, where a cheaper answer holds:
+:func:`torque_rows` leaves out the rows of a profile whose torques all stay below it, and
+:func:`torque_time_scale` refines only samples that need more than this share of the scale."""
+
+
+class TorqueModel(Protocol):
+    """The joint torques of a robot (:class:`cpr_kin.dynamics.Dynamics`)."""
+
+    @property
+    def effort(self) -> FloatArray:
+        """``(nj,)`` effort limits [N m or N], ``inf`` where unknown."""
+        ...
+
+    def torques(
+        self, q: FloatArray, qd: FloatArray | None = None, qdd: FloatArray | None = None
+    ) -> FloatArray:
+        """``(T, nj)`` torques at ``(T, nj)`` positions, velocities and accelerations."""
+        ...
+
+    def path_terms(
+        self, q: FloatArray, dq: FloatArray, ddq: FloatArray
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """``slope``, ``curve``, ``offset`` ``(T, nj)`` of the torques along a path (module docstring)."""
+        ...
+
+
+class TorqueRows(NamedTuple):
+    """Torque constraints at the grid points of a path: ``|slope s'' + curve s'^2 + offset| <= limit``."""
+
+    slope: FloatArray
+    """``(G, R)`` torque per unit path acceleration."""
+    curve: FloatArray
+    """``(G, R)`` torque per unit squared path speed."""
+    offset: FloatArray
+    """``(G, R)`` gravity's torque."""
+    limit: FloatArray
+    """``(R,)`` effort limits less :data:`HEADROOM`."""
+
+
+def torque_rows(
+    q: FloatArray, dq: FloatArray, ddq: FloatArray, ds: FloatArray, model: TorqueModel, x: FloatArray
+) -> TorqueRows | None:
+    """The rows of the joints with a known effort limit along the path ``q(s)`` ``(G, nj)``.
+
+    ``None`` when they cannot bind, or cannot be kept:
+
+    - no joint has a known effort limit;
+    - the profile ``x = s'^2`` without them (on the grid steps ``ds``) stays below
+      :data:`UNBOUND_SHARE` of every limit: a cap on it only lowers the speeds, so the rows
+      would change nothing but the cost (the final :func:`torque_time_scale` still holds
+      every torque to its limit);
+    - gravity alone exceeds a limit somewhere on the path: standing there is beyond the
+      motors, and the phase plane's rest-to-rest profile assumes it is not (the
+      verification then names the torque, as the timing cannot help).
+    """
+    limited = np.isfinite(model.effort)
+    if not limited.any():
+        return None
+    limit = model.effort[limited] * (1.0 - HEADROOM)
+    push = np.append(np.diff(x) / (2.0 * ds), 0.0)  # s'' on each grid step, from its first point
+    for points in (slice(None, None, PRECHECK_STRIDE), slice(None)):  # a cheap look first
+        slope, curve, offset = (
+            term[:, limited] for term in model.path_terms(q[points], dq[points], ddq[points])
+        )
+        if np.any(np.abs(offset) > limit):
+            return None
+        torque = slope * push[points, None] + curve * x[points, None] + offset
+        if np.all(np.abs(torque) <= UNBOUND_SHARE * limit):
+            return None
+    return TorqueRows(slope, curve, offset, limit)
+
+
+def torque_time_scale(trajectory: Trajectory, model: TorqueModel, at_least: float = 0.0) -> float:
+    """The least uniform time scale ``k`` whose trajectory keeps the torques within the limits.
+
+    Limits less :data:`HEADROOM`, at samples every :data:`COARSE_STEP_S` and at the knots,
+    then every :data:`FINE_STEP_S` around the samples within :data:`UNBOUND_SHARE` of the
+    largest scale (that or ``at_least``, a scale another limit needs: when every coarse
+    sample needs less than :data:`UNBOUND_SHARE` of it, the torques do not bind and the
+    coarse answer is returned). ``0`` when no torque binds however fast (no known limit, or
+    none moves it); ``inf`` when gravity alone exceeds a limit at a sample (no scale helps).
+    """
+    limited = np.isfinite(model.effort)
+    if not limited.any():
+        return 0.0
+    start, end = float(trajectory.knots[0]), float(trajectory.knots[-1])
+    count = max(2, int(np.ceil((end - start) / COARSE_STEP_S)) + 1)
+    coarse = np.union1d(np.linspace(start, end, count), trajectory.knots)
+    needed = _needed_scales(trajectory, model, limited, coarse)
+    top = max(float(needed.max()), at_least)
+    if not np.isfinite(top) or needed.max() < UNBOUND_SHARE * top:
+        return float(needed.max())
+    near = coarse[needed >= UNBOUND_SHARE * top]
+    offsets = np.arange(-COARSE_STEP_S, COARSE_STEP_S + FINE_STEP_S / 2, FINE_STEP_S)
+    fine = np.unique(np.clip((near[:, None] + offsets).ravel(), start, end))
+    return float(max(needed.max(), _needed_scales(trajectory, model, limited, fine).max()))
+
+
+def _needed_scales(
+    trajectory: Trajectory, model: TorqueModel, limited: NDArray[np.bool_], t: FloatArray
+) -> FloatArray:
+    """``(T,)`` the least time scale each sample at ``t`` [s] needs (module docstring)."""
+    q, qd, qdd = (trajectory(t, r) for r in range(3))
+    gravity = model.torques(q)[:, limited]
+    moving = model.torques(q, qd, qdd)[:, limited] - gravity
+    limit = model.effort[limited] * (1.0 - HEADROOM)
+    room = np.where(moving > 0.0, limit - gravity, limit + gravity)  # toward the limit it pushes
+    with np.errstate(divide="ignore", invalid="ignore"):
+        needed = np.where(room > 0.0, np.sqrt(np.abs(moving) / np.maximum(room, 1e-300)), np.inf)
+    return np.asarray(needed.max(axis=1))

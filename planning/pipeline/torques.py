@@ -1,0 +1,115 @@
+"""The joint torques a trajectory asks of the robot, checked against its effort limits.
+
+:func:`problem_dynamics` builds the robot's dynamics with the scene's payload once per
+problem and refuses a start or goal the motors cannot hold still. :func:`torque_profile`
+samples a trajectory's torques by Pinocchio's RNEA every :data:`CHECK_STEP_S` and at its
+knots: the verification (:func:`torque_problems`), the report and the plots read it. It
+shares nothing with the timing's torque terms (:mod:`planning.curves.torque_limits`) but the
+robot model: RNEA of the trajectory's own position, velocity and acceleration.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+import cpr_kin as ck
+from planning.curves.trajectory import Trajectory
+from planning.errors import PayloadTooHeavyError, PlanningError
+from planning.pipeline.scene import Scene
+
+FloatArray = NDArray[np.float64]
+
+CHECK_STEP_S = 1e-3
+"""Spacing of the instants at which a trajectory's torques are checked [s]."""
+TORQUE_TOLERANCE = 1e-9
+"""Relative excess of an effort limit that still passes (rounding)."""
+
+
+@dataclass(frozen=True)
+class TorqueProfile:
+    """A trajectory's joint torques at its check instants.
+
+    Attributes:
+        times_s: ``(T,)`` instants [s].
+        torques: ``(T, nq)`` joint torques [N m or N].
+        effort: ``(nq,)`` the limits they are held to [N m or N], ``inf`` where unknown.
+        joint_names: the joints, in order.
+    """
+
+    times_s: FloatArray
+    torques: FloatArray
+    effort: FloatArray
+    joint_names: tuple[str, ...]
+
+    @property
+    def utilisation(self) -> FloatArray:
+        """``(T, nq)`` ``|torque| / effort`` (0 where the effort is unknown)."""
+        return np.abs(self.torques) / self.effort
+
+    @property
+    def peak_utilisation(self) -> FloatArray:
+        """``(nq,)`` the largest ``|torque| / effort`` of each joint."""
+        return np.asarray(self.utilisation.max(axis=0))
+
+
+def torque_profile(
+    dynamics: ck.Dynamics, trajectory: Trajectory, step_s: float = CHECK_STEP_S
+) -> TorqueProfile:
+    """The torques of ``trajectory`` every ``step_s`` [s] and at its knots, by RNEA."""
+    start, end = float(trajectory.knots[0]), float(trajectory.knots[-1])
+    count = max(2, int(np.floor((end - start) / step_s + 1e-9)) + 1)
+    times = np.union1d(start + step_s * np.arange(count), trajectory.knots)
+    torques = dynamics.torques(trajectory(times), trajectory(times, 1), trajectory(times, 2))
+    return TorqueProfile(times, torques, dynamics.effort, dynamics.joint_names)
+
+
+def torque_problems(dynamics: ck.Dynamics, profile: TorqueProfile) -> list[str]:
+    """The worst joint torque of a trajectory's ``profile`` beyond its effort limit, as a problem, if any."""
+    if not dynamics.limited:
+        return []
+    usage = profile.utilisation
+    if usage.max() <= 1.0 + TORQUE_TOLERANCE:
+        return []
+    k, j = (int(index) for index in np.unravel_index(int(np.argmax(usage)), usage.shape))
+    name = dynamics.joint_names[j]
+    return [
+        f"drives the torque of joint '{name}' to {usage[k, j]:.3f} x its effort limit "
+        f"({abs(profile.torques[k, j]):.4g} of {dynamics.effort[j]:.4g}{_unit(dynamics, j)}) at t = "
+        f"{profile.times_s[k]:.3f} s"
+    ]
+
+
+def problem_dynamics(robot: ck.Robot, scene: Scene, q_start: FloatArray, q_goal: FloatArray) -> ck.Dynamics:
+    """The robot's dynamics with the scene's payload, able to hold the start and goal still.
+
+    Raises:
+        PlanningError: the payload's frame is not the robot's.
+        PayloadTooHeavyError: gravity's torque at the start or goal exceeds a joint's
+            effort limit (times ``torque_scale``), naming the joint, the torque and the limit.
+    """
+    try:
+        dynamics = ck.robot_dynamics(robot, scene.payload, scene.torque_scale)
+    except ck.CprKinError as exc:
+        raise PlanningError(f"payload: {exc}") from None
+    for label, q in (("start", q_start), ("goal", q_goal)):
+        holding = np.abs(dynamics.torques(q)[0])
+        j = int(np.argmax(holding / dynamics.effort))
+        if holding[j] > dynamics.effort[j]:
+            unit = _unit(dynamics, j)
+            carried = "" if scene.payload is None else f" with the {scene.payload.mass_kg:g} kg payload"
+            raise PayloadTooHeavyError(
+                f"holding the {label} still{carried} takes {holding[j]:.4g}{unit} at joint "
+                f"'{dynamics.joint_names[j]}', beyond its effort limit {dynamics.effort[j]:.4g}{unit} "
+                f"(URDF effort x torque_scale {dynamics.torque_scale:g}); lighten the payload or "
+                f"choose another {label}"
+            )
+    return dynamics
+
+
+def _unit(dynamics: ck.Dynamics, joint: int) -> str:
+    """`` N m`` for a revolute joint's torque, `` N`` for a prismatic joint's force."""
+    kind = dynamics.model.joints[joint + 1].shortname().removeprefix("JointModel")
+    return " N" if kind.startswith("P") else " N m"

@@ -1,0 +1,94 @@
+"""Torque limits in the timing: phase-plane rows with an offset, and the exact uniform time scale."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import cpr_kin as ck
+from planning.curves.path_timing import time_path
+from planning.curves.phase_plane import phase_plane_profile
+from planning.curves.spline import SepticSplineSolver, uniform_knots
+from planning.curves.torque_limits import HEADROOM, torque_time_scale
+from planning.curves.trajectory import Trajectory
+from planning.pipeline.scene import DEFAULT_SPLINE
+from planning.pipeline.torques import torque_profile
+
+
+def polynomial_path(seed: int, joints: int = 3) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    u = np.linspace(0.0, 1.0, 300)
+    coefficients = rng.normal(size=(4, joints))
+    d1 = np.column_stack([np.polyval(np.polyder(c[::-1]), u) for c in coefficients.T])
+    d2 = np.column_stack([np.polyval(np.polyder(c[::-1], 2), u) for c in coefficients.T])
+    return u, d1, d2
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_rows_with_an_offset_are_kept_at_every_grid_point(seed: int) -> None:
+    u, d1, d2 = polynomial_path(seed)
+    rng = np.random.default_rng(100 + seed)
+    a = rng.uniform(1.0, 3.0, 3)
+    offset = rng.uniform(-0.6, 0.6, (1, 3)) * a * np.cos(3 * u)[:, None]  # "gravity" within the limits
+    du = np.diff(u)
+    x = phase_plane_profile(d1, d2, du, np.full(3, np.inf), a, offset)
+    push = np.diff(x) / (2.0 * du)  # u'' on each step, applied from its first point
+    value = d1[:-1] * push[:, None] + d2[:-1] * x[:-1, None] + offset[:-1]
+    assert np.max(np.abs(value) / a) <= 1.0 + 1e-6
+    assert x[0] == x[-1] == 0.0 and x.max() > 0.0
+
+
+def test_a_redundant_row_changes_nothing() -> None:
+    u, d1, d2 = polynomial_path(7)
+    v, a, du = np.array([1.0, 1.5, 2.0]), np.array([2.0, 1.0, 3.0]), np.diff(u)
+    alone = phase_plane_profile(d1, d2, du, v, a, np.zeros_like(d1))
+    # a "torque" row that is joint 1's acceleration times 4, limited to 4 times its limit
+    rows = phase_plane_profile(
+        np.hstack([d1, 4 * d1[:, 1:2]]),
+        np.hstack([d2, 4 * d2[:, 1:2]]),
+        du,
+        np.append(v, np.inf),
+        np.append(a, 4 * a[1]),
+        np.zeros((len(u), 4)),
+    )
+    assert rows == pytest.approx(alone, rel=1e-9, abs=1e-12)
+
+
+@pytest.fixture(scope="module")
+def robot() -> ck.Robot:
+    return ck.load_cpr()
+
+
+@pytest.fixture(scope="module")
+def path(robot: ck.Robot) -> Trajectory:
+    nodes = np.array([[0.0, 0.1, 0.1, 0.0, 0.0], [0.8, 0.45, 0.3, 0.5, 0.2], [1.5, 0.5, 0.4, 1.0, 0.5]])
+    solver = SepticSplineSolver(uniform_knots(2, 2.0), DEFAULT_SPLINE)
+    return solver.solve(nodes).trajectory
+
+
+def test_the_uniform_scale_meets_the_torque_limit_exactly(robot: ck.Robot, path: Trajectory) -> None:
+    dynamics = ck.robot_dynamics(robot, ck.Payload(12.0, (0.0, 0.0, 0.05)))
+    fast = path.time_scaled(0.5)
+    scale = torque_time_scale(fast, dynamics)
+    assert scale > 1.0  # too fast for the payload
+    scaled = fast.time_scaled(scale)
+    usage = torque_profile(dynamics, scaled, step_s=scaled.duration / 4000).utilisation.max()
+    assert usage == pytest.approx(1.0 - HEADROOM, abs=2e-4)
+
+
+@pytest.mark.parametrize("mass_kg", [0.0, 8.0, 15.0])
+def test_the_fastest_timing_keeps_the_torques_and_uses_them_when_they_bind(
+    robot: ck.Robot, path: Trajectory, mass_kg: float
+) -> None:
+    limits = robot.limits
+    dynamics = ck.robot_dynamics(robot, ck.Payload(mass_kg, (0.0, 0.0, 0.05)))
+    kinematic = time_path(path, limits.velocity, limits.acceleration, limits.jerk)
+    timed = time_path(path, limits.velocity, limits.acceleration, limits.jerk, torque=dynamics)
+    usage = torque_profile(dynamics, timed).peak_utilisation
+    assert usage.max() <= 1.0
+    for r, limit in enumerate((limits.velocity, limits.acceleration, limits.jerk), start=1):
+        assert np.max(timed.extrema(r).peak / limit) <= 1.0 + 1e-9
+    if torque_profile(dynamics, kinematic).peak_utilisation.max() <= 1.0:  # torque does not bind
+        assert timed.duration == pytest.approx(kinematic.duration, rel=1e-12)
+    else:  # it binds: no time left on the table, and slower than the kinematic timing
+        assert usage.max() == pytest.approx(1.0 - HEADROOM, abs=2e-3) and timed.duration > kinematic.duration
