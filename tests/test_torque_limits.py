@@ -6,13 +6,16 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
+from planning.curves.jerk_window import sampled_path_durations
 from planning.curves.path_timing import time_path
 from planning.curves.phase_plane import phase_plane_profile
 from planning.curves.spline import SepticSplineSolver, uniform_knots
+from planning.curves.torque_estimate import sampled_torque_durations
 from planning.curves.torque_limits import HEADROOM, torque_time_scale
 from planning.curves.trajectory import Trajectory
+from planning.curves.velocity_caps import ROUNDS, TOLERANCE
 from planning.pipeline.scene import DEFAULT_SPLINE
-from planning.pipeline.torques import torque_profile
+from planning.pipeline.torques import search_torque, torque_profile
 
 
 def polynomial_path(seed: int, joints: int = 3) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -92,3 +95,33 @@ def test_the_fastest_timing_keeps_the_torques_and_uses_them_when_they_bind(
         assert timed.duration == pytest.approx(kinematic.duration, rel=1e-12)
     else:  # it binds: no time left on the table, and slower than the kinematic timing
         assert usage.max() == pytest.approx(1.0 - HEADROOM, abs=2e-3) and timed.duration > kinematic.duration
+
+
+def limits_of(kinematic: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    return kinematic[0], kinematic[1], kinematic[2]
+
+
+def test_the_search_estimate_keeps_the_torques_where_they_bind(robot: ck.Robot, path: Trajectory) -> None:
+    limits = robot.limits
+    kinematic = np.stack([limits.velocity, limits.acceleration, limits.jerk])
+    window = float(np.max(limits.acceleration / limits.jerk))
+    samples = path(np.linspace(path.knots[0], path.knots[-1], 64))[None]
+    fitted = np.arange(robot.nq)
+    plain = sampled_path_durations(samples, *limits_of(kinematic), window, ROUNDS, TOLERANCE)
+    light = ck.robot_dynamics(robot, ck.Payload(2.0, (0.0, 0.0, 0.05)))
+    assert sampled_torque_durations(samples, fitted, kinematic, light, window) == pytest.approx(
+        plain, rel=1e-12
+    )
+    heavy = ck.robot_dynamics(robot, ck.Payload(15.0, (0.0, 0.0, 0.05)))
+    estimate = sampled_torque_durations(samples, fitted, kinematic, heavy, window)[0]
+    timed = time_path(path, limits.velocity, limits.acceleration, limits.jerk, torque=heavy).duration
+    assert estimate > plain[0] and estimate == pytest.approx(timed, rel=0.1)
+
+
+def test_the_search_keeps_torques_only_when_they_bind_on_the_straight_path(robot: ck.Robot) -> None:
+    start, goal = np.array([0.0, 0.1, 0.1, 0.0, 0.0]), np.array([1.5, 0.5, 0.4, 1.0, 0.5])
+    light = ck.robot_dynamics(robot, ck.Payload(5.0))
+    heavy = ck.robot_dynamics(robot, ck.Payload(15.0))
+    assert search_torque(robot, light, start, goal) is None  # the CPR's torques stay below half
+    assert search_torque(robot, heavy, start, goal) is heavy
+    assert search_torque(robot, heavy, start, start) is None

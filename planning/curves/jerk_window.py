@@ -116,8 +116,67 @@ def sampled_path_durations(
         if len(d1) < 2:
             continue
         x = phase_plane_profile(d1, d2, steps, v, a, np.zeros_like(d1))
-        times = profile_instants(x, steps)
-        velocity = d1 * np.sqrt(np.maximum(x, 0.0))[:, None]
-        window, usage = needed_window(times, velocity, j, window_s, rounds, tolerance)
-        durations[s] = (times[-1] + TAIL * window) * max(1.0, usage ** (1.0 / 3.0))
+        durations[s] = jerk_limited_duration(x, steps, d1, j, window_s, rounds, tolerance)
     return durations
+
+
+@njit
+def jerk_limited_duration(
+    x: FloatArray,
+    steps: FloatArray,
+    d1: FloatArray,
+    j: FloatArray,
+    window_s: float,
+    rounds: int,
+    tolerance: float,
+) -> float:
+    """Duration [s] of the profile ``x`` (path steps ``steps``, ``dq/ds`` ``d1``) once its jerk is limited.
+
+    The profile's time plus :data:`TAIL` times the window :func:`needed_window` widens to,
+    stretched by ``usage^(1/3)`` where the last window still exceeds the jerk limit.
+    """
+    times = profile_instants(x, steps)
+    velocity = d1 * np.sqrt(np.maximum(x, 0.0))[:, None]
+    window, usage = needed_window(times, velocity, j, window_s, rounds, tolerance)
+    return float((times[-1] + TAIL * window) * max(1.0, usage ** (1.0 / 3.0)))
+
+
+@njit
+def torque_path_duration(
+    steps: FloatArray,
+    d1: FloatArray,
+    d2: FloatArray,
+    limits: FloatArray,
+    torque: FloatArray,
+    window_s: float,
+    rounds: int,
+    tolerance: float,
+) -> float:
+    """:func:`sampled_path_durations` of one path whose joint torques are limited too.
+
+    Args:
+        steps: ``(M - 1,)`` arc-length steps
+            (:func:`~planning.curves.phase_plane.sampled_derivatives`).
+        d1: ``(M, nj)`` ``dq/ds`` at the samples.
+        d2: ``(M, nj)`` ``d2q/ds2`` at the samples.
+        limits: ``(3, nj)`` velocity, acceleration and jerk limits.
+        torque: ``(4, M, R)`` the torques' slope, curve and offset at the samples and, in
+            ``torque[3, 0]``, their limits (:mod:`planning.curves.torque_limits`).
+        window_s: the first window [s], as in :func:`sampled_path_durations`.
+        rounds: its most widenings.
+        tolerance: the jerk excess left to the final scaling.
+    """
+    m, joints = d1.shape
+    rows = torque.shape[2]
+    first = np.empty((m, joints + rows))
+    second = np.empty((m, joints + rows))
+    offset = np.zeros((m, joints + rows))
+    first[:, :joints], first[:, joints:] = d1, torque[0]
+    second[:, :joints], second[:, joints:] = d2, torque[1]
+    offset[:, joints:] = torque[2]
+    velocity = np.full(joints + rows, np.inf)
+    velocity[:joints] = limits[0]
+    bound = np.empty(joints + rows)
+    bound[:joints], bound[joints:] = limits[1], torque[3, 0]
+    x = phase_plane_profile(first, second, steps, velocity, bound, offset)
+    return jerk_limited_duration(x, steps, d1, limits[2], window_s, rounds, tolerance)

@@ -158,24 +158,36 @@ def profile_time(x: FloatArray, du: FloatArray) -> float:
 
 
 @njit
-def sampled_derivatives(points: FloatArray, v: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Arc-length steps ``(M - 1,)`` and ``dq/ds``, ``d2q/ds2`` ``(M, nj)`` of a sampled path.
+def kept_samples(points: FloatArray, v: FloatArray) -> NDArray[np.int64]:
+    """Indices of the samples ``(M,)`` of a path ``(count, nj)`` farther than ``1e-9`` from the one before.
 
-    ``s`` measures each joint in seconds at its velocity limit; samples closer than ``1e-9``
-    to the one before are dropped; derivatives are the three-point formulas of a
-    non-uniform grid, taken from the neighbour at the ends.
+    Distances in seconds at the velocity limits ``v``; the first sample is always kept.
     """
     count, joints = points.shape
-    kept = np.empty((count, joints))
-    kept[0] = points[0]
+    index = np.empty(count, dtype=np.int64)
+    index[0] = 0
     m = 1
     for k in range(1, count):
         step = 0.0
         for j in range(joints):
-            step += ((points[k, j] - kept[m - 1, j]) / v[j]) ** 2
+            step += ((points[k, j] - points[index[m - 1], j]) / v[j]) ** 2
         if np.sqrt(step) > 1e-9:
-            kept[m] = points[k]
+            index[m] = k
             m += 1
+    return index[:m]
+
+
+@njit
+def sampled_derivatives(points: FloatArray, v: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Arc-length steps ``(M - 1,)`` and ``dq/ds``, ``d2q/ds2`` ``(M, nj)`` of a sampled path.
+
+    ``s`` measures each joint in seconds at its velocity limit; samples closer than ``1e-9``
+    to the one before are dropped (:func:`kept_samples`); derivatives are the three-point
+    formulas of a non-uniform grid, taken from the neighbour at the ends.
+    """
+    joints = points.shape[1]
+    kept = points[kept_samples(points, v)]
+    m = kept.shape[0]
     steps = np.empty(max(m - 1, 1))
     steps[0] = 1.0
     for k in range(m - 1):

@@ -122,7 +122,7 @@ class WaypointObjective:
         self.v_max, self.a_max = limits.velocity, limits.acceleration
         self.rule = FITNESS_RULES[settings.fitness]
         timed = duration.limits_bind_candidates
-        self.paths = executed_paths(limits, motion, settings, solver, timed)
+        self.paths = executed_paths(limits, motion, settings, solver, duration)
         # with the duration free, the clearance fitness ranks by how fast a path can be run
         self.estimates_duration = not timed and self.rule.ranks_by_duration and self.paths.estimates_duration
         segments = self.n_waypoints + 1

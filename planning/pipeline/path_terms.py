@@ -28,6 +28,7 @@ exactly, as the spline through constant nodes does.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -37,9 +38,14 @@ from planning.curves.jerk_window import sampled_path_durations
 from planning.curves.piecewise_sampler import PiecewiseSampler
 from planning.curves.polynomial_bounds import DerivativeBounds
 from planning.curves.spline import SepticSplineSolver
+from planning.curves.torque_estimate import sampled_torque_durations
+from planning.curves.torque_limits import TorqueModel
 from planning.curves.velocity_caps import ROUNDS, TOLERANCE
 from planning.pipeline.motion import Motion
 from planning.pipeline.settings import PlannerSettings
+
+if TYPE_CHECKING:
+    from planning.pipeline.timing import DurationRule
 
 FloatArray = NDArray[np.float64]
 
@@ -103,6 +109,8 @@ class SplinePaths:
         settings: planner settings (IPO, fitness samples).
         solver: the septic spline solver on the search's knots.
         timed: the knots are the final timing, so velocity, acceleration and jerk limits apply.
+        torque: the robot's torques, which the duration estimate then keeps too; ``None``:
+            kinematic limits only.
     """
 
     estimates_duration = True
@@ -114,12 +122,13 @@ class SplinePaths:
         settings: PlannerSettings,
         solver: SepticSplineSolver,
         timed: bool,
+        torque: TorqueModel | None = None,
     ) -> None:
         q_start, q_goal = motion.q_start, motion.q_goal
         self.q_start = q_start
         # joints the spline moves; the others stay at their start (= goal) value throughout
         self.fitted = np.union1d(motion.moving, np.flatnonzero(q_start != q_goal))
-        self.settings, self.solver, self.timed = settings, solver, timed
+        self.settings, self.solver, self.timed, self.torque = settings, solver, timed, torque
         self.lower_q, self.upper_q, self.range_q = limits.lower, limits.upper, limits.range
         self._derivative_limits = (limits.velocity, limits.acceleration, limits.jerk)
         knots = solver.knots
@@ -183,6 +192,9 @@ class SplinePaths:
         widenings (:data:`~planning.curves.velocity_caps.ROUNDS`,
         :data:`~planning.curves.velocity_caps.TOLERANCE`).
         """
+        if self.torque is not None:
+            limits = np.stack(self._fitted_limits)
+            return sampled_torque_durations(samples, self.fitted, limits, self.torque, self._window_s)
         points = np.ascontiguousarray(samples[:, :, self.fitted])
         return sampled_path_durations(points, *self._fitted_limits, self._window_s, ROUNDS, TOLERANCE)
 
@@ -199,9 +211,19 @@ ExecutedPaths = PtpPaths | SplinePaths
 
 
 def executed_paths(
-    limits: ck.JointLimits, motion: Motion, settings: PlannerSettings, solver: SepticSplineSolver, timed: bool
+    limits: ck.JointLimits,
+    motion: Motion,
+    settings: PlannerSettings,
+    solver: SepticSplineSolver,
+    duration: DurationRule,
 ) -> ExecutedPaths:
-    """The executed-path rule of ``settings.path``: ``spline`` (default) or ``ptp``."""
+    """The executed-path rule of ``settings.path``: ``spline`` (default) or ``ptp``.
+
+    ``duration``: the scene's duration rule (whether the limits bind candidates, and the
+    torques the duration estimate keeps).
+    """
     if settings.path == "ptp":
         return PtpPaths(limits, settings)
-    return SplinePaths(limits, motion, settings, solver, timed)
+    return SplinePaths(
+        limits, motion, settings, solver, duration.limits_bind_candidates, duration.search_torque
+    )

@@ -25,7 +25,7 @@ from planning.pipeline.motion import Motion
 from planning.pipeline.objective import WaypointObjective
 from planning.pipeline.scene import Scene
 from planning.pipeline.timing import FixedDuration, FreeDuration, duration_rule
-from planning.pipeline.torques import problem_dynamics
+from planning.pipeline.torques import problem_dynamics, search_torque
 
 FloatArray = NDArray[np.float64]
 
@@ -180,7 +180,7 @@ def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | No
     q_goal = endpoint(robot, world, scene, "goal", seed_q=q_start)
     motion = Motion(q_start, q_goal, moving_joints(robot, scene, q_start, q_goal))
     dynamics = problem_dynamics(robot, scene, q_start, q_goal)
-    duration = duration_rule(scene.duration)
+    duration = duration_rule(scene.duration, search_torque(robot, dynamics, q_start, q_goal))
     if isinstance(duration, FixedDuration):
         duration.check_reachable(robot, q_start, q_goal, rest_ends=scene.spline.ends == "rest")
     solver, objective = _search_space(scene, world, motion, duration)

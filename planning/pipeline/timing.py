@@ -81,6 +81,11 @@ class DurationRule(Protocol):
         ...
 
     @property
+    def search_torque(self) -> ck.Dynamics | None:
+        """The torques the search's duration estimate keeps (``None``: they do not bind)."""
+        ...
+
+    @property
     def still_method(self) -> Method:
         """How a trajectory that stands still is reported."""
         ...
@@ -113,6 +118,7 @@ class FixedDuration:
     seconds: float
     limits_bind_candidates: bool = True
     still_method: Method = "fixed"
+    search_torque: None = None
 
     def nominal_duration(self, segments: int) -> float:  # noqa: D102 - the protocol's
         return self.seconds
@@ -162,10 +168,17 @@ class FixedDuration:
 
 @dataclass(frozen=True)
 class FreeDuration:
-    """As fast as the limits allow along the path (module docstring)."""
+    """As fast as the limits allow along the path (module docstring).
+
+    Attributes:
+        search_torque: the robot's torques, when they bind on the straight path from start to
+            goal (:func:`~planning.pipeline.torques.search_torque`): the search's duration
+            estimate keeps them too.
+    """
 
     limits_bind_candidates: bool = False
     still_method: Method = "fastest"
+    search_torque: ck.Dynamics | None = None
 
     def nominal_duration(self, segments: int) -> float:  # noqa: D102 - the protocol's
         return float(segments)
@@ -204,9 +217,11 @@ class FreeDuration:
         return Timing(trajectory, "narrowed", fit, False, time.perf_counter() - started)
 
 
-def duration_rule(duration_s: float | None) -> FixedDuration | FreeDuration:
-    """The rule of a scene's ``duration``: fixed when given, free when ``None``."""
-    return FreeDuration() if duration_s is None else FixedDuration(duration_s)
+def duration_rule(
+    duration_s: float | None, search_torque: ck.Dynamics | None = None
+) -> FixedDuration | FreeDuration:
+    """The rule of a scene's ``duration``: fixed when given, free when ``None`` (with ``search_torque``)."""
+    return FreeDuration(search_torque=search_torque) if duration_s is None else FixedDuration(duration_s)
 
 
 def narrowed_timings(problem: Problem, offered: list[Timing]) -> list[Timing]:

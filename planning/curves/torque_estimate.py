@@ -1,0 +1,61 @@
+"""The search's duration estimate of sampled paths when the joint torques bind.
+
+The fitness ranks candidates by how fast their paths can be run
+(:func:`~planning.curves.jerk_window.sampled_path_durations`). Where the robot's torques
+bind (a payload, a fast arm), that estimate must keep them too, or the search prefers paths
+that gravity makes slow: :func:`sampled_torque_durations` adds the torques as rows of the
+phase plane (:mod:`planning.curves.torque_limits`), from their terms on a few samples of
+each path.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from planning.curves.jerk_window import sampled_path_durations, torque_path_duration
+from planning.curves.phase_plane import kept_samples, sampled_derivatives
+from planning.curves.torque_limits import HEADROOM, TorqueModel
+from planning.curves.velocity_caps import ROUNDS, TOLERANCE
+
+FloatArray = NDArray[np.float64]
+
+TERM_STRIDE = 4
+"""Every how many samples of a path :func:`sampled_torque_durations` computes the torques' terms."""
+
+
+def sampled_torque_durations(
+    samples: FloatArray, fitted: NDArray[np.intp], limits: FloatArray, model: TorqueModel, window_s: float
+) -> FloatArray:
+    """``(S,)`` the search's duration estimates [s] of sampled paths ``(S, K, nq)``, torques limited too.
+
+    :func:`~planning.curves.jerk_window.sampled_path_durations` on the ``fitted`` joints
+    (``limits`` ``(3, len(fitted))``) with the torques as rows of the phase plane
+    (:func:`~planning.curves.jerk_window.torque_path_duration`). Their terms are computed on
+    every :data:`TERM_STRIDE`-th sample and the last, and interpolated between (they vary
+    smoothly along a path); a path where gravity alone exceeds a limit keeps the estimate
+    without torques (the verification will refuse it, naming the torque).
+    """
+    limited = np.isfinite(model.effort)
+    bound = model.effort[limited] * (1.0 - HEADROOM)
+    points = np.ascontiguousarray(samples[:, :, fitted])
+    durations = sampled_path_durations(points, limits[0], limits[1], limits[2], window_s, ROUNDS, TOLERANCE)
+    for s in range(len(samples)):
+        index = kept_samples(points[s], limits[0])
+        if len(index) < 2:
+            continue
+        steps, d1, d2 = sampled_derivatives(points[s], limits[0])
+        dq, ddq = np.zeros((2, len(index), samples.shape[2]))
+        dq[:, fitted], ddq[:, fitted] = d1, d2
+        pick = np.unique(np.append(np.arange(0, len(index), TERM_STRIDE), len(index) - 1))
+        terms = np.stack(model.path_terms(samples[s, index[pick]], dq[pick], ddq[pick]))[:, :, limited]
+        if np.any(np.abs(terms[2]) > bound):
+            continue
+        where = np.arange(len(index))
+        right = np.clip(np.searchsorted(pick, where), 1, len(pick) - 1)
+        share = ((where - pick[right - 1]) / (pick[right] - pick[right - 1]))[None, :, None]
+        rows = np.empty((4, len(index), len(bound)))
+        rows[:3] = terms[:, right - 1] * (1.0 - share) + terms[:, right] * share
+        rows[3] = bound
+        durations[s] = torque_path_duration(steps, d1, d2, limits, rows, window_s, ROUNDS, TOLERANCE)
+    return durations
