@@ -1,5 +1,6 @@
 """Type stub of the package: what it exports, and from which module (read by ``lazy_loader``)."""
 
+from .carried import carrying
 from .clearance import BatchClearance, Clearance, PairDistance
 from .collision import CollisionWorld
 from .cpr import CPR_JOINTS, TCP_FRAME, cpr_spec, load_cpr, robot_spec
@@ -40,6 +41,7 @@ __all__ = [
     "RobotSpec",
     "UnreachableError",
     "UrdfError",
+    "carrying",
     "check_curve",
     "check_segment",
     "cpr_limits_path",

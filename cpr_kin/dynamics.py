@@ -23,6 +23,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import CprKinError
+from cpr_kin.obstacles import Obstacle
 from cpr_kin.urdf_file import parse_urdf
 
 if TYPE_CHECKING:
@@ -48,12 +49,16 @@ class Payload:
         inertia_kg_m2: its ``(3, 3)`` rotational inertia about the centre of mass, in the
             frame's axes [kg m^2]; ``None``: a point mass.
         frame: the frame it is attached to; ``None``: the robot's tool frame.
+        shape: its collision shape, placed in the frame (an :class:`~cpr_kin.Obstacle`'s
+            box, sphere, cylinder or capsule; its name unused); ``None``: none, only its
+            mass counts (:func:`cpr_kin.carried.carrying` attaches it to the robot).
     """
 
     mass_kg: float
     com_in_frame_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
     inertia_kg_m2: tuple[tuple[float, float, float], ...] | None = None
     frame: str | None = None
+    shape: Obstacle | None = None
 
     def __post_init__(self) -> None:
         mass = self.mass_kg
@@ -68,6 +73,8 @@ class Payload:
                 f"within {MAX_COM_OFFSET_M:g} m of its frame"
             )
         object.__setattr__(self, "com_in_frame_m", tuple(float(c) for c in com))
+        if self.shape is not None and self.shape.shape == "mesh":
+            raise CprKinError("payload shape must be a box, sphere, cylinder or capsule, not a mesh")
         if self.inertia_kg_m2 is not None:
             inertia = _checked_inertia(self.inertia_kg_m2)
             object.__setattr__(self, "inertia_kg_m2", tuple(tuple(float(v) for v in row) for row in inertia))

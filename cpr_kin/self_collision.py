@@ -104,6 +104,11 @@ def read_srdf(path: Path, links: Iterable[str]) -> SrdfPairs:
     return SrdfPairs(frozenset(pairs), tuple(sorted(unknown)))
 
 
+def adjacent(model: Any, joint_a: int, joint_b: int) -> bool:
+    """Links on joints ``joint_a`` and ``joint_b`` are adjacent: the same joint, or one the other's parent."""
+    return bool(joint_a == joint_b or model.parents[joint_a] == joint_b or model.parents[joint_b] == joint_a)
+
+
 def self_pairs(
     model: Any, collision_model: Any, disabled: frozenset[LinkPair]
 ) -> tuple[tuple[int, int], ...]:
@@ -116,8 +121,7 @@ def self_pairs(
     found = []
     for a in range(len(objects)):
         for b in range(a + 1, len(objects)):
-            ja, jb = objects[a].parentJoint, objects[b].parentJoint
-            if ja == jb or model.parents[ja] == jb or model.parents[jb] == ja:
+            if adjacent(model, objects[a].parentJoint, objects[b].parentJoint):
                 continue
             link_a = model.frames[objects[a].parentFrame].name
             link_b = model.frames[objects[b].parentFrame].name

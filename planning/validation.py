@@ -118,7 +118,8 @@ def describe_validation(
         elif item["type"] == "missing":
             problems.append(f"{where}: required key is missing")
         elif item["type"] in ("union_tag_invalid", "union_tag_not_found") and tag and isinstance(value, dict):
-            key, allowed = tag[0], ", ".join(tag[1])
+            expected = str(item.get("ctx", {}).get("expected_tags", "")).replace("'", "")
+            key, allowed = tag[0], expected or ", ".join(tag[1])  # this union's tags, if pydantic says
             problems.append(
                 f"{where}.{key} = {shown(value.get(key))}: unknown or missing {key}; allowed: {allowed}"
             )

@@ -83,7 +83,7 @@ def cmd_show(args: argparse.Namespace) -> int:
 
     document = read_trajectory(args.trajectory)
     scene = parse_scene(document.scene, source=f"{args.trajectory} (scene)")
-    robot = shown_robot(document, scene, args.urdf)
+    robot = ck.carrying(shown_robot(document, scene, args.urdf), scene.payload)  # its shape drawn too
     if robot.joint_names != document.joint_names:
         raise PlanningError(
             f"trajectory joints {list(document.joint_names)} are not the robot's {list(robot.joint_names)}"

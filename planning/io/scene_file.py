@@ -37,6 +37,7 @@ from planning.io.scene_schema import (
     BoxSpec,
     CapsuleSpec,
     CylinderSpec,
+    MeshSpec,
     SceneSpec,
     SphereSpec,
     describe_errors,
@@ -73,23 +74,8 @@ def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> S
     base = base or Path.cwd()
     obstacles = []
     for index, item in enumerate(spec.obstacles):
-        name = item.name or f"{item.shape}_{index}"
         try:
-            if isinstance(item, BoxSpec):
-                obstacles.append(ck.Obstacle.box(item.size, item.xyz, item.rpy, name=name))
-            elif isinstance(item, SphereSpec):
-                obstacles.append(ck.Obstacle.sphere(item.radius, item.xyz, name=name))
-            elif isinstance(item, CylinderSpec):
-                obstacles.append(
-                    ck.Obstacle.cylinder(item.radius, item.length, item.xyz, item.rpy, name=name)
-                )
-            elif isinstance(item, CapsuleSpec):
-                obstacles.append(ck.Obstacle.capsule(item.radius, item.length, item.xyz, item.rpy, name=name))
-            else:
-                mesh = (base / item.mesh).resolve()  # absolute: the scene may be planned elsewhere
-                obstacle = ck.Obstacle.from_mesh(mesh, item.xyz, item.rpy, item.scale, item.convex, name=name)
-                obstacle.geometry()  # read the file now: a broken mesh is a scene error
-                obstacles.append(obstacle)
+            obstacles.append(_obstacle(item, item.name or f"{item.shape}_{index}", base))
         except ck.CprKinError as exc:
             raise SceneError(f"{source}: obstacles[{index}]: {exc}") from None
     names = [o.name for o in obstacles]
@@ -106,7 +92,10 @@ def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> S
     except ck.CprKinError as exc:
         raise SceneError(f"{source}: robot: {exc}") from None
     try:
-        payload = None if spec.payload is None else spec.payload.payload()
+        payload = None
+        if spec.payload is not None:
+            shape = spec.payload.shape
+            payload = spec.payload.payload(None if shape is None else _obstacle(shape, "payload", base))
     except ck.CprKinError as exc:
         raise SceneError(f"{source}: payload: {exc}") from None
     try:
@@ -127,6 +116,28 @@ def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> S
         )
     except PlanningError as exc:
         raise SceneError(f"{source}: {exc}") from None
+
+
+def _obstacle(
+    item: BoxSpec | SphereSpec | CylinderSpec | CapsuleSpec | MeshSpec, name: str, base: Path
+) -> ck.Obstacle:
+    """The obstacle (or payload shape) of a validated entry; a mesh relative to ``base``.
+
+    Raises:
+        cpr_kin.CprKinError: a shape coal cannot build, a mesh that cannot be read.
+    """
+    if isinstance(item, BoxSpec):
+        return ck.Obstacle.box(item.size, item.xyz, item.rpy, name=name)
+    if isinstance(item, SphereSpec):
+        return ck.Obstacle.sphere(item.radius, item.xyz, name=name)
+    if isinstance(item, CylinderSpec):
+        return ck.Obstacle.cylinder(item.radius, item.length, item.xyz, item.rpy, name=name)
+    if isinstance(item, CapsuleSpec):
+        return ck.Obstacle.capsule(item.radius, item.length, item.xyz, item.rpy, name=name)
+    mesh = (base / item.mesh).resolve()  # absolute: the scene may be planned elsewhere
+    obstacle = ck.Obstacle.from_mesh(mesh, item.xyz, item.rpy, item.scale, item.convex, name=name)
+    obstacle.geometry()  # read the file now: a broken mesh is a scene error
+    return obstacle
 
 
 def load_scene(path: str | Path) -> Scene:
@@ -186,6 +197,8 @@ def payload_to_dict(payload: ck.Payload) -> dict[str, Any]:
         entry["inertia"] = [list(row) for row in payload.inertia_kg_m2]
     if payload.frame is not None:
         entry["frame"] = payload.frame
+    if payload.shape is not None:
+        entry["shape"] = {k: v for k, v in obstacle_to_dict(payload.shape).items() if k != "name"}
     return entry
 
 

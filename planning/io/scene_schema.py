@@ -160,6 +160,8 @@ class SplineSpec(Strict):
 
 
 Moment = Annotated[float, between(-1e3, 1e3)]
+PayloadShapeSpec = Annotated[BoxSpec | SphereSpec | CylinderSpec | CapsuleSpec, Field(discriminator="shape")]
+"""A payload's collision shape: an obstacle's box, sphere, cylinder or capsule, in its frame."""
 
 
 class PayloadSpec(Strict):
@@ -179,9 +181,14 @@ class PayloadSpec(Strict):
         | None
     ) = None
     frame: Name | None = None
+    shape: PayloadShapeSpec | None = None
 
-    def payload(self) -> ck.Payload:
-        """The :class:`cpr_kin.Payload` (raises :class:`cpr_kin.CprKinError` for an unphysical inertia)."""
+    def payload(self, shape: ck.Obstacle | None) -> ck.Payload:
+        """The :class:`cpr_kin.Payload` with ``shape`` built from :attr:`shape`.
+
+        Raises:
+            cpr_kin.CprKinError: an unphysical inertia.
+        """
         inertia = None
         if self.inertia is not None:
             inertia = np.diag(self.inertia) if np.ndim(self.inertia) == 1 else np.array(self.inertia)
@@ -190,6 +197,7 @@ class PayloadSpec(Strict):
             (self.com_in_tcp[0], self.com_in_tcp[1], self.com_in_tcp[2]),
             None if inertia is None else tuple(tuple(row) for row in inertia.tolist()),
             self.frame,
+            shape,
         )
 
 
@@ -234,6 +242,8 @@ def _model_at(location: tuple[int | str, ...]) -> type[BaseModel] | None:
     if len(location) == 1:
         return SceneSpec
     if location[0] == "obstacles" and len(location) >= 4:
+        return _SHAPE_SPECS.get(str(location[2]))
+    if location[:2] == ("payload", "shape") and len(location) >= 4:
         return _SHAPE_SPECS.get(str(location[2]))
     if location[0] == "robot":
         return RobotMapping

@@ -173,6 +173,10 @@ def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | No
     """
     started = time.perf_counter()
     robot = robot or (scene.robot.load() if scene.robot is not None else ck.load_cpr())
+    try:
+        robot = ck.carrying(robot, scene.payload)  # its shape, if it has one, checked as the robot's
+    except ck.CprKinError as exc:
+        raise PlanningError(f"payload: {exc}") from None
     world = ck.CollisionWorld(
         robot, scene.obstacles, num_threads=threads, allowed_pairs=scene.allowed_collisions
     )
