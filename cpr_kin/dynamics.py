@@ -24,7 +24,6 @@ from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import CprKinError
 from cpr_kin.obstacles import Obstacle
-from cpr_kin.urdf_file import parse_urdf
 
 if TYPE_CHECKING:
     from cpr_kin.robot import Robot
@@ -202,22 +201,5 @@ def robot_dynamics(robot: Robot, payload: Payload | None = None, torque_scale: f
         effort=effort,
         payload=payload,
         torque_scale=float(torque_scale),
-        massless_links=massless_links(robot),
+        massless_links=robot.massless_links,
     )
-
-
-def massless_links(robot: Robot) -> tuple[str, ...]:
-    """Links that a planned joint moves which have a shape but no ``<inertial>`` in the URDF."""
-    root = parse_urdf(robot.urdf_path).getroot()
-    weighed = {link.get("name") for link in root.findall("link") if link.find("inertial") is not None}
-    shaped = {
-        link.get("name")
-        for link in root.findall("link")
-        if link.find("collision") is not None or link.find("visual") is not None
-    }
-    moved = {
-        frame.name
-        for frame in robot.model.frames
-        if frame.type == pin.FrameType.BODY and frame.parentJoint > 0
-    }
-    return tuple(sorted((moved & shaped) - weighed))

@@ -45,6 +45,7 @@ from cpr_kin.supported import check_joints, check_limits, check_names
 from cpr_kin.urdf_file import (
     collision_names,
     is_bundled,
+    massless_links,
     parse_urdf,
     prepared_xml,
     validate_urdf,
@@ -164,6 +165,7 @@ class RobotSpec:
             srdf_path=srdf,
             self_pairs=self_pairs(model, collision, srdf_pairs.disabled),
             srdf_unknown_links=srdf_pairs.unknown_links,
+            massless_links=massless_links(tree, model),
         )
 
     def _planned(self, model: Any, tree: etree._ElementTree, path: Path, arm: ArmChain) -> tuple[str, ...]:

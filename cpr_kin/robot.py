@@ -71,6 +71,8 @@ class Robot:
         self_pairs: indices of the collision geometry pairs checked against each other
             (:mod:`cpr_kin.self_collision`); empty: the robot cannot meet itself.
         srdf_unknown_links: links the SRDF names that the URDF lacks (their entries skipped).
+        massless_links: links a planned joint moves that have a shape but no ``<inertial>``
+            (massless, the URDF's rule; :mod:`cpr_kin.dynamics`).
 
     """
 
@@ -89,6 +91,7 @@ class Robot:
     srdf_path: Path | None = None
     self_pairs: tuple[tuple[int, int], ...] = ()
     srdf_unknown_links: tuple[str, ...] = ()
+    massless_links: tuple[str, ...] = ()
 
     @cached_property
     def visual_model(self) -> Any:

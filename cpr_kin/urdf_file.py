@@ -149,3 +149,20 @@ def prepared_xml(tree: etree._ElementTree, path: Path, roots: Sequence[Path]) ->
 def is_bundled(path: Path) -> bool:
     """Whether ``path`` is the bundled CPR URDF, which the test suite validates with yourdfpy."""
     return path.resolve() == cpr_urdf_path().resolve()
+
+
+def massless_links(tree: etree._ElementTree, model: Any) -> tuple[str, ...]:
+    """Links that a planned joint of ``model`` moves which have a shape but no ``<inertial>``."""
+    import pinocchio as pin  # the model is Pinocchio's; reading a URDF alone needs none
+
+    links = tree.getroot().findall("link")
+    weighed = {link.get("name") for link in links if link.find("inertial") is not None}
+    shaped = {
+        link.get("name")
+        for link in links
+        if link.find("collision") is not None or link.find("visual") is not None
+    }
+    moved = {
+        frame.name for frame in model.frames if frame.type == pin.FrameType.BODY and frame.parentJoint > 0
+    }
+    return tuple(sorted((moved & shaped) - weighed))

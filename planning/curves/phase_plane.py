@@ -151,6 +151,11 @@ def profile_instants(x: FloatArray, du: FloatArray) -> FloatArray:
     return instants
 
 
+def path_acceleration(x: FloatArray, du: FloatArray) -> FloatArray:
+    """``(G,)`` the path acceleration ``u''`` of profile ``x`` on each step (from its first point), 0 last."""
+    return np.append(np.diff(x) / (2.0 * du), 0.0)
+
+
 @njit
 def profile_time(x: FloatArray, du: FloatArray) -> float:
     """Duration [s] of the profile ``x = u'^2`` on a grid of steps ``du`` ``(G - 1,)``."""

@@ -13,9 +13,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from planning.curves.jerk_window import sampled_path_durations, torque_path_duration
-from planning.curves.phase_plane import kept_samples, sampled_derivatives
-from planning.curves.torque_limits import HEADROOM, TorqueModel
+from planning.curves.jerk_window import jerk_limited_duration, sampled_path_durations
+from planning.curves.phase_plane import kept_samples, phase_plane_profile, sampled_derivatives
+from planning.curves.torque_limits import HEADROOM, TorqueModel, TorqueRows, phase_plane_rows
 from planning.curves.velocity_caps import ROUNDS, TOLERANCE
 
 FloatArray = NDArray[np.float64]
@@ -31,7 +31,7 @@ def sampled_torque_durations(
 
     :func:`~planning.curves.jerk_window.sampled_path_durations` on the ``fitted`` joints
     (``limits`` ``(3, len(fitted))``) with the torques as rows of the phase plane
-    (:func:`~planning.curves.jerk_window.torque_path_duration`). Their terms are computed on
+    (:func:`~planning.curves.torque_limits.phase_plane_rows`). Their terms are computed on
     every :data:`TERM_STRIDE`-th sample and the last, and interpolated between (they vary
     smoothly along a path); a path where gravity alone exceeds a limit keeps the estimate
     without torques (the verification will refuse it, naming the torque).
@@ -39,23 +39,28 @@ def sampled_torque_durations(
     limited = np.isfinite(model.effort)
     bound = model.effort[limited] * (1.0 - HEADROOM)
     points = np.ascontiguousarray(samples[:, :, fitted])
-    durations = sampled_path_durations(points, limits[0], limits[1], limits[2], window_s, ROUNDS, TOLERANCE)
+    velocity, acceleration, jerk = limits
+    durations = np.zeros(len(samples))
     for s in range(len(samples)):
-        index = kept_samples(points[s], limits[0])
+        index = kept_samples(points[s], velocity)
         if len(index) < 2:
             continue
-        steps, d1, d2 = sampled_derivatives(points[s], limits[0])
+        steps, d1, d2 = sampled_derivatives(points[s], velocity)
         dq, ddq = np.zeros((2, len(index), samples.shape[2]))
         dq[:, fitted], ddq[:, fitted] = d1, d2
         pick = np.unique(np.append(np.arange(0, len(index), TERM_STRIDE), len(index) - 1))
         terms = np.stack(model.path_terms(samples[s, index[pick]], dq[pick], ddq[pick]))[:, :, limited]
-        if np.any(np.abs(terms[2]) > bound):
+        if np.any(np.abs(terms[2]) > bound):  # gravity beyond a limit: the estimate without torques
+            plain = sampled_path_durations(
+                points[s : s + 1], velocity, acceleration, jerk, window_s, ROUNDS, TOLERANCE
+            )
+            durations[s] = plain[0]
             continue
         where = np.arange(len(index))
         right = np.clip(np.searchsorted(pick, where), 1, len(pick) - 1)
         share = ((where - pick[right - 1]) / (pick[right] - pick[right - 1]))[None, :, None]
-        rows = np.empty((4, len(index), len(bound)))
-        rows[:3] = terms[:, right - 1] * (1.0 - share) + terms[:, right] * share
-        rows[3] = bound
-        durations[s] = torque_path_duration(steps, d1, d2, limits, rows, window_s, ROUNDS, TOLERANCE)
+        slope, curve, offset = terms[:, right - 1] * (1.0 - share) + terms[:, right] * share
+        rows = phase_plane_rows(d1, d2, velocity, acceleration, TorqueRows(slope, curve, offset, bound))
+        x = phase_plane_profile(rows[0], rows[1], steps, rows[2], rows[3], rows[4])
+        durations[s] = jerk_limited_duration(x, steps, d1, jerk, window_s, ROUNDS, TOLERANCE)
     return durations

@@ -20,6 +20,7 @@ from typing import NamedTuple, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from planning.curves.phase_plane import path_acceleration
 from planning.curves.trajectory import Trajectory
 
 FloatArray = NDArray[np.float64]
@@ -73,6 +74,36 @@ class TorqueRows(NamedTuple):
     """``(R,)`` effort limits less :data:`HEADROOM`."""
 
 
+def phase_plane_rows(
+    dq: FloatArray, ddq: FloatArray, velocity: FloatArray, acceleration: FloatArray, rows: TorqueRows | None
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
+    """The joints' rows and the torque ``rows`` as the arguments of ``phase_plane_profile`` but the steps.
+
+    ``(d1, d2, v, a, offset)``: the joints' ``dq``, ``ddq`` ``(G, nj)`` with their limits and no
+    offset, then the torques' slope, curve, effort limit and gravity offset (no velocity limit).
+    """
+    if rows is None:
+        return dq, ddq, velocity, acceleration, np.zeros_like(dq)
+    return (
+        np.hstack([dq, rows.slope]),
+        np.hstack([ddq, rows.curve]),
+        np.concatenate([velocity, np.full(len(rows.limit), np.inf)]),
+        np.concatenate([acceleration, rows.limit]),
+        np.hstack([np.zeros_like(dq), rows.offset]),
+    )
+
+
+def profile_torques(
+    terms: tuple[FloatArray, FloatArray, FloatArray], x: FloatArray, push: FloatArray
+) -> FloatArray:
+    """The torques ``(G, R)`` of a profile from their ``terms`` (slope, curve, offset).
+
+    At ``x = s'^2`` and the path acceleration ``push = s''``.
+    """
+    slope, curve, offset = terms
+    return np.asarray(slope * push[:, None] + curve * x[:, None] + offset)
+
+
 def torque_rows(
     q: FloatArray, dq: FloatArray, ddq: FloatArray, ds: FloatArray, model: TorqueModel, x: FloatArray
 ) -> TorqueRows | None:
@@ -93,15 +124,16 @@ def torque_rows(
     if not limited.any():
         return None
     limit = model.effort[limited] * (1.0 - HEADROOM)
-    push = np.append(np.diff(x) / (2.0 * ds), 0.0)  # s'' on each grid step, from its first point
+    push = path_acceleration(x, ds)
     for points in (slice(None, None, PRECHECK_STRIDE), slice(None)):  # a cheap look first
         slope, curve, offset = (
             term[:, limited] for term in model.path_terms(q[points], dq[points], ddq[points])
         )
         if np.any(np.abs(offset) > limit):
             return None
-        torque = slope * push[points, None] + curve * x[points, None] + offset
-        if np.all(np.abs(torque) <= UNBOUND_SHARE * limit):
+        if np.all(
+            np.abs(profile_torques((slope, curve, offset), x[points], push[points])) <= UNBOUND_SHARE * limit
+        ):
             return None
     return TorqueRows(slope, curve, offset, limit)
 

@@ -21,7 +21,8 @@ from numpy.typing import NDArray
 
 from planning.curves.arc_length import ArcLengthPath
 from planning.curves.moving_average import arc_at_times, jerk_limited_motion, scaled_duration
-from planning.curves.phase_plane import phase_plane_profile, profile_time
+from planning.curves.phase_plane import path_acceleration, phase_plane_profile, profile_time
+from planning.curves.torque_limits import phase_plane_rows
 
 FloatArray = NDArray[np.float64]
 
@@ -133,19 +134,8 @@ def capped_profile(
 ) -> FloatArray:
     """Step 1: the phase-plane profile ``s'^2`` under the caps of :func:`_caps` and the torque rows."""
     velocity_cap, acceleration_cap = _caps(limits, share, ramp_s)
-    if path.torque is None:
-        return phase_plane_profile(
-            path.dq, path.ddq, path.ds, velocity_cap, acceleration_cap, np.zeros_like(path.dq)
-        )
-    rows = path.torque
-    return phase_plane_profile(
-        np.hstack([path.dq, rows.slope]),
-        np.hstack([path.ddq, rows.curve]),
-        path.ds,
-        np.concatenate([velocity_cap, np.full(len(rows.limit), np.inf)]),
-        np.concatenate([acceleration_cap, rows.limit]),
-        np.hstack([np.zeros_like(path.dq), rows.offset]),
-    )
+    d1, d2, v, a, offset = phase_plane_rows(path.dq, path.ddq, velocity_cap, acceleration_cap, path.torque)
+    return phase_plane_profile(d1, d2, path.ds, v, a, offset)
 
 
 def capped_motion(
@@ -189,6 +179,6 @@ def _window_s(path: ArcLengthPath, x: FloatArray, jerk: FloatArray) -> float:
     Each joint's largest acceleration in the profile ``x`` (``q'' s'^2 + q' s''``) over its
     jerk limit; the widest of them.
     """
-    push = np.diff(x) / (2.0 * path.ds)  # s'' on each grid interval
+    push = path_acceleration(x, path.ds)[:-1]  # s'' on each grid interval
     acceleration = np.abs(path.ddq[:-1] * x[:-1, None] + path.dq[:-1] * push[:, None])
     return float(np.max(acceleration.max(axis=0) / jerk))

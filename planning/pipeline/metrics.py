@@ -8,18 +8,16 @@ section (``docs/formats.md``); the trajectory file, ``report.md``, the batch's
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
+import cpr_kin as ck
 from planning.pipeline.choose import Choice
 from planning.pipeline.objective import Breakdown
-from planning.pipeline.torques import torque_profile
+from planning.pipeline.torques import TorqueProfile
 from planning.search.optimizer import SearchResult
 from planning.utilisation import ORDERS, limit_usage
-
-if TYPE_CHECKING:
-    from planning.pipeline.problem import Problem
 
 WALL_TIMES = ("planning_time_s", "optimiser_time_s", "timing_time_s")
 """The record's wall times: ``None`` in a file written without ``timings``."""
@@ -107,6 +105,18 @@ class Metrics:
         return record if timings else {**record, **dict.fromkeys(WALL_TIMES)}
 
 
+def torque_peaks(torques: TorqueProfile | None) -> dict[str, float]:
+    """Peak ``|torque| / effort`` per joint with a known effort limit (none: no torques checked)."""
+    if torques is None:
+        return {}
+    limited = np.isfinite(torques.effort)
+    return {
+        name: float(peak)
+        for name, peak, known in zip(torques.joint_names, torques.peak_utilisation, limited, strict=True)
+        if known
+    }
+
+
 class Elapsed(NamedTuple):
     """Wall times of a plan [s].
 
@@ -120,12 +130,12 @@ class Elapsed(NamedTuple):
 
 
 def measure(
-    problem: Problem, choice: Choice, breakdown: Breakdown, searched: SearchResult, elapsed: Elapsed
+    robot: ck.Robot, choice: Choice, breakdown: Breakdown, searched: SearchResult, elapsed: Elapsed
 ) -> Metrics:
     """The metrics of a verified trajectory.
 
     Args:
-        problem: the problem (robot, limits, dynamics).
+        robot: the robot (joint names, limits).
         choice: the verified candidate, its timing and its check.
         breakdown: the chosen candidate's fitness terms (one candidate).
         searched: the optimiser's run.
@@ -133,7 +143,6 @@ def measure(
     """
     timing, check = choice.timing, choice.verification.check
     trajectory = timing.trajectory
-    robot, dynamics = problem.robot, problem.dynamics
     limits = robot.limits
     names = robot.joint_names
     jerk = trajectory.extrema(3)
@@ -166,14 +175,5 @@ def measure(
         duration_stretched=timing.stretched,
         timing=timing.method,
         timing_time_s=timing.time_s,
-        torque_utilisation={
-            name: float(peak)
-            for name, peak, limited in zip(
-                names,
-                (choice.verification.torques or torque_profile(dynamics, trajectory)).peak_utilisation,
-                np.isfinite(dynamics.effort),
-                strict=True,
-            )
-            if limited
-        },
+        torque_utilisation=torque_peaks(choice.verification.torques),
     )

@@ -73,7 +73,7 @@ def assemble(problem: Problem, searched: SearchResult, choice: Choice, elapsed: 
         trajectory=timing.trajectory,
         spline=timing.fit,
         time_scale=timing.trajectory.duration / timing.fit.trajectory.duration,
-        metrics=measure(problem, choice, breakdown, searched, elapsed),
+        metrics=measure(problem.robot, choice, breakdown, searched, elapsed),
         breakdown=breakdown,
         optimiser=searched,
         verification=choice.verification.check,

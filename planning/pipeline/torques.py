@@ -16,8 +16,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from planning.curves.phase_plane import kept_samples, phase_plane_profile, sampled_derivatives
-from planning.curves.torque_limits import UNBOUND_SHARE
+from cpr_kin.robot import joint_units
+from planning.curves.phase_plane import (
+    kept_samples,
+    path_acceleration,
+    phase_plane_profile,
+    sampled_derivatives,
+)
+from planning.curves.torque_limits import UNBOUND_SHARE, profile_torques
 from planning.curves.trajectory import Trajectory
 from planning.errors import PayloadTooHeavyError, PlanningError
 from planning.pipeline.scene import Scene
@@ -72,8 +78,6 @@ def torque_profile(
 
 def torque_problems(dynamics: ck.Dynamics, profile: TorqueProfile) -> list[str]:
     """The worst joint torque of a trajectory's ``profile`` beyond its effort limit, as a problem, if any."""
-    if not dynamics.limited:
-        return []
     usage = profile.utilisation
     if usage.max() <= 1.0 + TORQUE_TOLERANCE:
         return []
@@ -130,13 +134,11 @@ def search_torque(
     points = np.linspace(q_start, q_goal, LINE_SAMPLES)
     steps, d1, d2 = sampled_derivatives(points, limits.velocity)
     x = phase_plane_profile(d1, d2, steps, limits.velocity, limits.acceleration, np.zeros_like(d1))
-    slope, curve, offset = dynamics.path_terms(points[kept_samples(points, limits.velocity)], d1, d2)
-    push = np.append(np.diff(x) / (2.0 * steps), 0.0)  # s'' on each step, from its first point
-    usage = dynamics.utilisation(slope * push[:, None] + curve * x[:, None] + offset)
+    terms = dynamics.path_terms(points[kept_samples(points, limits.velocity)], d1, d2)
+    usage = dynamics.utilisation(profile_torques(terms, x, path_acceleration(x, steps)))
     return dynamics if usage.max() >= UNBOUND_SHARE else None
 
 
 def _unit(dynamics: ck.Dynamics, joint: int) -> str:
     """`` N m`` for a revolute joint's torque, `` N`` for a prismatic joint's force."""
-    kind = dynamics.model.joints[joint + 1].shortname().removeprefix("JointModel")
-    return " N" if kind.startswith("P") else " N m"
+    return " N" if joint_units(dynamics.model)[joint] == "m" else " N m"

@@ -212,7 +212,7 @@ def verify_trajectory(
                 f"drives the {kind} of joint '{robot.joint_names[j]}' to {ratio[j]:.3f} x its limit"
             )
     torques = None
-    if required.dynamics is not None:
+    if required.dynamics is not None and required.dynamics.limited:
         torques = torque_profile(required.dynamics, trajectory)
         problems += torque_problems(required.dynamics, torques)
     return Verification(check=check, problems=tuple(problems), torques=torques)
