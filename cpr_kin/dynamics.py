@@ -125,6 +125,7 @@ class Dynamics:
         payload: the payload, if any.
         torque_scale: share of the URDF's effort limits the torques may use.
         massless_links: links with a shape but no ``<inertial>`` (module docstring).
+        threads: threads of the batched torque computations.
     """
 
     joint_names: tuple[str, ...]
@@ -133,11 +134,20 @@ class Dynamics:
     payload: Payload | None = None
     torque_scale: float = 1.0
     massless_links: tuple[str, ...] = ()
-    _data: Any = field(default=None, repr=False)
+    threads: int = 1
+    _pool: Any = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "_data", self.model.createData())
+        object.__setattr__(self, "_pool", pin.ModelPool(self.model, self.threads))
         self.effort.setflags(write=False)
+
+    def __getstate__(self) -> dict[str, Any]:
+        """The fields but the model pool, which does not pickle (rebuilt on unpickling)."""
+        return {**self.__dict__, "_pool": None}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        object.__setattr__(self, "_pool", pin.ModelPool(self.model, self.threads))
 
     @property
     def limited(self) -> bool:
@@ -148,14 +158,23 @@ class Dynamics:
         """``(T, nq)`` joint torques [N m or N] at ``(T, nq)`` positions, velocities and accelerations.
 
         ``qd`` and ``qdd`` default to zero: the torques that hold the robot still (gravity).
+        One call of Pinocchio's batched RNEA (``rneaInParallel``, :attr:`threads`) for all ``T``.
         """
-        q = np.atleast_2d(np.asarray(q, dtype=float))
-        qd = np.zeros_like(q) if qd is None else np.atleast_2d(np.asarray(qd, dtype=float))
-        qdd = np.zeros_like(q) if qdd is None else np.atleast_2d(np.asarray(qdd, dtype=float))
-        model, data = self.model, self._data
+        q = np.ascontiguousarray(np.atleast_2d(np.asarray(q, dtype=float)))
+        qd = (
+            np.zeros_like(q)
+            if qd is None
+            else np.ascontiguousarray(np.atleast_2d(np.asarray(qd, dtype=float)))
+        )
+        qdd = (
+            np.zeros_like(q)
+            if qdd is None
+            else np.ascontiguousarray(np.atleast_2d(np.asarray(qdd, dtype=float)))
+        )
         out = np.empty_like(q)
-        for k in range(len(q)):
-            out[k] = pin.rnea(model, data, q[k], qd[k], qdd[k])
+        pin.rneaInParallel(
+            self.threads, self._pool, q.T, qd.T, qdd.T, out.T
+        )  # (nq, T) views, written in place
         return out
 
     def path_terms(
@@ -177,8 +196,12 @@ class Dynamics:
         return np.abs(torques) / self.effort
 
 
-def robot_dynamics(robot: Robot, payload: Payload | None = None, torque_scale: float = 1.0) -> Dynamics:
+def robot_dynamics(
+    robot: Robot, payload: Payload | None = None, torque_scale: float = 1.0, threads: int = 1
+) -> Dynamics:
     """The robot's :class:`Dynamics` carrying ``payload``, its efforts times ``torque_scale``.
+
+    ``threads``: threads of its batched torque computations (a process per core: 1).
 
     Raises:
         CprKinError: an unknown payload frame, or ``torque_scale`` outside :data:`TORQUE_SCALE_RANGE`.
@@ -202,4 +225,5 @@ def robot_dynamics(robot: Robot, payload: Payload | None = None, torque_scale: f
         payload=payload,
         torque_scale=float(torque_scale),
         massless_links=robot.massless_links,
+        threads=max(1, int(threads)),
     )

@@ -183,7 +183,7 @@ def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | No
     q_start = endpoint(robot, world, scene, "start")
     q_goal = endpoint(robot, world, scene, "goal", seed_q=q_start)
     motion = Motion(q_start, q_goal, moving_joints(robot, scene, q_start, q_goal))
-    dynamics = problem_dynamics(robot, scene, q_start, q_goal)
+    dynamics = problem_dynamics(robot, scene, q_start, q_goal, world.num_threads)
     duration = duration_rule(scene.duration, search_torque(robot, dynamics, q_start, q_goal))
     if isinstance(duration, FixedDuration):
         duration.check_reachable(robot, q_start, q_goal, rest_ends=scene.spline.ends == "rest")

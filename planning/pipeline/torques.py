@@ -90,8 +90,12 @@ def torque_problems(dynamics: ck.Dynamics, profile: TorqueProfile) -> list[str]:
     ]
 
 
-def problem_dynamics(robot: ck.Robot, scene: Scene, q_start: FloatArray, q_goal: FloatArray) -> ck.Dynamics:
+def problem_dynamics(
+    robot: ck.Robot, scene: Scene, q_start: FloatArray, q_goal: FloatArray, threads: int = 1
+) -> ck.Dynamics:
     """The robot's dynamics with the scene's payload, able to hold the start and goal still.
+
+    ``threads``: those of its batched torque computations (the collision world's).
 
     Raises:
         PlanningError: the payload's frame is not the robot's.
@@ -99,7 +103,7 @@ def problem_dynamics(robot: ck.Robot, scene: Scene, q_start: FloatArray, q_goal:
             effort limit (times ``torque_scale``), naming the joint, the torque and the limit.
     """
     try:
-        dynamics = ck.robot_dynamics(robot, scene.payload, scene.torque_scale)
+        dynamics = ck.robot_dynamics(robot, scene.payload, scene.torque_scale, threads)
     except ck.CprKinError as exc:
         raise PlanningError(f"payload: {exc}") from None
     for label, q in (("start", q_start), ("goal", q_goal)):
