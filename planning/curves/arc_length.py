@@ -42,8 +42,8 @@ class ArcLengthPath(NamedTuple):
     """Arc length at the fine samples ``(FINE,)``."""
     table: FloatArray
     """Positions at the fine samples ``(FINE, nj)``."""
-    q: FloatArray
-    """Positions at the grid points ``(G, nj)``."""
+    u: FloatArray
+    """The path's own parameter at the grid points ``(G,)`` (``path(u)``: their positions)."""
     torque: TorqueRows | None = None
     """Torque constraints at the grid points, if the timing keeps any
     (:func:`planning.curves.torque_limits.torque_rows`)."""
@@ -84,4 +84,4 @@ def arc_length_path(path: Trajectory, velocity: FloatArray) -> ArcLengthPath:
         dq[index], ddq[index] = dq[nearest], ddq[nearest]
     steps = np.diff(s)
     keep = np.concatenate([[True], steps > 0])  # drop repeated points (the path standing still)
-    return ArcLengthPath(dq[keep], ddq[keep], np.diff(s[keep]), length, path(fine), path(u[keep]))
+    return ArcLengthPath(dq[keep], ddq[keep], np.diff(s[keep]), length, path(fine), u[keep])

@@ -87,7 +87,7 @@ def time_path(
     uncapped = None
     if torque is not None:
         uncapped = capped_profile(arc, limits, 1.0)
-        arc = arc._replace(torque=torque_rows(arc.q, arc.dq, arc.ddq, arc.ds, torque, uncapped))
+        arc = arc._replace(torque=torque_rows(path(arc.u), arc.dq, arc.ddq, arc.ds, torque, uncapped))
         uncapped = uncapped if arc.torque is None else None  # the rows change it
     node_step_s, smoothing = smoothing_limits(limits, node_step_s)
     fastest = fastest_motion(arc, smoothing, uncapped if smoothing is limits else None)

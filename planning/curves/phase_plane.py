@@ -77,6 +77,14 @@ def _largest_x(
     best = top
     rows = d1.shape[1]
     rate = 1.0 / (2.0 * du) if du > 0.0 else 0.0
+    slope, reach, shift = np.empty(rows), np.empty(rows), np.empty(rows)  # bounds: slope x + shift -+ reach
+    for k in range(rows):
+        if abs(d1[g, k]) > _TINY:
+            slope[k], reach[k], shift[k] = (
+                -d2[g, k] / d1[g, k],
+                a[k] / abs(d1[g, k]),
+                -offset[g, k] / d1[g, k],
+            )
     for i in range(rows):
         if abs(d1[g, i]) <= _TINY:  # the row is the curvature term alone: |d2 x + o| <= a
             if d2[g, i] > 0.0:
@@ -84,17 +92,10 @@ def _largest_x(
             elif d2[g, i] < 0.0:
                 best = min(best, (a[i] + offset[g, i]) / -d2[g, i])
             continue
-        # bounds: slope x + shift -+ reach
-        slope_i, reach_i, shift_i = -d2[g, i] / d1[g, i], a[i] / abs(d1[g, i]), -offset[g, i] / d1[g, i]
+        slope_i, reach_i, shift_i = slope[i], reach[i], shift[i]
         for k in range(rows):
-            if k != i and abs(d1[g, k]) > _TINY:  # lower of i below upper of k
-                slope_k, reach_k, shift_k = (
-                    -d2[g, k] / d1[g, k],
-                    a[k] / abs(d1[g, k]),
-                    -offset[g, k] / d1[g, k],
-                )
-                if slope_i - slope_k > 0.0:
-                    best = min(best, (reach_i + reach_k + (shift_k - shift_i)) / (slope_i - slope_k))
+            if k != i and abs(d1[g, k]) > _TINY and slope_i - slope[k] > 0.0:  # lower of i below upper of k
+                best = min(best, (reach_i + reach[k] + (shift[k] - shift_i)) / (slope_i - slope[k]))
         if du > 0.0:
             if slope_i + rate > 0.0:  # lower of i below the step's upper (ahead - x) rate
                 best = min(best, (ahead * rate + reach_i - shift_i) / (slope_i + rate))
