@@ -119,3 +119,16 @@ def test_torque_scale_is_checked_and_the_payload_round_trips() -> None:
     assert again.payload == scene.payload and again.torque_scale == 0.8
     assert isinstance(scene.payload, ck.Payload)
     assert np.allclose(np.array(scene.payload.inertia_kg_m2), np.diag([0.01, 0.02, 0.02]))
+
+
+def test_torques_that_never_bind_leave_the_plan_byte_for_byte_as_without_them(bare: PlanResult) -> None:
+    model = bare.robot.model.copy()
+    model.effortLimit[:] = 0.0  # no known effort: no torque rows, no torque scale, no check
+    unlimited = dataclasses.replace(bare.robot, model=model)
+    light = parse_scene(scene_with(payload={"mass_kg": 0.5, "com_in_tcp": [0.0, 0.0, 0.02]}))
+    without = plan(parse_scene(scene_with(payload=None)), unlimited)
+    assert not without.problem.dynamics.limited and bare.problem.dynamics.limited
+    for other in (without, plan(light)):
+        assert other.verification.accepted
+        np.testing.assert_array_equal(other.trajectory.knots, bare.trajectory.knots)
+        np.testing.assert_array_equal(other.trajectory.coefficients, bare.trajectory.coefficients)

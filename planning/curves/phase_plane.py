@@ -52,10 +52,31 @@ def _acceleration_bounds(
 
 
 @njit
+def _row_bounds(
+    d1: FloatArray, d2: FloatArray, offset: FloatArray, a: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """``(slope, reach, shift)`` ``(G, R)``: row ``j`` allows ``u''`` in ``slope x + shift -+ reach``.
+
+    ``slope = -q_j'' / q_j'``, ``reach = a_j / |q_j'|``, ``shift = -o_j / q_j'``; 0 where
+    ``|q_j'| <= _TINY`` (the row is its curvature term alone, handled apart).
+    """
+    n, rows = d1.shape
+    slope, reach, shift = np.zeros((n, rows)), np.zeros((n, rows)), np.zeros((n, rows))
+    for g in range(n):
+        for k in range(rows):
+            if abs(d1[g, k]) > _TINY:
+                slope[g, k] = -d2[g, k] / d1[g, k]
+                reach[g, k] = a[k] / abs(d1[g, k])
+                shift[g, k] = -offset[g, k] / d1[g, k]
+    return slope, reach, shift
+
+
+@njit
 def _largest_x(
     d1: FloatArray,
     d2: FloatArray,
     offset: FloatArray,
+    bounds: tuple[FloatArray, FloatArray, FloatArray],
     g: int,
     a: FloatArray,
     top: float,
@@ -68,23 +89,17 @@ def _largest_x(
     (``u''`` constant, ``x_next = x + 2 du u''``) must land in ``[0, ahead]``.
 
     Every bound on ``u''`` is affine in ``x``: row ``j`` allows ``u''`` in
-    ``(-+a_j - q_j'' x - o_j) / q_j'``, the step ``[-x, ahead - x] / (2 du)``. The bounds
-    overlap iff every lower bound is below every upper bound (intervals on a line), each pair
-    an affine inequality in ``x``: the answer is exact, the least of the pairs' limits, with
-    no bisection. ``x = 0`` (``u'' = 0``) qualifies when every ``|o_j| <= a_j`` (the
-    caller's condition), so the allowed ``x`` are an interval from 0.
+    ``(-+a_j - q_j'' x - o_j) / q_j'`` (``bounds``, :func:`_row_bounds`), the step
+    ``[-x, ahead - x] / (2 du)``. The bounds overlap iff every lower bound is below every
+    upper bound (intervals on a line), each pair an affine inequality in ``x``: the answer is
+    exact, the least of the pairs' limits, with no bisection. ``x = 0`` (``u'' = 0``)
+    qualifies when every ``|o_j| <= a_j`` (the caller's condition), so the allowed ``x`` are
+    an interval from 0.
     """
+    slope, reach, shift = bounds
     best = top
     rows = d1.shape[1]
     rate = 1.0 / (2.0 * du) if du > 0.0 else 0.0
-    slope, reach, shift = np.empty(rows), np.empty(rows), np.empty(rows)  # bounds: slope x + shift -+ reach
-    for k in range(rows):
-        if abs(d1[g, k]) > _TINY:
-            slope[k], reach[k], shift[k] = (
-                -d2[g, k] / d1[g, k],
-                a[k] / abs(d1[g, k]),
-                -offset[g, k] / d1[g, k],
-            )
     for i in range(rows):
         if abs(d1[g, i]) <= _TINY:  # the row is the curvature term alone: |d2 x + o| <= a
             if d2[g, i] > 0.0:
@@ -92,10 +107,10 @@ def _largest_x(
             elif d2[g, i] < 0.0:
                 best = min(best, (a[i] + offset[g, i]) / -d2[g, i])
             continue
-        slope_i, reach_i, shift_i = slope[i], reach[i], shift[i]
+        slope_i, reach_i, shift_i = slope[g, i], reach[g, i], shift[g, i]
         for k in range(rows):
-            if k != i and abs(d1[g, k]) > _TINY and slope_i - slope[k] > 0.0:  # lower of i below upper of k
-                best = min(best, (reach_i + reach[k] + (shift[k] - shift_i)) / (slope_i - slope[k]))
+            if k != i and abs(d1[g, k]) > _TINY and slope_i - slope[g, k] > 0.0:  # i low < k high
+                best = min(best, (reach_i + reach[g, k] + (shift[g, k] - shift_i)) / (slope_i - slope[g, k]))
         if du > 0.0:
             if slope_i + rate > 0.0:  # lower of i below the step's upper (ahead - x) rate
                 best = min(best, (ahead * rate + reach_i - shift_i) / (slope_i + rate))
@@ -123,16 +138,17 @@ def phase_plane_profile(
             torque), each within its limit.
     """
     n, rows = d1.shape
+    bounds = _row_bounds(d1, d2, offset, a)
     limit = np.empty(n)
     for g in range(n):  # the maximum velocity curve: velocity limits, then accelerations
         top = _HUGE
         for j in range(rows):
             if abs(d1[g, j]) > _TINY:
                 top = min(top, (v[j] / abs(d1[g, j])) ** 2)
-        limit[g] = _largest_x(d1, d2, offset, g, a, top, 0.0, 0.0)
+        limit[g] = _largest_x(d1, d2, offset, bounds, g, a, top, 0.0, 0.0)
     controllable = np.zeros(n)  # backward: from where the robot can still stop at the end
     for g in range(n - 2, -1, -1):
-        controllable[g] = _largest_x(d1, d2, offset, g, a, limit[g], du[g], controllable[g + 1])
+        controllable[g] = _largest_x(d1, d2, offset, bounds, g, a, limit[g], du[g], controllable[g + 1])
     x = np.zeros(n)  # forward: as fast as the limits allow without leaving the controllable set
     for g in range(n - 1):
         _, high = _acceleration_bounds(d1, d2, offset, g, x[g], a)
