@@ -9,7 +9,14 @@ and one process (warm library calls):
   same path (our trajectory's, in arc length): the time-optimal duration of that path
   without a jerk limit, a lower bound for it;
 - the timing alone, on the path the planner timed: wall time and duration with the torque
-  limits and without them (today's kinematic timing).
+  limits and without them (today's kinematic timing);
+- the jerk's own cost: Ruckig's time-optimal jerk-limited motion from start to goal (no
+  obstacle, no torque: a lower bound of any jerk-limited trajectory) over TOPP-RA's jerk-free
+  time along the straight line between them. Where it exceeds 1.10, no jerk-limited
+  trajectory meets "duration <= 1.10 x TOPP-RA" there; the duration is also given over
+  ``max(TOPP-RA bound, Ruckig bound)``, the bound of a robot whose jerk or torque binds,
+  and over the TOPP-RA bound times that straight line's jerk cost (an estimate of the path's
+  jerk-limited optimum, not a bound: none computes it exactly with torques).
 
 Problems: ``--scenes`` generated CPR scenes (``generate_scenes``, seed ``--scene-seed``) and
 the first ``--limit`` problems of each MotionBenchMaker class whose start and goal are valid
@@ -40,6 +47,7 @@ from planning.io.mbm import CLASSES, endpoint_violations, import_problem, proble
 from planning.io.report import markdown_table
 from planning.io.scene_file import load_scene
 from planning.io.scene_generator import generate_scenes
+from planning.peers.ruckig_bound import free_space_bound
 from planning.pipeline.planner import plan, warm_up
 from planning.pipeline.scene import Scene
 from planning.pipeline.torques import torque_profile
@@ -115,6 +123,8 @@ def measure(name: str, scene: Scene, robot: ck.Robot, payload_kg: float) -> dict
     torque_s = _timed(
         lambda: time_path(path, limits.velocity, limits.acceleration, limits.jerk, torque=dynamics)
     )
+    q_start, q_goal = result.problem.q_start, result.problem.q_goal
+    line = Trajectory(np.array([0.0, 1.0]), np.stack([q_start, q_goal - q_start], axis=-1)[None])
     return row | {
         "ok": True,
         "duration_s": result.trajectory.duration,
@@ -122,6 +132,8 @@ def measure(name: str, scene: Scene, robot: ck.Robot, payload_kg: float) -> dict
         "peak_torque_usage": float(usage),
         "within_effort": bool(usage <= 1.0),
         "toppra_s": toppra_bound(result.trajectory, robot, dynamics),
+        "ruckig_s": free_space_bound(result.problem),
+        "toppra_line_s": toppra_bound(line, robot, dynamics),
         "timing_kinematic_s": kinematic_s[0],
         "timing_torque_s": torque_s[0],
         "path_kinematic_duration_s": kinematic_s[1],
@@ -153,6 +165,13 @@ def summary(rows: list[dict[str, Any]], robot_name: str) -> list[tuple[str, ...]
         group = [r for r in mine if r["payload_kg"] == payload]
         done = [r for r in group if r["ok"]]
         bound = [r["duration_s"] / r["toppra_s"] for r in done if np.isfinite(r["toppra_s"])]
+        floor = [r["ruckig_s"] / r["toppra_line_s"] for r in done if np.isfinite(r["toppra_line_s"])]
+        either = [r["duration_s"] / np.nanmax([r["toppra_s"], r["ruckig_s"]]) for r in done]
+        jerk_cost = [
+            r["duration_s"] * r["toppra_line_s"] / (r["toppra_s"] * r["ruckig_s"])
+            for r in done
+            if np.isfinite(r["toppra_s"] * r["toppra_line_s"])
+        ]
         cost = [r["duration_s"] / bare[r["problem"]]["duration_s"] for r in done if r["problem"] in bare]
         path_cost = [r["path_torque_duration_s"] / r["path_kinematic_duration_s"] for r in done]
         torque_ms = [1e3 * r["timing_torque_s"] for r in done]
@@ -165,6 +184,9 @@ def summary(rows: list[dict[str, Any]], robot_name: str) -> list[tuple[str, ...]
                 f"{sum(r['within_effort'] for r in done)}/{len(done)}",
                 f"{percentile([r['peak_torque_usage'] for r in done], 50):.2f}",
                 f"{percentile(bound, 50):.3f} ({max(bound, default=float('nan')):.3f})",
+                f"{percentile(floor, 50):.3f} ({min(floor, default=float('nan')):.3f})",
+                f"{percentile(either, 50):.3f}",
+                f"{percentile(jerk_cost, 50):.3f}",
                 f"{percentile(cost, 50):.3f}",
                 f"{percentile(path_cost, 50):.3f}",
                 f"{percentile(torque_ms, 50):.1f} / {percentile(torque_ms, 95):.1f}",
@@ -181,6 +203,9 @@ HEADERS = (
     "within effort (1 ms)",
     "median peak torque / effort",
     "duration / TOPP-RA bound, median (max)",
+    "Ruckig / TOPP-RA on the straight line, median (min)",
+    "duration / max(TOPP-RA, Ruckig), median",
+    "duration / (TOPP-RA x the line's Ruckig / TOPP-RA), median",
     "duration / no payload's, median",
     "timing: torque / kinematic duration, median",
     "timing wall time, torque: median / p95 [ms]",
