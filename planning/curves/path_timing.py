@@ -60,6 +60,7 @@ def time_path(
     jerk: FloatArray,
     node_step_s: float = NODE_STEP_S,
     torque: TorqueModel | None = None,
+    still_jerk: bool = False,
 ) -> Trajectory:
     """The fast C3 septic rest-to-rest trajectory along ``path`` of the steps above.
 
@@ -74,6 +75,9 @@ def time_path(
         jerk: ``(nj,)`` limits [rad/s^3, m/s^3].
         node_step_s: largest knot spacing [s] (:func:`smoothing_limits`).
         torque: the robot's torques and effort limits; ``None``: kinematic limits only.
+        still_jerk: the jerk is zero at both ends too (not only the velocity and the
+            acceleration), so that such trajectories join C3 at rest
+            (:mod:`planning.curves.stop_and_go`).
 
     Raises:
         PlanningError: the path does not move, or a limit is not finite and positive.
@@ -91,7 +95,8 @@ def time_path(
         uncapped = uncapped if arc.torque is None else None  # the rows change it
     node_step_s, smoothing = smoothing_limits(limits, node_step_s)
     fastest = fastest_motion(arc, smoothing, uncapped if smoothing is limits else None)
-    trajectory = _septic(fastest.motion, fastest.step_s, node_step_s, path(path.knots[[0, -1]]))
+    ends = path(path.knots[[0, -1]])
+    trajectory = _septic(fastest.motion, fastest.step_s, node_step_s, ends, 4 if still_jerk else 3)
     return trajectory.time_scaled(limits_time_scale(trajectory, limits, torque))
 
 
@@ -128,11 +133,14 @@ def limits_time_scale(trajectory: Trajectory, limits: FloatArray, torque: Torque
     return max(scale, torque_scale) if np.isfinite(torque_scale) else scale
 
 
-def _septic(motion: FloatArray, step_s: float, node_step_s: float, ends: FloatArray) -> Trajectory:
+def _septic(
+    motion: FloatArray, step_s: float, node_step_s: float, ends: FloatArray, still: int = 3
+) -> Trajectory:
     """Septic Hermite segments whose knots take the motion's position and derivatives.
 
     ``motion`` ``(4, T, nj)`` holds them every ``step_s`` [s].
-    The first and last knots are exactly ``ends`` ``(2, nj)``, at rest.
+    The first and last knots are exactly ``ends`` ``(2, nj)``, at rest: their derivatives
+    of orders 1 to ``still - 1`` are zero.
     """
     samples = len(motion[0])
     count = max(1, int(np.ceil((samples - 1) * step_s / node_step_s)))
@@ -140,7 +148,7 @@ def _septic(motion: FloatArray, step_s: float, node_step_s: float, ends: FloatAr
     knots = index * step_s
     data = motion[:, index].transpose(1, 2, 0)  # (knots, nj, 4)
     data[[0, -1], :, 0] = ends
-    data[[0, -1], :, 1:3] = 0.0
+    data[[0, -1], :, 1:still] = 0.0
     steps = np.diff(knots)
     hermite = np.concatenate([data[:-1], data[1:]], axis=2) * node_scaling(steps)[:, None, :]
     coefficients = (hermite @ HERMITE_INV.T) * (steps[:, None, None] ** -np.arange(8.0))

@@ -4,7 +4,9 @@
 each attempt (the seeding rule decides the first and the next,
 :mod:`planning.pipeline.seeding`) is searched (:mod:`planning.pipeline.search`), its
 candidates are timed and verified best first (:mod:`planning.pipeline.choose`), and the
-first that passes becomes the :class:`~planning.pipeline.result.PlanResult`.
+first that passes becomes the :class:`~planning.pipeline.result.PlanResult`. When no
+attempt is left and the seeding found a sampling planner's path, that path is followed as it
+is (:mod:`planning.pipeline.path_following`) before the plan says "no solution".
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from planning.curves.trajectory import Trajectory
 from planning.errors import NoSolutionError
 from planning.pipeline.choose import Choice, Refusal, choose, verify
 from planning.pipeline.metrics import Elapsed
+from planning.pipeline.path_following import follow_path
 from planning.pipeline.problem import Problem, build_problem
 from planning.pipeline.result import PlanResult, assemble
 from planning.pipeline.scene import Scene
@@ -61,8 +64,20 @@ def solve(
             return assemble(attempt.problem, searched, chosen, elapsed)
         following = seeding.after(attempt, searched)
         if following is None:
-            raise chosen.error(attempt.tried)
+            break
         attempt = following
+    if attempt.path is None:
+        raise chosen.error(attempt.tried)
+    problem, followed = follow_path(attempt.problem, attempt.path)  # the last resort
+    if isinstance(followed, Refusal):
+        raise chosen.error(_joined(attempt.tried, f"RRT-Connect found a path, but {followed.cause}"))
+    elapsed = Elapsed(problem.build_time_s + time.perf_counter() - started, search_s)
+    return assemble(problem, searched, followed, elapsed)
+
+
+def _joined(*parts: str) -> str:
+    """The non-empty ``parts`` joined by semicolons."""
+    return "; ".join(part for part in parts if part)
 
 
 def stand_still(problem: Problem, started: float) -> PlanResult:

@@ -42,7 +42,7 @@ if TYPE_CHECKING:
     from planning.pipeline.problem import Problem
 
 FloatArray = NDArray[np.float64]
-Method = Literal["fixed", "fastest", "narrowed", "uniform"]
+Method = Literal["fixed", "fastest", "narrowed", "uniform", "stop_and_go"]
 
 
 @dataclass(frozen=True)
@@ -52,7 +52,8 @@ class Timing:
     Attributes:
         trajectory: the timed trajectory.
         method: ``fixed`` (the scene's duration), ``fastest``, ``narrowed`` or ``uniform``
-            (module docstring).
+            (module docstring), or ``stop_and_go`` (the sampling planner's path followed as it
+            is, :mod:`planning.pipeline.path_following`).
         fit: the spline through the nodes that was timed (before timing).
         stretched: a fixed duration broke a limit and was stretched.
         time_s: wall time of computing it [s].
@@ -100,6 +101,10 @@ class DurationRule(Protocol):
 
     def timings(self, problem: Problem, nodes: FloatArray) -> list[Timing]:
         """The timings of a candidate's ``nodes`` ``(p + 2, nq)`` to verify, in order of preference."""
+        ...
+
+    def held(self, trajectory: Trajectory) -> tuple[Trajectory, bool]:
+        """A trajectory timed as fast as the limits allow, held to the rule, and whether it was stretched."""
         ...
 
     def narrowed(self, problem: Problem, offered: list[Timing], share: float) -> Timing | None:
@@ -165,6 +170,12 @@ class FixedDuration:
     def narrowed(self, problem: Problem, offered: list[Timing], share: float) -> Timing | None:  # noqa: D102
         return None
 
+    def held(self, trajectory: Trajectory) -> tuple[Trajectory, bool]:
+        """``trajectory`` slowed to the scene's duration; as it is if it needs longer (stretched)."""
+        if trajectory.duration > self.seconds:
+            return trajectory, True
+        return trajectory.time_scaled(self.seconds / trajectory.duration), False
+
 
 @dataclass(frozen=True)
 class FreeDuration:
@@ -185,6 +196,9 @@ class FreeDuration:
 
     def still_duration(self, ipo_s: float) -> float:  # noqa: D102
         return ipo_s  # a trajectory needs a time interval; a controller executes nothing shorter
+
+    def held(self, trajectory: Trajectory) -> tuple[Trajectory, bool]:  # noqa: D102 - the protocol's
+        return trajectory, False
 
     def timings(self, problem: Problem, nodes: FloatArray) -> list[Timing]:  # noqa: D102
         limits = problem.robot.limits

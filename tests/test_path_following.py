@@ -1,0 +1,70 @@
+"""The last resort: the sampling planner's path followed vertex to vertex, verified like any plan."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import cpr_kin as ck
+from planning.curves.trajectory import Trajectory
+from planning.io.narrow_passages import narrow_scene
+from planning.io.scene_generator import generate_scenes
+from planning.pipeline.choose import Choice, Refusal
+from planning.pipeline.path_following import follow_path
+from planning.pipeline.planner import plan
+from planning.pipeline.problem import Problem, build_problem
+from planning.pipeline.seeding import sampled_path
+from planning.pipeline.timing import FixedDuration, FreeDuration
+
+
+@pytest.fixture(scope="module")
+def window(robot: ck.Robot) -> Problem:
+    """A window in a wall across the swing: the straight line is blocked."""
+    return build_problem(narrow_scene(np.random.default_rng(5), robot, "window"), robot)
+
+
+def test_a_sampled_path_is_followed_through_its_vertices_and_verified(window: Problem) -> None:
+    found = sampled_path(window, np.random.default_rng(3))
+    assert found is not None
+    problem, followed = follow_path(window, found.path)
+    assert isinstance(followed, Choice) and followed.verification.accepted
+    assert followed.timing.method == "stop_and_go" and not followed.timing.stretched
+    trajectory = followed.timing.trajectory
+    reached = trajectory(trajectory.knots)[:, window.moving]
+    for vertex in found.path:  # every vertex is a knot of the motion, where it stands still
+        k = int(np.argmin(np.abs(reached - vertex).max(axis=1)))
+        assert np.abs(reached[k] - vertex).max() < 1e-9
+        assert np.abs(trajectory(trajectory.knots[k], 1)).max() < 1e-9
+    assert problem.scene.planner.waypoints == max(1, len(found.path) - 2)
+    assert followed.x.size == problem.objective.lower.size
+
+
+def test_a_path_through_an_obstacle_is_refused_with_the_reason(window: Problem) -> None:
+    straight = np.array([window.q_start[window.moving], window.q_goal[window.moving]])
+    _, followed = follow_path(window, straight)
+    assert isinstance(followed, Refusal)
+    assert followed.cause.startswith("following it vertex to vertex") and "obstacle" in followed.cause
+
+
+def test_a_fixed_duration_holds_a_motion_that_fits_and_reports_one_that_does_not() -> None:
+    motion = Trajectory(np.array([0.0, 2.0]), np.array([[[0.0, 0.0, 0.75, -0.25]]]))  # rest to rest, 0 -> 1
+    slowed, stretched = FixedDuration(4.0).held(motion)
+    assert slowed.duration == pytest.approx(4.0) and not stretched
+    np.testing.assert_allclose(
+        slowed(np.array([0.0, 2.0, 4.0]))[:, 0], motion(np.array([0.0, 1.0, 2.0]))[:, 0]
+    )
+    kept, stretched = FixedDuration(1.0).held(motion)
+    assert kept is motion and stretched
+    assert FreeDuration().held(motion) == (motion, False)
+
+
+def test_a_scene_whose_splines_all_touch_the_passage_is_planned_not_refused(robot: ck.Robot) -> None:
+    """A false "no solution" of issue 33 (B.3): every spline near the passage failed; the path did not."""
+    scene = next(s for s in generate_scenes(40, 77, robot, narrow=10) if s.name == "scene_028")
+    result = plan(scene, robot)
+    assert result.verification.accepted and result.metrics.timing == "stop_and_go"
+    assert result.metrics.min_clearance_m >= scene.safety_margin
+    same = plan(dataclasses.replace(scene), robot)
+    np.testing.assert_array_equal(same.trajectory.coefficients, result.trajectory.coefficients)
