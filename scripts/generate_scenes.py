@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from planning.io.narrow_passages import ALL_KINDS, KINDS
 from planning.io.scene_file import dump_scene
 from planning.io.scene_generator import generate_scenes
 
@@ -17,11 +18,18 @@ def main() -> None:
         "--narrow",
         type=int,
         default=0,
-        help="of which narrow passages: beam, window, pillars in turn (default: 0)",
+        help="of which narrow passages, of --kinds in turn (default: 0)",
+    )
+    parser.add_argument(
+        "--kinds",
+        nargs="+",
+        choices=ALL_KINDS,
+        default=list(KINDS),
+        help=f"the narrow passages' kinds (default: {' '.join(KINDS)}; all: {' '.join(ALL_KINDS)})",
     )
     parser.add_argument("--out", type=Path, required=True, help="folder for the scene files")
     args = parser.parse_args()
-    for scene in generate_scenes(args.count, args.seed, narrow=args.narrow):
+    for scene in generate_scenes(args.count, args.seed, narrow=args.narrow, kinds=args.kinds):
         dump_scene(scene, args.out / f"{scene.name}.yaml")
     print(f"wrote {args.count} scenes into {args.out}")
 

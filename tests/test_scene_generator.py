@@ -5,7 +5,14 @@ import pytest
 
 import cpr_kin as ck
 from planning.errors import PlanningError
-from planning.io.narrow_passages import KINDS, narrow_scene
+from planning.io.narrow_passages import (
+    ARM_ABOVE_AXIS_M,
+    KINDS,
+    PLAY_RANGE_M,
+    TIGHT_PLAY_RANGE_M,
+    TOOL_BELOW_AXIS_M,
+    narrow_scene,
+)
 from planning.io.scene_file import parse_scene, scene_document
 from planning.io.scene_generator import generate_scenes
 
@@ -59,5 +66,34 @@ def test_narrow_passages_are_reproducible_and_block_the_straight_swing(robot: ck
 def test_narrow_count_is_checked(robot: ck.Robot) -> None:
     with pytest.raises(PlanningError, match="narrow = 5"):
         generate_scenes(3, robot=robot, narrow=5)
-    with pytest.raises(PlanningError, match="kind = 'slot'"):
-        narrow_scene(np.random.default_rng(0), robot, "slot")  # type: ignore[arg-type]
+    with pytest.raises(PlanningError, match="kind = 'tunnel'"):
+        narrow_scene(np.random.default_rng(0), robot, "tunnel")  # type: ignore[arg-type]
+    with pytest.raises(PlanningError, match=r"kinds = \['tunnel'\]; allowed: one or more of beam"):
+        generate_scenes(3, robot=robot, narrow=1, kinds=["tunnel"])  # type: ignore[list-item]
+
+
+def test_slots_are_millimetres_wide_and_overhangs_cover_the_goal(robot: ck.Robot) -> None:
+    scenes = generate_scenes(8, seed=4, robot=robot, narrow=8, kinds=["slot", "overhang"])
+    assert [s.name for s in scenes] == [f"{('slot', 'overhang')[i % 2]}_{i:03d}" for i in range(8)]
+    for scene in scenes:
+        margin = scene.safety_margin
+        obstacles = {o.name: o for o in scene.obstacles}
+        q = np.array([scene.start.configuration(robot), scene.goal.configuration(robot)])
+        world = ck.CollisionWorld(robot, scene.obstacles)
+        assert world.clearance_batch(q).min_clearance_m.min() >= margin + 0.02 - 1e-9
+        if scene.name.startswith("slot"):
+            crate, beam = obstacles["crate"], obstacles["beam"]
+            assert crate.size is not None and beam.size is not None
+            gap = (beam.xyz[2] - beam.size[2] / 2) - crate.size[2]
+            play = gap - (ARM_ABOVE_AXIS_M + TOOL_BELOW_AXIS_M + 2 * margin)
+            assert TIGHT_PLAY_RANGE_M[0] <= play <= TIGHT_PLAY_RANGE_M[1]  # 1-5 mm a side
+        else:
+            board = obstacles["board"]
+            assert board.size is not None and set(obstacles) == {"board", "post"}
+            underside = board.xyz[2] - board.size[2] / 2
+            arm_top = 0.25 + q[1, 1] + ARM_ABOVE_AXIS_M  # z_c = 0.25 + d2, and half the arm beam
+            play = underside - arm_top - margin
+            assert PLAY_RANGE_M[0] <= play <= PLAY_RANGE_M[1]
+            raised = q[1].copy()
+            raised[1] += play + 0.01  # the goal's arm lifted into the margin under the board
+            assert world.margin_violated(raised[None], margin)[0]

@@ -10,7 +10,9 @@ to find out.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -19,6 +21,9 @@ from planning.errors import PlanningError
 from planning.pipeline.scene import Scene
 from planning.pipeline.settings import PlannerSettings
 from planning.pipeline.target import Target
+
+if TYPE_CHECKING:
+    from planning.io.narrow_passages import Kind
 
 
 def _tcp(theta1: float, radius: float, height: float) -> tuple[float, float, float]:
@@ -78,17 +83,27 @@ def random_scene(
             )
 
 
-def generate_scenes(count: int, seed: int = 0, robot: ck.Robot | None = None, narrow: int = 0) -> list[Scene]:
+def generate_scenes(
+    count: int,
+    seed: int = 0,
+    robot: ck.Robot | None = None,
+    narrow: int = 0,
+    kinds: Sequence[Kind] | None = None,
+) -> list[Scene]:
     """``count`` random scenes from ``seed``; scene ``i`` plans with seed ``i``.
 
     The last ``narrow`` of them are narrow passages (:mod:`planning.io.narrow_passages`),
-    their kinds in turn, drawn from a stream of their own: the other scenes are the same
-    whatever ``narrow`` is.
+    of ``kinds`` in turn (default: :data:`~planning.io.narrow_passages.KINDS`), drawn from a
+    stream of their own: the other scenes are the same whatever ``narrow`` and ``kinds`` are.
     """
-    from planning.io.narrow_passages import KINDS, narrow_scene
+    from planning.io.narrow_passages import ALL_KINDS, KINDS, narrow_scene
 
     if not 0 <= narrow <= count:
         raise PlanningError(f"narrow = {narrow} scenes; allowed: 0 to count = {count}")
+    kinds = tuple(KINDS if kinds is None else kinds)
+    unknown = [kind for kind in kinds if kind not in ALL_KINDS]
+    if unknown or not kinds:
+        raise PlanningError(f"kinds = {list(kinds)}; allowed: one or more of {', '.join(ALL_KINDS)}")
     robot = robot or ck.load_cpr()
     rng = np.random.default_rng(seed)
     scenes = []
@@ -97,7 +112,7 @@ def generate_scenes(count: int, seed: int = 0, robot: ck.Robot | None = None, na
         scenes.append(replace(scene, planner=replace(scene.planner, seed=index)))
     narrow_rng = np.random.default_rng([seed, 1])
     for index in range(count - narrow, count):
-        kind = KINDS[(index - count + narrow) % len(KINDS)]
+        kind = kinds[(index - count + narrow) % len(kinds)]
         scene = narrow_scene(narrow_rng, robot, kind, name=f"{kind}_{index:03d}")
         scenes.append(replace(scene, planner=replace(scene.planner, seed=index)))
     return scenes
