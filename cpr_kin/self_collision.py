@@ -26,6 +26,7 @@ from lxml import etree
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import CprKinError, UrdfError
+from cpr_kin.self_bounds import ScreenedSelfTest
 from cpr_kin.user_files import read_bytes
 
 FloatArray = NDArray[np.float64]
@@ -159,8 +160,7 @@ class SelfCollision:
         self._data = model.createData()
         self._gdata = self.geometry_model.createData()
         self.num_threads = num_threads
-        self._pool: Any = None  # Pinocchio's GeometryPool, built on the first violated()
-        self._margin_m = float("nan")
+        self._test: ScreenedSelfTest | None = None  # built on the first violated()
 
     @property
     def pairs(self) -> tuple[tuple[str, str], ...]:
@@ -190,23 +190,16 @@ class SelfCollision:
         """``(N,)`` whether any pair is closer than ``margin_m`` [m] at configurations ``q``.
 
         coal's collision test with ``margin_m`` as its security margin, which stops at the first
-        pair closer than that, in parallel over :attr:`num_threads` threads (Pinocchio's
-        ``GeometryPool``): a fraction of :meth:`distances`' cost, with the same answer.
+        pair closer than that, in parallel over :attr:`num_threads` threads, screened by the
+        pairs' cheap bounds (:class:`~cpr_kin.self_bounds.ScreenedSelfTest`): a fraction of
+        :meth:`distances`' cost, with the same answer.
         """
         batch = np.atleast_2d(np.asarray(q, dtype=float))
         if not self._pairs or not len(batch):
             return np.zeros(len(batch), dtype=bool)
-        if self._pool is None:
-            self._pool = pin.GeometryPool(self.model, self.geometry_model, self.num_threads)
-        if margin_m != self._margin_m:
-            margins = np.full((self.geometry_model.ngeoms,) * 2, float(margin_m))
-            for gdata in self._pool.getGeometryDatas():
-                gdata.setSecurityMargins(self.geometry_model, margins, True, True)
-                for request in gdata.collisionRequests:
-                    request.enable_contact = False
-            self._margin_m = margin_m
-        hits = pin.computeCollisionsInParallel(self.num_threads, self._pool, np.asfortranarray(batch.T), True)
-        return np.asarray(hits, dtype=bool)
+        if self._test is None:
+            self._test = ScreenedSelfTest(self.model, self.geometry_model, self._pairs, self.num_threads)
+        return self._test.violated(batch, margin_m)
 
 
 @dataclass(frozen=True)

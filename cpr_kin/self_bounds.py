@@ -1,0 +1,255 @@
+"""Cheap lower bounds of the distances between a robot's own link pairs, for many configurations.
+
+The self-collision test (:meth:`cpr_kin.self_collision.SelfCollision.violated`) asks coal
+about every checked pair at every configuration; most pairs of a serial arm are far apart
+most of the time. As for obstacles (:mod:`cpr_kin.pair_bounds`), each geometry is enclosed
+in a capsule fixed to its joint (:func:`~cpr_kin.pair_bounds.bounding_capsule`), placed by
+the compiled kinematic chain; a pair's capsules are first compared by their bounding
+spheres, then by the exact distance between their segments less both radii. Both are at
+most coal's distance between the geometries, so a configuration whose every pair is bounded
+above a margin keeps it for certain, and only the others go to coal.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import NDArray
+
+from cpr_kin.batch_kinematics import ChainArrays, KinematicChain, place_joints
+from cpr_kin.compiled import njit
+from cpr_kin.pair_bounds import bounding_capsule
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+BoolArray = NDArray[np.bool_]
+
+
+@njit
+def segment_distance(p: FloatArray, q: FloatArray) -> float:
+    """Distance [m] between the segments ``p`` and ``q``, each ``(2, 3)`` end points.
+
+    The closest points of two segments (Ericson, *Real-Time Collision Detection*, 5.1.9):
+    the infinite lines' parameters clamped to ``[0, 1]`` in turn, degenerate segments
+    (points) and parallel ones included. Scalar arithmetic: no array is allocated.
+    """
+    d1x, d1y, d1z = p[1, 0] - p[0, 0], p[1, 1] - p[0, 1], p[1, 2] - p[0, 2]
+    d2x, d2y, d2z = q[1, 0] - q[0, 0], q[1, 1] - q[0, 1], q[1, 2] - q[0, 2]
+    rx, ry, rz = p[0, 0] - q[0, 0], p[0, 1] - q[0, 1], p[0, 2] - q[0, 2]
+    a = d1x * d1x + d1y * d1y + d1z * d1z
+    e = d2x * d2x + d2y * d2y + d2z * d2z
+    f = d2x * rx + d2y * ry + d2z * rz
+    tiny = 1e-18
+    if a <= tiny and e <= tiny:
+        s = t = 0.0
+    elif a <= tiny:
+        s, t = 0.0, min(max(f / e, 0.0), 1.0)
+    else:
+        c = d1x * rx + d1y * ry + d1z * rz
+        if e <= tiny:
+            s, t = min(max(-c / a, 0.0), 1.0), 0.0
+        else:
+            b = d1x * d2x + d1y * d2y + d1z * d2z
+            denominator = a * e - b * b
+            s = min(max((b * f - c * e) / denominator, 0.0), 1.0) if denominator > tiny else 0.0
+            t = (b * s + f) / e
+            if t < 0.0:
+                s, t = min(max(-c / a, 0.0), 1.0), 0.0
+            elif t > 1.0:
+                s, t = min(max((b - c) / a, 0.0), 1.0), 1.0
+    x = rx + s * d1x - t * d2x
+    y = ry + s * d1y - t * d2y
+    z = rz + s * d1z - t * d2z
+    return float(np.sqrt(x * x + y * y + z * z))
+
+
+@njit
+def self_bounds(
+    q: FloatArray,
+    threshold: float,
+    out: FloatArray,
+    chain: ChainArrays,
+    capsule_joint: IntArray,
+    capsule_ends: FloatArray,
+    capsule_radius: FloatArray,
+    capsule_reach: FloatArray,
+    pair_a: IntArray,
+    pair_b: IntArray,
+) -> None:
+    """Write into ``out[n, p]`` a lower bound [m] of pair ``p``'s distance at ``q[n]``.
+
+    A pair whose bounding spheres are more than ``threshold`` apart gets that sphere bound
+    (cheaper, looser); the others the capsules' distance.
+    """
+    joints = len(chain[0])
+    rotation, translation = np.empty((joints, 3, 3)), np.empty((joints, 3))
+    world = np.empty((len(capsule_joint), 2, 3))
+    scratch = np.empty((4, 3))
+    for n in range(len(q)):
+        place_joints(q[n], chain, rotation, translation, scratch)
+        for c in range(len(capsule_joint)):
+            j = capsule_joint[c]
+            for e in range(2):
+                for r in range(3):
+                    if j < 0:
+                        world[c, e, r] = capsule_ends[c, e, r]
+                    else:
+                        world[c, e, r] = (
+                            translation[j, r]
+                            + rotation[j, r, 0] * capsule_ends[c, e, 0]
+                            + rotation[j, r, 1] * capsule_ends[c, e, 1]
+                            + rotation[j, r, 2] * capsule_ends[c, e, 2]
+                        )
+        for k in range(len(pair_a)):
+            a, b = pair_a[k], pair_b[k]
+            x = 0.5 * (world[a, 0, 0] + world[a, 1, 0] - world[b, 0, 0] - world[b, 1, 0])
+            y = 0.5 * (world[a, 0, 1] + world[a, 1, 1] - world[b, 0, 1] - world[b, 1, 1])
+            z = 0.5 * (world[a, 0, 2] + world[a, 1, 2] - world[b, 0, 2] - world[b, 1, 2])
+            spheres = np.sqrt(x * x + y * y + z * z) - capsule_reach[a] - capsule_reach[b]
+            if spheres > threshold:
+                out[n, k] = spheres
+            else:
+                out[n, k] = segment_distance(world[a], world[b]) - capsule_radius[a] - capsule_radius[b]
+
+
+class SelfPairBounds:
+    """Lower bounds of a robot's own pair distances, for batches of configurations.
+
+    Args:
+        model: the robot's Pinocchio model (one-degree-of-freedom joints).
+        collision_model: the robot's Pinocchio geometry model.
+        pairs: ``(geometry index, geometry index)`` per output column.
+    """
+
+    def __init__(self, model: Any, collision_model: Any, pairs: Sequence[tuple[int, int]]) -> None:
+        self._chain = KinematicChain.from_model(model)
+        geometries = sorted({g for pair in pairs for g in pair})
+        slot = {g: k for k, g in enumerate(geometries)}
+        ends, radii, joints = [], [], []
+        for g in geometries:
+            obj = collision_model.geometryObjects[g]
+            local, radius = bounding_capsule(obj.geometry)
+            placement = obj.placement  # geometry in its joint's frame
+            ends.append(local @ np.asarray(placement.rotation).T + np.asarray(placement.translation))
+            radii.append(radius)
+            joints.append(int(obj.parentJoint) - 1)  # -1: fixed to the world
+        capsule_ends = np.array(ends, dtype=float).reshape(-1, 2, 3)
+        capsule_radius = np.array(radii, dtype=float)
+        reach = np.linalg.norm(capsule_ends[:, 1] - capsule_ends[:, 0], axis=1) / 2 + capsule_radius
+        self._arguments: tuple[Any, ...] = (
+            self._chain.arrays,
+            np.array(joints, dtype=np.int64),
+            capsule_ends,
+            capsule_radius,
+            reach,
+            np.array([slot[a] for a, _ in pairs], dtype=np.int64),
+            np.array([slot[b] for _, b in pairs], dtype=np.int64),
+        )
+        self.n_pairs = len(pairs)
+
+    def __call__(self, q: FloatArray, threshold_m: float = np.inf) -> FloatArray:
+        """``(N, P)`` lower bounds [m] of each pair's distance at configurations ``q`` ``(N, nq)``.
+
+        Pairs whose bounding spheres are more than ``threshold_m`` apart get the spheres'
+        bound; the others (all, by default) the capsules'.
+        """
+        batch = np.ascontiguousarray(np.atleast_2d(q), dtype=float)
+        out = np.empty((len(batch), self.n_pairs))
+        self_bounds(batch, float(threshold_m), out, *self._arguments)
+        return out
+
+    def any_below(self, q: FloatArray, threshold_m: float) -> BoolArray:
+        """``(N,)`` whether some pair may be within ``threshold_m`` [m] at configurations ``q``."""
+        return np.asarray((self(q, threshold_m) <= threshold_m).any(axis=1))
+
+
+PROBES = 256
+"""Random configurations on which :class:`ScreenedSelfTest` finds the pairs that are always near."""
+NEAR_SHARE = 0.5
+"""Share of those in which a pair's bound is uncertain that makes it a near pair."""
+PROBE_THRESHOLD_M = 0.05
+"""The distance [m] the probes ask the bounds about (a typical margin and more)."""
+BOUND_TOLERANCE_M = 1e-6
+"""Added to the margin a bound must exceed: coal's own tolerance."""
+
+
+class ScreenedSelfTest:
+    """coal's yes/no self-collision test, screened by the pairs' bounds (module docstring).
+
+    Some pairs of a serial arm are always close (a link and the one two joints down its
+    chain, a few centimetres apart by design): bounding them first would only delay coal.
+    So the pairs are split once, on :data:`PROBES` seeded random configurations within the
+    joint ranges: those whose bound is uncertain in more than :data:`NEAR_SHARE` of them
+    (*near*) go to coal at every configuration, the others (*far*) only at configurations
+    where some far pair's bound is within the margin. Each group has its own Pinocchio
+    ``GeometryPool``, run in parallel over ``num_threads`` threads, stopping at a
+    configuration's first hit. The answer is coal's on every pair.
+
+    Args:
+        model: the robot's Pinocchio model.
+        geometry_model: its geometry model with the pairs added, in order.
+        pairs: the pairs' geometry indices.
+        num_threads: threads of coal's batches.
+    """
+
+    def __init__(
+        self, model: Any, geometry_model: Any, pairs: Sequence[tuple[int, int]], num_threads: int
+    ) -> None:
+        self.model, self.geometry_model, self.num_threads = model, geometry_model, num_threads
+        rng = np.random.default_rng(0)
+        lower = np.clip(model.lowerPositionLimit, -np.pi, np.pi)
+        upper = np.clip(model.upperPositionLimit, -np.pi, np.pi)
+        probes = rng.uniform(lower, np.maximum(upper, lower), (PROBES, model.nq))
+        uncertain = (
+            SelfPairBounds(model, geometry_model, pairs)(probes, PROBE_THRESHOLD_M) <= PROBE_THRESHOLD_M
+        )
+        near = uncertain.mean(axis=0) > NEAR_SHARE
+        self.near_pairs = tuple(p for p, is_near in zip(pairs, near, strict=True) if is_near)
+        self.far_bounds = SelfPairBounds(
+            model, geometry_model, [p for p, n in zip(pairs, near, strict=True) if not n]
+        )
+        self._active = (near, ~near)
+        self._pools: list[Any] = []
+        self._margin_m = float("nan")
+
+    def violated(self, batch: FloatArray, margin_m: float) -> NDArray[np.bool_]:
+        """``(N,)`` whether any pair is closer than ``margin_m`` [m] at configurations ``batch``."""
+        self._prepare(margin_m)
+        hits = np.zeros(len(batch), dtype=bool)
+        if self.near_pairs:
+            hits[:] = self._coal(0, batch)
+        if self.far_bounds.n_pairs:
+            open_rows = np.flatnonzero(~hits)
+            doubtful = open_rows[self.far_bounds.any_below(batch[open_rows], margin_m + BOUND_TOLERANCE_M)]
+            if doubtful.size:
+                hits[doubtful] = self._coal(1, batch[doubtful])
+        return hits
+
+    def _coal(self, tier: int, batch: FloatArray) -> NDArray[np.bool_]:
+        """Coal's test of the pairs of ``tier`` (0 near, 1 far) at configurations ``batch``."""
+        found = pin.computeCollisionsInParallel(
+            self.num_threads, self._pools[tier], np.asfortranarray(batch.T), True
+        )
+        return np.asarray(found, dtype=bool)
+
+    def _prepare(self, margin_m: float) -> None:
+        """Build the two pools once; set their security margin when it changes."""
+        if not self._pools:
+            self._pools = [
+                pin.GeometryPool(self.model, self.geometry_model, self.num_threads) for _ in range(2)
+            ]
+            for pool, active in zip(self._pools, self._active, strict=True):
+                for gdata in pool.getGeometryDatas():
+                    for p, on in enumerate(active):
+                        (gdata.activateCollisionPair if on else gdata.deactivateCollisionPair)(p)
+        if margin_m != self._margin_m:
+            margins = np.full((self.geometry_model.ngeoms,) * 2, float(margin_m))
+            for pool in self._pools:
+                for gdata in pool.getGeometryDatas():
+                    gdata.setSecurityMargins(self.geometry_model, margins, True, True)
+                    for request in gdata.collisionRequests:
+                        request.enable_contact = False
+            self._margin_m = margin_m

@@ -1,0 +1,70 @@
+"""Cheap bounds of a robot's own pair distances: below coal's, and a screen that changes no answer."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import cpr_kin as ck
+from cpr_kin.packages import example_robot_data_share
+from cpr_kin.self_bounds import ScreenedSelfTest, SelfPairBounds, segment_distance
+from cpr_kin.self_collision import SelfCollision
+
+SHARE = example_robot_data_share()
+assert SHARE is not None, "example-robot-data is part of the robots extra, which make installs"
+ROBOTS = SHARE / "example-robot-data" / "robots"
+
+
+def brute_distance(p: np.ndarray, q: np.ndarray, count: int = 401) -> float:
+    u = np.linspace(0.0, 1.0, count)[:, None]
+    a, b = p[0] + u * (p[1] - p[0]), q[0] + u * (q[1] - q[0])
+    return float(np.sqrt(((a[:, None] - b[None]) ** 2).sum(axis=-1)).min())
+
+
+def test_the_segments_distance_is_their_closest_points(seed: int = 0) -> None:
+    rng = np.random.default_rng(seed)
+    for case in range(200):
+        p, q = rng.normal(size=(2, 2, 3))
+        if case % 5 == 1:  # parallel, overlapping or not
+            q[1] = q[0] + (p[1] - p[0]) * rng.uniform(-2.0, 2.0)
+        if case % 7 == 2:  # a point
+            p[1] = p[0]
+        exact = segment_distance(p, q)
+        brute = brute_distance(p, q)
+        assert exact <= brute + 1e-12  # never above a distance actually attained
+        assert brute - exact < 1e-2  # and the brute force's grid comes close to it
+    crossing = np.array([[[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]], [[0.0, -1.0, 0.5], [0.0, 1.0, 0.5]]])
+    assert segment_distance(*crossing) == pytest.approx(0.5, abs=1e-15)
+
+
+ARMS = ["panda_description/urdf/panda.urdf", "ur_description/urdf/ur5_robot.urdf"]
+
+
+@pytest.fixture(scope="module", params=ARMS)
+def arm(request: pytest.FixtureRequest) -> ck.Robot:
+    return ck.load_robot(ROBOTS / request.param)
+
+
+def test_the_bounds_are_below_coals_distances(arm: ck.Robot) -> None:
+    collision = ck.CollisionWorld(arm, []).self_collision
+    pairs = collision._pairs
+    names = [g.name for g in arm.geometries]
+    bounds = SelfPairBounds(arm.model, collision.geometry_model, pairs)
+    q = np.random.default_rng(1).uniform(arm.limits.lower, arm.limits.upper, (200, arm.nq))
+    below = bounds(q)
+    np.testing.assert_array_less(below.min(axis=1), collision.distances(q)[0] + 1e-9)
+    for k in range(0, len(pairs), 7):  # every 7th pair on its own against coal's distance
+        exact = SelfCollision(arm.model, arm.collision_model, (pairs[k],), names).distances(q)[0]
+        np.testing.assert_array_less(below[:, k], exact + 1e-9)
+    far = bounds(q, threshold_m=0.0)  # the spheres' bound where they are apart: looser, still below
+    assert np.all(far <= below + 1e-12)
+
+
+@pytest.mark.parametrize("margin_m", [0.0, 0.01, 0.05])
+def test_the_screen_gives_coals_answer(arm: ck.Robot, margin_m: float) -> None:
+    collision = ck.CollisionWorld(arm, []).self_collision
+    test = ScreenedSelfTest(arm.model, collision.geometry_model, collision._pairs, 2)
+    assert len(test.near_pairs) + test.far_bounds.n_pairs == len(collision._pairs)
+    q = np.random.default_rng(2).uniform(arm.limits.lower, arm.limits.upper, (500, arm.nq))
+    distance, _ = collision.distances(q)
+    np.testing.assert_array_equal(test.violated(q, margin_m), distance < margin_m)
