@@ -213,6 +213,8 @@ class ScreenedSelfTest:
         )
         self._active = (near, ~near)
         self._pools: list[Any] = []
+        self._data: Any = None
+        self._distance_data: list[Any] = []
         self._margin_m = float("nan")
 
     def violated(self, batch: FloatArray, margin_m: float) -> NDArray[np.bool_]:
@@ -228,6 +230,31 @@ class ScreenedSelfTest:
                 hits[doubtful] = self._coal(1, batch[doubtful])
         return hits
 
+    def distances(self, batch: FloatArray) -> tuple[FloatArray, IntArray]:
+        """Smallest self distance [m] and its pair (index among all pairs), ``(N,)`` each, exactly.
+
+        coal's distances of the near pairs at every configuration, and of the far pairs only
+        where their smallest bound is below the near pairs' distance: elsewhere no far pair
+        can be closer, so the answer is coal's over every pair.
+        """
+        self._prepare(float("nan"))
+        far_bound = (
+            self.far_bounds(batch).min(axis=1) if self.far_bounds.n_pairs else np.full(len(batch), np.inf)
+        )
+        distance = np.full(len(batch), np.inf)
+        closest = np.full(len(batch), -1, dtype=np.int64)
+        tiers = ((0, bool(self.near_pairs)), (1, bool(self.far_bounds.n_pairs)))
+        for tier, present in tiers:
+            gdata = self._distance_data[tier]
+            results = gdata.distanceResults
+            for k in range(len(batch) if present else 0):
+                if tier == 1 and far_bound[k] >= distance[k]:
+                    continue  # no far pair comes closer than the near pairs' distance
+                pair = pin.computeDistances(self.model, self._data, self.geometry_model, gdata, batch[k])
+                if results[pair].min_distance < distance[k]:
+                    distance[k], closest[k] = results[pair].min_distance, pair
+        return distance, closest
+
     def _coal(self, tier: int, batch: FloatArray) -> NDArray[np.bool_]:
         """Coal's test of the pairs of ``tier`` (0 near, 1 far) at configurations ``batch``."""
         found = pin.computeCollisionsInParallel(
@@ -236,8 +263,18 @@ class ScreenedSelfTest:
         return np.asarray(found, dtype=bool)
 
     def _prepare(self, margin_m: float) -> None:
-        """Build the two pools once; set their security margin when it changes."""
+        """Build the two pools and distance data once; set the pools' security margin when it changes.
+
+        A NaN ``margin_m`` leaves the margin as it is.
+        """
         if not self._pools:
+            self._data = self.model.createData()
+            self._distance_data = []
+            for active in self._active:
+                gdata = self.geometry_model.createData()
+                for p, on in enumerate(active):
+                    (gdata.activateCollisionPair if on else gdata.deactivateCollisionPair)(p)
+                self._distance_data.append(gdata)
             self._pools = [
                 pin.GeometryPool(self.model, self.geometry_model, self.num_threads) for _ in range(2)
             ]
@@ -245,7 +282,7 @@ class ScreenedSelfTest:
                 for gdata in pool.getGeometryDatas():
                     for p, on in enumerate(active):
                         (gdata.activateCollisionPair if on else gdata.deactivateCollisionPair)(p)
-        if margin_m != self._margin_m:
+        if margin_m != self._margin_m and not np.isnan(margin_m):
             margins = np.full((self.geometry_model.ngeoms,) * 2, float(margin_m))
             for pool in self._pools:
                 for gdata in pool.getGeometryDatas():

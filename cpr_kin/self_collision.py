@@ -176,15 +176,9 @@ class SelfCollision:
         ``inf`` and ``-1`` when there is no pair.
         """
         batch = np.atleast_2d(np.asarray(q, dtype=float))
-        distance = np.full(len(batch), np.inf)
-        closest = np.full(len(batch), -1, dtype=np.int64)
         if not self._pairs:
-            return distance, closest
-        results = self._gdata.distanceResults
-        for k, qk in enumerate(batch):
-            pair = pin.computeDistances(self.model, self._data, self.geometry_model, self._gdata, qk)
-            distance[k], closest[k] = results[pair].min_distance, pair
-        return distance, closest
+            return np.full(len(batch), np.inf), np.full(len(batch), -1, dtype=np.int64)
+        return self._screened().distances(batch)
 
     def violated(self, q: ArrayLike, margin_m: float) -> NDArray[np.bool_]:
         """``(N,)`` whether any pair is closer than ``margin_m`` [m] at configurations ``q``.
@@ -197,9 +191,13 @@ class SelfCollision:
         batch = np.atleast_2d(np.asarray(q, dtype=float))
         if not self._pairs or not len(batch):
             return np.zeros(len(batch), dtype=bool)
+        return self._screened().violated(batch, margin_m)
+
+    def _screened(self) -> ScreenedSelfTest:
+        """The screened coal queries of the pairs, built on first use."""
         if self._test is None:
             self._test = ScreenedSelfTest(self.model, self.geometry_model, self._pairs, self.num_threads)
-        return self._test.violated(batch, margin_m)
+        return self._test
 
 
 @dataclass(frozen=True)

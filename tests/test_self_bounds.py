@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
 import cpr_kin as ck
@@ -68,3 +69,21 @@ def test_the_screen_gives_coals_answer(arm: ck.Robot, margin_m: float) -> None:
     q = np.random.default_rng(2).uniform(arm.limits.lower, arm.limits.upper, (500, arm.nq))
     distance, _ = collision.distances(q)
     np.testing.assert_array_equal(test.violated(q, margin_m), distance < margin_m)
+
+
+def test_the_screened_distances_are_coals_over_every_pair(arm: ck.Robot) -> None:
+    collision = ck.CollisionWorld(arm, []).self_collision
+    q = np.random.default_rng(3).uniform(arm.limits.lower, arm.limits.upper, (300, arm.nq))
+    model, geometry_model = arm.model, collision.geometry_model
+    data, gdata = model.createData(), geometry_model.createData()  # every pair active
+    expected = np.empty(len(q))
+    for k, x in enumerate(q):  # read each result before the next call overwrites it
+        pair = pin.computeDistances(model, data, geometry_model, gdata, x)
+        expected[k] = gdata.distanceResults[pair].min_distance
+    distance, closest = collision.distances(q)
+    # coal's GJK starts from the pair's last answer: the order of queries moves results by ~1e-8
+    np.testing.assert_allclose(distance, expected, rtol=0.0, atol=1e-6)
+    pairs = geometry_model.collisionPairs
+    for k in range(0, len(q), 37):  # the pair named is one at that distance
+        a, b = pairs[int(closest[k])].first, pairs[int(closest[k])].second
+        assert (a, b) in collision._pairs
