@@ -5,7 +5,7 @@ planner's default search) and the shelf with each of the planner's modes (the pa
 the ``paper`` fitness, the ``ptp`` path, no refinement, no seeding), fixed and free durations,
 a goal at the start and ``--generated`` generated scenes (a quarter of them narrow
 passages), and prints the SHA-256 of each plan's ``cpr-trajectory/1`` file (without wall
-times; the recorded URDF path replaced by its name) and one digest of them all. Run it on
+times; the recorded URDF and SRDF paths replaced by their names) and one digest of them all. Run it on
 two checkouts: a refactoring that means to change no result must print the same digest.
 A scene with no trajectory prints the failure's class instead of a hash.
 """
@@ -71,7 +71,10 @@ def fingerprint(scene: Scene, robot: ck.Robot, optimizer: Optimizer | None = Non
         result = plan(scene, robot, optimizer=optimizer)
     except NoSolutionError as exc:
         return type(exc).__name__
-    text = trajectory_json(result).replace(str(robot.urdf_path), Path(robot.urdf_path).name)
+    text = trajectory_json(result)
+    for path in (robot.urdf_path, robot.srdf_path):  # the checkout's folder is no part of a plan
+        if path is not None:
+            text = text.replace(str(path), Path(path).name)
     return hashlib.sha256(text.encode()).hexdigest()
 
 
