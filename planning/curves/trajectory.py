@@ -13,7 +13,6 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from cpr_kin.compiled import njit
 from planning.errors import PlanningError
 
 FloatArray = NDArray[np.float64]
@@ -31,27 +30,6 @@ def derivative_coefficients(coefficients: FloatArray, r: int) -> FloatArray:
     out = np.zeros_like(coefficients)
     out[..., : order - r] = (coefficients * factor)[..., r:]
     return out
-
-
-@njit
-def _evaluate(coefficients: FloatArray, knots: FloatArray, times: FloatArray) -> FloatArray:
-    """``(K, nj)`` the polynomials ``coefficients`` ``(N, nj, order)`` at ``times`` ``(K,)`` by Horner's rule.
-
-    Each time in the segment ``i`` with ``knots[i] <= t < knots[i + 1]`` (the last segment
-    from its start on, the first before its end), clamped to the knots.
-    """
-    segments, joints, order = coefficients.shape
-    values = np.empty((len(times), joints))
-    for m in range(len(times)):
-        t = min(max(times[m], knots[0]), knots[-1])
-        i = min(max(np.searchsorted(knots, t, side="right") - 1, 0), segments - 1)
-        local = t - knots[i]
-        for j in range(joints):
-            value = coefficients[i, j, order - 1]
-            for k in range(order - 2, -1, -1):
-                value = value * local + coefficients[i, j, k]
-            values[m, j] = value
-    return values
 
 
 def _real_roots_in(coefficients: FloatArray, upper: FloatArray) -> FloatArray:
@@ -169,8 +147,10 @@ class Trajectory:
             raise PlanningError(
                 f"derivative order {derivative} must be in [0, {self.coefficients.shape[2] - 1}]"
             )
+        from planning.curves.horner import evaluate  # compiled: numba only once a trajectory is evaluated
+
         times = np.asarray(t, dtype=float)
-        value = _evaluate(self._coefficients(derivative), self.knots, np.atleast_1d(times).ravel())
+        value = evaluate(self._coefficients(derivative), self.knots, np.atleast_1d(times).ravel())
         return np.asarray(value[0] if times.ndim == 0 else value)
 
     def position(self, t: ArrayLike) -> FloatArray:
