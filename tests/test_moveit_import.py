@@ -315,14 +315,29 @@ def test_what_has_no_counterpart_is_refused_by_name(
 
 @pytest.mark.slow
 def test_every_motionbenchmaker_problem_converts() -> None:
-    """The 700 Panda and 700 UR5 problems of vamp-planner 0.6.4 (from PyPI, cached): convert, and count."""
+    """The 700 Panda and 700 UR5 problems of vamp-planner 0.6.4 (from PyPI, cached): convert, and count.
+
+    One process per robot, side by side (the script's own use, robot by robot, on two cores).
+    """
     import subprocess
     import sys
 
     script = Path(__file__).resolve().parents[1] / "scripts" / "import_mbm.py"
-    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=900)
-    assert done.returncode == 0, done.stderr
-    rows = [line.split() for line in done.stdout.splitlines() if line.startswith("all ")]
-    (panda_all, ur5_all) = rows
+    runs = {
+        robot: subprocess.Popen(
+            [sys.executable, str(script), "--robots", robot],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        for robot in ("panda", "ur5")
+    }
+    outputs = {robot: run.communicate(timeout=900) for robot, run in runs.items()}
+    for robot, run in runs.items():
+        assert run.returncode == 0, outputs[robot][1]
+    panda_all, ur5_all = (
+        next(line.split() for line in outputs[robot][0].splitlines() if line.startswith("all "))
+        for robot in ("panda", "ur5")
+    )
     assert panda_all[1:4] == ["700", "700", "700"]
     assert ur5_all[1:3] == ["700", "700"] and int(ur5_all[3]) >= 600  # hulls over the concave forearm: docs

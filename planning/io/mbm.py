@@ -61,7 +61,7 @@ def _download(target: Path) -> None:
         raise PlanningError(f"{SDIST} is not on the package index {index}")
     url, digest = found.groups()
     url = urllib.parse.urljoin(index, url)
-    partial = target.with_suffix(".part")
+    partial = target.with_suffix(f".{os.getpid()}.part")  # processes downloading at once each write their own
     with urllib.request.urlopen(url, timeout=600) as response, partial.open("wb") as out:
         out.write(response.read())
     if hashlib.sha256(partial.read_bytes()).hexdigest() != digest:
