@@ -153,6 +153,35 @@ def test_an_extension_is_at_most_one_step(step_m: float | None, monkeypatch: pyt
     assert reach[:count].max() >= step - 0.01  # the first sample lies farther than one step
 
 
+def thin_wall(q: NDArray[np.float64], shrink: float = 0.0) -> NDArray[np.bool_]:
+    """A wall 1 cm thick at ``x = 0.5`` with the slot ``0.45 < y < 0.5``: a 5 cm check steps over it."""
+    in_wall = (q[:, 0] > 0.495 + shrink) & (q[:, 0] < 0.505 - shrink)
+    in_slot = (q[:, 1] > 0.45 - shrink) & (q[:, 1] < 0.5 + shrink)
+    return np.asarray(~in_wall | in_slot)
+
+
+def test_trees_grown_on_coarse_checks_return_a_path_that_holds_at_the_fine_spacing() -> None:
+    """Edges checked every 5 cm jump the 1 cm wall anywhere; the path returned is checked every
+    2 mm, its blocked edges planned again: it crosses in the slot, with fewer checks in all
+    than growing the trees on the fine spacing."""
+    start, goal = np.array([0.1, 0.9]), np.array([0.9, 0.1])
+    fine = RrtSettings(resolution_m=0.002)
+    lazy = RrtSettings(resolution_m=0.002, explore_resolution_m=0.05)
+    checks = {"fine": 0, "lazy": 0}
+    for seed in range(5):
+        for name, settings in (("fine", fine), ("lazy", lazy)):
+            found = rrt_connect(
+                thin_wall, start, goal, LOWER, UPPER, WEIGHTS, np.random.default_rng(seed), settings
+            )
+            assert found is not None
+            np.testing.assert_array_equal(found.path[[0, -1]], [start, goal])
+            assert densely_valid(found.path, lambda q: thin_wall(q, 0.002))
+            checks[name] += found.checks
+    assert checks["lazy"] < checks["fine"]
+    with pytest.raises(PlanningError, match="explore_resolution_m"):
+        RrtSettings(resolution_m=0.01, explore_resolution_m=0.005)
+
+
 def test_settings_and_weights_are_validated() -> None:
     with pytest.raises(PlanningError, match="step_m"):
         RrtSettings(step_m=0.0)

@@ -178,10 +178,14 @@ def sampled_path(
             free[free] = ~problem.world.self_collision.violated(full[free], objective.required_self_m)
         return free
 
-    if settings is None:  # edges checked at most as far apart as the clearance required, 1-4 cm
+    if settings is None:  # the path's edges checked at most as far apart as the clearance required
         tuning = problem.scene.planner.tuning.seeding
         resolution = min(tuning.max_resolution_m, max(0.01, objective.required_m))
-        settings = RrtSettings(max_samples=tuning.max_samples, resolution_m=resolution)
+        settings = RrtSettings(
+            max_samples=tuning.max_samples,
+            resolution_m=resolution,
+            explore_resolution_m=tuning.max_resolution_m,
+        )
     limits = robot.limits
     return rrt_connect(
         valid,

@@ -24,8 +24,9 @@ class SeedingTuning:
         share: share of the population that starts at or around the seeds, in (0, 1].
         spread: standard deviation of the moves around a seed [share of each variable's
             range], in [0, 1].
-        max_resolution_m: largest spacing of the sampling planner's edge checks [m], in
-            (0, 1]; never more than the clearance the fitness requires (at least 1 cm).
+        max_resolution_m: spacing of the sampling planner's edge checks while its trees
+            grow [m], in (0, 1]; its path's edges are then checked as far apart as the
+            clearance the fitness requires (at least 1 cm), when that is less.
         path_attempts: most RRT-Connect paths drawn while the spline through a path's
             waypoints violates the clearance, in [1, 20].
         max_samples: random samples after which RRT-Connect gives up on a path, in

@@ -14,10 +14,20 @@ the executed spline gets the certified check). Distances are robot motion bounds
 |dq_j|`` [m] with the joints' motion radii (:func:`cpr_kin.motion_radii`), so a step means
 the same in every joint whatever its unit. The path found is then shortened
 (:func:`planning.search.edges.shortcut`). All randomness comes from the generator passed.
+
+The trees may grow on coarser checks than the path must hold (``explore_resolution_m``, as
+OMPL's motion checks are, a share of the space's extent): most edges a tree tries are
+thrown away, and a dense check of each would dominate the planner's time on a 6- or 7-joint
+arm. The shortened path's few edges are then checked at ``resolution_m``; an edge that
+passes between two coarse checks through an obstacle is replaced by RRT-Connect's path
+between its ends at that spacing, and when none is found the whole search runs again at it.
+The path returned always holds at ``resolution_m``.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import itertools
 import math
 from dataclasses import dataclass
 
@@ -43,14 +53,19 @@ class RrtSettings:
         step_m: longest extension towards a sample, as a robot motion bound [m], in (0, 10];
             ``None``: :data:`RANGE_FRACTION` of the sampling box's diagonal (in the same
             motion bound), at least ``resolution_m``.
-        resolution_m: spacing of the checked configurations along an edge [m], in
-            (0, step_m] (or (0, 10] with the default step).
+        resolution_m: spacing of the checked configurations along the returned path's
+            edges [m], in (0, step_m] (or (0, 10] with the default step).
+        explore_resolution_m: their spacing while the trees grow and the path is shortened
+            [m], at least ``resolution_m`` (``None``: the same); the path found is then
+            checked at ``resolution_m`` and its blocked edges planned again at that spacing
+            (module docstring).
         shortcuts: random shortcut attempts on the found path, in [0, 10000].
     """
 
     max_samples: int = 3000
     step_m: float | None = None
     resolution_m: float = 0.02
+    explore_resolution_m: float | None = None
     shortcuts: int = 20
 
     def __post_init__(self) -> None:
@@ -59,6 +74,8 @@ class RrtSettings:
             number_in("step_m", self.step_m, 0.0, 10.0, low_open=True, unit="m")
         high = 10.0 if self.step_m is None else self.step_m
         number_in("resolution_m", self.resolution_m, 0.0, high, low_open=True, unit="m")
+        if self.explore_resolution_m is not None:
+            number_in("explore_resolution_m", self.explore_resolution_m, self.resolution_m, high, unit="m")
         integer_in("shortcuts", self.shortcuts, 0, 10_000)
 
 
@@ -132,10 +149,13 @@ def rrt_connect(
     weights = np.asarray(weights, dtype=float)
     if not (weights.shape == start.shape == goal.shape and np.all(weights > 0)):
         raise PlanningError(f"weights {weights.tolist()} must be positive, one per joint of start and goal")
+    explore_m = settings.explore_resolution_m or settings.resolution_m
     step_m = settings.step_m
     if step_m is None:
         diagonal = float(np.linalg.norm(weights * (np.asarray(upper) - np.asarray(lower))))
-        step_m = max(settings.resolution_m, RANGE_FRACTION * diagonal)
+        step_m = max(explore_m, RANGE_FRACTION * diagonal)
+    if explore_m > settings.resolution_m:
+        return _lazy(valid, start, goal, (lower, upper), weights, rng, settings, step_m)
     edges = Edges(valid, weights, settings.resolution_m)
     if edges.free_fraction(start, goal) == 1.0:
         return RrtPath(np.array([start, goal]), 0, edges.checks)
@@ -168,6 +188,43 @@ def rrt_connect(
             path = shortcut(path, edges, rng, settings.shortcuts)
             return RrtPath(path, sample, edges.checks)
     return None
+
+
+def _lazy(
+    valid: Validity,
+    start: FloatArray,
+    goal: FloatArray,
+    box: tuple[FloatArray, FloatArray],
+    weights: FloatArray,
+    rng: np.random.Generator,
+    settings: RrtSettings,
+    step_m: float,
+) -> RrtPath | None:
+    """RRT-Connect on coarse edge checks, its path then held at ``resolution_m`` (module docstring)."""
+    fine = dataclasses.replace(settings, explore_resolution_m=None, step_m=step_m)
+    coarse = dataclasses.replace(fine, resolution_m=settings.explore_resolution_m or settings.resolution_m)
+    found = rrt_connect(valid, start, goal, *box, weights, rng, coarse)
+    if found is None:
+        return None
+    edges = Edges(valid, weights, settings.resolution_m)
+    samples, checks = found.samples, found.checks
+    pieces = [found.path[:1]]
+    for a, b in itertools.pairwise(found.path):
+        if edges.free_fraction(a, b) == 1.0:
+            pieces.append(b[None])
+            continue
+        detour = rrt_connect(valid, a, b, *box, weights, rng, dataclasses.replace(fine, shortcuts=0))
+        if detour is None:  # the coarse path is no guide here: search again at the fine spacing
+            again = rrt_connect(valid, start, goal, *box, weights, rng, fine)
+            if again is None:
+                return None
+            return RrtPath(again.path, samples + again.samples, checks + edges.checks + again.checks)
+        samples, checks = samples + detour.samples, checks + detour.checks
+        pieces.append(detour.path[1:])
+    path = np.concatenate(pieces)
+    if len(path) > len(found.path):  # detours: shortened again, on the fine checks
+        path = shortcut(path, edges, rng, settings.shortcuts)
+    return RrtPath(path, samples, checks + edges.checks)
 
 
 def _connect(
