@@ -7,6 +7,7 @@ from .cpr import CPR_JOINTS, TCP_FRAME, cpr_spec, load_cpr, robot_spec
 from .dynamics import Dynamics, Payload, robot_dynamics
 from .errors import CprKinError, IkMissError, JointLimitError, ObstacleError, UnreachableError, UrdfError
 from .ik import tcp_ik
+from .interval_motion import IntervalSpeed
 from .kinematics import frame_poses, frame_positions
 from .limits import JointLimits
 from .loading import RobotSpec, load_robot
@@ -30,6 +31,7 @@ __all__ = [
     "IkMissError",
     "IkSettings",
     "IkTarget",
+    "IntervalSpeed",
     "JointLimitError",
     "JointLimits",
     "Obstacle",

@@ -24,6 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 from cpr_kin.clearance import BatchClearance
 from cpr_kin.collision import CollisionWorld
 from cpr_kin.errors import CprKinError
+from cpr_kin.interval_motion import IntervalSpeed, interval_motion
 from cpr_kin.reach import robot_reach
 from cpr_kin.robot import GROUPS, Robot
 
@@ -84,6 +85,7 @@ def check_curve(
     speed_bound: ArrayLike,
     margin_m: float,
     step_m: float = 0.005,
+    interval_speed: IntervalSpeed | None = None,
 ) -> CurveCheck:
     """Certify that the curve ``q(t)``, ``t0 <= t <= t1``, keeps ``margin_m`` everywhere.
 
@@ -95,6 +97,10 @@ def check_curve(
         speed_bound: ``(nq,)`` bounds on ``|dq_j/dt|`` over the interval [rad/s, m/s].
         margin_m: required clearance [m].
         step_m: largest robot motion between two checks [m].
+        interval_speed: bounds on the robot's point speed over each interval between the
+            sample times (:data:`cpr_kin.interval_motion.IntervalSpeed`); each interval's
+            certified bound uses the lower of it and ``speed_bound``'s. The samples are
+            those of ``speed_bound``.
 
     Raises:
         CprKinError: bad arguments, or more than :data:`MAX_CURVE_CHECKS` samples needed.
@@ -116,11 +122,11 @@ def check_curve(
             f"{point_speed:.3g} m/s, step {step_m:g} m); at most {MAX_CURVE_CHECKS}: use a larger step"
         )
     times = np.linspace(t0, t1, max(count, 2))  # at least both ends
-    dt = times[1] - times[0]
-    batch = decisive_clearance(world, curve(times), point_speed * dt)
+    slack = interval_motion(times, point_speed, interval_speed)
+    batch = decisive_clearance(world, curve(times), slack)
     per_group = batch.clearance_m
-    # lower bound between neighbouring samples: distances change no faster than V
-    certified = 0.5 * (per_group[:-1] + per_group[1:] - point_speed * dt)
+    # lower bound between neighbouring samples: distances change no faster than the robot moves
+    certified = 0.5 * (per_group[:-1] + per_group[1:] - slack[:, None])
     group_bound = certified.min(axis=0)
     sample_min = per_group.min(axis=1)
     worst = int(np.argmin(sample_min))
@@ -143,11 +149,12 @@ def check_curve(
     )
 
 
-def decisive_clearance(world: CollisionWorld, q: FloatArray, slack_m: float) -> BatchClearance:
+def decisive_clearance(world: CollisionWorld, q: FloatArray, slack_m: float | FloatArray) -> BatchClearance:
     """Per-group clearance of the samples ``q`` ``(K, nq)`` of a curve, exact where it decides the check.
 
     :func:`check_curve` needs, per group, the smallest certified value
-    ``(c_k + c_{k+1} - slack_m) / 2`` and the smallest sampled clearance, each exactly (coal).
+    ``(c_k + c_{k+1} - slack_m) / 2`` (``slack_m`` one value, or one per interval ``(K - 1,)``)
+    and the smallest sampled clearance, each exactly (coal).
     Every sample starts with its cheap lower bound
     (:meth:`~cpr_kin.CollisionWorld.clearance_lower_bounds`); coal then computes the samples
     that could still be below the smallest exact value, in batches, until the minima are
@@ -170,10 +177,13 @@ def decisive_clearance(world: CollisionWorld, q: FloatArray, slack_m: float) -> 
     return BatchClearance(clearance_m=values, closest_pair=closest)
 
 
-def _undecided(values: FloatArray, known: NDArray[np.bool_], slack_m: float) -> NDArray[np.bool_]:
+def _undecided(
+    values: FloatArray, known: NDArray[np.bool_], slack_m: float | FloatArray
+) -> NDArray[np.bool_]:
     """Samples not yet exact whose exact value could still lower a minimum the check reports."""
     needed = np.zeros_like(known)
-    certified = 0.5 * (values[:-1] + values[1:] - slack_m)
+    slack = np.asarray(slack_m, dtype=float)
+    certified = 0.5 * (values[:-1] + values[1:] - (slack[:, None] if slack.ndim else slack))
     both_known = known[:-1] & known[1:]
     for g in range(values.shape[1]):
         column = certified[:, g]

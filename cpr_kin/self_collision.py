@@ -26,6 +26,7 @@ from lxml import etree
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import CprKinError, UrdfError
+from cpr_kin.interval_motion import IntervalSpeed, interval_motion
 from cpr_kin.self_bounds import ScreenedSelfTest
 from cpr_kin.user_files import read_bytes
 
@@ -229,13 +230,16 @@ def check_self_curve(
     point_speed: float,
     margin_m: float,
     step_m: float,
+    interval_speed: IntervalSpeed | None = None,
 ) -> SelfCheck:
     """Certify that the curve ``q(t)`` over ``interval`` keeps ``margin_m`` between the robot's own pairs.
 
     ``point_speed`` [m/s] bounds how fast any robot point moves (``motion_radii @ |q'|``);
     two points of a pair approach at most twice as fast, so the curve is sampled every
     ``dt = 2 step_m / (2 point_speed)`` and between samples ``k`` and ``k + 1`` the distance
-    is at least ``(c_k + c_{k+1} - 2 point_speed dt) / 2``.
+    is at least ``(c_k + c_{k+1} - 2 point_speed dt) / 2``; with ``interval_speed``
+    (:data:`cpr_kin.interval_motion.IntervalSpeed`), the lower of its bound and ``point_speed`` for
+    each interval.
 
     Raises:
         CprKinError: more than :data:`~cpr_kin.motion.MAX_CURVE_CHECKS` samples needed.
@@ -252,7 +256,9 @@ def check_self_curve(
         )
     times = np.linspace(t0, t1, max(count, 2))
     distance, closest = collision.distances(curve(times))
-    certified = 0.5 * (distance[:-1] + distance[1:] - approach * (times[1] - times[0]))
+    certified = 0.5 * (
+        distance[:-1] + distance[1:] - 2.0 * interval_motion(times, point_speed, interval_speed)
+    )
     worst = int(np.argmin(distance))
     pair = collision.pairs[int(closest[worst])] if closest[worst] >= 0 else None
     lowest = float(certified.min())

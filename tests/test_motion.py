@@ -206,3 +206,42 @@ def test_a_check_that_would_take_minutes_is_refused(paper_world: ck.CollisionWor
     speeds = paper_world.robot.limits.velocity  # a bound, however still the curve
     with pytest.raises(ck.CprKinError, match=r"the continuous check needs \d+ samples .* at most 1000000"):
         ck.check_curve(paper_world, still, 0.0, 600.0, speeds, 0.1, step_m=1e-4)
+
+
+def test_each_interval_bounded_by_its_own_speed_certifies_an_approach_to_rest_near_an_obstacle(
+    robot: ck.Robot, rng: np.random.Generator
+) -> None:
+    """A rest-to-rest motion (``s = 3 t^2 - 2 t^3``) ending 2 mm from a ball: one speed bound for
+    the whole motion leaves a step's worth of motion between the last samples and cannot certify
+    it with margin 0; each interval's own bound (from the speeds at its ends and the peak
+    acceleration) can, and stays below what a 50x denser sampling finds."""
+    start, goal = ck.tcp_ik(robot, (0.5, 0.45, 0.65)), ck.tcp_ik(robot, (-0.3, 0.5, 0.45))
+    tool = ck.frame_positions(robot, goal[None], ck.TCP_FRAME)[0]
+    probe = ck.CollisionWorld(
+        robot, [ck.Obstacle.sphere(0.05, tool + np.array([0.0, 0.0, -0.3]), name="ball")]
+    )
+    gap = probe.clearance(goal).min_clearance_m  # the ball 30 cm under the tool, then moved up to 2 mm
+    world = ck.CollisionWorld(
+        robot, [ck.Obstacle.sphere(0.05, tool + np.array([0.0, 0.0, -0.3 + gap - 0.002]), name="ball")]
+    )
+    delta = goal - start
+
+    def curve(t: np.ndarray) -> np.ndarray:
+        return np.asarray(start + (3 * t**2 - 2 * t**3)[:, None] * delta)
+
+    peak_speed, peak_acceleration = 1.5 * np.abs(delta), 6.0 * np.abs(delta)
+    radii = ck.motion_radii(robot)
+
+    def interval_speed(times: np.ndarray) -> np.ndarray:
+        speed = (6 * times - 6 * times**2)[:, None] * np.abs(delta)
+        rising = 0.5 * (speed[:-1] + speed[1:] + peak_acceleration * np.diff(times)[:, None])
+        return np.asarray(np.minimum(rising, peak_speed) @ radii)
+
+    uniform = ck.check_curve(world, curve, 0.0, 1.0, peak_speed, margin_m=0.0, step_m=0.005)
+    local = ck.check_curve(world, curve, 0.0, 1.0, peak_speed, 0.0, 0.005, interval_speed)
+    assert world.clearance(goal).min_clearance_m == pytest.approx(0.002, abs=1e-6)
+    assert not uniform.accepted and local.accepted
+    np.testing.assert_array_equal(uniform.times, local.times)  # the same samples, tighter bounds
+    assert uniform.certified_min_m <= local.certified_min_m <= local.sampled_min_m
+    dense = world.clearance_batch(curve(np.linspace(0.0, 1.0, 50 * len(local.times)))).min_clearance_m
+    assert local.certified_min_m <= dense.min() + 1e-9

@@ -126,3 +126,15 @@ def test_errors(trajectory: Trajectory) -> None:
     still = Trajectory(knots=np.array([0.0, 1.0]), coefficients=np.zeros((1, 2, 8)))
     with pytest.raises(PlanningError, match="does not move"):
         still.time_scale_for_limits([1.0, 1.0])
+
+
+def test_speed_bounds_hold_on_every_interval_and_never_exceed_the_peak(trajectory: Trajectory) -> None:
+    times = np.linspace(trajectory.knots[0], trajectory.knots[-1], 41)
+    bounds = trajectory.speed_bounds(times)
+    assert bounds.shape == (40, trajectory.n_joints)
+    for k in range(40):  # 200 samples inside each interval
+        inside = np.abs(trajectory.velocity(np.linspace(times[k], times[k + 1], 200)))
+        assert np.all(inside.max(axis=0) <= bounds[k] + 1e-12)
+    assert np.all(bounds <= trajectory.extrema(1).peak)
+    # at rest at both ends: the first and last intervals far below the peak
+    assert np.all(bounds[[0, -1]] < 0.5 * trajectory.extrema(1).peak)

@@ -173,6 +173,19 @@ class Trajectory:
         """Joint snaps [rad/s^4, m/s^4] at ``t`` [s] (discontinuous at the knots)."""
         return self(t, 4)
 
+    def speed_bounds(self, times: FloatArray) -> FloatArray:
+        """``(K - 1, nq)`` bounds on ``|q'_j|`` over each interval between the sorted ``times`` ``(K,)``.
+
+        Within ``[t_k, t_k+1]`` of length ``dt`` a joint's speed rises from either end at most
+        as fast as its peak acceleration ``A_j`` allows, so it stays below
+        ``(|q'_j(t_k)| + |q'_j(t_k+1)| + A_j dt) / 2``; never more than the peak speed.
+        Near rest (the ends of a motion) this is far below the peak [rad/s or m/s].
+        """
+        speed = np.abs(self.velocity(times))
+        dt = np.diff(times)[:, None]
+        rising = 0.5 * (speed[:-1] + speed[1:] + self.extrema(2).peak * dt)
+        return np.asarray(np.minimum(rising, self.extrema(1).peak))
+
     def extrema(self, derivative: int) -> Extrema:
         """Exact extrema of the ``derivative``-th derivative per joint.
 

@@ -101,6 +101,14 @@ def time_and_verify(
     dense = np.linspace(0.0, duration, 4001)
     positions = np.asarray(timed(dense))
     speeds = np.abs(np.asarray(timed(dense, 1))).max(axis=0) * 1.05 + 1e-9  # sampled, with 5 % slack
+    accelerations = np.abs(np.asarray(timed(dense, 2))).max(axis=0) * 1.05 + 1e-9
+    radii = ck.motion_radii(robot)
+
+    def interval_speed(times: FloatArray) -> FloatArray:  # as ours: each interval's own speed bound
+        at = np.abs(np.asarray(timed(times, 1)))
+        rising = 0.5 * (at[:-1] + at[1:] + accelerations * np.diff(times)[:, None])
+        return np.asarray(np.minimum(rising, speeds) @ radii)
+
     check = ck.check_curve(
         world,
         lambda t: np.asarray(timed(np.asarray(t))),
@@ -109,11 +117,12 @@ def time_and_verify(
         speeds,
         scene.safety_margin,
         scene.planner.verify_step_m,
+        interval_speed,
     )
     if check.accepted and world.self_collision:  # the robot's own pairs, certified as ours are
         from cpr_kin.self_collision import check_self_curve
 
-        point_speed = float(ck.motion_radii(robot) @ speeds)
+        point_speed = float(radii @ speeds)
         self_check = check_self_curve(
             world.self_collision,
             lambda t: np.asarray(timed(np.asarray(t))),
@@ -121,6 +130,7 @@ def time_and_verify(
             point_speed,
             scene.self_margin,
             scene.planner.verify_step_m,
+            interval_speed,
         )
         if not self_check.accepted:
             check = dataclasses.replace(check, accepted=False, certified_min_m=self_check.certified_min_m)

@@ -97,16 +97,30 @@ def _unchecked(margin_m: float, step_m: float) -> ck.CurveCheck:
     )
 
 
+def _interval_speed(trajectory: Trajectory, radii: FloatArray) -> ck.IntervalSpeed:
+    """Bounds on the robot's point speed between sample times, from the trajectory's own speeds."""
+    return lambda times: trajectory.speed_bounds(times) @ radii
+
+
 def _self_problems(
     world: ck.CollisionWorld, trajectory: Trajectory, margin_m: float, step_m: float
 ) -> list[str]:
     """The certified self-collision check's verdict, as problems (none for a robot without pairs)."""
     if not world.self_collision:
         return []
-    speed = float(ck.motion_radii(world.robot) @ trajectory.extrema(1).peak)
+    radii = ck.motion_radii(world.robot)
+    speed = float(radii @ trajectory.extrema(1).peak)
     interval = (float(trajectory.knots[0]), float(trajectory.knots[-1]))
     try:
-        check = check_self_curve(world.self_collision, trajectory.position, interval, speed, margin_m, step_m)
+        check = check_self_curve(
+            world.self_collision,
+            trajectory.position,
+            interval,
+            speed,
+            margin_m,
+            step_m,
+            _interval_speed(trajectory, radii),
+        )
     except ck.CprKinError as exc:
         return [f"cannot be certified clear of itself: {exc}"]
     if check.accepted:
@@ -173,9 +187,9 @@ def verify_trajectory(
     start, end = trajectory.knots[0], trajectory.knots[-1]
     problems = []
     try:
-        check = ck.check_curve(
-            world, trajectory.position, start, end, trajectory.extrema(1).peak, margin_m, step_m
-        )
+        speeds = trajectory.extrema(1).peak
+        local = _interval_speed(trajectory, ck.motion_radii(robot))
+        check = ck.check_curve(world, trajectory.position, start, end, speeds, margin_m, step_m, local)
     except ck.CprKinError as exc:  # too fast to certify: a verdict, not a crash
         problems.append(f"cannot be certified clear of obstacles: {exc}")
         check = _unchecked(margin_m, step_m)
