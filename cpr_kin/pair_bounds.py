@@ -16,7 +16,7 @@ The bounds themselves are compiled (:mod:`cpr_kin.bound_kernels`).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, NamedTuple
 
 import coal
 import numpy as np
@@ -51,6 +51,38 @@ def bounding_capsule(geometry: Any) -> tuple[FloatArray, float]:
     return ends, float(np.linalg.norm(np.delete(half, axis)))
 
 
+class JointCapsules(NamedTuple):
+    """Capsules enclosing geometries, each fixed to its joint (the compiled kernels' arguments).
+
+    Attributes:
+        joint: ``(G,)`` the joint each moves with, ``-1``: fixed to the world.
+        ends: ``(G, 2, 3)`` its segment's end points in that joint's frame [m].
+        radius: ``(G,)`` its radius [m].
+        reach: ``(G,)`` the radius of its bounding sphere about the segment's middle [m].
+    """
+
+    joint: IntArray
+    ends: FloatArray
+    radius: FloatArray
+    reach: FloatArray
+
+
+def joint_capsules(collision_model: Any, geometries: Sequence[int]) -> JointCapsules:
+    """The capsules (:func:`bounding_capsule`) of ``collision_model``'s ``geometries``, in joint frames."""
+    ends, radii, joints = [], [], []
+    for g in geometries:
+        obj = collision_model.geometryObjects[g]
+        local, radius = bounding_capsule(obj.geometry)
+        placement = obj.placement  # geometry in its joint's frame
+        ends.append(local @ np.asarray(placement.rotation).T + np.asarray(placement.translation))
+        radii.append(radius)
+        joints.append(int(obj.parentJoint) - 1)  # -1: fixed to the world
+    capsule_ends = np.array(ends, dtype=float).reshape(-1, 2, 3)
+    capsule_radius = np.array(radii, dtype=float)
+    reach = np.linalg.norm(capsule_ends[:, 1] - capsule_ends[:, 0], axis=1) / 2 + capsule_radius
+    return JointCapsules(np.array(joints, dtype=np.int64), capsule_ends, capsule_radius, reach)
+
+
 def _local_box(geometry: Any) -> tuple[FloatArray, FloatArray]:
     """Centre and half sides [m] of a coal geometry's bounding box in its own frame."""
     geometry.computeLocalAABB()
@@ -79,19 +111,8 @@ class PairBounds:
         self._chain = KinematicChain.from_model(model)
         geometries = sorted({g for g, _ in pairs})
         slot = {g: k for k, g in enumerate(geometries)}
-        ends, radii, joints = [], [], []
-        for g in geometries:
-            obj = collision_model.geometryObjects[g]
-            local, radius = bounding_capsule(obj.geometry)
-            placement = obj.placement  # geometry in its joint's frame
-            ends.append(local @ np.asarray(placement.rotation).T + np.asarray(placement.translation))
-            radii.append(radius)
-            joints.append(int(obj.parentJoint) - 1)  # -1: fixed to the world
-        capsule_ends = np.array(ends, dtype=float).reshape(-1, 2, 3)
-        capsule_radius = np.array(radii, dtype=float)
-        self._capsules = (np.array(joints, dtype=np.int64), capsule_ends, capsule_radius)
-        # radius of each capsule's bounding sphere about its segment's middle
-        capsule_reach = np.linalg.norm(capsule_ends[:, 1] - capsule_ends[:, 0], axis=1) / 2 + capsule_radius
+        capsules = joint_capsules(collision_model, geometries)
+        self._capsules = (capsules.joint, capsules.ends, capsules.radius)
         self._pairs = (
             np.array([slot[g] for g, _ in pairs], dtype=np.int64),
             np.array([k for _, k in pairs], dtype=np.int64),
@@ -115,7 +136,7 @@ class PairBounds:
         self._any_arguments: tuple[Any, ...] = (
             self._chain.arrays,
             *self._capsules,
-            capsule_reach,
+            capsules.reach,
             *self._pairs,
             *self._obstacles,
             obstacle_reach,

@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 
 from cpr_kin.batch_kinematics import ChainArrays, KinematicChain, place_joints
 from cpr_kin.compiled import njit
-from cpr_kin.pair_bounds import bounding_capsule
+from cpr_kin.pair_bounds import joint_capsules
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -128,23 +128,9 @@ class SelfPairBounds:
         self._chain = KinematicChain.from_model(model)
         geometries = sorted({g for pair in pairs for g in pair})
         slot = {g: k for k, g in enumerate(geometries)}
-        ends, radii, joints = [], [], []
-        for g in geometries:
-            obj = collision_model.geometryObjects[g]
-            local, radius = bounding_capsule(obj.geometry)
-            placement = obj.placement  # geometry in its joint's frame
-            ends.append(local @ np.asarray(placement.rotation).T + np.asarray(placement.translation))
-            radii.append(radius)
-            joints.append(int(obj.parentJoint) - 1)  # -1: fixed to the world
-        capsule_ends = np.array(ends, dtype=float).reshape(-1, 2, 3)
-        capsule_radius = np.array(radii, dtype=float)
-        reach = np.linalg.norm(capsule_ends[:, 1] - capsule_ends[:, 0], axis=1) / 2 + capsule_radius
         self._arguments: tuple[Any, ...] = (
             self._chain.arrays,
-            np.array(joints, dtype=np.int64),
-            capsule_ends,
-            capsule_radius,
-            reach,
+            *joint_capsules(collision_model, geometries),
             np.array([slot[a] for a, _ in pairs], dtype=np.int64),
             np.array([slot[b] for _, b in pairs], dtype=np.int64),
         )

@@ -158,10 +158,8 @@ class SelfCollision:
             self.geometry_model.addCollisionPair(pin.CollisionPair(a, b))
         self._pairs = pairs
         self._names = names
-        self._data = model.createData()
-        self._gdata = self.geometry_model.createData()
         self.num_threads = num_threads
-        self._test: ScreenedSelfTest | None = None  # built on the first violated()
+        self._test: ScreenedSelfTest | None = None  # built on the first query
 
     @property
     def pairs(self) -> tuple[tuple[str, str], ...]:
