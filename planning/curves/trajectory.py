@@ -32,6 +32,21 @@ def derivative_coefficients(coefficients: FloatArray, r: int) -> FloatArray:
     return out
 
 
+def interval_speed_bounds(
+    times: FloatArray, velocity: FloatArray, peak_speed: FloatArray, peak_acceleration: FloatArray
+) -> FloatArray:
+    """``(K - 1, nq)`` bounds on ``|q'_j|`` over each interval between the sorted ``times`` ``(K,)``.
+
+    ``velocity`` ``(K, nq)`` at the times [rad/s or m/s], bounded by ``peak_speed``, whose
+    rate is bounded by ``peak_acceleration`` [rad/s^2 or m/s^2]: from either end of an
+    interval of length ``dt`` the speed rises at most that fast, so it stays below
+    ``(|q'_j(t_k)| + |q'_j(t_k+1)| + A_j dt) / 2``, and never above the peak.
+    """
+    speed = np.abs(velocity)
+    rising = 0.5 * (speed[:-1] + speed[1:] + peak_acceleration * np.diff(times)[:, None])
+    return np.asarray(np.minimum(rising, peak_speed))
+
+
 def _real_roots_in(coefficients: FloatArray, upper: FloatArray) -> FloatArray:
     """Real roots in ``(0, upper)`` of each polynomial ``sum_k c[m, k] x^k``, ``(M, order - 1)``.
 
@@ -174,17 +189,11 @@ class Trajectory:
         return self(t, 4)
 
     def speed_bounds(self, times: FloatArray) -> FloatArray:
-        """``(K - 1, nq)`` bounds on ``|q'_j|`` over each interval between the sorted ``times`` ``(K,)``.
+        """:func:`interval_speed_bounds` of this trajectory between the sorted ``times`` ``(K,)``.
 
-        Within ``[t_k, t_k+1]`` of length ``dt`` a joint's speed rises from either end at most
-        as fast as its peak acceleration ``A_j`` allows, so it stays below
-        ``(|q'_j(t_k)| + |q'_j(t_k+1)| + A_j dt) / 2``; never more than the peak speed.
-        Near rest (the ends of a motion) this is far below the peak [rad/s or m/s].
+        Near rest (the ends of a motion) far below the peak speed [rad/s or m/s].
         """
-        speed = np.abs(self.velocity(times))
-        dt = np.diff(times)[:, None]
-        rising = 0.5 * (speed[:-1] + speed[1:] + self.extrema(2).peak * dt)
-        return np.asarray(np.minimum(rising, self.extrema(1).peak))
+        return interval_speed_bounds(times, self.velocity(times), self.extrema(1).peak, self.extrema(2).peak)
 
     def extrema(self, derivative: int) -> Extrema:
         """Exact extrema of the ``derivative``-th derivative per joint.

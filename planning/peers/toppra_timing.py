@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
+from planning.curves.trajectory import interval_speed_bounds
 from planning.pipeline.scene import Scene
 
 FloatArray = NDArray[np.float64]
@@ -105,9 +106,7 @@ def time_and_verify(
     radii = ck.motion_radii(robot)
 
     def interval_speed(times: FloatArray) -> FloatArray:  # as ours: each interval's own speed bound
-        at = np.abs(np.asarray(timed(times, 1)))
-        rising = 0.5 * (at[:-1] + at[1:] + accelerations * np.diff(times)[:, None])
-        return np.asarray(np.minimum(rising, speeds) @ radii)
+        return interval_speed_bounds(times, np.asarray(timed(times, 1)), speeds, accelerations) @ radii
 
     check = ck.check_curve(
         world,

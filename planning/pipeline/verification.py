@@ -103,23 +103,20 @@ def _interval_speed(trajectory: Trajectory, radii: FloatArray) -> ck.IntervalSpe
 
 
 def _self_problems(
-    world: ck.CollisionWorld, trajectory: Trajectory, margin_m: float, step_m: float
+    world: ck.CollisionWorld, trajectory: Trajectory, margin_m: float, step_m: float, radii: FloatArray
 ) -> list[str]:
-    """The certified self-collision check's verdict, as problems (none for a robot without pairs)."""
+    """The certified self-collision check's verdict, as problems (none for a robot without pairs).
+
+    ``radii``: the robot's motion radii (:func:`cpr_kin.motion_radii`).
+    """
     if not world.self_collision:
         return []
-    radii = ck.motion_radii(world.robot)
     speed = float(radii @ trajectory.extrema(1).peak)
     interval = (float(trajectory.knots[0]), float(trajectory.knots[-1]))
+    local = _interval_speed(trajectory, radii)
     try:
         check = check_self_curve(
-            world.self_collision,
-            trajectory.position,
-            interval,
-            speed,
-            margin_m,
-            step_m,
-            _interval_speed(trajectory, radii),
+            world.self_collision, trajectory.position, interval, speed, margin_m, step_m, local
         )
     except ck.CprKinError as exc:
         return [f"cannot be certified clear of itself: {exc}"]
@@ -186,9 +183,9 @@ def verify_trajectory(
     tolerance = LIMIT_TOLERANCE
     start, end = trajectory.knots[0], trajectory.knots[-1]
     problems = []
+    radii = ck.motion_radii(robot)
     try:
-        speeds = trajectory.extrema(1).peak
-        local = _interval_speed(trajectory, ck.motion_radii(robot))
+        speeds, local = trajectory.extrema(1).peak, _interval_speed(trajectory, radii)
         check = ck.check_curve(world, trajectory.position, start, end, speeds, margin_m, step_m, local)
     except ck.CprKinError as exc:  # too fast to certify: a verdict, not a crash
         problems.append(f"cannot be certified clear of obstacles: {exc}")
@@ -206,7 +203,7 @@ def verify_trajectory(
             f"comes within {check.certified_min_m:.4f} m (certified) of an obstacle, margin {margin_m} m: "
             f"closest at t = {check.worst_time:.2f} s between {check.worst_pair} ({check.worst_group})"
         )
-    problems += _self_problems(world, trajectory, required.self_margin_m, step_m)
+    problems += _self_problems(world, trajectory, required.self_margin_m, step_m, radii)
     positions = trajectory.extrema(0)
     for i, name in enumerate(robot.joint_names):
         low, high = positions.minimum[i], positions.maximum[i]
