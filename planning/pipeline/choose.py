@@ -77,9 +77,9 @@ class Refusal:
 
     accepted = False
 
-    def error(self, tried: str = "") -> NoTrajectoryFoundError:
+    def error(self, *tried: str) -> NoTrajectoryFoundError:
         """The error a planner raises when this was its last word; ``tried``: what else it tried."""
-        said = "; ".join(part for part in (self.verified, tried) if part)
+        said = "; ".join(part for part in (self.verified, *tried) if part)
         return NoTrajectoryFoundError(
             f"no collision-free trajectory found{f' ({said})' if said else ''}: {self.cause}", self.check
         )

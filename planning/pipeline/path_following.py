@@ -40,8 +40,7 @@ def follow_path(problem: Problem, path: FloatArray) -> tuple[Problem, Choice | R
     stretched.
     """
     started = time.perf_counter()
-    vertices = np.repeat(problem.q_start[None], len(path), axis=0)
-    vertices[:, problem.moving] = path
+    vertices = problem.configurations(path)
     vertices[0], vertices[-1] = problem.q_start, problem.q_goal
     limits = problem.robot.limits
     trajectory = stop_and_go(

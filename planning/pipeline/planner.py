@@ -70,14 +70,9 @@ def solve(
         raise chosen.error(attempt.tried)
     problem, followed = follow_path(attempt.problem, attempt.path)  # the last resort
     if isinstance(followed, Refusal):
-        raise chosen.error(_joined(attempt.tried, f"RRT-Connect found a path, but {followed.cause}"))
+        raise chosen.error(attempt.tried, f"RRT-Connect found a path, but {followed.cause}")
     elapsed = Elapsed(problem.build_time_s + time.perf_counter() - started, search_s)
     return assemble(problem, searched, followed, elapsed)
-
-
-def _joined(*parts: str) -> str:
-    """The non-empty ``parts`` joined by semicolons."""
-    return "; ".join(part for part in parts if part)
 
 
 def stand_still(problem: Problem, started: float) -> PlanResult:

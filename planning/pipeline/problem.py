@@ -75,6 +75,15 @@ class Problem:
         """Indices of the joints the waypoints move."""
         return self.motion.moving
 
+    def configurations(self, moving_q: FloatArray) -> FloatArray:
+        """``(k, nq)`` configurations from the moving joints' values ``moving_q`` ``(k, moving)``.
+
+        The other joints held where they start [rad, m].
+        """
+        full = np.repeat(self.q_start[None], len(moving_q), axis=0)
+        full[:, self.moving] = moving_q
+        return full
+
     @property
     def stands_still(self) -> bool:
         """The goal is the start (within :data:`SAME_POSE_TOLERANCE` in every joint)."""

@@ -168,11 +168,9 @@ def sampled_path(
 ) -> RrtPath | None:
     """RRT-Connect's path in the moving joints of ``problem``, clear of the fitness's clearance."""
     robot, moving, objective = problem.robot, problem.moving, problem.objective
-    held = problem.q_start
 
     def valid(q: FloatArray) -> BoolArray:
-        full = np.repeat(held[None], len(q), axis=0)
-        full[:, moving] = q
+        full = problem.configurations(q)
         free = ~problem.world.margin_violated(full, objective.required_m)
         if problem.world.self_collision and free.any():
             free[free] = ~problem.world.self_collision.violated(full[free], objective.required_self_m)
