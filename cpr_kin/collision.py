@@ -18,6 +18,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.clearance import BatchClearance, Clearance, PairDistance
+from cpr_kin.closest_pairs import closest_pairs
 from cpr_kin.errors import CprKinError
 from cpr_kin.obstacles import Obstacle
 from cpr_kin.pair_bounds import PairBounds
@@ -95,7 +96,6 @@ class CollisionWorld:
         self._pool: Any = None
         self._pool_margin: float | None = None
         self._reach_distance = pair_reach_distances(robot, self.obstacles, self._pairs)
-        self._culled_data: dict[tuple[bool, ...], Any] = {}
         self._pair_bounds: dict[tuple[bool, ...], PairBounds] = {}
         allowed = {frozenset(pair) for pair in allowed_pairs}
         links = [g.link for g in robot.geometries]
@@ -177,13 +177,23 @@ class CollisionWorld:
         """Smallest distance over every pair [m] and the index of that pair, ``(N,)`` each.
 
         One coal query per configuration (half the cost of :meth:`clearance_batch`) when
-        the groups need not be told apart. With ``below_m`` [m], pairs that stay at least
-        that far apart in every configuration (their reach, see :mod:`cpr_kin.reach`) are
-        skipped: a distance below ``below_m`` is exact, a larger one may be reported as
-        ``inf`` with pair ``-1`` (what a caller wants who asks only where a margin is violated).
+        the groups need not be told apart. With ``below_m`` [m], only the pairs that may be
+        closest and closer than that are computed (:func:`cpr_kin.closest_pairs`, on the
+        pair bounds of the pairs whose reach, :mod:`cpr_kin.reach`, comes within it): a
+        distance below ``below_m`` is exact, a larger one is reported as ``inf`` with pair
+        ``-1`` (what a caller wants who asks only where a margin is violated).
         """
         batch = self._check_batch(q)
-        return self._closest_pairs(batch, self._all if below_m is None else self._culled(below_m))
+        if below_m is None:
+            return self._closest_pairs(batch, self._all)
+        if not np.isfinite(below_m):
+            raise CprKinError(f"distance bound {below_m} m must be finite")
+        near = self._reach_distance <= below_m
+        bounds = self._bounds(tuple(near.tolist()))(batch) if near.any() else np.empty((len(batch), 0))
+        model = self.robot.model
+        return closest_pairs(
+            model, self.geometry_model, self._all, batch, bounds, np.flatnonzero(near), below_m
+        )
 
     def _closest_pairs(self, batch: FloatArray, gdata: Any) -> tuple[FloatArray, IntArray]:
         """Coal's smallest distance [m] over ``gdata``'s active pairs and that pair, per configuration.
@@ -202,24 +212,6 @@ class CollisionWorld:
                 clearance[k] = results[pair].min_distance
                 closest[k] = pair
         return clearance, closest
-
-    def _culled(self, below_m: float) -> Any:
-        """Geometry data with only the pairs that can come closer than ``below_m`` [m] active.
-
-        ``None`` when no pair can.
-        """
-        if not np.isfinite(below_m):
-            raise CprKinError(f"distance bound {below_m} m must be finite")
-        near = self._reach_distance <= below_m
-        if not near.any():
-            return None
-        key = tuple(near.tolist())
-        if key not in self._culled_data:
-            gdata = self.geometry_model.createData()
-            for p, active in enumerate(near):
-                (gdata.activateCollisionPair if active else gdata.deactivateCollisionPair)(p)
-            self._culled_data[key] = gdata
-        return self._culled_data[key]
 
     def _check_batch(self, q: ArrayLike) -> FloatArray:
         batch = np.asarray(q, dtype=float)

@@ -20,6 +20,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from cpr_kin.batch_kinematics import ChainArrays, KinematicChain, place_joints
+from cpr_kin.closest_pairs import closest_pairs
 from cpr_kin.compiled import njit
 from cpr_kin.pair_bounds import joint_capsules
 
@@ -197,10 +198,10 @@ class ScreenedSelfTest:
         self.far_bounds = SelfPairBounds(
             model, geometry_model, [p for p, n in zip(pairs, near, strict=True) if not n]
         )
+        self.all_bounds = SelfPairBounds(model, geometry_model, pairs)
         self._active = (near, ~near)
         self._pools: list[Any] = []
-        self._data: Any = None
-        self._distance_data: list[Any] = []
+        self._distance_data: Any = None
         self._margin_m = float("nan")
 
     def violated(self, batch: FloatArray, margin_m: float) -> NDArray[np.bool_]:
@@ -219,27 +220,14 @@ class ScreenedSelfTest:
     def distances(self, batch: FloatArray) -> tuple[FloatArray, IntArray]:
         """Smallest self distance [m] and its pair (index among all pairs), ``(N,)`` each, exactly.
 
-        coal's distances of the near pairs at every configuration, and of the far pairs only
-        where their smallest bound is below the near pairs' distance: elsewhere no far pair
-        can be closer, so the answer is coal's over every pair.
+        coal's distance of the closest pair, the pairs visited in the order of their bounds
+        until no pair left can be closer (:func:`cpr_kin.closest_pairs.closest_pairs`).
         """
         self._prepare(float("nan"))
-        far_bound = (
-            self.far_bounds(batch).min(axis=1) if self.far_bounds.n_pairs else np.full(len(batch), np.inf)
+        bounds = self.all_bounds(batch)
+        return closest_pairs(
+            self.model, self.geometry_model, self._distance_data, batch, bounds, np.arange(bounds.shape[1])
         )
-        distance = np.full(len(batch), np.inf)
-        closest = np.full(len(batch), -1, dtype=np.int64)
-        tiers = ((0, bool(self.near_pairs)), (1, bool(self.far_bounds.n_pairs)))
-        for tier, present in tiers:
-            gdata = self._distance_data[tier]
-            results = gdata.distanceResults
-            for k in range(len(batch) if present else 0):
-                if tier == 1 and far_bound[k] >= distance[k]:
-                    continue  # no far pair comes closer than the near pairs' distance
-                pair = pin.computeDistances(self.model, self._data, self.geometry_model, gdata, batch[k])
-                if results[pair].min_distance < distance[k]:
-                    distance[k], closest[k] = results[pair].min_distance, pair
-        return distance, closest
 
     def _coal(self, tier: int, batch: FloatArray) -> NDArray[np.bool_]:
         """Coal's test of the pairs of ``tier`` (0 near, 1 far) at configurations ``batch``."""
@@ -254,13 +242,7 @@ class ScreenedSelfTest:
         A NaN ``margin_m`` leaves the margin as it is.
         """
         if not self._pools:
-            self._data = self.model.createData()
-            self._distance_data = []
-            for active in self._active:
-                gdata = self.geometry_model.createData()
-                for p, on in enumerate(active):
-                    (gdata.activateCollisionPair if on else gdata.deactivateCollisionPair)(p)
-                self._distance_data.append(gdata)
+            self._distance_data = self.geometry_model.createData()
             self._pools = [
                 pin.GeometryPool(self.model, self.geometry_model, self.num_threads) for _ in range(2)
             ]

@@ -1,0 +1,87 @@
+"""The closest of many geometry pairs by coal, visiting the pairs in the order of their lower bounds.
+
+Where a configuration violates a margin, the planner asks how deep: the smallest distance
+over every pair. Pinocchio's ``computeDistances`` runs coal on every active pair, a hundred
+or more on an arm among shelves, although only a few come near. Given a lower bound of each
+pair's distance (:mod:`cpr_kin.pair_bounds`, :mod:`cpr_kin.self_bounds`), the pairs are
+visited from the smallest bound up and the visit stops at the first pair whose bound is no
+smaller than the smallest distance found: no pair left can be closer (a bound counts only
+when positive: overlapping shapes may penetrate any depth). The answer is coal's
+distance of the closest pair, as with every pair computed; only the pairs that may be
+closest cost a query.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import NDArray
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+BOUND_TOLERANCE_M = 1e-6
+"""How far below a bound coal's own distance may fall (its tolerance) [m]."""
+
+
+def closest_pairs(
+    model: Any,
+    geometry_model: Any,
+    geometry_data: Any,
+    batch: FloatArray,
+    bounds: FloatArray,
+    pair_index: IntArray,
+    below_m: float = np.inf,
+) -> tuple[FloatArray, IntArray]:
+    """Smallest coal distance [m] over the pairs at each configuration, and its pair.
+
+    Args:
+        model: the robot's Pinocchio model.
+        geometry_model: the geometry model holding the pairs.
+        geometry_data: its data (placements and distance results are written into it).
+        batch: ``(N, nq)`` configurations.
+        bounds: ``(N, P)`` lower bounds [m] of the pairs' distances at those configurations
+            (at most coal's distance plus :data:`BOUND_TOLERANCE_M`).
+        pair_index: ``(P,)`` the pairs' indices in ``geometry_model.collisionPairs``.
+        below_m: only distances below this matter [m]: pairs bounded above it are not
+            computed, and where the smallest distance is not below it, ``inf`` and ``-1``
+            are returned.
+
+    Returns:
+        The distance and the pair's index in ``geometry_model.collisionPairs`` (``-1``: none
+        computed), ``(N,)`` each.
+    """
+    distance = np.full(len(batch), np.inf)
+    closest = np.full(len(batch), -1, dtype=np.int64)
+    data = model.createData()
+    order = np.argsort(bounds, axis=1, kind="stable")
+    ordered = np.take_along_axis(bounds, order, axis=1)
+    place, compute = pin.updateGeometryPlacements, pin.computeDistance
+    for k in range(len(batch)):
+        row, columns = ordered[k], order[k]
+        if not row.size or _farther(row[0], below_m):
+            continue
+        place(model, data, geometry_model, geometry_data, batch[k])
+        best, which = np.inf, -1
+        for bound, column in zip(row.tolist(), columns.tolist(), strict=True):
+            if _farther(bound, min(best, below_m)):
+                break  # no pair left can be closer
+            pair = int(pair_index[column])
+            found = compute(geometry_model, geometry_data, pair).min_distance
+            if found < best:
+                best, which = found, pair
+        if best < below_m:
+            distance[k], closest[k] = best, which
+    return distance, closest
+
+
+def _farther(bound: float, distance: float) -> bool:
+    """Whether a pair bounded by ``bound`` [m] is certainly no closer than ``distance`` [m].
+
+    Only a positive bound bounds coal's distance: where the bounding shapes overlap, coal's
+    signed distance (a penetration depth) may be any negative value.
+    """
+    certain = bound - BOUND_TOLERANCE_M
+    return certain > 0.0 and certain >= distance
