@@ -1,8 +1,8 @@
 """The search stage: an attempt's waypoints searched on its problem's objective.
 
 By default the planner's own search, :class:`~planning.search.refined_firefly.RefinedFirefly`:
-the firefly from the attempt's seeds (and a random population), then, with ``refine: cma``
-and a feasible best, the CMA-ES refinement within the rest of the evaluation budget,
+the firefly from the attempt's seeds (and a random population), then, with ``refine: cma``,
+the CMA-ES refinement from its best within the rest of the evaluation budget,
 ``fireflies x (iterations + 1)``. A caller's :class:`~planning.search.optimizer.Optimizer`
 runs instead on the same objective and budget. Every draw comes from
 ``numpy.random.default_rng(seed)``.

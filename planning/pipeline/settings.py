@@ -27,7 +27,7 @@ Refine = Literal["cma", "none"]
 
 DEFAULT_FIREFLY = FireflySettings(fireflies=30, iterations=50, alpha=0.5, stall_iterations=4)
 """The planner's firefly: the paper's parameters (:class:`FireflySettings`'s defaults) with
-fewer fireflies, smaller random steps and an early stop once a feasible best stalls for 4
+fewer fireflies, smaller random steps and an early stop once its best stalls for 4
 iterations, after which the CMA-ES refinement (``refine: cma``) takes over."""
 
 PAPER_SEARCH: dict[str, Any] = {**dataclasses.asdict(FireflySettings()), "seeding": "none", "refine": "none"}
@@ -79,8 +79,8 @@ class PlannerSettings:
             that is blocked, from a sampling planner's path, with more waypoints if the
             path needs them (:mod:`planning.pipeline.seeding`); ``"none"`` (the paper): from a
             random population only.
-        refine: ``"cma"`` (default): once the firefly has a feasible best, a CMA-ES started
-            at it refines it within the rest of the evaluation budget
+        refine: ``"cma"`` (default): once the firefly stops, a CMA-ES started at its best
+            (feasible or not) refines it within the rest of the evaluation budget
             (:mod:`planning.search.refinement`); ``"none"`` (the paper): the firefly's best.
         refine_stall: generations in a row without a relative improvement of
             :data:`~planning.search.optimizer.STALL_TOLERANCE` that end the refinement,

@@ -1,9 +1,14 @@
 """The planner's search as one :class:`~planning.search.optimizer.Optimizer`: firefly, then CMA-ES.
 
 The firefly (:mod:`planning.search.firefly`) explores from its seeds and a random population
-until its early stop; from a feasible best, the CMA-ES refinement
-(:mod:`planning.search.refinement`) descends within the rest of the evaluation budget, on
-the same generator. The planner runs it on its waypoint objective, and the benchmark of peer
+until its early stop; from its best, the CMA-ES refinement (:mod:`planning.search.refinement`)
+descends within the rest of the evaluation budget, on the same generator. The best need not
+be feasible: a seed that misses only by a little (a spline overshooting a joint limit by a
+fraction of a percent, or grazing the margin) is one the firefly's random moves rarely
+improve, while the refinement's small steps follow the fitness's penalty down to feasible
+values; the early stop so counts stalled iterations whether the best is feasible or not.
+
+The planner runs it on its waypoint objective, and the benchmark of peer
 optimisers (``scripts/bench_peers.py``) runs the same object beside the peers, so both
 measure one search.
 """
@@ -29,16 +34,17 @@ FloatArray = NDArray[np.float64]
 
 @dataclass(frozen=True)
 class RefinedFirefly:
-    """The firefly and, from a feasible best, its CMA-ES refinement, as one optimiser.
+    """The firefly and, from its best, the CMA-ES refinement, as one optimiser.
 
     Attributes:
         firefly: the firefly's parameters; its iterations follow from the budget
             (``budget // fireflies - 1``).
         refinement: the refinement's settings; ``None``: the firefly's best as it is.
         stall_generations: the refinement's stalled generations that end it (0: to the budget).
+        feasible_below: the objective's bound of feasible values. Without a refinement the
+            firefly's early stop counts only once its best is at or below it: an infeasible
+            best keeps exploring, as nothing would repair it.
         seeds: ``(k, d)`` points that replace the first fireflies of the initial population.
-        feasible_below: the objective's bound of feasible values: the firefly's early stop
-            counts only once its best is at or below it, and only a feasible best is refined.
         lower_bound: about the least value the objective can take (the refinement counts
             stalls only near it); ``None``: unknown.
         progress: called after every firefly iteration.
@@ -65,10 +71,11 @@ class RefinedFirefly:
         iterations = max(budget // settings.fireflies - 1, 0)
         if iterations != settings.iterations:
             settings = dataclasses.replace(settings, iterations=iterations)
+        stall_below = self.feasible_below if self.refinement is None else math.inf
         found = firefly_minimize(
-            objective, lower, upper, settings, rng, self.progress, self.seeds, stall_below=self.feasible_below
+            objective, lower, upper, settings, rng, self.progress, self.seeds, stall_below=stall_below
         )
-        if self.refinement is None or found.fitness > self.feasible_below:
+        if self.refinement is None:
             return found
         return refine_search(
             objective,
