@@ -129,10 +129,11 @@ def pair_bounds(
 # The kernel below repeats the capsule placement and pair bound of ``pair_bounds``: factored into
 # compiled helpers (even with Numba's inline="always"), both kernels ran slower (docs/tuning.md).
 @njit
-def any_below(
+def groups_below(
     q: FloatArray,
     threshold: float,
     out: BoolArray,
+    pair_group: IntArray,
     chain: ChainArrays,
     capsule_joint: IntArray,
     capsule_ends: FloatArray,
@@ -147,12 +148,13 @@ def any_below(
     obstacle_half: FloatArray,
     obstacle_reach: FloatArray,
 ) -> None:
-    """Write into ``out[n]`` whether some pair's bound at ``q[n]`` is below ``threshold`` [m].
+    """Write into ``out[n, g]`` whether a pair of group ``g`` has a bound below ``threshold`` [m] at ``q[n]``.
 
-    The arguments are :func:`pair_bounds`', plus the bounding-sphere radii of the capsules
-    (``capsule_reach``) and obstacles (``obstacle_reach``): a pair whose spheres are farther
-    apart than ``threshold`` needs no finer bound, and a configuration stops at its first
-    pair below ``threshold``.
+    The arguments are :func:`pair_bounds`', plus each pair's group (``pair_group``, ``(P,)``
+    in ``[0, G)`` for ``out`` of shape ``(N, G)``) and the bounding-sphere radii of the
+    capsules (``capsule_reach``) and obstacles (``obstacle_reach``): a pair whose spheres
+    are farther apart than ``threshold`` needs no finer bound, a pair whose group is already
+    below none, and a configuration stops once every group is.
     """
     joints = len(chain[0])
     rotation, translation = np.empty((joints, 3, 3)), np.empty((joints, 3))
@@ -173,8 +175,12 @@ def any_below(
                             + rotation[j, r, 1] * capsule_ends[c, e, 1]
                             + rotation[j, r, 2] * capsule_ends[c, e, 2]
                         )
-        out[n] = False
+        out[n, :] = False
+        open_groups = out.shape[1]
         for p in range(len(pair_capsule)):
+            group = pair_group[p]
+            if out[n, group]:
+                continue
             c, o = pair_capsule[p], pair_obstacle[p]
             x = 0.5 * (world[c, 0, 0] + world[c, 1, 0]) - obstacle_origin[o, 0]
             y = 0.5 * (world[c, 0, 1] + world[c, 1, 1]) - obstacle_origin[o, 1]
@@ -211,5 +217,7 @@ def any_below(
                 else:
                     bound = np.sqrt(axis_distance * axis_distance + gap * gap) - radius
             if bound - capsule_radius[c] <= threshold:
-                out[n] = True
-                break
+                out[n, group] = True
+                open_groups -= 1
+                if open_groups == 0:
+                    break

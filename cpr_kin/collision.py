@@ -20,6 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 from cpr_kin.clearance import BatchClearance, Clearance, PairDistance
 from cpr_kin.closest_pairs import closest_pairs
 from cpr_kin.errors import CprKinError
+from cpr_kin.obstacle_pools import ObstaclePools
 from cpr_kin.obstacles import Obstacle
 from cpr_kin.pair_bounds import PairBounds
 from cpr_kin.reach import pair_reach_distances
@@ -93,8 +94,9 @@ class CollisionWorld:
                     gdata.deactivateCollisionPair(p)
             self._groups.append(gdata)
         self._group_has_pairs = [bool(np.any(self._pair_group == g)) for g in range(len(GROUPS))]
-        self._pool: Any = None
-        self._pool_margin: float | None = None
+        self._pools = ObstaclePools(
+            robot.model, model, np.array([k for _, k in pairs], dtype=np.int64), self.num_threads
+        )
         self._reach_distance = pair_reach_distances(robot, self.obstacles, self._pairs)
         self._pair_bounds: dict[tuple[bool, ...], PairBounds] = {}
         allowed = {frozenset(pair) for pair in allowed_pairs}
@@ -228,10 +230,11 @@ class CollisionWorld:
         parallel over :attr:`num_threads` threads (Pinocchio's ``GeometryPool``); several
         times faster than :meth:`clearance_batch` when distances are not needed. Pairs that
         cannot come within the margin in any configuration (their reach capsule is farther,
-        see :mod:`cpr_kin.reach`) are not tested, and configurations whose every pair is
-        certainly farther than the margin by a cheap bound (:mod:`cpr_kin.pair_bounds`,
-        computed for the whole batch at once) are not sent to coal. Distances within
-        :data:`BOUND_TOLERANCE_M` of the margin always go to coal.
+        see :mod:`cpr_kin.reach`) are not tested, and a configuration goes to coal only for
+        the obstacles of which some pair is not certainly farther than the margin by a cheap
+        bound (:mod:`cpr_kin.pair_bounds`, computed for the whole batch at once;
+        :mod:`cpr_kin.obstacle_pools`). Distances within :data:`BOUND_TOLERANCE_M` of the
+        margin always go to coal.
         """
         batch = self._check_batch(q)
         if not (np.isfinite(margin_m) and margin_m >= 0.0):
@@ -240,27 +243,11 @@ class CollisionWorld:
         near = self._reach_distance <= margin_m
         if not near.any() or not len(batch):
             return violated
-        if self._pool is None:
-            self._pool = pin.GeometryPool(self.robot.model, self.geometry_model, self.num_threads)
-        if self._pool_margin != margin_m:
-            margins = np.full((self.geometry_model.ngeoms,) * 2, float(margin_m))
-            for gdata in self._pool.getGeometryDatas():
-                gdata.setSecurityMargins(self.geometry_model, margins, True, True)
-                # pairs that stay farther than the margin in every configuration need no test
-                for p, active in enumerate(near):
-                    (gdata.activateCollisionPair if active else gdata.deactivateCollisionPair)(p)
-            self._pool_margin = margin_m
-        uncertain = np.flatnonzero(
-            self._bounds(tuple(near.tolist())).any_below(batch, margin_m + BOUND_TOLERANCE_M)
-        )
-        if uncertain.size:
-            result = pin.computeCollisionsInParallel(
-                self.num_threads,
-                self._pool,
-                np.asfortranarray(batch[uncertain].T),
-                True,  # stop at a configuration's first hit
-            )
-            violated[uncertain] = np.asarray(result, dtype=bool)
+        uncertain = self._bounds(tuple(near.tolist())).obstacles_below(batch, margin_m + BOUND_TOLERANCE_M)
+        for obstacle in np.flatnonzero(uncertain.any(axis=0)):
+            rows = np.flatnonzero(uncertain[:, obstacle] & ~violated)
+            if rows.size:
+                violated[rows] = self._pools.violated(int(obstacle), batch[rows], margin_m, near)
         return violated
 
     def _bounds(self, active: tuple[bool, ...]) -> PairBounds:

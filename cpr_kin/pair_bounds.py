@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cpr_kin.batch_kinematics import KinematicChain
-from cpr_kin.bound_kernels import BOX, CAPSULE, CYLINDER, SPHERE, any_below, pair_bounds
+from cpr_kin.bound_kernels import BOX, CAPSULE, CYLINDER, SPHERE, groups_below, pair_bounds
 from cpr_kin.obstacles import Obstacle
 
 FloatArray = NDArray[np.float64]
@@ -118,6 +118,7 @@ class PairBounds:
             np.array([k for _, k in pairs], dtype=np.int64),
         )
         bounds = [_obstacle_bound(obstacle) for obstacle in obstacles]
+        self.n_obstacles = len(bounds)
         self._obstacles = (
             np.array([b[0] for b in bounds], dtype=np.int64),
             np.array([b[1] for b in bounds], dtype=float).reshape(-1, 3, 3),
@@ -163,9 +164,20 @@ class PairBounds:
         far pairs cost only the spheres' test, and a configuration stops at its first
         uncertain pair.
         """
+        return self._below(q, threshold_m, np.zeros(self.n_pairs, dtype=np.int64), 1)[:, 0]
+
+    def obstacles_below(self, q: FloatArray, threshold_m: float) -> BoolArray:
+        """``(N, O)`` whether some pair with obstacle ``o`` may be within ``threshold_m`` [m] at ``q``.
+
+        :meth:`any_below` per obstacle (``O`` the obstacles given), each configuration's
+        test stopping once every obstacle has an uncertain pair.
+        """
+        return self._below(q, threshold_m, self._pairs[1], self.n_obstacles)
+
+    def _below(self, q: FloatArray, threshold_m: float, pair_group: IntArray, groups: int) -> BoolArray:
         batch = np.ascontiguousarray(q, dtype=float)
-        out = np.empty(len(batch), dtype=np.bool_)
-        any_below(batch, float(threshold_m), out, *self._any_arguments)
+        out = np.empty((len(batch), groups), dtype=np.bool_)
+        groups_below(batch, float(threshold_m), out, pair_group, *self._any_arguments)
         return out
 
 

@@ -103,6 +103,27 @@ def test_margin_violated_agrees_with_distances(
         assert 0 < violated.sum() < len(configurations)
 
 
+def test_margin_violated_among_several_obstacles_agrees_with_distances(
+    robot: ck.Robot, rng: np.random.Generator
+) -> None:
+    """Each configuration goes to coal only for the obstacles its bounds leave uncertain: same answer."""
+    world = ck.CollisionWorld(
+        robot,
+        [
+            ck.Obstacle.box(size=(0.3, 0.3, 0.3), xyz=(0.0, 0.6, 0.15), name="crate"),
+            ck.Obstacle.cylinder(radius=0.05, length=0.8, xyz=(0.4, 0.2, 0.4), name="pillar"),
+            ck.Obstacle.sphere(radius=0.1, xyz=(-0.3, 0.3, 0.5), name="ball"),
+        ],
+    )
+    configurations = random_configurations(robot, rng, 1000)
+    distances = world.clearance_batch(configurations).min_clearance_m
+    for margin in (0.0, 0.05, 0.1, 0.05):  # a margin set again reuses the pools
+        violated = world.margin_violated(configurations, margin)
+        ambiguous = np.abs(distances - margin) < 1e-6
+        np.testing.assert_array_equal(violated[~ambiguous], distances[~ambiguous] < margin)
+        assert 0 < violated.sum() < len(configurations)
+
+
 def test_world_without_obstacles(robot: ck.Robot) -> None:
     world = ck.CollisionWorld(robot, [])
     assert world.clearance(np.zeros(5)).min_clearance_m == np.inf

@@ -77,6 +77,25 @@ def test_any_below_is_sound_and_at_most_the_bounds_answer(robot: ck.Robot, rng: 
         assert uncertain.any() and not uncertain.all()
 
 
+def test_obstacles_below_is_any_below_per_obstacle(robot: ck.Robot, rng: np.random.Generator) -> None:
+    obstacles = [random_obstacle(shape, rng) for shape in SHAPES]
+    obstacles = [ck.Obstacle(**{**o.__dict__, "name": f"o{k}"}) for k, o in enumerate(obstacles)]
+    pairs = all_pairs(robot, obstacles)
+    bounds = PairBounds(robot.model, robot.collision_model, obstacles, pairs)
+    configurations = random_configurations(robot, rng, 300)
+    per_pair = bounds(configurations)
+    obstacle = np.array([k for _, k in pairs])
+    for threshold in (0.0, 0.05, 0.1):
+        grouped = bounds.obstacles_below(configurations, threshold)
+        assert grouped.shape == (len(configurations), len(obstacles))
+        np.testing.assert_array_equal(grouped.any(axis=1), bounds.any_below(configurations, threshold))
+        for k in range(len(obstacles)):  # each obstacle's answer is its own pairs' any_below
+            own = PairBounds(robot.model, robot.collision_model, obstacles, [p for p in pairs if p[1] == k])
+            np.testing.assert_array_equal(grouped[:, k], own.any_below(configurations, threshold))
+            assert not np.any(grouped[:, k] & ~(per_pair[:, obstacle == k] <= threshold).any(axis=1))
+    assert grouped.sum(axis=1).max() >= 2  # configurations near two obstacles at once occur
+
+
 def test_mesh_obstacle_is_bounded_by_its_bounding_box(
     robot: ck.Robot, rng: np.random.Generator, tmp_path: Path
 ) -> None:

@@ -61,7 +61,7 @@ def test_a_fixed_duration_holds_a_motion_that_fits_and_reports_one_that_does_not
 
 
 def test_a_scene_whose_splines_all_touch_the_passage_is_planned_not_refused(robot: ck.Robot) -> None:
-    """A false "no solution" of issue 33 (B.3): the search's splines near the passage failed; the path did not.
+    """A false "no solution" of issue 33 (B.3): the splines near the passage failed; the path did not.
 
     The default search now repairs its best spline there; without the refinement every
     spline still touches the passage, and the last resort follows the path.

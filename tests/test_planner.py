@@ -143,12 +143,12 @@ def test_bad_planner_settings() -> None:
 
 
 def test_warm_up_compiles_the_kernels_and_returns_its_time(robot: ck.Robot) -> None:
-    from cpr_kin.bound_kernels import any_below
+    from cpr_kin.bound_kernels import groups_below
     from planning.search.firefly import _move
 
     seconds = warm_up(robot)
     assert 0.0 < seconds < 120.0
-    compiled: list[Any] = [_move, any_below]  # what planning runs
+    compiled: list[Any] = [_move, groups_below]  # what planning runs
     assert all(kernel.signatures for kernel in compiled)  # compiled (or loaded from the cache)
 
 

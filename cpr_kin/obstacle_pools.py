@@ -1,0 +1,69 @@
+"""coal's yes/no margin test against one obstacle at a time, in parallel over configurations.
+
+Where a configuration's pair bounds (:mod:`cpr_kin.pair_bounds`) leave some pair uncertain,
+coal decides. Asking it about every pair of the world there made it test a hundred pairs
+or more on an arm among shelf boards, although the uncertain ones lie by one or two boards:
+most of coal's time went to pairs the bounds had already cleared. So each obstacle has its
+own Pinocchio ``GeometryPool`` with only its pairs active, built the first time a
+configuration is uncertain about it, and a configuration goes only to the pools of the
+obstacles its bounds are uncertain about. The answer is the same: a pair of another
+obstacle is certainly farther than the margin.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import NDArray
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+BoolArray = NDArray[np.bool_]
+
+
+class ObstaclePools:
+    """One ``GeometryPool`` per obstacle, its pairs within reach of the margin active.
+
+    Args:
+        model: the robot's Pinocchio model.
+        geometry_model: the world's geometry model (robot and obstacles, every pair added).
+        pair_obstacle: ``(P,)`` the obstacle of each of its collision pairs.
+        num_threads: threads of coal's batches.
+    """
+
+    def __init__(self, model: Any, geometry_model: Any, pair_obstacle: IntArray, num_threads: int) -> None:
+        self.model, self.geometry_model, self.num_threads = model, geometry_model, num_threads
+        self._pair_obstacle = pair_obstacle
+        self._pools: dict[int, Any] = {}
+        self._margin_m: dict[int, float] = {}
+
+    def violated(self, obstacle: int, batch: FloatArray, margin_m: float, near: BoolArray) -> BoolArray:
+        """``(N,)`` whether a pair with ``obstacle`` is closer than ``margin_m`` [m] at ``batch``.
+
+        ``near`` ``(P,)``: the pairs that may come within the margin (the others are not tested).
+        """
+        pool = self._prepared(obstacle, margin_m, near)
+        found = pin.computeCollisionsInParallel(
+            self.num_threads,
+            pool,
+            np.asfortranarray(batch.T),
+            True,  # stop at a configuration's first hit
+        )
+        return np.asarray(found, dtype=bool)
+
+    def _prepared(self, obstacle: int, margin_m: float, near: BoolArray) -> Any:
+        """The obstacle's pool, built once, its margin and active pairs set when the margin changes."""
+        if obstacle not in self._pools:
+            self._pools[obstacle] = pin.GeometryPool(self.model, self.geometry_model, self.num_threads)
+        pool = self._pools[obstacle]
+        if self._margin_m.get(obstacle) != margin_m:
+            margins = np.full((self.geometry_model.ngeoms,) * 2, float(margin_m))
+            active = near & (self._pair_obstacle == obstacle)
+            for gdata in pool.getGeometryDatas():
+                gdata.setSecurityMargins(self.geometry_model, margins, True, True)
+                for p, on in enumerate(active):
+                    (gdata.activateCollisionPair if on else gdata.deactivateCollisionPair)(p)
+            self._margin_m[obstacle] = margin_m
+        return pool
