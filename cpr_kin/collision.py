@@ -29,6 +29,7 @@ from cpr_kin.self_collision import SelfCollision
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
+BoolArray = NDArray[np.bool_]
 
 BOUND_TOLERANCE_M = 1e-6
 """A configuration goes to coal unless its pair bounds clear the margin by this much [m]
@@ -99,6 +100,9 @@ class CollisionWorld:
         )
         self._reach_distance = pair_reach_distances(robot, self.obstacles, self._pairs)
         self._pair_bounds: dict[tuple[bool, ...], PairBounds] = {}
+        self._near: dict[
+            float, tuple[BoolArray, PairBounds | None]
+        ] = {}  # per margin: pairs in reach, bounds
         allowed = {frozenset(pair) for pair in allowed_pairs}
         links = [g.link for g in robot.geometries]
         kept = tuple((a, b) for a, b in robot.self_pairs if frozenset((links[a], links[b])) not in allowed)
@@ -239,16 +243,14 @@ class CollisionWorld:
         batch = self._check_batch(q)
         if not (np.isfinite(margin_m) and margin_m >= 0.0):
             raise CprKinError(f"safety margin {margin_m} m must be a finite number >= 0")
-        violated = np.zeros(len(batch), dtype=bool)
-        near = self._reach_distance <= margin_m
-        if not near.any() or not len(batch):
-            return violated
-        uncertain = self._bounds(tuple(near.tolist())).obstacles_below(batch, margin_m + BOUND_TOLERANCE_M)
-        for obstacle in np.flatnonzero(uncertain.any(axis=0)):
-            rows = np.flatnonzero(uncertain[:, obstacle] & ~violated)
-            if rows.size:
-                violated[rows] = self._pools.violated(int(obstacle), batch[rows], margin_m, near)
-        return violated
+        if margin_m not in self._near:
+            near = self._reach_distance <= margin_m
+            self._near[margin_m] = (near, self._bounds(tuple(near.tolist())) if near.any() else None)
+        near, bounds = self._near[margin_m]
+        if bounds is None or not len(batch):
+            return np.zeros(len(batch), dtype=bool)
+        uncertain = bounds.obstacles_below(batch, margin_m + BOUND_TOLERANCE_M)
+        return self._pools.violated(batch, uncertain, margin_m, near)
 
     def _bounds(self, active: tuple[bool, ...]) -> PairBounds:
         """The pair bounds of the ``active`` pairs, built once per set of pairs."""

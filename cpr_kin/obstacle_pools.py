@@ -36,22 +36,42 @@ class ObstaclePools:
     def __init__(self, model: Any, geometry_model: Any, pair_obstacle: IntArray, num_threads: int) -> None:
         self.model, self.geometry_model, self.num_threads = model, geometry_model, num_threads
         self._pair_obstacle = pair_obstacle
+        self._data = model.createData()
         self._pools: dict[int, Any] = {}
         self._margin_m: dict[int, float] = {}
 
-    def violated(self, obstacle: int, batch: FloatArray, margin_m: float, near: BoolArray) -> BoolArray:
-        """``(N,)`` whether a pair with ``obstacle`` is closer than ``margin_m`` [m] at ``batch``.
+    def violated(
+        self, batch: FloatArray, uncertain: BoolArray, margin_m: float, near: BoolArray
+    ) -> BoolArray:
+        """``(N,)`` whether some pair is closer than ``margin_m`` [m] at configurations ``batch``.
 
-        ``near`` ``(P,)``: the pairs that may come within the margin (the others are not tested).
+        Args:
+            batch: ``(N, nq)`` configurations.
+            uncertain: ``(N, O)`` the obstacles coal must test at each (the others are
+                certainly farther than the margin).
+            margin_m: the security margin [m].
+            near: ``(P,)`` the pairs that may come within the margin (the others are not tested).
         """
-        pool = self._prepared(obstacle, margin_m, near)
-        found = pin.computeCollisionsInParallel(
-            self.num_threads,
-            pool,
-            np.asfortranarray(batch.T),
-            True,  # stop at a configuration's first hit
-        )
-        return np.asarray(found, dtype=bool)
+        violated = np.zeros(len(batch), dtype=bool)
+        if len(batch) == 1:  # one configuration (a sampling planner's query): no thread pool
+            for obstacle in np.flatnonzero(uncertain[0]).tolist():
+                gdata = self._prepared(obstacle, margin_m, near).getGeometryData(0)
+                if pin.computeCollisions(self.model, self._data, self.geometry_model, gdata, batch[0], True):
+                    violated[0] = True
+                    break
+            return violated
+        for obstacle in np.flatnonzero(uncertain.any(axis=0)).tolist():
+            rows = np.flatnonzero(uncertain[:, obstacle] & ~violated)
+            if rows.size:
+                pool = self._prepared(obstacle, margin_m, near)
+                found = pin.computeCollisionsInParallel(
+                    self.num_threads,
+                    pool,
+                    np.asfortranarray(batch[rows].T),
+                    True,  # stop at a first hit
+                )
+                violated[rows] = np.asarray(found, dtype=bool)
+        return violated
 
     def _prepared(self, obstacle: int, margin_m: float, near: BoolArray) -> Any:
         """The obstacle's pool, built once, its margin and active pairs set when the margin changes."""

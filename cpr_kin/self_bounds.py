@@ -201,6 +201,7 @@ class ScreenedSelfTest:
         self.all_bounds = SelfPairBounds(model, geometry_model, pairs)
         self._active = (near, ~near)
         self._pools: list[Any] = []
+        self._data: Any = None
         self._distance_data: Any = None
         self._margin_m = float("nan")
 
@@ -231,6 +232,11 @@ class ScreenedSelfTest:
 
     def _coal(self, tier: int, batch: FloatArray) -> NDArray[np.bool_]:
         """Coal's test of the pairs of ``tier`` (0 near, 1 far) at configurations ``batch``."""
+        if len(batch) == 1:  # one configuration (a sampling planner's query): no thread pool
+            gdata = self._pools[tier].getGeometryData(0)
+            return np.array(
+                [pin.computeCollisions(self.model, self._data, self.geometry_model, gdata, batch[0], True)]
+            )
         found = pin.computeCollisionsInParallel(
             self.num_threads, self._pools[tier], np.asfortranarray(batch.T), True
         )
@@ -242,6 +248,7 @@ class ScreenedSelfTest:
         A NaN ``margin_m`` leaves the margin as it is.
         """
         if not self._pools:
+            self._data = self.model.createData()
             self._distance_data = self.geometry_model.createData()
             self._pools = [
                 pin.GeometryPool(self.model, self.geometry_model, self.num_threads) for _ in range(2)

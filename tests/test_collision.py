@@ -122,6 +122,8 @@ def test_margin_violated_among_several_obstacles_agrees_with_distances(
         ambiguous = np.abs(distances - margin) < 1e-6
         np.testing.assert_array_equal(violated[~ambiguous], distances[~ambiguous] < margin)
         assert 0 < violated.sum() < len(configurations)
+        one_by_one = [world.margin_violated(q[None], margin)[0] for q in configurations[:200]]
+        np.testing.assert_array_equal(one_by_one, violated[:200])  # one configuration: no thread pool
 
 
 def test_world_without_obstacles(robot: ck.Robot) -> None:

@@ -68,7 +68,10 @@ def test_the_screen_gives_coals_answer(arm: ck.Robot, margin_m: float) -> None:
     assert len(test.near_pairs) + test.far_bounds.n_pairs == len(collision._pairs)
     q = np.random.default_rng(2).uniform(arm.limits.lower, arm.limits.upper, (500, arm.nq))
     distance, _ = collision.distances(q)
-    np.testing.assert_array_equal(test.violated(q, margin_m), distance < margin_m)
+    violated = test.violated(q, margin_m)
+    np.testing.assert_array_equal(violated, distance < margin_m)
+    one_by_one = [test.violated(x[None], margin_m)[0] for x in q[:100]]  # no thread pool
+    np.testing.assert_array_equal(one_by_one, violated[:100])
 
 
 def test_the_screened_distances_are_coals_over_every_pair(arm: ck.Robot) -> None:
