@@ -19,11 +19,10 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
+from cpr_kin.pair_bounds import BOUND_TOLERANCE_M
+
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
-
-BOUND_TOLERANCE_M = 1e-6
-"""How far below a bound coal's own distance may fall (its tolerance) [m]."""
 
 
 def closest_pairs(
@@ -43,7 +42,7 @@ def closest_pairs(
         geometry_data: its data (placements and distance results are written into it).
         batch: ``(N, nq)`` configurations.
         bounds: ``(N, P)`` lower bounds [m] of the pairs' distances at those configurations
-            (at most coal's distance plus :data:`BOUND_TOLERANCE_M`).
+            (at most coal's distance plus :data:`~cpr_kin.pair_bounds.BOUND_TOLERANCE_M`).
         pair_index: ``(P,)`` the pairs' indices in ``geometry_model.collisionPairs``.
         below_m: only distances below this matter [m]: pairs bounded above it are not
             computed, and where the smallest distance is not below it, ``inf`` and ``-1``

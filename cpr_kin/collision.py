@@ -22,7 +22,7 @@ from cpr_kin.closest_pairs import closest_pairs
 from cpr_kin.errors import CprKinError
 from cpr_kin.obstacle_pools import ObstaclePools
 from cpr_kin.obstacles import Obstacle
-from cpr_kin.pair_bounds import PairBounds
+from cpr_kin.pair_bounds import BOUND_TOLERANCE_M, PairBounds
 from cpr_kin.reach import pair_reach_distances
 from cpr_kin.robot import GROUPS, Robot
 from cpr_kin.self_collision import SelfCollision
@@ -30,10 +30,6 @@ from cpr_kin.self_collision import SelfCollision
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
-
-BOUND_TOLERANCE_M = 1e-6
-"""A configuration goes to coal unless its pair bounds clear the margin by this much [m]
-(coal's distances are accurate to about 1e-6 of their size)."""
 
 
 class CollisionWorld:
@@ -100,9 +96,7 @@ class CollisionWorld:
         )
         self._reach_distance = pair_reach_distances(robot, self.obstacles, self._pairs)
         self._pair_bounds: dict[tuple[bool, ...], PairBounds] = {}
-        self._near: dict[
-            float, tuple[BoolArray, PairBounds | None]
-        ] = {}  # per margin: pairs in reach, bounds
+        self._within: dict[float, tuple[BoolArray, PairBounds | None]] = {}
         allowed = {frozenset(pair) for pair in allowed_pairs}
         links = [g.link for g in robot.geometries]
         kept = tuple((a, b) for a, b in robot.self_pairs if frozenset((links[a], links[b])) not in allowed)
@@ -194,11 +188,10 @@ class CollisionWorld:
             return self._closest_pairs(batch, self._all)
         if not np.isfinite(below_m):
             raise CprKinError(f"distance bound {below_m} m must be finite")
-        near = self._reach_distance <= below_m
-        bounds = self._bounds(tuple(near.tolist()))(batch) if near.any() else np.empty((len(batch), 0))
-        model = self.robot.model
+        near, bounds = self._pairs_within(below_m)
+        values = np.empty((len(batch), 0)) if bounds is None else bounds(batch)
         return closest_pairs(
-            model, self.geometry_model, self._all, batch, bounds, np.flatnonzero(near), below_m
+            self.robot.model, self.geometry_model, self._all, batch, values, np.flatnonzero(near), below_m
         )
 
     def _closest_pairs(self, batch: FloatArray, gdata: Any) -> tuple[FloatArray, IntArray]:
@@ -243,14 +236,21 @@ class CollisionWorld:
         batch = self._check_batch(q)
         if not (np.isfinite(margin_m) and margin_m >= 0.0):
             raise CprKinError(f"safety margin {margin_m} m must be a finite number >= 0")
-        if margin_m not in self._near:
-            near = self._reach_distance <= margin_m
-            self._near[margin_m] = (near, self._bounds(tuple(near.tolist())) if near.any() else None)
-        near, bounds = self._near[margin_m]
+        near, bounds = self._pairs_within(margin_m)
         if bounds is None or not len(batch):
             return np.zeros(len(batch), dtype=bool)
         uncertain = bounds.obstacles_below(batch, margin_m + BOUND_TOLERANCE_M)
         return self._pools.violated(batch, uncertain, margin_m, near)
+
+    def _pairs_within(self, distance_m: float) -> tuple[BoolArray, PairBounds | None]:
+        """The pairs whose reach comes within ``distance_m`` [m] and their bounds (``None``: no pair).
+
+        Looked up once per distance (a plan asks a few margins many times).
+        """
+        if distance_m not in self._within:
+            near = self._reach_distance <= distance_m
+            self._within[distance_m] = (near, self._bounds(tuple(near.tolist())) if near.any() else None)
+        return self._within[distance_m]
 
     def _bounds(self, active: tuple[bool, ...]) -> PairBounds:
         """The pair bounds of the ``active`` pairs, built once per set of pairs."""

@@ -23,6 +23,22 @@ IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
 
 
+def pool_collisions(
+    pool: Any, model: Any, data: Any, geometry_model: Any, batch: FloatArray, num_threads: int
+) -> BoolArray:
+    """``(N,)`` coal's yes/no test of ``pool``'s active pairs at ``batch``, each stopping at its first hit.
+
+    In parallel over ``num_threads`` threads; one configuration (a sampling planner's query)
+    serially in ``data`` and the pool's first geometry data, where the threads would cost
+    more than the test.
+    """
+    if len(batch) == 1:
+        gdata = pool.getGeometryData(0)
+        return np.array([pin.computeCollisions(model, data, geometry_model, gdata, batch[0], True)])
+    found = pin.computeCollisionsInParallel(num_threads, pool, np.asfortranarray(batch.T), True)
+    return np.asarray(found, dtype=bool)
+
+
 class ObstaclePools:
     """One ``GeometryPool`` per obstacle, its pairs within reach of the margin active.
 
@@ -53,10 +69,10 @@ class ObstaclePools:
             near: ``(P,)`` the pairs that may come within the margin (the others are not tested).
         """
         violated = np.zeros(len(batch), dtype=bool)
-        if len(batch) == 1:  # one configuration (a sampling planner's query): no thread pool
+        if len(batch) == 1:  # one configuration: the obstacles in turn, without the array work
             for obstacle in np.flatnonzero(uncertain[0]).tolist():
-                gdata = self._prepared(obstacle, margin_m, near).getGeometryData(0)
-                if pin.computeCollisions(self.model, self._data, self.geometry_model, gdata, batch[0], True):
+                pool = self._prepared(obstacle, margin_m, near)
+                if pool_collisions(pool, self.model, self._data, self.geometry_model, batch, 1)[0]:
                     violated[0] = True
                     break
             return violated
@@ -64,13 +80,9 @@ class ObstaclePools:
             rows = np.flatnonzero(uncertain[:, obstacle] & ~violated)
             if rows.size:
                 pool = self._prepared(obstacle, margin_m, near)
-                found = pin.computeCollisionsInParallel(
-                    self.num_threads,
-                    pool,
-                    np.asfortranarray(batch[rows].T),
-                    True,  # stop at a first hit
+                violated[rows] = pool_collisions(
+                    pool, self.model, self._data, self.geometry_model, batch[rows], self.num_threads
                 )
-                violated[rows] = np.asarray(found, dtype=bool)
         return violated
 
     def _prepared(self, obstacle: int, margin_m: float, near: BoolArray) -> Any:

@@ -22,7 +22,8 @@ from numpy.typing import NDArray
 from cpr_kin.batch_kinematics import ChainArrays, KinematicChain, place_joints
 from cpr_kin.closest_pairs import closest_pairs
 from cpr_kin.compiled import njit
-from cpr_kin.pair_bounds import joint_capsules
+from cpr_kin.obstacle_pools import pool_collisions
+from cpr_kin.pair_bounds import BOUND_TOLERANCE_M, joint_capsules
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -159,8 +160,6 @@ NEAR_SHARE = 0.5
 """Share of those in which a pair's bound is uncertain that makes it a near pair."""
 PROBE_THRESHOLD_M = 0.05
 """The distance [m] the probes ask the bounds about (a typical margin and more)."""
-BOUND_TOLERANCE_M = 1e-6
-"""Added to the margin a bound must exceed: coal's own tolerance."""
 
 
 class ScreenedSelfTest:
@@ -190,15 +189,13 @@ class ScreenedSelfTest:
         lower = np.clip(model.lowerPositionLimit, -np.pi, np.pi)
         upper = np.clip(model.upperPositionLimit, -np.pi, np.pi)
         probes = rng.uniform(lower, np.maximum(upper, lower), (PROBES, model.nq))
-        uncertain = (
-            SelfPairBounds(model, geometry_model, pairs)(probes, PROBE_THRESHOLD_M) <= PROBE_THRESHOLD_M
-        )
+        self.all_bounds = SelfPairBounds(model, geometry_model, pairs)
+        uncertain = self.all_bounds(probes, PROBE_THRESHOLD_M) <= PROBE_THRESHOLD_M
         near = uncertain.mean(axis=0) > NEAR_SHARE
         self.near_pairs = tuple(p for p, is_near in zip(pairs, near, strict=True) if is_near)
         self.far_bounds = SelfPairBounds(
             model, geometry_model, [p for p, n in zip(pairs, near, strict=True) if not n]
         )
-        self.all_bounds = SelfPairBounds(model, geometry_model, pairs)
         self._active = (near, ~near)
         self._pools: list[Any] = []
         self._data: Any = None
@@ -232,15 +229,9 @@ class ScreenedSelfTest:
 
     def _coal(self, tier: int, batch: FloatArray) -> NDArray[np.bool_]:
         """Coal's test of the pairs of ``tier`` (0 near, 1 far) at configurations ``batch``."""
-        if len(batch) == 1:  # one configuration (a sampling planner's query): no thread pool
-            gdata = self._pools[tier].getGeometryData(0)
-            return np.array(
-                [pin.computeCollisions(self.model, self._data, self.geometry_model, gdata, batch[0], True)]
-            )
-        found = pin.computeCollisionsInParallel(
-            self.num_threads, self._pools[tier], np.asfortranarray(batch.T), True
+        return pool_collisions(
+            self._pools[tier], self.model, self._data, self.geometry_model, batch, self.num_threads
         )
-        return np.asarray(found, dtype=bool)
 
     def _prepare(self, margin_m: float) -> None:
         """Build the two pools and distance data once; set the pools' security margin when it changes.

@@ -41,10 +41,10 @@ class RefinedFirefly:
             (``budget // fireflies - 1``).
         refinement: the refinement's settings; ``None``: the firefly's best as it is.
         stall_generations: the refinement's stalled generations that end it (0: to the budget).
+        seeds: ``(k, d)`` points that replace the first fireflies of the initial population.
         feasible_below: the objective's bound of feasible values. Without a refinement the
             firefly's early stop counts only once its best is at or below it: an infeasible
             best keeps exploring, as nothing would repair it.
-        seeds: ``(k, d)`` points that replace the first fireflies of the initial population.
         lower_bound: about the least value the objective can take (the refinement counts
             stalls only near it); ``None``: unknown.
         progress: called after every firefly iteration.
