@@ -13,6 +13,7 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from planning.curves.segment_extrema import extremum_candidates
 from planning.errors import PlanningError
 
 FloatArray = NDArray[np.float64]
@@ -45,34 +46,6 @@ def interval_speed_bounds(
     speed = np.abs(velocity)
     rising = 0.5 * (speed[:-1] + speed[1:] + peak_acceleration * np.diff(times)[:, None])
     return np.asarray(np.minimum(rising, peak_speed))
-
-
-def _real_roots_in(coefficients: FloatArray, upper: FloatArray) -> FloatArray:
-    """Real roots in ``(0, upper)`` of each polynomial ``sum_k c[m, k] x^k``, ``(M, order - 1)``.
-
-    Each row holds its polynomial's roots, ``nan`` in the places of the others. Polynomials
-    are grouped by their effective degree (leading coefficients below a relative tolerance
-    are dropped) and the eigenvalues of their companion matrices computed in stacks, so many
-    small polynomials cost few NumPy calls and no Python loop over them.
-    """
-    m_count, order = coefficients.shape
-    roots = np.full((m_count, order - 1), np.nan)
-    scale = np.abs(coefficients).max(axis=1, keepdims=True)
-    significant = np.abs(coefficients) > 1e-13 * np.where(scale > 0, scale, 1.0)
-    degree = np.where(significant.any(axis=1), order - 1 - np.argmax(significant[:, ::-1], axis=1), 0)
-    for d in range(1, order):
-        rows = np.flatnonzero(degree == d)
-        if rows.size == 0:
-            continue
-        c = coefficients[rows, : d + 1]
-        companion = np.zeros((rows.size, d, d))
-        companion[:, 1:, :-1] = np.eye(d - 1)
-        companion[:, :, -1] = -c[:, :d] / c[:, d : d + 1]
-        z = np.linalg.eigvals(companion)
-        real = np.abs(z.imag) <= 1e-9 * (1.0 + np.abs(z.real))
-        inside = real & (z.real > 0.0) & (z.real < upper[rows, None])
-        roots[rows, :d] = np.where(inside, z.real, np.nan)
-    return roots
 
 
 @dataclass(frozen=True)
@@ -199,7 +172,8 @@ class Trajectory:
         """Exact extrema of the ``derivative``-th derivative per joint.
 
         Candidates are the segment ends and the real roots of the next derivative inside
-        each segment; no sampling is involved. Computed once per order (the trajectory is
+        the segments that may hold an extremum (:mod:`planning.curves.segment_extrema`); no
+        sampling is involved. Computed once per order (the trajectory is
         immutable).
         """
         if derivative in self._extrema:
@@ -208,9 +182,7 @@ class Trajectory:
         h = np.diff(self.knots)
         value = self._coefficients(derivative).reshape(n * nj, order)
         slope = self._coefficients(derivative + 1).reshape(n * nj, order)
-        # candidates of every (segment, joint): both ends and the slope's roots inside
-        ends = np.column_stack([np.zeros(n * nj), np.repeat(h, nj)])
-        local = np.concatenate([ends, _real_roots_in(slope, np.repeat(h, nj))], axis=1)  # (n nj, K)
+        local = extremum_candidates(value, slope, np.repeat(h, nj), nj)  # (n nj, K), nan: none
         values = np.zeros_like(local)
         for k in range(order - 1, -1, -1):  # Horner, all candidates at once (nan stays nan)
             values = values * local + value[:, k : k + 1]
