@@ -23,6 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.clearance import BatchClearance
 from cpr_kin.collision import CollisionWorld
+from cpr_kin.decisive import undecided
 from cpr_kin.errors import CprKinError
 from cpr_kin.interval_motion import IntervalSpeed, interval_motion
 from cpr_kin.reach import robot_reach
@@ -166,7 +167,7 @@ def decisive_clearance(world: CollisionWorld, q: FloatArray, slack_m: float | Fl
     values = world.clearance_lower_bounds(q)
     known = np.isinf(values) & (values > 0)  # groups without pairs: nothing to compute
     closest = np.full(values.shape, -1, dtype=np.int64)
-    while (needed := _undecided(values, known, slack_m)).any():
+    while (needed := undecided(values, known, slack_m)).any():
         for group_index in range(values.shape[1]):
             rows = np.flatnonzero(needed[:, group_index])
             if rows.size:
@@ -175,33 +176,6 @@ def decisive_clearance(world: CollisionWorld, q: FloatArray, slack_m: float | Fl
                 )
                 known[rows, group_index] = True
     return BatchClearance(clearance_m=values, closest_pair=closest)
-
-
-def _undecided(
-    values: FloatArray, known: NDArray[np.bool_], slack_m: float | FloatArray
-) -> NDArray[np.bool_]:
-    """Samples not yet exact whose exact value could still lower a minimum the check reports."""
-    needed = np.zeros_like(known)
-    slack = np.asarray(slack_m, dtype=float)
-    certified = 0.5 * (values[:-1] + values[1:] - (slack[:, None] if slack.ndim else slack))
-    both_known = known[:-1] & known[1:]
-    for g in range(values.shape[1]):
-        column = certified[:, g]
-        lowest = int(np.argmin(column))
-        if both_known[lowest, g]:
-            continue
-        best_exact = float(np.min(column[both_known[:, g]], initial=np.inf))
-        below = column <= best_exact if np.isfinite(best_exact) else np.arange(len(column)) == lowest
-        needed[:-1, g] |= below
-        needed[1:, g] |= below
-    lowest_sample = np.unravel_index(int(np.argmin(values)), values.shape)
-    if not known[lowest_sample]:
-        best_exact = float(np.min(values[known], initial=np.inf))
-        if np.isfinite(best_exact):
-            needed |= values <= best_exact
-        else:
-            needed[lowest_sample] = True
-    return needed & ~known
 
 
 def check_segment(

@@ -25,6 +25,7 @@ import pinocchio as pin
 from lxml import etree
 from numpy.typing import ArrayLike, NDArray
 
+from cpr_kin.decisive import propagated_bounds, undecided
 from cpr_kin.errors import CprKinError, UrdfError
 from cpr_kin.interval_motion import IntervalSpeed, interval_motion
 from cpr_kin.self_bounds import ScreenedSelfTest
@@ -37,7 +38,9 @@ LinkPair = frozenset[str]
 MAX_SRDF_BYTES = 10_000_000
 """Largest SRDF file [bytes]."""
 MAX_SELF_CHECKS = 200_000
-"""Most configurations one certified self-collision check of a curve queries."""
+"""Most configurations one certified self-collision check of a curve samples."""
+COARSE_STRIDE = 8
+"""The certified self check computes every this many samples first, the rest where they decide."""
 
 
 def find_srdf(urdf_path: Path, robot_name: str | None = None) -> Path | None:
@@ -206,7 +209,8 @@ class SelfCheck:
     Attributes:
         accepted: the certified self-clearance is at least the margin everywhere.
         margin_m: the self-clearance required [m].
-        checks: configurations checked.
+        checks: configurations sampled (each certified).
+        computed: those whose distances coal computed, the others bounded from them.
         certified_min_m: lower bound of the self-clearance over the whole curve [m]
             (``inf`` without pairs).
         worst_time: instant of the smallest sampled self-clearance [s].
@@ -216,6 +220,7 @@ class SelfCheck:
     accepted: bool
     margin_m: float
     checks: int
+    computed: int
     certified_min_m: float
     worst_time: float
     worst_pair: tuple[str, str] | None
@@ -237,27 +242,53 @@ def check_self_curve(
     ``dt = 2 step_m / (2 point_speed)`` and between samples ``k`` and ``k + 1`` the distance
     is at least ``(c_k + c_{k+1} - 2 point_speed dt) / 2``; with ``interval_speed``
     (:data:`cpr_kin.interval_motion.IntervalSpeed`), the lower of its bound and ``point_speed`` for
-    each interval.
+    each interval. coal computes only the samples that decide the smallest certified and
+    sampled distances (:func:`_decisive_distances`); the result is that of every sample computed.
 
     Raises:
         CprKinError: more than :data:`~cpr_kin.motion.MAX_CURVE_CHECKS` samples needed.
     """
     t0, t1 = interval
     if not collision:
-        return SelfCheck(True, float(margin_m), 0, np.inf, t0, None)
-    approach = 2.0 * point_speed
-    count = int(np.ceil((t1 - t0) * approach / (2.0 * step_m))) + 1 if approach > 0 else 1
+        return SelfCheck(True, float(margin_m), 0, 0, np.inf, t0, None)
+    fastest = 2.0 * point_speed
+    count = int(np.ceil((t1 - t0) * fastest / (2.0 * step_m))) + 1 if fastest > 0 else 1
     if count > MAX_SELF_CHECKS:
         raise CprKinError(
             f"the self-collision check needs {count} samples ({t1 - t0:.4g} s of motion, step {step_m:g} m); "
             f"at most {MAX_SELF_CHECKS}: use a larger step"
         )
     times = np.linspace(t0, t1, max(count, 2))
-    distance, closest = collision.distances(curve(times))
-    certified = 0.5 * (
-        distance[:-1] + distance[1:] - 2.0 * interval_motion(times, point_speed, interval_speed)
-    )
+    approach = 2.0 * interval_motion(times, point_speed, interval_speed)  # per interval [m]
+    distance, closest, computed = _decisive_distances(collision, curve(times), approach)
+    certified = 0.5 * (distance[:-1] + distance[1:] - approach)
     worst = int(np.argmin(distance))
     pair = collision.pairs[int(closest[worst])] if closest[worst] >= 0 else None
     lowest = float(certified.min())
-    return SelfCheck(bool(lowest >= margin_m), float(margin_m), len(times), lowest, float(times[worst]), pair)
+    return SelfCheck(
+        bool(lowest >= margin_m), float(margin_m), len(times), computed, lowest, float(times[worst]), pair
+    )
+
+
+def _decisive_distances(
+    collision: SelfCollision, q: FloatArray, approach_m: FloatArray
+) -> tuple[FloatArray, IntArray, int]:
+    """Self distances [m] of the samples ``q`` ``(K, nq)``, exact where they decide the check.
+
+    Every :data:`COARSE_STRIDE`-th sample is computed first; the others are bounded from
+    them (distances change by at most ``approach_m`` ``(K - 1,)`` [m] between neighbours),
+    and coal computes those whose exact value could still lower the smallest certified or
+    sampled value (:func:`cpr_kin.decisive.undecided`) until both are exact. Elsewhere the
+    distance is the lower bound and the pair ``-1``.
+    """
+    count = len(q)
+    distance, closest = np.zeros(count), np.full(count, -1, dtype=np.int64)
+    known = np.zeros(count, dtype=bool)
+    reach = np.concatenate([[0.0], np.cumsum(approach_m)])
+    rows = np.unique(np.append(np.arange(0, count, COARSE_STRIDE), count - 1))
+    while rows.size:
+        distance[rows], closest[rows] = collision.distances(q[rows])
+        known[rows] = True
+        distance = propagated_bounds(distance, known, reach)
+        rows = np.flatnonzero(undecided(distance[:, None], known[:, None], approach_m)[:, 0])
+    return distance, closest, int(known.sum())

@@ -96,6 +96,32 @@ def test_the_certificate_is_a_lower_bound_no_denser_sampling_beats(panda: ck.Rob
         assert collision.distances(curve(dense))[0].min() >= check.certified_min_m - 1e-9
 
 
+def test_the_certificate_computes_few_samples_and_equals_computing_every_one(panda: ck.Robot) -> None:
+    # the samples coal skips are bounded from their neighbours: the certified minimum, the
+    # worst sample and its pair are those of the distances at every sample (a pair whose
+    # distance stays flat at the minimum, a link turning about its own axis, needs them all)
+    collision = ck.CollisionWorld(panda, []).self_collision
+    assert collision is not None
+    radii = ck.motion_radii(panda)
+    computed, sampled = 0, 0
+    for a, b in random_curves(panda, 12, 7):
+
+        def line(t: np.ndarray, a: np.ndarray = a, b: np.ndarray = b) -> np.ndarray:
+            return np.asarray(a + np.asarray(t)[:, None] * (b - a))
+
+        point_speed = float(radii @ np.abs(b - a))
+        check = check_self_curve(collision, line, (0.0, 1.0), point_speed, 0.0, 0.001)
+        times = np.linspace(0.0, 1.0, check.checks)
+        every, pair = collision.distances(line(times))
+        certified = 0.5 * (every[:-1] + every[1:] - 2.0 * point_speed * np.diff(times))
+        assert check.certified_min_m == pytest.approx(float(certified.min()), abs=1e-12)
+        worst = int(np.argmin(every))
+        assert check.worst_time == pytest.approx(times[worst])
+        assert check.worst_pair == collision.pairs[int(pair[worst])]
+        computed, sampled = computed + check.computed, sampled + check.checks
+    assert computed < 0.8 * sampled  # samples far from the minima are bounded, not computed
+
+
 def folded_through_itself(panda: ck.Robot) -> tuple[np.ndarray, np.ndarray]:
     """Two poses clear of themselves whose straight joint-space line passes through the arm."""
     collision = ck.CollisionWorld(panda, []).self_collision

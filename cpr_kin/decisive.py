@@ -1,0 +1,59 @@
+"""Which samples of a certified curve check must be exact for its minima to be exact.
+
+A certified check samples a curve at ``K`` instants and reports, per column (a group of
+pairs), the smallest certified value ``(c_k + c_{k+1} - slack_k) / 2`` over the intervals and
+the smallest sampled value. Where a cheap lower bound of ``c_k`` is known, only the samples
+whose exact value could still lower one of those minima need coal: :func:`undecided` names
+them, and a check computes them and asks again until none is left. Values computed from lower
+bounds are at most the true ones, so a minimum found from exact values is the true minimum.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+FloatArray = NDArray[np.float64]
+
+
+def undecided(values: FloatArray, known: NDArray[np.bool_], slack_m: float | FloatArray) -> NDArray[np.bool_]:
+    """``(K, G)`` samples not yet exact whose exact value could still lower a minimum the check reports.
+
+    Args:
+        values: ``(K, G)`` sampled values [m], exact where ``known``, lower bounds elsewhere.
+        known: ``(K, G)`` which values are exact.
+        slack_m: the certified bound's slack, one value or one per interval ``(K - 1,)`` [m].
+    """
+    needed = np.zeros_like(known)
+    slack = np.asarray(slack_m, dtype=float)
+    certified = 0.5 * (values[:-1] + values[1:] - (slack[:, None] if slack.ndim else slack))
+    both_known = known[:-1] & known[1:]
+    for g in range(values.shape[1]):
+        column = certified[:, g]
+        lowest = int(np.argmin(column))
+        if both_known[lowest, g]:
+            continue
+        best_exact = float(np.min(column[both_known[:, g]], initial=np.inf))
+        below = column <= best_exact if np.isfinite(best_exact) else np.arange(len(column)) == lowest
+        needed[:-1, g] |= below
+        needed[1:, g] |= below
+    lowest_sample = np.unravel_index(int(np.argmin(values)), values.shape)
+    if not known[lowest_sample]:
+        best_exact = float(np.min(values[known], initial=np.inf))
+        if np.isfinite(best_exact):
+            needed |= values <= best_exact
+        else:
+            needed[lowest_sample] = True
+    return needed & ~known
+
+
+def propagated_bounds(values: FloatArray, known: NDArray[np.bool_], reach_m: FloatArray) -> FloatArray:
+    """``(K,)`` lower bounds of a sampled distance from its exact values at the ``known`` samples.
+
+    ``reach_m`` ``(K,)`` is cumulative: between samples ``i < j`` the distance changes by at
+    most ``reach_m[j] - reach_m[i]`` [m]. Each sample gets the best bound any exact sample
+    gives it (``-inf`` with none); the exact values are kept.
+    """
+    left = np.maximum.accumulate(np.where(known, values + reach_m, -np.inf)) - reach_m
+    right = np.maximum.accumulate(np.where(known, values - reach_m, -np.inf)[::-1])[::-1] + reach_m
+    return np.asarray(np.where(known, values, np.maximum(left, right)))
