@@ -55,6 +55,28 @@ def test_a_jump_at_a_knot_is_named(
     )
 
 
+def test_rounding_at_a_knot_where_the_robot_rests_is_not_a_jump(
+    result: PlanResult, paper_world: ck.CollisionWorld
+) -> None:
+    # a rest-to-rest septic move of theta1, then two segments holding its end (a stop-and-go
+    # trajectory rests so at its vertices): between the holds every local magnitude
+    # vanishes, and a jerk of 2e-6 rad/s^3 there is rounding against the move's peak jerk
+    # (26.25 rad/s^3), not a break
+    coefficients = np.zeros((3, 5, 8))
+    coefficients[:, :, 0] = result.waypoints[0]
+    coefficients[0, 0, 4:] = 0.5 * np.array([35.0, -84.0, 70.0, -20.0])  # zero v, a, j at both ends
+    coefficients[1:, 0, 0] += 0.5
+    coefficients[2, 0, 3] = 2e-6 / 6
+    knots = np.array([0.0, 1.0, 2.0, 3.0])
+    requirements = Requirements(0.1, 0.005)
+    rested = Trajectory(knots, coefficients)
+    assert rested.extrema(3).peak[0] == pytest.approx(26.25)
+    assert not any("continuous" in p for p in verify_trajectory(paper_world, rested, requirements).problems)
+    coefficients[2, 0, 3] = 4e-4 / 6  # beyond rounding: 15e-6 of the peak
+    problems = verify_trajectory(paper_world, Trajectory(knots, coefficients), requirements).problems
+    assert any("(knot 2): the jerk of joint 'theta1' jumps by 0.0004 rad/s^3" in p for p in problems)
+
+
 def test_knot_jumps_agree_with_evaluation_and_vanish_for_the_planned_spline(result: PlanResult) -> None:
     trajectory = result.trajectory
     jump, relative = trajectory.knot_jumps(4)

@@ -60,14 +60,16 @@ LIMIT_TOLERANCE = 1e-9
 CONTINUITY_TOLERANCE = 1e-6
 """Largest jump of position, velocity, acceleration or jerk at a knot of a C3 trajectory
 (:meth:`~planning.curves.trajectory.Trajectory.knot_jumps`): relative to the magnitudes
-summed, or absolute [rad/s^r or m/s^r], whichever is larger (rounding in another tool's file
-must not count)."""
+summed there, or to the joint's largest |value| of that derivative over the trajectory
+(at least 1 rad/s^r or m/s^r), whichever is larger: rounding, in our file or another
+tool's, must not count, also at a knot where the robot rests and the local magnitudes vanish."""
 
 
 def _discontinuity(trajectory: Trajectory, robot: ck.Robot) -> str | None:
     """The worst jump at a knot beyond :data:`CONTINUITY_TOLERANCE`, as a sentence, if any."""
     jump, relative = trajectory.knot_jumps(CONTINUITY + 1)
-    relative = np.where(jump > CONTINUITY_TOLERANCE, relative, 0.0)
+    peak = np.stack([trajectory.extrema(r).peak for r in range(CONTINUITY + 1)], axis=1)  # (nj, r)
+    relative = np.where(jump > CONTINUITY_TOLERANCE * np.maximum(peak, 1.0), relative, 0.0)
     if relative.size == 0 or relative.max() <= CONTINUITY_TOLERANCE:
         return None
     knot, joint, r = np.unravel_index(int(np.argmax(relative)), relative.shape)
