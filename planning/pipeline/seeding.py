@@ -12,8 +12,9 @@ is a small part of its space, rarely met by a random population. So, with the pl
    the clearance the fitness requires (margin plus verification step), and its waypoints
    (:func:`~planning.search.rrt_connect.waypoints_along`) are the second seed. A path is
    clear, but the spline through its few waypoints cuts its corners and may not be: then
-   RRT-Connect draws another path, up to ``path_attempts`` in all, and the first whose
-   seed is feasible (else the one whose seed ranks best) is taken;
+   RRT-Connect draws another path, up to ``path_attempts`` in all while the paths so far
+   took fewer than ``redraw_samples`` samples, and the first whose seed is feasible (else
+   the one whose seed ranks best) is taken;
 3. if a search with the scene's waypoints fails, the next attempt (:meth:`PathSeeding.after`)
    asks for more waypoints when no candidate was feasible (as many as the spline needs to
    follow the path: at least two more and the path's corners, then two more at a time, up
@@ -234,21 +235,25 @@ def _path_seed(problem: Problem, path: FloatArray, count: int, weights: FloatArr
 def _followable_path(problem: Problem, weights: FloatArray) -> tuple[FloatArray | None, PathSeed | None]:
     """RRT-Connect's path whose waypoints seed ``problem`` best (module docstring, step 2), and its seed.
 
-    Up to ``path_attempts`` paths, all drawn from the stream ``default_rng([seed, 1])``;
-    the first whose seed is feasible, else the one of the best fitness; ``None`` when
+    Up to ``path_attempts`` paths, all drawn from the stream ``default_rng([seed, 1])``,
+    another only while those drawn took fewer than ``redraw_samples`` samples in all; the
+    first whose seed is feasible, else the one of the best fitness; ``None`` when
     RRT-Connect finds none (a further draw is not tried: a failed one has used up its samples).
     """
     settings = problem.scene.planner
+    tuning = settings.tuning.seeding
     rng = np.random.default_rng([settings.seed, 1])
     best: tuple[FloatArray, PathSeed] | None = None
-    for _ in range(settings.tuning.seeding.path_attempts):
+    samples = 0
+    for _ in range(tuning.path_attempts):
         found = sampled_path(problem, rng)
         if found is None:
             break
+        samples += found.samples
         seeded = _path_seed(problem, found.path, settings.waypoints, weights)
         if best is None or seeded.fitness < best[1].fitness:
             best = (found.path, seeded)
-        if problem.objective.feasible(seeded.fitness):
+        if problem.objective.feasible(seeded.fitness) or samples >= tuning.redraw_samples:
             break
     return (None, None) if best is None else best
 

@@ -29,6 +29,10 @@ class SeedingTuning:
             clearance the fitness requires (at least 1 cm), when that is less.
         path_attempts: most RRT-Connect paths drawn while the spline through a path's
             waypoints violates the clearance, in [1, 20].
+        redraw_samples: another path is drawn only while the paths drawn so far took fewer
+            random samples than this in all, in [0, 100000]: a path found quickly is worth
+            another try, one that took thousands of samples costs as much again (the
+            search's retries with more waypoints repair its spline instead).
         max_samples: random samples after which RRT-Connect gives up on a path, in
             [1, 100000] (a narrow passage may need several thousand; a failed draw costs
             about 0.15 ms a sample).
@@ -44,6 +48,7 @@ class SeedingTuning:
     spread: float = 0.01
     max_resolution_m: float = 0.04
     path_attempts: int = 3
+    redraw_samples: int = 1_000
     max_samples: int = 10_000
     more_waypoints: int = 6
     finer_step: float = 0.2
@@ -53,6 +58,7 @@ class SeedingTuning:
         number_in("spread", self.spread, 0.0, 1.0)
         number_in("max_resolution_m", self.max_resolution_m, 0.0, 1.0, unit="m", low_open=True)
         integer_in("path_attempts", self.path_attempts, 1, 20)
+        integer_in("redraw_samples", self.redraw_samples, 0, 100_000)
         integer_in("max_samples", self.max_samples, 1, 100_000)
         integer_in("more_waypoints", self.more_waypoints, 0, 20)
         number_in("finer_step", self.finer_step, 0.0, 1.0, low_open=True)
