@@ -12,14 +12,16 @@ is (:mod:`planning.pipeline.path_following`) before the plan says "no solution".
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import time
 from collections.abc import Callable
 
 import numpy as np
+from numpy.typing import NDArray
 
 import cpr_kin as ck
 from planning.curves.trajectory import Trajectory
-from planning.errors import NoSolutionError
+from planning.errors import NoSolutionError, PlanningError
 from planning.pipeline.choose import Choice, Refusal, choose, verify
 from planning.pipeline.metrics import Elapsed
 from planning.pipeline.path_following import follow_path
@@ -28,9 +30,12 @@ from planning.pipeline.result import PlanResult, assemble
 from planning.pipeline.scene import Scene
 from planning.pipeline.search import search
 from planning.pipeline.seeding import SEEDINGS, NoSeeding
+from planning.pipeline.target import Target
 from planning.pipeline.timing import Timing
 from planning.search.firefly import FireflyProgress
 from planning.search.optimizer import Optimizer, SearchResult
+
+FloatArray = NDArray[np.float64]
 
 
 def solve(
@@ -133,11 +138,51 @@ def warm_up(robot: ck.Robot | None = None) -> float:
 
     Planning does it anyway on its first call; this moves the one-time cost (several
     seconds on a new machine, a fraction of a second per process afterwards) out of a plan
-    that is timed. It plans the paper case with two fireflies for one iteration.
+    that is timed. It plans the paper case with two fireflies for one iteration and, for a
+    robot of its own, a small motion of that robot in its joint space (the paper's poses may
+    be out of its reach), then asks its collision world every kind of query once.
     """
     from planning.io.bundled import paper_scene
 
     started = time.perf_counter()
+    small = paper_scene(fireflies=2, iterations=1)
     with contextlib.suppress(NoSolutionError):  # a search this small may find nothing: the kernels ran
-        plan(paper_scene(fireflies=2, iterations=1), robot, threads=1)
+        plan(small, robot, threads=1)
+    if robot is not None:
+        q = _configurations(robot, 64)
+        collision = ck.CollisionWorld(robot, []).self_collision
+        if collision:  # the configuration farthest from itself
+            q = q[np.argsort(-collision.distances(q)[0])]
+        start, goal = (
+            Target(q=tuple(q[0])),
+            Target(q=tuple(np.minimum(robot.model.upperPositionLimit, q[0] + 0.1))),
+        )
+        far = ck.Obstacle.box((0.1, 0.1, 0.1), (0.0, 0.0, 10.0))
+        own = dataclasses.replace(
+            small, start=start, goal=goal, obstacles=(far,), self_margin=0.0, duration=None
+        )
+        with contextlib.suppress(PlanningError, NoSolutionError):  # what ran, ran
+            plan(own, robot, threads=1)
+        _query_collisions(robot)
     return time.perf_counter() - started
+
+
+def _configurations(robot: ck.Robot, count: int) -> FloatArray:
+    """``count`` seeded random configurations of ``robot`` in its ranges (continuous joints: one turn)."""
+    lower = np.clip(robot.model.lowerPositionLimit, -np.pi, np.pi)
+    upper = np.clip(robot.model.upperPositionLimit, -np.pi, np.pi)
+    return np.random.default_rng(0).uniform(lower, np.maximum(upper, lower), (count, robot.nq))
+
+
+def _query_collisions(robot: ck.Robot) -> None:
+    """Ask ``robot``'s collision world every kind of query once, its own pairs' too.
+
+    A compiled kernel loads from its cache on its first call in a process.
+    """
+    q = _configurations(robot, 4)
+    world = ck.CollisionWorld(robot, [ck.Obstacle.box((0.1, 0.1, 0.1), (0.0, 0.0, 10.0))])
+    world.margin_violated(q, 0.01)
+    world.min_clearance_batch(q)
+    if world.self_collision:
+        world.self_collision.violated(q, 0.01)
+        world.self_collision.distances(q)
