@@ -91,11 +91,15 @@ class ObstaclePools:
             self._pools[obstacle] = pin.GeometryPool(self.model, self.geometry_model, self.num_threads)
         pool = self._pools[obstacle]
         if self._margin_m.get(obstacle) != margin_m:
-            margins = np.full((self.geometry_model.ngeoms,) * 2, float(margin_m))
-            active = near & (self._pair_obstacle == obstacle)
-            for gdata in pool.getGeometryDatas():
-                gdata.setSecurityMargins(self.geometry_model, margins, True, True)
-                for p, on in enumerate(active):
-                    (gdata.activateCollisionPair if on else gdata.deactivateCollisionPair)(p)
+            configure_pool(pool, self.geometry_model, margin_m, near & (self._pair_obstacle == obstacle))
             self._margin_m[obstacle] = margin_m
         return pool
+
+
+def configure_pool(pool: Any, geometry_model: Any, margin_m: float, active: BoolArray) -> None:
+    """Give each geometry data of ``pool`` the security margin ``margin_m`` [m], only ``active`` pairs on."""
+    margins = np.full((geometry_model.ngeoms,) * 2, float(margin_m))
+    for gdata in pool.getGeometryDatas():
+        gdata.setSecurityMargins(geometry_model, margins, True, True)
+        for p, on in enumerate(active):
+            (gdata.activateCollisionPair if on else gdata.deactivateCollisionPair)(p)

@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 from cpr_kin.batch_kinematics import ChainArrays, KinematicChain, place_joints
 from cpr_kin.closest_pairs import closest_pairs
 from cpr_kin.compiled import njit
-from cpr_kin.obstacle_pools import pool_collisions
+from cpr_kin.obstacle_pools import configure_pool, pool_collisions
 from cpr_kin.pair_bounds import BOUND_TOLERANCE_M, joint_capsules
 
 FloatArray = NDArray[np.float64]
@@ -234,7 +234,7 @@ class ScreenedSelfTest:
         )
 
     def _prepare(self, margin_m: float) -> None:
-        """Build the two pools and distance data once; set the pools' security margin when it changes.
+        """Build the two pools and distance data once; set their margin and pairs when the margin changes.
 
         A NaN ``margin_m`` leaves the margin as it is.
         """
@@ -244,15 +244,10 @@ class ScreenedSelfTest:
             self._pools = [
                 pin.GeometryPool(self.model, self.geometry_model, self.num_threads) for _ in range(2)
             ]
-            for pool, active in zip(self._pools, self._active, strict=True):
-                for gdata in pool.getGeometryDatas():
-                    for p, on in enumerate(active):
-                        (gdata.activateCollisionPair if on else gdata.deactivateCollisionPair)(p)
         if margin_m != self._margin_m and not np.isnan(margin_m):
-            margins = np.full((self.geometry_model.ngeoms,) * 2, float(margin_m))
-            for pool in self._pools:
+            for pool, active in zip(self._pools, self._active, strict=True):
+                configure_pool(pool, self.geometry_model, margin_m, active)
                 for gdata in pool.getGeometryDatas():
-                    gdata.setSecurityMargins(self.geometry_model, margins, True, True)
                     for request in gdata.collisionRequests:
                         request.enable_contact = False
             self._margin_m = margin_m
