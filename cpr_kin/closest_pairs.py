@@ -27,6 +27,7 @@ IntArray = NDArray[np.int64]
 
 def closest_pairs(
     model: Any,
+    data: Any,
     geometry_model: Any,
     geometry_data: Any,
     batch: FloatArray,
@@ -38,6 +39,7 @@ def closest_pairs(
 
     Args:
         model: the robot's Pinocchio model.
+        data: its data (the joint placements are written into it).
         geometry_model: the geometry model holding the pairs.
         geometry_data: its data (placements and distance results are written into it).
         batch: ``(N, nq)`` configurations.
@@ -54,7 +56,6 @@ def closest_pairs(
     """
     distance = np.full(len(batch), np.inf)
     closest = np.full(len(batch), -1, dtype=np.int64)
-    data = model.createData()
     order = np.argsort(bounds, axis=1, kind="stable")
     ordered = np.take_along_axis(bounds, order, axis=1)
     place, compute = pin.updateGeometryPlacements, pin.computeDistance

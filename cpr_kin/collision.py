@@ -191,7 +191,14 @@ class CollisionWorld:
         near, bounds = self._pairs_within(below_m)
         values = np.empty((len(batch), 0)) if bounds is None else bounds(batch)
         return closest_pairs(
-            self.robot.model, self.geometry_model, self._all, batch, values, np.flatnonzero(near), below_m
+            self.robot.model,
+            self._data,
+            self.geometry_model,
+            self._all,
+            batch,
+            values,
+            np.flatnonzero(near),
+            below_m,
         )
 
     def _closest_pairs(self, batch: FloatArray, gdata: Any) -> tuple[FloatArray, IntArray]:

@@ -224,7 +224,13 @@ class ScreenedSelfTest:
         self._prepare(float("nan"))
         bounds = self.all_bounds(batch)
         return closest_pairs(
-            self.model, self.geometry_model, self._distance_data, batch, bounds, np.arange(bounds.shape[1])
+            self.model,
+            self._data,
+            self.geometry_model,
+            self._distance_data,
+            batch,
+            bounds,
+            np.arange(bounds.shape[1]),
         )
 
     def _coal(self, tier: int, batch: FloatArray) -> NDArray[np.bool_]:

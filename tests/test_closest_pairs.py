@@ -70,14 +70,16 @@ def test_exact_bounds_cost_one_query_and_useless_ones_every_pair(
     counting = CountingDistance()
     monkeypatch.setattr(pin, "computeDistance", counting)
     distance, closest = closest_pairs(
-        model, geometry_model, geometry_model.createData(), q, exact - 1e-3, pairs
+        model, model.createData(), geometry_model, geometry_model.createData(), q, exact - 1e-3, pairs
     )
     assert counting.calls == len(q)  # the closest pair's bound is the smallest, and the next is farther
     np.testing.assert_allclose(distance, exact.min(axis=1), atol=1e-5)
     np.testing.assert_array_equal(closest, exact.argmin(axis=1))
     counting.calls = 0
     useless = np.zeros_like(exact)  # a bound of 0 says nothing: every pair must be asked
-    distance, _ = closest_pairs(model, geometry_model, geometry_model.createData(), q, useless, pairs)
+    distance, _ = closest_pairs(
+        model, model.createData(), geometry_model, geometry_model.createData(), q, useless, pairs
+    )
     assert counting.calls == exact.size
     np.testing.assert_allclose(distance, exact.min(axis=1), atol=1e-5)
 
@@ -94,6 +96,7 @@ def test_a_non_positive_bound_never_hides_a_deeper_penetration(
     bounds = np.where(exact < 0, -1.0 - exact, exact)
     distance, _ = closest_pairs(
         robot.model,
+        robot.model.createData(),
         cluttered.geometry_model,
         cluttered.geometry_model.createData(),
         q,
