@@ -9,7 +9,7 @@ from .errors import CprKinError, IkMissError, JointLimitError, ObstacleError, Un
 from .ik import tcp_ik
 from .interval_motion import IntervalSpeed
 from .kinematics import frame_poses, frame_positions
-from .limits import JointLimits
+from .limits import JointLimits, sampled_configurations
 from .loading import RobotSpec, load_robot
 from .motion import CurveCheck, check_curve, check_segment, motion_radii
 from .numerical_ik import IkSettings, IkTarget, solve_ik
@@ -56,6 +56,7 @@ __all__ = [
     "motion_radii",
     "robot_dynamics",
     "robot_spec",
+    "sampled_configurations",
     "solve_ik",
     "tcp_ik",
 ]

@@ -202,3 +202,13 @@ def read_dynamic_limits(
                 f"the URDF's {urdf_velocity[i]}; edit one so that they match"
             )
     return DynamicLimits(acc, jerk, path, tuple(defaulted))
+
+
+def sampled_configurations(model: Any, count: int, rng: np.random.Generator) -> FloatArray:
+    """``(count, nq)`` configurations drawn uniformly within ``model``'s position limits.
+
+    Each range is clipped to one turn, ``[-pi, pi]`` (a continuous joint's is unbounded).
+    """
+    lower = np.clip(model.lowerPositionLimit, -np.pi, np.pi)
+    upper = np.clip(model.upperPositionLimit, -np.pi, np.pi)
+    return np.asarray(rng.uniform(lower, np.maximum(upper, lower), (count, model.nq)))

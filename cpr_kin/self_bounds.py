@@ -22,6 +22,7 @@ from numpy.typing import NDArray
 from cpr_kin.batch_kinematics import ChainArrays, KinematicChain, place_joints
 from cpr_kin.closest_pairs import closest_pairs
 from cpr_kin.compiled import njit
+from cpr_kin.limits import sampled_configurations
 from cpr_kin.obstacle_pools import configure_pool, pool_collisions
 from cpr_kin.pair_bounds import BOUND_TOLERANCE_M, joint_capsules
 
@@ -185,10 +186,7 @@ class ScreenedSelfTest:
         self, model: Any, geometry_model: Any, pairs: Sequence[tuple[int, int]], num_threads: int
     ) -> None:
         self.model, self.geometry_model, self.num_threads = model, geometry_model, num_threads
-        rng = np.random.default_rng(0)
-        lower = np.clip(model.lowerPositionLimit, -np.pi, np.pi)
-        upper = np.clip(model.upperPositionLimit, -np.pi, np.pi)
-        probes = rng.uniform(lower, np.maximum(upper, lower), (PROBES, model.nq))
+        probes = sampled_configurations(model, PROBES, np.random.default_rng(0))
         self.all_bounds = SelfPairBounds(model, geometry_model, pairs)
         uncertain = self.all_bounds(probes, PROBE_THRESHOLD_M) <= PROBE_THRESHOLD_M
         near = uncertain.mean(axis=0) > NEAR_SHARE

@@ -149,38 +149,28 @@ def warm_up(robot: ck.Robot | None = None) -> float:
     with contextlib.suppress(NoSolutionError):  # a search this small may find nothing: the kernels ran
         plan(small, robot, threads=1)
     if robot is not None:
-        q = _configurations(robot, 64)
-        collision = ck.CollisionWorld(robot, []).self_collision
-        if collision:  # the configuration farthest from itself
-            q = q[np.argsort(-collision.distances(q)[0])]
+        world = ck.CollisionWorld(robot, [ck.Obstacle.box((0.1, 0.1, 0.1), (0.0, 0.0, 10.0))])
+        q = ck.sampled_configurations(robot.model, 64, np.random.default_rng(0))
+        if world.self_collision:  # the configuration farthest from itself first
+            q = q[np.argsort(-world.self_collision.distances(q)[0])]
         start, goal = (
             Target(q=tuple(q[0])),
             Target(q=tuple(np.minimum(robot.model.upperPositionLimit, q[0] + 0.1))),
         )
-        far = ck.Obstacle.box((0.1, 0.1, 0.1), (0.0, 0.0, 10.0))
         own = dataclasses.replace(
-            small, start=start, goal=goal, obstacles=(far,), self_margin=0.0, duration=None
+            small, start=start, goal=goal, obstacles=world.obstacles, self_margin=0.0, duration=None
         )
         with contextlib.suppress(PlanningError, NoSolutionError):  # what ran, ran
             plan(own, robot, threads=1)
-        _query_collisions(robot)
+        _query_collisions(world, q[:4])
     return time.perf_counter() - started
 
 
-def _configurations(robot: ck.Robot, count: int) -> FloatArray:
-    """``count`` seeded random configurations of ``robot`` in its ranges (continuous joints: one turn)."""
-    lower = np.clip(robot.model.lowerPositionLimit, -np.pi, np.pi)
-    upper = np.clip(robot.model.upperPositionLimit, -np.pi, np.pi)
-    return np.random.default_rng(0).uniform(lower, np.maximum(upper, lower), (count, robot.nq))
-
-
-def _query_collisions(robot: ck.Robot) -> None:
-    """Ask ``robot``'s collision world every kind of query once, its own pairs' too.
+def _query_collisions(world: ck.CollisionWorld, q: FloatArray) -> None:
+    """Ask ``world`` every kind of query once at configurations ``q``, its robot's own pairs too.
 
     A compiled kernel loads from its cache on its first call in a process.
     """
-    q = _configurations(robot, 4)
-    world = ck.CollisionWorld(robot, [ck.Obstacle.box((0.1, 0.1, 0.1), (0.0, 0.0, 10.0))])
     world.margin_violated(q, 0.01)
     world.min_clearance_batch(q)
     if world.self_collision:
