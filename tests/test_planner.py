@@ -13,8 +13,10 @@ import cpr_kin as ck
 from planning.errors import NoTrajectoryFoundError, PlanningError, TargetOutOfReachError
 from planning.io.bundled import paper_scene
 from planning.pipeline.planner import plan, warm_up
+from planning.pipeline.problem import build_problem
 from planning.pipeline.result import PlanResult
 from planning.pipeline.scene import Scene
+from planning.pipeline.seeding import seed_search
 from planning.pipeline.settings import PlannerSettings
 from planning.pipeline.target import Target
 from planning.pipeline.tuning import SearchTuning
@@ -226,7 +228,9 @@ def test_early_stop_and_seeds_keep_a_plan_byte_identical(robot: ck.Robot) -> Non
 def test_refinement_continues_the_firefly_and_only_improves(robot: ck.Robot) -> None:
     from planning.io.scene_generator import generate_scenes
 
+    exploring = SearchTuning(explore_feasible_seed=True)  # the firefly runs from feasible seeds too
     for scene in generate_scenes(4, seed=2, robot=robot, narrow=1):
+        scene = dataclasses.replace(scene, planner=scene.planner.updated(tuning=exploring))
         refined = plan(scene, robot)
         alone = plan(dataclasses.replace(scene, planner=scene.planner.updated(refine="none")), robot)
         assert scene.planner.refine == "cma" and refined.verification.accepted
@@ -237,6 +241,26 @@ def test_refinement_continues_the_firefly_and_only_improves(robot: ck.Robot) -> 
         assert refined.optimiser.fitness <= firefly.fitness
         assert refined.optimiser.evaluations >= firefly.evaluations
         assert refined.optimiser.evaluations <= scene.planner.firefly.evaluations
+
+
+def test_a_feasible_seed_is_refined_without_the_firefly(robot: ck.Robot) -> None:
+    from planning.io.scene_generator import generate_scenes
+
+    refined_at_once = 0
+    for scene in generate_scenes(4, seed=2, robot=robot, narrow=1):
+        problem = build_problem(scene, robot)
+        seeds = seed_search(problem)
+        result = plan(scene, robot)
+        assert result.verification.accepted
+        first = result.optimiser
+        if seeds.feasible:  # the refinement's first entry: the seeds, evaluated once
+            refined_at_once += 1
+            assert first.evaluation_history[0] == len(seeds.candidates)
+            objective = seeds.problem.objective
+            assert first.best_history[0] == pytest.approx(objective(seeds.candidates).min(), rel=1e-12)
+        else:  # the firefly's population first
+            assert first.evaluation_history[0] == scene.planner.firefly.fireflies
+    assert refined_at_once >= 2
 
 
 def test_refine_stall_zero_runs_the_same_refinement_on_to_the_budget(robot: ck.Robot) -> None:

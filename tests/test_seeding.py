@@ -30,6 +30,7 @@ def test_a_clear_straight_line_is_the_only_path_seed(robot: ck.Robot) -> None:
     problem = build_problem(scene, robot)
     seeds = seed_search(problem)
     assert seeds.straight_line_clear and seeds.path is None and seeds.problem is problem
+    assert seeds.feasible  # the search refines the straight line at once
     np.testing.assert_array_equal(seeds.candidates[0], problem.objective.straight_line())
     assert len(seeds.candidates) == int(SeedingTuning().share * scene.planner.firefly.fireflies)
     objective = problem.objective
@@ -53,6 +54,9 @@ def test_a_blocked_line_is_seeded_with_a_clear_sampled_path(robot: ck.Robot, win
     # the straight line, then the path's waypoints
     np.testing.assert_array_equal(seeds.candidates[0], seeds.problem.objective.straight_line())
     assert seeds.candidates.shape[1] == seeds.problem.objective.dimension
+    # feasible as the path's seed is
+    objective = seeds.problem.objective
+    assert seeds.feasible == bool(objective.feasible(objective(seeds.candidates[1:2])[0]))
 
 
 def test_more_waypoints_follow_the_path_until_the_spline_keeps_the_clearance(window: Problem) -> None:

@@ -30,9 +30,10 @@ cut to ``finer_step`` of it (1 mm of the default 5 mm), which lets a path pass w
 millimetre of the margin at the price of a denser certified check.
 
 The seeds and ``spread``-sized moves around them make up ``share`` of the initial
-population (:class:`~planning.pipeline.tuning.SeedingTuning`). The sampling planner and the
-moves draw from their own streams, ``default_rng([seed, 1])`` and ``[seed, 2]``: the
-firefly's draws are the same with or without them. ``seeding: none`` (the paper,
+population (:class:`~planning.pipeline.tuning.SeedingTuning`); when a seed is feasible, the
+search refines it without the firefly (:attr:`Attempt.feasible_seed`). The sampling planner
+and the moves draw from their own streams, ``default_rng([seed, 1])`` and ``[seed, 2]``:
+the firefly's draws are the same with or without them. ``seeding: none`` (the paper,
 :class:`NoSeeding`) searches once, from a random population.
 """
 
@@ -79,6 +80,7 @@ class Seeds:
         path: the sampling planner's path in the moving joints, or ``None`` when the
             straight line was clear or no path was found [joint units].
         straight_line_clear: the straight line's candidate is feasible.
+        feasible: a seed is feasible, the straight line's or the path's.
         time_s: wall time of the seeding [s].
     """
 
@@ -86,6 +88,7 @@ class Seeds:
     candidates: FloatArray
     path: FloatArray | None
     straight_line_clear: bool
+    feasible: bool
     time_s: float
 
 
@@ -99,6 +102,7 @@ class Attempt:
         path: the sampling planner's path the seeds follow, reused by the next attempt.
         number: 0 for the first attempt, then 1, 2, ...
         tried: what the seeding tried and did not find, for a message (empty: nothing).
+        feasible_seed: a seed is feasible: the search refines it without the firefly.
     """
 
     problem: Problem
@@ -106,6 +110,7 @@ class Attempt:
     path: FloatArray | None = None
     number: int = 0
     tried: str = ""
+    feasible_seed: bool = False
 
 
 class Seeding(Protocol):
@@ -144,9 +149,9 @@ class PathSeeding:
             if finer < settings.verify_step_m:
                 closer = seed_search(with_planner(problem, verify_step_m=finer))
                 if closer.path is not None:  # a passage narrower than margin plus the step
-                    return Attempt(closer.problem, closer.candidates, closer.path, 0)
+                    return Attempt(closer.problem, closer.candidates, closer.path, 0, "", closer.feasible)
                 tried += f" (nor {closer.problem.objective.required_m:.4g} m)"
-        return Attempt(seeds.problem, seeds.candidates, seeds.path, 0, tried)
+        return Attempt(seeds.problem, seeds.candidates, seeds.path, 0, tried, seeds.feasible)
 
     def after(self, attempt: Attempt, searched: SearchResult) -> Attempt | None:  # noqa: D102
         problem = attempt.problem
@@ -157,7 +162,8 @@ class PathSeeding:
             samples = problem.scene.planner.fitness_samples
             problem = with_planner(problem, fitness_samples=min(2 * samples, MAX_FITNESS_SAMPLES))
         seeds = seed_search(problem, widen, attempt.path)
-        return Attempt(seeds.problem, seeds.candidates, seeds.path, attempt.number + 1, attempt.tried)
+        number, tried = attempt.number + 1, attempt.tried
+        return Attempt(seeds.problem, seeds.candidates, seeds.path, number, tried, seeds.feasible)
 
 
 SEEDINGS: dict[str, Seeding] = {"paths": PathSeeding(), "none": NoSeeding()}
@@ -215,14 +221,17 @@ def seed_search(problem: Problem, more_waypoints: bool = False, path: FloatArray
     if path is None and not clear:
         path, seeded = _followable_path(problem, weights)
     if path is None:
-        return Seeds(problem, _around(problem, straight[None]), None, clear, time.perf_counter() - started)
+        return Seeds(
+            problem, _around(problem, straight[None]), None, clear, clear, time.perf_counter() - started
+        )
     if more_waypoints:
         seeded = _fewest_waypoints(problem, path, weights)
     elif seeded is None:
         seeded = _path_seed(problem, path, problem.scene.planner.waypoints, weights)
     problem = seeded.problem
     candidates = np.array([problem.objective.straight_line(), seeded.x])
-    return Seeds(problem, _around(problem, candidates), path, clear, time.perf_counter() - started)
+    feasible = clear or bool(problem.objective.feasible(seeded.fitness))
+    return Seeds(problem, _around(problem, candidates), path, clear, feasible, time.perf_counter() - started)
 
 
 def _path_seed(problem: Problem, path: FloatArray, count: int, weights: FloatArray) -> PathSeed:

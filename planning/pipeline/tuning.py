@@ -79,6 +79,10 @@ class SearchTuning:
         narrowed_acceleration: shares of the acceleration limits of the narrowed timings,
             tried in turn once a fastest timing fails the certified check; each in (0, 1),
             decreasing.
+        explore_feasible_seed: the firefly explores before the refinement even when a seed
+            (the straight line's or the sampling planner's) is feasible; by default the
+            refinement then starts from it at once, and the firefly runs only when no seed
+            is feasible.
     """
 
     seeding: SeedingTuning = field(default_factory=SeedingTuning)
@@ -86,11 +90,16 @@ class SearchTuning:
     retries: int = 2
     preferred_first: int = 3
     narrowed_acceleration: tuple[float, ...] = (0.7, 0.5, 0.35)
+    explore_feasible_seed: bool = False
 
     def __post_init__(self) -> None:
         if not isinstance(self.seeding, SeedingTuning) or not isinstance(self.refinement, RefinementSettings):
             raise PlanningError("seeding and refinement must be a SeedingTuning and a RefinementSettings")
         integer_in("retries", self.retries, 0, 10)
+        if not isinstance(self.explore_feasible_seed, bool):
+            raise PlanningError(
+                f"explore_feasible_seed = {self.explore_feasible_seed!r} must be True or False"
+            )
         integer_in("preferred_first", self.preferred_first, 1, 100)
         shares = tuple(self.narrowed_acceleration)
         for k, share in enumerate(shares):

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from planning.errors import PlanningError
 
@@ -150,3 +150,34 @@ class Optimizer(Protocol):
     ) -> SearchResult:
         """Minimise ``objective`` over ``[lower, upper]`` in at most ``budget`` evaluations."""
         ...
+
+
+def evaluated_points(
+    objective: BatchObjective, lower: ArrayLike, upper: ArrayLike, points: ArrayLike
+) -> SearchResult:
+    """``points`` ``(k, d)`` of the box evaluated in one batch, as a search's result.
+
+    The best of them is its point, all of them its population (best first); one history
+    entry.
+
+    Raises:
+        PlanningError: ``points`` is not a non-empty ``(k, d)`` batch of the box.
+    """
+    lo, hi = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+    given = np.asarray(points, dtype=float)
+    if (
+        given.ndim != 2
+        or len(given) == 0
+        or given.shape[1:] != lo.shape
+        or not np.all((given >= lo) & (given <= hi))
+    ):
+        raise PlanningError(
+            f"points of shape {given.shape} must be k >= 1 points of the box, {lo.shape} each"
+        )
+    span = hi - lo
+    u = (given - lo) / span
+    values = evaluate_in_box(objective, lo, span, u)
+    order = np.argsort(values, kind="stable")
+    history = History()
+    history.record(float(values[order[0]]), float(np.mean(values)), len(values))
+    return history.result(lo, span, u[order[0]], float(values[order[0]]), u[order], values[order])

@@ -7,6 +7,8 @@ be feasible: a seed that misses only by a little (a spline overshooting a joint 
 fraction of a percent, or grazing the margin) is one the firefly's random moves rarely
 improve, while the refinement's small steps follow the fitness's penalty down to feasible
 values; the early stop so counts stalled iterations whether the best is feasible or not.
+With ``explore=False`` (the planner's default) a feasible seed is refined at once: the
+firefly's moves around it rarely improve on it (``docs/tuning.md``).
 
 The planner runs it on its waypoint objective, and the benchmark of peer
 optimisers (``scripts/bench_peers.py``) runs the same object beside the peers, so both
@@ -25,7 +27,7 @@ from numpy.typing import NDArray
 
 from planning.search.firefly import FireflyProgress, firefly_minimize
 from planning.search.firefly_settings import FireflySettings
-from planning.search.optimizer import BatchObjective, SearchResult
+from planning.search.optimizer import BatchObjective, SearchResult, evaluated_points
 from planning.search.refinement import refine_search
 from planning.search.refinement_settings import STALL_GENERATIONS, RefinementSettings
 
@@ -48,6 +50,9 @@ class RefinedFirefly:
         lower_bound: about the least value the objective can take (the refinement counts
             stalls only near it); ``None``: unknown.
         progress: called after every firefly iteration.
+        explore: the firefly runs before the refinement. ``False``: the refinement starts
+            from the best of the ``seeds`` when that one is feasible (the firefly runs when
+            none is, or without seeds or a refinement).
     """
 
     firefly: FireflySettings
@@ -57,6 +62,7 @@ class RefinedFirefly:
     feasible_below: float = math.inf
     lower_bound: float | None = None
     progress: Callable[[FireflyProgress], None] | None = None
+    explore: bool = True
 
     def __call__(
         self,
@@ -71,10 +77,16 @@ class RefinedFirefly:
         iterations = max(budget // settings.fireflies - 1, 0)
         if iterations != settings.iterations:
             settings = dataclasses.replace(settings, iterations=iterations)
-        stall_below = self.feasible_below if self.refinement is None else math.inf
-        found = firefly_minimize(
-            objective, lower, upper, settings, rng, self.progress, self.seeds, stall_below=stall_below
-        )
+        found: SearchResult | None = None
+        if not self.explore and self.seeds is not None and self.refinement is not None:
+            found = evaluated_points(objective, lower, upper, self.seeds)
+            if found.fitness > self.feasible_below:
+                found = None
+        if found is None:
+            stall_below = self.feasible_below if self.refinement is None else math.inf
+            found = firefly_minimize(
+                objective, lower, upper, settings, rng, self.progress, self.seeds, stall_below=stall_below
+            )
         if self.refinement is None:
             return found
         return refine_search(
