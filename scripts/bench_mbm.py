@@ -11,9 +11,11 @@ margins 0 as in MoveIt), then, alternating, is planned warm by
   collision model (obstacles and self pairs), 1 s per attempt, new seeds up to ``--timeout``.
 
 Both are verified by the same certified checks. Printed per class: problems whose start and
-goal are valid in our model, solved by each, median and p95 warm planning time of each and
-the ratio of the medians, ours' median duration over Ruckig's jerk-limited bound for the
-straight line, OMPL's median jerk over the limit. Rows go to ``DIR/mbm.csv``, the table as
+goal are valid in our model, solved by each, median and p95 warm planning time of each over
+the problems it solved and the ratio of those medians, then the ratio of the medians over the
+problems both solved (the same problems) and over every valid problem (a failure counted at
+the time it took, up to the timeout), ours' median duration over Ruckig's jerk-limited bound
+for the straight line, OMPL's median jerk over the limit. Rows go to ``DIR/mbm.csv``, the table as
 markdown to ``DIR/mbm.md``. Needs the ``bench`` extra; the problems are downloaded once
 (:mod:`planning.io.mbm`).
 """
@@ -116,6 +118,11 @@ def percentile(values: list[float], q: float) -> float:
     return float(np.percentile(values, q)) if values else float("nan")
 
 
+def median_ratio(mine: list[float], peer: list[float]) -> float:
+    """Median of ``mine`` over median of ``peer`` (nan when either is empty)."""
+    return statistics.median(mine) / statistics.median(peer) if mine and peer else float("nan")
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--robots", nargs="+", default=["panda", "ur5"], choices=["panda", "ur5", "fetch"])
@@ -145,7 +152,7 @@ def main() -> int:
                 try:
                     row |= {f"ours_{k}": v for k, v in future.result(timeout=args.timeout).items()}
                 except FutureTimeout:
-                    row |= {"ours_ok": False, "ours_time_s": float("inf"), "ours_why": "timeout"}
+                    row |= {"ours_ok": False, "ours_time_s": args.timeout, "ours_why": "timeout"}
                     for process in list(getattr(pool, "_processes", {}).values()):
                         process.kill()
                     pool.shutdown(wait=False, cancel_futures=True)
@@ -161,14 +168,14 @@ def main() -> int:
         writer.writeheader()
         writer.writerows(rows)
     print(f"\n{'robot':6s} {'class':17s} {'valid':>5s} {'ours':>4s} {'ompl':>4s}", end="")
-    print(f"  {'ours med/p95 s':>15s}  {'ompl med/p95 s':>15s}  ratio  dur/bound  ompl jerk/lim")
+    print(f"  {'ours med/p95 s':>15s}  {'ompl med/p95 s':>15s}  ratio  both   all  dur/bound  ompl jerk/lim")
     report = [
         f"MotionBenchMaker, {args.limit or 100} problem(s) per class, timeout {args.timeout:g} s, warm "
         "(`scripts/bench_mbm.py`)",
         "",
         "| robot | class | valid | solved ours | solved OMPL | ours median (p95) [s] | OMPL median (p95) [s] "
-        "| ratio | ours duration / Ruckig bound | OMPL jerk / limit |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        "| ratio | ratio, both solved | ratio, all | ours duration / Ruckig bound | OMPL jerk / limit |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for robot_name in args.robots:
         for problem_class in [*args.classes, "all"]:
@@ -180,17 +187,22 @@ def main() -> int:
             peer = [r["ompl_time_s"] for r in group if r.get("ompl_ok")]
             bounds = [r["ours_over_bound"] for r in group if r.get("ours_ok")]
             jerks = [r["ompl_jerk"] for r in group if r.get("ompl_ok")]
-            ratio = statistics.median(mine) / statistics.median(peer) if mine and peer else float("nan")
+            ratio = median_ratio(mine, peer)
+            both = [r for r in group if r.get("ours_ok") and r.get("ompl_ok")]
+            ratio_both = median_ratio([r["ours_time_s"] for r in both], [r["ompl_time_s"] for r in both])
+            ratio_all = median_ratio([r["ours_time_s"] for r in group], [r["ompl_time_s"] for r in group])
             print(
                 f"{robot_name:6s} {problem_class:17s} {len(group):5d} {len(mine):4d} {len(peer):4d}  "
                 f"{percentile(mine, 50):6.2f} / {percentile(mine, 95):6.2f}  "
                 f"{percentile(peer, 50):6.2f} / {percentile(peer, 95):6.2f}"
-                f"  {ratio:5.2f}  {percentile(bounds, 50):9.3f}  {percentile(jerks, 50):13.1f}"
+                f"  {ratio:5.2f} {ratio_both:5.2f} {ratio_all:5.2f}"
+                f"  {percentile(bounds, 50):9.3f}  {percentile(jerks, 50):13.1f}"
             )
             report.append(
                 f"| {robot_name} | {problem_class} | {len(group)} | {len(mine)} | {len(peer)} "
                 f"| {percentile(mine, 50):.2f} ({percentile(mine, 95):.2f}) "
                 f"| {percentile(peer, 50):.2f} ({percentile(peer, 95):.2f}) | {ratio:.2f} "
+                f"| {ratio_both:.2f} ({len(both)}) | {ratio_all:.2f} "
                 f"| {percentile(bounds, 50):.3f} | {percentile(jerks, 50):.1f} |"
             )
     (args.out / "mbm.md").write_text("\n".join(report) + "\n")
