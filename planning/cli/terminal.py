@@ -22,7 +22,10 @@ def terminal_bar(total: int, desc: str, unit: str, leave: bool = True) -> Any:
 
 
 def firefly_progress(enabled: bool) -> tuple[Callable[[FireflyProgress], None] | None, Callable[[], None]]:
-    """A tqdm bar over the firefly iterations when enabled (stdout is a terminal), and its closer."""
+    """A tqdm bar over the search's firefly iterations when enabled (stdout is a terminal), and its closer.
+
+    A search that refines a feasible seed without the firefly shows the seeds' best only.
+    """
     if not enabled:
         return None, lambda: None
     bar: Any = None
@@ -30,7 +33,7 @@ def firefly_progress(enabled: bool) -> tuple[Callable[[FireflyProgress], None] |
     def update(progress: FireflyProgress) -> None:
         nonlocal bar
         if bar is None:
-            bar = terminal_bar(progress.iterations, "firefly", "it", leave=False)
+            bar = terminal_bar(progress.iterations, "search", "it", leave=False)
         else:
             bar.update(1)
         bar.set_postfix(best=f"{progress.best:.4g}")

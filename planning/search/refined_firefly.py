@@ -49,7 +49,8 @@ class RefinedFirefly:
             best keeps exploring, as nothing would repair it.
         lower_bound: about the least value the objective can take (the refinement counts
             stalls only near it); ``None``: unknown.
-        progress: called after every firefly iteration.
+        progress: called after every firefly iteration, or once for the seeds when the
+            firefly does not run.
         explore: the firefly runs before the refinement. ``False``: the refinement starts
             from the best of the ``seeds`` when that one is feasible (the firefly runs when
             none is, or without seeds or a refinement).
@@ -82,6 +83,9 @@ class RefinedFirefly:
             found = evaluated_points(objective, lower, upper, self.seeds)
             if found.fitness > self.feasible_below:
                 found = None
+            elif self.progress is not None:  # the seeds are the search's initial population
+                mean = float(found.mean_history[0])
+                self.progress(FireflyProgress(0, settings.iterations, found.fitness, mean, found.evaluations))
         if found is None:
             stall_below = self.feasible_below if self.refinement is None else math.inf
             found = firefly_minimize(
