@@ -31,6 +31,13 @@ def _is_number(value: Any) -> bool:
     return isinstance(value, Real | np.floating | np.integer) and not isinstance(value, bool | np.bool_)
 
 
+def boolean(name: str, value: Any) -> bool:
+    """``value`` if it is ``True`` or ``False``; else a :class:`PlanningError`."""
+    if not isinstance(value, bool):
+        raise PlanningError(f"{name} = {shown(value)} must be True or False")
+    return value
+
+
 def integer_in(name: str, value: Any, low: int, high: int) -> int:
     """``value`` as an ``int`` if it is an integer in ``[low, high]``; else a :class:`PlanningError`."""
     if (

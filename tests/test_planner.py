@@ -144,6 +144,10 @@ def test_bad_planner_settings() -> None:
         PlannerSettings().updated(fire_flies=10)
     with pytest.raises(PlanningError, match=r"exactly one of 'q' \(joint values\), 'tcp'"):
         Target()
+    with pytest.raises(PlanningError, match="explore_feasible_seed = 1 must be True or False"):
+        SearchTuning(explore_feasible_seed=1)  # type: ignore[arg-type]
+    with pytest.raises(PlanningError, match="active = 'yes' must be True or False"):
+        RefinementSettings(active="yes")  # type: ignore[arg-type]
 
 
 def test_warm_up_compiles_the_kernels_and_returns_its_time(robot: ck.Robot) -> None:

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 from planning.errors import PlanningError
 from planning.search.refinement_settings import RefinementSettings
-from planning.validation import integer_in, number_in
+from planning.validation import boolean, integer_in, number_in
 
 
 @dataclass(frozen=True)
@@ -96,10 +96,7 @@ class SearchTuning:
         if not isinstance(self.seeding, SeedingTuning) or not isinstance(self.refinement, RefinementSettings):
             raise PlanningError("seeding and refinement must be a SeedingTuning and a RefinementSettings")
         integer_in("retries", self.retries, 0, 10)
-        if not isinstance(self.explore_feasible_seed, bool):
-            raise PlanningError(
-                f"explore_feasible_seed = {self.explore_feasible_seed!r} must be True or False"
-            )
+        boolean("explore_feasible_seed", self.explore_feasible_seed)
         integer_in("preferred_first", self.preferred_first, 1, 100)
         shares = tuple(self.narrowed_acceleration)
         for k, share in enumerate(shares):

@@ -9,7 +9,7 @@ import math
 from dataclasses import dataclass
 
 from planning.errors import PlanningError
-from planning.validation import number_in
+from planning.validation import boolean, number_in
 
 STALL_GENERATIONS = 4
 """Generations in a row without a relative improvement of ``stall_tolerance`` that end the
@@ -46,8 +46,7 @@ class RefinementSettings:
 
     def __post_init__(self) -> None:
         number_in("sigma", self.sigma, 0.0, 1.0, low_open=True)
-        if not isinstance(self.active, bool):
-            raise PlanningError(f"active = {self.active!r} must be True or False")
+        boolean("active", self.active)
         if not (isinstance(self.near_bound, int | float) and self.near_bound >= 1.0):
             raise PlanningError(f"near_bound = {self.near_bound!r} must be a number >= 1 (or inf)")
         number_in("min_sigma", self.min_sigma, 0.0, self.sigma, low_open=True)
