@@ -11,7 +11,7 @@ from .interval_motion import IntervalSpeed
 from .kinematics import frame_poses, frame_positions
 from .limits import JointLimits, sampled_configurations
 from .loading import RobotSpec, load_robot
-from .motion import CurveCheck, check_curve, check_segment, motion_radii
+from .motion import CurveCheck, check_curve, check_segment, motion_radii, path_weights
 from .numerical_ik import IkSettings, IkTarget, solve_ik
 from .obstacles import SHAPES, Obstacle
 from .resources import cpr_limits_path, cpr_urdf_path
@@ -54,6 +54,7 @@ __all__ = [
     "load_cpr",
     "load_robot",
     "motion_radii",
+    "path_weights",
     "robot_dynamics",
     "robot_spec",
     "sampled_configurations",

@@ -44,6 +44,23 @@ def motion_radii(robot: Robot) -> FloatArray:
     return np.asarray(np.max([r.radii for r in robot_reach(robot)], axis=0))
 
 
+PATH_WEIGHT_FLOOR = 0.01
+"""A path metric's weight of a joint that moves no collision geometry, as a share of the largest."""
+
+
+def path_weights(robot: Robot) -> FloatArray:
+    """Per-joint weights of a joint-space path's length: the motion radii, none zero [m/rad, m/m].
+
+    A joint that carries no collision geometry (a gripper, or a wrist roll whose link has
+    only a visual mesh, as the SO-100's) has motion radius 0: moving it moves nothing that
+    can collide. A path must still move it to its goal, and a sampling planner's distances,
+    steps and shortcuts must see it: its weight is :data:`PATH_WEIGHT_FLOOR` of the largest
+    radius. The other joints keep their radii.
+    """
+    radii = motion_radii(robot)
+    return np.where(radii > 0.0, radii, PATH_WEIGHT_FLOOR * float(radii.max(initial=0.0)) or 1.0)
+
+
 @dataclass(frozen=True)
 class CurveCheck:
     """Result of a continuous clearance check.

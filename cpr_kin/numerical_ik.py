@@ -22,7 +22,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import CprKinError, IkMissError
-from cpr_kin.motion import motion_radii
+from cpr_kin.motion import path_weights
 from cpr_kin.robot import Robot
 
 FloatArray = NDArray[np.float64]
@@ -195,5 +195,5 @@ def solve_ik(
             f"no configuration puts frame '{robot.tcp_frame}' at {np.round(target.position, 4).tolist()} m: "
             f"the closest of {settings.restarts + 1} IK starts came {target.miss(closest)}"
         )
-    radii = motion_radii(robot)
-    return min(accepted or found, key=lambda q: float(radii @ np.abs(q - seed)))
+    weights = path_weights(robot)
+    return min(accepted or found, key=lambda q: float(weights @ np.abs(q - seed)))

@@ -1,5 +1,6 @@
 """Robots no one here wrote, end to end through the CLI: a scene with an obstacle plans, passes
-``check`` and is drawn, for the SO-101, the UR5, the Panda and the xArm7 of example-robot-data.
+``check`` and is drawn, for the SO-100, the SO-101, the UR5, the Panda and the xArm7 of example-robot-data
+(the SO-100's wrist roll and gripper carry no collision mesh: a path must still move them).
 
 Each scene is drawn at random (seeded) in the robot's own workspace: a start configuration, a
 goal pose of the tool, and a sphere on the tool's straight joint-space way between them, so
@@ -20,7 +21,7 @@ import cpr_kin as ck
 from cpr_kin.packages import example_robot
 from planning.cli import main
 
-ARMS = ("so101", "ur5", "panda", "xarm7")
+ARMS = ("so100", "so101", "ur5", "panda", "xarm7")
 MARGIN_M = 0.02
 
 

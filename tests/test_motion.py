@@ -8,6 +8,8 @@ import pytest
 import trimesh
 
 import cpr_kin as ck
+from cpr_kin.motion import PATH_WEIGHT_FLOOR
+from cpr_kin.packages import example_robot
 
 from .conftest import PAPER_GOAL_TCP, PAPER_START_TCP, random_configurations
 
@@ -43,6 +45,16 @@ def test_radii_values(robot: ck.Robot) -> None:
     assert 0.95 < radii[0] < 0.97
     # the wrist joints carry the 0.15 m tool
     assert 0.15 < radii[3] < 0.16 and 0.15 < radii[4] < 0.16
+
+
+def test_path_weights_are_the_radii_with_no_zero(robot: ck.Robot) -> None:
+    np.testing.assert_array_equal(ck.path_weights(robot), ck.motion_radii(robot))  # none zero: the same
+    so100 = ck.load_robot(example_robot("so100"))  # its wrist roll and gripper carry no collision mesh
+    radii, weights = ck.motion_radii(so100), ck.path_weights(so100)
+    moving_nothing = radii == 0.0
+    assert moving_nothing.tolist() == [False, False, False, False, True, True]
+    np.testing.assert_array_equal(weights[~moving_nothing], radii[~moving_nothing])
+    np.testing.assert_allclose(weights[moving_nothing], PATH_WEIGHT_FLOOR * radii.max())
 
 
 def test_reach_is_computed_once_per_robot(robot: ck.Robot) -> None:

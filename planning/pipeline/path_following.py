@@ -60,5 +60,5 @@ def follow_path(problem: Problem, path: FloatArray) -> tuple[Problem, Choice | R
         return problem, Refusal(f"following it vertex to vertex {cause}", verification.check)
     count = int(np.clip(len(path) - 2, 1, MAX_WAYPOINTS))
     counted = with_planner(problem, waypoints=count)
-    x = waypoints_along(path, count, ck.motion_radii(problem.robot)[problem.moving]).ravel()
+    x = waypoints_along(path, count, ck.path_weights(problem.robot)[problem.moving]).ravel()
     return counted, Choice(x, vertices, timing, verification, 1)

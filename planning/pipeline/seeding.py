@@ -198,7 +198,7 @@ def sampled_path(
         problem.q_goal[moving],
         limits.lower[moving],
         limits.upper[moving],
-        ck.motion_radii(robot)[moving],
+        ck.path_weights(robot)[moving],
         rng,
         settings,
     )
@@ -216,7 +216,7 @@ def seed_search(problem: Problem, more_waypoints: bool = False, path: FloatArray
     started = time.perf_counter()
     straight = problem.objective.straight_line()
     clear = bool(problem.objective.breakdown(straight[None]).feasible[0])
-    weights = ck.motion_radii(problem.robot)[problem.moving]
+    weights = ck.path_weights(problem.robot)[problem.moving]
     seeded: PathSeed | None = None
     if path is None and not clear:
         path, seeded = _followable_path(problem, weights)
