@@ -6,13 +6,21 @@ does not branch into two moving subtrees; the joints met are the arm's, and wher
 ends (or the one fixed leaf below it, such as a ``tcp`` link) is its tool. A last moving joint
 beside a tool frame (a fixed leaf link with no geometry, as the SO-101's ``gripper_frame_link``
 beside its jaw) is a gripper's: the walk ends before it, at the tool frame.
+
+A tree that branches before its second joint (a mobile manipulator's base into its arms and
+head, a humanoid's torso) has no such arm: :func:`default_joints` then asks for the tool
+frame, and plans the joints from the root to it.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
 
 from lxml import etree
+
+from cpr_kin.errors import UrdfError
 
 
 @dataclass(frozen=True)
@@ -24,10 +32,12 @@ class ArmChain:
             moving subtrees (a hand's fingers branch), in order.
         tool: the link where the walk ends, or its only fixed descendant leaf (a tool frame
             such as ``panda_hand_tcp``) when it has exactly one.
+        branches: where the walk ended at a branch, the first link of each moving subtree.
     """
 
     joints: tuple[str, ...]
     tool: str
+    branches: tuple[str, ...] = ()
 
 
 def arm_chain(tree: etree._ElementTree) -> ArmChain:
@@ -85,4 +95,38 @@ def arm_chain(tree: etree._ElementTree) -> ArmChain:
     leaves = fixed_leaves(link)
     frames = [leaf for leaf in leaves if bare(leaf)]
     tool = leaves[0] if len(leaves) == 1 else frames[0] if len(frames) == 1 else link
-    return ArmChain(tuple(joints), tool)
+    return ArmChain(tuple(joints), tool, tuple(child_of(j) for j in moving))
+
+
+def default_joints(
+    model: Any, arm: ArmChain, tcp: str | None, mimics: set[str], path: Path
+) -> tuple[str, ...]:
+    """The planned joints when none are named: the arm's, or those from the root to ``tcp``.
+
+    Args:
+        model: the URDF's Pinocchio model (every joint).
+        arm: its :func:`arm_chain`.
+        tcp: the tool frame the user named (a link or joint name), or ``None``.
+        mimics: the joints that mimic another (never planned).
+        path: the URDF file, for messages.
+
+    Raises:
+        UrdfError: no ``tcp`` is named and the tree branches before its second joint
+            (module docstring), naming the branches. (A ``tcp`` the model does not have is
+            the loader's to name.)
+    """
+    names = tuple(model.names[1:])
+    if tcp is not None and model.existFrame(tcp):
+        supports = model.supports[model.frames[model.getFrameId(tcp)].parentJoint]
+        along = {model.names[j] for j in supports}
+        return tuple(n for n in names if n in along and n not in mimics)
+    planned = tuple(n for n in names if n in arm.joints and n not in mimics)
+    others = [n for n in names if n not in arm.joints and n not in mimics]
+    if len(planned) < 2 and others:
+        raise UrdfError(
+            f"URDF '{path}' has no single arm: its tree branches after {len(planned)} joint(s) "
+            f"{list(planned)} at link '{arm.tool}' into {list(arm.branches)}, {len(others)} more "
+            "moving joints; name the tool frame (robot: {urdf: ..., tcp: <link>}: the joints from "
+            "the root to it are planned) or the joints (joints: [...])"
+        )
+    return planned

@@ -34,7 +34,7 @@ import numpy as np
 import pinocchio as pin
 from lxml import etree
 
-from cpr_kin.arm import ArmChain, arm_chain
+from cpr_kin.arm import ArmChain, arm_chain, default_joints
 from cpr_kin.errors import UrdfError
 from cpr_kin.limits import LIMITS_NAMES, JointLimits, find_limits_file, read_dynamic_limits
 from cpr_kin.packages import package_roots
@@ -67,9 +67,10 @@ class RobotSpec:
             ``limits_names``, else ``default_limits``, else a maker's file shipped for the
             URDF's robot name (:func:`cpr_kin.resources.makers_limits_path`), else the
             documented defaults.
-        joints: the planned joints, in configuration order; default: the arm's
-            (:func:`arm_chain`: from the root until the tree branches, as a hand into its
-            fingers), but mimic joints. The others are held.
+        joints: the planned joints, in configuration order; default: those from the root
+            to ``tcp`` when it is named, else the arm's (:func:`arm_chain`: from the root
+            until the tree branches, as a hand into its fingers), but mimic joints. The
+            others are held.
         tcp: the tool-centre-point frame (a link or joint name); default: ``tcp`` if the URDF
             has one, else the arm's tool link (:func:`arm_chain`).
         held: ``(joint, value)`` pairs of held joints [rad or m].
@@ -173,7 +174,7 @@ class RobotSpec:
         names = tuple(model.names[1:])
         mimics = {j.get("name") for j in tree.getroot().findall("joint") if j.find("mimic") is not None}
         if self.joints is None:
-            return tuple(n for n in names if n in arm.joints and n not in mimics)
+            return default_joints(model, arm, self.tcp, mimics, path)
         unknown = [j for j in self.joints if j not in names]
         if unknown:
             raise UrdfError(f"URDF '{path}' has no joint(s) {unknown}; its joints are {list(names)}")

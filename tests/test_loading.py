@@ -140,3 +140,40 @@ def test_a_tool_without_collision_geometry_leaves_the_effector_group_to_the_link
     so100 = ck.load_robot(ROBOTS / "so_arm_description/urdf/so100.urdf")  # gripper and jaw: visual only
     assert {g.link for g in so100.geometries if g.group == "effector"} == {"wrist"}
     assert {g.group for g in so100.geometries} == set(ck.GROUPS)
+
+
+def urdf_joints_to(urdf: Path, link: str) -> list[str]:
+    """The moving joints from the URDF's root down to ``link``, read from the XML alone (the oracle)."""
+    from lxml import etree
+
+    into = {j.find("child").get("link"): j for j in etree.parse(str(urdf)).getroot().findall("joint")}
+    joints: list[str] = []
+    while link in into:
+        joint = into[link]
+        if joint.get("type") != "fixed" and joint.find("mimic") is None:
+            joints.append(joint.get("name"))
+        link = joint.find("parent").get("link")
+    return joints[::-1]
+
+
+@pytest.mark.parametrize(
+    ("urdf", "tool", "branches"),
+    [
+        (
+            "pr2_description/urdf/pr2.urdf",
+            "r_gripper_tool_frame",
+            "'r_shoulder_pan_link', 'l_shoulder_pan_link'",
+        ),
+        ("baxter_description/urdf/baxter.urdf", "right_gripper", "'right_arm_mount', 'left_arm_mount'"),
+    ],
+)
+def test_a_robot_of_several_arms_plans_the_joints_to_the_tool_it_is_given(
+    urdf: str, tool: str, branches: str
+) -> None:
+    with pytest.raises(
+        ck.UrdfError, match=rf"has no single arm: its tree branches .*{branches}.*name the tool"
+    ):
+        ck.load_robot(ROBOTS / urdf)
+    robot = ck.load_robot(ROBOTS / urdf, tcp=tool)
+    assert list(robot.joint_names) == urdf_joints_to(ROBOTS / urdf, tool) and robot.nq >= 7
+    assert robot.tcp_frame == tool
