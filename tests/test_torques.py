@@ -85,8 +85,12 @@ def test_a_payload_the_motors_cannot_hold_is_exit_3(
     assert code == 3 and not (tmp_path / "out").exists()
     assert "holding the start still with the 20 kg payload takes 237.4 N at joint 'd2'" in err
     assert "beyond its effort limit 200 N" in err and "Traceback" not in err
-    with pytest.raises(PayloadTooHeavyError):
-        build_problem(dataclasses.replace(parse_scene(SCENE), torque_scale=0.5))
+    assert "lighten the payload or choose another start" in err
+    with pytest.raises(
+        PayloadTooHeavyError, match="choose another start, or give the URDF the effort"
+    ) as raised:
+        build_problem(parse_scene(scene_with(payload=None, torque_scale=0.005)))
+    assert "payload" not in str(raised.value)  # none was given: the arm alone is too heavy
 
 
 @pytest.mark.parametrize(

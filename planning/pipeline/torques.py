@@ -112,11 +112,16 @@ def problem_dynamics(
         if holding[j] > dynamics.effort[j]:
             unit = _unit(dynamics, j)
             carried = "" if scene.payload is None else f" with the {scene.payload.mass_kg:g} kg payload"
+            fix = (
+                f"lighten the payload or choose another {label}"
+                if scene.payload is not None
+                else f"choose another {label}, or give the URDF the effort limits the arm has (a "
+                "counterbalanced arm's springs are not in its URDF)"
+            )
             raise PayloadTooHeavyError(
                 f"holding the {label} still{carried} takes {holding[j]:.4g}{unit} at joint "
                 f"'{dynamics.joint_names[j]}', beyond its effort limit {dynamics.effort[j]:.4g}{unit} "
-                f"(URDF effort x torque_scale {dynamics.torque_scale:g}); lighten the payload or "
-                f"choose another {label}"
+                f"(URDF effort x torque_scale {dynamics.torque_scale:g}); {fix}"
             )
     return dynamics
 
