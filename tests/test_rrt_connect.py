@@ -146,11 +146,27 @@ def test_an_extension_is_at_most_one_step(step_m: float | None, monkeypatch: pyt
     settings = RrtSettings(step_m=step_m, resolution_m=0.01)
     rrt_connect(recorded, start, goal, LOWER, UPPER, weights, np.random.default_rng(0), settings)
     step = 0.2 * float(np.hypot(2.0, 0.5)) if step_m is None else step_m
-    # batch 0 is the straight line; batch 1 the first extension from the start (then a connection)
+    # batch 0 checks the ends, 1 is the straight line, 2 the first extension from the start (then a
+    # connection)
+    np.testing.assert_array_equal(batches[0], [start, goal])
     count = math.ceil(step / 0.01 - 1e-9)
-    reach = np.abs(batches[1] - start) @ weights
+    reach = np.abs(batches[2] - start) @ weights
     assert reach[:count].max() <= step * (1 + 1e-9)
     assert reach[:count].max() >= step - 0.01  # the first sample lies farther than one step
+
+
+def test_an_invalid_end_is_no_path_at_once() -> None:
+    """A goal inside the wall: one call of the validity check, no sample spent."""
+    calls: list[int] = []
+
+    def counted(q: NDArray[np.float64]) -> NDArray[np.bool_]:
+        calls.append(len(q))
+        return wall_with_slot(q)
+
+    start, goal = np.array([0.1, 0.9]), np.array([0.5, 0.1])
+    assert not wall_with_slot(goal[None])[0]
+    assert rrt_connect(counted, start, goal, LOWER, UPPER, np.ones(2), np.random.default_rng(0)) is None
+    assert calls == [2]
 
 
 def thin_wall(q: NDArray[np.float64], shrink: float = 0.0) -> NDArray[np.bool_]:

@@ -147,3 +147,23 @@ def test_a_passage_rrt_connect_needs_thousands_of_samples_for_is_planned(robot: 
     assert seed_search(with_planner(build_problem(scene, robot), tuning=small)).path is None
     result = plan(scene, robot)
     assert result.verification.accepted and result.metrics.min_clearance_m >= scene.safety_margin
+
+
+def test_a_goal_within_margin_plus_step_plans_with_the_finer_step_at_once(robot: ck.Robot) -> None:
+    """A goal 2 mm from a ball, margin 0 (a grasp): RRT-Connect at margin plus 5 mm cannot end there."""
+    from planning.io.scene_generator import generate_scenes
+    from planning.pipeline.planner import plan
+
+    scene = dataclasses.replace(generate_scenes(1, 5, robot)[0], safety_margin=0.0)
+    q_goal = build_problem(scene, robot).q_goal
+    tool = ck.frame_poses(robot, q_goal[None])[0, :3, 3]
+    probe = ck.Obstacle.sphere(0.02, tuple(tool + np.array([0.0, 0.0, 0.25])), name="ball")
+    gap = ck.CollisionWorld(robot, [probe]).clearance_batch(q_goal[None]).clearance_m.min()
+    ball = ck.Obstacle.sphere(0.02 + gap - 0.002, probe.xyz, name="ball")  # 2 mm from the goal
+    near = dataclasses.replace(scene, obstacles=(*scene.obstacles, ball))
+    problem = build_problem(near, robot)
+    assert problem.world.margin_violated(q_goal[None], problem.objective.required_m)[0]
+    assert not problem.world.margin_violated(q_goal[None], 0.0)[0]
+    result = plan(near, robot)
+    assert result.verification.accepted and result.verification.certified_min_m >= 0.0
+    assert result.problem.scene.planner.verify_step_m == scene.planner.finer_verify_step_m

@@ -4,13 +4,14 @@ The same scene, URDF, collision world and limits as the firefly planner
 (:func:`planning.pipeline.problem.build_problem`): RRT-Connect searches the moving joints with our
 coal margin checks as state validity (the margin, and the self margin between the robot's own
 checked pairs, each plus the verification step, the clearances the firefly's fitness asks of
-its samples), the path is simplified, and
-:func:`planning.peers.toppra_timing.time_and_verify` times and verifies it. The peer is
+its samples; with a start or goal inside those, the seeding's finer step, as ours), the path
+is simplified, and :func:`planning.peers.toppra_timing.time_and_verify` times and verifies it. The peer is
 optional (``pip install '.[bench]'``).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import time
 
 import numpy as np
@@ -53,6 +54,13 @@ def plan_rrt_connect(
         q[moving] = [state[i] for i in range(moving.size)]  # type: ignore[index]
         return q
 
+    ends, objective = np.stack([q_start, q_goal]), problem.objective
+    inside = world.margin_violated(ends, objective.required_m).any() or bool(
+        world.self_collision and world.self_collision.violated(ends, objective.required_self_m).any()
+    )
+    if inside:  # an end within margin plus step (a grasp): the finer step, as the firefly's seeding
+        finer = scene.planner.updated(verify_step_m=scene.planner.finer_verify_step_m)
+        scene = dataclasses.replace(scene, planner=finer)
     self_clearance_m = scene.self_margin + scene.planner.verify_step_m
 
     def valid(state: object) -> bool:

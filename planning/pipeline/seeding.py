@@ -25,9 +25,9 @@ is a small part of its space, rarely met by a random population. So, with the pl
 
 The clearance required is the margin plus the certified check's step (``verify_step_m``):
 what moves between two checks is counted against the margin. A passage narrower than that
-has no path: when RRT-Connect finds none, the first attempt asks once more with the step
-cut to ``finer_step`` of it (1 mm of the default 5 mm), which lets a path pass within a
-millimetre of the margin at the price of a denser certified check.
+has no path: when RRT-Connect finds none (at once for a start or goal that close, a grasp),
+the first attempt asks once more with the step cut to ``finer_step`` of it (1 mm of the
+default 5 mm): a path may pass within a millimetre of the margin, checked more densely.
 
 The seeds and ``spread``-sized moves around them make up ``share`` of the initial
 population (:class:`~planning.pipeline.tuning.SeedingTuning`); when a seed is feasible, the
@@ -48,7 +48,7 @@ from numpy.typing import NDArray
 
 import cpr_kin as ck
 from planning.pipeline.problem import Problem, with_planner
-from planning.pipeline.settings import MAX_FITNESS_SAMPLES, MAX_WAYPOINTS, VERIFY_STEP_RANGE_M
+from planning.pipeline.settings import MAX_FITNESS_SAMPLES, MAX_WAYPOINTS
 from planning.search.optimizer import SearchResult
 from planning.search.rrt_connect import RrtPath, RrtSettings, rrt_connect, waypoints_along
 
@@ -141,7 +141,7 @@ class PathSeeding:
     def first(self, problem: Problem) -> Attempt:  # noqa: D102 - the protocol's
         seeds = seed_search(problem)
         settings = problem.scene.planner
-        finer = max(settings.verify_step_m * settings.tuning.seeding.finer_step, VERIFY_STEP_RANGE_M[0])
+        finer = settings.finer_verify_step_m
         tried = ""
         if seeds.path is None and not seeds.straight_line_clear:
             required = problem.objective.required_m

@@ -138,6 +138,11 @@ class PlannerSettings:
         """Settings from the scene file's flat ``planner:`` block (firefly keys included)."""
         return cls().updated(**values)
 
+    @property
+    def finer_verify_step_m(self) -> float:
+        """The check step [m] tried where margin plus step leaves no way: ``finer_step`` of it, floored."""
+        return max(self.verify_step_m * self.tuning.seeding.finer_step, VERIFY_STEP_RANGE_M[0])
+
     def updated(self, **changes: Any) -> PlannerSettings:
         """A copy with ``changes``; the firefly's keys (``fireflies``, ``alpha``, ...) go to :attr:`firefly`.
 

@@ -134,8 +134,12 @@ def rrt_connect(
 ) -> RrtPath | None:
     """A valid path from ``start`` to ``goal`` in the box ``[lower, upper]``, or ``None``.
 
+    ``None`` at once when ``start`` or ``goal`` is not valid itself: no valid path begins or
+    ends there, and the samples would be spent for nothing (a goal closer to an obstacle than
+    the clearance asked, though outside the margin).
+
     Args:
-        valid: the batched validity check (both ends must pass it).
+        valid: the batched validity check.
         start: ``(d,)`` start configuration [joint units].
         goal: ``(d,)`` goal configuration.
         lower: ``(d,)`` lower bounds of the samples.
@@ -149,6 +153,8 @@ def rrt_connect(
     weights = np.asarray(weights, dtype=float)
     if not (weights.shape == start.shape == goal.shape and np.all(weights > 0)):
         raise PlanningError(f"weights {weights.tolist()} must be positive, one per joint of start and goal")
+    if not np.all(valid(np.stack([start, goal]))):
+        return None
     explore_m = settings.explore_resolution_m or settings.resolution_m
     step_m = settings.step_m
     if step_m is None:
