@@ -163,3 +163,32 @@ def test_shortcut_path_keeps_ends_and_checks_every_new_segment() -> None:
     for p, q in itertools.pairwise(path):
         assert any(within(p, a, b) and within(q, a, b) for a, b in known)
         assert clear(p, q)
+
+
+def test_the_peers_timing_stays_within_the_joint_ranges_along_a_limit(robot: ck.Robot) -> None:
+    """A path that runs along d2's lower limit: the clamped cubic dips below it, PCHIP does not."""
+    pytest.importorskip("toppra")
+    import dataclasses
+    import time
+
+    from planning.peers.toppra_timing import PchipPath, _geometric_path, time_and_verify
+
+    waypoints = np.array(
+        [
+            [-1.0, 0.3, 0.2, 0.0, 0.0],
+            [-0.5, 0.0, 0.2, 0.0, 0.0],
+            [0.5, 0.0, 0.2, 0.0, 0.0],
+            [1.0, 0.3, 0.2, 0.0, 0.0],
+        ]
+    )
+    s = np.array([0.0, 0.3, 0.7, 1.0])
+    cubic = _geometric_path(s[[0, 3]], waypoints[[0, 3]], robot.limits)  # no vertex on a limit: the cubic
+    assert not isinstance(cubic, PchipPath)
+    along = _geometric_path(s, waypoints, robot.limits)
+    assert isinstance(along, PchipPath)
+    q = along(np.linspace(0.0, 1.0, 1001))
+    assert q[:, 1].min() >= 0.0  # the cubic's would go below 0 between the two vertices at 0
+    np.testing.assert_allclose(along(s), waypoints, atol=1e-12)
+    scene = dataclasses.replace(paper_scene(), obstacles=())
+    result = time_and_verify(robot, ck.CollisionWorld(robot, []), scene, waypoints, time.perf_counter())
+    assert result.success, result.reason

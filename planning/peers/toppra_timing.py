@@ -2,7 +2,12 @@
 
 A clamped cubic spline through the path's vertices is timed by TOPP-RA (``toppra``) under
 the joints' velocity and acceleration limits (it has no jerk limit) and verified by the same
-certified continuous check as the firefly planner's trajectories.
+certified continuous check as the firefly planner's trajectories. Where the cubic leaves a
+joint's range (a path that runs along a joint limit, as the Fetch's torso at its lowest does),
+the shape-preserving PCHIP interpolant through the same vertices is timed instead: between
+two vertices it stays within their values, so within every range they are in; and TOPP-RA's
+trajectory then follows it exactly (its constant-acceleration parametrisation, where the
+default fits a spline in time that may stray out of the range again).
 """
 
 from __future__ import annotations
@@ -86,15 +91,16 @@ def time_and_verify(
     s_grid = np.concatenate([[0.0], np.cumsum(steps[steps > 1e-9])])
     if len(waypoints) < 2:
         return SamplingResult.failure("the simplified path is a single point", robot.nq, started)
-    geometric = toppra.SplineInterpolator(s_grid / s_grid[-1], waypoints, bc_type="clamped")
+    geometric = _geometric_path(s_grid / s_grid[-1], waypoints, limits)
     constraints = [
         toppra.constraint.JointVelocityConstraint(np.column_stack([-limits.velocity, limits.velocity])),
         toppra.constraint.JointAccelerationConstraint(
             np.column_stack([-limits.acceleration, limits.acceleration])
         ),
     ]
+    exact = "ParametrizeConstAccel" if isinstance(geometric, PchipPath) else None  # on the path, in range
     timed = toppra.algorithm.TOPPRA(
-        constraints, geometric, gridpoints=np.linspace(0, 1, 401)
+        constraints, geometric, gridpoints=np.linspace(0, 1, 401), parametrizer=exact
     ).compute_trajectory(0, 0)
     if timed is None:
         return SamplingResult.failure("TOPP-RA found no timing", robot.nq, started)
@@ -156,3 +162,47 @@ def time_and_verify(
         jerk_over_limit=float(np.max(np.abs(jerk) / limits.jerk)),
         planning_time_s=time.perf_counter() - started,
     )
+
+
+class PchipPath:
+    """The shape-preserving PCHIP interpolant of ``waypoints`` at ``s``, as a TOPP-RA geometric path.
+
+    Between two waypoints each joint stays within their two values (scipy's ``PchipInterpolator``).
+    """
+
+    def __init__(self, s: FloatArray, waypoints: FloatArray) -> None:
+        from scipy.interpolate import PchipInterpolator
+
+        spline = PchipInterpolator(s, waypoints)
+        self.s, self.q = s, waypoints
+        self.derivatives = (spline, spline.derivative(), spline.derivative(2))
+
+    def __call__(self, positions: FloatArray, order: int = 0) -> FloatArray:
+        """The path's ``order``-th derivative (0 to 2) at ``positions``."""
+        return np.asarray(self.derivatives[order](positions))
+
+    @property
+    def dof(self) -> int:
+        """Number of joints."""
+        return int(self.q.shape[1])
+
+    @property
+    def path_interval(self) -> FloatArray:
+        """First and last path positions."""
+        return np.array([self.s[0], self.s[-1]])
+
+    @property
+    def waypoints(self) -> tuple[FloatArray, FloatArray]:
+        """The path positions and the waypoints."""
+        return self.s, self.q
+
+
+def _geometric_path(s: FloatArray, waypoints: FloatArray, limits: ck.JointLimits) -> object:
+    """The path through ``waypoints`` at ``s`` in [0, 1]: the clamped cubic, else PCHIP (module doc)."""
+    import toppra
+
+    cubic = toppra.SplineInterpolator(s, waypoints, bc_type="clamped")
+    q = cubic(np.linspace(0.0, 1.0, 2001))
+    if np.all(q >= limits.lower - 1e-9) and np.all(q <= limits.upper + 1e-9):
+        return cubic
+    return PchipPath(s, waypoints)
