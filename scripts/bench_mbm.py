@@ -1,6 +1,7 @@
 """MotionBenchMaker: our planner beside OMPL's RRT-Connect pipeline, problem by problem, in one run.
 
     python scripts/bench_mbm.py [--robots panda ur5] [--classes ...] [--limit N] [--timeout S] [--out DIR]
+    python scripts/bench_mbm.py --scenes out/arms/*/*.yaml [--timeout S] [--out DIR]
 
 Each problem goes the way a user's does (``import-moveit``, :mod:`planning.io.moveit_import`,
 margins 0 as in MoveIt), then, alternating, is planned warm by
@@ -18,6 +19,10 @@ the time it took, up to the timeout), ours' median duration over Ruckig's jerk-l
 for the straight line, OMPL's median jerk over the limit. Rows go to ``DIR/mbm.csv``, the table as
 markdown to ``DIR/mbm.md``. Needs the ``bench`` extra; the problems are downloaded once
 (:mod:`planning.io.mbm`).
+
+``--scenes FILE ...`` runs scene files instead, of any robot (``generate_arm_scenes.py``'s, a
+user's own), the same way; rows are grouped by the file's folder (the "robot" column) and its
+name without a trailing ``_<number>`` (the "class").
 """
 
 from __future__ import annotations
@@ -28,6 +33,7 @@ import multiprocessing
 import statistics
 import sys
 import time
+from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures import TimeoutError as FutureTimeout
 from pathlib import Path
@@ -89,7 +95,11 @@ def theirs(scene_path: str, timeout_s: float) -> dict[str, Any]:
     started = time.perf_counter()
     seed = 0
     while time.perf_counter() - started < timeout_s:
-        result = plan_rrt_connect(scene, robot, min(1.0, timeout_s - (time.perf_counter() - started)), seed)
+        left_s = timeout_s - (time.perf_counter() - started)
+        try:
+            result = plan_rrt_connect(scene, robot, min(1.0, left_s), seed)
+        except NoSolutionError as exc:  # the problem itself has none (a start the motors cannot hold)
+            return {"ok": False, "time_s": time.perf_counter() - started, "why": str(exc)[:100]}
         if result.success:
             elapsed = time.perf_counter() - started
             return {
@@ -123,44 +133,56 @@ def median_ratio(mine: list[float], peer: list[float]) -> float:
     return statistics.median(mine) / statistics.median(peer) if mine and peer else float("nan")
 
 
+def cases(args: argparse.Namespace) -> Iterator[tuple[str, str, int, Path]]:
+    """``(robot, class, number, scene file)`` of each problem: MotionBenchMaker's, or ``--scenes``."""
+    if args.scenes:
+        for path in args.scenes:
+            group, _, number = path.stem.rpartition("_")
+            if not (group and number.isdigit()):
+                group, number = path.stem, "0"
+            yield path.resolve().parent.name, group, int(number), path
+        return
+    for robot_name in args.robots:
+        for problem in problems(robot_name, tuple(args.classes), args.limit):
+            path = args.out / "scenes" / robot_name / f"{problem.name}.yaml"
+            import_problem(problem, path)
+            yield robot_name, problem.problem_class, problem.index, path
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--robots", nargs="+", default=["panda", "ur5"], choices=["panda", "ur5", "fetch"])
     parser.add_argument("--classes", nargs="+", default=list(CLASSES), choices=list(CLASSES))
     parser.add_argument("--limit", type=int, help="problems per class (default: all 100)")
     parser.add_argument("--timeout", type=float, default=10.0, help="seconds per problem and planner")
+    parser.add_argument(
+        "--scenes", nargs="+", type=Path, help="scene files to run instead of MotionBenchMaker's (any robot)"
+    )
     parser.add_argument("--out", type=Path, default=Path("out/bench_mbm"))
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     rows: list[dict[str, Any]] = []
     context = multiprocessing.get_context("spawn")
     pool = ProcessPoolExecutor(1, mp_context=context)
-    for robot_name in args.robots:
-        chosen = list(problems(robot_name, tuple(args.classes), args.limit))
-        for number, problem in enumerate(chosen, start=1):
-            path = args.out / "scenes" / robot_name / f"{problem.name}.yaml"
-            import_problem(problem, path)
-            row: dict[str, Any] = {
-                "robot": robot_name,
-                "class": problem.problem_class,
-                "problem": problem.index,
-            }
-            row["invalid"] = valid(path) or ""
-            if not row["invalid"]:
-                pool.submit(warm, str(path)).result()  # loaded once per robot and worker, untimed
-                future = pool.submit(ours, str(path))
-                try:
-                    row |= {f"ours_{k}": v for k, v in future.result(timeout=args.timeout).items()}
-                except FutureTimeout:
-                    row |= {"ours_ok": False, "ours_time_s": args.timeout, "ours_why": "timeout"}
-                    for process in list(getattr(pool, "_processes", {}).values()):
-                        process.kill()
-                    pool.shutdown(wait=False, cancel_futures=True)
-                    pool = ProcessPoolExecutor(1, mp_context=context)
-                row |= {f"ompl_{k}": v for k, v in theirs(str(path), args.timeout).items()}
-            rows.append(row)
-            mark = "-" if row["invalid"] else summary(row)
-            print(f"[{number}/{len(chosen)}] {robot_name} {problem.name}: {mark}", flush=True)
+    chosen = list(cases(args))
+    for number, (robot_name, problem_class, index, path) in enumerate(chosen, start=1):
+        row: dict[str, Any] = {"robot": robot_name, "class": problem_class, "problem": index}
+        row["invalid"] = valid(path) or ""
+        if not row["invalid"]:
+            pool.submit(warm, str(path)).result()  # loaded once per robot and worker, untimed
+            future = pool.submit(ours, str(path))
+            try:
+                row |= {f"ours_{k}": v for k, v in future.result(timeout=args.timeout).items()}
+            except FutureTimeout:
+                row |= {"ours_ok": False, "ours_time_s": args.timeout, "ours_why": "timeout"}
+                for process in list(getattr(pool, "_processes", {}).values()):
+                    process.kill()
+                pool.shutdown(wait=False, cancel_futures=True)
+                pool = ProcessPoolExecutor(1, mp_context=context)
+            row |= {f"ompl_{k}": v for k, v in theirs(str(path), args.timeout).items()}
+        rows.append(row)
+        mark = "-" if row["invalid"] else summary(row)
+        print(f"[{number}/{len(chosen)}] {robot_name} {path.stem}: {mark}", flush=True)
     pool.shutdown(cancel_futures=True)
     keys = sorted({k for row in rows for k in row})
     with (args.out / "mbm.csv").open("w", newline="") as out:
@@ -170,15 +192,15 @@ def main() -> int:
     print(f"\n{'robot':6s} {'class':17s} {'valid':>5s} {'ours':>4s} {'ompl':>4s}", end="")
     print(f"  {'ours med/p95 s':>15s}  {'ompl med/p95 s':>15s}  ratio  both   all  dur/bound  ompl jerk/lim")
     report = [
-        f"MotionBenchMaker, {args.limit or 100} problem(s) per class, timeout {args.timeout:g} s, warm "
-        "(`scripts/bench_mbm.py`)",
+        f"{'Scene files' if args.scenes else f'MotionBenchMaker, {args.limit or 100} problem(s) per class'}, "
+        f"timeout {args.timeout:g} s, warm (`scripts/bench_mbm.py`)",
         "",
         "| robot | class | valid | solved ours | solved OMPL | ours median (p95) [s] | OMPL median (p95) [s] "
         "| ratio | ratio, both solved | ratio, all | ours duration / Ruckig bound | OMPL jerk / limit |",
         "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
-    for robot_name in args.robots:
-        for problem_class in [*args.classes, "all"]:
+    for robot_name in dict.fromkeys(r["robot"] for r in rows):
+        for problem_class in [*dict.fromkeys(r["class"] for r in rows if r["robot"] == robot_name), "all"]:
             group = [r for r in rows if r["robot"] == robot_name and problem_class in ("all", r["class"])]
             group = [r for r in group if not r["invalid"]]
             if not group:

@@ -76,7 +76,8 @@ def test_bring_your_own_robot_runs_as_written(tmp_path: Path, monkeypatch: pytes
     _, fragment, _ = blocks(README, "yaml")
     own = parse_scene(yaml.safe_load(fragment))
     assert own.robot is not None and own.robot.urdf.name == "my_arm.urdf" and own.goal.pose is not None
-    commands = [line.split("#")[0] for line in blocks(README, "sh")[-1].splitlines() if line.strip()]
+    panda = next(block for block in blocks(README, "sh") if "panda_post.yaml" in block)
+    commands = [line.split("#")[0] for line in panda.splitlines() if line.strip()]
     monkeypatch.chdir(ROOT)
     for command in commands:
         words = shlex.split(command.replace("out/panda", str(tmp_path / "panda")))

@@ -1,0 +1,88 @@
+"""Seeded random scenes for any arm: a start, a goal pose, and a ball across the way between them.
+
+:mod:`planning.io.scene_generator` draws the CPR's scenes from its geometry; an arm someone
+brings (a URDF, an example-robot-data name) has none we know. So :func:`blocked_scene` draws
+in the robot's own joint space: a start configuration and a goal configuration in the middle
+60 % of every joint's range whose tool positions lie at least half the arm's reach apart,
+and a ball of 12 % of that reach at the tool's position halfway along the straight joint-space
+way between them, at least 10 % of the reach above the base. The goal is given as the tool's
+pose (solved by the planner's IK), the start as the configuration. Start and goal must keep
+``margin_m + 0.02`` m from the ball and ``self_clearance_m`` between the robot's own checked
+pairs; a draw that does not is drawn again. The straight way is blocked; whether a way
+around exists is for the planners to find out.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+import cpr_kin as ck
+from planning.errors import PlanningError
+
+DRAWS = 4000
+"""Most draws of a start and goal before :func:`blocked_scene` gives up."""
+
+
+def blocked_scene(
+    name: str,
+    robot_entry: str | dict[str, Any],
+    robot: ck.Robot,
+    seed: int,
+    margin_m: float = 0.02,
+    self_clearance_m: float = 0.02,
+    draws: int = DRAWS,
+) -> dict[str, Any]:
+    """A scene file's document (module docstring) for ``robot``, drawn from ``seed``.
+
+    Args:
+        name: the scene's name.
+        robot_entry: what the scene file's ``robot:`` holds (a name, a URDF path, a mapping).
+        robot: that robot, loaded.
+        seed: seed of every draw.
+        margin_m: the scene's safety margin [m].
+        self_clearance_m: the least distance between the robot's own pairs at start and goal [m].
+        draws: most draws of a start and goal.
+
+    Raises:
+        PlanningError: no start and goal of ``draws`` draws qualify.
+    """
+    rng = np.random.default_rng(seed)
+    lower, upper = robot.limits.lower, robot.limits.upper
+    middle, half = (lower + upper) / 2, (upper - lower) / 2
+    reach = float(np.linalg.norm(ck.frame_poses(robot, middle[None])[0][:3, 3]))
+    for _ in range(draws):
+        start, goal = rng.uniform(middle - 0.6 * half, middle + 0.6 * half, (2, robot.nq))
+        tools = ck.frame_poses(robot, np.array([start, (start + goal) / 2, goal]))
+        if np.linalg.norm(tools[0, :3, 3] - tools[2, :3, 3]) < 0.5 * reach or tools[1, 2, 3] < 0.1 * reach:
+            continue
+        ball = ck.Obstacle.sphere(0.12 * reach, tuple(tools[1, :3, 3]), name="ball")
+        world = ck.CollisionWorld(robot, [ball])
+        ends = np.array([start, goal])
+        if world.clearance_batch(ends).clearance_m.min() <= margin_m + 0.02:
+            continue
+        if world.self_collision and world.self_collision.distances(ends)[0].min() <= self_clearance_m:
+            continue
+        return {
+            "name": name,
+            "robot": robot_entry,
+            "safety_margin": margin_m,
+            "start": {"q": start.tolist()},
+            "goal": {"pose": {"xyz": tools[2, :3, 3].tolist(), "rpy": _rpy(tools[2, :3, :3])}},
+            "obstacles": [
+                {"name": "ball", "shape": "sphere", "radius": 0.12 * reach, "xyz": list(map(float, ball.xyz))}
+            ],
+            "planner": {"seed": seed},
+        }
+    raise PlanningError(
+        f"no start and goal of {draws} draws for '{name}' keep {margin_m + 0.02:g} m from the ball and "
+        f"{self_clearance_m:g} m between the robot's own pairs; lower self_clearance_m"
+    )
+
+
+def _rpy(rotation: np.ndarray) -> list[float]:
+    """Roll, pitch, yaw [rad] of a rotation matrix."""
+    import pinocchio as pin
+
+    return [float(v) for v in pin.rpy.matrixToRpy(rotation)]

@@ -1,0 +1,62 @@
+"""Write seeded scenes for any arm (a ball across its way) as scene files, for ``bench_mbm.py --scenes``.
+
+    python scripts/generate_arm_scenes.py --robot ur10 --count 10 --seed 0 --out out/arms/ur10
+    python scripts/generate_arm_scenes.py --robot path/to/pr2.urdf --tcp r_gripper_tool_frame ...
+
+The scenes of :func:`planning.io.arm_scenes.blocked_scene`, seeds ``--seed`` to
+``--seed + --count - 1``, named ``<robot>_<seed>``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+import cpr_kin as ck
+from cpr_kin.packages import EXAMPLE_ROBOTS, example_robot
+from planning.errors import PlanningError
+from planning.io.arm_scenes import blocked_scene
+
+
+def main() -> int:
+    """Write the scenes (module docstring)."""
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--robot", required=True, help=f"a URDF path or one of {sorted(EXAMPLE_ROBOTS)}")
+    parser.add_argument("--tcp", help="its tool frame (the planned joints: those from the root to it)")
+    parser.add_argument("--count", type=int, default=10, help="number of scenes (default: 10)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the first scene (default: 0)")
+    parser.add_argument("--margin", type=float, default=0.02, help="safety margin [m] (default: 0.02)")
+    parser.add_argument(
+        "--self-clearance",
+        type=float,
+        default=0.02,
+        help="least distance of the robot's own pairs at start and goal [m] (default: 0.02)",
+    )
+    parser.add_argument("--out", type=Path, required=True, help="folder for the scene files")
+    args = parser.parse_args()
+    named = args.robot in EXAMPLE_ROBOTS
+    urdf = example_robot(args.robot) if named else Path(args.robot).resolve()
+    entry: str | dict[str, Any] = args.robot if named else str(urdf)
+    if args.tcp:
+        entry = {"urdf": entry, "tcp": args.tcp}
+    try:
+        robot = ck.load_robot(urdf, tcp=args.tcp)
+        stem = args.robot if named else urdf.stem
+        args.out.mkdir(parents=True, exist_ok=True)
+        for seed in range(args.seed, args.seed + args.count):
+            name = f"{stem}_{seed}"
+            document = blocked_scene(name, entry, robot, seed, args.margin, args.self_clearance)
+            (args.out / f"{name}.yaml").write_text(yaml.safe_dump(document, sort_keys=False))
+    except (ck.CprKinError, PlanningError) as exc:
+        print(f"generate_arm_scenes: {exc}", file=sys.stderr)
+        return 2
+    print(f"wrote {args.count} scenes into {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

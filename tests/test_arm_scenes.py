@@ -1,0 +1,78 @@
+"""Scenes drawn for any arm: start and goal keep their clearances, far apart, the ball above the base."""
+
+from __future__ import annotations
+
+import csv
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import cpr_kin as ck
+from cpr_kin.packages import example_robot
+from planning.errors import PlanningError
+from planning.io.arm_scenes import blocked_scene
+from planning.io.scene_file import parse_scene
+from planning.pipeline.problem import build_problem
+
+
+@pytest.fixture(scope="module")
+def ur5() -> ck.Robot:
+    return ck.load_robot(example_robot("ur5"))
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_start_and_goal_keep_their_clearances_and_lie_apart(ur5: ck.Robot, seed: int) -> None:
+    document = blocked_scene(f"ur5_{seed}", "ur5", ur5, seed, margin_m=0.03, self_clearance_m=0.02)
+    problem = build_problem(parse_scene(document), ur5)  # the goal pose solved by the IK, verified
+    world, ends = problem.world, np.array([problem.q_start, problem.q_goal])
+    assert world.clearance_batch(ends).clearance_m.min() > 0.03
+    assert world.self_collision is not None and world.self_collision.distances(ends)[0].min() > 0.02
+    tools = ck.frame_poses(ur5, ends)[:, :3, 3]
+    ball = np.array(document["obstacles"][0]["xyz"])
+    reach = document["obstacles"][0]["radius"] / 0.12
+    assert np.linalg.norm(tools[0] - tools[1]) >= 0.5 * reach and ball[2] >= 0.1 * reach
+    assert blocked_scene(f"ur5_{seed}", "ur5", ur5, seed, margin_m=0.03) == document  # seeded
+
+
+def test_no_qualifying_draw_is_an_error_naming_the_fix(ur5: ck.Robot) -> None:
+    with pytest.raises(
+        PlanningError, match=r"no start and goal of 20 draws .* 1 m between .*lower self_clearance_m"
+    ):
+        blocked_scene("ur5_0", "ur5", ur5, 0, self_clearance_m=1.0, draws=20)
+
+
+@pytest.mark.slow
+def test_the_scripts_draw_scenes_and_run_them_beside_ompl(tmp_path: Path) -> None:
+    """The README's two commands for one's own arm: scene files, then both planners on them."""
+    pytest.importorskip("ompl")
+    root = Path(__file__).resolve().parent.parent
+    scenes, scripts = tmp_path / "xarm7", root / "scripts"
+    draw = ["--robot", "xarm7", "--count", "2", "--seed", "5", "--out", str(scenes)]
+    drawn = subprocess.run(
+        [sys.executable, str(scripts / "generate_arm_scenes.py"), *draw],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert drawn.returncode == 0, drawn.stderr[-2000:]
+    assert sorted(p.name for p in scenes.iterdir()) == ["xarm7_5.yaml", "xarm7_6.yaml"]
+    files = [str(p) for p in sorted(scenes.iterdir())]
+    bench = subprocess.run(
+        [sys.executable, str(scripts / "bench_mbm.py"), "--scenes", *files, "--out", str(tmp_path / "bench")],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+    assert bench.returncode == 0, bench.stderr[-2000:]
+    with (tmp_path / "bench" / "mbm.csv").open() as rows:
+        read = list(csv.DictReader(rows))
+    assert [(r["robot"], r["class"], r["problem"]) for r in read] == [
+        ("xarm7", "xarm7", "5"),
+        ("xarm7", "xarm7", "6"),
+    ]
+    assert all(r["ours_ok"] == "True" and float(r["ours_time_s"]) > 0 for r in read)
+    assert "| xarm7 | all | 2 | 2 |" in (tmp_path / "bench" / "mbm.md").read_text()
