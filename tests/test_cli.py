@@ -82,7 +82,7 @@ BAD_INPUTS = [
         with_changes(planner__moving_joints=["elbow"]),
         "planner.moving_joints names ['elbow'], not among the robot's planned joints",
     ),
-    ("goal inside margin", with_changes(goal={"tcp": [0.0, 0.45, 0.4]}), "goal q = "),
+    ("goal inside margin", with_changes(goal={"tcp": [0.0, 0.45, 0.38]}), "goal q = "),  # 0.08 m, margin 0.1
     (
         "panda: six values",
         {**PANDA, "start": {"q": [0.0] * 6}},
