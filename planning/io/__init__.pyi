@@ -1,5 +1,6 @@
 """Type stub of the package: what it exports, and from which module (read by ``lazy_loader``)."""
 
+from .arm_scenes import blocked_scene
 from .bundled import bundled_scene_paths, paper_scene, paper_scene_path
 from .narrow_passages import narrow_scene
 from .outputs import plan_files
@@ -16,6 +17,7 @@ __all__ = [
     "OutputFolder",
     "TrajectoryFile",
     "TrajectoryFileError",
+    "blocked_scene",
     "bundled_scene_paths",
     "dump_scene",
     "generate_scenes",
