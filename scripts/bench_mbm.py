@@ -1,6 +1,7 @@
 """MotionBenchMaker: our planner beside OMPL's RRT-Connect pipeline, problem by problem, in one run.
 
     python scripts/bench_mbm.py [--robots panda ur5] [--classes ...] [--limit N] [--timeout S] [--out DIR]
+                                [--workers N]
     python scripts/bench_mbm.py --scenes out/arms/*/*.yaml [--timeout S] [--out DIR]
 
 Each problem goes the way a user's does (``import-moveit``, :mod:`planning.io.moveit_import`,
@@ -20,6 +21,8 @@ for the straight line, OMPL's median jerk over the limit. Rows go to ``DIR/mbm.c
 markdown to ``DIR/mbm.md``. Needs the ``bench`` extra; the problems are downloaded once
 (:mod:`planning.io.mbm`).
 
+Each planner runs in its own worker process; ``--workers N`` plans N problems at once (on a
+2-core machine both planners then share the cores, and both take longer: compare the ratios).
 ``--scenes FILE ...`` runs scene files instead, of any robot (``generate_arm_scenes.py``'s, a
 user's own), the same way; rows are grouped by the file's folder (the "robot" column) and its
 name without a trailing ``_<number>`` (the "class").
@@ -29,12 +32,14 @@ from __future__ import annotations
 
 import argparse
 import csv
+import itertools
 import multiprocessing
+import queue
 import statistics
 import sys
 import time
 from collections.abc import Iterator
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from concurrent.futures import TimeoutError as FutureTimeout
 from pathlib import Path
 from typing import Any
@@ -133,6 +138,43 @@ def median_ratio(mine: list[float], peer: list[float]) -> float:
     return statistics.median(mine) / statistics.median(peer) if mine and peer else float("nan")
 
 
+class Lane:
+    """One problem at a time: ours in a worker process (killed at the timeout), OMPL's in another."""
+
+    def __init__(self, context: Any) -> None:
+        self.context = context
+        self.ours, self.theirs = self._pool(), self._pool()
+
+    def _pool(self) -> ProcessPoolExecutor:
+        return ProcessPoolExecutor(1, mp_context=self.context)
+
+    def run(self, path: Path, timeout_s: float) -> dict[str, Any]:
+        """Both planners on the scene file ``path``, warm: the row's ``ours_*`` and ``ompl_*`` values."""
+        row: dict[str, Any] = {}
+        self.ours.submit(warm, str(path)).result()  # loaded once per robot and process, untimed
+        future = self.ours.submit(ours, str(path))
+        try:
+            row |= {f"ours_{k}": v for k, v in future.result(timeout=timeout_s).items()}
+        except FutureTimeout:
+            row |= {"ours_ok": False, "ours_time_s": timeout_s, "ours_why": "timeout"}
+            self._kill(self.ours)
+            self.ours = self._pool()
+        self.theirs.submit(warm, str(path)).result()
+        row |= {f"ompl_{k}": v for k, v in self.theirs.submit(theirs, str(path), timeout_s).result().items()}
+        return row
+
+    def close(self) -> None:
+        """Stop both worker processes."""
+        for pool in (self.ours, self.theirs):
+            pool.shutdown(cancel_futures=True)
+
+    @staticmethod
+    def _kill(pool: ProcessPoolExecutor) -> None:
+        for process in list(getattr(pool, "_processes", {}).values()):
+            process.kill()
+        pool.shutdown(wait=False, cancel_futures=True)
+
+
 def cases(args: argparse.Namespace) -> Iterator[tuple[str, str, int, Path]]:
     """``(robot, class, number, scene file)`` of each problem: MotionBenchMaker's, or ``--scenes``."""
     if args.scenes:
@@ -158,32 +200,38 @@ def main() -> int:
     parser.add_argument(
         "--scenes", nargs="+", type=Path, help="scene files to run instead of MotionBenchMaker's (any robot)"
     )
+    parser.add_argument(
+        "--workers", type=int, default=1, help="problems planned at once (each by both planners in turn)"
+    )
     parser.add_argument("--out", type=Path, default=Path("out/bench_mbm"))
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
-    rows: list[dict[str, Any]] = []
-    context = multiprocessing.get_context("spawn")
-    pool = ProcessPoolExecutor(1, mp_context=context)
     chosen = list(cases(args))
-    for number, (robot_name, problem_class, index, path) in enumerate(chosen, start=1):
-        row: dict[str, Any] = {"robot": robot_name, "class": problem_class, "problem": index}
-        row["invalid"] = valid(path) or ""
+    rows: list[dict[str, Any]] = [
+        {"robot": robot, "class": group, "problem": index, "invalid": valid(path) or ""}
+        for robot, group, index, path in chosen
+    ]
+    context = multiprocessing.get_context("spawn")
+    lanes: queue.Queue[Lane] = queue.Queue()
+    for _ in range(args.workers):
+        lanes.put(Lane(context))
+    finished = itertools.count(1)
+
+    def solve(number: int) -> None:
+        row, path = rows[number], chosen[number][3]
         if not row["invalid"]:
-            pool.submit(warm, str(path)).result()  # loaded once per robot and worker, untimed
-            future = pool.submit(ours, str(path))
+            lane = lanes.get()
             try:
-                row |= {f"ours_{k}": v for k, v in future.result(timeout=args.timeout).items()}
-            except FutureTimeout:
-                row |= {"ours_ok": False, "ours_time_s": args.timeout, "ours_why": "timeout"}
-                for process in list(getattr(pool, "_processes", {}).values()):
-                    process.kill()
-                pool.shutdown(wait=False, cancel_futures=True)
-                pool = ProcessPoolExecutor(1, mp_context=context)
-            row |= {f"ompl_{k}": v for k, v in theirs(str(path), args.timeout).items()}
-        rows.append(row)
+                row |= lane.run(path, args.timeout)
+            finally:
+                lanes.put(lane)
         mark = "-" if row["invalid"] else summary(row)
-        print(f"[{number}/{len(chosen)}] {robot_name} {path.stem}: {mark}", flush=True)
-    pool.shutdown(cancel_futures=True)
+        print(f"[{next(finished)}/{len(chosen)}] {row['robot']} {path.stem}: {mark}", flush=True)
+
+    with ThreadPoolExecutor(args.workers) as threads:
+        list(threads.map(solve, range(len(chosen))))
+    while not lanes.empty():
+        lanes.get().close()
     keys = sorted({k for row in rows for k in row})
     with (args.out / "mbm.csv").open("w", newline="") as out:
         writer = csv.DictWriter(out, fieldnames=keys)

@@ -61,7 +61,16 @@ def test_the_scripts_draw_scenes_and_run_them_beside_ompl(tmp_path: Path) -> Non
     assert sorted(p.name for p in scenes.iterdir()) == ["xarm7_5.yaml", "xarm7_6.yaml"]
     files = [str(p) for p in sorted(scenes.iterdir())]
     bench = subprocess.run(
-        [sys.executable, str(scripts / "bench_mbm.py"), "--scenes", *files, "--out", str(tmp_path / "bench")],
+        [
+            sys.executable,
+            str(scripts / "bench_mbm.py"),
+            "--scenes",
+            *files,
+            "--workers",
+            "2",
+            "--out",
+            str(tmp_path / "bench"),
+        ],
         capture_output=True,
         text=True,
         timeout=600,
