@@ -84,7 +84,7 @@ import-mbm: $(STAMP)
 	$(PY) scripts/import_mbm.py
 
 bench-mbm: $(STAMP)
-	$(PY) scripts/bench_mbm.py --out out/bench_mbm
+	$(PY) scripts/bench_mbm.py --out out/bench_mbm $(MBM_ARGS)
 
 bench-torque: $(STAMP)
 	$(PY) scripts/bench_torque.py --out out/bench_torque
