@@ -249,6 +249,18 @@ class CollisionWorld:
         uncertain = bounds.obstacles_below(batch, margin_m + BOUND_TOLERANCE_M)
         return self._pools.violated(batch, uncertain, margin_m, near)
 
+    def keeps_clearance(self, q: ArrayLike, margin_m: float, self_margin_m: float) -> NDArray[np.bool_]:
+        """``(N,)`` whether each configuration keeps its clearances: to obstacles and its own links.
+
+        ``margin_m`` [m] from every obstacle (:meth:`margin_violated`), then, only where that
+        holds, ``self_margin_m`` [m] between the robot's own checked pairs.
+        """
+        batch = np.asarray(q, dtype=float)  # margin_violated checks it
+        free = ~self.margin_violated(batch, margin_m)
+        if self.self_collision and free.any():
+            free[free] = ~self.self_collision.violated(batch[free], self_margin_m)
+        return free
+
     def _pairs_within(self, distance_m: float) -> tuple[BoolArray, PairBounds | None]:
         """The pairs whose reach comes within ``distance_m`` [m] and their bounds (``None``: no pair).
 

@@ -254,3 +254,20 @@ def test_reach_distance_of_the_turning_column_is_exact(robot: ck.Robot) -> None:
     world = ck.CollisionWorld(robot, [crate])
     column = [p for p, (geometry, _, _) in enumerate(world.pairs) if geometry == "column"]
     assert world._reach_distance[column[0]] == pytest.approx(0.45 - 0.06 * np.sqrt(2), abs=1e-6)
+
+
+def test_keeps_clearance_is_both_margins_from_distances(rng: np.random.Generator) -> None:
+    """The Panda among a ball: clear of it by the margin and of its own links by the self margin."""
+    from cpr_kin.packages import example_robot
+
+    panda = ck.load_robot(example_robot("panda"))
+    world = ck.CollisionWorld(panda, [ck.Obstacle.sphere(0.15, (0.45, 0.0, 0.4), name="ball")])
+    q = rng.uniform(panda.limits.lower, panda.limits.upper, (300, panda.nq))
+    margin_m, self_margin_m = 0.05, 0.02
+    assert world.self_collision
+    obstacles = world.clearance_batch(q).min_clearance_m
+    own = world.self_collision.distances(q)[0]
+    expected = (obstacles >= margin_m) & (own >= self_margin_m)
+    sure = (np.abs(obstacles - margin_m) > 1e-6) & (np.abs(own - self_margin_m) > 1e-6)
+    assert 0 < expected.sum() < len(q)  # both outcomes drawn
+    np.testing.assert_array_equal(world.keeps_clearance(q, margin_m, self_margin_m)[sure], expected[sure])

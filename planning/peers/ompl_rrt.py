@@ -55,19 +55,14 @@ def plan_rrt_connect(
         return q
 
     ends, objective = np.stack([q_start, q_goal]), problem.objective
-    inside = world.margin_violated(ends, objective.required_m).any() or bool(
-        world.self_collision and world.self_collision.violated(ends, objective.required_self_m).any()
-    )
-    if inside:  # an end within margin plus step (a grasp): the finer step, as the firefly's seeding
+    if not world.keeps_clearance(ends, objective.required_m, objective.required_self_m).all():
+        # an end within margin plus step (a grasp): the finer step, as the firefly's seeding
         finer = scene.planner.updated(verify_step_m=scene.planner.finer_verify_step_m)
         scene = dataclasses.replace(scene, planner=finer)
-    self_clearance_m = scene.self_margin + scene.planner.verify_step_m
+    margin_m, self_margin_m = planning_clearance_m(scene), scene.self_margin + scene.planner.verify_step_m
 
     def valid(state: object) -> bool:
-        q = full(state)[None]
-        if world.margin_violated(q, planning_clearance_m(scene))[0]:
-            return False
-        return not (world.self_collision and world.self_collision.violated(q, self_clearance_m)[0])
+        return bool(world.keeps_clearance(full(state)[None], margin_m, self_margin_m)[0])
 
     information.setStateValidityChecker(valid)
     information.setStateValidityCheckingResolution(0.002)  # of the space's extent, ~1.2 cm in theta1

@@ -177,11 +177,9 @@ def sampled_path(
     robot, moving, objective = problem.robot, problem.moving, problem.objective
 
     def valid(q: FloatArray) -> BoolArray:
-        full = problem.configurations(q)
-        free = ~problem.world.margin_violated(full, objective.required_m)
-        if problem.world.self_collision and free.any():
-            free[free] = ~problem.world.self_collision.violated(full[free], objective.required_self_m)
-        return free
+        return problem.world.keeps_clearance(
+            problem.configurations(q), objective.required_m, objective.required_self_m
+        )
 
     if settings is None:  # the path's edges checked at most as far apart as the clearance required
         tuning = problem.scene.planner.tuning.seeding
