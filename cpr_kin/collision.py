@@ -23,7 +23,7 @@ from cpr_kin.errors import CprKinError
 from cpr_kin.obstacle_pools import ObstaclePools
 from cpr_kin.obstacles import Obstacle
 from cpr_kin.pair_bounds import BOUND_TOLERANCE_M, PairBounds
-from cpr_kin.reach import pair_reach_distances
+from cpr_kin.reach import pair_reach_distances, robot_reach
 from cpr_kin.robot import GROUPS, Robot
 from cpr_kin.self_collision import SelfCollision
 
@@ -101,7 +101,10 @@ class CollisionWorld:
         links = [g.link for g in robot.geometries]
         kept = tuple((a, b) for a, b in robot.self_pairs if frozenset((links[a], links[b])) not in allowed)
         names = [g.name for g in robot.geometries]
-        self.self_collision = SelfCollision(robot.model, robot.collision_model, kept, names, self.num_threads)
+        radii = np.array([r.radii for r in robot_reach(robot)])
+        self.self_collision = SelfCollision(
+            robot.model, robot.collision_model, kept, names, self.num_threads, geometry_radii=radii
+        )
 
     @property
     def pairs(self) -> tuple[tuple[str, str, str], ...]:

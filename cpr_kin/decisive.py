@@ -16,13 +16,22 @@ from numpy.typing import NDArray
 FloatArray = NDArray[np.float64]
 
 
-def undecided(values: FloatArray, known: NDArray[np.bool_], slack_m: float | FloatArray) -> NDArray[np.bool_]:
+def undecided(
+    values: FloatArray,
+    known: NDArray[np.bool_],
+    slack_m: float | FloatArray,
+    certified_ceiling_m: float = np.inf,
+    sampled_ceiling_m: float = np.inf,
+) -> NDArray[np.bool_]:
     """``(K, G)`` samples not yet exact whose exact value could still lower a minimum the check reports.
 
     Args:
         values: ``(K, G)`` sampled values [m], exact where ``known``, lower bounds elsewhere.
         known: ``(K, G)`` which values are exact.
         slack_m: the certified bound's slack, one value or one per interval ``(K - 1,)`` [m].
+        certified_ceiling_m: a certified value the check has found elsewhere [m]: no value
+            at or above it can lower the certified minimum.
+        sampled_ceiling_m: the same for the smallest sampled value [m].
     """
     needed = np.zeros_like(known)
     slack = np.asarray(slack_m, dtype=float)
@@ -31,15 +40,15 @@ def undecided(values: FloatArray, known: NDArray[np.bool_], slack_m: float | Flo
     for g in range(values.shape[1]):
         column = certified[:, g]
         lowest = int(np.argmin(column))
-        if both_known[lowest, g]:
+        if both_known[lowest, g] or column[lowest] >= certified_ceiling_m:
             continue
-        best_exact = float(np.min(column[both_known[:, g]], initial=np.inf))
+        best_exact = min(float(np.min(column[both_known[:, g]], initial=np.inf)), certified_ceiling_m)
         below = column <= best_exact if np.isfinite(best_exact) else np.arange(len(column)) == lowest
         needed[:-1, g] |= below
         needed[1:, g] |= below
     lowest_sample = np.unravel_index(int(np.argmin(values)), values.shape)
-    if not known[lowest_sample]:
-        best_exact = float(np.min(values[known], initial=np.inf))
+    if not known[lowest_sample] and values[lowest_sample] < sampled_ceiling_m:
+        best_exact = min(float(np.min(values[known], initial=np.inf)), sampled_ceiling_m)
         if np.isfinite(best_exact):
             needed |= values <= best_exact
         else:

@@ -1,6 +1,6 @@
 """How far a robot point may move between two samples of a curve: the certified checks' slack.
 
-:func:`cpr_kin.check_curve` and :func:`cpr_kin.self_collision.check_self_curve` bound the
+:func:`cpr_kin.check_curve` and :func:`cpr_kin.self_curve.check_self_curve` bound the
 clearance between neighbouring samples by their values minus the robot's motion in between.
 One speed bound for the whole curve is its peak, reached mid-motion; near the ends, where a
 trajectory starts and stops at rest and often passes closest to an obstacle (a grasp, a

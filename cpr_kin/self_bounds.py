@@ -150,6 +150,15 @@ class SelfPairBounds:
         self_bounds(batch, float(threshold_m), out, *self._arguments)
         return out
 
+    def column(self, q: FloatArray, pair: int) -> FloatArray:
+        """``(N,)`` the capsules' lower bound [m] of the distance of pair ``pair`` (a column) alone."""
+        batch = np.ascontiguousarray(np.atleast_2d(q), dtype=float)
+        out = np.empty((len(batch), 1))
+        chain, joint, ends, radius, reach, pair_a, pair_b = self._arguments
+        one = slice(pair, pair + 1)
+        self_bounds(batch, np.inf, out, chain, joint, ends, radius, reach, pair_a[one], pair_b[one])
+        return out[:, 0]
+
     def any_below(self, q: FloatArray, threshold_m: float) -> BoolArray:
         """``(N,)`` whether some pair may be within ``threshold_m`` [m] at configurations ``q``."""
         return np.asarray((self(q, threshold_m) <= threshold_m).any(axis=1))
@@ -230,6 +239,23 @@ class ScreenedSelfTest:
             bounds,
             np.arange(bounds.shape[1]),
         )
+
+    def pair_bounds(self, batch: FloatArray, pair: int) -> FloatArray:
+        """``(N,)`` lower bounds [m] of pair ``pair``'s distance (its capsules') at ``batch``."""
+        return self.all_bounds.column(batch, pair)
+
+    def pair_distances(self, batch: FloatArray, pair: int) -> FloatArray:
+        """``(N,)`` coal's distance [m] of pair ``pair`` (index among all pairs) at ``batch``."""
+        self._prepare(float("nan"))
+        return closest_pairs(
+            self.model,
+            self._data,
+            self.geometry_model,
+            self._distance_data,
+            batch,
+            np.full((len(batch), 1), -np.inf),
+            np.array([pair], dtype=np.int64),
+        )[0]
 
     def _coal(self, tier: int, batch: FloatArray) -> NDArray[np.bool_]:
         """Coal's test of the pairs of ``tier`` (0 near, 1 far) at configurations ``batch``."""

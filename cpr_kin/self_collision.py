@@ -8,14 +8,14 @@ pair (the CPR: its SRDF disables all) costs nothing.
 
 The self-clearance required is its own, ``self_margin_m`` (a safety margin against
 obstacles is not one a robot can keep from itself: its links pass centimetres apart).
-Between two configurations both links of a pair move: their distance changes at most twice
-as fast as the fastest robot point (:func:`cpr_kin.motion_radii`), which the certified check
-of a curve counts.
+Between two configurations a pair's distance changes only by the joints that carry one of
+its links and not the other (:attr:`SelfCollision.pair_radii`), which the certified check of
+a curve counts (:mod:`cpr_kin.self_curve`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -25,10 +25,10 @@ import pinocchio as pin
 from lxml import etree
 from numpy.typing import ArrayLike, NDArray
 
-from cpr_kin.decisive import propagated_bounds, undecided
 from cpr_kin.errors import CprKinError, UrdfError
-from cpr_kin.interval_motion import IntervalSpeed, interval_motion
+from cpr_kin.reach import geometry_reach
 from cpr_kin.self_bounds import ScreenedSelfTest
+from cpr_kin.self_curve import relative_radii
 from cpr_kin.user_files import read_bytes
 
 FloatArray = NDArray[np.float64]
@@ -37,10 +37,6 @@ LinkPair = frozenset[str]
 
 MAX_SRDF_BYTES = 10_000_000
 """Largest SRDF file [bytes]."""
-MAX_SELF_CHECKS = 200_000
-"""Most configurations one certified self-collision check of a curve samples."""
-COARSE_STRIDE = 8
-"""The certified self check computes every this many samples first, the rest where they decide."""
 
 
 def find_srdf(urdf_path: Path, robot_name: str | None = None) -> Path | None:
@@ -145,6 +141,9 @@ class SelfCollision:
         pairs: geometry index pairs to check (:func:`self_pairs`).
         names: the geometries' names, by index.
         num_threads: threads of :meth:`violated`'s batches.
+        geometry_radii: ``(G, nj)`` each geometry's motion radius about each joint
+            (:attr:`cpr_kin.reach.GeometryReach.radii`, within the robot's joint ranges);
+            by default from the model's position limits.
     """
 
     def __init__(
@@ -154,11 +153,22 @@ class SelfCollision:
         pairs: tuple[tuple[int, int], ...],
         names: list[str],
         num_threads: int = 1,
+        geometry_radii: FloatArray | None = None,
     ) -> None:
         self.model = model
         self.geometry_model = collision_model.copy()
         for a, b in pairs:
             self.geometry_model.addCollisionPair(pin.CollisionPair(a, b))
+        if geometry_radii is None and pairs:
+            reach = geometry_reach(model, collision_model, model.lowerPositionLimit, model.upperPositionLimit)
+            geometry_radii = np.array([r.radii for r in reach])
+        self.pair_radii = (
+            relative_radii(model, collision_model, pairs, geometry_radii)
+            if geometry_radii is not None
+            else np.zeros((0, model.njoints - 1))
+        )
+        """``(P, nj)`` per pair, how fast its distance may change per joint speed [m/rad, m/m]
+        (:func:`cpr_kin.self_curve.relative_radii`)."""
         self._pairs = pairs
         self._names = names
         self.num_threads = num_threads
@@ -182,6 +192,18 @@ class SelfCollision:
             return np.full(len(batch), np.inf), np.full(len(batch), -1, dtype=np.int64)
         return self._screened().distances(batch)
 
+    def pair_distances(self, q: FloatArray, pair: int) -> FloatArray:
+        """``(N,)`` coal's distance [m] of pair ``pair`` (index in :attr:`pairs`) at ``q`` ``(N, nq)``."""
+        return self._screened().pair_distances(np.atleast_2d(np.asarray(q, dtype=float)), pair)
+
+    def pair_bounds(self, q: FloatArray, pair: int) -> FloatArray:
+        """``(N,)`` lower bounds [m] of pair ``pair``'s distance at configurations ``q`` ``(N, nq)``, cheaply.
+
+        Its capsules' distance (:class:`~cpr_kin.self_bounds.SelfPairBounds`), at most coal's
+        plus :data:`~cpr_kin.pair_bounds.BOUND_TOLERANCE_M`.
+        """
+        return self._screened().pair_bounds(np.atleast_2d(np.asarray(q, dtype=float)), pair)
+
     def violated(self, q: ArrayLike, margin_m: float) -> NDArray[np.bool_]:
         """``(N,)`` whether any pair is closer than ``margin_m`` [m] at configurations ``q``.
 
@@ -200,95 +222,3 @@ class SelfCollision:
         if self._test is None:
             self._test = ScreenedSelfTest(self.model, self.geometry_model, self._pairs, self.num_threads)
         return self._test
-
-
-@dataclass(frozen=True)
-class SelfCheck:
-    """Result of :func:`check_self_curve`.
-
-    Attributes:
-        accepted: the certified self-clearance is at least the margin everywhere.
-        margin_m: the self-clearance required [m].
-        checks: configurations sampled (each certified).
-        computed: those whose distances coal computed, the others bounded from them.
-        certified_min_m: lower bound of the self-clearance over the whole curve [m]
-            (``inf`` without pairs).
-        worst_time: instant of the smallest sampled self-clearance [s].
-        worst_pair: the geometry pair closest then, or ``None``.
-    """
-
-    accepted: bool
-    margin_m: float
-    checks: int
-    computed: int
-    certified_min_m: float
-    worst_time: float
-    worst_pair: tuple[str, str] | None
-
-
-def check_self_curve(
-    collision: SelfCollision,
-    curve: Callable[[FloatArray], FloatArray],
-    interval: tuple[float, float],
-    point_speed: float,
-    margin_m: float,
-    step_m: float,
-    interval_speed: IntervalSpeed | None = None,
-) -> SelfCheck:
-    """Certify that the curve ``q(t)`` over ``interval`` keeps ``margin_m`` between the robot's own pairs.
-
-    ``point_speed`` [m/s] bounds how fast any robot point moves (``motion_radii @ |q'|``);
-    two points of a pair approach at most twice as fast, so the curve is sampled every
-    ``dt = 2 step_m / (2 point_speed)`` and between samples ``k`` and ``k + 1`` the distance
-    is at least ``(c_k + c_{k+1} - 2 point_speed dt) / 2``; with ``interval_speed``
-    (:data:`cpr_kin.interval_motion.IntervalSpeed`), the lower of its bound and ``point_speed`` for
-    each interval. coal computes only the samples that decide the smallest certified and
-    sampled distances (:func:`_decisive_distances`); the result is that of every sample computed.
-
-    Raises:
-        CprKinError: more than :data:`~cpr_kin.motion.MAX_CURVE_CHECKS` samples needed.
-    """
-    t0, t1 = interval
-    if not collision:
-        return SelfCheck(True, float(margin_m), 0, 0, np.inf, t0, None)
-    fastest = 2.0 * point_speed
-    count = int(np.ceil((t1 - t0) * fastest / (2.0 * step_m))) + 1 if fastest > 0 else 1
-    if count > MAX_SELF_CHECKS:
-        raise CprKinError(
-            f"the self-collision check needs {count} samples ({t1 - t0:.4g} s of motion, step {step_m:g} m); "
-            f"at most {MAX_SELF_CHECKS}: use a larger step"
-        )
-    times = np.linspace(t0, t1, max(count, 2))
-    approach = 2.0 * interval_motion(times, point_speed, interval_speed)  # per interval [m]
-    distance, closest, computed = _decisive_distances(collision, curve(times), approach)
-    certified = 0.5 * (distance[:-1] + distance[1:] - approach)
-    worst = int(np.argmin(distance))
-    pair = collision.pairs[int(closest[worst])] if closest[worst] >= 0 else None
-    lowest = float(certified.min())
-    return SelfCheck(
-        bool(lowest >= margin_m), float(margin_m), len(times), computed, lowest, float(times[worst]), pair
-    )
-
-
-def _decisive_distances(
-    collision: SelfCollision, q: FloatArray, approach_m: FloatArray
-) -> tuple[FloatArray, IntArray, int]:
-    """Self distances [m] of the samples ``q`` ``(K, nq)``, exact where they decide the check.
-
-    Every :data:`COARSE_STRIDE`-th sample is computed first; the others are bounded from
-    them (distances change by at most ``approach_m`` ``(K - 1,)`` [m] between neighbours),
-    and coal computes those whose exact value could still lower the smallest certified or
-    sampled value (:func:`cpr_kin.decisive.undecided`) until both are exact. Elsewhere the
-    distance is the lower bound and the pair ``-1``.
-    """
-    count = len(q)
-    distance, closest = np.zeros(count), np.full(count, -1, dtype=np.int64)
-    known = np.zeros(count, dtype=bool)
-    reach = np.concatenate([[0.0], np.cumsum(approach_m)])
-    rows = np.unique(np.append(np.arange(0, count, COARSE_STRIDE), count - 1))
-    while rows.size:
-        distance[rows], closest[rows] = collision.distances(q[rows])
-        known[rows] = True
-        distance = propagated_bounds(distance, known, reach)
-        rows = np.flatnonzero(undecided(distance[:, None], known[:, None], approach_m)[:, 0])
-    return distance, closest, int(known.sum())

@@ -10,7 +10,8 @@ import pytest
 
 import cpr_kin as ck
 from cpr_kin.packages import example_robot_data_share
-from cpr_kin.self_collision import SelfCollision, check_self_curve, read_srdf, self_pairs
+from cpr_kin.self_collision import SelfCollision, read_srdf, self_pairs
+from cpr_kin.self_curve import check_self_curve
 from planning import Scene, Target, plan
 from planning.errors import PlanningError
 
@@ -79,10 +80,8 @@ def random_curves(robot: ck.Robot, count: int, seed: int) -> list[tuple[np.ndarr
 
 
 def test_the_certificate_is_a_lower_bound_no_denser_sampling_beats(panda: ck.Robot) -> None:
-    # straight joint-space segments and cubic curves at random: the certified minimum is at
-    # most every distance an independent sampling 20 times denser finds
     collision = ck.CollisionWorld(panda, []).self_collision
-    radii = ck.motion_radii(panda)
+    assert collision is not None
     for k, (a, b) in enumerate(random_curves(panda, 12, 5)):
         bend = np.random.default_rng(k).normal(0.0, 0.3, panda.nq)
 
@@ -91,35 +90,64 @@ def test_the_certificate_is_a_lower_bound_no_denser_sampling_beats(panda: ck.Rob
             return np.asarray(a + s * (b - a) + 4 * s * (1 - s) * bend)
 
         speed = np.abs(b - a) + 4 * np.abs(bend)  # bounds |q'(t)| on [0, 1]
-        check = check_self_curve(collision, curve, (0.0, 1.0), float(radii @ speed), 0.0, 0.01)
-        dense = np.linspace(0.0, 1.0, 20 * check.checks)
+        check = check_self_curve(collision, curve, (0.0, 1.0), speed, 0.0, 0.01)
+        dense = np.linspace(0.0, 1.0, 20_000)
         assert collision.distances(curve(dense))[0].min() >= check.certified_min_m - 1e-9
 
 
-def test_the_certificate_computes_few_samples_and_equals_computing_every_one(panda: ck.Robot) -> None:
-    # the samples coal skips are bounded from their neighbours: the certified minimum, the
-    # worst sample and its pair are those of the distances at every sample (a pair whose
-    # distance stays flat at the minimum, a link turning about its own axis, needs them all)
+def test_a_pairs_distance_changes_no_faster_than_its_relative_radii(panda: ck.Robot) -> None:
+    # oracle: coal's distances of each pair at a configuration and a small random step from it;
+    # only the joints carrying one geometry of a pair and not the other count
     collision = ck.CollisionWorld(panda, []).self_collision
     assert collision is not None
-    radii = ck.motion_radii(panda)
+    rng = np.random.default_rng(3)
+    whole = ck.motion_radii(panda)
+    for q in rng.uniform(panda.limits.lower, panda.limits.upper, (40, panda.nq)):
+        step = rng.normal(0.0, 0.02, panda.nq)
+        for p, radii in enumerate(collision.pair_radii):
+            change = abs(
+                float(
+                    collision.pair_distances(np.array([q + step]), p)[0]
+                    - collision.pair_distances(q[None], p)[0]
+                )
+            )
+            assert change <= radii @ np.abs(step) + 1e-9
+            assert np.all(radii <= 2 * whole + 1e-12)
+    names = collision.pairs
+    link5_finger = names.index(("panda_link5", "panda_leftfinger_0"))
+    assert np.all(collision.pair_radii[link5_finger][:5] == 0.0)  # joints 1-5 carry both
+
+
+def test_the_certificate_computes_few_samples_and_equals_computing_every_one(panda: ck.Robot) -> None:
+    # each pair is sampled at its own relative speed; the samples coal skips are bounded from
+    # their neighbours and the capsules: the certified minimum, the worst sample and its pair are
+    # those of the distances at every sample of every pair (a pair whose distance stays flat at
+    # the minimum, a link turning about its own axis, needs them all)
+    collision = ck.CollisionWorld(panda, []).self_collision
+    assert collision is not None
     computed, sampled = 0, 0
     for a, b in random_curves(panda, 12, 7):
 
         def line(t: np.ndarray, a: np.ndarray = a, b: np.ndarray = b) -> np.ndarray:
             return np.asarray(a + np.asarray(t)[:, None] * (b - a))
 
-        point_speed = float(radii @ np.abs(b - a))
-        check = check_self_curve(collision, line, (0.0, 1.0), point_speed, 0.0, 0.001)
-        times = np.linspace(0.0, 1.0, check.checks)
-        every, pair = collision.distances(line(times))
-        certified = 0.5 * (every[:-1] + every[1:] - 2.0 * point_speed * np.diff(times))
-        assert check.certified_min_m == pytest.approx(float(certified.min()), abs=1e-12)
-        worst = int(np.argmin(every))
-        assert check.worst_time == pytest.approx(times[worst])
-        assert check.worst_pair == collision.pairs[int(pair[worst])]
+        speed = np.abs(b - a)
+        check = check_self_curve(collision, line, (0.0, 1.0), speed, 0.0, 0.001)
+        certified, worst = np.inf, (np.inf, 0.0, -1)
+        for p, radii in enumerate(collision.pair_radii):
+            pair_speed = float(radii @ speed)
+            times = np.linspace(0.0, 1.0, max(int(np.ceil(pair_speed / 0.002)) + 1, 2))
+            every = collision.pair_distances(line(times), p)
+            certified = min(
+                certified, float(np.min(0.5 * (every[:-1] + every[1:] - pair_speed * np.diff(times))))
+            )
+            k = int(np.argmin(every))
+            worst = min(worst, (float(every[k]), float(times[k]), p))
+        assert check.certified_min_m == pytest.approx(certified, abs=1e-12)
+        assert check.worst_time == pytest.approx(worst[1])
+        assert check.worst_pair == collision.pairs[worst[2]]
         computed, sampled = computed + check.computed, sampled + check.checks
-    assert computed < 0.8 * sampled  # samples far from the minima are bounded, not computed
+    assert computed < 0.2 * sampled  # most pairs and samples are bounded, not computed
 
 
 def folded_through_itself(panda: ck.Robot) -> tuple[np.ndarray, np.ndarray]:

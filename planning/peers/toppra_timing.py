@@ -112,7 +112,10 @@ def time_and_verify(
     radii = ck.motion_radii(robot)
 
     def interval_speed(times: FloatArray) -> FloatArray:  # as ours: each interval's own speed bound
-        return interval_speed_bounds(times, np.asarray(timed(times, 1)), speeds, accelerations) @ radii
+        return joint_speeds(times) @ radii
+
+    def joint_speeds(times: FloatArray) -> FloatArray:
+        return interval_speed_bounds(times, np.asarray(timed(times, 1)), speeds, accelerations)
 
     check = ck.check_curve(
         world,
@@ -125,17 +128,16 @@ def time_and_verify(
         interval_speed,
     )
     if check.accepted and world.self_collision:  # the robot's own pairs, certified as ours are
-        from cpr_kin.self_collision import check_self_curve
+        from cpr_kin.self_curve import check_self_curve
 
-        point_speed = float(radii @ speeds)
         self_check = check_self_curve(
             world.self_collision,
             lambda t: np.asarray(timed(np.asarray(t))),
             (0.0, duration),
-            point_speed,
+            speeds,
             scene.self_margin,
             scene.planner.verify_step_m,
-            interval_speed,
+            joint_speeds,
         )
         if not self_check.accepted:
             check = dataclasses.replace(check, accepted=False, certified_min_m=self_check.certified_min_m)

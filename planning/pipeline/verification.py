@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from cpr_kin.self_collision import check_self_curve
+from cpr_kin.self_curve import check_self_curve
 from planning.curves.hermite import CONTINUITY
 from planning.curves.trajectory import DERIVATIVE_NAMES, Trajectory
 from planning.pipeline.scene import DEFAULT_SELF_MARGIN_M
@@ -105,20 +105,21 @@ def _interval_speed(trajectory: Trajectory, radii: FloatArray) -> ck.IntervalSpe
 
 
 def _self_problems(
-    world: ck.CollisionWorld, trajectory: Trajectory, margin_m: float, step_m: float, radii: FloatArray
+    world: ck.CollisionWorld, trajectory: Trajectory, margin_m: float, step_m: float
 ) -> list[str]:
-    """The certified self-collision check's verdict, as problems (none for a robot without pairs).
-
-    ``radii``: the robot's motion radii (:func:`cpr_kin.motion_radii`).
-    """
+    """The certified self-collision check's verdict, as problems (none for a robot without pairs)."""
     if not world.self_collision:
         return []
-    speed = float(radii @ trajectory.extrema(1).peak)
     interval = (float(trajectory.knots[0]), float(trajectory.knots[-1]))
-    local = _interval_speed(trajectory, radii)
     try:
         check = check_self_curve(
-            world.self_collision, trajectory.position, interval, speed, margin_m, step_m, local
+            world.self_collision,
+            trajectory.position,
+            interval,
+            trajectory.extrema(1).peak,
+            margin_m,
+            step_m,
+            trajectory.speed_bounds,
         )
     except ck.CprKinError as exc:
         return [f"cannot be certified clear of itself: {exc}"]
@@ -170,7 +171,7 @@ def verify_trajectory(
     - the certified clearance (:func:`cpr_kin.check_curve`, robot motion between checks at
       most ``step_m``) is at least ``margin_m`` [m];
     - the certified self-clearance of the robot's checked pairs
-      (:func:`cpr_kin.self_collision.check_self_curve`) is at least ``self_margin_m`` [m];
+      (:func:`cpr_kin.self_curve.check_self_curve`) is at least ``self_margin_m`` [m];
     - every joint stays within its range, and within its velocity, acceleration and jerk
       limits (exact extrema);
     - with ``endpoints = (start, goal)``: it starts and ends there (:meth:`Target.miss`: a
@@ -205,7 +206,7 @@ def verify_trajectory(
             f"comes within {check.certified_min_m:.4f} m (certified) of an obstacle, margin {margin_m} m: "
             f"closest at t = {check.worst_time:.2f} s between {check.worst_pair} ({check.worst_group})"
         )
-    problems += _self_problems(world, trajectory, required.self_margin_m, step_m, radii)
+    problems += _self_problems(world, trajectory, required.self_margin_m, step_m)
     positions = trajectory.extrema(0)
     for i, name in enumerate(robot.joint_names):
         low, high = positions.minimum[i], positions.maximum[i]

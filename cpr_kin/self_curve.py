@@ -1,0 +1,243 @@
+"""The certified self-collision check of a curve, pair by pair, each at its own relative speed.
+
+The joints that carry both geometries of a pair move them together and leave their distance
+as it is; only a joint that carries one and not the other changes it, at most as fast as
+that geometry's points turn about the joint's axis (its *motion radius* about the joint,
+:class:`cpr_kin.reach.GeometryReach`). So pair ``p``'s distance changes at most as fast as
+``sum_j R_pj |q'_j|`` (:func:`relative_radii`): a forearm and the wrist two joints down the
+chain, always a centimetre apart, move against each other many times slower than the hand
+moves in the world. Each pair is sampled at its own rate, every ``2 step_m`` of its relative
+motion, and between its samples ``k`` and ``k + 1`` its distance is at least
+``(c_k + c_{k+1} - slack_k) / 2``, at most ``step_m`` below the smaller sample, as in the
+obstacle check (:func:`cpr_kin.check_curve`).
+
+The pairs are screened by their capsules (:meth:`cpr_kin.self_collision.SelfCollision.pair_bounds`)
+at a coarser spacing, and visited from the lowest certified bound the screen gives; a pair
+that cannot lower the minima found so far is skipped, and within a pair coal computes only
+the samples that decide (:func:`cpr_kin.decisive.undecided`). The minima reported are those of computing every
+sample of every pair.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from cpr_kin.decisive import propagated_bounds, undecided
+from cpr_kin.errors import CprKinError
+from cpr_kin.pair_bounds import BOUND_TOLERANCE_M
+
+if TYPE_CHECKING:
+    from cpr_kin.self_collision import SelfCollision
+
+FloatArray = NDArray[np.float64]
+
+JointSpeeds = Callable[[FloatArray], FloatArray]
+"""Sample times ``(K,)`` [s] -> ``(K - 1, nj)`` bounds on ``|q'_j|`` over each interval between
+them [rad/s, m/s] (e.g. :meth:`~planning.curves.trajectory.Trajectory.speed_bounds`)."""
+
+MAX_SELF_CHECKS = 200_000
+"""Most samples the certified self-collision check of a curve takes of one pair."""
+COARSE_STRIDE = 8
+"""Of a pair's samples its capsules leave in doubt, every this many are computed first."""
+SCREEN_STRIDE = 8
+"""A pair is first screened by its capsules at this many times its samples' spacing."""
+
+
+def relative_radii(
+    model: Any, collision_model: Any, pairs: Sequence[tuple[int, int]], geometry_radii: ArrayLike
+) -> FloatArray:
+    """``(P, nj)`` how fast each pair's distance may change per joint speed [m/rad, m/m].
+
+    Args:
+        model: the robot's Pinocchio model (one-degree-of-freedom joints).
+        collision_model: its geometry model.
+        pairs: ``(geometry index, geometry index)`` per pair.
+        geometry_radii: ``(G, nj)`` each geometry's motion radius about each joint, 0 for the
+            joints that do not carry it (:attr:`cpr_kin.reach.GeometryReach.radii`).
+
+    A joint carrying both geometries or neither counts 0; one carrying only one of them,
+    that geometry's radius about it.
+    """
+    joints = model.njoints - 1
+    carried = np.zeros((len(collision_model.geometryObjects), joints), dtype=bool)
+    for g, obj in enumerate(collision_model.geometryObjects):
+        joint = obj.parentJoint
+        while joint > 0:
+            carried[g, joint - 1] = True
+            joint = model.parents[joint]
+    radii = np.asarray(geometry_radii, dtype=float)
+    out = np.zeros((len(pairs), joints))
+    for p, (a, b) in enumerate(pairs):
+        only_a, only_b = carried[a] & ~carried[b], carried[b] & ~carried[a]
+        out[p] = np.where(only_a, radii[a], 0.0) + np.where(only_b, radii[b], 0.0)
+    return out
+
+
+@dataclass(frozen=True)
+class SelfCheck:
+    """Result of :func:`check_self_curve`.
+
+    Attributes:
+        accepted: the certified self-clearance is at least the margin everywhere.
+        margin_m: the self-clearance required [m].
+        checks: samples taken, summed over the pairs (each pair at its own rate).
+        computed: those whose distance coal computed, the others bounded.
+        certified_min_m: lower bound of the self-clearance over the whole curve [m]
+            (``inf`` without pairs).
+        worst_time: instant of the smallest sampled self-clearance [s].
+        worst_pair: the geometry pair closest then, or ``None``.
+    """
+
+    accepted: bool
+    margin_m: float
+    checks: int
+    computed: int
+    certified_min_m: float
+    worst_time: float
+    worst_pair: tuple[str, str] | None
+
+
+@dataclass(frozen=True)
+class _PairSamples:
+    """One pair's samples: index, times ``(K,)`` [s], configurations, slack per interval [m], bounds [m]."""
+
+    index: int
+    times: FloatArray
+    q: FloatArray
+    slack: FloatArray
+    bounds: FloatArray
+
+    @property
+    def certified_bound(self) -> float:
+        """The lowest certified value the capsule bounds allow [m]."""
+        return float(np.min(0.5 * (self.bounds[:-1] + self.bounds[1:] - self.slack)))
+
+
+def check_self_curve(
+    collision: SelfCollision,
+    curve: Callable[[FloatArray], FloatArray],
+    interval: tuple[float, float],
+    joint_speed: ArrayLike,
+    margin_m: float,
+    step_m: float,
+    interval_joint_speed: JointSpeeds | None = None,
+) -> SelfCheck:
+    """Certify that the curve ``q(t)`` over ``interval`` keeps ``margin_m`` between the robot's own pairs.
+
+    Args:
+        collision: the robot's pairs.
+        curve: vectorised ``q(t)``: times ``(K,)`` [s] -> configurations ``(K, nq)``.
+        interval: ``(t0, t1)`` [s].
+        joint_speed: ``(nj,)`` bounds on ``|q'_j|`` over the interval [rad/s, m/s].
+        margin_m: the self-clearance required [m].
+        step_m: largest relative motion of a pair between two of its samples [m].
+        interval_joint_speed: tighter bounds per interval between samples
+            (:data:`JointSpeeds`); each interval's slack uses the lower of both.
+
+    Raises:
+        CprKinError: bad arguments, or a pair needing more than :data:`MAX_SELF_CHECKS` samples.
+    """
+    t0, t1 = interval
+    if not collision:
+        return SelfCheck(True, float(margin_m), 0, 0, np.inf, t0, None)
+    speed = np.asarray(joint_speed, dtype=float)
+    radii = collision.pair_radii
+    if speed.shape != radii.shape[1:] or not np.all(np.isfinite(speed) & (speed >= 0)):
+        raise CprKinError(f"joint speed bound {speed.tolist()} must be {radii.shape[1]} finite numbers >= 0")
+    if not (np.isfinite(step_m) and step_m > 0):
+        raise CprKinError(f"motion step {step_m} m must be a finite number > 0")
+    pair_speed = radii @ speed  # [m/s]
+    counts = np.maximum(np.ceil((t1 - t0) * pair_speed / (2.0 * step_m)).astype(np.int64) + 1, 2)
+    if counts.max() > MAX_SELF_CHECKS:
+        p = int(np.argmax(counts))
+        raise CprKinError(
+            f"the self-collision check of {collision.pairs[p]} needs {counts[p]} samples ({t1 - t0:.4g} s "
+            f"of motion at up to {pair_speed[p]:.3g} m/s, step {step_m:g} m); at most {MAX_SELF_CHECKS}: "
+            "use a larger step"
+        )
+
+    def sampled(p: int, count: int) -> _PairSamples:
+        times = np.linspace(t0, t1, count)
+        return _samples(collision, p, curve, times, pair_speed[p], interval_joint_speed)
+
+    screens = [sampled(p, max(-(-counts[p] // SCREEN_STRIDE), 2)) for p in range(len(radii))]
+    certified_min, sampled_min, worst_time, worst_pair, computed = np.inf, np.inf, t0, -1, 0
+    for screen in sorted(screens, key=lambda s: s.certified_bound):
+        # the screen bounds the pair's distance everywhere, its samples' certified value to step_m less
+        if screen.certified_bound - step_m >= certified_min and screen.certified_bound >= sampled_min:
+            continue  # neither minimum can come from this pair
+        pair = sampled(screen.index, int(counts[screen.index]))
+        if pair.certified_bound >= certified_min and pair.bounds.min() >= sampled_min:
+            continue
+        values, known = _decisive_values(collision, pair, certified_min, sampled_min)
+        computed += int(known.sum())
+        certified_min = min(certified_min, float(np.min(0.5 * (values[:-1] + values[1:] - pair.slack))))
+        lowest = int(np.argmin(values))
+        if known[lowest] and values[lowest] < sampled_min:
+            sampled_min, worst_time, worst_pair = float(values[lowest]), float(pair.times[lowest]), pair.index
+    return SelfCheck(
+        accepted=bool(certified_min >= margin_m),
+        margin_m=float(margin_m),
+        checks=int(counts.sum()),
+        computed=computed,
+        certified_min_m=certified_min,
+        worst_time=worst_time,
+        worst_pair=collision.pairs[worst_pair] if worst_pair >= 0 else None,
+    )
+
+
+def _samples(
+    collision: SelfCollision,
+    index: int,
+    curve: Callable[[FloatArray], FloatArray],
+    times: FloatArray,
+    speed: float,
+    interval_joint_speed: JointSpeeds | None,
+) -> _PairSamples:
+    """Pair ``index``'s samples at ``times``: configurations, slack, capsule bounds.
+
+    The slack of an interval is its duration times ``speed`` [m/s] or the interval's own
+    bound, the lower.
+    """
+    q = np.asarray(curve(times), dtype=float)
+    interval_speed = np.full(len(times) - 1, speed)
+    if interval_joint_speed is not None:
+        interval_speed = np.minimum(interval_speed, interval_joint_speed(times) @ collision.pair_radii[index])
+    slack = interval_speed * np.diff(times)
+    bounds = collision.pair_bounds(q, index) - BOUND_TOLERANCE_M  # at most coal's distance
+    return _PairSamples(index, times, q, slack, bounds)
+
+
+def _decisive_values(
+    collision: SelfCollision, pair: _PairSamples, certified_ceiling: float, sampled_ceiling: float
+) -> tuple[FloatArray, NDArray[np.bool_]]:
+    """The pair's distances [m] at its samples, exact where they decide, else lower bounds; which are exact.
+
+    Decide: could lower the pair's smallest certified or sampled value below the ceilings
+    (the check's minima so far) [m]. The capsules' bounds and the exact values' neighbours
+    (distances change by at most the slack per interval) bound the others.
+    """
+    count = len(pair.times)
+    values, known = pair.bounds.copy(), np.zeros(count, dtype=bool)
+    reach = np.concatenate([[0.0], np.cumsum(pair.slack)])
+    doubtful = np.zeros(count, dtype=bool)
+    low = 0.5 * (values[:-1] + values[1:] - pair.slack) < certified_ceiling
+    doubtful[:-1] |= low
+    doubtful[1:] |= low
+    coarse = np.zeros(count, dtype=bool)
+    coarse[::COARSE_STRIDE] = True
+    coarse[-1] = True
+    rows = np.flatnonzero(doubtful & coarse)
+    while rows.size:
+        values[rows] = collision.pair_distances(pair.q[rows], pair.index)
+        known[rows] = True
+        propagated = propagated_bounds(values, known, reach)  # exact where known
+        values = np.where(known, propagated, np.maximum(pair.bounds, propagated))
+        needed = undecided(values[:, None], known[:, None], pair.slack, certified_ceiling, sampled_ceiling)
+        rows = np.flatnonzero(needed[:, 0])
+    return values, known
