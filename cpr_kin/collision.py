@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import os
 from collections.abc import Sequence
-from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -81,16 +80,6 @@ class CollisionWorld:
         )
         self._data = robot.model.createData()
         self._all = model.createData()
-        self._groups = []
-        for group_index in range(len(GROUPS)):
-            gdata = model.createData()
-            for p, pair_group in enumerate(self._pair_group):
-                if pair_group == group_index:
-                    gdata.activateCollisionPair(p)
-                else:
-                    gdata.deactivateCollisionPair(p)
-            self._groups.append(gdata)
-        self._group_has_pairs = [bool(np.any(self._pair_group == g)) for g in range(len(GROUPS))]
         self._pools = ObstaclePools(
             robot.model, model, np.array([k for _, k in pairs], dtype=np.int64), self.num_threads
         )
@@ -151,10 +140,17 @@ class CollisionWorld:
         """Clearance [m] of group ``GROUPS[group_index]`` at configurations ``q`` ``(N, nq)``, by coal.
 
         Also the index of the closest pair per configuration; ``inf`` and ``-1`` for a group
-        with no pair.
+        with no pair. coal's distance of the closest pair, as with every pair computed; the
+        pairs are visited in the order of their bounds and only those that may be closest
+        are computed (:func:`cpr_kin.closest_pairs.closest_pairs`).
         """
-        gdata = self._groups[group_index] if self._group_has_pairs[group_index] else None
-        return self._closest_pairs(self._check_batch(q), gdata)
+        batch = self._check_batch(q)
+        columns = self._pair_group == group_index
+        if not columns.any():
+            return np.full(len(batch), np.inf), np.full(len(batch), -1, dtype=np.int64)
+        bounds = self._bounds(tuple(columns.tolist()))(batch)
+        model, data, pairs = self.robot.model, self._data, np.flatnonzero(columns)
+        return closest_pairs(model, data, self.geometry_model, self._all, batch, bounds, pairs)
 
     def clearance_lower_bounds(self, q: ArrayLike) -> FloatArray:
         """``(N, len(GROUPS))`` lower bounds [m] of each group's clearance at ``q`` ``(N, nq)``.
@@ -179,17 +175,16 @@ class CollisionWorld:
     def min_clearance_batch(self, q: ArrayLike, below_m: float | None = None) -> tuple[FloatArray, IntArray]:
         """Smallest distance over every pair [m] and the index of that pair, ``(N,)`` each.
 
-        One coal query per configuration (half the cost of :meth:`clearance_batch`) when
-        the groups need not be told apart. With ``below_m`` [m], only the pairs that may be
-        closest and closer than that are computed (:func:`cpr_kin.closest_pairs`, on the
-        pair bounds of the pairs whose reach, :mod:`cpr_kin.reach`, comes within it): a
-        distance below ``below_m`` is exact, a larger one is reported as ``inf`` with pair
-        ``-1`` (what a caller wants who asks only where a margin is violated).
+        Only the pairs that may be closest are computed (:func:`cpr_kin.closest_pairs`, on
+        the pair bounds). With ``below_m`` [m], only those closer than that too (of the pairs
+        whose reach, :mod:`cpr_kin.reach`, comes within it): a distance below ``below_m`` is
+        exact, a larger one is reported as ``inf`` with pair ``-1`` (what a caller wants who
+        asks only where a margin is violated).
         """
         batch = self._check_batch(q)
         if below_m is None:
-            return self._closest_pairs(batch, self._all)
-        if not np.isfinite(below_m):
+            below_m = np.inf
+        elif not np.isfinite(below_m):
             raise CprKinError(f"distance bound {below_m} m must be finite")
         near, bounds = self._pairs_within(below_m)
         values = np.empty((len(batch), 0)) if bounds is None else bounds(batch)
@@ -203,24 +198,6 @@ class CollisionWorld:
             np.flatnonzero(near),
             below_m,
         )
-
-    def _closest_pairs(self, batch: FloatArray, gdata: Any) -> tuple[FloatArray, IntArray]:
-        """Coal's smallest distance [m] over ``gdata``'s active pairs and that pair, per configuration.
-
-        ``inf`` and ``-1`` everywhere when ``gdata`` is ``None`` (no pair to compute).
-        """
-        n = len(batch)
-        clearance = np.full(n, np.inf)
-        closest = np.full(n, -1, dtype=np.int64)
-        if gdata is not None:
-            model, data, gmodel = self.robot.model, self._data, self.geometry_model
-            results = gdata.distanceResults
-            compute = pin.computeDistances
-            for k in range(n):
-                pair = compute(model, data, gmodel, gdata, batch[k])
-                clearance[k] = results[pair].min_distance
-                closest[k] = pair
-        return clearance, closest
 
     def _check_batch(self, q: ArrayLike) -> FloatArray:
         batch = np.asarray(q, dtype=float)

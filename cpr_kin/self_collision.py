@@ -196,6 +196,10 @@ class SelfCollision:
         """``(N,)`` coal's distance [m] of pair ``pair`` (index in :attr:`pairs`) at ``q`` ``(N, nq)``."""
         return self._screened().pair_distances(np.atleast_2d(np.asarray(q, dtype=float)), pair)
 
+    def bounds(self, q: FloatArray) -> FloatArray:
+        """``(N, P)`` lower bounds [m] of every pair's distance at ``q`` ``(N, nq)`` (:meth:`pair_bounds`)."""
+        return self._screened().all_bounds(np.atleast_2d(np.asarray(q, dtype=float)))
+
     def pair_bounds(self, q: FloatArray, pair: int) -> FloatArray:
         """``(N,)`` lower bounds [m] of pair ``pair``'s distance at configurations ``q`` ``(N, nq)``, cheaply.
 

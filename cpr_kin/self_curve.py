@@ -11,10 +11,11 @@ motion, and between its samples ``k`` and ``k + 1`` its distance is at least
 ``(c_k + c_{k+1} - slack_k) / 2``, at most ``step_m`` below the smaller sample, as in the
 obstacle check (:func:`cpr_kin.check_curve`).
 
-The pairs are screened by their capsules (:meth:`cpr_kin.self_collision.SelfCollision.pair_bounds`)
-at a coarser spacing, and visited from the lowest certified bound the screen gives; a pair
-that cannot lower the minima found so far is skipped, and within a pair coal computes only
-the samples that decide (:func:`cpr_kin.decisive.undecided`). The minima reported are those of computing every
+The pairs are first screened by their capsules
+(:meth:`cpr_kin.self_collision.SelfCollision.bounds`) on one coarser grid, and visited from
+the lowest bound the screen gives; a pair that cannot lower the minima found so far is
+skipped, and within a pair coal computes only the samples that decide
+(:func:`cpr_kin.decisive.undecided`). The minima reported are those of computing every
 sample of every pair.
 """
 
@@ -45,7 +46,7 @@ MAX_SELF_CHECKS = 200_000
 COARSE_STRIDE = 8
 """Of a pair's samples its capsules leave in doubt, every this many are computed first."""
 SCREEN_STRIDE = 8
-"""A pair is first screened by its capsules at this many times its samples' spacing."""
+"""The screen's grid is this many times coarser than the fastest pair's samples."""
 
 
 def relative_radii(
@@ -165,13 +166,13 @@ def check_self_curve(
         times = np.linspace(t0, t1, count)
         return _samples(collision, p, curve, times, pair_speed[p], interval_joint_speed)
 
-    screens = [sampled(p, max(-(-counts[p] // SCREEN_STRIDE), 2)) for p in range(len(radii))]
+    screen = _screen(collision, curve, (t0, t1), pair_speed, step_m, interval_joint_speed)
     certified_min, sampled_min, worst_time, worst_pair, computed = np.inf, np.inf, t0, -1, 0
-    for screen in sorted(screens, key=lambda s: s.certified_bound):
+    for p in np.argsort(screen, kind="stable"):
         # the screen bounds the pair's distance everywhere, its samples' certified value to step_m less
-        if screen.certified_bound - step_m >= certified_min and screen.certified_bound >= sampled_min:
+        if screen[p] - step_m >= certified_min and screen[p] >= sampled_min:
             continue  # neither minimum can come from this pair
-        pair = sampled(screen.index, int(counts[screen.index]))
+        pair = sampled(int(p), int(counts[p]))
         if pair.certified_bound >= certified_min and pair.bounds.min() >= sampled_min:
             continue
         values, known = _decisive_values(collision, pair, certified_min, sampled_min)
@@ -189,6 +190,29 @@ def check_self_curve(
         worst_time=worst_time,
         worst_pair=collision.pairs[worst_pair] if worst_pair >= 0 else None,
     )
+
+
+def _screen(
+    collision: SelfCollision,
+    curve: Callable[[FloatArray], FloatArray],
+    interval: tuple[float, float],
+    pair_speed: FloatArray,
+    step_m: float,
+    interval_joint_speed: JointSpeeds | None,
+) -> FloatArray:
+    """``(P,)`` lower bounds [m] of each pair's distance over the whole curve, from its capsules.
+
+    One grid for every pair, every ``2 SCREEN_STRIDE step_m`` of the fastest pair's relative
+    motion; each pair's bound is its smallest ``(b_k + b_{k+1} - slack_k) / 2``.
+    """
+    t0, t1 = interval
+    count = max(int(np.ceil((t1 - t0) * pair_speed.max() / (2.0 * SCREEN_STRIDE * step_m))) + 1, 2)
+    times = np.linspace(t0, t1, count)
+    speed = np.broadcast_to(pair_speed, (count - 1, len(pair_speed)))
+    if interval_joint_speed is not None:
+        speed = np.minimum(speed, interval_joint_speed(times) @ collision.pair_radii.T)
+    bounds = collision.bounds(curve(times)) - BOUND_TOLERANCE_M
+    return np.asarray(np.min(0.5 * (bounds[:-1] + bounds[1:] - speed * np.diff(times)[:, None]), axis=0))
 
 
 def _samples(
