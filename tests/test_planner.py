@@ -133,6 +133,43 @@ def test_infeasible_scene_raises_with_the_best_clearance(robot: ck.Robot) -> Non
     assert info.value.worst_pair is not None and info.value.worst_pair[1] == "wall"
 
 
+def test_a_best_candidate_deep_inside_the_margin_is_verified_in_one_timing_only(
+    robot: ck.Robot, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # the wall scene's best candidate crosses the wall: every timing of its path would be
+    # refused, so one verification says why; a feasible best is verified timing after timing
+    import planning.pipeline.choose as choosing
+    from planning.pipeline.search import search
+    from planning.pipeline.seeding import SEEDINGS
+
+    wall = ck.Obstacle.box((0.05, 1.3, 2.0), (0.0, 0.95, 1.0), name="wall")
+    scene = Scene(
+        start=Target(tcp=PAPER_START_TCP),
+        goal=Target(tcp=PAPER_GOAL_TCP),
+        obstacles=(wall,),
+        duration=4.0,
+        planner=PlannerSettings(firefly=FireflySettings(fireflies=10, iterations=5), seeding="none"),
+    )
+    problem = build_problem(scene, robot)
+    searched = search(SEEDINGS["none"].first(problem))
+    assert choosing.beyond_margin(problem, searched)
+    samples = problem.objective.paths(problem.objective.nodes(searched.x[None])).samples[0]
+    deepest = min(problem.world.clearance(q).min_clearance_m for q in samples)  # oracle: every sample
+    assert deepest < scene.safety_margin - scene.planner.verify_step_m
+    original, verified = choosing.verify, []
+
+    def counted(*args: Any) -> Any:
+        verified.append(args)
+        return original(*args)
+
+    monkeypatch.setattr(choosing, "verify", counted)
+    chosen = choosing.choose(problem, searched)
+    assert isinstance(chosen, choosing.Refusal) and len(verified) == 1
+    assert "wall" in chosen.cause
+    paper = build_problem(paper_scene(0), robot)
+    assert not choosing.beyond_margin(paper, search(SEEDINGS["none"].first(paper)))
+
+
 def test_bad_planner_settings() -> None:
     with pytest.raises(PlanningError, match=r"waypoints = 0 must be an integer in \[1, 20\]"):
         PlannerSettings(waypoints=0)

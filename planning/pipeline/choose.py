@@ -16,7 +16,9 @@ and returns the first whose timed trajectory passes the certified continuous che
 3. their other timings (the uniform ones), shortest first;
 4. each further candidate's timings, in order.
 
-Each candidate is timed once, however often the search returns it.
+Each candidate is timed once, however often the search returns it. A best candidate that
+comes deeper inside the margin than one verification step at one of its samples
+(:func:`beyond_margin`) is verified in its first timing only: every timing follows its path.
 """
 
 from __future__ import annotations
@@ -131,6 +133,31 @@ def infeasibility(breakdown: Breakdown, problem: Problem) -> str:
     return ", ".join(reasons) or "infeasible"
 
 
+def beyond_margin(problem: Problem, searched: SearchResult) -> bool:
+    """The search's best is infeasible and, at one of its samples, deeper inside a margin than a step.
+
+    The fitness asks ``safety_margin + verify_step_m`` at its samples, and a candidate short
+    of that only within the step may still pass the certified check, which asks the margin.
+    One whose path comes more than ``verify_step_m`` inside the margin at one of its samples
+    (from an obstacle, or inside the self margin from its own links) cannot: each of its
+    timings follows that path to within the millimetres its moving averages cut off bends.
+    All the samples count, also those the fitness left unchecked once the candidate was
+    infeasible (:meth:`~planning.pipeline.objective.WaypointObjective.breakdown`).
+    """
+    objective, scene, world = problem.objective, problem.scene, problem.world
+    if objective.feasible(searched.fitness):
+        return False
+    paths = objective.paths(objective.nodes(searched.x[None]))
+    samples = objective.checked_configurations(paths.samples[0])
+    step = scene.planner.verify_step_m
+    inside, _ = world.min_clearance_batch(samples, below_m=scene.safety_margin - step)
+    if np.isfinite(inside).any():
+        return True
+    if not world.self_collision:
+        return False
+    return bool(world.self_collision.distances(samples)[0].min() < scene.self_margin - step)
+
+
 def choose(problem: Problem, searched: SearchResult) -> Choice | Refusal:
     """The first candidate whose timed trajectory passes the verification (module docstring)."""
     objective = problem.objective
@@ -139,12 +166,15 @@ def choose(problem: Problem, searched: SearchResult) -> Choice | Refusal:
     candidates = distinct([searched.x] + [searched.population[k] for k in order if feasible[k]])
     timed: list[list[Timing]] = []
     first: Verification | None = None
+    hopeless = beyond_margin(problem, searched)
     for k, timing in _attempts(problem, candidates, timed):
         verification = verify(problem, timing.trajectory, timing.fit)
         first = first or verification
         if verification.accepted:
             x = candidates[k]
             return Choice(x, objective.nodes(x[None])[0], timing, verification, len(timed))
+        if hopeless:
+            break  # its other timings follow the same path
     assert first is not None  # candidates is never empty
     found = f"the best candidate {'; '.join(first.problems)}"
     if not objective.feasible(searched.fitness):  # the cause comes first, the obstacle named

@@ -174,6 +174,10 @@ class WaypointObjective:
         direct = np.stack([self.q_start, self.q_goal])
         return float(ptp_time(direct, self.v_max, self.a_max))
 
+    def checked_configurations(self, samples: FloatArray) -> FloatArray:
+        """The configurations the fitness checks for a path's ``samples`` ``(..., nq)``: within the ranges."""
+        return np.clip(samples, self.lower_q, self.upper_q)
+
     def __call__(self, x: FloatArray) -> FloatArray:
         """``(S,)`` fitness of candidates ``x`` ``(S, p k)`` in joint units."""
         return self.breakdown(x).fitness
@@ -232,7 +236,7 @@ class WaypointObjective:
             np.zeros_like(deviation) if bound is None else np.maximum(deviation / bound - 1.0, 0.0)
         )
         other = paths.overshoot + excess + deviation_excess
-        clearance = self._clearance(np.clip(paths.samples, self.lower_q, self.upper_q), other <= 0.0)
+        clearance = self._clearance(self.checked_configurations(paths.samples), other <= 0.0)
         shortfall = np.maximum(self.required_m - clearance, 0.0)
         effector = np.asarray((clearance[:, :, 0] < self.required_m).any(axis=1))
         links = np.asarray((clearance[:, :, 1] < self.required_m).any(axis=1))
