@@ -132,3 +132,24 @@ def test_a_signal_once_the_command_is_over_changes_nothing(tmp_path: Path) -> No
     )
     assert done.returncode == 0 and done.stderr == "" and "Traceback" not in done.stdout
     assert complete_set(out)
+
+
+def test_a_swallowed_signal_is_raised_again_at_the_checkpoint() -> None:
+    # a compiled extension's import swallowed the interrupt once (the command then wrote its
+    # files); the signal is recorded, and the checkpoint before publishing raises it again
+    import os
+
+    from planning.cli.signals import checkpoint, interrupts
+
+    with interrupts() as signalled:
+        checkpoint()  # nothing came: nothing raised
+        try:
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(1.0)  # the handler runs here
+        except KeyboardInterrupt:
+            pass  # swallowed, as the import did
+        assert signalled()
+        with pytest.raises(KeyboardInterrupt, match="SIGTERM"):
+            checkpoint()
+    with interrupts():
+        checkpoint()  # a new command starts with no signal

@@ -10,11 +10,15 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from cpr_kin.names import escaped
+from planning.cli.signals import checkpoint
 from planning.cli.terminal import firefly_progress
 from planning.outcome import EXIT_OK, Interrupted, interruption
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+
     from planning.pipeline.scene import Scene
+    from planning.search.firefly import FireflyProgress
 
 OVERRIDES = ("seed", "fitness", "fireflies", "iterations")
 """Planner settings the command line may change, by their scene-file keys."""
@@ -25,6 +29,17 @@ def load(path: Path) -> Scene:
     from planning.io.scene_file import load_scene
 
     return load_scene(path)
+
+
+def _checked(update: Callable[[FireflyProgress], None] | None) -> Callable[[FireflyProgress], None]:
+    """The search's progress callback, with a :func:`~planning.cli.signals.checkpoint` each iteration."""
+
+    def progress(state: FireflyProgress) -> None:
+        checkpoint()  # a signal something swallowed stops the search at its next iteration
+        if update is not None:
+            update(state)
+
+    return progress
 
 
 def _plan_and_write(scene: Scene, out: str, args: argparse.Namespace, paper: bool) -> int:
@@ -42,10 +57,12 @@ def _plan_and_write(scene: Scene, out: str, args: argparse.Namespace, paper: boo
     update, close = firefly_progress(sys.stdout.isatty() and not args.json)
     with OutputFolder(out) as folder:  # locked from here: a second writer is refused at once
         try:
-            result = plan(scene, progress=update)
+            result = plan(scene, progress=_checked(update))
             close()
             extras = {"plots": paper or args.plots, "html": paper or args.html}
-            outputs = folder.publish(plan_files(result, paper=paper, timings=args.timings, **extras))
+            files = plan_files(result, paper=paper, timings=args.timings, **extras)
+            checkpoint()  # a signal something swallowed still stops the command before it writes
+            outputs = folder.publish(files)
             if args.json:
                 print(json.dumps({**summary(result), "outputs": [str(p) for p in outputs]}, indent=1))
             else:
