@@ -16,6 +16,18 @@ from numpy.typing import NDArray
 FloatArray = NDArray[np.float64]
 
 
+def certified(values: FloatArray, slack_m: float | FloatArray) -> FloatArray:
+    """``(c_k + c_{k+1} - slack_k) / 2`` per interval: the least the distance can be between samples.
+
+    ``values`` ``(K,)`` or ``(K, G)`` [m]; ``slack_m`` one value, one per interval ``(K - 1,)``
+    (for every column) or ``(K - 1, G)`` [m].
+    """
+    slack = np.asarray(slack_m, dtype=float)
+    if slack.ndim == 1 and values.ndim == 2:
+        slack = slack[:, None]
+    return np.asarray(0.5 * (values[:-1] + values[1:] - slack))
+
+
 def undecided(
     values: FloatArray,
     known: NDArray[np.bool_],
@@ -34,11 +46,10 @@ def undecided(
         sampled_ceiling_m: the same for the smallest sampled value [m].
     """
     needed = np.zeros_like(known)
-    slack = np.asarray(slack_m, dtype=float)
-    certified = 0.5 * (values[:-1] + values[1:] - (slack[:, None] if slack.ndim else slack))
+    lower = certified(values, slack_m)
     both_known = known[:-1] & known[1:]
     for g in range(values.shape[1]):
-        column = certified[:, g]
+        column = lower[:, g]
         lowest = int(np.argmin(column))
         if both_known[lowest, g] or column[lowest] >= certified_ceiling_m:
             continue

@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.clearance import BatchClearance
 from cpr_kin.collision import CollisionWorld
-from cpr_kin.decisive import undecided
+from cpr_kin.decisive import certified, undecided
 from cpr_kin.errors import CprKinError
 from cpr_kin.interval_motion import IntervalSpeed, interval_motion
 from cpr_kin.reach import robot_reach
@@ -144,8 +144,7 @@ def check_curve(
     batch = decisive_clearance(world, curve(times), slack)
     per_group = batch.clearance_m
     # lower bound between neighbouring samples: distances change no faster than the robot moves
-    certified = 0.5 * (per_group[:-1] + per_group[1:] - slack[:, None])
-    group_bound = certified.min(axis=0)
+    group_bound = certified(per_group, slack).min(axis=0)
     sample_min = per_group.min(axis=1)
     worst = int(np.argmin(sample_min))
     worst_group_index = int(np.argmin(per_group[worst]))

@@ -228,17 +228,8 @@ class ScreenedSelfTest:
         coal's distance of the closest pair, the pairs visited in the order of their bounds
         until no pair left can be closer (:func:`cpr_kin.closest_pairs.closest_pairs`).
         """
-        self._prepare(float("nan"))
         bounds = self.all_bounds(batch)
-        return closest_pairs(
-            self.model,
-            self._data,
-            self.geometry_model,
-            self._distance_data,
-            batch,
-            bounds,
-            np.arange(bounds.shape[1]),
-        )
+        return self._closest(batch, bounds, np.arange(bounds.shape[1]))
 
     def pair_bounds(self, batch: FloatArray, pair: int) -> FloatArray:
         """``(N,)`` lower bounds [m] of pair ``pair``'s distance (its capsules') at ``batch``."""
@@ -246,16 +237,13 @@ class ScreenedSelfTest:
 
     def pair_distances(self, batch: FloatArray, pair: int) -> FloatArray:
         """``(N,)`` coal's distance [m] of pair ``pair`` (index among all pairs) at ``batch``."""
+        return self._closest(batch, np.full((len(batch), 1), -np.inf), np.array([pair], dtype=np.int64))[0]
+
+    def _closest(self, batch: FloatArray, bounds: FloatArray, pairs: IntArray) -> tuple[FloatArray, IntArray]:
+        """:func:`~cpr_kin.closest_pairs.closest_pairs` of ``pairs`` (bounded by ``bounds``) at ``batch``."""
         self._prepare(float("nan"))
-        return closest_pairs(
-            self.model,
-            self._data,
-            self.geometry_model,
-            self._distance_data,
-            batch,
-            np.full((len(batch), 1), -np.inf),
-            np.array([pair], dtype=np.int64),
-        )[0]
+        data = (self.model, self._data, self.geometry_model, self._distance_data)
+        return closest_pairs(*data, batch, bounds, pairs)
 
     def _coal(self, tier: int, batch: FloatArray) -> NDArray[np.bool_]:
         """Coal's test of the pairs of ``tier`` (0 near, 1 far) at configurations ``batch``."""

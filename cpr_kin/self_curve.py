@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from cpr_kin.decisive import propagated_bounds, undecided
+from cpr_kin.decisive import certified, propagated_bounds, undecided
 from cpr_kin.errors import CprKinError
 from cpr_kin.pair_bounds import BOUND_TOLERANCE_M
 
@@ -116,7 +116,7 @@ class _PairSamples:
     @property
     def certified_bound(self) -> float:
         """The lowest certified value the capsule bounds allow [m]."""
-        return float(np.min(0.5 * (self.bounds[:-1] + self.bounds[1:] - self.slack)))
+        return float(np.min(certified(self.bounds, self.slack)))
 
 
 def check_self_curve(
@@ -177,7 +177,7 @@ def check_self_curve(
             continue
         values, known = _decisive_values(collision, pair, certified_min, sampled_min)
         computed += int(known.sum())
-        certified_min = min(certified_min, float(np.min(0.5 * (values[:-1] + values[1:] - pair.slack))))
+        certified_min = min(certified_min, float(np.min(certified(values, pair.slack))))
         lowest = int(np.argmin(values))
         if known[lowest] and values[lowest] < sampled_min:
             sampled_min, worst_time, worst_pair = float(values[lowest]), float(pair.times[lowest]), pair.index
@@ -212,7 +212,7 @@ def _screen(
     if interval_joint_speed is not None:
         speed = np.minimum(speed, interval_joint_speed(times) @ collision.pair_radii.T)
     bounds = collision.bounds(curve(times)) - BOUND_TOLERANCE_M
-    return np.asarray(np.min(0.5 * (bounds[:-1] + bounds[1:] - speed * np.diff(times)[:, None]), axis=0))
+    return np.asarray(np.min(certified(bounds, speed * np.diff(times)[:, None]), axis=0))
 
 
 def _samples(
@@ -250,7 +250,7 @@ def _decisive_values(
     values, known = pair.bounds.copy(), np.zeros(count, dtype=bool)
     reach = np.concatenate([[0.0], np.cumsum(pair.slack)])
     doubtful = np.zeros(count, dtype=bool)
-    low = 0.5 * (values[:-1] + values[1:] - pair.slack) < certified_ceiling
+    low = certified(values, pair.slack) < certified_ceiling
     doubtful[:-1] |= low
     doubtful[1:] |= low
     coarse = np.zeros(count, dtype=bool)

@@ -111,11 +111,11 @@ def time_and_verify(
     accelerations = np.abs(np.asarray(timed(dense, 2))).max(axis=0) * 1.05 + 1e-9
     radii = ck.motion_radii(robot)
 
-    def interval_speed(times: FloatArray) -> FloatArray:  # as ours: each interval's own speed bound
-        return joint_speeds(times) @ radii
-
-    def joint_speeds(times: FloatArray) -> FloatArray:
+    def joint_speeds(times: FloatArray) -> FloatArray:  # as ours: each interval's own speed bound
         return interval_speed_bounds(times, np.asarray(timed(times, 1)), speeds, accelerations)
+
+    def interval_speed(times: FloatArray) -> FloatArray:
+        return joint_speeds(times) @ radii
 
     check = ck.check_curve(
         world,
