@@ -14,6 +14,8 @@ from cpr_kin.self_collision import SelfCollision, read_srdf, self_pairs
 from cpr_kin.self_curve import check_self_curve
 from planning import Scene, Target, plan
 from planning.errors import PlanningError
+from planning.pipeline.problem import build_problem, with_planner
+from planning.pipeline.settings import PlannerSettings
 
 SHARE = example_robot_data_share()
 assert SHARE is not None, "example-robot-data is part of the robots extra, which make installs"
@@ -206,3 +208,46 @@ def test_the_fast_violation_test_agrees_with_the_distances(panda: ck.Robot, marg
     violated = collision.violated(q, margin_m)
     assert 0 < violated.sum() < len(q)
     np.testing.assert_array_equal(violated, distance < margin_m)
+
+
+def near_itself(panda: ck.Robot) -> tuple[np.ndarray, np.ndarray]:
+    """Two poses whose straight joint-space line passes 1-3 cm from the arm itself, midway."""
+    collision = ck.CollisionWorld(panda, []).self_collision
+    rng = np.random.default_rng(5)
+    for _ in range(4000):
+        a, b = rng.uniform(panda.limits.lower, panda.limits.upper, (2, panda.nq))
+        d = collision.distances(a + np.linspace(0, 1, 41)[:, None] * (b - a))[0]
+        if 0.01 < d.min() < 0.03 and min(d[0], d[-1]) > d.min() + 0.02:
+            return a, b
+    raise AssertionError("no pair of poses found")
+
+
+def test_the_self_check_asks_its_own_finer_step_beyond_the_self_margin(panda: ck.Robot) -> None:
+    a, b = near_itself(panda)
+    scene = Scene(start=Target(q=tuple(a)), goal=Target(q=tuple(b)), self_margin=0.0)
+    objective = build_problem(scene, panda).objective
+    straight = objective.straight_line()[None]
+    samples = objective.paths(objective.nodes(straight)).samples[0]
+    closest = float(objective.world.self_collision.distances(samples)[0].min())
+    # the self margin 3 mm below the line's closest sample: within the default self step's
+    # 1 mm beyond it, not within the obstacle step's 5 mm
+    scene = dataclasses.replace(scene, self_margin=closest - 0.003)
+    problem = build_problem(scene, panda)
+    assert problem.scene.planner.self_step_m == 0.001
+    assert problem.objective.required_self_m == pytest.approx(closest - 0.002)
+    assert problem.objective.breakdown(straight).feasible[0]
+    coarse = with_planner(problem, self_verify_step_m=0.005)
+    assert coarse.objective.required_self_m == pytest.approx(closest + 0.002)
+    assert not coarse.objective.breakdown(straight).feasible[0]
+    result = plan(scene, panda)  # certified at the finer step too
+    assert result.verification.accepted
+    dense = result.trajectory(np.linspace(0.0, result.trajectory.duration, 4000))
+    assert result.problem.world.self_collision.distances(dense)[0].min() >= scene.self_margin - 1e-9
+
+
+def test_the_self_step_is_never_coarser_than_the_obstacle_step() -> None:
+    settings = PlannerSettings(verify_step_m=0.0005)
+    assert settings.self_step_m == 0.0005 and PlannerSettings().self_step_m == 0.001
+    refused = r"self_verify_step_m = 0.5 m must be a number in \[0.0001, 0.1\] m"
+    with pytest.raises(PlanningError, match=refused):
+        PlannerSettings(self_verify_step_m=0.5)

@@ -129,6 +129,7 @@ class PlannerSpec(Strict):
     ipo: Annotated[float, between(*IPO_RANGE_S)] = _P.ipo
     fitness_samples: Annotated[int, Field(ge=2, le=MAX_FITNESS_SAMPLES)] = _P.fitness_samples
     verify_step_m: Annotated[float, between(*VERIFY_STEP_RANGE_M)] = _P.verify_step_m
+    self_verify_step_m: Annotated[float, between(*VERIFY_STEP_RANGE_M)] = _P.self_verify_step_m
     max_node_deviation: Annotated[float, Field(gt=0, le=1)] | None = _P.max_node_deviation
     moving_joints: Annotated[list[Name], Field(min_length=1, max_length=64)] | None = None
     seeding: Literal["paths", "none"] = _P.seeding

@@ -59,7 +59,7 @@ def plan_rrt_connect(
         # an end within margin plus step (a grasp): the finer step, as the firefly's seeding
         finer = scene.planner.updated(verify_step_m=scene.planner.finer_verify_step_m)
         scene = dataclasses.replace(scene, planner=finer)
-    margin_m, self_margin_m = planning_clearance_m(scene), scene.self_margin + scene.planner.verify_step_m
+    margin_m, self_margin_m = planning_clearance_m(scene), scene.self_margin + scene.planner.self_step_m
 
     def valid(state: object) -> bool:
         return bool(world.keeps_clearance(full(state)[None], margin_m, self_margin_m)[0])

@@ -136,7 +136,7 @@ def time_and_verify(
             (0.0, duration),
             speeds,
             scene.self_margin,
-            scene.planner.verify_step_m,
+            scene.planner.self_step_m,
             joint_speeds,
         )
         if not self_check.accepted:

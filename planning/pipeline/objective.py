@@ -13,11 +13,12 @@ between the fixed start and goal. Its terms:
 
 **Feasible** (:meth:`WaypointObjective.feasible`, the one place the rule is written): the
 fitness is at most ``t_max``, which holds exactly when the executed path keeps
-``margin + verify_step_m`` from every obstacle at the ``fitness_samples`` samples (coal),
-stays within the joint ranges, deviates from its nodes by at most ``max_node_deviation``
-(when set) and, when the scene fixes the duration, keeps velocity, acceleration and jerk
-within the limits at that duration (checked at the IPO samples; the final timing uses exact
-extrema). How the terms become the fitness, feasible or not, is the fitness rule's
+``margin + verify_step_m`` from every obstacle and ``self_margin + self_verify_step_m``
+between the robot's own pairs at the ``fitness_samples`` samples (coal), stays within the
+joint ranges, deviates from its nodes by at most ``max_node_deviation`` (when set) and,
+when the scene fixes the duration, keeps velocity, acceleration and jerk within the limits
+at that duration (checked at the IPO samples; the final timing uses exact extrema). How
+the terms become the fitness, feasible or not, is the fitness rule's
 (:mod:`planning.pipeline.fitness`); the paths themselves are those of
 :mod:`planning.pipeline.path_terms`.
 
@@ -116,7 +117,7 @@ class WaypointObjective:
         self.solver = solver
         self.n_waypoints = settings.waypoints
         self.required_m = margin_m + settings.verify_step_m
-        self.required_self_m = self_margin_m + settings.verify_step_m
+        self.required_self_m = self_margin_m + settings.self_step_m
         limits = robot.limits
         self.lower_q, self.upper_q = limits.lower, limits.upper
         self.v_max, self.a_max = limits.velocity, limits.acceleration

@@ -23,8 +23,9 @@ is a small part of its space, rarely met by a random population. So, with the pl
    candidates failed the certified check (a violation between two samples escaped the
    fitness); ``retries`` times at most.
 
-The clearance required is the margin plus the certified check's step (``verify_step_m``):
-what moves between two checks is counted against the margin. A passage narrower than that
+The clearance required is the margin plus the certified check's step (``verify_step_m``;
+between the robot's own pairs the self margin plus its finer ``self_verify_step_m``): what
+moves between two checks is counted against the margin. A passage narrower than that
 has no path: when RRT-Connect finds none (at once for a start or goal that close, a grasp),
 the first attempt asks once more with the step cut to ``finer_step`` of it (1 mm of the
 default 5 mm): a path may pass within a millimetre of the margin, checked more densely.

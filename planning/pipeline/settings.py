@@ -71,6 +71,13 @@ class PlannerSettings:
         verify_step_m: robot motion between two checks in the final verification [m], in
             :data:`VERIFY_STEP_RANGE_M`; the fitness requires this much clearance beyond the
             margin.
+        self_verify_step_m: the same for the robot's own link pairs [m], in
+            :data:`VERIFY_STEP_RANGE_M`: motion of one link of a pair against the other
+            between two checks; the fitness requires this much beyond the self margin. Never
+            coarser than ``verify_step_m`` (:attr:`self_step_m`). Finer by default: a pair
+            moves against itself a tenth as fast as the hand in the world, so its checks
+            cost little, and a grasp often holds the wrist within millimetres of the forearm
+            all the way out (``docs/tuning.md``).
         max_node_deviation: largest spline node deviation a candidate may have [rad or m];
             ``None`` (default): no bound. The paper case requires 20e-6.
         moving_joints: joints the waypoints move; default: theta1, d2, d3, and a wrist
@@ -100,6 +107,7 @@ class PlannerSettings:
     ipo: float = 0.012
     fitness_samples: int = 64
     verify_step_m: float = 0.005
+    self_verify_step_m: float = 0.001
     max_node_deviation: float | None = None
     moving_joints: tuple[str, ...] | None = None
     seeding: Seeding = "paths"
@@ -128,6 +136,7 @@ class PlannerSettings:
         if self.max_node_deviation is not None:
             number_in("max_node_deviation", self.max_node_deviation, 0.0, 1.0, low_open=True)
         number_in("verify_step_m", self.verify_step_m, *VERIFY_STEP_RANGE_M, unit="m")
+        number_in("self_verify_step_m", self.self_verify_step_m, *VERIFY_STEP_RANGE_M, unit="m")
         if self.moving_joints is not None:
             names = list(self.moving_joints)
             if len(set(names)) != len(names):
@@ -137,6 +146,11 @@ class PlannerSettings:
     def from_flat(cls, values: Mapping[str, Any]) -> PlannerSettings:
         """Settings from the scene file's flat ``planner:`` block (firefly keys included)."""
         return cls().updated(**values)
+
+    @property
+    def self_step_m(self) -> float:
+        """The certified self check's step [m]: ``self_verify_step_m``, at most ``verify_step_m``."""
+        return min(self.self_verify_step_m, self.verify_step_m)
 
     @property
     def finer_verify_step_m(self) -> float:

@@ -139,6 +139,8 @@ class Requirements:
         margin_m: clearance from every obstacle [m].
         step_m: largest robot motion between two checks of the certified check [m].
         self_margin_m: clearance between the robot's checked link pairs [m].
+        self_step_m: largest motion of a pair's link against the other between two checks of
+            the certified self check [m]; ``None``: ``step_m``.
         endpoints: ``(start, goal)`` it must start and end at; ``None``: not checked.
         dynamics: the robot's torques (payload included) and effort limits; ``None``: not checked.
     """
@@ -146,6 +148,7 @@ class Requirements:
     margin_m: float
     step_m: float
     self_margin_m: float = DEFAULT_SELF_MARGIN_M
+    self_step_m: float | None = None
     endpoints: tuple[Target, Target] | None = None
     dynamics: ck.Dynamics | None = None
 
@@ -157,6 +160,7 @@ class Requirements:
             margin_m=scene.safety_margin,
             step_m=scene.planner.verify_step_m,
             self_margin_m=scene.self_margin,
+            self_step_m=scene.planner.self_step_m,
             endpoints=(scene.start, scene.goal) if endpoints else None,
             dynamics=problem.dynamics,
         )
@@ -171,7 +175,8 @@ def verify_trajectory(
     - the certified clearance (:func:`cpr_kin.check_curve`, robot motion between checks at
       most ``step_m``) is at least ``margin_m`` [m];
     - the certified self-clearance of the robot's checked pairs
-      (:func:`cpr_kin.self_curve.check_self_curve`) is at least ``self_margin_m`` [m];
+      (:func:`cpr_kin.self_curve.check_self_curve`, a pair's motion between checks at most
+      ``self_step_m``) is at least ``self_margin_m`` [m];
     - every joint stays within its range, and within its velocity, acceleration and jerk
       limits (exact extrema);
     - with ``endpoints = (start, goal)``: it starts and ends there (:meth:`Target.miss`: a
@@ -206,7 +211,8 @@ def verify_trajectory(
             f"comes within {check.certified_min_m:.4f} m (certified) of an obstacle, margin {margin_m} m: "
             f"closest at t = {check.worst_time:.2f} s between {check.worst_pair} ({check.worst_group})"
         )
-    problems += _self_problems(world, trajectory, required.self_margin_m, step_m)
+    self_step_m = step_m if required.self_step_m is None else required.self_step_m
+    problems += _self_problems(world, trajectory, required.self_margin_m, self_step_m)
     positions = trajectory.extrema(0)
     for i, name in enumerate(robot.joint_names):
         low, high = positions.minimum[i], positions.maximum[i]
