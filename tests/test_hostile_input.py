@@ -90,6 +90,11 @@ CASES: list[tuple[str, Callable[[Path], str], str | re.Pattern[str]]] = [
         "planner.verify_step_m = 1e-12: Input should be greater than or equal to 0.0001",
     ),
     (
+        "huge self step",
+        lambda _: GOOD + "planner: {self_verify_step_m: 0.5}\n",
+        "planner.self_verify_step_m = 0.5: Input should be less than or equal to 0.1",
+    ),
+    (
         "huge population",
         lambda _: GOOD + "planner: {fireflies: 1000000000}\n",
         "planner.fireflies = 1000000000: Input should be less than or equal to 1000",
