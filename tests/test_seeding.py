@@ -9,7 +9,7 @@ import pytest
 
 import cpr_kin as ck
 from planning.io.narrow_passages import narrow_scene
-from planning.pipeline.problem import Problem, build_problem, with_planner
+from planning.pipeline.problem import Problem, build_problem, finer_step_m, with_planner
 from planning.pipeline.scene import Scene
 from planning.pipeline.seeding import sampled_path, seed_search
 from planning.pipeline.settings import PlannerSettings
@@ -167,3 +167,25 @@ def test_a_goal_within_margin_plus_step_plans_with_the_finer_step_at_once(robot:
     result = plan(near, robot)
     assert result.verification.accepted and result.verification.certified_min_m >= 0.0
     assert result.problem.scene.planner.verify_step_m == scene.planner.finer_verify_step_m
+
+
+def test_a_goal_closer_than_the_finer_step_plans_with_half_its_clearance(robot: ck.Robot) -> None:
+    """A goal 0.6 mm from a ball, margin 0: even 1 mm beyond the margin leaves it no path."""
+    from planning.io.scene_generator import generate_scenes
+    from planning.pipeline.planner import plan
+
+    scene = dataclasses.replace(generate_scenes(1, 5, robot)[0], safety_margin=0.0)
+    far = build_problem(scene, robot)
+    assert finer_step_m(far) == scene.planner.finer_verify_step_m  # the ends lie centimetres away
+    tool = ck.frame_poses(robot, far.q_goal[None])[0, :3, 3]
+    probe = ck.Obstacle.sphere(0.02, tuple(tool + np.array([0.0, 0.0, 0.25])), name="ball")
+    gap = ck.CollisionWorld(robot, [probe]).clearance_batch(far.q_goal[None]).clearance_m.min()
+    ball = ck.Obstacle.sphere(0.02 + gap - 0.0006, probe.xyz, name="ball")
+    near = dataclasses.replace(scene, obstacles=(*scene.obstacles, ball))
+    problem = build_problem(near, robot)
+    clearance = float(problem.world.min_clearance_batch(problem.q_goal[None])[0][0])
+    assert clearance == pytest.approx(0.0006, abs=1e-6)
+    assert finer_step_m(problem) == pytest.approx(clearance / 2)
+    result = plan(near, robot)
+    assert result.verification.accepted and result.verification.certified_min_m >= 0.0
+    assert result.problem.scene.planner.verify_step_m == pytest.approx(clearance / 2)

@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 
 import cpr_kin as ck
 from planning.peers.toppra_timing import SamplingResult, planning_clearance_m, time_and_verify
-from planning.pipeline.problem import build_problem
+from planning.pipeline.problem import build_problem, finer_step_m
 from planning.pipeline.scene import Scene
 
 FloatArray = NDArray[np.float64]
@@ -57,7 +57,7 @@ def plan_rrt_connect(
     ends, objective = np.stack([q_start, q_goal]), problem.objective
     if not world.keeps_clearance(ends, objective.required_m, objective.required_self_m).all():
         # an end within margin plus step (a grasp): the finer step, as the firefly's seeding
-        finer = scene.planner.updated(verify_step_m=scene.planner.finer_verify_step_m)
+        finer = scene.planner.updated(verify_step_m=finer_step_m(problem))
         scene = dataclasses.replace(scene, planner=finer)
     margin_m, self_margin_m = planning_clearance_m(scene), scene.self_margin + scene.planner.self_step_m
 

@@ -24,6 +24,7 @@ from planning.errors import PlanningError, TargetOutOfReachError
 from planning.pipeline.motion import Motion
 from planning.pipeline.objective import WaypointObjective
 from planning.pipeline.scene import Scene
+from planning.pipeline.settings import VERIFY_STEP_RANGE_M
 from planning.pipeline.timing import FixedDuration, FreeDuration, duration_rule
 from planning.pipeline.torques import problem_dynamics, search_torque
 
@@ -229,6 +230,24 @@ def with_planner(problem: Problem, **changes: Any) -> Problem:
         objective=objective,
         build_time_s=problem.build_time_s + time.perf_counter() - started,
     )
+
+
+def finer_step_m(problem: Problem) -> float:
+    """The certified step [m] tried where the margins plus ``verify_step_m`` leave no path.
+
+    The settings' :attr:`~planning.pipeline.settings.PlannerSettings.finer_verify_step_m`
+    (``finer_step`` of the step); where the start or goal lies no farther than that beyond
+    its margin (a grasp a fraction of a millimetre from its shelf, a wrist as close to its
+    own forearm), half its clearance beyond the margin, so that both ends keep the margins
+    plus the step, as every configuration of a path must. At least ``VERIFY_STEP_RANGE_M[0]``.
+    """
+    scene, world = problem.scene, problem.world
+    ends = np.stack([problem.q_start, problem.q_goal])
+    excess = float(world.min_clearance_batch(ends)[0].min()) - scene.safety_margin
+    if world.self_collision:
+        excess = min(excess, float(world.self_collision.distances(ends)[0].min()) - scene.self_margin)
+    finer = scene.planner.finer_verify_step_m
+    return finer if excess > finer else max(excess / 2, VERIFY_STEP_RANGE_M[0])
 
 
 def _search_space(

@@ -28,7 +28,7 @@ between the robot's own pairs the self margin plus its finer ``self_verify_step_
 moves between two checks is counted against the margin. A passage narrower than that
 has no path: when RRT-Connect finds none (at once for a start or goal that close, a grasp),
 the first attempt asks once more with the step cut to ``finer_step`` of it (1 mm of the
-default 5 mm): a path may pass within a millimetre of the margin, checked more densely.
+default 5 mm; half an end's clearance beyond its margin where less, :func:`finer_step_m`).
 
 The seeds and ``spread``-sized moves around them make up ``share`` of the initial
 population (:class:`~planning.pipeline.tuning.SeedingTuning`); when a seed is feasible, the
@@ -48,7 +48,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from planning.pipeline.problem import Problem, with_planner
+from planning.pipeline.problem import Problem, finer_step_m, with_planner
 from planning.pipeline.settings import MAX_FITNESS_SAMPLES, MAX_WAYPOINTS
 from planning.search.optimizer import SearchResult
 from planning.search.rrt_connect import RrtPath, RrtSettings, rrt_connect, waypoints_along
@@ -142,7 +142,7 @@ class PathSeeding:
     def first(self, problem: Problem) -> Attempt:  # noqa: D102 - the protocol's
         seeds = seed_search(problem)
         settings = problem.scene.planner
-        finer = settings.finer_verify_step_m
+        finer = finer_step_m(problem)
         tried = ""
         if seeds.path is None and not seeds.straight_line_clear:
             required = problem.objective.required_m
