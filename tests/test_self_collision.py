@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -152,17 +153,22 @@ def test_the_certificate_computes_few_samples_and_equals_computing_every_one(pan
     assert computed < 0.2 * sampled  # most pairs and samples are bounded, not computed
 
 
-def folded_through_itself(panda: ck.Robot) -> tuple[np.ndarray, np.ndarray]:
-    """Two poses clear of themselves whose straight joint-space line passes through the arm."""
+def poses_whose_line(
+    panda: ck.Robot, seed: int, draws: int, wanted: Callable[[np.ndarray], bool]
+) -> tuple[np.ndarray, np.ndarray]:
+    """Two random poses whose straight joint-space line's self distances (41 samples) are ``wanted``."""
     collision = ck.CollisionWorld(panda, []).self_collision
-    rng = np.random.default_rng(11)
-    for _ in range(2000):
+    rng = np.random.default_rng(seed)
+    for _ in range(draws):
         a, b = rng.uniform(panda.limits.lower, panda.limits.upper, (2, panda.nq))
-        line = a + np.linspace(0, 1, 41)[:, None] * (b - a)
-        d = collision.distances(line)[0]
-        if d[0] > 0.05 and d[-1] > 0.05 and d.min() < -0.01:
+        if wanted(collision.distances(a + np.linspace(0, 1, 41)[:, None] * (b - a))[0]):
             return a, b
     raise AssertionError("no pair of poses found")
+
+
+def folded_through_itself(panda: ck.Robot) -> tuple[np.ndarray, np.ndarray]:
+    """Two poses clear of themselves whose straight joint-space line passes through the arm."""
+    return poses_whose_line(panda, 11, 2000, lambda d: d[0] > 0.05 and d[-1] > 0.05 and d.min() < -0.01)
 
 
 def test_a_plan_goes_around_its_own_arm_and_passes_the_check(panda: ck.Robot) -> None:
@@ -212,14 +218,9 @@ def test_the_fast_violation_test_agrees_with_the_distances(panda: ck.Robot, marg
 
 def near_itself(panda: ck.Robot) -> tuple[np.ndarray, np.ndarray]:
     """Two poses whose straight joint-space line passes 1-3 cm from the arm itself, midway."""
-    collision = ck.CollisionWorld(panda, []).self_collision
-    rng = np.random.default_rng(5)
-    for _ in range(4000):
-        a, b = rng.uniform(panda.limits.lower, panda.limits.upper, (2, panda.nq))
-        d = collision.distances(a + np.linspace(0, 1, 41)[:, None] * (b - a))[0]
-        if 0.01 < d.min() < 0.03 and min(d[0], d[-1]) > d.min() + 0.02:
-            return a, b
-    raise AssertionError("no pair of poses found")
+    return poses_whose_line(
+        panda, 5, 4000, lambda d: 0.01 < d.min() < 0.03 and min(d[0], d[-1]) > d.min() + 0.02
+    )
 
 
 def test_the_self_check_asks_its_own_finer_step_beyond_the_self_margin(panda: ck.Robot) -> None:

@@ -11,15 +11,14 @@ optional (``pip install '.[bench]'``).
 
 from __future__ import annotations
 
-import dataclasses
 import time
 
 import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from planning.peers.toppra_timing import SamplingResult, planning_clearance_m, time_and_verify
-from planning.pipeline.problem import build_problem, finer_step_m
+from planning.peers.toppra_timing import SamplingResult, time_and_verify
+from planning.pipeline.problem import build_problem, finer_step_m, with_planner
 from planning.pipeline.scene import Scene
 
 FloatArray = NDArray[np.float64]
@@ -57,9 +56,9 @@ def plan_rrt_connect(
     ends, objective = np.stack([q_start, q_goal]), problem.objective
     if not world.keeps_clearance(ends, objective.required_m, objective.required_self_m).all():
         # an end within margin plus step (a grasp): the finer step, as the firefly's seeding
-        finer = scene.planner.updated(verify_step_m=finer_step_m(problem))
-        scene = dataclasses.replace(scene, planner=finer)
-    margin_m, self_margin_m = planning_clearance_m(scene), scene.self_margin + scene.planner.self_step_m
+        problem = with_planner(problem, verify_step_m=finer_step_m(problem))
+        scene, objective = problem.scene, problem.objective
+    margin_m, self_margin_m = objective.required_m, objective.required_self_m  # the fitness's clearances
 
     def valid(state: object) -> bool:
         return bool(world.keeps_clearance(full(state)[None], margin_m, self_margin_m)[0])
