@@ -29,6 +29,7 @@ from planning.io.scene_file import load_scene
 
 def reason(text: str) -> str:
     """A violation in a few words: which margin, and the pair (numbers left out)."""
+    text = re.sub(r" q = \[[^]]*\]", "", text)  # the configuration, if given
     return re.sub(r" is -?[0-9.]+ m from", " near", text.split(" (")[0])
 
 

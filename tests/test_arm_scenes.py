@@ -14,8 +14,9 @@ import cpr_kin as ck
 from cpr_kin.packages import example_robot
 from planning.errors import PlanningError
 from planning.io.arm_scenes import blocked_scene
+from planning.io.mbm import endpoint_violations
 from planning.io.scene_file import parse_scene
-from planning.pipeline.problem import build_problem
+from planning.pipeline.problem import build_problem, margin_violation
 
 
 @pytest.fixture(scope="module")
@@ -42,6 +43,31 @@ def test_no_qualifying_draw_is_an_error_naming_the_fix(ur5: ck.Robot) -> None:
         PlanningError, match=r"no start and goal of 20 draws .* 1 m between .*lower self_clearance_m"
     ):
         blocked_scene("ur5_0", "ur5", ur5, 0, self_clearance_m=1.0, draws=20)
+
+
+def test_a_goal_pose_is_valid_when_a_clear_ik_solution_reaches_it() -> None:
+    """The benchmarks' validity test finds the ends as the planner does, not by the IK's first solution.
+
+    UR10 scene 461 (self clearance 15 mm at its drawn goal): the IK solution nearest
+    mid-range, taken without the margins, puts the forearm inside the self margin of the
+    wrist; another solution of the same pose keeps every margin, and the planner takes it.
+    """
+    ur10 = ck.load_robot(example_robot("ur10"))
+    scene = parse_scene(blocked_scene("ur10_461", "ur10", ur10, 461, self_clearance_m=0.015))
+    world = ck.CollisionWorld(ur10, scene.obstacles)
+    first = margin_violation(world, scene, scene.goal.configuration(ur10))
+    assert first is not None and "self margin" in first  # the IK alone lands inside it
+    assert endpoint_violations(scene, ur10) == []
+    problem = build_problem(scene, ur10)
+    assert margin_violation(problem.world, scene, problem.q_goal) is None
+    assert scene.goal.miss(ur10, problem.q_goal) is None  # and it reaches the pose
+
+
+def test_an_end_inside_a_margin_is_named(ur5: ck.Robot) -> None:
+    document = blocked_scene("ur5_0", "ur5", ur5, 0)
+    document["obstacles"][0]["radius"] = 5.0  # the ball swallows the robot
+    (violation,) = [v for v in endpoint_violations(parse_scene(document), ur5) if v.startswith("start")]
+    assert "inside the safety margin" in violation and "ball" in violation
 
 
 @pytest.mark.slow

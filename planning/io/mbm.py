@@ -148,18 +148,24 @@ def import_problem(problem: Problem, out: Path) -> Path:
 def endpoint_violations(scene: Scene, robot: ck.Robot) -> list[str]:
     """Why the scene's start and goal are not valid in ``robot``'s collision model (empty: both are).
 
-    Each is ``"<start|goal> <what>"``: a joint value out of range, or what comes inside the
-    safety or self margin (:func:`planning.pipeline.problem.margin_violation`).
+    Each is ``"<start|goal> <what>"``: a joint value out of range, a pose out of reach, or
+    what comes inside the safety or self margin. Found as the planner finds its ends
+    (:func:`planning.pipeline.problem.endpoint`): a ``pose`` or ``tcp`` by the IK solution
+    clear of the margins nearest the start, so a pose with a clear solution is valid even
+    where the IK's first solution is not.
     """
-    from planning.pipeline.problem import margin_violation
+    from planning.errors import NoSolutionError
+    from planning.pipeline.problem import endpoint
 
     world = ck.CollisionWorld(robot, scene.obstacles, allowed_pairs=scene.allowed_collisions)
     found = []
-    for label, target in (("start", scene.start), ("goal", scene.goal)):
+    q_start = None
+    for label in ("start", "goal"):
         try:
-            violation = margin_violation(world, scene, target.configuration(robot))
-        except ck.CprKinError as exc:
-            violation = f"is refused: {exc}"
-        if violation is not None:
-            found.append(f"{label} {violation}")
+            q = endpoint(robot, world, scene, label, seed_q=q_start)
+        except (PlanningError, NoSolutionError, ck.CprKinError) as exc:
+            found.append(str(exc) if str(exc).startswith(label) else f"{label} is refused: {exc}")
+            continue
+        if label == "start":
+            q_start = q
     return found
