@@ -13,9 +13,9 @@ from planning.io.narrow_passages import narrow_scene
 from planning.io.scene_generator import generate_scenes
 from planning.pipeline.choose import Choice, Refusal
 from planning.pipeline.path_following import follow_path
+from planning.pipeline.path_seeds import sampled_path
 from planning.pipeline.planner import plan
 from planning.pipeline.problem import Problem, build_problem
-from planning.pipeline.seeding import sampled_path
 from planning.pipeline.timing import FixedDuration, FreeDuration
 
 

@@ -3,15 +3,17 @@
 from __future__ import annotations
 
 import dataclasses
+from typing import Any
 
 import numpy as np
 import pytest
 
 import cpr_kin as ck
 from planning.io.narrow_passages import narrow_scene
+from planning.pipeline.path_seeds import sampled_path
 from planning.pipeline.problem import Problem, build_problem, finer_step_m, with_planner
 from planning.pipeline.scene import Scene
-from planning.pipeline.seeding import sampled_path, seed_search
+from planning.pipeline.seeding import PathSeeding, seed_search
 from planning.pipeline.settings import PlannerSettings
 from planning.pipeline.target import Target
 from planning.pipeline.tuning import SearchTuning, SeedingTuning
@@ -189,3 +191,36 @@ def test_a_goal_closer_than_the_finer_step_plans_with_half_its_clearance(robot: 
     result = plan(near, robot)
     assert result.verification.accepted and result.verification.certified_min_m >= 0.0
     assert result.problem.scene.planner.verify_step_m == pytest.approx(clearance / 2)
+
+
+def test_where_rrt_connect_found_no_path_the_next_attempts_do_not_ask_again(
+    window: Problem, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Its draws are seeded and the clearance it keeps is the same: it would fail alike.
+
+    With one sample RRT-Connect finds no way through the window, at the whole step nor at
+    the finer one; the attempts after the first search from the straight line without it.
+    """
+    from planning.pipeline import path_seeds
+    from planning.pipeline.search import search
+
+    drawn: list[object] = []
+
+    def counted(*args: Any, **kwargs: Any) -> object:
+        found = sampled_path(*args, **kwargs)
+        drawn.append(found)
+        return found
+
+    monkeypatch.setattr(path_seeds, "sampled_path", counted)
+    one_sample = with_planner(window, tuning=SearchTuning(seeding=SeedingTuning(max_samples=1)))
+    attempt = PathSeeding().first(one_sample)
+    assert drawn == [None, None] and attempt.no_path and "no RRT-Connect path keeps" in attempt.tried
+    for number in (1, 2):  # the retries
+        following = PathSeeding().after(attempt, search(attempt, None, None))
+        assert following is not None and following.number == number
+        assert following.no_path and following.path is None and following.tried == attempt.tried
+        attempt = following
+    assert len(drawn) == 2  # not asked again
+    blocked = seed_search(one_sample, sample=False)
+    assert blocked.path is None and not blocked.no_path and len(drawn) == 2
+    assert seed_search(one_sample).no_path and len(drawn) == 3

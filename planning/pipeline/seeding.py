@@ -8,7 +8,8 @@ is a small part of its space, rarely met by a random population. So, with the pl
    duration free it is the fastest path when it is clear, and a good start when it is
    nearly clear;
 2. if the spline through it violates the margin, RRT-Connect
-   (:mod:`planning.search.rrt_connect`) looks for a path in the moving joints, clear of
+   (:mod:`planning.search.rrt_connect`, drawn by :mod:`planning.pipeline.path_seeds`)
+   looks for a path in the moving joints, clear of
    the clearance the fitness requires (margin plus verification step), and its waypoints
    (:func:`~planning.search.rrt_connect.waypoints_along`) are the second seed. A path is
    clear, but the spline through its few waypoints cuts its corners and may not be: then
@@ -21,7 +22,8 @@ is a small part of its space, rarely met by a random population. So, with the pl
    to ``more_waypoints`` more and :data:`~planning.pipeline.settings.MAX_WAYPOINTS`, until the
    spline through them keeps the clearance), or for twice the fitness samples when feasible
    candidates failed the certified check (a violation between two samples escaped the
-   fitness); ``retries`` times at most.
+   fitness); ``retries`` times at most. Where RRT-Connect found no path, they do not ask it
+   again: its draws are seeded and its clearance the same, so it would fail alike.
 
 The clearance required is the margin plus the certified check's step (``verify_step_m``;
 between the robot's own pairs the self margin plus its finer ``self_verify_step_m``): what
@@ -42,33 +44,18 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from typing import NamedTuple, Protocol
+from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
+from planning.pipeline.path_seeds import PathSeed, fewest_waypoints, followable_path, path_seed
 from planning.pipeline.problem import Problem, finer_step_m, with_planner
-from planning.pipeline.settings import MAX_FITNESS_SAMPLES, MAX_WAYPOINTS
+from planning.pipeline.settings import MAX_FITNESS_SAMPLES
 from planning.search.optimizer import SearchResult
-from planning.search.rrt_connect import RrtPath, RrtSettings, rrt_connect, waypoints_along
 
 FloatArray = NDArray[np.float64]
-BoolArray = NDArray[np.bool_]
-
-
-class PathSeed(NamedTuple):
-    """A path's seed.
-
-    Attributes:
-        fitness: its fitness on ``problem``'s objective.
-        problem: the problem it seeds (with the waypoints it has).
-        x: its decision vector.
-    """
-
-    fitness: float
-    problem: Problem
-    x: FloatArray
 
 
 @dataclass(frozen=True)
@@ -83,6 +70,7 @@ class Seeds:
         straight_line_clear: the straight line's candidate is feasible.
         feasible: a seed is feasible, the straight line's or the path's.
         time_s: wall time of the seeding [s].
+        no_path: RRT-Connect was asked for a path and found none.
     """
 
     problem: Problem
@@ -91,6 +79,7 @@ class Seeds:
     straight_line_clear: bool
     feasible: bool
     time_s: float
+    no_path: bool = False
 
 
 @dataclass(frozen=True)
@@ -104,6 +93,7 @@ class Attempt:
         number: 0 for the first attempt, then 1, 2, ...
         tried: what the seeding tried and did not find, for a message (empty: nothing).
         feasible_seed: a seed is feasible: the search refines it without the firefly.
+        no_path: RRT-Connect found no path for this plan: the next attempts do not ask again.
     """
 
     problem: Problem
@@ -112,6 +102,7 @@ class Attempt:
     number: int = 0
     tried: str = ""
     feasible_seed: bool = False
+    no_path: bool = False
 
 
 class Seeding(Protocol):
@@ -152,7 +143,7 @@ class PathSeeding:
                 if closer.path is not None:  # a passage narrower than margin plus the step
                     return Attempt(closer.problem, closer.candidates, closer.path, 0, "", closer.feasible)
                 tried += f" (nor {closer.problem.objective.required_m:.4g} m)"
-        return Attempt(seeds.problem, seeds.candidates, seeds.path, 0, tried, seeds.feasible)
+        return Attempt(seeds.problem, seeds.candidates, seeds.path, 0, tried, seeds.feasible, seeds.no_path)
 
     def after(self, attempt: Attempt, searched: SearchResult) -> Attempt | None:  # noqa: D102
         problem = attempt.problem
@@ -162,48 +153,18 @@ class PathSeeding:
         if not widen:  # feasible ones failed the certified check: check twice as many samples
             samples = problem.scene.planner.fitness_samples
             problem = with_planner(problem, fitness_samples=min(2 * samples, MAX_FITNESS_SAMPLES))
-        seeds = seed_search(problem, widen, attempt.path)
-        number, tried = attempt.number + 1, attempt.tried
-        return Attempt(seeds.problem, seeds.candidates, seeds.path, number, tried, seeds.feasible)
+        seeds = seed_search(problem, widen, attempt.path, sample=not attempt.no_path)
+        number, tried, no_path = attempt.number + 1, attempt.tried, attempt.no_path or seeds.no_path
+        return Attempt(seeds.problem, seeds.candidates, seeds.path, number, tried, seeds.feasible, no_path)
 
 
 SEEDINGS: dict[str, Seeding] = {"paths": PathSeeding(), "none": NoSeeding()}
 """The seeding rules by the scene file's name (``planner.seeding``)."""
 
 
-def sampled_path(
-    problem: Problem, rng: np.random.Generator, settings: RrtSettings | None = None
-) -> RrtPath | None:
-    """RRT-Connect's path in the moving joints of ``problem``, clear of the fitness's clearance."""
-    robot, moving, objective = problem.robot, problem.moving, problem.objective
-
-    def valid(q: FloatArray) -> BoolArray:
-        return problem.world.keeps_clearance(
-            problem.configurations(q), objective.required_m, objective.required_self_m
-        )
-
-    if settings is None:  # the path's edges checked at most as far apart as the clearance required
-        tuning = problem.scene.planner.tuning.seeding
-        resolution = min(tuning.max_resolution_m, max(0.01, objective.required_m))
-        settings = RrtSettings(
-            max_samples=tuning.max_samples,
-            resolution_m=resolution,
-            explore_resolution_m=tuning.max_resolution_m,
-        )
-    limits = robot.limits
-    return rrt_connect(
-        valid,
-        problem.q_start[moving],
-        problem.q_goal[moving],
-        limits.lower[moving],
-        limits.upper[moving],
-        ck.path_weights(robot)[moving],
-        rng,
-        settings,
-    )
-
-
-def seed_search(problem: Problem, more_waypoints: bool = False, path: FloatArray | None = None) -> Seeds:
+def seed_search(
+    problem: Problem, more_waypoints: bool = False, path: FloatArray | None = None, sample: bool = True
+) -> Seeds:
     """The seeds of ``problem``'s search (module docstring).
 
     Args:
@@ -211,80 +172,28 @@ def seed_search(problem: Problem, more_waypoints: bool = False, path: FloatArray
         more_waypoints: a search with the problem's waypoints failed: give the search two or
             more waypoints beyond them, as many as the spline needs to follow the path.
         path: the path an earlier call found (saves finding it again).
+        sample: ask RRT-Connect for a path when none is given and the straight line is not
+            clear (``False``: an earlier call found none).
     """
     started = time.perf_counter()
     straight = problem.objective.straight_line()
     clear = bool(problem.objective.breakdown(straight[None]).feasible[0])
     weights = ck.path_weights(problem.robot)[problem.moving]
     seeded: PathSeed | None = None
-    if path is None and not clear:
-        path, seeded = _followable_path(problem, weights)
+    asked = path is None and not clear and sample
+    if asked:
+        path, seeded = followable_path(problem, weights)
     if path is None:
-        return Seeds(
-            problem, _around(problem, straight[None]), None, clear, clear, time.perf_counter() - started
-        )
+        elapsed = time.perf_counter() - started
+        return Seeds(problem, _around(problem, straight[None]), None, clear, clear, elapsed, asked)
     if more_waypoints:
-        seeded = _fewest_waypoints(problem, path, weights)
+        seeded = fewest_waypoints(problem, path, weights)
     elif seeded is None:
-        seeded = _path_seed(problem, path, problem.scene.planner.waypoints, weights)
+        seeded = path_seed(problem, path, problem.scene.planner.waypoints, weights)
     problem = seeded.problem
     candidates = np.array([problem.objective.straight_line(), seeded.x])
     feasible = clear or bool(problem.objective.feasible(seeded.fitness))
     return Seeds(problem, _around(problem, candidates), path, clear, feasible, time.perf_counter() - started)
-
-
-def _path_seed(problem: Problem, path: FloatArray, count: int, weights: FloatArray) -> PathSeed:
-    """The seed of ``path`` with ``count`` waypoints along it."""
-    counted = with_planner(problem, waypoints=count)
-    along = waypoints_along(path, count, weights).ravel()
-    return PathSeed(float(counted.objective(along[None])[0]), counted, along)
-
-
-def _followable_path(problem: Problem, weights: FloatArray) -> tuple[FloatArray | None, PathSeed | None]:
-    """RRT-Connect's path whose waypoints seed ``problem`` best (module docstring, step 2), and its seed.
-
-    Up to ``path_attempts`` paths, all drawn from the stream ``default_rng([seed, 1])``,
-    another only while those drawn took fewer than ``redraw_samples`` samples in all; the
-    first whose seed is feasible, else the one of the best fitness; ``None`` when
-    RRT-Connect finds none (a further draw is not tried: a failed one has used up its samples).
-    """
-    settings = problem.scene.planner
-    tuning = settings.tuning.seeding
-    rng = np.random.default_rng([settings.seed, 1])
-    best: tuple[FloatArray, PathSeed] | None = None
-    samples = 0
-    for _ in range(tuning.path_attempts):
-        found = sampled_path(problem, rng)
-        if found is None:
-            break
-        samples += found.samples
-        seeded = _path_seed(problem, found.path, settings.waypoints, weights)
-        if best is None or seeded.fitness < best[1].fitness:
-            best = (found.path, seeded)
-        if problem.objective.feasible(seeded.fitness) or samples >= tuning.redraw_samples:
-            break
-    return (None, None) if best is None else best
-
-
-def _fewest_waypoints(problem: Problem, path: FloatArray, weights: FloatArray) -> PathSeed:
-    """The seed of ``path`` with the fewest waypoints beyond ``problem``'s that keeps the clearance.
-
-    Two or more beyond them, the path's corners at least, then two more at a time up to
-    ``more_waypoints`` more (and :data:`~planning.pipeline.settings.MAX_WAYPOINTS`); if none
-    keeps it, the count whose seed ranks best.
-    """
-    settings = problem.scene.planner
-    first = min(max(settings.waypoints + 2, len(path) - 2), MAX_WAYPOINTS)
-    last = min(first + settings.tuning.seeding.more_waypoints, MAX_WAYPOINTS)
-    best: PathSeed | None = None
-    for count in range(first, last + 1, 2):
-        seeded = _path_seed(problem, path, count, weights)
-        if best is None or seeded.fitness < best.fitness:
-            best = seeded
-        if seeded.problem.objective.feasible(seeded.fitness):  # the fewest waypoints that follow
-            break
-    assert best is not None  # the range is never empty
-    return best
 
 
 def _around(problem: Problem, seeds: FloatArray) -> FloatArray:

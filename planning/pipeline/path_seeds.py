@@ -1,0 +1,123 @@
+"""RRT-Connect's paths as seeds of the waypoint search: drawn, cut to waypoints, ranked.
+
+Steps 2 and 3 of :mod:`planning.pipeline.seeding` that concern the sampling planner's path:
+:func:`sampled_path` draws one clear of the fitness's clearance, :func:`followable_path`
+draws up to ``path_attempts`` until the spline through one's waypoints is feasible, and
+:func:`fewest_waypoints` gives a path the waypoints the spline needs to follow it.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from numpy.typing import NDArray
+
+import cpr_kin as ck
+from planning.pipeline.problem import Problem, with_planner
+from planning.pipeline.settings import MAX_WAYPOINTS
+from planning.search.rrt_connect import RrtPath, RrtSettings, rrt_connect, waypoints_along
+
+FloatArray = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
+
+
+class PathSeed(NamedTuple):
+    """A path's seed.
+
+    Attributes:
+        fitness: its fitness on ``problem``'s objective.
+        problem: the problem it seeds (with the waypoints it has).
+        x: its decision vector.
+    """
+
+    fitness: float
+    problem: Problem
+    x: FloatArray
+
+
+def sampled_path(
+    problem: Problem, rng: np.random.Generator, settings: RrtSettings | None = None
+) -> RrtPath | None:
+    """RRT-Connect's path in the moving joints of ``problem``, clear of the fitness's clearance."""
+    robot, moving, objective = problem.robot, problem.moving, problem.objective
+
+    def valid(q: FloatArray) -> BoolArray:
+        return problem.world.keeps_clearance(
+            problem.configurations(q), objective.required_m, objective.required_self_m
+        )
+
+    if settings is None:  # the path's edges checked at most as far apart as the clearance required
+        tuning = problem.scene.planner.tuning.seeding
+        resolution = min(tuning.max_resolution_m, max(0.01, objective.required_m))
+        settings = RrtSettings(
+            max_samples=tuning.max_samples,
+            resolution_m=resolution,
+            explore_resolution_m=tuning.max_resolution_m,
+        )
+    limits = robot.limits
+    return rrt_connect(
+        valid,
+        problem.q_start[moving],
+        problem.q_goal[moving],
+        limits.lower[moving],
+        limits.upper[moving],
+        ck.path_weights(robot)[moving],
+        rng,
+        settings,
+    )
+
+
+def path_seed(problem: Problem, path: FloatArray, count: int, weights: FloatArray) -> PathSeed:
+    """The seed of ``path`` with ``count`` waypoints along it."""
+    counted = with_planner(problem, waypoints=count)
+    along = waypoints_along(path, count, weights).ravel()
+    return PathSeed(float(counted.objective(along[None])[0]), counted, along)
+
+
+def followable_path(problem: Problem, weights: FloatArray) -> tuple[FloatArray | None, PathSeed | None]:
+    """RRT-Connect's path whose waypoints seed ``problem`` best, and its seed.
+
+    (:mod:`planning.pipeline.seeding`'s step 2.)
+    Up to ``path_attempts`` paths, all drawn from the stream ``default_rng([seed, 1])``,
+    another only while those drawn took fewer than ``redraw_samples`` samples in all; the
+    first whose seed is feasible, else the one of the best fitness; ``None`` when
+    RRT-Connect finds none (a further draw is not tried: a failed one has used up its samples).
+    """
+    settings = problem.scene.planner
+    tuning = settings.tuning.seeding
+    rng = np.random.default_rng([settings.seed, 1])
+    best: tuple[FloatArray, PathSeed] | None = None
+    samples = 0
+    for _ in range(tuning.path_attempts):
+        found = sampled_path(problem, rng)
+        if found is None:
+            break
+        samples += found.samples
+        seeded = path_seed(problem, found.path, settings.waypoints, weights)
+        if best is None or seeded.fitness < best[1].fitness:
+            best = (found.path, seeded)
+        if problem.objective.feasible(seeded.fitness) or samples >= tuning.redraw_samples:
+            break
+    return (None, None) if best is None else best
+
+
+def fewest_waypoints(problem: Problem, path: FloatArray, weights: FloatArray) -> PathSeed:
+    """The seed of ``path`` with the fewest waypoints beyond ``problem``'s that keeps the clearance.
+
+    Two or more beyond them, the path's corners at least, then two more at a time up to
+    ``more_waypoints`` more (and :data:`~planning.pipeline.settings.MAX_WAYPOINTS`); if none
+    keeps it, the count whose seed ranks best.
+    """
+    settings = problem.scene.planner
+    first = min(max(settings.waypoints + 2, len(path) - 2), MAX_WAYPOINTS)
+    last = min(first + settings.tuning.seeding.more_waypoints, MAX_WAYPOINTS)
+    best: PathSeed | None = None
+    for count in range(first, last + 1, 2):
+        seeded = path_seed(problem, path, count, weights)
+        if best is None or seeded.fitness < best.fitness:
+            best = seeded
+        if seeded.problem.objective.feasible(seeded.fitness):  # the fewest waypoints that follow
+            break
+    assert best is not None  # the range is never empty
+    return best
