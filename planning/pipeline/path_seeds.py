@@ -78,11 +78,11 @@ def path_seed(problem: Problem, path: FloatArray, count: int, weights: FloatArra
 def followable_path(problem: Problem, weights: FloatArray) -> tuple[FloatArray | None, PathSeed | None]:
     """RRT-Connect's path whose waypoints seed ``problem`` best, and its seed.
 
-    (:mod:`planning.pipeline.seeding`'s step 2.)
-    Up to ``path_attempts`` paths, all drawn from the stream ``default_rng([seed, 1])``,
-    another only while those drawn took fewer than ``redraw_samples`` samples in all; the
-    first whose seed is feasible, else the one of the best fitness; ``None`` when
-    RRT-Connect finds none (a further draw is not tried: a failed one has used up its samples).
+    Step 2 of :mod:`planning.pipeline.seeding`: up to ``path_attempts`` paths, all drawn
+    from the stream ``default_rng([seed, 1])``, another only while those drawn took fewer
+    than ``redraw_samples`` samples in all; the first whose seed is feasible, else the one
+    of the best fitness; ``None`` when RRT-Connect finds none (a further draw is not tried:
+    a failed one has used up its samples).
     """
     settings = problem.scene.planner
     tuning = settings.tuning.seeding

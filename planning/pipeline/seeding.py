@@ -132,13 +132,12 @@ class PathSeeding:
 
     def first(self, problem: Problem) -> Attempt:  # noqa: D102 - the protocol's
         seeds = seed_search(problem)
-        settings = problem.scene.planner
-        finer = finer_step_m(problem)
         tried = ""
-        if seeds.path is None and not seeds.straight_line_clear:
+        if seeds.no_path:
             required = problem.objective.required_m
             tried = f"no RRT-Connect path keeps {required:.4g} m clear"
-            if finer < settings.verify_step_m:
+            finer = finer_step_m(problem)  # the ends' clearances, asked only here
+            if finer < problem.scene.planner.verify_step_m:
                 closer = seed_search(with_planner(problem, verify_step_m=finer))
                 if closer.path is not None:  # a passage narrower than margin plus the step
                     return Attempt(closer.problem, closer.candidates, closer.path, 0, "", closer.feasible)
