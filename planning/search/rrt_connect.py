@@ -8,12 +8,15 @@ in milliseconds, and its path, cut to a few waypoints, seeds the firefly's popul
 Two trees grow from start and goal: one extends a step towards a random sample, the other
 then greedily connects to the new node; they swap roles every sample. The step is by default
 a fifth of the sampling box's diagonal, OMPL's default range (``docs/tuning.md``). The
-extension and the connection are checked in one call (the connection speculatively, towards
-the step's end), edges in batches as :mod:`planning.search.edges` describes (not certified:
-the executed spline gets the certified check). Distances are robot motion bounds ``sum_j R_j
-|dq_j|`` [m] with the joints' motion radii (:func:`cpr_kin.motion_radii`), so a step means
-the same in every joint whatever its unit. The path found is then shortened
-(:func:`planning.search.edges.shortcut`). All randomness comes from the generator passed.
+connection is checked once the extension is known, from where it stopped: checking both in
+one call, the connection towards the step's end, saves a call when the extension reaches
+it but wastes the connection's checks when it stops short, as most do on a 6- or 7-joint
+arm (``docs/tuning.md``). Edges are checked in batches as :mod:`planning.search.edges`
+describes (not certified: the executed spline gets the certified check). Distances are
+robot motion bounds ``sum_j R_j |dq_j|`` [m] with the joints' motion radii
+(:func:`cpr_kin.motion_radii`), so a step means the same in every joint whatever its unit.
+The path found is then shortened (:func:`planning.search.edges.shortcut`). All randomness
+comes from the generator passed.
 
 The trees may grow on coarser checks than the path must hold (``explore_resolution_m``, as
 OMPL's motion checks are, a share of the space's extent): most edges a tree tries are
@@ -175,16 +178,12 @@ def rrt_connect(
         if length <= 1e-12:
             continue
         end = origin + (target - origin) * min(1.0, step_m / length)
-        # the extension and the other tree's connection to its end, checked in one call (the
-        # connection is wasted only when the extension stops short)
-        other_near = other.nearest(end, weights)
-        extended, connected = edges.free_fractions([(origin, end), (other.nodes[other_near], end)])
+        extended = edges.free_fraction(origin, end)
         if extended == 0.0:
             continue
         new = grow.add(origin + extended * (end - origin), near)
-        if extended < 1.0:
-            other_near = other.nearest(grow.nodes[new], weights)
-            connected = edges.free_fraction(other.nodes[other_near], grow.nodes[new])
+        other_near = other.nearest(grow.nodes[new], weights)
+        connected = edges.free_fraction(other.nodes[other_near], grow.nodes[new])
         joined = _connect(other, other_near, grow.nodes[new], connected, step_m, weights)
         if joined is not None:
             # root of grow ... new == joined ... root of other (the meeting point once)
