@@ -105,6 +105,7 @@ BAD_INPUTS = [
         "robot: 'no_such_robot' is neither a URDF file",
     ),
     ("zero fireflies", with_changes(planner__fireflies=0), "planner.fireflies = 0"),
+    ("negative time limit", with_changes(planner__time_limit_s=-1), "planner.time_limit_s = -1"),
     (
         "all spline weights zero",
         with_changes(spline__a=[0, 0, 0]),

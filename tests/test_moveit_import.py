@@ -103,8 +103,10 @@ def test_shapes_poses_and_the_matrix_follow_moveits_conventions(
     assert main(["import-moveit", *write(tmp_path, SCENE, REQUEST), "--out", str(out)]) == 0
     printed = capsys.readouterr().out
     assert "4 obstacle(s), 7 planned joints, a 'q' goal, 1 allowed link pair(s)" in printed
-    assert "left out or adjusted: request.planner_id; request.allowed_planning_time" in printed  # said
+    assert "left out or adjusted: request.planner_id" in printed  # said
+    assert "allowed_planning_time" not in printed
     scene = load_scene(out)
+    assert scene.planner.time_limit_s == 5.0  # MoveIt's allowed_planning_time
     box, cylinder, sphere, cone = scene.obstacles
     assert [o.name for o in scene.obstacles] == ["post_0", "post_1", "lamp_0", "lamp_1"]
     np.testing.assert_allclose(np.asarray(box.size), np.array([0.1, 0.2, 0.6]))

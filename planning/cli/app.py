@@ -35,6 +35,13 @@ def build_parser() -> argparse.ArgumentParser:
         sub.add_argument("--fireflies", type=int, help="population size (default: the scene's)")
         sub.add_argument("--iterations", type=int, help="firefly iterations (default: the scene's)")
         sub.add_argument(
+            "--time-limit",
+            dest="time_limit_s",
+            type=float,
+            metavar="SECONDS",
+            help="stop the search after this many seconds and keep what it found (default: the scene's)",
+        )
+        sub.add_argument(
             "--paper-search",
             action="store_true",
             help="search with the paper's firefly (n = 50, 50 iterations, alpha 1, beta0 0.5, every "

@@ -20,7 +20,7 @@ if TYPE_CHECKING:
     from planning.pipeline.scene import Scene
     from planning.search.firefly import FireflyProgress
 
-OVERRIDES = ("seed", "fitness", "fireflies", "iterations")
+OVERRIDES = ("seed", "fitness", "fireflies", "iterations", "time_limit_s")
 """Planner settings the command line may change, by their scene-file keys."""
 
 

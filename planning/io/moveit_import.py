@@ -13,11 +13,13 @@
 - **Obstacles:** :mod:`planning.io.moveit_objects`; in the URDF root's frame, or a frame of
   ``fixed_frame_transforms``.
 - **Allowed collisions:** the matrix's robot-link pairs marked ``true``.
+- **Time:** ``allowed_planning_time`` (when > 0) becomes the planner's ``time_limit_s`` (at
+  most :data:`~planning.pipeline.settings.MAX_TIME_LIMIT_S`).
 
 What would change the problem and has no counterpart (attached objects, path or trajectory
 constraints, an octomap, padding, velocity scaling other than 0 or 1, a robot base placed
 away from the world's origin, allowed contact with an object) is refused naming it; what only
-steers MoveIt's own planner (planner id, attempts, time, workspace) is listed as ignored.
+steers MoveIt's own planner (planner id, pipeline, attempts, workspace) is listed as ignored.
 """
 
 from __future__ import annotations
@@ -42,6 +44,7 @@ from planning.io.moveit_messages import Constraints, MotionPlanRequest, Planning
 from planning.io.moveit_objects import MoveItImportError, convert_object
 from planning.io.moveit_state import joint_values, position_ranges, within_ranges, wrapped
 from planning.io.publish import write_file
+from planning.pipeline.settings import MAX_TIME_LIMIT_S
 from planning.validation import describe_validation
 
 MAX_MESSAGE_BYTES = 50_000_000
@@ -120,7 +123,7 @@ def _refuse_unsupported(scene: PlanningScene, request: MotionPlanRequest) -> lis
                 )
     ignored = [
         f"request.{key}"
-        for key in ("planner_id", "pipeline_id", "allowed_planning_time")
+        for key in ("planner_id", "pipeline_id", "num_planning_attempts")
         if getattr(request, key)
     ]
     return ignored + (["request.workspace_parameters"] if request.workspace_parameters else [])
@@ -203,6 +206,8 @@ def import_moveit(
         "goal": goal,
         "obstacles": obstacles,
     }
+    if request.allowed_planning_time > 0:
+        document["planner"] = {"time_limit_s": min(float(request.allowed_planning_time), MAX_TIME_LIMIT_S)}
     return ImportedScene(document=document, meshes=meshes, ignored=tuple(ignored))
 
 

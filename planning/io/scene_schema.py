@@ -45,6 +45,7 @@ from planning.pipeline.settings import (
     IPO_RANGE_S,
     MAX_FITNESS_SAMPLES,
     MAX_SEED,
+    MAX_TIME_LIMIT_S,
     MAX_WAYPOINTS,
     VERIFY_STEP_RANGE_M,
     PlannerSettings,
@@ -135,6 +136,7 @@ class PlannerSpec(Strict):
     seeding: Literal["paths", "none"] = _P.seeding
     refine: Literal["cma", "none"] = _P.refine
     refine_stall: Annotated[int, Field(ge=0, le=MAX_ITERATIONS)] = _P.refine_stall
+    time_limit_s: Annotated[float, Field(gt=0, le=MAX_TIME_LIMIT_S)] | None = _P.time_limit_s
 
 
 class SplineSpec(Strict):

@@ -65,6 +65,7 @@ def sampled_path(
         ck.path_weights(robot)[moving],
         rng,
         settings,
+        problem.deadline.passed,
     )
 
 

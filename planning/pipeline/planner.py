@@ -6,7 +6,9 @@ each attempt (the seeding rule decides the first and the next,
 candidates are timed and verified best first (:mod:`planning.pipeline.choose`), and the
 first that passes becomes the :class:`~planning.pipeline.result.PlanResult`. When no
 attempt is left and the seeding found a sampling planner's path, that path is followed as it
-is (:mod:`planning.pipeline.path_following`) before the plan says "no solution".
+is (:mod:`planning.pipeline.path_following`) before the plan says "no solution". With a
+``time_limit_s`` the stages stop where it passes (:mod:`planning.pipeline.deadline`) and
+the plan times and verifies what its last search found, with no attempt after it.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ import cpr_kin as ck
 from planning.curves.trajectory import Trajectory
 from planning.errors import NoSolutionError, PlanningError
 from planning.pipeline.choose import Choice, Refusal, choose, verify
+from planning.pipeline.deadline import Deadline
 from planning.pipeline.metrics import Elapsed
 from planning.pipeline.path_following import follow_path
 from planning.pipeline.problem import Problem, build_problem
@@ -53,11 +56,14 @@ def solve(
             once from a random population; default: the planner's seeded search.
 
     Raises:
-        NoTrajectoryFoundError: no candidate passes the verification.
+        NoTrajectoryFoundError: no candidate passes the verification (its message names
+            the time limit when that stopped the plan).
     """
     started = time.perf_counter()
     if problem.stands_still:
         return stand_still(problem, started)
+    deadline = Deadline.after(problem.scene.planner.time_limit_s, started)
+    problem = dataclasses.replace(problem, deadline=deadline)
     seeding = SEEDINGS[problem.scene.planner.seeding] if optimizer is None else NoSeeding()
     attempt = seeding.first(problem)
     while True:
@@ -67,6 +73,8 @@ def solve(
         if isinstance(chosen, Choice):
             elapsed = Elapsed(attempt.problem.build_time_s + time.perf_counter() - started, search_s)
             return assemble(attempt.problem, searched, chosen, elapsed)
+        if deadline.passed():
+            raise chosen.error(attempt.tried, deadline.reason(time.perf_counter() - started))
         following = seeding.after(attempt, searched)
         if following is None:
             break

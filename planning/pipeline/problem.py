@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 import cpr_kin as ck
 from planning.curves.spline import SepticSplineSolver, uniform_knots
 from planning.errors import PlanningError, TargetOutOfReachError
+from planning.pipeline.deadline import Deadline
 from planning.pipeline.motion import Motion
 from planning.pipeline.objective import WaypointObjective
 from planning.pipeline.scene import Scene
@@ -49,6 +50,8 @@ class Problem:
         objective: the waypoint objective the search minimises.
         dynamics: the robot's torques with the scene's payload, and their limits.
         build_time_s: wall time of :func:`build_problem` [s].
+        deadline: when its plan must stop (:func:`~planning.pipeline.planner.solve` sets it
+            from the planner's ``time_limit_s``; default: never).
     """
 
     scene: Scene
@@ -60,6 +63,7 @@ class Problem:
     objective: WaypointObjective = field(repr=False)
     dynamics: ck.Dynamics = field(repr=False)
     build_time_s: float = 0.0
+    deadline: Deadline = field(default_factory=Deadline)
 
     @property
     def q_start(self) -> FloatArray:

@@ -37,6 +37,7 @@ def planner_search(
         lower_bound=objective.lower_bound if settings.refine == "cma" else None,
         progress=progress,
         explore=settings.tuning.explore_feasible_seed or attempt is None or not attempt.feasible_seed,
+        stop=problem.deadline.passed,
     )
 
 

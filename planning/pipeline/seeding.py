@@ -133,7 +133,7 @@ class PathSeeding:
     def first(self, problem: Problem) -> Attempt:  # noqa: D102 - the protocol's
         seeds = seed_search(problem)
         tried = ""
-        if seeds.no_path:
+        if seeds.no_path and not problem.deadline.passed():  # else the time limit cut it short
             required = problem.objective.required_m
             tried = f"no RRT-Connect path keeps {required:.4g} m clear"
             finer = finer_step_m(problem)  # the ends' clearances, asked only here

@@ -47,6 +47,8 @@ VERIFY_STEP_RANGE_M = (1e-4, 0.1)
 """Allowed robot motion between two verification checks [m]: below 0.1 mm the check of a
 long trajectory takes minutes, above 0.1 m it is no check."""
 MAX_SEED = 2**63 - 1
+MAX_TIME_LIMIT_S = 86_400.0
+"""Longest ``time_limit_s`` [s] (a day)."""
 """Largest seed (it is stored in the trajectory file as a JSON integer)."""
 
 _FIREFLY_FIELDS = frozenset(f.name for f in dataclasses.fields(FireflySettings))
@@ -95,6 +97,12 @@ class PlannerSettings:
             objective's lower bound, in [0, ``MAX_ITERATIONS``]; 0: run it to the evaluation
             budget (better fitness for more planning time); default
             :data:`~planning.search.refinement_settings.STALL_GENERATIONS`.
+        time_limit_s: the search's time limit [s], from its start (the problem built: the
+            robot loaded, start and goal solved), in (0, :data:`MAX_TIME_LIMIT_S`];
+            ``None`` (default): none. When it
+            passes the plan stops searching, times and verifies what it has found and
+            returns it, or says "no solution" naming the limit
+            (:mod:`planning.pipeline.deadline`; MoveIt's ``allowed_planning_time``).
         tuning: the search's internal knobs (:class:`~planning.pipeline.tuning.SearchTuning`),
             set from Python only: a scene file does not hold them.
     """
@@ -113,6 +121,7 @@ class PlannerSettings:
     seeding: Seeding = "paths"
     refine: Refine = "cma"
     refine_stall: int = STALL_GENERATIONS
+    time_limit_s: float | None = None
     tuning: SearchTuning = field(default_factory=SearchTuning)
 
     def __post_init__(self) -> None:
@@ -137,6 +146,8 @@ class PlannerSettings:
             number_in("max_node_deviation", self.max_node_deviation, 0.0, 1.0, low_open=True)
         number_in("verify_step_m", self.verify_step_m, *VERIFY_STEP_RANGE_M, unit="m")
         number_in("self_verify_step_m", self.self_verify_step_m, *VERIFY_STEP_RANGE_M, unit="m")
+        if self.time_limit_s is not None:
+            number_in("time_limit_s", self.time_limit_s, 0.0, MAX_TIME_LIMIT_S, low_open=True, unit="s")
         if self.moving_joints is not None:
             names = list(self.moving_joints)
             if len(set(names)) != len(names):

@@ -59,6 +59,7 @@ def firefly_minimize(
     callback: Callable[[FireflyProgress], None] | None = None,
     seeds: ArrayLike | None = None,
     stall_below: float = np.inf,
+    stop: Callable[[], bool] | None = None,
 ) -> SearchResult:
     """Minimise ``objective`` over the box ``[lower, upper]`` with the firefly algorithm.
 
@@ -74,6 +75,8 @@ def firefly_minimize(
         stall_below: the early stop (``settings.stall_iterations``) counts an iteration as
             stalled only while the best value is at or below this (e.g. the objective's
             bound of feasible values: an infeasible best keeps searching).
+        stop: asked before every iteration; ``True`` ends the search with its best so far
+            (a time limit). ``None``: never.
     """
     settings = settings or FireflySettings()
     lo = np.asarray(lower, dtype=float)
@@ -108,6 +111,8 @@ def firefly_minimize(
     alpha = settings.alpha
     early_stop = EarlyStop(settings.stall_iterations, best_f)
     for iteration in range(1, settings.iterations + 1):
+        if stop is not None and stop():
+            break
         alpha *= settings.theta
         if settings.mode == "sweep":
             u = _sweep(u, f, alpha, settings, generator)

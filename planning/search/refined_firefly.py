@@ -51,6 +51,8 @@ class RefinedFirefly:
             stalls only near it); ``None``: unknown.
         progress: called after every firefly iteration, or once for the seeds when the
             firefly does not run.
+        stop: asked before every firefly iteration and refinement generation; ``True`` ends
+            the search with its best so far (a time limit). ``None``: never.
         explore: the firefly runs before the refinement. ``False``: the refinement starts
             from the best of the ``seeds`` when that one is feasible (the firefly runs when
             none is, or without seeds or a refinement).
@@ -64,6 +66,7 @@ class RefinedFirefly:
     lower_bound: float | None = None
     progress: Callable[[FireflyProgress], None] | None = None
     explore: bool = True
+    stop: Callable[[], bool] | None = None
 
     def __call__(
         self,
@@ -89,7 +92,15 @@ class RefinedFirefly:
         if found is None:
             stall_below = self.feasible_below if self.refinement is None else math.inf
             found = firefly_minimize(
-                objective, lower, upper, settings, rng, self.progress, self.seeds, stall_below=stall_below
+                objective,
+                lower,
+                upper,
+                settings,
+                rng,
+                self.progress,
+                self.seeds,
+                stall_below=stall_below,
+                stop=self.stop,
             )
         if self.refinement is None:
             return found
@@ -103,4 +114,5 @@ class RefinedFirefly:
             self.refinement,
             stall_generations=self.stall_generations,
             lower_bound=self.lower_bound,
+            stop=self.stop,
         )

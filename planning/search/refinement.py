@@ -27,6 +27,7 @@ evaluation budget. The same generator state gives the same run.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -51,6 +52,7 @@ def cma_refine(
     *,
     stall_generations: int = STALL_GENERATIONS,
     lower_bound: float | None = None,
+    stop: Callable[[], bool] | None = None,
 ) -> SearchResult:
     """Refine ``start`` (value ``start_value``) with a CMA-ES within ``budget`` evaluations.
 
@@ -69,6 +71,8 @@ def cma_refine(
         lower_bound: about the least value the objective can take (e.g. a waypoint
             objective's ``lower_bound``); stalled generations count only while the best is
             within ``settings.near_bound`` times it. ``None``: always.
+        stop: asked before every generation; ``True`` ends the refinement with its best so
+            far (a time limit). ``None``: never.
 
     Returns:
         The best of ``start`` and every evaluated point; histories per generation (entry 0:
@@ -110,7 +114,7 @@ def cma_refine(
     history.record(best_f, best_f, 0)
     evaluations, generation = 0, 0
     early_stop = EarlyStop(stall_generations, best_f)
-    while evaluations + lam <= budget and sigma >= settings.min_sigma:
+    while evaluations + lam <= budget and sigma >= settings.min_sigma and not (stop is not None and stop()):
         generation += 1
         steps = rng.standard_normal((lam, d)) @ (basis * scales).T
         population = np.clip(mean + sigma * steps, 0.0, 1.0)
@@ -162,6 +166,7 @@ def refine_search(
     *,
     stall_generations: int = STALL_GENERATIONS,
     lower_bound: float | None = None,
+    stop: Callable[[], bool] | None = None,
 ) -> SearchResult:
     """``searched`` (a global search's result) refined by :func:`cma_refine` from its best point.
 
@@ -172,7 +177,7 @@ def refine_search(
     the whole improvement apart, so that a caller whose check refuses the best (the
     refinement goes as close to the constraints as the objective lets it) falls back to
     distinct, less tight points before the global search's. ``settings``,
-    ``stall_generations`` and ``lower_bound`` are :func:`cma_refine`'s.
+    ``stall_generations``, ``lower_bound`` and ``stop`` are :func:`cma_refine`'s.
     """
     settings = settings or RefinementSettings()
     refined = cma_refine(
@@ -186,6 +191,7 @@ def refine_search(
         settings,
         stall_generations=stall_generations,
         lower_bound=lower_bound,
+        stop=stop,
     )
     if refined.evaluations == 0:
         return searched

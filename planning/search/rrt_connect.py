@@ -32,6 +32,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -134,6 +135,7 @@ def rrt_connect(
     weights: FloatArray,
     rng: np.random.Generator,
     settings: RrtSettings | None = None,
+    stop: Callable[[], bool] | None = None,
 ) -> RrtPath | None:
     """A valid path from ``start`` to ``goal`` in the box ``[lower, upper]``, or ``None``.
 
@@ -150,6 +152,8 @@ def rrt_connect(
         weights: ``(d,)`` motion radius of each joint [m per joint unit], > 0.
         rng: the source of every random draw.
         settings: the planner's parameters (default :class:`RrtSettings`).
+        stop: asked before every sample; ``True`` ends the search without a path (a time
+            limit). ``None``: never.
     """
     settings = settings or RrtSettings()
     start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
@@ -164,12 +168,14 @@ def rrt_connect(
         diagonal = float(np.linalg.norm(weights * (np.asarray(upper) - np.asarray(lower))))
         step_m = max(explore_m, RANGE_FRACTION * diagonal)
     if explore_m > settings.resolution_m:
-        return _lazy(valid, start, goal, (lower, upper), weights, rng, settings, step_m)
+        return _lazy(valid, start, goal, (lower, upper), weights, rng, settings, step_m, stop)
     edges = Edges(valid, weights, settings.resolution_m)
     if edges.free_fraction(start, goal) == 1.0:
         return RrtPath(np.array([start, goal]), 0, edges.checks)
     trees = (_Tree(start), _Tree(goal))
     for sample in range(1, settings.max_samples + 1):
+        if stop is not None and stop():
+            return None
         grow, other = trees[(sample - 1) % 2], trees[sample % 2]
         target = rng.uniform(lower, upper)
         near = grow.nearest(target, weights)
@@ -204,11 +210,12 @@ def _lazy(
     rng: np.random.Generator,
     settings: RrtSettings,
     step_m: float,
+    stop: Callable[[], bool] | None,
 ) -> RrtPath | None:
     """RRT-Connect on coarse edge checks, its path then held at ``resolution_m`` (module docstring)."""
     fine = dataclasses.replace(settings, explore_resolution_m=None, step_m=step_m)
     coarse = dataclasses.replace(fine, resolution_m=settings.explore_resolution_m or settings.resolution_m)
-    found = rrt_connect(valid, start, goal, *box, weights, rng, coarse)
+    found = rrt_connect(valid, start, goal, *box, weights, rng, coarse, stop)
     if found is None:
         return None
     edges = Edges(valid, weights, settings.resolution_m)
@@ -218,9 +225,9 @@ def _lazy(
         if edges.free_fraction(a, b) == 1.0:
             pieces.append(b[None])
             continue
-        detour = rrt_connect(valid, a, b, *box, weights, rng, dataclasses.replace(fine, shortcuts=0))
+        detour = rrt_connect(valid, a, b, *box, weights, rng, dataclasses.replace(fine, shortcuts=0), stop)
         if detour is None:  # the coarse path is no guide here: search again at the fine spacing
-            again = rrt_connect(valid, start, goal, *box, weights, rng, fine)
+            again = rrt_connect(valid, start, goal, *box, weights, rng, fine, stop)
             if again is None:
                 return None
             return RrtPath(again.path, samples + again.samples, checks + edges.checks + again.checks)

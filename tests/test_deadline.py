@@ -1,0 +1,114 @@
+"""The planner's time limit (:mod:`planning.pipeline.deadline`): each stage stops where it passes."""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import cpr_kin as ck
+from planning.cli.app import main
+from planning.errors import NoTrajectoryFoundError, PlanningError
+from planning.io.bundled import paper_scene
+from planning.pipeline.deadline import Deadline
+from planning.pipeline.planner import plan
+from planning.pipeline.scene import Scene
+from planning.pipeline.settings import PlannerSettings
+from planning.search.firefly import firefly_minimize
+from planning.search.firefly_settings import FireflySettings
+from planning.search.refinement import cma_refine
+from planning.search.rrt_connect import rrt_connect
+
+from .test_rrt_connect import LOWER, UPPER, WEIGHTS, wall_with_slot
+
+
+def after_calls(count: int) -> tuple[list[int], object]:
+    """A stop that says ``True`` from its ``count + 1``-th call on, and the list of its calls."""
+    calls: list[int] = []
+
+    def stop() -> bool:
+        calls.append(1)
+        return len(calls) > count
+
+    return calls, stop
+
+
+def sphere(x: np.ndarray) -> np.ndarray:
+    return np.asarray(np.sum((x - 0.3) ** 2, axis=1))
+
+
+def test_a_deadline_passes_at_its_limit() -> None:
+    now = time.perf_counter()
+    assert not Deadline().passed()
+    assert Deadline.after(None, now) == Deadline()
+    assert Deadline.after(1e-9, now - 1.0).passed()
+    assert not Deadline.after(3600.0, now).passed()
+    assert "after 2.1 s by the time limit time_limit_s = 2 s" in Deadline.after(2.0, now).reason(2.1)
+
+
+def test_rrt_connect_stops_without_a_path() -> None:
+    start, goal = np.array([0.1, 0.9]), np.array([0.9, 0.1])
+    args = (wall_with_slot, start, goal, LOWER, UPPER, WEIGHTS)
+    assert rrt_connect(*args, np.random.default_rng(0)) is not None  # the oracle: it finds the slot
+    calls, stop = after_calls(3)
+    assert rrt_connect(*args, np.random.default_rng(0), stop=stop) is None  # type: ignore[arg-type]
+    assert len(calls) == 4  # asked before each sample: three drawn, the fourth not
+
+
+def test_the_searches_stop_with_their_best_so_far() -> None:
+    settings = FireflySettings(fireflies=10, iterations=50, stall_iterations=0)
+    bounds = (np.zeros(3), np.ones(3))
+    full = firefly_minimize(sphere, *bounds, settings, 1)
+    _, stop = after_calls(2)
+    cut = firefly_minimize(sphere, *bounds, settings, 1, stop=stop)  # type: ignore[arg-type]
+    assert cut.evaluations == 3 * 10  # the initial population and two iterations
+    np.testing.assert_array_equal(cut.best_history, full.best_history[:3])  # the same run, cut short
+    start = np.full(3, 0.8)
+    value = float(sphere(start[None])[0])
+    _, never = after_calls(10**9)
+    refined = cma_refine(sphere, *bounds, start, value, 500, np.random.default_rng(2), stop=never)  # type: ignore[arg-type]
+    _, at_once = after_calls(0)
+    kept = cma_refine(sphere, *bounds, start, value, 500, np.random.default_rng(2), stop=at_once)  # type: ignore[arg-type]
+    assert refined.evaluations > 0 and refined.fitness < value
+    assert kept.evaluations == 0 and kept.fitness == value
+    np.testing.assert_array_equal(kept.x, start)
+
+
+def limited(scene: Scene, limit_s: float | None) -> Scene:
+    return dataclasses.replace(scene, planner=scene.planner.updated(time_limit_s=limit_s))
+
+
+def test_a_plan_stopped_by_its_limit_says_so(robot: ck.Robot) -> None:
+    scene = limited(paper_scene(), 1e-9)  # the crate blocks the straight line: a search is needed
+    with pytest.raises(NoTrajectoryFoundError, match=r"by the time limit time_limit_s = 1e-09 s \(raise it"):
+        plan(scene, robot)
+
+
+def test_a_plan_within_its_limit_is_the_plan_without(robot: ck.Robot) -> None:
+    free = plan(paper_scene(), robot)
+    within = plan(limited(paper_scene(), 3600.0), robot)
+    np.testing.assert_array_equal(within.trajectory.coefficients, free.trajectory.coefficients)
+
+
+def test_a_plan_cut_short_returns_what_it_verified(robot: ck.Robot) -> None:
+    # nothing in the way: the straight line, the first seed, is verified and returned
+    scene = limited(dataclasses.replace(paper_scene(), obstacles=()), 1e-9)
+    result = plan(scene, robot)
+    assert result.verification.accepted
+    assert result.optimiser.evaluations <= scene.planner.firefly.fireflies  # no iteration after the seeds
+
+
+def test_the_limit_is_validated() -> None:
+    with pytest.raises(PlanningError, match=r"time_limit_s = 0.0 s must be a number in \(0, 86400\] s"):
+        PlannerSettings(time_limit_s=0.0)
+
+
+def test_the_command_line_limit(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "out"
+    code = main(["paper", "--out", str(out), "--time-limit", "1e-9"])
+    stderr = capsys.readouterr().err
+    assert code == 3 and "time limit time_limit_s = 1e-09 s" in stderr and "Traceback" not in stderr
+    assert not out.exists()
