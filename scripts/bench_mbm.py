@@ -1,14 +1,16 @@
 """MotionBenchMaker: our planner beside OMPL's RRT-Connect pipeline, problem by problem, in one run.
 
     python scripts/bench_mbm.py [--robots panda ur5] [--classes ...] [--limit N] [--timeout S] [--out DIR]
-                                [--workers N]
+                                [--workers N] [--time-limit S]
     python scripts/bench_mbm.py --scenes out/arms/*/*.yaml [--timeout S] [--out DIR]
 
 Each problem goes the way a user's does (``import-moveit``, :mod:`planning.io.moveit_import`,
 margins 0 as in MoveIt), then, alternating, is planned warm by
 
-- ours: :func:`planning.pipeline.planner.plan` with the scene's default settings, in a worker
-  process (robot loaded, kernels compiled) stopped after ``--timeout`` seconds;
+- ours: :func:`planning.pipeline.planner.plan` with the scene's default settings and a time
+  limit (``time_limit_s``, ``--time-limit``, default 0.8 of the timeout: what a user with that
+  budget sets; the plan returns what it verified by then), in a worker process (robot loaded,
+  kernels compiled) stopped after ``--timeout`` seconds;
 - OMPL RRT-Connect + simplification + TOPP-RA (:mod:`planning.peers.ompl_rrt`) on the same
   collision model (obstacles and self pairs), 1 s per attempt, new seeds up to ``--timeout``.
 
@@ -32,6 +34,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import dataclasses
 import itertools
 import multiprocessing
 import queue
@@ -66,12 +69,13 @@ def _robot(scene_path: str) -> tuple[Any, ck.Robot]:
     return scene, _ROBOTS[key]
 
 
-def ours(scene_path: str) -> dict[str, Any]:
+def ours(scene_path: str, time_limit_s: float) -> dict[str, Any]:
     """Our planner on one scene file, warm (in the worker): success, time, duration over Ruckig's bound."""
     from planning.peers.ruckig_bound import free_space_bound
     from planning.pipeline.planner import plan
 
     scene, robot = _robot(scene_path)
+    scene = dataclasses.replace(scene, planner=scene.planner.updated(time_limit_s=time_limit_s))
     started = time.perf_counter()
     try:
         result = plan(scene, robot)
@@ -148,11 +152,11 @@ class Lane:
     def _pool(self) -> ProcessPoolExecutor:
         return ProcessPoolExecutor(1, mp_context=self.context)
 
-    def run(self, path: Path, timeout_s: float) -> dict[str, Any]:
+    def run(self, path: Path, timeout_s: float, time_limit_s: float) -> dict[str, Any]:
         """Both planners on the scene file ``path``, warm: the row's ``ours_*`` and ``ompl_*`` values."""
         row: dict[str, Any] = {}
         self.ours.submit(warm, str(path)).result()  # loaded once per robot and process, untimed
-        future = self.ours.submit(ours, str(path))
+        future = self.ours.submit(ours, str(path), time_limit_s)
         try:
             row |= {f"ours_{k}": v for k, v in future.result(timeout=timeout_s).items()}
         except FutureTimeout:
@@ -198,6 +202,9 @@ def main() -> int:
     parser.add_argument("--limit", type=int, help="problems per class (default: all 100)")
     parser.add_argument("--timeout", type=float, default=10.0, help="seconds per problem and planner")
     parser.add_argument(
+        "--time-limit", type=float, help="our planner's time_limit_s [s] (default: 0.8 of --timeout)"
+    )
+    parser.add_argument(
         "--scenes", nargs="+", type=Path, help="scene files to run instead of MotionBenchMaker's (any robot)"
     )
     parser.add_argument(
@@ -205,6 +212,8 @@ def main() -> int:
     )
     parser.add_argument("--out", type=Path, default=Path("out/bench_mbm"))
     args = parser.parse_args()
+    if args.time_limit is not None and not 0 < args.time_limit <= args.timeout:
+        parser.error(f"--time-limit {args.time_limit:g} s must be in (0, --timeout = {args.timeout:g}] s")
     args.out.mkdir(parents=True, exist_ok=True)
     chosen = list(cases(args))
     rows: list[dict[str, Any]] = [
@@ -222,7 +231,7 @@ def main() -> int:
         if not row["invalid"]:
             lane = lanes.get()
             try:
-                row |= lane.run(path, args.timeout)
+                row |= lane.run(path, args.timeout, args.time_limit or 0.8 * args.timeout)
             finally:
                 lanes.put(lane)
         mark = "-" if row["invalid"] else summary(row)
@@ -241,7 +250,8 @@ def main() -> int:
     print(f"  {'ours med/p95 s':>15s}  {'ompl med/p95 s':>15s}  ratio  both   all  dur/bound  ompl jerk/lim")
     report = [
         f"{'Scene files' if args.scenes else f'MotionBenchMaker, {args.limit or 100} problem(s) per class'}, "
-        f"timeout {args.timeout:g} s, warm (`scripts/bench_mbm.py`)",
+        f"timeout {args.timeout:g} s (ours: time_limit_s {args.time_limit or 0.8 * args.timeout:g} s), "
+        "warm (`scripts/bench_mbm.py`)",
         "",
         "| robot | class | valid | solved ours | solved OMPL | ours median (p95) [s] | OMPL median (p95) [s] "
         "| ratio | ratio, both solved | ratio, all | ours duration / Ruckig bound | OMPL jerk / limit |",

@@ -6,9 +6,10 @@ loads its robot before the clock of ``allowed_planning_time`` runs.
 A plan's stages ask :meth:`Deadline.passed` where they can stop with what they have:
 RRT-Connect between samples (it returns no path), the firefly between iterations and the
 CMA-ES refinement between generations (each returns its best so far), the planner between
-attempts (it times and verifies the candidates it has, then stops). So a plan ends a little
-after its limit, by what its last stage takes to finish: the timing and the certified check
-of the candidates found (a fraction of a second on a 7-joint arm).
+attempts (it times and verifies the candidates it has and, failing those, follows the
+sampling planner's path as its last resort, then stops). So a plan ends a little after its
+limit, by what its last stages take to finish: the timing and the certified check of the
+candidates found (a fraction of a second on a 7-joint arm).
 """
 
 from __future__ import annotations

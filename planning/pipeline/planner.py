@@ -7,8 +7,9 @@ candidates are timed and verified best first (:mod:`planning.pipeline.choose`), 
 first that passes becomes the :class:`~planning.pipeline.result.PlanResult`. When no
 attempt is left and the seeding found a sampling planner's path, that path is followed as it
 is (:mod:`planning.pipeline.path_following`) before the plan says "no solution". With a
-``time_limit_s`` the stages stop where it passes (:mod:`planning.pipeline.deadline`) and
-the plan times and verifies what its last search found, with no attempt after it.
+``time_limit_s`` the stages stop where it passes (:mod:`planning.pipeline.deadline`): the
+plan times and verifies what its last search found and, failing that, follows the path
+found, with no attempt after it.
 """
 
 from __future__ import annotations
@@ -73,17 +74,16 @@ def solve(
         if isinstance(chosen, Choice):
             elapsed = Elapsed(attempt.problem.build_time_s + time.perf_counter() - started, search_s)
             return assemble(attempt.problem, searched, chosen, elapsed)
-        if deadline.passed():
-            raise chosen.error(attempt.tried, deadline.reason(time.perf_counter() - started))
-        following = seeding.after(attempt, searched)
+        following = None if deadline.passed() else seeding.after(attempt, searched)
         if following is None:
             break
         attempt = following
+    stopped = deadline.reason(time.perf_counter() - started) if deadline.passed() else ""
     if attempt.path is None:
-        raise chosen.error(attempt.tried)
+        raise chosen.error(attempt.tried, stopped)
     problem, followed = follow_path(attempt.problem, attempt.path)  # the last resort
     if isinstance(followed, Refusal):
-        raise chosen.error(attempt.tried, f"RRT-Connect found a path, but {followed.cause}")
+        raise chosen.error(attempt.tried, stopped, f"RRT-Connect found a path, but {followed.cause}")
     elapsed = Elapsed(problem.build_time_s + time.perf_counter() - started, search_s)
     return assemble(problem, searched, followed, elapsed)
 
