@@ -47,9 +47,9 @@ VERIFY_STEP_RANGE_M = (1e-4, 0.1)
 """Allowed robot motion between two verification checks [m]: below 0.1 mm the check of a
 long trajectory takes minutes, above 0.1 m it is no check."""
 MAX_SEED = 2**63 - 1
+"""Largest seed (it is stored in the trajectory file as a JSON integer)."""
 MAX_TIME_LIMIT_S = 86_400.0
 """Longest ``time_limit_s`` [s] (a day)."""
-"""Largest seed (it is stored in the trajectory file as a JSON integer)."""
 
 _FIREFLY_FIELDS = frozenset(f.name for f in dataclasses.fields(FireflySettings))
 
@@ -99,10 +99,9 @@ class PlannerSettings:
             :data:`~planning.search.refinement_settings.STALL_GENERATIONS`.
         time_limit_s: the search's time limit [s], from its start (the problem built: the
             robot loaded, start and goal solved), in (0, :data:`MAX_TIME_LIMIT_S`];
-            ``None`` (default): none. When it
-            passes the plan stops searching, times and verifies what it has found and
-            returns it, or says "no solution" naming the limit
-            (:mod:`planning.pipeline.deadline`; MoveIt's ``allowed_planning_time``).
+            ``None`` (default): none. When it passes the plan stops searching, times and
+            verifies what it has found and returns it, or says "no solution" naming the
+            limit (:mod:`planning.pipeline.deadline`; MoveIt's ``allowed_planning_time``).
         tuning: the search's internal knobs (:class:`~planning.pipeline.tuning.SearchTuning`),
             set from Python only: a scene file does not hold them.
     """
