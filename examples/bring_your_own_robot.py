@@ -6,7 +6,8 @@ The robot is one of example-robot-data's arms (default: the Panda); for yours, g
 ``RobotSpec`` your files (``urdf``, ``srdf``, ``package_dirs``, ``limits``) and a start of
 yours. What is not given is found by the rules of ``cpr_kin.RobotSpec``: the planned joints,
 the tool frame, the SRDF. The goal is the tool's pose after turning the first joint by
-1.2 rad, given as a pose (the IK finds a configuration for it), with a ball on the way.
+1.2 rad, given as a pose (the IK finds a configuration for it), with a ball on the way; the
+search has 30 s (``time_limit_s``: past it the plan returns what it verified, or says why not).
 """
 
 import sys
@@ -15,7 +16,7 @@ import numpy as np
 
 import cpr_kin as ck
 from cpr_kin.packages import example_robot
-from planning import Scene, Target, dump_scene, plan, write_trajectory
+from planning import PlannerSettings, Scene, Target, dump_scene, plan, write_trajectory
 
 HOMES = {  # a start of each arm [rad]: its maker's ready pose, or one above the table
     "panda": [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785],
@@ -41,6 +42,7 @@ scene = Scene(
     goal=Target(pose=(tuple(goal_position), tuple(map(tuple, goal_rotation)))),
     obstacles=(ball,),
     safety_margin=0.01,
+    planner=PlannerSettings(time_limit_s=30.0),  # a time budget, as MoveIt's allowed_planning_time
     name=f"{name}_turn",
 )
 result = plan(scene, robot)  # IK (verified) -> search -> septic spline -> timing -> certified check
