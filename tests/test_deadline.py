@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -25,7 +26,7 @@ from planning.search.rrt_connect import rrt_connect
 from .test_rrt_connect import LOWER, UPPER, WEIGHTS, wall_with_slot
 
 
-def after_calls(count: int) -> tuple[list[int], object]:
+def after_calls(count: int) -> tuple[list[int], Callable[[], bool]]:
     """A stop that says ``True`` from its ``count + 1``-th call on, and the list of its calls."""
     calls: list[int] = []
 
@@ -54,7 +55,7 @@ def test_rrt_connect_stops_without_a_path() -> None:
     args = (wall_with_slot, start, goal, LOWER, UPPER, WEIGHTS)
     assert rrt_connect(*args, np.random.default_rng(0)) is not None  # the oracle: it finds the slot
     calls, stop = after_calls(3)
-    assert rrt_connect(*args, np.random.default_rng(0), stop=stop) is None  # type: ignore[arg-type]
+    assert rrt_connect(*args, np.random.default_rng(0), stop=stop) is None
     assert len(calls) == 4  # asked before each sample: three drawn, the fourth not
 
 
@@ -63,15 +64,15 @@ def test_the_searches_stop_with_their_best_so_far() -> None:
     bounds = (np.zeros(3), np.ones(3))
     full = firefly_minimize(sphere, *bounds, settings, 1)
     _, stop = after_calls(2)
-    cut = firefly_minimize(sphere, *bounds, settings, 1, stop=stop)  # type: ignore[arg-type]
+    cut = firefly_minimize(sphere, *bounds, settings, 1, stop=stop)
     assert cut.evaluations == 3 * 10  # the initial population and two iterations
     np.testing.assert_array_equal(cut.best_history, full.best_history[:3])  # the same run, cut short
     start = np.full(3, 0.8)
     value = float(sphere(start[None])[0])
     _, never = after_calls(10**9)
-    refined = cma_refine(sphere, *bounds, start, value, 500, np.random.default_rng(2), stop=never)  # type: ignore[arg-type]
+    refined = cma_refine(sphere, *bounds, start, value, 500, np.random.default_rng(2), stop=never)
     _, at_once = after_calls(0)
-    kept = cma_refine(sphere, *bounds, start, value, 500, np.random.default_rng(2), stop=at_once)  # type: ignore[arg-type]
+    kept = cma_refine(sphere, *bounds, start, value, 500, np.random.default_rng(2), stop=at_once)
     assert refined.evaluations > 0 and refined.fitness < value
     assert kept.evaluations == 0 and kept.fitness == value
     np.testing.assert_array_equal(kept.x, start)
