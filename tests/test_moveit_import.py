@@ -316,7 +316,7 @@ def test_what_has_no_counterpart_is_refused_by_name(
 
 
 @pytest.mark.slow
-def test_every_motionbenchmaker_problem_converts() -> None:
+def test_every_motionbenchmaker_problem_converts(tmp_path: Path) -> None:
     """The 700 Panda and 700 UR5 problems of vamp-planner 0.6.4 (from PyPI, cached): convert, and count.
 
     One process per robot, side by side (the script's own use, robot by robot, on two cores).
@@ -327,7 +327,7 @@ def test_every_motionbenchmaker_problem_converts() -> None:
     script = Path(__file__).resolve().parents[1] / "scripts" / "import_mbm.py"
     runs = {
         robot: subprocess.Popen(
-            [sys.executable, str(script), "--robots", robot],
+            [sys.executable, str(script), "--robots", robot, "--out", str(tmp_path)],
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,
             text=True,
