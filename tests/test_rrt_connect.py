@@ -10,7 +10,8 @@ import pytest
 from numpy.typing import NDArray
 
 from planning.errors import PlanningError
-from planning.search.rrt_connect import RrtSettings, rrt_connect, waypoints_along
+from planning.search.rrt_connect import Relaxation, RrtSettings, rrt_connect
+from planning.search.waypoints import waypoints_along
 
 WEIGHTS = np.ones(2)
 LOWER, UPPER = np.zeros(2), np.ones(2)
@@ -216,3 +217,54 @@ def test_waypoints_keep_the_corners_and_split_the_longest_pieces() -> None:
     zigzag = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [2.0, 1.0], [2.0, 2.0]])
     np.testing.assert_allclose(waypoints_along(zigzag, 1, WEIGHTS), [[1.0, 1.0]])
     assert waypoints_along(path, 1, WEIGHTS).shape == (1, 2)
+
+
+def closed_wall(q: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """The wall with its slot closed: no way across (a clearance larger than the slot)."""
+    return np.asarray((q[:, 0] <= 0.45) | (q[:, 0] >= 0.55))
+
+
+def test_a_relaxation_lets_the_trees_through_after_its_samples() -> None:
+    """Under the strict validity there is no way; after ``after_samples`` the trees go on under
+    the looser one (the slot open), keep what they grew, and the path holds only under it."""
+    start, goal = np.array([0.1, 0.9]), np.array([0.9, 0.1])
+    settings = RrtSettings(max_samples=2000)
+    assert (
+        rrt_connect(closed_wall, start, goal, LOWER, UPPER, WEIGHTS, np.random.default_rng(0), settings)
+        is None
+    )
+    relaxation = Relaxation(wall_with_slot, after_samples=100)
+    found = rrt_connect(
+        closed_wall,
+        start,
+        goal,
+        LOWER,
+        UPPER,
+        WEIGHTS,
+        np.random.default_rng(0),
+        settings,
+        relaxation=relaxation,
+    )
+    assert found is not None and found.relaxed and 100 < found.samples <= 2000
+    assert densely_valid(found.path, eroded) and not densely_valid(found.path, closed_wall)
+
+
+def test_a_relaxation_changes_nothing_before_its_samples_and_holds_at_once_for_ends_that_need_it() -> None:
+    start, goal = np.array([0.1, 0.9]), np.array([0.9, 0.1])
+    plain = rrt_connect(wall_with_slot, start, goal, LOWER, UPPER, WEIGHTS, np.random.default_rng(3))
+    late = Relaxation(lambda q: np.ones(len(q), dtype=bool), after_samples=10_000)
+    relaxable = rrt_connect(
+        wall_with_slot, start, goal, LOWER, UPPER, WEIGHTS, np.random.default_rng(3), relaxation=late
+    )
+    assert plain is not None and relaxable is not None and not relaxable.relaxed
+    np.testing.assert_array_equal(plain.path, relaxable.path)
+    in_the_wall = np.array([0.46, 0.9])  # an end only the looser validity accepts
+    assert (
+        rrt_connect(wall_with_slot, in_the_wall, goal, LOWER, UPPER, WEIGHTS, np.random.default_rng(0))
+        is None
+    )
+    thin = Relaxation(lambda q: wall_with_slot(q, shrink=0.02), after_samples=10_000)
+    found = rrt_connect(
+        wall_with_slot, in_the_wall, goal, LOWER, UPPER, WEIGHTS, np.random.default_rng(0), relaxation=thin
+    )
+    assert found is not None and found.relaxed and densely_valid(found.path, thin.valid)

@@ -17,7 +17,7 @@ from planning.pipeline.seeding import PathSeeding, seed_search
 from planning.pipeline.settings import PlannerSettings
 from planning.pipeline.target import Target
 from planning.pipeline.tuning import SearchTuning, SeedingTuning
-from planning.search.rrt_connect import waypoints_along
+from planning.search.waypoints import waypoints_along
 
 
 @pytest.fixture(scope="module")
@@ -122,9 +122,9 @@ def test_seeding_none_is_a_setting(robot: ck.Robot) -> None:
 
 
 def test_a_passage_narrower_than_margin_plus_step_is_found_with_a_finer_step(robot: ck.Robot) -> None:
-    """Generated scene 43 of seed 13: the only way passes 2 mm outside the margin, closer than
-    the margin plus the 5 mm certified step; RRT-Connect finds no path keeping that clear, and
-    the seeding asks again with a 1 mm step."""
+    """Generated scene 43 of seed 13: RRT-Connect finds no path keeping the margin plus the 5 mm
+    certified step clear in all its samples (its way passes 2 mm outside the margin); its
+    trees go on at a 1 mm step's clearance, and the plan is searched and certified at it."""
     from planning.io.scene_generator import generate_scenes
     from planning.pipeline.planner import plan
 
@@ -134,7 +134,34 @@ def test_a_passage_narrower_than_margin_plus_step_is_found_with_a_finer_step(rob
     assert seed_search(problem).path is None  # nothing keeps margin + 5 mm clear
     result = plan(scene, robot)
     assert result.scene.planner.verify_step_m == pytest.approx(0.001)
-    assert scene.safety_margin <= result.metrics.min_clearance_m < scene.safety_margin + 0.005
+    assert result.verification.accepted and result.metrics.min_clearance_m >= scene.safety_margin
+
+
+def test_after_finer_after_samples_the_trees_keep_the_finer_clearance(robot: ck.Robot) -> None:
+    """Scene 43 of seed 13 again: after ``finer_after`` samples the trees go on keeping the
+    finer step's clearance, and the path found so (relaxed) holds it, not the whole step's;
+    with no finer step to go to (the step already the smallest allowed), they never do."""
+    from planning.io.scene_generator import generate_scenes
+    from planning.pipeline.seeding import finer_problem
+    from planning.pipeline.settings import VERIFY_STEP_RANGE_M
+
+    scene = generate_scenes(100, seed=13, robot=robot, narrow=33)[43]
+    early = SearchTuning(seeding=SeedingTuning(finer_after=300))
+    problem = with_planner(build_problem(scene, robot), tuning=early)
+    finer = finer_problem(problem)
+    assert finer is not None and finer.scene.planner.verify_step_m == 0.001
+    found = sampled_path(problem, np.random.default_rng(0), finer=finer)
+    assert found is not None and found.relaxed and found.samples > 300
+    dense = np.concatenate([waypoints_along(found.path, 200, ck.path_weights(robot)[problem.moving])])
+    keeps = problem.world.keeps_clearance
+    assert keeps(
+        finer.configurations(dense), finer.objective.required_m, finer.objective.required_self_m
+    ).all()
+    assert not keeps(problem.configurations(dense), problem.objective.required_m, np.inf).all()
+    attempt = PathSeeding().first(problem)
+    assert attempt.path is not None and attempt.problem.scene.planner.verify_step_m == 0.001
+    smallest = with_planner(problem, verify_step_m=VERIFY_STEP_RANGE_M[0])
+    assert finer_problem(smallest) is None  # no finer step than this: the trees keep its clearance
 
 
 def test_a_passage_rrt_connect_needs_thousands_of_samples_for_is_planned(robot: ck.Robot) -> None:
@@ -198,8 +225,9 @@ def test_where_rrt_connect_found_no_path_the_next_attempts_do_not_ask_again(
 ) -> None:
     """Its draws are seeded and the clearance it keeps is the same: it would fail alike.
 
-    With one sample RRT-Connect finds no way through the window, at the whole step nor at
-    the finer one; the attempts after the first search from the straight line without it.
+    With one sample RRT-Connect finds no way through the window, at the whole step nor (its
+    trees going on) at the finer one; the attempts after the first search from the straight
+    line without it.
     """
     from planning.pipeline import path_seeds
     from planning.pipeline.search import search
@@ -214,13 +242,15 @@ def test_where_rrt_connect_found_no_path_the_next_attempts_do_not_ask_again(
     monkeypatch.setattr(path_seeds, "sampled_path", counted)
     one_sample = with_planner(window, tuning=SearchTuning(seeding=SeedingTuning(max_samples=1)))
     attempt = PathSeeding().first(one_sample)
-    assert drawn == [None, None] and attempt.no_path and "no RRT-Connect path keeps" in attempt.tried
+    assert drawn == [None] and attempt.no_path and "no RRT-Connect path keeps" in attempt.tried
     for number in (1, 2):  # the retries
         following = PathSeeding().after(attempt, search(attempt, None, None))
         assert following is not None and following.number == number
         assert following.no_path and following.path is None and following.tried == attempt.tried
         attempt = following
-    assert len(drawn) == 2  # not asked again
+    assert len(drawn) == 1  # not asked again
     blocked = seed_search(one_sample, sample=False)
-    assert blocked.path is None and not blocked.no_path and len(drawn) == 2
-    assert seed_search(one_sample).no_path and len(drawn) == 3
+    assert blocked.path is None and not blocked.no_path and len(drawn) == 1
+    assert seed_search(one_sample).no_path and len(drawn) == 2
+    few = with_planner(window, tuning=SearchTuning(seeding=SeedingTuning(max_samples=2, finer_after=1)))
+    assert "keeps 0.055 m clear (nor 0.051 m after 1) in 2 samples" in PathSeeding().first(few).tried

@@ -25,7 +25,7 @@ from planning.pipeline.choose import Choice, Refusal, verify
 from planning.pipeline.problem import Problem, with_planner
 from planning.pipeline.settings import MAX_WAYPOINTS
 from planning.pipeline.timing import Timing
-from planning.search.rrt_connect import waypoints_along
+from planning.search.waypoints import waypoints_along
 
 FloatArray = NDArray[np.float64]
 

@@ -8,6 +8,7 @@ draws up to ``path_attempts`` until the spline through one's waypoints is feasib
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
@@ -16,7 +17,8 @@ from numpy.typing import NDArray
 import cpr_kin as ck
 from planning.pipeline.problem import Problem, with_planner
 from planning.pipeline.settings import MAX_WAYPOINTS
-from planning.search.rrt_connect import RrtPath, RrtSettings, rrt_connect, waypoints_along
+from planning.search.rrt_connect import Relaxation, RrtPath, RrtSettings, rrt_connect
+from planning.search.waypoints import waypoints_along
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
@@ -37,27 +39,39 @@ class PathSeed(NamedTuple):
 
 
 def sampled_path(
-    problem: Problem, rng: np.random.Generator, settings: RrtSettings | None = None
+    problem: Problem,
+    rng: np.random.Generator,
+    settings: RrtSettings | None = None,
+    finer: Problem | None = None,
 ) -> RrtPath | None:
-    """RRT-Connect's path in the moving joints of ``problem``, clear of the fitness's clearance."""
-    robot, moving, objective = problem.robot, problem.moving, problem.objective
+    """RRT-Connect's path in the moving joints of ``problem``, clear of the fitness's clearance.
 
-    def valid(q: FloatArray) -> BoolArray:
-        return problem.world.keeps_clearance(
-            problem.configurations(q), objective.required_m, objective.required_self_m
-        )
+    With ``finer`` (``problem`` with a finer certified step, so a smaller clearance), the
+    trees go on keeping its clearance after the seeding's ``finer_after`` samples, or from
+    the start where an end is too close for ``problem``'s; the path is then ``relaxed``.
+    """
+    robot, moving = problem.robot, problem.moving
 
+    def keeping(kept: Problem) -> Callable[[FloatArray], BoolArray]:
+        required_m, required_self_m = kept.objective.required_m, kept.objective.required_self_m
+
+        def valid(q: FloatArray) -> BoolArray:
+            return problem.world.keeps_clearance(problem.configurations(q), required_m, required_self_m)
+
+        return valid
+
+    tuning = problem.scene.planner.tuning.seeding
     if settings is None:  # the path's edges checked at most as far apart as the clearance required
-        tuning = problem.scene.planner.tuning.seeding
-        resolution = min(tuning.max_resolution_m, max(0.01, objective.required_m))
+        resolution = min(tuning.max_resolution_m, max(0.01, problem.objective.required_m))
         settings = RrtSettings(
             max_samples=tuning.max_samples,
             resolution_m=resolution,
             explore_resolution_m=tuning.max_resolution_m,
         )
     limits = robot.limits
+    relaxation = None if finer is None else Relaxation(keeping(finer), tuning.finer_after)
     return rrt_connect(
-        valid,
+        keeping(problem),
         problem.q_start[moving],
         problem.q_goal[moving],
         limits.lower[moving],
@@ -66,6 +80,7 @@ def sampled_path(
         rng,
         settings,
         problem.deadline.passed,
+        relaxation,
     )
 
 
@@ -76,14 +91,17 @@ def path_seed(problem: Problem, path: FloatArray, count: int, weights: FloatArra
     return PathSeed(float(counted.objective(along[None])[0]), counted, along)
 
 
-def followable_path(problem: Problem, weights: FloatArray) -> tuple[FloatArray | None, PathSeed | None]:
+def followable_path(
+    problem: Problem, weights: FloatArray, finer: Problem | None = None
+) -> tuple[FloatArray | None, PathSeed | None]:
     """RRT-Connect's path whose waypoints seed ``problem`` best, and its seed.
 
     Step 2 of :mod:`planning.pipeline.seeding`: up to ``path_attempts`` paths, all drawn
     from the stream ``default_rng([seed, 1])``, another only while those drawn took fewer
     than ``redraw_samples`` samples in all; the first whose seed is feasible, else the one
     of the best fitness; ``None`` when RRT-Connect finds none (a further draw is not tried:
-    a failed one has used up its samples).
+    a failed one has used up its samples). A path found keeping only ``finer``'s
+    clearance (:func:`sampled_path`) seeds ``finer``.
     """
     settings = problem.scene.planner
     tuning = settings.tuning.seeding
@@ -91,14 +109,15 @@ def followable_path(problem: Problem, weights: FloatArray) -> tuple[FloatArray |
     best: tuple[FloatArray, PathSeed] | None = None
     samples = 0
     for _ in range(tuning.path_attempts):
-        found = sampled_path(problem, rng)
+        found = sampled_path(problem, rng, finer=finer)
         if found is None:
             break
         samples += found.samples
-        seeded = path_seed(problem, found.path, settings.waypoints, weights)
+        kept = finer if finer is not None and found.relaxed else problem
+        seeded = path_seed(kept, found.path, settings.waypoints, weights)
         if best is None or seeded.fitness < best[1].fitness:
             best = (found.path, seeded)
-        if problem.objective.feasible(seeded.fitness) or samples >= tuning.redraw_samples:
+        if kept.objective.feasible(seeded.fitness) or samples >= tuning.redraw_samples:
             break
     return (None, None) if best is None else best
 

@@ -11,7 +11,7 @@ is a small part of its space, rarely met by a random population. So, with the pl
    (:mod:`planning.search.rrt_connect`, drawn by :mod:`planning.pipeline.path_seeds`)
    looks for a path in the moving joints, clear of
    the clearance the fitness requires (margin plus verification step), and its waypoints
-   (:func:`~planning.search.rrt_connect.waypoints_along`) are the second seed. A path is
+   (:func:`~planning.search.waypoints.waypoints_along`) are the second seed. A path is
    clear, but the spline through its few waypoints cuts its corners and may not be: then
    RRT-Connect draws another path, up to ``path_attempts`` in all while the paths so far
    took fewer than ``redraw_samples`` samples, and the first whose seed is feasible (else
@@ -27,10 +27,13 @@ is a small part of its space, rarely met by a random population. So, with the pl
 
 The clearance required is the margin plus the certified check's step (``verify_step_m``;
 between the robot's own pairs the self margin plus its finer ``self_verify_step_m``): what
-moves between two checks is counted against the margin. A passage narrower than that
-has no path: when RRT-Connect finds none (at once for a start or goal that close, a grasp),
-the first attempt asks once more with the step cut to ``finer_step`` of it (1 mm of the
-default 5 mm; half an end's clearance beyond its margin where less, :func:`finer_step_m`).
+moves between two checks is counted against the margin. A passage narrower than that has
+no path at that step, so the first attempt's RRT-Connect trees go on keeping only the
+clearance of a finer step after ``finer_after`` samples (at once for a start or goal that
+close, a grasp): ``finer_step`` of the step (1 mm of the default 5 mm; half an end's
+clearance beyond its margin where less, :func:`finer_step_m`). What the trees grew holds at
+the finer clearance too, so no sample is drawn again; a path found so is searched, and
+certified, with the finer step.
 
 The seeds and ``spread``-sized moves around them make up ``share`` of the initial
 population (:class:`~planning.pipeline.tuning.SeedingTuning`); when a seed is feasible, the
@@ -131,17 +134,15 @@ class PathSeeding:
     """The straight line and a sampling planner's path as seeds, escalated on failure (module docstring)."""
 
     def first(self, problem: Problem) -> Attempt:  # noqa: D102 - the protocol's
-        seeds = seed_search(problem)
+        seeds = seed_search(problem, finer=True)
         tried = ""
         if seeds.no_path and not problem.deadline.passed():  # else the time limit cut it short
-            required = problem.objective.required_m
-            tried = f"no RRT-Connect path keeps {required:.4g} m clear"
-            finer = finer_step_m(problem)  # the ends' clearances, asked only here
-            if finer < problem.scene.planner.verify_step_m:
-                closer = seed_search(with_planner(problem, verify_step_m=finer))
-                if closer.path is not None:  # a passage narrower than margin plus the step
-                    return Attempt(closer.problem, closer.candidates, closer.path, 0, "", closer.feasible)
-                tried += f" (nor {closer.problem.objective.required_m:.4g} m)"
+            tuning = problem.scene.planner.tuning.seeding
+            tried = f"no RRT-Connect path keeps {problem.objective.required_m:.4g} m clear"
+            finer = finer_problem(problem)
+            if finer is not None and tuning.finer_after < tuning.max_samples:
+                tried += f" (nor {finer.objective.required_m:.4g} m after {tuning.finer_after})"
+            tried += f" in {tuning.max_samples} samples"
         return Attempt(seeds.problem, seeds.candidates, seeds.path, 0, tried, seeds.feasible, seeds.no_path)
 
     def after(self, attempt: Attempt, searched: SearchResult) -> Attempt | None:  # noqa: D102
@@ -162,7 +163,11 @@ SEEDINGS: dict[str, Seeding] = {"paths": PathSeeding(), "none": NoSeeding()}
 
 
 def seed_search(
-    problem: Problem, more_waypoints: bool = False, path: FloatArray | None = None, sample: bool = True
+    problem: Problem,
+    more_waypoints: bool = False,
+    path: FloatArray | None = None,
+    sample: bool = True,
+    finer: bool = False,
 ) -> Seeds:
     """The seeds of ``problem``'s search (module docstring).
 
@@ -173,6 +178,8 @@ def seed_search(
         path: the path an earlier call found (saves finding it again).
         sample: ask RRT-Connect for a path when none is given and the straight line is not
             clear (``False``: an earlier call found none).
+        finer: RRT-Connect's trees go on keeping the clearance of :func:`finer_problem`
+            after ``finer_after`` samples, and a path found so seeds that problem.
     """
     started = time.perf_counter()
     straight = problem.objective.straight_line()
@@ -181,7 +188,7 @@ def seed_search(
     seeded: PathSeed | None = None
     asked = path is None and not clear and sample
     if asked:
-        path, seeded = followable_path(problem, weights)
+        path, seeded = followable_path(problem, weights, finer_problem(problem) if finer else None)
     if path is None:
         elapsed = time.perf_counter() - started
         return Seeds(problem, _around(problem, straight[None]), None, clear, clear, elapsed, asked)
@@ -193,6 +200,13 @@ def seed_search(
     candidates = np.array([problem.objective.straight_line(), seeded.x])
     feasible = clear or bool(problem.objective.feasible(seeded.fitness))
     return Seeds(problem, _around(problem, candidates), path, clear, feasible, time.perf_counter() - started)
+
+
+def finer_problem(problem: Problem) -> Problem | None:
+    """``problem`` with the finer certified step (:func:`finer_step_m`); ``None``: its own is as fine."""
+    step_m = finer_step_m(problem)
+    finer = step_m < problem.scene.planner.verify_step_m
+    return with_planner(problem, verify_step_m=step_m) if finer else None
 
 
 def _around(problem: Problem, seeds: FloatArray) -> FloatArray:

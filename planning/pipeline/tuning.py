@@ -36,6 +36,10 @@ class SeedingTuning:
         max_samples: random samples after which RRT-Connect gives up on a path, in
             [1, 100000] (a narrow passage may need several thousand; a failed draw costs
             about 0.15 ms a sample).
+        finer_after: random samples RRT-Connect draws keeping the margin plus the whole
+            verification step before its trees go on keeping only the finer step's
+            clearance (where ``finer_step`` makes one), in [1, 100000]: a passage narrower
+            than margin plus step would take all ``max_samples`` in vain.
         more_waypoints: how many waypoints beyond the path's corners the seeding may add,
             two at a time, in [0, 20].
         finer_step: when RRT-Connect finds no path keeping the margin plus the verification
@@ -50,6 +54,7 @@ class SeedingTuning:
     path_attempts: int = 3
     redraw_samples: int = 1_000
     max_samples: int = 10_000
+    finer_after: int = 3_000
     more_waypoints: int = 6
     finer_step: float = 0.2
 
@@ -60,6 +65,7 @@ class SeedingTuning:
         integer_in("path_attempts", self.path_attempts, 1, 20)
         integer_in("redraw_samples", self.redraw_samples, 0, 100_000)
         integer_in("max_samples", self.max_samples, 1, 100_000)
+        integer_in("finer_after", self.finer_after, 1, 100_000)
         integer_in("more_waypoints", self.more_waypoints, 0, 20)
         number_in("finer_step", self.finer_step, 0.0, 1.0, low_open=True)
 

@@ -5,13 +5,15 @@ from .firefly import FireflyProgress, firefly_minimize
 from .firefly_settings import FireflySettings
 from .optimizer import BatchObjective, Optimizer, SearchResult
 from .refinement import cma_refine, refine_search
-from .rrt_connect import RrtPath, RrtSettings, waypoints_along
+from .rrt_connect import Relaxation, RrtPath, RrtSettings
+from .waypoints import waypoints_along
 
 __all__ = [
     "BatchObjective",
     "FireflyProgress",
     "FireflySettings",
     "Optimizer",
+    "Relaxation",
     "RrtPath",
     "RrtSettings",
     "SearchResult",

@@ -3,7 +3,7 @@
 The firefly searches a few waypoints well but cannot find a narrow passage by chance: a way
 under a beam or through a window is a small region of its space. A sampling planner finds one
 in milliseconds, and its path, cut to a few waypoints, seeds the firefly's population
-(:func:`waypoints_along`).
+(:func:`planning.search.waypoints.waypoints_along`).
 
 Two trees grow from start and goal: one extends a step towards a random sample, the other
 then greedily connects to the new node; they swap roles every sample. The step is by default
@@ -25,6 +25,11 @@ arm. The shortened path's few edges are then checked at ``resolution_m``; an edg
 passes between two coarse checks through an obstacle is replaced by RRT-Connect's path
 between its ends at that spacing, and when none is found the whole search runs again at it.
 The path returned always holds at ``resolution_m``.
+
+A :class:`Relaxation` lets the trees go on under a looser validity after some samples (a
+smaller clearance, where a passage is narrower than the one asked): what they grew holds
+under it too, so no sample is drawn again; where start or goal fails the strict validity,
+the looser one holds from the start. A path found under it is marked ``relaxed``.
 """
 
 from __future__ import annotations
@@ -91,11 +96,26 @@ class RrtPath:
         path: ``(k, d)`` vertices from start to goal, shortened [joint units].
         samples: random samples drawn.
         checks: configurations checked.
+        relaxed: found under the :class:`Relaxation`'s validity (it holds under that one only).
     """
 
     path: FloatArray
     samples: int
     checks: int
+    relaxed: bool = False
+
+
+@dataclass(frozen=True)
+class Relaxation:
+    """A looser validity the trees go on with after ``after_samples`` samples (module docstring).
+
+    Attributes:
+        valid: the looser check: it accepts every configuration the strict one accepts.
+        after_samples: samples drawn under the strict validity first.
+    """
+
+    valid: Validity
+    after_samples: int
 
 
 class _Tree:
@@ -136,12 +156,13 @@ def rrt_connect(
     rng: np.random.Generator,
     settings: RrtSettings | None = None,
     stop: Callable[[], bool] | None = None,
+    relaxation: Relaxation | None = None,
 ) -> RrtPath | None:
     """A valid path from ``start`` to ``goal`` in the box ``[lower, upper]``, or ``None``.
 
-    ``None`` at once when ``start`` or ``goal`` is not valid itself: no valid path begins or
-    ends there, and the samples would be spent for nothing (a goal closer to an obstacle than
-    the clearance asked, though outside the margin).
+    ``None`` at once when ``start`` or ``goal`` is not valid itself (nor under the
+    relaxation): no valid path begins or ends there, and the samples would be spent for
+    nothing (a goal closer to an obstacle than the clearance asked, though outside the margin).
 
     Args:
         valid: the batched validity check.
@@ -154,28 +175,37 @@ def rrt_connect(
         settings: the planner's parameters (default :class:`RrtSettings`).
         stop: asked before every sample; ``True`` ends the search without a path (a time
             limit). ``None``: never.
+        relaxation: the looser validity the trees go on with after its samples (``None``:
+            none; module docstring).
     """
     settings = settings or RrtSettings()
     start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
     weights = np.asarray(weights, dtype=float)
     if not (weights.shape == start.shape == goal.shape and np.all(weights > 0)):
         raise PlanningError(f"weights {weights.tolist()} must be positive, one per joint of start and goal")
+    relaxed = False
     if not np.all(valid(np.stack([start, goal]))):
-        return None
+        if relaxation is None or not np.all(relaxation.valid(np.stack([start, goal]))):
+            return None
+        valid, relaxation, relaxed = relaxation.valid, None, True  # the ends ask for it
     explore_m = settings.explore_resolution_m or settings.resolution_m
     step_m = settings.step_m
     if step_m is None:
         diagonal = float(np.linalg.norm(weights * (np.asarray(upper) - np.asarray(lower))))
         step_m = max(explore_m, RANGE_FRACTION * diagonal)
     if explore_m > settings.resolution_m:
-        return _lazy(valid, start, goal, (lower, upper), weights, rng, settings, step_m, stop)
+        found = _lazy(valid, start, goal, (lower, upper), weights, rng, settings, step_m, stop, relaxation)
+        return found if found is None or not relaxed else dataclasses.replace(found, relaxed=True)
     edges = Edges(valid, weights, settings.resolution_m)
     if edges.free_fraction(start, goal) == 1.0:
-        return RrtPath(np.array([start, goal]), 0, edges.checks)
-    trees = (_Tree(start), _Tree(goal))
+        return RrtPath(np.array([start, goal]), 0, edges.checks, relaxed)
+    trees, strict_checks = (_Tree(start), _Tree(goal)), 0
     for sample in range(1, settings.max_samples + 1):
         if stop is not None and stop():
             return None
+        if relaxation is not None and sample > relaxation.after_samples:  # the trees hold under it
+            strict_checks, edges = edges.checks, Edges(relaxation.valid, weights, settings.resolution_m)
+            relaxation, relaxed = None, True
         grow, other = trees[(sample - 1) % 2], trees[sample % 2]
         target = rng.uniform(lower, upper)
         near = grow.nearest(target, weights)
@@ -197,7 +227,7 @@ def rrt_connect(
             if grow is not trees[0]:
                 path = path[::-1]
             path = shortcut(path, edges, rng, settings.shortcuts)
-            return RrtPath(path, sample, edges.checks)
+            return RrtPath(path, sample, strict_checks + edges.checks, relaxed)
     return None
 
 
@@ -211,13 +241,16 @@ def _lazy(
     settings: RrtSettings,
     step_m: float,
     stop: Callable[[], bool] | None,
+    relaxation: Relaxation | None,
 ) -> RrtPath | None:
     """RRT-Connect on coarse edge checks, its path then held at ``resolution_m`` (module docstring)."""
     fine = dataclasses.replace(settings, explore_resolution_m=None, step_m=step_m)
     coarse = dataclasses.replace(fine, resolution_m=settings.explore_resolution_m or settings.resolution_m)
-    found = rrt_connect(valid, start, goal, *box, weights, rng, coarse, stop)
+    found = rrt_connect(valid, start, goal, *box, weights, rng, coarse, stop, relaxation)
     if found is None:
         return None
+    if found.relaxed and relaxation is not None:  # the path holds at the looser validity only
+        valid, relaxation = relaxation.valid, None
     edges = Edges(valid, weights, settings.resolution_m)
     samples, checks = found.samples, found.checks
     pieces = [found.path[:1]]
@@ -227,16 +260,17 @@ def _lazy(
             continue
         detour = rrt_connect(valid, a, b, *box, weights, rng, dataclasses.replace(fine, shortcuts=0), stop)
         if detour is None:  # the coarse path is no guide here: search again at the fine spacing
-            again = rrt_connect(valid, start, goal, *box, weights, rng, fine, stop)
+            again = rrt_connect(valid, start, goal, *box, weights, rng, fine, stop, relaxation)
             if again is None:
                 return None
-            return RrtPath(again.path, samples + again.samples, checks + edges.checks + again.checks)
+            total = checks + edges.checks + again.checks
+            return RrtPath(again.path, samples + again.samples, total, found.relaxed or again.relaxed)
         samples, checks = samples + detour.samples, checks + detour.checks
         pieces.append(detour.path[1:])
     path = np.concatenate(pieces)
     if len(path) > len(found.path):  # detours: shortened again, on the fine checks
         path = shortcut(path, edges, rng, settings.shortcuts)
-    return RrtPath(path, samples, checks + edges.checks)
+    return RrtPath(path, samples, checks + edges.checks, found.relaxed)
 
 
 def _connect(
@@ -255,30 +289,3 @@ def _connect(
     for k in range(1, nodes + 1):
         parent = tree.add(origin + (fraction * k / nodes) * (target - origin), parent)
     return parent if fraction == 1.0 else None
-
-
-def waypoints_along(path: FloatArray, count: int, weights: FloatArray) -> FloatArray:
-    """``(count, d)`` interior waypoints for a spline that follows ``path`` (its vertices kept).
-
-    The path's interior vertices are its corners and are kept when there are at most
-    ``count``; the rest are placed on the longest pieces (each split evenly), so that
-    the spline through start, waypoints and goal stays near the path. With more corners
-    than ``count``, points evenly spaced in arc length.
-    """
-    corners = path[1:-1]
-    if len(corners) > count:
-        lengths = np.abs(np.diff(path, axis=0)) @ weights
-        arc = np.concatenate([[0.0], np.cumsum(lengths)])
-        at = arc[-1] * np.arange(1, count + 1) / (count + 1)
-        return np.array([np.interp(at, arc, path[:, j]) for j in range(path.shape[1])]).T
-    pieces = len(path) - 1
-    splits = np.ones(pieces, dtype=np.intp)  # parts per piece
-    lengths = np.abs(np.diff(path, axis=0)) @ weights
-    for _ in range(count - len(corners)):
-        splits[int(np.argmax(lengths / splits))] += 1
-    points: list[FloatArray] = []
-    for k in range(pieces):
-        points.extend(path[k] + (m / splits[k]) * (path[k + 1] - path[k]) for m in range(1, splits[k]))
-        if k + 1 < pieces:
-            points.append(path[k + 1])
-    return np.array(points)
