@@ -6,6 +6,7 @@ import dataclasses
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -16,7 +17,10 @@ from planning.errors import NoTrajectoryFoundError, PlanningError
 from planning.io.bundled import paper_scene
 from planning.pipeline.deadline import Deadline
 from planning.pipeline.planner import plan
+from planning.pipeline.problem import build_problem
 from planning.pipeline.scene import Scene
+from planning.pipeline.search import search
+from planning.pipeline.seeding import Attempt
 from planning.pipeline.settings import PlannerSettings
 from planning.search.firefly import firefly_minimize
 from planning.search.firefly_settings import FireflySettings
@@ -100,6 +104,30 @@ def test_a_plan_cut_short_returns_what_it_verified(robot: ck.Robot) -> None:
     result = plan(scene, robot)
     assert result.verification.accepted
     assert result.optimiser.evaluations <= scene.planner.firefly.fireflies  # no iteration after the seeds
+
+
+def test_a_callers_optimizer_is_stopped_through_its_objective(robot: ck.Robot) -> None:
+    """A caller's optimiser knows no deadline: past it, its objective's next call ends its run
+    (even through its own ``except Exception``), and the search returns the best it saw."""
+    problem = dataclasses.replace(build_problem(paper_scene(), robot), deadline=Deadline(0.0, 1.0))
+    batches: list[tuple[np.ndarray, np.ndarray]] = []
+
+    def endless(objective: Any, lower: np.ndarray, upper: np.ndarray, budget: int, rng: Any) -> Any:
+        for _ in range(50):  # a budget of its own, never reached while time is up
+            x = rng.uniform(lower, upper, (4, lower.size))
+            try:
+                batches.append((x, objective(x)))
+            except Exception:  # an optimiser that swallows its objective's errors
+                continue
+        raise AssertionError("the deadline did not stop it")
+
+    searched = search(Attempt(problem), None, endless)
+    ((x, values),) = batches  # the first batch only: time was up before it
+    assert searched.evaluations == 4 and searched.fitness == values.min()
+    np.testing.assert_array_equal(searched.x, x[np.argmin(values)])
+    free = dataclasses.replace(problem, deadline=Deadline())  # without a deadline it runs to its end
+    with pytest.raises(AssertionError, match="did not stop"):
+        search(Attempt(free), None, endless)
 
 
 def test_the_limit_is_validated() -> None:

@@ -5,11 +5,13 @@ loads its robot before the clock of ``allowed_planning_time`` runs.
 
 A plan's stages ask :meth:`Deadline.passed` where they can stop with what they have:
 RRT-Connect between samples (it returns no path), the firefly between iterations and the
-CMA-ES refinement between generations (each returns its best so far), the planner between
+CMA-ES refinement between generations (each returns its best so far), a caller's own
+optimiser through its objective (:mod:`planning.pipeline.search`), the planner between
 attempts (it times and verifies the candidates it has and, failing those, follows the
-sampling planner's path as its last resort, then stops). So a plan ends a little after its
-limit, by what its last stages take to finish: the timing and the certified check of the
-candidates found (a fraction of a second on a 7-joint arm).
+sampling planner's path as its last resort, then stops). So a plan ends after its limit by
+what its last stages take to finish: the timing and the certified check of the candidates
+found (``docs/benchmarks.md``: up to 3 s on a 7-joint arm among shelves, where each
+certified check of a timing takes about a second).
 """
 
 from __future__ import annotations

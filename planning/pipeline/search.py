@@ -6,19 +6,75 @@ the CMA-ES refinement from its best within the rest of the evaluation budget,
 ``fireflies x (iterations + 1)``. A caller's :class:`~planning.search.optimizer.Optimizer`
 runs instead on the same objective and budget. Every draw comes from
 ``numpy.random.default_rng(seed)``.
+
+The planner's search asks the plan's deadline itself (:mod:`planning.pipeline.deadline`). A
+caller's optimiser knows nothing of it, so it gets the objective watched: once the deadline
+has passed, the watched objective's next call raises :class:`TimeUp` through the optimiser
+(after its first batch, so that something was evaluated), and the search returns the best
+candidate the objective saw. :class:`TimeUp` derives from ``BaseException``, as
+``asyncio.CancelledError`` does: an optimiser's ``except Exception`` does not swallow it.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 import numpy as np
+from numpy.typing import NDArray
 
 from planning.pipeline.problem import Problem
 from planning.pipeline.seeding import Attempt
 from planning.search.firefly import FireflyProgress
-from planning.search.optimizer import Optimizer, SearchResult
+from planning.search.optimizer import BatchObjective, Optimizer, SearchResult
 from planning.search.refined_firefly import RefinedFirefly
+
+FloatArray = NDArray[np.float64]
+
+
+class TimeUp(BaseException):
+    """Raised by a watched objective once the plan's deadline has passed (module docstring)."""
+
+
+class WatchedObjective:
+    """``objective`` keeping the best candidate it evaluated; past ``passed()`` it raises :class:`TimeUp`.
+
+    Args:
+        objective: the batch objective watched.
+        passed: whether time is up (the plan's :meth:`~planning.pipeline.deadline.Deadline.passed`).
+    """
+
+    def __init__(self, objective: BatchObjective, passed: Callable[[], bool]) -> None:
+        self.objective, self.passed = objective, passed
+        self.best_x: FloatArray | None = None
+        self.best_value = math.inf
+        self.evaluations = 0
+
+    def __call__(self, x: FloatArray) -> FloatArray:
+        """``(S,)`` values of ``x`` ``(S, d)``; :class:`TimeUp` once time is up (never on the first call)."""
+        if self.evaluations and self.passed():
+            raise TimeUp
+        values = np.asarray(self.objective(x), dtype=float)
+        self.evaluations += len(values)
+        if len(values) and (self.best_x is None or float(np.min(values)) < self.best_value):
+            k = int(np.argmin(values))
+            self.best_x, self.best_value = np.array(x[k], dtype=float), float(values[k])
+        return values
+
+    def result(self) -> SearchResult:
+        """The best candidate seen, as a search's result (one entry per history); after a call."""
+        assert self.best_x is not None  # TimeUp comes only after a call
+        value = np.array([self.best_value])
+        return SearchResult(
+            x=self.best_x,
+            fitness=self.best_value,
+            evaluations=self.evaluations,
+            best_history=value,
+            mean_history=value,
+            evaluation_history=np.array([self.evaluations], dtype=np.int64),
+            population=self.best_x[None],
+            population_fitness=value,
+        )
 
 
 def planner_search(
@@ -51,11 +107,19 @@ def search(
     Args:
         attempt: the problem and where its search starts.
         progress: called after every firefly iteration (the planner's search only).
-        optimizer: another optimiser; default: :func:`planner_search`.
+        optimizer: another optimiser; default: :func:`planner_search`. It is stopped at the
+            plan's deadline through its objective (module docstring).
     """
     problem = attempt.problem
     objective, settings = problem.objective, problem.scene.planner
-    if optimizer is None:
-        optimizer = planner_search(problem, attempt, progress)
     rng = np.random.default_rng(settings.seed)
-    return optimizer(objective, objective.lower, objective.upper, settings.firefly.evaluations, rng)
+    budget = settings.firefly.evaluations
+    if optimizer is None:
+        return planner_search(problem, attempt, progress)(
+            objective, objective.lower, objective.upper, budget, rng
+        )
+    watched = WatchedObjective(objective, problem.deadline.passed)
+    try:
+        return optimizer(watched, objective.lower, objective.upper, budget, rng)
+    except TimeUp:
+        return watched.result()
