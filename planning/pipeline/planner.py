@@ -105,16 +105,7 @@ def stand_still(problem: Problem, started: float) -> PlanResult:
     if not verification.accepted:  # pragma: no cover - the start was checked clear of the margin
         raise Refusal(f"standing still fails: {'; '.join(verification.problems)}", verification.check).error()
     fitness = float(objective(x[None])[0])
-    searched = SearchResult(
-        x=x,
-        fitness=fitness,
-        evaluations=1,
-        best_history=np.array([fitness]),
-        mean_history=np.array([fitness]),
-        evaluation_history=np.array([1], dtype=np.int64),
-        population=x[None],
-        population_fitness=np.array([fitness]),
-    )
+    searched = SearchResult.of_point(x, fitness, 1)
     timing = Timing(trajectory, problem.duration.still_method, fit, False, 0.0)
     choice = Choice(x, objective.nodes(x[None])[0], timing, verification, 1)
     elapsed = Elapsed(problem.build_time_s + time.perf_counter() - started, 0.0)

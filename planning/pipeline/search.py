@@ -64,17 +64,7 @@ class WatchedObjective:
     def result(self) -> SearchResult:
         """The best candidate seen, as a search's result (one entry per history); after a call."""
         assert self.best_x is not None  # TimeUp comes only after a call
-        value = np.array([self.best_value])
-        return SearchResult(
-            x=self.best_x,
-            fitness=self.best_value,
-            evaluations=self.evaluations,
-            best_history=value,
-            mean_history=value,
-            evaluation_history=np.array([self.evaluations], dtype=np.int64),
-            population=self.best_x[None],
-            population_fitness=value,
-        )
+        return SearchResult.of_point(self.best_x, self.best_value, self.evaluations)
 
 
 def planner_search(

@@ -92,6 +92,21 @@ class SearchResult:
     population: FloatArray
     population_fitness: FloatArray
 
+    @classmethod
+    def of_point(cls, x: FloatArray, fitness: float, evaluations: int) -> SearchResult:
+        """A search that ends at the single point ``x`` of value ``fitness`` after ``evaluations``."""
+        value = np.array([fitness])
+        return cls(
+            x=x,
+            fitness=fitness,
+            evaluations=evaluations,
+            best_history=value,
+            mean_history=value,
+            evaluation_history=np.array([evaluations], dtype=np.int64),
+            population=x[None],
+            population_fitness=value,
+        )
+
 
 @dataclass
 class History:
