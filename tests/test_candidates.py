@@ -11,7 +11,8 @@ from planning.curves.trajectory import Trajectory
 from planning.io.bundled import paper_scene
 from planning.io.scene_generator import generate_scenes
 from planning.pipeline import choose as choose_module
-from planning.pipeline.choose import Choice, choose, distinct, verify
+from planning.pipeline.choose import Choice, Refusal, choose, distinct, verify
+from planning.pipeline.deadline import Deadline
 from planning.pipeline.planner import solve
 from planning.pipeline.problem import Problem
 from planning.pipeline.timing import FixedDuration, Timing
@@ -42,15 +43,13 @@ def test_distinct_keeps_the_first_of_each_point_in_order() -> None:
     assert distinct([]) == []
 
 
-def test_a_refused_point_is_timed_and_verified_once(robot: ck.Robot) -> None:
-    # after a refinement the best is also its population's first: refused once, it is not
-    # timed and verified again before the next distinct candidate
-    problem = build_problem(paper_scene(0), robot)
-    blocked = problem.objective.straight_line()  # the paper case's straight swing hits the crate
+def blocked_then_found(problem: Problem) -> SearchResult:
+    """The paper case's straight swing (it hits the crate) twice, then the plan's own best."""
+    blocked = problem.objective.straight_line()
     fixed = problem.duration.timings(problem, problem.objective.nodes(blocked[None])[0])[0]
     assert not verify(problem, fixed.trajectory, fixed.fit).accepted
     found = solve(problem).optimiser.x
-    result = SearchResult(
+    return SearchResult(
         x=blocked,
         fitness=1.0,
         evaluations=3,
@@ -60,12 +59,32 @@ def test_a_refused_point_is_timed_and_verified_once(robot: ck.Robot) -> None:
         population=np.stack([blocked, blocked.copy(), found]),
         population_fitness=np.array([1.0, 1.0, 2.0]),
     )
+
+
+def test_a_refused_point_is_timed_and_verified_once(robot: ck.Robot) -> None:
+    # after a refinement the best is also its population's first: refused once, it is not
+    # timed and verified again before the next distinct candidate
+    problem = build_problem(paper_scene(0), robot)
+    result = blocked_then_found(problem)
     counting = CountingDuration(4.0)  # the paper case's duration
     chosen = choose(replace(problem, duration=counting), result)
     assert isinstance(chosen, Choice)
-    np.testing.assert_array_equal(chosen.x, found)
+    np.testing.assert_array_equal(chosen.x, result.population[2])
     assert chosen.verification.accepted
     assert chosen.candidates_timed == len(counting.timed) == 2
+
+
+def test_past_the_deadline_only_the_timing_in_hand_is_verified(robot: ck.Robot) -> None:
+    # the same candidates, time up: the best's timing is verified, refused, and nothing more tried
+    problem = build_problem(paper_scene(0), robot)
+    result = blocked_then_found(problem)
+    counting = CountingDuration(4.0)
+    late = replace(problem, duration=counting, deadline=Deadline(0.0, 1.0))
+    chosen = choose(late, result)
+    assert isinstance(chosen, Refusal) and chosen.verified == "1 candidate verified"
+    assert len(counting.timed) == 1
+    in_time = choose(replace(late, deadline=Deadline()), result)
+    assert isinstance(in_time, Choice)  # the oracle: a later candidate passes
 
 
 def test_once_the_best_is_refused_the_shortest_passing_timing_wins(

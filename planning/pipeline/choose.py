@@ -19,6 +19,8 @@ and returns the first whose timed trajectory passes the certified continuous che
 Each candidate is timed once, however often the search returns it. A best candidate that
 comes deeper inside the margin than one verification step at one of its samples
 (:func:`beyond_margin`) is verified in its first timing only: every timing follows its path.
+Once the problem's deadline has passed, no further timing is tried after one that failed:
+past its time limit a plan verifies only the timing in hand (the best's first, at least).
 """
 
 from __future__ import annotations
@@ -166,15 +168,17 @@ def choose(problem: Problem, searched: SearchResult) -> Choice | Refusal:
     candidates = distinct([searched.x] + [searched.population[k] for k in order if feasible[k]])
     timed: list[list[Timing]] = []
     first: Verification | None = None
+    verified: set[int] = set()
     hopeless = beyond_margin(problem, searched)
     for k, timing in _attempts(problem, candidates, timed):
         verification = verify(problem, timing.trajectory, timing.fit)
         first = first or verification
+        verified.add(k)
         if verification.accepted:
             x = candidates[k]
             return Choice(x, objective.nodes(x[None])[0], timing, verification, len(timed))
-        if hopeless:
-            break  # its other timings follow the same path
+        if hopeless or problem.deadline.passed():
+            break  # its other timings follow the same path; or time is up
     assert first is not None  # candidates is never empty
     found = f"the best candidate {'; '.join(first.problems)}"
     if not objective.feasible(searched.fitness):  # the cause comes first, the obstacle named
@@ -184,8 +188,8 @@ def choose(problem: Problem, searched: SearchResult) -> Choice | Refusal:
         found = (
             f"no candidate was feasible; the best:{closest} {check.certified_min_m:.3f} m certified, {why}"
         )
-    verified = f"{len(candidates)} candidate{'' if len(candidates) == 1 else 's'} verified"
-    return Refusal(found, first.check, verified)
+    said = f"{len(verified)} candidate{'' if len(verified) == 1 else 's'} verified"
+    return Refusal(found, first.check, said)
 
 
 def _attempts(

@@ -6,12 +6,13 @@ loads its robot before the clock of ``allowed_planning_time`` runs.
 A plan's stages ask :meth:`Deadline.passed` where they can stop with what they have:
 RRT-Connect between samples (it returns no path), the firefly between iterations and the
 CMA-ES refinement between generations (each returns its best so far), a caller's own
-optimiser through its objective (:mod:`planning.pipeline.search`), the planner between
-attempts (it times and verifies the candidates it has and, failing those, follows the
-sampling planner's path as its last resort, then stops). So a plan ends after its limit by
-what its last stages take to finish: the timing and the certified check of the candidates
-found (``docs/benchmarks.md``: up to 3 s on a 7-joint arm among shelves, where each
-certified check of a timing takes about a second).
+optimiser through its objective (:mod:`planning.pipeline.search`), the choice between
+the timings it verifies (:mod:`planning.pipeline.choose`: past the limit, none after one
+that failed), the planner between attempts (failing those, it follows the sampling
+planner's path as its last resort, then stops). So a plan ends after its limit by what its
+last stages take to finish: the stage under way when it passed, at most one timing and
+certified check of the best candidate, and the last resort's (on a 7-joint arm among
+shelves a certified check takes up to about a second).
 """
 
 from __future__ import annotations
