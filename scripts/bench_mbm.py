@@ -23,8 +23,9 @@ for the straight line, OMPL's median jerk over the limit. Rows go to ``DIR/mbm.c
 markdown to ``DIR/mbm.md``. Needs the ``bench`` extra; the problems are downloaded once
 (:mod:`planning.io.mbm`).
 
-Each planner runs in its own worker process; ``--workers N`` plans N problems at once (on a
-2-core machine both planners then share the cores, and both take longer: compare the ratios).
+Each planner runs in its own worker process; ``--workers N`` plans N problems at once, ours'
+parallel collision checks then on a share of the cores each (on a 2-core machine both
+planners share the cores, and both take longer: compare the ratios with a run of one worker).
 ``--scenes FILE ...`` runs scene files instead, of any robot (``generate_arm_scenes.py``'s, a
 user's own), the same way; rows are grouped by the file's folder (the "robot" column) and its
 name without a trailing ``_<number>`` (the "class").
@@ -37,6 +38,7 @@ import csv
 import dataclasses
 import itertools
 import multiprocessing
+import os
 import queue
 import statistics
 import sys
@@ -71,8 +73,11 @@ def _robot(scene_path: str) -> tuple[Any, ck.Robot]:
     return scene, _ROBOTS[key]
 
 
-def ours(scene_path: str, time_limit_s: float) -> dict[str, Any]:
-    """Our planner on one scene file, warm (in the worker): success, time, duration over Ruckig's bound."""
+def ours(scene_path: str, time_limit_s: float, threads: int | None = None) -> dict[str, Any]:
+    """Our planner on one scene file, warm (in the worker): success, time, duration over Ruckig's bound.
+
+    ``threads``: of its parallel collision checks (``None``: the planner's default, up to 2).
+    """
     from planning.peers.ruckig_bound import free_space_bound
     from planning.pipeline.planner import plan
 
@@ -80,7 +85,7 @@ def ours(scene_path: str, time_limit_s: float) -> dict[str, Any]:
     scene = dataclasses.replace(scene, planner=scene.planner.updated(time_limit_s=time_limit_s))
     started = time.perf_counter()
     try:
-        result = plan(scene, robot)
+        result = plan(scene, robot, threads=threads)
     except NoSolutionError as exc:
         return {"ok": False, "time_s": time.perf_counter() - started, "why": str(exc)[:100]}
     elapsed = time.perf_counter() - started
@@ -147,8 +152,8 @@ def median_ratio(mine: list[float], peer: list[float]) -> float:
 class Lane:
     """One problem at a time: ours in a worker process (killed at the timeout), OMPL's in another."""
 
-    def __init__(self, context: Any) -> None:
-        self.context = context
+    def __init__(self, context: Any, threads: int | None = None) -> None:
+        self.context, self.threads = context, threads
         self.ours, self.theirs = self._pool(), self._pool()
 
     def _pool(self) -> ProcessPoolExecutor:
@@ -158,7 +163,7 @@ class Lane:
         """Both planners on the scene file ``path``, warm: the row's ``ours_*`` and ``ompl_*`` values."""
         row: dict[str, Any] = {}
         self.ours.submit(warm, str(path)).result()  # loaded once per robot and process, untimed
-        future = self.ours.submit(ours, str(path), time_limit_s)
+        future = self.ours.submit(ours, str(path), time_limit_s, self.threads)
         try:
             row |= {f"ours_{k}": v for k, v in future.result(timeout=timeout_s).items()}
         except FutureTimeout:
@@ -227,8 +232,11 @@ def main() -> int:
     ]
     context = multiprocessing.get_context("spawn")
     lanes: queue.Queue[Lane] = queue.Queue()
+    # N lanes share the cores: ours' parallel checks get a share each (oversubscribed, they slow
+    # ours far more than OMPL's one-state checks, and the ratio with it: docs/benchmarks.md)
+    threads = None if args.workers == 1 else max(1, (os.cpu_count() or 1) // args.workers)
     for _ in range(args.workers):
-        lanes.put(Lane(context))
+        lanes.put(Lane(context, threads))
     finished = itertools.count(1)
 
     def solve(number: int) -> None:
@@ -242,8 +250,8 @@ def main() -> int:
         mark = "-" if row["invalid"] else summary(row)
         print(f"[{next(finished)}/{len(chosen)}] {row['robot']} {path.stem}: {mark}", flush=True)
 
-    with ThreadPoolExecutor(args.workers) as threads:
-        list(threads.map(solve, range(len(chosen))))
+    with ThreadPoolExecutor(args.workers) as pool:
+        list(pool.map(solve, range(len(chosen))))
     while not lanes.empty():
         lanes.get().close()
     keys = sorted({k for row in rows for k in row})
