@@ -26,10 +26,10 @@ Validity = Callable[[FloatArray], BoolArray]
 """``(N, d) -> (N,)``: whether each configuration is valid (clear of the margin)."""
 COARSE_STRIDE = 8
 """Configurations an edge's coarse pass steps over (:meth:`Edges.free_fractions`)."""
-WHOLE_BELOW = 128
+WHOLE_BELOW = 48
 """Edges of fewer configurations are checked whole in the first pass: a second call of the
-validity check would cost more than it saves (a 5-joint arm's edges have 16-100; a 7-joint
-arm's, whose joints move points farther, hundreds)."""
+validity check would cost more than it saves (a 5-joint arm's edges have 16-100; a 6- or
+7-joint arm's, whose joints move points farther, 60 and more; ``docs/tuning.md``)."""
 
 
 class Edges:
