@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 
@@ -10,7 +11,8 @@ import pytest
 from numpy.typing import NDArray
 
 from planning.errors import PlanningError
-from planning.search.rrt_connect import Relaxation, RrtSettings, rrt_connect
+from planning.search.rrt_connect import Relaxation, rrt_connect
+from planning.search.rrt_settings import RrtSettings
 from planning.search.waypoints import waypoints_along
 
 WEIGHTS = np.ones(2)
@@ -204,8 +206,38 @@ def test_settings_and_weights_are_validated() -> None:
         RrtSettings(step_m=0.0)
     with pytest.raises(PlanningError, match="resolution_m"):
         RrtSettings(step_m=0.1, resolution_m=0.2)
+    with pytest.raises(PlanningError, match="local_share"):
+        RrtSettings(local_share=1.5)
+    with pytest.raises(PlanningError, match="local_spread"):
+        RrtSettings(local_spread=0.0)
     with pytest.raises(PlanningError, match="weights"):
         rrt_connect(wall_with_slot, LOWER, UPPER, LOWER, UPPER, -WEIGHTS, np.random.default_rng(0))
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_local_samples_are_drawn_about_the_trees_nodes(seed: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every sample local, of a small spread: the first extension ends a few spreads from the start.
+
+    Uniform samples put it a whole step away (a fifth of the box's diagonal, 0.28 here).
+    """
+    import planning.search.edges
+
+    monkeypatch.setattr(planning.search.edges, "WHOLE_BELOW", 10**9)  # one batch per call: all, in order
+    batches: list[NDArray[np.float64]] = []
+
+    def recorded(q: NDArray[np.float64]) -> NDArray[np.bool_]:
+        batches.append(q.copy())
+        return wall_with_slot(q)
+
+    start, goal = np.array([0.1, 0.9]), np.array([0.9, 0.1])
+    settings = RrtSettings(resolution_m=0.01, local_share=1.0, local_spread=0.01)
+    rrt_connect(recorded, start, goal, LOWER, UPPER, WEIGHTS, np.random.default_rng(seed), settings)
+    # batch 0 checks the ends, 1 the straight line, 2 the first extension from the start
+    assert np.abs(batches[2][-1] - start).max() < 5 * 0.01
+    uniform = dataclasses.replace(settings, local_share=0.0)
+    batches.clear()
+    rrt_connect(recorded, start, goal, LOWER, UPPER, WEIGHTS, np.random.default_rng(seed), uniform)
+    assert np.abs(batches[2][-1] - start).max() > 5 * 0.01
 
 
 def test_waypoints_keep_the_corners_and_split_the_longest_pieces() -> None:

@@ -95,21 +95,26 @@ def drawn_paths(problem: Problem) -> list[tuple[np.ndarray, float]]:
     return drawn
 
 
+def uniform_samples(problem: Problem, **seeding: Any) -> Problem:
+    """``problem`` whose RRT-Connect draws uniform samples only (those the scenes below were chosen by)."""
+    return with_planner(problem, tuning=SearchTuning(seeding=SeedingTuning(local_share=0.0, **seeding)))
+
+
 def test_a_path_whose_spline_violates_the_clearance_is_drawn_again(robot: ck.Robot) -> None:
     """A beam: the spline through the first path's waypoints cuts into the margin, the second's not."""
-    problem = build_problem(narrow_scene(np.random.default_rng(6), robot, "beam"), robot)
+    problem = uniform_samples(build_problem(narrow_scene(np.random.default_rng(6), robot, "beam"), robot))
     drawn = drawn_paths(problem)
     (first, first_fitness), (second, second_fitness) = drawn[:2]
     assert first_fitness > problem.objective.t_max >= second_fitness
     seeds = seed_search(problem)
     np.testing.assert_array_equal(seeds.path, second)
     assert seeds.problem is problem  # a feasible seed with the scene's waypoints: no more needed
-    one_attempt = SearchTuning(seeding=SeedingTuning(path_attempts=1))  # keeps the first path
-    np.testing.assert_array_equal(seed_search(with_planner(problem, tuning=one_attempt)).path, first)
+    one_attempt = uniform_samples(problem, path_attempts=1)  # keeps the first path
+    np.testing.assert_array_equal(seed_search(one_attempt).path, first)
 
 
 def test_when_no_path_seed_is_feasible_the_best_ranked_is_kept(robot: ck.Robot) -> None:
-    problem = build_problem(narrow_scene(np.random.default_rng(3), robot, "pillars"), robot)
+    problem = uniform_samples(build_problem(narrow_scene(np.random.default_rng(3), robot, "pillars"), robot))
     drawn = drawn_paths(problem)
     fitness = [value for _, value in drawn]
     assert min(fitness) > problem.objective.t_max and int(np.argmin(fitness)) > 0
@@ -165,15 +170,21 @@ def test_after_finer_after_samples_the_trees_keep_the_finer_clearance(robot: ck.
 
 
 def test_a_passage_rrt_connect_needs_thousands_of_samples_for_is_planned(robot: ck.Robot) -> None:
-    """Generated scene 70 of seed 12 (24 narrow): RRT-Connect needs just over 3000 samples for
-    it, the former budget, after which the search had only the blocked straight line."""
+    """Generated scene 70 of seed 12 (24 narrow): RRT-Connect on uniform samples needs just over
+    3000 for it, the former budget, after which the search had only the blocked straight line;
+    with a fifth of its samples drawn about its trees' nodes (the default) it needs fewer."""
     from planning.io.scene_generator import generate_scenes
     from planning.pipeline.planner import plan
 
     scene = {s.name: s for s in generate_scenes(100, seed=12, robot=robot, narrow=24)}["scene_070"]
-    small = SearchTuning(seeding=SeedingTuning(max_samples=3000))
-    assert seed_search(build_problem(scene, robot)).path is not None
-    assert seed_search(with_planner(build_problem(scene, robot), tuning=small)).path is None
+    problem = build_problem(scene, robot)
+    assert seed_search(problem).path is not None
+    assert seed_search(uniform_samples(problem, max_samples=3000)).path is None
+    assert seed_search(uniform_samples(problem)).path is not None
+    assert (
+        seed_search(with_planner(problem, tuning=SearchTuning(seeding=SeedingTuning(max_samples=3000)))).path
+        is not None
+    )
     result = plan(scene, robot)
     assert result.verification.accepted and result.metrics.min_clearance_m >= scene.safety_margin
 
@@ -254,3 +265,29 @@ def test_where_rrt_connect_found_no_path_the_next_attempts_do_not_ask_again(
     assert seed_search(one_sample).no_path and len(drawn) == 2
     few = with_planner(window, tuning=SearchTuning(seeding=SeedingTuning(max_samples=2, finer_after=1)))
     assert "keeps 0.055 m clear (nor 0.051 m after 1) in 2 samples" in PathSeeding().first(few).tried
+
+
+@pytest.mark.slow
+def test_samples_near_the_trees_lead_a_goal_out_of_its_shelf(tmp_path: Any) -> None:
+    """MotionBenchMaker's Panda bookshelf_thin_0089 (vamp-planner's problems, from PyPI, cached).
+
+    Its goal reaches between cans on a thin shelf (a third of the configurations 0.1 rad about
+    it collide): the goal's tree extended towards uniform samples almost never grows out, and
+    RRT-Connect finds no path keeping the clearance in 3,000 samples. Drawing a fifth of the
+    samples about the trees' own nodes (the default) finds one within them, for every seed.
+    """
+    from planning.io.mbm import import_problem, problems
+    from planning.io.scene_file import load_scene
+    from planning.pipeline.seeding import finer_problem
+    from planning.search.rrt_settings import RrtSettings
+
+    problem = next(p for p in problems("panda", ("bookshelf_thin",)) if p.index == 89)
+    built = build_problem(load_scene(import_problem(problem, tmp_path / "thin_0089.yaml")))
+    finer = finer_problem(built)
+    tuning = SeedingTuning()
+    settings = RrtSettings(max_samples=3000, resolution_m=0.01, explore_resolution_m=tuning.max_resolution_m)
+    for seed in range(3):
+        local = sampled_path(built, np.random.default_rng(seed), settings, finer)
+        assert local is not None and not local.relaxed  # the margin kept, without the finer step's
+        uniform = dataclasses.replace(settings, local_share=0.0)
+        assert sampled_path(built, np.random.default_rng(seed), uniform, finer) is None

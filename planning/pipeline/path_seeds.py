@@ -17,7 +17,8 @@ from numpy.typing import NDArray
 import cpr_kin as ck
 from planning.pipeline.problem import Problem, with_planner
 from planning.pipeline.settings import MAX_WAYPOINTS
-from planning.search.rrt_connect import Relaxation, RrtPath, RrtSettings, rrt_connect
+from planning.search.rrt_connect import Relaxation, RrtPath, rrt_connect
+from planning.search.rrt_settings import RrtSettings
 from planning.search.waypoints import waypoints_along
 
 FloatArray = NDArray[np.float64]
@@ -67,6 +68,8 @@ def sampled_path(
             max_samples=tuning.max_samples,
             resolution_m=resolution,
             explore_resolution_m=tuning.max_resolution_m,
+            local_share=tuning.local_share,
+            local_spread=tuning.local_spread,
         )
     limits = robot.limits
     relaxation = None if finer is None else Relaxation(keeping(finer), tuning.finer_after)

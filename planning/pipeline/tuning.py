@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 from planning.errors import PlanningError
 from planning.search.refinement_settings import RefinementSettings
+from planning.search.rrt_settings import LOCAL_SHARE, LOCAL_SPREAD
 from planning.validation import boolean, integer_in, number_in
 
 
@@ -46,6 +47,11 @@ class SeedingTuning:
             step clear, the share of the step tried once more, in (0, 1): a finer certified
             check lets a path pass closer to the margin (a passage narrower than the margin
             plus the step). The verification step never goes below the smallest allowed.
+        local_share: share of RRT-Connect's samples drawn near a node of the tree they
+            extend, in [0, 1] (:mod:`planning.search.rrt_connect`): a tree trapped in a
+            pocket about a goal in a shelf grows out of it; 0: uniform samples only.
+        local_spread: standard deviation of those samples about their node [share of each
+            joint's range], in (0, 1].
     """
 
     share: float = 0.6
@@ -57,6 +63,8 @@ class SeedingTuning:
     finer_after: int = 3_000
     more_waypoints: int = 6
     finer_step: float = 0.2
+    local_share: float = LOCAL_SHARE
+    local_spread: float = LOCAL_SPREAD
 
     def __post_init__(self) -> None:
         number_in("share", self.share, 0.0, 1.0, low_open=True)
@@ -68,6 +76,8 @@ class SeedingTuning:
         integer_in("finer_after", self.finer_after, 1, 100_000)
         integer_in("more_waypoints", self.more_waypoints, 0, 20)
         number_in("finer_step", self.finer_step, 0.0, 1.0, low_open=True)
+        number_in("local_share", self.local_share, 0.0, 1.0)
+        number_in("local_spread", self.local_spread, 0.0, 1.0, low_open=True)
 
 
 @dataclass(frozen=True)

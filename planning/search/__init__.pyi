@@ -5,7 +5,8 @@ from .firefly import FireflyProgress, firefly_minimize
 from .firefly_settings import FireflySettings
 from .optimizer import BatchObjective, Optimizer, SearchResult
 from .refinement import cma_refine, refine_search
-from .rrt_connect import Relaxation, RrtPath, RrtSettings
+from .rrt_connect import Relaxation, RrtPath
+from .rrt_settings import RrtSettings
 from .waypoints import waypoints_along
 
 __all__ = [

@@ -26,6 +26,13 @@ passes between two coarse checks through an obstacle is replaced by RRT-Connect'
 between its ends at that spacing, and when none is found the whole search runs again at it.
 The path returned always holds at ``resolution_m``.
 
+A share of the samples (``local_share``) is drawn about a random node of the tree they
+extend (a normal spread of ``local_spread`` of each joint's range), the others uniformly in
+the box. A tree rooted in a pocket (a goal between cans on a shelf) extended only towards
+uniform samples hits the pocket's walls nearly every time, for thousands of samples, while
+the other tree fills the free space; samples about its own nodes let it grow through the
+pocket to its way out (``docs/tuning.md``).
+
 A :class:`Relaxation` lets the trees go on under a looser validity after some samples (a
 smaller clearance, where a passage is narrower than the one asked): what they grew holds
 under it too, so no sample is drawn again; where start or goal fails the strict validity,
@@ -45,47 +52,9 @@ from numpy.typing import NDArray
 
 from planning.errors import PlanningError
 from planning.search.edges import Edges, Validity, shortcut
-from planning.validation import integer_in, number_in
+from planning.search.rrt_settings import RANGE_FRACTION, RrtSettings
 
 FloatArray = NDArray[np.float64]
-
-RANGE_FRACTION = 0.2
-"""Default extension step as a fraction of the sampling box's diagonal (OMPL's default range)."""
-
-
-@dataclass(frozen=True)
-class RrtSettings:
-    """Parameters of :func:`rrt_connect`; validated on construction.
-
-    Attributes:
-        max_samples: random samples before giving up, in [1, 100000].
-        step_m: longest extension towards a sample, as a robot motion bound [m], in (0, 10];
-            ``None``: :data:`RANGE_FRACTION` of the sampling box's diagonal (in the same
-            motion bound), at least ``resolution_m``.
-        resolution_m: spacing of the checked configurations along the returned path's
-            edges [m], in (0, step_m] (or (0, 10] with the default step).
-        explore_resolution_m: their spacing while the trees grow and the path is shortened
-            [m], at least ``resolution_m`` (``None``: the same); the path found is then
-            checked at ``resolution_m`` and its blocked edges planned again at that spacing
-            (module docstring).
-        shortcuts: random shortcut attempts on the found path, in [0, 10000].
-    """
-
-    max_samples: int = 3000
-    step_m: float | None = None
-    resolution_m: float = 0.02
-    explore_resolution_m: float | None = None
-    shortcuts: int = 20
-
-    def __post_init__(self) -> None:
-        integer_in("max_samples", self.max_samples, 1, 100_000)
-        if self.step_m is not None:
-            number_in("step_m", self.step_m, 0.0, 10.0, low_open=True, unit="m")
-        high = 10.0 if self.step_m is None else self.step_m
-        number_in("resolution_m", self.resolution_m, 0.0, high, low_open=True, unit="m")
-        if self.explore_resolution_m is not None:
-            number_in("explore_resolution_m", self.explore_resolution_m, self.resolution_m, high, unit="m")
-        integer_in("shortcuts", self.shortcuts, 0, 10_000)
 
 
 @dataclass(frozen=True)
@@ -181,6 +150,7 @@ def rrt_connect(
     settings = settings or RrtSettings()
     start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
     weights = np.asarray(weights, dtype=float)
+    lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
     if not (weights.shape == start.shape == goal.shape and np.all(weights > 0)):
         raise PlanningError(f"weights {weights.tolist()} must be positive, one per joint of start and goal")
     relaxed = False
@@ -207,7 +177,7 @@ def rrt_connect(
             strict_checks, edges = edges.checks, Edges(relaxation.valid, weights, settings.resolution_m)
             relaxation, relaxed = None, True
         grow, other = trees[(sample - 1) % 2], trees[sample % 2]
-        target = rng.uniform(lower, upper)
+        target = _sample(grow, lower, upper, rng, settings)
         near = grow.nearest(target, weights)
         origin = grow.nodes[near]
         length = float(np.abs(target - origin) @ weights)
@@ -229,6 +199,18 @@ def rrt_connect(
             path = shortcut(path, edges, rng, settings.shortcuts)
             return RrtPath(path, sample, strict_checks + edges.checks, relaxed)
     return None
+
+
+def _sample(
+    tree: _Tree, lower: FloatArray, upper: FloatArray, rng: np.random.Generator, settings: RrtSettings
+) -> FloatArray:
+    """A sample for ``tree``: with ``local_share``, near one of its nodes; else uniform in the box."""
+    if settings.local_share and rng.uniform() < settings.local_share:
+        node: FloatArray = tree.nodes[rng.integers(tree.size)]
+        spread = settings.local_spread * (upper - lower)
+        drawn: FloatArray = np.clip(node + spread * rng.standard_normal(node.size), lower, upper)
+        return drawn
+    return rng.uniform(lower, upper)
 
 
 def _lazy(
