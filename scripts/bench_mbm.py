@@ -19,9 +19,10 @@ goal are valid in our model, solved by each, median and p95 warm planning time o
 the problems it solved and the ratio of those medians, then the ratio of the medians over the
 problems both solved (the same problems) and over every valid problem (a failure counted at
 the time it took, up to the timeout), ours' median duration over Ruckig's jerk-limited bound
-for the straight line, OMPL's median jerk over the limit. Rows go to ``DIR/mbm.csv``, the table as
-markdown to ``DIR/mbm.md``. Needs the ``bench`` extra; the problems are downloaded once
-(:mod:`planning.io.mbm`).
+for the straight line, OMPL's median jerk over the limit, and how many of ours pass
+``cpr-plan check`` (the trajectory file read back and verified anew, untimed). Rows go to
+``DIR/mbm.csv``, the table as markdown to ``DIR/mbm.md``. Needs the ``bench`` extra; the
+problems are downloaded once (:mod:`planning.io.mbm`).
 
 Each planner runs in its own worker process; ``--workers N`` plans N problems at once, ours'
 parallel collision checks then on a share of the cores each (on a 2-core machine both
@@ -42,6 +43,7 @@ import os
 import queue
 import statistics
 import sys
+import tempfile
 import time
 from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
@@ -55,6 +57,7 @@ import cpr_kin as ck
 from planning.errors import NoSolutionError
 from planning.io.mbm import CLASSES, endpoint_violations, import_problem, problems
 from planning.io.scene_file import load_scene
+from planning.io.trajectory_io import trajectory_json
 
 TIME_LIMIT_SHARE = 0.8
 """Our planner's default ``time_limit_s`` as a share of ``--timeout``: room to time and verify."""
@@ -95,7 +98,30 @@ def ours(scene_path: str, time_limit_s: float, threads: int | None = None) -> di
         "time_s": elapsed,
         "duration_s": result.trajectory.duration,
         "over_bound": result.trajectory.duration / bound,
+        "file": trajectory_json(result),
     }
+
+
+def passes_check(scene_path: str, trajectory_text: str) -> bool:
+    """``cpr-plan check``'s verdict on a trajectory file (in the worker, untimed).
+
+    The file read back and verified against the scene file on a problem built anew, as the
+    command does: certified clearance to every obstacle and between the robot's own pairs,
+    joint ranges, velocity, acceleration and jerk limits, and the ends.
+    """
+    from planning.io.trajectory_reader import read_trajectory
+    from planning.pipeline.problem import build_problem
+    from planning.pipeline.verification import Requirements, verify_trajectory
+
+    scene, robot = _robot(scene_path)
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "trajectory.json"
+        path.write_text(trajectory_text)
+        document = read_trajectory(path)
+    problem = build_problem(scene, robot)
+    required = Requirements.of(problem, endpoints=True)
+    verification = verify_trajectory(problem.world, document.trajectory, required)
+    return document.joint_names == robot.joint_names and not verification.problems
 
 
 def warm(scene_path: str) -> None:
@@ -165,7 +191,11 @@ class Lane:
         self.ours.submit(warm, str(path)).result()  # loaded once per robot and process, untimed
         future = self.ours.submit(ours, str(path), time_limit_s, self.threads)
         try:
-            row |= {f"ours_{k}": v for k, v in future.result(timeout=timeout_s).items()}
+            found = future.result(timeout=timeout_s)
+            text = found.pop("file", None)
+            row |= {f"ours_{k}": v for k, v in found.items()}
+            if text is not None:
+                row["ours_checked"] = self.ours.submit(passes_check, str(path), text).result()
         except FutureTimeout:
             row |= {"ours_ok": False, "ours_time_s": timeout_s, "ours_why": "timeout"}
             self._kill(self.ours)
@@ -260,15 +290,17 @@ def main() -> int:
         writer.writeheader()
         writer.writerows(rows)
     print(f"\n{'robot':6s} {'class':17s} {'valid':>5s} {'ours':>4s} {'ompl':>4s}", end="")
-    print(f"  {'ours med/p95 s':>15s}  {'ompl med/p95 s':>15s}  ratio  both   all  dur/bound  ompl jerk/lim")
+    print(f"  {'ours med/p95 s':>15s}  {'ompl med/p95 s':>15s}  ratio  both   all  dur/bound", end="")
+    print("  ompl jerk/lim  checked")
     report = [
         f"{'Scene files' if args.scenes else f'MotionBenchMaker, {args.limit or 100} problem(s) per class'}, "
         f"timeout {args.timeout:g} s (ours: time_limit_s {time_limit_s:g} s), "
         "warm (`scripts/bench_mbm.py`)",
         "",
         "| robot | class | valid | solved ours | solved OMPL | ours median (p95) [s] | OMPL median (p95) [s] "
-        "| ratio | ratio, both solved | ratio, all | ours duration / Ruckig bound | OMPL jerk / limit |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "| ratio | ratio, both solved | ratio, all | ours duration / Ruckig bound | OMPL jerk / limit "
+        "| ours passing `check` |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for robot_name in dict.fromkeys(r["robot"] for r in rows):
         for problem_class in [*dict.fromkeys(r["class"] for r in rows if r["robot"] == robot_name), "all"]:
@@ -284,19 +316,20 @@ def main() -> int:
             both = [r for r in group if r.get("ours_ok") and r.get("ompl_ok")]
             ratio_both = median_ratio([r["ours_time_s"] for r in both], [r["ompl_time_s"] for r in both])
             ratio_all = median_ratio([r["ours_time_s"] for r in group], [r["ompl_time_s"] for r in group])
+            checked = sum(1 for r in group if r.get("ours_checked"))
             print(
                 f"{robot_name:6s} {problem_class:17s} {len(group):5d} {len(mine):4d} {len(peer):4d}  "
                 f"{percentile(mine, 50):6.2f} / {percentile(mine, 95):6.2f}  "
                 f"{percentile(peer, 50):6.2f} / {percentile(peer, 95):6.2f}"
                 f"  {ratio:5.2f} {ratio_both:5.2f} {ratio_all:5.2f}"
-                f"  {percentile(bounds, 50):9.3f}  {percentile(jerks, 50):13.1f}"
+                f"  {percentile(bounds, 50):9.3f}  {percentile(jerks, 50):13.1f}  {checked:7d}"
             )
             report.append(
                 f"| {robot_name} | {problem_class} | {len(group)} | {len(mine)} | {len(peer)} "
                 f"| {percentile(mine, 50):.2f} ({percentile(mine, 95):.2f}) "
                 f"| {percentile(peer, 50):.2f} ({percentile(peer, 95):.2f}) | {ratio:.2f} "
                 f"| {ratio_both:.2f} ({len(both)}) | {ratio_all:.2f} "
-                f"| {percentile(bounds, 50):.3f} | {percentile(jerks, 50):.1f} |"
+                f"| {percentile(bounds, 50):.3f} | {percentile(jerks, 50):.1f} | {checked} |"
             )
     (args.out / "mbm.md").write_text("\n".join(report) + "\n")
     print(f"\nrows: {args.out / 'mbm.csv'}; table: {args.out / 'mbm.md'}")
