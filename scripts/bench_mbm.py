@@ -111,16 +111,14 @@ def passes_check(scene_path: str, trajectory_text: str) -> bool:
     """
     from planning.io.trajectory_reader import read_trajectory
     from planning.pipeline.problem import build_problem
-    from planning.pipeline.verification import Requirements, verify_trajectory
+    from planning.pipeline.verification import verify_for_scene
 
     scene, robot = _robot(scene_path)
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "trajectory.json"
         path.write_text(trajectory_text)
         document = read_trajectory(path)
-    problem = build_problem(scene, robot)
-    required = Requirements.of(problem, endpoints=True)
-    verification = verify_trajectory(problem.world, document.trajectory, required)
+    verification = verify_for_scene(build_problem(scene, robot), document.trajectory)
     return document.joint_names == robot.joint_names and not verification.problems
 
 

@@ -17,6 +17,7 @@ from planning.pipeline.seeding import PathSeeding, seed_search
 from planning.pipeline.settings import PlannerSettings
 from planning.pipeline.target import Target
 from planning.pipeline.tuning import SearchTuning, SeedingTuning
+from planning.pipeline.verification import Requirements, verify_for_scene, verify_trajectory
 from planning.search.waypoints import waypoints_along
 
 
@@ -207,6 +208,10 @@ def test_a_goal_within_margin_plus_step_plans_with_the_finer_step_at_once(robot:
     result = plan(near, robot)
     assert result.verification.accepted and result.verification.certified_min_m >= 0.0
     assert result.problem.scene.planner.verify_step_m == scene.planner.finer_verify_step_m
+    # cpr-plan check: the scene's 5 mm step cannot certify the last 2 mm; the finer step does
+    at_scene_step = verify_trajectory(problem.world, result.trajectory, Requirements.of(problem, True))
+    assert not at_scene_step.check.accepted
+    assert verify_for_scene(problem, result.trajectory).problems == ()
 
 
 def test_a_goal_closer_than_the_finer_step_plans_with_half_its_clearance(robot: ck.Robot) -> None:

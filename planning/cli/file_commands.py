@@ -23,7 +23,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     """Re-verify a trajectory file against a scene; exit 3 when it fails."""
     from planning.io.trajectory_reader import read_trajectory
     from planning.pipeline.problem import build_problem
-    from planning.pipeline.verification import Requirements, verify_trajectory
+    from planning.pipeline.verification import verify_for_scene
 
     scene = load(args.scene)
     document = read_trajectory(args.trajectory)
@@ -33,8 +33,7 @@ def cmd_check(args: argparse.Namespace) -> int:
         raise PlanningError(
             f"trajectory joints {list(document.joint_names)} are not the robot's {list(robot.joint_names)}"
         )
-    required = Requirements.of(problem, endpoints=True)
-    verification = verify_trajectory(problem.world, document.trajectory, required)
+    verification = verify_for_scene(problem, document.trajectory)
     check, problems = verification.check, verification.problems
     if args.json:
         print(json.dumps(verification.to_record(), indent=1))

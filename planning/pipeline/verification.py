@@ -5,6 +5,7 @@ What the planner accepts is what ``cpr-plan check`` re-checks: one function serv
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -236,3 +237,24 @@ def verify_trajectory(
         torques = torque_profile(required.dynamics, trajectory)
         problems += torque_problems(required.dynamics, torques)
     return Verification(check=check, problems=tuple(problems), torques=torques)
+
+
+def verify_for_scene(problem: Problem, trajectory: Trajectory) -> Verification:
+    """What ``cpr-plan check`` says of ``trajectory`` against ``problem``'s scene, its ends included.
+
+    :func:`verify_trajectory` at the scene's certified step; where that step cannot certify
+    the clearance, once more at the finer step the planner falls back to where margin plus
+    step leaves no way (:func:`~planning.pipeline.problem.finer_step_m`), as a plan through a
+    narrow passage or to a grasp is certified. A finer step only tightens the certified
+    bound (more checks, less slack between them); the margins required are the scene's.
+    """
+    from planning.pipeline.problem import finer_step_m
+
+    required = Requirements.of(problem, endpoints=True)
+    verification = verify_trajectory(problem.world, trajectory, required)
+    if verification.check.accepted:
+        return verification
+    finer_m = finer_step_m(problem)
+    if finer_m >= required.step_m:
+        return verification
+    return verify_trajectory(problem.world, trajectory, dataclasses.replace(required, step_m=finer_m))
