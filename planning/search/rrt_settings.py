@@ -19,7 +19,7 @@ LOCAL_SPREAD = 0.05
 
 @dataclass(frozen=True)
 class RrtSettings:
-    """Parameters of :func:`rrt_connect`; validated on construction.
+    """Parameters of :func:`~planning.search.rrt_connect.rrt_connect`; validated on construction.
 
     Attributes:
         max_samples: random samples before giving up, in [1, 100000].
