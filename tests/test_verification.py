@@ -1,6 +1,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -87,3 +88,29 @@ def test_knot_jumps_agree_with_evaluation_and_vanish_for_the_planned_spline(resu
     t = trajectory.knots[1]
     left, right = trajectory(t - 1e-12, 1), Trajectory(trajectory.knots, coefficients)(t, 1)
     assert jump[0, 2, 1] == pytest.approx(abs(left[2] - right[2]), abs=1e-9) == pytest.approx(0.25)
+
+
+@pytest.mark.slow
+def test_check_certifies_what_the_planner_certified_at_its_finer_self_step(tmp_path: Path) -> None:
+    """MotionBenchMaker's UR5 table_under_pick_0062 (vamp-planner's problems, from PyPI, cached).
+
+    Its grasp holds the wrist within a millimetre of the forearm: the planner certifies the
+    self-clearance at the finer step (:func:`~planning.pipeline.problem.finer_step_m`), and
+    ``cpr-plan check``, reading the file back onto a problem built anew, must too, not only
+    the obstacle clearance.
+    """
+    from planning.io.mbm import import_problem, problems
+    from planning.io.scene_file import load_scene
+    from planning.io.trajectory_io import write_trajectory
+    from planning.io.trajectory_reader import read_trajectory
+    from planning.pipeline.problem import build_problem
+    from planning.pipeline.verification import verify_for_scene
+
+    problem = next(p for p in problems("ur5", ("table_under_pick",)) if p.index == 62)
+    scene = load_scene(import_problem(problem, tmp_path / "table_under_pick_0062.yaml"))
+    result = plan(scene)
+    assert result.verification.accepted
+    path = tmp_path / "trajectory.json"
+    write_trajectory(result, path)
+    fresh = build_problem(scene)
+    assert verify_for_scene(fresh, read_trajectory(path).trajectory).problems == ()

@@ -242,19 +242,19 @@ def verify_trajectory(
 def verify_for_scene(problem: Problem, trajectory: Trajectory) -> Verification:
     """What ``cpr-plan check`` says of ``trajectory`` against ``problem``'s scene, its ends included.
 
-    :func:`verify_trajectory` at the scene's certified step; where that step cannot certify
-    the clearance, once more at the finer step the planner falls back to where margin plus
-    step leaves no way (:func:`~planning.pipeline.problem.finer_step_m`), as a plan through a
-    narrow passage or to a grasp is certified. A finer step only tightens the certified
-    bound (more checks, less slack between them); the margins required are the scene's.
+    :func:`verify_trajectory` at the scene's certified steps; where they cannot certify it,
+    once more with the obstacle and the self check both at the finer step the planner falls
+    back to where margin plus step leaves no way (:func:`~planning.pipeline.problem.finer_step_m`),
+    as a plan through a narrow passage or to a grasp is certified. A finer step only tightens
+    the certified bound (more checks, less slack between them); the margins are the scene's.
     """
     from planning.pipeline.problem import finer_step_m
 
     required = Requirements.of(problem, endpoints=True)
     verification = verify_trajectory(problem.world, trajectory, required)
-    if verification.check.accepted:
-        return verification
     finer_m = finer_step_m(problem)
-    if finer_m >= required.step_m:
+    if verification.accepted or finer_m >= required.step_m:
         return verification
-    return verify_trajectory(problem.world, trajectory, dataclasses.replace(required, step_m=finer_m))
+    self_step_m = required.step_m if required.self_step_m is None else required.self_step_m
+    finer = dataclasses.replace(required, step_m=finer_m, self_step_m=min(self_step_m, finer_m))
+    return verify_trajectory(problem.world, trajectory, finer)
