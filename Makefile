@@ -89,7 +89,7 @@ bench-mbm: $(STAMP)
 	$(PY) scripts/bench_mbm.py --out out/bench_mbm $(MBM_ARGS)
 
 bench-torque: $(STAMP)
-	$(PY) scripts/bench_torque.py --out out/bench_torque
+	$(PY) scripts/bench_torque.py --scenes 20 --limit 3 --out out/bench_torque
 
 clean:
 	rm -rf $(VENV) .venv-latest build *.egg-info .pytest_cache .mypy_cache .ruff_cache
