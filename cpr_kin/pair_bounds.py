@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 
 from cpr_kin.batch_kinematics import KinematicChain
 from cpr_kin.bound_kernels import BOX, CAPSULE, CYLINDER, SPHERE, groups_below, pair_bounds
+from cpr_kin.capsule_fit import Capsule, fitted_capsule
 from cpr_kin.obstacles import Obstacle
 
 FloatArray = NDArray[np.float64]
@@ -40,8 +41,11 @@ def bounding_capsule(geometry: Any) -> tuple[FloatArray, float]:
     """A capsule containing a coal geometry: segment end points ``(2, 3)`` [m] and radius [m].
 
     In the geometry's own frame. Spheres, capsules and cylinders keep their axis and radius
-    (the capsule's caps cover a cylinder's rims); any other shape gets its bounding box's
-    longest axis, with the box's half diagonal across that axis as radius.
+    (the capsule's caps cover a cylinder's rims). A mesh (a convex one or a triangle soup)
+    gets the capsule fitted to its vertices (:func:`cpr_kin.capsule_fit.fitted_capsule`)
+    or its bounding box's, whichever is smaller; any other shape its bounding box's: the
+    box's longest axis, with the box's half diagonal across that axis as radius. A swept
+    sphere radius grows the capsule by as much.
     """
     if isinstance(geometry, coal.Sphere):
         return np.zeros((2, 3)), float(geometry.radius)
@@ -53,7 +57,26 @@ def bounding_capsule(geometry: Any) -> tuple[FloatArray, float]:
     ends = np.array([centre, centre])
     ends[0, axis] -= half[axis]
     ends[1, axis] += half[axis]
-    return ends, float(np.linalg.norm(np.delete(half, axis)))
+    boxed = Capsule(ends, float(np.linalg.norm(np.delete(half, axis))))
+    vertices = _vertices(geometry)
+    if vertices is None:
+        return boxed.ends, boxed.radius
+    fitted = fitted_capsule(vertices)
+    swept = float(geometry.getSweptSphereRadius()) if hasattr(geometry, "getSweptSphereRadius") else 0.0
+    fitted = Capsule(fitted.ends, fitted.radius + swept)
+    best = min((boxed, fitted), key=lambda capsule: capsule.volume)
+    return best.ends, best.radius
+
+
+def _vertices(geometry: Any) -> FloatArray | None:
+    """``(N, 3)`` a mesh's vertices in its own frame [m]; ``None`` for another shape or an empty mesh."""
+    if isinstance(geometry, coal.Convex):
+        points = np.asarray(geometry.points(), dtype=float)
+    elif isinstance(geometry, coal.BVHModelBase):
+        points = np.asarray(geometry.vertices(), dtype=float)
+    else:
+        return None
+    return points.reshape(-1, 3) if points.size else None
 
 
 class JointCapsules(NamedTuple):
