@@ -213,7 +213,9 @@ def _obstacle_bound(obstacle: Obstacle) -> tuple[int, FloatArray, FloatArray, fl
     """Kind, rotation, centre [m], radius [m], half sides (z: half length) [m] and reach [m] of a bound.
 
     A box's radius is its half diagonal (the radius of its bounding sphere); the reach is
-    the radius of the obstacle's bounding sphere about the centre.
+    the radius of the obstacle's bounding sphere about the centre. A mesh is bounded by its
+    bounding box or by the capsule fitted to its vertices
+    (:func:`cpr_kin.capsule_fit.fitted_capsule`), whichever is smaller.
     """
     placement = obstacle.placement
     rotation = np.asarray(placement.rotation, dtype=float)
@@ -227,6 +229,28 @@ def _obstacle_bound(obstacle: Obstacle) -> tuple[int, FloatArray, FloatArray, fl
         if obstacle.shape == "cylinder":
             return CYLINDER, rotation, origin, radius, half, float(np.hypot(radius, half_length))
         return CAPSULE, rotation, origin, radius, half, radius + half_length
-    centre, half = _local_box(obstacle.geometry())  # a box, or a mesh's bounding box
+    geometry = obstacle.geometry()
+    centre, half = _local_box(geometry)  # a box, or a mesh's bounding box
     diagonal = float(np.linalg.norm(half))
+    vertices = _vertices(geometry)
+    if vertices is not None:  # a mesh: the capsule fitted to it where that is smaller than its box
+        fitted = fitted_capsule(vertices)
+        if fitted.volume < 8.0 * float(np.prod(half)):
+            return _capsule_bound(fitted, rotation, origin)
     return BOX, rotation, origin + rotation @ centre, diagonal, half, diagonal
+
+
+def _capsule_bound(
+    capsule: Capsule, rotation: FloatArray, origin: FloatArray
+) -> tuple[int, FloatArray, FloatArray, float, FloatArray, float]:
+    """:func:`_obstacle_bound`'s values of a capsule given in the obstacle's frame (its axis as z)."""
+    middle = capsule.ends.mean(axis=0)
+    along = capsule.ends[1] - capsule.ends[0]
+    half_length = float(np.linalg.norm(along)) / 2
+    z = along / (2 * half_length) if half_length > 0.0 else np.array([0.0, 0.0, 1.0])
+    x = np.cross(np.eye(3)[int(np.argmin(np.abs(z)))], z)
+    x /= np.linalg.norm(x)
+    axes = np.column_stack([x, np.cross(z, x), z])  # the capsule's frame in the obstacle's
+    half = np.array([0.0, 0.0, half_length])
+    reach = capsule.radius + half_length
+    return CAPSULE, rotation @ axes, origin + rotation @ middle, capsule.radius, half, reach

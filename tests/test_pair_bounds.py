@@ -9,7 +9,8 @@ import pytest
 import trimesh
 
 import cpr_kin as ck
-from cpr_kin.pair_bounds import PairBounds, bounding_capsule
+from cpr_kin.bound_kernels import CAPSULE
+from cpr_kin.pair_bounds import PairBounds, _obstacle_bound, bounding_capsule
 
 from .conftest import random_configurations
 from .test_collision import random_obstacle
@@ -105,6 +106,30 @@ def test_mesh_obstacle_is_bounded_by_its_bounding_box(
         faces=[[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
     ).export(path)
     mesh = ck.Obstacle.from_mesh(path, xyz=(0.2, 0.45, 0.3), rpy=(0.3, -0.2, 0.5), name="tetra")
+    world = ck.CollisionWorld(robot, [mesh])
+    configurations = random_configurations(robot, rng, 300)
+    bounds = PairBounds(robot.model, robot.collision_model, [mesh], all_pairs(robot, [mesh]))(configurations)
+    exact = coal_distances(robot, world, configurations)
+    positive = bounds > 0.0
+    assert positive.mean() > 0.5
+    assert np.all(bounds[positive] <= exact[positive] + 2e-6)
+
+
+def test_a_round_mesh_obstacle_is_bounded_by_its_fitted_capsule(
+    robot: ck.Robot, rng: np.random.Generator, tmp_path: Path
+) -> None:
+    """A tilted rod (radius 0.03 m, 0.5 m long): its box's half diagonal across would be 0.2 m."""
+    path = tmp_path / "rod.stl"
+    rod = trimesh.creation.cylinder(radius=0.03, height=0.5, sections=32)
+    rod.apply_transform(trimesh.transformations.rotation_matrix(0.8, [1.0, 1.0, 0.0]))  # type: ignore[no-untyped-call]
+    rod.export(path)
+    mesh = ck.Obstacle.from_mesh(path, xyz=(0.3, 0.4, 0.3), rpy=(0.1, 0.2, 0.3), name="rod")
+    kind, _, _, radius, half, _ = _obstacle_bound(mesh)
+    assert (
+        kind == CAPSULE
+        and radius == pytest.approx(0.03, abs=1e-6)
+        and half[2] == pytest.approx(0.25, abs=1e-6)
+    )
     world = ck.CollisionWorld(robot, [mesh])
     configurations = random_configurations(robot, rng, 300)
     bounds = PairBounds(robot.model, robot.collision_model, [mesh], all_pairs(robot, [mesh]))(configurations)
