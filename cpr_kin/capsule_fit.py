@@ -83,11 +83,8 @@ def enclosing_circle(points: FloatArray) -> tuple[FloatArray, float]:
 
 def capsule_along(points: FloatArray, axis: FloatArray) -> Capsule:
     """The capsule along ``axis`` ``(3,)`` of least radius, then shortest, holding ``points`` ``(N, 3)``."""
-    axis = axis / np.linalg.norm(axis)
-    helper = np.eye(3)[int(np.argmin(np.abs(axis)))]
-    across = np.cross(axis, helper)
-    across /= np.linalg.norm(across)
-    basis = np.stack([across, np.cross(axis, across)])  # (2, 3), orthonormal, across the axis
+    frame = frame_about(axis)
+    axis, basis = frame[:, 2], frame[:, :2].T  # basis (2, 3): orthonormal, across the axis
     along, plane = points @ axis, points @ basis.T
     centre, radius = enclosing_circle(plane)
     off_axis = np.linalg.norm(plane - centre, axis=1)
@@ -99,6 +96,14 @@ def capsule_along(points: FloatArray, axis: FloatArray) -> Capsule:
     base = centre @ basis
     ends = np.array([base + low * axis, base + high * axis])
     return Capsule(ends, radius + CONTAINMENT_TOLERANCE_M)
+
+
+def frame_about(axis: FloatArray) -> FloatArray:
+    """``(3, 3)`` a right-handed orthonormal frame whose z column is ``axis`` ``(3,)`` (normalised)."""
+    z = axis / np.linalg.norm(axis)
+    x = np.cross(np.eye(3)[int(np.argmin(np.abs(z)))], z)
+    x /= np.linalg.norm(x)
+    return np.column_stack([x, np.cross(z, x), z])
 
 
 def fitted_capsule(points: FloatArray) -> Capsule:

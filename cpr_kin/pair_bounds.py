@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 from cpr_kin.batch_kinematics import KinematicChain
 from cpr_kin.bound_kernels import BOX, CAPSULE, CYLINDER, SPHERE, groups_below, pair_bounds
-from cpr_kin.capsule_fit import Capsule, fitted_capsule
+from cpr_kin.capsule_fit import Capsule, fitted_capsule, frame_about
 from cpr_kin.obstacles import Obstacle
 
 FloatArray = NDArray[np.float64]
@@ -247,10 +247,7 @@ def _capsule_bound(
     middle = capsule.ends.mean(axis=0)
     along = capsule.ends[1] - capsule.ends[0]
     half_length = float(np.linalg.norm(along)) / 2
-    z = along / (2 * half_length) if half_length > 0.0 else np.array([0.0, 0.0, 1.0])
-    x = np.cross(np.eye(3)[int(np.argmin(np.abs(z)))], z)
-    x /= np.linalg.norm(x)
-    axes = np.column_stack([x, np.cross(z, x), z])  # the capsule's frame in the obstacle's
+    axes = frame_about(along if half_length > 0.0 else np.array([0.0, 0.0, 1.0]))  # in the obstacle's frame
     half = np.array([0.0, 0.0, half_length])
     reach = capsule.radius + half_length
     return CAPSULE, rotation @ axes, origin + rotation @ middle, capsule.radius, half, reach

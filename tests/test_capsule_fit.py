@@ -8,7 +8,7 @@ import pytest
 import trimesh
 from scipy.spatial.transform import Rotation
 
-from cpr_kin.capsule_fit import Capsule, capsule_along, enclosing_circle, fitted_capsule
+from cpr_kin.capsule_fit import Capsule, capsule_along, enclosing_circle, fitted_capsule, frame_about
 from cpr_kin.pair_bounds import bounding_capsule
 
 
@@ -111,6 +111,14 @@ def test_a_meshs_capsule_holds_its_surface_and_is_tighter_than_its_box() -> None
     assert bounding_capsule(swept)[1] == pytest.approx(
         bounding_capsule(hull(mesh.vertices, mesh.faces))[1] + 0.01
     )
+
+
+@pytest.mark.parametrize("axis", [[0.0, 0.0, 2.0], [1.0, 0.0, 0.0], [0.3, -0.4, 0.5]])
+def test_the_frame_about_an_axis_is_right_handed_and_orthonormal(axis: list[float]) -> None:
+    frame = frame_about(np.array(axis))
+    np.testing.assert_allclose(frame.T @ frame, np.eye(3), atol=1e-15)
+    assert np.linalg.det(frame) == pytest.approx(1.0)
+    np.testing.assert_allclose(frame[:, 2], np.array(axis) / np.linalg.norm(axis))
 
 
 def test_the_fit_is_memoised_and_refuses_bad_points() -> None:
