@@ -252,8 +252,10 @@ def verify_for_scene(problem: Problem, trajectory: Trajectory) -> Verification:
 
     required = Requirements.of(problem, endpoints=True)
     verification = verify_trajectory(problem.world, trajectory, required)
+    if verification.accepted:
+        return verification
     finer_m = finer_step_m(problem)
-    if verification.accepted or finer_m >= required.step_m:
+    if finer_m >= required.step_m:
         return verification
     self_step_m = required.step_m if required.self_step_m is None else required.self_step_m
     finer = dataclasses.replace(required, step_m=finer_m, self_step_m=min(self_step_m, finer_m))
