@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from planning.search.edges import Edges
+from planning.search.edges import COARSE_STRIDE, HEAD, WHOLE_BELOW, Edges
 
 
 def discs(q: np.ndarray) -> np.ndarray:
@@ -28,8 +28,19 @@ def test_the_free_fractions_are_those_of_checking_every_configuration() -> None:
     weights = np.array([1.0, 2.0])
     edges = Edges(discs, weights, 0.002)  # long edges: hundreds of configurations, checked coarse to fine
     pairs = [(a, b) for a, b in rng.uniform(0, 1, (200, 2, 2)) if discs(a[None])[0]]
-    found = edges.free_fractions(pairs)
+    found = [edges.free_fraction(a, b) for a, b in pairs]
     assert found == [exhaustive(a, b, weights, 0.002) for a, b in pairs]
     assert 0 < sum(f < 1 for f in found) < len(found)  # some edges blocked, some free
     every = sum(max(1, math.ceil(float(np.abs(b - a) @ weights) / 0.002)) for a, b in pairs)
     assert edges.checks < every  # blocked edges were not checked past their obstacle
+
+
+def test_an_edge_blocked_at_once_is_known_from_its_coarse_pass() -> None:
+    weights = np.array([1.0, 2.0])
+    edges = Edges(discs, weights, 0.002)
+    a, b = np.array([0.3, 0.1795]), np.array([0.3, 0.9])  # half a step from the first disc, across it
+    count = math.ceil(float(np.abs(b - a) @ weights) / 0.002)
+    assert discs(a[None])[0] and count >= WHOLE_BELOW
+    assert edges.free_fraction(a, b) == 0.0
+    coarse = set(range(HEAD)) | set(range(COARSE_STRIDE - 1, count, COARSE_STRIDE)) | {count - 1}
+    assert edges.checks == len(coarse)  # the coarse pass alone: nothing past the first invalid one

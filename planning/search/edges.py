@@ -3,9 +3,10 @@
 A sampling planner spends most of its time asking whether straight edges are valid. Here
 an edge is checked as OMPL checks a motion, at configurations a fixed robot motion apart
 (``resolution_m``, a motion bound ``sum_j R_j |dq_j|`` [m] with per-joint weights), but every
-edge of a call in batched calls to the validity check, which is what makes it fast in
-Python: a coarse pass over every edge, then the rest of each edge up to where the coarse pass
-found it blocked (OMPL stops at a motion's first invalid state in the same spirit). The same
+edge in at most two batched calls of the validity check, which is what makes it fast in
+Python: a coarse pass (the edge's first configurations and every few), then the rest of the
+edge up to where the coarse pass found it blocked (OMPL stops at a motion's first invalid
+state in the same spirit). The same
 checks shorten a found path: random shortcuts (a straight edge between two points on it
 replaces what lies between when it is valid), then skipping vertices (from each vertex
 straight to the farthest one it sees), then dropping collinear vertices.
@@ -13,7 +14,6 @@ straight to the farthest one it sees), then dropping collinear vertices.
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Callable
 
@@ -25,7 +25,13 @@ BoolArray = NDArray[np.bool_]
 Validity = Callable[[FloatArray], BoolArray]
 """``(N, d) -> (N,)``: whether each configuration is valid (clear of the margin)."""
 COARSE_STRIDE = 8
-"""Configurations an edge's coarse pass steps over (:meth:`Edges.free_fractions`)."""
+"""Configurations an edge's coarse pass steps over (:meth:`Edges.free_fraction`)."""
+HEAD = 2
+"""An edge's first configurations, checked in its coarse pass: most edges a tree tries start
+at a node that stopped against an obstacle and are blocked at once (of the edges of
+:data:`WHOLE_BELOW` configurations and more: UR5 68 %, Panda 51 %, the CPR 90 %, on
+MotionBenchMaker's and generated narrow scenes), and are then known from the first call,
+not the second (``docs/tuning.md``)."""
 WHOLE_BELOW = 48
 """Edges of fewer configurations are checked whole in the first pass: a second call of the
 validity check would cost more than it saves (a 5-joint arm's edges have 16-100; a 6- or
@@ -33,74 +39,49 @@ validity check would cost more than it saves (a 5-joint arm's edges have 16-100;
 
 
 class Edges:
-    """Validity of straight edges, each checked in one batch; counts the configurations checked."""
+    """Validity of straight edges, one edge a call, coarse to fine; counts the configurations checked."""
 
     def __init__(self, valid: Validity, weights: FloatArray, resolution_m: float) -> None:
         self.valid, self.weights, self.resolution_m, self.checks = valid, weights, resolution_m, 0
 
     def free_fraction(self, a: FloatArray, b: FloatArray) -> float:
-        """The fraction of the edge ``a -> b`` valid from ``a`` on, in [0, 1] (``a`` assumed valid)."""
-        return self.free_fractions([(a, b)])[0]
+        """The fraction of the edge ``a -> b`` valid from ``a`` on, in [0, 1] (``a`` assumed valid).
 
-    def free_fractions(self, edges: list[tuple[FloatArray, FloatArray]]) -> list[float]:
-        """:meth:`free_fraction` of each edge, coarse to fine in at most two calls of the validity check.
-
-        Every :data:`COARSE_STRIDE`-th configuration of every edge first (and its end; an edge
-        of fewer than :data:`WHOLE_BELOW` configurations whole); then, of each edge, the others
-        up to its first invalid one of those: an edge that hits an obstacle is not checked
-        beyond it. The answer is that of checking every configuration.
+        Its configurations every ``resolution_m`` (the last one ``b``), in at most two calls
+        of the validity check: an edge of fewer than :data:`WHOLE_BELOW` whole; a longer one
+        its first :data:`HEAD` and every :data:`COARSE_STRIDE`-th (and ``b``) first, then
+        the others up to the first invalid one of those: an edge that hits an obstacle is
+        not checked beyond it. The answer is that of checking every configuration.
         """
-        counts = [
-            max(1, math.ceil(float(np.abs(b - a) @ self.weights) / self.resolution_m)) for a, b in edges
-        ]
-        fractions = [np.arange(1, count + 1) / count for count in counts]
-        points = [a + f[:, None] * (b - a) for (a, b), f in zip(edges, fractions, strict=True)]
-        if max(counts) < WHOLE_BELOW:  # every edge whole, in one call (no masks: this is the hot path)
-            answers = self.valid(np.concatenate(points))
-            self.checks += len(answers)
-            bounds = np.cumsum([0, *counts])
-            ok = [answers[start:stop] for start, stop in itertools.pairwise(bounds)]
+        count = max(1, math.ceil(float(np.abs(b - a) @ self.weights) / self.resolution_m))
+        points = a + (np.arange(1, count + 1) / count)[:, None] * (b - a)
+        if count < WHOLE_BELOW:
+            ok = self.valid(points)
+            self.checks += count
         else:
-            ok = self._coarse_to_fine(points, counts)
-        found = []
-        for count, f, part in zip(counts, fractions, ok, strict=True):
-            first_bad = count if part.all() else int(np.argmin(part))
-            found.append(1.0 if first_bad == count else 0.0 if first_bad == 0 else float(f[first_bad - 1]))
-        return found
+            ok = self._coarse_to_fine(points)
+        if ok.all():
+            return 1.0
+        return int(np.argmin(ok)) / count
 
-    def _coarse_to_fine(self, points: list[FloatArray], counts: list[int]) -> list[BoolArray]:
-        """Each edge's validity, checked up to its first invalid configuration (module docstring)."""
-        coarse = []
-        for count in counts:
-            rows = np.ones(count, dtype=bool)
-            if count >= WHOLE_BELOW:
-                rows[:] = False
-                rows[COARSE_STRIDE - 1 :: COARSE_STRIDE] = True
-                rows[-1] = True
-            coarse.append(rows)
-        ok = [np.ones(count, dtype=bool) for count in counts]
-        self._check(points, coarse, ok)
-        fine = []
-        for rows, part in zip(coarse, ok, strict=True):
-            rest = ~rows
-            if rest.any():
-                blocked = np.flatnonzero(~part)
-                if blocked.size:
-                    rest[blocked[0] :] = False  # nothing past the first invalid coarse one matters
-            fine.append(rest)
-        if any(rest.any() for rest in fine):
-            self._check(points, fine, ok)
+    def _coarse_to_fine(self, points: FloatArray) -> BoolArray:
+        """The validity of ``points``, checked up to the first invalid one (:meth:`free_fraction`)."""
+        count = len(points)
+        coarse = np.zeros(count, dtype=bool)
+        coarse[:HEAD] = True
+        coarse[COARSE_STRIDE - 1 :: COARSE_STRIDE] = True
+        coarse[-1] = True
+        ok = np.ones(count, dtype=bool)
+        ok[coarse] = self.valid(points[coarse])
+        self.checks += int(np.count_nonzero(coarse))
+        rest = ~coarse
+        blocked = np.flatnonzero(~ok)
+        if blocked.size:
+            rest[blocked[0] :] = False  # nothing past the first invalid coarse one matters
+        if rest.any():
+            ok[rest] = self.valid(points[rest])
+            self.checks += int(np.count_nonzero(rest))
         return ok
-
-    def _check(self, points: list[FloatArray], rows: list[BoolArray], ok: list[BoolArray]) -> None:
-        """Check ``points[k][rows[k]]`` of every edge ``k`` in one call; write the answers into ``ok``."""
-        answers = self.valid(np.concatenate([p[r] for p, r in zip(points, rows, strict=True)]))
-        self.checks += len(answers)
-        offset = 0
-        for part, r in zip(ok, rows, strict=True):
-            size = int(np.count_nonzero(r))
-            part[r] = answers[offset : offset + size]
-            offset += size
 
 
 def shortcut(path: FloatArray, edges: Edges, rng: np.random.Generator, attempts: int) -> FloatArray:
