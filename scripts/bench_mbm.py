@@ -54,7 +54,7 @@ from typing import Any
 import numpy as np
 
 import cpr_kin as ck
-from planning.errors import NoSolutionError
+from planning.errors import NoSolutionError, PlanningError
 from planning.io.mbm import CLASSES, endpoint_violations, import_problem, problems
 from planning.io.scene_file import load_scene
 from planning.io.trajectory_io import trajectory_json
@@ -118,8 +118,12 @@ def passes_check(scene_path: str, trajectory_text: str) -> bool:
         path = Path(folder) / "trajectory.json"
         path.write_text(trajectory_text)
         document = read_trajectory(path)
-    verification = verify_for_scene(build_problem(scene, robot), document.trajectory)
-    return document.joint_names == robot.joint_names and not verification.problems
+    problem = build_problem(scene, robot)
+    try:
+        verification = verify_for_scene(problem, document.trajectory, document.joint_names)
+    except PlanningError:  # the file's joints are not the robot's
+        return False
+    return not verification.problems
 
 
 def warm(scene_path: str) -> None:

@@ -8,11 +8,12 @@ import pytest
 
 import cpr_kin as ck
 from planning.curves.trajectory import Trajectory
+from planning.errors import PlanningError
 from planning.io.bundled import paper_scene
 from planning.pipeline.planner import plan
 from planning.pipeline.result import PlanResult
 from planning.pipeline.target import Target
-from planning.pipeline.verification import Requirements, verify_trajectory
+from planning.pipeline.verification import Requirements, verify_for_scene, verify_trajectory
 
 
 @pytest.fixture(scope="module")
@@ -25,6 +26,15 @@ def test_planned_trajectory_is_accepted(result: PlanResult, paper_world: ck.Coll
     verification = verify_trajectory(paper_world, result.trajectory, Requirements(0.1, 0.005, endpoints=ends))
     assert verification.accepted and verification.problems == ()
     assert verification.check.certified_min_m == pytest.approx(result.metrics.min_clearance_m)
+
+
+def test_a_file_in_another_joint_order_is_refused_by_name(result: PlanResult) -> None:
+    names = list(result.problem.robot.joint_names)
+    assert not verify_for_scene(result.problem, result.trajectory, names).problems
+    swapped = [names[1], names[0], *names[2:]]
+    named = f"trajectory joints \\['{names[1]}', '{names[0]}'.*are not the robot's"
+    with pytest.raises(PlanningError, match=named):
+        verify_for_scene(result.problem, result.trajectory, swapped)
 
 
 def test_each_violation_is_named(result: PlanResult, paper_world: ck.CollisionWorld) -> None:

@@ -6,6 +6,7 @@ What the planner accepts is what ``cpr-plan check`` re-checks: one function serv
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -16,6 +17,7 @@ import cpr_kin as ck
 from cpr_kin.self_curve import check_self_curve
 from planning.curves.hermite import CONTINUITY
 from planning.curves.trajectory import DERIVATIVE_NAMES, Trajectory
+from planning.errors import PlanningError
 from planning.pipeline.scene import DEFAULT_SELF_MARGIN_M
 from planning.pipeline.target import Target
 from planning.pipeline.torques import TorqueProfile, torque_problems, torque_profile
@@ -239,7 +241,9 @@ def verify_trajectory(
     return Verification(check=check, problems=tuple(problems), torques=torques)
 
 
-def verify_for_scene(problem: Problem, trajectory: Trajectory) -> Verification:
+def verify_for_scene(
+    problem: Problem, trajectory: Trajectory, joint_names: Sequence[str] | None = None
+) -> Verification:
     """What ``cpr-plan check`` says of ``trajectory`` against ``problem``'s scene, its ends included.
 
     :func:`verify_trajectory` at the scene's certified steps; where they cannot certify it,
@@ -247,8 +251,20 @@ def verify_for_scene(problem: Problem, trajectory: Trajectory) -> Verification:
     back to where margin plus step leaves no way (:func:`~planning.pipeline.problem.finer_step_m`),
     as a plan through a narrow passage or to a grasp is certified. A finer step only tightens
     the certified bound (more checks, less slack between them); the margins are the scene's.
+
+    Args:
+        problem: the scene's problem, built anew.
+        trajectory: the trajectory, in the robot's joint order.
+        joint_names: the joint order the trajectory's file records, if read from one.
+
+    Raises:
+        PlanningError: ``joint_names`` are not the robot's.
     """
     from planning.pipeline.problem import finer_step_m
+
+    robot_names = list(problem.robot.joint_names)
+    if joint_names is not None and list(joint_names) != robot_names:
+        raise PlanningError(f"trajectory joints {list(joint_names)} are not the robot's {robot_names}")
 
     required = Requirements.of(problem, endpoints=True)
     verification = verify_trajectory(problem.world, trajectory, required)
