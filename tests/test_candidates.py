@@ -6,9 +6,12 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
+from cpr_kin.packages import example_robot
 from planning import build_problem
 from planning.curves.trajectory import Trajectory
+from planning.io.arm_scenes import blocked_scene
 from planning.io.bundled import paper_scene
+from planning.io.scene_file import parse_scene
 from planning.io.scene_generator import generate_scenes
 from planning.pipeline import choose as choose_module
 from planning.pipeline.choose import Choice, Refusal, choose, distinct, verify
@@ -121,3 +124,18 @@ def test_once_the_best_is_refused_the_shortest_passing_timing_wins(
     chosen = choose(problem, result)
     assert isinstance(chosen, Choice) and chosen.verification.accepted
     assert chosen.timing.trajectory.duration == min(passing)
+
+
+def test_a_refusal_for_the_robots_own_links_names_them_not_an_obstacle() -> None:
+    # a UR10 whose straight swing folds its wrist onto its forearm, the ball far away: the
+    # message once named the closest obstacle pair (1.06 m, clear) beside a mean depth of 1e-7 m
+    ur10 = ck.load_robot(example_robot("ur10"))
+    document = blocked_scene("ur10_523", "ur10", ur10, 523, self_clearance_m=0.015)
+    problem = build_problem(parse_scene(document), ur10)
+    straight = problem.objective.straight_line()
+    fitness = float(problem.objective(straight[None])[0])
+    assert not problem.objective.feasible(fitness)
+    chosen = choose(problem, SearchResult.of_point(straight, fitness, 1))
+    assert isinstance(chosen, Refusal)
+    assert chosen.cause.startswith("no candidate was feasible; the best comes within -")
+    assert "(certified) of itself, forearm_link to wrist_" in chosen.cause and "ball" not in chosen.cause

@@ -126,7 +126,7 @@ def infeasibility(breakdown: Breakdown, problem: Problem) -> str:
             f"limits exceeded by {excess:.0%} in {seconds:g} s (lengthen duration or leave it out)"
         )
     if breakdown.depth_m[0] > 0:
-        reasons.append(f"{breakdown.depth_m[0]:.3g} m inside the clearance")
+        reasons.append(f"inside the {problem.objective.required_m:.3g} m the search asks")  # margin + step
     if breakdown.overshoot[0] > 0:
         reasons.append(f"{100 * breakdown.overshoot[0]:.2g} % of a joint range beyond it")
     bound = problem.scene.planner.max_node_deviation
@@ -181,13 +181,14 @@ def choose(problem: Problem, searched: SearchResult) -> Choice | Refusal:
             break  # its other timings follow the same path; or time is up
     assert first is not None  # candidates is never empty
     found = f"the best candidate {'; '.join(first.problems)}"
-    if not objective.feasible(searched.fitness):  # the cause comes first, the obstacle named
+    if not objective.feasible(searched.fitness):  # the cause comes first, the pair named
         why = infeasibility(objective.breakdown(searched.x[None]), problem)
         check = first.check
-        closest = "" if check.worst_pair is None else f" {check.worst_pair[0]} to '{check.worst_pair[1]}'"
-        found = (
-            f"no candidate was feasible; the best:{closest} {check.certified_min_m:.3f} m certified, {why}"
-        )
+        if check.worst_pair is not None and check.certified_min_m < check.margin_m:  # an obstacle
+            closest = f"{check.worst_pair[0]} to '{check.worst_pair[1]}' {check.certified_min_m:.3f} m"
+            found = f"no candidate was feasible; the best: {closest} certified, {why}"
+        else:  # its own links, a limit: the check's words
+            found = f"no candidate was feasible; the best {'; '.join(first.problems)}"
     said = f"{len(verified)} candidate{'' if len(verified) == 1 else 's'} verified"
     return Refusal(found, first.check, said)
 

@@ -128,9 +128,10 @@ def _self_problems(
         return [f"cannot be certified clear of itself: {exc}"]
     if check.accepted:
         return []
+    pair = "" if check.worst_pair is None else f", {check.worst_pair[0]} to {check.worst_pair[1]}"
     return [
-        f"comes within {check.certified_min_m:.4f} m (certified) of itself, self margin {margin_m} m: "
-        f"closest at t = {check.worst_time:.2f} s between {check.worst_pair}"
+        f"comes within {check.certified_min_m:.4f} m (certified) of itself{pair} "
+        f"at t = {check.worst_time:.2f} s (self margin {margin_m} m)"
     ]
 
 
