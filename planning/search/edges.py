@@ -2,14 +2,14 @@
 
 A sampling planner spends most of its time asking whether straight edges are valid. Here
 an edge is checked as OMPL checks a motion, at configurations a fixed robot motion apart
-(``resolution_m``, a motion bound ``sum_j R_j |dq_j|`` [m] with per-joint weights), but every
-edge in at most two batched calls of the validity check, which is what makes it fast in
-Python: a coarse pass (the edge's first configurations and every few), then the rest of the
-edge up to where the coarse pass found it blocked (OMPL stops at a motion's first invalid
-state in the same spirit). The same
-checks shorten a found path: random shortcuts (a straight edge between two points on it
-replaces what lies between when it is valid), then skipping vertices (from each vertex
-straight to the farthest one it sees), then dropping collinear vertices.
+(``resolution_m``, a motion bound ``sum_j R_j |dq_j|`` [m] with per-joint weights), but in
+at most two batched calls of the validity check, which is what makes it fast in Python: a
+coarse pass (the edge's first configurations and every few), then the rest of the edge up
+to where the coarse pass found it blocked (OMPL stops at a motion's first invalid state in
+the same spirit). The same checks shorten a found path: random shortcuts (a straight edge
+between two points on it replaces what lies between when it is valid), then skipping
+vertices (from each vertex straight to the farthest one it sees), then dropping collinear
+vertices.
 """
 
 from __future__ import annotations
