@@ -139,3 +139,18 @@ def test_a_refusal_for_the_robots_own_links_names_them_not_an_obstacle() -> None
     assert isinstance(chosen, Refusal)
     assert chosen.cause.startswith("no candidate was feasible; the best comes within -")
     assert "(certified) of itself, forearm_link to wrist_" in chosen.cause and "ball" not in chosen.cause
+
+
+def test_a_refusal_off_the_obstacles_keeps_the_fixed_durations_advice(robot: ck.Robot) -> None:
+    # no obstacle: the check's words name the nodes, not the fixed duration's limits, which a
+    # detour of the first joint exceeds in 1.2 s
+    problem = build_problem(replace(paper_scene(0), duration=1.2, obstacles=()), robot)
+    waypoints = problem.objective.straight_line().reshape(problem.scene.planner.waypoints, -1)
+    waypoints[:, 0] += 0.4  # theta1 [rad]
+    detour = waypoints.ravel()
+    fitness = float(problem.objective(detour[None])[0])
+    assert problem.objective.breakdown(detour[None]).limit_excess[0] > 0
+    chosen = choose(problem, SearchResult.of_point(detour, fitness, 1))
+    assert isinstance(chosen, Refusal)
+    assert chosen.cause.startswith("no candidate was feasible: limits exceeded by ")
+    assert "in 1.2 s (lengthen duration or leave it out); the best " in chosen.cause

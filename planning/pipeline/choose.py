@@ -117,14 +117,20 @@ def distinct(points: list[FloatArray]) -> list[FloatArray]:
     return kept
 
 
-def infeasibility(breakdown: Breakdown, problem: Problem) -> str:
-    """Why a candidate is infeasible, from its terms (one candidate), in a few words."""
+def infeasibility(breakdown: Breakdown, problem: Problem, besides_check: bool = False) -> str:
+    """Why a candidate is infeasible, from its terms (one candidate), in a few words.
+
+    With ``besides_check``, only what the certified check's own words do not say (the fixed
+    duration's limits); the clearance, the joint ranges and the node deviation they state.
+    """
     reasons = []
     if breakdown.limit_excess[0] > 0:
         excess, seconds = breakdown.limit_excess[0], problem.scene.duration
         reasons.append(
             f"limits exceeded by {excess:.0%} in {seconds:g} s (lengthen duration or leave it out)"
         )
+    if besides_check:
+        return ", ".join(reasons)
     if breakdown.depth_m[0] > 0:
         reasons.append(f"inside the {problem.objective.required_m:.3g} m the search asks")  # margin + step
     if breakdown.overshoot[0] > 0:
@@ -182,13 +188,15 @@ def choose(problem: Problem, searched: SearchResult) -> Choice | Refusal:
     assert first is not None  # candidates is never empty
     found = f"the best candidate {'; '.join(first.problems)}"
     if not objective.feasible(searched.fitness):  # the cause comes first, the pair named
-        why = infeasibility(objective.breakdown(searched.x[None]), problem)
-        check = first.check
+        breakdown, check = objective.breakdown(searched.x[None]), first.check
         if check.worst_pair is not None and check.certified_min_m < check.margin_m:  # an obstacle
             closest = f"{check.worst_pair[0]} to '{check.worst_pair[1]}' {check.certified_min_m:.3f} m"
+            why = infeasibility(breakdown, problem)
             found = f"no candidate was feasible; the best: {closest} certified, {why}"
-        else:  # its own links, a limit: the check's words
-            found = f"no candidate was feasible; the best {'; '.join(first.problems)}"
+        else:  # its own links, a joint range: the check's words, and what they do not say
+            besides = infeasibility(breakdown, problem, besides_check=True)
+            said_of_it = "; ".join(first.problems)
+            found = f"no candidate was feasible{f': {besides}' if besides else ''}; the best {said_of_it}"
     said = f"{len(verified)} candidate{'' if len(verified) == 1 else 's'} verified"
     return Refusal(found, first.check, said)
 
