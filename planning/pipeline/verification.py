@@ -156,6 +156,11 @@ class Requirements:
     endpoints: tuple[Target, Target] | None = None
     dynamics: ck.Dynamics | None = None
 
+    @property
+    def self_check_step_m(self) -> float:
+        """The certified self check's step [m]: ``self_step_m``, or ``step_m`` where that is ``None``."""
+        return self.step_m if self.self_step_m is None else self.self_step_m
+
     @classmethod
     def of(cls, problem: Problem, endpoints: bool = False) -> Requirements:
         """The scene's requirements (its start and goal too if ``endpoints``), torques included."""
@@ -215,8 +220,7 @@ def verify_trajectory(
             f"comes within {check.certified_min_m:.4f} m (certified) of an obstacle, margin {margin_m} m: "
             f"closest at t = {check.worst_time:.2f} s between {check.worst_pair} ({check.worst_group})"
         )
-    self_step_m = step_m if required.self_step_m is None else required.self_step_m
-    problems += _self_problems(world, trajectory, required.self_margin_m, self_step_m)
+    problems += _self_problems(world, trajectory, required.self_margin_m, required.self_check_step_m)
     positions = trajectory.extrema(0)
     for i, name in enumerate(robot.joint_names):
         low, high = positions.minimum[i], positions.maximum[i]
@@ -274,6 +278,6 @@ def verify_for_scene(
     finer_m = finer_step_m(problem)
     if finer_m >= required.step_m:
         return verification
-    self_step_m = required.step_m if required.self_step_m is None else required.self_step_m
-    finer = dataclasses.replace(required, step_m=finer_m, self_step_m=min(self_step_m, finer_m))
+    self_step_m = min(required.self_check_step_m, finer_m)
+    finer = dataclasses.replace(required, step_m=finer_m, self_step_m=self_step_m)
     return verify_trajectory(problem.world, trajectory, finer)
