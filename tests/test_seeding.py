@@ -114,6 +114,22 @@ def test_a_path_whose_spline_violates_the_clearance_is_drawn_again(robot: ck.Rob
     np.testing.assert_array_equal(seed_search(one_attempt).path, first)
 
 
+def test_a_redraw_gets_what_remains_of_redraw_samples_and_gives_up_beyond(robot: ck.Robot) -> None:
+    """The same beam: its first path takes 1 sample, the second (feasible) one 2.
+
+    With ``redraw_samples = 3`` the redraw may take 2 and finds the second path; with 2 it
+    may take 1, gives up, and the first path (in hand, its seed infeasible) is kept.
+    """
+    problem = uniform_samples(build_problem(narrow_scene(np.random.default_rng(6), robot, "beam"), robot))
+    rng = np.random.default_rng([problem.scene.planner.seed, 1])
+    first, second = sampled_path(problem, rng), sampled_path(problem, rng)
+    assert first is not None and second is not None and (first.samples, second.samples) == (1, 2)
+    np.testing.assert_array_equal(seed_search(uniform_samples(problem, redraw_samples=3)).path, second.path)
+    kept = seed_search(uniform_samples(problem, redraw_samples=2))
+    np.testing.assert_array_equal(kept.path, first.path)
+    assert not kept.feasible and not kept.no_path
+
+
 def test_when_no_path_seed_is_feasible_the_best_ranked_is_kept(robot: ck.Robot) -> None:
     problem = uniform_samples(build_problem(narrow_scene(np.random.default_rng(3), robot, "pillars"), robot))
     drawn = drawn_paths(problem)

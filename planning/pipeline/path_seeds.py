@@ -44,12 +44,15 @@ def sampled_path(
     rng: np.random.Generator,
     settings: RrtSettings | None = None,
     finer: Problem | None = None,
+    max_samples: int | None = None,
 ) -> RrtPath | None:
     """RRT-Connect's path in the moving joints of ``problem``, clear of the fitness's clearance.
 
     With ``finer`` (``problem`` with a finer certified step, so a smaller clearance), the
     trees go on keeping its clearance after the seeding's ``finer_after`` samples, or from
     the start where an end is too close for ``problem``'s; the path is then ``relaxed``.
+    ``max_samples``: the draw's budget when the default ``settings`` are used (``None``: the
+    seeding's ``max_samples``).
     """
     robot, moving = problem.robot, problem.moving
 
@@ -65,7 +68,7 @@ def sampled_path(
     if settings is None:  # the path's edges checked at most as far apart as the clearance required
         resolution = min(tuning.max_resolution_m, max(0.01, problem.objective.required_m))
         settings = RrtSettings(
-            max_samples=tuning.max_samples,
+            max_samples=tuning.max_samples if max_samples is None else max_samples,
             resolution_m=resolution,
             explore_resolution_m=tuning.max_resolution_m,
             local_share=tuning.local_share,
@@ -101,9 +104,11 @@ def followable_path(
 
     Step 2 of :mod:`planning.pipeline.seeding`: up to ``path_attempts`` paths, all drawn
     from the stream ``default_rng([seed, 1])``, another only while those drawn took fewer
-    than ``redraw_samples`` samples in all; the first whose seed is feasible, else the one
-    of the best fitness; ``None`` when RRT-Connect finds none (a further draw is not tried:
-    a failed one has used up its samples). A path found keeping only ``finer``'s
+    than ``redraw_samples`` samples in all, and given what remains of them: a redraw that
+    needs more gives up (a path is in hand; one that takes thousands of samples costs more
+    than a better seed saves). The first whose seed is feasible, else the one of the best
+    fitness; ``None`` when RRT-Connect finds none in its first draw (a further draw is not
+    tried: a failed one has used up its samples). A path found keeping only ``finer``'s
     clearance (:func:`sampled_path`) seeds ``finer``.
     """
     settings = problem.scene.planner
@@ -112,7 +117,8 @@ def followable_path(
     best: tuple[FloatArray, PathSeed] | None = None
     samples = 0
     for _ in range(tuning.path_attempts):
-        found = sampled_path(problem, rng, finer=finer)
+        budget = None if best is None else tuning.redraw_samples - samples
+        found = sampled_path(problem, rng, finer=finer, max_samples=budget)
         if found is None:
             break
         samples += found.samples

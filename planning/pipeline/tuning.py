@@ -31,9 +31,10 @@ class SeedingTuning:
         path_attempts: most RRT-Connect paths drawn while the spline through a path's
             waypoints violates the clearance, in [1, 20].
         redraw_samples: another path is drawn only while the paths drawn so far took fewer
-            random samples than this in all, in [0, 100000]: a path found quickly is worth
-            another try, one that took thousands of samples costs as much again (the
-            search's retries with more waypoints repair its spline instead).
+            random samples than this in all, and it may take only what remains of them, in
+            [0, 100000]: a path found quickly is worth another try, one that took thousands
+            of samples costs as much again (the search's retries with more waypoints repair
+            its spline instead).
         max_samples: random samples after which RRT-Connect gives up on a path, in
             [1, 100000] (a narrow passage may need several thousand; a failed draw costs
             about 0.15 ms a sample).
