@@ -312,3 +312,29 @@ def test_samples_near_the_trees_lead_a_goal_out_of_its_shelf(tmp_path: Any) -> N
         assert local is not None and not local.relaxed  # the margin kept, without the finer step's
         uniform = dataclasses.replace(settings, local_share=0.0)
         assert sampled_path(built, np.random.default_rng(seed), uniform, finer) is None
+
+
+def test_an_infeasible_path_seed_is_refined_without_the_firefly(robot: ck.Robot) -> None:
+    """Pillars whose paths' seeds all cut into the margin: the refinement starts from the best seed.
+
+    With ``explore_path_seed`` the firefly explores first, as it does from the straight line
+    alone; both plans pass the certified check.
+    """
+    from planning.pipeline.planner import solve
+    from planning.pipeline.search import explores
+
+    problem = uniform_samples(build_problem(narrow_scene(np.random.default_rng(3), robot, "pillars"), robot))
+    attempt = PathSeeding().first(problem)
+    assert attempt.path is not None and not attempt.feasible_seed and attempt.seeds is not None
+    tuning = problem.scene.planner.tuning
+    assert not explores(attempt, tuning)
+    assert explores(attempt, dataclasses.replace(tuning, explore_path_seed=True))
+    assert explores(dataclasses.replace(attempt, path=None), tuning)  # the straight line alone
+    assert not explores(dataclasses.replace(attempt, feasible_seed=True), tuning)
+    assert explores(None, tuning) and explores(dataclasses.replace(attempt, seeds=None), tuning)
+
+    at_once = solve(problem)
+    exploring = solve(with_planner(problem, tuning=dataclasses.replace(tuning, explore_path_seed=True)))
+    assert at_once.verification.accepted and exploring.verification.accepted
+    assert at_once.optimiser.evaluation_history[0] == len(attempt.seeds)  # the seeds, evaluated once
+    assert exploring.optimiser.evaluation_history[0] == problem.scene.planner.firefly.fireflies

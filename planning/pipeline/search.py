@@ -25,6 +25,7 @@ from numpy.typing import NDArray
 
 from planning.pipeline.problem import Problem
 from planning.pipeline.seeding import Attempt
+from planning.pipeline.tuning import SearchTuning
 from planning.search.firefly import FireflyProgress
 from planning.search.optimizer import BatchObjective, Optimizer, SearchResult
 from planning.search.refined_firefly import RefinedFirefly
@@ -82,9 +83,25 @@ def planner_search(
         feasible_below=objective.feasible_below,
         lower_bound=objective.lower_bound if settings.refine == "cma" else None,
         progress=progress,
-        explore=settings.tuning.explore_feasible_seed or attempt is None or not attempt.feasible_seed,
+        explore=explores(attempt, settings.tuning),
         stop=problem.deadline.passed,
     )
+
+
+def explores(attempt: Attempt | None, tuning: SearchTuning) -> bool:
+    """Whether the firefly explores before the refinement, or the refinement starts from the seeds at once.
+
+    At once from a feasible seed, or from one that follows the sampling planner's path
+    (unless ``explore_feasible_seed`` and ``explore_path_seed`` ask otherwise); the firefly
+    explores from the straight line alone, or without seeds.
+    """
+    if attempt is None or attempt.seeds is None:
+        return True
+    if attempt.feasible_seed:
+        return tuning.explore_feasible_seed
+    if attempt.path is not None:
+        return tuning.explore_path_seed
+    return True
 
 
 def search(

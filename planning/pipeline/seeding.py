@@ -36,8 +36,9 @@ the finer clearance too, so no sample is drawn again; a path found so is searche
 certified, with the finer step.
 
 The seeds and ``spread``-sized moves around them make up ``share`` of the initial
-population (:class:`~planning.pipeline.tuning.SeedingTuning`); when a seed is feasible, the
-search refines it without the firefly (:attr:`Attempt.feasible_seed`). The sampling planner
+population (:class:`~planning.pipeline.tuning.SeedingTuning`); when a seed is feasible or
+follows RRT-Connect's path, the search refines the best one without the firefly
+(:func:`planning.pipeline.search.explores`). The sampling planner
 and the moves draw from their own streams, ``default_rng([seed, 1])`` and ``[seed, 2]``:
 the firefly's draws are the same with or without them. ``seeding: none`` (the paper,
 :class:`NoSeeding`) searches once, from a random population.
@@ -95,7 +96,7 @@ class Attempt:
         path: the sampling planner's path the seeds follow, reused by the next attempt.
         number: 0 for the first attempt, then 1, 2, ...
         tried: what the seeding tried and did not find, for a message (empty: nothing).
-        feasible_seed: a seed is feasible: the search refines it without the firefly.
+        feasible_seed: a seed is feasible (:func:`planning.pipeline.search.explores`).
         no_path: RRT-Connect found no path for this plan: the next attempts do not ask again.
     """
 

@@ -98,8 +98,13 @@ class SearchTuning:
             decreasing.
         explore_feasible_seed: the firefly explores before the refinement even when a seed
             (the straight line's or the sampling planner's) is feasible; by default the
-            refinement then starts from it at once, and the firefly runs only when no seed
-            is feasible.
+            refinement then starts from it at once.
+        explore_path_seed: the firefly explores before the refinement when no seed is
+            feasible but one follows the sampling planner's path; by default the
+            refinement starts from the best seed at once (the spline through the path's
+            waypoints misses its corners by millimetres, which the refinement's small steps
+            repair and the firefly's random population does not). The firefly runs
+            whenever the seeds hold no such path (:func:`~planning.pipeline.search.explores`).
     """
 
     seeding: SeedingTuning = field(default_factory=SeedingTuning)
@@ -108,12 +113,14 @@ class SearchTuning:
     preferred_first: int = 3
     narrowed_acceleration: tuple[float, ...] = (0.7, 0.5, 0.35)
     explore_feasible_seed: bool = False
+    explore_path_seed: bool = False
 
     def __post_init__(self) -> None:
         if not isinstance(self.seeding, SeedingTuning) or not isinstance(self.refinement, RefinementSettings):
             raise PlanningError("seeding and refinement must be a SeedingTuning and a RefinementSettings")
         integer_in("retries", self.retries, 0, 10)
         boolean("explore_feasible_seed", self.explore_feasible_seed)
+        boolean("explore_path_seed", self.explore_path_seed)
         integer_in("preferred_first", self.preferred_first, 1, 100)
         shares = tuple(self.narrowed_acceleration)
         for k, share in enumerate(shares):

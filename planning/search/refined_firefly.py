@@ -7,8 +7,10 @@ be feasible: a seed that misses only by a little (a spline overshooting a joint 
 fraction of a percent, or grazing the margin) is one the firefly's random moves rarely
 improve, while the refinement's small steps follow the fitness's penalty down to feasible
 values; the early stop so counts stalled iterations whether the best is feasible or not.
-With ``explore=False`` (the planner's default) a feasible seed is refined at once: the
-firefly's moves around it rarely improve on it (``docs/tuning.md``).
+With ``explore=False`` the best seed is refined at once: the planner asks it for a
+feasible seed, whose neighbourhood the firefly's moves rarely improve, and for one that
+follows a sampling planner's path, which the refinement repairs where the firefly's random
+population wanders off (:func:`planning.pipeline.search.explores`, ``docs/tuning.md``).
 
 The planner runs it on its waypoint objective, and the benchmark of peer
 optimisers (``scripts/bench_peers.py``) runs the same object beside the peers, so both
@@ -54,8 +56,8 @@ class RefinedFirefly:
         stop: asked before every firefly iteration and refinement generation; ``True`` ends
             the search with its best so far (a time limit). ``None``: never.
         explore: the firefly runs before the refinement. ``False``: the refinement starts
-            from the best of the ``seeds`` when that one is feasible (the firefly runs when
-            none is, or without seeds or a refinement).
+            from the best of the ``seeds``, feasible or not (the firefly runs without seeds
+            or a refinement).
     """
 
     firefly: FireflySettings
@@ -84,9 +86,7 @@ class RefinedFirefly:
         found: SearchResult | None = None
         if not self.explore and self.seeds is not None and self.refinement is not None:
             found = evaluated_points(objective, lower, upper, self.seeds)
-            if found.fitness > self.feasible_below:
-                found = None
-            elif self.progress is not None:  # the seeds are the search's initial population
+            if self.progress is not None:  # the seeds are the search's initial population
                 mean = float(found.mean_history[0])
                 self.progress(FireflyProgress(0, settings.iterations, found.fitness, mean, found.evaluations))
         if found is None:
