@@ -90,39 +90,47 @@ def test_past_the_deadline_only_the_timing_in_hand_is_verified(robot: ck.Robot) 
     assert isinstance(in_time, Choice)  # the oracle: a later candidate passes
 
 
-def test_once_the_best_is_refused_the_shortest_passing_timing_wins(
+def test_once_the_best_is_refused_the_next_candidates_run_at_full_speed_before_any_narrowed_timing(
     robot: ck.Robot, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    # a worse candidate at full speed competes with the narrowed timings by duration, not by rank
+    # the refinement's population is nearly as good as its best: the next one at full speed,
+    # timed only once the best failed; the narrowed timings only once those fail, shortest first
     problem = build_problem(generate_scenes(31, 0, robot)[30], robot)
     searched = solve(problem).optimiser
     order = np.argsort(searched.population_fitness, kind="stable")
     points = distinct([searched.x] + [searched.population[k] for k in order])[:PREFERRED_FIRST]
+    assert len(points) == PREFERRED_FIRST
     result = replace(
         searched,
         population=np.stack(points),
         population_fitness=np.arange(1.0, len(points) + 1),
     )
     offered = [problem.duration.timings(problem, problem.objective.nodes(x[None])[0]) for x in points]
-    refused = offered[0][0].trajectory.duration  # the best's fastest timing
+    fastest = [timing[0] for timing in offered]
+    assert verify(problem, fastest[1].trajectory, fastest[1].fit).accepted  # the oracle
+    refused = {fastest[0].trajectory.duration}
 
     def refusing(problem_: object, trajectory: Trajectory, fit: object) -> Verification:
         checked = verify(problem, trajectory, fit)  # type: ignore[arg-type]
-        if trajectory.duration == refused:
+        if trajectory.duration in refused:
             return Verification(checked.check, ("refused by the test",))
         return checked
 
-    options: list[Timing | None] = [timing[0] for timing in offered[1:]]
-    options += [problem.duration.narrowed(problem, timing, NARROWED_ACCELERATION[0]) for timing in offered]
+    monkeypatch.setattr(choose_module, "verify", refusing)
+    chosen = choose(problem, result)
+    assert isinstance(chosen, Choice) and chosen.candidates_timed == 2  # the third not timed
+    assert chosen.timing.trajectory.duration == fastest[1].trajectory.duration
+
+    refused.update(timing.trajectory.duration for timing in fastest)  # every full-speed timing
+    narrowed = [problem.duration.narrowed(problem, timing, NARROWED_ACCELERATION[0]) for timing in offered]
     passing = [
         t.trajectory.duration
-        for t in options
+        for t in narrowed
         if t is not None and verify(problem, t.trajectory, t.fit).accepted
     ]
     assert passing
-    monkeypatch.setattr(choose_module, "verify", refusing)
     chosen = choose(problem, result)
-    assert isinstance(chosen, Choice) and chosen.verification.accepted
+    assert isinstance(chosen, Choice) and chosen.timing.method == "narrowed"
     assert chosen.timing.trajectory.duration == min(passing)
 
 

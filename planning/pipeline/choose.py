@@ -7,14 +7,17 @@ and returns the first whose timed trajectory passes the certified continuous che
 :class:`Choice`; or a :class:`Refusal` saying why the best one failed. In order:
 
 1. the best's preferred (fastest) timing;
-2. the narrowed timings (:meth:`~planning.pipeline.timing.FreeDuration.narrowed`) of the
+2. the preferred timings of the next candidates up to ``preferred_first``, in the search's
+   order, each timed only when the one before failed: the refinement's population is
+   nearly as good as its best, and such a candidate run at full speed is shorter than the
+   best run slower, or longer by a few per cent, for a fraction of the narrowed timings'
+   cost (``docs/tuning.md``);
+3. the narrowed timings (:meth:`~planning.pipeline.timing.FreeDuration.narrowed`) of those
    first ``preferred_first``, one share of ``narrowed_acceleration`` after the other (each
    computed only when the previous share failed), each share's shortest first, whichever
-   candidate they time; the first share's go with the other preferred candidates' own
-   timings: a nearly as good candidate run at full speed beats the best one run slower, and
-   a worse one run at full speed does not;
-3. their other timings (the uniform ones), shortest first;
-4. each further candidate's timings, in order.
+   candidate they time;
+4. their other timings (the uniform ones), shortest first;
+5. each further candidate's timings, in order.
 
 Each candidate is timed once, however often the search returns it. A best candidate that
 comes deeper inside the margin than one verification step at one of its samples
@@ -217,13 +220,12 @@ def _attempts(
         return sorted(found, key=lambda pair: pair[1].trajectory.duration)  # stable
 
     preferred = list(range(min(tuning.preferred_first, len(candidates))))
-    yield 0, offered(0)[0]  # most plans end here, after one timing
-    others: list[tuple[int, Timing | None]] = [(k, offered(k)[0]) for k in preferred[1:]]
+    for k in preferred:  # most plans end at the first, after one timing
+        yield k, offered(k)[0]
     narrowing = preferred
     for share in tuning.narrowed_acceleration:  # share by share: a path that passes costs no lower share
         found = [(k, duration.narrowed(problem, offered(k), share)) for k in narrowing]
-        yield from shortest_first(others + found)
-        others = []
+        yield from shortest_first(found)
         narrowing = [k for k, timing in found if timing is not None]  # a lower share is slower still
     yield from shortest_first([(k, timing) for k in preferred for timing in offered(k)[1:]])
     yield from ((k, timing) for k in range(len(preferred), len(candidates)) for timing in offered(k))
