@@ -59,7 +59,7 @@ class SeedingTuning:
     spread: float = 0.01
     max_resolution_m: float = 0.04
     path_attempts: int = 3
-    redraw_samples: int = 1_000
+    redraw_samples: int = 300
     max_samples: int = 10_000
     finer_after: int = 3_000
     more_waypoints: int = 6
