@@ -14,8 +14,8 @@ is a small part of its space, rarely met by a random population. So, with the pl
    (:func:`~planning.search.waypoints.waypoints_along`) are the second seed. A path is
    clear, but the spline through its few waypoints cuts its corners and may not be: then
    RRT-Connect draws another path, up to ``path_attempts`` in all while the paths so far
-   took fewer than ``redraw_samples`` samples, and the first whose seed is feasible (else
-   the one whose seed ranks best) is taken;
+   took fewer than ``redraw_samples`` samples (a redraw gets what remains of them), and
+   the first whose seed is feasible (else the one whose seed ranks best) is taken;
 3. if a search with the scene's waypoints fails, the next attempt (:meth:`PathSeeding.after`)
    asks for more waypoints when no candidate was feasible (as many as the spline needs to
    follow the path: at least two more and the path's corners, then two more at a time, up
