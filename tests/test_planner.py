@@ -357,7 +357,7 @@ def test_the_refinement_stops_early_only_near_the_objectives_lower_bound(robot: 
             went_on += 1
             assert result.optimiser.evaluations > counted.optimiser.evaluations
             assert result.optimiser.fitness < counted.optimiser.fitness
-    assert went_on >= 1
+    assert 0 < went_on < 3  # both branches: one scene went on, the others stopped near the bound
 
 
 def test_the_paper_search_does_not_refine() -> None:

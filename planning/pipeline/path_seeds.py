@@ -8,6 +8,7 @@ draws up to ``path_attempts`` until the spline through one's waypoints is feasib
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from typing import NamedTuple
 
@@ -51,8 +52,8 @@ def sampled_path(
     With ``finer`` (``problem`` with a finer certified step, so a smaller clearance), the
     trees go on keeping its clearance after the seeding's ``finer_after`` samples, or from
     the start where an end is too close for ``problem``'s; the path is then ``relaxed``.
-    ``max_samples``: the draw's budget when the default ``settings`` are used (``None``: the
-    seeding's ``max_samples``).
+    ``max_samples``: the draw's budget, in place of ``settings``' (``None``: theirs; the
+    default settings take the seeding's ``max_samples``).
     """
     robot, moving = problem.robot, problem.moving
 
@@ -68,12 +69,14 @@ def sampled_path(
     if settings is None:  # the path's edges checked at most as far apart as the clearance required
         resolution = min(tuning.max_resolution_m, max(0.01, problem.objective.required_m))
         settings = RrtSettings(
-            max_samples=tuning.max_samples if max_samples is None else max_samples,
+            max_samples=tuning.max_samples,
             resolution_m=resolution,
             explore_resolution_m=tuning.max_resolution_m,
             local_share=tuning.local_share,
             local_spread=tuning.local_spread,
         )
+    if max_samples is not None:
+        settings = dataclasses.replace(settings, max_samples=max_samples)
     limits = robot.limits
     relaxation = None if finer is None else Relaxation(keeping(finer), tuning.finer_after)
     return rrt_connect(
