@@ -3,11 +3,11 @@
 The firefly explores and finds the basin; near its best point its moves are too coarse to
 descend (a sweep kicks every firefly by about ``alpha sqrt(n) / 2`` per iteration), and its
 early stop ends the search there. A covariance matrix adaptation evolution strategy (Hansen
-2016, "The CMA Evolution Strategy: A Tutorial", default parameters, :mod:`cma_rates`; its
-active covariance update is optional) learns the valley's directions from a few
-generations and walks along them, also where the valley does not follow the variables' axes
-(the tests: a rotated quadratic of condition number 1000, where a search that adapts only
-its step length needs about that many times more evaluations). What it gains on planning
+2016, "The CMA Evolution Strategy: A Tutorial", default parameters, :mod:`cma_rates`, and
+its active covariance update unless the settings turn it off) learns the valley's
+directions from a few generations and walks along them, also where the valley does not
+follow the variables' axes (the tests: a rotated quadratic of condition number 1000, where
+a search that adapts only its step length needs about that many times more evaluations). What it gains on planning
 scenes and the paper objective: ``docs/tuning.md``.
 
 Written here rather than taken from ``cma`` or ``cmaes``: both import ``scipy.stats``, a large

@@ -24,7 +24,8 @@ class RefinementSettings:
         sigma: initial step [share of each variable's range], in (0, 1]: the search's best
             lies in the right basin, so the refinement starts local.
         active: the active covariance update of Hansen's tutorial: the worse half of each
-            generation shrinks the covariance along its steps (a constraint's normal).
+            generation shrinks the covariance along its steps (a constraint's normal, where
+            the refinement's best presses against the clearance).
         near_bound: how close to the objective's lower bound (a ratio >= 1) the best must be
             before stalled generations count towards the early stop; farther, the
             refinement runs on until its step collapses or the budget ends. ``inf``: every
@@ -39,7 +40,7 @@ class RefinementSettings:
     """
 
     sigma: float = 0.03
-    active: bool = False
+    active: bool = True
     near_bound: float = 1.3
     min_sigma: float = 1e-4
     fallback_spacing: float = 1 / 8
