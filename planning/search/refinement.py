@@ -7,8 +7,8 @@ early stop ends the search there. A covariance matrix adaptation evolution strat
 its active covariance update unless the settings turn it off) learns the valley's
 directions from a few generations and walks along them, also where the valley does not
 follow the variables' axes (the tests: a rotated quadratic of condition number 1000, where
-a search that adapts only its step length needs about that many times more evaluations). What it gains on planning
-scenes and the paper objective: ``docs/tuning.md``.
+a search that adapts only its step length needs about that many times more evaluations).
+What it gains on planning scenes and the paper objective: ``docs/tuning.md``.
 
 Written here rather than taken from ``cma`` or ``cmaes``: both import ``scipy.stats``, a large
 part of the time a plan may take in a new process; the method itself is the textbook's, in
