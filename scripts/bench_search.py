@@ -16,12 +16,15 @@ Ruckig's jerk-limited bound on them, which no jerk-limited planner's median can 
 and, with ``--cli-runs``,
 the wall time of ``cpr-plan plan`` on one scene as a user runs it (a new process each time,
 kernels cached on disk). Targets (issue 17): success >= OMPL's on each class, warm time
-ratio <= 1, ``cpr-plan plan`` <= 1.5 s. Needs the ``bench`` extra.
+ratio <= 1, ``cpr-plan plan`` <= 1.5 s. ``--refine-stall N`` plans ours with the planner
+setting ``refine_stall: N`` (shorter trajectories for more planning time,
+``docs/tuning.md``); OMPL's pipeline has no such setting. Needs the ``bench`` extra.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import statistics
 import subprocess
 import sys
@@ -33,7 +36,7 @@ from pathlib import Path
 import numpy as np
 
 import cpr_kin as ck
-from planning.errors import NoSolutionError
+from planning.errors import NoSolutionError, PlanningError
 from planning.io.narrow_passages import ALL_KINDS, KINDS
 from planning.io.scene_file import dump_scene
 from planning.io.scene_generator import generate_scenes
@@ -105,10 +108,24 @@ def main() -> None:
     parser.add_argument(
         "--cli-runs", type=int, default=5, help="runs of `cpr-plan plan` (default: 5; 0: none)"
     )
+    parser.add_argument(
+        "--refine-stall",
+        type=int,
+        default=None,
+        help="our planner's refine_stall (default: the scenes' own, the planner's default)",
+    )
     args = parser.parse_args()
 
     robot = ck.load_cpr()
-    scenes = generate_scenes(args.scenes, args.seed, robot, narrow=args.narrow, kinds=args.kinds)
+    try:
+        scenes = generate_scenes(args.scenes, args.seed, robot, narrow=args.narrow, kinds=args.kinds)
+        if args.refine_stall is not None:
+            scenes = [
+                dataclasses.replace(scene, planner=scene.planner.updated(refine_stall=args.refine_stall))
+                for scene in scenes
+            ]
+    except PlanningError as error:
+        parser.error(str(error))
     warm_up(robot)
     plan_rrt_connect(scenes[0], robot, args.budget, 0)  # OMPL's imports and first call, untimed
     rows = []

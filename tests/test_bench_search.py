@@ -1,0 +1,41 @@
+"""``scripts/bench_search.py``: ours beside OMPL's pipeline on generated scenes, as a user runs it."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "bench_search.py"
+
+
+def run(*arguments: str) -> subprocess.CompletedProcess[str]:
+    """The script in a new process with ``arguments``."""
+    command = [sys.executable, str(SCRIPT), "--cli-runs", "0", *arguments]
+    return subprocess.run(command, capture_output=True, text=True, timeout=600, check=False)
+
+
+@pytest.mark.slow
+def test_the_benchmark_prints_each_class_and_the_bound_with_a_refine_stall() -> None:
+    pytest.importorskip("ompl")
+    scenes = ("--scenes", "2", "--narrow", "1", "--kinds", "pillars", "--seed", "3")
+    completed = run(*scenes, "--refine-stall", "8")
+    assert completed.returncode == 0, completed.stderr[-2000:]
+    out = completed.stdout
+    assert "  regular " in out and "  pillars " in out
+    assert "Ruckig's free-space bound" in out and "over 2 scenes" in out
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        (("--refine-stall", "-1"), "refine_stall = -1 must be an integer in [0, 10000]"),
+        (("--scenes", "2", "--narrow", "3"), "narrow = 3 scenes; allowed: 0 to count = 2"),
+    ],
+)
+def test_a_bad_argument_is_one_line_naming_it(arguments: tuple[str, ...], message: str) -> None:
+    completed = run(*arguments)
+    assert completed.returncode == 2
+    assert message in completed.stderr and "Traceback" not in completed.stderr
