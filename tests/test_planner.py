@@ -306,9 +306,8 @@ def test_a_feasible_or_path_seed_is_refined_without_the_firefly(robot: ck.Robot)
         result = plan(scene, robot)
         assert result.verification.accepted
         first = result.optimiser
-        if (
-            seeds.feasible or seeds.path is not None
-        ):  # the refinement's first entry: the seeds, evaluated once
+        if seeds.feasible or seeds.path is not None:
+            # the refinement's first entry: the seeds, evaluated once
             refined_at_once += 1
             assert first.evaluation_history[0] == len(seeds.candidates)
             objective = seeds.problem.objective
