@@ -14,6 +14,7 @@ came.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -28,6 +29,10 @@ from cpr_kin.robot import Robot
 FloatArray = NDArray[np.float64]
 
 
+PROGRESS = 0.05
+"""The relative decrease of a start's least error that counts as progress (:attr:`IkSettings.patience`)."""
+
+
 @dataclass(frozen=True)
 class IkSettings:
     """How :func:`solve_ik` searches.
@@ -39,6 +44,9 @@ class IkSettings:
         max_step: largest change of a joint per step [rad or m].
         seed: seed of the random starts.
         choices: solutions found (that ``accept`` allows) before the nearest is chosen.
+        patience: steps in a row that leave a start's least error (:meth:`IkTarget.excess`)
+            not :data:`PROGRESS` smaller that end that start: it is stuck (at a joint limit,
+            or circling), and a converging start steps far faster (``docs/tuning.md``).
     """
 
     restarts: int = 30
@@ -47,9 +55,10 @@ class IkSettings:
     max_step: float = 0.3
     seed: int = 0
     choices: int = 4
+    patience: int = 20
 
     def __post_init__(self) -> None:
-        for name, low in (("restarts", 0), ("iterations", 1), ("choices", 1)):
+        for name, low in (("restarts", 0), ("iterations", 1), ("choices", 1), ("patience", 1)):
             value = getattr(self, name)
             if not isinstance(value, int) or isinstance(value, bool) or not low <= value <= 100_000:
                 raise CprKinError(f"IkSettings.{name} = {value!r} must be an integer in [{low}, 100000]")
@@ -120,15 +129,27 @@ class IkTarget:
 def _descend(
     robot: Robot, target: IkTarget, q: FloatArray, free: NDArray[np.bool_], settings: IkSettings
 ) -> FloatArray:
-    """One start's damped least squares descent, moving the ``free`` joints; the configuration it ends at."""
+    """One start's damped least squares descent, moving the ``free`` joints; the configuration it ends at.
+
+    It ends where the target is reached, after ``settings.iterations`` steps, or once
+    ``settings.patience`` steps in a row have not made progress.
+    """
     model, data, frame = robot.model, robot.data, robot.frame_id(robot.tcp_frame)
     lower, upper = robot.limits.lower, robot.limits.upper
     frame_type = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+    least, stuck = math.inf, 0
     for _ in range(settings.iterations):
         pin.framesForwardKinematics(model, data, q)
         placement = data.oMf[frame]
-        if target.reached(placement):
+        excess = target.excess(placement)
+        if excess <= 1.0:  # reached
             break
+        if excess < (1.0 - PROGRESS) * least:
+            least, stuck = excess, 0
+        else:
+            stuck += 1
+            if stuck >= settings.patience:
+                break
         jacobian = pin.computeFrameJacobian(model, data, q, frame, frame_type)
         error = target.position - placement.translation
         if target.rotation is not None:

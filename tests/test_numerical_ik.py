@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 import pytest
 import yourdfpy
 
@@ -87,12 +88,37 @@ def test_a_target_out_of_reach_says_how_close_the_solver_came() -> None:
         ck.solve_ik(robot, ck.IkTarget(np.array([2.0, 0.0, 0.5])))
 
 
+class CountedTarget(ck.IkTarget):
+    """An IK target that counts how often a descent measures its error."""
+
+    steps = 0
+
+    def excess(self, placement: pin.SE3) -> float:
+        CountedTarget.steps += 1
+        return super().excess(placement)
+
+
+def test_a_start_that_makes_no_progress_ends_after_its_patience() -> None:
+    robot = ck.load_robot(example_robot("ur5"))
+    target = CountedTarget(np.array([5.0, 0.0, 0.5]))  # out of reach: the arm stretches, then stalls
+    steps = {}
+    for patience in (20, 1000):
+        CountedTarget.steps = 0
+        settings = ck.IkSettings(restarts=0, iterations=1000, patience=patience)
+        with pytest.raises(ck.IkMissError, match=r"the closest of 1 IK starts came 4\.1"):
+            ck.solve_ik(robot, target, settings=settings)
+        steps[patience] = CountedTarget.steps
+    assert 20 < steps[20] <= 100  # its patience ran out soon after the stretch
+    assert steps[1000] == 1000  # without it, every step is taken
+
+
 @pytest.mark.parametrize(
     ("changes", "pattern"),
     [
         ({"restarts": -1}, r"IkSettings\.restarts = -1 must be an integer in \[0, 100000\]"),
         ({"iterations": 2.5}, r"IkSettings\.iterations = 2\.5 must be an integer"),
         ({"damping": 0.0}, r"IkSettings\.damping = 0\.0 must be a number in \(0, 10\]"),
+        ({"patience": 0}, r"IkSettings\.patience = 0 must be an integer in \[1, 100000\]"),
     ],
 )
 def test_bad_settings_are_refused(changes: dict[str, float], pattern: str) -> None:
