@@ -2,6 +2,8 @@
 
     python scripts/generate_arm_scenes.py --robot ur10 --count 10 --seed 0 --out out/arms/ur10
     python scripts/generate_arm_scenes.py --robot path/to/pr2.urdf --tcp r_gripper_tool_frame ...
+    python scripts/generate_arm_scenes.py --robot path/to/baxter.urdf --tcp left_gripper
+        --srdf path/to/baxter_manipulation.srdf ...   (an SRDF its name does not find)
 
 The scenes of :func:`planning.io.arm_scenes.blocked_scene`, seeds ``--seed`` to
 ``--seed + --count - 1``, named ``<robot>_<seed>``.
@@ -27,6 +29,11 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--robot", required=True, help=f"a URDF path or one of {sorted(EXAMPLE_ROBOTS)}")
     parser.add_argument("--tcp", help="its tool frame (the planned joints: those from the root to it)")
+    parser.add_argument(
+        "--srdf",
+        type=Path,
+        help="its SRDF (default: found by name beside the URDF or in its package's srdf folder)",
+    )
     parser.add_argument("--count", type=int, default=10, help="number of scenes (default: 10)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the first scene (default: 0)")
     parser.add_argument("--margin", type=float, default=0.02, help="safety margin [m] (default: 0.02)")
@@ -41,10 +48,13 @@ def main() -> int:
     named = args.robot in EXAMPLE_ROBOTS
     urdf = example_robot(args.robot) if named else Path(args.robot).resolve()
     entry: str | dict[str, Any] = args.robot if named else str(urdf)
-    if args.tcp:
-        entry = {"urdf": entry, "tcp": args.tcp}
+    srdf = None if args.srdf is None else args.srdf.resolve()
+    if args.tcp or srdf:
+        entry = {"urdf": entry}
+        entry.update({"tcp": args.tcp} if args.tcp else {})
+        entry.update({"srdf": str(srdf)} if srdf else {})
     try:
-        robot = ck.load_robot(urdf, tcp=args.tcp)
+        robot = ck.load_robot(urdf, tcp=args.tcp, srdf=srdf)
         stem = args.robot if named else urdf.stem
         args.out.mkdir(parents=True, exist_ok=True)
         for seed in range(args.seed, args.seed + args.count):

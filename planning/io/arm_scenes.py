@@ -8,8 +8,9 @@ and a ball of 12 % of that reach at the tool's position halfway along the straig
 way between them, at least 10 % of the reach above the base. The goal is given as the tool's
 pose (solved by the planner's IK), the start as the configuration. Start and goal must keep
 ``margin_m + 0.02`` m from the ball and ``self_clearance_m`` between the robot's own checked
-pairs; a draw that does not is drawn again. The straight way is blocked; whether a way
-around exists is for the planners to find out.
+pairs, and gravity's torques there must be within the URDF's effort limits (the planner
+refuses an end its motors cannot hold still); a draw that does not is drawn again. The
+straight way is blocked; whether a way around exists is for the planners to find out.
 """
 
 from __future__ import annotations
@@ -52,6 +53,7 @@ def blocked_scene(
     lower, upper = robot.limits.lower, robot.limits.upper
     middle, half = (lower + upper) / 2, (upper - lower) / 2
     reach = float(np.linalg.norm(ck.frame_poses(robot, middle[None])[0][:3, 3]))
+    dynamics = ck.robot_dynamics(robot)
     for _ in range(draws):
         start, goal = rng.uniform(middle - 0.6 * half, middle + 0.6 * half, (2, robot.nq))
         tools = ck.frame_poses(robot, np.array([start, (start + goal) / 2, goal]))
@@ -63,6 +65,8 @@ def blocked_scene(
         if world.clearance_batch(ends).clearance_m.min() <= margin_m + 0.02:
             continue
         if world.self_collision and world.self_collision.distances(ends)[0].min() <= self_clearance_m:
+            continue
+        if np.any(np.abs(dynamics.torques(ends)) > dynamics.effort):
             continue
         return {
             "name": name,
@@ -77,7 +81,8 @@ def blocked_scene(
         }
     raise PlanningError(
         f"no start and goal of {draws} draws for '{name}' keep {margin_m + 0.02:g} m from the ball and "
-        f"{self_clearance_m:g} m between the robot's own pairs; lower self_clearance_m"
+        f"{self_clearance_m:g} m between the robot's own pairs, with gravity's torques within the effort "
+        "limits; lower self_clearance_m"
     )
 
 
