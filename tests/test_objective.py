@@ -9,7 +9,7 @@ import cpr_kin as ck
 from planning.curves.spline import SepticSplineSolver, uniform_knots
 from planning.io.bundled import paper_scene
 from planning.pipeline.motion import Motion
-from planning.pipeline.objective import WaypointObjective
+from planning.pipeline.objective import PathRules, WaypointObjective
 from planning.pipeline.settings import PlannerSettings
 from planning.pipeline.timing import FixedDuration
 
@@ -26,7 +26,7 @@ def make_objective(
     solver = SepticSplineSolver(uniform_knots(settings.waypoints + 1, 4.0), scene.spline)
     world = ck.CollisionWorld(robot, obstacles)
     motion = Motion(q_start, q_goal, np.array([0, 1, 2]))
-    return WaypointObjective(world, motion, (0.1, 0.01), settings, solver, FixedDuration(4.0))
+    return WaypointObjective(world, motion, PathRules(0.1, 0.01), settings, solver, FixedDuration(4.0))
 
 
 @pytest.fixture(scope="module")

@@ -42,6 +42,7 @@ from planning.pipeline.motion import Motion
 from planning.pipeline.path_terms import executed_paths
 from planning.pipeline.settings import PlannerSettings
 from planning.pipeline.timing import DurationRule
+from planning.pipeline.torques import GravityLimit
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
@@ -69,6 +70,9 @@ class Breakdown:
         limit_excess: largest |velocity|, |acceleration| or |jerk| over its limit, minus 1
             (0 when within limits or when the duration is free).
         node_deviation: largest spline node deviation [rad or m].
+        holding_excess: where the problem holds paths to a gravity limit, how far gravity's
+            largest torque over its effort limit exceeds 1 on the path (0: every checked
+            configuration can be held still).
         min_clearance_m: smallest sampled clearance (``inf`` where every sample is clear of
             the required clearance: distances are computed only where it is violated).
     """
@@ -84,7 +88,25 @@ class Breakdown:
     overshoot: FloatArray
     limit_excess: FloatArray
     node_deviation: FloatArray
+    holding_excess: FloatArray
     min_clearance_m: FloatArray
+
+
+@dataclass(frozen=True)
+class PathRules:
+    """What every configuration of a candidate's path keeps, besides the joint limits.
+
+    Attributes:
+        margin_m: the safety margin from every obstacle [m].
+        self_margin_m: the self margin between the robot's own checked pairs [m].
+        gravity: where gravity may exceed an effort limit, the rule that the motors hold
+            every configuration of a path still (checked at every 4th sample and the last);
+            ``None``: no such rule.
+    """
+
+    margin_m: float
+    self_margin_m: float
+    gravity: GravityLimit | None = None
 
 
 class WaypointObjective:
@@ -93,7 +115,7 @@ class WaypointObjective:
     Args:
         world: robot and obstacles.
         motion: start, goal and the joints the waypoints move.
-        margins_m: the safety margin from obstacles and the self margin [m].
+        rules: the margins every path keeps and, where gravity may bind, its gravity limit.
         settings: planner settings (fitness rule, path kind, IPO, samples, verification step).
         solver: the septic spline solver on the search's knots (``N = p + 1`` segments).
         duration: the scene's duration rule: with a fixed duration the knots are the final
@@ -104,20 +126,20 @@ class WaypointObjective:
         self,
         world: ck.CollisionWorld,
         motion: Motion,
-        margins_m: tuple[float, float],
+        rules: PathRules,
         settings: PlannerSettings,
         solver: SepticSplineSolver,
         duration: DurationRule,
     ) -> None:
-        margin_m, self_margin_m = margins_m
         robot = world.robot
         self.world, self.motion = world, motion
         self.q_start, self.q_goal, self.moving = motion.q_start, motion.q_goal, motion.moving
         self.settings = settings
         self.solver = solver
+        self.gravity = rules.gravity
         self.n_waypoints = settings.waypoints
-        self.required_m = margin_m + settings.verify_step_m
-        self.required_self_m = self_margin_m + settings.self_step_m
+        self.required_m = rules.margin_m + settings.verify_step_m
+        self.required_self_m = rules.self_margin_m + settings.self_step_m
         limits = robot.limits
         self.lower_q, self.upper_q = limits.lower, limits.upper
         self.v_max, self.a_max = limits.velocity, limits.acceleration
@@ -236,8 +258,10 @@ class WaypointObjective:
         deviation_excess = (
             np.zeros_like(deviation) if bound is None else np.maximum(deviation / bound - 1.0, 0.0)
         )
-        other = paths.overshoot + excess + deviation_excess
-        clearance = self._clearance(self.checked_configurations(paths.samples), other <= 0.0)
+        configurations = self.checked_configurations(paths.samples)
+        holding = np.zeros(len(x)) if self.gravity is None else self.gravity.path_excess(configurations)
+        other = paths.overshoot + excess + deviation_excess + holding
+        clearance = self._clearance(configurations, other <= 0.0)
         shortfall = np.maximum(self.required_m - clearance, 0.0)
         effector = np.asarray((clearance[:, :, 0] < self.required_m).any(axis=1))
         links = np.asarray((clearance[:, :, 1] < self.required_m).any(axis=1))
@@ -264,5 +288,6 @@ class WaypointObjective:
             overshoot=paths.overshoot,
             limit_excess=excess,
             node_deviation=deviation,
+            holding_excess=holding,
             min_clearance_m=np.nanmin(clearance, axis=(1, 2)),
         )

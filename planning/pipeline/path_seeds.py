@@ -61,7 +61,11 @@ def sampled_path(
         required_m, required_self_m = kept.objective.required_m, kept.objective.required_self_m
 
         def valid(q: FloatArray) -> BoolArray:
-            return problem.world.keeps_clearance(problem.configurations(q), required_m, required_self_m)
+            configurations = problem.configurations(q)
+            free = problem.world.keeps_clearance(configurations, required_m, required_self_m)
+            if problem.gravity is not None and free.any():  # and can be held still
+                free[free] = problem.gravity.holds(configurations[free])
+            return free
 
         return valid
 

@@ -23,11 +23,11 @@ from planning.curves.spline import SepticSplineSolver, uniform_knots
 from planning.errors import PlanningError, TargetOutOfReachError
 from planning.pipeline.deadline import Deadline
 from planning.pipeline.motion import Motion
-from planning.pipeline.objective import WaypointObjective
+from planning.pipeline.objective import PathRules, WaypointObjective
 from planning.pipeline.scene import Scene
 from planning.pipeline.settings import VERIFY_STEP_RANGE_M
 from planning.pipeline.timing import FixedDuration, FreeDuration, duration_rule
-from planning.pipeline.torques import problem_dynamics, search_torque
+from planning.pipeline.torques import GravityLimit, gravity_limit, problem_dynamics, search_torque
 
 FloatArray = NDArray[np.float64]
 
@@ -49,6 +49,10 @@ class Problem:
             the scene fixes the duration, else the geometric path's.
         objective: the waypoint objective the search minimises.
         dynamics: the robot's torques with the scene's payload, and their limits.
+        gravity: where gravity may exceed an effort limit between start and goal, the rule
+            that every configuration of a path be one the motors can hold still (the
+            search's and the sampling planner's; :func:`~planning.pipeline.torques.gravity_limit`);
+            ``None`` elsewhere.
         build_time_s: wall time of :func:`build_problem` [s].
         deadline: when its plan must stop (:func:`~planning.pipeline.planner.solve` sets it
             from the planner's ``time_limit_s``; default: never).
@@ -62,6 +66,7 @@ class Problem:
     solver: SepticSplineSolver = field(repr=False)
     objective: WaypointObjective = field(repr=False)
     dynamics: ck.Dynamics = field(repr=False)
+    gravity: GravityLimit | None = field(default=None, repr=False)
     build_time_s: float = 0.0
     deadline: Deadline = field(default_factory=Deadline)
 
@@ -201,7 +206,8 @@ def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | No
     duration = duration_rule(scene.duration, search_torque(robot, dynamics, q_start, q_goal))
     if isinstance(duration, FixedDuration):
         duration.check_reachable(robot, q_start, q_goal, rest_ends=scene.spline.ends == "rest")
-    solver, objective = _search_space(scene, world, motion, duration)
+    gravity = gravity_limit(robot, dynamics, q_start, motion.moving)
+    solver, objective = _search_space(scene, world, motion, duration, gravity)
     return Problem(
         scene=scene,
         robot=robot,
@@ -211,6 +217,7 @@ def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | No
         solver=solver,
         objective=objective,
         dynamics=dynamics,
+        gravity=gravity,
         build_time_s=time.perf_counter() - started,
     )
 
@@ -226,7 +233,7 @@ def with_planner(problem: Problem, **changes: Any) -> Problem:
         return problem
     started = time.perf_counter()
     scene = dataclasses.replace(problem.scene, planner=settings)
-    solver, objective = _search_space(scene, problem.world, problem.motion, problem.duration)
+    solver, objective = _search_space(scene, problem.world, problem.motion, problem.duration, problem.gravity)
     return dataclasses.replace(
         problem,
         scene=scene,
@@ -255,13 +262,17 @@ def finer_step_m(problem: Problem) -> float:
 
 
 def _search_space(
-    scene: Scene, world: ck.CollisionWorld, motion: Motion, duration: FixedDuration | FreeDuration
+    scene: Scene,
+    world: ck.CollisionWorld,
+    motion: Motion,
+    duration: FixedDuration | FreeDuration,
+    gravity: GravityLimit | None,
 ) -> tuple[SepticSplineSolver, WaypointObjective]:
-    """The spline solver on the search's knots and the waypoint objective."""
+    """The spline solver on the search's knots and the waypoint objective (held to ``gravity``, if any)."""
     segments = scene.planner.waypoints + 1
     # the spline on the search's knots: the trajectory itself when the scene fixes the duration,
     # else the geometric path that the timing runs as fast as the limits allow
     solver = SepticSplineSolver(uniform_knots(segments, duration.nominal_duration(segments)), scene.spline)
-    margins = (scene.safety_margin, scene.self_margin)
-    objective = WaypointObjective(world, motion, margins, scene.planner, solver, duration)
+    rules = PathRules(scene.safety_margin, scene.self_margin, gravity)
+    objective = WaypointObjective(world, motion, rules, scene.planner, solver, duration)
     return solver, objective

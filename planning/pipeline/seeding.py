@@ -144,6 +144,8 @@ class PathSeeding:
             if finer is not None and tuning.finer_after < tuning.max_samples:
                 tried += f" (nor {finer.objective.required_m:.4g} m after {tuning.finer_after})"
             tried += f" in {tuning.max_samples} samples"
+            if problem.gravity is not None:
+                tried += " through configurations the motors can hold still"
         return Attempt(seeds.problem, seeds.candidates, seeds.path, 0, tried, seeds.feasible, seeds.no_path)
 
     def after(self, attempt: Attempt, searched: SearchResult) -> Attempt | None:  # noqa: D102

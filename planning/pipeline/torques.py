@@ -1,7 +1,11 @@
 """The joint torques a trajectory asks of the robot, checked against its effort limits.
 
 :func:`problem_dynamics` builds the robot's dynamics with the scene's payload once per
-problem and refuses a start or goal the motors cannot hold still. :func:`torque_profile`
+problem and refuses a start or goal the motors cannot hold still. Where gravity alone may
+exceed a limit between them (a heavy arm, weak shoulder motors, a payload),
+:func:`gravity_limit` gives the search the rule of :class:`GravityLimit`: every configuration
+of a path must be one the motors can hold still, as no timing makes a motion through one
+they cannot feasible. :func:`torque_profile`
 samples a trajectory's torques by Pinocchio's RNEA every :data:`CHECK_STEP_S` and at its
 knots: the verification (:func:`torque_problems`), the report and the plots read it. It
 shares nothing with the timing's torque terms (:mod:`planning.curves.torque_limits`) but the
@@ -36,6 +40,64 @@ CHECK_STEP_S = 1e-3
 """Spacing of the instants at which a trajectory's torques are checked [s]."""
 TORQUE_TOLERANCE = 1e-9
 """Relative excess of an effort limit that still passes (rounding)."""
+GRAVITY_SAMPLES = 256
+"""Seeded configurations of the moving joints at which :func:`gravity_limit` asks whether gravity binds."""
+GRAVITY_GATE = 0.75
+"""The share of an effort limit that gravity must need at one of those configurations for
+:func:`gravity_limit` to hold the search to :class:`GravityLimit` (a margin for the
+configurations between the samples: gravity's torques vary smoothly over the ranges)."""
+
+
+@dataclass(frozen=True)
+class GravityLimit:
+    """The configurations the motors can hold still: gravity's torques within the effort limits.
+
+    Attributes:
+        dynamics: the robot's dynamics with the scene's payload.
+    """
+
+    dynamics: ck.Dynamics
+
+    def usage(self, q: FloatArray) -> FloatArray:
+        """``(N,)`` the largest ``|gravity torque| / effort`` of the joints at ``q`` ``(N, nq)``."""
+        if not len(q):
+            return np.zeros(0)
+        return np.asarray(np.max(np.abs(self.dynamics.torques(q)) / self.dynamics.effort, axis=1))
+
+    def path_excess(self, samples: FloatArray) -> FloatArray:
+        """``(S,)`` how far gravity's largest torque over its effort exceeds 1 on paths ``(S, K, nq)``.
+
+        0 where every configuration checked can be held still. Checked at every 4th sample
+        and the last: gravity's torques vary smoothly along a path.
+        """
+        count, k, nq = samples.shape
+        checked = np.unique(np.append(np.arange(0, k, 4), k - 1))
+        usage = self.usage(samples[:, checked].reshape(-1, nq)).reshape(count, len(checked))
+        return np.asarray(np.maximum(usage.max(axis=1) - 1.0, 0.0))
+
+    def holds(self, q: FloatArray) -> NDArray[np.bool_]:
+        """``(N,)`` whether the motors can hold each configuration of ``q`` ``(N, nq)`` still."""
+        return np.asarray(self.usage(q) <= 1.0 + TORQUE_TOLERANCE)
+
+
+def gravity_limit(
+    robot: ck.Robot, dynamics: ck.Dynamics, q_start: FloatArray, moving: NDArray[np.intp]
+) -> GravityLimit | None:
+    """The :class:`GravityLimit` of ``dynamics`` where gravity may bind, else ``None``.
+
+    Bind: at one of :data:`GRAVITY_SAMPLES` seeded configurations (the ``moving`` joints drawn
+    over their ranges, the others where they start), gravity needs :data:`GRAVITY_GATE` of an
+    effort limit or more. Elsewhere (the example arms, the CPR, without a heavy payload) the
+    search is spared the torques of its samples; the verification checks the torques of
+    every trajectory all the same.
+    """
+    if not dynamics.limited:
+        return None
+    lower, upper = robot.limits.lower[moving], robot.limits.upper[moving]
+    q = np.tile(q_start, (GRAVITY_SAMPLES, 1))
+    q[:, moving] = np.random.default_rng(0).uniform(lower, upper, (GRAVITY_SAMPLES, len(moving)))
+    limit = GravityLimit(dynamics)
+    return limit if float(limit.usage(q).max()) >= GRAVITY_GATE else None
 
 
 @dataclass(frozen=True)
