@@ -19,8 +19,11 @@ goal are valid in our model, solved by each, median and p95 warm planning time o
 the problems it solved and the ratio of those medians, then the ratio of the medians over the
 problems both solved (the same problems) and over every valid problem (a failure counted at
 the time it took, up to the timeout), ours' median duration over Ruckig's jerk-limited bound
-for the straight line, OMPL's median jerk over the limit, and how many of ours pass
-``cpr-plan check`` (the trajectory file read back and verified anew, untimed). Rows go to
+for the straight line, OMPL's median jerk over the limit, how many of OMPL's trajectories
+drive a joint's torque beyond its effort limit (RNEA every millisecond with the scene's
+payload, untimed; TOPP-RA's timing knows neither jerk nor torque limits, ours keeps both), and
+how many of ours pass ``cpr-plan check`` (the trajectory file read back and verified anew,
+untimed). Rows go to
 ``DIR/mbm.csv``, the table as markdown to ``DIR/mbm.md``. Needs the ``bench`` extra; the
 problems are downloaded once (:mod:`planning.io.mbm`).
 
@@ -151,9 +154,22 @@ def theirs(scene_path: str, timeout_s: float) -> dict[str, Any]:
                 "time_s": elapsed,
                 "duration_s": result.duration,
                 "jerk": result.jerk_over_limit,
+                "torque": torque_over_limit(scene, robot, result.timed, result.duration),
             }
         seed += 1
     return {"ok": False, "time_s": time.perf_counter() - started}
+
+
+def torque_over_limit(scene: Any, robot: ck.Robot, timed: Any, duration_s: float) -> float:
+    """The largest ``|torque| / effort`` of a joint along a timed trajectory (RNEA every ms, untimed).
+
+    ``timed(t, order)``: positions, velocities, accelerations at times ``t`` [s]; the scene's
+    payload and ``torque_scale`` as ours are held to. 0 where no joint has an effort limit.
+    """
+    dynamics = ck.robot_dynamics(robot, scene.payload, scene.torque_scale)
+    times = np.union1d(np.arange(0.0, duration_s, 1e-3), [duration_s])
+    torques = dynamics.torques(*(np.asarray(timed(times, order)) for order in (0, 1, 2)))
+    return float(np.max(np.abs(torques) / dynamics.effort))
 
 
 def valid(scene_path: Path) -> str | None:
@@ -293,7 +309,7 @@ def main() -> int:
         writer.writerows(rows)
     print(f"\n{'robot':6s} {'class':17s} {'valid':>5s} {'ours':>4s} {'ompl':>4s}", end="")
     print(f"  {'ours med/p95 s':>15s}  {'ompl med/p95 s':>15s}  ratio  both   all  dur/bound", end="")
-    print("  ompl jerk/lim  checked")
+    print("  ompl jerk/lim  ompl >effort  checked")
     report = [
         f"{'Scene files' if args.scenes else f'MotionBenchMaker, {args.limit or 100} problem(s) per class'}, "
         f"timeout {args.timeout:g} s (ours: time_limit_s {time_limit_s:g} s), "
@@ -301,8 +317,8 @@ def main() -> int:
         "",
         "| robot | class | valid | solved ours | solved OMPL | ours median (p95) [s] | OMPL median (p95) [s] "
         "| ratio | ratio, both solved | ratio, all | ours duration / Ruckig bound | OMPL jerk / limit "
-        "| ours passing `check` |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "| OMPL beyond an effort limit | ours passing `check` |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for robot_name in dict.fromkeys(r["robot"] for r in rows):
         for problem_class in [*dict.fromkeys(r["class"] for r in rows if r["robot"] == robot_name), "all"]:
@@ -319,19 +335,20 @@ def main() -> int:
             ratio_both = median_ratio([r["ours_time_s"] for r in both], [r["ompl_time_s"] for r in both])
             ratio_all = median_ratio([r["ours_time_s"] for r in group], [r["ompl_time_s"] for r in group])
             checked = sum(1 for r in group if r.get("ours_checked"))
+            beyond = sum(1 for r in group if r.get("ompl_ok") and r["ompl_torque"] > 1.0 + 1e-9)
             print(
                 f"{robot_name:6s} {problem_class:17s} {len(group):5d} {len(mine):4d} {len(peer):4d}  "
                 f"{percentile(mine, 50):6.2f} / {percentile(mine, 95):6.2f}  "
                 f"{percentile(peer, 50):6.2f} / {percentile(peer, 95):6.2f}"
                 f"  {ratio:5.2f} {ratio_both:5.2f} {ratio_all:5.2f}"
-                f"  {percentile(bounds, 50):9.3f}  {percentile(jerks, 50):13.1f}  {checked:7d}"
+                f"  {percentile(bounds, 50):9.3f}  {percentile(jerks, 50):13.1f}  {beyond:11d}  {checked:7d}"
             )
             report.append(
                 f"| {robot_name} | {problem_class} | {len(group)} | {len(mine)} | {len(peer)} "
                 f"| {percentile(mine, 50):.2f} ({percentile(mine, 95):.2f}) "
                 f"| {percentile(peer, 50):.2f} ({percentile(peer, 95):.2f}) | {ratio:.2f} "
                 f"| {ratio_both:.2f} ({len(both)}) | {ratio_all:.2f} "
-                f"| {percentile(bounds, 50):.3f} | {percentile(jerks, 50):.1f} | {checked} |"
+                f"| {percentile(bounds, 50):.3f} | {percentile(jerks, 50):.1f} | {beyond} | {checked} |"
             )
     (args.out / "mbm.md").write_text("\n".join(report) + "\n")
     print(f"\nrows: {args.out / 'mbm.csv'}; table: {args.out / 'mbm.md'}")

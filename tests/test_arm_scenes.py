@@ -132,7 +132,9 @@ def test_the_scripts_draw_scenes_and_run_them_beside_ompl(tmp_path: Path) -> Non
     ]
     assert all(r["ours_ok"] == "True" and float(r["ours_time_s"]) > 0 for r in read)
     assert all(r["ours_checked"] == "True" for r in read)  # cpr-plan check's verdict on the file
-    assert "| xarm7 | all | 2 | 2 |" in (tmp_path / "bench" / "mbm.md").read_text()
+    table = (tmp_path / "bench" / "mbm.md").read_text()
+    assert "| xarm7 | all | 2 | 2 |" in table and "| OMPL beyond an effort limit |" in table
+    assert all(float(r["ompl_torque"]) > 0 for r in read if r["ompl_ok"] == "True")  # gravity at least
 
 
 @pytest.mark.slow

@@ -14,7 +14,8 @@ from __future__ import annotations
 
 import dataclasses
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -42,6 +43,8 @@ class SamplingResult:
         jerk_over_limit: the largest |jerk| / jerk limit over the joints, the same way
             (TOPP-RA knows no jerk limit).
         planning_time_s: wall time of search, simplification, timing and verification [s].
+        timed: TOPP-RA's trajectory, ``timed(t, order)`` at times ``t`` [s] (``None`` when it
+            failed before timing): a benchmark reads its torques from it, untimed.
     """
 
     success: bool
@@ -53,6 +56,7 @@ class SamplingResult:
     max_abs_jerk: float
     jerk_over_limit: float
     planning_time_s: float
+    timed: Any = field(default=None, repr=False, compare=False)
 
     @classmethod
     def failure(cls, reason: str, nq: int, started: float) -> SamplingResult:
@@ -163,6 +167,7 @@ def time_and_verify(
         max_abs_jerk=float(np.abs(jerk).max()),
         jerk_over_limit=float(np.max(np.abs(jerk) / limits.jerk)),
         planning_time_s=time.perf_counter() - started,
+        timed=timed,
     )
 
 

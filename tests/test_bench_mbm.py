@@ -1,0 +1,48 @@
+"""``scripts/bench_mbm.py``'s figures of OMPL's trajectories: the torques it reads from them."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+from types import ModuleType, SimpleNamespace
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import cpr_kin as ck
+from cpr_kin.packages import example_robot
+
+SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "bench_mbm.py"
+
+
+@pytest.fixture(scope="module")
+def bench() -> ModuleType:
+    spec = importlib.util.spec_from_file_location("bench_mbm", SCRIPT)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_torque_over_the_limit_is_pinocchio_s_rnea_along_the_trajectory(bench: ModuleType) -> None:
+    robot = ck.load_robot(example_robot("ur5"))
+    start = np.array([0.3, -1.2, 1.0, -0.5, 0.8, 0.1])
+    acceleration = np.array([2.0, -3.0, 4.0, 1.0, -2.0, 3.0])  # [rad/s^2], uniform
+
+    def timed(t: np.ndarray, order: int) -> np.ndarray:
+        t = np.asarray(t)[:, None]
+        values: list[np.ndarray] = [start + acceleration * t**2 / 2, acceleration * t, acceleration + 0 * t]
+        return values[order]
+
+    scene = SimpleNamespace(payload=None, torque_scale=0.5)
+    usage = bench.torque_over_limit(scene, robot, timed, 0.4)
+    model = robot.model
+    data = model.createData()
+    effort = 0.5 * model.effortLimit
+    times = np.linspace(0.0, 0.4, 401)  # the same millisecond grid
+    oracle = max(
+        float(np.max(np.abs(pin.rnea(model, data, *(timed(np.array([t]), k)[0] for k in range(3)))) / effort))
+        for t in times
+    )
+    assert usage == pytest.approx(oracle, rel=1e-9)
