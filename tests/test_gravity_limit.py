@@ -94,3 +94,16 @@ def test_no_path_names_the_rule_it_kept(talos: ck.Robot) -> None:
     attempt = PathSeeding().first(one_sample)
     assert attempt.no_path
     assert attempt.tried.endswith("in 1 samples through configurations the motors can hold still")
+
+
+def test_a_goal_pose_takes_an_ik_solution_the_motors_can_hold() -> None:
+    # the PR2's right arm, scene 700: the clear solution nearest the start needs 38.4 N m of
+    # the shoulder lift (30 N m); another one of the same pose needs less
+    pr2_description = SHARE / "example-robot-data" / "robots" / "pr2_description"
+    entry = {"urdf": str(pr2_description / "urdf" / "pr2.urdf"), "tcp": "r_gripper_tool_frame"}
+    pr2 = ck.load_robot(entry["urdf"], tcp=entry["tcp"])
+    scene = parse_scene(blocked_scene("pr2_700", entry, pr2, 700, self_clearance_m=0.015))
+    problem = build_problem(scene, pr2)
+    holding = problem.dynamics.torques(problem.q_goal)[0]
+    assert np.all(np.abs(holding) <= problem.dynamics.effort)
+    assert scene.goal.miss(pr2, problem.q_goal) is None  # and it reaches the pose

@@ -149,20 +149,25 @@ def endpoint_violations(scene: Scene, robot: ck.Robot) -> list[str]:
     """Why the scene's start and goal are not valid in ``robot``'s collision model (empty: both are).
 
     Each is ``"<start|goal> <what>"``: a joint value out of range, a pose out of reach, or
-    what comes inside the safety or self margin. Found as the planner finds its ends
-    (:func:`planning.pipeline.problem.endpoint`): a ``pose`` or ``tcp`` by the IK solution
-    clear of the margins nearest the start, so a pose with a clear solution is valid even
-    where the IK's first solution is not.
+    what comes inside the safety or self margin, or a configuration the motors cannot hold
+    still. Found as the planner finds its ends (:func:`planning.pipeline.problem.endpoint`): a
+    ``pose`` or ``tcp`` by the IK solution clear of the margins, and held, nearest the start,
+    so a pose with such a solution is valid even where the IK's first solution is not.
     """
     from planning.errors import NoSolutionError
     from planning.pipeline.problem import endpoint
+    from planning.pipeline.torques import scene_dynamics
 
     world = ck.CollisionWorld(robot, scene.obstacles, allowed_pairs=scene.allowed_collisions)
+    try:
+        dynamics = scene_dynamics(robot, scene)
+    except PlanningError as exc:
+        return [f"start is refused: {exc}", f"goal is refused: {exc}"]
     found = []
     q_start = None
     for label in ("start", "goal"):
         try:
-            q = endpoint(robot, world, scene, label, seed_q=q_start)
+            q = endpoint(robot, world, scene, label, seed_q=q_start, dynamics=dynamics)
         except (PlanningError, NoSolutionError, ck.CprKinError) as exc:
             found.append(str(exc) if str(exc).startswith(label) else f"{label} is refused: {exc}")
             continue

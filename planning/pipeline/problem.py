@@ -27,7 +27,7 @@ from planning.pipeline.objective import PathRules, WaypointObjective
 from planning.pipeline.scene import Scene
 from planning.pipeline.settings import VERIFY_STEP_RANGE_M
 from planning.pipeline.timing import FixedDuration, FreeDuration, duration_rule
-from planning.pipeline.torques import GravityLimit, gravity_limit, problem_dynamics, search_torque
+from planning.pipeline.torques import GravityLimit, check_held, gravity_limit, scene_dynamics, search_torque
 
 FloatArray = NDArray[np.float64]
 
@@ -148,21 +148,34 @@ def margin_violation(world: ck.CollisionWorld, scene: Scene, q: FloatArray) -> s
 
 
 def endpoint(
-    robot: ck.Robot, world: ck.CollisionWorld, scene: Scene, label: str, seed_q: FloatArray | None = None
+    robot: ck.Robot,
+    world: ck.CollisionWorld,
+    scene: Scene,
+    label: str,
+    seed_q: FloatArray | None = None,
+    dynamics: ck.Dynamics | None = None,
 ) -> FloatArray:
     """The configuration of the scene's start or goal, verified; refused if out of reach or inside a margin.
 
     A ``tcp`` or ``pose`` is solved by IK (:meth:`~planning.pipeline.target.Target.configuration`):
-    the solution nearest ``seed_q`` of those clear of the margins.
+    the solution nearest ``seed_q`` of those clear of the margins and, with ``dynamics``, that
+    the motors can hold still (:func:`~planning.pipeline.torques.check_held`).
 
     Raises:
         PlanningError: a joint vector of the wrong length, naming the wrong joints or outside
             the ranges; a configuration inside the safety or self margin.
         TargetOutOfReachError: no configuration reaches a ``tcp`` or ``pose`` (its distance named).
+        PayloadTooHeavyError: with ``dynamics``, the motors cannot hold the configuration still.
     """
     target = scene.start if label == "start" else scene.goal
+
+    def accepted(q: FloatArray) -> bool:
+        if margin_violation(world, scene, q) is not None:
+            return False
+        return dynamics is None or bool(np.all(np.abs(dynamics.torques(q)[0]) <= dynamics.effort))
+
     try:
-        q = target.configuration(robot, seed_q, lambda x: margin_violation(world, scene, x) is None)
+        q = target.configuration(robot, seed_q, accepted)
     except ck.IkMissError as exc:
         raise TargetOutOfReachError(f"{label} is out of reach: {exc}") from None
     except ck.CprKinError as exc:
@@ -171,6 +184,8 @@ def endpoint(
     violation = margin_violation(world, scene, q)
     if violation is not None:
         raise PlanningError(f"{label} q = {np.round(q, 4).tolist()} {violation}")
+    if dynamics is not None:
+        check_held(dynamics, scene, label, q)
     return q
 
 
@@ -199,10 +214,10 @@ def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | No
     world = ck.CollisionWorld(
         robot, scene.obstacles, num_threads=threads, allowed_pairs=scene.allowed_collisions
     )
-    q_start = endpoint(robot, world, scene, "start")
-    q_goal = endpoint(robot, world, scene, "goal", seed_q=q_start)
+    dynamics = scene_dynamics(robot, scene, world.num_threads)
+    q_start = endpoint(robot, world, scene, "start", dynamics=dynamics)
+    q_goal = endpoint(robot, world, scene, "goal", seed_q=q_start, dynamics=dynamics)
     motion = Motion(q_start, q_goal, moving_joints(robot, scene, q_start, q_goal))
-    dynamics = problem_dynamics(robot, scene, q_start, q_goal, world.num_threads)
     duration = duration_rule(scene.duration, search_torque(robot, dynamics, q_start, q_goal))
     if isinstance(duration, FixedDuration):
         duration.check_reachable(robot, q_start, q_goal, rest_ends=scene.spline.ends == "rest")

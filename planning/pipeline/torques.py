@@ -1,7 +1,7 @@
 """The joint torques a trajectory asks of the robot, checked against its effort limits.
 
-:func:`problem_dynamics` builds the robot's dynamics with the scene's payload once per
-problem and refuses a start or goal the motors cannot hold still. Where gravity alone may
+:func:`scene_dynamics` builds the robot's dynamics with the scene's payload once per
+problem and :func:`check_held` refuses a start or goal the motors cannot hold still. Where gravity alone may
 exceed a limit between them (a heavy arm, weak shoulder motors, a payload),
 :func:`gravity_limit` gives the search the rule of :class:`GravityLimit`: every configuration
 of a path must be one the motors can hold still, as no timing makes a motion through one
@@ -152,40 +152,44 @@ def torque_problems(dynamics: ck.Dynamics, profile: TorqueProfile) -> list[str]:
     ]
 
 
-def problem_dynamics(
-    robot: ck.Robot, scene: Scene, q_start: FloatArray, q_goal: FloatArray, threads: int = 1
-) -> ck.Dynamics:
-    """The robot's dynamics with the scene's payload, able to hold the start and goal still.
+def scene_dynamics(robot: ck.Robot, scene: Scene, threads: int = 1) -> ck.Dynamics:
+    """The robot's dynamics with the scene's payload and ``torque_scale``.
 
     ``threads``: those of its batched torque computations (the collision world's).
 
     Raises:
         PlanningError: the payload's frame is not the robot's.
-        PayloadTooHeavyError: gravity's torque at the start or goal exceeds a joint's
-            effort limit (times ``torque_scale``), naming the joint, the torque and the limit.
     """
     try:
-        dynamics = ck.robot_dynamics(robot, scene.payload, scene.torque_scale, threads)
+        return ck.robot_dynamics(robot, scene.payload, scene.torque_scale, threads)
     except ck.CprKinError as exc:
         raise PlanningError(f"payload: {exc}") from None
-    for label, q in (("start", q_start), ("goal", q_goal)):
-        holding = np.abs(dynamics.torques(q)[0])
-        j = int(np.argmax(holding / dynamics.effort))
-        if holding[j] > dynamics.effort[j]:
-            unit = _unit(dynamics, j)
-            carried = "" if scene.payload is None else f" with the {scene.payload.mass_kg:g} kg payload"
-            fix = (
-                f"lighten the payload or choose another {label}"
-                if scene.payload is not None
-                else f"choose another {label}, or give the URDF the effort limits the arm has (a "
-                "counterbalanced arm's springs are not in its URDF)"
-            )
-            raise PayloadTooHeavyError(
-                f"holding the {label} still{carried} takes {holding[j]:.4g}{unit} at joint "
-                f"'{dynamics.joint_names[j]}', beyond its effort limit {dynamics.effort[j]:.4g}{unit} "
-                f"(URDF effort x torque_scale {dynamics.torque_scale:g}); {fix}"
-            )
-    return dynamics
+
+
+def check_held(dynamics: ck.Dynamics, scene: Scene, label: str, q: FloatArray) -> None:
+    """Refuse the scene's start or goal (``label``) at ``q`` if the motors cannot hold it still.
+
+    Raises:
+        PayloadTooHeavyError: gravity's torque at ``q`` exceeds a joint's effort limit (times
+            ``torque_scale``), naming the joint, the torque and the limit.
+    """
+    holding = np.abs(dynamics.torques(q)[0])
+    j = int(np.argmax(holding / dynamics.effort))
+    if holding[j] <= dynamics.effort[j]:
+        return
+    unit = _unit(dynamics, j)
+    carried = "" if scene.payload is None else f" with the {scene.payload.mass_kg:g} kg payload"
+    fix = (
+        f"lighten the payload or choose another {label}"
+        if scene.payload is not None
+        else f"choose another {label}, or give the URDF the effort limits the arm has (a "
+        "counterbalanced arm's springs are not in its URDF)"
+    )
+    raise PayloadTooHeavyError(
+        f"holding the {label} still{carried} takes {holding[j]:.4g}{unit} at joint "
+        f"'{dynamics.joint_names[j]}', beyond its effort limit {dynamics.effort[j]:.4g}{unit} "
+        f"(URDF effort x torque_scale {dynamics.torque_scale:g}); {fix}"
+    )
 
 
 def search_torque(
