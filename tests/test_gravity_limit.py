@@ -18,7 +18,8 @@ from planning.pipeline.tuning import SearchTuning, SeedingTuning
 
 SHARE = example_robot_data_share()
 assert SHARE is not None, "example-robot-data is part of the robots extra, which make installs"
-TALOS = SHARE / "example-robot-data" / "robots" / "talos_data" / "robots" / "talos_left_arm.urdf"
+ROBOTS = SHARE / "example-robot-data" / "robots"
+TALOS = ROBOTS / "talos_data" / "robots" / "talos_left_arm.urdf"
 TALOS_TOOL = "gripper_left_base_link"
 
 
@@ -99,7 +100,7 @@ def test_no_path_names_the_rule_it_kept(talos: ck.Robot) -> None:
 def test_a_goal_pose_takes_an_ik_solution_the_motors_can_hold() -> None:
     # the PR2's right arm, scene 700: the clear solution nearest the start needs 38.4 N m of
     # the shoulder lift (30 N m); another one of the same pose needs less
-    pr2_description = SHARE / "example-robot-data" / "robots" / "pr2_description"
+    pr2_description = ROBOTS / "pr2_description"
     entry = {"urdf": str(pr2_description / "urdf" / "pr2.urdf"), "tcp": "r_gripper_tool_frame"}
     pr2 = ck.load_robot(entry["urdf"], tcp=entry["tcp"])
     scene = parse_scene(blocked_scene("pr2_700", entry, pr2, 700, self_clearance_m=0.015))
