@@ -93,7 +93,7 @@ in 0.1 s), below what arms' makers publish (Franka's Panda: 500 a)."""
 
 @dataclass(frozen=True)
 class DynamicLimits:
-    """Acceleration and jerk limits of the planned joints, and where they came from.
+    """Velocity, acceleration and jerk limits of the planned joints, and where they came from.
 
     Attributes:
         acceleration: per joint [rad/s^2 or m/s^2].
@@ -101,12 +101,15 @@ class DynamicLimits:
         source: the limits file read, or ``None`` when none was found.
         defaulted: the joints whose acceleration or jerk is a default
             (:data:`DEFAULT_ACCELERATION_PER_S`, :data:`DEFAULT_JERK_PER_S`).
+        velocity: per joint [rad/s or m/s]: the URDF's, or the file's where the URDF gives
+            none (0 or no ``velocity``); ``None``: the URDF's throughout.
     """
 
     acceleration: FloatArray
     jerk: FloatArray
     source: Path | None
     defaulted: tuple[str, ...]
+    velocity: FloatArray | None = None
 
 
 def default_limits(velocity: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -140,9 +143,10 @@ def read_dynamic_limits(
     """Read acceleration and jerk limits from a limits file (the format of ``cpr_limits.yaml``).
 
     The file maps joint names to ``{velocity, acceleration, jerk}``; ``velocity`` is optional
-    and, when given, must agree with the URDF's. A joint the file leaves out, or whose
-    acceleration or jerk it leaves out, gets :func:`default_limits`; with no file (``path``
-    ``None``) every joint does.
+    and, when given, must agree with the URDF's, unless the URDF gives none (0, as many
+    description-only URDFs do): then the file's is the joint's. A joint the file leaves out,
+    or whose acceleration or jerk it leaves out, gets :func:`default_limits` of its velocity;
+    with no file (``path`` ``None``) every joint does.
 
     Args:
         path: the file, or ``None``.
@@ -152,10 +156,13 @@ def read_dynamic_limits(
 
     Raises:
         UrdfError: the file is unreadable, names a joint the URDF lacks, or holds a value
-            that is not a number, or a velocity that disagrees with the URDF's.
+            that is not a number, or a velocity that disagrees with the URDF's; a joint has a
+            velocity limit from neither.
     """
-    acc_default, jerk_default = default_limits(urdf_velocity)
+    urdf_velocity = np.asarray(urdf_velocity, dtype=float)
     if path is None:
+        _require_velocity(names, urdf_velocity, None)
+        acc_default, jerk_default = default_limits(urdf_velocity)
         return DynamicLimits(acc_default, jerk_default, None, tuple(names))
     try:
         raw = load_yaml(path, MAX_LIMITS_BYTES, "joint limits file")
@@ -170,8 +177,13 @@ def read_dynamic_limits(
             f"joint limits file '{path}' names unknown joint(s) [{listed}]; the robot's are "
             f"{list(dict.fromkeys((*names, *known)))}"
         )
-    acc = acc_default.copy()
-    jerk = jerk_default.copy()
+    velocity = urdf_velocity.copy()
+    for i, name in enumerate(names):  # the file's velocity where the URDF gives none
+        entry = raw.get(name)
+        if not velocity[i] > 0.0 and isinstance(entry, dict) and _is_number(entry.get("velocity")):
+            velocity[i] = float(entry["velocity"])
+    _require_velocity(names, velocity, path)
+    acc, jerk = default_limits(velocity)
     defaulted = []
     for i, name in enumerate(names):
         entry = raw.get(name, {})
@@ -187,7 +199,7 @@ def read_dynamic_limits(
                 f"joint limits file '{path}': joint '{name}' has unknown key(s) {extra}; "
                 f"allowed: {list(_KINDS)}"
             )
-        defaults = {"velocity": urdf_velocity[i], "acceleration": acc[i], "jerk": jerk[i]}
+        defaults = {"velocity": velocity[i], "acceleration": acc[i], "jerk": jerk[i]}
         values: dict[str, Any] = {kind: entry.get(kind, defaults[kind]) for kind in _KINDS}
         for kind, value in values.items():
             if isinstance(value, bool) or not isinstance(value, int | float):
@@ -196,12 +208,28 @@ def read_dynamic_limits(
                     f"joint limits file '{path}': joint '{name}' {kind} = {shown} must be a number"
                 )
         acc[i], jerk[i], vel = float(values["acceleration"]), float(values["jerk"]), float(values["velocity"])
-        if not np.isclose(vel, urdf_velocity[i]):
+        if not np.isclose(vel, velocity[i]):
             raise UrdfError(
                 f"joint limits file '{path}': joint '{name}' velocity {vel} disagrees with "
                 f"the URDF's {urdf_velocity[i]}; edit one so that they match"
             )
-    return DynamicLimits(acc, jerk, path, tuple(defaulted))
+    given = None if np.array_equal(velocity, urdf_velocity) else velocity
+    return DynamicLimits(acc, jerk, path, tuple(defaulted), given)
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool)
+
+
+def _require_velocity(names: tuple[str, ...], velocity: FloatArray, path: Path | None) -> None:
+    """Refuse joints with no velocity limit > 0, naming them and the two places to give one."""
+    missing = [name for name, v in zip(names, velocity, strict=True) if not v > 0.0]
+    if missing:
+        where = f"the limits file '{path}'" if path is not None else "a limits file (limits=...)"
+        raise UrdfError(
+            f"joint(s) {missing} have no velocity limit (the URDF's is 0 or missing); the timing needs "
+            f"one > 0 [rad/s or m/s]: give <limit velocity=...> in the URDF, or 'velocity' in {where}"
+        )
 
 
 def sampled_configurations(model: Any, count: int, rng: np.random.Generator) -> FloatArray:

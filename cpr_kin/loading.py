@@ -127,6 +127,9 @@ class RobotSpec:
             or makers_limits_path(tree.getroot().get("name", ""), known)
         )
         dynamic = read_dynamic_limits(limits_file, names, velocity, known)
+        if dynamic.velocity is not None:  # the file's, where the URDF gives none
+            velocity = dynamic.velocity
+            model.velocityLimit = velocity
         limits = JointLimits(
             names=names,
             lower=np.array(model.lowerPositionLimit, dtype=float),

@@ -34,6 +34,11 @@ def main() -> int:
         type=Path,
         help="its SRDF (default: found by name beside the URDF or in its package's srdf folder)",
     )
+    parser.add_argument(
+        "--limits",
+        type=Path,
+        help="its velocity, acceleration and jerk limits file (default: found beside the URDF)",
+    )
     parser.add_argument("--count", type=int, default=10, help="number of scenes (default: 10)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the first scene (default: 0)")
     parser.add_argument("--margin", type=float, default=0.02, help="safety margin [m] (default: 0.02)")
@@ -49,12 +54,14 @@ def main() -> int:
     urdf = example_robot(args.robot) if named else Path(args.robot).resolve()
     entry: str | dict[str, Any] = args.robot if named else str(urdf)
     srdf = None if args.srdf is None else args.srdf.resolve()
-    if args.tcp or srdf:
+    limits = None if args.limits is None else args.limits.resolve()
+    if args.tcp or srdf or limits:
         entry = {"urdf": entry}
         entry.update({"tcp": args.tcp} if args.tcp else {})
         entry.update({"srdf": str(srdf)} if srdf else {})
+        entry.update({"limits": str(limits)} if limits else {})
     try:
-        robot = ck.load_robot(urdf, tcp=args.tcp, srdf=srdf)
+        robot = ck.load_robot(urdf, tcp=args.tcp, srdf=srdf, limits=limits)
         stem = args.robot if named else urdf.stem
         args.out.mkdir(parents=True, exist_ok=True)
         for seed in range(args.seed, args.seed + args.count):

@@ -133,6 +133,33 @@ def test_limits_file_disagreeing_velocity(tmp_path: Path) -> None:
         ck.load_cpr(tmp_path / "cpr.urdf")
 
 
+def test_a_velocity_the_urdf_leaves_out_comes_from_the_limits_file(tmp_path: Path) -> None:
+    # description-only URDFs often give velocity="0": the limits file may give it instead
+    no_speed = URDF_TEXT.replace(
+        '<limit lower="0.0" upper="0.6" velocity="0.5" effort="200"/>',
+        '<limit lower="0.0" upper="0.6" velocity="0" effort="200"/>',
+    )
+    assert no_speed != URDF_TEXT
+    (tmp_path / "cpr.urdf").write_text(no_speed)
+    limits = ck.cpr_limits_path().read_text()
+    (tmp_path / "cpr_limits.yaml").write_text(
+        limits.replace("d2:     {velocity: 0.5, acceleration: 2.0, jerk: 10.0}", "d2:     {velocity: 0.4}")
+    )
+    robot = ck.load_cpr(tmp_path / "cpr.urdf")
+    d2 = robot.limits.index("d2")
+    assert robot.limits.velocity[d2] == 0.4 and robot.model.velocityLimit[d2] == 0.4
+    assert robot.limits.acceleration[d2] == pytest.approx(0.8)  # the default 2 v of the file's v
+    (tmp_path / "cpr_limits.yaml").write_text(
+        limits.replace("d2:     {velocity: 0.5, acceleration: 2.0, jerk: 10.0}", "d2:     {jerk: 10.0}")
+    )
+    with pytest.raises(
+        ck.UrdfError,
+        match=r"joint\(s\) \['d2'\] have no velocity limit .*give <limit velocity=...> in the URDF, "
+        r"or 'velocity' in the limits file '.*cpr_limits\.yaml'",
+    ):
+        ck.load_cpr(tmp_path / "cpr.urdf")
+
+
 def test_limits_file_unknown_joint(tmp_path: Path) -> None:
     (tmp_path / "cpr.urdf").write_text(URDF_TEXT)
     (tmp_path / "cpr_limits.yaml").write_text(
