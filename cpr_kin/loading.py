@@ -150,9 +150,22 @@ class RobotSpec:
             else _carried_alone(model, collision, tcp)
         )
         geometries = _geometries(model, collision, collision_names(tree), effector)
+        if not geometries:
+            raise UrdfError(
+                f"URDF '{path}' has no <collision> geometry: the planner keeps its clearances between "
+                "collision shapes; give the links <collision> elements"
+            )
         for group in GROUPS:
             if not any(g.group == group for g in geometries):
-                raise UrdfError(f"URDF '{path}' has no collision geometry in group '{group}'")
+                fix = (
+                    f"name links that have shapes in effector_links (now {sorted(effector)})"
+                    if group == "effector"
+                    else "give the links before the tool <collision> shapes, or name fewer effector_links"
+                )
+                raise UrdfError(
+                    f"URDF '{path}' has no collision geometry in group '{group}' (the effector: the links "
+                    f"the tool frame's joint carries, the links: the others); {fix}"
+                )
         return Robot(
             urdf_path=path,
             model=model,

@@ -15,7 +15,7 @@ import pytest
 import yourdfpy
 
 import cpr_kin as ck
-from cpr_kin.packages import example_robot_data_share
+from cpr_kin.packages import example_robot, example_robot_data_share
 from cpr_kin.resources import makers_limits_path
 
 SHARE = example_robot_data_share()
@@ -177,3 +177,19 @@ def test_a_robot_of_several_arms_plans_the_joints_to_the_tool_it_is_given(
     robot = ck.load_robot(ROBOTS / urdf, tcp=tool)
     assert list(robot.joint_names) == urdf_joints_to(ROBOTS / urdf, tool) and robot.nq >= 7
     assert robot.tcp_frame == tool
+
+
+def test_a_urdf_without_collision_shapes_is_refused_naming_the_fix() -> None:
+    with pytest.raises(
+        ck.UrdfError, match=r"has no <collision> geometry: .*give the links <collision> elements"
+    ):
+        ck.load_robot(ROBOTS / "asr_twodof_description" / "urdf" / "TwoDofs.urdf")
+
+
+def test_effector_links_without_shapes_are_refused_naming_them() -> None:
+    with pytest.raises(
+        ck.UrdfError,
+        match=r"no collision geometry in group 'effector' .*name links that have shapes in effector_links "
+        r"\(now \['tool0'\]\)",
+    ):
+        ck.load_robot(example_robot("ur5"), effector_links=("tool0",))
