@@ -25,7 +25,7 @@ Loading, in order:
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -36,10 +36,11 @@ from lxml import etree
 
 from cpr_kin.arm import ArmChain, arm_chain, default_joints
 from cpr_kin.errors import UrdfError
+from cpr_kin.geometry_groups import carried_alone, grouped_geometries
 from cpr_kin.limits import LIMITS_NAMES, JointLimits, find_limits_file, read_dynamic_limits
 from cpr_kin.packages import package_roots
 from cpr_kin.resources import makers_limits_path
-from cpr_kin.robot import GROUPS, Robot, RobotGeometry, joint_units
+from cpr_kin.robot import Robot, joint_units
 from cpr_kin.self_collision import SrdfPairs, find_srdf, read_srdf, self_pairs
 from cpr_kin.supported import check_joints, check_limits, check_names
 from cpr_kin.urdf_file import (
@@ -147,25 +148,9 @@ class RobotSpec:
         effector = (
             set(self.effector_links)
             if self.effector_links is not None
-            else _carried_alone(model, collision, tcp)
+            else carried_alone(model, collision, tcp)
         )
-        geometries = _geometries(model, collision, collision_names(tree), effector)
-        if not geometries:
-            raise UrdfError(
-                f"URDF '{path}' has no <collision> geometry: the planner keeps its clearances between "
-                "collision shapes; give the links <collision> elements"
-            )
-        for group in GROUPS:
-            if not any(g.group == group for g in geometries):
-                fix = (
-                    f"name links that have shapes in effector_links (now {sorted(effector)})"
-                    if group == "effector"
-                    else "give the links before the tool <collision> shapes, or name fewer effector_links"
-                )
-                raise UrdfError(
-                    f"URDF '{path}' has no collision geometry in group '{group}' (the effector: the links "
-                    f"the tool frame's joint carries, the links: the others); {fix}"
-                )
+        geometries = grouped_geometries(model, collision, collision_names(tree), effector, path)
         return Robot(
             urdf_path=path,
             model=model,
@@ -262,37 +247,6 @@ class RobotSpec:
 def _range(model: Any, joint: str) -> tuple[float, float]:
     i = model.joints[model.getJointId(joint)].idx_q
     return float(model.lowerPositionLimit[i]), float(model.upperPositionLimit[i])
-
-
-def _carried_alone(model: Any, collision: Any, tcp: str) -> set[str]:
-    """The links (body frames) of the last joint up from ``tcp`` that carries collision geometry.
-
-    The joint that carries the tool frame, or, when its links have no collision geometry (a
-    gripper described only visually, as the SO-100's), the nearest joint above it that does.
-    """
-    joint = model.frames[model.getFrameId(tcp)].parentJoint
-    carriers = {obj.parentJoint for obj in collision.geometryObjects}
-    while joint > 0 and joint not in carriers:
-        joint = model.parents[joint]
-    return {f.name for f in model.frames if f.type == pin.FrameType.BODY and f.parentJoint == joint}
-
-
-def _geometries(
-    model: Any, collision: Any, names_by_link: Mapping[str, Sequence[str]], effector: set[str]
-) -> tuple[RobotGeometry, ...]:
-    """The collision geometries, named as in the URDF and sorted into their groups."""
-    geometries = []
-    used: dict[str, int] = {}
-    for index, obj in enumerate(collision.geometryObjects):
-        link = model.frames[obj.parentFrame].name
-        k = used.get(link, 0)
-        used[link] = k + 1
-        names = names_by_link.get(link, ())
-        name = names[k] if k < len(names) else f"{link}_{k}"
-        obj.name = name
-        group = "effector" if link in effector else "links"
-        geometries.append(RobotGeometry(name=name, link=link, group=group, index=index))
-    return tuple(geometries)
 
 
 def load_robot(urdf_path: str | Path, **options: Any) -> Robot:

@@ -39,7 +39,6 @@ from __future__ import annotations
 
 import argparse
 import csv
-import dataclasses
 import itertools
 import multiprocessing
 import os
@@ -88,7 +87,7 @@ def ours(scene_path: str, time_limit_s: float, threads: int | None = None) -> di
     from planning.pipeline.planner import plan
 
     scene, robot = _robot(scene_path)
-    scene = dataclasses.replace(scene, planner=scene.planner.updated(time_limit_s=time_limit_s))
+    scene = scene.with_planner(time_limit_s=time_limit_s)
     started = time.perf_counter()
     try:
         result = plan(scene, robot, threads=threads)

@@ -24,7 +24,7 @@ import dataclasses
 import statistics
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -87,7 +87,7 @@ def default_search(robot: ck.Robot, scene: Scene, refine_stall: int | None = Non
     changes = {**dataclasses.asdict(DEFAULT_FIREFLY), "seeding": "paths", "refine": "cma"}
     if refine_stall is not None:
         changes["refine_stall"] = refine_stall
-    problem = build_problem(replace(scene, planner=scene.planner.updated(**changes)), robot)
+    problem = build_problem(scene.with_planner(**changes), robot)
 
     def run(
         objective: BatchObjective, lower: FloatArray, upper: FloatArray, budget: int, rng: np.random.Generator

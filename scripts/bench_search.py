@@ -24,7 +24,6 @@ setting ``refine_stall: N`` (shorter trajectories for more planning time,
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import statistics
 import subprocess
 import sys
@@ -120,10 +119,7 @@ def main() -> None:
     try:
         scenes = generate_scenes(args.scenes, args.seed, robot, narrow=args.narrow, kinds=args.kinds)
         if args.refine_stall is not None:
-            scenes = [
-                dataclasses.replace(scene, planner=scene.planner.updated(refine_stall=args.refine_stall))
-                for scene in scenes
-            ]
+            scenes = [scene.with_planner(refine_stall=args.refine_stall) for scene in scenes]
     except PlanningError as error:
         parser.error(str(error))
     warm_up(robot)

@@ -62,7 +62,7 @@ def scenes(generated: int, robot: ck.Robot) -> Iterator[tuple[str, Scene]]:
 
 
 def _changed(scene: Scene, **changes: Any) -> Scene:
-    return dataclasses.replace(scene, planner=scene.planner.updated(**changes))
+    return scene.with_planner(**changes)
 
 
 def fingerprint(scene: Scene, robot: ck.Robot, optimizer: Optimizer | None = None) -> str:

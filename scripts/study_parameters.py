@@ -16,7 +16,6 @@ random population, no refinement).
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import statistics
 import time
 from typing import Any, NamedTuple
@@ -85,7 +84,7 @@ class Outcome(NamedTuple):
 
 def run(scene: Scene, robot: ck.Robot, changes: dict[str, Any]) -> Outcome:
     """Plan ``scene`` with the planner-setting ``changes``, warm."""
-    changed = dataclasses.replace(scene, planner=scene.planner.updated(**changes))
+    changed = scene.with_planner(**changes)
     started = time.perf_counter()
     try:
         result = plan(changed, robot)

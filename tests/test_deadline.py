@@ -83,7 +83,7 @@ def test_the_searches_stop_with_their_best_so_far() -> None:
 
 
 def limited(scene: Scene, limit_s: float | None) -> Scene:
-    return dataclasses.replace(scene, planner=scene.planner.updated(time_limit_s=limit_s))
+    return scene.with_planner(time_limit_s=limit_s)
 
 
 def test_a_plan_stopped_by_its_limit_says_so(robot: ck.Robot) -> None:

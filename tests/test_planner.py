@@ -263,7 +263,7 @@ def test_narrow_passages_are_planned_through_by_the_seeded_search(robot: ck.Robo
         assert result.verification.accepted
         assert result.metrics.min_clearance_m >= scene.safety_margin
         try:
-            plan(dataclasses.replace(scene, planner=scene.planner.updated(seeding="none")), robot)
+            plan(scene.with_planner(seeding="none"), robot)
             unseeded += 1
         except NoTrajectoryFoundError:
             pass
@@ -292,10 +292,10 @@ def test_refinement_continues_the_firefly_and_only_improves(robot: ck.Robot) -> 
 
     exploring = SearchTuning(explore_feasible_seed=True, explore_path_seed=True)  # the firefly runs first
     for scene in generate_scenes(4, seed=2, robot=robot, narrow=1):
-        scene = dataclasses.replace(scene, planner=scene.planner.updated(tuning=exploring))
+        scene = scene.with_planner(tuning=exploring)
         iterations: list[int] = []  # the firefly's, of every search the plan ran
         refined = plan(scene, robot, progress=functools.partial(record_iteration, iterations))
-        alone = plan(dataclasses.replace(scene, planner=scene.planner.updated(refine="none")), robot)
+        alone = plan(scene.with_planner(refine="none"), robot)
         assert scene.planner.refine == "cma" and refined.verification.accepted
         # the same generator draws the firefly's moves first: the firefly's run is the same up to
         # where the refinement took over (its early stop counts stalls even while infeasible,
@@ -339,9 +339,7 @@ def test_refine_stall_zero_runs_the_same_refinement_on_to_the_budget(robot: ck.R
     for scene in generate_scenes(3, seed=2, robot=robot, narrow=1):
         stopped = plan(scene, robot).optimiser
         budget = scene.planner.firefly.evaluations
-        full = plan(
-            dataclasses.replace(scene, planner=scene.planner.updated(refine_stall=0)), robot
-        ).optimiser
+        full = plan(scene.with_planner(refine_stall=0), robot).optimiser
         n = len(stopped.best_history)
         np.testing.assert_array_equal(full.best_history[:n], stopped.best_history)
         assert full.fitness <= stopped.fitness
@@ -359,7 +357,7 @@ def test_the_refinement_stops_early_only_near_the_objectives_lower_bound(robot: 
     near_bound = RefinementSettings().near_bound
     went_on = 0
     for scene in (scenes[0], scenes[5], scenes[7]):
-        counted = plan(dataclasses.replace(scene, planner=scene.planner.updated(tuning=everywhere)), robot)
+        counted = plan(scene.with_planner(tuning=everywhere), robot)
         result = plan(scene, robot)
         bound = result.problem.objective.lower_bound
         assert 0 < bound <= result.trajectory.duration

@@ -1,6 +1,7 @@
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import math
 import re
 from pathlib import Path
@@ -15,7 +16,7 @@ from hypothesis import strategies as st
 import cpr_kin as ck
 from cpr_kin.user_files import StrictLoader
 from planning.curves.spline_settings import SplineSettings
-from planning.errors import SceneError
+from planning.errors import PlanningError, SceneError
 from planning.io.bundled import paper_scene, paper_scene_path
 from planning.io.scene_file import (
     dump_scene,
@@ -297,3 +298,13 @@ def test_arbitrary_bytes_and_yaml_features_load_or_raise_one_short_scene_error(
         load_scene(path)
     except SceneError as exc:
         assert "\n" not in str(exc) and len(str(exc)) < 300 + len(str(path))
+
+
+def test_with_planner_changes_the_settings_named_and_nothing_else() -> None:
+    scene = paper_scene()
+    changed = scene.with_planner(seed=7, fireflies=12)
+    assert (changed.planner.seed, changed.planner.firefly.fireflies) == (7, 12)
+    assert changed.planner == scene.planner.updated(seed=7, fireflies=12)
+    assert dataclasses.replace(changed, planner=scene.planner) == scene
+    with pytest.raises(PlanningError, match="fireflies"):
+        scene.with_planner(fireflies=0)

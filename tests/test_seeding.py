@@ -74,7 +74,7 @@ def test_more_waypoints_follow_the_path_until_the_spline_keeps_the_clearance(win
 def test_same_seed_same_seeds_and_the_sampler_has_its_own_stream(window: Problem) -> None:
     a, b = seed_search(window), seed_search(window)
     np.testing.assert_array_equal(a.candidates, b.candidates)
-    other = dataclasses.replace(window.scene, planner=window.scene.planner.updated(seed=1))
+    other = window.scene.with_planner(seed=1)
     c = seed_search(build_problem(other, window.robot))
     assert not np.array_equal(a.candidates, c.candidates)
     # the sampled path comes from default_rng([seed, 1]), not the firefly's default_rng(seed)

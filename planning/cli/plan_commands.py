@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 import sys
 from pathlib import Path
@@ -53,7 +52,7 @@ def _plan_and_write(scene: Scene, out: str, args: argparse.Namespace, paper: boo
     if getattr(args, "paper_search", False):
         overrides = {**PAPER_SEARCH, **overrides}  # a --fireflies or --iterations given still wins
     if overrides:
-        scene = dataclasses.replace(scene, planner=scene.planner.updated(**overrides))
+        scene = scene.with_planner(**overrides)
     update, close = firefly_progress(sys.stdout.isatty() and not args.json)
     with OutputFolder(out) as folder:  # locked from here: a second writer is refused at once
         try:

@@ -6,7 +6,6 @@ The paper case (docs/paper_case.md) exists once, as ``planning/scenes/paper.yaml
 
 from __future__ import annotations
 
-import dataclasses
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -39,4 +38,4 @@ def paper_scene(seed: int = 0, **planner_changes: Any) -> Scene:
             (:meth:`~planning.pipeline.settings.PlannerSettings.updated`), e.g. ``fireflies=10``.
     """
     scene = load_scene(paper_scene_path())
-    return dataclasses.replace(scene, planner=scene.planner.updated(seed=seed, **planner_changes))
+    return scene.with_planner(seed=seed, **planner_changes)

@@ -7,8 +7,10 @@ A :class:`Scene` is the pipeline's input (``scene.yaml`` is its file form,
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -127,3 +129,12 @@ class Scene:
                     f"duration / planner.ipo = {samples:.0f} IPO samples; at most {MAX_IPO_SAMPLES}: "
                     "lengthen ipo or shorten the duration"
                 )
+
+    def with_planner(self, **changes: Any) -> Scene:
+        """The scene with planner settings changed, by their scene-file keys (e.g. ``seed=1``).
+
+        Raises:
+            PlanningError: an unknown setting, or a value the settings refuse
+                (:meth:`~planning.pipeline.settings.PlannerSettings.updated`).
+        """
+        return dataclasses.replace(self, planner=self.planner.updated(**changes))
