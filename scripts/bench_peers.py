@@ -43,7 +43,7 @@ from planning.pipeline.planner import plan, warm_up
 from planning.pipeline.problem import build_problem, with_planner
 from planning.pipeline.scene import Scene
 from planning.pipeline.search import planner_search
-from planning.pipeline.seeding import Attempt, seed_search
+from planning.pipeline.seeding import SEEDINGS
 from planning.pipeline.settings import DEFAULT_FIREFLY
 from planning.search import baselines
 from planning.search.optimizer import BatchObjective, Optimizer, SearchResult
@@ -80,9 +80,10 @@ def default_search(robot: ck.Robot, scene: Scene, refine_stall: int | None = Non
 
     The scene with the planner's default search settings (:data:`DEFAULT_FIREFLY`, seeded
     with paths, CMA-ES refinement; ``refine_stall`` as that planner setting, 0 to run the
-    refinement to the budget); each run seeds the search as the planner does
-    (:func:`~planning.pipeline.seeding.seed_search`, its streams seeded from ``rng``) and
-    runs :func:`~planning.pipeline.search.planner_search`'s optimiser on the objective given.
+    refinement to the budget); each run begins as the planner's first attempt does (its
+    seeding's ``first``: the seeds, whether one is feasible and the sampling planner's path,
+    which decide whether the firefly explores; its streams seeded from ``rng``) and runs
+    :func:`~planning.pipeline.search.planner_search`'s optimiser on the objective given.
     """
     changes = {**dataclasses.asdict(DEFAULT_FIREFLY), "seeding": "paths", "refine": "cma"}
     if refine_stall is not None:
@@ -93,9 +94,8 @@ def default_search(robot: ck.Robot, scene: Scene, refine_stall: int | None = Non
         objective: BatchObjective, lower: FloatArray, upper: FloatArray, budget: int, rng: np.random.Generator
     ) -> SearchResult:
         seeded = with_planner(problem, seed=int(rng.integers(2**31)))
-        seeds = seed_search(seeded)
-        search = planner_search(seeds.problem, Attempt(seeds.problem, seeds.candidates))
-        return search(objective, lower, upper, budget, rng)
+        attempt = SEEDINGS[seeded.scene.planner.seeding].first(seeded)  # the planner's first attempt
+        return planner_search(attempt.problem, attempt)(objective, lower, upper, budget, rng)
 
     return run
 
