@@ -21,6 +21,7 @@ import numpy as np
 
 import cpr_kin as ck
 from planning.errors import PlanningError
+from planning.pipeline.torques import held
 
 DRAWS = 4000
 """Most draws of a start and goal before :func:`blocked_scene` gives up."""
@@ -66,7 +67,7 @@ def blocked_scene(
             continue
         if world.self_collision and world.self_collision.distances(ends)[0].min() <= self_clearance_m:
             continue
-        if np.any(np.abs(dynamics.torques(ends)) > dynamics.effort):
+        if not held(dynamics, ends).all():
             continue
         return {
             "name": name,

@@ -27,7 +27,14 @@ from planning.pipeline.objective import PathRules, WaypointObjective
 from planning.pipeline.scene import Scene
 from planning.pipeline.settings import VERIFY_STEP_RANGE_M
 from planning.pipeline.timing import FixedDuration, FreeDuration, duration_rule
-from planning.pipeline.torques import GravityLimit, check_held, gravity_limit, scene_dynamics, search_torque
+from planning.pipeline.torques import (
+    GravityLimit,
+    check_held,
+    gravity_limit,
+    held,
+    scene_dynamics,
+    search_torque,
+)
 
 FloatArray = NDArray[np.float64]
 
@@ -172,7 +179,7 @@ def endpoint(
     def accepted(q: FloatArray) -> bool:
         if margin_violation(world, scene, q) is not None:
             return False
-        return dynamics is None or bool(np.all(np.abs(dynamics.torques(q)[0]) <= dynamics.effort))
+        return dynamics is None or bool(held(dynamics, q[None])[0])
 
     try:
         q = target.configuration(robot, seed_q, accepted)

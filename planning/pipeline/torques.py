@@ -1,11 +1,11 @@
 """The joint torques a trajectory asks of the robot, checked against its effort limits.
 
 :func:`scene_dynamics` builds the robot's dynamics with the scene's payload once per
-problem and :func:`check_held` refuses a start or goal the motors cannot hold still. Where gravity alone may
-exceed a limit between them (a heavy arm, weak shoulder motors, a payload),
-:func:`gravity_limit` gives the search the rule of :class:`GravityLimit`: every configuration
-of a path must be one the motors can hold still, as no timing makes a motion through one
-they cannot feasible. :func:`torque_profile`
+problem; :func:`held` is the one rule of a configuration the motors can hold still (gravity's
+torques within every effort limit), by which :func:`check_held` refuses a start or goal.
+Where gravity alone may exceed a limit between them (a heavy arm, weak shoulder motors, a
+payload), :func:`gravity_limit` holds the search to it (:class:`GravityLimit`): no timing
+makes a motion through a configuration the motors cannot hold feasible. :func:`torque_profile`
 samples a trajectory's torques by Pinocchio's RNEA every :data:`CHECK_STEP_S` and at its
 knots: the verification (:func:`torque_problems`), the report and the plots read it. It
 shares nothing with the timing's torque terms (:mod:`planning.curves.torque_limits`) but the
@@ -48,6 +48,16 @@ GRAVITY_GATE = 0.75
 configurations between the samples: gravity's torques vary smoothly over the ranges)."""
 
 
+def held(dynamics: ck.Dynamics, q: FloatArray) -> NDArray[np.bool_]:
+    """``(N,)`` whether the motors can hold each configuration of ``q`` ``(N, nq)`` still.
+
+    Gravity's torque at every joint within its effort limit (times ``torque_scale``).
+    """
+    if not len(q):
+        return np.zeros(0, dtype=bool)
+    return np.asarray(np.all(np.abs(dynamics.torques(q)) <= dynamics.effort, axis=1))
+
+
 @dataclass(frozen=True)
 class GravityLimit:
     """The configurations the motors can hold still: gravity's torques within the effort limits.
@@ -76,8 +86,8 @@ class GravityLimit:
         return np.asarray(np.maximum(usage.max(axis=1) - 1.0, 0.0))
 
     def holds(self, q: FloatArray) -> NDArray[np.bool_]:
-        """``(N,)`` whether the motors can hold each configuration of ``q`` ``(N, nq)`` still."""
-        return np.asarray(self.usage(q) <= 1.0 + TORQUE_TOLERANCE)
+        """``(N,)`` whether the motors can hold each of ``q`` ``(N, nq)`` still (:func:`held`)."""
+        return held(self.dynamics, q)
 
 
 def gravity_limit(
@@ -173,10 +183,10 @@ def check_held(dynamics: ck.Dynamics, scene: Scene, label: str, q: FloatArray) -
         PayloadTooHeavyError: gravity's torque at ``q`` exceeds a joint's effort limit (times
             ``torque_scale``), naming the joint, the torque and the limit.
     """
+    if held(dynamics, np.atleast_2d(q))[0]:
+        return
     holding = np.abs(dynamics.torques(q)[0])
     j = int(np.argmax(holding / dynamics.effort))
-    if holding[j] <= dynamics.effort[j]:
-        return
     unit = _unit(dynamics, j)
     carried = "" if scene.payload is None else f" with the {scene.payload.mass_kg:g} kg payload"
     fix = (
