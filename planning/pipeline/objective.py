@@ -15,9 +15,10 @@ between the fixed start and goal. Its terms:
 fitness is at most ``t_max``, which holds exactly when the executed path keeps
 ``margin + verify_step_m`` from every obstacle and ``self_margin + self_verify_step_m``
 between the robot's own pairs at the ``fitness_samples`` samples (coal), stays within the
-joint ranges, deviates from its nodes by at most ``max_node_deviation`` (when set) and,
-when the scene fixes the duration, keeps velocity, acceleration and jerk within the limits
-at that duration (checked at the IPO samples; the final timing uses exact extrema). How
+joint ranges, deviates from its nodes by at most ``max_node_deviation`` (when set), with a
+gravity limit (:attr:`PathRules.gravity`) can be held still at every 4th sample and, when
+the scene fixes the duration, keeps velocity, acceleration and jerk within the limits at
+that duration (checked at the IPO samples; the final timing uses exact extrema). How
 the terms become the fitness, feasible or not, is the fitness rule's
 (:mod:`planning.pipeline.fitness`); the paths themselves are those of
 :mod:`planning.pipeline.path_terms`.
