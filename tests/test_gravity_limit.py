@@ -34,6 +34,18 @@ def limit_of(robot: ck.Robot) -> GravityLimit | None:
     return gravity_limit(robot, ck.robot_dynamics(robot), middle, np.arange(robot.nq))
 
 
+@pytest.fixture(scope="module")
+def talos_limit(talos: ck.Robot) -> GravityLimit:
+    limit = limit_of(talos)
+    assert limit is not None
+    return limit
+
+
+def drawn(robot: ck.Robot, seed: int, count: int) -> np.ndarray:
+    """``count`` seeded configurations of ``robot`` over its ranges."""
+    return np.random.default_rng(seed).uniform(robot.limits.lower, robot.limits.upper, (count, robot.nq))
+
+
 def test_the_limit_binds_only_where_gravity_can_exceed_an_effort(talos: ck.Robot) -> None:
     assert limit_of(talos) is not None
     assert limit_of(ck.load_cpr()) is None  # gravity needs at most a fifth of its efforts
@@ -41,11 +53,9 @@ def test_the_limit_binds_only_where_gravity_can_exceed_an_effort(talos: ck.Robot
 
 
 def test_held_configurations_are_those_whose_gravity_torques_pinocchio_finds_within_the_efforts(
-    talos: ck.Robot,
+    talos: ck.Robot, talos_limit: GravityLimit
 ) -> None:
-    limit = limit_of(talos)
-    assert limit is not None
-    q = np.random.default_rng(3).uniform(talos.limits.lower, talos.limits.upper, (200, talos.nq))
+    limit, q = talos_limit, drawn(talos, 3, 200)
     model = limit.dynamics.model
     data = model.createData()
     gravity = np.array([pin.computeGeneralizedGravity(model, data, qi) for qi in q])  # the oracle
@@ -56,11 +66,9 @@ def test_held_configurations_are_those_whose_gravity_torques_pinocchio_finds_wit
 
 
 def test_a_path_through_a_configuration_it_cannot_hold_exceeds_by_its_worst_checked_sample(
-    talos: ck.Robot,
+    talos: ck.Robot, talos_limit: GravityLimit
 ) -> None:
-    limit = limit_of(talos)
-    assert limit is not None
-    q = np.random.default_rng(4).uniform(talos.limits.lower, talos.limits.upper, (400, talos.nq))
+    limit, q = talos_limit, drawn(talos, 4, 400)
     usage = limit.usage(q)
     held, dropped = q[usage < 0.5][:2], q[usage > 1.1][0]
     path = np.linspace(held[0], held[1], 9)  # samples 0, 4 and 8 are checked
