@@ -5,7 +5,7 @@
 Each problem goes the way a user's does: ``import-moveit`` (:func:`planning.io.moveit_import.import_moveit`
 on vamp-planner 0.6.4's URDF and SRDF, margins 0 as in MoveIt), the scene file written and
 read back (:func:`planning.io.scene_file.load_scene`); then its start and goal are checked
-against the obstacles and the robot's own links (:func:`planning.pipeline.problem.margin_violation`,
+against the obstacles and the robot's own links (:func:`planning.pipeline.endpoints.margin_violation`,
 on our collision model: the URDF's meshes as convex hulls, the SRDF's and the scene's allowed
 pairs). Prints per class: problems, converted, start and goal valid, and why the others are not.
 The archive is downloaded once from PyPI and cached (:mod:`planning.io.mbm`).

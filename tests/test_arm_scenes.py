@@ -17,7 +17,8 @@ from planning.errors import PlanningError
 from planning.io.arm_scenes import blocked_scene
 from planning.io.mbm import endpoint_violations
 from planning.io.scene_file import parse_scene
-from planning.pipeline.problem import build_problem, margin_violation
+from planning.pipeline.endpoints import margin_violation
+from planning.pipeline.problem import build_problem
 
 
 @pytest.fixture(scope="module")

@@ -21,6 +21,7 @@ from planning.pipeline.settings import PlannerSettings
 SHARE = example_robot_data_share()
 assert SHARE is not None, "example-robot-data is part of the robots extra, which make installs"
 PANDA = SHARE / "example-robot-data" / "robots" / "panda_description" / "urdf" / "panda.urdf"
+BAXTER = SHARE / "example-robot-data" / "robots" / "baxter_description"
 
 
 @pytest.fixture(scope="module")
@@ -252,3 +253,16 @@ def test_the_self_step_is_never_coarser_than_the_obstacle_step() -> None:
     refused = r"self_verify_step_m = 0.5 m must be a number in \[0.0001, 0.1\] m"
     with pytest.raises(PlanningError, match=refused):
         PlannerSettings(self_verify_step_m=0.5)
+
+
+def test_an_end_inside_the_self_margin_of_a_robot_without_an_srdf_says_so() -> None:
+    # Baxter's SRDF is not named after its URDF: without it, its elbow's two collision links
+    # overlap in nearly every configuration, and the message points at the missing file
+    urdf, srdf = BAXTER / "urdf" / "baxter.urdf", BAXTER / "srdf" / "baxter_manipulation.srdf"
+    start = [-0.4969, -1.0176, 1.5676, 1.2144, 1.5085, -0.6318, -0.879]
+    scene = Scene(start=Target(q=tuple(start)), goal=Target(q=tuple(start)))
+    bare = ck.load_robot(urdf, tcp="left_gripper")
+    with pytest.raises(PlanningError, match=r"inside the self margin: .*no SRDF was found for this URDF"):
+        build_problem(scene, bare)
+    listed = ck.load_robot(urdf, tcp="left_gripper", srdf=srdf)
+    assert build_problem(scene, listed).robot.srdf_path == srdf

@@ -150,12 +150,12 @@ def endpoint_violations(scene: Scene, robot: ck.Robot) -> list[str]:
 
     Each is ``"<start|goal> <what>"``: a joint value out of range, a pose out of reach, or
     what comes inside the safety or self margin, or a configuration the motors cannot hold
-    still. Found as the planner finds its ends (:func:`planning.pipeline.problem.endpoint`): a
+    still. Found as the planner finds its ends (:func:`planning.pipeline.endpoints.endpoint`): a
     ``pose`` or ``tcp`` by the IK solution clear of the margins, and held, nearest the start,
     so a pose with such a solution is valid even where the IK's first solution is not.
     """
     from planning.errors import NoSolutionError
-    from planning.pipeline.problem import endpoint
+    from planning.pipeline.endpoints import endpoint
     from planning.pipeline.torques import scene_dynamics
 
     world = ck.CollisionWorld(robot, scene.obstacles, allowed_pairs=scene.allowed_collisions)

@@ -20,21 +20,15 @@ from numpy.typing import NDArray
 
 import cpr_kin as ck
 from planning.curves.spline import SepticSplineSolver, uniform_knots
-from planning.errors import PlanningError, TargetOutOfReachError
+from planning.errors import PlanningError
 from planning.pipeline.deadline import Deadline
+from planning.pipeline.endpoints import endpoint
 from planning.pipeline.motion import Motion
 from planning.pipeline.objective import PathRules, WaypointObjective
 from planning.pipeline.scene import Scene
 from planning.pipeline.settings import VERIFY_STEP_RANGE_M
 from planning.pipeline.timing import FixedDuration, FreeDuration, duration_rule
-from planning.pipeline.torques import (
-    GravityLimit,
-    check_held,
-    gravity_limit,
-    held,
-    scene_dynamics,
-    search_torque,
-)
+from planning.pipeline.torques import GravityLimit, gravity_limit, scene_dynamics, search_torque
 
 FloatArray = NDArray[np.float64]
 
@@ -133,67 +127,6 @@ def moving_joints(robot: ck.Robot, scene: Scene, q_start: FloatArray, q_goal: Fl
     if not names:
         raise PlanningError("moving_joints is empty; name at least one joint the waypoints may move")
     return np.array([robot.limits.index(n) for n in names], dtype=np.intp)
-
-
-def margin_violation(world: ck.CollisionWorld, scene: Scene, q: FloatArray) -> str | None:
-    """What at ``q`` comes inside the scene's safety or self margin, or ``None`` if nothing does."""
-    clearance = world.clearance(q)
-    closest = clearance.closest
-    if closest is not None and clearance.min_clearance_m < scene.safety_margin:
-        return (
-            f"is inside the safety margin: {closest.robot_geometry} is {clearance.min_clearance_m:.3f} m "
-            f"from obstacle '{closest.obstacle}' (margin {scene.safety_margin} m)"
-        )
-    distance, pair = world.self_collision.distances(q[None])
-    if distance[0] < scene.self_margin:
-        a, b = world.self_collision.pairs[int(pair[0])]
-        return (
-            f"is inside the self margin: {a} is {distance[0]:.3f} m from {b} "
-            f"(self_margin {scene.self_margin} m; allowed_collisions lets a pair touch)"
-        )
-    return None
-
-
-def endpoint(
-    robot: ck.Robot,
-    world: ck.CollisionWorld,
-    scene: Scene,
-    label: str,
-    seed_q: FloatArray | None = None,
-    dynamics: ck.Dynamics | None = None,
-) -> FloatArray:
-    """The configuration of the scene's start or goal, verified; refused if out of reach or inside a margin.
-
-    A ``tcp`` or ``pose`` is solved by IK (:meth:`~planning.pipeline.target.Target.configuration`):
-    the solution nearest ``seed_q`` of those clear of the margins and, with ``dynamics``, that
-    the motors can hold still (:func:`~planning.pipeline.torques.check_held`).
-
-    Raises:
-        PlanningError: a joint vector of the wrong length, naming the wrong joints or outside
-            the ranges; a configuration inside the safety or self margin.
-        TargetOutOfReachError: no configuration reaches a ``tcp`` or ``pose`` (its distance named).
-        PayloadTooHeavyError: with ``dynamics``, the motors cannot hold the configuration still.
-    """
-    target = scene.start if label == "start" else scene.goal
-
-    def accepted(q: FloatArray) -> bool:
-        if margin_violation(world, scene, q) is not None:
-            return False
-        return dynamics is None or bool(held(dynamics, q[None])[0])
-
-    try:
-        q = target.configuration(robot, seed_q, accepted)
-    except ck.IkMissError as exc:
-        raise TargetOutOfReachError(f"{label} is out of reach: {exc}") from None
-    except ck.CprKinError as exc:
-        where = f"{label}.q" if target.q is not None else f"{label} is not reachable"
-        raise PlanningError(f"{where}: {exc}") from None
-    violation = margin_violation(world, scene, q)
-    if violation is not None:
-        raise PlanningError(f"{label} q = {np.round(q, 4).tolist()} {violation}")
-    if dynamics is not None:
-        check_held(dynamics, scene, label, q)
-    return q
 
 
 def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | None = None) -> Problem:
