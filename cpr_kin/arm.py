@@ -21,6 +21,7 @@ from typing import Any
 from lxml import etree
 
 from cpr_kin.errors import UrdfError
+from cpr_kin.frames import frame_index
 
 
 @dataclass(frozen=True)
@@ -117,7 +118,7 @@ def default_joints(
     """
     names = tuple(model.names[1:])
     if tcp is not None and model.existFrame(tcp):
-        supports = model.supports[model.frames[model.getFrameId(tcp)].parentJoint]
+        supports = model.supports[model.frames[frame_index(model, tcp)].parentJoint]
         along = {model.names[j] for j in supports}
         return tuple(n for n in names if n in along and n not in mimics)
     planned = tuple(n for n in names if n in arm.joints and n not in mimics)

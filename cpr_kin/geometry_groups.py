@@ -15,6 +15,7 @@ from typing import Any
 import pinocchio as pin
 
 from cpr_kin.errors import UrdfError
+from cpr_kin.frames import frame_index
 from cpr_kin.robot import GROUPS, RobotGeometry
 
 
@@ -24,7 +25,7 @@ def carried_alone(model: Any, collision: Any, tcp: str) -> set[str]:
     The joint that carries the tool frame, or, when its links have no collision geometry (a
     gripper described only visually, as the SO-100's), the nearest joint above it that does.
     """
-    joint = model.frames[model.getFrameId(tcp)].parentJoint
+    joint = model.frames[frame_index(model, tcp)].parentJoint
     carriers = {obj.parentJoint for obj in collision.geometryObjects}
     while joint > 0 and joint not in carriers:
         joint = model.parents[joint]

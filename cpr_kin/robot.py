@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import CprKinError, JointLimitError
+from cpr_kin.frames import frame_index
 from cpr_kin.limits import JointLimits
 
 FloatArray = NDArray[np.float64]
@@ -115,10 +116,11 @@ class Robot:
 
     def frame_id(self, frame: str) -> int:
         """Pinocchio id of ``frame``; raises :class:`CprKinError` naming the known frames."""
-        if not self.model.existFrame(frame):
+        index = frame_index(self.model, frame)
+        if index < 0:
             known = sorted({f.name for f in self.model.frames})
             raise CprKinError(f"unknown frame '{frame}'; the robot's frames are {known}")
-        return int(self.model.getFrameId(frame))
+        return index
 
     def configuration(self, values: ArrayLike | dict[str, float], *, check_limits: bool = True) -> FloatArray:
         """Validate a joint vector and return it as a float array of shape ``(nq,)``.

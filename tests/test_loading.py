@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pinocchio as pin
 import pytest
 import yourdfpy
 
@@ -193,3 +194,20 @@ def test_effector_links_without_shapes_are_refused_naming_them() -> None:
         r"\(now \['tool0'\]\)",
     ):
         ck.load_robot(example_robot("ur5"), effector_links=("tool0",))
+
+
+def test_a_tool_named_as_a_joint_and_a_link_is_the_link() -> None:
+    # the B1-Z1 names a fixed joint and its child link 'gripperStator': Pinocchio's
+    # getFrameId refused to choose (a ValueError, not a message); the link's frame is taken
+    b1_description = ROBOTS / "b1_description"
+    robot = ck.load_robot(
+        b1_description / "urdf" / "b1-z1.urdf",
+        tcp="gripperStator",
+        srdf=b1_description / "srdf" / "b1-z1.srdf",
+    )
+    assert robot.joint_names == tuple(f"joint{k}" for k in range(1, 7))  # the arm's, not the legs'
+    frames = [f for f in robot.model.frames if f.name == "gripperStator"]
+    assert {f.type for f in frames} == {pin.FrameType.BODY, pin.FrameType.FIXED_JOINT}
+    chosen = robot.model.frames[robot.frame_id("gripperStator")]
+    assert chosen.type == pin.FrameType.BODY
+    assert all(f.placement.isApprox(chosen.placement) for f in frames)  # one place either way
