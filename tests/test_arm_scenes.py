@@ -61,10 +61,14 @@ def test_start_and_goal_are_ends_the_motors_can_hold_still() -> None:
 
 
 def test_no_qualifying_draw_is_an_error_naming_the_fix(ur5: ck.Robot) -> None:
+    assert ur5.srdf_path is not None
     with pytest.raises(
-        PlanningError, match=r"no start and goal of 20 draws .* 1 m between .*lower self_clearance_m"
+        PlanningError, match=r"no start and goal of 20 draws .* 1 m between .*lower self_clearance_m$"
     ):
         blocked_scene("ur5_0", "ur5", ur5, 0, self_clearance_m=1.0, draws=20)
+    ur10 = ck.load_robot(example_robot("ur10"))  # example-robot-data has no SRDF for it
+    with pytest.raises(PlanningError, match=r"lower self_clearance_m, or give the robot its SRDF"):
+        blocked_scene("ur10_0", "ur10", ur10, 0, self_clearance_m=1.0, draws=20)
 
 
 def test_a_goal_pose_is_valid_when_a_clear_ik_solution_reaches_it() -> None:

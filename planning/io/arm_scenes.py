@@ -80,10 +80,11 @@ def blocked_scene(
             ],
             "planner": {"seed": seed},
         }
+    unlisted = "" if robot.srdf_path is not None else ", or give the robot its SRDF (none was found)"
     raise PlanningError(
         f"no start and goal of {draws} draws for '{name}' keep {margin_m + 0.02:g} m from the ball and "
         f"{self_clearance_m:g} m between the robot's own pairs, with gravity's torques within the effort "
-        "limits; lower self_clearance_m"
+        f"limits; lower self_clearance_m{unlisted}"
     )
 
 
