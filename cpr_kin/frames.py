@@ -24,7 +24,7 @@ PREFERENCE = (
 
 def frame_index(model: Any, name: str) -> int:
     """The id of ``model``'s frame ``name`` (module docstring); ``-1`` when it has none."""
-    found = [index for index, frame in enumerate(model.frames) if frame.name == name]
-    if not found:
-        return -1
-    return min(found, key=lambda index: PREFERENCE.index(model.frames[index].type))
+    for kind in PREFERENCE:  # Pinocchio's own lookup, asked by type
+        if model.existFrame(name, kind):
+            return int(model.getFrameId(name, kind))
+    return -1

@@ -168,7 +168,7 @@ def torque_over_limit(scene: Any, robot: ck.Robot, timed: Any, duration_s: float
     dynamics = ck.robot_dynamics(robot, scene.payload, scene.torque_scale)
     times = np.union1d(np.arange(0.0, duration_s, 1e-3), [duration_s])
     torques = dynamics.torques(*(np.asarray(timed(times, order)) for order in (0, 1, 2)))
-    return float(np.max(np.abs(torques) / dynamics.effort))
+    return float(dynamics.utilisation(torques).max())
 
 
 def valid(scene_path: Path) -> str | None:

@@ -55,11 +55,10 @@ def main() -> int:
     entry: str | dict[str, Any] = args.robot if named else str(urdf)
     srdf = None if args.srdf is None else args.srdf.resolve()
     limits = None if args.limits is None else args.limits.resolve()
-    if args.tcp or srdf or limits:
-        entry = {"urdf": entry}
-        entry.update({"tcp": args.tcp} if args.tcp else {})
-        entry.update({"srdf": str(srdf)} if srdf else {})
-        entry.update({"limits": str(limits)} if limits else {})
+    given = {"tcp": args.tcp, "srdf": srdf, "limits": limits}
+    options = {key: str(value) for key, value in given.items() if value}
+    if options:
+        entry = {"urdf": entry, **options}
     try:
         robot = ck.load_robot(urdf, tcp=args.tcp, srdf=srdf, limits=limits)
         stem = args.robot if named else urdf.stem

@@ -72,7 +72,7 @@ class GravityLimit:
         """``(N,)`` the largest ``|gravity torque| / effort`` of the joints at ``q`` ``(N, nq)``."""
         if not len(q):
             return np.zeros(0)
-        return np.asarray(np.max(np.abs(self.dynamics.torques(q)) / self.dynamics.effort, axis=1))
+        return np.asarray(self.dynamics.utilisation(self.dynamics.torques(q)).max(axis=1))
 
     def path_excess(self, samples: FloatArray) -> FloatArray:
         """``(S,)`` how far gravity's largest torque over its effort exceeds 1 on paths ``(S, K, nq)``.
