@@ -25,48 +25,12 @@ from cpr_kin.compiled import njit
 from cpr_kin.limits import sampled_configurations
 from cpr_kin.obstacle_pools import configure_pool, pool_collisions
 from cpr_kin.pair_bounds import BOUND_TOLERANCE_M, joint_capsules
+from cpr_kin.segments import segment_distance
+from cpr_kin.self_blocks import PairBlocks, blocks_below
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
-
-
-@njit
-def segment_distance(p: FloatArray, q: FloatArray) -> float:
-    """Distance [m] between the segments ``p`` and ``q``, each ``(2, 3)`` end points.
-
-    The closest points of two segments (Ericson, *Real-Time Collision Detection*, 5.1.9):
-    the infinite lines' parameters clamped to ``[0, 1]`` in turn, degenerate segments
-    (points) and parallel ones included. Scalar arithmetic: no array is allocated.
-    """
-    d1x, d1y, d1z = p[1, 0] - p[0, 0], p[1, 1] - p[0, 1], p[1, 2] - p[0, 2]
-    d2x, d2y, d2z = q[1, 0] - q[0, 0], q[1, 1] - q[0, 1], q[1, 2] - q[0, 2]
-    rx, ry, rz = p[0, 0] - q[0, 0], p[0, 1] - q[0, 1], p[0, 2] - q[0, 2]
-    a = d1x * d1x + d1y * d1y + d1z * d1z
-    e = d2x * d2x + d2y * d2y + d2z * d2z
-    f = d2x * rx + d2y * ry + d2z * rz
-    tiny = 1e-18
-    if a <= tiny and e <= tiny:
-        s = t = 0.0
-    elif a <= tiny:
-        s, t = 0.0, min(max(f / e, 0.0), 1.0)
-    else:
-        c = d1x * rx + d1y * ry + d1z * rz
-        if e <= tiny:
-            s, t = min(max(-c / a, 0.0), 1.0), 0.0
-        else:
-            b = d1x * d2x + d1y * d2y + d1z * d2z
-            denominator = a * e - b * b
-            s = min(max((b * f - c * e) / denominator, 0.0), 1.0) if denominator > tiny else 0.0
-            t = (b * s + f) / e
-            if t < 0.0:
-                s, t = min(max(-c / a, 0.0), 1.0), 0.0
-            elif t > 1.0:
-                s, t = min(max((b - c) / a, 0.0), 1.0), 1.0
-    x = rx + s * d1x - t * d2x
-    y = ry + s * d1y - t * d2y
-    z = rz + s * d1z - t * d2z
-    return float(np.sqrt(x * x + y * y + z * z))
 
 
 @njit
@@ -131,12 +95,15 @@ class SelfPairBounds:
         self._chain = KinematicChain.from_model(model)
         geometries = sorted({g for pair in pairs for g in pair})
         slot = {g: k for k, g in enumerate(geometries)}
+        capsules = joint_capsules(collision_model, geometries)
         self._arguments: tuple[Any, ...] = (
             self._chain.arrays,
-            *joint_capsules(collision_model, geometries),
+            *capsules,
             np.array([slot[a] for a, _ in pairs], dtype=np.int64),
             np.array([slot[b] for _, b in pairs], dtype=np.int64),
         )
+        blocks = PairBlocks.build(capsules, [(slot[a], slot[b]) for a, b in pairs])
+        self._blocks: tuple[Any, ...] = (tuple(capsules), blocks.arrays)
         self.n_pairs = len(pairs)
 
     def __call__(self, q: FloatArray, threshold_m: float = np.inf) -> FloatArray:
@@ -160,8 +127,15 @@ class SelfPairBounds:
         return out[:, 0]
 
     def any_below(self, q: FloatArray, threshold_m: float) -> BoolArray:
-        """``(N,)`` whether some pair may be within ``threshold_m`` [m] at configurations ``q``."""
-        return np.asarray((self(q, threshold_m) <= threshold_m).any(axis=1))
+        """``(N,)`` whether some pair may be within ``threshold_m`` [m] at configurations ``q``.
+
+        Whether some column of ``self(q, threshold_m)`` is at most ``threshold_m``, found by
+        blocks of pairs (:mod:`cpr_kin.self_blocks`).
+        """
+        batch = np.ascontiguousarray(np.atleast_2d(q), dtype=float)
+        out = np.empty(len(batch), dtype=bool)
+        blocks_below(batch, float(threshold_m), out, self._chain.arrays, *self._blocks)
+        return out
 
 
 PROBES = 256

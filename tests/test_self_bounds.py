@@ -8,7 +8,8 @@ import pytest
 
 import cpr_kin as ck
 from cpr_kin.packages import example_robot_data_share
-from cpr_kin.self_bounds import ScreenedSelfTest, SelfPairBounds, segment_distance
+from cpr_kin.segments import segment_distance
+from cpr_kin.self_bounds import ScreenedSelfTest, SelfPairBounds
 from cpr_kin.self_collision import SelfCollision
 
 SHARE = example_robot_data_share()
