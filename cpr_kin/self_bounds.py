@@ -12,6 +12,7 @@ above a margin keeps it for certain, and only the others go to coal.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from typing import Any
 
@@ -95,16 +96,20 @@ class SelfPairBounds:
         self._chain = KinematicChain.from_model(model)
         geometries = sorted({g for pair in pairs for g in pair})
         slot = {g: k for k, g in enumerate(geometries)}
-        capsules = joint_capsules(collision_model, geometries)
+        self._capsules = joint_capsules(collision_model, geometries)
         self._arguments: tuple[Any, ...] = (
             self._chain.arrays,
-            *capsules,
+            *self._capsules,
             np.array([slot[a] for a, _ in pairs], dtype=np.int64),
             np.array([slot[b] for _, b in pairs], dtype=np.int64),
         )
-        blocks = PairBlocks.build(capsules, [(slot[a], slot[b]) for a, b in pairs])
-        self._blocks: tuple[Any, ...] = (tuple(capsules), blocks.arrays)
         self.n_pairs = len(pairs)
+
+    @functools.cached_property
+    def _blocks(self) -> tuple[Any, ...]:
+        """:func:`~cpr_kin.self_blocks.blocks_below`'s capsules and blocks, built on the first call."""
+        pairs = list(zip(self._arguments[-2].tolist(), self._arguments[-1].tolist(), strict=True))
+        return (tuple(self._capsules), PairBlocks.build(self._capsules, pairs).arrays)
 
     def __call__(self, q: FloatArray, threshold_m: float = np.inf) -> FloatArray:
         """``(N, P)`` lower bounds [m] of each pair's distance at configurations ``q`` ``(N, nq)``.
