@@ -38,6 +38,7 @@ from cpr_kin.arm import ArmChain, arm_chain, default_joints
 from cpr_kin.errors import UrdfError
 from cpr_kin.geometry_groups import carried_alone, grouped_geometries
 from cpr_kin.limits import LIMITS_NAMES, JointLimits, find_limits_file, read_dynamic_limits
+from cpr_kin.overlapping_pairs import overlapping_pairs
 from cpr_kin.packages import package_roots
 from cpr_kin.resources import makers_limits_path
 from cpr_kin.robot import Robot, joint_units
@@ -141,7 +142,7 @@ class RobotSpec:
             effort=np.array(model.effortLimit, dtype=float),
         )
         check_limits(limits, joint_units(model), path)
-        convex_hulls(collision)
+        capsule_meshes = convex_hulls(collision)
         srdf = self.srdf or find_srdf(path, tree.getroot().get("name")) or self.default_srdf
         links = {f.name for f in model.frames}
         srdf_pairs = read_srdf(srdf, links) if srdf is not None else SrdfPairs(frozenset())
@@ -151,6 +152,9 @@ class RobotSpec:
             else carried_alone(model, collision, tcp)
         )
         geometries = grouped_geometries(model, collision, collision_names(tree), effector, path)
+        checked = self_pairs(model, collision, srdf_pairs.disabled)
+        overlapping = overlapping_pairs(model, collision, checked)
+        link = [model.frames[obj.parentFrame].name for obj in collision.geometryObjects]
         return Robot(
             urdf_path=path,
             model=model,
@@ -165,9 +169,11 @@ class RobotSpec:
             limits_defaulted=dynamic.defaulted,
             held=held,
             srdf_path=srdf,
-            self_pairs=self_pairs(model, collision, srdf_pairs.disabled),
+            self_pairs=tuple(pair for pair in checked if pair not in overlapping),
+            overlapping_links=tuple(dict.fromkeys((link[a], link[b]) for a, b in overlapping)),
             srdf_unknown_links=srdf_pairs.unknown_links,
             massless_links=massless_links(tree, model),
+            capsule_meshes=capsule_meshes,
         )
 
     def _planned(self, model: Any, tree: etree._ElementTree, path: Path, arm: ArmChain) -> tuple[str, ...]:

@@ -70,7 +70,7 @@ def bounding_capsule(geometry: Any) -> tuple[FloatArray, float]:
 
 def _vertices(geometry: Any) -> FloatArray | None:
     """``(N, 3)`` a mesh's vertices in its own frame [m]; ``None`` for another shape or an empty mesh."""
-    if isinstance(geometry, coal.Convex):
+    if isinstance(geometry, coal.ConvexBase):
         points = np.asarray(geometry.points(), dtype=float)
     elif isinstance(geometry, coal.BVHModelBase):
         points = np.asarray(geometry.vertices(), dtype=float)

@@ -72,8 +72,12 @@ class Robot:
         self_pairs: indices of the collision geometry pairs checked against each other
             (:mod:`cpr_kin.self_collision`); empty: the robot cannot meet itself.
         srdf_unknown_links: links the SRDF names that the URDF lacks (their entries skipped).
+        overlapping_links: link pairs whose shapes collide in every sampled configuration,
+            touching by design and not checked (:mod:`cpr_kin.overlapping_pairs`).
         massless_links: links a planned joint moves that have a shape but no ``<inertial>``
             (massless, the URDF's rule; :mod:`cpr_kin.dynamics`).
+        capsule_meshes: collision geometries whose convex hull coal cannot hold (a vertex
+            with more than 255 neighbours), checked as their bounding capsule instead.
 
     """
 
@@ -92,7 +96,9 @@ class Robot:
     srdf_path: Path | None = None
     self_pairs: tuple[tuple[int, int], ...] = ()
     srdf_unknown_links: tuple[str, ...] = ()
+    overlapping_links: tuple[tuple[str, str], ...] = ()
     massless_links: tuple[str, ...] = ()
+    capsule_meshes: tuple[str, ...] = ()
 
     @cached_property
     def visual_model(self) -> Any:

@@ -2,7 +2,8 @@
 
 Every mesh of the collision model becomes its convex hull (:func:`convex_hulls`), which
 contains it: a clearance to the hull is at most the clearance to the mesh (safe), and coal
-gives signed distances between convex shapes.
+gives signed distances between convex shapes. A hull coal cannot hold becomes the mesh's
+bounding capsule, which contains it as well.
 """
 
 from __future__ import annotations
@@ -15,7 +16,9 @@ import coal
 import numpy as np
 import pinocchio as pin
 
+from cpr_kin.capsule_fit import frame_about
 from cpr_kin.errors import UrdfError
+from cpr_kin.pair_bounds import bounding_capsule
 from cpr_kin.urdf_file import captured_stderr
 
 
@@ -55,10 +58,42 @@ class VisualModel:
         return visual
 
 
-def convex_hulls(collision: Any) -> None:
-    """Replace every mesh of ``collision`` by its convex hull (module docstring, step 6)."""
+def convex_hulls(collision: Any) -> tuple[str, ...]:
+    """Replace every mesh of ``collision`` by its convex hull (module docstring, step 6).
+
+    coal's convex shapes give a vertex at most 255 neighbours. A hull whose triangles put
+    more around a vertex (a fine fan, as Centauro's pelvis has: 566) is built of polygons
+    instead (qhull's merged facets, the same hull); one whose polygons still do (a cone's
+    apex) is replaced by the mesh's bounding capsule
+    (:func:`cpr_kin.pair_bounds.bounding_capsule`), which contains it too.
+
+    Returns:
+        The names of the geometries replaced by a capsule.
+    """
+    capsules = []
     for obj in collision.geometryObjects:
         geometry = obj.geometry
-        if isinstance(geometry, coal.BVHModelBase):
-            geometry.buildConvexHull(True, "Qt")
+        if not isinstance(geometry, coal.BVHModelBase):
+            continue
+        for keep_triangles, qhull_options in ((True, "Qt"), (False, "Qx")):
+            try:
+                geometry.buildConvexHull(keep_triangles, qhull_options)
+            except RuntimeError:  # "Too many neighbors."
+                continue
             obj.geometry = geometry.convex
+            break
+        else:
+            obj.geometry, in_geometry = _capsule(geometry)
+            obj.placement = obj.placement * in_geometry
+            capsules.append(obj.name)
+    return tuple(capsules)
+
+
+def _capsule(mesh: Any) -> tuple[Any, Any]:
+    """The bounding capsule of ``mesh`` (a coal shape) and its placement in the mesh's frame."""
+    ends, radius = bounding_capsule(mesh)
+    axis = ends[1] - ends[0]
+    length = float(np.linalg.norm(axis))
+    rotation = frame_about(axis) if length > 0.0 else np.eye(3)
+    shape = coal.Capsule(radius, length) if length > 0.0 else coal.Sphere(radius)
+    return shape, pin.SE3(rotation, ends.mean(axis=0))

@@ -179,3 +179,14 @@ def test_the_report_states_default_limits(tmp_path: Path) -> None:
     report = report_markdown(plan(scene, robot))
     assert "Acceleration and jerk limits of theta1, d2, d3, theta4, theta5 are the defaults" in report
     assert "no limits file" in report and "Held" not in report
+
+
+def test_a_limit_without_lower_and_upper_is_the_specifications_zero_range(tmp_path: Path) -> None:
+    # the URDF specification makes both optional (0 by default; urdfdom reads them so), where
+    # yourdfpy's validation called the file invalid: Centauro's wheels load with its arm
+    # (tests/test_urdf_models.py); a planned joint with that range is refused by name
+    no_range = variant(tmp_path, lambda t: t.replace(THETA1, '<limit velocity="1.5" effort="100"/>'))
+    with pytest.raises(
+        ck.UrdfError, match=rf"joint 'theta1' range \[0, 0\] rad is not supported; {SUPPORTED}"
+    ):
+        ck.load_cpr(no_range, validate=True)

@@ -164,6 +164,19 @@ def limits_section(result: PlanResult) -> list[str]:
             "as MoveIt skips them.",
             "",
         ]
+    if robot.overlapping_links:
+        pairs = ", ".join(f"{a} / {b}" for a, b in robot.overlapping_links)
+        lines += [
+            f"Link pairs whose shapes collide in every sampled configuration, touching by design and "
+            f"not checked (MoveIt's setup assistant disables them as always in collision): {pairs}.",
+            "",
+        ]
+    if robot.capsule_meshes:
+        lines += [
+            f"Collision meshes checked as their bounding capsule (coal cannot hold their convex hull): "
+            f"{', '.join(robot.capsule_meshes)}.",
+            "",
+        ]
     return lines
 
 
