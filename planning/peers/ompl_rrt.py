@@ -18,12 +18,14 @@ from numpy.typing import NDArray
 
 import cpr_kin as ck
 from planning.peers.toppra_timing import SamplingResult, time_and_verify
+from planning.pipeline.blas_threads import one_blas_thread
 from planning.pipeline.problem import build_problem, finer_step_m, with_planner
 from planning.pipeline.scene import Scene
 
 FloatArray = NDArray[np.float64]
 
 
+@one_blas_thread  # as our planner runs: the same machine for both (blas_threads)
 def plan_rrt_connect(
     scene: Scene, robot: ck.Robot | None = None, time_limit_s: float = 2.0, seed: int = 0
 ) -> SamplingResult:

@@ -23,12 +23,14 @@ from numpy.typing import NDArray
 
 import cpr_kin as ck
 from planning.peers.toppra_timing import SamplingResult, planning_clearance_m, time_and_verify
+from planning.pipeline.blas_threads import one_blas_thread
 from planning.pipeline.problem import build_problem
 from planning.pipeline.scene import Scene
 
 FloatArray = NDArray[np.float64]
 
 
+@one_blas_thread  # as our planner runs: the same machine for both (blas_threads)
 def plan_pyroboplan_rrt_connect(
     scene: Scene, robot: ck.Robot | None = None, time_limit_s: float = 2.0, seed: int = 0
 ) -> SamplingResult:

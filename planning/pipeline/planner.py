@@ -25,6 +25,7 @@ from numpy.typing import NDArray
 import cpr_kin as ck
 from planning.curves.trajectory import Trajectory
 from planning.errors import NoSolutionError, PlanningError
+from planning.pipeline.blas_threads import one_blas_thread
 from planning.pipeline.choose import Choice, Refusal, choose, verify
 from planning.pipeline.deadline import Deadline
 from planning.pipeline.metrics import Elapsed
@@ -42,6 +43,7 @@ from planning.search.optimizer import Optimizer, SearchResult
 FloatArray = NDArray[np.float64]
 
 
+@one_blas_thread
 def solve(
     problem: Problem,
     progress: Callable[[FireflyProgress], None] | None = None,
@@ -112,6 +114,7 @@ def stand_still(problem: Problem, started: float) -> PlanResult:
     return assemble(problem, searched, choice, elapsed)
 
 
+@one_blas_thread
 def plan(
     scene: Scene,
     robot: ck.Robot | None = None,
