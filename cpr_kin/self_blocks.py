@@ -3,11 +3,11 @@
 A humanoid's or a dual arm's hand carries a dozen finger links, each paired with every link
 of the body and upper arm: a few hundred pairs, most of them far apart, each compared by its
 bounding spheres at every configuration (:func:`cpr_kin.self_bounds.self_bounds`). Here the
-pairs are grouped in *blocks* that share one capsule on one side and one joint on the other
-(the fingers of one hand, say, against the torso). The other side's capsules on that joint
-are enclosed in one sphere fixed to the joint; where the shared capsule's sphere and that
-sphere are more than the threshold apart, so is every pair of the block, and none of them is
-looked at. The others are bounded pair by pair as in
+capsules of each joint (the world's too) are split into clusters of at most
+:data:`CLUSTER_RADIUS_M` (a hand's links, a stretch of the torso), each enclosed in a sphere
+fixed to its joint, and the pairs are grouped in *blocks* by the clusters of their two
+capsules. Where a block's two spheres are more than the threshold apart, so is every pair of
+the block, and none of them is looked at; the others are bounded pair by pair as in
 :func:`~cpr_kin.self_bounds.self_bounds`, and a configuration stops at its first pair within
 the threshold. The answer is the pair-by-pair bounds' (:meth:`SelfPairBounds.any_below
 <cpr_kin.self_bounds.SelfPairBounds.any_below>`), only cheaper.
