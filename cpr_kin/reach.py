@@ -168,23 +168,27 @@ def pair_reach_distances(
     import pinocchio as pin
 
     reach = robot_reach(robot)
-    request, distances = coal.DistanceRequest(), []
-    for g, k in pairs:
-        obstacle = obstacles[k]
-        placement = coal.Transform3s(obstacle.placement.rotation, obstacle.placement.translation)
-        bound = -np.inf  # every hull gives a lower bound: keep the largest
+    swept: dict[int, list[tuple[Any, Any]]] = {}  # geometry index -> its capsules, placed
+    for g in {g for g, _ in pairs}:
+        swept[g] = []
         for hull in reach[robot.geometries[g].index].hulls:
             centre, axis, half, radius = hull.capsule()
             rotation = pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), axis).matrix()
+            swept[g].append((coal.Capsule(radius, 2 * half), coal.Transform3s(rotation, centre)))
+    placed = {
+        k: (
+            obstacles[k].geometry(),
+            coal.Transform3s(obstacles[k].placement.rotation, obstacles[k].placement.translation),
+        )
+        for k in {k for _, k in pairs}
+    }
+    request, distances = coal.DistanceRequest(), []
+    for g, k in pairs:
+        shape, placement = placed[k]
+        bound = -np.inf  # every hull gives a lower bound: keep the largest
+        for capsule, transform in swept[g]:
             result = coal.DistanceResult()
-            coal.distance(
-                coal.Capsule(radius, 2 * half),
-                coal.Transform3s(rotation, centre),
-                obstacle.geometry(),
-                placement,
-                request,
-                result,
-            )
+            coal.distance(capsule, transform, shape, placement, request, result)
             bound = max(bound, result.min_distance)
         distances.append(bound)
     return np.array(distances)
