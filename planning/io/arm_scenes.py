@@ -15,6 +15,7 @@ straight way is blocked; whether a way around exists is for the planners to find
 
 from __future__ import annotations
 
+from collections import Counter
 from typing import Any
 
 import numpy as np
@@ -55,6 +56,7 @@ def blocked_scene(
     middle, half = (lower + upper) / 2, (upper - lower) / 2
     reach = float(np.linalg.norm(ck.frame_poses(robot, middle[None])[0][:3, 3]))
     dynamics = ck.robot_dynamics(robot)
+    too_close: Counter[tuple[str, str]] = Counter()  # the closest pair of each end refused for it
     for _ in range(draws):
         start, goal = rng.uniform(middle - 0.6 * half, middle + 0.6 * half, (2, robot.nq))
         tools = ck.frame_poses(robot, np.array([start, (start + goal) / 2, goal]))
@@ -65,8 +67,11 @@ def blocked_scene(
         ends = np.array([start, goal])
         if world.clearance_batch(ends).clearance_m.min() <= margin_m + 0.02:
             continue
-        if world.self_collision and world.self_collision.distances(ends)[0].min() <= self_clearance_m:
-            continue
+        if world.self_collision:
+            distance, pair = world.self_collision.distances(ends)
+            if distance.min() <= self_clearance_m:
+                too_close[world.self_collision.pairs[int(pair[np.argmin(distance)])]] += 1
+                continue
         if not held(dynamics, ends).all():
             continue
         return {
@@ -81,10 +86,17 @@ def blocked_scene(
             "planner": {"seed": seed},
         }
     unlisted = "" if robot.srdf_path is not None else ", or give the robot its SRDF (none was found)"
+    closest = ""
+    if too_close:
+        (a, b), count = too_close.most_common(1)[0]
+        closest = (
+            f" ({count} of the {sum(too_close.values())} draws refused for their own pairs had "
+            f"{a} and {b} closest: if they sit that close by design, allow the pair in the SRDF)"
+        )
     raise PlanningError(
         f"no start and goal of {draws} draws for '{name}' keep {margin_m + 0.02:g} m from the ball and "
         f"{self_clearance_m:g} m between the robot's own pairs, with gravity's torques within the effort "
-        f"limits; lower self_clearance_m{unlisted}"
+        f"limits; lower self_clearance_m{unlisted}{closest}"
     )
 
 
