@@ -154,7 +154,6 @@ class RobotSpec:
         geometries = grouped_geometries(model, collision, collision_names(tree), effector, path)
         checked = self_pairs(model, collision, srdf_pairs.disabled)
         overlapping = overlapping_pairs(model, collision, checked)
-        link = [model.frames[obj.parentFrame].name for obj in collision.geometryObjects]
         return Robot(
             urdf_path=path,
             model=model,
@@ -170,7 +169,9 @@ class RobotSpec:
             held=held,
             srdf_path=srdf,
             self_pairs=tuple(pair for pair in checked if pair not in overlapping),
-            overlapping_links=tuple(dict.fromkeys((link[a], link[b]) for a, b in overlapping)),
+            overlapping_links=tuple(
+                dict.fromkeys((geometries[a].link, geometries[b].link) for a, b in overlapping)
+            ),
             srdf_unknown_links=srdf_pairs.unknown_links,
             massless_links=massless_links(tree, model),
             capsule_meshes=capsule_meshes,

@@ -74,20 +74,19 @@ class PairBlocks:
     def build(cls, capsules: JointCapsules, pairs: Sequence[tuple[int, int]]) -> PairBlocks:
         """Blocks of ``pairs`` (capsule slots of ``capsules``), each pair in one block."""
         slots = sorted({s for pair in pairs for s in pair})
-        clusters: list[list[int]] = []
+        clusters: list[tuple[list[int], FloatArray, float]] = []  # members, centre, radius
         for joint in sorted({int(capsules.joint[s]) for s in slots}):
             clusters += _split(capsules, [s for s in slots if capsules.joint[s] == joint])
-        cluster_of = {s: m for m, members in enumerate(clusters) for s in members}
-        spheres = [_enclosing_sphere(capsules, members) for members in clusters]
+        cluster_of = {s: m for m, (members, _, _) in enumerate(clusters) for s in members}
         members_of: dict[tuple[int, int], list[tuple[int, int]]] = {}
         for a, b in pairs:
             key = (cluster_of[a], cluster_of[b])
             members_of.setdefault(key, []).append((a, b))
         ordered = [pair for block in members_of.values() for pair in block]
         return cls(
-            np.array([capsules.joint[members[0]] for members in clusters], dtype=np.int64),
-            np.array([centre for centre, _ in spheres], dtype=float).reshape(-1, 3),
-            np.array([radius for _, radius in spheres], dtype=float),
+            np.array([capsules.joint[members[0]] for members, _, _ in clusters], dtype=np.int64),
+            np.array([centre for _, centre, _ in clusters], dtype=float).reshape(-1, 3),
+            np.array([radius for _, _, radius in clusters], dtype=float),
             np.array([a for a, _ in members_of], dtype=np.int64),
             np.array([b for _, b in members_of], dtype=np.int64),
             np.cumsum([0] + [len(block) for block in members_of.values()], dtype=np.int64),
@@ -96,14 +95,15 @@ class PairBlocks:
         )
 
 
-def _split(capsules: JointCapsules, slots: list[int]) -> list[list[int]]:
+def _split(capsules: JointCapsules, slots: list[int]) -> list[tuple[list[int], FloatArray, float]]:
     """``slots`` (capsules on one joint) in clusters within :data:`CLUSTER_RADIUS_M` or of one capsule.
 
-    Halved recursively at the median of the capsules' middles along their widest axis.
+    Each cluster with its enclosing sphere (:func:`_enclosing_sphere`). Halved recursively
+    at the median of the capsules' middles along their widest axis.
     """
-    _, radius = _enclosing_sphere(capsules, slots)
+    centre, radius = _enclosing_sphere(capsules, slots)
     if radius <= CLUSTER_RADIUS_M or len(slots) == 1:
-        return [slots]
+        return [(slots, centre, radius)]
     middles = capsules.ends[slots].mean(axis=1)
     axis = int(np.argmax(middles.max(axis=0) - middles.min(axis=0)))
     order = [slots[i] for i in np.argsort(middles[:, axis], kind="stable")]

@@ -97,19 +97,19 @@ class SelfPairBounds:
         geometries = sorted({g for pair in pairs for g in pair})
         slot = {g: k for k, g in enumerate(geometries)}
         self._capsules = joint_capsules(collision_model, geometries)
+        self._slot_pairs = [(slot[a], slot[b]) for a, b in pairs]  # capsule slots
         self._arguments: tuple[Any, ...] = (
             self._chain.arrays,
             *self._capsules,
-            np.array([slot[a] for a, _ in pairs], dtype=np.int64),
-            np.array([slot[b] for _, b in pairs], dtype=np.int64),
+            np.array([a for a, _ in self._slot_pairs], dtype=np.int64),
+            np.array([b for _, b in self._slot_pairs], dtype=np.int64),
         )
         self.n_pairs = len(pairs)
 
     @functools.cached_property
     def _blocks(self) -> tuple[Any, ...]:
         """:func:`~cpr_kin.self_blocks.blocks_below`'s capsules and blocks, built on the first call."""
-        pairs = list(zip(self._arguments[-2].tolist(), self._arguments[-1].tolist(), strict=True))
-        return (tuple(self._capsules), PairBlocks.build(self._capsules, pairs).arrays)
+        return (tuple(self._capsules), PairBlocks.build(self._capsules, self._slot_pairs).arrays)
 
     def __call__(self, q: FloatArray, threshold_m: float = np.inf) -> FloatArray:
         """``(N, P)`` lower bounds [m] of each pair's distance at configurations ``q`` ``(N, nq)``.
