@@ -2,6 +2,7 @@
 
 from .carried import carrying
 from .clearance import BatchClearance, Clearance, PairDistance
+from .close_pairs import ClosePair
 from .collision import CollisionWorld
 from .cpr import CPR_JOINTS, TCP_FRAME, cpr_spec, load_cpr, robot_spec
 from .dynamics import Dynamics, Payload, robot_dynamics
@@ -24,6 +25,7 @@ __all__ = [
     "TCP_FRAME",
     "BatchClearance",
     "Clearance",
+    "ClosePair",
     "CollisionWorld",
     "CprKinError",
     "CurveCheck",

@@ -34,6 +34,7 @@ def closest_pairs(
     bounds: FloatArray,
     pair_index: IntArray,
     below_m: float = np.inf,
+    offsets_m: FloatArray | None = None,
 ) -> tuple[FloatArray, IntArray]:
     """Smallest coal distance [m] over the pairs at each configuration, and its pair.
 
@@ -49,6 +50,8 @@ def closest_pairs(
         below_m: only distances below this matter [m]: pairs bounded above it are not
             computed, and where the smallest distance is not below it, ``inf`` and ``-1``
             are returned.
+        offsets_m: ``(P,)`` added to each pair's coal distance [m] (its bound includes it);
+            a pair with a positive offset is always computed.
 
     Returns:
         The distance and the pair's index in ``geometry_model.collisionPairs`` (``-1``: none
@@ -56,6 +59,9 @@ def closest_pairs(
     """
     distance = np.full(len(batch), np.inf)
     closest = np.full(len(batch), -1, dtype=np.int64)
+    offsets = np.zeros(bounds.shape[1]) if offsets_m is None else np.asarray(offsets_m, dtype=float)
+    if np.any(offsets > 0.0):
+        bounds = np.where(offsets > 0.0, -np.inf, bounds)  # an offset bound tells nothing of coal's sign
     order = np.argsort(bounds, axis=1, kind="stable")
     ordered = np.take_along_axis(bounds, order, axis=1)
     place, compute = pin.updateGeometryPlacements, pin.computeDistance
@@ -69,7 +75,7 @@ def closest_pairs(
             if _farther(bound, min(best, below_m)):
                 break  # no pair left can be closer
             pair = int(pair_index[column])
-            found = compute(geometry_model, geometry_data, pair).min_distance
+            found = compute(geometry_model, geometry_data, pair).min_distance + offsets[column]
             if found < best:
                 best, which = found, pair
         if best < below_m:

@@ -39,6 +39,10 @@ class CollisionWorld:
         obstacles: the obstacles; their names must be unique.
         num_threads: threads for :meth:`margin_violated` (default: up to 2).
         allowed_pairs: link pairs of the robot allowed to touch (a scene's), beyond its SRDF's.
+        self_margin_m: the self margin the world's user holds the robot's own pairs to [m]: a
+            pair closer than it by design (:attr:`cpr_kin.Robot.close_pairs`, its largest
+            distance below it) is held to contact only, its distance counting the margin as
+            kept (:attr:`cpr_kin.self_collision.SelfCollision.allowance_m`). Default 0: none is.
 
     Attributes:
         self_collision: the robot's own pairs (:mod:`cpr_kin.self_collision`), false when
@@ -53,6 +57,7 @@ class CollisionWorld:
         *,
         num_threads: int | None = None,
         allowed_pairs: Sequence[tuple[str, str]] = (),
+        self_margin_m: float = 0.0,
     ) -> None:
         names = [o.name for o in obstacles]
         duplicated = sorted({n for n in names if names.count(n) > 1})
@@ -91,8 +96,15 @@ class CollisionWorld:
         kept = tuple((a, b) for a, b in robot.self_pairs if frozenset((links[a], links[b])) not in allowed)
         names = [g.name for g in robot.geometries]
         radii = np.array([r.radii for r in robot_reach(robot)])
+        contact_only = {c.geometries for c in robot.close_pairs if c.largest_m < self_margin_m}
         self.self_collision = SelfCollision(
-            robot.model, robot.collision_model, kept, names, self.num_threads, geometry_radii=radii
+            robot.model,
+            robot.collision_model,
+            kept,
+            names,
+            self.num_threads,
+            geometry_radii=radii,
+            allowance_m=np.array([self_margin_m if pair in contact_only else 0.0 for pair in kept]),
         )
 
     @property

@@ -35,6 +35,7 @@ import pinocchio as pin
 from lxml import etree
 
 from cpr_kin.arm import ArmChain, arm_chain, default_joints
+from cpr_kin.close_pairs import close_pairs
 from cpr_kin.errors import UrdfError
 from cpr_kin.geometry_groups import carried_alone, grouped_geometries
 from cpr_kin.limits import LIMITS_NAMES, JointLimits, find_limits_file, read_dynamic_limits
@@ -154,6 +155,7 @@ class RobotSpec:
         geometries = grouped_geometries(model, collision, collision_names(tree), effector, path)
         checked = self_pairs(model, collision, srdf_pairs.disabled)
         overlapping = overlapping_pairs(model, collision, checked)
+        kept = tuple(pair for pair in checked if pair not in overlapping)
         return Robot(
             urdf_path=path,
             model=model,
@@ -168,10 +170,11 @@ class RobotSpec:
             limits_defaulted=dynamic.defaulted,
             held=held,
             srdf_path=srdf,
-            self_pairs=tuple(pair for pair in checked if pair not in overlapping),
+            self_pairs=kept,
             overlapping_links=tuple(
                 dict.fromkeys((geometries[a].link, geometries[b].link) for a, b in overlapping)
             ),
+            close_pairs=close_pairs(model, collision, kept, [g.link for g in geometries]),
             srdf_unknown_links=srdf_pairs.unknown_links,
             massless_links=massless_links(tree, model),
             capsule_meshes=capsule_meshes,

@@ -96,9 +96,19 @@ class ObstaclePools:
         return pool
 
 
-def configure_pool(pool: Any, geometry_model: Any, margin_m: float, active: BoolArray) -> None:
-    """Give each geometry data of ``pool`` the security margin ``margin_m`` [m], only ``active`` pairs on."""
-    margins = np.full((geometry_model.ngeoms,) * 2, float(margin_m))
+def configure_pool(pool: Any, geometry_model: Any, margin_m: float | FloatArray, active: BoolArray) -> None:
+    """Give each geometry data of ``pool`` the security margin ``margin_m`` [m], only ``active`` pairs on.
+
+    ``margin_m`` is one margin for every pair, or one per collision pair of ``geometry_model``.
+    """
+    if np.ndim(margin_m) == 0:
+        margins = np.full((geometry_model.ngeoms,) * 2, float(margin_m))
+    else:
+        margins = np.zeros((geometry_model.ngeoms,) * 2)
+        for pair, margin in zip(
+            geometry_model.collisionPairs, np.asarray(margin_m, dtype=float), strict=True
+        ):
+            margins[pair.first, pair.second] = margins[pair.second, pair.first] = margin
     for gdata in pool.getGeometryDatas():
         gdata.setSecurityMargins(geometry_model, margins, True, True)
         for p, on in enumerate(active):

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from cpr_kin.close_pairs import ClosePair
 from cpr_kin.errors import CprKinError, JointLimitError
 from cpr_kin.frames import frame_index
 from cpr_kin.limits import JointLimits
@@ -74,6 +75,9 @@ class Robot:
         srdf_unknown_links: links the SRDF names that the URDF lacks (their entries skipped).
         overlapping_links: link pairs whose shapes collide in every sampled configuration,
             touching by design and not checked (:mod:`cpr_kin.overlapping_pairs`).
+        close_pairs: checked pairs a few millimetres apart in every sampled configuration and
+            touching in none, held to contact only by a self margin above their largest
+            distance (:mod:`cpr_kin.close_pairs`).
         massless_links: links a planned joint moves that have a shape but no ``<inertial>``
             (massless, the URDF's rule; :mod:`cpr_kin.dynamics`).
         capsule_meshes: collision geometries whose convex hull coal cannot hold (a vertex
@@ -97,6 +101,7 @@ class Robot:
     self_pairs: tuple[tuple[int, int], ...] = ()
     srdf_unknown_links: tuple[str, ...] = ()
     overlapping_links: tuple[tuple[str, str], ...] = ()
+    close_pairs: tuple[ClosePair, ...] = ()
     massless_links: tuple[str, ...] = ()
     capsule_meshes: tuple[str, ...] = ()
 

@@ -163,17 +163,29 @@ class ScreenedSelfTest:
     ``GeometryPool``, run in parallel over ``num_threads`` threads, stopping at a
     configuration's first hit. The answer is coal's on every pair.
 
+    A pair's distance counts its allowance (:mod:`cpr_kin.close_pairs`): coal's distance plus
+    ``allowance_m``, so a margin asks coal for that much less of the pair (never below contact).
+
     Args:
         model: the robot's Pinocchio model.
         geometry_model: its geometry model with the pairs added, in order.
         pairs: the pairs' geometry indices.
         num_threads: threads of coal's batches.
+        allowance_m: ``(P,)`` each pair's allowance [m] (default: none).
     """
 
     def __init__(
-        self, model: Any, geometry_model: Any, pairs: Sequence[tuple[int, int]], num_threads: int
+        self,
+        model: Any,
+        geometry_model: Any,
+        pairs: Sequence[tuple[int, int]],
+        num_threads: int,
+        allowance_m: FloatArray | None = None,
     ) -> None:
         self.model, self.geometry_model, self.num_threads = model, geometry_model, num_threads
+        self.allowance_m = (
+            np.zeros(len(pairs)) if allowance_m is None else np.asarray(allowance_m, dtype=float)
+        )
         probes = sampled_configurations(model, PROBES, np.random.default_rng(0))
         self.all_bounds = SelfPairBounds(model, geometry_model, pairs)
         uncertain = self.all_bounds(probes, PROBE_THRESHOLD_M) <= PROBE_THRESHOLD_M
@@ -207,12 +219,16 @@ class ScreenedSelfTest:
         coal's distance of the closest pair, the pairs visited in the order of their bounds
         until no pair left can be closer (:func:`cpr_kin.closest_pairs.closest_pairs`).
         """
-        bounds = self.all_bounds(batch)
+        bounds = self.bounds(batch)
         return self._closest(batch, bounds, np.arange(bounds.shape[1]))
+
+    def bounds(self, batch: FloatArray) -> FloatArray:
+        """``(N, P)`` lower bounds [m] of every pair's distance (its capsules') at ``batch``."""
+        return self.all_bounds(batch) + self.allowance_m
 
     def pair_bounds(self, batch: FloatArray, pair: int) -> FloatArray:
         """``(N,)`` lower bounds [m] of pair ``pair``'s distance (its capsules') at ``batch``."""
-        return self.all_bounds.column(batch, pair)
+        return self.all_bounds.column(batch, pair) + float(self.allowance_m[pair])
 
     def pair_distances(self, batch: FloatArray, pair: int) -> FloatArray:
         """``(N,)`` coal's distance [m] of pair ``pair`` (index among all pairs) at ``batch``."""
@@ -222,7 +238,7 @@ class ScreenedSelfTest:
         """:func:`~cpr_kin.closest_pairs.closest_pairs` of ``pairs`` (bounded by ``bounds``) at ``batch``."""
         self._prepare(float("nan"))
         data = (self.model, self._data, self.geometry_model, self._distance_data)
-        return closest_pairs(*data, batch, bounds, pairs)
+        return closest_pairs(*data, batch, bounds, pairs, offsets_m=self.allowance_m[pairs])
 
     def _coal(self, tier: int, batch: FloatArray) -> NDArray[np.bool_]:
         """Coal's test of the pairs of ``tier`` (0 near, 1 far) at configurations ``batch``."""
@@ -242,8 +258,9 @@ class ScreenedSelfTest:
                 pin.GeometryPool(self.model, self.geometry_model, self.num_threads) for _ in range(2)
             ]
         if margin_m != self._margin_m and not np.isnan(margin_m):
+            margins = np.maximum(margin_m - self.allowance_m, 0.0) if self.allowance_m.any() else margin_m
             for pool, active in zip(self._pools, self._active, strict=True):
-                configure_pool(pool, self.geometry_model, margin_m, active)
+                configure_pool(pool, self.geometry_model, margins, active)
                 for gdata in pool.getGeometryDatas():
                     for request in gdata.collisionRequests:
                         request.enable_contact = False

@@ -144,6 +144,8 @@ class SelfCollision:
         geometry_radii: ``(G, nj)`` each geometry's motion radius about each joint
             (:attr:`cpr_kin.reach.GeometryReach.radii`, within the robot's joint ranges);
             by default from the model's position limits.
+        allowance_m: ``(P,)`` added to each pair's coal distance [m] wherever a distance,
+            bound or margin is asked (:attr:`allowance_m`); default none.
     """
 
     def __init__(
@@ -154,6 +156,7 @@ class SelfCollision:
         names: list[str],
         num_threads: int = 1,
         geometry_radii: FloatArray | None = None,
+        allowance_m: FloatArray | None = None,
     ) -> None:
         self.model = model
         self.geometry_model = collision_model.copy()
@@ -169,6 +172,14 @@ class SelfCollision:
         )
         """``(P, nj)`` per pair, how fast its distance may change per joint speed [m/rad, m/m]
         (:func:`cpr_kin.self_curve.relative_radii`)."""
+        self.allowance_m = (
+            np.zeros(len(pairs)) if allowance_m is None else np.asarray(allowance_m, dtype=float)
+        )
+        """``(P,)`` what each pair's distance counts beyond coal's [m]: a world's self margin for a
+        pair it holds to contact only (:mod:`cpr_kin.close_pairs`), else 0. Every distance,
+        bound and margin of this class is of coal's distance plus it."""
+        if self.allowance_m.shape != (len(pairs),) or not np.all(self.allowance_m >= 0.0):
+            raise CprKinError(f"allowance_m must be {len(pairs)} distances >= 0 [m], one per pair")
         self._pairs = pairs
         self._names = names
         self.num_threads = num_threads
@@ -185,7 +196,8 @@ class SelfCollision:
     def distances(self, q: ArrayLike) -> tuple[FloatArray, IntArray]:
         """Smallest self distance [m] and its pair, ``(N,)`` each, at configurations ``q`` ``(N, nq)``.
 
-        ``inf`` and ``-1`` when there is no pair.
+        A pair's distance is coal's plus its :attr:`allowance_m`; ``inf`` and ``-1`` when there
+        is no pair.
         """
         batch = np.atleast_2d(np.asarray(q, dtype=float))
         if not self._pairs:
@@ -198,7 +210,7 @@ class SelfCollision:
 
     def bounds(self, q: FloatArray) -> FloatArray:
         """``(N, P)`` lower bounds [m] of every pair's distance at ``q`` ``(N, nq)`` (:meth:`pair_bounds`)."""
-        return self._screened().all_bounds(np.atleast_2d(np.asarray(q, dtype=float)))
+        return self._screened().bounds(np.atleast_2d(np.asarray(q, dtype=float)))
 
     def pair_bounds(self, q: FloatArray, pair: int) -> FloatArray:
         """``(N,)`` lower bounds [m] of pair ``pair``'s distance at configurations ``q`` ``(N, nq)``, cheaply.
@@ -224,5 +236,7 @@ class SelfCollision:
     def _screened(self) -> ScreenedSelfTest:
         """The screened coal queries of the pairs, built on first use."""
         if self._test is None:
-            self._test = ScreenedSelfTest(self.model, self.geometry_model, self._pairs, self.num_threads)
+            self._test = ScreenedSelfTest(
+                self.model, self.geometry_model, self._pairs, self.num_threads, self.allowance_m
+            )
         return self._test

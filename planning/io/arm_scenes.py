@@ -63,7 +63,7 @@ def blocked_scene(
         if np.linalg.norm(tools[0, :3, 3] - tools[2, :3, 3]) < 0.5 * reach or tools[1, 2, 3] < 0.1 * reach:
             continue
         ball = ck.Obstacle.sphere(0.12 * reach, tuple(tools[1, :3, 3]), name="ball")
-        world = ck.CollisionWorld(robot, [ball])
+        world = ck.CollisionWorld(robot, [ball], self_margin_m=self_clearance_m)
         ends = np.array([start, goal])
         if world.clearance_batch(ends).clearance_m.min() <= margin_m + 0.02:
             continue

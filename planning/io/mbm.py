@@ -158,7 +158,9 @@ def endpoint_violations(scene: Scene, robot: ck.Robot) -> list[str]:
     from planning.pipeline.endpoints import endpoint
     from planning.pipeline.torques import scene_dynamics
 
-    world = ck.CollisionWorld(robot, scene.obstacles, allowed_pairs=scene.allowed_collisions)
+    world = ck.CollisionWorld(
+        robot, scene.obstacles, allowed_pairs=scene.allowed_collisions, self_margin_m=scene.self_margin
+    )
     try:
         dynamics = scene_dynamics(robot, scene)
     except PlanningError as exc:

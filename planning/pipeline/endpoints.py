@@ -32,6 +32,7 @@ def margin_violation(world: ck.CollisionWorld, scene: Scene, q: FloatArray) -> s
     distance, pair = world.self_collision.distances(q[None])
     if distance[0] < scene.self_margin:
         a, b = world.self_collision.pairs[int(pair[0])]
+        coal_m = distance[0] - world.self_collision.allowance_m[int(pair[0])]  # a close pair's own distance
         unlisted = (
             ""
             if world.robot.srdf_path is not None
@@ -39,7 +40,7 @@ def margin_violation(world: ck.CollisionWorld, scene: Scene, q: FloatArray) -> s
             "goes in robot: {srdf: ...}"
         )
         return (
-            f"is inside the self margin: {a} is {distance[0]:.3f} m from {b} "
+            f"is inside the self margin: {a} is {coal_m:.3f} m from {b} "
             f"(self_margin {scene.self_margin} m; allowed_collisions lets a pair touch{unlisted})"
         )
     return None

@@ -152,7 +152,11 @@ def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | No
     except ck.CprKinError as exc:
         raise PlanningError(f"payload: {exc}") from None
     world = ck.CollisionWorld(
-        robot, scene.obstacles, num_threads=threads, allowed_pairs=scene.allowed_collisions
+        robot,
+        scene.obstacles,
+        num_threads=threads,
+        allowed_pairs=scene.allowed_collisions,
+        self_margin_m=scene.self_margin,
     )
     dynamics = scene_dynamics(robot, scene, world.num_threads)
     q_start = endpoint(robot, world, scene, "start", dynamics=dynamics)

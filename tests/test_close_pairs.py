@@ -1,0 +1,148 @@
+"""Pairs a few millimetres apart by design: found, held to contact only, and nothing else changed."""
+
+from __future__ import annotations
+
+import coal
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import cpr_kin as ck
+from cpr_kin.close_pairs import CLOSE_LIMIT_M, close_pairs
+from cpr_kin.packages import example_robot_data_share
+from cpr_kin.self_collision import SelfCollision
+from planning.io.arm_scenes import blocked_scene
+from planning.io.report import report_markdown
+from planning.io.scene_file import parse_scene
+from planning.pipeline.planner import plan
+from planning.pipeline.problem import build_problem
+from planning.pipeline.verification import verify_for_scene
+
+SHARE = example_robot_data_share()
+assert SHARE is not None, "example-robot-data is part of the robots extra, which make installs"
+ROBOTS = SHARE / "example-robot-data" / "robots"
+
+
+def _turning_balls() -> tuple[pin.Model, pin.GeometryModel, dict[str, int]]:
+    """A joint turning balls about a hub on its axis: their gaps to the hub never change."""
+    model = pin.Model()
+    joint = model.addJoint(0, pin.JointModelRZ(), pin.SE3.Identity(), "spin")
+    model.lowerPositionLimit[:] = -np.pi
+    model.upperPositionLimit[:] = np.pi
+    geometry_model = pin.GeometryModel()
+
+    def ball(name: str, parent: int, radius: float, x: float) -> int:
+        placement = pin.SE3(np.eye(3), np.array([x, 0.0, 0.0]))
+        return int(
+            geometry_model.addGeometryObject(pin.GeometryObject(name, parent, placement, coal.Sphere(radius)))
+        )
+
+    ids = {
+        "hub": ball("hub", 0, 0.2, 0.0),
+        "close": ball("close", joint, 0.1, 0.306),  # 6 mm from the hub at every angle
+        "touching": ball("touching", joint, 0.1, 0.29),  # 10 mm into it at every angle
+        "far": ball("far", joint, 0.1, 0.5),  # 200 mm from it
+        "post": ball("post", 0, 0.05, 0.462),  # 6 mm from the close ball at angle 0 only
+    }
+    return model, geometry_model, ids
+
+
+def test_only_a_pair_apart_and_close_at_every_angle_is_found_with_its_largest_gap() -> None:
+    model, geometry_model, ids = _turning_balls()
+    names = ("hub", "close"), ("hub", "touching"), ("hub", "far"), ("post", "close")
+    pairs = [(ids[a], ids[b]) for a, b in names]
+    links = [f"link_of_{obj.name}" for obj in geometry_model.geometryObjects]
+    (found,) = close_pairs(model, geometry_model, pairs, links)
+    assert found.geometries == (ids["hub"], ids["close"])
+    assert found.largest_m == pytest.approx(0.006, abs=1e-9)  # the balls' gap, analytic
+    assert found.links == ("link_of_hub", "link_of_close")
+    assert close_pairs(model, geometry_model, [], links) == ()
+    assert CLOSE_LIMIT_M > 0.006
+
+
+def _held_pair(allowance_m: float) -> tuple[SelfCollision, np.ndarray, np.ndarray]:
+    """The close ball and the post (6 mm apart at angle 0, 0.618 m at pi), one allowance."""
+    model, geometry_model, ids = _turning_balls()
+    names = [obj.name for obj in geometry_model.geometryObjects]
+    pairs = ((ids["post"], ids["close"]),)
+    collision = SelfCollision(model, geometry_model, pairs, names, allowance_m=np.array([allowance_m]))
+    angles = np.linspace(-np.pi, np.pi, 721)[:, None]
+    centre = 0.306 * np.column_stack([np.cos(angles[:, 0]), np.sin(angles[:, 0])])
+    exact = np.linalg.norm(centre - [0.462, 0.0], axis=1) - 0.15  # the balls' distance, analytic
+    return collision, angles, exact
+
+
+@pytest.mark.parametrize("allowance_m", [0.0, 0.01])
+def test_an_allowance_adds_to_every_distance_bound_and_margin(allowance_m: float) -> None:
+    collision, q, exact = _held_pair(allowance_m)
+    counted = exact + allowance_m
+    assert np.allclose(collision.distances(q)[0], counted, atol=1e-6)
+    assert np.allclose(collision.pair_distances(q, 0), counted, atol=1e-6)
+    assert np.all(collision.bounds(q)[:, 0] <= counted + 1e-6)
+    assert np.all(collision.pair_bounds(q, 0) <= counted + 1e-6)
+    for margin_m in (0.004, 0.012, 0.03, 0.1):
+        # coal is asked for margin_m less the allowance, never below contact
+        threshold = max(margin_m, allowance_m)
+        decided = np.abs(counted - threshold) > 1e-6
+        assert np.array_equal(collision.violated(q, margin_m)[decided], (counted < threshold)[decided])
+        assert 0 < np.sum(counted < threshold) < len(q) or threshold < 0.006 + allowance_m
+
+
+def test_a_pair_held_to_contact_only_is_still_checked_for_contact() -> None:
+    collision, _, _ = _held_pair(0.01)
+    # the post pushed 10 mm closer, 4 mm into the ball: held to contact, the margin still refuses it
+    model, geometry_model, ids = _turning_balls()
+    geometry_model.geometryObjects[ids["post"]].placement = pin.SE3(np.eye(3), np.array([0.452, 0.0, 0.0]))
+    names = [obj.name for obj in geometry_model.geometryObjects]
+    pairs = ((ids["post"], ids["close"]),)
+    touching = SelfCollision(model, geometry_model, pairs, names, allowance_m=np.array([0.01]))
+    at_zero = np.zeros((1, 1))
+    assert touching.violated(at_zero, 0.01)[0] and not collision.violated(at_zero, 0.01)[0]
+    assert touching.distances(at_zero)[0][0] == pytest.approx(-0.004 + 0.01, abs=1e-6)
+
+
+def test_an_allowance_must_be_one_distance_per_pair() -> None:
+    model, geometry_model, ids = _turning_balls()
+    names = [obj.name for obj in geometry_model.geometryObjects]
+    pairs = ((ids["post"], ids["close"]),)
+    with pytest.raises(ck.CprKinError, match="allowance_m must be 1 distances >= 0"):
+        SelfCollision(model, geometry_model, pairs, names, allowance_m=np.array([-0.01]))
+
+
+TIAGO = {"urdf": str(ROBOTS / "tiago_description" / "robots" / "tiago.urdf"), "tcp": "arm_tool_link"}
+
+
+def test_tiagos_wrist_pair_is_close_by_design_and_its_arm_plans() -> None:
+    # Tiago's arm_5_link and arm_tool_link stay 4.3-6.6 mm apart (no SRDF): held to a 10 mm
+    # self margin, every start was refused
+    robot = ck.load_robot(TIAGO["urdf"], tcp=TIAGO["tcp"])
+    close = {c.links: c.largest_m for c in robot.close_pairs}
+    assert 0.004 < close[("arm_5_link", "arm_tool_link")] < 0.008
+    q = np.random.default_rng(3).uniform(robot.limits.lower, robot.limits.upper, (300, robot.nq))
+    strict = ck.CollisionWorld(robot, []).self_collision
+    held = ck.CollisionWorld(robot, [], self_margin_m=0.01).self_collision
+    assert strict.violated(q, 0.01).all()  # the pair alone refuses every configuration
+    refused = held.violated(q, 0.01)
+    assert 0.1 < refused.mean() < 0.9  # the arm folded into the torso still is
+    counted = held.distances(q[:40])[0]
+    assert np.array_equal(refused[:40], counted < 0.01)
+    # the smallest of coal's distances over every pair, the close pair's plus 10 mm, pair by pair
+    geometry_model = held.geometry_model
+    data, geometry_data = robot.model.createData(), geometry_model.createData()
+    for x, found in zip(q[:40], counted, strict=True):
+        pin.computeDistances(robot.model, data, geometry_model, geometry_data, x)
+        every = [r.min_distance for r in geometry_data.distanceResults] + held.allowance_m
+        assert found == pytest.approx(min(every), abs=1e-9)
+    scene = parse_scene(blocked_scene("tiago_700", TIAGO, robot, 700, self_clearance_m=0.015))
+    result = plan(scene, robot)
+    assert not verify_for_scene(build_problem(scene, robot), result.trajectory).problems  # `check`'s verdict
+    assert "held to contact only (their largest sampled distance): arm_5_link / arm_tool_link (6.6 mm)" in (
+        report_markdown(result)
+    )
+
+
+def test_arms_without_such_pairs_keep_every_margin() -> None:
+    for urdf in ("panda_description/urdf/panda.urdf", "ur_description/urdf/ur5_robot.urdf"):
+        robot = ck.load_robot(ROBOTS / urdf)
+        world = ck.CollisionWorld(robot, [], self_margin_m=0.01)
+        assert not world.self_collision.allowance_m.any()
