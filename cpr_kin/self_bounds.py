@@ -159,9 +159,11 @@ class ScreenedSelfTest:
     So the pairs are split once, on :data:`PROBES` seeded random configurations within the
     joint ranges: those whose bound is uncertain in more than :data:`NEAR_SHARE` of them
     (*near*) go to coal at every configuration, the others (*far*) only at configurations
-    where some far pair's bound is within the margin. Each group has its own Pinocchio
-    ``GeometryPool``, run in parallel over ``num_threads`` threads, stopping at a
-    configuration's first hit. The answer is coal's on every pair.
+    where some far pair's bound is within the margin, and there only the far pairs whose
+    bounds are within it in some configuration of the batch (a few of a thousand pairs on an
+    arm whose hand has a dozen links). Each group has its own Pinocchio ``GeometryPool``, run
+    in parallel over ``num_threads`` threads, stopping at a configuration's first hit. The
+    answer is coal's on every pair.
 
     A pair's distance counts its allowance (:mod:`cpr_kin.close_pairs`): coal's distance plus
     ``allowance_m``, so a margin asks coal for that much less of the pair (never below contact).
@@ -194,7 +196,9 @@ class ScreenedSelfTest:
         self.far_bounds = SelfPairBounds(
             model, geometry_model, [p for p, n in zip(pairs, near, strict=True) if not n]
         )
-        self._active = (near, ~near)
+        self._near = near
+        self._far_index = np.flatnonzero(~near)
+        self._far_on = np.zeros(len(pairs), dtype=bool)  # the far pool's active pairs
         self._pools: list[Any] = []
         self._data: Any = None
         self._distance_data: Any = None
@@ -208,10 +212,23 @@ class ScreenedSelfTest:
             hits[:] = self._coal(0, batch)
         if self.far_bounds.n_pairs:
             open_rows = np.flatnonzero(~hits)
-            doubtful = open_rows[self.far_bounds.any_below(batch[open_rows], margin_m + BOUND_TOLERANCE_M)]
+            threshold = margin_m + BOUND_TOLERANCE_M
+            doubtful = open_rows[self.far_bounds.any_below(batch[open_rows], threshold)]
             if doubtful.size:
+                within = self.far_bounds(batch[doubtful], threshold) <= threshold
+                self._switch_far(np.any(within, axis=0))
                 hits[doubtful] = self._coal(1, batch[doubtful])
         return hits
+
+    def _switch_far(self, doubtful: BoolArray) -> None:
+        """Make the far pool test only the far pairs ``doubtful`` ``(P_far,)``: the rest clear the margin."""
+        wanted = np.zeros_like(self._far_on)
+        wanted[self._far_index[doubtful]] = True
+        changed = np.flatnonzero(wanted != self._far_on).tolist()
+        for gdata in self._pools[1].getGeometryDatas():
+            for p in changed:
+                (gdata.activateCollisionPair if wanted[p] else gdata.deactivateCollisionPair)(p)
+        self._far_on = wanted
 
     def distances(self, batch: FloatArray) -> tuple[FloatArray, IntArray]:
         """Smallest self distance [m] and its pair (index among all pairs), ``(N,)`` each, exactly.
@@ -259,7 +276,7 @@ class ScreenedSelfTest:
             ]
         if margin_m != self._margin_m and not np.isnan(margin_m):
             margins = np.maximum(margin_m - self.allowance_m, 0.0) if self.allowance_m.any() else margin_m
-            for pool, active in zip(self._pools, self._active, strict=True):
+            for pool, active in zip(self._pools, (self._near, self._far_on), strict=True):
                 configure_pool(pool, self.geometry_model, margins, active)
                 for gdata in pool.getGeometryDatas():
                     for request in gdata.collisionRequests:

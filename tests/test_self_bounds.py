@@ -73,6 +73,12 @@ def test_the_screen_gives_coals_answer(arm: ck.Robot, margin_m: float) -> None:
     np.testing.assert_array_equal(violated, distance < margin_m)
     one_by_one = [test.violated(x[None], margin_m)[0] for x in q[:100]]  # no thread pool
     np.testing.assert_array_equal(one_by_one, violated[:100])
+    # in small batches, another margin between them: the far pairs tested change every call
+    in_fives = []
+    for k in range(0, 200, 5):
+        in_fives.append(test.violated(q[k : k + 5], margin_m))
+        test.violated(q[k + 300 : k + 305], margin_m + 0.02)
+    np.testing.assert_array_equal(np.concatenate(in_fives), violated[:200])
 
 
 def test_the_screened_distances_are_coals_over_every_pair(arm: ck.Robot) -> None:
