@@ -118,6 +118,21 @@ def test_the_search_estimate_keeps_the_torques_where_they_bind(robot: ck.Robot, 
     assert estimate > plain[0] and estimate == pytest.approx(timed, rel=0.1)
 
 
+def test_the_search_estimate_of_many_paths_is_each_paths_own(robot: ck.Robot, path: Trajectory) -> None:
+    # one batched RNEA for every path's rows: each path's estimate as if it were alone
+    limits = robot.limits
+    kinematic = np.stack([limits.velocity, limits.acceleration, limits.jerk])
+    window = float(np.max(limits.acceleration / limits.jerk))
+    along = path(np.linspace(path.knots[0], path.knots[-1], 64))
+    still = np.repeat(along[:1], 64, axis=0)  # a path that does not move: no estimate
+    samples = np.stack([along, still, along[::-1], along * 0.5, along])
+    heavy = ck.robot_dynamics(robot, ck.Payload(15.0, (0.0, 0.0, 0.05)))
+    fitted = np.arange(robot.nq)
+    together = sampled_torque_durations(samples, fitted, kinematic, heavy, window)
+    alone = [sampled_torque_durations(one[None], fitted, kinematic, heavy, window)[0] for one in samples]
+    assert together.tolist() == alone and together[1] == 0.0 and len(set(together.tolist())) >= 3
+
+
 def test_the_search_keeps_torques_only_when_they_bind_on_the_straight_path(robot: ck.Robot) -> None:
     start, goal = np.array([0.0, 0.1, 0.1, 0.0, 0.0]), np.array([1.5, 0.5, 0.4, 1.0, 0.5])
     light = ck.robot_dynamics(robot, ck.Payload(5.0))

@@ -41,22 +41,35 @@ def sampled_torque_durations(
     points = np.ascontiguousarray(samples[:, :, fitted])
     velocity, acceleration, jerk = limits
     durations = np.zeros(len(samples))
-    for s in range(len(samples)):
+    paths, rows_q, rows_dq, rows_ddq = [], [], [], []
+    for s in range(len(samples)):  # each path's samples kept, derivatives and picked rows
         index = kept_samples(points[s], velocity)
         if len(index) < 2:
             continue
         steps, d1, d2 = sampled_derivatives(points[s], velocity)
-        dq, ddq = np.zeros((2, len(index), samples.shape[2]))
-        dq[:, fitted], ddq[:, fitted] = d1, d2
         pick = np.unique(np.append(np.arange(0, len(index), TERM_STRIDE), len(index) - 1))
-        terms = np.stack(model.path_terms(samples[s, index[pick]], dq[pick], ddq[pick]))[:, :, limited]
+        dq, ddq = np.zeros((2, len(pick), samples.shape[2]))
+        dq[:, fitted], ddq[:, fitted] = d1[pick], d2[pick]
+        paths.append((s, len(index), steps, d1, d2, pick))
+        rows_q.append(samples[s, index[pick]])
+        rows_dq.append(dq)
+        rows_ddq.append(ddq)
+    if not paths:
+        return durations
+    # one batched RNEA for every path's picked rows
+    every = np.stack(
+        model.path_terms(np.concatenate(rows_q), np.concatenate(rows_dq), np.concatenate(rows_ddq))
+    )
+    ends = np.cumsum([len(pick) for *_, pick in paths])
+    for (s, kept, steps, d1, d2, pick), end in zip(paths, ends, strict=True):
+        terms = every[:, end - len(pick) : end][:, :, limited]
         if np.any(np.abs(terms[2]) > bound):  # gravity beyond a limit: the estimate without torques
             plain = sampled_path_durations(
                 points[s : s + 1], velocity, acceleration, jerk, window_s, ROUNDS, TOLERANCE
             )
             durations[s] = plain[0]
             continue
-        where = np.arange(len(index))
+        where = np.arange(kept)
         right = np.clip(np.searchsorted(pick, where), 1, len(pick) - 1)
         share = ((where - pick[right - 1]) / (pick[right] - pick[right - 1]))[None, :, None]
         slope, curve, offset = terms[:, right - 1] * (1.0 - share) + terms[:, right] * share
