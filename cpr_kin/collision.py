@@ -25,6 +25,7 @@ from cpr_kin.pair_bounds import BOUND_TOLERANCE_M, PairBounds
 from cpr_kin.reach import pair_reach_distances, robot_reach
 from cpr_kin.robot import GROUPS, Robot
 from cpr_kin.self_collision import SelfCollision
+from cpr_kin.self_screen import robot_self_screen
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -105,6 +106,7 @@ class CollisionWorld:
             self.num_threads,
             geometry_radii=radii,
             allowance_m=np.array([self_margin_m if pair in contact_only else 0.0 for pair in kept]),
+            screen=robot_self_screen(robot, kept) if kept else None,
         )
 
     @property

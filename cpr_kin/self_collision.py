@@ -27,8 +27,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import CprKinError, UrdfError
 from cpr_kin.reach import geometry_reach
-from cpr_kin.self_bounds import ScreenedSelfTest
 from cpr_kin.self_curve import relative_radii
+from cpr_kin.self_screen import ScreenedSelfTest, SelfScreen
 from cpr_kin.user_files import read_bytes
 
 FloatArray = NDArray[np.float64]
@@ -146,6 +146,8 @@ class SelfCollision:
             by default from the model's position limits.
         allowance_m: ``(P,)`` added to each pair's coal distance [m] wherever a distance,
             bound or margin is asked (:attr:`allowance_m`); default none.
+        screen: the pairs' near/far split and bounds (:class:`~cpr_kin.self_screen.SelfScreen`);
+            by default built on the first query.
     """
 
     def __init__(
@@ -157,6 +159,7 @@ class SelfCollision:
         num_threads: int = 1,
         geometry_radii: FloatArray | None = None,
         allowance_m: FloatArray | None = None,
+        screen: SelfScreen | None = None,
     ) -> None:
         self.model = model
         self.geometry_model = collision_model.copy()
@@ -183,6 +186,7 @@ class SelfCollision:
         self._pairs = pairs
         self._names = names
         self.num_threads = num_threads
+        self._screen = screen
         self._test: ScreenedSelfTest | None = None  # built on the first query
 
     @property
@@ -225,7 +229,7 @@ class SelfCollision:
 
         coal's collision test with ``margin_m`` as its security margin, which stops at the first
         pair closer than that, in parallel over :attr:`num_threads` threads, screened by the
-        pairs' cheap bounds (:class:`~cpr_kin.self_bounds.ScreenedSelfTest`): a fraction of
+        pairs' cheap bounds (:class:`~cpr_kin.self_screen.ScreenedSelfTest`): a fraction of
         :meth:`distances`' cost, with the same answer.
         """
         batch = np.atleast_2d(np.asarray(q, dtype=float))
@@ -237,6 +241,6 @@ class SelfCollision:
         """The screened coal queries of the pairs, built on first use."""
         if self._test is None:
             self._test = ScreenedSelfTest(
-                self.model, self.geometry_model, self._pairs, self.num_threads, self.allowance_m
+                self.model, self.geometry_model, self._pairs, self.num_threads, self.allowance_m, self._screen
             )
         return self._test

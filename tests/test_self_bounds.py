@@ -9,8 +9,9 @@ import pytest
 import cpr_kin as ck
 from cpr_kin.packages import example_robot_data_share
 from cpr_kin.segments import segment_distance
-from cpr_kin.self_bounds import ScreenedSelfTest, SelfPairBounds
+from cpr_kin.self_bounds import SelfPairBounds
 from cpr_kin.self_collision import SelfCollision
+from cpr_kin.self_screen import ScreenedSelfTest, SelfScreen, robot_self_screen
 
 SHARE = example_robot_data_share()
 assert SHARE is not None, "example-robot-data is part of the robots extra, which make installs"
@@ -97,3 +98,17 @@ def test_the_screened_distances_are_coals_over_every_pair(arm: ck.Robot) -> None
     for k in range(0, len(q), 37):  # the pair named is one at that distance
         a, b = pairs[int(closest[k])].first, pairs[int(closest[k])].second
         assert (a, b) in collision._pairs
+
+
+def test_a_robots_screen_is_built_once_for_each_set_of_pairs(arm: ck.Robot) -> None:
+    first, again = (ck.CollisionWorld(arm, []).self_collision for _ in range(2))
+    assert robot_self_screen(arm, first._pairs) is robot_self_screen(arm, again._pairs)
+    links = [g.link for g in arm.geometries]
+    a, b = first._pairs[0]
+    fewer = ck.CollisionWorld(arm, [], allowed_pairs=[(links[a], links[b])]).self_collision
+    screen = robot_self_screen(arm, fewer._pairs)
+    assert screen is not robot_self_screen(arm, first._pairs)
+    assert screen.all_bounds.n_pairs == len(fewer._pairs) < len(first._pairs)
+    # the same split as one built afresh for those pairs
+    fresh = SelfScreen.build(arm.model, arm.collision_model, fewer._pairs)
+    np.testing.assert_array_equal(screen.near, fresh.near)
