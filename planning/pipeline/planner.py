@@ -37,6 +37,7 @@ from planning.pipeline.search import search
 from planning.pipeline.seeding import SEEDINGS, NoSeeding
 from planning.pipeline.target import Target
 from planning.pipeline.timing import Timing
+from planning.pipeline.torques import held
 from planning.search.firefly import FireflyProgress
 from planning.search.optimizer import Optimizer, SearchResult
 
@@ -161,16 +162,19 @@ def warm_up(robot: ck.Robot | None = None) -> float:
         q = ck.sampled_configurations(robot.model, 64, np.random.default_rng(0))
         if world.self_collision:  # the configuration farthest from itself first
             q = q[np.argsort(-world.self_collision.distances(q)[0])]
-        start, goal = (
-            Target(q=tuple(q[0])),
-            Target(q=tuple(np.minimum(robot.model.upperPositionLimit, q[0] + 0.1))),
-        )
+        ends = np.stack([q, np.minimum(robot.model.upperPositionLimit, q + 0.1)])
+        # ends the motors can hold still, or the plan stops before its timing is compiled
+        dynamics = ck.robot_dynamics(robot)
+        first = int(np.argmax(held(dynamics, ends[0]) & held(dynamics, ends[1])))
+        start, goal = Target(q=tuple(ends[0, first])), Target(q=tuple(ends[1, first]))
         own = dataclasses.replace(
             small, start=start, goal=goal, obstacles=world.obstacles, self_margin=0.0, duration=None
         )
         with contextlib.suppress(PlanningError, NoSolutionError):  # what ran, ran
             plan(own, robot, threads=1)
-        _query_collisions(world, q[:4])
+        # an obstacle at the tool, so that the pairs' bounds leave it in doubt and coal decides
+        tool = ck.frame_poses(robot, ends[0, first][None])[0][:3, 3]
+        _query_collisions(ck.CollisionWorld(robot, [ck.Obstacle.sphere(0.05, tuple(tool))]), ends[:, first])
     return time.perf_counter() - started
 
 
