@@ -87,21 +87,36 @@ def parse_srdf(path: Path) -> etree._Element:
 
 
 def read_srdf(path: Path, links: Iterable[str]) -> SrdfPairs:
-    """The link pairs an SRDF's ``<disable_collisions link1 link2>`` lists (:class:`SrdfPairs`).
+    """The link pairs an SRDF disables (:class:`SrdfPairs`), as MoveIt reads them.
+
+    Those ``<disable_collisions link1 link2>`` lists, and every pair of a link that
+    ``<disable_default_collisions link>`` names, but those ``<enable_collisions link1 link2>``
+    lists (srdfdom's default entries and their exceptions).
 
     Raises:
         UrdfError: the file is unreadable or not XML.
     """
     root = parse_srdf(path)
     known = set(links)
-    pairs = set()
     unknown: set[str] = set()
-    for element in root.iter("disable_collisions"):
-        pair = (element.get("link1", ""), element.get("link2", ""))
-        missing = {link for link in pair if link not in known}
-        unknown |= missing
-        if not missing:
-            pairs.add(frozenset(pair))
+
+    def listed(tag: str) -> set[LinkPair]:
+        found = set()
+        for element in root.iter(tag):
+            pair = (element.get("link1", ""), element.get("link2", ""))
+            missing = {link for link in pair if link not in known}
+            unknown.update(missing)
+            if not missing:
+                found.add(frozenset(pair))
+        return found
+
+    pairs, enabled = listed("disable_collisions"), listed("enable_collisions")
+    for element in root.iter("disable_default_collisions"):
+        link = element.get("link", "")
+        if link not in known:
+            unknown.add(link)
+            continue
+        pairs |= {frozenset((link, other)) for other in known if other != link} - enabled
     return SrdfPairs(frozenset(pairs), tuple(sorted(unknown)))
 
 

@@ -69,6 +69,20 @@ def test_the_srdf_skips_unknown_links_as_moveit_does_and_says_so(tmp_path: Path,
         read_srdf(bad, links)
 
 
+def test_an_srdfs_default_entries_disable_a_links_pairs_but_those_enabled(tmp_path: Path) -> None:
+    # srdfdom's <disable_default_collisions> and <enable_collisions> (MoveIt 2's setup assistant)
+    links = {"base", "arm", "hand", "tool"}
+    srdf = tmp_path / "defaults.srdf"
+    srdf.write_text(
+        '<robot><disable_default_collisions link="hand"/>'
+        '<enable_collisions link1="hand" link2="base" reason="checked"/>'
+        '<disable_collisions link1="arm" link2="tool"/><disable_default_collisions link="wheel"/></robot>'
+    )
+    pairs = read_srdf(srdf, links)
+    expected = {frozenset(pair) for pair in [("hand", "arm"), ("hand", "tool"), ("arm", "tool")]}
+    assert pairs.disabled == expected and pairs.unknown_links == ("wheel",)
+
+
 def test_the_pandas_srdf_leaves_the_pairs_that_can_meet(panda: ck.Robot) -> None:
     assert panda.srdf_path is not None and panda.srdf_path.name == "panda.srdf"
     links = {frozenset((panda.geometries[a].link, panda.geometries[b].link)) for a, b in panda.self_pairs}
