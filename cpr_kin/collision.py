@@ -60,6 +60,8 @@ class CollisionWorld:
         allowed_pairs: Sequence[tuple[str, str]] = (),
         self_margin_m: float = 0.0,
     ) -> None:
+        if not (np.isfinite(self_margin_m) and self_margin_m >= 0.0):
+            raise CprKinError(f"self_margin_m = {self_margin_m} m must be a finite distance >= 0")
         names = [o.name for o in obstacles]
         duplicated = sorted({n for n in names if names.count(n) > 1})
         if duplicated:

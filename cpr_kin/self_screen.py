@@ -4,7 +4,8 @@ The self-collision test (:meth:`cpr_kin.self_collision.SelfCollision.violated`) 
 only about the pairs whose cheap bounds (:class:`~cpr_kin.self_bounds.SelfPairBounds`) leave
 them in doubt. Which pairs are always close is a property of the robot: :class:`SelfScreen`
 finds them, and :func:`robot_self_screen` builds it once per robot and set of pairs (a
-collision world is built per plan, and a robot of a few hundred pairs took 3-9 ms to split).
+collision world is built per plan, and the split costs milliseconds on a robot of a few
+hundred pairs: ``docs/benchmarks.md``).
 """
 
 from __future__ import annotations

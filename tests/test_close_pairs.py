@@ -141,6 +141,13 @@ def test_tiagos_wrist_pair_is_close_by_design_and_its_arm_plans() -> None:
     )
 
 
+def test_a_world_refuses_a_self_margin_that_is_no_distance() -> None:
+    robot = ck.load_cpr()
+    for bad in (-0.01, float("nan"), float("inf")):
+        with pytest.raises(ck.CprKinError, match="must be a finite distance >= 0"):
+            ck.CollisionWorld(robot, [], self_margin_m=bad)
+
+
 def test_arms_without_such_pairs_keep_every_margin() -> None:
     for urdf in ("panda_description/urdf/panda.urdf", "ur_description/urdf/ur5_robot.urdf"):
         robot = ck.load_robot(ROBOTS / urdf)
