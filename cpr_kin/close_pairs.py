@@ -27,7 +27,7 @@ import numpy as np
 import pinocchio as pin
 
 from cpr_kin.limits import sampled_configurations
-from cpr_kin.self_bounds import SelfPairBounds
+from cpr_kin.self_bounds import bounded_pairs
 
 SAMPLES = 1000
 """Seeded configurations in which a pair must stay close, and apart, to be close by design."""
@@ -64,23 +64,16 @@ def close_pairs(
     ``links`` names each geometry's link, by index.
 
     The configurations are drawn uniformly within ``model``'s ranges (seed 0). A pair's
-    capsule bound at or above the limit at any of them rules it out
+    capsule bound above the limit at any of them rules it out
     (:class:`~cpr_kin.self_bounds.SelfPairBounds`); coal decides the rest, configuration by
     configuration, until the pair touches or comes apart beyond the limit.
     """
     if not pairs:
         return ()
     q = sampled_configurations(model, samples, np.random.default_rng(0))
-    bounds = SelfPairBounds(model, collision_model, pairs)(q)
-    candidates = [
-        pair for pair, column in zip(pairs, bounds.T, strict=True) if np.all(column < CLOSE_LIMIT_M)
-    ]
+    candidates, geometry_model = bounded_pairs(model, collision_model, pairs, q, CLOSE_LIMIT_M)
     if not candidates:
         return ()
-    geometry_model = collision_model.copy()
-    geometry_model.removeAllCollisionPairs()
-    for a, b in candidates:
-        geometry_model.addCollisionPair(pin.CollisionPair(a, b))
     data, geometry_data = model.createData(), geometry_model.createData()
     largest = np.zeros(len(candidates))
     alive = np.ones(len(candidates), dtype=bool)

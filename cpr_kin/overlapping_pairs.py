@@ -19,7 +19,7 @@ import numpy as np
 import pinocchio as pin
 
 from cpr_kin.limits import sampled_configurations
-from cpr_kin.self_bounds import SelfPairBounds
+from cpr_kin.self_bounds import bounded_pairs
 
 SAMPLES = 1000
 """Seeded configurations in which a pair must collide to be taken as touching by design."""
@@ -37,14 +37,9 @@ def overlapping_pairs(
     if not pairs:
         return ()
     q = sampled_configurations(model, samples, np.random.default_rng(0))
-    bounds = SelfPairBounds(model, collision_model, pairs)(q)
-    candidates = [pair for pair, column in zip(pairs, bounds.T, strict=True) if np.all(column <= 0.0)]
+    candidates, geometry_model = bounded_pairs(model, collision_model, pairs, q, 0.0)
     if not candidates:
         return ()
-    geometry_model = collision_model.copy()
-    geometry_model.removeAllCollisionPairs()
-    for a, b in candidates:
-        geometry_model.addCollisionPair(pin.CollisionPair(a, b))
     data, geometry_data = model.createData(), geometry_model.createData()
     touching = np.ones(len(candidates), dtype=bool)
     for x in q:

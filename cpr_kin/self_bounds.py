@@ -18,6 +18,7 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
+import pinocchio as pin
 from numpy.typing import NDArray
 
 from cpr_kin.batch_kinematics import ChainArrays, KinematicChain, place_joints
@@ -138,3 +139,23 @@ class SelfPairBounds:
         out = np.empty(len(batch), dtype=bool)
         blocks_below(batch, float(threshold_m), out, self._chain.arrays, *self._blocks)
         return out
+
+
+def bounded_pairs(
+    model: Any, collision_model: Any, pairs: Sequence[tuple[int, int]], q: FloatArray, at_most_m: float
+) -> tuple[list[tuple[int, int]], Any]:
+    """The ``pairs`` bounded by at most ``at_most_m`` [m] at every configuration ``q``, and their model.
+
+    The bound is their capsules'; a pair bounded above it somewhere is certainly farther
+    there, and coal decides the others, in the copy of ``collision_model`` returned, holding
+    them as its only collision pairs, in order.
+    """
+    bounds = SelfPairBounds(model, collision_model, pairs)(q)
+    candidates = [
+        pair for pair, below in zip(pairs, np.all(bounds <= at_most_m, axis=0), strict=True) if below
+    ]
+    geometry_model = collision_model.copy()
+    geometry_model.removeAllCollisionPairs()
+    for a, b in candidates:
+        geometry_model.addCollisionPair(pin.CollisionPair(a, b))
+    return candidates, geometry_model

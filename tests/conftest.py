@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import coal
 import numpy as np
+import pinocchio as pin
 import pytest
 
 import cpr_kin as ck
@@ -64,3 +66,25 @@ def lines(robot: ck.Robot) -> list[tuple[np.ndarray, np.ndarray]]:
         a[3:] = b[3:] = 0.0
         pairs.append((a, b))
     return pairs
+
+
+def turning_balls(
+    balls: dict[str, tuple[bool, float, float]],
+) -> tuple[pin.Model, pin.GeometryModel, dict[str, int]]:
+    """A joint turning about z through a full turn, and balls centred on the x axis.
+
+    ``balls``: ``name: (turning, radius [m], x [m])``, a turning ball carried by the joint;
+    a turning ball's distance to a fixed ball at the origin never changes. Returns the model,
+    the geometry model and each ball's geometry index.
+    """
+    model = pin.Model()
+    joint = model.addJoint(0, pin.JointModelRZ(), pin.SE3.Identity(), "spin")
+    model.lowerPositionLimit[:] = -np.pi
+    model.upperPositionLimit[:] = np.pi
+    geometry_model = pin.GeometryModel()
+    ids = {}
+    for name, (turning, radius, x) in balls.items():
+        placement = pin.SE3(np.eye(3), np.array([x, 0.0, 0.0]))
+        ball = pin.GeometryObject(name, joint if turning else 0, placement, coal.Sphere(radius))
+        ids[name] = int(geometry_model.addGeometryObject(ball))
+    return model, geometry_model, ids

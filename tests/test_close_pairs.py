@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import coal
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -18,33 +17,24 @@ from planning.pipeline.planner import plan
 from planning.pipeline.problem import build_problem
 from planning.pipeline.verification import verify_for_scene
 
+from .conftest import turning_balls
+
 SHARE = example_robot_data_share()
 assert SHARE is not None, "example-robot-data is part of the robots extra, which make installs"
 ROBOTS = SHARE / "example-robot-data" / "robots"
 
 
 def _turning_balls() -> tuple[pin.Model, pin.GeometryModel, dict[str, int]]:
-    """A joint turning balls about a hub on its axis: their gaps to the hub never change."""
-    model = pin.Model()
-    joint = model.addJoint(0, pin.JointModelRZ(), pin.SE3.Identity(), "spin")
-    model.lowerPositionLimit[:] = -np.pi
-    model.upperPositionLimit[:] = np.pi
-    geometry_model = pin.GeometryModel()
-
-    def ball(name: str, parent: int, radius: float, x: float) -> int:
-        placement = pin.SE3(np.eye(3), np.array([x, 0.0, 0.0]))
-        return int(
-            geometry_model.addGeometryObject(pin.GeometryObject(name, parent, placement, coal.Sphere(radius)))
-        )
-
-    ids = {
-        "hub": ball("hub", 0, 0.2, 0.0),
-        "close": ball("close", joint, 0.1, 0.306),  # 6 mm from the hub at every angle
-        "touching": ball("touching", joint, 0.1, 0.29),  # 10 mm into it at every angle
-        "far": ball("far", joint, 0.1, 0.5),  # 200 mm from it
-        "post": ball("post", 0, 0.05, 0.462),  # 6 mm from the close ball at angle 0 only
-    }
-    return model, geometry_model, ids
+    """Balls turning about a hub on the joint's axis: their gaps to the hub never change."""
+    return turning_balls(
+        {
+            "hub": (False, 0.2, 0.0),
+            "close": (True, 0.1, 0.306),  # 6 mm from the hub at every angle
+            "touching": (True, 0.1, 0.29),  # 10 mm into it at every angle
+            "far": (True, 0.1, 0.5),  # 200 mm from it
+            "post": (False, 0.05, 0.462),  # 6 mm from the close ball at angle 0 only
+        }
+    )
 
 
 def test_only_a_pair_apart_and_close_at_every_angle_is_found_with_its_largest_gap() -> None:

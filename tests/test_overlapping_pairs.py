@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import coal
 import numpy as np
-import pinocchio as pin
 
 import cpr_kin as ck
 from cpr_kin.overlapping_pairs import overlapping_pairs
@@ -17,27 +15,23 @@ from planning.pipeline.planner import plan
 from planning.pipeline.problem import build_problem
 from planning.pipeline.verification import verify_for_scene
 
+from .conftest import turning_balls
+
 SHARE = example_robot_data_share()
 assert SHARE is not None, "example-robot-data is part of the robots extra, which make installs"
 ROBOTS = SHARE / "example-robot-data" / "robots"
 
 
 def test_only_a_pair_that_collides_wherever_the_joint_turns_is_found() -> None:
-    model = pin.Model()
-    joint = model.addJoint(0, pin.JointModelRZ(), pin.SE3.Identity(), "spin")
-    model.lowerPositionLimit[:] = -np.pi
-    model.upperPositionLimit[:] = np.pi
-    geometry_model = pin.GeometryModel()
-
-    def ball(name: str, parent: int, radius: float, x: float) -> int:
-        placement = pin.SE3(np.eye(3), np.array([x, 0.0, 0.0]))
-        return int(
-            geometry_model.addGeometryObject(pin.GeometryObject(name, parent, placement, coal.Sphere(radius)))
-        )
-
-    hub = ball("hub", 0, 0.2, 0.0)  # on the axis: the turning balls stay 0.25 m and 0.5 m from it
-    inner, outer = ball("inner", joint, 0.1, 0.25), ball("outer", joint, 0.1, 0.5)
-    post = ball("post", 0, 0.05, 0.25)  # met by the inner ball only near angle 0
+    model, geometry_model, ids = turning_balls(
+        {
+            "hub": (False, 0.2, 0.0),  # on the axis: the turning balls stay 0.25 m and 0.5 m from it
+            "inner": (True, 0.1, 0.25),
+            "outer": (True, 0.1, 0.5),
+            "post": (False, 0.05, 0.25),  # met by the inner ball only near angle 0
+        }
+    )
+    hub, inner, outer, post = (ids[name] for name in ("hub", "inner", "outer", "post"))
     pairs = [(hub, inner), (hub, outer), (post, inner), (post, outer)]
     assert overlapping_pairs(model, geometry_model, pairs) == ((hub, inner),)
     assert overlapping_pairs(model, geometry_model, []) == ()
