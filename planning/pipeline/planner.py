@@ -15,6 +15,7 @@ found, with no attempt after it.
 from __future__ import annotations
 
 import contextlib
+import copy
 import dataclasses
 import time
 from collections.abc import Callable
@@ -30,6 +31,7 @@ from planning.pipeline.choose import Choice, Refusal, choose, verify
 from planning.pipeline.deadline import Deadline
 from planning.pipeline.metrics import Elapsed
 from planning.pipeline.path_following import follow_path
+from planning.pipeline.path_terms import SplinePaths
 from planning.pipeline.problem import Problem, build_problem
 from planning.pipeline.result import PlanResult, assemble
 from planning.pipeline.scene import Scene
@@ -141,41 +143,69 @@ def warm_up(robot: ck.Robot | None = None) -> float:
 
     Planning does it anyway on its first call; this moves the one-time cost (several
     seconds on a new machine, a fraction of a second per process afterwards) out of a plan
-    that is timed. It plans the paper case with two fireflies for one iteration and, for a
-    robot of its own, a small motion of that robot in its joint space (the paper's poses may
-    be out of its reach, or reached inside the paper's obstacle), then asks its collision
-    world every kind of query once.
+    that is timed. It plans the paper case with two fireflies for one iteration and a small
+    motion of the robot (the CPR if none is given) in its joint space, runs the search's
+    duration estimates with and without the torques, and asks its collision world every
+    kind of query once (:func:`_warm_own_motion`).
     """
     from planning.io.bundled import paper_scene
 
     started = time.perf_counter()
     small = paper_scene(fireflies=2, iterations=1)
-    # a search this small may find nothing: the kernels ran; a robot of its own may reach the
-    # paper's poses inside the paper's crate, or not at all: its own motion below warms it
+    # a search this small may find nothing; a robot of its own may reach the paper's poses
+    # inside the paper's crate, or not at all: the motion of its own below warms the rest
     expected: tuple[type[Exception], ...] = (NoSolutionError,)
     if robot is not None:
         expected = (NoSolutionError, PlanningError)
     with contextlib.suppress(*expected):
         plan(small, robot, threads=1)
-    if robot is not None:
-        world = ck.CollisionWorld(robot, [ck.Obstacle.box((0.1, 0.1, 0.1), (0.0, 0.0, 10.0))])
-        q = ck.sampled_configurations(robot.model, 64, np.random.default_rng(0))
-        if world.self_collision:  # the configuration farthest from itself first
-            q = q[np.argsort(-world.self_collision.distances(q)[0])]
-        ends = np.stack([q, np.minimum(robot.model.upperPositionLimit, q + 0.1)])
-        # ends the motors can hold still, or the plan stops before its timing is compiled
-        dynamics = ck.robot_dynamics(robot)
-        first = int(np.argmax(held(dynamics, ends[0]) & held(dynamics, ends[1])))
-        start, goal = Target(q=tuple(ends[0, first])), Target(q=tuple(ends[1, first]))
-        own = dataclasses.replace(
-            small, start=start, goal=goal, obstacles=world.obstacles, self_margin=0.0, duration=None
-        )
-        with contextlib.suppress(PlanningError, NoSolutionError):  # what ran, ran
-            plan(own, robot, threads=1)
-        # an obstacle at the tool, so that the pairs' bounds leave it in doubt and coal decides
-        tool = ck.frame_poses(robot, ends[0, first][None])[0][:3, 3]
-        _query_collisions(ck.CollisionWorld(robot, [ck.Obstacle.sphere(0.05, tuple(tool))]), ends[:, first])
+    _warm_own_motion(robot if robot is not None else ck.load_cpr(), small)
     return time.perf_counter() - started
+
+
+def _warm_own_motion(robot: ck.Robot, small: Scene) -> None:
+    """Plan a small motion of ``robot`` in its joint space, run its estimates, ask every query.
+
+    The paper's small search may find nothing (its timing then never runs), and a robot of
+    its own may reach the paper's poses inside the paper's crate, or not at all. The motion
+    starts at the sampled configuration farthest from itself that the motors can hold still.
+    """
+    world = ck.CollisionWorld(robot, [ck.Obstacle.box((0.1, 0.1, 0.1), (0.0, 0.0, 10.0))])
+    q = ck.sampled_configurations(robot.model, 64, np.random.default_rng(0))
+    if world.self_collision:  # the configuration farthest from itself first
+        q = q[np.argsort(-world.self_collision.distances(q)[0])]
+    ends = np.stack([q, np.minimum(robot.model.upperPositionLimit, q + 0.1)])
+    # ends the motors can hold still, or the plan stops before its timing is compiled
+    dynamics = ck.robot_dynamics(robot)
+    first = int(np.argmax(held(dynamics, ends[0]) & held(dynamics, ends[1])))
+    start, goal = Target(q=tuple(ends[0, first])), Target(q=tuple(ends[1, first]))
+    own = dataclasses.replace(
+        small, start=start, goal=goal, obstacles=world.obstacles, self_margin=0.0, duration=None
+    )
+    with contextlib.suppress(PlanningError, NoSolutionError):  # what ran, ran
+        plan(own, robot, threads=1)
+    with contextlib.suppress(PlanningError):
+        _estimate_durations(build_problem(own, robot), dynamics)
+    # an obstacle at the tool, so that the pairs' bounds leave it in doubt and coal decides
+    tool = ck.frame_poses(robot, ends[0, first][None])[0][:3, 3]
+    _query_collisions(ck.CollisionWorld(robot, [ck.Obstacle.sphere(0.05, tuple(tool))]), ends[:, first])
+
+
+def _estimate_durations(problem: Problem, dynamics: ck.Dynamics) -> None:
+    """Run the search's duration estimates of ``problem``'s straight line, kinematic and torque-limited.
+
+    A plan keeps the torques in its estimate only where they bind on its straight line
+    (:func:`~planning.pipeline.torques.search_torque`), which a warm-up motion seldom does.
+    """
+    objective = problem.objective
+    paths = objective.paths
+    if not isinstance(paths, SplinePaths):  # point to point: no estimate
+        return
+    samples = paths(objective.nodes(objective.straight_line())).samples
+    for torque in (None, dynamics):
+        estimate = copy.copy(paths)
+        estimate.torque = torque
+        estimate.durations(samples)
 
 
 def _query_collisions(world: ck.CollisionWorld, q: FloatArray) -> None:
