@@ -51,6 +51,10 @@ class ClosePair:
     links: tuple[str, str]
     largest_m: float
 
+    def held_to_contact(self, self_margin_m: float) -> bool:
+        """Whether a self margin of ``self_margin_m`` [m] holds the pair to contact only (above its gap)."""
+        return self.largest_m < self_margin_m
+
 
 def close_pairs(
     model: Any,

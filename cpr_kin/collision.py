@@ -99,7 +99,7 @@ class CollisionWorld:
         kept = tuple((a, b) for a, b in robot.self_pairs if frozenset((links[a], links[b])) not in allowed)
         names = [g.name for g in robot.geometries]
         radii = np.array([r.radii for r in robot_reach(robot)])
-        contact_only = {c.geometries for c in robot.close_pairs if c.largest_m < self_margin_m}
+        contact_only = {c.geometries for c in robot.close_pairs if c.held_to_contact(self_margin_m)}
         self.self_collision = SelfCollision(
             robot.model,
             robot.collision_model,

@@ -171,7 +171,7 @@ def limits_section(result: PlanResult) -> list[str]:
             f"not checked (MoveIt's setup assistant disables them as always in collision): {pairs}.",
             "",
         ]
-    held_to_contact = [c for c in robot.close_pairs if c.largest_m < result.scene.self_margin]
+    held_to_contact = [c for c in robot.close_pairs if c.held_to_contact(result.scene.self_margin)]
     if held_to_contact:
         pairs = ", ".join(
             f"{c.links[0]} / {c.links[1]} ({1000 * c.largest_m:.1f} mm)" for c in held_to_contact

@@ -183,9 +183,9 @@ def _warm_own_motion(robot: ck.Robot, small: Scene) -> None:
         small, start=start, goal=goal, obstacles=world.obstacles, self_margin=0.0, duration=None
     )
     with contextlib.suppress(PlanningError, NoSolutionError):  # what ran, ran
-        plan(own, robot, threads=1)
-    with contextlib.suppress(PlanningError):
-        _estimate_durations(build_problem(own, robot), dynamics)
+        problem = build_problem(own, robot, threads=1)
+        _estimate_durations(problem, dynamics)  # before the plan, which may find nothing
+        solve(problem)
     # an obstacle at the tool, so that the pairs' bounds leave it in doubt and coal decides
     tool = ck.frame_poses(robot, ends[0, first][None])[0][:3, 3]
     _query_collisions(ck.CollisionWorld(robot, [ck.Obstacle.sphere(0.05, tuple(tool))]), ends[:, first])
