@@ -225,6 +225,11 @@ class RobotSpec:
             low, high = float(model.lowerPositionLimit[i]), float(model.upperPositionLimit[i])
             if name in mimic and name not in given:
                 leader = mimic[name].get("joint", "")
+                if leader not in names:
+                    raise UrdfError(
+                        f"URDF '{path}': joint '{name}' mimics joint '{leader}', which the URDF does not "
+                        f"have; name one of its joints in the <mimic>, or hold '{name}' (held={{...}})"
+                    )
                 if leader in planned:
                     raise UrdfError(f"URDF '{path}': joint '{name}' mimics planned joint '{leader}'")
                 multiplier = float(mimic[name].get("multiplier", "1"))

@@ -42,10 +42,25 @@ def parse_urdf(path: Path) -> etree._ElementTree:
         raise UrdfError(f"URDF file '{path}' has {path.stat().st_size} bytes; at most {MAX_URDF_BYTES}")
     parser = etree.XMLParser(recover=False, resolve_entities=False, no_network=True, huge_tree=False)
     try:
-        return etree.parse(str(path), parser)
+        tree = etree.parse(str(path), parser)
     except etree.XMLSyntaxError as exc:
         message = str(exc) if len(str(exc)) <= 120 else str(exc)[:117] + "..."
         raise UrdfError(f"URDF file '{path}' is not well-formed XML: {message}") from None
+    root = tree.getroot()  # a named robot with links, or the parsers' complaints name neither file nor fix
+    if root.tag != "robot":
+        raise UrdfError(
+            f"URDF file '{path}' has root element <{root.tag}>; a URDF's root is <robot name=...>"
+        )
+    if root.find("link") is None:
+        raise UrdfError(
+            f"URDF file '{path}' has no <link>: an empty robot; a URDF "
+            "written by xacro without its arguments can be (run xacro with them)"
+        )
+    if not root.get("name"):
+        raise UrdfError(
+            f"URDF file '{path}': <robot> has no name attribute; the URDF specification requires one"
+        )
+    return tree
 
 
 SPEC_OPTIONAL = frozenset(
@@ -69,7 +84,7 @@ def validate_urdf(path: Path) -> None:
             str(path), build_scene_graph=False, load_meshes=False, load_collision_meshes=False
         )
     except Exception as exc:  # yourdfpy raises bare exceptions on structural problems
-        raise UrdfError(f"URDF file '{path}' cannot be read: {exc}") from None
+        raise UrdfError(f"URDF file '{path}' cannot be read ({type(exc).__name__}: {exc})") from None
     found: list[Any] = []
 
     def keep(errors: list[Any]) -> bool:
@@ -127,12 +142,15 @@ def prepared_xml(tree: etree._ElementTree, path: Path, roots: Sequence[Path]) ->
     """The URDF's text as the models are built from it.
 
     Every ``continuous`` joint becomes a ``revolute`` one within
-    :data:`CONTINUOUS_RANGE_RAD` (its velocity and effort kept), and every mesh file name is
-    made absolute (:func:`cpr_kin.packages.resolve_mesh`), so that a missing mesh is named
-    before Pinocchio reads anything.
+    :data:`CONTINUOUS_RANGE_RAD` (its velocity and effort kept; where the URDF gives none, as
+    its specification allows for a continuous joint, they are 0: unknown, so that a planned
+    joint without a velocity limit is refused by name at load, naming the two places to give
+    one, while a joint the planner only holds, such as a mobile base's caster wheel, loads),
+    and every mesh file name is made absolute (:func:`cpr_kin.packages.resolve_mesh`), so
+    that a missing mesh is named before Pinocchio reads anything.
 
     Raises:
-        UrdfError: a continuous joint without a velocity limit, or a mesh not found.
+        UrdfError: a mesh not found.
     """
     root = copy.deepcopy(tree.getroot())
     for joint in root.findall("joint"):
@@ -140,11 +158,11 @@ def prepared_xml(tree: etree._ElementTree, path: Path, roots: Sequence[Path]) ->
             continue
         joint.set("type", "revolute")
         limit = joint.find("limit")
-        if limit is None or limit.get("velocity") is None:
-            raise UrdfError(
-                f"URDF '{path}': continuous joint '{joint.get('name')}' has no velocity limit; "
-                'give it <limit velocity=".." effort=".."/>'
-            )
+        if limit is None:
+            limit = etree.SubElement(joint, "limit")
+        for unknown in ("velocity", "effort"):
+            if limit.get(unknown) is None:
+                limit.set(unknown, "0")
         limit.set("lower", repr(-CONTINUOUS_RANGE_RAD))
         limit.set("upper", repr(CONTINUOUS_RANGE_RAD))
     for mesh in root.iter("mesh"):

@@ -7,6 +7,7 @@ yourdfpy's, an independent URDF reader, at random configurations.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -135,6 +136,49 @@ def test_planned_and_held_joints_are_checked() -> None:
         "panda_finger_joint1": 0.04,
         "panda_finger_joint2": 0.04,
     }  # the mimic follows
+
+
+def panda_copy(folder: Path, edit: Callable[[str], str]) -> Path:
+    """The Panda's URDF edited, under another robot name (so no maker's limits file), meshes in place."""
+    text = ARMS["panda"][0].read_text().replace("package://example-robot-data/robots/", f"file://{ROBOTS}/")
+    urdf = folder / "arm.urdf"
+    urdf.write_text(edit(text.replace('<robot name="panda"', '<robot name="my_arm"', 1)))
+    return urdf
+
+
+def test_a_mimic_of_a_joint_the_urdf_lacks_is_named_and_holding_the_joint_loads(tmp_path: Path) -> None:
+    # alex_psyonic_hands.urdf's fingers mimic 'index_q1', a joint it does not have: an IndexError
+    urdf = panda_copy(
+        tmp_path, lambda t: t.replace('<mimic joint="panda_finger_joint1"', '<mimic joint="nope"')
+    )
+    with pytest.raises(
+        ck.UrdfError, match=r"joint 'panda_finger_joint2' mimics joint 'nope', which the URDF does not have"
+    ):
+        ck.load_robot(urdf)
+    held = ck.load_robot(urdf, held={"panda_finger_joint2": 0.01})
+    assert dict(held.held) == {"panda_finger_joint1": 0.0, "panda_finger_joint2": 0.01}
+
+
+def test_a_continuous_joint_without_limits_is_held_but_not_planned(tmp_path: Path) -> None:
+    # the URDF specification leaves a continuous joint's <limit> out; tiago_dual.urdf's caster
+    # wheels have none, and the whole robot was refused for them
+    def free_wrist(text: str) -> str:
+        start = text.index('<joint name="panda_joint7" type="revolute">')
+        limit_at = text.index("<limit", start)
+        limit_end = text.index("/>", limit_at) + 2
+        edited = text[:limit_at] + text[limit_end:]
+        return edited.replace(
+            '<joint name="panda_joint7" type="revolute">', '<joint name="panda_joint7" type="continuous">'
+        )
+
+    urdf = panda_copy(tmp_path, free_wrist)
+    with pytest.raises(ck.UrdfError, match=r"joint\(s\) \['panda_joint7'\] have no velocity limit"):
+        ck.load_robot(urdf)
+    arm = [f"panda_joint{k}" for k in range(1, 7)]
+    robot = ck.load_robot(urdf, joints=arm, held={"panda_joint7": 0.3})
+    assert robot.joint_names == tuple(arm) and dict(robot.held)["panda_joint7"] == 0.3
+    with pytest.raises(ck.UrdfError, match=r"held joint 'panda_joint7' = 4 is outside \[-3.14159, 3.14159\]"):
+        ck.load_robot(urdf, joints=arm, held={"panda_joint7": 4.0})  # one turn, as a planned one
 
 
 def test_a_tool_without_collision_geometry_leaves_the_effector_group_to_the_link_above() -> None:

@@ -51,6 +51,28 @@ def test_malformed_xml(tmp_path: Path) -> None:
         ck.load_cpr(path)
 
 
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ('<robot name="arm"></robot>', r"empty\.urdf' has no <link>: an empty robot"),
+        ('<robot><link name="base"/></robot>', r"empty\.urdf': <robot> has no name attribute"),
+        (
+            '<sdf version="1.6"><model name="arm"/></sdf>',
+            r"empty\.urdf' has root element <sdf>; a URDF's root is <robot",
+        ),
+    ],
+    ids=["no link", "no name", "not a robot"],
+)
+def test_a_urdf_that_is_no_robot_is_refused_by_name(tmp_path: Path, text: str, message: str) -> None:
+    # example-robot-data's ur3.urdf is an empty <robot> (xacro run without arguments); yourdfpy
+    # said only "cannot be read: 'name'"
+    path = tmp_path / "empty.urdf"
+    path.write_text(text)
+    for validate in (True, False):
+        with pytest.raises(ck.UrdfError, match=message):
+            ck.load_cpr(path, validate=validate)
+
+
 def test_urdf_with_dangling_joint_is_invalid(tmp_path: Path) -> None:
     path = tmp_path / "dangling.urdf"
     path.write_text(URDF_TEXT.replace('<child link="tcp"/>', '<child link="no_such_link"/>'))
