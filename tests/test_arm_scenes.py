@@ -64,7 +64,8 @@ def test_no_qualifying_draw_is_an_error_naming_the_fix(ur5: ck.Robot) -> None:
     assert ur5.srdf_path is not None
     with pytest.raises(
         PlanningError,
-        match=r"no start and goal of 20 draws .* 1 m between .*lower self_clearance_m \(\d+ of the \d+ draws "
+        match=r"no start and goal of 20 draws .* 1 m between .* \(refused: .*\d+ with the robot's own pairs "
+        r"too close.*\); lower self_clearance_m \(\d+ of the \d+ draws "
         r"refused for their own pairs had \w+ and \w+ closest: if they sit that close by design, allow "
         r"the pair in the SRDF\)$",
     ):  # the pair most often closest among the draws the self clearance refused
@@ -72,6 +73,21 @@ def test_no_qualifying_draw_is_an_error_naming_the_fix(ur5: ck.Robot) -> None:
     ur10 = ck.load_robot(example_robot("ur10"))  # example-robot-data has no SRDF for it
     with pytest.raises(PlanningError, match=r"lower self_clearance_m, or give the robot its SRDF"):
         blocked_scene("ur10_0", "ur10", ur10, 0, self_clearance_m=1.0, draws=20)
+
+
+def test_an_arm_that_hangs_below_its_base_is_told_why_it_gets_no_scene() -> None:
+    # example-robot-data's hextilt flying arm hangs below the drone: every draw's midway tool
+    # point is below the base, and the message once said only "lower self_clearance_m"
+    share = example_robot_data_share()
+    assert share is not None
+    urdf = share / "example-robot-data/robots/hextilt_description/urdf/hextilt_flying_arm_5.urdf"
+    arm = ck.load_robot(urdf)
+    with pytest.raises(
+        PlanningError,
+        match=r"\(refused: .*\d+ with the tool's midway point less than a tenth of the reach above the "
+        r"base.*\); the generator draws arms that reach up from their base",
+    ):
+        blocked_scene("hextilt_0", str(urdf), arm, 0, draws=50)
 
 
 def test_a_goal_pose_is_valid_when_a_clear_ik_solution_reaches_it() -> None:

@@ -57,22 +57,30 @@ def blocked_scene(
     reach = float(np.linalg.norm(ck.frame_poses(robot, middle[None])[0][:3, 3]))
     dynamics = ck.robot_dynamics(robot)
     too_close: Counter[tuple[str, str]] = Counter()  # the closest pair of each end refused for it
+    refused: Counter[str] = Counter()  # why each draw was refused (REFUSALS' keys)
     for _ in range(draws):
         start, goal = rng.uniform(middle - 0.6 * half, middle + 0.6 * half, (2, robot.nq))
         tools = ck.frame_poses(robot, np.array([start, (start + goal) / 2, goal]))
-        if np.linalg.norm(tools[0, :3, 3] - tools[2, :3, 3]) < 0.5 * reach or tools[1, 2, 3] < 0.1 * reach:
+        if np.linalg.norm(tools[0, :3, 3] - tools[2, :3, 3]) < 0.5 * reach:
+            refused["near"] += 1
+            continue
+        if tools[1, 2, 3] < 0.1 * reach:
+            refused["low"] += 1
             continue
         ball = ck.Obstacle.sphere(0.12 * reach, tuple(tools[1, :3, 3]), name="ball")
         world = ck.CollisionWorld(robot, [ball], self_margin_m=self_clearance_m)
         ends = np.array([start, goal])
         if world.clearance_batch(ends).clearance_m.min() <= margin_m + 0.02:
+            refused["ball"] += 1
             continue
         if world.self_collision:
             distance, pair = world.self_collision.distances(ends)
             if distance.min() <= self_clearance_m:
                 too_close[world.self_collision.pairs[int(pair[np.argmin(distance)])]] += 1
+                refused["self"] += 1
                 continue
         if not held(dynamics, ends).all():
+            refused["gravity"] += 1
             continue
         return {
             "name": name,
@@ -85,19 +93,46 @@ def blocked_scene(
             ],
             "planner": {"seed": seed},
         }
-    unlisted = "" if robot.srdf_path is not None else ", or give the robot its SRDF (none was found)"
-    closest = ""
-    if too_close:
-        (a, b), count = too_close.most_common(1)[0]
-        closest = (
-            f" ({count} of the {sum(too_close.values())} draws refused for their own pairs had "
-            f"{a} and {b} closest: if they sit that close by design, allow the pair in the SRDF)"
-        )
+    counts = ", ".join(f"{count} {REFUSALS[why]}" for why, count in refused.most_common())
+    blocker = [why for why in REFUSALS if refused[why]][-1]  # the last test refused every draw it saw
+    fix = _fix(blocker, robot, too_close)
     raise PlanningError(
         f"no start and goal of {draws} draws for '{name}' keep {margin_m + 0.02:g} m from the ball and "
         f"{self_clearance_m:g} m between the robot's own pairs, with gravity's torques within the effort "
-        f"limits; lower self_clearance_m{unlisted}{closest}"
+        f"limits (refused: {counts}); {fix}"
     )
+
+
+REFUSALS = {
+    "near": "with the tool's ends less than half the reach apart",
+    "low": "with the tool's midway point less than a tenth of the reach above the base",
+    "ball": "with an end near the ball",
+    "self": "with the robot's own pairs too close",
+    "gravity": "where the motors cannot hold an end against gravity",
+}
+"""Why a draw of :func:`blocked_scene` is refused, in the order of its tests; its error counts them."""
+
+
+def _fix(blocker: str, robot: ck.Robot, too_close: Counter[tuple[str, str]]) -> str:
+    """What to do about ``blocker`` (a :data:`REFUSALS` key), the test no draw passed."""
+    if blocker == "self":
+        unlisted = "" if robot.srdf_path is not None else ", or give the robot its SRDF (none was found)"
+        (a, b), count = too_close.most_common(1)[0]
+        return (
+            f"lower self_clearance_m{unlisted} ({count} of the {sum(too_close.values())} draws refused "
+            f"for their own pairs had {a} and {b} closest: if they sit that close by design, allow "
+            "the pair in the SRDF)"
+        )
+    if blocker == "low":
+        return (
+            "the generator draws arms that reach up from their base, with the ball above it; an arm "
+            "that hangs below its base (a flying arm) has no such scene: write its scenes by hand"
+        )
+    if blocker == "ball":
+        return "its links stay near the ball whatever its ends: lower margin_m, or write its scenes by hand"
+    if blocker == "gravity":
+        return "check the URDF's masses and effort limits, or give the scenes a lighter arm"
+    return "its reach and joint ranges leave no room for the ball between its ends: write its scenes by hand"
 
 
 def _rpy(rotation: np.ndarray) -> list[float]:
