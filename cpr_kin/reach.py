@@ -155,6 +155,32 @@ def _carry(
     return radii, Hull(points=points, ball=ball)
 
 
+_ROBOT_SWEPT: weakref.WeakKeyDictionary[Robot, tuple[tuple[tuple[Any, Any], ...], ...]] = (
+    weakref.WeakKeyDictionary()
+)
+
+
+def _robot_swept(robot: Robot) -> tuple[tuple[tuple[Any, Any], ...], ...]:
+    """Per robot geometry (``robot.geometries``' order), its swept capsules as coal shapes, placed.
+
+    Built once per robot, as :func:`robot_reach`: every problem's world asks for them.
+    """
+    import coal
+    import pinocchio as pin
+
+    if robot not in _ROBOT_SWEPT:
+        reach, swept = robot_reach(robot), []
+        for geometry in robot.geometries:
+            placed = []
+            for hull in reach[geometry.index].hulls:
+                centre, axis, half, radius = hull.capsule()
+                rotation = pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), axis).matrix()
+                placed.append((coal.Capsule(radius, 2 * half), coal.Transform3s(rotation, centre)))
+            swept.append(tuple(placed))
+        _ROBOT_SWEPT[robot] = tuple(swept)
+    return _ROBOT_SWEPT[robot]
+
+
 def pair_reach_distances(
     robot: Robot, obstacles: Sequence[Obstacle], pairs: Sequence[tuple[int, int]]
 ) -> FloatArray:
@@ -165,16 +191,8 @@ def pair_reach_distances(
     bounds the pair's distance from below, whatever the joints do.
     """
     import coal
-    import pinocchio as pin
 
-    reach = robot_reach(robot)
-    swept: dict[int, list[tuple[Any, Any]]] = {}  # geometry index -> its capsules, placed
-    for g in {g for g, _ in pairs}:
-        swept[g] = []
-        for hull in reach[robot.geometries[g].index].hulls:
-            centre, axis, half, radius = hull.capsule()
-            rotation = pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), axis).matrix()
-            swept[g].append((coal.Capsule(radius, 2 * half), coal.Transform3s(rotation, centre)))
+    swept = _robot_swept(robot)
     placed = {
         k: (
             obstacles[k].geometry(),

@@ -72,11 +72,11 @@ def relative_radii(
             carried[g, joint - 1] = True
             joint = model.parents[joint]
     radii = np.asarray(geometry_radii, dtype=float)
-    out = np.zeros((len(pairs), joints))
-    for p, (a, b) in enumerate(pairs):
-        only_a, only_b = carried[a] & ~carried[b], carried[b] & ~carried[a]
-        out[p] = np.where(only_a, radii[a], 0.0) + np.where(only_b, radii[b], 0.0)
-    return out
+    if not len(pairs):
+        return np.zeros((0, joints))
+    a, b = np.asarray(pairs, dtype=np.intp).T
+    only_a, only_b = carried[a] & ~carried[b], carried[b] & ~carried[a]
+    return np.where(only_a, radii[a], 0.0) + np.where(only_b, radii[b], 0.0)
 
 
 @dataclass(frozen=True)
