@@ -65,11 +65,13 @@ def test_a_scene_whose_splines_all_touch_the_passage_is_planned_not_refused(robo
 
     The default search now repairs its best spline there; without the refinement every
     spline still touches the passage, and the last resort follows the path (RRT-Connect's
-    path drawn from uniform samples only, as when the scene was found).
+    path drawn from uniform samples only, as when the scene was found, and seeded by its
+    corners' placement alone: the firefly finds a spline through the evenly spaced one).
     """
     scene = next(s for s in generate_scenes(40, 77, robot, narrow=10) if s.name == "scene_028")
     tuning = scene.planner.tuning
-    uniform = dataclasses.replace(tuning, seeding=dataclasses.replace(tuning.seeding, local_share=0.0))
+    seeding = dataclasses.replace(tuning.seeding, local_share=0.0, placements=(0.0,))
+    uniform = dataclasses.replace(tuning, seeding=seeding)
     scene = dataclasses.replace(scene, planner=dataclasses.replace(scene.planner, tuning=uniform))
     for planner in (scene.planner, scene.planner.updated(refine="none")):
         result = plan(dataclasses.replace(scene, planner=planner), robot)

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
+from planning.errors import PlanningError
 from planning.io.narrow_passages import narrow_scene
 from planning.pipeline.path_seeds import sampled_path
 from planning.pipeline.problem import Problem, build_problem, finer_step_m, with_planner
@@ -18,7 +19,7 @@ from planning.pipeline.settings import PlannerSettings
 from planning.pipeline.target import Target
 from planning.pipeline.tuning import SearchTuning, SeedingTuning
 from planning.pipeline.verification import Requirements, verify_for_scene, verify_trajectory
-from planning.search.waypoints import waypoints_along
+from planning.search.waypoints import evenly_along, placements_along, waypoints_along
 
 
 @pytest.fixture(scope="module")
@@ -91,8 +92,9 @@ def drawn_paths(problem: Problem) -> list[tuple[np.ndarray, float]]:
     for _ in range(problem.scene.planner.tuning.seeding.path_attempts):
         found = sampled_path(problem, rng)
         assert found is not None
-        seed = waypoints_along(found.path, problem.scene.planner.waypoints, weights).ravel()
-        drawn.append((found.path, float(problem.objective(seed[None])[0])))
+        shares = problem.scene.planner.tuning.seeding.placements
+        offered = placements_along(found.path, problem.scene.planner.waypoints, weights, shares)
+        drawn.append((found.path, float(problem.objective(offered.reshape(len(shares), -1)).min())))
     return drawn
 
 
@@ -131,13 +133,62 @@ def test_a_redraw_gets_what_remains_of_redraw_samples_and_gives_up_beyond(robot:
 
 
 def test_when_no_path_seed_is_feasible_the_best_ranked_is_kept(robot: ck.Robot) -> None:
-    # its three draws take 194, 9 and 168 samples: a budget for all three
+    # its three draws take 194, 9 and 168 samples: a budget for all three; the corners'
+    # placement alone (with the evenly spaced ones offered too, the first path's seed is
+    # feasible: test_the_best_placement_along_the_path_seeds_the_search)
     built = build_problem(narrow_scene(np.random.default_rng(3), robot, "pillars"), robot)
-    problem = uniform_samples(built, redraw_samples=1_000)
+    problem = uniform_samples(built, redraw_samples=1_000, placements=(0.0,))
     drawn = drawn_paths(problem)
     fitness = [value for _, value in drawn]
     assert min(fitness) > problem.objective.t_max and int(np.argmin(fitness)) > 0
     np.testing.assert_array_equal(seed_search(problem).path, drawn[int(np.argmin(fitness))][0])
+
+
+def test_the_best_placement_along_the_path_seeds_the_search(robot: ck.Robot) -> None:
+    """A window (seed 7): the spline through the first path's corners cuts into the margin, the
+    ones through waypoints evenly spaced along it, or halfway between, do not; the seeding keeps
+    the best placement and draws no other path. Offered the corners alone, it finds no feasible
+    seed in the draws its budget allows."""
+    built = build_problem(narrow_scene(np.random.default_rng(7), robot, "window"), robot)
+    found = sampled_path(built, np.random.default_rng([built.scene.planner.seed, 1]))
+    assert found is not None
+    weights = ck.path_weights(robot)[built.moving]
+    count, shares = built.scene.planner.waypoints, built.scene.planner.tuning.seeding.placements
+    assert shares == (0.0, 0.5, 1.0)
+    offered = placements_along(found.path, count, weights, shares)
+    objective = built.objective
+    fitness = objective(offered.reshape(len(shares), -1))
+    assert not objective.feasible(fitness[0]) and objective.feasible(fitness.min())
+    np.testing.assert_array_equal(offered[0], waypoints_along(found.path, count, weights))
+    seeds = seed_search(built)
+    np.testing.assert_array_equal(seeds.path, found.path)  # the first path, not drawn again
+    assert seeds.feasible and seeds.problem is built
+    assert objective(seeds.candidates[1][None])[0] == fitness.min()
+    corners = with_planner(built, tuning=SearchTuning(seeding=SeedingTuning(placements=(0.0,))))
+    assert not seed_search(corners).feasible
+
+
+def test_placements_are_between_the_corners_and_evenly_spaced_waypoints() -> None:
+    path = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 3.0]])  # arc length 4
+    weights = np.ones(2)
+    corners = waypoints_along(path, 3, weights)
+    even = evenly_along(path, 3, weights)
+    np.testing.assert_allclose(even, [[1.0, 0.0], [1.0, 1.0], [1.0, 2.0]])  # at arc 1, 2, 3
+    zigzag = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [4.0, 1.0]])  # arc 5: at 1.25, 2.5, 3.75
+    np.testing.assert_allclose(evenly_along(zigzag, 3, weights), [[1.25, 0.0], [2.0, 0.5], [2.75, 1.0]])
+    offered = placements_along(zigzag, 3, weights, (0.0, 0.25, 1.0))
+    np.testing.assert_allclose(offered[0], waypoints_along(zigzag, 3, weights))
+    np.testing.assert_allclose(offered[2], evenly_along(zigzag, 3, weights))
+    np.testing.assert_allclose(offered[1], 0.75 * offered[0] + 0.25 * offered[2])
+    assert np.array_equal(placements_along(path, 3, weights, (0.0,))[0], corners)
+
+
+def test_placements_are_validated() -> None:
+    with pytest.raises(PlanningError, match=r"placements\[1\] = 1.5 .*\[0, 1\]"):
+        SeedingTuning(placements=(0.0, 1.5))
+    with pytest.raises(PlanningError, match=r"placements = \[\] must hold at least one share"):
+        SeedingTuning(placements=())
+    assert SeedingTuning(placements=[0.5]).placements == (0.5,)  # type: ignore[arg-type]
 
 
 def test_seeding_none_is_a_setting(robot: ck.Robot) -> None:
@@ -213,7 +264,10 @@ def test_a_goal_within_margin_plus_step_plans_with_the_finer_step_at_once(robot:
     from planning.io.scene_generator import generate_scenes
     from planning.pipeline.planner import plan
 
-    scene = dataclasses.replace(generate_scenes(1, 5, robot)[0], safety_margin=0.0)
+    corners = PlannerSettings(tuning=SearchTuning(seeding=SeedingTuning(placements=(0.0,))))
+    # the corners' placement, whose path approaches the goal fast enough that the scene's
+    # step cannot certify its last 2 mm (below)
+    scene = dataclasses.replace(generate_scenes(1, 5, robot)[0], safety_margin=0.0, planner=corners)
     q_goal = build_problem(scene, robot).q_goal
     tool = ck.frame_poses(robot, q_goal[None])[0, :3, 3]
     probe = ck.Obstacle.sphere(0.02, tuple(tool + np.array([0.0, 0.0, 0.25])), name="ball")
@@ -237,7 +291,10 @@ def test_a_goal_closer_than_the_finer_step_plans_with_half_its_clearance(robot: 
     from planning.io.scene_generator import generate_scenes
     from planning.pipeline.planner import plan
 
-    scene = dataclasses.replace(generate_scenes(1, 5, robot)[0], safety_margin=0.0)
+    corners = PlannerSettings(tuning=SearchTuning(seeding=SeedingTuning(placements=(0.0,))))
+    # the corners' placement, whose path approaches the goal fast enough that the scene's
+    # step cannot certify its last 2 mm (below)
+    scene = dataclasses.replace(generate_scenes(1, 5, robot)[0], safety_margin=0.0, planner=corners)
     far = build_problem(scene, robot)
     assert finer_step_m(far) == scene.planner.finer_verify_step_m  # the ends lie centimetres away
     tool = ck.frame_poses(robot, far.q_goal[None])[0, :3, 3]
@@ -325,7 +382,8 @@ def test_an_infeasible_path_seed_is_refined_without_the_firefly(robot: ck.Robot)
     from planning.pipeline.planner import solve
     from planning.pipeline.search import explores
 
-    problem = uniform_samples(build_problem(narrow_scene(np.random.default_rng(3), robot, "pillars"), robot))
+    built = build_problem(narrow_scene(np.random.default_rng(3), robot, "pillars"), robot)
+    problem = uniform_samples(built, placements=(0.0,))  # the corners' placement: every seed infeasible
     attempt = PathSeeding().first(problem)
     assert attempt.path is not None and not attempt.feasible_seed and attempt.seeds is not None
     tuning = problem.scene.planner.tuning

@@ -20,7 +20,7 @@ from planning.pipeline.problem import Problem, with_planner
 from planning.pipeline.settings import MAX_WAYPOINTS
 from planning.search.rrt_connect import Relaxation, RrtPath, rrt_connect
 from planning.search.rrt_settings import RrtSettings
-from planning.search.waypoints import waypoints_along
+from planning.search.waypoints import placements_along
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
@@ -98,10 +98,17 @@ def sampled_path(
 
 
 def path_seed(problem: Problem, path: FloatArray, count: int, weights: FloatArray) -> PathSeed:
-    """The seed of ``path`` with ``count`` waypoints along it."""
+    """The seed of ``path`` with ``count`` waypoints along it: the best of the tuning's placements.
+
+    The placements (:func:`~planning.search.waypoints.placements_along`) are evaluated in
+    one batch; the first of the best fitness is kept.
+    """
     counted = with_planner(problem, waypoints=count)
-    along = waypoints_along(path, count, weights).ravel()
-    return PathSeed(float(counted.objective(along[None])[0]), counted, along)
+    shares = problem.scene.planner.tuning.seeding.placements
+    offered = placements_along(path, count, weights, shares).reshape(len(shares), -1)
+    fitness = counted.objective(offered)
+    best = int(np.argmin(fitness))
+    return PathSeed(float(fitness[best]), counted, offered[best])
 
 
 def followable_path(

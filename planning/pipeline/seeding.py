@@ -11,7 +11,8 @@ is a small part of its space, rarely met by a random population. So, with the pl
    (:mod:`planning.search.rrt_connect`, drawn by :mod:`planning.pipeline.path_seeds`)
    looks for a path in the moving joints, clear of
    the clearance the fitness requires (margin plus verification step), and its waypoints
-   (:func:`~planning.search.waypoints.waypoints_along`) are the second seed. A path is
+   are the second seed: the best of the ``placements`` along it, from its corners kept to
+   evenly spaced (:func:`~planning.search.waypoints.placements_along`). A path is
    clear, but the spline through its few waypoints cuts its corners and may not be: then
    RRT-Connect draws another path, up to ``path_attempts`` in all while the paths so far
    took fewer than ``redraw_samples`` samples (a redraw gets what remains of them), and

@@ -53,6 +53,10 @@ class SeedingTuning:
             pocket about a goal in a shelf grows out of it; 0: uniform samples only.
         local_spread: standard deviation of those samples about their node [share of each
             joint's range], in (0, 1].
+        placements: the waypoint placements along a path offered as its seed, each a share
+            of the way from the corners' placement (0) to the evenly spaced one (1), in
+            [0, 1] (:func:`~planning.search.waypoints.placements_along`); the best of them
+            seeds the search.
     """
 
     share: float = 0.6
@@ -66,6 +70,7 @@ class SeedingTuning:
     finer_step: float = 0.2
     local_share: float = LOCAL_SHARE
     local_spread: float = LOCAL_SPREAD
+    placements: tuple[float, ...] = (0.0, 0.5, 1.0)
 
     def __post_init__(self) -> None:
         number_in("share", self.share, 0.0, 1.0, low_open=True)
@@ -79,6 +84,12 @@ class SeedingTuning:
         number_in("finer_step", self.finer_step, 0.0, 1.0, low_open=True)
         number_in("local_share", self.local_share, 0.0, 1.0)
         number_in("local_spread", self.local_spread, 0.0, 1.0, low_open=True)
+        shares = tuple(self.placements)
+        if not shares:
+            raise PlanningError("placements = [] must hold at least one share in [0, 1]")
+        for k, share in enumerate(shares):
+            number_in(f"placements[{k}]", share, 0.0, 1.0)
+        object.__setattr__(self, "placements", shares)
 
 
 @dataclass(frozen=True)
