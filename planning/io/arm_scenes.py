@@ -49,8 +49,11 @@ def blocked_scene(
         draws: most draws of a start and goal.
 
     Raises:
-        PlanningError: no start and goal of ``draws`` draws qualify.
+        PlanningError: no start and goal of ``draws`` draws qualify (the message counts why), or
+            ``draws`` is no whole number >= 1.
     """
+    if not (isinstance(draws, int) and draws >= 1):
+        raise PlanningError(f"draws = {draws!r} must be a whole number >= 1")
     rng = np.random.default_rng(seed)
     lower, upper = robot.limits.lower, robot.limits.upper
     middle, half = (lower + upper) / 2, (upper - lower) / 2
