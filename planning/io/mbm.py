@@ -156,11 +156,10 @@ def endpoint_violations(scene: Scene, robot: ck.Robot) -> list[str]:
     """
     from planning.errors import NoSolutionError
     from planning.pipeline.endpoints import endpoint
+    from planning.pipeline.problem import scene_world
     from planning.pipeline.torques import scene_dynamics
 
-    world = ck.CollisionWorld(
-        robot, scene.obstacles, allowed_pairs=scene.allowed_collisions, self_margin_m=scene.self_margin
-    )
+    world = scene_world(scene, robot)
     try:
         dynamics = scene_dynamics(robot, scene)
     except PlanningError as exc:

@@ -129,6 +129,22 @@ def moving_joints(robot: ck.Robot, scene: Scene, q_start: FloatArray, q_goal: Fl
     return np.array([robot.limits.index(n) for n in names], dtype=np.intp)
 
 
+def scene_world(scene: Scene, robot: ck.Robot, threads: int | None = None) -> ck.CollisionWorld:
+    """``robot`` among ``scene``'s obstacles, its pairs held as the scene holds them.
+
+    The scene's ``allowed_collisions`` may touch; a pair close by design is held to contact
+    only where the scene's self margin exceeds its gap (:mod:`cpr_kin.close_pairs`).
+    ``threads``: those of the parallel collision checks (default: up to 2).
+    """
+    return ck.CollisionWorld(
+        robot,
+        scene.obstacles,
+        num_threads=threads,
+        allowed_pairs=scene.allowed_collisions,
+        self_margin_m=scene.self_margin,
+    )
+
+
 def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | None = None) -> Problem:
     """Everything about ``scene`` that a search needs, checked.
 
@@ -151,13 +167,7 @@ def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | No
         robot = ck.carrying(robot, scene.payload)  # its shape, if it has one, checked as the robot's
     except ck.CprKinError as exc:
         raise PlanningError(f"payload: {exc}") from None
-    world = ck.CollisionWorld(
-        robot,
-        scene.obstacles,
-        num_threads=threads,
-        allowed_pairs=scene.allowed_collisions,
-        self_margin_m=scene.self_margin,
-    )
+    world = scene_world(scene, robot, threads)
     dynamics = scene_dynamics(robot, scene, world.num_threads)
     q_start = endpoint(robot, world, scene, "start", dynamics=dynamics)
     q_goal = endpoint(robot, world, scene, "goal", seed_q=q_start, dynamics=dynamics)
