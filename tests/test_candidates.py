@@ -16,9 +16,10 @@ from planning.io.scene_generator import generate_scenes
 from planning.pipeline import choose as choose_module
 from planning.pipeline.choose import Choice, Refusal, choose, distinct, verify
 from planning.pipeline.deadline import Deadline
+from planning.pipeline.offered import Offered
 from planning.pipeline.planner import solve
 from planning.pipeline.problem import Problem
-from planning.pipeline.timing import FixedDuration, Timing
+from planning.pipeline.timing import FixedDuration
 from planning.pipeline.tuning import SearchTuning
 from planning.pipeline.verification import Verification
 from planning.search.optimizer import SearchResult
@@ -33,7 +34,7 @@ class CountingDuration(FixedDuration):
 
     timed: list[np.ndarray] = field(default_factory=list)
 
-    def timings(self, problem: Problem, nodes: np.ndarray) -> list[Timing]:
+    def timings(self, problem: Problem, nodes: np.ndarray) -> Offered:
         self.timed.append(nodes)
         return super().timings(problem, nodes)
 
@@ -49,7 +50,7 @@ def test_distinct_keeps_the_first_of_each_point_in_order() -> None:
 def blocked_then_found(problem: Problem) -> SearchResult:
     """The paper case's straight swing (it hits the crate) twice, then the plan's own best."""
     blocked = problem.objective.straight_line()
-    fixed = problem.duration.timings(problem, problem.objective.nodes(blocked[None])[0])[0]
+    fixed = problem.duration.timings(problem, problem.objective.nodes(blocked[None])[0]).first
     assert not verify(problem, fixed.trajectory, fixed.fit).accepted
     found = solve(problem).optimiser.x
     return SearchResult(
@@ -106,7 +107,7 @@ def test_once_the_best_is_refused_the_next_candidates_run_at_full_speed_before_a
         population_fitness=np.arange(1.0, len(points) + 1),
     )
     offered = [problem.duration.timings(problem, problem.objective.nodes(x[None])[0]) for x in points]
-    fastest = [timing[0] for timing in offered]
+    fastest = [timing.first for timing in offered]
     assert verify(problem, fastest[1].trajectory, fastest[1].fit).accepted  # the oracle
     refused = {fastest[0].trajectory.duration}
 

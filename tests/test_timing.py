@@ -15,7 +15,7 @@ from planning.io.trajectory_io import trajectory_document
 from planning.pipeline.choose import Choice, choose, verify
 from planning.pipeline.planner import plan, solve
 from planning.pipeline.result import PlanResult
-from planning.pipeline.timing import narrowed_timings, uniform_scale
+from planning.pipeline.timing import least_uniform_scale, narrowed_timings, uniform_scale
 from planning.pipeline.tuning import SearchTuning
 from planning.search.optimizer import SearchResult
 
@@ -79,11 +79,30 @@ def test_the_fastest_timing_is_never_longer_than_the_uniform_one(free_results: l
 def test_timings_are_offered_fastest_first(robot: ck.Robot, free_results: list[PlanResult]) -> None:
     result = free_results[0]
     offered = result.problem.duration.timings(result.problem, result.waypoints)
-    assert [t.method for t in offered] == ["fastest", "uniform"]
-    assert offered[0].trajectory.duration <= offered[1].trajectory.duration
+    assert [t.method for t in offered.all] == ["fastest", "uniform"]
+    assert offered.all[0].trajectory.duration <= offered.all[1].trajectory.duration
     fixed = build_problem(paper_scene(0), robot)
-    (only,) = fixed.duration.timings(fixed, solve(fixed).waypoints)
+    (only,) = fixed.duration.timings(fixed, solve(fixed).waypoints).all
     assert only.method == "fixed" and only.trajectory.duration == pytest.approx(4.0)
+
+
+def test_the_uniform_timing_is_computed_only_when_asked_for_unless_it_may_be_shorter(
+    free_results: list[PlanResult],
+) -> None:
+    """The sampled bound is below the exact scale and within a per cent of it; the fastest
+    timing shorter than that bound, the uniform one waits until asked for, and is then the
+    one computed at once (the same trajectory)."""
+    for result in free_results:
+        problem, fit = result.problem, result.spline
+        least, exact = least_uniform_scale(fit, problem), uniform_scale(fit, problem)
+        assert exact * 0.99 <= least <= exact
+        offered = problem.duration.timings(problem, result.waypoints)
+        assert offered.first.method == "fastest"
+        assert "others" not in vars(offered)  # not computed yet (functools.cached_property)
+        (uniform,) = offered.others
+        assert uniform.method == "uniform" and offered.of("uniform") is uniform
+        assert uniform.trajectory.duration == pytest.approx(fit.trajectory.duration * exact, rel=1e-12)
+        assert offered.first.trajectory.duration < uniform.trajectory.duration
 
 
 def test_narrowed_timings_meet_the_lowered_acceleration_and_beat_the_uniform_one(
@@ -92,14 +111,14 @@ def test_narrowed_timings_meet_the_lowered_acceleration_and_beat_the_uniform_one
     limits = robot.limits
     result = free_results[0]
     offered = result.problem.duration.timings(result.problem, result.waypoints)
-    uniform = next(t for t in offered if t.method == "uniform").trajectory
+    uniform = next(t for t in offered.all if t.method == "uniform").trajectory
     narrowed = narrowed_timings(result.problem, offered)
     assert narrowed, "a share of 0.7 costs well under the uniform timing's 15-35 %"
     durations = [timing.trajectory.duration for timing in narrowed]
     assert durations == sorted(durations) and durations[-1] < uniform.duration
     for share, timing in zip(NARROWED_ACCELERATION, narrowed, strict=False):
         trajectory = timing.trajectory
-        assert timing.method == "narrowed" and timing.fit is offered[0].fit
+        assert timing.method == "narrowed" and timing.fit is offered.first.fit
         used = [
             float(np.max(trajectory.extrema(r).peak / limit))
             for r, limit in enumerate((limits.velocity, share * limits.acceleration, limits.jerk), start=1)
@@ -131,7 +150,7 @@ def test_a_path_whose_fastest_timing_cuts_into_the_margin_runs_narrowed(
         problem = result.problem
         offered = problem.duration.timings(problem, result.waypoints)
         narrowed = narrowed_timings(problem, offered)
-        fastest_m = verify(problem, offered[0].trajectory, offered[0].fit).check.certified_min_m
+        fastest_m = verify(problem, offered.first.trajectory, offered.first.fit).check.certified_min_m
         narrowed_m = verify(problem, narrowed[0].trajectory, narrowed[0].fit).check.certified_min_m
         if narrowed_m < fastest_m + 5e-4:
             continue
@@ -143,8 +162,8 @@ def test_a_path_whose_fastest_timing_cuts_into_the_margin_runs_narrowed(
         chosen = choose(raised, _alone(x, float(raised.objective(x[None])[0])))
         assert isinstance(chosen, Choice) and chosen.timing.method == "narrowed"
         assert chosen.verification.accepted and chosen.verification.check.certified_min_m >= margin_m
-        assert not verify(raised, offered[0].trajectory, offered[0].fit).accepted
-        uniform = next(t for t in offered if t.method == "uniform").trajectory
+        assert not verify(raised, offered.first.trajectory, offered.first.fit).accepted
+        uniform = next(t for t in offered.all if t.method == "uniform").trajectory
         assert chosen.timing.trajectory.duration < uniform.duration
         jump, relative = chosen.timing.trajectory.knot_jumps(4)
         assert np.all((relative < 1e-7) | (jump < 1e-7))
@@ -162,7 +181,7 @@ def test_the_search_ranks_candidates_by_a_bound_tight_to_the_executed_duration(
     window)."""
     ratios = []
     for result in free_results:
-        fastest = result.problem.duration.timings(result.problem, result.waypoints)[0]
+        fastest = result.problem.duration.timings(result.problem, result.waypoints).first
         assert fastest.method == "fastest"
         ratios.append(float(result.breakdown.duration_s[0]) / fastest.trajectory.duration)
     assert all(0.95 <= ratio <= 1.2 for ratio in ratios), ratios

@@ -4,6 +4,7 @@ from .choose import Choice, Refusal
 from .metrics import Elapsed, Metrics
 from .motion import Motion
 from .objective import Breakdown, WaypointObjective
+from .offered import Offered, Timing
 from .planner import plan, solve, warm_up
 from .problem import Problem, build_problem, with_planner
 from .result import PlanResult
@@ -12,7 +13,7 @@ from .search import planner_search
 from .seeding import Attempt, Seeds, seed_search
 from .settings import DEFAULT_FIREFLY, PAPER_SEARCH, PlannerSettings
 from .target import Target
-from .timing import FixedDuration, FreeDuration, Timing
+from .timing import FixedDuration, FreeDuration
 from .tuning import SearchTuning, SeedingTuning
 from .verification import Verification, verify_trajectory
 
@@ -29,6 +30,7 @@ __all__ = [
     "FreeDuration",
     "Metrics",
     "Motion",
+    "Offered",
     "PlanResult",
     "PlannerSettings",
     "Problem",

@@ -39,8 +39,8 @@ from planning.curves.spline import SplineFit
 from planning.curves.trajectory import Trajectory
 from planning.errors import NoTrajectoryFoundError
 from planning.pipeline.objective import Breakdown
+from planning.pipeline.offered import Offered, Timing
 from planning.pipeline.problem import Problem
-from planning.pipeline.timing import Timing
 from planning.pipeline.verification import Requirements, Verification, verify_trajectory
 from planning.search.optimizer import SearchResult
 
@@ -175,7 +175,7 @@ def choose(problem: Problem, searched: SearchResult) -> Choice | Refusal:
     order = np.argsort(searched.population_fitness, kind="stable")
     feasible = objective.feasible(searched.population_fitness)
     candidates = distinct([searched.x] + [searched.population[k] for k in order if feasible[k]])
-    timed: list[list[Timing]] = []
+    timed: list[Offered] = []
     first: Verification | None = None
     verified: set[int] = set()
     hopeless = beyond_margin(problem, searched)
@@ -205,12 +205,12 @@ def choose(problem: Problem, searched: SearchResult) -> Choice | Refusal:
 
 
 def _attempts(
-    problem: Problem, candidates: list[FloatArray], timed: list[list[Timing]]
+    problem: Problem, candidates: list[FloatArray], timed: list[Offered]
 ) -> Iterator[tuple[int, Timing]]:
     """``(candidate, timing)`` in the module docstring's order; ``timed`` fills as they are timed."""
     tuning, duration, objective = problem.scene.planner.tuning, problem.duration, problem.objective
 
-    def offered(k: int) -> list[Timing]:
+    def offered(k: int) -> Offered:
         while len(timed) <= k:
             timed.append(duration.timings(problem, objective.nodes(candidates[len(timed)][None])[0]))
         return timed[k]
@@ -221,11 +221,11 @@ def _attempts(
 
     preferred = list(range(min(tuning.preferred_first, len(candidates))))
     for k in preferred:  # most plans end at the first, after one timing
-        yield k, offered(k)[0]
+        yield k, offered(k).first
     narrowing = preferred
     for share in tuning.narrowed_acceleration:  # share by share: a path that passes costs no lower share
         found = [(k, duration.narrowed(problem, offered(k), share)) for k in narrowing]
         yield from shortest_first(found)
         narrowing = [k for k, timing in found if timing is not None]  # a lower share is slower still
-    yield from shortest_first([(k, timing) for k in preferred for timing in offered(k)[1:]])
-    yield from ((k, timing) for k in range(len(preferred), len(candidates)) for timing in offered(k))
+    yield from shortest_first([(k, timing) for k in preferred for timing in offered(k).others])
+    yield from ((k, timing) for k in range(len(preferred), len(candidates)) for timing in offered(k).all)

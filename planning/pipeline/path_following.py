@@ -22,9 +22,9 @@ import cpr_kin as ck
 from planning.curves.spline import SplineFit
 from planning.curves.stop_and_go import stop_and_go
 from planning.pipeline.choose import Choice, Refusal, verify
+from planning.pipeline.offered import Timing
 from planning.pipeline.problem import Problem, with_planner
 from planning.pipeline.settings import MAX_WAYPOINTS
-from planning.pipeline.timing import Timing
 from planning.search.waypoints import waypoints_along
 
 FloatArray = NDArray[np.float64]

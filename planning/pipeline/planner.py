@@ -30,6 +30,7 @@ from planning.pipeline.blas_threads import one_blas_thread
 from planning.pipeline.choose import Choice, Refusal, choose, verify
 from planning.pipeline.deadline import Deadline
 from planning.pipeline.metrics import Elapsed
+from planning.pipeline.offered import Timing
 from planning.pipeline.path_following import follow_path
 from planning.pipeline.path_terms import SplinePaths
 from planning.pipeline.problem import Problem, build_problem
@@ -38,7 +39,6 @@ from planning.pipeline.scene import Scene
 from planning.pipeline.search import search
 from planning.pipeline.seeding import SEEDINGS, NoSeeding
 from planning.pipeline.target import Target
-from planning.pipeline.timing import Timing
 from planning.pipeline.torques import held
 from planning.search.firefly import FireflyProgress
 from planning.search.optimizer import Optimizer, SearchResult
