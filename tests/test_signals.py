@@ -39,7 +39,7 @@ def stuck(*args, **kwargs):  # the timing step, held inside a compiled kernel un
     real(*args, **kwargs)
     ready.touch()
     while True:
-        jerk_limited_motion(positions, 0.2, 0.01, np.full(5, 15.0), 3, 0.02)
+        jerk_limited_motion(positions, 0.2, 0.01, np.full(5, 15.0), 3, 0.02, 0.125)
 
 
 timing.time_path = stuck

@@ -7,7 +7,7 @@ import pytest
 
 import cpr_kin as ck
 from planning.curves.jerk_window import sampled_path_durations
-from planning.curves.path_timing import time_path
+from planning.curves.path_timing import SECOND_SHARE, time_path
 from planning.curves.phase_plane import phase_plane_profile
 from planning.curves.spline import SepticSplineSolver, uniform_knots
 from planning.curves.torque_estimate import sampled_torque_durations
@@ -107,13 +107,13 @@ def test_the_search_estimate_keeps_the_torques_where_they_bind(robot: ck.Robot, 
     window = float(np.max(limits.acceleration / limits.jerk))
     samples = path(np.linspace(path.knots[0], path.knots[-1], 64))[None]
     fitted = np.arange(robot.nq)
-    plain = sampled_path_durations(samples, *limits_of(kinematic), window, ROUNDS, TOLERANCE)
+    plain = sampled_path_durations(samples, *limits_of(kinematic), window, ROUNDS, TOLERANCE, SECOND_SHARE)
     light = ck.robot_dynamics(robot, ck.Payload(2.0, (0.0, 0.0, 0.05)))
-    assert sampled_torque_durations(samples, fitted, kinematic, light, window) == pytest.approx(
+    assert sampled_torque_durations(samples, fitted, kinematic, light, window, SECOND_SHARE) == pytest.approx(
         plain, rel=1e-12
     )
     heavy = ck.robot_dynamics(robot, ck.Payload(15.0, (0.0, 0.0, 0.05)))
-    estimate = sampled_torque_durations(samples, fitted, kinematic, heavy, window)[0]
+    estimate = sampled_torque_durations(samples, fitted, kinematic, heavy, window, SECOND_SHARE)[0]
     timed = time_path(path, limits.velocity, limits.acceleration, limits.jerk, torque=heavy).duration
     assert estimate > plain[0] and estimate == pytest.approx(timed, rel=0.1)
 
@@ -128,8 +128,11 @@ def test_the_search_estimate_of_many_paths_is_each_paths_own(robot: ck.Robot, pa
     samples = np.stack([along, still, along[::-1], along * 0.5, along])
     heavy = ck.robot_dynamics(robot, ck.Payload(15.0, (0.0, 0.0, 0.05)))
     fitted = np.arange(robot.nq)
-    together = sampled_torque_durations(samples, fitted, kinematic, heavy, window)
-    alone = [sampled_torque_durations(one[None], fitted, kinematic, heavy, window)[0] for one in samples]
+    together = sampled_torque_durations(samples, fitted, kinematic, heavy, window, SECOND_SHARE)
+    alone = [
+        sampled_torque_durations(one[None], fitted, kinematic, heavy, window, SECOND_SHARE)[0]
+        for one in samples
+    ]
     assert together.tolist() == alone and together[1] == 0.0 and len(set(together.tolist())) >= 3
 
 

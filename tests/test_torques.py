@@ -68,7 +68,7 @@ def test_check_fails_a_trajectory_too_fast_for_the_payload(
     code = main(["check", str(scene), str(tmp_path / "fast.json")])
     out = capsys.readouterr().out
     assert code == 3 and re.search(
-        r"drives the torque of joint 'd2' to 1\.\d+ x its effort limit \(2\d\d of 200 N\)", out
+        r"drives the torque of joint 'd2' to 1\.\d+ x its effort limit \(2\d\d(\.\d)? of 200 N\)", out
     )
     (tmp_path / "bare.yaml").write_text(yaml.safe_dump(scene_with(payload=None)))
     assert main(["check", str(tmp_path / "bare.yaml"), str(tmp_path / "fast.json")]) == 0

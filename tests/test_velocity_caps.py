@@ -8,26 +8,27 @@ import numpy as np
 import cpr_kin as ck
 from planning.curves import velocity_caps
 from planning.curves.arc_length import ArcLengthPath, arc_length_path
+from planning.curves.path_timing import SECOND_SHARE
 from planning.curves.phase_plane import profile_time
 from planning.curves.velocity_caps import CappedMotion, capped_motion, capped_profile, fastest_motion
 
 from .conftest import LIFT, PAPER_GOAL_TCP, PAPER_START_TCP, limits_of, spline_path
 
 
-def every_cap(grid: ArcLengthPath, limits: np.ndarray) -> CappedMotion:
+def every_cap(grid: ArcLengthPath, limits: np.ndarray, second: float) -> CappedMotion:
     """The cap search with no early stop: every cap of the grid, as first written."""
-    tried = {1.0: velocity_caps.capped_motion(grid, limits, 1.0)}
+    tried = {1.0: velocity_caps.capped_motion(grid, limits, second, 1.0)}
     peak = tried[1.0].peak
     for share in (factor * peak for factor in velocity_caps.FACTORS):
-        tried[share] = velocity_caps.capped_motion(grid, limits, share)
+        tried[share] = velocity_caps.capped_motion(grid, limits, second, share)
     for high, low in pairwise(sorted(tried, reverse=True)):
         if tried[high].widened and not tried[low].widened:
-            velocity_caps.bisect_widening(grid, limits, tried, high, low, peak)
+            velocity_caps.bisect_widening(grid, limits, second, tried, high, low, peak)
             break
     share = min(tried, key=lambda share: (tried[share].duration_s, -share))
     best = tried[share]
     for factor in velocity_caps.RAMP_FACTORS:
-        found = velocity_caps.capped_motion(grid, limits, share, factor * best.window_s)
+        found = velocity_caps.capped_motion(grid, limits, second, share, factor * best.window_s)
         if found.duration_s < best.duration_s:
             best = found
     return best
@@ -46,7 +47,7 @@ def test_the_cap_search_stops_early_with_what_every_cap_gives(
             grid = arc_length_path(path, narrowed[0])
             for name, search in (("stopped", fastest_motion), ("every", every_cap)):
                 with mock.patch.object(velocity_caps, "capped_motion", wraps=capped_motion) as spy:
-                    found = search(grid, narrowed)
+                    found = search(grid, narrowed, SECOND_SHARE)
                 calls[name] += spy.call_count
                 if name == "stopped":
                     stopped = found

@@ -1,19 +1,20 @@
 """How long a phase-plane profile takes once its jerk is limited: the fitness's duration estimate.
 
 :func:`~planning.curves.path_timing.time_path` runs each joint's motion along the
-phase-plane profile through two moving averages, of widths ``w`` and ``w / 4``, starting at
+phase-plane profile through two moving averages, of widths ``w`` and ``r w`` (``r``, the
+second share, :func:`~planning.curves.path_timing.smoothing_limits`), starting at
 ``w = max_j a_j / j_j``, and widens ``w`` while the averaged jerk exceeds its limit
 (:func:`~planning.curves.moving_average.jerk_limited_motion`); the motion lasts the
-profile's time plus ``1.25 w``. Where a joint switches from accelerating to braking at once
-(a move too short to cruise), its acceleration swings by ``2 a`` and the window doubles, so
-the constant allowance ``1.25 a / j`` of the narrowest window underestimates such paths by
-``1.25 a / j``.
+profile's time plus ``(1 + r) w``. Where a joint switches from accelerating to braking at
+once (a move too short to cruise), its acceleration swings by ``2 a`` and the window
+doubles, so the constant allowance ``(1 + r) a / j`` of the narrowest window underestimates
+such paths by as much again.
 
 This module repeats the widening on the profile itself. The two averages' jerk is a
 difference of the joint's velocity ``v`` at four instants (the averages of an acceleration
 are differences of its integral)::
 
-    jerk(t) = (v(t) - v(t - w/4) - v(t - w) + v(t - 5w/4)) / (w^2 / 4)
+    jerk(t) = (v(t) - v(t - r w) - v(t - w) + v(t - (1 + r) w)) / (r w^2)
 
 With ``v`` linear between the profile's grid points, its extrema lie where one of the four
 instants meets a grid point, so a few hundred evaluations give it exactly, without the
@@ -33,29 +34,39 @@ from planning.curves.phase_plane import phase_plane_profile, profile_instants, s
 
 FloatArray = NDArray[np.float64]
 
-TERMS = ((0.0, 1.0), (0.25, -1.0), (1.0, -1.0), (1.25, 1.0))
-"""The four velocities of the averaged jerk: each one's delay, as a share of the window, and sign."""
-TAIL = 1.25
-"""What the two averages add to the motion's duration, as a share of the window."""
+SIGNS = (1.0, -1.0, -1.0, 1.0)
+"""The signs of the averaged jerk's four velocities (module docstring)."""
+SAMPLED_SECOND_SHARE = 0.25
+"""The least second share with which :func:`jerk_limited_duration` checks the jerk of a
+sampled path: the fitness knows a path at a few dozen samples, between which its velocity
+bends at kinks the timing's fine table does not have; a narrower second average would widen
+windows for them that the timing does not (on the CPR, a second share of 1/8 checked as
+such put a 64-sample estimate up to 7 % above the timing, against 4 % so, and the planner's
+trajectories 0.4 % longer: ``docs/benchmarks.md``)."""
 
 
 @njit
-def averaged_jerk_usage(times: FloatArray, velocity: FloatArray, jerk: FloatArray, window_s: float) -> float:
-    """Largest ``|jerk| / limit`` of the two averages of width ``window_s`` and a quarter of it.
+def averaged_jerk_usage(
+    times: FloatArray, velocity: FloatArray, jerk: FloatArray, window_s: float, second_share: float
+) -> float:
+    """Largest ``|jerk| / limit`` of the two averages of width ``window_s`` and ``second_share`` of it.
 
     Args:
         times: ``(G,)`` increasing instants of the profile's grid [s], from rest to rest.
         velocity: ``(G, nj)`` joint velocities there [rad/s, m/s].
         jerk: ``(nj,)`` jerk limits.
         window_s: the first average's width [s], > 0.
+        second_share: the second average's width as a share of ``window_s``, in (0, 1].
     """
     count, joints = velocity.shape
-    scale = 4.0 / window_s**2
+    scale = 1.0 / (second_share * window_s**2)
+    delays = (0.0, second_share, 1.0, 1.0 + second_share)  # of the four velocities, shares of the window
     averaged = np.zeros((count, joints))
     usage = 0.0
-    for breakpoint, _ in TERMS:  # the instants where one of the four velocities meets a grid point
+    for breakpoint in delays:  # the instants where one of the four velocities meets a grid point
         averaged[:] = 0.0
-        for delay, sign in TERMS:
+        for term in range(4):
+            delay, sign = delays[term], SIGNS[term]
             offset = (breakpoint - delay) * window_s
             k = 0  # the grid interval of times[g] + offset, increasing with g
             for g in range(count):
@@ -75,19 +86,25 @@ def averaged_jerk_usage(times: FloatArray, velocity: FloatArray, jerk: FloatArra
 
 @njit
 def needed_window(
-    times: FloatArray, velocity: FloatArray, jerk: FloatArray, window_s: float, rounds: int, tolerance: float
+    times: FloatArray,
+    velocity: FloatArray,
+    jerk: FloatArray,
+    window_s: float,
+    rounds: int,
+    tolerance: float,
+    second_share: float,
 ) -> tuple[float, float]:
     """The window the timing ends with, and its jerk usage (the widenings of ``jerk_limited_motion``).
 
     Each of at most ``rounds`` widenings multiplies the window by the usage (at most 2) while
     the usage exceeds ``1 + tolerance``.
     """
-    usage = averaged_jerk_usage(times, velocity, jerk, window_s)
+    usage = averaged_jerk_usage(times, velocity, jerk, window_s, second_share)
     for _ in range(rounds):
         if usage <= 1.0 + tolerance:
             break
         window_s *= min(usage, 2.0)
-        usage = averaged_jerk_usage(times, velocity, jerk, window_s)
+        usage = averaged_jerk_usage(times, velocity, jerk, window_s, second_share)
     return window_s, usage
 
 
@@ -100,11 +117,12 @@ def sampled_path_durations(
     window_s: float,
     rounds: int,
     tolerance: float,
+    second_share: float,
 ) -> FloatArray:
     """``(S,)`` durations [s] of the jerk-limited motions along ``S`` sampled paths ``(S, M, nj)``.
 
     The phase-plane time under the velocity and acceleration limits ``v``, ``a``
-    (:func:`~planning.curves.phase_plane.sampled_path_times`), plus :data:`TAIL` times the
+    (:func:`~planning.curves.phase_plane.sampled_path_times`), plus ``1 + second_share`` times the
     window :func:`needed_window` widens to for the jerk limits ``j`` from ``window_s`` (the
     timing's ``max a / j`` over all the robot's joints) [s], stretched by ``usage^(1/3)``
     where the last window still exceeds the jerk limit (as the timing's final uniform
@@ -116,7 +134,7 @@ def sampled_path_durations(
         if len(d1) < 2:
             continue
         x = phase_plane_profile(d1, d2, steps, v, a, np.zeros_like(d1))
-        durations[s] = jerk_limited_duration(x, steps, d1, j, window_s, rounds, tolerance)
+        durations[s] = jerk_limited_duration(x, steps, d1, j, window_s, rounds, tolerance, second_share)
     return durations
 
 
@@ -129,13 +147,16 @@ def jerk_limited_duration(
     window_s: float,
     rounds: int,
     tolerance: float,
+    second_share: float,
 ) -> float:
     """Duration [s] of the profile ``x`` (path steps ``steps``, ``dq/ds`` ``d1``) once its jerk is limited.
 
-    The profile's time plus :data:`TAIL` times the window :func:`needed_window` widens to,
+    The profile's time plus ``1 + second_share`` times the window :func:`needed_window`
+    widens to (its jerk checked with a second share of at least :data:`SAMPLED_SECOND_SHARE`),
     stretched by ``usage^(1/3)`` where the last window still exceeds the jerk limit.
     """
     times = profile_instants(x, steps)
     velocity = d1 * np.sqrt(np.maximum(x, 0.0))[:, None]
-    window, usage = needed_window(times, velocity, j, window_s, rounds, tolerance)
-    return float((times[-1] + TAIL * window) * max(1.0, usage ** (1.0 / 3.0)))
+    checked = max(second_share, SAMPLED_SECOND_SHARE)
+    window, usage = needed_window(times, velocity, j, window_s, rounds, tolerance, checked)
+    return float((times[-1] + (1.0 + second_share) * window) * max(1.0, usage ** (1.0 / 3.0)))

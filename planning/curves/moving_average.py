@@ -6,9 +6,9 @@ jerk of the averaged motion is the change of its acceleration over the window, a
 ``a / w`` for a window of ``w`` seconds: a window of ``w = a / j`` turns a velocity- and
 acceleration-limited profile into a jerk-limited one, and the motion ends ``w`` later
 (Tajima and Sencer 2016, "Kinematic corner smoothing for high speed machine tools"). A
-second average of ``w / 4`` rounds the jerk's own steps, so the septic through samples of the
-motion does not overshoot them. :mod:`planning.curves.path_timing` uses these kernels on
-the phase-plane profile of a path.
+second, narrower average (``second_share`` of ``w``) rounds the jerk's own steps, so the
+septic through samples of the motion does not overshoot them.
+:mod:`planning.curves.path_timing` uses these kernels on the phase-plane profile of a path.
 """
 
 from __future__ import annotations
@@ -90,16 +90,16 @@ def _gradient(values: FloatArray, step_s: float) -> FloatArray:
 
 
 @njit
-def averaged_motion(positions: FloatArray, window_s: float, step_s: float) -> FloatArray:
+def averaged_motion(positions: FloatArray, window_s: float, step_s: float, second_share: float) -> FloatArray:
     """``(4, T', nj)`` position, velocity, acceleration and jerk of the averaged positions.
 
-    The positions ``(T, nj)`` every ``step_s`` are averaged over ``window_s``, then over a
-    quarter of it. The derivatives are central differences of the averaged positions
+    The positions ``(T, nj)`` every ``step_s`` are averaged over ``window_s``, then over
+    ``second_share`` of it. The derivatives are central differences of the averaged positions
     themselves: the Hermite data a septic takes from them must agree with each other, or
     small disagreements become large jerks over a short segment.
     """
     first = max(1, round(window_s / step_s))
-    second = max(1, round(window_s / 4.0 / step_s))
+    second = max(1, round(second_share * window_s / step_s))
     smooth = _average(_average(positions, first), second)
     out = np.empty((4, smooth.shape[0], smooth.shape[1]))
     out[0] = smooth
@@ -110,7 +110,13 @@ def averaged_motion(positions: FloatArray, window_s: float, step_s: float) -> Fl
 
 @njit
 def jerk_limited_motion(
-    positions: FloatArray, window_s: float, step_s: float, jerk: FloatArray, rounds: int, tolerance: float
+    positions: FloatArray,
+    window_s: float,
+    step_s: float,
+    jerk: FloatArray,
+    rounds: int,
+    tolerance: float,
+    second_share: float,
 ) -> tuple[FloatArray, float]:
     """:func:`averaged_motion` with the window widened until the jerk is within ``1 + tolerance``.
 
@@ -119,7 +125,7 @@ def jerk_limited_motion(
     widenings multiplies the window by the jerk's excess (at most 2). Returns the motion
     and the window it took [s].
     """
-    motion = averaged_motion(positions, window_s, step_s)
+    motion = averaged_motion(positions, window_s, step_s, second_share)
     for _ in range(rounds):
         usage = 0.0
         for k in range(motion.shape[1]):
@@ -128,7 +134,7 @@ def jerk_limited_motion(
         if usage <= 1.0 + tolerance:
             break
         window_s *= min(usage, 2.0)
-        motion = averaged_motion(positions, window_s, step_s)
+        motion = averaged_motion(positions, window_s, step_s, second_share)
     return motion, window_s
 
 

@@ -35,6 +35,8 @@ limits. How close this method comes to Ruckig's time-optimal jerk-limited durati
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -51,6 +53,8 @@ NODE_STEP_S = 0.1
 """Largest spacing of the trajectory's knots [s]."""
 MIN_NODE_STEP_S = 0.02
 """Smallest spacing of the trajectory's knots [s] (see :func:`smoothing_limits`)."""
+SECOND_SHARE = 0.125
+"""The second moving average's least width, as a share of the first's (:func:`smoothing_limits`)."""
 
 
 def time_path(
@@ -93,30 +97,46 @@ def time_path(
         uncapped = capped_profile(arc, limits, 1.0)
         arc = arc._replace(torque=torque_rows(path(arc.u), arc.dq, arc.ddq, arc.ds, torque, uncapped))
         uncapped = uncapped if arc.torque is None else None  # the rows change it
-    node_step_s, smoothing = smoothing_limits(limits, node_step_s)
-    fastest = fastest_motion(arc, smoothing, uncapped if smoothing is limits else None)
+    smoothing = smoothing_limits(limits, node_step_s)
+    kept = smoothing.limits is limits
+    fastest = fastest_motion(arc, smoothing.limits, smoothing.second_share, uncapped if kept else None)
     ends = path(path.knots[[0, -1]])
-    trajectory = _septic(fastest.motion, fastest.step_s, node_step_s, ends, 4 if still_jerk else 3)
+    trajectory = _septic(fastest.motion, fastest.step_s, smoothing.step_s, ends, 4 if still_jerk else 3)
     return trajectory.time_scaled(limits_time_scale(trajectory, limits, torque))
 
 
-def smoothing_limits(limits: FloatArray, node_step_s: float) -> tuple[float, FloatArray]:
-    """The knot spacing [s] and the limits of steps 1 and 2 for ``limits`` ``(3, nj)``.
+class Smoothing(NamedTuple):
+    """How a robot's limits are smoothed in steps 1 and 2 (:func:`smoothing_limits`)."""
+
+    step_s: float
+    """The trajectory's knot spacing [s]."""
+    limits: FloatArray
+    """``(3, nj)`` velocity, acceleration and jerk limits of the phase plane and the averages."""
+    second_share: float
+    """The second moving average's width as a share of the first."""
+
+
+def smoothing_limits(limits: FloatArray, node_step_s: float) -> Smoothing:
+    """The knot spacing, the limits of steps 1 and 2, and the second average's share for ``limits``.
 
     A septic segment cannot follow an acceleration that ramps up much faster than the
     segment lasts: between its knots it overshoots, and the final scaling pays for it (a
     Panda, whose jerk limits ramp its accelerations in 2 ms, ran 25 % slower through knots
-    every 0.1 s). So the knots come every half ramp ``max_j a_j / j_j`` (between
+    every 0.1 s). So the knots come every quarter ramp ``w = max_j a_j / j_j`` (between
     :data:`MIN_NODE_STEP_S` and ``node_step_s``), and the moving average ramps no faster
     than two knot spacings: its jerk limits are lowered to ``a / (2 step)`` where they are
-    higher. The final scaling still holds the trajectory to the given limits. Limits whose
-    ramps are at least two spacings (the CPR's) are returned as they are.
+    higher. The second average, which rounds the jerk's steps so that the septic does not
+    overshoot them, spans half a knot spacing, and at least :data:`SECOND_SHARE` of the
+    ramp: the motion lasts that much longer than the first average's (``docs/method.md``).
+    The final scaling still holds the trajectory to the given limits. Limits whose ramps
+    are at least two spacings (the CPR's) are kept as they are.
     """
-    step = float(np.clip(np.max(limits[1] / limits[2]) / 2.0, MIN_NODE_STEP_S, node_step_s))
+    step = float(np.clip(np.max(limits[1] / limits[2]) / 4.0, MIN_NODE_STEP_S, node_step_s))
     jerk = np.minimum(limits[2], limits[1] / (2.0 * step))
-    if np.array_equal(jerk, limits[2]):
-        return step, limits
-    return step, np.stack([limits[0], limits[1], jerk])
+    if not np.array_equal(jerk, limits[2]):
+        limits = np.stack([limits[0], limits[1], jerk])
+    ramp_s = float(np.max(limits[1] / limits[2]))
+    return Smoothing(step, limits, max(SECOND_SHARE, step / (2.0 * ramp_s)))
 
 
 def limits_time_scale(trajectory: Trajectory, limits: FloatArray, torque: TorqueModel | None = None) -> float:
@@ -151,5 +171,8 @@ def _septic(
     data[[0, -1], :, 1:still] = 0.0
     steps = np.diff(knots)
     hermite = np.concatenate([data[:-1], data[1:]], axis=2) * node_scaling(steps)[:, None, :]
+    start = data[:-1, :, 0].copy()  # each segment solved about its first position: the jerk's
+    hermite[:, :, [0, 4]] -= start[:, :, None]  # rounding then scales with the segment's motion
     coefficients = (hermite @ HERMITE_INV.T) * (steps[:, None, None] ** -np.arange(8.0))
+    coefficients[:, :, 0] += start
     return Trajectory(knots=knots, coefficients=coefficients)

@@ -25,12 +25,18 @@ TERM_STRIDE = 4
 
 
 def sampled_torque_durations(
-    samples: FloatArray, fitted: NDArray[np.intp], limits: FloatArray, model: TorqueModel, window_s: float
+    samples: FloatArray,
+    fitted: NDArray[np.intp],
+    limits: FloatArray,
+    model: TorqueModel,
+    window_s: float,
+    second_share: float,
 ) -> FloatArray:
     """``(S,)`` the search's duration estimates [s] of sampled paths ``(S, K, nq)``, torques limited too.
 
     :func:`~planning.curves.jerk_window.sampled_path_durations` on the ``fitted`` joints
-    (``limits`` ``(3, len(fitted))``) with the torques as rows of the phase plane
+    (``limits`` ``(3, len(fitted))``, the averages' ``window_s`` [s] and ``second_share``)
+    with the torques as rows of the phase plane
     (:func:`~planning.curves.torque_limits.phase_plane_rows`). Their terms are computed on
     every :data:`TERM_STRIDE`-th sample and the last, and interpolated between (they vary
     smoothly along a path); a path where gravity alone exceeds a limit keeps the estimate
@@ -65,7 +71,7 @@ def sampled_torque_durations(
         terms = every[:, end - len(pick) : end][:, :, limited]
         if np.any(np.abs(terms[2]) > bound):  # gravity beyond a limit: the estimate without torques
             plain = sampled_path_durations(
-                points[s : s + 1], velocity, acceleration, jerk, window_s, ROUNDS, TOLERANCE
+                points[s : s + 1], velocity, acceleration, jerk, window_s, ROUNDS, TOLERANCE, second_share
             )
             durations[s] = plain[0]
             continue
@@ -75,5 +81,5 @@ def sampled_torque_durations(
         slope, curve, offset = terms[:, right - 1] * (1.0 - share) + terms[:, right] * share
         rows = phase_plane_rows(d1, d2, velocity, acceleration, TorqueRows(slope, curve, offset, bound))
         x = phase_plane_profile(rows[0], rows[1], steps, rows[2], rows[3], rows[4])
-        durations[s] = jerk_limited_duration(x, steps, d1, jerk, window_s, ROUNDS, TOLERANCE)
+        durations[s] = jerk_limited_duration(x, steps, d1, jerk, window_s, ROUNDS, TOLERANCE, second_share)
     return durations

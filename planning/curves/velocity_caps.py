@@ -67,11 +67,12 @@ class CappedMotion(NamedTuple):
 
 
 def fastest_motion(
-    path: ArcLengthPath, limits: FloatArray, uncapped: FloatArray | None = None
+    path: ArcLengthPath, limits: FloatArray, second_share: float, uncapped: FloatArray | None = None
 ) -> CappedMotion:
     """The fastest motion along ``path`` over the caps of :data:`FACTORS` and :data:`RAMP_FACTORS`.
 
-    ``limits`` ``(3, nj)``: velocity, acceleration and jerk limits. The uncapped profile
+    ``limits`` ``(3, nj)``: velocity, acceleration and jerk limits; ``second_share``: the
+    second moving average's width as a share of the first's. The uncapped profile
     first, then velocity caps at :data:`FACTORS` of its peak (above the peak a cap changes
     nothing); between the first pair of neighbours where the window stops widening, the
     largest cap that needs no wider window, found by bisection and taken :data:`MARGIN`
@@ -82,7 +83,7 @@ def fastest_motion(
     a lower cap only slows the profile, and the averages add to it, so no cap below can win.
     The result is the whole grid's (the tests compare), in less time (``docs/tuning.md``).
     """
-    tried = {1.0: capped_motion(path, limits, 1.0, profile=uncapped)}
+    tried = {1.0: capped_motion(path, limits, second_share, 1.0, profile=uncapped)}
     peak = tried[1.0].peak
     higher, bisected = 1.0, False
     for share in (factor * peak for factor in FACTORS):
@@ -90,9 +91,9 @@ def fastest_motion(
         slower = profile_time(x, path.ds) > min(found.duration_s for found in tried.values())
         if slower and (bisected or not tried[higher].widened):
             break
-        tried[share] = capped_motion(path, limits, share, profile=x)
+        tried[share] = capped_motion(path, limits, second_share, share, profile=x)
         if not bisected and tried[higher].widened and not tried[share].widened:
-            bisect_widening(path, limits, tried, higher, share, peak)
+            bisect_widening(path, limits, second_share, tried, higher, share, peak)
             bisected = True
         if slower:  # its neighbour above widened: it was needed to tell whether the window stops
             break
@@ -100,7 +101,7 @@ def fastest_motion(
     share = min(tried, key=lambda share: (tried[share].duration_s, -share))
     best = tried[share]
     for factor in RAMP_FACTORS:
-        found = capped_motion(path, limits, share, factor * best.window_s)
+        found = capped_motion(path, limits, second_share, share, factor * best.window_s)
         if found.duration_s < best.duration_s:
             best = found
     return best
@@ -109,6 +110,7 @@ def fastest_motion(
 def bisect_widening(
     path: ArcLengthPath,
     limits: FloatArray,
+    second_share: float,
     tried: dict[float, CappedMotion],
     high: float,
     low: float,
@@ -121,12 +123,12 @@ def bisect_widening(
     bottom = low
     for _ in range(BISECTIONS):
         middle = 0.5 * (low + high)
-        if capped_motion(path, limits, middle).widened:
+        if capped_motion(path, limits, second_share, middle).widened:
             high = middle
         else:
             low = middle
     if low - MARGIN * peak > bottom:
-        tried[low - MARGIN * peak] = capped_motion(path, limits, low - MARGIN * peak)
+        tried[low - MARGIN * peak] = capped_motion(path, limits, second_share, low - MARGIN * peak)
 
 
 def capped_profile(
@@ -141,12 +143,14 @@ def capped_profile(
 def capped_motion(
     path: ArcLengthPath,
     limits: FloatArray,
+    second_share: float,
     share: float,
     ramp_s: float = np.inf,
     profile: FloatArray | None = None,
 ) -> CappedMotion:
     """Steps 1 and 2 with the caps of :func:`_caps` (``profile``: step 1's, if already computed).
 
+    ``second_share``: the second moving average's width as a share of the first's.
     Positions along the path are interpolated in its table at the profile's arc lengths.
     """
     x = capped_profile(path, limits, share, ramp_s) if profile is None else profile
@@ -155,7 +159,7 @@ def capped_motion(
     step_s = float(np.max(limits[1] / limits[2])) / STEPS_PER_RAMP
     s = arc_at_times(x, path.ds, step_s)
     positions = np.column_stack([np.interp(s, path.length, column) for column in path.table.T])
-    motion, used = jerk_limited_motion(positions, window, step_s, limits[2], ROUNDS, TOLERANCE)
+    motion, used = jerk_limited_motion(positions, window, step_s, limits[2], ROUNDS, TOLERANCE, second_share)
     duration_s = scaled_duration(motion, step_s, *limits)
     return CappedMotion(duration_s, used > window, peak, window, motion, step_s)
 

@@ -35,6 +35,7 @@ from numpy.typing import NDArray
 
 import cpr_kin as ck
 from planning.curves.jerk_window import sampled_path_durations
+from planning.curves.path_timing import NODE_STEP_S, smoothing_limits
 from planning.curves.piecewise_sampler import PiecewiseSampler
 from planning.curves.polynomial_bounds import DerivativeBounds
 from planning.curves.spline import SepticSplineSolver
@@ -147,6 +148,8 @@ class SplinePaths:
             limits.jerk[self.fitted].copy(),
         )
         self._window_s = float(np.max(limits.acceleration / limits.jerk))
+        kinematic = np.stack([limits.velocity, limits.acceleration, limits.jerk])
+        self._second_share = smoothing_limits(kinematic, NODE_STEP_S).second_share  # the timing's
         self._steps = np.empty((len(ipo_times) - 1, 0))  # reused buffer of IPO steps
         self._tiled: dict[int, tuple[FloatArray, ...]] = {}
 
@@ -194,9 +197,13 @@ class SplinePaths:
         """
         if self.torque is not None:
             limits = np.stack(self._fitted_limits)
-            return sampled_torque_durations(samples, self.fitted, limits, self.torque, self._window_s)
+            return sampled_torque_durations(
+                samples, self.fitted, limits, self.torque, self._window_s, self._second_share
+            )
         points = np.ascontiguousarray(samples[:, :, self.fitted])
-        return sampled_path_durations(points, *self._fitted_limits, self._window_s, ROUNDS, TOLERANCE)
+        return sampled_path_durations(
+            points, *self._fitted_limits, self._window_s, ROUNDS, TOLERANCE, self._second_share
+        )
 
     def _tiles(self, s: int) -> tuple[FloatArray, ...]:
         """Fitted joints' ranges, bounds and ``(3, S k)`` v/a/j limits, repeated for ``s`` candidates."""
