@@ -90,10 +90,8 @@ def robot_self_screen(robot: Robot, pairs: Pairs) -> SelfScreen:
 class ScreenedSelfTest:
     """coal's yes/no self-collision test, screened by the pairs' bounds.
 
-    Some pairs of a serial arm are always close (a link and the one two joints down its
-    chain, a few centimetres apart by design): bounding them first would only delay coal.
-    So the pairs are split once (:class:`SelfScreen`): the *near* go to coal at every
-    configuration, the others (*far*) only at configurations
+    The pairs are split once into near and far (:class:`SelfScreen`): the *near* go to coal
+    at every configuration, the others (*far*) only at configurations
     where some far pair's bound is within the margin, and there only the far pairs whose
     bounds are within it in some configuration of the batch (a few of a thousand pairs on an
     arm whose hand has a dozen links). Each group has its own Pinocchio ``GeometryPool``, run

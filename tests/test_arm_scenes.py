@@ -117,6 +117,25 @@ def test_an_end_inside_a_margin_is_named(ur5: ck.Robot) -> None:
     assert "inside the safety margin" in violation and "ball" in violation
 
 
+def test_the_ends_are_checked_with_the_payloads_shape_as_the_planner_checks_them(ur5: ck.Robot) -> None:
+    """A carried sphere held inside the ball at the start: the validity test finds it as the planner does."""
+    document = blocked_scene("ur5_0", "ur5", ur5, 0)
+    scene = parse_scene(document)
+    assert endpoint_violations(scene, ur5) == []
+    tool_in_base = ck.frame_poses(ur5, build_problem(scene, ur5).q_start[None])[0]
+    ball_in_base = np.asarray(scene.obstacles[0].xyz)
+    ball_in_tool = tool_in_base[:3, :3].T @ (ball_in_base - tool_in_base[:3, 3])
+    document["payload"] = {
+        "mass_kg": 0.0,
+        "shape": {"shape": "sphere", "radius": 0.01, "xyz": ball_in_tool.tolist()},
+    }
+    carried = parse_scene(document)
+    (violation,) = [v for v in endpoint_violations(carried, ur5) if v.startswith("start")]
+    assert "ball" in violation
+    with pytest.raises(PlanningError, match="ball"):
+        build_problem(carried, ur5)
+
+
 @pytest.mark.slow
 def test_the_scripts_draw_scenes_and_run_them_beside_ompl(tmp_path: Path) -> None:
     """The README's two commands for one's own arm: scene files, then both planners on them."""

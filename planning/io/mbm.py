@@ -156,14 +156,15 @@ def endpoint_violations(scene: Scene, robot: ck.Robot) -> list[str]:
     """
     from planning.errors import NoSolutionError
     from planning.pipeline.endpoints import endpoint
-    from planning.pipeline.problem import scene_world
+    from planning.pipeline.problem import scene_robot, scene_world
     from planning.pipeline.torques import scene_dynamics
 
-    world = scene_world(scene, robot)
     try:
+        robot = scene_robot(scene, robot)  # as the planner checks it
         dynamics = scene_dynamics(robot, scene)
     except PlanningError as exc:
         return [f"start is refused: {exc}", f"goal is refused: {exc}"]
+    world = scene_world(scene, robot)
     found = []
     q_start = None
     for label in ("start", "goal"):

@@ -129,6 +129,18 @@ def moving_joints(robot: ck.Robot, scene: Scene, q_start: FloatArray, q_goal: Fl
     return np.array([robot.limits.index(n) for n in names], dtype=np.intp)
 
 
+def scene_robot(scene: Scene, robot: ck.Robot) -> ck.Robot:
+    """``robot`` carrying ``scene``'s payload: its shape, if it has one, checked as the robot's.
+
+    Raises:
+        PlanningError: the payload's frame is not the robot's.
+    """
+    try:
+        return ck.carrying(robot, scene.payload)
+    except ck.CprKinError as exc:
+        raise PlanningError(f"payload: {exc}") from None
+
+
 def scene_world(scene: Scene, robot: ck.Robot, threads: int | None = None) -> ck.CollisionWorld:
     """``robot`` among ``scene``'s obstacles, its pairs held as the scene holds them.
 
@@ -162,11 +174,7 @@ def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | No
         cpr_kin.CprKinError: the robot's URDF or an obstacle is invalid.
     """
     started = time.perf_counter()
-    robot = robot or (scene.robot.load() if scene.robot is not None else ck.load_cpr())
-    try:
-        robot = ck.carrying(robot, scene.payload)  # its shape, if it has one, checked as the robot's
-    except ck.CprKinError as exc:
-        raise PlanningError(f"payload: {exc}") from None
+    robot = scene_robot(scene, robot or (scene.robot.load() if scene.robot is not None else ck.load_cpr()))
     world = scene_world(scene, robot, threads)
     dynamics = scene_dynamics(robot, scene, world.num_threads)
     q_start = endpoint(robot, world, scene, "start", dynamics=dynamics)
