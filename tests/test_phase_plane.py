@@ -3,7 +3,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from planning.curves.phase_plane import phase_plane_profile, profile_time, sampled_path_times
+from planning.curves.phase_plane import (
+    _largest_x,
+    _row_bounds,
+    phase_plane_profile,
+    profile_time,
+    sampled_path_times,
+)
 
 
 def straight(delta: np.ndarray, points: int = 400) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -90,3 +96,22 @@ def test_sampled_paths_are_timed_in_arc_length() -> None:
     assert times[1] == pytest.approx(times[0], rel=0.02)
     still = np.zeros((1, 10, 3))
     assert sampled_path_times(still, v, a)[0] == 0.0
+
+
+def test_the_backward_pass_may_skip_the_rows_bounds_below_the_limit_curve() -> None:
+    """Below the maximum velocity curve (every row's bounds at once), the largest feasible
+    ``x`` of a step is the same whether the rows' pairs are checked again or not."""
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        g, rows = 12, 4
+        d1, d2 = rng.normal(size=(g, rows)), rng.normal(size=(g, rows))
+        d1[rng.random((g, rows)) < 0.1] = 0.0  # rows of their curvature term alone
+        offset = 0.1 * rng.normal(size=(g, rows))
+        a = rng.uniform(1.0, 3.0, rows)
+        bounds = _row_bounds(d1, d2, offset, a)
+        for point in range(g):
+            limit = _largest_x(d1, d2, offset, bounds, point, a, 1e12, 0.0, 0.0)
+            du, ahead = float(rng.uniform(0.01, 0.1)), float(rng.uniform(0.0, 2.0) * limit)
+            checked = _largest_x(d1, d2, offset, bounds, point, a, limit, du, ahead)
+            skipped = _largest_x(d1, d2, offset, bounds, point, a, limit, du, ahead, False)
+            assert skipped == checked

@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from cpr_kin.compiled import njit
+from cpr_kin.compiled import njit, njit_inline
 
 FloatArray = NDArray[np.float64]
 
@@ -31,7 +31,7 @@ _TINY = 1e-12
 _HUGE = 1e12
 
 
-@njit
+@njit_inline
 def _acceleration_bounds(
     d1: FloatArray, d2: FloatArray, offset: FloatArray, g: int, x: float, a: FloatArray
 ) -> tuple[float, float]:
@@ -71,7 +71,7 @@ def _row_bounds(
     return slope, reach, shift
 
 
-@njit
+@njit_inline
 def _largest_x(
     d1: FloatArray,
     d2: FloatArray,
@@ -82,11 +82,15 @@ def _largest_x(
     top: float,
     du: float,
     ahead: float,
+    rows_too: bool = True,
 ) -> float:
     """The largest ``x`` in ``[0, top]`` at grid point ``g`` that some path acceleration allows.
 
     That ``u''`` must keep every row within its limit and, if ``du > 0``, one step of ``du``
-    (``u''`` constant, ``x_next = x + 2 du u''``) must land in ``[0, ahead]``.
+    (``u''`` constant, ``x_next = x + 2 du u''``) must land in ``[0, ahead]``. Without
+    ``rows_too``, ``top`` is known to satisfy the rows' own bounds (it is at most the
+    maximum velocity curve, their least), so only the step's are checked: the answer is the
+    same, the rows' pairs (``R^2`` of them) skipped.
 
     Every bound on ``u''`` is affine in ``x``: row ``j`` allows ``u''`` in
     ``(-+a_j - q_j'' x - o_j) / q_j'`` (``bounds``, :func:`_row_bounds`), the step
@@ -102,13 +106,13 @@ def _largest_x(
     rate = 1.0 / (2.0 * du) if du > 0.0 else 0.0
     for i in range(rows):
         if abs(d1[g, i]) <= _TINY:  # the row is the curvature term alone: |d2 x + o| <= a
-            if d2[g, i] > 0.0:
+            if rows_too and d2[g, i] > 0.0:
                 best = min(best, (a[i] - offset[g, i]) / d2[g, i])
-            elif d2[g, i] < 0.0:
+            elif rows_too and d2[g, i] < 0.0:
                 best = min(best, (a[i] + offset[g, i]) / -d2[g, i])
             continue
         slope_i, reach_i, shift_i = slope[g, i], reach[g, i], shift[g, i]
-        for k in range(rows):
+        for k in range(rows if rows_too else 0):
             if k != i and abs(d1[g, k]) > _TINY and slope_i - slope[g, k] > 0.0:  # i low < k high
                 best = min(best, (reach_i + reach[g, k] + (shift[g, k] - shift_i)) / (slope_i - slope[g, k]))
         if du > 0.0:
@@ -148,7 +152,9 @@ def phase_plane_profile(
         limit[g] = _largest_x(d1, d2, offset, bounds, g, a, top, 0.0, 0.0)
     controllable = np.zeros(n)  # backward: from where the robot can still stop at the end
     for g in range(n - 2, -1, -1):
-        controllable[g] = _largest_x(d1, d2, offset, bounds, g, a, limit[g], du[g], controllable[g + 1])
+        controllable[g] = _largest_x(  # limit[g] holds the rows' bounds: only the step's are new
+            d1, d2, offset, bounds, g, a, limit[g], du[g], controllable[g + 1], False
+        )
     x = np.zeros(n)  # forward: as fast as the limits allow without leaving the controllable set
     for g in range(n - 1):
         _, high = _acceleration_bounds(d1, d2, offset, g, x[g], a)
