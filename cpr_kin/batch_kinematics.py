@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from cpr_kin.compiled import njit
+from cpr_kin.compiled import njit, njit_inline
 from cpr_kin.errors import CprKinError
 from cpr_kin.reach import joint_axis
 
@@ -26,7 +26,7 @@ ChainArrays = tuple[IntArray, IntArray, BoolArray, FloatArray, FloatArray, Float
 """A :class:`KinematicChain`'s arrays, in its field order, as compiled code takes them."""
 
 
-@njit
+@njit_inline
 def place_joints(
     q: FloatArray,
     chain: ChainArrays,
