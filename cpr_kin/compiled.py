@@ -25,7 +25,6 @@ def njit_inline(function: F) -> F:
     """:func:`njit`, and inlined into the compiled functions that call it.
 
     For a small helper called in a compiled loop: passing it arrays costs their reference
-    counts at every call, which can outweigh its work (the phase plane's per-point bounds
-    took half its time so).
+    counts at every call, which can outweigh its work (``docs/benchmarks.md``, stop 59).
     """
     return cast(F, numba.njit(cache=True, nogil=True, inline="always")(function))

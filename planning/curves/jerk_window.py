@@ -40,9 +40,7 @@ SAMPLED_SECOND_SHARE = 0.25
 """The least second share with which :func:`jerk_limited_duration` checks the jerk of a
 sampled path: the fitness knows a path at a few dozen samples, between which its velocity
 bends at kinks the timing's fine table does not have; a narrower second average would widen
-windows for them that the timing does not (on the CPR, a second share of 1/8 checked as
-such put a 64-sample estimate up to 7 % above the timing, against 4 % so, and the planner's
-trajectories 0.4 % longer: ``docs/benchmarks.md``)."""
+windows for them that the timing does not (measured in ``docs/tuning.md``)."""
 
 
 @njit

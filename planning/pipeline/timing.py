@@ -219,9 +219,9 @@ class FreeDuration:
         fastest = Timing(trajectory, "fastest", fit, False, time.perf_counter() - started)
 
         def uniform() -> Timing:
-            started = time.perf_counter()
-            trajectory = fit.trajectory.time_scaled(uniform_scale(fit, problem))
-            return Timing(trajectory, "uniform", fit, False, time.perf_counter() - started)
+            begun = time.perf_counter()
+            scaled = fit.trajectory.time_scaled(uniform_scale(fit, problem))
+            return Timing(scaled, "uniform", fit, False, time.perf_counter() - begun)
 
         if trajectory.duration <= fit.trajectory.duration * least_uniform_scale(fit, problem):
             return Offered(fastest, lambda: [uniform()])
