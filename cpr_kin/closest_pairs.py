@@ -63,31 +63,24 @@ def closest_pairs(
     if np.any(offsets > 0.0):
         bounds = np.where(offsets > 0.0, -np.inf, bounds)  # an offset bound tells nothing of coal's sign
     order = np.argsort(bounds, axis=1, kind="stable")
-    ordered = np.take_along_axis(bounds, order, axis=1)
+    # each pair's bound less the tolerance, certain where positive; where the bounding shapes
+    # overlap, coal's signed distance (a penetration depth) may be any negative value: -inf
+    certain = np.take_along_axis(bounds, order, axis=1) - BOUND_TOLERANCE_M
+    certain[certain <= 0.0] = -np.inf
+    pairs, extra = pair_index.tolist(), offsets.tolist()
     place, compute = pin.updateGeometryPlacements, pin.computeDistance
     for k in range(len(batch)):
-        row, columns = ordered[k], order[k]
-        if not row.size or _farther(row[0], below_m):
+        row = certain[k]
+        if not row.size or row[0] >= below_m:
             continue
         place(model, data, geometry_model, geometry_data, batch[k])
-        best, which = np.inf, -1
-        for bound, column in zip(row.tolist(), columns.tolist(), strict=True):
-            if _farther(bound, min(best, below_m)):
+        best, which, limit = np.inf, -1, below_m
+        for bound, column in zip(row.tolist(), order[k].tolist(), strict=True):
+            if bound >= limit:
                 break  # no pair left can be closer
-            pair = int(pair_index[column])
-            found = compute(geometry_model, geometry_data, pair).min_distance + offsets[column]
+            found = compute(geometry_model, geometry_data, pairs[column]).min_distance + extra[column]
             if found < best:
-                best, which = found, pair
+                best, which, limit = found, pairs[column], min(found, below_m)
         if best < below_m:
             distance[k], closest[k] = best, which
     return distance, closest
-
-
-def _farther(bound: float, distance: float) -> bool:
-    """Whether a pair bounded by ``bound`` [m] is certainly no closer than ``distance`` [m].
-
-    Only a positive bound bounds coal's distance: where the bounding shapes overlap, coal's
-    signed distance (a penetration depth) may be any negative value.
-    """
-    certain = bound - BOUND_TOLERANCE_M
-    return certain > 0.0 and certain >= distance
