@@ -10,7 +10,13 @@ from planning.curves import velocity_caps
 from planning.curves.arc_length import ArcLengthPath, arc_length_path
 from planning.curves.path_timing import SECOND_SHARE
 from planning.curves.phase_plane import profile_time
-from planning.curves.velocity_caps import CappedMotion, capped_motion, capped_profile, fastest_motion
+from planning.curves.velocity_caps import (
+    CappedMotion,
+    capped_motion,
+    capped_profile,
+    duration_lower_bound,
+    fastest_motion,
+)
 
 from .conftest import LIFT, PAPER_GOAL_TCP, PAPER_START_TCP, limits_of, spline_path
 
@@ -66,3 +72,22 @@ def test_a_lower_velocity_cap_never_shortens_the_phase_plane_time(robot: ck.Robo
             profile_time(capped_profile(grid, limits, share), grid.ds) for share in np.linspace(1, 0.1, 60)
         ]
         assert np.all(np.diff(times) >= -1e-12 * times[0])
+
+
+def test_the_duration_lower_bound_is_below_every_caps_motion(
+    robot: ck.Robot, lines: list[tuple[np.ndarray, np.ndarray]]
+) -> None:
+    """What skipping a cap rests on: no cap's averaged, scaled motion is shorter than its bound."""
+    limits = np.stack(limits_of(robot))
+    paths = [spline_path(np.linspace(q0, q1, 5)) for q0, q1 in lines]
+    paths += [spline_path(np.array([q0, q0 + LIFT, q1 + LIFT * [-1, 1, 1, 1, 1], q1])) for q0, q1 in lines]
+    gaps = []
+    for path in paths:
+        grid = arc_length_path(path, limits[0])
+        for share in (1.0, 0.8, 0.5, 0.3):
+            for ramp_s in (np.inf, 0.05):
+                x = capped_profile(grid, limits, share, ramp_s)
+                bound = duration_lower_bound(grid, limits, SECOND_SHARE, x)
+                found = capped_motion(grid, limits, SECOND_SHARE, share, ramp_s, profile=x)
+                gaps.append(found.duration_s - bound)
+    assert min(gaps) >= 0.0

@@ -81,16 +81,22 @@ def fastest_motion(
 
     The grid stops at the first cap whose phase-plane time exceeds the best duration so far:
     a lower cap only slows the profile, and the averages add to it, so no cap below can win.
-    The result is the whole grid's (the tests compare), in less time (``docs/tuning.md``).
+    A cap whose :func:`duration_lower_bound` exceeds the best is not averaged where its
+    window's widening decides nothing (after the bisection, the bisection's last cap, the
+    ramps' caps). The result is the whole grid's (the tests compare), in less time
+    (``docs/tuning.md``).
     """
     tried = {1.0: capped_motion(path, limits, second_share, 1.0, profile=uncapped)}
     peak = tried[1.0].peak
     higher, bisected = 1.0, False
     for share in (factor * peak for factor in FACTORS):
         x = capped_profile(path, limits, share)
-        slower = profile_time(x, path.ds) > min(found.duration_s for found in tried.values())
+        shortest_s = min(found.duration_s for found in tried.values())
+        slower = profile_time(x, path.ds) > shortest_s
         if slower and (bisected or not tried[higher].widened):
             break
+        if bisected and duration_lower_bound(path, limits, second_share, x) > shortest_s:
+            continue  # cannot win, and past the bisection its widening is not asked
         tried[share] = capped_motion(path, limits, second_share, share, profile=x)
         if not bisected and tried[higher].widened and not tried[share].widened:
             bisect_widening(path, limits, second_share, tried, higher, share, peak)
@@ -101,7 +107,10 @@ def fastest_motion(
     share = min(tried, key=lambda share: (tried[share].duration_s, -share))
     best = tried[share]
     for factor in RAMP_FACTORS:
-        found = capped_motion(path, limits, second_share, share, factor * best.window_s)
+        x = capped_profile(path, limits, share, factor * best.window_s)
+        if duration_lower_bound(path, limits, second_share, x) > best.duration_s:
+            continue
+        found = capped_motion(path, limits, second_share, share, factor * best.window_s, profile=x)
         if found.duration_s < best.duration_s:
             best = found
     return best
@@ -127,8 +136,27 @@ def bisect_widening(
             high = middle
         else:
             low = middle
-    if low - MARGIN * peak > bottom:
-        tried[low - MARGIN * peak] = capped_motion(path, limits, second_share, low - MARGIN * peak)
+    cap = low - MARGIN * peak
+    if cap > bottom:
+        x = capped_profile(path, limits, cap)
+        if duration_lower_bound(path, limits, second_share, x) <= min(
+            found.duration_s for found in tried.values()
+        ):
+            tried[cap] = capped_motion(path, limits, second_share, cap, profile=x)
+
+
+def duration_lower_bound(
+    path: ArcLengthPath, limits: FloatArray, second_share: float, x: FloatArray
+) -> float:
+    """A lower bound [s] of :func:`capped_motion`'s duration for the profile ``x``, without averaging.
+
+    The averaged motion lasts the profile's time plus both windows, each at least the one the
+    profile's accelerations need (:func:`_window_s`; a widening only adds), less the time
+    grid's rounding (three steps); the final uniform scaling only stretches it.
+    """
+    step_s = float(np.max(limits[1] / limits[2])) / STEPS_PER_RAMP
+    window_s = _window_s(path, x, limits[2])
+    return profile_time(x, path.ds) + (1.0 + second_share) * window_s - 3.0 * step_s
 
 
 def capped_profile(
