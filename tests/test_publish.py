@@ -2,6 +2,7 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import stat
 import subprocess
 import sys
@@ -106,6 +107,26 @@ def test_a_second_writer_is_refused_naming_the_first(tmp_path: Path) -> None:
         holder.wait()
     with OutputFolder(tmp_path / "out") as folder:  # the kernel released the killed holder's lock
         folder.publish(FILES)
+
+
+@pytest.mark.parametrize("during", ["ftruncate", "flock"])
+def test_a_signal_while_the_lock_is_taken_leaves_no_lock_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, during: str
+) -> None:
+    """Ctrl-C just after the lock file is created: the command stops, and leaves nothing behind."""
+    import fcntl
+
+    module = os if during == "ftruncate" else fcntl  # the modules publish calls into
+    original = getattr(module, during)
+
+    def interrupted(*args: object) -> object:
+        signal.raise_signal(signal.SIGINT)  # Python's handler: KeyboardInterrupt
+        return original(*args)
+
+    monkeypatch.setattr(module, during, interrupted)
+    with pytest.raises(KeyboardInterrupt), OutputFolder(tmp_path / "out"):
+        pytest.fail("the interrupted command went on")  # pragma: no cover
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_a_killed_writers_leftovers_are_rolled_back_or_removed(tmp_path: Path) -> None:

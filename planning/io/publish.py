@@ -4,7 +4,9 @@ A plan's files are *published as a whole* (:class:`OutputFolder`):
 
 1. A lock, ``fcntl.flock`` on ``<parent>/.<name>.lock``, is held from before planning to the
    end: a second writer into the same folder stops at once with a message naming the first
-   one's process. The kernel releases the lock when its process ends, even killed.
+   one's process. The kernel releases the lock when its process ends, even killed; a
+   ``SIGINT`` or ``SIGTERM`` while the lock is taken or given back waits for that to end, so
+   that an interrupted command leaves no lock file behind.
 2. The files go into a new hidden folder beside the target, each flushed to disk, with
    ``manifest.json`` listing every file and its SHA-256.
 3. Two renames put it in place: the previous set (if any) aside, the new set in; then the
@@ -144,17 +146,23 @@ class FolderLock:
             self.target.parent.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
             raise OutputError(f"cannot create '{self.target.parent}': {exc.strerror or exc}") from None
-        self._lock = _acquire(self._lock_path, self.path)
+        try:  # a signal waits until the lock is ours, then finds it released and its file removed
+            with uninterrupted():
+                self._lock = _acquire(self._lock_path, self.path)
+        except BaseException:
+            self.__exit__(None, None, None)
+            raise
         return self
 
     def __exit__(
         self, kind: type[BaseException] | None, error: BaseException | None, trace: TracebackType | None
     ) -> None:
-        if self._lock is not None:
-            with contextlib.suppress(OSError):
-                self._lock_path.unlink()  # while still locked: the next writer makes a new one
-            os.close(self._lock)
-            self._lock = None
+        with uninterrupted():  # the file goes with the lock, whatever signal comes
+            if self._lock is not None:
+                with contextlib.suppress(OSError):
+                    self._lock_path.unlink()  # while still locked: the next writer makes a new one
+                os.close(self._lock)
+                self._lock = None
 
 
 class OutputFolder(FolderLock):
