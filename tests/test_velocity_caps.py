@@ -10,6 +10,7 @@ from planning.curves import velocity_caps
 from planning.curves.arc_length import ArcLengthPath, arc_length_path
 from planning.curves.path_timing import SECOND_SHARE
 from planning.curves.phase_plane import profile_time
+from planning.curves.trajectory import Trajectory
 from planning.curves.velocity_caps import (
     CappedMotion,
     capped_motion,
@@ -40,12 +41,19 @@ def every_cap(grid: ArcLengthPath, limits: np.ndarray, second: float) -> CappedM
     return best
 
 
+def straight_and_lifted(lines: list[tuple[np.ndarray, np.ndarray]]) -> list[Trajectory]:
+    """Splines along each line, and through a lift above each end: the timings' test paths."""
+    paths = [spline_path(np.linspace(q0, q1, 5)) for q0, q1 in lines]
+    return paths + [
+        spline_path(np.array([q0, q0 + LIFT, q1 + LIFT * [-1, 1, 1, 1, 1], q1])) for q0, q1 in lines
+    ]
+
+
 def test_the_cap_search_stops_early_with_what_every_cap_gives(
     robot: ck.Robot, lines: list[tuple[np.ndarray, np.ndarray]]
 ) -> None:
     limits = np.stack(limits_of(robot))
-    paths = [spline_path(np.linspace(q0, q1, 5)) for q0, q1 in lines]
-    paths += [spline_path(np.array([q0, q0 + LIFT, q1 + LIFT * [-1, 1, 1, 1, 1], q1])) for q0, q1 in lines]
+    paths = straight_and_lifted(lines)
     calls = {"stopped": 0, "every": 0}
     for path in paths:
         for factor in (1.0, 0.35):  # the planner's limits and its narrowed ones
@@ -79,8 +87,7 @@ def test_the_duration_lower_bound_is_below_every_caps_motion(
 ) -> None:
     """What skipping a cap rests on: no cap's averaged, scaled motion is shorter than its bound."""
     limits = np.stack(limits_of(robot))
-    paths = [spline_path(np.linspace(q0, q1, 5)) for q0, q1 in lines]
-    paths += [spline_path(np.array([q0, q0 + LIFT, q1 + LIFT * [-1, 1, 1, 1, 1], q1])) for q0, q1 in lines]
+    paths = straight_and_lifted(lines)
     gaps = []
     for path in paths:
         grid = arc_length_path(path, limits[0])
