@@ -347,6 +347,23 @@ def test_where_rrt_connect_found_no_path_the_next_attempts_do_not_ask_again(
     assert "keeps 0.055 m clear (nor 0.051 m after 1) in 2 samples" in PathSeeding().first(few).tried
 
 
+def test_a_time_limit_draws_until_the_limit_rather_than_max_samples(window: Problem) -> None:
+    """A path that needs more samples than ``max_samples`` is found when the plan has time left."""
+    import time
+
+    from planning.pipeline.deadline import Deadline
+    from planning.pipeline.path_seeds import DEADLINE_SAMPLES, draw_samples
+
+    few = with_planner(window, tuning=SearchTuning(seeding=SeedingTuning(max_samples=2, finer_after=1)))
+    assert draw_samples(few) == 2 and PathSeeding().first(few).no_path
+    timed = dataclasses.replace(few, deadline=Deadline.after(60.0, time.perf_counter()))
+    assert draw_samples(timed) == DEADLINE_SAMPLES
+    attempt = PathSeeding().first(timed)
+    assert not attempt.no_path and attempt.path is not None and attempt.tried == ""
+    passed = dataclasses.replace(few, deadline=Deadline.after(1e-9, time.perf_counter()))
+    assert PathSeeding().first(passed).path is None  # the limit ends the draw
+
+
 @pytest.mark.slow
 def test_samples_near_the_trees_lead_a_goal_out_of_its_shelf(tmp_path: Any) -> None:
     """MotionBenchMaker's Panda bookshelf_thin_0089 (vamp-planner's problems, from PyPI, cached).

@@ -25,6 +25,20 @@ from planning.search.waypoints import placements_along
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 
+DEADLINE_SAMPLES = 100_000
+"""Most samples of a draw when the plan has a time limit (``time_limit_s``): the limit, the
+time its user gave the plan, ends a hard draw rather than the seeding's ``max_samples``."""
+
+
+def draw_samples(problem: Problem) -> int:
+    """Samples RRT-Connect's draw may take: ``max_samples``, or :data:`DEADLINE_SAMPLES` with a time limit.
+
+    With a time limit the limit ends a hard draw first, so that a path that needs more
+    samples than the seeding's ``max_samples`` is not given up while the user's time lasts.
+    """
+    max_samples = problem.scene.planner.tuning.seeding.max_samples
+    return max_samples if problem.deadline.limit_s is None else max(max_samples, DEADLINE_SAMPLES)
+
 
 class PathSeed(NamedTuple):
     """A path's seed.
@@ -53,7 +67,7 @@ def sampled_path(
     trees go on keeping its clearance after the seeding's ``finer_after`` samples, or from
     the start where an end is too close for ``problem``'s; the path is then ``relaxed``.
     ``max_samples``: the draw's budget, in place of ``settings``' (``None``: theirs; the
-    default settings take the seeding's ``max_samples``).
+    default settings take :func:`draw_samples`).
     """
     robot, moving = problem.robot, problem.moving
 
@@ -73,7 +87,7 @@ def sampled_path(
     if settings is None:  # the path's edges checked at most as far apart as the clearance required
         resolution = min(tuning.max_resolution_m, max(0.01, problem.objective.required_m))
         settings = RrtSettings(
-            max_samples=tuning.max_samples,
+            max_samples=draw_samples(problem),
             resolution_m=resolution,
             explore_resolution_m=tuning.max_resolution_m,
             local_share=tuning.local_share,

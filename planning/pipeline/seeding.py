@@ -55,7 +55,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from planning.pipeline.path_seeds import PathSeed, fewest_waypoints, followable_path, path_seed
+from planning.pipeline.path_seeds import PathSeed, draw_samples, fewest_waypoints, followable_path, path_seed
 from planning.pipeline.problem import Problem, finer_step_m, with_planner
 from planning.pipeline.settings import MAX_FITNESS_SAMPLES
 from planning.search.optimizer import SearchResult
@@ -142,9 +142,10 @@ class PathSeeding:
             tuning = problem.scene.planner.tuning.seeding
             tried = f"no RRT-Connect path keeps {problem.objective.required_m:.4g} m clear"
             finer = finer_problem(problem)
-            if finer is not None and tuning.finer_after < tuning.max_samples:
+            samples = draw_samples(problem)
+            if finer is not None and tuning.finer_after < samples:
                 tried += f" (nor {finer.objective.required_m:.4g} m after {tuning.finer_after})"
-            tried += f" in {tuning.max_samples} samples"
+            tried += f" in {samples} samples"
             if problem.gravity is not None:
                 tried += " through configurations the motors can hold still"
         return Attempt(seeds.problem, seeds.candidates, seeds.path, 0, tried, seeds.feasible, seeds.no_path)

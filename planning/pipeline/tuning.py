@@ -37,7 +37,8 @@ class SeedingTuning:
             its spline instead).
         max_samples: random samples after which RRT-Connect gives up on a path, in
             [1, 100000] (a narrow passage may need several thousand; a failed draw costs
-            about 0.15 ms a sample).
+            about 0.15 ms a sample). A plan with a time limit draws until the limit instead
+            (:func:`~planning.pipeline.path_seeds.draw_samples`).
         finer_after: random samples RRT-Connect draws keeping the margin plus the whole
             verification step before its trees go on keeping only the finer step's
             clearance (where ``finer_step`` makes one), in [1, 100000]: a passage narrower
