@@ -154,9 +154,8 @@ def duration_lower_bound(
     profile's accelerations need (:func:`_window_s`; a widening only adds), less the time
     grid's rounding (three steps); the final uniform scaling only stretches it.
     """
-    step_s = float(np.max(limits[1] / limits[2])) / STEPS_PER_RAMP
     window_s = _window_s(path, x, limits[2])
-    return profile_time(x, path.ds) + (1.0 + second_share) * window_s - 3.0 * step_s
+    return profile_time(x, path.ds) + (1.0 + second_share) * window_s - 3.0 * _time_step_s(limits)
 
 
 def capped_profile(
@@ -184,12 +183,17 @@ def capped_motion(
     x = capped_profile(path, limits, share, ramp_s) if profile is None else profile
     window = _window_s(path, x, limits[2])
     peak = float(np.max(np.abs(path.dq) * np.sqrt(np.maximum(x, 0.0))[:, None] / limits[0]))
-    step_s = float(np.max(limits[1] / limits[2])) / STEPS_PER_RAMP
+    step_s = _time_step_s(limits)
     s = arc_at_times(x, path.ds, step_s)
     positions = np.column_stack([np.interp(s, path.length, column) for column in path.table.T])
     motion, used = jerk_limited_motion(positions, window, step_s, limits[2], ROUNDS, TOLERANCE, second_share)
     duration_s = scaled_duration(motion, step_s, *limits)
     return CappedMotion(duration_s, used > window, peak, window, motion, step_s)
+
+
+def _time_step_s(limits: FloatArray) -> float:
+    """The time step [s] of the grid the joints' motion is averaged on: :data:`STEPS_PER_RAMP` a ramp."""
+    return float(np.max(limits[1] / limits[2])) / STEPS_PER_RAMP
 
 
 def _caps(limits: FloatArray, share: float, ramp_s: float) -> tuple[FloatArray, FloatArray]:
