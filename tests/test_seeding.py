@@ -198,15 +198,17 @@ def test_seeding_none_is_a_setting(robot: ck.Robot) -> None:
 
 def test_a_passage_narrower_than_margin_plus_step_is_found_with_a_finer_step(robot: ck.Robot) -> None:
     """Generated scene 43 of seed 13: RRT-Connect finds no path keeping the margin plus the 5 mm
-    certified step clear in all its samples (its way passes 2 mm outside the margin); its
-    trees go on at a 1 mm step's clearance, and the plan is searched and certified at it."""
+    certified step clear in 10,000 samples (its way passes 2 mm outside the margin; in more,
+    an edge checked every 4 cm may slip through); its trees go on at a 1 mm step's
+    clearance, and the plan is searched and certified at it."""
     from planning.io.scene_generator import generate_scenes
     from planning.pipeline.planner import plan
 
     scene = generate_scenes(100, seed=13, robot=robot, narrow=33)[43]
     assert scene.planner.verify_step_m == 0.005
     problem = build_problem(scene, robot)
-    assert seed_search(problem).path is None  # nothing keeps margin + 5 mm clear
+    strict = with_planner(problem, tuning=SearchTuning(seeding=SeedingTuning(max_samples=10_000)))
+    assert seed_search(strict).path is None  # nothing keeps margin + 5 mm clear
     result = plan(scene, robot)
     assert result.scene.planner.verify_step_m == pytest.approx(0.001)
     assert result.verification.accepted and result.metrics.min_clearance_m >= scene.safety_margin
@@ -255,6 +257,22 @@ def test_a_passage_rrt_connect_needs_thousands_of_samples_for_is_planned(robot: 
         seed_search(with_planner(problem, tuning=SearchTuning(seeding=SeedingTuning(max_samples=3000)))).path
         is not None
     )
+    result = plan(scene, robot)
+    assert result.verification.accepted and result.metrics.min_clearance_m >= scene.safety_margin
+
+
+def test_a_passage_rrt_connect_needs_tens_of_thousands_of_samples_for_is_planned(robot: ck.Robot) -> None:
+    """Generated scene 25 of seed 85: RRT-Connect needs more than 10,000 samples (the former
+    budget, after which the plan said "no solution" though OMPL's RRT-Connect finds a path in
+    its 5 s); within the default budget it finds one, and the plan is certified."""
+    from planning.io.scene_generator import generate_scenes
+    from planning.pipeline.planner import plan
+
+    scene = generate_scenes(26, seed=85, robot=robot)[25]
+    problem = build_problem(scene, robot)
+    former = SearchTuning(seeding=SeedingTuning(max_samples=10_000))
+    assert seed_search(with_planner(problem, tuning=former), finer=True).no_path
+    assert SeedingTuning().max_samples > 10_000
     result = plan(scene, robot)
     assert result.verification.accepted and result.metrics.min_clearance_m >= scene.safety_margin
 

@@ -36,8 +36,9 @@ class SeedingTuning:
             of samples costs as much again (the search's retries with more waypoints repair
             its spline instead).
         max_samples: random samples after which RRT-Connect gives up on a path, in
-            [1, 100000] (a narrow passage may need several thousand; a failed draw costs
-            about 0.15 ms a sample). A plan with a time limit draws until the limit instead
+            [1, 100000] (a narrow passage may need tens of thousands; a failed draw costs
+            about 0.1 ms a sample on the CPR, so the default gives up after about the 5 s
+            OMPL's peer is given). A plan with a time limit draws until the limit instead
             (:func:`~planning.pipeline.path_seeds.draw_samples`).
         finer_after: random samples RRT-Connect draws keeping the margin plus the whole
             verification step before its trees go on keeping only the finer step's
@@ -65,7 +66,7 @@ class SeedingTuning:
     max_resolution_m: float = 0.04
     path_attempts: int = 3
     redraw_samples: int = 300
-    max_samples: int = 10_000
+    max_samples: int = 50_000
     finer_after: int = 3_000
     more_waypoints: int = 6
     finer_step: float = 0.2
