@@ -95,20 +95,26 @@ def test_once_the_best_is_refused_the_next_candidates_run_at_full_speed_before_a
     robot: ck.Robot, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     # the refinement's population is nearly as good as its best: the next one at full speed,
-    # timed only once the best failed; the narrowed timings only once those fail, shortest first
-    problem = build_problem(generate_scenes(31, 0, robot)[30], robot)
-    searched = solve(problem).optimiser
-    order = np.argsort(searched.population_fitness, kind="stable")
-    points = distinct([searched.x] + [searched.population[k] for k in order])[:PREFERRED_FIRST]
-    assert len(points) == PREFERRED_FIRST
+    # timed only once the best failed; the narrowed timings only once those fail, shortest first.
+    # The order without the foresight (tested in test_averaged_path.py), on the first generated
+    # scene (of seed 0, from 30 on) whose second candidate's fastest timing passes (the oracle)
+    monkeypatch.setattr(choose_module, "foreseen_clear", lambda _, x: np.ones(len(x), dtype=bool))
+    for scene in generate_scenes(40, 0, robot)[30:]:
+        problem = build_problem(scene, robot)
+        searched = solve(problem).optimiser
+        order = np.argsort(searched.population_fitness, kind="stable")
+        points = distinct([searched.x] + [searched.population[k] for k in order])[:PREFERRED_FIRST]
+        offered = [problem.duration.timings(problem, problem.objective.nodes(x[None])[0]) for x in points]
+        fastest = [timing.first for timing in offered]
+        if len(points) == PREFERRED_FIRST and verify(problem, fastest[1].trajectory, fastest[1].fit).accepted:
+            break
+    else:
+        pytest.fail("no scene of seed 0 from 30 to 39 whose second candidate passes at full speed")
     result = replace(
         searched,
         population=np.stack(points),
         population_fitness=np.arange(1.0, len(points) + 1),
     )
-    offered = [problem.duration.timings(problem, problem.objective.nodes(x[None])[0]) for x in points]
-    fastest = [timing.first for timing in offered]
-    assert verify(problem, fastest[1].trajectory, fastest[1].fit).accepted  # the oracle
     refused = {fastest[0].trajectory.duration}
 
     def refusing(problem_: object, trajectory: Trajectory, fit: object) -> Verification:

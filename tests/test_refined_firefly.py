@@ -7,6 +7,7 @@ from planning.errors import PlanningError
 from planning.search.firefly_settings import FireflySettings
 from planning.search.optimizer import evaluated_points
 from planning.search.refined_firefly import RefinedFirefly
+from planning.search.refinement_settings import RefinementSettings
 
 D = 6
 CENTRE = np.linspace(0.2, 0.4, D)
@@ -66,3 +67,32 @@ def test_without_explore_the_best_seed_is_refined_feasible_or_not() -> None:
     assert direct.evaluation_history[0] == len(SEEDS) and direct.best_history[0] == bowl(SEEDS).min()
     assert explored.evaluation_history[0] == FIREFLY.fireflies
     assert direct.fitness < below_every_seed  # the refinement's steps go below it
+
+
+@pytest.mark.parametrize(("feasible_below", "feasible"), [(np.inf, True), (0.0, False)])
+def test_an_infeasible_best_starts_the_refinement_with_the_larger_step(
+    feasible_below: float, feasible: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import planning.search.refined_firefly as module
+    from planning.search.refinement import refine_search as refine
+
+    steps: list[float] = []
+
+    def recording(*args: object, **kwargs: object) -> object:
+        steps.append(args[6].sigma)  # type: ignore[attr-defined]  # the settings, positional
+        return refine(*args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(module, "refine_search", recording)
+    settings = RefinementSettings(sigma=0.01, infeasible_sigma=0.05)
+    optimiser = RefinedFirefly(
+        firefly=FIREFLY, refinement=settings, seeds=SEEDS, feasible_below=feasible_below, explore=False
+    )
+    optimiser(bowl, LOWER, UPPER, BUDGET, np.random.default_rng(3))
+    assert steps == [0.01 if feasible else 0.05]
+
+
+def test_refinement_steps_are_validated() -> None:
+    with pytest.raises(PlanningError, match=r"infeasible_sigma = 0\.0 must be a number in \(0, 1\]"):
+        RefinementSettings(infeasible_sigma=0.0)
+    with pytest.raises(PlanningError, match=r"min_sigma = 0\.02 must be a number in \(0, 0\.01\]"):
+        RefinementSettings(sigma=0.05, infeasible_sigma=0.01, min_sigma=0.02)

@@ -11,7 +11,10 @@ and returns the first whose timed trajectory passes the certified continuous che
    order, each timed only when the one before failed: the refinement's population is
    nearly as good as its best, and such a candidate run at full speed is shorter than the
    best run slower, or longer by a few per cent, for a fraction of the narrowed timings'
-   cost (``docs/tuning.md``);
+   cost (``docs/tuning.md``). Among these first ``preferred_first``, those whose path the
+   fastest timing's moving averages are foreseen to bring inside the clearance
+   (:func:`foreseen_clear`) come after the others: their fastest timing would most often
+   fail the check, after costing a timing and a verification;
 3. the narrowed timings (:meth:`~planning.pipeline.timing.FreeDuration.narrowed`) of those
    first ``preferred_first``, one share of ``narrowed_acceleration`` after the other (each
    computed only when the previous share failed), each share's shortest first, whichever
@@ -45,6 +48,7 @@ from planning.pipeline.verification import Requirements, Verification, verify_tr
 from planning.search.optimizer import SearchResult
 
 FloatArray = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
 
 
 @dataclass(frozen=True)
@@ -169,13 +173,43 @@ def beyond_margin(problem: Problem, searched: SearchResult) -> bool:
     return bool(world.self_collision.distances(samples)[0].min() < scene.self_margin - step)
 
 
+def foreseen_clear(problem: Problem, candidates: FloatArray) -> BoolArray:
+    """``(S,)`` whether each candidate's path keeps the clearance where the timing's averages take it.
+
+    The path's samples moved as :meth:`~planning.pipeline.path_terms.SplinePaths.averaged`
+    foresees (:mod:`planning.curves.averaged_path`), checked as the fitness checks its
+    samples but with only the tuning's ``foresight_step_share`` of the verification step
+    beyond the margin (and of the self step beyond the self margin): the foreseen samples
+    are those of the uncapped profile and miss the motion between them, so the whole step
+    would foresee cuts the timing does not make (``docs/tuning.md``). ``True`` where
+    nothing is foreseen: a fixed duration (its timing is the candidate's own),
+    point-to-point paths, a torque-limited estimate.
+    """
+    objective, settings = problem.objective, problem.scene.planner
+    short_of = 1.0 - settings.tuning.foresight_step_share
+    clear = np.ones(len(candidates), dtype=bool)
+    if not objective.estimates_duration:
+        return clear
+    samples = objective.paths(objective.nodes(candidates)).samples
+    moved = objective.paths.averaged(samples)
+    if moved is None:
+        return clear
+    configurations = objective.checked_configurations(moved).reshape(-1, samples.shape[2])
+    keeps = problem.world.keeps_clearance(
+        configurations,
+        objective.required_m - short_of * settings.verify_step_m,
+        objective.required_self_m - short_of * settings.self_step_m,
+    )
+    return np.asarray(keeps.reshape(len(candidates), -1).all(axis=1))
+
+
 def choose(problem: Problem, searched: SearchResult) -> Choice | Refusal:
     """The first candidate whose timed trajectory passes the verification (module docstring)."""
     objective = problem.objective
     order = np.argsort(searched.population_fitness, kind="stable")
     feasible = objective.feasible(searched.population_fitness)
     candidates = distinct([searched.x] + [searched.population[k] for k in order if feasible[k]])
-    timed: list[Offered] = []
+    timed: dict[int, Offered] = {}
     first: Verification | None = None
     verified: set[int] = set()
     hopeless = beyond_margin(problem, searched)
@@ -205,14 +239,14 @@ def choose(problem: Problem, searched: SearchResult) -> Choice | Refusal:
 
 
 def _attempts(
-    problem: Problem, candidates: list[FloatArray], timed: list[Offered]
+    problem: Problem, candidates: list[FloatArray], timed: dict[int, Offered]
 ) -> Iterator[tuple[int, Timing]]:
     """``(candidate, timing)`` in the module docstring's order; ``timed`` fills as they are timed."""
     tuning, duration, objective = problem.scene.planner.tuning, problem.duration, problem.objective
 
     def offered(k: int) -> Offered:
-        while len(timed) <= k:
-            timed.append(duration.timings(problem, objective.nodes(candidates[len(timed)][None])[0]))
+        if k not in timed:
+            timed[k] = duration.timings(problem, objective.nodes(candidates[k][None])[0])
         return timed[k]
 
     def shortest_first(pairs: list[tuple[int, Timing | None]]) -> list[tuple[int, Timing]]:
@@ -220,7 +254,13 @@ def _attempts(
         return sorted(found, key=lambda pair: pair[1].trajectory.duration)  # stable
 
     preferred = list(range(min(tuning.preferred_first, len(candidates))))
+    foreseen_cut: list[int] = []
     for k in preferred:  # most plans end at the first, after one timing
+        if foreseen_clear(problem, candidates[k][None])[0]:
+            yield k, offered(k).first
+        else:
+            foreseen_cut.append(k)
+    for k in foreseen_cut:
         yield k, offered(k).first
     narrowing = preferred
     for share in tuning.narrowed_acceleration:  # share by share: a path that passes costs no lower share

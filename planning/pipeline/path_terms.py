@@ -34,6 +34,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
+from planning.curves.averaged_path import averaged_samples
 from planning.curves.jerk_window import sampled_path_durations
 from planning.curves.path_timing import NODE_STEP_S, smoothing_limits
 from planning.curves.piecewise_sampler import PiecewiseSampler
@@ -99,6 +100,10 @@ class PtpPaths:
     def durations(self, samples: FloatArray) -> FloatArray:
         """Not estimated for straight lines: the fitness ranks by the point-to-point time."""
         raise NotImplementedError("PtpPaths gives no duration estimate")
+
+    def averaged(self, samples: FloatArray) -> FloatArray | None:
+        """``None``: not foreseen for straight lines, whose fitness ranks by the point-to-point time."""
+        return None
 
 
 class SplinePaths:
@@ -204,6 +209,22 @@ class SplinePaths:
         return sampled_path_durations(
             points, *self._fitted_limits, self._window_s, ROUNDS, TOLERANCE, self._second_share
         )
+
+    def averaged(self, samples: FloatArray) -> FloatArray | None:
+        """``(S, K, nq)`` the samples where the fastest timing's moving averages take them.
+
+        :func:`~planning.curves.averaged_path.averaged_samples` on the profile and window of
+        :meth:`durations`; ``None`` where the estimate is torque-limited (its profile is not
+        the one the kinematic timing averages).
+        """
+        if self.torque is not None:
+            return None
+        points = np.ascontiguousarray(samples[:, :, self.fitted])
+        moved = samples.copy()
+        moved[:, :, self.fitted] = averaged_samples(
+            points, *self._fitted_limits, self._window_s, ROUNDS, TOLERANCE, self._second_share
+        )
+        return moved
 
     def _tiles(self, s: int) -> tuple[FloatArray, ...]:
         """Fitted joints' ranges, bounds and ``(3, S k)`` v/a/j limits, repeated for ``s`` candidates."""

@@ -109,6 +109,11 @@ class SearchTuning:
         narrowed_acceleration: shares of the acceleration limits of the narrowed timings,
             tried in turn once a fastest timing fails the certified check; each in (0, 1),
             decreasing.
+        foresight_step_share: how much of the verification step beyond the margin (and of
+            the self step beyond the self margin) the samples of a candidate's path, moved
+            where the fastest timing's averages take them, must keep for its fastest timing
+            to be tried among the first (:func:`~planning.pipeline.choose.foreseen_clear`),
+            in [0, 1].
         explore_feasible_seed: the firefly explores before the refinement even when a seed
             (the straight line's or the sampling planner's) is feasible; by default the
             refinement then starts from it at once.
@@ -125,6 +130,7 @@ class SearchTuning:
     retries: int = 2
     preferred_first: int = 3
     narrowed_acceleration: tuple[float, ...] = (0.7, 0.5, 0.35)
+    foresight_step_share: float = 0.6
     explore_feasible_seed: bool = False
     explore_path_seed: bool = False
 
@@ -135,6 +141,7 @@ class SearchTuning:
         boolean("explore_feasible_seed", self.explore_feasible_seed)
         boolean("explore_path_seed", self.explore_path_seed)
         integer_in("preferred_first", self.preferred_first, 1, 100)
+        number_in("foresight_step_share", self.foresight_step_share, 0.0, 1.0)
         shares = tuple(self.narrowed_acceleration)
         for k, share in enumerate(shares):
             number_in(f"narrowed_acceleration[{k}]", share, 0.0, 1.0, low_open=True)

@@ -48,7 +48,8 @@ class RefinedFirefly:
         seeds: ``(k, d)`` points that replace the first fireflies of the initial population.
         feasible_below: the objective's bound of feasible values. Without a refinement the
             firefly's early stop counts only once its best is at or below it: an infeasible
-            best keeps exploring, as nothing would repair it.
+            best keeps exploring, as nothing would repair it. With one, an infeasible best
+            starts it with the refinement's ``infeasible_sigma``.
         lower_bound: about the least value the objective can take (the refinement counts
             stalls only near it); ``None``: unknown.
         progress: called after every firefly iteration, or once for the seeds when the
@@ -104,6 +105,9 @@ class RefinedFirefly:
             )
         if self.refinement is None:
             return found
+        refinement = self.refinement
+        if found.fitness > self.feasible_below:  # farther to go than a polish
+            refinement = dataclasses.replace(refinement, sigma=refinement.infeasible_sigma)
         return refine_search(
             objective,
             lower,
@@ -111,7 +115,7 @@ class RefinedFirefly:
             found,
             budget - found.evaluations,
             rng,
-            self.refinement,
+            refinement,
             stall_generations=self.stall_generations,
             lower_bound=self.lower_bound,
             stop=self.stop,
