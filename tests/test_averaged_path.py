@@ -14,12 +14,12 @@ from planning.pipeline.choose import foreseen_clear, verify
 from planning.pipeline.planner import plan
 from planning.pipeline.result import PlanResult
 
-LIMITS = (np.array([1.0, 1.0]), np.array([2.0, 2.0]), np.array([20.0, 20.0]))  # v, a, j
+LIMITS = np.array([[1.0, 1.0], [2.0, 2.0], [20.0, 20.0]])  # v, a, j
 WINDOW_S, SECOND_SHARE = 0.1, 0.125  # a / j, the timing's eighth
 
 
 def averaged(points: np.ndarray) -> np.ndarray:
-    return np.asarray(averaged_samples(points[None], *LIMITS, WINDOW_S, ROUNDS, TOLERANCE, SECOND_SHARE)[0])
+    return np.asarray(averaged_samples(points[None], LIMITS, WINDOW_S, ROUNDS, TOLERANCE, SECOND_SHARE)[0])
 
 
 @pytest.mark.parametrize("share", [0.125, 0.25, 1.0])

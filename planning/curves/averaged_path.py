@@ -26,13 +26,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cpr_kin.compiled import njit
-from planning.curves.jerk_window import SAMPLED_SECOND_SHARE, needed_window
-from planning.curves.phase_plane import (
-    kept_samples,
-    phase_plane_profile,
-    profile_instants,
-    sampled_derivatives,
-)
+from planning.curves.jerk_window import profile_window
+from planning.curves.phase_plane import kept_samples, phase_plane_profile, sampled_derivatives
 
 FloatArray = NDArray[np.float64]
 
@@ -60,21 +55,15 @@ def trapezoid_kernel(window_s: float, second_share: float, points: int) -> tuple
 
 @njit
 def averaged_samples(
-    points: FloatArray,
-    v: FloatArray,
-    a: FloatArray,
-    j: FloatArray,
-    window_s: float,
-    rounds: int,
-    tolerance: float,
-    second_share: float,
+    points: FloatArray, limits: FloatArray, window_s: float, rounds: int, tolerance: float, share: float
 ) -> FloatArray:
     """``(S, M, nj)`` the samples of ``S`` paths ``(S, M, nj)`` where the timing's averages take them.
 
-    Each path's profile under the velocity and acceleration limits ``v``, ``a`` and its
-    window for the jerk limits ``j`` (from ``window_s``, widened at most ``rounds`` times
-    while the jerk exceeds ``1 + tolerance`` of its limit) are the duration estimate's
-    (:func:`~planning.curves.jerk_window.sampled_path_durations`); each sample is averaged
+    Each path's profile under the velocity and acceleration limits ``limits[0]``,
+    ``limits[1]`` and its window for the jerk limits ``limits[2]`` (from ``window_s``,
+    widened at most ``rounds`` times while the jerk exceeds ``1 + tolerance`` of its
+    limit; ``share``: the second average's width as a share of the first's) are the
+    duration estimate's (:func:`~planning.curves.jerk_window.sampled_path_durations`); each sample is averaged
     over the kernel of :func:`trapezoid_kernel` about the instant the profile reaches it
     (before the start and after the end the path rests at its ends). A sample the profile
     drops (closer than ``1e-9`` to the one before) takes its predecessor's displacement. A
@@ -82,17 +71,14 @@ def averaged_samples(
     """
     averaged = points.copy()
     for s in range(points.shape[0]):
-        index = kept_samples(points[s], v)
-        steps, d1, d2 = sampled_derivatives(points[s], v)
+        index = kept_samples(points[s], limits[0])
+        steps, d1, d2 = sampled_derivatives(points[s], limits[0])
         if index.size < 2 or len(d1) < 2:
             continue
         kept = points[s][index]
-        x = phase_plane_profile(d1, d2, steps, v, a, np.zeros_like(d1))
-        times = profile_instants(x, steps)
-        velocity = d1 * np.sqrt(np.maximum(x, 0.0))[:, None]
-        checked = max(second_share, SAMPLED_SECOND_SHARE)
-        window, _ = needed_window(times, velocity, j, window_s, rounds, tolerance, checked)
-        offsets, weights = trapezoid_kernel(window, second_share, QUADRATURE)
+        x = phase_plane_profile(d1, d2, steps, limits[0], limits[1], np.zeros_like(d1))
+        times, window, _ = profile_window(x, steps, d1, limits[2], window_s, rounds, tolerance, share)
+        offsets, weights = trapezoid_kernel(window, share, QUADRATURE)
         moved = _averaged(kept, times, offsets, weights)
         g = 0
         for i in range(points.shape[1]):  # back onto every sample

@@ -37,7 +37,7 @@ FloatArray = NDArray[np.float64]
 SIGNS = (1.0, -1.0, -1.0, 1.0)
 """The signs of the averaged jerk's four velocities (module docstring)."""
 SAMPLED_SECOND_SHARE = 0.25
-"""The least second share with which :func:`jerk_limited_duration` checks the jerk of a
+"""The least second share with which :func:`profile_window` checks the jerk of a
 sampled path: the fitness knows a path at a few dozen samples, between which its velocity
 bends at kinks the timing's fine table does not have; a narrower second average would widen
 windows for them that the timing does not (measured in ``docs/tuning.md``)."""
@@ -132,12 +132,24 @@ def sampled_path_durations(
         if len(d1) < 2:
             continue
         x = phase_plane_profile(d1, d2, steps, v, a, np.zeros_like(d1))
-        durations[s] = jerk_limited_duration(x, steps, d1, j, window_s, rounds, tolerance, second_share)
+        times, window, usage = profile_window(x, steps, d1, j, window_s, rounds, tolerance, second_share)
+        durations[s] = jerk_limited_duration(times, window, usage, second_share)
     return durations
 
 
 @njit
-def jerk_limited_duration(
+def jerk_limited_duration(times: FloatArray, window_s: float, usage: float, second_share: float) -> float:
+    """Duration [s] of a profile reaching its grid points at ``times`` once its jerk is limited.
+
+    The profile's time plus ``1 + second_share`` times the window ``window_s`` its jerk
+    needs, stretched by ``usage^(1/3)`` where that window still exceeds the jerk limit
+    (:func:`profile_window` gives all three).
+    """
+    return float((times[-1] + (1.0 + second_share) * window_s) * max(1.0, usage ** (1.0 / 3.0)))
+
+
+@njit
+def profile_window(
     x: FloatArray,
     steps: FloatArray,
     d1: FloatArray,
@@ -146,15 +158,15 @@ def jerk_limited_duration(
     rounds: int,
     tolerance: float,
     second_share: float,
-) -> float:
-    """Duration [s] of the profile ``x`` (path steps ``steps``, ``dq/ds`` ``d1``) once its jerk is limited.
+) -> tuple[FloatArray, float, float]:
+    """When the profile ``x`` reaches its grid points [s], the window it ends with [s], its jerk usage.
 
-    The profile's time plus ``1 + second_share`` times the window :func:`needed_window`
-    widens to (its jerk checked with a second share of at least :data:`SAMPLED_SECOND_SHARE`),
-    stretched by ``usage^(1/3)`` where the last window still exceeds the jerk limit.
+    ``x`` on path steps ``steps`` with ``dq/ds`` ``d1``; the window is the one
+    :func:`needed_window` widens to from ``window_s`` for the jerk limits ``j``, the jerk
+    checked with a second share of at least :data:`SAMPLED_SECOND_SHARE`.
     """
     times = profile_instants(x, steps)
     velocity = d1 * np.sqrt(np.maximum(x, 0.0))[:, None]
     checked = max(second_share, SAMPLED_SECOND_SHARE)
     window, usage = needed_window(times, velocity, j, window_s, rounds, tolerance, checked)
-    return float((times[-1] + (1.0 + second_share) * window) * max(1.0, usage ** (1.0 / 3.0)))
+    return times, window, usage

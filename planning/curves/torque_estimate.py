@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from planning.curves.jerk_window import jerk_limited_duration, sampled_path_durations
+from planning.curves.jerk_window import jerk_limited_duration, profile_window, sampled_path_durations
 from planning.curves.phase_plane import kept_samples, phase_plane_profile, sampled_derivatives
 from planning.curves.torque_limits import HEADROOM, TorqueModel, TorqueRows, phase_plane_rows
 from planning.curves.velocity_caps import ROUNDS, TOLERANCE
@@ -81,5 +81,6 @@ def sampled_torque_durations(
         slope, curve, offset = terms[:, right - 1] * (1.0 - share) + terms[:, right] * share
         rows = phase_plane_rows(d1, d2, velocity, acceleration, TorqueRows(slope, curve, offset, bound))
         x = phase_plane_profile(rows[0], rows[1], steps, rows[2], rows[3], rows[4])
-        durations[s] = jerk_limited_duration(x, steps, d1, jerk, window_s, ROUNDS, TOLERANCE, second_share)
+        times, window, usage = profile_window(x, steps, d1, jerk, window_s, ROUNDS, TOLERANCE, second_share)
+        durations[s] = jerk_limited_duration(times, window, usage, second_share)
     return durations

@@ -222,7 +222,7 @@ class SplinePaths:
         points = np.ascontiguousarray(samples[:, :, self.fitted])
         moved = samples.copy()
         moved[:, :, self.fitted] = averaged_samples(
-            points, *self._fitted_limits, self._window_s, ROUNDS, TOLERANCE, self._second_share
+            points, np.stack(self._fitted_limits), self._window_s, ROUNDS, TOLERANCE, self._second_share
         )
         return moved
 
