@@ -14,7 +14,8 @@ and returns the first whose timed trajectory passes the certified continuous che
    cost (``docs/tuning.md``). Among these first ``preferred_first``, those whose path the
    fastest timing's moving averages are foreseen to bring inside the clearance
    (:func:`foreseen_clear`) come after the others: their fastest timing would most often
-   fail the check, after costing a timing and a verification;
+   fail the check, after costing a timing and a verification (unless the best is
+   infeasible, whose check says why no candidate passes, or the time limit has passed);
 3. the narrowed timings (:meth:`~planning.pipeline.timing.FreeDuration.narrowed`) of those
    first ``preferred_first``, one share of ``narrowed_acceleration`` after the other (each
    computed only when the previous share failed), each share's shortest first, whichever
@@ -210,20 +211,22 @@ def choose(problem: Problem, searched: SearchResult) -> Choice | Refusal:
     feasible = objective.feasible(searched.population_fitness)
     candidates = distinct([searched.x] + [searched.population[k] for k in order if feasible[k]])
     timed: dict[int, Offered] = {}
-    first: Verification | None = None
-    verified: set[int] = set()
+    verified: dict[int, Verification] = {}  # each candidate's first verification
     hopeless = beyond_margin(problem, searched)
-    for k, timing in _attempts(problem, candidates, timed):
+    # an infeasible best is verified first, whatever its foresight: its check says why
+    foresee = bool(objective.feasible(searched.fitness)) and not problem.deadline.passed()
+    for k, timing in _attempts(problem, candidates, timed, foresee):
         verification = verify(problem, timing.trajectory, timing.fit)
-        first = first or verification
-        verified.add(k)
+        verified.setdefault(k, verification)
         if verification.accepted:
             x = candidates[k]
             return Choice(x, objective.nodes(x[None])[0], timing, verification, len(timed))
         if hopeless or problem.deadline.passed():
             break  # its other timings follow the same path; or time is up
-    assert first is not None  # candidates is never empty
+    first = verified.get(0) or next(iter(verified.values()))  # candidates is never empty
     found = f"the best candidate {'; '.join(first.problems)}"
+    if 0 not in verified:  # time ran out after a candidate foreseen clear
+        found = f"the candidate verified {'; '.join(first.problems)}"
     if not objective.feasible(searched.fitness):  # the cause comes first, the pair named
         breakdown, check = objective.breakdown(searched.x[None]), first.check
         if check.worst_pair is not None and check.certified_min_m < check.margin_m:  # an obstacle
@@ -239,9 +242,12 @@ def choose(problem: Problem, searched: SearchResult) -> Choice | Refusal:
 
 
 def _attempts(
-    problem: Problem, candidates: list[FloatArray], timed: dict[int, Offered]
+    problem: Problem, candidates: list[FloatArray], timed: dict[int, Offered], foresee: bool
 ) -> Iterator[tuple[int, Timing]]:
-    """``(candidate, timing)`` in the module docstring's order; ``timed`` fills as they are timed."""
+    """``(candidate, timing)`` in the module docstring's order; ``timed`` fills as they are timed.
+
+    ``foresee``: the first candidates' fastest timings foreseen to be cut come after the others'.
+    """
     tuning, duration, objective = problem.scene.planner.tuning, problem.duration, problem.objective
 
     def offered(k: int) -> Offered:
@@ -256,7 +262,7 @@ def _attempts(
     preferred = list(range(min(tuning.preferred_first, len(candidates))))
     foreseen_cut: list[int] = []
     for k in preferred:  # most plans end at the first, after one timing
-        if foreseen_clear(problem, candidates[k][None])[0]:
+        if not foresee or foreseen_clear(problem, candidates[k][None])[0]:
             yield k, offered(k).first
         else:
             foreseen_cut.append(k)
