@@ -192,10 +192,13 @@ def _warm_own_motion(robot: ck.Robot, small: Scene) -> None:
 
 
 def _estimate_durations(problem: Problem, dynamics: ck.Dynamics) -> None:
-    """Run the search's duration estimates of ``problem``'s straight line, kinematic and torque-limited.
+    """Run the search's estimates of ``problem``'s straight line: durations, the averages' foresight.
 
-    A plan keeps the torques in its estimate only where they bind on its straight line
-    (:func:`~planning.pipeline.torques.search_torque`), which a warm-up motion seldom does.
+    The duration estimates kinematic and torque-limited; the samples the choice's foresight
+    averages (:func:`~planning.pipeline.choose.foreseen_clear`). A plan keeps the torques in
+    its estimate only where they bind on its straight line
+    (:func:`~planning.pipeline.torques.search_torque`), which a warm-up motion seldom does;
+    the choice foresees the averages only behind a feasible best.
     """
     objective = problem.objective
     paths = objective.paths
@@ -206,6 +209,9 @@ def _estimate_durations(problem: Problem, dynamics: ck.Dynamics) -> None:
         estimate = copy.copy(paths)
         estimate.torque = torque
         estimate.durations(samples)
+    kinematic = copy.copy(paths)
+    kinematic.torque = None
+    kinematic.averaged(samples)
 
 
 def _query_collisions(world: ck.CollisionWorld, q: FloatArray) -> None:
