@@ -209,9 +209,7 @@ def _estimate_durations(problem: Problem, dynamics: ck.Dynamics) -> None:
         estimate = copy.copy(paths)
         estimate.torque = torque
         estimate.durations(samples)
-    kinematic = copy.copy(paths)
-    kinematic.torque = None
-    kinematic.averaged(samples)
+        estimate.averaged(samples)  # the kinematic one's; None where torque-limited
 
 
 def _query_collisions(world: ck.CollisionWorld, q: FloatArray) -> None:
