@@ -87,7 +87,7 @@ def test_the_foreseen_samples_lie_on_the_timed_trajectory(pillars_87: PlanResult
 
     shift = (np.abs(moved - samples[0]) / limits.velocity).max(axis=1)
     bent = shift > 0.2 * shift.max()
-    assert shift.max() > 0.01  # a bend the averages cut by a visible amount
+    assert shift.max() > 0.005  # a bend the averages cut by a visible amount (7 ms at the limits)
     assert np.median(off_trajectory(moved[bent])) < 0.1 * np.median(off_trajectory(samples[0][bent]))
 
 

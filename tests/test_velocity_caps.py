@@ -23,7 +23,7 @@ from .conftest import LIFT, PAPER_GOAL_TCP, PAPER_START_TCP, limits_of, spline_p
 
 
 def every_cap(grid: ArcLengthPath, limits: np.ndarray, second: float) -> CappedMotion:
-    """The cap search with no early stop: every cap of the grid, as first written."""
+    """The cap search with no early stop: every cap of the grid, as first written, then the local caps."""
     tried = {1.0: velocity_caps.capped_motion(grid, limits, second, 1.0)}
     peak = tried[1.0].peak
     for share in (factor * peak for factor in velocity_caps.FACTORS):
@@ -38,6 +38,10 @@ def every_cap(grid: ArcLengthPath, limits: np.ndarray, second: float) -> CappedM
         found = velocity_caps.capped_motion(grid, limits, second, share, factor * best.window_s)
         if found.duration_s < best.duration_s:
             best = found
+    if tried[1.0].widened:
+        local = velocity_caps.locally_capped(grid, limits, second, tried[1.0])
+        if local.duration_s < best.duration_s:
+            best = local
     return best
 
 

@@ -56,6 +56,26 @@ def arc_at_times(x: FloatArray, ds: FloatArray, step_s: float) -> FloatArray:
 
 
 @njit
+def positions_at(s: FloatArray, length: FloatArray, table: FloatArray) -> FloatArray:
+    """``(T, nj)`` the path's positions at the non-decreasing arc lengths ``s`` ``(T,)``.
+
+    Linear between the path's fine samples ``table`` ``(F, nj)`` at the increasing arc lengths
+    ``length`` ``(F,)``, held beyond them: ``numpy.interp`` of each column, in one pass.
+    """
+    count, joints = len(s), table.shape[1]
+    out = np.empty((count, joints))
+    k = 0
+    for i in range(count):
+        while k < len(length) - 2 and length[k + 1] < s[i]:
+            k += 1
+        span = length[k + 1] - length[k]
+        share = min(max((s[i] - length[k]) / span, 0.0), 1.0) if span > 0.0 else 0.0
+        for j in range(joints):
+            out[i, j] = table[k, j] + share * (table[k + 1, j] - table[k, j])
+    return out
+
+
+@njit
 def _average(values: FloatArray, width: int) -> FloatArray:
     """Moving average over ``width`` samples along axis 0, ``width`` samples longer.
 

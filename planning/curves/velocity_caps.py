@@ -20,7 +20,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from planning.curves.arc_length import ArcLengthPath
-from planning.curves.moving_average import arc_at_times, jerk_limited_motion, scaled_duration
+from planning.curves.local_caps import locally_capped_motion
+from planning.curves.moving_average import arc_at_times, jerk_limited_motion, positions_at, scaled_duration
 from planning.curves.phase_plane import path_acceleration, phase_plane_profile, profile_time
 from planning.curves.torque_limits import phase_plane_rows
 
@@ -113,7 +114,31 @@ def fastest_motion(
         found = capped_motion(path, limits, second_share, share, factor * best.window_s, profile=x)
         if found.duration_s < best.duration_s:
             best = found
+    if tried[1.0].widened:
+        local = locally_capped(path, limits, second_share, tried[1.0], best.duration_s)
+        if local.duration_s < best.duration_s:
+            best = local
     return best
+
+
+def locally_capped(
+    path: ArcLengthPath,
+    limits: FloatArray,
+    second_share: float,
+    uncapped: CappedMotion,
+    shortest_s: float = np.inf,
+) -> CappedMotion:
+    """The motion of :func:`~planning.curves.local_caps.locally_capped_motion` from the uncapped profile.
+
+    ``uncapped``: the uncapped profile's motion, whose window widened; its narrower window is
+    kept. Its duration is ``inf`` where no round is shorter than ``shortest_s`` [s].
+    """
+    _, acceleration_cap = _caps(limits, 1.0, np.inf)
+    step_s = _time_step_s(limits)
+    duration_s, motion = locally_capped_motion(
+        path, limits, acceleration_cap, second_share, uncapped.window_s, step_s, TOLERANCE, shortest_s
+    )
+    return CappedMotion(duration_s, False, uncapped.peak, uncapped.window_s, motion, step_s)
 
 
 def bisect_widening(
@@ -185,7 +210,7 @@ def capped_motion(
     peak = float(np.max(np.abs(path.dq) * np.sqrt(np.maximum(x, 0.0))[:, None] / limits[0]))
     step_s = _time_step_s(limits)
     s = arc_at_times(x, path.ds, step_s)
-    positions = np.column_stack([np.interp(s, path.length, column) for column in path.table.T])
+    positions = positions_at(s, path.length, path.table)
     motion, used = jerk_limited_motion(positions, window, step_s, limits[2], ROUNDS, TOLERANCE, second_share)
     duration_s = scaled_duration(motion, step_s, *limits)
     return CappedMotion(duration_s, used > window, peak, window, motion, step_s)

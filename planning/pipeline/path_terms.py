@@ -213,16 +213,19 @@ class SplinePaths:
     def averaged(self, samples: FloatArray) -> FloatArray | None:
         """``(S, K, nq)`` the samples where the fastest timing's moving averages take them.
 
-        :func:`~planning.curves.averaged_path.averaged_samples` on the profile and window of
-        :meth:`durations`; ``None`` where the estimate is torque-limited (its profile is not
-        the one the kinematic timing averages).
+        :func:`~planning.curves.averaged_path.averaged_samples` on the profile of
+        :meth:`durations` with the narrowest window, never widened: where the profile's jerk
+        would widen it, the timing mostly keeps it and lowers the swinging joint's
+        acceleration locally instead (:mod:`planning.curves.local_caps`; ``docs/tuning.md``).
+        ``None`` where the estimate is torque-limited (its profile is not the one the
+        kinematic timing averages).
         """
         if self.torque is not None:
             return None
         points = np.ascontiguousarray(samples[:, :, self.fitted])
         moved = samples.copy()
         moved[:, :, self.fitted] = averaged_samples(
-            points, np.stack(self._fitted_limits), self._window_s, ROUNDS, TOLERANCE, self._second_share
+            points, np.stack(self._fitted_limits), self._window_s, 0, TOLERANCE, self._second_share
         )
         return moved
 
