@@ -57,7 +57,12 @@ class ObstaclePools:
         self._margin_m: dict[int, float] = {}
 
     def violated(
-        self, batch: FloatArray, uncertain: BoolArray, margin_m: float, near: BoolArray
+        self,
+        batch: FloatArray,
+        uncertain: BoolArray,
+        margin_m: float,
+        near: BoolArray,
+        ordered: bool = False,
     ) -> BoolArray:
         """``(N,)`` whether some pair is closer than ``margin_m`` [m] at configurations ``batch``.
 
@@ -67,14 +72,18 @@ class ObstaclePools:
                 certainly farther than the margin).
             margin_m: the security margin [m].
             near: ``(P,)`` the pairs that may come within the margin (the others are not tested).
+            ordered: decide the configurations in order, one at a time, up to the first
+                violated one; those after it are reported violated without a test.
         """
         violated = np.zeros(len(batch), dtype=bool)
-        if len(batch) == 1:  # one configuration: the obstacles in turn, without the array work
-            for obstacle in np.flatnonzero(uncertain[0]).tolist():
-                pool = self._prepared(obstacle, margin_m, near)
-                if pool_collisions(pool, self.model, self._data, self.geometry_model, batch, 1)[0]:
-                    violated[0] = True
-                    break
+        if ordered or len(batch) == 1:  # one at a time, the obstacles in turn, without the array work
+            for row in np.flatnonzero(uncertain.any(axis=1)).tolist():
+                for obstacle in np.flatnonzero(uncertain[row]).tolist():
+                    pool = self._prepared(obstacle, margin_m, near)
+                    one = batch[row : row + 1]
+                    if pool_collisions(pool, self.model, self._data, self.geometry_model, one, 1)[0]:
+                        violated[row:] = True
+                        return violated
             return violated
         for obstacle in np.flatnonzero(uncertain.any(axis=0)).tolist():
             rows = np.flatnonzero(uncertain[:, obstacle] & ~violated)

@@ -256,6 +256,36 @@ def test_reach_distance_of_the_turning_column_is_exact(robot: ck.Robot) -> None:
     assert world._reach_distance[column[0]] == pytest.approx(0.45 - 0.06 * np.sqrt(2), abs=1e-6)
 
 
+def test_an_ordered_check_is_exact_up_to_the_first_failure(rng: np.random.Generator) -> None:
+    """What an edge check needs: ordered, the answer up to the first failure, the rest failed."""
+    from cpr_kin.packages import example_robot
+
+    panda = ck.load_robot(example_robot("panda"))
+    world = ck.CollisionWorld(
+        panda,
+        [
+            ck.Obstacle.sphere(0.15, (0.45, 0.0, 0.4), name="ball"),
+            ck.Obstacle.box(size=(0.2, 0.6, 0.02), xyz=(0.4, 0.0, 0.2), name="board"),
+        ],
+    )
+    starts = rng.uniform(panda.limits.lower, panda.limits.upper, (60, panda.nq))
+    ends = rng.uniform(panda.limits.lower, panda.limits.upper, (60, panda.nq))
+    blocked_inside = 0
+    for a, b in zip(starts, ends, strict=True):  # edges of 20 configurations, in order
+        edge = a + np.linspace(0.0, 1.0, 20)[:, None] * (b - a)
+        for full, ordered in (
+            (world.margin_violated(edge, 0.05), world.margin_violated(edge, 0.05, ordered=True)),
+            (~world.keeps_clearance(edge, 0.05, 0.02), ~world.keeps_clearance(edge, 0.05, 0.02, True)),
+        ):
+            first = int(np.argmax(full)) if full.any() else len(edge)
+            np.testing.assert_array_equal(ordered[: first + 1], full[: first + 1])
+            blocked_inside += int(0 < first < len(edge) - 1)
+        violated = world.margin_violated(edge, 0.05)
+        if violated.any():  # past the first violation: reported violated, untested
+            assert world.margin_violated(edge, 0.05, ordered=True)[int(np.argmax(violated)) :].all()
+    assert blocked_inside >= 10  # edges first blocked part of the way along, both checks
+
+
 def test_keeps_clearance_is_both_margins_from_distances(rng: np.random.Generator) -> None:
     """The Panda among a ball: clear of it by the margin and of its own links by the self margin."""
     from cpr_kin.packages import example_robot

@@ -44,3 +44,24 @@ def test_an_edge_blocked_at_once_is_known_from_its_coarse_pass() -> None:
     assert edges.free_fraction(a, b) == 0.0
     coarse = set(range(HEAD)) | set(range(COARSE_STRIDE - 1, count, COARSE_STRIDE)) | {count - 1}
     assert edges.checks == len(coarse)  # the coarse pass alone: nothing past the first invalid one
+
+
+def test_a_check_that_stops_at_the_first_invalid_configuration_gives_the_same_fractions() -> None:
+    """The validity's contract: exact up to the first invalid configuration, anything after it."""
+    noise = np.random.default_rng(5)
+
+    def stops_early(q: np.ndarray) -> np.ndarray:
+        ok = discs(q)
+        if not ok.all():
+            after = int(np.argmin(ok)) + 1
+            ok[after:] = noise.uniform(size=len(q) - after) < 0.5
+        return ok
+
+    rng = np.random.default_rng(4)
+    weights = np.array([1.0, 2.0])
+    pairs = [(a, b) for a, b in rng.uniform(0, 1, (200, 2, 2)) if discs(a[None])[0]]
+    for resolution_m in (0.002, 0.03):  # coarse to fine, and whole edges
+        exact, early = Edges(discs, weights, resolution_m), Edges(stops_early, weights, resolution_m)
+        found = [early.free_fraction(a, b) for a, b in pairs]
+        assert found == [exact.free_fraction(a, b) for a, b in pairs]
+        assert 0 < sum(f < 1 for f in found) < len(found)

@@ -299,4 +299,6 @@ def test_a_relaxation_changes_nothing_before_its_samples_and_holds_at_once_for_e
     found = rrt_connect(
         wall_with_slot, in_the_wall, goal, LOWER, UPPER, WEIGHTS, np.random.default_rng(0), relaxation=thin
     )
-    assert found is not None and found.relaxed and densely_valid(found.path, thin.valid)
+    assert found is not None and found.relaxed
+    # held at the check's resolution: the looser wall eroded by it, as `eroded` for the strict one
+    assert densely_valid(found.path, lambda q: wall_with_slot(q, 0.02 + RrtSettings().resolution_m))

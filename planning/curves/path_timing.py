@@ -11,16 +11,19 @@ touching one of them (no time left on the table). Steps:
    even where the path's own parameter slows to a stop, as the planner's rest-to-rest
    splines do at their ends.
 2. **Jerk.** Each joint's motion goes through two moving averages of widths ``w = max_j
-   a_j / j_j`` and ``w / 4`` (the "FIR" interpolation of CNC controllers, Tajima and Sencer
-   2016). An average of velocities within their limit stays within it, and so does one of
-   accelerations; the jerk is the change of acceleration over a window, at most ``a / w = j``
-   where the profile ramps its acceleration up or down, as Ruckig's time-optimal solution
-   also takes ``a / j`` to. Where it switches from accelerating to braking at once (a short
-   move), the window widens until the jerk fits. The motion ends ``1.25 w`` later; the
-   averaged path cuts bends by a few millimetres (the averages of nearby points of a curve
-   lie inside it), which the planner's certified check accounts for. Steps 1 and 2 are
-   tried under several caps of the profile's velocity and acceleration, and the fastest
-   motion is kept (:mod:`planning.curves.velocity_caps`).
+   a_j / j_j`` and ``r w`` (``r`` at least 1/8, :func:`smoothing_limits`; the "FIR"
+   interpolation of CNC controllers, Tajima and Sencer 2016). An average of velocities
+   within their limit stays within it, and so does one of accelerations; the jerk is the
+   change of acceleration over a window, at most ``a / w = j`` where the profile ramps its
+   acceleration up or down, as Ruckig's time-optimal solution also takes ``a / j`` to. Where
+   it switches from accelerating to braking at once (a short move), the window widens until
+   the jerk fits. The motion ends ``(1 + r) w`` later; the averaged path cuts bends by a few
+   millimetres (the averages of nearby points of a curve lie inside it), which the planner's
+   certified check accounts for. Steps 1 and 2 are tried under several caps of the profile's
+   velocity and acceleration, and, where the window would widen, with the narrow window and
+   the swinging joint's acceleration lowered only where its jerk exceeds
+   (:mod:`planning.curves.local_caps`); the fastest motion is kept
+   (:mod:`planning.curves.velocity_caps`).
 3. **Septic.** Knots every ``node_step_s``; the averaged position, velocity, acceleration and
    jerk there are the Hermite data of the segments (paper eq. 14), so the trajectory is C3
    by construction.

@@ -85,7 +85,8 @@ def fastest_motion(
     A cap whose :func:`duration_lower_bound` exceeds the best is not averaged where its
     window's widening decides nothing (after the bisection, the bisection's last cap, the
     ramps' caps). The result is the whole grid's (the tests compare), in less time
-    (``docs/tuning.md``).
+    (``docs/tuning.md``). Last, where the uncapped profile's window widened, the narrow
+    window with accelerations lowered locally (:func:`locally_capped`), if shorter.
     """
     tried = {1.0: capped_motion(path, limits, second_share, 1.0, profile=uncapped)}
     peak = tried[1.0].peak

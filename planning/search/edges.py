@@ -20,10 +20,15 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
+from cpr_kin.compiled import njit
+
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 Validity = Callable[[FloatArray], BoolArray]
-"""``(N, d) -> (N,)``: whether each configuration is valid (clear of the margin)."""
+"""``(N, d) -> (N,)``: whether each configuration is valid (clear of the margin), in order.
+
+Exact up to the first invalid configuration; after it, a check may report any value (an
+edge is known by where it is first blocked, so a check may stop there)."""
 COARSE_STRIDE = 8
 """Configurations an edge's coarse pass steps over (:meth:`Edges.free_fraction`)."""
 HEAD = 2
@@ -53,8 +58,8 @@ class Edges:
         the others up to the first invalid one of those: an edge that hits an obstacle is
         not checked beyond it. The answer is that of checking every configuration.
         """
-        count = max(1, math.ceil(float(np.abs(b - a) @ self.weights) / self.resolution_m))
-        points = a + (np.arange(1, count + 1) / count)[:, None] * (b - a)
+        points = edge_points(a, b, self.weights, self.resolution_m)
+        count = len(points)
         if count < WHOLE_BELOW:
             ok = self.valid(points)
             self.checks += count
@@ -82,6 +87,25 @@ class Edges:
             ok[rest] = self.valid(points[rest])
             self.checks += int(np.count_nonzero(rest))
         return ok
+
+
+@njit
+def edge_points(a: FloatArray, b: FloatArray, weights: FloatArray, resolution_m: float) -> FloatArray:
+    """``(count, d)`` the configurations of the edge ``a -> b`` every ``resolution_m``, ``b`` last.
+
+    ``count`` spans the edge's motion bound ``sum_j w_j |b_j - a_j|`` [m] in steps of at most
+    ``resolution_m`` (at least one). Compiled: a sampling planner builds one or two a sample.
+    """
+    length = 0.0
+    for j in range(len(a)):
+        length += abs(b[j] - a[j]) * weights[j]
+    count = max(1, math.ceil(length / resolution_m))
+    points = np.empty((count, len(a)))
+    for k in range(count):
+        share = (k + 1) / count
+        for j in range(len(a)):
+            points[k, j] = a[j] + share * (b[j] - a[j])
+    return points
 
 
 def shortcut(path: FloatArray, edges: Edges, rng: np.random.Generator, attempts: int) -> FloatArray:

@@ -50,6 +50,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from cpr_kin.compiled import njit
 from planning.errors import PlanningError
 from planning.search.edges import Edges, Validity, shortcut
 from planning.search.rrt_settings import RANGE_FRACTION, RrtSettings
@@ -104,7 +105,7 @@ class _Tree:
         return self.size - 1
 
     def nearest(self, q: FloatArray, weights: FloatArray) -> int:
-        return int(np.argmin(np.abs(self.nodes[: self.size] - q) @ weights))
+        return nearest_node(self.nodes, self.size, q, weights)
 
     def branch(self, index: int) -> FloatArray:
         """The nodes from ``index`` back to the root."""
@@ -200,6 +201,19 @@ def rrt_connect(
             path = shortcut(path, edges, rng, settings.shortcuts)
             return RrtPath(path, sample, strict_checks + edges.checks, relaxed)
     return None
+
+
+@njit
+def nearest_node(nodes: FloatArray, size: int, q: FloatArray, weights: FloatArray) -> int:
+    """Index of the first of ``nodes[:size]`` nearest to ``q`` by the motion bound ``sum_j w_j |dq_j|``."""
+    best, index = np.inf, 0
+    for i in range(size):
+        distance = 0.0
+        for j in range(len(q)):
+            distance += abs(nodes[i, j] - q[j]) * weights[j]
+        if distance < best:
+            best, index = distance, i
+    return index
 
 
 class _Sampler:
