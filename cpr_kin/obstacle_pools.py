@@ -76,14 +76,15 @@ class ObstaclePools:
                 violated one; those after it are reported violated without a test.
         """
         violated = np.zeros(len(batch), dtype=bool)
-        if ordered or len(batch) == 1:  # one at a time, the obstacles in turn, without the array work
+        if len(batch) == 1:  # one configuration: the obstacles in turn, without the array work
+            violated[0] = self._one_violated(batch, np.flatnonzero(uncertain[0]).tolist(), margin_m, near)
+            return violated
+        if ordered:  # one at a time, up to the first violated
             for row in np.flatnonzero(uncertain.any(axis=1)).tolist():
-                for obstacle in np.flatnonzero(uncertain[row]).tolist():
-                    pool = self._prepared(obstacle, margin_m, near)
-                    one = batch[row : row + 1]
-                    if pool_collisions(pool, self.model, self._data, self.geometry_model, one, 1)[0]:
-                        violated[row:] = True
-                        return violated
+                obstacles = np.flatnonzero(uncertain[row]).tolist()
+                if self._one_violated(batch[row : row + 1], obstacles, margin_m, near):
+                    violated[row:] = True
+                    break
             return violated
         for obstacle in np.flatnonzero(uncertain.any(axis=0)).tolist():
             rows = np.flatnonzero(uncertain[:, obstacle] & ~violated)
@@ -93,6 +94,14 @@ class ObstaclePools:
                     pool, self.model, self._data, self.geometry_model, batch[rows], self.num_threads
                 )
         return violated
+
+    def _one_violated(self, one: FloatArray, obstacles: list[int], margin_m: float, near: BoolArray) -> bool:
+        """Whether the configuration ``one`` ``(1, nq)`` violates the margin of one of ``obstacles``."""
+        for obstacle in obstacles:
+            pool = self._prepared(obstacle, margin_m, near)
+            if pool_collisions(pool, self.model, self._data, self.geometry_model, one, 1)[0]:
+                return True
+        return False
 
     def _prepared(self, obstacle: int, margin_m: float, near: BoolArray) -> Any:
         """The obstacle's pool, built once, its margin and active pairs set when the margin changes."""
