@@ -76,7 +76,7 @@ def sampled_path(
 
         def valid(q: FloatArray) -> BoolArray:
             configurations = problem.configurations(q)
-            free = problem.world.keeps_clearance(configurations, required_m, required_self_m, True)
+            free = problem.world.keeps_clearance(configurations, required_m, required_self_m, ordered=True)
             if problem.gravity is not None and free.any():  # and can be held still
                 free[free] = problem.gravity.holds(configurations[free])
             return free
