@@ -219,7 +219,7 @@ class CollisionWorld:
         batch = np.asarray(q, dtype=float)
         if batch.ndim != 2 or batch.shape[1] != self.robot.nq:
             raise CprKinError(f"configurations of shape {batch.shape}; expected (N, {self.robot.nq})")
-        if not np.all(np.isfinite(batch)):
+        if not np.isfinite(batch).all():
             raise CprKinError("configurations contain NaN or inf")
         return batch
 

@@ -79,10 +79,9 @@ class ObstaclePools:
         if len(batch) == 1:  # one configuration: the obstacles in turn, without the array work
             violated[0] = self._one_violated(batch, np.flatnonzero(uncertain[0]).tolist(), margin_m, near)
             return violated
-        if ordered:  # one at a time, up to the first violated
-            for row in np.flatnonzero(uncertain.any(axis=1)).tolist():
-                obstacles = np.flatnonzero(uncertain[row]).tolist()
-                if self._one_violated(batch[row : row + 1], obstacles, margin_m, near):
+        if ordered:  # one at a time, up to the first violated (row by row, each row's obstacles in turn)
+            for row, obstacle in zip(*(index.tolist() for index in np.nonzero(uncertain)), strict=True):
+                if self._one_violated(batch[row : row + 1], [obstacle], margin_m, near):
                     violated[row:] = True
                     break
             return violated

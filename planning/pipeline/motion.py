@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import NDArray
@@ -24,6 +25,11 @@ class Motion:
     q_start: FloatArray
     q_goal: FloatArray
     moving: NDArray[np.intp]
+
+    @cached_property
+    def moves_every_joint(self) -> bool:
+        """The waypoints move every joint, in order: a configuration is its moving joints' values."""
+        return bool(np.array_equal(self.moving, np.arange(self.q_start.size)))
 
     def nodes(self, x: FloatArray, waypoints: int) -> FloatArray:
         """``(S, waypoints + 2, nq)`` start, waypoints and goal of candidates ``x`` ``(S, waypoints k)``."""

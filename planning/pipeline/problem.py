@@ -91,6 +91,8 @@ class Problem:
 
         The other joints held where they start [rad, m].
         """
+        if self.motion.moves_every_joint:
+            return np.array(moving_q, dtype=float)
         full = np.repeat(self.q_start[None], len(moving_q), axis=0)
         full[:, self.moving] = moving_q
         return full
