@@ -6,12 +6,12 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
-from planning.curves.jerk_window import sampled_path_durations
+from planning.curves.jerk_window import jerk_limited_duration, profile_window, sampled_path_durations
 from planning.curves.path_timing import SECOND_SHARE, time_path
-from planning.curves.phase_plane import phase_plane_profile
+from planning.curves.phase_plane import phase_plane_profile, sampled_derivatives
 from planning.curves.spline import SepticSplineSolver, uniform_knots
-from planning.curves.torque_estimate import sampled_torque_durations
-from planning.curves.torque_limits import HEADROOM, torque_time_scale
+from planning.curves.torque_estimate import sampled_torque_durations, torque_limited_duration
+from planning.curves.torque_limits import HEADROOM, TorqueRows, phase_plane_rows, torque_time_scale
 from planning.curves.trajectory import Trajectory
 from planning.curves.velocity_caps import ROUNDS, TOLERANCE
 from planning.pipeline.scene import DEFAULT_SPLINE
@@ -134,6 +134,39 @@ def test_the_search_estimate_of_many_paths_is_each_paths_own(robot: ck.Robot, pa
         for one in samples
     ]
     assert together.tolist() == alone and together[1] == 0.0 and len(set(together.tolist())) >= 3
+
+
+def test_the_compiled_estimate_of_a_path_is_the_rows_profile_and_window_composed(
+    robot: ck.Robot, path: Trajectory
+) -> None:
+    """torque_limited_duration against its pieces in Python: the interpolated torque rows of
+    phase_plane_rows, the phase-plane profile, its jerk window and duration."""
+    limits = robot.limits
+    kinematic = np.stack([limits.velocity, limits.acceleration, limits.jerk])
+    window = float(np.max(limits.acceleration / limits.jerk))
+    points = path(np.linspace(path.knots[0], path.knots[-1], 64))
+    heavy = ck.robot_dynamics(robot, ck.Payload(15.0, (0.0, 0.0, 0.05)))
+    steps, d1, d2 = sampled_derivatives(points, limits.velocity)
+    pick = np.append(np.arange(0, len(d1), 4), len(d1) - 1)
+    terms = np.stack(heavy.path_terms(points[pick], d1[pick], d2[pick]))
+    bound = heavy.effort * (1.0 - HEADROOM)
+    where = np.arange(len(d1))
+    right = np.clip(np.searchsorted(pick, where), 1, len(pick) - 1)
+    share = ((where - pick[right - 1]) / (pick[right] - pick[right - 1]))[None, :, None]
+    slope, curve, offset = terms[:, right - 1] * (1.0 - share) + terms[:, right] * share
+    torque_rows = TorqueRows(slope, curve, offset, bound)
+    rows = phase_plane_rows(d1, d2, limits.velocity, limits.acceleration, torque_rows)
+    x = phase_plane_profile(rows[0], rows[1], steps, rows[2], rows[3], rows[4])
+    times, used, usage = profile_window(x, steps, d1, limits.jerk, window, ROUNDS, TOLERANCE, SECOND_SHARE)
+    composed = jerk_limited_duration(times, used, usage, SECOND_SHARE)
+    compiled = torque_limited_duration(
+        steps, d1, d2, pick, terms, bound, kinematic, window, ROUNDS, TOLERANCE, SECOND_SHARE
+    )
+    assert compiled == composed
+    plain = sampled_path_durations(
+        points[None], *limits_of(kinematic), window, ROUNDS, TOLERANCE, SECOND_SHARE
+    )
+    assert compiled > plain[0]  # the payload's torques bind
 
 
 def test_the_search_keeps_torques_only_when_they_bind_on_the_straight_path(robot: ck.Robot) -> None:

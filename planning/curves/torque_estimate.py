@@ -13,9 +13,10 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from cpr_kin.compiled import njit
 from planning.curves.jerk_window import jerk_limited_duration, profile_window, sampled_path_durations
 from planning.curves.phase_plane import kept_samples, phase_plane_profile, sampled_derivatives
-from planning.curves.torque_limits import HEADROOM, TorqueModel, TorqueRows, phase_plane_rows
+from planning.curves.torque_limits import HEADROOM, TorqueModel
 from planning.curves.velocity_caps import ROUNDS, TOLERANCE
 
 FloatArray = NDArray[np.float64]
@@ -53,7 +54,8 @@ def sampled_torque_durations(
         if len(index) < 2:
             continue
         steps, d1, d2 = sampled_derivatives(points[s], velocity)
-        pick = np.unique(np.append(np.arange(0, len(index), TERM_STRIDE), len(index) - 1))
+        pick = np.arange(0, len(index), TERM_STRIDE)  # and the last sample
+        pick = pick if pick[-1] == len(index) - 1 else np.append(pick, len(index) - 1)
         dq, ddq = np.zeros((2, len(pick), samples.shape[2]))
         dq[:, fitted], ddq[:, fitted] = d1[pick], d2[pick]
         paths.append((s, len(index), steps, d1, d2, pick))
@@ -67,20 +69,63 @@ def sampled_torque_durations(
         model.path_terms(np.concatenate(rows_q), np.concatenate(rows_dq), np.concatenate(rows_ddq))
     )
     ends = np.cumsum([len(pick) for *_, pick in paths])
-    for (s, kept, steps, d1, d2, pick), end in zip(paths, ends, strict=True):
-        terms = every[:, end - len(pick) : end][:, :, limited]
+    for (s, _, steps, d1, d2, pick), end in zip(paths, ends, strict=True):
+        terms = np.ascontiguousarray(every[:, end - len(pick) : end][:, :, limited])
         if np.any(np.abs(terms[2]) > bound):  # gravity beyond a limit: the estimate without torques
             plain = sampled_path_durations(
                 points[s : s + 1], velocity, acceleration, jerk, window_s, ROUNDS, TOLERANCE, second_share
             )
             durations[s] = plain[0]
             continue
-        where = np.arange(kept)
-        right = np.clip(np.searchsorted(pick, where), 1, len(pick) - 1)
-        share = ((where - pick[right - 1]) / (pick[right] - pick[right - 1]))[None, :, None]
-        slope, curve, offset = terms[:, right - 1] * (1.0 - share) + terms[:, right] * share
-        rows = phase_plane_rows(d1, d2, velocity, acceleration, TorqueRows(slope, curve, offset, bound))
-        x = phase_plane_profile(rows[0], rows[1], steps, rows[2], rows[3], rows[4])
-        times, window, usage = profile_window(x, steps, d1, jerk, window_s, ROUNDS, TOLERANCE, second_share)
-        durations[s] = jerk_limited_duration(times, window, usage, second_share)
+        durations[s] = torque_limited_duration(
+            steps, d1, d2, pick, terms, bound, limits, window_s, ROUNDS, TOLERANCE, second_share
+        )
     return durations
+
+
+@njit
+def torque_limited_duration(
+    steps: FloatArray,
+    d1: FloatArray,
+    d2: FloatArray,
+    pick: NDArray[np.int64],
+    terms: FloatArray,
+    bound: FloatArray,
+    limits: FloatArray,
+    window_s: float,
+    rounds: int,
+    tolerance: float,
+    second_share: float,
+) -> float:
+    """The duration estimate [s] of one sampled path with its torques as rows of the phase plane.
+
+    The path's arc-length steps ``steps`` and derivatives ``d1``, ``d2`` ``(M, nj)``
+    (:func:`~planning.curves.phase_plane.sampled_derivatives`); the torques' ``terms``
+    ``(3, P, L)`` (slope, curve, gravity's offset) at its samples ``pick`` ``(P,)``,
+    interpolated linearly between them, each within ``bound`` ``(L,)``; ``limits`` ``(3, nj)``
+    velocity, acceleration and jerk. The rows of
+    :func:`~planning.curves.torque_limits.phase_plane_rows`, compiled with the interpolation,
+    the profile, its jerk window and duration: the per-path work of
+    :func:`sampled_torque_durations` without the Python between them.
+    """
+    kept, joints = d1.shape
+    torques = terms.shape[2]
+    rows = joints + torques
+    slope, curve, offset = np.zeros((kept, rows)), np.zeros((kept, rows)), np.zeros((kept, rows))
+    slope[:, :joints], curve[:, :joints] = d1, d2
+    right = 1
+    for k in range(kept):
+        while right < len(pick) - 1 and pick[right] < k:
+            right += 1
+        share = (k - pick[right - 1]) / (pick[right] - pick[right - 1])
+        for r in range(torques):
+            slope[k, joints + r] = terms[0, right - 1, r] * (1.0 - share) + terms[0, right, r] * share
+            curve[k, joints + r] = terms[1, right - 1, r] * (1.0 - share) + terms[1, right, r] * share
+            offset[k, joints + r] = terms[2, right - 1, r] * (1.0 - share) + terms[2, right, r] * share
+    velocity = np.full(rows, np.inf)
+    velocity[:joints] = limits[0]
+    acceleration = np.empty(rows)
+    acceleration[:joints], acceleration[joints:] = limits[1], bound
+    x = phase_plane_profile(slope, curve, steps, velocity, acceleration, offset)
+    times, window, usage = profile_window(x, steps, d1, limits[2], window_s, rounds, tolerance, second_share)
+    return jerk_limited_duration(times, window, usage, second_share)
