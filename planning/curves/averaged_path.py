@@ -11,13 +11,15 @@ the margin, and its fastest timing fails the certified check after it has cost a
 a verification.
 
 :func:`averaged_samples` computes, for a path known at a few dozen samples, the profile the
-duration estimate computes (:mod:`planning.curves.jerk_window`: the same phase plane, the same
-window widenings), the instants at which it reaches each sample, and each sample's position
-averaged over the kernel about its instant (a midpoint rule of :data:`QUADRATURE` points on
-the path interpolated linearly in time). The choice stage
-(:mod:`planning.pipeline.choose`) times first the candidates whose averaged samples keep the
-clearance. Not modelled, as in the estimate: the timing's velocity caps, which slow the
-profile where they bind and so cut less; the prediction errs towards a cut.
+duration estimate computes (:mod:`planning.curves.jerk_window`: the same phase plane, and the
+window widened at most the rounds the caller asks: the choice's foresight asks none, as the
+timing mostly keeps the narrow window, :mod:`planning.curves.local_caps`), the instants at
+which it reaches each sample, and each sample's position averaged over the kernel about its
+instant (a midpoint rule of :data:`QUADRATURE` points on the path interpolated linearly in
+time). The choice stage (:mod:`planning.pipeline.choose`) times first the candidates whose
+averaged samples keep the clearance. Not modelled: the timing's velocity caps and locally
+lowered accelerations, which slow the profile where they bind and so cut less; the
+prediction errs towards a cut.
 """
 
 from __future__ import annotations

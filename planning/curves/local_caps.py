@@ -47,7 +47,9 @@ def locally_capped_motion(
     window_s: float,
     step_s: float,
     tolerance: float,
+    *,
     shortest_s: float = np.inf,
+    uncapped: FloatArray | None = None,
 ) -> tuple[float, FloatArray]:
     """The shortest motion of the rounds above, as ``(duration [s], motion (4, T, nj))``.
 
@@ -66,13 +68,18 @@ def locally_capped_motion(
         step_s: the time grid's step [s].
         tolerance: excess of the jerk limit left to the final uniform scaling.
         shortest_s: the shortest duration the caller has already [s].
+        uncapped: the first round's profile (no limit lowered), if the caller has it.
     """
     caps = np.ones_like(path.dq)  # each joint's acceleration cap at each grid point, a share of its limit
     first = max(1, round(window_s / step_s))
     reach = first + max(1, round(second_share * window_s / step_s))  # an input sample's outputs
     best: tuple[float, FloatArray] = (np.inf, np.empty((4, 0, path.dq.shape[1])))
-    for _ in range(LOCAL_ROUNDS):
-        x = _profile(path, limits[0], acceleration_cap, caps)
+    for round_ in range(LOCAL_ROUNDS):
+        x = (
+            uncapped
+            if round_ == 0 and uncapped is not None
+            else _profile(path, limits[0], acceleration_cap, caps)
+        )
         instants = profile_instants(x, path.ds)
         if instants[-1] + (1.0 + second_share) * window_s - 3.0 * step_s > min(shortest_s, best[0]):
             break

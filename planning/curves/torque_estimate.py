@@ -58,7 +58,7 @@ def sampled_torque_durations(
         pick = pick if pick[-1] == len(index) - 1 else np.append(pick, len(index) - 1)
         dq, ddq = np.zeros((2, len(pick), samples.shape[2]))
         dq[:, fitted], ddq[:, fitted] = d1[pick], d2[pick]
-        paths.append((s, len(index), steps, d1, d2, pick))
+        paths.append((s, steps, d1, d2, pick))
         rows_q.append(samples[s, index[pick]])
         rows_dq.append(dq)
         rows_ddq.append(ddq)
@@ -69,7 +69,7 @@ def sampled_torque_durations(
         model.path_terms(np.concatenate(rows_q), np.concatenate(rows_dq), np.concatenate(rows_ddq))
     )
     ends = np.cumsum([len(pick) for *_, pick in paths])
-    for (s, _, steps, d1, d2, pick), end in zip(paths, ends, strict=True):
+    for (s, steps, d1, d2, pick), end in zip(paths, ends, strict=True):
         terms = np.ascontiguousarray(every[:, end - len(pick) : end][:, :, limited])
         if np.any(np.abs(terms[2]) > bound):  # gravity beyond a limit: the estimate without torques
             plain = sampled_path_durations(

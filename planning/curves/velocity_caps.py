@@ -88,6 +88,8 @@ def fastest_motion(
     (``docs/tuning.md``). Last, where the uncapped profile's window widened, the narrow
     window with accelerations lowered locally (:func:`locally_capped`), if shorter.
     """
+    if uncapped is None:
+        uncapped = capped_profile(path, limits, 1.0)
     tried = {1.0: capped_motion(path, limits, second_share, 1.0, profile=uncapped)}
     peak = tried[1.0].peak
     higher, bisected = 1.0, False
@@ -116,7 +118,7 @@ def fastest_motion(
         if found.duration_s < best.duration_s:
             best = found
     if tried[1.0].widened:
-        local = locally_capped(path, limits, second_share, tried[1.0], best.duration_s)
+        local = locally_capped(path, limits, second_share, tried[1.0], best.duration_s, uncapped)
         if local.duration_s < best.duration_s:
             best = local
     return best
@@ -128,16 +130,26 @@ def locally_capped(
     second_share: float,
     uncapped: CappedMotion,
     shortest_s: float = np.inf,
+    profile: FloatArray | None = None,
 ) -> CappedMotion:
     """The motion of :func:`~planning.curves.local_caps.locally_capped_motion` from the uncapped profile.
 
     ``uncapped``: the uncapped profile's motion, whose window widened; its narrower window is
     kept. Its duration is ``inf`` where no round is shorter than ``shortest_s`` [s].
+    ``profile``: the uncapped profile itself, if the caller has it.
     """
     _, acceleration_cap = _caps(limits, 1.0, np.inf)
     step_s = _time_step_s(limits)
     duration_s, motion = locally_capped_motion(
-        path, limits, acceleration_cap, second_share, uncapped.window_s, step_s, TOLERANCE, shortest_s
+        path,
+        limits,
+        acceleration_cap,
+        second_share,
+        uncapped.window_s,
+        step_s,
+        TOLERANCE,
+        shortest_s=shortest_s,
+        uncapped=profile,
     )
     return CappedMotion(duration_s, False, uncapped.peak, uncapped.window_s, motion, step_s)
 
