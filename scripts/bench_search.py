@@ -18,12 +18,16 @@ the wall time of ``cpr-plan plan`` on one scene as a user runs it (a new process
 kernels cached on disk). Targets (issue 17): success >= OMPL's on each class, warm time
 ratio <= 1, ``cpr-plan plan`` <= 1.5 s. ``--refine-stall N`` plans ours with the planner
 setting ``refine_stall: N`` (shorter trajectories for more planning time,
-``docs/tuning.md``); OMPL's pipeline has no such setting. Needs the ``bench`` extra.
+``docs/tuning.md``); OMPL's pipeline has no such setting. ``--bundled`` adds the bundled
+scenes (the shelf, and the paper's with its duration free), as issue 33's B.1 counts them;
+``--planner-seed N`` plans ours with the planner setting ``seed: N``, the search's own random
+draw, so that a figure can be told from the draw that gave it. Needs the ``bench`` extra.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import statistics
 import subprocess
 import sys
@@ -36,8 +40,9 @@ import numpy as np
 
 import cpr_kin as ck
 from planning.errors import NoSolutionError, PlanningError
+from planning.io.bundled import bundled_scene_paths, paper_scene
 from planning.io.narrow_passages import ALL_KINDS, KINDS
-from planning.io.scene_file import dump_scene
+from planning.io.scene_file import dump_scene, load_scene
 from planning.io.scene_generator import generate_scenes
 from planning.peers.ompl_rrt import plan_rrt_connect
 from planning.peers.ruckig_bound import free_space_bound
@@ -87,6 +92,12 @@ def cli_wall_times(scene: Scene, runs: int) -> list[float]:
     return times
 
 
+def bundled_scenes() -> list[Scene]:
+    """The bundled scenes, each its own class: the shelf, and the paper's with its duration free."""
+    scenes = [load_scene(path) for path in bundled_scene_paths() if path.stem != "paper"]
+    return [*scenes, dataclasses.replace(paper_scene(), name="paper_free", duration=None)]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
@@ -113,13 +124,28 @@ def main() -> None:
         default=None,
         help="our planner's refine_stall (default: the scenes' own, the planner's default)",
     )
+    parser.add_argument(
+        "--planner-seed",
+        type=int,
+        default=None,
+        help="our planner's seed, its search's random draw (default: the scenes' own, 0)",
+    )
+    parser.add_argument(
+        "--bundled",
+        action="store_true",
+        help="add the bundled scenes: the shelf and the paper's with its duration free (issue 33 B.1)",
+    )
     args = parser.parse_args()
 
     robot = ck.load_cpr()
     try:
         scenes = generate_scenes(args.scenes, args.seed, robot, narrow=args.narrow, kinds=args.kinds)
+        if args.bundled:
+            scenes += bundled_scenes()
         if args.refine_stall is not None:
             scenes = [scene.with_planner(refine_stall=args.refine_stall) for scene in scenes]
+        if args.planner_seed is not None:
+            scenes = [scene.with_planner(seed=args.planner_seed) for scene in scenes]
     except PlanningError as error:
         parser.error(str(error))
     warm_up(robot)

@@ -28,10 +28,21 @@ def test_the_benchmark_prints_each_class_and_the_bound_with_a_refine_stall() -> 
     assert "Ruckig's free-space bound" in out and "over 2 scenes" in out
 
 
+@pytest.mark.slow
+def test_the_bundled_scenes_count_each_as_its_own_class() -> None:
+    pytest.importorskip("ompl")
+    completed = run("--scenes", "1", "--narrow", "0", "--seed", "3", "--bundled", "--planner-seed", "2")
+    assert completed.returncode == 0, completed.stderr[-2000:]
+    out = completed.stdout
+    assert "  shelf " in out and "  paper " in out and "paper_free" in out
+    assert "over 3 scenes" in out
+
+
 @pytest.mark.parametrize(
     ("arguments", "message"),
     [
         (("--refine-stall", "-1"), "refine_stall = -1 must be an integer in [0, 10000]"),
+        (("--planner-seed", "-1"), "seed = -1"),
         (("--scenes", "2", "--narrow", "3"), "narrow = 3 scenes; allowed: 0 to count = 2"),
     ],
 )
