@@ -158,13 +158,16 @@ class CollisionWorld:
         Also the index of the closest pair per configuration; ``inf`` and ``-1`` for a group
         with no pair. coal's distance of the closest pair, as with every pair computed; the
         pairs are visited in the order of their bounds and only those that may be closest
-        are computed (:func:`cpr_kin.closest_pairs.closest_pairs`).
+        are computed (:func:`cpr_kin.closest_pairs.closest_pairs`). The bounds are the
+        group's columns of every pair's (each pair's bound is its own): the world builds
+        them once, for :meth:`clearance_lower_bounds` too, where a set of the group's own
+        would be built again in every world.
         """
         batch = self._check_batch(q)
         columns = self._pair_group == group_index
         if not columns.any():
             return np.full(len(batch), np.inf), np.full(len(batch), -1, dtype=np.int64)
-        bounds = self._bounds(tuple(columns.tolist()))(batch)
+        bounds = self._bounds((True,) * len(self._pairs))(batch)[:, columns]
         model, data, pairs = self.robot.model, self._data, np.flatnonzero(columns)
         return closest_pairs(model, data, self.geometry_model, self._all, batch, bounds, pairs)
 
