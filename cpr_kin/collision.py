@@ -167,7 +167,7 @@ class CollisionWorld:
         columns = self._pair_group == group_index
         if not columns.any():
             return np.full(len(batch), np.inf), np.full(len(batch), -1, dtype=np.int64)
-        bounds = self._bounds((True,) * len(self._pairs))(batch)[:, columns]
+        bounds = self._every_pair_bounds()(batch)[:, columns]
         model, data, pairs = self.robot.model, self._data, np.flatnonzero(columns)
         return closest_pairs(model, data, self.geometry_model, self._all, batch, bounds, pairs)
 
@@ -183,7 +183,7 @@ class CollisionWorld:
         bounds = np.full((len(batch), len(GROUPS)), np.inf)
         if not self._pairs:
             return bounds
-        per_pair = self._bounds((True,) * len(self._pairs))(batch)
+        per_pair = self._every_pair_bounds()(batch)
         for group_index in range(len(GROUPS)):
             columns = self._pair_group == group_index
             if columns.any():
@@ -277,6 +277,10 @@ class CollisionWorld:
             near = self._reach_distance <= distance_m
             self._within[distance_m] = (near, self._bounds(tuple(near.tolist())) if near.any() else None)
         return self._within[distance_m]
+
+    def _every_pair_bounds(self) -> PairBounds:
+        """The bounds of every pair (built once; each pair's column is its own)."""
+        return self._bounds((True,) * len(self._pairs))
 
     def _bounds(self, active: tuple[bool, ...]) -> PairBounds:
         """The pair bounds of the ``active`` pairs, built once per set of pairs."""

@@ -27,7 +27,6 @@ draw, so that a figure can be told from the draw that gave it. Needs the ``bench
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import statistics
 import subprocess
 import sys
@@ -40,9 +39,9 @@ import numpy as np
 
 import cpr_kin as ck
 from planning.errors import NoSolutionError, PlanningError
-from planning.io.bundled import bundled_scene_paths, paper_scene
+from planning.io.bundled import duration_free_scenes
 from planning.io.narrow_passages import ALL_KINDS, KINDS
-from planning.io.scene_file import dump_scene, load_scene
+from planning.io.scene_file import dump_scene
 from planning.io.scene_generator import generate_scenes
 from planning.peers.ompl_rrt import plan_rrt_connect
 from planning.peers.ruckig_bound import free_space_bound
@@ -92,12 +91,6 @@ def cli_wall_times(scene: Scene, runs: int) -> list[float]:
     return times
 
 
-def bundled_scenes() -> list[Scene]:
-    """The bundled scenes, each its own class: the shelf, and the paper's with its duration free."""
-    scenes = [load_scene(path) for path in bundled_scene_paths() if path.stem != "paper"]
-    return [*scenes, dataclasses.replace(paper_scene(), name="paper_free", duration=None)]
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
@@ -141,7 +134,7 @@ def main() -> None:
     try:
         scenes = generate_scenes(args.scenes, args.seed, robot, narrow=args.narrow, kinds=args.kinds)
         if args.bundled:
-            scenes += bundled_scenes()
+            scenes += duration_free_scenes()  # each its own class
         if args.refine_stall is not None:
             scenes = [scene.with_planner(refine_stall=args.refine_stall) for scene in scenes]
         if args.planner_seed is not None:

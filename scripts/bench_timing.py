@@ -31,7 +31,7 @@ from __future__ import annotations
 import argparse
 import statistics
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -41,9 +41,8 @@ from planning.curves.path_timing import time_path
 from planning.curves.spline import SepticSplineSolver, uniform_knots
 from planning.curves.spline_settings import SplineSettings
 from planning.errors import NoSolutionError, PlanningError
-from planning.io.bundled import bundled_scene_paths, paper_scene
+from planning.io.bundled import duration_free_scenes
 from planning.io.report import markdown_table, text_table
-from planning.io.scene_file import load_scene
 from planning.io.scene_generator import generate_scenes
 from planning.peers.ompl_rrt import plan_rrt_connect
 from planning.peers.ruckig_bound import free_space_bound
@@ -148,8 +147,7 @@ def main() -> None:
     robot = ck.load_cpr()
     warm_up(robot)
     scenes = generate_scenes(args.scenes, args.scene_seed, robot)
-    scenes += [load_scene(path) for path in bundled_scene_paths() if path.stem != "paper"]
-    scenes.append(replace(paper_scene(), name="paper (duration free)", duration=None))
+    scenes += duration_free_scenes()
     rows = []
     for scene in scenes:
         rows.append(row := measure(scene, robot, args.rrt_time))

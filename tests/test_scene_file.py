@@ -17,7 +17,7 @@ import cpr_kin as ck
 from cpr_kin.user_files import StrictLoader
 from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError, SceneError
-from planning.io.bundled import paper_scene, paper_scene_path
+from planning.io.bundled import bundled_scene_paths, duration_free_scenes, paper_scene, paper_scene_path
 from planning.io.scene_file import (
     dump_scene,
     load_scene,
@@ -224,6 +224,15 @@ def test_valid_scene_loads_with_finite_values() -> None:
 def test_bundled_example_scene_loads() -> None:
     scene = load_scene(paper_scene_path().parent / "shelf.yaml")
     assert sorted(o.shape for o in scene.obstacles) == ["box", "cylinder", "sphere"]
+
+
+def test_duration_free_scenes_are_every_bundled_one_the_paper_freed() -> None:
+    scenes = duration_free_scenes()
+    assert len(scenes) == len(bundled_scene_paths())
+    assert all(scene.duration is None for scene in scenes)
+    freed = scenes[-1]
+    assert freed.name == "paper_free" and freed.obstacles == paper_scene().obstacles
+    assert paper_scene().duration == 4.0
 
 
 def yaml12_floats(document: Any) -> Any:

@@ -6,6 +6,7 @@ The paper case (docs/paper_case.md) exists once, as ``planning/scenes/paper.yaml
 
 from __future__ import annotations
 
+import dataclasses
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -39,3 +40,14 @@ def paper_scene(seed: int = 0, **planner_changes: Any) -> Scene:
     """
     scene = load_scene(paper_scene_path())
     return scene.with_planner(seed=seed, **planner_changes)
+
+
+def duration_free_scenes() -> list[Scene]:
+    """Every bundled scene with its duration free: the others as they are, the paper's freed.
+
+    The paper case fixes its duration (4 s); freed, it is timed as fast as the limits allow
+    like the others, as the benchmarks of durations over Ruckig's bound need (its name
+    ``paper_free``).
+    """
+    scenes = [load_scene(path) for path in bundled_scene_paths() if path != paper_scene_path()]
+    return [*scenes, dataclasses.replace(paper_scene(), name="paper_free", duration=None)]
