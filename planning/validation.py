@@ -134,6 +134,13 @@ def describe_validation(
             message = item["msg"].removeprefix("Value error, ")
             if isinstance(value, dict):  # a block (a model's input): its keys tell more than its repr
                 problems.append(f"{where}: {message}")
+            elif item["type"] in ("too_long", "too_short") and isinstance(value, list | tuple):
+                context = item.get("ctx", {})  # its count and the bound, not a cut repr
+                if item["type"] == "too_long":
+                    bound = f"at most {context.get('max_length')} allowed"
+                else:
+                    bound = f"needs at least {context.get('min_length')}"
+                problems.append(f"{where}: {len(value)} item{'' if len(value) == 1 else 's'}; {bound}")
             else:
                 problems.append(f"{where} = {shown(value)}: {message}")
     listed = problems[:1]

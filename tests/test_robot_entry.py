@@ -130,7 +130,7 @@ def test_a_quaternion_and_roll_pitch_yaw_give_the_same_pose() -> None:
             {"robot": {"urdf": "panda", "gripper": "hand"}},
             "robot.gripper: unknown key; allowed here: urdf, srdf",
         ),
-        ({"robot": {"urdf": "panda", "joints": []}}, "robot.joints = []: List should have at least 1 item"),
+        ({"robot": {"urdf": "panda", "joints": []}}, "robot.joints: 0 items; needs at least 1"),
         ({"robot": 3}, "robot = 3: Input should be a valid string"),
         ({"start": {"q": [0.0, "x"]}}, "start.q[1] = 'x': Input should be a valid number"),
         (

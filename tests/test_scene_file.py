@@ -83,7 +83,11 @@ def test_every_shape_and_relative_mesh_path(tmp_path: Path) -> None:
         ({"safety_margn": 0.1}, "safety_margn: unknown key; allowed here: name, robot, safety_margin"),
         (
             {"obstacles": [{"shape": "box", "size": [0.1, 0.1], "xyz": [0, 0, 0]}]},
-            "obstacles[0].size = [0.1, 0.1]",
+            "obstacles[0].size: 2 items; needs at least 3",
+        ),
+        (
+            {"obstacles": [{"shape": "sphere", "radius": 0.01, "xyz": [0, 0, 3 + k]} for k in range(501)]},
+            "obstacles: 501 items; at most 500 allowed",  # the count, not the list
         ),
         (
             {"obstacles": [{"shape": "box", "size": [0.1, 0.1, 0.1]}]},
