@@ -1,7 +1,7 @@
 """MotionBenchMaker: our planner beside OMPL's RRT-Connect pipeline, problem by problem, in one run.
 
-    python scripts/bench_mbm.py [--robots panda ur5] [--classes ...] [--limit N] [--timeout S] [--out DIR]
-                                [--workers N] [--time-limit S]
+    python scripts/bench_mbm.py [--robots panda ur5] [--classes ...] [--limit N [--sample-seed S]]
+                                [--timeout S] [--out DIR] [--workers N] [--time-limit S]
     python scripts/bench_mbm.py --scenes out/arms/*/*.yaml [--timeout S] [--out DIR]
 
 Each problem goes the way a user's does (``import-moveit``, :mod:`planning.io.moveit_import`,
@@ -26,6 +26,10 @@ how many of ours pass ``cpr-plan check`` (the trajectory file read back and veri
 untimed). Rows go to
 ``DIR/mbm.csv``, the table as markdown to ``DIR/mbm.md``. Needs the ``bench`` extra; the
 problems are downloaded once (:mod:`planning.io.mbm`).
+
+``--limit N`` takes the first N problems of each class, those the development looked at most;
+with ``--sample-seed S`` it draws N of each class at random instead (the same seed, the same
+problems): a held-out sample.
 
 Each planner runs in its own worker process; ``--workers N`` plans N problems at once, ours'
 parallel collision checks then on a share of the cores each (on a 2-core machine both
@@ -243,7 +247,7 @@ def cases(args: argparse.Namespace) -> Iterator[tuple[str, str, int, Path]]:
             yield path.resolve().parent.name, group, int(number), path
         return
     for robot_name in args.robots:
-        for problem in problems(robot_name, tuple(args.classes), args.limit):
+        for problem in problems(robot_name, tuple(args.classes), args.limit, args.sample_seed):
             path = args.out / "scenes" / robot_name / f"{problem.name}.yaml"
             import_problem(problem, path)
             yield robot_name, problem.problem_class, problem.index, path
@@ -254,6 +258,11 @@ def main() -> int:
     parser.add_argument("--robots", nargs="+", default=["panda", "ur5"], choices=["panda", "ur5", "fetch"])
     parser.add_argument("--classes", nargs="+", default=list(CLASSES), choices=list(CLASSES))
     parser.add_argument("--limit", type=int, help="problems per class (default: all 100)")
+    parser.add_argument(
+        "--sample-seed",
+        type=int,
+        help="draw --limit problems of each class at random with this seed (default: the first --limit)",
+    )
     parser.add_argument("--timeout", type=float, default=10.0, help="seconds per problem and planner")
     parser.add_argument(
         "--time-limit",
@@ -268,6 +277,10 @@ def main() -> int:
     )
     parser.add_argument("--out", type=Path, default=Path("out/bench_mbm"))
     args = parser.parse_args()
+    if args.limit is not None and not 1 <= args.limit <= 100:
+        parser.error(f"--limit {args.limit} must be in [1, 100] problems per class")
+    if args.sample_seed is not None and (args.sample_seed < 0 or args.limit is None):
+        parser.error(f"--sample-seed {args.sample_seed} must be >= 0, with --limit (its size per class)")
     if args.time_limit is not None and not 0 < args.time_limit <= args.timeout:
         parser.error(f"--time-limit {args.time_limit:g} s must be in (0, --timeout = {args.timeout:g}] s")
     time_limit_s = args.time_limit or TIME_LIMIT_SHARE * args.timeout
@@ -309,8 +322,10 @@ def main() -> int:
     print(f"\n{'robot':6s} {'class':17s} {'valid':>5s} {'ours':>4s} {'ompl':>4s}", end="")
     print(f"  {'ours med/p95 s':>15s}  {'ompl med/p95 s':>15s}  ratio  both   all  dur/bound", end="")
     print("  ompl jerk/lim  ompl >effort  checked")
+    drawn = f" drawn with seed {args.sample_seed}" if args.sample_seed is not None and not args.scenes else ""
     report = [
-        f"{'Scene files' if args.scenes else f'MotionBenchMaker, {args.limit or 100} problem(s) per class'}, "
+        f"{'Scene files' if args.scenes else f'MotionBenchMaker, {args.limit or 100} problem(s) per class'}"
+        f"{drawn}, "
         f"timeout {args.timeout:g} s (ours: time_limit_s {time_limit_s:g} s), "
         "warm (`scripts/bench_mbm.py`)",
         "",

@@ -21,6 +21,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 import cpr_kin as ck
 from planning.errors import PlanningError
 
@@ -114,13 +116,36 @@ class Problem:
         return f"{self.problem_class}_{self.index:04d}"
 
 
-def problems(robot: str, classes: tuple[str, ...] = CLASSES, limit: int | None = None) -> Iterator[Problem]:
-    """The problems of ``robot``'s ``classes``, the first ``limit`` of each (all: ``None``)."""
+def problems(
+    robot: str,
+    classes: tuple[str, ...] = CLASSES,
+    limit: int | None = None,
+    sample_seed: int | None = None,
+) -> Iterator[Problem]:
+    """The problems of ``robot``'s ``classes``: ``limit`` of each (all: ``None``), in index order.
+
+    Args:
+        robot: ``panda``, ``ur5`` or ``fetch``.
+        classes: the classes, in the order given.
+        limit: problems per class, >= 1; ``None``: all of them.
+        sample_seed: ``None``: the first ``limit`` of each class; else ``limit`` drawn at
+            random from each class, without replacement, by a generator of this seed and the
+            class (a sample no one tuned on; the same seed, the same problems of a class
+            whichever other classes are asked).
+    """
+    if limit is not None and limit < 1:
+        raise PlanningError(f"limit = {limit} problems per class must be at least 1 (or None: all)")
+    if sample_seed is not None and sample_seed < 0:
+        raise PlanningError(f"sample_seed = {sample_seed} must be a non-negative integer")
     folder = vamp_resources(robot) / "problems"
     for problem_class in classes:
         if problem_class not in CLASSES:
             raise PlanningError(f"class '{problem_class}' is not one of {list(CLASSES)}")
         requests = sorted((folder / f"{problem_class}_{robot}").glob("request*.yaml"))
+        if sample_seed is not None and limit is not None and limit < len(requests):
+            rng = np.random.default_rng([sample_seed, CLASSES.index(problem_class)])
+            drawn = np.sort(rng.choice(len(requests), size=limit, replace=False))
+            requests = [requests[k] for k in drawn]
         for request in requests[:limit]:
             index = int(request.stem.removeprefix("request"))
             scene = request.with_name(f"scene{index:04d}.yaml")
