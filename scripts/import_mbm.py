@@ -1,6 +1,6 @@
 """Convert every MotionBenchMaker problem to a scene file and count those whose start and goal are valid.
 
-    python scripts/import_mbm.py [--robots panda ur5] [--limit N] [--out DIR]
+    python scripts/import_mbm.py [--robots panda ur5] [--limit N [--sample-seed S]] [--out DIR]
 
 Each problem goes the way a user's does: ``import-moveit`` (:func:`planning.io.moveit_import.import_moveit`
 on vamp-planner 0.6.4's URDF and SRDF, margins 0 as in MoveIt), the scene file written and
@@ -8,6 +8,8 @@ read back (:func:`planning.io.scene_file.load_scene`); then its start and goal a
 against the obstacles and the robot's own links (:func:`planning.pipeline.endpoints.margin_violation`,
 on our collision model: the URDF's meshes as convex hulls, the SRDF's and the scene's allowed
 pairs). Prints per class: problems, converted, start and goal valid, and why the others are not.
+``--limit N --sample-seed S`` converts N problems of each class drawn at random (the same seed,
+the same problems): written with ``--out``, a held-out set for ``bench_mbm.py --scenes``.
 The archive is downloaded once from PyPI and cached (:mod:`planning.io.mbm`).
 """
 
@@ -38,14 +40,23 @@ def main() -> int:
     parser.add_argument("--robots", nargs="+", default=["panda", "ur5"], choices=["panda", "ur5", "fetch"])
     parser.add_argument("--classes", nargs="+", default=list(CLASSES), choices=list(CLASSES))
     parser.add_argument("--limit", type=int, help="problems per class (default: all 100)")
+    parser.add_argument(
+        "--sample-seed",
+        type=int,
+        help="draw --limit problems of each class at random with this seed (default: the first --limit)",
+    )
     parser.add_argument("--out", type=Path, help="folder for the scene files (default: a temporary one)")
     args = parser.parse_args()
+    if args.limit is not None and not 1 <= args.limit <= 100:
+        parser.error(f"--limit {args.limit} must be in [1, 100] problems per class")
+    if args.sample_seed is not None and (args.sample_seed < 0 or args.limit is None):
+        parser.error(f"--sample-seed {args.sample_seed} must be >= 0, with --limit (its size per class)")
     out = args.out or Path(tempfile.mkdtemp(prefix="mbm-"))
     for robot_name in args.robots:
         robot: ck.Robot | None = None
         started = time.perf_counter()
         table: dict[str, collections.Counter[str]] = collections.defaultdict(collections.Counter)
-        for problem in problems(robot_name, tuple(args.classes), args.limit):
+        for problem in problems(robot_name, tuple(args.classes), args.limit, args.sample_seed):
             counts = table[problem.problem_class]
             counts["problems"] += 1
             try:

@@ -46,3 +46,27 @@ def test_the_torque_over_the_limit_is_pinocchio_s_rnea_along_the_trajectory(benc
         for t in times
     )
     assert usage == pytest.approx(oracle, rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        (["--limit", "0"], "--limit 0 must be in [1, 100] problems per class"),
+        (["--sample-seed", "3"], "--sample-seed 3 must be >= 0, with --limit"),
+        (["--limit", "2", "--sample-seed", "-1"], "--sample-seed -1 must be >= 0"),
+    ],
+)
+def test_a_bad_sample_is_named_before_anything_runs(
+    bench: ModuleType,
+    arguments: list[str],
+    message: str,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    tmp_path: Path,
+) -> None:
+    monkeypatch.setattr("sys.argv", ["bench_mbm.py", *arguments, "--out", str(tmp_path / "out")])
+    with pytest.raises(SystemExit) as info:
+        bench.main()
+    assert info.value.code == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()  # nothing written
