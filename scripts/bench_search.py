@@ -21,7 +21,10 @@ setting ``refine_stall: N`` (shorter trajectories for more planning time,
 ``docs/tuning.md``); OMPL's pipeline has no such setting. ``--bundled`` adds the bundled
 scenes (the shelf, and the paper's with its duration free), as issue 33's B.1 counts them;
 ``--planner-seed N`` plans ours with the planner setting ``seed: N``, the search's own random
-draw, so that a figure can be told from the draw that gave it. Needs the ``bench`` extra.
+draw, so that a figure can be told from the draw that gave it. ``--seed S1 S2 ...`` runs and
+reports each generator seed in turn, then issue 33's B per seed and the median of the seeds'
+B.1 medians (fresh seeds: the figure a user meets, not one seed's draw). Needs the ``bench``
+extra.
 """
 
 from __future__ import annotations
@@ -33,7 +36,9 @@ import sys
 import tempfile
 import time
 from collections import defaultdict
+from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -50,10 +55,45 @@ from planning.pipeline.problem import build_problem
 from planning.pipeline.scene import Scene
 
 CLI_TARGET_S = 1.5
+B1_TARGET = 1.10
+"""Issue 33 B.1: our duration over Ruckig's free-space bound, median over a seed's scenes."""
 
 
-Outcome = tuple[bool, float, float]
-"""Success, warm wall time [s] and duration [s] of one planner on one scene."""
+class Outcome(NamedTuple):
+    """One planner on one scene."""
+
+    solved: bool
+    """A certified trajectory."""
+    time_s: float
+    """Warm wall time [s]."""
+    duration_s: float
+    """The trajectory's duration [s] (``nan`` if none)."""
+
+
+@dataclass(frozen=True)
+class Row:
+    """Both planners on one scene."""
+
+    kind: str
+    """Its class: ``regular``, a narrow passage's kind, or a bundled scene's."""
+    scene: Scene
+    ours: Outcome
+    theirs: Outcome
+    bound_s: float
+    """Ruckig's jerk-limited free-space bound [s] (:func:`~planning.peers.ruckig_bound.free_space_bound`)."""
+
+
+@dataclass(frozen=True)
+class SeedSummary:
+    """A generator seed's figures of issue 33 B."""
+
+    seed: int
+    over_bound: float
+    """B.1: our duration / bound, median over the scenes we solve."""
+    time_ratios: dict[str, float]
+    """B.2: ours / OMPL's median warm planning time, per class."""
+    overall_ratio: float
+    """The same over every scene."""
 
 
 def ours(scene: Scene, robot: ck.Robot) -> Outcome:
@@ -62,16 +102,16 @@ def ours(scene: Scene, robot: ck.Robot) -> Outcome:
     try:
         result = plan(scene, robot)
     except NoSolutionError:
-        return False, time.perf_counter() - started, float("nan")
+        return Outcome(False, time.perf_counter() - started, float("nan"))
     elapsed = time.perf_counter() - started
-    return result.verification.accepted, elapsed, result.trajectory.duration
+    return Outcome(result.verification.accepted, elapsed, result.trajectory.duration)
 
 
 def theirs(scene: Scene, robot: ck.Robot, budget_s: float) -> Outcome:
     """The same for OMPL RRT-Connect + simplification + TOPP-RA."""
     started = time.perf_counter()
     result = plan_rrt_connect(scene, robot, budget_s, scene.planner.seed)
-    return result.success, time.perf_counter() - started, result.duration
+    return Outcome(result.success, time.perf_counter() - started, result.duration)
 
 
 def cli_wall_times(scene: Scene, runs: int) -> list[float]:
@@ -91,13 +131,20 @@ def cli_wall_times(scene: Scene, runs: int) -> list[float]:
     return times
 
 
-def main() -> None:
+def parse_arguments(robot: ck.Robot) -> argparse.Namespace:
+    """The command line (module docstring), with each seed's scenes for ``robot`` (``scene_sets``)."""
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
     parser.add_argument("--scenes", type=int, default=100, help="number of scenes (default: 100)")
     parser.add_argument("--narrow", type=int, default=24, help="of which narrow passages (default: 24)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the scene generator (default: 0)")
+    parser.add_argument(
+        "--seed",
+        type=int,
+        nargs="+",
+        default=[0],
+        help="seed(s) of the scene generator, each its own run and report (default: 0)",
+    )
     parser.add_argument(
         "--kinds",
         nargs="+",
@@ -129,67 +176,77 @@ def main() -> None:
         help="add the bundled scenes: the shelf and the paper's with its duration free (issue 33 B.1)",
     )
     args = parser.parse_args()
-
-    robot = ck.load_cpr()
-    try:
-        scenes = generate_scenes(args.scenes, args.seed, robot, narrow=args.narrow, kinds=args.kinds)
-        if args.bundled:
-            scenes += duration_free_scenes()  # each its own class
-        if args.refine_stall is not None:
-            scenes = [scene.with_planner(refine_stall=args.refine_stall) for scene in scenes]
-        if args.planner_seed is not None:
-            scenes = [scene.with_planner(seed=args.planner_seed) for scene in scenes]
+    try:  # every seed's scenes, before anything runs: a bad argument is named at once
+        args.scene_sets = [seed_scenes(args, seed, robot) for seed in args.seed]
     except PlanningError as error:
         parser.error(str(error))
-    warm_up(robot)
-    plan_rrt_connect(scenes[0], robot, args.budget, 0)  # OMPL's imports and first call, untimed
+    return args
+
+
+def seed_scenes(args: argparse.Namespace, seed: int, robot: ck.Robot) -> list[Scene]:
+    """The scenes of generator ``seed`` for ``robot`` with the command line's planner settings."""
+    scenes = generate_scenes(args.scenes, seed, robot, narrow=args.narrow, kinds=args.kinds)
+    if args.bundled:
+        scenes += duration_free_scenes()  # each its own class
+    if args.refine_stall is not None:
+        scenes = [scene.with_planner(refine_stall=args.refine_stall) for scene in scenes]
+    if args.planner_seed is not None:
+        scenes = [scene.with_planner(seed=args.planner_seed) for scene in scenes]
+    return scenes
+
+
+def run_scenes(scenes: list[Scene], robot: ck.Robot, budget_s: float) -> list[Row]:
+    """Both planners on every scene, alternating, each line printed as it comes."""
     rows = []
     print(f"{'scene':<14}{'ours':>6}{'time s':>9}{'dur s':>8}   {'OMPL':>6}{'time s':>9}{'dur s':>8}")
     for scene in scenes:
-        mine = ours(scene, robot)
-        peer = theirs(scene, robot, args.budget)
-        rows.append((scene.name.split("_")[0], scene.name, mine, peer))
+        mine, peer = ours(scene, robot), theirs(scene, robot, budget_s)
+        kind = scene.name.split("_")[0]
+        bound = free_space_bound(build_problem(scene, robot))
+        rows.append(Row("regular" if kind == "scene" else kind, scene, mine, peer, bound))
         print(
-            f"{scene.name:<14}{'ok' if mine[0] else 'FAIL':>6}{mine[1]:9.3f}{mine[2]:8.3f}   "
-            f"{'ok' if peer[0] else 'FAIL':>6}{peer[1]:9.3f}{peer[2]:8.3f}",
+            f"{scene.name:<14}{'ok' if mine.solved else 'FAIL':>6}{mine.time_s:9.3f}{mine.duration_s:8.3f}   "
+            f"{'ok' if peer.solved else 'FAIL':>6}{peer.time_s:9.3f}{peer.duration_s:8.3f}",
             flush=True,
         )
+    return rows
 
+
+def report(seed: int, rows: list[Row]) -> SeedSummary:
+    """Print a seed's figures (module docstring) and return issue 33 B's."""
     print(
         "\nper class: success (ours / OMPL; target: ours >= OMPL's) and median warm planning time "
         "(a failure at the time it took; target: ratio <= 1)"
     )
-    classes: dict[str, list[tuple[Outcome, Outcome]]] = defaultdict(list)
-    for kind, _, mine, peer in rows:
-        classes["regular" if kind == "scene" else kind].append((mine, peer))
-    for kind, outcomes in classes.items():
-        won, theirs_won = sum(m[0] for m, _ in outcomes), sum(p[0] for _, p in outcomes)
+    classes: dict[str, list[Row]] = defaultdict(list)
+    for row in rows:
+        classes[row.kind].append(row)
+    ratios = {}
+    for kind, members in classes.items():
+        won, theirs_won = sum(r.ours.solved for r in members), sum(r.theirs.solved for r in members)
         verdict = "met" if won >= theirs_won else "NOT met"
-        mine_s = statistics.median(m[1] for m, _ in outcomes)
-        theirs_s = statistics.median(p[1] for _, p in outcomes)
+        mine_s = statistics.median(r.ours.time_s for r in members)
+        theirs_s = statistics.median(r.theirs.time_s for r in members)
+        ratios[kind] = mine_s / theirs_s
         print(
-            f"  {kind:<8} {won:3d} / {theirs_won:3d} of {len(outcomes):3d}   {verdict:<8}"
-            f"{mine_s:7.3f} s / {theirs_s:7.3f} s = {mine_s / theirs_s:5.2f}"
+            f"  {kind:<8} {won:3d} / {theirs_won:3d} of {len(members):3d}   {verdict:<8}"
+            f"{mine_s:7.3f} s / {theirs_s:7.3f} s = {ratios[kind]:5.2f}"
         )
-    missed = [name for _, name, mine, peer in rows if peer[0] and not mine[0]]
+    missed = [r.scene.name for r in rows if r.theirs.solved and not r.ours.solved]
     print(f"  solved by OMPL, not by us: {', '.join(missed) if missed else 'none'}")
 
-    our_time = statistics.median(mine[1] for *_, mine, _ in rows)
-    their_time = statistics.median(peer[1] for *_, peer in rows)
+    our_time = statistics.median(r.ours.time_s for r in rows)
+    their_time = statistics.median(r.theirs.time_s for r in rows)
     print(
         f"\nwarm planning time, median over {len(rows)} scenes: ours {our_time:.3f} s, OMPL pipeline "
         f"{their_time:.3f} s, ratio {our_time / their_time:.2f} (target <= 1)"
     )
-    both = [
-        (scene, mine[2], peer[2])
-        for scene, (_, _, mine, peer) in zip(scenes, rows, strict=True)
-        if mine[0] and peer[0]
-    ]
+    both = [r for r in rows if r.ours.solved and r.theirs.solved]
     if both:
-        mine_d, peer_d = np.median([b[1] for b in both]), np.median([b[2] for b in both])
-        bounds = [free_space_bound(build_problem(scene, robot)) for scene, *_ in both]
-        bound_d = np.median(bounds)
-        beaten = sum(b[2] < bound for b, bound in zip(both, bounds, strict=True))
+        mine_d = np.median([r.ours.duration_s for r in both])
+        peer_d = np.median([r.theirs.duration_s for r in both])
+        bound_d = np.median([r.bound_s for r in both])
+        beaten = sum(r.theirs.duration_s < r.bound_s for r in both)
         print(
             f"duration on the {len(both)} scenes both solve, median: ours {mine_d:.3f} s (jerk-limited), "
             f"OMPL + TOPP-RA {peer_d:.3f} s (jerk unbounded), ratio {mine_d / peer_d:.3f}\n"
@@ -197,21 +254,60 @@ def main() -> None:
             f"{bound_d / peer_d:.3f}); OMPL + TOPP-RA beats the bound on {beaten} of {len(both)} scenes"
         )
     over_bound: dict[str, list[float]] = defaultdict(list)
-    for scene, (kind, _, mine, _) in zip(scenes, rows, strict=True):
-        if mine[0]:
-            bound = free_space_bound(build_problem(scene, robot))
-            over_bound["regular" if kind == "scene" else kind].append(mine[2] / bound)
-    every = [ratio for ratios in over_bound.values() for ratio in ratios]
+    for row in rows:
+        if row.ours.solved:
+            over_bound[row.kind].append(row.ours.duration_s / row.bound_s)
+    every = [ratio for kind_ratios in over_bound.values() for ratio in kind_ratios]
+    median = statistics.median(every) if every else float("nan")
     print(
         f"our duration / Ruckig's free-space bound (which ignores the obstacles), median: "
-        f"{statistics.median(every):.3f} over {len(every)} scenes (target <= 1.10); per class: "
+        f"{median:.3f} over {len(every)} scenes (target <= {B1_TARGET:.2f}); per class: "
         + ", ".join(f"{kind} {statistics.median(r):.3f}" for kind, r in over_bound.items())
     )
+    return SeedSummary(seed, median, ratios, our_time / their_time)
+
+
+def summarise(summaries: list[SeedSummary]) -> None:
+    """Issue 33 B over several generator seeds: each seed's figures, then the median of their B.1."""
+    print(
+        "\nissue 33 B per generator seed: B.1 duration / bound (median), "
+        "B.2 the slowest generated class's time ratio"
+    )
+    for summary in summaries:
+        generated = {k: r for k, r in summary.time_ratios.items() if k == "regular" or k in ALL_KINDS}
+        kind, ratio = max(generated.items(), key=lambda item: item[1])
+        b1 = "met" if summary.over_bound <= B1_TARGET else "NOT met"
+        b2 = "met" if ratio <= 1.0 else "NOT met"
+        print(
+            f"  seed {summary.seed:<6} B.1 {summary.over_bound:.3f} {b1:<8}"
+            f"B.2 {kind} {ratio:.2f} {b2:<8}over all {summary.overall_ratio:.2f}"
+        )
+    medians = [summary.over_bound for summary in summaries]
+    met = sum(median <= B1_TARGET for median in medians)
+    print(
+        f"B.1 met on {met} of {len(medians)} seeds; the median of the seeds' medians "
+        f"{statistics.median(medians):.3f} (range {min(medians):.3f}-{max(medians):.3f})"
+    )
+
+
+def main() -> None:
+    robot = ck.load_cpr()
+    args = parse_arguments(robot)
+    warm_up(robot)
+    plan_rrt_connect(args.scene_sets[0][0], robot, args.budget, 0)  # OMPL's imports and first call, untimed
+    summaries = []
+    for seed, scenes in zip(args.seed, args.scene_sets, strict=True):
+        if len(args.seed) > 1:
+            print(f"\n== generator seed {seed}")
+        summaries.append(report(seed, run_scenes(scenes, robot, args.budget)))
+    if len(summaries) > 1:
+        summarise(summaries)
     if args.cli_runs:
-        times = cli_wall_times(scenes[0], args.cli_runs)
+        scene = args.scene_sets[0][0]
+        times = cli_wall_times(scene, args.cli_runs)
         median = statistics.median(times)
         print(
-            f"`cpr-plan plan {scenes[0].name}` in a new process: median {median:.2f} s "
+            f"`cpr-plan plan {scene.name}` in a new process: median {median:.2f} s "
             f"over {len(times)} runs ({', '.join(f'{t:.2f}' for t in times)}); target <= {CLI_TARGET_S} s"
         )
 

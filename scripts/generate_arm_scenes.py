@@ -50,6 +50,8 @@ def main() -> int:
     )
     parser.add_argument("--out", type=Path, required=True, help="folder for the scene files")
     args = parser.parse_args()
+    if args.count < 1 or args.seed < 0:
+        parser.error(f"--count {args.count} must be >= 1 and --seed {args.seed} >= 0")
     named = args.robot in EXAMPLE_ROBOTS
     urdf = example_robot(args.robot) if named else Path(args.robot).resolve()
     entry: str | dict[str, Any] = args.robot if named else str(urdf)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from planning.errors import PlanningError
 from planning.io.narrow_passages import ALL_KINDS, KINDS
 from planning.io.scene_file import dump_scene
 from planning.io.scene_generator import generate_scenes
@@ -29,7 +30,11 @@ def main() -> None:
     )
     parser.add_argument("--out", type=Path, required=True, help="folder for the scene files")
     args = parser.parse_args()
-    for scene in generate_scenes(args.count, args.seed, narrow=args.narrow, kinds=args.kinds):
+    try:
+        scenes = generate_scenes(args.count, args.seed, narrow=args.narrow, kinds=args.kinds)
+    except PlanningError as error:
+        parser.error(str(error))
+    for scene in scenes:
         dump_scene(scene, args.out / f"{scene.name}.yaml")
     print(f"wrote {args.count} scenes into {args.out}")
 

@@ -72,6 +72,8 @@ def test_no_qualifying_draw_is_an_error_naming_the_fix(ur5: ck.Robot) -> None:
         blocked_scene("ur5_0", "ur5", ur5, 0, self_clearance_m=1.0, draws=20)
     with pytest.raises(PlanningError, match=r"draws = 0 must be a whole number >= 1"):
         blocked_scene("ur5_0", "ur5", ur5, 0, draws=0)
+    with pytest.raises(PlanningError, match=r"seed = -1 must be an integer in \[0, "):
+        blocked_scene("ur5_0", "ur5", ur5, -1)
     ur10 = ck.load_robot(example_robot("ur10"))  # example-robot-data has no SRDF for it
     with pytest.raises(PlanningError, match=r"lower self_clearance_m, or give the robot its SRDF"):
         blocked_scene("ur10_0", "ur10", ur10, 0, self_clearance_m=1.0, draws=20)

@@ -38,12 +38,27 @@ def test_the_bundled_scenes_count_each_as_its_own_class() -> None:
     assert "over 3 scenes" in out
 
 
+@pytest.mark.slow
+def test_several_generator_seeds_end_with_issue_33_b_per_seed_and_the_median_of_medians() -> None:
+    pytest.importorskip("ompl")
+    completed = run("--scenes", "1", "--narrow", "1", "--kinds", "pillars", "--seed", "3", "4", "--bundled")
+    assert completed.returncode == 0, completed.stderr[-2000:]
+    out = completed.stdout
+    assert "== generator seed 3" in out and "== generator seed 4" in out
+    assert out.count("our duration / Ruckig's free-space bound") == 2
+    summary = out[out.index("issue 33 B per generator seed") :]
+    assert "seed 3 " in summary and "seed 4 " in summary
+    assert "B.2 pillars" in summary  # the generated class, not the bundled paper scene's own search
+    assert "of 2 seeds; the median of the seeds' medians" in summary
+
+
 @pytest.mark.parametrize(
     ("arguments", "message"),
     [
         (("--refine-stall", "-1"), "refine_stall = -1 must be an integer in [0, 10000]"),
         (("--planner-seed", "-1"), "seed = -1"),
         (("--scenes", "2", "--narrow", "3"), "narrow = 3 scenes; allowed: 0 to count = 2"),
+        (("--seed", "3", "-1"), "seed = -1 must be an integer in [0, "),
     ],
 )
 def test_a_bad_argument_is_one_line_naming_it(arguments: tuple[str, ...], message: str) -> None:

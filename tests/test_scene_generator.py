@@ -64,6 +64,10 @@ def test_narrow_passages_are_reproducible_and_block_the_straight_swing(robot: ck
 
 
 def test_narrow_count_is_checked(robot: ck.Robot) -> None:
+    with pytest.raises(PlanningError, match=r"seed = -1 must be an integer in \[0, "):
+        generate_scenes(2, -1, robot)  # numpy's own error before: "expected non-negative integer"
+    with pytest.raises(PlanningError, match=r"count = -2 must be an integer in \[0, 100000\]"):
+        generate_scenes(-2, 0, robot)
     with pytest.raises(PlanningError, match="narrow = 5"):
         generate_scenes(3, robot=robot, narrow=5)
     with pytest.raises(PlanningError, match="kind = 'tunnel'"):

@@ -22,7 +22,9 @@ import numpy as np
 
 import cpr_kin as ck
 from planning.errors import PlanningError
+from planning.pipeline.settings import MAX_SEED
 from planning.pipeline.torques import held
+from planning.validation import integer_in
 
 DRAWS = 4000
 """Most draws of a start and goal before :func:`blocked_scene` gives up."""
@@ -50,10 +52,11 @@ def blocked_scene(
 
     Raises:
         PlanningError: no start and goal of ``draws`` draws qualify (the message counts why), or
-            ``draws`` is no whole number >= 1.
+            ``draws`` is no whole number >= 1, or ``seed`` no non-negative integer.
     """
     if not (isinstance(draws, int) and draws >= 1):
         raise PlanningError(f"draws = {draws!r} must be a whole number >= 1")
+    integer_in("seed", seed, 0, MAX_SEED)
     rng = np.random.default_rng(seed)
     lower, upper = robot.limits.lower, robot.limits.upper
     middle, half = (lower + upper) / 2, (upper - lower) / 2

@@ -19,8 +19,12 @@ import numpy as np
 import cpr_kin as ck
 from planning.errors import PlanningError
 from planning.pipeline.scene import Scene
-from planning.pipeline.settings import PlannerSettings
+from planning.pipeline.settings import MAX_SEED, PlannerSettings
 from planning.pipeline.target import Target
+from planning.validation import integer_in
+
+MAX_SCENES = 100_000
+"""Most scenes one call generates."""
 
 if TYPE_CHECKING:
     from planning.io.narrow_passages import Kind
@@ -95,9 +99,15 @@ def generate_scenes(
     The last ``narrow`` of them are narrow passages (:mod:`planning.io.narrow_passages`),
     of ``kinds`` in turn (default: :data:`~planning.io.narrow_passages.KINDS`), drawn from a
     stream of their own: the other scenes are the same whatever ``narrow`` and ``kinds`` are.
+
+    Raises:
+        PlanningError: ``count`` is no integer in [0, :data:`MAX_SCENES`], ``seed`` no
+            non-negative integer, ``narrow`` not within [0, ``count``], or an unknown kind.
     """
     from planning.io.narrow_passages import ALL_KINDS, KINDS, narrow_scene
 
+    integer_in("count", count, 0, MAX_SCENES)
+    integer_in("seed", seed, 0, MAX_SEED)
     if not 0 <= narrow <= count:
         raise PlanningError(f"narrow = {narrow} scenes; allowed: 0 to count = {count}")
     kinds = tuple(KINDS if kinds is None else kinds)
