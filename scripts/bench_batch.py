@@ -24,6 +24,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from planning.cli.arguments import COUNT, SEED, integer_at_least
+
 TARGET_S = 10.0
 
 
@@ -74,11 +76,13 @@ def write_scenes(code: Path, folder: Path, count: int, seed: int, narrow: int) -
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--scenes", type=int, default=100, help="generated scenes (default: 100)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the scene generator (default: 0)")
-    parser.add_argument("--narrow", type=int, default=0, help="of which narrow passages (default: 0)")
-    parser.add_argument("--workers", type=int, default=2, help="worker processes (default: 2)")
-    parser.add_argument("--runs", type=int, default=3, help="timed runs (default: 3)")
+    parser.add_argument("--scenes", type=COUNT, default=100, help="generated scenes (default: 100)")
+    parser.add_argument("--seed", type=SEED, default=0, help="seed of the scene generator (default: 0)")
+    parser.add_argument(
+        "--narrow", type=integer_at_least(0), default=0, help="of which narrow passages (default: 0)"
+    )
+    parser.add_argument("--workers", type=COUNT, default=2, help="worker processes (default: 2)")
+    parser.add_argument("--runs", type=COUNT, default=3, help="timed runs (default: 3)")
     parser.add_argument("--compare", type=Path, help="another checkout to time beside this one")
     args = parser.parse_args()
     here = Path(__file__).resolve().parents[1]

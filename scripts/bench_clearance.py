@@ -16,6 +16,7 @@ from collections.abc import Callable
 import numpy as np
 
 import cpr_kin as ck
+from planning.cli.arguments import COUNT
 
 
 def median_seconds(fn: Callable[[], object], repeats: int) -> float:
@@ -29,8 +30,8 @@ def median_seconds(fn: Callable[[], object], repeats: int) -> float:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeats", type=int, default=15)
-    parser.add_argument("--batch", type=int, default=1000)
+    parser.add_argument("--repeats", type=COUNT, default=15)
+    parser.add_argument("--batch", type=COUNT, default=1000)
     args = parser.parse_args()
 
     robot = ck.load_cpr()

@@ -18,6 +18,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from planning.cli.arguments import COUNT, SECONDS
+
 GOOD = "start: {tcp: [0.5, 0.45, 0.25]}\ngoal: {tcp: [-0.5, 0.45, 0.25]}\n"
 CASES = {
     "alias bomb (9^9 strings, 517 bytes)": 'a: &a ["lol","lol","lol","lol","lol","lol","lol","lol","lol"]\n'
@@ -60,8 +62,8 @@ def run(code: Path, scene: Path, out: Path, timeout: float) -> tuple[int | None,
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--compare", type=Path, help="another checkout to run beside this one")
-    parser.add_argument("--timeout", type=float, default=20.0, help="seconds before a run is stopped")
-    parser.add_argument("--runs", type=int, default=3, help="runs per case (median)")
+    parser.add_argument("--timeout", type=SECONDS, default=20.0, help="seconds before a run is stopped")
+    parser.add_argument("--runs", type=COUNT, default=3, help="runs per case (median)")
     args = parser.parse_args()
     here = Path(__file__).resolve().parents[1]
     codes = {"ours": here} | ({"compared": args.compare.resolve()} if args.compare else {})

@@ -25,6 +25,7 @@ import numpy as np
 import cpr_kin as ck
 from cpr_kin.motion import path_weights
 from cpr_kin.packages import EXAMPLE_ROBOTS, example_robot
+from planning.cli.arguments import COUNT, SEED
 
 
 @dataclasses.dataclass
@@ -61,11 +62,9 @@ def refusal_s(robot: ck.Robot, settings: ck.IkSettings) -> float:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--targets", type=int, default=40, help="targets per arm (default: 40)")
-    parser.add_argument("--seed", type=int, default=1, help="seed of the draws (default: 1)")
+    parser.add_argument("--targets", type=COUNT, default=40, help="targets per arm (default: 40)")
+    parser.add_argument("--seed", type=SEED, default=1, help="seed of the draws (default: 1)")
     args = parser.parse_args()
-    if args.targets < 1:
-        parser.error(f"--targets {args.targets} must be at least 1")
     new = ck.IkSettings()
     old = dataclasses.replace(new, patience=new.iterations)
     print(

@@ -60,6 +60,7 @@ from typing import Any
 import numpy as np
 
 import cpr_kin as ck
+from planning.cli.arguments import COUNT, SECONDS, SEED
 from planning.errors import NoSolutionError, PlanningError
 from planning.io.mbm import CLASSES, endpoint_violations, import_problem, problems
 from planning.io.scene_file import load_scene
@@ -257,30 +258,30 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--robots", nargs="+", default=["panda", "ur5"], choices=["panda", "ur5", "fetch"])
     parser.add_argument("--classes", nargs="+", default=list(CLASSES), choices=list(CLASSES))
-    parser.add_argument("--limit", type=int, help="problems per class (default: all 100)")
+    parser.add_argument("--limit", type=COUNT, help="problems per class (default: all 100)")
     parser.add_argument(
         "--sample-seed",
-        type=int,
+        type=SEED,
         help="draw --limit problems of each class at random with this seed (default: the first --limit)",
     )
-    parser.add_argument("--timeout", type=float, default=10.0, help="seconds per problem and planner")
+    parser.add_argument("--timeout", type=SECONDS, default=10.0, help="seconds per problem and planner")
     parser.add_argument(
         "--time-limit",
-        type=float,
+        type=SECONDS,
         help=f"our planner's time_limit_s [s] (default: {TIME_LIMIT_SHARE:g} of --timeout)",
     )
     parser.add_argument(
         "--scenes", nargs="+", type=Path, help="scene files to run instead of MotionBenchMaker's (any robot)"
     )
     parser.add_argument(
-        "--workers", type=int, default=1, help="problems planned at once (each by both planners in turn)"
+        "--workers", type=COUNT, default=1, help="problems planned at once (each by both planners in turn)"
     )
     parser.add_argument("--out", type=Path, default=Path("out/bench_mbm"))
     args = parser.parse_args()
-    if args.limit is not None and not 1 <= args.limit <= 100:
+    if args.limit is not None and args.limit > 100:
         parser.error(f"--limit {args.limit} must be in [1, 100] problems per class")
-    if args.sample_seed is not None and (args.sample_seed < 0 or args.limit is None):
-        parser.error(f"--sample-seed {args.sample_seed} must be >= 0, with --limit (its size per class)")
+    if args.sample_seed is not None and args.limit is None:
+        parser.error(f"--sample-seed {args.sample_seed} goes with --limit (the sample's size per class)")
     if args.time_limit is not None and not 0 < args.time_limit <= args.timeout:
         parser.error(f"--time-limit {args.time_limit:g} s must be in (0, --timeout = {args.timeout:g}] s")
     time_limit_s = args.time_limit or TIME_LIMIT_SHARE * args.timeout

@@ -31,6 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
+from planning.cli.arguments import COUNT, SECONDS, SEED
 from planning.errors import NoSolutionError, PlanningError
 from planning.io.bundled import paper_scene
 from planning.io.report import markdown_table
@@ -286,12 +287,14 @@ def planner_rows(robot: ck.Robot, scenes: list[Scene], time_limit_s: float) -> l
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--scenes", type=int, default=50, help="generated scenes (default: 50)")
+    parser.add_argument("--scenes", type=COUNT, default=50, help="generated scenes (default: 50)")
     parser.add_argument(
-        "--seeds", type=int, default=10, help="seeds of the optimiser comparison (default: 10)"
+        "--seeds", type=COUNT, default=10, help="seeds of the optimiser comparison (default: 10)"
     )
-    parser.add_argument("--scene-seed", type=int, default=0, help="seed of the scene generator (default: 0)")
-    parser.add_argument("--rrt-time", type=float, default=2.0, help="RRT-Connect time limit [s] (default: 2)")
+    parser.add_argument("--scene-seed", type=SEED, default=0, help="seed of the scene generator (default: 0)")
+    parser.add_argument(
+        "--rrt-time", type=SECONDS, default=2.0, help="RRT-Connect time limit [s] (default: 2)"
+    )
     parser.add_argument("--out", type=Path, default=Path("out/bench_peers.md"), help="Markdown report")
     args = parser.parse_args()
     robot = ck.load_cpr()

@@ -11,13 +11,14 @@ import argparse
 import statistics
 
 import cpr_kin as ck
+from planning.cli.arguments import COUNT
 from planning.io.bundled import paper_scene
 from planning.pipeline.planner import plan
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--runs", type=int, default=7, help="seeds 0..runs-1 (default: 7)")
+    parser.add_argument("--runs", type=COUNT, default=7, help="seeds 0..runs-1 (default: 7)")
     args = parser.parse_args()
     robot = ck.load_cpr()
     plan(paper_scene(0), robot)  # warm-up: imports, caches, thread pool

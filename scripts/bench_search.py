@@ -43,6 +43,7 @@ from typing import NamedTuple
 import numpy as np
 
 import cpr_kin as ck
+from planning.cli.arguments import COUNT, SECONDS, SEED, integer_at_least
 from planning.errors import NoSolutionError, PlanningError
 from planning.io.bundled import duration_free_scenes
 from planning.io.narrow_passages import ALL_KINDS, KINDS
@@ -136,11 +137,13 @@ def parse_arguments(robot: ck.Robot) -> argparse.Namespace:
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
-    parser.add_argument("--scenes", type=int, default=100, help="number of scenes (default: 100)")
-    parser.add_argument("--narrow", type=int, default=24, help="of which narrow passages (default: 24)")
+    parser.add_argument("--scenes", type=COUNT, default=100, help="number of scenes (default: 100)")
+    parser.add_argument(
+        "--narrow", type=integer_at_least(0), default=24, help="of which narrow passages (default: 24)"
+    )
     parser.add_argument(
         "--seed",
-        type=int,
+        type=SEED,
         nargs="+",
         default=[0],
         help="seed(s) of the scene generator, each its own run and report (default: 0)",
@@ -153,10 +156,13 @@ def parse_arguments(robot: ck.Robot) -> argparse.Namespace:
         help=f"the narrow passages' kinds, in turn (default: {' '.join(KINDS)}; all: {' '.join(ALL_KINDS)})",
     )
     parser.add_argument(
-        "--budget", type=float, default=5.0, help="RRT-Connect's time budget [s] (default: 5)"
+        "--budget", type=SECONDS, default=5.0, help="RRT-Connect's time budget [s] (default: 5)"
     )
     parser.add_argument(
-        "--cli-runs", type=int, default=5, help="runs of `cpr-plan plan` (default: 5; 0: none)"
+        "--cli-runs",
+        type=integer_at_least(0),
+        default=5,
+        help="runs of `cpr-plan plan` (default: 5; 0: none)",
     )
     parser.add_argument(
         "--refine-stall",

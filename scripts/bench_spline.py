@@ -20,6 +20,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from planning.cli.arguments import COUNT
 from planning.curves import banded_system
 from planning.curves.spline import SepticSplineSolver, fit_septic_spline
 from planning.curves.spline_settings import SplineSettings
@@ -69,7 +70,7 @@ def measure(
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeats", type=int, default=300)
+    parser.add_argument("--repeats", type=COUNT, default=300)
     args = parser.parse_args()
     rng = np.random.default_rng(0)
     settings = SplineSettings(p=1e6, a=(0.0, 0.0, 1.0))

@@ -37,6 +37,7 @@ from pathlib import Path
 import numpy as np
 
 import cpr_kin as ck
+from planning.cli.arguments import COUNT, SECONDS, SEED
 from planning.curves.path_timing import time_path
 from planning.curves.spline import SepticSplineSolver, uniform_knots
 from planning.curves.spline_settings import SplineSettings
@@ -137,10 +138,12 @@ def monotonicity(robot: ck.Robot, paths: int, seed: int) -> tuple[int, int, floa
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--scenes", type=int, default=50, help="generated scenes (default: 50)")
-    parser.add_argument("--scene-seed", type=int, default=0, help="seed of the scene generator (default: 0)")
-    parser.add_argument("--rrt-time", type=float, default=2.0, help="RRT-Connect time limit [s] (default: 2)")
-    parser.add_argument("--paths", type=int, default=40, help="random paths of the monotonicity check")
+    parser.add_argument("--scenes", type=COUNT, default=50, help="generated scenes (default: 50)")
+    parser.add_argument("--scene-seed", type=SEED, default=0, help="seed of the scene generator (default: 0)")
+    parser.add_argument(
+        "--rrt-time", type=SECONDS, default=2.0, help="RRT-Connect time limit [s] (default: 2)"
+    )
+    parser.add_argument("--paths", type=COUNT, default=40, help="random paths of the monotonicity check")
     parser.add_argument("--out", type=Path, default=Path("out/bench_timing.md"), help="Markdown report")
     args = parser.parse_args()
 

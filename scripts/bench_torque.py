@@ -40,6 +40,7 @@ from typing import Any
 import numpy as np
 
 import cpr_kin as ck
+from planning.cli.arguments import COUNT, SEED
 from planning.curves.path_timing import time_path
 from planning.curves.trajectory import Trajectory
 from planning.errors import NoSolutionError
@@ -217,9 +218,9 @@ def main() -> int:
     """Run the benchmark (module docstring)."""
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--robots", nargs="+", default=["cpr", "panda", "ur5"], choices=list(PAYLOADS_KG))
-    parser.add_argument("--scenes", type=int, default=12, help="generated CPR scenes")
-    parser.add_argument("--scene-seed", type=int, default=31)
-    parser.add_argument("--limit", type=int, default=1, help="MotionBenchMaker problems per class")
+    parser.add_argument("--scenes", type=COUNT, default=12, help="generated CPR scenes")
+    parser.add_argument("--scene-seed", type=SEED, default=31)
+    parser.add_argument("--limit", type=COUNT, default=1, help="MotionBenchMaker problems per class")
     parser.add_argument("--out", type=Path, default=Path("out/bench_torque"))
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)

@@ -28,6 +28,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+from planning.cli.arguments import COUNT
+
 COMMAND = "import sys; from planning.cli import main; sys.exit(main())"
 WALL_TIME = re.compile(rb"\d+\.\d+ s\b")
 
@@ -78,7 +80,7 @@ def outputs(code: Path, scenes: list[Path], seeds: int, work: Path) -> dict[str,
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--compare", type=Path, required=True, help="the other checkout")
-    parser.add_argument("--seeds", type=int, default=3, help="seeds per bundled scene (default: 3)")
+    parser.add_argument("--seeds", type=COUNT, default=3, help="seeds per bundled scene (default: 3)")
     args = parser.parse_args()
     here = Path(__file__).resolve().parents[1]
     if not (args.compare / "planning").is_dir():

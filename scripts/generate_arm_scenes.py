@@ -20,6 +20,7 @@ import yaml
 
 import cpr_kin as ck
 from cpr_kin.packages import EXAMPLE_ROBOTS, example_robot
+from planning.cli.arguments import COUNT, SEED
 from planning.errors import PlanningError
 from planning.io.arm_scenes import blocked_scene
 
@@ -39,8 +40,8 @@ def main() -> int:
         type=Path,
         help="its velocity, acceleration and jerk limits file (default: found beside the URDF)",
     )
-    parser.add_argument("--count", type=int, default=10, help="number of scenes (default: 10)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the first scene (default: 0)")
+    parser.add_argument("--count", type=COUNT, default=10, help="number of scenes (default: 10)")
+    parser.add_argument("--seed", type=SEED, default=0, help="seed of the first scene (default: 0)")
     parser.add_argument("--margin", type=float, default=0.02, help="safety margin [m] (default: 0.02)")
     parser.add_argument(
         "--self-clearance",
@@ -50,8 +51,6 @@ def main() -> int:
     )
     parser.add_argument("--out", type=Path, required=True, help="folder for the scene files")
     args = parser.parse_args()
-    if args.count < 1 or args.seed < 0:
-        parser.error(f"--count {args.count} must be >= 1 and --seed {args.seed} >= 0")
     named = args.robot in EXAMPLE_ROBOTS
     urdf = example_robot(args.robot) if named else Path(args.robot).resolve()
     entry: str | dict[str, Any] = args.robot if named else str(urdf)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from planning.cli.arguments import COUNT, SEED
 from planning.errors import PlanningError
 from planning.io.narrow_passages import ALL_KINDS, KINDS
 from planning.io.scene_file import dump_scene
@@ -13,8 +14,8 @@ from planning.io.scene_generator import generate_scenes
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--count", type=int, default=100, help="number of scenes (default: 100)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the generator (default: 0)")
+    parser.add_argument("--count", type=COUNT, default=100, help="number of scenes (default: 100)")
+    parser.add_argument("--seed", type=SEED, default=0, help="seed of the generator (default: 0)")
     parser.add_argument(
         "--narrow",
         type=int,

@@ -24,6 +24,7 @@ import time
 from pathlib import Path
 
 import cpr_kin as ck
+from planning.cli.arguments import COUNT, SEED
 from planning.errors import PlanningError
 from planning.io.mbm import CLASSES, endpoint_violations, import_problem, problems
 from planning.io.scene_file import load_scene
@@ -39,18 +40,18 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--robots", nargs="+", default=["panda", "ur5"], choices=["panda", "ur5", "fetch"])
     parser.add_argument("--classes", nargs="+", default=list(CLASSES), choices=list(CLASSES))
-    parser.add_argument("--limit", type=int, help="problems per class (default: all 100)")
+    parser.add_argument("--limit", type=COUNT, help="problems per class (default: all 100)")
     parser.add_argument(
         "--sample-seed",
-        type=int,
+        type=SEED,
         help="draw --limit problems of each class at random with this seed (default: the first --limit)",
     )
     parser.add_argument("--out", type=Path, help="folder for the scene files (default: a temporary one)")
     args = parser.parse_args()
-    if args.limit is not None and not 1 <= args.limit <= 100:
+    if args.limit is not None and args.limit > 100:
         parser.error(f"--limit {args.limit} must be in [1, 100] problems per class")
-    if args.sample_seed is not None and (args.sample_seed < 0 or args.limit is None):
-        parser.error(f"--sample-seed {args.sample_seed} must be >= 0, with --limit (its size per class)")
+    if args.sample_seed is not None and args.limit is None:
+        parser.error(f"--sample-seed {args.sample_seed} goes with --limit (the sample's size per class)")
     out = args.out or Path(tempfile.mkdtemp(prefix="mbm-"))
     for robot_name in args.robots:
         robot: ck.Robot | None = None

@@ -14,6 +14,7 @@ import statistics
 import sys
 
 import cpr_kin as ck
+from planning.cli.arguments import COUNT, SEED
 from planning.errors import NoSolutionError, PlanningError
 from planning.io.bundled import paper_scene
 from planning.io.outputs import plan_files
@@ -50,8 +51,10 @@ def seed_summary(robot: ck.Robot, seeds: int) -> tuple[list[tuple[int, str]], li
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="out/paper", help="output folder (default: out/paper)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the reported run (default: 0)")
-    parser.add_argument("--seeds", type=int, default=10, help="seeds 0..N-1 to count successes (default: 10)")
+    parser.add_argument("--seed", type=SEED, default=0, help="seed of the reported run (default: 0)")
+    parser.add_argument(
+        "--seeds", type=COUNT, default=10, help="seeds 0..N-1 to count successes (default: 10)"
+    )
     args = parser.parse_args(argv)
     robot = ck.load_cpr()
     compile_s = warm_up(robot)  # planning times below exclude the one-time JIT compilation

@@ -21,6 +21,7 @@ from typing import Any
 
 import cpr_kin as ck
 from planning import NoSolutionError, Optimizer, PlannerSettings, Scene, load_scene, plan, warm_up
+from planning.cli.arguments import integer_at_least
 from planning.io.bundled import bundled_scene_paths, paper_scene_path
 from planning.io.scene_generator import generate_scenes
 from planning.io.trajectory_io import trajectory_json
@@ -80,7 +81,9 @@ def fingerprint(scene: Scene, robot: ck.Robot, optimizer: Optimizer | None = Non
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--generated", type=int, default=20, help="generated scenes (default: 20)")
+    parser.add_argument(
+        "--generated", type=integer_at_least(0), default=20, help="generated scenes (default: 20)"
+    )
     args = parser.parse_args()
     robot = ck.load_cpr()
     warm_up(robot)

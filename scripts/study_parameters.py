@@ -23,6 +23,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 import cpr_kin as ck
+from planning.cli.arguments import COUNT, SEED, integer_at_least
 from planning.errors import NoSolutionError
 from planning.io.scene_generator import generate_scenes
 from planning.pipeline.planner import plan, warm_up
@@ -97,9 +98,11 @@ def run(scene: Scene, robot: ck.Robot, changes: dict[str, Any]) -> Outcome:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--scenes", type=int, default=30, help="generated scenes (default: 30)")
-    parser.add_argument("--narrow", type=int, default=6, help="of which narrow passages (default: 6)")
-    parser.add_argument("--seed", type=int, default=1, help="seed of the scene generator (default: 1)")
+    parser.add_argument("--scenes", type=COUNT, default=30, help="generated scenes (default: 30)")
+    parser.add_argument(
+        "--narrow", type=integer_at_least(0), default=6, help="of which narrow passages (default: 6)"
+    )
+    parser.add_argument("--seed", type=SEED, default=1, help="seed of the scene generator (default: 1)")
     args = parser.parse_args()
     robot = ck.load_cpr()
     warm_up(robot)

@@ -51,9 +51,11 @@ def test_the_torque_over_the_limit_is_pinocchio_s_rnea_along_the_trajectory(benc
 @pytest.mark.parametrize(
     ("arguments", "message"),
     [
-        (["--limit", "0"], "--limit 0 must be in [1, 100] problems per class"),
-        (["--sample-seed", "3"], "--sample-seed 3 must be >= 0, with --limit"),
-        (["--limit", "2", "--sample-seed", "-1"], "--sample-seed -1 must be >= 0"),
+        (["--limit", "0"], "argument --limit: 0 must be an integer >= 1"),
+        (["--limit", "101"], "--limit 101 must be in [1, 100] problems per class"),
+        (["--sample-seed", "3"], "--sample-seed 3 goes with --limit"),
+        (["--limit", "2", "--sample-seed", "-1"], "argument --sample-seed: -1 must be an integer >= 0"),
+        (["--timeout", "0"], "argument --timeout: 0 must be a number > 0 s"),
     ],
 )
 def test_a_bad_sample_is_named_before_anything_runs(

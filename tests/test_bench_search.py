@@ -58,7 +58,8 @@ def test_several_generator_seeds_end_with_issue_33_b_per_seed_and_the_median_of_
         (("--refine-stall", "-1"), "refine_stall = -1 must be an integer in [0, 10000]"),
         (("--planner-seed", "-1"), "seed = -1"),
         (("--scenes", "2", "--narrow", "3"), "narrow = 3 scenes; allowed: 0 to count = 2"),
-        (("--seed", "3", "-1"), "seed = -1 must be an integer in [0, "),
+        (("--seed", "3", "-1"), "argument --seed: -1 must be an integer >= 0"),
+        (("--budget", "0"), "argument --budget: 0 must be a number > 0 s"),
     ],
 )
 def test_a_bad_argument_is_one_line_naming_it(arguments: tuple[str, ...], message: str) -> None:

@@ -1,0 +1,50 @@
+"""Argument types for the project's scripts: a bad value is argparse's one line and exit 2.
+
+``parser.add_argument("--scenes", type=integer_at_least(1))`` refuses ``--scenes -3`` with
+``argument --scenes: -3 must be an integer >= 1``, before anything runs, where ``type=int``
+would let it through to fail later with a traceback (an empty median, a negative seed).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from collections.abc import Callable
+
+
+def integer_at_least(low: int) -> Callable[[str], int]:
+    """An argparse type: the text as an ``int`` that is at least ``low``."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = low - 1
+        if value < low:
+            raise argparse.ArgumentTypeError(f"{text} must be an integer >= {low}")
+        return value
+
+    return parse
+
+
+def number_above(low: float, unit: str = "") -> Callable[[str], float]:
+    """An argparse type: the text as a finite ``float`` greater than ``low`` (``unit``: shown after it)."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not (math.isfinite(value) and value > low):
+            raise argparse.ArgumentTypeError(f"{text} must be a number > {low:g}{f' {unit}' if unit else ''}")
+        return value
+
+    return parse
+
+
+SEED = integer_at_least(0)
+"""A random generator's seed: a non-negative integer."""
+COUNT = integer_at_least(1)
+"""A count of scenes, runs, problems: a positive integer."""
+SECONDS = number_above(0.0, "s")
+"""A time [s], > 0."""
