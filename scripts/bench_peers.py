@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from planning.cli.arguments import COUNT, SECONDS, SEED
+from planning.cli.arguments import COUNT, SECONDS, SEED, integer_at_least
 from planning.errors import NoSolutionError, PlanningError
 from planning.io.bundled import paper_scene
 from planning.io.report import markdown_table
@@ -287,7 +287,9 @@ def planner_rows(robot: ck.Robot, scenes: list[Scene], time_limit_s: float) -> l
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--scenes", type=COUNT, default=50, help="generated scenes (default: 50)")
+    parser.add_argument(
+        "--scenes", type=integer_at_least(0), default=50, help="generated scenes (default: 50; 0: none)"
+    )
     parser.add_argument(
         "--seeds", type=COUNT, default=10, help="seeds of the optimiser comparison (default: 10)"
     )

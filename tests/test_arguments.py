@@ -39,7 +39,7 @@ def test_a_number_must_be_finite_and_above_its_bound() -> None:
         ("bench_batch", ["--runs", "0"], "argument --runs: 0 must be an integer >= 1"),
         ("bench_hostile", ["--timeout", "-1"], "argument --timeout: -1 must be a number > 0 s"),
         ("bench_ik", ["--seed", "-1"], "argument --seed: -1 must be an integer >= 0"),
-        ("bench_peers", ["--scenes", "-1"], "argument --scenes: -1 must be an integer >= 1"),
+        ("bench_peers", ["--scenes", "-1"], "argument --scenes: -1 must be an integer >= 0"),
         ("bench_planner", ["--runs", "0"], "argument --runs: 0 must be an integer >= 1"),
         ("bench_timing", ["--rrt-time", "0"], "argument --rrt-time: 0 must be a number > 0 s"),
         ("bench_torque", ["--limit", "-1"], "argument --limit: -1 must be an integer >= 1"),
