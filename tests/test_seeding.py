@@ -227,7 +227,7 @@ def test_after_finer_after_samples_the_trees_keep_the_finer_clearance(robot: ck.
     problem = with_planner(build_problem(scene, robot), tuning=early)
     finer = finer_problem(problem)
     assert finer is not None and finer.scene.planner.verify_step_m == 0.001
-    found = sampled_path(problem, np.random.default_rng(0), finer=finer)
+    found = sampled_path(problem, np.random.default_rng(0), finer=lambda: finer)
     assert found is not None and found.relaxed and found.samples > 300
     dense = np.concatenate([waypoints_along(found.path, 200, ck.path_weights(robot)[problem.moving])])
     keeps = problem.world.keeps_clearance
@@ -239,6 +239,25 @@ def test_after_finer_after_samples_the_trees_keep_the_finer_clearance(robot: ck.
     assert attempt.path is not None and attempt.problem.scene.planner.verify_step_m == 0.001
     smallest = with_planner(problem, verify_step_m=VERIFY_STEP_RANGE_M[0])
     assert finer_problem(smallest) is None  # no finer step than this: the trees keep its clearance
+
+
+def test_the_finer_problem_is_built_once_and_only_when_the_trees_need_it(window: Problem) -> None:
+    from planning.pipeline.seeding import finer_problem, lazy_finer_problem
+
+    built: list[Problem] = []
+
+    def finer() -> Problem:
+        made = finer_problem(window)
+        assert made is not None
+        built.append(made)
+        return made
+
+    found = sampled_path(window, np.random.default_rng(3), finer=finer)
+    assert found is not None and not found.relaxed and found.samples < SeedingTuning().finer_after
+    assert not built  # the draw ended before the trees would keep the finer clearance
+    lazy = lazy_finer_problem(window)
+    assert lazy is not None and lazy() is lazy()  # built once, kept
+    assert lazy().scene.planner == finer().scene.planner  # the same problem as finer_problem's
 
 
 def test_a_passage_rrt_connect_needs_thousands_of_samples_for_is_planned(robot: ck.Robot) -> None:
@@ -393,12 +412,12 @@ def test_samples_near_the_trees_lead_a_goal_out_of_its_shelf(tmp_path: Any) -> N
     """
     from planning.io.mbm import import_problem, problems
     from planning.io.scene_file import load_scene
-    from planning.pipeline.seeding import finer_problem
+    from planning.pipeline.seeding import lazy_finer_problem
     from planning.search.rrt_settings import RrtSettings
 
     problem = next(p for p in problems("panda", ("bookshelf_thin",)) if p.index == 89)
     built = build_problem(load_scene(import_problem(problem, tmp_path / "thin_0089.yaml")))
-    finer = finer_problem(built)
+    finer = lazy_finer_problem(built)
     tuning = SeedingTuning()
     settings = RrtSettings(max_samples=3000, resolution_m=0.01, explore_resolution_m=tuning.max_resolution_m)
     for seed in range(3):

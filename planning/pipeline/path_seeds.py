@@ -54,11 +54,16 @@ class PathSeed(NamedTuple):
     x: FloatArray
 
 
+FinerProblem = Callable[[], Problem]
+"""``problem`` with a finer certified step (:func:`~planning.pipeline.seeding.finer_problem`),
+built when first asked: most draws end before the trees would keep its clearance."""
+
+
 def sampled_path(
     problem: Problem,
     rng: np.random.Generator,
     settings: RrtSettings | None = None,
-    finer: Problem | None = None,
+    finer: FinerProblem | None = None,
     max_samples: int | None = None,
 ) -> RrtPath | None:
     """RRT-Connect's path in the moving joints of ``problem``, clear of the fitness's clearance.
@@ -66,15 +71,16 @@ def sampled_path(
     With ``finer`` (``problem`` with a finer certified step, so a smaller clearance), the
     trees go on keeping its clearance after the seeding's ``finer_after`` samples, or from
     the start where an end is too close for ``problem``'s; the path is then ``relaxed``.
+    ``finer`` is called only then.
     ``max_samples``: the draw's budget, in place of ``settings``' (``None``: theirs; the
     default settings take :func:`draw_samples`).
     """
     robot, moving = problem.robot, problem.moving
 
-    def keeping(kept: Problem) -> Callable[[FloatArray], BoolArray]:
-        required_m, required_self_m = kept.objective.required_m, kept.objective.required_self_m
-
+    def keeping(kept: FinerProblem) -> Callable[[FloatArray], BoolArray]:
         def valid(q: FloatArray) -> BoolArray:
+            objective = kept().objective  # the finer problem built at its first check
+            required_m, required_self_m = objective.required_m, objective.required_self_m
             configurations = problem.configurations(q)
             free = problem.world.keeps_clearance(configurations, required_m, required_self_m, ordered=True)
             if problem.gravity is not None and free.any():  # and can be held still
@@ -98,7 +104,7 @@ def sampled_path(
     limits = robot.limits
     relaxation = None if finer is None else Relaxation(keeping(finer), tuning.finer_after)
     return rrt_connect(
-        keeping(problem),
+        keeping(lambda: problem),
         problem.q_start[moving],
         problem.q_goal[moving],
         limits.lower[moving],
@@ -126,7 +132,7 @@ def path_seed(problem: Problem, path: FloatArray, count: int, weights: FloatArra
 
 
 def followable_path(
-    problem: Problem, weights: FloatArray, finer: Problem | None = None
+    problem: Problem, weights: FloatArray, finer: FinerProblem | None = None
 ) -> tuple[FloatArray | None, PathSeed | None]:
     """RRT-Connect's path whose waypoints seed ``problem`` best, and its seed.
 
@@ -150,7 +156,7 @@ def followable_path(
         if found is None:
             break
         samples += found.samples
-        kept = finer if finer is not None and found.relaxed else problem
+        kept = finer() if finer is not None and found.relaxed else problem
         seeded = path_seed(kept, found.path, settings.waypoints, weights)
         if best is None or seeded.fitness < best[1].fitness:
             best = (found.path, seeded)

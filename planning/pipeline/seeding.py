@@ -47,6 +47,7 @@ the firefly's draws are the same with or without them. ``seeding: none`` (the pa
 
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass
 from typing import Protocol
@@ -55,7 +56,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from planning.pipeline.path_seeds import PathSeed, draw_samples, fewest_waypoints, followable_path, path_seed
+from planning.pipeline.path_seeds import (
+    FinerProblem,
+    PathSeed,
+    draw_samples,
+    fewest_waypoints,
+    followable_path,
+    path_seed,
+)
 from planning.pipeline.problem import Problem, finer_step_m, with_planner
 from planning.pipeline.settings import MAX_FITNESS_SAMPLES
 from planning.search.optimizer import SearchResult
@@ -193,7 +201,7 @@ def seed_search(
     seeded: PathSeed | None = None
     asked = path is None and not clear and sample
     if asked:
-        path, seeded = followable_path(problem, weights, finer_problem(problem) if finer else None)
+        path, seeded = followable_path(problem, weights, lazy_finer_problem(problem) if finer else None)
     if path is None:
         elapsed = time.perf_counter() - started
         return Seeds(problem, _around(problem, straight[None]), None, clear, clear, elapsed, asked)
@@ -209,9 +217,21 @@ def seed_search(
 
 def finer_problem(problem: Problem) -> Problem | None:
     """``problem`` with the finer certified step (:func:`finer_step_m`); ``None``: its own is as fine."""
+    build = lazy_finer_problem(problem)
+    return None if build is None else build()
+
+
+def lazy_finer_problem(problem: Problem) -> FinerProblem | None:
+    """:func:`finer_problem` as a function that builds it on its first call and keeps it.
+
+    ``None`` where there is no finer step. Building a problem costs more than most
+    RRT-Connect draws that could need it (about a millisecond on the CPR), and most end
+    before the trees would keep its clearance.
+    """
     step_m = finer_step_m(problem)
-    finer = step_m < problem.scene.planner.verify_step_m
-    return with_planner(problem, verify_step_m=step_m) if finer else None
+    if step_m >= problem.scene.planner.verify_step_m:
+        return None
+    return functools.cache(lambda: with_planner(problem, verify_step_m=step_m))
 
 
 def _around(problem: Problem, seeds: FloatArray) -> FloatArray:
