@@ -10,6 +10,7 @@ distance between any of its geometries and any obstacle. Distances are accurate 
 from __future__ import annotations
 
 import os
+from collections import Counter
 from collections.abc import Sequence
 
 import numpy as np
@@ -62,8 +63,7 @@ class CollisionWorld:
     ) -> None:
         if not (np.isfinite(self_margin_m) and self_margin_m >= 0.0):
             raise CprKinError(f"self_margin_m = {self_margin_m} m must be a finite distance >= 0")
-        names = [o.name for o in obstacles]
-        duplicated = sorted({n for n in names if names.count(n) > 1})
+        duplicated = sorted(n for n, count in Counter(o.name for o in obstacles).items() if count > 1)
         if duplicated:
             raise CprKinError(f"obstacle names must be unique; {duplicated} appear more than once")
         self.robot = robot
