@@ -25,6 +25,8 @@ import numpy as np
 
 import cpr_kin as ck
 from planning.errors import PlanningError
+from planning.pipeline.settings import MAX_SEED
+from planning.validation import integer_in
 
 if TYPE_CHECKING:
     from planning.pipeline.scene import Scene
@@ -135,8 +137,8 @@ def problems(
     """
     if limit is not None and limit < 1:
         raise PlanningError(f"limit = {limit} problems per class must be at least 1 (or None: all)")
-    if sample_seed is not None and sample_seed < 0:
-        raise PlanningError(f"sample_seed = {sample_seed} must be a non-negative integer")
+    if sample_seed is not None:
+        integer_in("sample_seed", sample_seed, 0, MAX_SEED)
     folder = vamp_resources(robot) / "problems"
     for problem_class in classes:
         if problem_class not in CLASSES:
