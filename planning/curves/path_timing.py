@@ -58,6 +58,12 @@ MIN_NODE_STEP_S = 0.02
 """Smallest spacing of the trajectory's knots [s] (see :func:`smoothing_limits`)."""
 SECOND_SHARE = 0.125
 """The second moving average's least width, as a share of the first's (:func:`smoothing_limits`)."""
+SEPTIC_JERK_AIM = 1.025
+"""How far below a binding jerk limit the averages aim (its divisor, :func:`smoothing_limits`).
+
+The septic through the averaged motion's knots overshoots the motion's jerk between them
+(2.7 % at the median on 300 paths of the CPR, ``docs/tuning.md``), and step 4 would stretch
+the whole motion by the cube root of that; aiming lower widens only the acceleration ramps."""
 
 
 def time_path(
@@ -101,7 +107,7 @@ def time_path(
         arc = arc._replace(torque=torque_rows(path(arc.u), arc.dq, arc.ddq, arc.ds, torque, uncapped))
         uncapped = uncapped if arc.torque is None else None  # the rows change it
     smoothing = smoothing_limits(limits, node_step_s)
-    kept = smoothing.limits is limits
+    kept = np.array_equal(smoothing.limits, limits)  # else the jerk's caps change the uncapped profile
     fastest = fastest_motion(arc, smoothing.limits, smoothing.second_share, uncapped if kept else None)
     ends = path(path.knots[[0, -1]])
     trajectory = _septic(fastest.motion, fastest.step_s, smoothing.step_s, ends, 4 if still_jerk else 3)
@@ -131,15 +137,15 @@ def smoothing_limits(limits: FloatArray, node_step_s: float) -> Smoothing:
     higher. The second average, which rounds the jerk's steps so that the septic does not
     overshoot them, spans half a knot spacing, and at least :data:`SECOND_SHARE` of the
     ramp: the motion lasts that much longer than the first average's (``docs/method.md``).
-    The final scaling still holds the trajectory to the given limits. Limits whose ramps
-    are at least two spacings (the CPR's) are kept as they are.
+    Where the jerk limit itself binds (ramps of at least two spacings: the CPR's), the
+    averages aim at :data:`SEPTIC_JERK_AIM` below it, the septic's overshoot between its
+    knots. The final scaling still holds the trajectory to the given limits.
     """
     step = float(np.clip(np.max(limits[1] / limits[2]) / 4.0, MIN_NODE_STEP_S, node_step_s))
-    jerk = np.minimum(limits[2], limits[1] / (2.0 * step))
-    if not np.array_equal(jerk, limits[2]):
-        limits = np.stack([limits[0], limits[1], jerk])
-    ramp_s = float(np.max(limits[1] / limits[2]))
-    return Smoothing(step, limits, max(SECOND_SHARE, step / (2.0 * ramp_s)))
+    jerk = np.minimum(limits[2] / SEPTIC_JERK_AIM, limits[1] / (2.0 * step))
+    aimed = np.stack([limits[0], limits[1], jerk])
+    ramp_s = float(np.max(aimed[1] / aimed[2]))
+    return Smoothing(step, aimed, max(SECOND_SHARE, step / (2.0 * ramp_s)))
 
 
 def limits_time_scale(trajectory: Trajectory, limits: FloatArray, torque: TorqueModel | None = None) -> float:
