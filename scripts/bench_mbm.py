@@ -60,9 +60,10 @@ from typing import Any
 import numpy as np
 
 import cpr_kin as ck
-from planning.cli.arguments import COUNT, SECONDS, SEED
+from planning.cli.arguments import COUNT, SECONDS
+from planning.cli.problem_selection import add_selection, check_selection, selected_problems
 from planning.errors import NoSolutionError, PlanningError
-from planning.io.mbm import CLASSES, endpoint_violations, import_problem, problems
+from planning.io.mbm import endpoint_violations, import_problem
 from planning.io.scene_file import load_scene
 from planning.io.trajectory_io import trajectory_json
 
@@ -248,7 +249,7 @@ def cases(args: argparse.Namespace) -> Iterator[tuple[str, str, int, Path]]:
             yield path.resolve().parent.name, group, int(number), path
         return
     for robot_name in args.robots:
-        for problem in problems(robot_name, tuple(args.classes), args.limit, args.sample_seed):
+        for problem in selected_problems(args, robot_name):
             path = args.out / "scenes" / robot_name / f"{problem.name}.yaml"
             import_problem(problem, path)
             yield robot_name, problem.problem_class, problem.index, path
@@ -256,14 +257,7 @@ def cases(args: argparse.Namespace) -> Iterator[tuple[str, str, int, Path]]:
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--robots", nargs="+", default=["panda", "ur5"], choices=["panda", "ur5", "fetch"])
-    parser.add_argument("--classes", nargs="+", default=list(CLASSES), choices=list(CLASSES))
-    parser.add_argument("--limit", type=COUNT, help="problems per class (default: all 100)")
-    parser.add_argument(
-        "--sample-seed",
-        type=SEED,
-        help="draw --limit problems of each class at random with this seed (default: the first --limit)",
-    )
+    add_selection(parser)
     parser.add_argument("--timeout", type=SECONDS, default=10.0, help="seconds per problem and planner")
     parser.add_argument(
         "--time-limit",
@@ -278,10 +272,7 @@ def main() -> int:
     )
     parser.add_argument("--out", type=Path, default=Path("out/bench_mbm"))
     args = parser.parse_args()
-    if args.limit is not None and args.limit > 100:
-        parser.error(f"--limit {args.limit} must be in [1, 100] problems per class")
-    if args.sample_seed is not None and args.limit is None:
-        parser.error(f"--sample-seed {args.sample_seed} goes with --limit (the sample's size per class)")
+    check_selection(parser, args)
     if args.time_limit is not None and not 0 < args.time_limit <= args.timeout:
         parser.error(f"--time-limit {args.time_limit:g} s must be in (0, --timeout = {args.timeout:g}] s")
     time_limit_s = args.time_limit or TIME_LIMIT_SHARE * args.timeout

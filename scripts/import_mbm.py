@@ -24,9 +24,9 @@ import time
 from pathlib import Path
 
 import cpr_kin as ck
-from planning.cli.arguments import COUNT, SEED
+from planning.cli.problem_selection import add_selection, check_selection, selected_problems
 from planning.errors import PlanningError
-from planning.io.mbm import CLASSES, endpoint_violations, import_problem, problems
+from planning.io.mbm import endpoint_violations, import_problem
 from planning.io.scene_file import load_scene
 
 
@@ -38,26 +38,16 @@ def reason(text: str) -> str:
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--robots", nargs="+", default=["panda", "ur5"], choices=["panda", "ur5", "fetch"])
-    parser.add_argument("--classes", nargs="+", default=list(CLASSES), choices=list(CLASSES))
-    parser.add_argument("--limit", type=COUNT, help="problems per class (default: all 100)")
-    parser.add_argument(
-        "--sample-seed",
-        type=SEED,
-        help="draw --limit problems of each class at random with this seed (default: the first --limit)",
-    )
+    add_selection(parser)
     parser.add_argument("--out", type=Path, help="folder for the scene files (default: a temporary one)")
     args = parser.parse_args()
-    if args.limit is not None and args.limit > 100:
-        parser.error(f"--limit {args.limit} must be in [1, 100] problems per class")
-    if args.sample_seed is not None and args.limit is None:
-        parser.error(f"--sample-seed {args.sample_seed} goes with --limit (the sample's size per class)")
+    check_selection(parser, args)
     out = args.out or Path(tempfile.mkdtemp(prefix="mbm-"))
     for robot_name in args.robots:
         robot: ck.Robot | None = None
         started = time.perf_counter()
         table: dict[str, collections.Counter[str]] = collections.defaultdict(collections.Counter)
-        for problem in problems(robot_name, tuple(args.classes), args.limit, args.sample_seed):
+        for problem in selected_problems(args, robot_name):
             counts = table[problem.problem_class]
             counts["problems"] += 1
             try:

@@ -1,0 +1,45 @@
+"""Which MotionBenchMaker problems a script runs: ``--robots``, ``--classes``, ``--limit``, ``--sample-seed``.
+
+``scripts/bench_mbm.py`` and ``scripts/import_mbm.py`` take the same selection::
+
+    add_selection(parser)
+    args = parser.parse_args()
+    check_selection(parser, args)  # argparse's one line and exit 2 for a bad combination
+    for problem in selected_problems(args): ...
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Iterator
+
+from planning.cli.arguments import COUNT, SEED
+from planning.io.mbm import CLASSES, ROBOTS, Problem, problems
+
+PER_CLASS = 100
+"""Problems in each MotionBenchMaker class: the largest ``--limit``."""
+
+
+def add_selection(parser: argparse.ArgumentParser, robots: tuple[str, ...] = ("panda", "ur5")) -> None:
+    """Add ``--robots`` (default: ``robots``), ``--classes``, ``--limit``, ``--sample-seed`` to ``parser``."""
+    parser.add_argument("--robots", nargs="+", default=list(robots), choices=list(ROBOTS))
+    parser.add_argument("--classes", nargs="+", default=list(CLASSES), choices=list(CLASSES))
+    parser.add_argument("--limit", type=COUNT, help=f"problems per class (default: all {PER_CLASS})")
+    parser.add_argument(
+        "--sample-seed",
+        type=SEED,
+        help="draw --limit problems of each class at random with this seed (default: the first --limit)",
+    )
+
+
+def check_selection(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """Refuse (``parser.error``) a ``--limit`` above :data:`PER_CLASS`, a sample seed without a limit."""
+    if args.limit is not None and args.limit > PER_CLASS:
+        parser.error(f"--limit {args.limit} must be in [1, {PER_CLASS}] problems per class")
+    if args.sample_seed is not None and args.limit is None:
+        parser.error(f"--sample-seed {args.sample_seed} goes with --limit (the sample's size per class)")
+
+
+def selected_problems(args: argparse.Namespace, robot: str) -> Iterator[Problem]:
+    """``robot``'s problems of the selection in ``args`` (:func:`planning.io.mbm.problems`)."""
+    return problems(robot, tuple(args.classes), args.limit, args.sample_seed)
