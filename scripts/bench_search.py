@@ -132,8 +132,20 @@ def cli_wall_times(scene: Scene, runs: int) -> list[float]:
     return times
 
 
-def parse_arguments(robot: ck.Robot) -> argparse.Namespace:
-    """The command line (module docstring), with each seed's scenes for ``robot`` (``scene_sets``)."""
+@dataclass(frozen=True)
+class Benchmark:
+    """What the command line asks (:func:`parse_arguments`)."""
+
+    scene_sets: tuple[tuple[int, list[Scene]], ...]
+    """``(generator seed, its scenes)`` in the order given (a seed given twice runs twice)."""
+    budget_s: float
+    """RRT-Connect's time budget [s]."""
+    cli_runs: int
+    """Runs of ``cpr-plan plan`` in a new process (0: none)."""
+
+
+def parse_arguments(robot: ck.Robot) -> Benchmark:
+    """The command line (module docstring), with each seed's scenes for ``robot``."""
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
@@ -183,10 +195,10 @@ def parse_arguments(robot: ck.Robot) -> argparse.Namespace:
     )
     args = parser.parse_args()
     try:  # every seed's scenes, before anything runs: a bad argument is named at once
-        args.scene_sets = [seed_scenes(args, seed, robot) for seed in args.seed]
+        scene_sets = tuple((seed, seed_scenes(args, seed, robot)) for seed in args.seed)
     except PlanningError as error:
         parser.error(str(error))
-    return args
+    return Benchmark(scene_sets, args.budget, args.cli_runs)
 
 
 def seed_scenes(args: argparse.Namespace, seed: int, robot: ck.Robot) -> list[Scene]:
@@ -298,19 +310,20 @@ def summarise(summaries: list[SeedSummary]) -> None:
 
 def main() -> None:
     robot = ck.load_cpr()
-    args = parse_arguments(robot)
+    benchmark = parse_arguments(robot)
+    first = benchmark.scene_sets[0][1][0]
     warm_up(robot)
-    plan_rrt_connect(args.scene_sets[0][0], robot, args.budget, 0)  # OMPL's imports and first call, untimed
+    plan_rrt_connect(first, robot, benchmark.budget_s, 0)  # OMPL's imports and first call, untimed
     summaries = []
-    for seed, scenes in zip(args.seed, args.scene_sets, strict=True):
-        if len(args.seed) > 1:
+    for seed, scenes in benchmark.scene_sets:
+        if len(benchmark.scene_sets) > 1:
             print(f"\n== generator seed {seed}")
-        summaries.append(report(seed, run_scenes(scenes, robot, args.budget)))
+        summaries.append(report(seed, run_scenes(scenes, robot, benchmark.budget_s)))
     if len(summaries) > 1:
         summarise(summaries)
-    if args.cli_runs:
-        scene = args.scene_sets[0][0]
-        times = cli_wall_times(scene, args.cli_runs)
+    if benchmark.cli_runs:
+        scene = first
+        times = cli_wall_times(scene, benchmark.cli_runs)
         median = statistics.median(times)
         print(
             f"`cpr-plan plan {scene.name}` in a new process: median {median:.2f} s "
