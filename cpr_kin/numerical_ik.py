@@ -49,7 +49,7 @@ class IkSettings:
             or circling), and a converging start steps far faster (``docs/tuning.md``).
     """
 
-    restarts: int = 30
+    restarts: int = 100
     iterations: int = 150
     damping: float = 1e-3
     max_step: float = 0.3
@@ -165,6 +165,25 @@ def _descend(
     return q
 
 
+def tool_reach_m(robot: Robot) -> float:
+    """An upper bound of the tool frame's distance from the model's origin, in any configuration [m].
+
+    The offsets along the chain from the origin to the tool frame, added up (a joint turns an
+    offset, never lengthens it), plus each prismatic joint's largest travel.
+    """
+    model = robot.model
+    frame = model.frames[robot.frame_id(robot.tcp_frame)]
+    reach = float(np.linalg.norm(frame.placement.translation))
+    joint = frame.parentJoint
+    while joint > 0:
+        reach += float(np.linalg.norm(model.jointPlacements[joint].translation))
+        if model.joints[joint].shortname().removeprefix("JointModel").startswith("P"):  # prismatic
+            index = model.joints[joint].idx_q
+            reach += float(max(abs(model.lowerPositionLimit[index]), abs(model.upperPositionLimit[index])))
+        joint = model.parents[joint]
+    return reach
+
+
 def solve_ik(
     robot: Robot,
     target: IkTarget,
@@ -184,10 +203,17 @@ def solve_ik(
         held: joints kept at their ``seed_q`` values (the CPR's wrist angles of a ``tcp`` goal).
 
     Raises:
-        IkMissError: no start reaches the target within its tolerance.
+        IkMissError: the target lies beyond :func:`tool_reach_m`, or no start reaches it
+            within its tolerance.
         JointLimitError: ``held`` names a joint the robot does not plan.
     """
     settings = settings or IkSettings()
+    distance, reach = float(np.linalg.norm(target.position)), tool_reach_m(robot)
+    if distance > reach + target.tolerance_m:  # no start can reach it: say so at once
+        raise IkMissError(
+            f"no configuration puts frame '{robot.tcp_frame}' at {np.round(target.position, 4).tolist()} m: "
+            f"it lies {distance:.4g} m from the robot's base, beyond the {reach:.4g} m its links reach"
+        )
     lower, upper = robot.limits.lower, robot.limits.upper
     seed = (lower + upper) / 2 if seed_q is None else np.clip(np.asarray(seed_q, dtype=float), lower, upper)
     free = np.ones(robot.nq, dtype=bool)

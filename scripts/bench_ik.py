@@ -10,7 +10,9 @@ start runs all its steps, the rule before it). The two alternate target by targe
 one process. It prints per arm: the targets each solves, the mean time per target [ms], the
 targets where both choose the same configuration, where they differ the geometric mean of
 the distance to the seed (new over old, in robot motion ``sum_j R_j |dq_j|``), and the time
-to refuse a target out of reach (5 m away).
+to refuse a target out of reach: 5 m away, beyond :func:`cpr_kin.numerical_ik.tool_reach_m` (refused
+before any start), and 10 % beyond the farthest of 20,000 random configurations' tool positions
+but within that bound (every start runs).
 """
 
 from __future__ import annotations
@@ -50,14 +52,21 @@ def timed(
     return q
 
 
-def refusal_s(robot: ck.Robot, settings: ck.IkSettings) -> float:
-    """Seconds to refuse a position 5 m from the base."""
+def refusal_s(robot: ck.Robot, settings: ck.IkSettings, position: np.ndarray) -> float:
+    """Seconds to refuse the tool ``position`` [m] (a target out of reach)."""
     started = time.perf_counter()
     try:
-        ck.solve_ik(robot, ck.IkTarget(np.array([5.0, 0.0, 0.5])), settings=settings)
+        ck.solve_ik(robot, ck.IkTarget(position), settings=settings)
     except ck.IkMissError:
         return time.perf_counter() - started
-    raise SystemExit(f"a target 5 m away was reached by {robot.tcp_frame}")
+    raise SystemExit(f"{robot.tcp_frame} reached {position.round(3).tolist()} m, a target out of reach")
+
+
+def beyond_sampled_reach(robot: ck.Robot, rng: np.random.Generator) -> np.ndarray:
+    """A tool position 10 % beyond the farthest of 20,000 random configurations' [m]."""
+    configurations = rng.uniform(robot.limits.lower, robot.limits.upper, (20_000, robot.nq))
+    positions = ck.frame_poses(robot, configurations)[:, :3, 3]
+    return np.asarray(1.1 * positions[np.argmax(np.linalg.norm(positions, axis=1))], dtype=float)
 
 
 def main() -> None:
@@ -69,7 +78,7 @@ def main() -> None:
     old = dataclasses.replace(new, patience=new.iterations)
     print(
         f"{'arm':<8}{'solved new/old':>16}{'ms new/old':>16}{'ratio':>7}{'same':>6}"
-        f"{'dist new/old':>14}{'refuse ms new/old':>20}"
+        f"{'dist new/old':>14}{'refuse ms, 5 m':>16}{'refuse ms, near':>17}"
     )
     for name in sorted(EXAMPLE_ROBOTS):
         robot = ck.load_robot(example_robot(name))
@@ -89,13 +98,17 @@ def main() -> None:
             else:
                 distance = {label: float(weights @ np.abs(q - seed)) for label, q in found.items()}
                 ratios.append(distance["new"] / max(distance["old"], 1e-12))
-        refuse_new, refuse_old = refusal_s(robot, new), refusal_s(robot, old)
+        far, near = np.array([5.0, 0.0, 0.5]), beyond_sampled_reach(robot, rng)
+        both = (("new", new), ("old", old))
+        refuse_far = {label: refusal_s(robot, settings, far) for label, settings in both}
+        refuse_near = {label: refusal_s(robot, settings, near) for label, settings in both}
         ms = {label: 1e3 * tally.seconds / args.targets for label, tally in tallies.items()}
         geo = f"{math.exp(float(np.mean(np.log(ratios)))):.3f}" if ratios else "-"
         print(
             f"{name:<8}{tallies['new'].solved:>9} / {tallies['old'].solved:<4}"
             f"{ms['new']:>9.1f} / {ms['old']:<5.1f}{ms['new'] / ms['old']:>6.2f}{same:>6}{geo:>14}"
-            f"{1e3 * refuse_new:>12.0f} / {1e3 * refuse_old:<5.0f}"
+            f"{1e3 * refuse_far['new']:>8.0f} / {1e3 * refuse_far['old']:<5.0f}"
+            f"{1e3 * refuse_near['new']:>9.0f} / {1e3 * refuse_near['old']:<5.0f}"
         )
 
 

@@ -10,6 +10,7 @@ import pytest
 import yourdfpy
 
 import cpr_kin as ck
+from cpr_kin.numerical_ik import tool_reach_m
 from cpr_kin.packages import example_robot
 
 ARMS = ("so101", "ur5", "panda", "xarm7")
@@ -82,10 +83,30 @@ def test_a_target_out_of_reach_says_how_close_the_solver_came() -> None:
     robot = ck.load_robot(example_robot("panda"))
     with pytest.raises(
         ck.IkMissError,
-        match=r"no configuration puts frame 'panda_hand_tcp' at \[2\.0, 0\.0, 0\.5\] m: the closest of 31 "
-        r"IK starts came 1\.\d+ m from the position \(tolerance 0\.0001 m\)",
+        match=r"no configuration puts frame 'panda_hand_tcp' at \[1\.3, 0\.0, 0\.333\] m: the closest of 101 "
+        r"IK starts came 0\.\d+ m from the position \(tolerance 0\.0001 m\)",
     ):
-        ck.solve_ik(robot, ck.IkTarget(np.array([2.0, 0.0, 0.5])))
+        ck.solve_ik(robot, ck.IkTarget(np.array([1.3, 0.0, 0.333])))  # within the bound, out of reach
+
+
+@pytest.mark.parametrize("name", ["panda", "ur5", "so101", "z1"])
+def test_the_reach_bound_holds_over_random_configurations(name: str) -> None:
+    """An oracle: the tool's distance from the base at 20,000 random configurations (FK)."""
+    robot = ck.load_robot(example_robot(name))
+    lower, upper = robot.limits.lower, robot.limits.upper
+    configurations = np.random.default_rng(2).uniform(lower, upper, (20_000, robot.nq))
+    distances = np.linalg.norm(ck.frame_poses(robot, configurations)[:, :3, 3], axis=1)
+    assert distances.max() <= tool_reach_m(robot)
+    assert distances.max() >= 0.6 * tool_reach_m(robot)  # a bound, not a wild one
+
+
+def test_the_reach_bound_counts_prismatic_travel(robot: ck.Robot) -> None:
+    """The CPR's carriage and arm slide 0.6 and 0.5 m: its bound holds its sampled reach."""
+    lower, upper = robot.limits.lower, robot.limits.upper
+    configurations = np.random.default_rng(3).uniform(lower, upper, (20_000, robot.nq))
+    distances = np.linalg.norm(ck.frame_poses(robot, configurations)[:, :3, 3], axis=1)
+    without_travel = tool_reach_m(robot) - 0.6 - 0.5
+    assert without_travel < distances.max() <= tool_reach_m(robot)
 
 
 class CountedTarget(ck.IkTarget):
@@ -100,16 +121,28 @@ class CountedTarget(ck.IkTarget):
 
 def test_a_start_that_makes_no_progress_ends_after_its_patience() -> None:
     robot = ck.load_robot(example_robot("ur5"))
-    target = CountedTarget(np.array([5.0, 0.0, 0.5]))  # out of reach: the arm stretches, then stalls
+    target = CountedTarget(np.array([1.25, 0.0, 0.3]))  # out of reach: the arm stretches, then stalls
     steps = {}
     for patience in (20, 1000):
         CountedTarget.steps = 0
         settings = ck.IkSettings(restarts=0, iterations=1000, patience=patience)
-        with pytest.raises(ck.IkMissError, match=r"the closest of 1 IK starts came 4\.1"):
+        with pytest.raises(ck.IkMissError, match=r"the closest of 1 IK starts came 0\.3"):
             ck.solve_ik(robot, target, settings=settings)
         steps[patience] = CountedTarget.steps
     assert 20 < steps[20] <= 100  # its patience ran out soon after the stretch
     assert steps[1000] == 1000  # without it, every step is taken
+
+
+def test_a_target_beyond_the_reach_bound_is_refused_before_any_start() -> None:
+    robot = ck.load_robot(example_robot("ur5"))
+    CountedTarget.steps = 0
+    with pytest.raises(
+        ck.IkMissError,
+        match=r"at \[5\.0, 0\.0, 0\.5\] m: it lies 5\.025 m from the robot's base, "
+        r"beyond the 1\.329 m its links reach",
+    ):
+        ck.solve_ik(robot, CountedTarget(np.array([5.0, 0.0, 0.5])))
+    assert CountedTarget.steps == 0
 
 
 @pytest.mark.parametrize(

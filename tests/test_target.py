@@ -49,6 +49,8 @@ def test_a_variant_the_analytic_ik_misses_is_solved_numerically(tilted_cpr: ck.R
 
 def test_a_tcp_the_variant_cannot_reach_names_both_answers(tilted_cpr: ck.Robot) -> None:
     with pytest.raises(ck.IkMissError, match=r"came .* m from the position .*; the analytic IK: "):
+        Target(tcp=(1.6, 0.0, 0.3)).configuration(tilted_cpr)  # within the reach bound, out of reach
+    with pytest.raises(ck.IkMissError, match=r"beyond the 1\.8 m its links reach; the analytic IK: "):
         Target(tcp=(3.0, 0.0, 0.3)).configuration(tilted_cpr)
 
 
