@@ -63,14 +63,16 @@ def main() -> int:
     try:
         robot = ck.load_robot(urdf, tcp=args.tcp, srdf=srdf, limits=limits)
         stem = args.robot if named else urdf.stem
-        args.out.mkdir(parents=True, exist_ok=True)
-        for seed in range(args.seed, args.seed + args.count):
-            name = f"{stem}_{seed}"
-            document = blocked_scene(name, entry, robot, seed, args.margin, args.self_clearance)
-            (args.out / f"{name}.yaml").write_text(yaml.safe_dump(document, sort_keys=False))
+        documents = [  # all drawn before any is written: a scene that cannot be drawn leaves no files
+            blocked_scene(f"{stem}_{seed}", entry, robot, seed, args.margin, args.self_clearance)
+            for seed in range(args.seed, args.seed + args.count)
+        ]
     except (ck.CprKinError, PlanningError) as exc:
         print(f"generate_arm_scenes: {exc}", file=sys.stderr)
         return 2
+    args.out.mkdir(parents=True, exist_ok=True)
+    for document in documents:
+        (args.out / f"{document['name']}.yaml").write_text(yaml.safe_dump(document, sort_keys=False))
     print(f"wrote {args.count} scenes into {args.out}")
     return 0
 

@@ -79,6 +79,42 @@ def test_no_qualifying_draw_is_an_error_naming_the_fix(ur5: ck.Robot) -> None:
         blocked_scene("ur10_0", "ur10", ur10, 0, self_clearance_m=1.0, draws=20)
 
 
+def test_a_self_clearance_below_the_self_margin_lowers_the_scenes_margin() -> None:
+    """UR3 (no SRDF) at 5 mm: its ends lie outside the default 10 mm self margin only with it lowered.
+
+    Before, scenes 901 and 904 put the start inside the default margin, and the benchmarks
+    counted them invalid.
+    """
+    ur3 = ck.load_robot(example_robot("ur3"))
+    for seed in (901, 904):
+        document = blocked_scene(f"ur3_{seed}", "ur3", ur3, seed, self_clearance_m=0.005)
+        assert document["self_margin"] == 0.0025
+        assert endpoint_violations(parse_scene(document), ur3) == []
+    assert "self_margin" not in blocked_scene(
+        "ur3_900", "ur3", ur3, 900, self_clearance_m=0.01
+    )  # the default
+
+
+def test_a_bad_margin_is_named_before_any_draw(ur5: ck.Robot) -> None:
+    with pytest.raises(PlanningError, match=r"margin_m = -0\.01 m must be a number in \[0, 1\] m"):
+        blocked_scene("ur5_0", "ur5", ur5, 0, margin_m=-0.01)
+    with pytest.raises(PlanningError, match=r"self_clearance_m = 0\.0 m must be a number in \(0, 1\] m"):
+        blocked_scene("ur5_0", "ur5", ur5, 0, self_clearance_m=0.0)
+
+
+def test_the_script_writes_no_file_when_a_scene_cannot_be_drawn(tmp_path: Path) -> None:
+    script = Path(__file__).resolve().parent.parent / "scripts" / "generate_arm_scenes.py"
+    out = tmp_path / "none"
+    done = subprocess.run(
+        [sys.executable, str(script), "--robot=ur5", "--count=2", "--self-clearance=1", f"--out={out}"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert done.returncode == 2 and done.stderr.startswith("generate_arm_scenes: no start and goal")
+    assert "Traceback" not in done.stderr and not out.exists()
+
+
 def test_an_arm_that_hangs_below_its_base_is_told_why_it_gets_no_scene() -> None:
     # example-robot-data's hextilt flying arm hangs below the drone: every draw's midway tool
     # point is below the base, and the message once said only "lower self_clearance_m"

@@ -11,6 +11,8 @@ pose (solved by the planner's IK), the start as the configuration. Start and goa
 pairs, and gravity's torques there must be within the URDF's effort limits (the planner
 refuses an end its motors cannot hold still); a draw that does not is drawn again. The
 straight way is blocked; whether a way around exists is for the planners to find out.
+The scene keeps the default self margin, or half ``self_clearance_m`` where that is lower
+(the ends must lie outside the margin the planner asks of them).
 """
 
 from __future__ import annotations
@@ -22,9 +24,10 @@ import numpy as np
 
 import cpr_kin as ck
 from planning.errors import PlanningError
+from planning.pipeline.scene import DEFAULT_SELF_MARGIN_M, MAX_SAFETY_MARGIN_M
 from planning.pipeline.settings import MAX_SEED
 from planning.pipeline.torques import held
-from planning.validation import integer_in
+from planning.validation import integer_in, number_in
 
 DRAWS = 4000
 """Most draws of a start and goal before :func:`blocked_scene` gives up."""
@@ -52,11 +55,14 @@ def blocked_scene(
 
     Raises:
         PlanningError: no start and goal of ``draws`` draws qualify (the message counts why), or
-            ``draws`` is no whole number >= 1, or ``seed`` no non-negative integer.
+            ``draws`` is no whole number >= 1, ``seed`` no non-negative integer, ``margin_m``
+            or ``self_clearance_m`` not a margin the scene file allows.
     """
     if not (isinstance(draws, int) and draws >= 1):
         raise PlanningError(f"draws = {draws!r} must be a whole number >= 1")
     integer_in("seed", seed, 0, MAX_SEED)
+    number_in("margin_m", margin_m, 0.0, MAX_SAFETY_MARGIN_M, unit="m")
+    number_in("self_clearance_m", self_clearance_m, 0.0, MAX_SAFETY_MARGIN_M, unit="m", low_open=True)
     rng = np.random.default_rng(seed)
     lower, upper = robot.limits.lower, robot.limits.upper
     middle, half = (lower + upper) / 2, (upper - lower) / 2
@@ -92,6 +98,7 @@ def blocked_scene(
             "name": name,
             "robot": robot_entry,
             "safety_margin": margin_m,
+            **({"self_margin": self_clearance_m / 2} if self_clearance_m < DEFAULT_SELF_MARGIN_M else {}),
             "start": {"q": start.tolist()},
             "goal": {"pose": {"xyz": tools[2, :3, 3].tolist(), "rpy": _rpy(tools[2, :3, :3])}},
             "obstacles": [
