@@ -101,14 +101,13 @@ def time_path(
             f"limits of shape {limits.shape} must be finite and > 0 for {path.n_joints} joints"
         )
     arc = arc_length_path(path, limits[0])
+    smoothing = smoothing_limits(limits, node_step_s)
     uncapped = None
     if torque is not None:
-        uncapped = capped_profile(arc, limits, 1.0)
+        uncapped = capped_profile(arc, smoothing.limits, 1.0)
         arc = arc._replace(torque=torque_rows(path(arc.u), arc.dq, arc.ddq, arc.ds, torque, uncapped))
         uncapped = uncapped if arc.torque is None else None  # the rows change it
-    smoothing = smoothing_limits(limits, node_step_s)
-    kept = np.array_equal(smoothing.limits, limits)  # else the jerk's caps change the uncapped profile
-    fastest = fastest_motion(arc, smoothing.limits, smoothing.second_share, uncapped if kept else None)
+    fastest = fastest_motion(arc, smoothing.limits, smoothing.second_share, uncapped)
     ends = path(path.knots[[0, -1]])
     trajectory = _septic(fastest.motion, fastest.step_s, smoothing.step_s, ends, 4 if still_jerk else 3)
     return trajectory.time_scaled(limits_time_scale(trajectory, limits, torque))
