@@ -47,18 +47,24 @@ class IkSettings:
         patience: steps in a row that leave a start's least error (:meth:`IkTarget.excess`)
             not :data:`PROGRESS` smaller that end that start: it is stuck (at a joint limit,
             or circling), and a converging start steps far faster (``docs/tuning.md``).
+        more_restarts: random starts after those when none of them found a solution that
+            ``accept`` allows: near the edge of the workspace some branches of an arm's
+            solutions fall short of a pose, and every start may have descended into those
+            (``docs/tuning.md``).
     """
 
-    restarts: int = 100
+    restarts: int = 30
     iterations: int = 150
     damping: float = 1e-3
     max_step: float = 0.3
     seed: int = 0
     choices: int = 4
     patience: int = 20
+    more_restarts: int = 70
 
     def __post_init__(self) -> None:
-        for name, low in (("restarts", 0), ("iterations", 1), ("choices", 1), ("patience", 1)):
+        counts = (("restarts", 0), ("iterations", 1), ("choices", 1), ("patience", 1), ("more_restarts", 0))
+        for name, low in counts:
             value = getattr(self, name)
             if not isinstance(value, int) or isinstance(value, bool) or not low <= value <= 100_000:
                 raise CprKinError(f"IkSettings.{name} = {value!r} must be an integer in [{low}, 100000]")
@@ -223,8 +229,11 @@ def solve_ik(
     accepted: list[FloatArray] = []  # ``accept`` asked once per solution
     closest: pin.SE3 | None = None
     frame = robot.frame_id(robot.tcp_frame)
-    for draw in [seed, *rng.uniform(lower, upper, (settings.restarts, robot.nq))]:
-        start = np.where(free, draw, seed)
+    draws = [seed, *rng.uniform(lower, upper, (settings.restarts, robot.nq))]
+    tried = 0
+    while tried < len(draws):
+        start = np.where(free, draws[tried], seed)
+        tried += 1
         q = _descend(robot, target, start, free, settings)
         pin.framesForwardKinematics(robot.model, robot.data, q)
         placement = pin.SE3(robot.data.oMf[frame])
@@ -236,11 +245,13 @@ def solve_ik(
                 accepted.append(q)
                 if len(accepted) >= settings.choices:
                     break
+        if tried == settings.restarts + 1 and not accepted:  # then more, drawn only now
+            draws += list(rng.uniform(lower, upper, (settings.more_restarts, robot.nq)))
     if not found:
         assert closest is not None  # the seed is always tried
         raise IkMissError(
             f"no configuration puts frame '{robot.tcp_frame}' at {np.round(target.position, 4).tolist()} m: "
-            f"the closest of {settings.restarts + 1} IK starts came {target.miss(closest)}"
+            f"the closest of {tried} IK starts came {target.miss(closest)}"
         )
     weights = path_weights(robot)
     return min(accepted or found, key=lambda q: float(weights @ np.abs(q - seed)))

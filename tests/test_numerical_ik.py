@@ -125,7 +125,7 @@ def test_a_start_that_makes_no_progress_ends_after_its_patience() -> None:
     steps = {}
     for patience in (20, 1000):
         CountedTarget.steps = 0
-        settings = ck.IkSettings(restarts=0, iterations=1000, patience=patience)
+        settings = ck.IkSettings(restarts=0, more_restarts=0, iterations=1000, patience=patience)
         with pytest.raises(ck.IkMissError, match=r"the closest of 1 IK starts came 0\.3"):
             ck.solve_ik(robot, target, settings=settings)
         steps[patience] = CountedTarget.steps
