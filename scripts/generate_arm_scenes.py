@@ -20,7 +20,7 @@ import yaml
 
 import cpr_kin as ck
 from cpr_kin.packages import EXAMPLE_ROBOTS, example_robot
-from planning.cli.arguments import COUNT, SEED
+from planning.cli.arguments import COUNT, SEED, number_above, number_at_least
 from planning.errors import PlanningError
 from planning.io.arm_scenes import blocked_scene
 
@@ -42,10 +42,12 @@ def main() -> int:
     )
     parser.add_argument("--count", type=COUNT, default=10, help="number of scenes (default: 10)")
     parser.add_argument("--seed", type=SEED, default=0, help="seed of the first scene (default: 0)")
-    parser.add_argument("--margin", type=float, default=0.02, help="safety margin [m] (default: 0.02)")
+    parser.add_argument(
+        "--margin", type=number_at_least(0.0, "m"), default=0.02, help="safety margin [m] (default: 0.02)"
+    )
     parser.add_argument(
         "--self-clearance",
-        type=float,
+        type=number_above(0.0, "m"),
         default=0.02,
         help="least distance of the robot's own pairs at start and goal [m] (default: 0.02)",
     )

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from planning.cli.arguments import COUNT, SECONDS, SEED, integer_at_least, number_above
+from planning.cli.arguments import COUNT, SECONDS, SEED, integer_at_least, number_above, number_at_least
 
 SCRIPTS = Path(__file__).resolve().parents[1] / "scripts"
 
@@ -33,6 +33,14 @@ def test_a_number_must_be_finite_and_above_its_bound() -> None:
     assert SEED("0") == 0 and COUNT("1") == 1 and math.isclose(SECONDS("0.01"), 0.01)
 
 
+def test_a_number_at_least_its_bound_takes_the_bound_itself() -> None:
+    parse = number_at_least(0.0, "m")
+    assert parse("0") == 0.0 and parse("0.02") == 0.02
+    for text in ("-0.001", "nan", "-inf", "x"):
+        with pytest.raises(argparse.ArgumentTypeError, match=r"must be a number >= 0 m"):
+            parse(text)
+
+
 @pytest.mark.parametrize(
     ("script", "arguments", "message"),
     [
@@ -46,6 +54,16 @@ def test_a_number_must_be_finite_and_above_its_bound() -> None:
         ("generate_scenes", ["--seed", "-1", "--out", "x"], "argument --seed: -1 must be an integer >= 0"),
         ("study_parameters", ["--narrow", "-1"], "argument --narrow: -1 must be an integer >= 0"),
         ("paper_case", ["--seeds", "0"], "argument --seeds: 0 must be an integer >= 1"),
+        (
+            "generate_arm_scenes",
+            ["--robot", "ur5", "--margin", "-0.01", "--out", "x"],
+            "argument --margin: -0.01 must be a number >= 0 m",
+        ),
+        (
+            "generate_arm_scenes",
+            ["--robot", "ur5", "--self-clearance", "0", "--out", "x"],
+            "argument --self-clearance: 0 must be a number > 0 m",
+        ),
     ],
 )
 def test_a_script_names_a_bad_value_before_it_runs(

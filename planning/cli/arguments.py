@@ -29,14 +29,27 @@ def integer_at_least(low: int) -> Callable[[str], int]:
 
 def number_above(low: float, unit: str = "") -> Callable[[str], float]:
     """An argparse type: the text as a finite ``float`` greater than ``low`` (``unit``: shown after it)."""
+    return _number(low, unit, strict=True)
+
+
+def number_at_least(low: float, unit: str = "") -> Callable[[str], float]:
+    """An argparse type: the text as a finite ``float`` at least ``low`` (``unit``: shown after it)."""
+    return _number(low, unit, strict=False)
+
+
+def _number(low: float, unit: str, strict: bool) -> Callable[[str], float]:
+    """The text as a finite ``float`` above ``low`` (``strict``) or at least ``low``."""
+    relation = ">" if strict else ">="
 
     def parse(text: str) -> float:
         try:
             value = float(text)
         except ValueError:
             value = math.nan
-        if not (math.isfinite(value) and value > low):
-            raise argparse.ArgumentTypeError(f"{text} must be a number > {low:g}{f' {unit}' if unit else ''}")
+        if not (math.isfinite(value) and (value > low if strict else value >= low)):
+            raise argparse.ArgumentTypeError(
+                f"{text} must be a number {relation} {low:g}{f' {unit}' if unit else ''}"
+            )
         return value
 
     return parse
