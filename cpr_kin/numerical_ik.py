@@ -24,7 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import CprKinError, IkMissError
 from cpr_kin.motion import path_weights
-from cpr_kin.robot import Robot
+from cpr_kin.robot import Robot, joint_units
 
 FloatArray = NDArray[np.float64]
 
@@ -179,11 +179,12 @@ def tool_reach_m(robot: Robot) -> float:
     """
     model = robot.model
     frame = model.frames[robot.frame_id(robot.tcp_frame)]
+    units = joint_units(model)
     reach = float(np.linalg.norm(frame.placement.translation))
     joint = frame.parentJoint
     while joint > 0:
         reach += float(np.linalg.norm(model.jointPlacements[joint].translation))
-        if model.joints[joint].shortname().removeprefix("JointModel").startswith("P"):  # prismatic
+        if units[joint - 1] == "m":  # prismatic
             index = model.joints[joint].idx_q
             reach += float(max(abs(model.lowerPositionLimit[index]), abs(model.upperPositionLimit[index])))
         joint = model.parents[joint]
@@ -214,11 +215,12 @@ def solve_ik(
         JointLimitError: ``held`` names a joint the robot does not plan.
     """
     settings = settings or IkSettings()
+    missed = f"no configuration puts frame '{robot.tcp_frame}' at {np.round(target.position, 4).tolist()} m"
     distance, reach = float(np.linalg.norm(target.position)), tool_reach_m(robot)
     if distance > reach + target.tolerance_m:  # no start can reach it: say so at once
         raise IkMissError(
-            f"no configuration puts frame '{robot.tcp_frame}' at {np.round(target.position, 4).tolist()} m: "
-            f"it lies {distance:.4g} m from the robot's base, beyond the {reach:.4g} m its links reach"
+            f"{missed}: it lies {distance:.4g} m from the robot's base, "
+            f"beyond the {reach:.4g} m its links reach"
         )
     lower, upper = robot.limits.lower, robot.limits.upper
     seed = (lower + upper) / 2 if seed_q is None else np.clip(np.asarray(seed_q, dtype=float), lower, upper)
@@ -249,9 +251,6 @@ def solve_ik(
             draws += list(rng.uniform(lower, upper, (settings.more_restarts, robot.nq)))
     if not found:
         assert closest is not None  # the seed is always tried
-        raise IkMissError(
-            f"no configuration puts frame '{robot.tcp_frame}' at {np.round(target.position, 4).tolist()} m: "
-            f"the closest of {tried} IK starts came {target.miss(closest)}"
-        )
+        raise IkMissError(f"{missed}: the closest of {tried} IK starts came {target.miss(closest)}")
     weights = path_weights(robot)
     return min(accepted or found, key=lambda q: float(weights @ np.abs(q - seed)))
