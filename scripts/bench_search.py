@@ -322,11 +322,10 @@ def main() -> None:
     if len(summaries) > 1:
         summarise(summaries)
     if benchmark.cli_runs:
-        scene = first
-        times = cli_wall_times(scene, benchmark.cli_runs)
+        times = cli_wall_times(first, benchmark.cli_runs)
         median = statistics.median(times)
         print(
-            f"`cpr-plan plan {scene.name}` in a new process: median {median:.2f} s "
+            f"`cpr-plan plan {first.name}` in a new process: median {median:.2f} s "
             f"over {len(times)} runs ({', '.join(f'{t:.2f}' for t in times)}); target <= {CLI_TARGET_S} s"
         )
 

@@ -5,7 +5,7 @@
     add_selection(parser)
     args = parser.parse_args()
     check_selection(parser, args)  # argparse's one line and exit 2 for a bad combination
-    for problem in selected_problems(args): ...
+    for problem in selected_problems(args, "panda"): ...
 """
 
 from __future__ import annotations
@@ -20,9 +20,9 @@ PER_CLASS = 100
 """Problems in each MotionBenchMaker class: the largest ``--limit``."""
 
 
-def add_selection(parser: argparse.ArgumentParser, robots: tuple[str, ...] = ("panda", "ur5")) -> None:
-    """Add ``--robots`` (default: ``robots``), ``--classes``, ``--limit``, ``--sample-seed`` to ``parser``."""
-    parser.add_argument("--robots", nargs="+", default=list(robots), choices=list(ROBOTS))
+def add_selection(parser: argparse.ArgumentParser) -> None:
+    """Add ``--robots`` (default: panda, ur5), ``--classes``, ``--limit``, ``--sample-seed`` to ``parser``."""
+    parser.add_argument("--robots", nargs="+", default=["panda", "ur5"], choices=list(ROBOTS))
     parser.add_argument("--classes", nargs="+", default=list(CLASSES), choices=list(CLASSES))
     parser.add_argument("--limit", type=COUNT, help=f"problems per class (default: all {PER_CLASS})")
     parser.add_argument(
