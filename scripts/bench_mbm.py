@@ -2,7 +2,7 @@
 
     python scripts/bench_mbm.py [--robots panda ur5] [--classes ...] [--limit N [--sample-seed S]]
                                 [--timeout S] [--out DIR] [--workers N] [--time-limit S]
-    python scripts/bench_mbm.py --scenes out/arms/*/*.yaml [--timeout S] [--out DIR]
+    python scripts/bench_mbm.py --scenes out/arms/ur3 out/arms/panda/*.yaml [--timeout S] [--out DIR]
 
 Each problem goes the way a user's does (``import-moveit``, :mod:`planning.io.moveit_import`,
 margins 0 as in MoveIt), then, alternating, is planned warm by
@@ -34,9 +34,12 @@ problems): a held-out sample.
 Each planner runs in its own worker process; ``--workers N`` plans N problems at once, ours'
 parallel collision checks then on a share of the cores each (on a 2-core machine both
 planners share the cores, and both take longer: compare the ratios with a run of one worker).
-``--scenes FILE ...`` runs scene files instead, of any robot (``generate_arm_scenes.py``'s, a
-user's own), the same way; rows are grouped by the file's folder (the "robot" column) and its
-name without a trailing ``_<number>`` (the "class").
+``--scenes FILE_OR_FOLDER ...`` runs scene files instead (a folder: its ``*.yaml`` files), of
+any robot (``generate_arm_scenes.py``'s, a user's own; the bundled CPR where a scene names
+none), the same way; rows are grouped by the file's folder (the "robot" column) and its name
+without a trailing ``_<number>`` (the "class"). Every scene and robot is loaded before
+anything runs: a missing or malformed file, or a robot that does not load, is named in one
+line.
 """
 
 from __future__ import annotations
@@ -60,6 +63,7 @@ from typing import Any
 import numpy as np
 
 import cpr_kin as ck
+from planning.batch import scene_files
 from planning.cli.arguments import COUNT, SECONDS
 from planning.cli.problem_selection import add_selection, check_selection, selected_problems
 from planning.errors import NoSolutionError, PlanningError
@@ -73,13 +77,16 @@ _ROBOTS: dict[str, ck.Robot] = {}
 
 
 def _robot(scene_path: str) -> tuple[Any, ck.Robot]:
+    """The scene file's scene and robot (the bundled CPR where it names none, as ``cpr-plan plan``).
+
+    Each robot is loaded and its kernels compiled once per process.
+    """
     scene = load_scene(Path(scene_path))
-    assert scene.robot is not None  # an imported scene names its robot
-    key = str(scene.robot)
+    key = str(scene.robot) if scene.robot is not None else "cpr"
     if key not in _ROBOTS:
         from planning.pipeline.planner import warm_up
 
-        _ROBOTS[key] = scene.robot.load()
+        _ROBOTS[key] = scene.robot.load() if scene.robot is not None else ck.load_cpr()
         warm_up(_ROBOTS[key])
     return scene, _ROBOTS[key]
 
@@ -137,6 +144,18 @@ def passes_check(scene_path: str, trajectory_text: str) -> bool:
 def warm(scene_path: str) -> None:
     """Load the scene's robot and compile the kernels in this process (untimed)."""
     _robot(scene_path)
+
+
+def warm_peer(scene_path: str) -> None:
+    """:func:`warm`, and import OMPL's pipeline (untimed).
+
+    Its first call in a process would otherwise count the imports, TOPP-RA's above all:
+    0.32 s against 0.035 s warm on the bundled shelf.
+    """
+    from planning.peers.ompl_rrt import import_peer
+
+    warm(scene_path)
+    import_peer()
 
 
 def theirs(scene_path: str, timeout_s: float) -> dict[str, Any]:
@@ -223,7 +242,7 @@ class Lane:
             row |= {"ours_ok": False, "ours_time_s": timeout_s, "ours_why": "timeout"}
             self._kill(self.ours)
             self.ours = self._pool()
-        self.theirs.submit(warm, str(path)).result()
+        self.theirs.submit(warm_peer, str(path)).result()
         row |= {f"ompl_{k}": v for k, v in self.theirs.submit(theirs, str(path), timeout_s).result().items()}
         return row
 
@@ -242,7 +261,7 @@ class Lane:
 def cases(args: argparse.Namespace) -> Iterator[tuple[str, str, int, Path]]:
     """``(robot, class, number, scene file)`` of each problem: MotionBenchMaker's, or ``--scenes``."""
     if args.scenes:
-        for path in args.scenes:
+        for path in scene_paths(args.scenes):
             group, _, number = path.stem.rpartition("_")
             if not (group and number.isdigit()):
                 group, number = path.stem, "0"
@@ -255,6 +274,11 @@ def cases(args: argparse.Namespace) -> Iterator[tuple[str, str, int, Path]]:
             yield robot_name, problem.problem_class, problem.index, path
 
 
+def scene_paths(given: list[Path]) -> list[Path]:
+    """The scene files of ``--scenes``: each file as given, each folder's ``*.yaml`` files by name."""
+    return [found for path in given for found in (scene_files(path) if path.is_dir() else [path])]
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     add_selection(parser)
@@ -265,7 +289,10 @@ def main() -> int:
         help=f"our planner's time_limit_s [s] (default: {TIME_LIMIT_SHARE:g} of --timeout)",
     )
     parser.add_argument(
-        "--scenes", nargs="+", type=Path, help="scene files to run instead of MotionBenchMaker's (any robot)"
+        "--scenes",
+        nargs="+",
+        type=Path,
+        help="scene files or folders of them to run instead of MotionBenchMaker's (any robot)",
     )
     parser.add_argument(
         "--workers", type=COUNT, default=1, help="problems planned at once (each by both planners in turn)"
@@ -276,12 +303,15 @@ def main() -> int:
     if args.time_limit is not None and not 0 < args.time_limit <= args.timeout:
         parser.error(f"--time-limit {args.time_limit:g} s must be in (0, --timeout = {args.timeout:g}] s")
     time_limit_s = args.time_limit or TIME_LIMIT_SHARE * args.timeout
+    try:  # every scene and robot loaded before anything runs: a bad file is one line
+        chosen = list(cases(args))
+        rows: list[dict[str, Any]] = [
+            {"robot": robot, "class": group, "problem": index, "invalid": valid(path) or ""}
+            for robot, group, index, path in chosen
+        ]
+    except (PlanningError, ck.CprKinError, OSError) as exc:
+        parser.error(str(exc))
     args.out.mkdir(parents=True, exist_ok=True)
-    chosen = list(cases(args))
-    rows: list[dict[str, Any]] = [
-        {"robot": robot, "class": group, "problem": index, "invalid": valid(path) or ""}
-        for robot, group, index, path in chosen
-    ]
     context = multiprocessing.get_context("spawn")
     lanes: queue.Queue[Lane] = queue.Queue()
     # N lanes share the cores: ours' parallel checks get a share each (oversubscribed, they slow

@@ -14,6 +14,7 @@ import cpr_kin as ck
 from cpr_kin.packages import example_robot
 
 SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "bench_mbm.py"
+SHELF = Path(__file__).resolve().parents[1] / "examples" / "scenes" / "shelf.yaml"
 
 
 @pytest.fixture(scope="module")
@@ -72,3 +73,60 @@ def test_a_bad_sample_is_named_before_anything_runs(
     assert info.value.code == 2
     assert message in capsys.readouterr().err
     assert not (tmp_path / "out").exists()  # nothing written
+
+
+def test_scene_folders_expand_to_their_scene_files_by_name(bench: ModuleType, tmp_path: Path) -> None:
+    folder = tmp_path / "arm"
+    folder.mkdir()
+    for name in ("b_2.yaml", "a_1.yaml", "notes.txt"):
+        (folder / name).write_text("name: x\n")
+    single = tmp_path / "c_3.yaml"
+    single.write_text("name: y\n")
+    assert bench.scene_paths([folder, single]) == [folder / "a_1.yaml", folder / "b_2.yaml", single]
+
+
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        (None, "does not exist"),
+        ("foo: [\n", "is not valid YAML at line 2"),
+        ("robot: {urdf: missing.urdf}", "missing.urdf"),  # the shelf with this robot
+    ],
+)
+def test_a_bad_scene_file_is_named_before_anything_runs(
+    bench: ModuleType,
+    content: str | None,
+    message: str,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    tmp_path: Path,
+) -> None:
+    scene = tmp_path / "scene_1.yaml"
+    if content is not None and content.startswith("robot:"):
+        scene.write_text(SHELF.read_text().replace("robot: ../../cpr_kin/urdf/cpr.urdf", content))
+    elif content is not None:
+        scene.write_text(content)
+    monkeypatch.setattr("sys.argv", ["bench_mbm.py", "--scenes", str(scene), "--out", str(tmp_path / "out")])
+    with pytest.raises(SystemExit) as info:
+        bench.main()
+    assert info.value.code == 2
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err
+    assert not (tmp_path / "out").exists()  # nothing written
+
+
+def test_a_scene_without_a_robot_is_the_cpr_s(bench: ModuleType, tmp_path: Path) -> None:
+    text = "\n".join(line for line in SHELF.read_text().splitlines() if not line.startswith("robot:"))
+    (tmp_path / "shelf.yaml").write_text(text + "\n")
+    scene, robot = bench._robot(str(tmp_path / "shelf.yaml"))
+    assert scene.robot is None
+    assert robot.limits.names == ck.load_cpr().limits.names
+
+
+def test_the_peer_s_imports_are_done_before_its_first_timed_call() -> None:
+    import sys
+
+    from planning.peers import import_peer
+
+    import_peer()
+    assert {"ompl.geometric", "toppra.algorithm", "toppra.constraint"} <= set(sys.modules)
