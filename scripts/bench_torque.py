@@ -41,6 +41,7 @@ import numpy as np
 
 import cpr_kin as ck
 from planning.cli.arguments import COUNT, SEED
+from planning.cli.problem_selection import check_limit
 from planning.curves.path_timing import time_path
 from planning.curves.trajectory import Trajectory
 from planning.errors import NoSolutionError
@@ -223,6 +224,7 @@ def main() -> int:
     parser.add_argument("--limit", type=COUNT, default=1, help="MotionBenchMaker problems per class")
     parser.add_argument("--out", type=Path, default=Path("out/bench_torque"))
     args = parser.parse_args()
+    check_limit(parser, args.limit)
     args.out.mkdir(parents=True, exist_ok=True)
     warm_up()
     rows: list[dict[str, Any]] = []

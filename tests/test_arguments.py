@@ -51,6 +51,7 @@ def test_a_number_at_least_its_bound_takes_the_bound_itself() -> None:
         ("bench_planner", ["--runs", "0"], "argument --runs: 0 must be an integer >= 1"),
         ("bench_timing", ["--rrt-time", "0"], "argument --rrt-time: 0 must be a number > 0 s"),
         ("bench_torque", ["--limit", "-1"], "argument --limit: -1 must be an integer >= 1"),
+        ("bench_torque", ["--limit", "101"], "--limit 101 must be in [1, 100] problems per class"),
         ("generate_scenes", ["--seed", "-1", "--out", "x"], "argument --seed: -1 must be an integer >= 0"),
         ("study_parameters", ["--narrow", "-1"], "argument --narrow: -1 must be an integer >= 0"),
         ("paper_case", ["--seeds", "0"], "argument --seeds: 0 must be an integer >= 1"),

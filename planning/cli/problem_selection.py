@@ -34,10 +34,15 @@ def add_selection(parser: argparse.ArgumentParser) -> None:
 
 def check_selection(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
     """Refuse (``parser.error``) a ``--limit`` above :data:`PER_CLASS`, a sample seed without a limit."""
-    if args.limit is not None and args.limit > PER_CLASS:
-        parser.error(f"--limit {args.limit} must be in [1, {PER_CLASS}] problems per class")
+    check_limit(parser, args.limit)
     if args.sample_seed is not None and args.limit is None:
         parser.error(f"--sample-seed {args.sample_seed} goes with --limit (the sample's size per class)")
+
+
+def check_limit(parser: argparse.ArgumentParser, limit: int | None) -> None:
+    """Refuse (``parser.error``) a ``--limit`` above :data:`PER_CLASS` (``None``: all of them)."""
+    if limit is not None and limit > PER_CLASS:
+        parser.error(f"--limit {limit} must be in [1, {PER_CLASS}] problems per class")
 
 
 def selected_problems(args: argparse.Namespace, robot: str) -> Iterator[Problem]:
