@@ -70,6 +70,7 @@ from planning.errors import NoSolutionError, PlanningError
 from planning.io.mbm import endpoint_violations, import_problem
 from planning.io.scene_file import load_scene
 from planning.io.trajectory_io import trajectory_json
+from planning.outcome import classify
 
 TIME_LIMIT_SHARE = 0.8
 """Our planner's default ``time_limit_s`` as a share of ``--timeout``: room to time and verify."""
@@ -309,8 +310,11 @@ def main() -> int:
             {"robot": robot, "class": group, "problem": index, "invalid": valid(path) or ""}
             for robot, group, index, path in chosen
         ]
-    except (PlanningError, ck.CprKinError, OSError) as exc:
-        parser.error(str(exc))
+    except Exception as exc:  # bad input is named in one line (the project's one rule for it)
+        outcome = classify(exc)
+        if outcome.status != "invalid":
+            raise
+        parser.error(outcome.message)
     args.out.mkdir(parents=True, exist_ok=True)
     context = multiprocessing.get_context("spawn")
     lanes: queue.Queue[Lane] = queue.Queue()
