@@ -63,6 +63,12 @@ class CollisionWorld:
     ) -> None:
         if not (np.isfinite(self_margin_m) and self_margin_m >= 0.0):
             raise CprKinError(f"self_margin_m = {self_margin_m} m must be a finite distance >= 0")
+        strangers = [type(o).__name__ for o in obstacles if not isinstance(o, Obstacle)]
+        if strangers:  # e.g. names or dicts, which failed deep inside
+            raise CprKinError(
+                f"obstacles hold {len(strangers)} item(s) that are not cpr_kin.Obstacle "
+                f"(a {strangers[0]}); make them with Obstacle.box, .sphere, .cylinder, ..."
+            )
         duplicated = sorted(n for n, count in Counter(o.name for o in obstacles).items() if count > 1)
         if duplicated:
             raise CprKinError(f"obstacle names must be unique; {duplicated} appear more than once")

@@ -43,6 +43,7 @@ from cpr_kin.overlapping_pairs import overlapping_pairs
 from cpr_kin.packages import package_roots
 from cpr_kin.resources import makers_limits_path
 from cpr_kin.robot import Robot, joint_units
+from cpr_kin.robot_options import check_not_one_name, check_options, check_tcp
 from cpr_kin.self_collision import SrdfPairs, find_srdf, read_srdf, self_pairs
 from cpr_kin.supported import check_joints, check_limits, check_names
 from cpr_kin.urdf_file import (
@@ -99,6 +100,9 @@ class RobotSpec:
     default_srdf: Path | None = None
     validate: bool | None = field(default=None, compare=False)
 
+    def __post_init__(self) -> None:
+        check_options(self)
+
     def load(self) -> Robot:
         """The robot (module docstring)."""
         path = Path(self.urdf)
@@ -110,6 +114,7 @@ class RobotSpec:
         xml = prepared_xml(tree, path, package_roots(path, self.package_dirs))
         arm = arm_chain(tree)
         model, collision = build_models(xml, path)
+        check_tcp(self.tcp, model, path)
         planned = self._planned(model, tree, path, arm)
         held = self._held_values(model, tree, planned, path)
         visual = VisualModel(xml, path)
@@ -121,7 +126,7 @@ class RobotSpec:
             model, (collision,) = pin.buildReducedModel(model, [collision], lock, q_ref)
             visual = VisualModel(xml, path, tuple(lock), tuple(q_ref))
         names = tuple(model.names[1:])
-        tcp = self._tcp_frame(model, path, arm)
+        tcp = self._tcp_frame(model, arm)
         velocity = np.array(model.velocityLimit, dtype=float)
         known = tuple(j.get("name", "") for j in tree.getroot().findall("joint"))
         limits_file = (
@@ -245,14 +250,9 @@ class RobotSpec:
             values[name] = value
         return values
 
-    def _tcp_frame(self, model: Any, path: Path, arm: ArmChain) -> str:
-        """The tool-centre-point frame (attribute ``tcp``)."""
+    def _tcp_frame(self, model: Any, arm: ArmChain) -> str:
+        """The tool-centre-point frame (attribute ``tcp``, checked by :func:`check_tcp`)."""
         if self.tcp is not None:
-            if not model.existFrame(self.tcp):
-                known = sorted({f.name for f in model.frames})
-                raise UrdfError(
-                    f"URDF '{path}' has no link or frame named '{self.tcp}'; its frames are {known}"
-                )
             return self.tcp
         if model.existFrame("tcp"):
             return "tcp"
@@ -275,6 +275,7 @@ def load_robot(urdf_path: str | Path, **options: Any) -> Robot:
         if options.get(key) is not None:
             options[key] = Path(options[key])
     for key in ("package_dirs", "joints", "effector_links", "wrist_joints", "limits_names"):
+        check_not_one_name(key, options.get(key))
         if key in options and options[key] is not None:
             options[key] = tuple(options[key])
     if isinstance(options.get("held"), Mapping):

@@ -41,8 +41,20 @@ def example_robot_data_share() -> Path | None:
 
 
 def package_roots(urdf_path: Path, package_dirs: Sequence[Path] = ()) -> list[Path]:
-    """The folders a ``package://`` URI is looked for in, in order (module docstring)."""
+    """The folders a ``package://`` URI is looked for in, in order (module docstring).
+
+    Raises:
+        UrdfError: a folder of ``package_dirs`` is not a folder (a typo would otherwise go
+            unnoticed wherever the meshes are found elsewhere).
+    """
     roots = [Path(d).resolve() for d in package_dirs]
+    for given, root in zip(package_dirs, roots, strict=True):
+        if not root.is_dir():
+            problem = "is not a folder" if root.exists() else "does not exist"
+            raise UrdfError(
+                f"package folder '{given}' (packages, for URDF '{urdf_path}') {problem}; "
+                "give folders that hold the packages its package:// meshes name"
+            )
     folder = urdf_path.resolve().parent
     roots += [folder, *folder.parents]
     share = example_robot_data_share()

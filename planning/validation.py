@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from numbers import Real
-from typing import Any
+from typing import Any, get_args
 
 import numpy as np
 from pydantic import BaseModel, ValidationError
@@ -95,6 +95,36 @@ def field_path(location: Location, hidden: Sequence[str] = ()) -> str:
             key = str(part) if len(str(part)) <= MAX_VALUE_CHARS else str(part)[: MAX_VALUE_CHARS - 3] + "..."
             text += f".{key}" if text else key
     return text or "(top level)"
+
+
+def model_within(root: type[BaseModel]) -> Callable[[Location], type[BaseModel] | None]:
+    """The ``model_at`` of :func:`describe_validation` for nested models without unions of models.
+
+    Follows a location's keys through ``root``'s fields (a field of a model, or a list,
+    tuple, dict or optional of one) to the model that owns its last key.
+    """
+
+    def model_at(location: Location) -> type[BaseModel] | None:
+        model: type[BaseModel] = root
+        for part in location[:-1]:
+            if isinstance(part, int):
+                continue  # an item of a list the last field held
+            field = model.model_fields.get(str(part))
+            found = _model_in(field.annotation) if field is not None else None
+            if found is None:
+                return None
+            model = found
+        return model
+
+    return model_at
+
+
+def _model_in(annotation: Any) -> type[BaseModel] | None:
+    """The model an annotation holds: itself, or the one model among its arguments."""
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return annotation
+    models = {m for m in map(_model_in, get_args(annotation)) if m is not None}
+    return models.pop() if len(models) == 1 else None
 
 
 def describe_validation(

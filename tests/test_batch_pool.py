@@ -16,11 +16,13 @@ import sys
 import time
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 
 import cpr_kin as ck
-from planning.batch import check_scheduler
+from planning.batch import check_scheduler, check_workers, run_batch
+from planning.cli import main
 from planning.errors import PlanningError
 from planning.io.bundled import bundled_scene_paths, paper_scene_path
 from planning.io.publish import complete_set
@@ -183,6 +185,40 @@ def test_a_malformed_scheduler_address_is_refused_at_once(address: str, message:
 )
 def test_a_well_formed_address_passes(address: str) -> None:
     check_scheduler(address)
+
+
+@pytest.mark.parametrize(
+    ("workers", "scheduler", "message"),
+    [
+        (0, None, r"workers = 0 must be an integer >= 1"),
+        (-3, None, r"workers = -3 must be an integer >= 1"),
+        (True, None, r"workers = True must be an integer >= 1"),
+        (2, "tcp://127.0.0.1:8786", r"workers = 2 limits local processes; .*leave workers out"),
+    ],
+)
+def test_a_count_of_workers_is_checked_before_anything_runs(
+    tmp_path: Path, workers: Any, scheduler: str | None, message: str
+) -> None:
+    # 0 and -3 ran on every core and on one, and a count beside a scheduler was ignored
+    with pytest.raises(PlanningError, match=message):
+        run_batch([tmp_path / "a.yaml"], tmp_path / "out", workers=workers, scheduler=scheduler)
+    assert not (tmp_path / "out").exists()
+    check_workers(None, scheduler)
+    check_workers(1, None)
+
+
+def test_the_command_refuses_workers_with_a_scheduler_before_the_output_folder(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "scenes").mkdir()
+    (tmp_path / "scenes" / "a.yaml").write_text(paper_scene_path().read_text())
+    out = tmp_path / "out"
+    command = ["batch", str(tmp_path / "scenes"), "--out", str(out), "--workers", "2"]
+    assert main([*command, "--scheduler", "tcp://127.0.0.1:8786"]) == 2
+    assert "leave workers out with a scheduler" in capsys.readouterr().err and not out.exists()
+    with pytest.raises(SystemExit):  # argparse: exit 2, naming the option
+        main(["batch", str(tmp_path / "scenes"), "--out", str(out), "--workers", "0"])
+    assert "--workers" in capsys.readouterr().err and not out.exists()
 
 
 @pytest.mark.slow

@@ -301,3 +301,9 @@ def test_keeps_clearance_is_both_margins_from_distances(rng: np.random.Generator
     sure = (np.abs(obstacles - margin_m) > 1e-6) & (np.abs(own - self_margin_m) > 1e-6)
     assert 0 < expected.sum() < len(q)  # both outcomes drawn
     np.testing.assert_array_equal(world.keeps_clearance(q, margin_m, self_margin_m)[sure], expected[sure])
+
+
+def test_a_world_of_something_else_is_named(robot: ck.Robot) -> None:
+    # a list of names or dicts failed deep inside with an AttributeError
+    with pytest.raises(ck.CprKinError, match=r"1 item\(s\) that are not cpr_kin.Obstacle \(a str\)"):
+        ck.CollisionWorld(robot, [ck.Obstacle.sphere(0.1, (1.0, 0.0, 0.0)), "crate"])  # type: ignore[list-item]

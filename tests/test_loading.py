@@ -121,6 +121,11 @@ def test_package_dirs_are_looked_in_first(tmp_path: Path) -> None:
     (tmp_path / "share" / "my_arms").symlink_to(ROBOTS)
     robot = ck.load_robot(urdf, package_dirs=[tmp_path / "share"])
     assert robot.nq == 7
+    # a folder that is not there is named, not passed over (the meshes may be found anyway)
+    with pytest.raises(ck.UrdfError, match=r"package folder '.*shared' \(packages, .*\) does not exist"):
+        ck.load_robot(urdf, package_dirs=[tmp_path / "shared", tmp_path / "share"])
+    with pytest.raises(ck.UrdfError, match=r"package folder '.*xarm7.urdf' .* is not a folder"):
+        ck.load_robot(urdf, package_dirs=[urdf])
 
 
 def test_planned_and_held_joints_are_checked() -> None:
@@ -224,6 +229,17 @@ def test_a_robot_of_several_arms_plans_the_joints_to_the_tool_it_is_given(
     assert robot.tcp_frame == tool
 
 
+def test_a_tool_the_urdf_lacks_is_named_not_taken_for_no_tool() -> None:
+    # on a tree of several arms a misspelt tcp used to read "has no single arm ... name the
+    # tool frame", as if none had been given
+    with pytest.raises(
+        ck.UrdfError,
+        match=r"has no link or frame named 'r_gripper_tool' \(the tool frame, tcp\); "
+        r"did you mean .*'r_gripper_tool_frame'",
+    ):
+        ck.load_robot(ROBOTS / "pr2_description/urdf/pr2.urdf", tcp="r_gripper_tool")
+
+
 def test_a_urdf_without_collision_shapes_is_refused_naming_the_fix() -> None:
     with pytest.raises(
         ck.UrdfError, match=r"has no <collision> geometry: .*give the links <collision> elements"
@@ -255,3 +271,19 @@ def test_a_tool_named_as_a_joint_and_a_link_is_the_link() -> None:
     chosen = robot.model.frames[robot.frame_id("gripperStator")]
     assert chosen.type == pin.FrameType.BODY
     assert all(f.placement.isApprox(chosen.placement) for f in frames)  # one place either way
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        ({"joints": "panda_joint1"}, r"joints = 'panda_joint1' must be a sequence, not one name"),
+        ({"package_dirs": "/tmp"}, r"package_dirs = '/tmp' must be a sequence, not one name"),
+        ({"tcp": 7}, r"tcp = 7 must be a frame's name"),
+        ({"joints": ["panda_joint1", 2]}, r"joints = \('panda_joint1', 2\) must be a sequence of names"),
+        ({"held": {"panda_finger_joint1": "open"}}, r"held = .* must map joint names to numbers"),
+    ],
+)
+def test_options_of_the_wrong_kind_are_named(options: dict[str, Any], message: str) -> None:
+    # a string of joint names was split into letters, an int tcp reached Pinocchio's C++ signature
+    with pytest.raises(ck.UrdfError, match=message):
+        ck.load_robot(example_robot("panda"), **options)

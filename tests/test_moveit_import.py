@@ -245,6 +245,26 @@ def test_without_an_srdf_the_default_joints_load_with_the_package_dirs(
     assert loaded.robot is not None and loaded.robot.joints == tuple(joints)
 
 
+@pytest.mark.parametrize(
+    ("option", "name", "message"),
+    [
+        ("--package-dir", "nowhere", "package folder '{path}' (packages, for URDF"),
+        ("--limits", "nowhere.yaml", "joint limits file '{path}' does not exist"),
+    ],
+)
+def test_a_robot_file_that_is_not_there_is_named_before_anything_is_written(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], option: str, name: str, message: str
+) -> None:
+    # the SRDF's group gives the joints without loading the robot: these were written into
+    # the scene file, and only planning it named them
+    out, missing = tmp_path / "out.yaml", tmp_path / name
+    arguments = [*write(tmp_path, SCENE, REQUEST), option, str(missing), "--out", str(out)]
+    assert main(["import-moveit", *arguments]) == 2
+    error = capsys.readouterr().err
+    assert message.format(path=missing) in error and len(error.strip().splitlines()) == 1
+    assert not out.exists()
+
+
 def changed(document: dict[str, Any], dotted: str, value: Any) -> dict[str, Any]:
     document = copy.deepcopy(document)
     *parents, last = dotted.split(".")
@@ -277,7 +297,18 @@ REFUSALS = [
         [[False, False, True], [False, False, False], [True, False, False]],
         "contact with an object is not supported",
     ),
-    ("scene", "world.colision_objects", [], "world.colision_objects: unknown key"),
+    (
+        "scene",
+        "world.colision_objects",
+        [],
+        "world.colision_objects: unknown key; allowed here: collision_objects, octomap",
+    ),
+    (  # the keys allowed are those of the nested message the key is in
+        "scene",
+        "world.collision_objects.0.primitive_posez",
+        [],
+        "world.collision_objects[0].primitive_posez: unknown key; allowed here: header, pose, id, type",
+    ),
     (
         "scene",
         "world.collision_objects.0.primitives.0.dimensions",

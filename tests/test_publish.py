@@ -1,7 +1,9 @@
 from __future__ import annotations
 
+import errno
 import json
 import os
+import re
 import signal
 import stat
 import subprocess
@@ -161,11 +163,13 @@ def test_write_file_is_atomic_and_cleans_up_after_the_dead(
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.json"]
 
     def refuse(*_: object) -> None:
-        raise OSError("disk full")
+        raise OSError(errno.ENOSPC, "No space left on device", "/somewhere/.other.json.tmp-1-ab")
 
     monkeypatch.setattr(os, "replace", refuse)
-    with pytest.raises(OSError, match="disk full"):
-        write_file(tmp_path / "other.json", "{}")
+    other = tmp_path / "other.json"  # named as asked for, not by the temporary file beside it
+    named = rf"cannot write '{re.escape(str(other))}': No space left on device"
+    with pytest.raises(OutputError, match=named):
+        write_file(other, "{}")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.json"]
     with pytest.raises(OutputError, match="is a folder"):
         write_file(tmp_path, "x")

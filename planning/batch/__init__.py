@@ -11,12 +11,13 @@ The process that dispatches the scenes imports none of the planner: each worker 
 
 from planning.batch.cluster import check_scheduler
 from planning.batch.items import BatchItem, plan_scene_file, scene_files, summary_csv
-from planning.batch.pool import BatchRun, run_batch
+from planning.batch.pool import BatchRun, check_workers, run_batch
 
 __all__ = [
     "BatchItem",
     "BatchRun",
     "check_scheduler",
+    "check_workers",
     "plan_scene_file",
     "run_batch",
     "scene_files",

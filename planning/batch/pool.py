@@ -25,6 +25,7 @@ from pathlib import Path
 
 from planning.batch.cluster import run_on_cluster
 from planning.batch.items import BatchItem, finished_items, plan_scene_file
+from planning.errors import PlanningError
 from planning.validation import shown
 
 Task = Callable[..., BatchItem]
@@ -102,6 +103,21 @@ def _alone(task: Task, arguments: tuple[Path, Path]) -> BatchItem:
     return _outcome(future, arguments[0].stem)
 
 
+def check_workers(workers: int | None, scheduler: str | None) -> None:
+    """Refuse a count of local workers below 1, or one given with a cluster's ``scheduler``.
+
+    Raises:
+        PlanningError: naming the value and what is allowed.
+    """
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise PlanningError(f"workers = {workers!r} must be an integer >= 1 (or None: every core)")
+    if workers is not None and scheduler is not None:
+        raise PlanningError(
+            f"workers = {workers} limits local processes; on a Dask cluster its workers' threads "
+            "decide how many scenes run at once: leave workers out with a scheduler"
+        )
+
+
 def run_batch(
     paths: Sequence[Path],
     out: Path,
@@ -115,16 +131,20 @@ def run_batch(
     Args:
         paths: scene files.
         out: output folder.
-        workers: parallel scenes locally (default: every core).
+        workers: parallel scenes locally, at least 1 (default: every core); not with a
+            ``scheduler``, whose workers' threads decide.
         scheduler: address of a ``dask.distributed`` scheduler, e.g. ``tcp://127.0.0.1:8786``.
         progress: called with each item as it completes.
         task: what plans one scene, ``(scene file, output folder) -> BatchItem`` (default
             :func:`~planning.batch.items.plan_scene_file`; the tests pass one that crashes).
 
     Raises:
-        PlanningError: no Dask, or an unreachable scheduler.
+        PlanningError: ``workers`` below 1 or given with a ``scheduler``; no Dask, or an
+            unreachable scheduler.
     """
     from loky import cpu_count
+
+    check_workers(workers, scheduler)
 
     tasks = [(path, out / path.stem) for path in paths]
     results: dict[int, BatchItem] = {}
@@ -136,7 +156,7 @@ def run_batch(
 
     try:
         if scheduler is None:
-            _run_local(task, tasks, max(1, min(workers or cpu_count(), len(tasks))), done)
+            _run_local(task, tasks, min(workers or cpu_count(), len(tasks)), done)
         else:
             run_on_cluster(task, tasks, scheduler, done)
     except KeyboardInterrupt:

@@ -9,6 +9,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from cpr_kin.names import escaped
+from planning.cli.arguments import integer_at_least
 from planning.cli.batch_command import cmd_batch
 from planning.cli.file_commands import EXPORTERS, cmd_check, cmd_export, cmd_show
 from planning.cli.moveit_command import cmd_import_moveit
@@ -175,7 +176,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub.add_argument("scenes", type=Path, metavar="SCENES_DIR", help="folder of scene files")
     sub.add_argument("--out", required=True, help="output folder (a subfolder per scene, and summary.csv)")
-    sub.add_argument("--workers", type=int, help="parallel tasks (default: all cores, or the cluster's)")
+    sub.add_argument(
+        "--workers",
+        type=integer_at_least(1),
+        help="parallel scenes on this machine (default: all cores; with --scheduler: the cluster's threads)",
+    )
     sub.add_argument(
         "--scheduler", metavar="ADDRESS", help="dask.distributed scheduler, e.g. tcp://127.0.0.1:8786"
     )

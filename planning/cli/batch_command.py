@@ -22,12 +22,13 @@ def cmd_batch(args: argparse.Namespace) -> int:
     scene's (0, 2, 3 or 4; :mod:`planning.outcome`), or 130 when interrupted;
     ``summary.csv`` is written in every case, for the scenes done.
     """
-    from planning.batch import check_scheduler, run_batch, scene_files, summary_csv
+    from planning.batch import check_scheduler, check_workers, run_batch, scene_files, summary_csv
     from planning.io.publish import FolderLock, write_file
     from planning.io.report import text_table
 
     if args.scheduler is not None:
         check_scheduler(args.scheduler)
+    check_workers(args.workers, args.scheduler)
     paths = scene_files(args.scenes)
     with FolderLock(args.out) as lock:
         out = lock.target  # absolute: the workers write there, wherever they run

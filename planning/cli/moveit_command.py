@@ -10,8 +10,8 @@ from planning.outcome import EXIT_OK
 
 def cmd_import_moveit(args: argparse.Namespace) -> int:
     """Convert ``args.scene`` and ``args.request`` into the scene file ``args.out``."""
-    from planning.io.moveit_import import RobotFiles, import_moveit, read_message, write_imported
-    from planning.io.moveit_messages import MotionPlanRequest, PlanningScene
+    from planning.io.moveit_import import RobotFiles, import_moveit, write_imported
+    from planning.io.moveit_messages import MotionPlanRequest, PlanningScene, read_message
 
     scene = read_message(args.scene, PlanningScene)
     request = read_message(args.request, MotionPlanRequest)

@@ -12,8 +12,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from planning.io.moveit_messages import MotionPlanRequest
-from planning.io.moveit_objects import MoveItImportError
+from planning.io.moveit_messages import MotionPlanRequest, MoveItImportError
 
 
 def goal_entry(request: MotionPlanRequest, planned: tuple[str, ...]) -> tuple[dict[str, Any], str | None]:

@@ -27,28 +27,25 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any
 
 import numpy as np
 import trimesh
 import yaml
 from lxml import etree
-from pydantic import BaseModel, ValidationError
 
 import cpr_kin as ck
+from cpr_kin.limits import MAX_LIMITS_BYTES
+from cpr_kin.packages import package_roots
 from cpr_kin.srdf_groups import group_joints
 from cpr_kin.urdf_file import parse_urdf
 from cpr_kin.user_files import load_yaml
 from planning.io.moveit_goal import goal_entry
-from planning.io.moveit_messages import Constraints, MotionPlanRequest, PlanningScene
-from planning.io.moveit_objects import MoveItImportError, convert_object
+from planning.io.moveit_messages import Constraints, MotionPlanRequest, MoveItImportError, PlanningScene
+from planning.io.moveit_objects import convert_object
 from planning.io.moveit_state import joint_values, position_ranges, within_ranges, wrapped
 from planning.io.publish import write_file
 from planning.pipeline.settings import MAX_TIME_LIMIT_S
-from planning.validation import describe_validation
-
-MAX_MESSAGE_BYTES = 50_000_000
-Model = TypeVar("Model", bound=BaseModel)
 
 
 @dataclass(frozen=True)
@@ -82,15 +79,6 @@ class ImportedScene:
     document: dict[str, Any]
     meshes: dict[str, trimesh.Trimesh] = field(default_factory=dict)
     ignored: tuple[str, ...] = ()
-
-
-def read_message(path: Path, model: type[Model]) -> Model:
-    """The message of the YAML file ``path``, validated by ``model``; errors name the file and field."""
-    data = load_yaml(Path(path), MAX_MESSAGE_BYTES, f"MoveIt {model.__name__} file")
-    try:
-        return model.model_validate(data if data is not None else {})
-    except ValidationError as exc:
-        raise MoveItImportError(f"{path}: {describe_validation(exc)}") from None
 
 
 def _refuse_unsupported(scene: PlanningScene, request: MotionPlanRequest) -> list[str]:
@@ -144,6 +132,9 @@ def import_moveit(
     """
     ignored = _refuse_unsupported(scene, request)
     tree = parse_urdf(robot.urdf)
+    package_roots(robot.urdf, robot.package_dirs)  # names a package folder that is not there
+    if robot.limits is not None:  # a file that is not there or not YAML is named now, not at planning
+        load_yaml(robot.limits, MAX_LIMITS_BYTES, "joint limits file")
     root = _root_link(tree)
     planned = (
         group_joints(robot.srdf, request.group_name, tree).joints

@@ -9,11 +9,16 @@ not support is refused there (:mod:`planning.io.moveit_import`), never dropped.
 
 from __future__ import annotations
 
-from typing import Annotated, Any
+from pathlib import Path
+from typing import Annotated, Any, TypeVar
 
 import numpy as np
 import pinocchio as pin
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError
+
+from cpr_kin.user_files import load_yaml
+from planning.errors import PlanningError
+from planning.validation import describe_validation, model_within
 
 Number = Annotated[float, Field(allow_inf_nan=False)]
 
@@ -254,3 +259,24 @@ class MotionPlanRequest(Message):
     cartesian_speed_end_effector_link: str = ""
     cartesian_speed_limited_link: str = ""
     max_cartesian_speed: Number = 0.0
+
+
+MAX_MESSAGE_BYTES = 50_000_000
+"""Largest MoveIt message file read [bytes]."""
+Model = TypeVar("Model", bound=BaseModel)
+
+
+class MoveItImportError(PlanningError):
+    """A MoveIt file holds what the conversion does not support, or is inconsistent."""
+
+
+def read_message(path: Path, model: type[Model]) -> Model:
+    """The message of the YAML file ``path``, validated by ``model``; errors name the file and field.
+
+    An unknown key lists the keys allowed in the (nested) message that holds it.
+    """
+    data = load_yaml(Path(path), MAX_MESSAGE_BYTES, f"MoveIt {model.__name__} file")
+    try:
+        return model.model_validate(data if data is not None else {})
+    except ValidationError as exc:
+        raise MoveItImportError(f"{path}: {describe_validation(exc, model_within(model))}") from None

@@ -21,18 +21,13 @@ import numpy as np
 import pinocchio as pin
 import trimesh
 
-from planning.errors import PlanningError
-from planning.io.moveit_messages import CollisionObject, Mesh, Pose
+from planning.io.moveit_messages import CollisionObject, Mesh, MoveItImportError, Pose
 
 CONE_SIDES = 32
 """Sides of the pyramid that stands for a cone."""
 PRIMITIVE_TYPES = {1: "box", 2: "sphere", 3: "cylinder", 4: "cone", 5: "prism"}
 """``SolidPrimitive.type`` numbers and names."""
 ADD_OPERATIONS = (0, "0", "ADD", "add")
-
-
-class MoveItImportError(PlanningError):
-    """A MoveIt file holds what the conversion does not support, or is inconsistent."""
 
 
 @dataclass(frozen=True)

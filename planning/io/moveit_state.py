@@ -12,8 +12,7 @@ import math
 
 from lxml import etree
 
-from planning.io.moveit_messages import RobotState
-from planning.io.moveit_objects import MoveItImportError
+from planning.io.moveit_messages import MoveItImportError, RobotState
 
 
 def joint_values(*states: RobotState) -> dict[str, float]:

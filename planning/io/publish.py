@@ -76,22 +76,27 @@ def write_file(path: str | Path, content: str | bytes) -> Path:
     """Write one file atomically: to ``.<name>.tmp-<pid>-<random>`` beside it, then renamed over it.
 
     Temporary files that a killed writer left beside it are removed.
+
+    Raises:
+        OutputError: ``path`` names a folder or no file, or cannot be written (naming it).
     """
     path = Path(path)
     if not path.name or path.name in (".", ".."):
         raise OutputError(f"'{path}' names no file")
     if path.is_dir():
         raise OutputError(f"'{path}' is a folder; give a file name")
-    path.parent.mkdir(parents=True, exist_ok=True)
     prefix = f".{path.name}.tmp-"
-    for stale in path.parent.iterdir():
-        pid = stale.name.removeprefix(prefix).split("-")[0]
-        if stale.name.startswith(prefix) and pid.isdigit() and not _alive(int(pid)):
-            stale.unlink(missing_ok=True)
     temporary = path.with_name(f"{prefix}{os.getpid()}-{os.urandom(4).hex()}")
     try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        for stale in path.parent.iterdir():
+            pid = stale.name.removeprefix(prefix).split("-")[0]
+            if stale.name.startswith(prefix) and pid.isdigit() and not _alive(int(pid)):
+                stale.unlink(missing_ok=True)
         _write(temporary, content)
         os.replace(temporary, path)
+    except OSError as exc:  # named by the file asked for, not the temporary one beside it
+        raise OutputError(f"cannot write '{path}': {exc.strerror or exc}") from None
     finally:
         temporary.unlink(missing_ok=True)
     return path
