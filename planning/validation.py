@@ -31,6 +31,15 @@ def _is_number(value: Any) -> bool:
     return isinstance(value, Real | np.floating | np.integer) and not isinstance(value, bool | np.bool_)
 
 
+def instance_of(name: str, value: Any, kind: type | tuple[type, ...], hint: str) -> None:
+    """Refuse a ``value`` that is not a ``kind`` (a str where a Scene belongs), naming how to make one.
+
+    ``hint``: where such a value comes from, e.g. ``"planning.Scene (load_scene, paper_scene)"``.
+    """
+    if not isinstance(value, kind):
+        raise PlanningError(f"{name} is a {type(value).__name__}; give a {hint}")
+
+
 def boolean(name: str, value: Any) -> bool:
     """``value`` if it is ``True`` or ``False``; else a :class:`PlanningError`."""
     if not isinstance(value, bool):

@@ -14,7 +14,7 @@ import cpr_kin as ck
 from cpr_kin.packages import example_robot_data_share
 from planning.errors import NoTrajectoryFoundError, PlanningError, TargetOutOfReachError
 from planning.io.bundled import paper_scene
-from planning.pipeline.planner import plan, warm_up
+from planning.pipeline.planner import plan, solve, warm_up
 from planning.pipeline.problem import build_problem
 from planning.pipeline.result import PlanResult
 from planning.pipeline.scene import Scene
@@ -190,6 +190,22 @@ def test_bad_planner_settings() -> None:
         RefinementSettings(active="yes")  # type: ignore[arg-type]
 
 
+def test_objects_of_the_wrong_kind_are_named_at_the_entry_points(robot: ck.Robot) -> None:
+    # a name where an obstacle belongs, a path where a robot does, failed deep inside with an
+    # AttributeError
+    start, goal = Target(tcp=PAPER_START_TCP), Target(tcp=PAPER_GOAL_TCP)
+    with pytest.raises(PlanningError, match=r"obstacles\[1\] is a str; give a cpr_kin.Obstacle"):
+        Scene(start=start, goal=goal, obstacles=(ck.Obstacle.sphere(0.1, (0, 0, 2)), "crate"))  # type: ignore[arg-type]
+    with pytest.raises(PlanningError, match=r"goal is a tuple; give a planning.Target"):
+        Scene(start=start, goal=(0.0, 0.1, 0.1, 0.0, 0.0))  # type: ignore[arg-type]
+    with pytest.raises(PlanningError, match=r"robot is a str; give a cpr_kin.Robot"):
+        build_problem(paper_scene(seed=0), "cpr.urdf")  # type: ignore[arg-type]
+    with pytest.raises(PlanningError, match=r"scene is a str; give a planning.Scene"):
+        plan("paper.yaml", robot)  # type: ignore[arg-type]
+    with pytest.raises(PlanningError, match=r"problem is a Scene; give a planning.Problem"):
+        solve(paper_scene(seed=0))  # type: ignore[arg-type]
+
+
 def test_warm_up_compiles_the_kernels_and_returns_its_time(robot: ck.Robot) -> None:
     from cpr_kin.bound_kernels import groups_below
     from planning.search.firefly import _move
@@ -264,7 +280,7 @@ import cpr_kin as ck
 from cpr_kin.packages import example_robot_data_share
 from planning.io.arm_scenes import blocked_scene
 from planning.io.scene_file import parse_scene
-from planning.pipeline.planner import plan, warm_up
+from planning.pipeline.planner import plan, solve, warm_up
 
 baxter = example_robot_data_share() / "example-robot-data" / "robots" / "baxter_description"
 entry = {
@@ -279,7 +295,7 @@ CPR_SCENES = """
 import dataclasses
 import cpr_kin as ck
 from planning.io.scene_generator import generate_scenes
-from planning.pipeline.planner import plan, warm_up
+from planning.pipeline.planner import plan, solve, warm_up
 
 robot = None
 cpr = ck.load_cpr()

@@ -43,6 +43,7 @@ from planning.pipeline.torques import held
 from planning.search.firefly import FireflyProgress
 from planning.search.optimizer import Optimizer, SearchResult
 from planning.search.rrt_connect import rrt_connect
+from planning.validation import instance_of
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
@@ -68,6 +69,7 @@ def solve(
             the time limit when that stopped the plan).
     """
     started = time.perf_counter()
+    instance_of("problem", problem, Problem, "planning.Problem (build_problem(scene))")
     if problem.stands_still:
         return stand_still(problem, started)
     deadline = Deadline.after(problem.scene.planner.time_limit_s, started)

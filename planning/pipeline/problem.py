@@ -29,6 +29,7 @@ from planning.pipeline.scene import Scene
 from planning.pipeline.settings import VERIFY_STEP_RANGE_M
 from planning.pipeline.timing import FixedDuration, FreeDuration, duration_rule
 from planning.pipeline.torques import GravityLimit, gravity_limit, scene_dynamics, search_torque
+from planning.validation import instance_of
 
 FloatArray = NDArray[np.float64]
 
@@ -176,6 +177,9 @@ def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | No
         cpr_kin.CprKinError: the robot's URDF or an obstacle is invalid.
     """
     started = time.perf_counter()
+    instance_of("scene", scene, Scene, "planning.Scene (load_scene, paper_scene, Scene(start=..., goal=...))")
+    if robot is not None:
+        instance_of("robot", robot, ck.Robot, "cpr_kin.Robot (load_robot, load_cpr), or None: the scene's")
     robot = scene_robot(scene, robot or (scene.robot.load() if scene.robot is not None else ck.load_cpr()))
     world = scene_world(scene, robot, threads)
     dynamics = scene_dynamics(robot, scene, world.num_threads)

@@ -22,7 +22,7 @@ from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError
 from planning.pipeline.settings import PlannerSettings
 from planning.pipeline.target import Target
-from planning.validation import number_in, shown
+from planning.validation import instance_of, number_in, shown
 
 FloatArray = NDArray[np.float64]
 
@@ -104,6 +104,14 @@ class Scene:
             raise PlanningError(
                 f"scene name {shown(self.name)} holds {character}; names must be printable text"
             )
+        for end in ("start", "goal"):
+            instance_of(end, getattr(self, end), Target, "planning.Target (q=..., tcp=... or pose=...)")
+        instance_of("planner", self.planner, PlannerSettings, "planning.PlannerSettings")
+        instance_of("spline", self.spline, SplineSettings, "planning.SplineSettings")
+        if self.payload is not None:
+            instance_of("payload", self.payload, ck.Payload, "cpr_kin.Payload")
+        for k, obstacle in enumerate(self.obstacles):
+            instance_of(f"obstacles[{k}]", obstacle, ck.Obstacle, "cpr_kin.Obstacle (Obstacle.box, ...)")
         number_in("safety_margin", self.safety_margin, 0.0, MAX_SAFETY_MARGIN_M, unit="m")
         number_in("self_margin", self.self_margin, 0.0, MAX_SAFETY_MARGIN_M, unit="m")
         number_in("torque_scale", self.torque_scale, *TORQUE_SCALE_RANGE)
