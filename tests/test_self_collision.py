@@ -214,6 +214,9 @@ def test_a_start_inside_itself_is_refused_unless_allowed(panda: ck.Robot) -> Non
     assert plan(
         Scene(start=scene.start, goal=scene.goal, allowed_collisions=allowed), panda
     ).verification.accepted
+    misspelt = ((allowed[0][0], "panda_lnk7"), *allowed[1:])  # the pair would stay checked, silently
+    with pytest.raises(PlanningError, match=r"allowed_collisions names \['panda_lnk7'\], not links"):
+        plan(Scene(start=scene.start, goal=scene.goal, allowed_collisions=misspelt), panda)
 
 
 def collision_distance(robot: ck.Robot, q: np.ndarray, first: str, second: str) -> float:

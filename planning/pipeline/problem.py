@@ -150,7 +150,15 @@ def scene_world(scene: Scene, robot: ck.Robot, threads: int | None = None) -> ck
     The scene's ``allowed_collisions`` may touch; a pair close by design is held to contact
     only where the scene's self margin exceeds its gap (:mod:`cpr_kin.close_pairs`).
     ``threads``: those of the parallel collision checks (default: up to 2).
+
+    Raises:
+        PlanningError: ``allowed_collisions`` names a link the robot does not have (a typo
+            would leave the pair checked, silently).
     """
+    unknown = sorted({n for pair in scene.allowed_collisions for n in pair if not robot.model.existFrame(n)})
+    if unknown:
+        links = sorted({g.link for g in robot.geometries})
+        raise PlanningError(f"allowed_collisions names {unknown}, not links of the robot; its links: {links}")
     return ck.CollisionWorld(
         robot,
         scene.obstacles,
