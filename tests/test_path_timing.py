@@ -13,6 +13,7 @@ from planning.curves.path_timing import (
     time_path,
 )
 from planning.curves.trajectory import Trajectory
+from planning.errors import PlanningError
 from planning.peers.ruckig_bound import ruckig_duration
 
 from .conftest import LIFT, PAPER_GOAL_TCP, PAPER_START_TCP, limits_of, spline_path
@@ -140,3 +141,13 @@ def test_the_jerk_aim_applies_only_where_the_jerk_limit_binds() -> None:
     panda_like = np.array([[2.0, 2.5], [15.0, 10.0], [7500.0, 5000.0]])  # ramps of 2 ms: the knots bind
     smoothing = smoothing_limits(panda_like, NODE_STEP_S)
     np.testing.assert_allclose(smoothing.limits[2], panda_like[1] / (2.0 * MIN_NODE_STEP_S))
+
+
+def test_limits_of_another_robot_are_named(robot: ck.Robot) -> None:
+    # three velocity limits for a five-joint path failed in numpy's stack
+    path = spline_path(np.linspace(ck.tcp_ik(robot, PAPER_START_TCP), ck.tcp_ik(robot, PAPER_GOAL_TCP), 5))
+    velocity, acceleration, jerk = limits_of(robot)
+    with pytest.raises(PlanningError, match=r"limits of shapes \[\(3,\), \(5,\), \(5,\)\]; 5 values each"):
+        time_path(path, velocity[:3], acceleration, jerk)
+    with pytest.raises(PlanningError, match=r"must be finite and > 0 for 5 joints"):
+        time_path(path, -velocity, acceleration, jerk)

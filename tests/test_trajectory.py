@@ -121,6 +121,8 @@ def test_errors(trajectory: Trajectory) -> None:
         trajectory.time_scale_for_limits([0.0, 1.0, 1.0])
     with pytest.raises(PlanningError, match=re.escape("derivative order 9 must be in [0, 7]")):
         trajectory(0.0, 9)
+    with pytest.raises(PlanningError, match=re.escape("time t = nan s must be a finite number")):
+        trajectory([0.0, np.nan])  # came back as NaN positions
     with pytest.raises(PlanningError, match="must be at least two increasing times"):
         Trajectory(knots=np.array([0.0, 0.0]), coefficients=np.zeros((1, 1, 8)))
     still = Trajectory(knots=np.array([0.0, 1.0]), coefficients=np.zeros((1, 2, 8)))

@@ -95,11 +95,16 @@ def time_path(
     Raises:
         PlanningError: the path does not move, or a limit is not finite and positive.
     """
-    limits = np.stack([np.asarray(x, dtype=float) for x in (velocity, acceleration, jerk)])
-    if limits.shape != (3, path.n_joints) or not np.all(np.isfinite(limits) & (limits > 0)):
+    given = [np.asarray(x, dtype=float) for x in (velocity, acceleration, jerk)]
+    shapes = [x.shape for x in given]
+    if any(shape != (path.n_joints,) for shape in shapes):
         raise PlanningError(
-            f"limits of shape {limits.shape} must be finite and > 0 for {path.n_joints} joints"
+            f"velocity, acceleration and jerk limits of shapes {shapes}; {path.n_joints} values each, "
+            "one per joint of the path"
         )
+    limits = np.stack(given)
+    if not np.all(np.isfinite(limits) & (limits > 0)):
+        raise PlanningError(f"limits {limits.tolist()} must be finite and > 0 for {path.n_joints} joints")
     arc = arc_length_path(path, limits[0])
     smoothing = smoothing_limits(limits, node_step_s)
     uncapped = None

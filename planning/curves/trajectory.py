@@ -130,6 +130,10 @@ class Trajectory:
 
         Returns ``(nj,)`` for a scalar time, ``(K, nj)`` for ``K`` times. Times outside the
         knots are clamped to the ends.
+
+        Raises:
+            PlanningError: a derivative order the polynomials do not have, or a time that is
+                not a finite number (NaN would come back as NaN positions).
         """
         if derivative < 0 or derivative >= self.coefficients.shape[2]:
             raise PlanningError(
@@ -138,6 +142,9 @@ class Trajectory:
         from planning.curves.horner import evaluate  # compiled: numba only once a trajectory is evaluated
 
         times = np.asarray(t, dtype=float)
+        if not np.isfinite(times).all():
+            bad = times[~np.isfinite(times)].ravel()[0] if times.ndim else times
+            raise PlanningError(f"time t = {float(bad)} s must be a finite number [s]")
         value = evaluate(self._coefficients(derivative), self.knots, np.atleast_1d(times).ravel())
         return np.asarray(value[0] if times.ndim == 0 else value)
 
