@@ -22,10 +22,11 @@ from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial import ConvexHull, QhullError
 
 FloatArray = NDArray[np.float64]
 
+HULL_ABOVE = 64
+"""Point sets larger than this are reduced to their convex hull's vertices before a fit."""
 CONTAINMENT_TOLERANCE_M = 1e-9
 """Added to a fitted radius [m]: rounding in the fit never leaves a vertex outside."""
 
@@ -125,9 +126,15 @@ def _fitted(data: bytes, count: int) -> Capsule:
 
 
 def _hull_points(points: FloatArray) -> FloatArray:
-    """The vertices of ``points``' convex hull (all of them where it is flat or too few)."""
-    if len(points) <= points.shape[1] + 1:
+    """The vertices of ``points``' convex hull (all of them where it is flat or few).
+
+    Up to :data:`HULL_ABOVE` points are all kept: the fits take any superset of the hull's
+    vertices, and a primitive's few corners (a box's eight) then need no SciPy in a process.
+    """
+    if len(points) <= max(HULL_ABOVE, points.shape[1] + 1):
         return points
+    from scipy.spatial import ConvexHull, QhullError  # only a mesh's geometry needs it: not at import
+
     try:
         hull: FloatArray = points[ConvexHull(points).vertices]
         return hull

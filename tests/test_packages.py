@@ -71,6 +71,20 @@ def test_loading_a_robot_imports_what_it_needs() -> None:
 
 
 @pytest.mark.slow
+def test_a_plan_among_primitives_imports_no_scipy_module_it_does_not_use() -> None:
+    # SciPy's ndimage (a running minimum of the timing's local caps) and spatial (the convex
+    # hull of a box's eight corners) took 0.1 s of every new process that planned the shelf
+    modules = ["scipy.ndimage", "scipy.spatial"]
+    code = (
+        "import sys, cpr_kin as ck; from planning import load_scene, plan; from planning.io.bundled "
+        "import bundled_scene_paths; plan(load_scene(bundled_scene_paths()[1]), ck.load_cpr()); "
+        f"print(*[m in sys.modules for m in {modules!r}])"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.split() == ["False", "False"]
+
+
+@pytest.mark.slow
 def test_an_installed_wheel_carries_its_data_and_stubs(tmp_path: Path) -> None:
     # the wheel, not the checkout: the URDF, limits and scenes as package data, and the
     # __init__.pyi stubs that the lazy exports are read from
