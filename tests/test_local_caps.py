@@ -1,6 +1,7 @@
 from __future__ import annotations
 
 import numpy as np
+from scipy.ndimage import minimum_filter1d
 
 import cpr_kin as ck
 from planning.curves import velocity_caps
@@ -27,6 +28,16 @@ def test_each_input_takes_the_least_cut_of_the_outputs_it_enters() -> None:
         spread = entering(cut, reach)
         for i in range(40):  # input i enters the outputs i .. i + reach (brute force)
             np.testing.assert_array_equal(spread[i], cut[i : i + reach + 1].min(axis=0))
+
+
+def test_the_running_minimum_is_scipys_on_every_size() -> None:
+    # SciPy's minimum_filter1d, an independent oracle (the windows ahead, clamped at the end)
+    rng = np.random.default_rng(5)
+    for rows in (1, 2, 3, 17, 200, 1001):
+        for reach in (0, 1, 2, 7, 8, 113, 300, 2000):
+            cut = rng.uniform(0.5, 1.0, (rows, 3))
+            expected = minimum_filter1d(cut, reach + 1, axis=0, origin=-((reach + 1) // 2), mode="nearest")
+            np.testing.assert_array_equal(entering(cut, reach), expected)
 
 
 def test_the_local_caps_win_where_the_window_widens_and_stay_within_the_limits(robot: ck.Robot) -> None:
