@@ -23,14 +23,20 @@ from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.clearance import BatchClearance
 from cpr_kin.collision import CollisionWorld
-from cpr_kin.decisive import certified, undecided
+from cpr_kin.decisive import certified, propagated_bounds, undecided
 from cpr_kin.errors import CprKinError
 from cpr_kin.interval_motion import IntervalSpeed, interval_motion
+from cpr_kin.pair_bounds import BOUND_TOLERANCE_M
 from cpr_kin.reach import robot_reach
 from cpr_kin.robot import GROUPS, Robot
 
 FloatArray = NDArray[np.float64]
 
+COARSE_STRIDE = 8
+"""Of the samples in doubt, every how many coal computes first: its exact values bound their
+neighbours' (a distance changes no faster than the robot moves), which may then need none."""
+COARSE_BELOW = 64
+"""Fewer samples in doubt than this are computed at once (another round costs more than they)."""
 MAX_CURVE_CHECKS = 1_000_000
 """Most configurations one continuous check queries (about 10 to 20 s of coal on 2 cores)."""
 
@@ -170,27 +176,38 @@ def decisive_clearance(world: CollisionWorld, q: FloatArray, slack_m: float | Fl
     """Per-group clearance of the samples ``q`` ``(K, nq)`` of a curve, exact where it decides the check.
 
     :func:`check_curve` needs, per group, the smallest certified value
-    ``(c_k + c_{k+1} - slack_m) / 2`` (``slack_m`` one value, or one per interval ``(K - 1,)``)
-    and the smallest sampled clearance, each exactly (coal).
+    ``(c_k + c_{k+1} - slack_m) / 2`` and the smallest sampled clearance, each exactly (coal).
+    ``slack_m`` (one value, or one per interval ``(K - 1,)``) bounds how far any robot point
+    moves between neighbouring samples [m], so a clearance changes by at most that much.
     Every sample starts with its cheap lower bound
-    (:meth:`~cpr_kin.CollisionWorld.clearance_lower_bounds`); coal then computes the samples
-    that could still be below the smallest exact value, in batches, until the minima are
-    exact. Values computed from lower bounds are at most the true ones, so a minimum found
-    exactly is the true minimum. Along a trajectory most samples are far from every
-    obstacle, and coal computes about a fifth of them. Elsewhere :attr:`clearance_m` holds
-    the lower bound and :attr:`closest_pair` ``-1``.
+    (:meth:`~cpr_kin.CollisionWorld.clearance_lower_bounds`); coal then computes, in rounds,
+    the samples that could still be below the smallest exact value (every
+    :data:`COARSE_STRIDE`-th of them first, where :data:`COARSE_BELOW` or more are in doubt),
+    and each exact value bounds its neighbours (its value less the motion between them, less
+    coal's own tolerance), until the minima are exact. Values computed from lower bounds are
+    at most the true ones, so a minimum found exactly is the true minimum. Elsewhere
+    :attr:`clearance_m` holds the best lower bound and :attr:`closest_pair` ``-1``.
     """
-    values = world.clearance_lower_bounds(q)
+    bounds = world.clearance_lower_bounds(q)
+    values = bounds.copy()
     known = np.isinf(values) & (values > 0)  # groups without pairs: nothing to compute
     closest = np.full(values.shape, -1, dtype=np.int64)
+    slack = np.broadcast_to(np.asarray(slack_m, dtype=float), (max(len(q) - 1, 0),))
+    reach = np.concatenate([[0.0], np.cumsum(slack)])
     while (needed := undecided(values, known, slack_m)).any():
         for group_index in range(values.shape[1]):
             rows = np.flatnonzero(needed[:, group_index])
+            rows = rows[:: COARSE_STRIDE if rows.size >= COARSE_BELOW else 1]
             if rows.size:
                 values[rows, group_index], closest[rows, group_index] = world.group_clearance(
                     q[rows], group_index
                 )
                 known[rows, group_index] = True
+                # coal's values are accurate to BOUND_TOLERANCE_M: a neighbour's bound keeps that much below
+                column, exact = values[:, group_index], known[:, group_index]
+                propagated = propagated_bounds(column, exact, reach) - BOUND_TOLERANCE_M
+                lowest = np.maximum(bounds[:, group_index], propagated)
+                values[:, group_index] = np.where(exact, column, lowest)
     return BatchClearance(clearance_m=values, closest_pair=closest)
 
 

@@ -160,28 +160,32 @@ def test_clearance_lower_bounds_are_below_coal(
     assert np.all(alone.clearance_lower_bounds(q) == np.inf)
 
 
-@pytest.mark.parametrize("slack_m", [0.0, 0.01, 0.05])
+@pytest.mark.parametrize("samples", [60, 300, 1500])
 def test_decisive_clearance_finds_the_minima_of_the_full_evaluation(
-    robot: ck.Robot, cluttered_world: ck.CollisionWorld, rng: np.random.Generator, slack_m: float
+    robot: ck.Robot, cluttered_world: ck.CollisionWorld, rng: np.random.Generator, samples: int
 ) -> None:
     from cpr_kin.motion import decisive_clearance
 
     saved = 0
     for _ in range(8):  # random joint-space segments, sampled densely
         a, b = random_configurations(robot, rng, 2)
-        q = np.linspace(a, b, 300)
+        q = np.linspace(a, b, samples)
+        slack_m = np.abs(np.diff(q, axis=0)) @ ck.motion_radii(robot)  # the motion between samples
         full = cluttered_world.clearance_batch(q)
         lazy = decisive_clearance(cluttered_world, q, slack_m)
         exact = lazy.closest_pair >= 0
         saved += int((~exact).sum())
-        # coal's distances depend slightly on the order of the queries (GJK's warm start)
-        np.testing.assert_allclose(lazy.clearance_m[exact], full.clearance_m[exact], atol=1e-6)
-        assert np.all(lazy.clearance_m <= full.clearance_m + 1e-6)
-        certified = [0.5 * (c[:-1] + c[1:] - slack_m) for c in (lazy.clearance_m, full.clearance_m)]
-        np.testing.assert_allclose(certified[0].min(axis=0), certified[1].min(axis=0), atol=1e-6)
+        # coal's distances depend slightly on the order of the queries (GJK's warm start):
+        # about 1e-6 of 0.27 m between two runs of the same configuration
+        tolerance = 2e-6
+        np.testing.assert_allclose(lazy.clearance_m[exact], full.clearance_m[exact], atol=tolerance)
+        assert np.all(lazy.clearance_m <= full.clearance_m + tolerance)  # bounds and exact values
+        certified = [0.5 * (c[:-1] + c[1:] - slack_m[:, None]) for c in (lazy.clearance_m, full.clearance_m)]
+        np.testing.assert_allclose(certified[0].min(axis=0), certified[1].min(axis=0), atol=tolerance)
         worst = np.unravel_index(np.argmin(lazy.clearance_m), lazy.clearance_m.shape)
-        assert exact[worst] and lazy.clearance_m[worst] == pytest.approx(full.clearance_m.min(), abs=1e-6)
-    assert saved > 0.3 * 8 * 300 * 2  # and coal was spared most samples
+        assert exact[worst]
+        assert lazy.clearance_m[worst] == pytest.approx(full.clearance_m.min(), abs=tolerance)
+    assert saved > 0.3 * 8 * samples * 2  # and coal was spared most samples
 
 
 def test_thin_plate_between_samples_is_caught(robot: ck.Robot) -> None:
