@@ -260,8 +260,9 @@ def _decisive_values(
     while rows.size:
         values[rows] = collision.pair_distances(pair.q[rows], pair.index)
         known[rows] = True
-        propagated = propagated_bounds(values, known, reach)  # exact where known
-        values = np.where(known, propagated, np.maximum(pair.bounds, propagated))
+        # exact where known; a neighbour's bound keeps coal's own tolerance below (as the obstacles')
+        propagated = propagated_bounds(values, known, reach)
+        values = np.where(known, propagated, np.maximum(pair.bounds, propagated - BOUND_TOLERANCE_M))
         needed = undecided(values[:, None], known[:, None], pair.slack, certified_ceiling, sampled_ceiling)
         rows = np.flatnonzero(needed[:, 0])
     return values, known
