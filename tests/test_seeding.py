@@ -98,9 +98,14 @@ def drawn_paths(problem: Problem) -> list[tuple[np.ndarray, float]]:
     return drawn
 
 
+THREE = 3
+"""The waypoints the scenes below were chosen with (the planner's default until stop 67)."""
+
+
 def uniform_samples(problem: Problem, **seeding: Any) -> Problem:
-    """``problem`` whose RRT-Connect draws uniform samples only (those the scenes below were chosen by)."""
-    return with_planner(problem, tuning=SearchTuning(seeding=SeedingTuning(local_share=0.0, **seeding)))
+    """``problem`` whose RRT-Connect draws uniform samples only, with :data:`THREE` waypoints (as chosen)."""
+    tuning = SearchTuning(seeding=SeedingTuning(local_share=0.0, **seeding))
+    return with_planner(problem, waypoints=THREE, tuning=tuning)
 
 
 def test_a_path_whose_spline_violates_the_clearance_is_drawn_again(robot: ck.Robot) -> None:
@@ -149,7 +154,8 @@ def test_the_best_placement_along_the_path_seeds_the_search(robot: ck.Robot) -> 
     ones through waypoints evenly spaced along it, or halfway between, do not; the seeding keeps
     the best placement and draws no other path. Offered the corners alone, it finds no feasible
     seed in the draws its budget allows."""
-    built = build_problem(narrow_scene(np.random.default_rng(7), robot, "window"), robot)
+    window = build_problem(narrow_scene(np.random.default_rng(7), robot, "window"), robot)
+    built = with_planner(window, waypoints=THREE)
     found = sampled_path(built, np.random.default_rng([built.scene.planner.seed, 1]))
     assert found is not None
     weights = ck.path_weights(robot)[built.moving]
@@ -301,7 +307,7 @@ def test_a_goal_within_margin_plus_step_plans_with_the_finer_step_at_once(robot:
     from planning.io.scene_generator import generate_scenes
     from planning.pipeline.planner import plan
 
-    corners = PlannerSettings(tuning=SearchTuning(seeding=SeedingTuning(placements=(0.0,))))
+    corners = PlannerSettings(waypoints=THREE, tuning=SearchTuning(seeding=SeedingTuning(placements=(0.0,))))
     # the corners' placement, whose path approaches the goal fast enough that the scene's
     # step cannot certify its last 2 mm (below)
     scene = dataclasses.replace(generate_scenes(1, 5, robot)[0], safety_margin=0.0, planner=corners)

@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 
 import cpr_kin as ck
 from planning.pipeline.problem import Problem, with_planner
-from planning.pipeline.settings import MAX_WAYPOINTS
+from planning.pipeline.settings import MAX_WAYPOINTS, PlannerSettings
 from planning.search.rrt_connect import Relaxation, RrtPath, rrt_connect
 from planning.search.rrt_settings import RrtSettings
 from planning.search.waypoints import placements_along
@@ -157,12 +157,22 @@ def followable_path(
             break
         samples += found.samples
         kept = finer() if finer is not None and found.relaxed else problem
-        seeded = path_seed(kept, found.path, settings.waypoints, weights)
+        seeded = path_seed(kept, found.path, corner_waypoints(settings, found.path), weights)
         if best is None or seeded.fitness < best[1].fitness:
             best = (found.path, seeded)
         if kept.objective.feasible(seeded.fitness) or samples >= tuning.redraw_samples:
             break
     return (None, None) if best is None else best
+
+
+def corner_waypoints(settings: PlannerSettings, path: FloatArray) -> int:
+    """The waypoints of ``path``'s seed: one per interior corner, between the planner's and the tuning's most.
+
+    At least ``settings.waypoints``; more, one per corner, up to
+    :attr:`~planning.pipeline.tuning.SeedingTuning.corner_waypoints`.
+    """
+    corners = len(path) - 2
+    return max(settings.waypoints, min(corners, settings.tuning.seeding.corner_waypoints))
 
 
 def fewest_waypoints(problem: Problem, path: FloatArray, weights: FloatArray) -> PathSeed:

@@ -11,8 +11,10 @@ is a small part of its space, rarely met by a random population. So, with the pl
    (:mod:`planning.search.rrt_connect`, drawn by :mod:`planning.pipeline.path_seeds`)
    looks for a path in the moving joints, clear of
    the clearance the fitness requires (margin plus verification step), and its waypoints
-   are the second seed: the best of the ``placements`` along it, from its corners kept to
-   evenly spaced (:func:`~planning.search.waypoints.placements_along`). A path is
+   are the second seed: one per corner of the path, at least the planner's ``waypoints``
+   and at most ``corner_waypoints`` (:func:`~planning.pipeline.path_seeds.corner_waypoints`),
+   the best of the ``placements`` along it, from its corners kept to evenly spaced
+   (:func:`~planning.search.waypoints.placements_along`). A path is
    clear, but the spline through its few waypoints cuts its corners and may not be: then
    RRT-Connect draws another path, up to ``path_attempts`` in all while the paths so far
    took fewer than ``redraw_samples`` samples (a redraw gets what remains of them), and
@@ -59,6 +61,7 @@ import cpr_kin as ck
 from planning.pipeline.path_seeds import (
     FinerProblem,
     PathSeed,
+    corner_waypoints,
     draw_samples,
     fewest_waypoints,
     followable_path,
@@ -208,7 +211,7 @@ def seed_search(
     if more_waypoints:
         seeded = fewest_waypoints(problem, path, weights)
     elif seeded is None:
-        seeded = path_seed(problem, path, problem.scene.planner.waypoints, weights)
+        seeded = path_seed(problem, path, corner_waypoints(problem.scene.planner, path), weights)
     problem = seeded.problem
     candidates = np.array([problem.objective.straight_line(), seeded.x])
     feasible = clear or bool(problem.objective.feasible(seeded.fitness))

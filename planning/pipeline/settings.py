@@ -60,8 +60,9 @@ class PlannerSettings:
 
     Attributes:
         firefly: the firefly algorithm's parameters (default :data:`DEFAULT_FIREFLY`).
-        waypoints: number of intermediate waypoints p, at most :data:`MAX_WAYPOINTS`. The
-            paper: 3.
+        waypoints: number of intermediate waypoints p, at most :data:`MAX_WAYPOINTS` (the
+            paper: 3); a sampled path's seed takes one per corner of the path up to
+            :attr:`~planning.pipeline.tuning.SeedingTuning.corner_waypoints`, never fewer.
         fitness: ``"clearance"`` (feasible first, infeasible ranked by coal's violation
             depth) or ``"paper"`` (eq. 4-6).
         seed: seed of the random generator.
@@ -107,7 +108,7 @@ class PlannerSettings:
     """
 
     firefly: FireflySettings = DEFAULT_FIREFLY
-    waypoints: int = 3
+    waypoints: int = 2
     fitness: Fitness = "clearance"
     seed: int = 0
     path: PathKind = "spline"

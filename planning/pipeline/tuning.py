@@ -46,6 +46,10 @@ class SeedingTuning:
             than margin plus step would take all ``max_samples`` in vain.
         more_waypoints: how many waypoints beyond the path's corners the seeding may add,
             two at a time, in [0, 20].
+        corner_waypoints: the most waypoints a sampled path's seed takes, one per interior
+            corner of the path (never fewer than the planner's ``waypoints``), in [1, 20]:
+            a path of one or two corners is followed by two waypoints, whose search converges
+            further in the refinement's generations than three's (``docs/tuning.md``).
         finer_step: when RRT-Connect finds no path keeping the margin plus the verification
             step clear, the share of the step tried once more, in (0, 1): a finer certified
             check lets a path pass closer to the margin (a passage narrower than the margin
@@ -69,6 +73,7 @@ class SeedingTuning:
     max_samples: int = 50_000
     finer_after: int = 3_000
     more_waypoints: int = 6
+    corner_waypoints: int = 3
     finer_step: float = 0.2
     local_share: float = LOCAL_SHARE
     local_spread: float = LOCAL_SPREAD
@@ -83,6 +88,7 @@ class SeedingTuning:
         integer_in("max_samples", self.max_samples, 1, 100_000)
         integer_in("finer_after", self.finer_after, 1, 100_000)
         integer_in("more_waypoints", self.more_waypoints, 0, 20)
+        integer_in("corner_waypoints", self.corner_waypoints, 1, 20)
         number_in("finer_step", self.finer_step, 0.0, 1.0, low_open=True)
         number_in("local_share", self.local_share, 0.0, 1.0)
         number_in("local_spread", self.local_spread, 0.0, 1.0, low_open=True)
