@@ -40,21 +40,32 @@ def example_robot_data_share() -> Path | None:
     return None
 
 
-def package_roots(urdf_path: Path, package_dirs: Sequence[Path] = ()) -> list[Path]:
-    """The folders a ``package://`` URI is looked for in, in order (module docstring).
+def check_package_dirs(urdf_path: Path, package_dirs: Sequence[Path]) -> None:
+    """Refuse a folder of ``package_dirs`` that is not a folder.
+
+    A typo would otherwise go unnoticed wherever the meshes are found elsewhere.
 
     Raises:
-        UrdfError: a folder of ``package_dirs`` is not a folder (a typo would otherwise go
-            unnoticed wherever the meshes are found elsewhere).
+        UrdfError: naming the folder and the URDF.
     """
-    roots = [Path(d).resolve() for d in package_dirs]
-    for given, root in zip(package_dirs, roots, strict=True):
+    for given in package_dirs:
+        root = Path(given).resolve()
         if not root.is_dir():
             problem = "is not a folder" if root.exists() else "does not exist"
             raise UrdfError(
                 f"package folder '{given}' (packages, for URDF '{urdf_path}') {problem}; "
                 "give folders that hold the packages its package:// meshes name"
             )
+
+
+def package_roots(urdf_path: Path, package_dirs: Sequence[Path] = ()) -> list[Path]:
+    """The folders a ``package://`` URI is looked for in, in order (module docstring).
+
+    Raises:
+        UrdfError: a folder of ``package_dirs`` is not a folder (:func:`check_package_dirs`).
+    """
+    check_package_dirs(urdf_path, package_dirs)
+    roots = [Path(d).resolve() for d in package_dirs]
     folder = urdf_path.resolve().parent
     roots += [folder, *folder.parents]
     share = example_robot_data_share()

@@ -36,7 +36,7 @@ from lxml import etree
 
 import cpr_kin as ck
 from cpr_kin.limits import MAX_LIMITS_BYTES
-from cpr_kin.packages import package_roots
+from cpr_kin.packages import check_package_dirs
 from cpr_kin.srdf_groups import group_joints
 from cpr_kin.urdf_file import parse_urdf
 from cpr_kin.user_files import load_yaml
@@ -132,7 +132,7 @@ def import_moveit(
     """
     ignored = _refuse_unsupported(scene, request)
     tree = parse_urdf(robot.urdf)
-    package_roots(robot.urdf, robot.package_dirs)  # names a package folder that is not there
+    check_package_dirs(robot.urdf, robot.package_dirs)
     if robot.limits is not None:  # a file that is not there or not YAML is named now, not at planning
         load_yaml(robot.limits, MAX_LIMITS_BYTES, "joint limits file")
     root = _root_link(tree)
