@@ -18,6 +18,18 @@ import unicodedata
 
 UNPRINTABLE_CATEGORIES = frozenset({"Cc", "Cf", "Cs", "Co", "Cn", "Zl", "Zp"})
 """Unicode general categories that are never printed as they are."""
+MAX_SHOWN_CHARS = 40
+"""Longest rendering of a value in a message: a hostile value must not flood the terminal."""
+
+
+def cut(text: str, limit: int = MAX_SHOWN_CHARS) -> str:
+    """``text``, cut to ``limit`` characters with an ellipsis."""
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def shown(value: object, limit: int = MAX_SHOWN_CHARS) -> str:
+    """``repr(value)``, cut to ``limit`` characters, as a message shows a value."""
+    return cut(repr(value), limit)
 
 
 def _unprintable(character: str) -> bool:

@@ -11,7 +11,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import ObstacleError
-from cpr_kin.names import unprintable
+from cpr_kin.names import shown, unprintable
 from cpr_kin.user_files import UserFileError, read_bytes
 
 FloatArray = NDArray[np.float64]
@@ -39,9 +39,8 @@ MAX_NAME_CHARS = 100
 
 
 def _shown(value: object) -> str:
-    """``repr`` of a value (a list for an array), cut to 40 characters."""
-    text = repr(value.tolist() if isinstance(value, np.ndarray) else value)
-    return text if len(text) <= 40 else text[:37] + "..."
+    """:func:`~cpr_kin.names.shown` of a value, an array as a list."""
+    return shown(value.tolist() if isinstance(value, np.ndarray) else value)
 
 
 def _vector(value: ArrayLike, what: str, n: int, low: float, high: float, unit: str) -> FloatArray:

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from cpr_kin.errors import UrdfError
+from cpr_kin.names import shown
 
 if TYPE_CHECKING:
     from cpr_kin.loading import RobotSpec
@@ -23,8 +24,8 @@ NAME_OPTIONS = ("joints", "effector_links", "wrist_joints", "limits_names")
 """The options that hold a sequence of names."""
 OPTIONAL = ("joints", "effector_links")
 """Those of :data:`NAME_OPTIONS` that may be ``None`` (a default chosen at the load)."""
-MAX_SHOWN_CHARS = 60
-"""Longest rendering of a value in a message."""
+SHOWN_CHARS = 60
+"""Longest rendering of an option's value in a message (a tuple of names runs long)."""
 
 
 def check_options(spec: RobotSpec) -> None:
@@ -40,9 +41,13 @@ def check_options(spec: RobotSpec) -> None:
         if value is None and key in OPTIONAL:
             continue
         if not isinstance(value, tuple) or not all(isinstance(n, str) and n for n in value):
-            raise UrdfError(f"{key} = {shown(value)} must be a sequence of names (non-empty strings)")
+            raise UrdfError(
+                f"{key} = {shown(value, SHOWN_CHARS)} must be a sequence of names (non-empty strings)"
+            )
     if spec.tcp is not None and not (isinstance(spec.tcp, str) and spec.tcp):
-        raise UrdfError(f"tcp = {shown(spec.tcp)} must be a frame's name (a non-empty string) or None")
+        raise UrdfError(
+            f"tcp = {shown(spec.tcp, SHOWN_CHARS)} must be a frame's name (a non-empty string) or None"
+        )
     held_ok = isinstance(spec.held, tuple) and all(
         isinstance(pair, tuple)
         and len(pair) == 2
@@ -52,11 +57,13 @@ def check_options(spec: RobotSpec) -> None:
         for pair in spec.held
     )
     if not held_ok:
-        raise UrdfError(f"held = {shown(spec.held)} must map joint names to numbers [rad or m]")
+        raise UrdfError(f"held = {shown(spec.held, SHOWN_CHARS)} must map joint names to numbers [rad or m]")
     if not isinstance(spec.package_dirs, tuple) or not all(
         isinstance(d, str | Path) for d in spec.package_dirs
     ):
-        raise UrdfError(f"package_dirs = {shown(spec.package_dirs)} must be a sequence of folders")
+        raise UrdfError(
+            f"package_dirs = {shown(spec.package_dirs, SHOWN_CHARS)} must be a sequence of folders"
+        )
 
 
 def check_not_one_name(key: str, value: Any) -> None:
@@ -66,7 +73,9 @@ def check_not_one_name(key: str, value: Any) -> None:
         UrdfError: naming the option and how to give it.
     """
     if isinstance(value, str | Path):
-        raise UrdfError(f"{key} = {shown(value)} must be a sequence, not one name: give [{str(value)!r}]")
+        raise UrdfError(
+            f"{key} = {shown(value, SHOWN_CHARS)} must be a sequence, not one name: give [{str(value)!r}]"
+        )
 
 
 def check_tcp(tcp: str | None, model: Any, path: Path) -> None:
@@ -87,9 +96,3 @@ def check_tcp(tcp: str | None, model: Any, path: Path) -> None:
         f"URDF '{path}' has no link or frame named '{tcp}' (the tool frame, tcp); "
         f"{hint}its frames are {known}"
     )
-
-
-def shown(value: Any) -> str:
-    """``repr(value)``, cut to :data:`MAX_SHOWN_CHARS` characters."""
-    text = repr(value)
-    return text if len(text) <= MAX_SHOWN_CHARS else text[: MAX_SHOWN_CHARS - 3] + "..."

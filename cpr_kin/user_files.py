@@ -29,6 +29,7 @@ from typing import Any
 import yaml
 
 from cpr_kin.errors import CprKinError
+from cpr_kin.names import cut, shown
 
 MAX_DEPTH = 16
 """Deepest nesting of sequences and mappings (a scene file nests 4 levels)."""
@@ -60,7 +61,7 @@ class StrictLoader(_BASE):  # type: ignore[misc, valid-type]
                 raise yaml.constructor.ConstructorError(
                     None,
                     None,
-                    f"duplicate key {_shown(key)} (first given at line {first})",
+                    f"duplicate key {shown(key)} (first given at line {first})",
                     key_node.start_mark,
                 )
             seen[key] = key_node.start_mark.line + 1
@@ -72,14 +73,6 @@ StrictLoader.add_implicit_resolver(
     re.compile(r"^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
     list("-+0123456789"),
 )
-
-
-def _cut(text: str, limit: int = 40) -> str:
-    return text if len(text) <= limit else text[: limit - 3] + "..."
-
-
-def _shown(value: object) -> str:
-    return _cut(repr(value))
 
 
 def _line(event: Any) -> str:
@@ -170,10 +163,10 @@ def load_yaml(path: Path, max_bytes: int, what: str = "YAML file") -> Any:
         raise UserFileError(f"{source}: nested too deeply") from None
     except (ValueError, TypeError, IndexError, OverflowError) as exc:  # a constructor's own error
         raise UserFileError(
-            f"{source} is not valid YAML: {_cut(f'{type(exc).__name__}: {exc}', 120)}"
+            f"{source} is not valid YAML: {cut(f'{type(exc).__name__}: {exc}', 120)}"
         ) from None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
         problem = getattr(exc, "problem", None) or " ".join(str(exc).split())
-        raise UserFileError(f"{source} is not valid YAML{where}: {_cut(str(problem), 120)}") from None
+        raise UserFileError(f"{source} is not valid YAML{where}: {cut(str(problem), 120)}") from None

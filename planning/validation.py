@@ -15,16 +15,9 @@ from typing import Any, get_args
 import numpy as np
 from pydantic import BaseModel, ValidationError
 
+from cpr_kin.names import cut
+from cpr_kin.names import shown as shown  # re-exported: the search's settings use it, not cpr_kin
 from planning.errors import PlanningError
-
-MAX_VALUE_CHARS = 40
-"""Longest rendering of a value in a message; longer ones are cut with an ellipsis."""
-
-
-def shown(value: Any) -> str:
-    """``repr(value)``, cut to :data:`MAX_VALUE_CHARS` characters."""
-    text = repr(value)
-    return text if len(text) <= MAX_VALUE_CHARS else text[: MAX_VALUE_CHARS - 3] + "..."
 
 
 def _is_number(value: Any) -> bool:
@@ -101,7 +94,7 @@ def field_path(location: Location, hidden: Sequence[str] = ()) -> str:
         if isinstance(part, int):
             text += f"[{part}]"
         elif part not in hidden:
-            key = str(part) if len(str(part)) <= MAX_VALUE_CHARS else str(part)[: MAX_VALUE_CHARS - 3] + "..."
+            key = cut(str(part))
             text += f".{key}" if text else key
     return text or "(top level)"
 

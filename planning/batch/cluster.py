@@ -24,10 +24,9 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import urlsplit
 
-from cpr_kin.names import escaped
+from cpr_kin.names import escaped, shown
 from planning.batch.items import BatchItem, finished_items
 from planning.errors import PlanningError
-from planning.validation import shown
 
 SCHEDULER_PROTOCOLS = ("tcp", "tls", "ws", "wss", "inproc", "ucx")
 """Protocols of a ``dask.distributed`` scheduler address."""

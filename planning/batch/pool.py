@@ -23,10 +23,10 @@ from concurrent.futures import FIRST_COMPLETED, Future, wait
 from dataclasses import dataclass
 from pathlib import Path
 
+from cpr_kin.names import shown
 from planning.batch.cluster import run_on_cluster
 from planning.batch.items import BatchItem, finished_items, plan_scene_file
 from planning.errors import PlanningError
-from planning.validation import shown
 
 Task = Callable[..., BatchItem]
 """Plans one scene file into an output folder, ``(scene file, output folder) -> BatchItem``

@@ -17,12 +17,12 @@ from numpy.typing import NDArray
 
 import cpr_kin as ck
 from cpr_kin.dynamics import TORQUE_SCALE_RANGE
-from cpr_kin.names import unprintable
+from cpr_kin.names import shown, unprintable
 from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError
 from planning.pipeline.settings import PlannerSettings
 from planning.pipeline.target import Target
-from planning.validation import instance_of, number_in, shown
+from planning.validation import instance_of, number_in
 
 FloatArray = NDArray[np.float64]
 

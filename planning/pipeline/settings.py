@@ -14,11 +14,12 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
+from cpr_kin.names import shown
 from planning.errors import PlanningError
 from planning.pipeline.tuning import SearchTuning
 from planning.search.firefly_settings import MAX_ITERATIONS, FireflySettings
 from planning.search.refinement_settings import STALL_GENERATIONS
-from planning.validation import integer_in, number_in, shown
+from planning.validation import integer_in, number_in
 
 Fitness = Literal["clearance", "paper"]
 PathKind = Literal["spline", "ptp"]
