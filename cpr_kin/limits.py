@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -10,6 +11,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cpr_kin.errors import CprKinError, UrdfError
+from cpr_kin.packages import installed
 from cpr_kin.user_files import UserFileError, load_yaml
 
 FloatArray = NDArray[np.float64]
@@ -138,7 +140,11 @@ def find_limits_file(
 
 
 def read_dynamic_limits(
-    path: Path | None, names: tuple[str, ...], urdf_velocity: FloatArray, known: tuple[str, ...] = ()
+    path: Path | None,
+    names: tuple[str, ...],
+    urdf_velocity: FloatArray,
+    known: tuple[str, ...] = (),
+    urdf: Path | None = None,
 ) -> DynamicLimits:
     """Read acceleration and jerk limits from a limits file (the format of ``cpr_limits.yaml``).
 
@@ -153,6 +159,7 @@ def read_dynamic_limits(
         names: the planned joints, in order.
         urdf_velocity: their velocity limits from the URDF.
         known: every joint of the URDF (the file may name held joints too); default ``names``.
+        urdf: the URDF, whose velocity limits a message may suggest editing (not an installed one).
 
     Raises:
         UrdfError: the file is unreadable, names a joint the URDF lacks, or holds a value
@@ -161,7 +168,7 @@ def read_dynamic_limits(
     """
     urdf_velocity = np.asarray(urdf_velocity, dtype=float)
     if path is None:
-        _require_velocity(names, urdf_velocity, None)
+        _require_velocity(names, urdf_velocity, None, urdf)
         acc_default, jerk_default = default_limits(urdf_velocity)
         return DynamicLimits(acc_default, jerk_default, None, tuple(names))
     try:
@@ -182,7 +189,7 @@ def read_dynamic_limits(
         entry = raw.get(name)
         if not velocity[i] > 0.0 and isinstance(entry, dict) and _is_number(entry.get("velocity")):
             velocity[i] = float(entry["velocity"])
-    _require_velocity(names, velocity, path)
+    _require_velocity(names, velocity, path, urdf)
     acc, jerk = default_limits(velocity)
     defaulted = []
     for i, name in enumerate(names):
@@ -202,10 +209,10 @@ def read_dynamic_limits(
         defaults = {"velocity": velocity[i], "acceleration": acc[i], "jerk": jerk[i]}
         values: dict[str, Any] = {kind: entry.get(kind, defaults[kind]) for kind in _KINDS}
         for kind, value in values.items():
-            if isinstance(value, bool) or not isinstance(value, int | float):
+            if isinstance(value, bool) or not isinstance(value, int | float) or not 0 < value < math.inf:
                 shown = repr(value) if len(repr(value)) <= 40 else repr(value)[:37] + "..."
                 raise UrdfError(
-                    f"joint limits file '{path}': joint '{name}' {kind} = {shown} must be a number"
+                    f"joint limits file '{path}': joint '{name}' {kind} = {shown} must be a finite number > 0"
                 )
         acc[i], jerk[i], vel = float(values["acceleration"]), float(values["jerk"]), float(values["velocity"])
         if not np.isclose(vel, velocity[i]):
@@ -221,14 +228,20 @@ def _is_number(value: Any) -> bool:
     return isinstance(value, int | float) and not isinstance(value, bool)
 
 
-def _require_velocity(names: tuple[str, ...], velocity: FloatArray, path: Path | None) -> None:
-    """Refuse joints with no velocity limit > 0, naming them and the two places to give one."""
+def _require_velocity(
+    names: tuple[str, ...], velocity: FloatArray, path: Path | None, urdf: Path | None
+) -> None:
+    """Refuse joints with no velocity limit > 0, naming them and where to give one.
+
+    The URDF is suggested only where it is the user's to edit, not inside an installed package.
+    """
     missing = [name for name, v in zip(names, velocity, strict=True) if not v > 0.0]
     if missing:
         where = f"the limits file '{path}'" if path is not None else "a limits file (limits=...)"
+        in_urdf = "" if urdf is not None and installed(urdf) else "<limit velocity=...> in the URDF, or "
         raise UrdfError(
             f"joint(s) {missing} have no velocity limit (the URDF's is 0 or missing); the timing needs "
-            f"one > 0 [rad/s or m/s]: give <limit velocity=...> in the URDF, or 'velocity' in {where}"
+            f"one > 0 [rad/s or m/s]: give {in_urdf}'velocity' in {where}"
         )
 
 

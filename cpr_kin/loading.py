@@ -134,7 +134,7 @@ class RobotSpec:
             or find_limits_file(path, self.default_limits, self.limits_names)
             or makers_limits_path(tree.getroot().get("name", ""), known)
         )
-        dynamic = read_dynamic_limits(limits_file, names, velocity, known)
+        dynamic = read_dynamic_limits(limits_file, names, velocity, known, path)
         if dynamic.velocity is not None:  # the file's, where the URDF gives none
             velocity = dynamic.velocity
             model.velocityLimit = velocity
@@ -192,6 +192,7 @@ class RobotSpec:
         if self.joints is None:
             return default_joints(model, arm, self.tcp, mimics, path)
         unknown = [j for j in self.joints if j not in names]
+        _refuse_fixed(tree, unknown, "joints", names, path)
         if unknown:
             raise UrdfError(f"URDF '{path}' has no joint(s) {unknown}; its joints are {list(names)}")
         order = [j for j in names if j in self.joints]
@@ -212,6 +213,7 @@ class RobotSpec:
         given = dict(self.held)
         names = tuple(model.names[1:])
         unknown = sorted(set(given) - set(names))
+        _refuse_fixed(tree, unknown, "held", names, path)
         if unknown or set(given) & set(planned):
             problem = (
                 f"no joint(s) {unknown}"
@@ -228,8 +230,9 @@ class RobotSpec:
         for name in (n for n in names if n not in planned):
             i = model.joints[model.getJointId(name)].idx_q
             low, high = float(model.lowerPositionLimit[i]), float(model.upperPositionLimit[i])
-            if name in mimic and name not in given:
-                leader = mimic[name].get("joint", "")
+            value = float(given.get(name, np.clip(0.0, low, high)))
+            leader = mimic[name].get("joint", "") if name in mimic else ""
+            if name in mimic and (name not in given or leader in names):
                 if leader not in names:
                     raise UrdfError(
                         f"URDF '{path}': joint '{name}' mimics joint '{leader}', which the URDF does not "
@@ -240,9 +243,14 @@ class RobotSpec:
                 multiplier = float(mimic[name].get("multiplier", "1"))
                 offset = float(mimic[name].get("offset", "0"))
                 lead = given.get(leader, float(np.clip(0.0, *_range(model, leader))))
-                value = multiplier * lead + offset
-            else:
-                value = float(given.get(name, np.clip(0.0, low, high)))
+                follows = multiplier * lead + offset
+                if name in given and abs(value - follows) > 1e-9:
+                    raise UrdfError(
+                        f"URDF '{path}': held joint '{name}' = {value:g} mimics '{leader}' = {lead:g} "
+                        f"({multiplier:g} x '{leader}' + {offset:g} = {follows:g}); hold '{leader}' "
+                        f"and leave '{name}' to follow it"
+                    )
+                value = follows
             if not low - 1e-9 <= value <= high + 1e-9:
                 raise UrdfError(
                     f"URDF '{path}': held joint '{name}' = {value:g} is outside [{low:g}, {high:g}]"
@@ -257,6 +265,15 @@ class RobotSpec:
         if model.existFrame("tcp"):
             return "tcp"
         return arm.tool
+
+
+def _refuse_fixed(tree: etree._ElementTree, given: list[str], key: str, names: Any, path: Path) -> None:
+    """Refuse names in ``given`` (of option ``key``) of the URDF's fixed joints, which never move."""
+    fixed = sorted(set(given) & {j.get("name") for j in tree.getroot().findall("joint")})
+    if fixed:
+        raise UrdfError(
+            f"URDF '{path}': {key} names fixed joint(s) {fixed}; its movable joints: {list(names)}"
+        )
 
 
 def _range(model: Any, joint: str) -> tuple[float, float]:

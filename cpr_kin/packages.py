@@ -11,6 +11,9 @@ package ``NAME``, in order:
    side);
 3. the installed ``example-robot-data`` (its share folder holds ``example-robot-data/``).
 
+A ``package://`` path that leaves its package (``package://NAME/../../etc/passwd``, resolved
+without following links) is refused, whatever is there.
+
 A mesh found nowhere is a :class:`~cpr_kin.errors.UrdfError` naming the mesh and every
 folder looked in.
 """
@@ -18,11 +21,14 @@ folder looked in.
 from __future__ import annotations
 
 import functools
+import os
+import sysconfig
 from collections.abc import Sequence
 from importlib import metadata
 from pathlib import Path
 
 from cpr_kin.errors import UrdfError
+from cpr_kin.names import shown
 
 PACKAGE = "package://"
 
@@ -38,6 +44,13 @@ def example_robot_data_share() -> Path | None:
         if str(file).endswith("example-robot-data/package.xml"):
             return Path(str(file.locate())).resolve().parent.parent
     return None
+
+
+def installed(path: Path) -> bool:
+    """Whether ``path`` lies in an installed Python distribution (site-packages): not the user's to edit."""
+    resolved = Path(path).resolve()
+    folders = {sysconfig.get_paths()[key] for key in ("purelib", "platlib")}
+    return any(resolved.is_relative_to(Path(folder).resolve()) for folder in folders)
 
 
 def check_package_dirs(urdf_path: Path, package_dirs: Sequence[Path]) -> None:
@@ -87,6 +100,11 @@ def resolve_mesh(filename: str, urdf_path: Path, roots: Sequence[Path]) -> Path:
             return path
         raise UrdfError(f"URDF '{urdf_path}': mesh '{filename}' does not exist (looked for '{path}')")
     name, _, inside = filename.removeprefix(PACKAGE).partition("/")
+    if os.path.normpath(inside).split(os.sep)[0] == os.pardir or Path(inside).is_absolute():
+        raise UrdfError(
+            f"URDF '{urdf_path}': mesh {shown(filename, 120)} leaves its package '{name}' "
+            "(a package:// path names a file inside the package); fix the path"
+        )
     candidates = []
     for root in roots:
         candidates.append(root / name / inside)

@@ -147,6 +147,12 @@ class Robot:
 
         """
         if isinstance(values, dict):
+            held = sorted(set(values) & set(self.held))
+            if held:
+                raise JointLimitError(
+                    f"joint(s) {held} are held (fixed), not planned; a map names the planned joints "
+                    f"{list(self.joint_names)} (plan them with the robot's joints option)"
+                )
             for name in values:
                 self.limits.index(name)
             missing = [n for n in self.joint_names if n not in values]

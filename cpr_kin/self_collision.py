@@ -26,6 +26,7 @@ from lxml import etree
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import CprKinError, UrdfError
+from cpr_kin.names import cut
 from cpr_kin.reach import geometry_reach
 from cpr_kin.self_curve import relative_radii
 from cpr_kin.self_screen import ScreenedSelfTest, SelfScreen
@@ -79,11 +80,21 @@ def parse_srdf(path: Path) -> etree._Element:
     """
     parser = etree.XMLParser(recover=False, resolve_entities=False, no_network=True)
     try:
-        return etree.fromstring(read_bytes(path, MAX_SRDF_BYTES, "SRDF file"), parser)
+        root = etree.fromstring(read_bytes(path, MAX_SRDF_BYTES, "SRDF file"), parser)
     except etree.XMLSyntaxError as exc:
         raise UrdfError(f"SRDF file '{path}' is not well-formed XML: {str(exc)[:120]}") from None
     except CprKinError as exc:
         raise UrdfError(str(exc)) from None
+    if root.tag != "robot":
+        raise UrdfError(
+            f"SRDF file '{path}' has root element <{cut(str(root.tag), 40)}>; an SRDF's is <robot>"
+        )
+    if root.find("link") is not None or root.find("joint") is not None:
+        raise UrdfError(
+            f"SRDF file '{path}' holds <link> or <joint> elements: it is a URDF; give the robot's "
+            "SRDF (groups, disable_collisions), which MoveIt's setup assistant writes"
+        )
+    return root
 
 
 def read_srdf(path: Path, links: Iterable[str]) -> SrdfPairs:

@@ -8,6 +8,7 @@ bounding capsule, which contains it as well.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -15,6 +16,7 @@ from typing import Any
 import coal
 import numpy as np
 import pinocchio as pin
+from lxml import etree
 
 from cpr_kin.capsule_fit import frame_about
 from cpr_kin.errors import UrdfError
@@ -29,9 +31,27 @@ def build_models(xml: str, path: Path, kind: Any = pin.GeometryType.COLLISION) -
             model = pin.buildModelFromXML(xml)
             geometry = pin.buildGeomFromUrdfString(model, xml, kind)
     except Exception as exc:  # Pinocchio reports C++ exceptions as RuntimeError/ValueError
+        unread = re.search(r"Could not load resource (.+?)\s*(?:\n|$)", str(exc))
+        if unread is not None:  # coal's loader names its own source file; the link is what helps
+            raise UrdfError(_unreadable_mesh(xml, path, unread.group(1))) from None
         said = " ".join(line.strip() for line in complaints[:2])
         raise UrdfError(f"Pinocchio cannot build a model from '{path}': {exc} {said}".strip()) from None
     return model, geometry
+
+
+def _unreadable_mesh(xml: str, path: Path, mesh: str) -> str:
+    """The message for a mesh file coal (assimp) cannot read: the link, the file, the formats."""
+    root = etree.fromstring(xml.encode(), etree.XMLParser(resolve_entities=False, no_network=True))
+    links = [
+        link.get("name", "")
+        for link in root.findall("link")
+        if any(m.get("filename") == mesh for m in link.iter("mesh"))
+    ]
+    named = f"link '{links[0]}': " if links else ""
+    return (
+        f"URDF '{path}': {named}mesh '{mesh}' is not a mesh file coal can read "
+        "(STL, OBJ, DAE, PLY, ... as assimp reads them); give a mesh file, or fix its path"
+    )
 
 
 @dataclass(frozen=True)

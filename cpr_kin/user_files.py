@@ -96,7 +96,8 @@ def _scan(text: str, source: str) -> None:
             nodes += 1
             if nodes > MAX_NODES:
                 raise UserFileError(
-                    f"{source}: more than {MAX_NODES} values; this is not a file of this kind"
+                    f"{source}: more than {MAX_NODES} values (numbers, strings, lists, mappings); "
+                    f"at most {MAX_NODES} are read"
                 )
         if isinstance(event, yaml.SequenceStartEvent | yaml.MappingStartEvent):
             depth += 1

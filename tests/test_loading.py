@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
+from re import escape as re_escape
 from typing import Any
 
 import numpy as np
@@ -287,3 +288,113 @@ def test_options_of_the_wrong_kind_are_named(options: dict[str, Any], message: s
     # a string of joint names was split into letters, an int tcp reached Pinocchio's C++ signature
     with pytest.raises(ck.UrdfError, match=message):
         ck.load_robot(example_robot("panda"), **options)
+
+
+def test_fixed_joints_and_mimics_in_the_options_are_named_as_such() -> None:
+    panda, arm = ARMS["panda"][0], [f"panda_joint{k}" for k in range(1, 8)]
+    with pytest.raises(ck.UrdfError, match=r"joints names fixed joint\(s\) \['panda_joint8'\]; its movable"):
+        ck.load_robot(panda, joints=[*arm, "panda_joint8"])
+    with pytest.raises(ck.UrdfError, match=r"held names fixed joint\(s\) \['panda_hand_joint'\]"):
+        ck.load_robot(panda, held={"panda_hand_joint": 0.0})
+    # a mimic held at a value its <mimic> contradicts: refused, naming the leader to hold instead
+    with pytest.raises(
+        ck.UrdfError,
+        match=r"held joint 'panda_finger_joint2' = 0.03 mimics 'panda_finger_joint1' = 0 "
+        r".*hold 'panda_finger_joint1'",
+    ):
+        ck.load_robot(panda, held={"panda_finger_joint2": 0.03})
+    agreeing = ck.load_robot(panda, held={"panda_finger_joint1": 0.03, "panda_finger_joint2": 0.03})
+    assert dict(agreeing.held) == {"panda_finger_joint1": 0.03, "panda_finger_joint2": 0.03}
+
+
+def test_a_joint_map_naming_a_held_joint_says_it_is_held() -> None:
+    panda = ck.load_robot(ARMS["panda"][0])
+    values = {name: 0.0 for name in panda.joint_names} | {"panda_finger_joint1": 0.0}
+    with pytest.raises(
+        ck.JointLimitError, match=r"\['panda_finger_joint1'\] are held \(fixed\), not planned"
+    ):
+        panda.configuration(values)
+
+
+def test_a_mesh_that_is_not_a_mesh_names_its_link_and_file(tmp_path: Path) -> None:
+    (tmp_path / "link3.stl").write_text("a text file, not a mesh\n")
+    urdf = panda_copy(
+        tmp_path,
+        lambda t: t.replace(
+            f"file://{ROBOTS}/panda_description/meshes/collision/link3.stl", str(tmp_path / "link3.stl")
+        ),
+    )
+    with pytest.raises(ck.UrdfError) as info:
+        ck.load_robot(urdf)
+    message = str(info.value)
+    assert f"link 'panda_link3': mesh '{tmp_path / 'link3.stl'}' is not a mesh file coal can read" in message
+    assert ".cpp" not in message and len(message) < 300
+
+
+@pytest.mark.parametrize(("value", "shown"), [(".nan", "nan"), ("-5", "-5"), (".inf", "inf")])
+def test_a_limits_file_value_that_is_no_positive_number_names_the_file_and_joint(
+    tmp_path: Path, value: str, shown: str
+) -> None:
+    limits = tmp_path / "limits.yaml"
+    limits.write_text(f"panda_joint3: {{acceleration: {value}, jerk: 100}}\n")
+    with pytest.raises(
+        ck.UrdfError,
+        match=rf"joint limits file '{limits}': joint 'panda_joint3' acceleration = {shown} "
+        "must be a finite number > 0",
+    ):
+        ck.load_robot(ARMS["panda"][0], limits=limits)
+
+
+def test_a_zero_velocity_of_an_installed_urdf_suggests_a_limits_file_only(tmp_path: Path) -> None:
+    from cpr_kin.packages import installed
+
+    def stopped(text: str) -> str:
+        return text.replace('velocity="2.175"', 'velocity="0"', 1)
+
+    own = panda_copy(tmp_path, stopped)
+    with pytest.raises(ck.UrdfError, match=r"give <limit velocity=\.\.\.> in the URDF, or 'velocity' in"):
+        ck.load_robot(own)
+    assert installed(ARMS["panda"][0]) and not installed(own)
+    # the installed URDF's own zero: a limits file is the only thing the user should edit
+    from cpr_kin.limits import read_dynamic_limits
+
+    with pytest.raises(ck.UrdfError) as info:
+        read_dynamic_limits(None, ("panda_joint1",), np.zeros(1), urdf=ARMS["panda"][0])
+    assert "in the URDF" not in str(info.value) and "'velocity' in a limits file (limits=...)" in str(
+        info.value
+    )
+
+
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        ("<html><body>a page</body></html>", "has root element <html>; an SRDF's is <robot>"),
+        (None, "holds <link> or <joint> elements: it is a URDF"),
+    ],
+)
+def test_an_srdf_that_is_no_srdf_is_refused(tmp_path: Path, content: str | None, message: str) -> None:
+    srdf = tmp_path / "panda.srdf"
+    srdf.write_text(content if content is not None else ARMS["panda"][0].read_text())
+    with pytest.raises(ck.UrdfError, match=re_escape(message)):
+        ck.load_robot(ARMS["panda"][0], srdf=srdf)
+
+
+@pytest.mark.parametrize("ups", [1, 8, 20])
+def test_a_package_path_that_leaves_its_package_is_refused(tmp_path: Path, ups: int) -> None:
+    escape = "package://example-robot-data/" + "../" * ups + "etc/hostname"
+    urdf = panda_copy(
+        tmp_path,
+        lambda t: t.replace(f"file://{ROBOTS}/panda_description/meshes/collision/link3.stl", escape),
+    )
+    with pytest.raises(
+        ck.UrdfError, match=re_escape(f"mesh '{escape}' leaves its package 'example-robot-data'")
+    ):
+        ck.load_robot(urdf)
+    inside = panda_copy(  # a path that goes up and back in stays inside: loaded
+        tmp_path,
+        lambda t: t.replace(
+            f"file://{ROBOTS}/panda_description/meshes/collision/link3.stl",
+            "package://example-robot-data/robots/panda_description/../panda_description/meshes/collision/link3.stl",
+        ),
+    )
+    assert ck.load_robot(inside).nq == 7
