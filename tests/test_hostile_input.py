@@ -315,3 +315,66 @@ def test_check_of_any_changed_coefficient_ends_in_a_verdict(
     bad = changed(good, edit, tmp_path / "fuzzed.json")
     code, _, stderr = run(["check", str(scene), str(bad)], capsys)
     assert code in (0, 2, 3) and "Traceback" not in stderr and stderr.count("\n") <= 1
+
+
+def rename(first: int, as_name: str) -> Callable[[dict[str, object]], None]:
+    def edit(document: dict[str, object]) -> None:
+        document["joint_names"][first] = as_name  # type: ignore[index]
+
+    return edit
+
+
+@pytest.mark.parametrize(
+    ("edit", "message"),
+    [
+        (
+            shift(3, 0, 0, 0.5),
+            "is not continuous (C3) at t = 3 s (knot 3): the position of joint 'theta1' jumps by 0.5 "
+            "rad or m",
+        ),
+        (rename(1, "theta1"), "names ['theta1'] more than once; each joint once"),
+        (set_value(1, float("nan")), "segments[1].coeffs[0][0] = nan: Input should be a finite number"),
+    ],
+)
+def test_export_reads_the_file_as_check_does(
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    trajectory_file: tuple[Path, Path],
+    edit: Callable[[dict[str, object]], None],
+    message: str,
+) -> None:
+    _, good = trajectory_file
+    bad = changed(good, edit, tmp_path / "bad.json")
+    out = tmp_path / "ros.yaml"
+    code, _, stderr = run(["export", str(bad), "--format", "joint-trajectory", "--out", str(out)], capsys)
+    assert code == 2 and message in stderr and stderr.count("\n") == 1 and not out.exists()
+
+
+def test_a_joint_named_twice_fails_check_too(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], trajectory_file: tuple[Path, Path]
+) -> None:
+    scene, good = trajectory_file
+    bad = changed(good, rename(1, "theta1"), tmp_path / "twice.json")
+    code, _, stderr = run(["check", str(scene), str(bad)], capsys)
+    assert code == 2 and "names ['theta1'] more than once" in stderr
+
+
+@pytest.mark.parametrize("link", ["same", "symlink", "hardlink"])
+def test_export_and_show_never_write_over_the_trajectory(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], trajectory_file: tuple[Path, Path], link: str
+) -> None:
+    _, good = trajectory_file
+    trajectory = tmp_path / "t.json"
+    trajectory.write_bytes(good.read_bytes())
+    out = {"same": trajectory, "symlink": tmp_path / "out.json", "hardlink": tmp_path / "out.json"}[link]
+    if link == "symlink":
+        out.symlink_to(trajectory)
+    elif link == "hardlink":
+        out.hardlink_to(trajectory)
+    for command in (
+        ["export", str(trajectory), "--format", "joint-trajectory", "--out", str(out)],
+        ["show", str(trajectory), "--html", str(out)],
+    ):
+        code, _, stderr = run(command, capsys)
+        assert code == 2 and f"is the trajectory file '{trajectory}', an input of this command" in stderr
+        assert trajectory.read_bytes() == good.read_bytes()

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -70,12 +71,17 @@ def shown_robot(document: TrajectoryFile, scene: Scene, urdf: Path | None) -> ck
 
 def cmd_show(args: argparse.Namespace) -> int:
     """Show a trajectory file in a live meshcat viewer, or write it as one HTML page."""
+    from planning.curves.continuity import discontinuity
+    from planning.io.output_paths import check_not_inputs
     from planning.io.publish import write_file
     from planning.io.scene_file import parse_scene
     from planning.io.trajectory_reader import read_trajectory
     from planning.viz import artifacts
 
     document = read_trajectory(args.trajectory)
+    jump = discontinuity(document.trajectory, document.joint_names)
+    if jump is not None:  # shown all the same: seeing it is what show is for
+        print(escaped(f"warning: {args.trajectory} {jump}; `cpr-plan check` fails it"), file=sys.stderr)
     scene = parse_scene(document.scene, source=f"{args.trajectory} (scene)")
     robot = ck.carrying(shown_robot(document, scene, args.urdf), scene.payload)  # its shape drawn too
     if robot.joint_names != document.joint_names:
@@ -84,6 +90,7 @@ def cmd_show(args: argparse.Namespace) -> int:
         )
     world = ck.CollisionWorld(robot, scene.obstacles)
     if args.html is not None:
+        check_not_inputs([args.html], {"trajectory file": args.trajectory, "URDF": args.urdf})
         html = artifacts.viewer_html(
             world, scene.safety_margin, document.trajectory, document.waypoints, args.collision
         )
@@ -110,14 +117,19 @@ EXPORTERS = {"joint-trajectory": "ROS trajectory_msgs/JointTrajectory (YAML or J
 
 
 def cmd_export(args: argparse.Namespace) -> int:
-    """Write a trajectory file in another format (:data:`EXPORTERS`)."""
-    from planning.io.joint_trajectory import joint_trajectory, write_joint_trajectory
-    from planning.io.trajectory_reader import read_trajectory
+    """Write a trajectory file in another format (:data:`EXPORTERS`).
 
-    document = read_trajectory(args.trajectory)
-    exported = joint_trajectory(document.trajectory, document.joint_names, args.rate)
-    written = write_joint_trajectory(exported, args.out)
-    points = len(exported["points"])
+    The file is read as ``check`` reads it, and a trajectory that jumps at a knot is refused:
+    a controller would be sent the jump.
+    """
+    from planning.io.joint_trajectory import sample_times, write_joint_trajectory
+    from planning.io.output_paths import check_not_inputs
+    from planning.io.trajectory_reader import read_trajectory, require_continuous
+
+    check_not_inputs([args.out], {"trajectory file": args.trajectory})
+    document = require_continuous(read_trajectory(args.trajectory), f"trajectory file '{args.trajectory}'")
+    points = len(sample_times(document.trajectory, args.rate))
+    written = write_joint_trajectory(document.trajectory, document.joint_names, args.out, args.rate)
     print(
         escaped(f"wrote {written}: {points} points of {len(document.joint_names)} joints at {args.rate:g} Hz")
     )

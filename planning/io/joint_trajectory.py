@@ -6,12 +6,16 @@ The document has the message's fields: ``header`` (empty frame, zero stamp: "sta
 ``builtin_interfaces/Duration`` (``sec``, ``nanosec``). Points are sampled every ``1 / rate_hz``
 seconds from the trajectory's start, and at its end. Written as YAML (``.yaml``, ``.yml``) or
 JSON (``.json``): what ``ros2 topic pub`` and a ``FollowJointTrajectory`` action client take.
+
+:func:`write_joint_trajectory` streams the points, :data:`CHUNK_POINTS` at a time: its memory
+does not grow with the number of points (up to :data:`MAX_POINTS`).
 """
 
 from __future__ import annotations
 
 import json
 import math
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -28,7 +32,10 @@ DEFAULT_RATE_HZ = 100.0
 """Sampling rate unless one is given [Hz]."""
 MAX_POINTS = 1_000_000
 """Most points one document holds (a duration times a rate beyond it is refused)."""
+CHUNK_POINTS = 10_000
+"""Points evaluated and written at a time."""
 SUFFIXES = (".yaml", ".yml", ".json")
+POINT_KEYS = ("positions", "velocities", "accelerations")
 
 
 def _duration(seconds: float) -> dict[str, int]:
@@ -37,10 +44,8 @@ def _duration(seconds: float) -> dict[str, int]:
     return {"sec": total // 1_000_000_000, "nanosec": total % 1_000_000_000}
 
 
-def joint_trajectory(
-    trajectory: Trajectory, joint_names: tuple[str, ...], rate_hz: float = DEFAULT_RATE_HZ
-) -> dict[str, Any]:
-    """The ``JointTrajectory`` document of ``trajectory`` sampled at ``rate_hz`` [Hz] (module docstring).
+def sample_times(trajectory: Trajectory, rate_hz: float = DEFAULT_RATE_HZ) -> np.ndarray:
+    """The times the points are sampled at [s]: every ``1 / rate_hz`` from the start, and the end.
 
     Raises:
         PlanningError: a rate outside :data:`RATE_RANGE_HZ`, or more than :data:`MAX_POINTS` points.
@@ -56,35 +61,98 @@ def joint_trajectory(
         )
     times = start + np.arange(count) / rate_hz
     if end - times[-1] > 1e-9:
-        times = np.append(times, end)
-    else:
-        times[-1] = end
-    positions, velocities, accelerations = (trajectory(times, r).tolist() for r in range(3))
-    points = [
-        {
-            "positions": positions[k],
-            "velocities": velocities[k],
-            "accelerations": accelerations[k],
-            "effort": [],
-            "time_from_start": _duration(float(t - start)),
-        }
-        for k, t in enumerate(times)
-    ]
-    header = {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": ""}
-    return {"header": header, "joint_names": list(joint_names), "points": points}
+        return np.append(times, end)
+    times[-1] = end
+    return times
 
 
-def write_joint_trajectory(document: dict[str, Any], path: str | Path) -> Path:
-    """Write a :func:`joint_trajectory` document as YAML or JSON by ``path``'s suffix, atomically.
+def _points(trajectory: Trajectory, times: np.ndarray) -> Iterator[dict[str, Any]]:
+    """The points at ``times``, evaluated :data:`CHUNK_POINTS` at a time."""
+    start = float(trajectory.knots[0])
+    for first in range(0, len(times), CHUNK_POINTS):
+        chunk = times[first : first + CHUNK_POINTS]
+        positions, velocities, accelerations = (trajectory(chunk, r).tolist() for r in range(3))
+        for k, t in enumerate(chunk.tolist()):
+            yield {
+                "positions": positions[k],
+                "velocities": velocities[k],
+                "accelerations": accelerations[k],
+                "effort": [],
+                "time_from_start": _duration(t - start),
+            }
+
+
+def _header(joint_names: tuple[str, ...]) -> dict[str, Any]:
+    return {"header": {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": ""}, "joint_names": list(joint_names)}
+
+
+def joint_trajectory(
+    trajectory: Trajectory, joint_names: tuple[str, ...], rate_hz: float = DEFAULT_RATE_HZ
+) -> dict[str, Any]:
+    """The ``JointTrajectory`` document of ``trajectory`` sampled at ``rate_hz`` [Hz] (module docstring).
+
+    The whole document in memory; :func:`write_joint_trajectory` streams it to a file.
 
     Raises:
-        PlanningError: a suffix other than ``.yaml``, ``.yml`` or ``.json``.
+        PlanningError: a rate outside :data:`RATE_RANGE_HZ`, or more than :data:`MAX_POINTS` points.
+    """
+    points = list(_points(trajectory, sample_times(trajectory, rate_hz)))
+    return {**_header(joint_names), "points": points}
+
+
+def _yaml_float(value: float) -> str:
+    """``value`` as YAML 1.1 (PyYAML) reads back as the same float: an exponent needs a dot."""
+    text = repr(value)
+    return text.replace("e", ".0e", 1) if "e" in text and "." not in text else text
+
+
+def _yaml_parts(header: dict[str, Any], points: Iterator[dict[str, Any]]) -> Iterator[str]:
+    """The document as YAML, in block style with flow-style lists (as ``yaml.safe_dump`` writes it)."""
+    yield yaml.safe_dump(header, sort_keys=False, default_flow_style=None, width=1000)
+    yield "points:\n"
+    lines = []
+    for point in points:
+        rows = [f"[{', '.join(map(_yaml_float, point[key]))}]" for key in POINT_KEYS]
+        stamp = point["time_from_start"]
+        lines.append(
+            f"- positions: {rows[0]}\n  velocities: {rows[1]}\n  accelerations: {rows[2]}\n  effort: []\n"
+            f"  time_from_start: {{sec: {stamp['sec']}, nanosec: {stamp['nanosec']}}}\n"
+        )
+        if len(lines) == CHUNK_POINTS:
+            yield "".join(lines)
+            lines = []
+    yield "".join(lines)
+
+
+def _json_parts(header: dict[str, Any], points: Iterator[dict[str, Any]]) -> Iterator[str]:
+    """The document as JSON, one point a line."""
+    yield json.dumps(header)[:-1] + ', "points": [\n'
+    lines = []
+    for k, point in enumerate(points):
+        lines.append(("" if k == 0 else ",\n") + json.dumps(point))
+        if len(lines) == CHUNK_POINTS:
+            yield "".join(lines)
+            lines = []
+    yield "".join(lines) + "\n]}\n"
+
+
+def write_joint_trajectory(
+    trajectory: Trajectory,
+    joint_names: tuple[str, ...],
+    path: str | Path,
+    rate_hz: float = DEFAULT_RATE_HZ,
+) -> Path:
+    """Write the ``JointTrajectory`` of ``trajectory`` as YAML or JSON by ``path``'s suffix, atomically.
+
+    The points are streamed (module docstring): memory stays small up to :data:`MAX_POINTS`.
+
+    Raises:
+        PlanningError: a suffix other than ``.yaml``, ``.yml`` or ``.json``; a rate outside
+            :data:`RATE_RANGE_HZ`, or more than :data:`MAX_POINTS` points.
     """
     path = Path(path)
     if path.suffix.lower() not in SUFFIXES:
         raise PlanningError(f"'{path}': the file name must end in one of {list(SUFFIXES)} (YAML or JSON)")
-    if path.suffix.lower() == ".json":
-        text = json.dumps(document, indent=1)
-    else:
-        text = yaml.safe_dump(document, sort_keys=False, default_flow_style=None, width=1000)
-    return write_file(path, text + ("" if text.endswith("\n") else "\n"))
+    points = _points(trajectory, sample_times(trajectory, rate_hz))
+    parts = _json_parts if path.suffix.lower() == ".json" else _yaml_parts
+    return write_file(path, parts(_header(joint_names), points))

@@ -32,6 +32,7 @@ import hashlib
 import json
 import os
 import shutil
+from collections.abc import Iterable
 from pathlib import Path
 from types import TracebackType
 from typing import Any
@@ -52,12 +53,18 @@ class OutputError(PlanningError):
     """An output folder cannot be used: not a folder, not ours, or locked by another writer."""
 
 
-def _write(path: Path, content: str | bytes) -> None:
+Content = str | bytes | Iterable[str]
+"""What a file is written from: its text or bytes, or its text in parts (streamed, never whole
+in memory)."""
+
+
+def _write(path: Path, content: Content) -> None:
     """Create ``path`` (which must not exist) with ``content``, flushed to disk, umask permissions."""
-    data = content.encode("utf-8") if isinstance(content, str) else content
+    parts = [content] if isinstance(content, str | bytes) else content
     descriptor = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)  # the umask applies
     with os.fdopen(descriptor, "wb") as stream:
-        stream.write(data)
+        for part in parts:
+            stream.write(part.encode("utf-8") if isinstance(part, str) else part)
         stream.flush()
         os.fsync(stream.fileno())
 
@@ -72,8 +79,11 @@ def _alive(pid: int) -> bool:
     return True
 
 
-def write_file(path: str | Path, content: str | bytes) -> Path:
+def write_file(path: str | Path, content: Content) -> Path:
     """Write one file atomically: to ``.<name>.tmp-<pid>-<random>`` beside it, then renamed over it.
+
+    ``content`` given in parts (an iterable of str) is written part by part: a large file
+    needs no more memory than its largest part; if making a part fails, nothing is left.
 
     Temporary files that a killed writer left beside it are removed.
 

@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from cpr_kin.user_files import UserFileError, read_bytes
+from planning.curves.continuity import discontinuity
 from planning.curves.hermite import ORDER
 from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
@@ -90,6 +91,9 @@ class TrajectoryFile:
 def _consistent(document: _Document) -> str | None:
     """The first inconsistency between knots, segments, coefficients and waypoints, if any."""
     knots, segments, joints = document.knots, document.segments, len(document.joint_names)
+    twice = sorted({n for n in document.joint_names if document.joint_names.count(n) > 1})
+    if twice:
+        return f"joint_names = {document.joint_names} names {twice} more than once; each joint once"
     if len(segments) != len(knots) - 1:
         return f"{len(segments)} segments for {len(knots)} knots; expected one segment per knot interval"
     for i, (a, b) in enumerate(itertools.pairwise(knots)):
@@ -144,6 +148,21 @@ def parse_trajectory(data: bytes, source: str = "trajectory file") -> Trajectory
         scene=document.scene,
         metrics=document.metrics,
     )
+
+
+def require_continuous(document: TrajectoryFile, source: str = "trajectory file") -> TrajectoryFile:
+    """``document`` if its trajectory is continuous (C3) at its knots, by ``check``'s rule.
+
+    For a reader that passes the trajectory on (``export``): ``check`` reports a jump as a
+    failure of the trajectory instead (:mod:`planning.curves.continuity`).
+
+    Raises:
+        TrajectoryFileError: naming the knot, the joint and the jump.
+    """
+    jump = discontinuity(document.trajectory, document.joint_names)
+    if jump is not None:
+        raise TrajectoryFileError(f"{source} {jump}; `cpr-plan check` fails it, so it is not exported")
+    return document
 
 
 def read_trajectory(path: str | Path) -> TrajectoryFile:

@@ -15,8 +15,8 @@ from numpy.typing import NDArray
 
 import cpr_kin as ck
 from cpr_kin.self_curve import check_self_curve
-from planning.curves.hermite import CONTINUITY
-from planning.curves.trajectory import DERIVATIVE_NAMES, Trajectory
+from planning.curves.continuity import discontinuity
+from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
 from planning.pipeline.scene import DEFAULT_SELF_MARGIN_M
 from planning.pipeline.target import Target
@@ -60,29 +60,6 @@ class Verification:
 
 LIMIT_TOLERANCE = 1e-9
 """Relative excess of a joint's range or limit that still passes (rounding)."""
-CONTINUITY_TOLERANCE = 1e-6
-"""Largest jump of position, velocity, acceleration or jerk at a knot of a C3 trajectory
-(:meth:`~planning.curves.trajectory.Trajectory.knot_jumps`): relative to the magnitudes
-summed there, or to the joint's largest |value| of that derivative over the trajectory
-(at least 1 rad/s^r or m/s^r), whichever is larger: rounding, in our file or another
-tool's, must not count, also at a knot where the robot rests and the local magnitudes vanish."""
-
-
-def _discontinuity(trajectory: Trajectory, robot: ck.Robot) -> str | None:
-    """The worst jump at a knot beyond :data:`CONTINUITY_TOLERANCE`, as a sentence, if any."""
-    jump, relative = trajectory.knot_jumps(CONTINUITY + 1)
-    peak = np.stack([trajectory.extrema(r).peak for r in range(CONTINUITY + 1)], axis=1)  # (nj, r)
-    relative = np.where(jump > CONTINUITY_TOLERANCE * np.maximum(peak, 1.0), relative, 0.0)
-    if relative.size == 0 or relative.max() <= CONTINUITY_TOLERANCE:
-        return None
-    knot, joint, r = np.unravel_index(int(np.argmax(relative)), relative.shape)
-    name = robot.joint_names[joint]
-    unit = robot.joint_unit(name) + ("" if r == 0 else "/s" if r == 1 else f"/s^{r}")
-    where = f"t = {trajectory.knots[knot + 1]:.4g} s (knot {knot + 1})"
-    return (
-        f"is not continuous (C3) at {where}: the {DERIVATIVE_NAMES[r]} of joint '{name}' "
-        f"jumps by {jump[knot, joint, r]:.3g} {unit}"
-    )
 
 
 def _unchecked(margin_m: float, step_m: float) -> ck.CurveCheck:
@@ -207,7 +184,7 @@ def verify_trajectory(
     except ck.CprKinError as exc:  # too fast to certify: a verdict, not a crash
         problems.append(f"cannot be certified clear of obstacles: {exc}")
         check = _unchecked(margin_m, step_m)
-    jumps = _discontinuity(trajectory, robot)
+    jumps = discontinuity(trajectory, robot.joint_names, [robot.joint_unit(n) for n in robot.joint_names])
     if jumps is not None:
         problems.append(jumps)
     if endpoints is not None:
