@@ -182,3 +182,29 @@ def describe_validation(
         listed.append(problem)
     more = len(problems) - len(listed)
     return "; ".join(listed) + (f"; and {more} more" if more > 0 else "")
+
+
+QUATERNION_NORM_TOLERANCE = 1e-3
+"""How far a quaternion's norm may be from 1 and still be normalised (rounding of printed
+values); beyond it the numbers are not a rotation and are refused (as MoveIt's orientation
+constraints warn beyond it)."""
+
+
+def unit_quaternion(xyzw: Sequence[float]) -> tuple[float, float, float, float]:
+    """``xyzw`` normalised, if its norm is within :data:`QUATERNION_NORM_TOLERANCE` of 1.
+
+    One rule for every quaternion a file gives: rounding is normalised away, a quaternion
+    that is no rotation (a norm of 0, or far from 1) is a ``ValueError`` naming the norm
+    (pydantic prefixes the field and its value).
+    """
+    values = np.asarray(xyzw, dtype=float)
+    norm = math.hypot(*values)  # no overflow warning for 1e308
+    if not abs(norm - 1.0) <= QUATERNION_NORM_TOLERANCE:
+        meant = [round(float(v), 6) for v in values / norm] if 0 < norm < math.inf else []
+        hint = f"; did you mean {meant}?" if any(meant) else ""
+        raise ValueError(
+            f"has norm {norm:.6g}; a rotation's quaternion [x, y, z, w] has norm 1 "
+            f"(within {QUATERNION_NORM_TOLERANCE:g}){hint}"
+        )
+    x, y, z, w = (float(v) for v in values / norm)
+    return x, y, z, w

@@ -289,7 +289,8 @@ REFUSALS = [
         "scene",
         "world.collision_objects.0.header.frame_id",
         "camera",
-        "frame 'camera' is not the robot's base",
+        "world.collision_objects[0] ('post').header.frame_id: frame 'camera' is not known; the frames "
+        "fixed to the world here: 'panda_link0'",
     ),
     (
         "scene",
@@ -313,7 +314,8 @@ REFUSALS = [
         "scene",
         "world.collision_objects.0.primitives.0.dimensions",
         [0.1, 0.2, 500.0],
-        "obstacles[0].size[2] = 500.0",
+        "scene.world.collision_objects[0] ('post').primitives[0].dimensions[2] = 500.0: a box's [x, y, z] "
+        "must each be in [0.0001, 100] m",
     ),
     (
         "request",
@@ -374,3 +376,309 @@ def test_every_motionbenchmaker_problem_converts(tmp_path: Path) -> None:
     )
     assert panda_all[1:4] == ["700", "700", "700"]
     assert ur5_all[1:3] == ["700", "700"] and int(ur5_all[3]) >= 600  # hulls over the concave forearm: docs
+
+
+# Hostile files (issue 73): each the exact input, refused with exit 2 naming the field, or
+# converted as MoveIt reads it and said.
+
+
+def test_an_orientation_of_all_zeros_is_the_identity_and_said(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = changed(SCENE, "world.collision_objects.0.pose.orientation", [0, 0, 0, 0])
+    scene = changed(
+        scene, "world.collision_objects.0.primitive_poses.0.orientation", {"x": 0, "y": 0, "z": 0}
+    )
+    out = tmp_path / "zero.yaml"
+    assert main(["import-moveit", *write(tmp_path, scene, REQUEST), "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "scene.world.collision_objects[0].pose.orientation of all zeros read as the identity" in printed
+    box = load_scene(out).obstacles[0]
+    np.testing.assert_allclose(box.xyz, [0.5, 0.3, 0.3], atol=1e-12)  # the object's pose unrotated
+    np.testing.assert_allclose(box.rpy, [0.0, 0.0, 0.0], atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "message"),
+    [
+        (
+            "world.collision_objects.0.pose.orientation",
+            [0.9, 0.9, 0, 0],
+            "world.collision_objects[0].pose.orientation = [0.9, 0.9, 0, 0]: has norm 1.27279",
+        ),
+        (
+            "world.collision_objects.0.pose.orientation",
+            {"x": 1, "y": 0, "z": 0},
+            "gives no w: ROS 1 reads it as 0, ROS 2 as 1",
+        ),
+        (
+            "world.collision_objects.0.primitives.0.dimensions",
+            ["0.1", 0.2, 0.6],
+            "dimensions[0] = '0.1': Input should be a valid number",
+        ),
+        (
+            "allowed_collision_matrix.entry_values",
+            [["yes", True, False], [True, False, False], [False, False, False]],
+            "entry_values[0][0] = 'yes': Input should be a valid boolean",
+        ),
+        (
+            "world.collision_objects.0.primitives.0.dimensions",
+            [0.1, -0.05, 0.6],
+            "scene.world.collision_objects[0] ('post').primitives[0].dimensions[1] = -0.05: a box's",
+        ),
+        (
+            "world.collision_objects.1.primitive_poses.0.position",
+            [300.0, 0.0, 0.0],
+            "scene.world.collision_objects[1] ('lamp').primitives[0]: placed at [300.0, 0.0, 0.0] m",
+        ),
+    ],
+)
+def test_a_hostile_scene_is_refused_naming_the_input_field(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], key: str, value: Any, message: str
+) -> None:
+    out = tmp_path / "o" / "m10.yaml"
+    assert (
+        main(["import-moveit", *write(tmp_path, changed(SCENE, key, value), REQUEST), "--out", str(out)]) == 2
+    )
+    error = capsys.readouterr().err
+    assert message in error and "m10.yaml" not in error and len(error.strip().splitlines()) == 1
+    assert not (tmp_path / "o").exists()
+
+
+def test_an_empty_file_is_refused_and_a_scene_without_objects_said(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    arguments = write(tmp_path, {"robot_state": SCENE["robot_state"]}, REQUEST)
+    assert main(["import-moveit", *arguments, "--out", str(tmp_path / "free.yaml")]) == 0
+    assert "no collision objects in the PlanningScene: the scene has no obstacles" in capsys.readouterr().out
+    (tmp_path / "scene.yaml").write_text("# nothing\n")
+    assert main(["import-moveit", *arguments, "--out", str(tmp_path / "none.yaml")]) == 2
+    assert "PlanningScene file" in capsys.readouterr().err and not (tmp_path / "none.yaml").exists()
+
+
+@pytest.mark.parametrize("which", ["scene", "request", "urdf", "link"])
+def test_an_output_that_is_an_input_is_refused_and_the_input_kept(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], which: str
+) -> None:
+    urdf = tmp_path / "panda.urdf"
+    urdf.write_text(PANDA.read_text().replace("package://example-robot-data/robots/", f"{PANDA.parents[2]}/"))
+    arguments = write(tmp_path, SCENE, REQUEST)
+    arguments[arguments.index("--urdf") + 1] = str(urdf)
+    (tmp_path / "link.yaml").symlink_to(tmp_path / "scene.yaml")
+    out = {"scene": "scene.yaml", "request": "request.yaml", "urdf": "panda.urdf", "link": "link.yaml"}[which]
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    assert main(["import-moveit", *arguments, "--out", str(tmp_path / out)]) == 2
+    assert "an input of this command" in capsys.readouterr().err
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+
+
+def request_with_goal_in(frame: str, fixed: list[dict[str, Any]] | None = None) -> dict[str, Any]:
+    request = copy.deepcopy(REQUEST)
+    request["goal_constraints"] = [
+        {
+            "position_constraints": [
+                {
+                    "header": {"frame_id": frame},
+                    "link_name": "panda_hand_tcp",
+                    "constraint_region": {
+                        "primitives": [{"type": 2, "dimensions": [0.002]}],
+                        "primitive_poses": [{"position": [0.1, 0.2, 0.3]}],
+                    },
+                }
+            ],
+            "orientation_constraints": [
+                {
+                    "header": {"frame_id": frame},
+                    "link_name": "panda_hand_tcp",
+                    "orientation": [1, 0, 0, 0],
+                    "absolute_x_axis_tolerance": 0.01,
+                    "absolute_y_axis_tolerance": 0.01,
+                    "absolute_z_axis_tolerance": 3.14,
+                }
+            ],
+        }
+    ]
+    return request
+
+
+def test_a_goal_in_a_world_fixed_frame_is_moved_into_the_base(tmp_path: Path) -> None:
+    # a frame of fixed_frame_transforms, and an object's frame: the goal pose is T @ pose,
+    # checked with scipy's rotations
+    table = {"header": {"frame_id": "panda_link0"}, "child_frame_id": "table"}
+    table["transform"] = {"translation": [0.4, -0.1, 0.05], "rotation": [0, 0, 0.3826834, 0.9238795]}
+    scene = {**SCENE, "fixed_frame_transforms": [table]}
+    for frame, frame_in_base in (
+        ("table", transform([0.4, -0.1, 0.05], [0, 0, 0.3826834, 0.9238795])),
+        ("post", transform([0.5, 0.3, 0.0], [0, 0, 0.3826834, 0.9238795])),
+        ("", np.eye(4)),
+    ):
+        out = tmp_path / f"goal_{frame}.yaml"
+        assert (
+            main(["import-moveit", *write(tmp_path, scene, request_with_goal_in(frame)), "--out", str(out)])
+            == 0
+        )
+        goal = load_scene(out).goal
+        assert goal.pose is not None
+        expected = frame_in_base @ transform([0.1, 0.2, 0.3], [1, 0, 0, 0])
+        np.testing.assert_allclose(goal.pose[0], expected[:3, 3], atol=1e-7)
+        np.testing.assert_allclose(np.array(goal.pose[1]), expected[:3, :3], atol=1e-6)
+
+
+@pytest.mark.parametrize(
+    ("frame", "message"),
+    [
+        ("panda_link7", "frame 'panda_link7' is a link that joint 'panda_joint1' moves"),
+        ("camera_link", "frame 'camera_link' is not known; the frames fixed to the world here:"),
+    ],
+)
+def test_a_goal_in_a_moving_or_unknown_frame_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], frame: str, message: str
+) -> None:
+    out = tmp_path / "goal.yaml"
+    assert (
+        main(["import-moveit", *write(tmp_path, SCENE, request_with_goal_in(frame)), "--out", str(out)]) == 2
+    )
+    error = capsys.readouterr().err
+    assert "request.goal_constraints[0].position_constraints[0].header.frame_id" in error and message in error
+    assert not out.exists()
+
+
+def test_a_goal_region_with_a_negative_radius_names_the_field(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    request = changed(
+        request_with_goal_in("panda_link0"),
+        "goal_constraints.0.position_constraints.0.constraint_region.primitives.0.dimensions",
+        [-0.1],
+    )
+    assert main(["import-moveit", *write(tmp_path, SCENE, request), "--out", str(tmp_path / "g.yaml")]) == 2
+    assert (
+        "constraint_region.primitives[0].dimensions = [-0.1]: a sphere's radius must be > 0 m"
+        in capsys.readouterr().err
+    )
+
+
+def test_a_wide_yaw_tolerance_is_narrowed_and_said(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    request = changed(
+        request_with_goal_in("panda_link0"),
+        "goal_constraints.0.orientation_constraints.0.absolute_x_axis_tolerance",
+        3.14,
+    )
+    request = changed(request, "goal_constraints.0.orientation_constraints.0.absolute_y_axis_tolerance", 3.14)
+    out = tmp_path / "wide.yaml"
+    assert main(["import-moveit", *write(tmp_path, SCENE, request), "--out", str(out)]) == 0
+    assert "orientation tolerance 3.14 rad narrowed to 0.5 rad" in capsys.readouterr().out
+    assert load_scene(out).goal.tolerance_rad == 0.5
+
+
+def test_mimic_joints_of_the_start_state_follow_their_leader(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the state gives both fingers, the second a value its <mimic> contradicts: MoveIt sets it
+    # from the first, and so does the scene (fixed: holds the leader only)
+    scene = changed(
+        SCENE, "robot_state.joint_state.name", [*JOINTS, "panda_finger_joint1", "panda_finger_joint2"]
+    )
+    scene = changed(scene, "robot_state.joint_state.position", [*READY, 0.03, 0.01])
+    out = tmp_path / "fingers.yaml"
+    assert main(["import-moveit", *write(tmp_path, scene, REQUEST), "--out", str(out)]) == 0
+    assert "mimic joint(s) ['panda_finger_joint2']" in capsys.readouterr().out
+    loaded = load_scene(out)
+    assert loaded.robot is not None and dict(loaded.robot.held) == {"panda_finger_joint1": 0.03}
+
+
+@pytest.mark.parametrize(
+    ("count", "message"),
+    [
+        (600, "scene.world.collision_objects make 600 obstacles; a scene holds at most 500"),
+        (20_000, "more than 100000 values (numbers, strings, lists, mappings); at most 100000 are read"),
+    ],
+)
+def test_too_many_objects_are_refused_saying_the_limit(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], count: int, message: str
+) -> None:
+    arguments = write(tmp_path, SCENE, REQUEST)
+    box = (
+        "  - {{id: box{}, primitives: [{{type: 1, dimensions: [0.1, 0.1, 0.1]}}], "
+        "primitive_poses: [{{position: [1, 1, 1]}}]}}\n"
+    )
+    (tmp_path / "scene.yaml").write_text(
+        "world:\n collision_objects:\n" + "".join(box.format(k) for k in range(count))
+    )
+    assert main(["import-moveit", *arguments, "--out", str(tmp_path / "many.yaml")]) == 2
+    assert message in capsys.readouterr().err and not (tmp_path / "many.yaml").exists()
+
+
+@pytest.mark.parametrize(
+    ("which", "key", "value", "message"),
+    [
+        (
+            "scene",
+            "world.collision_objects.1.id",
+            "post",
+            "collision_objects[0] has the same id; ids must be unique",
+        ),
+        ("scene", "world.collision_objects.1.id", "", "collision_objects[1] ('').id must be 1-96 printable"),
+        (
+            "scene",
+            "robot_state.joint_state.name",
+            [*JOINTS[:6], "panda_joint1", "panda_finger_joint1"],
+            "joint_state.name gives ['panda_joint1'] more than once",
+        ),
+        (
+            "request",
+            "goal_constraints.0.joint_constraints.6.joint_name",
+            "panda_joint1",
+            "joint_constraints constrain ['panda_joint1'] more than once",
+        ),
+    ],
+)
+def test_names_given_twice_or_not_at_all_are_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], which: str, key: str, value: Any, message: str
+) -> None:
+    scene = changed(SCENE, key, value) if which == "scene" else SCENE
+    request = changed(REQUEST, key, value) if which == "request" else REQUEST
+    assert main(["import-moveit", *write(tmp_path, scene, request), "--out", str(tmp_path / "o.yaml")]) == 2
+    assert message in capsys.readouterr().err and not (tmp_path / "o.yaml").exists()
+
+
+def test_an_object_id_that_is_a_path_names_a_mesh_file_inside_the_mesh_folder(tmp_path: Path) -> None:
+    scene = changed(SCENE, "world.collision_objects.1.id", "../../escaped")  # the lamp's cone is a mesh
+    out = tmp_path / "deep" / "er" / "s.yaml"
+    assert main(["import-moveit", *write(tmp_path, scene, REQUEST), "--out", str(out)]) == 0
+    assert sorted(p.name for p in (out.parent / "s_meshes").iterdir()) == ["_.._escaped_1.stl"]
+    assert not list(tmp_path.glob("escaped*")) and load_scene(out).obstacles[3].name == "../../escaped_1"
+
+
+def test_an_output_that_cannot_be_written_leaves_no_mesh(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "s.yaml"
+    out.mkdir()  # a folder where the scene file goes: the meshes were left behind
+    assert main(["import-moveit", *write(tmp_path, SCENE, REQUEST), "--out", str(out)]) == 2
+    assert "is a folder; give a file name" in capsys.readouterr().err
+    assert not (tmp_path / "s_meshes").exists()
+
+
+def test_ros1_frames_and_the_srdfs_world_are_known(tmp_path: Path) -> None:
+    srdf = tmp_path / "panda.srdf"
+    srdf.write_text(
+        PANDA_SRDF.read_text().replace(
+            "</robot>",
+            '<virtual_joint name="v" type="fixed" parent_frame="world" child_link="panda_link0"/></robot>',
+        )
+    )
+    scene = changed(SCENE, "world.collision_objects.0.header.frame_id", "/world")  # ROS 1's leading slash
+    arguments = write(tmp_path, scene, request_with_goal_in("/panda_link0"))
+    arguments[arguments.index("--srdf") + 1] = str(srdf)
+    out = tmp_path / "world.yaml"
+    assert main(["import-moveit", *arguments, "--out", str(out)]) == 0
+    np.testing.assert_allclose(load_scene(out).obstacles[0].xyz, [0.5, 0.3, 0.3], atol=1e-6)
+
+
+def test_a_group_name_without_an_srdf_is_said(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    arguments = write(tmp_path, SCENE, REQUEST)[:-2]  # no --srdf
+    assert main(["import-moveit", *arguments, "--out", str(tmp_path / "o.yaml")]) == 0
+    assert "request.group_name 'arm' (no SRDF to look it up in): planned (" in capsys.readouterr().out

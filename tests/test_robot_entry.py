@@ -114,6 +114,38 @@ def test_a_quaternion_and_roll_pitch_yaw_give_the_same_pose() -> None:
 
 
 @pytest.mark.parametrize(
+    ("quat_xyzw", "rotation"),
+    [
+        ([1.0000000001, 0, 0, 0], np.diag([1.0, -1.0, -1.0])),  # rounding: normalised
+        ([0.7071, 0, 0, 0.7071], pin.rpy.rpyToMatrix(np.pi / 2, 0, 0)),  # printed to 4 digits
+        ([0.9, 0.9, 0, 0], None),  # not a rotation: refused, with the one it may mean
+        ([0.0, 0.0, 0.0, 1.0005], np.eye(3)),
+        ([0.0, 0.0, 0.0, 1.002], None),
+    ],
+)
+def test_a_quaternion_is_normalised_within_the_stated_tolerance_and_refused_beyond(
+    quat_xyzw: list[float], rotation: np.ndarray | None
+) -> None:
+    from planning.validation import QUATERNION_NORM_TOLERANCE
+
+    document = {
+        "robot": "panda",
+        "start": PANDA_START,
+        "goal": {"pose": {"xyz": [0.4, 0, 0.4], "quat_xyzw": quat_xyzw}},
+    }
+    if rotation is None:
+        with pytest.raises(
+            SceneError, match=rf"quat_xyzw = .*has norm .*within {QUATERNION_NORM_TOLERANCE:g}"
+        ):
+            parse_scene(document)
+        return
+    pose = parse_scene(document).goal.pose
+    assert pose is not None
+    np.testing.assert_allclose(np.array(pose[1]), rotation, atol=1e-4)
+    np.testing.assert_allclose(np.array(pose[1]) @ np.array(pose[1]).T, np.eye(3), atol=1e-12)  # a rotation
+
+
+@pytest.mark.parametrize(
     ("change", "pattern"),
     [
         ({"goal": {"pose": {"xyz": [0.4, 0, 0.4]}}}, "give exactly one of 'quat_xyzw' [x, y, z, w] or 'rpy'"),
@@ -123,7 +155,7 @@ def test_a_quaternion_and_roll_pitch_yaw_give_the_same_pose() -> None:
         ),
         (
             {"goal": {"pose": {"xyz": [0.4, 0, 0.4], "quat_xyzw": [0, 0, 0, 0]}}},
-            "is no rotation (its norm is 0)",
+            "has norm 0; a rotation",
         ),
         ({"goal": {"tcp": [0.4, 0, 0.4], "tolerance_m": 0.5}}, "goal.tolerance_m = 0.5"),
         (

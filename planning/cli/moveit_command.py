@@ -23,7 +23,15 @@ def cmd_import_moveit(args: argparse.Namespace) -> int:
     )
     name = scene.name or args.scene.stem
     imported = import_moveit(scene, request, robot, name, (args.safety_margin, args.self_margin))
-    written = write_imported(imported, args.out)
+    inputs = {
+        "PlanningScene file": args.scene,
+        "MotionPlanRequest file": args.request,
+        "URDF": robot.urdf,
+        "SRDF": robot.srdf,
+        "joint limits file": robot.limits,
+    }
+    source = f"the scene converted from '{args.scene}' and '{args.request}'"
+    written = write_imported(imported, args.out, inputs, source)
     document = imported.document
     goal = next(iter(document["goal"]))
     print(

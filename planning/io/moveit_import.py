@@ -9,9 +9,13 @@
 - **Goal:** one ``Constraints``: joint constraints on every planned joint (``q``), or a position
   constraint (a sphere or box region: its centre, and its radius or smallest half side as the
   tolerance) with or without an orientation constraint on the same link (the smallest axis
-  tolerance) as a ``tcp`` or ``pose`` goal.
-- **Obstacles:** :mod:`planning.io.moveit_objects`; in the URDF root's frame, or a frame of
-  ``fixed_frame_transforms``.
+  tolerance) as a ``tcp`` or ``pose`` goal (:mod:`planning.io.moveit_goal`).
+- **Frames:** a pose is given in a frame fixed to the world: the URDF's root, a link fixed to
+  it, the SRDF's virtual joint's parent (``world``), a ``fixed_frame_transforms`` child, an
+  object's id; one that moves with the robot, or is unknown, is refused
+  (:mod:`planning.io.moveit_frames`). An orientation of all zeros is the identity, as in MoveIt.
+- **Obstacles:** :mod:`planning.io.moveit_objects`, at most
+  :data:`~planning.pipeline.scene.MAX_OBSTACLES`; object ids unique.
 - **Allowed collisions:** the matrix's robot-link pairs marked ``true``.
 - **Time:** ``allowed_planning_time`` (when > 0) becomes the planner's ``time_limit_s`` (at
   most :data:`~planning.pipeline.settings.MAX_TIME_LIMIT_S`).
@@ -19,32 +23,44 @@
 What would change the problem and has no counterpart (attached objects, path or trajectory
 constraints, an octomap, padding, velocity scaling other than 0 or 1, a robot base placed
 away from the world's origin, allowed contact with an object) is refused naming it; what only
-steers MoveIt's own planner (planner id, pipeline, attempts, workspace) is listed as ignored.
+steers MoveIt's own planner (planner id, pipeline, attempts, workspace) is listed as ignored
+(:mod:`planning.io.moveit_support`). :func:`write_imported` never writes over an input file.
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import trimesh
 import yaml
-from lxml import etree
 
 import cpr_kin as ck
 from cpr_kin.limits import MAX_LIMITS_BYTES
 from cpr_kin.packages import check_package_dirs
+from cpr_kin.self_collision import parse_srdf
 from cpr_kin.srdf_groups import group_joints
 from cpr_kin.urdf_file import parse_urdf
 from cpr_kin.user_files import load_yaml
+from planning.io.moveit_frames import Frames
 from planning.io.moveit_goal import goal_entry
-from planning.io.moveit_messages import Constraints, MotionPlanRequest, MoveItImportError, PlanningScene
+from planning.io.moveit_matrix import allowed_pairs
+from planning.io.moveit_messages import (
+    MotionPlanRequest,
+    MoveItImportError,
+    PlanningScene,
+)
 from planning.io.moveit_objects import convert_object
+from planning.io.moveit_poses import Pose, zero_quaternions
 from planning.io.moveit_state import joint_values, position_ranges, within_ranges, wrapped
+from planning.io.moveit_support import refuse_unsupported
+from planning.io.output_paths import check_not_inputs
 from planning.io.publish import write_file
+from planning.pipeline.scene import MAX_OBSTACLES
 from planning.pipeline.settings import MAX_TIME_LIMIT_S
 
 
@@ -81,42 +97,6 @@ class ImportedScene:
     ignored: tuple[str, ...] = ()
 
 
-def _refuse_unsupported(scene: PlanningScene, request: MotionPlanRequest) -> list[str]:
-    """Raise on content without a counterpart; return what is ignored."""
-    refusals = {
-        "scene.robot_state.attached_collision_objects": scene.robot_state.attached_collision_objects,
-        "request.start_state.attached_collision_objects": request.start_state.attached_collision_objects,
-        "scene.world.octomap": scene.world.octomap.get("octomap", {}).get("data"),
-        "scene.link_padding": [p for p in scene.link_padding if p.get("padding", 0.0) != 0.0],
-        "scene.link_scale": [s for s in scene.link_scale if s.get("scale", 1.0) != 1.0],
-        "request.path_constraints": request.path_constraints != Constraints(),
-        "request.trajectory_constraints": request.trajectory_constraints.get("constraints"),
-        "request.reference_trajectories": request.reference_trajectories,
-    }
-    for key, value in refusals.items():
-        if value:
-            raise MoveItImportError(f"{key} is not supported; remove it from the file")
-    for key in ("max_velocity_scaling_factor", "max_acceleration_scaling_factor"):
-        if getattr(request, key) not in (0.0, 1.0):
-            raise MoveItImportError(
-                f"request.{key} = {getattr(request, key)}: scaling is not supported (0 or 1: the full "
-                "limits); scale the limits file instead"
-            )
-    for state in (scene.robot_state, request.start_state):
-        for transform in state.multi_dof_joint_state.transforms:
-            if not np.allclose(transform.matrix(), np.eye(4), atol=1e-9):
-                raise MoveItImportError(
-                    f"a robot base placed at {transform.translation} in the world is not supported; "
-                    "give the objects in the robot's base frame"
-                )
-    ignored = [
-        f"request.{key}"
-        for key in ("planner_id", "pipeline_id", "num_planning_attempts")
-        if getattr(request, key)
-    ]
-    return ignored + (["request.workspace_parameters"] if request.workspace_parameters else [])
-
-
 def import_moveit(
     scene: PlanningScene,
     request: MotionPlanRequest,
@@ -130,20 +110,61 @@ def import_moveit(
         MoveItImportError: unsupported or inconsistent content, naming it.
         cpr_kin.UrdfError: the robot's files do not load.
     """
-    ignored = _refuse_unsupported(scene, request)
+    ignored = refuse_unsupported(scene, request)
+    ignored += [
+        f"{where} of all zeros read as the identity (as MoveIt does)"
+        for where in zero_quaternions(scene, "scene") + zero_quaternions(request, "request")
+    ]
     tree = parse_urdf(robot.urdf)
     check_package_dirs(robot.urdf, robot.package_dirs)
     if robot.limits is not None:  # a file that is not there or not YAML is named now, not at planning
         load_yaml(robot.limits, MAX_LIMITS_BYTES, "joint limits file")
-    root = _root_link(tree)
     planned = (
         group_joints(robot.srdf, request.group_name, tree).joints
         if robot.srdf is not None and request.group_name
         else replace(ck.robot_spec(robot.urdf), package_dirs=robot.package_dirs).load().joint_names
     )
-    goal, tcp = goal_entry(request, planned)
-    movable = {j.get("name", "") for j in tree.getroot().findall("joint") if j.get("type") != "fixed"}
-    continuous = {j.get("name", "") for j in tree.getroot().findall("joint") if j.get("type") == "continuous"}
+    if request.group_name and robot.srdf is None:
+        ignored.append(
+            f"request.group_name '{request.group_name}' (no SRDF to look it up in): planned {planned}"
+        )
+    frames = Frames.of_urdf(tree)
+    if robot.srdf is not None:
+        frames.add_virtual_joints(parse_srdf(robot.srdf))
+    frames.add_transforms(scene.fixed_frame_transforms)
+    obstacles: list[dict[str, Any]] = []
+    meshes: dict[str, trimesh.Trimesh] = {}
+    ids: dict[str, int] = {}
+    for k, obj in enumerate(scene.world.collision_objects):
+        where = f"scene.world.collision_objects[{k}] ('{obj.id}')"
+        if obj.id in ids:
+            raise MoveItImportError(
+                f"{where}.id: collision_objects[{ids[obj.id]}] has the same id; ids must be unique"
+            )
+        ids[obj.id] = k
+        frame_in_base = frames.pose(obj.header.frame_id, f"{where}.header.frame_id")
+        converted = convert_object(obj, where, frame_in_base)
+        clash = sorted(set(converted.meshes) & set(meshes))
+        if clash:
+            raise MoveItImportError(
+                f"{where}: its mesh file {clash[0]} is another object's; rename the object"
+            )
+        obstacles += converted.obstacles
+        meshes.update(converted.meshes)
+        if obj.id and obj.id not in frames.fixed:  # MoveIt names an object's frame by its id
+            frames.fixed[obj.id] = frame_in_base @ (obj.pose or Pose()).matrix()
+    if len(obstacles) > MAX_OBSTACLES:
+        raise MoveItImportError(
+            f"scene.world.collision_objects make {len(obstacles)} obstacles; "
+            f"a scene holds at most {MAX_OBSTACLES}"
+        )
+    if not obstacles:
+        ignored.append("no collision objects in the PlanningScene: the scene has no obstacles")
+    goal, tcp = goal_entry(request, planned, frames, ignored)
+    joints = tree.getroot().findall("joint")
+    movable = {j.get("name", "") for j in joints if j.get("type") != "fixed"}
+    continuous = {j.get("name", "") for j in joints if j.get("type") == "continuous"}
+    mimics = {j.get("name", "") for j in joints if j.find("mimic") is not None}
     ranges = position_ranges(tree)
     values = within_ranges(
         wrapped(joint_values(scene.robot_state, request.start_state), continuous), ranges, ignored
@@ -158,22 +179,9 @@ def import_moveit(
         ignored.append(
             f"start values of {len(not_moving)} joint(s) the URDF does not move ({', '.join(not_moving)})"
         )
-    frames = {"": np.eye(4), root: np.eye(4)}
-    for stamped in scene.fixed_frame_transforms:
-        if stamped.header.frame_id not in ("", root):
-            raise MoveItImportError(f"fixed frame '{stamped.child_frame_id}' is given in another frame")
-        frames[stamped.child_frame_id] = stamped.transform.matrix()
-    obstacles: list[dict[str, Any]] = []
-    meshes: dict[str, trimesh.Trimesh] = {}
-    for k, obj in enumerate(scene.world.collision_objects):
-        where = f"scene.world.collision_objects[{k}] ('{obj.id}')"
-        if obj.header.frame_id not in frames:
-            raise MoveItImportError(
-                f"{where}: frame '{obj.header.frame_id}' is not the robot's base '{root}'"
-            )
-        converted = convert_object(obj, where, frames[obj.header.frame_id])
-        obstacles += converted.obstacles
-        meshes.update(converted.meshes)
+    following = sorted(set(values) & mimics - set(planned))
+    if following:  # MoveIt sets a mimic joint from its leader, whatever the state says
+        ignored.append(f"start values of mimic joint(s) {following}: each follows the joint it mimics")
     links = {link.get("name", "") for link in tree.getroot().findall("link")}
     objects = {obj.id for obj in scene.world.collision_objects}
     matrix = scene.allowed_collision_matrix
@@ -185,14 +193,14 @@ def import_moveit(
     robot_entry |= {"packages": [str(d) for d in robot.package_dirs]} if robot.package_dirs else {}
     robot_entry |= {"limits": str(robot.limits)} if robot.limits else {}
     robot_entry |= {"tcp": tcp} if tcp else {}
-    held = {j: v for j, v in values.items() if j in movable and j not in planned}
+    held = {j: v for j, v in values.items() if j in movable - mimics and j not in planned}
     robot_entry |= {"fixed": held} if held else {}
     document: dict[str, Any] = {
         "name": name,
         "robot": robot_entry,
         "safety_margin": margins_m[0],
         "self_margin": margins_m[1],
-        "allowed_collisions": _allowed(scene, links, objects),
+        "allowed_collisions": allowed_pairs(scene.allowed_collision_matrix, links, objects),
         "start": {"q": {j: values[j] for j in planned}},
         "goal": goal,
         "obstacles": obstacles,
@@ -202,54 +210,26 @@ def import_moveit(
     return ImportedScene(document=document, meshes=meshes, ignored=tuple(ignored))
 
 
-def _root_link(tree: etree._ElementTree) -> str:
-    children = {
-        j.find("child").get("link") for j in tree.getroot().findall("joint") if j.find("child") is not None
-    }
-    roots = [
-        link.get("name", "") for link in tree.getroot().findall("link") if link.get("name") not in children
-    ]
-    return roots[0] if roots else ""
-
-
-def _allowed(scene: PlanningScene, links: set[str], objects: set[str]) -> list[list[str]]:
-    """The allowed-collision matrix's robot-link pairs; contact with an object is refused.
-
-    Entries of names that are neither links nor objects change nothing (as in MoveIt); the
-    caller lists them as ignored.
-    """
-    matrix = scene.allowed_collision_matrix
-    names = matrix.entry_names
-    if len(matrix.entry_values) != len(names) or any(len(row) != len(names) for row in matrix.entry_values):
-        raise MoveItImportError(
-            f"allowed_collision_matrix: {len(names)} names need a {len(names)} x {len(names)} matrix"
-        )
-    pairs = {
-        tuple(sorted((names[i], names[j])))
-        for i in range(len(names))
-        for j in range(i + 1, len(names))
-        if matrix.entry_values[i][j] or matrix.entry_values[j][i]
-    }
-    for name, value in zip(matrix.default_entry_names, matrix.default_entry_values, strict=False):
-        if value:
-            pairs |= {tuple(sorted((name, link))) for link in links if link != name}
-    touching = sorted(p for p in pairs if (p[0] in objects) != (p[1] in objects))
-    if touching:
-        raise MoveItImportError(
-            f"allowed_collision_matrix allows {list(touching[0])} to touch; "
-            "contact with an object is not supported"
-        )
-    return [list(p) for p in sorted(pairs) if p[0] in links and p[1] in links]
-
-
-def write_imported(imported: ImportedScene, out: Path) -> Path:
+def write_imported(
+    imported: ImportedScene,
+    out: Path,
+    inputs: Mapping[str, Path | None] | None = None,
+    source: str = "the converted scene",
+) -> Path:
     """Write the scene file ``out`` and its meshes (``<stem>_meshes/``), paths relative to ``out``.
 
     The scene is validated (:func:`~planning.io.scene_file.parse_scene`) before its file is
     written; if it is refused, the meshes written for it are removed and nothing is left.
 
+    Args:
+        imported: the converted problem.
+        out: the scene file to write.
+        inputs: the files the conversion read, by what they are: none may be overwritten.
+        source: what the scene was converted from, for a refusal's message.
+
     Raises:
-        SceneError: the converted scene is not a valid scene (a size beyond the allowed range, say).
+        OutputError: ``out`` or one of its meshes is one of ``inputs``.
+        SceneError: the converted scene is not a valid scene.
     """
     from planning.io.scene_file import parse_scene
 
@@ -274,16 +254,18 @@ def write_imported(imported: ImportedScene, out: Path) -> Path:
             obstacle = {**obstacle, "mesh": f"{mesh_folder}/{obstacle['mesh']}"}
         obstacles.append(obstacle)
     document["obstacles"] = obstacles
-    written = [
-        write_file(folder / mesh_folder / file, bytes(trimesh.exchange.stl.export_stl(mesh)))
-        for file, mesh in imported.meshes.items()
-    ]
+    check_not_inputs([out, *(folder / mesh_folder / file for file in imported.meshes)], inputs or {})
+    written: list[Path] = []
     try:
-        parse_scene(document, source=str(out), base=folder)
-    except Exception:
+        for file, mesh in imported.meshes.items():
+            written.append(
+                write_file(folder / mesh_folder / file, bytes(trimesh.exchange.stl.export_stl(mesh)))
+            )
+        parse_scene(document, source=source, base=folder)
+        return write_file(out, yaml.safe_dump(document, sort_keys=False, default_flow_style=None, width=100))
+    except BaseException:  # refused, unwritable or interrupted: no mesh is left without its scene
         for path in written:
             path.unlink(missing_ok=True)
-        if written and not any((folder / mesh_folder).iterdir()):
+        with contextlib.suppress(OSError):  # only if empty: a folder of the user's own stays
             (folder / mesh_folder).rmdir()
         raise
-    return write_file(out, yaml.safe_dump(document, sort_keys=False, default_flow_style=None, width=100))

@@ -1,10 +1,9 @@
 """MoveIt's ``PlanningScene`` and ``MotionPlanRequest`` messages as YAML, validated.
 
 The models list every field of the messages (ROS 1 Noetic and ROS 2), so that a misspelt
-or unknown key is refused by name. Poses take both YAML forms seen in the wild: lists
-(``position: [x, y, z]``, ``orientation: [x, y, z, w]``, as MotionBenchMaker writes) and
-mappings (``{x: .., y: .., z: ..}``, as ``rostopic echo`` writes). What the conversion does
-not support is refused there (:mod:`planning.io.moveit_import`), never dropped.
+or unknown key is refused by name; a number must be a number, a flag true or false. Poses
+and quaternions: :mod:`planning.io.moveit_poses`. What the conversion does not support is
+refused there (:mod:`planning.io.moveit_import`), never dropped.
 """
 
 from __future__ import annotations
@@ -12,36 +11,19 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated, Any, TypeVar
 
-import numpy as np
-import pinocchio as pin
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, Field, ValidationError
 
 from cpr_kin.user_files import load_yaml
 from planning.errors import PlanningError
+from planning.io.moveit_poses import (
+    Message,
+    Number,
+    Pose,
+    Quaternion,
+    Transform,
+    Vector3,
+)
 from planning.validation import describe_validation, model_within
-
-Number = Annotated[float, Field(allow_inf_nan=False)]
-
-
-def _vector(keys: str) -> Any:
-    """A list of numbers, also given as a mapping with the keys ``keys`` (``"xyz"``, ``"xyzw"``)."""
-
-    def as_list(value: Any) -> Any:
-        if isinstance(value, dict) and set(value) <= set(keys):
-            return [value.get(k, 0.0) for k in keys]
-        return value
-
-    return BeforeValidator(as_list)
-
-
-Vector3 = Annotated[list[Number], Field(min_length=3, max_length=3), _vector("xyz")]
-Quaternion = Annotated[list[Number], Field(min_length=4, max_length=4), _vector("xyzw")]
-
-
-class Message(BaseModel):
-    """A message: unknown keys refused, every field optional as in ROS (defaults: empty, zero)."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
 
 class Header(Message):
@@ -50,35 +32,6 @@ class Header(Message):
     seq: int = 0
     stamp: dict[str, Any] = Field(default_factory=dict)
     frame_id: str = ""
-
-
-class Pose(Message):
-    """``geometry_msgs/Pose``."""
-
-    position: Vector3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-    orientation: Quaternion = Field(default_factory=lambda: [0.0, 0.0, 0.0, 1.0])
-
-    def matrix(self) -> np.ndarray:
-        """The ``(4, 4)`` homogeneous transform [m]; the quaternion normalised."""
-        x, y, z, w = self.orientation
-        quaternion = pin.Quaternion(w, x, y, z)
-        if quaternion.norm() < 1e-9:
-            raise ValueError(f"orientation {self.orientation} is no rotation (its norm is 0)")
-        transform = np.eye(4)
-        transform[:3, :3] = quaternion.normalized().matrix()
-        transform[:3, 3] = self.position
-        return transform
-
-
-class Transform(Message):
-    """``geometry_msgs/Transform``."""
-
-    translation: Vector3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-    rotation: Quaternion = Field(default_factory=lambda: [0.0, 0.0, 0.0, 1.0])
-
-    def matrix(self) -> np.ndarray:
-        """The ``(4, 4)`` homogeneous transform [m]."""
-        return Pose(position=self.translation, orientation=self.rotation).matrix()
 
 
 class SolidPrimitive(Message):
@@ -273,10 +226,14 @@ class MoveItImportError(PlanningError):
 def read_message(path: Path, model: type[Model]) -> Model:
     """The message of the YAML file ``path``, validated by ``model``; errors name the file and field.
 
-    An unknown key lists the keys allowed in the (nested) message that holds it.
+    An unknown key lists the keys allowed in the (nested) message that holds it; a file that
+    holds nothing (empty, or only comments) is refused: it is not a message.
     """
-    data = load_yaml(Path(path), MAX_MESSAGE_BYTES, f"MoveIt {model.__name__} file")
+    what = f"MoveIt {model.__name__} file"
+    data = load_yaml(Path(path), MAX_MESSAGE_BYTES, what)
+    if data is None:
+        raise MoveItImportError(f"{what} '{path}' is empty; it must hold a {model.__name__} message")
     try:
-        return model.model_validate(data if data is not None else {})
+        return model.model_validate(data)
     except ValidationError as exc:
         raise MoveItImportError(f"{path}: {describe_validation(exc, model_within(model))}") from None

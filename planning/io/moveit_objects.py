@@ -14,6 +14,7 @@ prisms and operations other than ``ADD`` are refused, naming the object.
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from typing import Any
 
@@ -21,7 +22,10 @@ import numpy as np
 import pinocchio as pin
 import trimesh
 
-from planning.io.moveit_messages import CollisionObject, Mesh, MoveItImportError, Pose
+from cpr_kin.names import unprintable
+from cpr_kin.obstacles import MAX_COORDINATE_M, MAX_NAME_CHARS, SIZE_RANGE_M
+from planning.io.moveit_messages import CollisionObject, Mesh, MoveItImportError
+from planning.io.moveit_poses import Pose
 
 CONE_SIDES = 32
 """Sides of the pyramid that stands for a cone."""
@@ -57,6 +61,11 @@ def _kind(value: int | str, where: str) -> str:
     return kind
 
 
+def mesh_file(name: str) -> str:
+    """A file name for the mesh of obstacle ``name``: no folder, no hidden file (``../x`` is ``x``)."""
+    return (re.sub(r"[^A-Za-z0-9_.-]", "_", name).lstrip(".") or "mesh") + ".stl"
+
+
 def cone_mesh(height_m: float, radius_m: float) -> trimesh.Trimesh:
     """A pyramid of :data:`CONE_SIDES` sides around a cone of ``height_m`` and base ``radius_m``, centred."""
     circumscribed = radius_m / math.cos(math.pi / CONE_SIDES)
@@ -75,18 +84,25 @@ def _primitive(
         raise MoveItImportError(
             f"{where}: prisms are not supported (boxes, spheres, cylinders, cones, meshes)"
         )
+    meaning = "[x, y, z]" if kind == "box" else "[radius]" if kind == "sphere" else "[height, radius]"
     if len(dimensions) != needed[kind]:
         raise MoveItImportError(
-            f"{where}.dimensions = {dimensions}: a {kind} needs {needed[kind]} "
-            f"({'[x, y, z]' if kind == 'box' else '[radius]' if kind == 'sphere' else '[height, radius]'})"
+            f"{where}.dimensions = {dimensions}: a {kind} needs {needed[kind]} ({meaning})"
         )
+    low, high = SIZE_RANGE_M
+    for k, value in enumerate(dimensions):
+        if not low <= value <= high:
+            raise MoveItImportError(
+                f"{where}.dimensions[{k}] = {value!r}: a {kind}'s {meaning} must each be "
+                f"in [{low:g}, {high:g}] m"
+            )
     if kind == "box":
         return {"shape": "box", "size": list(dimensions)}
     if kind == "sphere":
         return {"shape": "sphere", "radius": dimensions[0]}
     if kind == "cylinder":
         return {"shape": "cylinder", "radius": dimensions[1], "length": dimensions[0]}
-    file = f"{name}.stl"
+    file = mesh_file(name)
     meshes[file] = cone_mesh(dimensions[0], dimensions[1])
     return {"shape": "mesh", "mesh": file, "convex": True}
 
@@ -99,7 +115,7 @@ def _mesh(mesh: Mesh, where: str, name: str, meshes: dict[str, trimesh.Trimesh])
             f"{where}: {len(faces)} triangles over {len(vertices)} vertices; "
             "a mesh needs triangles whose indices name its vertices"
         )
-    file = f"{name}.stl"
+    file = mesh_file(name)
     meshes[file] = trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
     return {"shape": "mesh", "mesh": file, "convex": True}
 
@@ -110,6 +126,11 @@ def convert_object(obj: CollisionObject, where: str, frame_in_base: np.ndarray) 
     Raises:
         MoveItImportError: an operation other than ADD, planes, a prism, a wrong dimension count.
     """
+    if not obj.id or len(obj.id) > MAX_NAME_CHARS - 4 or unprintable(obj.id) is not None:
+        raise MoveItImportError(
+            f"{where}.id must be 1-{MAX_NAME_CHARS - 4} printable characters: every object needs an id, "
+            "which names its obstacles"
+        )
     if obj.operation not in ADD_OPERATIONS:
         raise MoveItImportError(
             f"{where}.operation = {obj.operation!r}; only ADD (0) objects can be imported"
@@ -134,8 +155,14 @@ def convert_object(obj: CollisionObject, where: str, frame_in_base: np.ndarray) 
     for k, (mesh, pose) in enumerate(zip(obj.meshes, obj.mesh_poses, strict=True)):
         name = names[len(obj.primitives) + k]
         parts.append((_mesh(mesh, f"{where}.meshes[{k}]", name, meshes), pose))
-    obstacles = tuple(
-        {"name": name, **entry, **_placement(object_in_base @ pose.matrix())}
-        for name, (entry, pose) in zip(names, parts, strict=True)
-    )
-    return ConvertedObject(obstacles=obstacles, meshes=meshes)
+    obstacles = []
+    for k, (name, (entry, pose)) in enumerate(zip(names, parts, strict=True)):
+        placement = _placement(object_in_base @ pose.matrix())
+        if not max(map(abs, placement["xyz"])) <= MAX_COORDINATE_M:
+            part = f"primitives[{k}]" if k < len(obj.primitives) else f"meshes[{k - len(obj.primitives)}]"
+            raise MoveItImportError(
+                f"{where}.{part}: placed at {[round(v, 3) for v in placement['xyz']]} m in the robot's base "
+                f"frame; a scene's coordinates are within +-{MAX_COORDINATE_M:g} m"
+            )
+        obstacles.append({"name": name, **entry, **placement})
+    return ConvertedObject(obstacles=tuple(obstacles), meshes=meshes)

@@ -19,7 +19,7 @@ def joint_values(*states: RobotState) -> dict[str, float]:
     """The joint values of ``states``, a later state's over an earlier one's.
 
     Raises:
-        MoveItImportError: a joint state with more names than positions, or fewer.
+        MoveItImportError: a joint state with more names than positions, or fewer, or a name twice.
     """
     values: dict[str, float] = {}
     for state in states:
@@ -28,6 +28,9 @@ def joint_values(*states: RobotState) -> dict[str, float]:
             raise MoveItImportError(
                 f"joint_state has {len(joint_state.name)} names and {len(joint_state.position)} positions"
             )
+        twice = sorted({n for n in joint_state.name if joint_state.name.count(n) > 1})
+        if twice:
+            raise MoveItImportError(f"joint_state.name gives {twice} more than once; each joint once")
         values.update(zip(joint_state.name, joint_state.position, strict=True))
     return values
 

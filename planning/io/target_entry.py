@@ -15,7 +15,7 @@ from typing import Annotated, Any
 
 import numpy as np
 import pinocchio as pin
-from pydantic import Field, Tag, model_validator
+from pydantic import AfterValidator, Field, Tag, model_validator
 
 from planning.io.schema_types import (
     BY_KIND,
@@ -28,7 +28,14 @@ from planning.io.schema_types import (
     Turn,
     between,
 )
-from planning.pipeline.target import DEFAULT_TOLERANCE_M, DEFAULT_TOLERANCE_RAD, Target
+from planning.pipeline.target import (
+    DEFAULT_TOLERANCE_M,
+    DEFAULT_TOLERANCE_RAD,
+    TOLERANCE_M_RANGE,
+    TOLERANCE_RAD_RANGE,
+    Target,
+)
+from planning.validation import unit_quaternion
 
 JointValues = Annotated[list[Angle], Field(min_length=1, max_length=64)]
 JointMap = Annotated[dict[Name, Angle], Field(min_length=1, max_length=64)]
@@ -40,7 +47,12 @@ class PoseSpec(Strict):
 
     xyz: Point
     quat_xyzw: (
-        Annotated[list[Annotated[float, between(-1.0, 1.0)]], Field(min_length=4, max_length=4)] | None
+        Annotated[
+            list[Annotated[float, Field(allow_inf_nan=False)]],
+            Field(min_length=4, max_length=4),
+            AfterValidator(lambda xyzw: list(unit_quaternion(xyzw))),
+        ]
+        | None
     ) = None
     rpy: Turn | None = None
 
@@ -48,15 +60,13 @@ class PoseSpec(Strict):
     def _one_orientation(self) -> PoseSpec:
         if (self.quat_xyzw is None) == (self.rpy is None):
             raise ValueError("give exactly one of 'quat_xyzw' [x, y, z, w] or 'rpy' [roll, pitch, yaw] [rad]")
-        if self.quat_xyzw is not None and not np.linalg.norm(self.quat_xyzw) > 1e-6:
-            raise ValueError(f"quat_xyzw = {self.quat_xyzw} is no rotation (its norm is 0)")
         return self
 
     def rotation(self) -> np.ndarray:
         """The orientation as a rotation matrix."""
         if self.quat_xyzw is not None:
             x, y, z, w = self.quat_xyzw
-            return np.asarray(pin.Quaternion(w, x, y, z).normalized().matrix())
+            return np.asarray(pin.Quaternion(w, x, y, z).matrix())  # normalised (unit_quaternion)
         assert self.rpy is not None  # exactly one (validator)
         return np.asarray(pin.rpy.rpyToMatrix(*self.rpy))
 
@@ -69,8 +79,8 @@ class TargetSpec(Strict):
     pose: PoseSpec | None = None
     theta4: Angle = 0.0
     theta5: Angle = 0.0
-    tolerance_m: Annotated[float, between(1e-9, 0.1)] = DEFAULT_TOLERANCE_M
-    tolerance_rad: Annotated[float, between(1e-9, 0.5)] = DEFAULT_TOLERANCE_RAD
+    tolerance_m: Annotated[float, between(*TOLERANCE_M_RANGE)] = DEFAULT_TOLERANCE_M
+    tolerance_rad: Annotated[float, between(*TOLERANCE_RAD_RANGE)] = DEFAULT_TOLERANCE_RAD
 
     @model_validator(mode="after")
     def _one_of(self) -> TargetSpec:

@@ -30,6 +30,10 @@ DEFAULT_TOLERANCE_M = 1e-4
 """Largest position error of an IK solution unless a target says otherwise [m]."""
 DEFAULT_TOLERANCE_RAD = 1e-3
 """Largest orientation error of an IK solution unless a target says otherwise [rad]."""
+TOLERANCE_M_RANGE = (1e-9, 0.1)
+"""Position tolerances a target may give [m]."""
+TOLERANCE_RAD_RANGE = (1e-9, 0.5)
+"""Orientation tolerances a target may give [rad]."""
 SAME_Q_TOLERANCE = 1e-6
 """Largest difference in a joint [rad or m] at which a configuration meets a joint-vector target."""
 
