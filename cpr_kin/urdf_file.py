@@ -51,6 +51,10 @@ def parse_urdf(path: Path) -> etree._ElementTree:
         raise UrdfError(
             f"URDF file '{path}' has root element <{root.tag}>; a URDF's root is <robot name=...>"
         )
+    if root.find("link") is None and root.find("group") is not None:
+        raise UrdfError(
+            f"URDF file '{path}' holds <group>s and no <link>: it is an SRDF; give the robot's URDF"
+        )
     if root.find("link") is None:
         raise UrdfError(
             f"URDF file '{path}' has no <link>: an empty robot; a URDF "

@@ -398,3 +398,11 @@ def test_a_package_path_that_leaves_its_package_is_refused(tmp_path: Path, ups: 
         ),
     )
     assert ck.load_robot(inside).nq == 7
+
+
+def test_an_srdf_given_as_the_urdf_is_named_as_such() -> None:
+    srdf = ARMS["panda"][0].parents[1] / "srdf" / "panda.srdf"
+    with pytest.raises(
+        ck.UrdfError, match="holds <group>s and no <link>: it is an SRDF; give the robot's URDF"
+    ):
+        ck.load_robot(srdf)

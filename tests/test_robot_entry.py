@@ -164,6 +164,10 @@ def test_a_quaternion_is_normalised_within_the_stated_tolerance_and_refused_beyo
         ),
         ({"robot": {"urdf": "panda", "joints": []}}, "robot.joints: 0 items; needs at least 1"),
         ({"robot": 3}, "robot = 3: Input should be a valid string"),
+        (
+            {"robot": {"urdf": "panda", "fixed": {"panda_finger_joint1": float("nan")}}},
+            "robot.fixed.panda_finger_joint1 = nan: Input should be a finite number",
+        ),
         ({"start": {"q": [0.0, "x"]}}, "start.q[1] = 'x': Input should be a valid number"),
         (
             {"start": {"q": {"panda_joint1": "up"}}},

@@ -54,7 +54,7 @@ from planning.io.moveit_messages import (
     MoveItImportError,
     PlanningScene,
 )
-from planning.io.moveit_objects import convert_object
+from planning.io.moveit_objects import ConvertedObject, convert_object
 from planning.io.moveit_poses import Pose, zero_quaternions
 from planning.io.moveit_state import joint_values, position_ranges, within_ranges, wrapped
 from planning.io.moveit_support import refuse_unsupported
@@ -97,6 +97,43 @@ class ImportedScene:
     ignored: tuple[str, ...] = ()
 
 
+def convert_objects(scene: PlanningScene, frames: Frames) -> ConvertedObject:
+    """The obstacles of every collision object, in the base frame; each object's id becomes a frame.
+
+    Raises:
+        MoveItImportError: an id given twice, an object in a frame that moves or is unknown,
+            what :func:`~planning.io.moveit_objects.convert_object` refuses, more than
+            :data:`~planning.pipeline.scene.MAX_OBSTACLES` obstacles.
+    """
+    obstacles: list[dict[str, Any]] = []
+    meshes: dict[str, trimesh.Trimesh] = {}
+    ids: dict[str, int] = {}
+    for k, obj in enumerate(scene.world.collision_objects):
+        where = f"scene.world.collision_objects[{k}] ('{obj.id}')"
+        if obj.id in ids:
+            raise MoveItImportError(
+                f"{where}.id: collision_objects[{ids[obj.id]}] has the same id; ids must be unique"
+            )
+        ids[obj.id] = k
+        frame_in_base = frames.pose(obj.header.frame_id, f"{where}.header.frame_id")
+        converted = convert_object(obj, where, frame_in_base)
+        clash = sorted(set(converted.meshes) & set(meshes))
+        if clash:
+            raise MoveItImportError(
+                f"{where}: its mesh file {clash[0]} is another object's; rename the object"
+            )
+        obstacles += converted.obstacles
+        meshes.update(converted.meshes)
+        if obj.id not in frames.fixed:  # MoveIt names an object's frame by its id
+            frames.fixed[obj.id] = frame_in_base @ (obj.pose or Pose()).matrix()
+    if len(obstacles) > MAX_OBSTACLES:
+        raise MoveItImportError(
+            f"scene.world.collision_objects make {len(obstacles)} obstacles; "
+            f"a scene holds at most {MAX_OBSTACLES}"
+        )
+    return ConvertedObject(obstacles=tuple(obstacles), meshes=meshes)
+
+
 def import_moveit(
     scene: PlanningScene,
     request: MotionPlanRequest,
@@ -132,32 +169,8 @@ def import_moveit(
     if robot.srdf is not None:
         frames.add_virtual_joints(parse_srdf(robot.srdf))
     frames.add_transforms(scene.fixed_frame_transforms)
-    obstacles: list[dict[str, Any]] = []
-    meshes: dict[str, trimesh.Trimesh] = {}
-    ids: dict[str, int] = {}
-    for k, obj in enumerate(scene.world.collision_objects):
-        where = f"scene.world.collision_objects[{k}] ('{obj.id}')"
-        if obj.id in ids:
-            raise MoveItImportError(
-                f"{where}.id: collision_objects[{ids[obj.id]}] has the same id; ids must be unique"
-            )
-        ids[obj.id] = k
-        frame_in_base = frames.pose(obj.header.frame_id, f"{where}.header.frame_id")
-        converted = convert_object(obj, where, frame_in_base)
-        clash = sorted(set(converted.meshes) & set(meshes))
-        if clash:
-            raise MoveItImportError(
-                f"{where}: its mesh file {clash[0]} is another object's; rename the object"
-            )
-        obstacles += converted.obstacles
-        meshes.update(converted.meshes)
-        if obj.id and obj.id not in frames.fixed:  # MoveIt names an object's frame by its id
-            frames.fixed[obj.id] = frame_in_base @ (obj.pose or Pose()).matrix()
-    if len(obstacles) > MAX_OBSTACLES:
-        raise MoveItImportError(
-            f"scene.world.collision_objects make {len(obstacles)} obstacles; "
-            f"a scene holds at most {MAX_OBSTACLES}"
-        )
+    converted = convert_objects(scene, frames)
+    obstacles, meshes = list(converted.obstacles), converted.meshes
     if not obstacles:
         ignored.append("no collision objects in the PlanningScene: the scene has no obstacles")
     goal, tcp = goal_entry(request, planned, frames, ignored)

@@ -22,7 +22,7 @@ from pydantic import Field, Tag
 
 import cpr_kin as ck
 from cpr_kin.packages import EXAMPLE_ROBOTS, example_robot
-from planning.io.schema_types import BY_KIND, MAPPING_TAG, OTHER_TAG, FilePath, Name, Strict
+from planning.io.schema_types import BY_KIND, MAPPING_TAG, OTHER_TAG, Angle, FilePath, Name, Strict
 
 
 class RobotMapping(Strict):
@@ -34,7 +34,7 @@ class RobotMapping(Strict):
     limits: FilePath | None = None
     joints: Annotated[list[Name], Field(min_length=1, max_length=64)] | None = None
     tcp: Name | None = None
-    fixed: Annotated[dict[Name, float], Field(max_length=64)] = Field(default_factory=dict)
+    fixed: Annotated[dict[Name, Angle], Field(max_length=64)] = Field(default_factory=dict)
 
 
 RobotEntry = Annotated[
