@@ -139,6 +139,24 @@ def find_limits_file(
     return default
 
 
+def read_limits_file(path: Path) -> dict[Any, Any]:
+    """The mapping of a limits file, read safely; its entries are checked by :func:`read_dynamic_limits`.
+
+    Raises:
+        UrdfError: the file is unreadable, not YAML, or not a mapping of joint names.
+    """
+    try:
+        raw = load_yaml(path, MAX_LIMITS_BYTES, "joint limits file")
+    except UserFileError as exc:
+        raise UrdfError(str(exc)) from None
+    if not isinstance(raw, dict):
+        raise UrdfError(
+            f"joint limits file '{path}' must map joint names to limits ({{joint: {{acceleration: ..., "
+            f"jerk: ...}}}}), not {type(raw).__name__}"
+        )
+    return raw
+
+
 def read_dynamic_limits(
     path: Path | None,
     names: tuple[str, ...],
@@ -171,12 +189,7 @@ def read_dynamic_limits(
         _require_velocity(names, urdf_velocity, None, urdf)
         acc_default, jerk_default = default_limits(urdf_velocity)
         return DynamicLimits(acc_default, jerk_default, None, tuple(names))
-    try:
-        raw = load_yaml(path, MAX_LIMITS_BYTES, "joint limits file")
-    except UserFileError as exc:
-        raise UrdfError(str(exc)) from None
-    if not isinstance(raw, dict):
-        raise UrdfError(f"joint limits file '{path}' must map joint names to limits")
+    raw = read_limits_file(path)
     unknown = sorted(set(map(str, raw)) - set(names) - set(known))
     if unknown:
         listed = ", ".join(repr(n)[:40] for n in unknown[:3]) + (", ..." if len(unknown) > 3 else "")

@@ -682,3 +682,25 @@ def test_a_group_name_without_an_srdf_is_said(tmp_path: Path, capsys: pytest.Cap
     arguments = write(tmp_path, SCENE, REQUEST)[:-2]  # no --srdf
     assert main(["import-moveit", *arguments, "--out", str(tmp_path / "o.yaml")]) == 0
     assert "request.group_name 'arm' (no SRDF to look it up in): planned (" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        (["--safety-margin", "-1"], "--safety-margin = -1.0 m must be a number in [0, 1] m"),
+        (["--self-margin", "nan"], "--self-margin = nan m must be a number in [0, 1] m"),
+        (
+            ["--limits", str(PANDA)],
+            "must map joint names to limits ({joint: {acceleration: ..., jerk: ...}}), not str",
+        ),
+        (["--out-suffix", ".json"], "must end in .yaml or .yml: a scene file is YAML"),
+    ],
+)
+def test_bad_options_are_named_by_their_flag(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], options: list[str], message: str
+) -> None:
+    out = tmp_path / ("converted" + (options[1] if options[0] == "--out-suffix" else ".yaml"))
+    extra = [] if options[0] == "--out-suffix" else options
+    assert main(["import-moveit", *write(tmp_path, SCENE, REQUEST), *extra, "--out", str(out)]) == 2
+    error = capsys.readouterr().err
+    assert message in error and len(error.strip().splitlines()) == 1 and not out.exists()

@@ -8,6 +8,7 @@ import signal
 import stat
 import subprocess
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -173,3 +174,22 @@ def test_write_file_is_atomic_and_cleans_up_after_the_dead(
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.json"]
     with pytest.raises(OutputError, match="is a folder"):
         write_file(tmp_path, "x")
+
+
+def test_a_file_is_never_renamed_over_a_device_or_a_pipe(tmp_path: Path) -> None:
+    # as root, `--out /dev/null` replaced the device by a regular file: a FIFO stands for it here
+    fifo = tmp_path / "pipe.yaml"
+    os.mkfifo(fifo)
+    with pytest.raises(OutputError, match=r"is not a regular file \(a device, a pipe or a socket\)"):
+        write_file(fifo, "text\n")
+    assert stat.S_ISFIFO(fifo.lstat().st_mode) and sorted(p.name for p in tmp_path.iterdir()) == ["pipe.yaml"]
+
+
+def test_a_file_written_in_parts_that_fails_leaves_nothing(tmp_path: Path) -> None:
+    def parts() -> Iterator[str]:
+        yield "first part\n"
+        raise RuntimeError("the producer failed")
+
+    with pytest.raises(RuntimeError, match="the producer failed"):
+        write_file(tmp_path / "big.yaml", parts())
+    assert list(tmp_path.iterdir()) == []

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from cpr_kin.names import escaped
+from planning.errors import PlanningError
 from planning.outcome import EXIT_OK
 
 
@@ -12,7 +13,13 @@ def cmd_import_moveit(args: argparse.Namespace) -> int:
     """Convert ``args.scene`` and ``args.request`` into the scene file ``args.out``."""
     from planning.io.moveit_import import RobotFiles, import_moveit, write_imported
     from planning.io.moveit_messages import MotionPlanRequest, PlanningScene, read_message
+    from planning.pipeline.scene import MAX_SAFETY_MARGIN_M
+    from planning.validation import number_in
 
+    if args.out.suffix.lower() not in (".yaml", ".yml"):
+        raise PlanningError(f"--out '{args.out}' must end in .yaml or .yml: a scene file is YAML")
+    for flag, value in (("--safety-margin", args.safety_margin), ("--self-margin", args.self_margin)):
+        number_in(flag, value, 0.0, MAX_SAFETY_MARGIN_M, unit="m")
     scene = read_message(args.scene, PlanningScene)
     request = read_message(args.request, MotionPlanRequest)
     robot = RobotFiles(

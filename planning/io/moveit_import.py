@@ -40,12 +40,11 @@ import trimesh
 import yaml
 
 import cpr_kin as ck
-from cpr_kin.limits import MAX_LIMITS_BYTES
+from cpr_kin.limits import read_limits_file
 from cpr_kin.packages import check_package_dirs
 from cpr_kin.self_collision import parse_srdf
 from cpr_kin.srdf_groups import group_joints
 from cpr_kin.urdf_file import parse_urdf
-from cpr_kin.user_files import load_yaml
 from planning.io.moveit_frames import Frames
 from planning.io.moveit_goal import goal_entry
 from planning.io.moveit_matrix import allowed_pairs
@@ -154,8 +153,8 @@ def import_moveit(
     ]
     tree = parse_urdf(robot.urdf)
     check_package_dirs(robot.urdf, robot.package_dirs)
-    if robot.limits is not None:  # a file that is not there or not YAML is named now, not at planning
-        load_yaml(robot.limits, MAX_LIMITS_BYTES, "joint limits file")
+    if robot.limits is not None:  # a file that is not there, or no limits file, is named now
+        read_limits_file(robot.limits)
     planned = (
         group_joints(robot.srdf, request.group_name, tree).joints
         if robot.srdf is not None and request.group_name

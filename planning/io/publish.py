@@ -88,13 +88,16 @@ def write_file(path: str | Path, content: Content) -> Path:
     Temporary files that a killed writer left beside it are removed.
 
     Raises:
-        OutputError: ``path`` names a folder or no file, or cannot be written (naming it).
+        OutputError: ``path`` names a folder, a device, a pipe or no file, or cannot be written
+            (naming it).
     """
     path = Path(path)
     if not path.name or path.name in (".", ".."):
         raise OutputError(f"'{path}' names no file")
     if path.is_dir():
         raise OutputError(f"'{path}' is a folder; give a file name")
+    if path.exists() and not path.is_file():  # renamed over, /dev/null would become a file
+        raise OutputError(f"'{path}' is not a regular file (a device, a pipe or a socket); give a file name")
     prefix = f".{path.name}.tmp-"
     temporary = path.with_name(f"{prefix}{os.getpid()}-{os.urandom(4).hex()}")
     try:
