@@ -704,3 +704,9 @@ def test_bad_options_are_named_by_their_flag(
     assert main(["import-moveit", *write(tmp_path, SCENE, REQUEST), *extra, "--out", str(out)]) == 2
     error = capsys.readouterr().err
     assert message in error and len(error.strip().splitlines()) == 1 and not out.exists()
+
+
+def test_a_scene_of_another_robot_model_is_said(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    scene = {**SCENE, "robot_model_name": "ur5_robotiq85"}  # MoveIt warns and applies it
+    assert main(["import-moveit", *write(tmp_path, scene, REQUEST), "--out", str(tmp_path / "o.yaml")]) == 0
+    assert "scene.robot_model_name 'ur5_robotiq85' is not the URDF's robot 'panda'" in capsys.readouterr().out

@@ -152,6 +152,11 @@ def import_moveit(
         for where in zero_quaternions(scene, "scene") + zero_quaternions(request, "request")
     ]
     tree = parse_urdf(robot.urdf)
+    model_name = tree.getroot().get("name", "")
+    if scene.robot_model_name and scene.robot_model_name != model_name:  # MoveIt warns, and goes on
+        ignored.append(
+            f"scene.robot_model_name '{scene.robot_model_name}' is not the URDF's robot '{model_name}'"
+        )
     check_package_dirs(robot.urdf, robot.package_dirs)
     if robot.limits is not None:  # a file that is not there, or no limits file, is named now
         read_limits_file(robot.limits)
