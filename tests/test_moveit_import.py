@@ -456,16 +456,18 @@ def test_an_empty_file_is_refused_and_a_scene_without_objects_said(
     assert "PlanningScene file" in capsys.readouterr().err and not (tmp_path / "none.yaml").exists()
 
 
-@pytest.mark.parametrize("which", ["scene", "request", "urdf", "link"])
+@pytest.mark.parametrize("which", ["scene", "request", "limits", "symlink", "hardlink"])
 def test_an_output_that_is_an_input_is_refused_and_the_input_kept(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], which: str
 ) -> None:
     urdf = tmp_path / "panda.urdf"
     urdf.write_text(PANDA.read_text().replace("package://example-robot-data/robots/", f"{PANDA.parents[2]}/"))
-    arguments = write(tmp_path, SCENE, REQUEST)
+    (tmp_path / "limits.yaml").write_text("panda_joint1: {acceleration: 10, jerk: 100}\n")
+    arguments = [*write(tmp_path, SCENE, REQUEST), "--limits", str(tmp_path / "limits.yaml")]
     arguments[arguments.index("--urdf") + 1] = str(urdf)
-    (tmp_path / "link.yaml").symlink_to(tmp_path / "scene.yaml")
-    out = {"scene": "scene.yaml", "request": "request.yaml", "urdf": "panda.urdf", "link": "link.yaml"}[which]
+    (tmp_path / "symlink.yaml").symlink_to(tmp_path / "scene.yaml")  # the scene, by another name
+    (tmp_path / "hardlink.yaml").hardlink_to(urdf)  # the URDF, by another name
+    out = f"{which}.yaml"
     before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
     assert main(["import-moveit", *arguments, "--out", str(tmp_path / out)]) == 2
     assert "an input of this command" in capsys.readouterr().err
