@@ -23,6 +23,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import CprKinError
+from cpr_kin.names import unprintable
 from cpr_kin.obstacles import Obstacle
 
 if TYPE_CHECKING:
@@ -34,13 +35,15 @@ MAX_PAYLOAD_KG = 1000.0
 """Heaviest payload accepted [kg]: more than any serial arm's rated payload."""
 MAX_COM_OFFSET_M = 5.0
 """Farthest a payload's centre of mass may lie from its frame [m]."""
+PAYLOAD_NAME = "payload"
+"""What a payload is called unless it is given a name (its collision geometry's name)."""
 TORQUE_SCALE_RANGE = (1e-3, 1.0)
 """Allowed safety factors on the effort limits: the torque may use this share of them."""
 
 
 @dataclass(frozen=True)
 class Payload:
-    """A rigid load carried by the robot.
+    """A rigid load carried by the robot: an attached object, with its mass and its shape.
 
     Attributes:
         mass_kg: its mass [kg], in ``[0, MAX_PAYLOAD_KG]``.
@@ -49,8 +52,12 @@ class Payload:
             frame's axes [kg m^2]; ``None``: a point mass.
         frame: the frame it is attached to; ``None``: the robot's tool frame.
         shape: its collision shape, placed in the frame (an :class:`~cpr_kin.Obstacle`'s
-            box, sphere, cylinder or capsule; its name unused); ``None``: none, only its
-            mass counts (:func:`cpr_kin.carried.carrying` attaches it to the robot).
+            box, sphere, cylinder, capsule or mesh, a mesh by its convex hull; its name
+            unused); ``None``: none, only its mass counts (:func:`cpr_kin.carried.carrying`
+            attaches it to the robot).
+        touch_links: links of the robot the shape may touch (the fingers that hold it): no
+            self-clearance is required between them, as MoveIt's ``touch_links``.
+        name: what messages and reports call it (MoveIt's object id).
     """
 
     mass_kg: float
@@ -58,6 +65,8 @@ class Payload:
     inertia_kg_m2: tuple[tuple[float, float, float], ...] | None = None
     frame: str | None = None
     shape: Obstacle | None = None
+    touch_links: tuple[str, ...] = ()
+    name: str = PAYLOAD_NAME
 
     def __post_init__(self) -> None:
         mass = self.mass_kg
@@ -72,8 +81,11 @@ class Payload:
                 f"within {MAX_COM_OFFSET_M:g} m of its frame"
             )
         object.__setattr__(self, "com_in_frame_m", tuple(float(c) for c in com))
-        if self.shape is not None and self.shape.shape == "mesh":
-            raise CprKinError("payload shape must be a box, sphere, cylinder or capsule, not a mesh")
+        if isinstance(self.touch_links, str) or not all(isinstance(n, str) for n in self.touch_links):
+            raise CprKinError(f"payload touch_links = {self.touch_links!r} must be a sequence of link names")
+        object.__setattr__(self, "touch_links", tuple(self.touch_links))
+        if not isinstance(self.name, str) or not self.name or unprintable(self.name) is not None:
+            raise CprKinError(f"payload name = {self.name!r} must be printable text")
         if self.inertia_kg_m2 is not None:
             inertia = _checked_inertia(self.inertia_kg_m2)
             object.__setattr__(self, "inertia_kg_m2", tuple(tuple(float(v) for v in row) for row in inertia))

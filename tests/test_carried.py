@@ -80,7 +80,12 @@ def test_the_shape_round_trips_through_the_scene_file() -> None:
         (
             {"shape": "mesh", "mesh": "a.stl", "xyz": [0, 0, 0]},
             2,
-            "allowed: box, sphere, cylinder, capsule\n",
+            "payload: obstacle 'payload': mesh file",
+        ),
+        (
+            {"shape": "cone", "radius": 0.05, "xyz": [0, 0, 0]},
+            2,
+            "allowed: box, sphere, cylinder, capsule, mesh\n",
         ),
         (
             {"shape": "sphere", "radius": 0.05, "xyz": [0, 0, 0], "colour": 1},
@@ -98,3 +103,42 @@ def test_a_shape_in_the_arm_or_a_bad_shape_is_refused(
     err = capsys.readouterr().err
     assert message in err and err.count("\n") == 1, err
     assert not (tmp_path / "out").exists()
+
+
+def test_touch_links_are_left_out_of_the_shapes_self_pairs(robot: ck.Robot) -> None:
+    touching = ck.carrying(robot, ck.Payload(1.0, shape=BOX, touch_links=("arm_link",), name="part"))
+    added = touching.geometries[-1]
+    assert added.name == "part"
+    partners = {touching.geometries[a].link for a, b in touching.self_pairs if b == added.index}
+    assert partners == {"base_link", "column_link", "carriage_link"}
+    with pytest.raises(ck.CprKinError, match=r"touch_links \['hand'\] are not links of the robot; its links"):
+        ck.carrying(robot, ck.Payload(1.0, shape=BOX, touch_links=("hand",)))
+
+
+def test_a_shape_that_touches_a_touch_link_plans_and_passes_check(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the box reaching up into the arm is refused at the start (above); the arm may touch it
+    into_the_arm = {"shape": "box", "size": [0.08, 0.08, 0.2], "xyz": [0, 0, 0.1]}
+    payload = {"name": "rod", "mass_kg": 1.0, "shape": into_the_arm, "touch_links": ["arm_link"]}
+    scene = tmp_path / "scene.yaml"
+    scene.write_text(yaml.safe_dump({**SCENE, "payload": payload}))
+    assert main(["plan", str(scene), "--out", str(tmp_path / "out")]) == 0, capsys.readouterr().err
+    assert main(["check", str(scene), str(tmp_path / "out" / "trajectory.json")]) == 0
+    again = parse_scene(scene_document(parse_scene(yaml.safe_load(scene.read_text()))))
+    assert again.payload is not None and again.payload.touch_links == ("arm_link",)
+    assert again.payload.name == "rod"
+
+
+def test_a_mesh_shape_is_its_convex_hull(robot: ck.Robot, tmp_path: Path) -> None:
+    import trimesh
+
+    mesh = trimesh.creation.box(extents=(0.08, 0.08, 0.2))
+    mesh.export(tmp_path / "part.stl")
+    as_mesh = ck.Obstacle.from_mesh(tmp_path / "part.stl", (0.0, 0.0, -0.1), convex=False, name="part")
+    carried = ck.carrying(robot, ck.Payload(1.0, shape=as_mesh))
+    tcp = ck.frame_positions(carried, Q)
+    below = ck.Obstacle.sphere(0.05, tcp + np.array([0.0, 0.0, -0.3]), name="ball")
+    clearance = ck.CollisionWorld(carried, [below]).clearance(Q)  # as the box's (above)
+    assert clearance.closest is not None and clearance.closest.robot_geometry == PAYLOAD_GEOMETRY
+    assert clearance.min_clearance_m == pytest.approx(0.05, abs=1e-6)

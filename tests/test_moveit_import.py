@@ -7,6 +7,7 @@ MotionBenchMaker set (downloaded from PyPI, cached) is converted whole in the sl
 from __future__ import annotations
 
 import copy
+import json
 from pathlib import Path
 from typing import Any
 
@@ -280,7 +281,7 @@ REFUSALS = [
         "scene",
         "robot_state.attached_collision_objects",
         [{"link_name": "panda_hand"}],
-        "attached_collision_objects is not supported",
+        "robot_state.attached_collision_objects[0].object: required key is missing",
     ),
     ("scene", "world.collision_objects.0.planes", [{"coef": [0, 0, 1, 0]}], "planes are not supported"),
     ("scene", "world.collision_objects.0.operation", 1, "operation = 1; only ADD (0)"),
@@ -712,3 +713,107 @@ def test_a_scene_of_another_robot_model_is_said(tmp_path: Path, capsys: pytest.C
     scene = {**SCENE, "robot_model_name": "ur5_robotiq85"}  # MoveIt warns and applies it
     assert main(["import-moveit", *write(tmp_path, scene, REQUEST), "--out", str(tmp_path / "o.yaml")]) == 0
     assert "scene.robot_model_name 'ur5_robotiq85' is not the URDF's robot 'panda'" in capsys.readouterr().out
+
+
+PART: dict[str, Any] = {  # a part held between the Panda's fingers, sticking out below them
+    "link_name": "panda_hand",
+    "object": {
+        "id": "part",
+        "header": {"frame_id": "panda_hand"},
+        "primitives": [{"type": 1, "dimensions": [0.02, 0.02, 0.08]}],
+        "primitive_poses": [{"position": [0.0, 0.0, 0.12]}],
+    },
+    "touch_links": ["panda_leftfinger", "panda_rightfinger"],
+    "weight": 0.4,
+}
+
+
+def test_an_attached_object_becomes_the_payload_and_plans_certified(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = changed(SCENE, "robot_state.attached_collision_objects", [PART])
+    scene = changed(scene, "allowed_collision_matrix.entry_names", ["panda_link0", "panda_link7", "part"])
+    scene = changed(  # the matrix lets the part touch link 7 too: a touch link, as in MoveIt
+        scene,
+        "allowed_collision_matrix.entry_values",
+        [[False, False, False], [False, False, True], [False, True, False]],
+    )
+    out = tmp_path / "carry.yaml"
+    assert (
+        main(
+            ["import-moveit", *write(tmp_path, scene, REQUEST), "--safety-margin", "0.01", "--out", str(out)]
+        )
+        == 0
+    )
+    loaded = load_scene(out)
+    payload = loaded.payload
+    assert payload is not None and payload.shape is not None
+    assert (payload.name, payload.frame, payload.mass_kg) == ("part", "panda_hand", 0.4)
+    assert payload.touch_links == ("panda_leftfinger", "panda_link7", "panda_rightfinger")
+    np.testing.assert_allclose(payload.com_in_frame_m, [0.0, 0.0, 0.12])
+    np.testing.assert_allclose(np.asarray(payload.shape.size), [0.02, 0.02, 0.08])
+    np.testing.assert_allclose(payload.shape.xyz, [0.0, 0.0, 0.12])
+    plan = tmp_path / "plan"
+    assert main(["plan", str(out), "--out", str(plan)]) == 0, capsys.readouterr().err
+    assert main(["check", str(out), str(plan / "trajectory.json")]) == 0
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (
+            lambda part: [part, {**part, "object": {**part["object"], "id": "second"}}],
+            "2 attached objects ['part', 'second']; one is supported",
+        ),
+        (
+            lambda part: [{**part, "object": {**part["object"], "header": {"frame_id": "panda_link0"}}}],
+            "object.header.frame_id = 'panda_link0': give the attached object in its link's frame "
+            "'panda_hand'",
+        ),
+        (lambda part: [{**part, "link_name": "gripper"}], "link_name = 'gripper' is not a link of the URDF"),
+        (lambda part: [{**part, "weight": -1.0}], "weight = -1.0 kg must be in [0, 1000] kg"),
+        (
+            lambda part: [{**part, "touch_links": ["finger"]}],
+            "touch_links ['finger'] are not links of the URDF",
+        ),
+    ],
+)
+def test_an_attached_object_that_does_not_fit_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], change: Any, message: str
+) -> None:
+    unshared = json.loads(json.dumps(change(PART)))  # no YAML anchors for shared parts
+    scene = changed(SCENE, "robot_state.attached_collision_objects", unshared)
+    assert main(["import-moveit", *write(tmp_path, scene, REQUEST), "--out", str(tmp_path / "o.yaml")]) == 2
+    error = capsys.readouterr().err
+    assert "attached_collision_objects" in error and message in error and not (tmp_path / "o.yaml").exists()
+
+
+def test_an_attached_mesh_is_written_beside_the_scene_with_its_centroid_as_the_mass_centre(
+    tmp_path: Path,
+) -> None:
+    import trimesh
+
+    box = trimesh.creation.box(extents=(0.02, 0.02, 0.08))
+    box.apply_translation([0.0, 0.0, 0.04])  # its centroid 4 cm above the mesh's origin
+    mesh = {
+        "vertices": box.vertices.tolist(),
+        "triangles": [{"vertex_indices": f.tolist()} for f in box.faces],
+    }
+    part = copy.deepcopy(PART)
+    part["object"] = {"id": "part", "meshes": [mesh], "mesh_poses": [{"position": [0.0, 0.0, 0.08]}]}
+    out = tmp_path / "mesh.yaml"
+    assert (
+        main(
+            [
+                "import-moveit",
+                *write(tmp_path, changed(SCENE, "robot_state.attached_collision_objects", [part]), REQUEST),
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
+    assert yaml.safe_load(out.read_text())["payload"]["shape"]["mesh"] == "mesh_meshes/part.stl"
+    payload = load_scene(out).payload
+    assert payload is not None and payload.shape is not None and payload.shape.shape == "mesh"
+    np.testing.assert_allclose(payload.com_in_frame_m, [0.0, 0.0, 0.12], atol=1e-9)

@@ -11,8 +11,9 @@ from planning.outcome import EXIT_OK
 
 def cmd_import_moveit(args: argparse.Namespace) -> int:
     """Convert ``args.scene`` and ``args.request`` into the scene file ``args.out``."""
-    from planning.io.moveit_import import RobotFiles, import_moveit, write_imported
+    from planning.io.moveit_import import RobotFiles, import_moveit
     from planning.io.moveit_messages import MotionPlanRequest, PlanningScene, read_message
+    from planning.io.moveit_write import write_imported
     from planning.pipeline.scene import MAX_SAFETY_MARGIN_M
     from planning.validation import number_in
 

@@ -162,8 +162,9 @@ def import_problem(problem: Problem, out: Path) -> Path:
     Raises:
         MoveItImportError: what the conversion cannot represent; SceneError, cpr_kin.UrdfError.
     """
-    from planning.io.moveit_import import RobotFiles, import_moveit, write_imported
+    from planning.io.moveit_import import RobotFiles, import_moveit
     from planning.io.moveit_messages import MotionPlanRequest, PlanningScene, read_message
+    from planning.io.moveit_write import write_imported
 
     folder = vamp_resources(problem.robot)
     files = RobotFiles(urdf=folder / f"{problem.robot}.urdf", srdf=folder / f"{problem.robot}.srdf")

@@ -20,24 +20,23 @@
 - **Time:** ``allowed_planning_time`` (when > 0) becomes the planner's ``time_limit_s`` (at
   most :data:`~planning.pipeline.settings.MAX_TIME_LIMIT_S`).
 
-What would change the problem and has no counterpart (attached objects, path or trajectory
+- **Attached object:** the robot state's one attached collision object becomes the scene's
+  ``payload`` (:mod:`planning.io.moveit_attached`).
+
+What would change the problem and has no counterpart (path or trajectory
 constraints, an octomap, padding, velocity scaling other than 0 or 1, a robot base placed
 away from the world's origin, allowed contact with an object) is refused naming it; what only
 steers MoveIt's own planner (planner id, pipeline, attempts, workspace) is listed as ignored
-(:mod:`planning.io.moveit_support`). :func:`write_imported` never writes over an input file.
+(:mod:`planning.io.moveit_support`). :mod:`planning.io.moveit_write` writes the result.
 """
 
 from __future__ import annotations
 
-import contextlib
-import os
-from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import trimesh
-import yaml
 
 import cpr_kin as ck
 from cpr_kin.limits import read_limits_file
@@ -45,6 +44,7 @@ from cpr_kin.packages import check_package_dirs
 from cpr_kin.self_collision import parse_srdf
 from cpr_kin.srdf_groups import group_joints
 from cpr_kin.urdf_file import parse_urdf
+from planning.io.moveit_attached import attached_payload
 from planning.io.moveit_frames import Frames
 from planning.io.moveit_goal import goal_entry
 from planning.io.moveit_matrix import allowed_pairs
@@ -57,8 +57,6 @@ from planning.io.moveit_objects import ConvertedObject, convert_object
 from planning.io.moveit_poses import Pose, zero_quaternions
 from planning.io.moveit_state import joint_values, position_ranges, within_ranges, wrapped
 from planning.io.moveit_support import refuse_unsupported
-from planning.io.output_paths import check_not_inputs
-from planning.io.publish import write_file
 from planning.pipeline.scene import MAX_OBSTACLES
 from planning.pipeline.settings import MAX_TIME_LIMIT_S
 
@@ -85,7 +83,7 @@ class ImportedScene:
     """A converted MoveIt problem.
 
     Attributes:
-        document: the scene file's document (absolute paths; :func:`write_imported` makes
+        document: the scene file's document (absolute paths; :mod:`~planning.io.moveit_write` makes
             them relative to the file).
         meshes: mesh files the obstacles name, by file name.
         ignored: what the conversion left out or adjusted, each in a few words.
@@ -201,17 +199,18 @@ def import_moveit(
         ignored.append(f"start values of mimic joint(s) {following}: each follows the joint it mimics")
     links = {link.get("name", "") for link in tree.getroot().findall("link")}
     objects = {obj.id for obj in scene.world.collision_objects}
+    payload = attached_payload(scene, request, links, ignored)
+    clash = sorted(set(payload.meshes) & set(meshes))
+    if clash:
+        raise MoveItImportError(f"the attached object's mesh file {clash[0]} is a world object's; rename one")
+    meshes |= payload.meshes
     matrix = scene.allowed_collision_matrix
-    unknown = sorted((set(matrix.entry_names) | set(matrix.default_entry_names)) - links - objects)
+    attached = {payload.entry["name"]} if payload.entry else set()
+    unknown = sorted((set(matrix.entry_names) | set(matrix.default_entry_names)) - links - objects - attached)
     if unknown:
         ignored.append(f"allowed-collision entries of {unknown}, neither links of the URDF nor objects")
-    robot_entry: dict[str, Any] = {"urdf": str(robot.urdf), "joints": list(planned)}
-    robot_entry |= {"srdf": str(robot.srdf)} if robot.srdf else {}
-    robot_entry |= {"packages": [str(d) for d in robot.package_dirs]} if robot.package_dirs else {}
-    robot_entry |= {"limits": str(robot.limits)} if robot.limits else {}
-    robot_entry |= {"tcp": tcp} if tcp else {}
     held = {j: v for j, v in values.items() if j in movable - mimics and j not in planned}
-    robot_entry |= {"fixed": held} if held else {}
+    robot_entry = _robot_entry(robot, planned, tcp, held)
     document: dict[str, Any] = {
         "name": name,
         "robot": robot_entry,
@@ -222,67 +221,20 @@ def import_moveit(
         "goal": goal,
         "obstacles": obstacles,
     }
+    if payload.entry is not None:
+        document["payload"] = payload.entry
     if request.allowed_planning_time > 0:
         document["planner"] = {"time_limit_s": min(float(request.allowed_planning_time), MAX_TIME_LIMIT_S)}
     return ImportedScene(document=document, meshes=meshes, ignored=tuple(ignored))
 
 
-def write_imported(
-    imported: ImportedScene,
-    out: Path,
-    inputs: Mapping[str, Path | None] | None = None,
-    source: str = "the converted scene",
-) -> Path:
-    """Write the scene file ``out`` and its meshes (``<stem>_meshes/``), paths relative to ``out``.
-
-    The scene is validated (:func:`~planning.io.scene_file.parse_scene`) before its file is
-    written; if it is refused, the meshes written for it are removed and nothing is left.
-
-    Args:
-        imported: the converted problem.
-        out: the scene file to write.
-        inputs: the files the conversion read, by what they are: none may be overwritten.
-        source: what the scene was converted from, for a refusal's message.
-
-    Raises:
-        OutputError: ``out`` or one of its meshes is one of ``inputs``.
-        SceneError: the converted scene is not a valid scene.
-    """
-    from planning.io.scene_file import parse_scene
-
-    out = Path(out)
-    folder = out.parent.resolve()
-    document = dict(imported.document)
-
-    def relative(path: str) -> str:
-        return os.path.relpath(path, folder)
-
-    robot = dict(document["robot"])
-    for key in ("urdf", "srdf", "limits"):
-        if key in robot:
-            robot[key] = relative(robot[key])
-    if "packages" in robot:
-        robot["packages"] = [relative(p) for p in robot["packages"]]
-    document["robot"] = robot
-    mesh_folder = f"{out.stem}_meshes"
-    obstacles = []
-    for obstacle in document["obstacles"]:
-        if obstacle["shape"] == "mesh":
-            obstacle = {**obstacle, "mesh": f"{mesh_folder}/{obstacle['mesh']}"}
-        obstacles.append(obstacle)
-    document["obstacles"] = obstacles
-    check_not_inputs([out, *(folder / mesh_folder / file for file in imported.meshes)], inputs or {})
-    written: list[Path] = []
-    try:
-        for file, mesh in imported.meshes.items():
-            written.append(
-                write_file(folder / mesh_folder / file, bytes(trimesh.exchange.stl.export_stl(mesh)))
-            )
-        parse_scene(document, source=source, base=folder)
-        return write_file(out, yaml.safe_dump(document, sort_keys=False, default_flow_style=None, width=100))
-    except BaseException:  # refused, unwritable or interrupted: no mesh is left without its scene
-        for path in written:
-            path.unlink(missing_ok=True)
-        with contextlib.suppress(OSError):  # only if empty: a folder of the user's own stays
-            (folder / mesh_folder).rmdir()
-        raise
+def _robot_entry(
+    robot: RobotFiles, planned: tuple[str, ...], tcp: str | None, held: dict[str, float]
+) -> dict[str, Any]:
+    """The scene's ``robot:`` mapping, with absolute paths (made relative when written)."""
+    entry: dict[str, Any] = {"urdf": str(robot.urdf), "joints": list(planned)}
+    entry |= {"srdf": str(robot.srdf)} if robot.srdf else {}
+    entry |= {"packages": [str(d) for d in robot.package_dirs]} if robot.package_dirs else {}
+    entry |= {"limits": str(robot.limits)} if robot.limits else {}
+    entry |= {"tcp": tcp} if tcp else {}
+    return entry | ({"fixed": held} if held else {})

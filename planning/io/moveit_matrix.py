@@ -1,8 +1,9 @@
 """A MoveIt allowed-collision matrix as a scene file's ``allowed_collisions``: robot-link pairs.
 
 A pair is allowed when either of its two entries is ``true``; a default entry ``true`` allows
-its name with every link. Contact between a link and an object has no counterpart (the scene's
-obstacles are always checked) and is refused.
+its name with every link. Contact between a link and an object of the world has no
+counterpart (the scene's obstacles are always checked) and is refused; contact with the
+attached object is its ``touch_links`` (:func:`links_allowed_to_touch`).
 """
 
 from __future__ import annotations
@@ -10,12 +11,8 @@ from __future__ import annotations
 from planning.io.moveit_messages import AllowedCollisionMatrix, MoveItImportError
 
 
-def allowed_pairs(matrix: AllowedCollisionMatrix, links: set[str], objects: set[str]) -> list[list[str]]:
-    """The allowed-collision matrix's robot-link pairs; contact with an object is refused.
-
-    Entries of names that are neither links nor objects change nothing (as in MoveIt); the
-    caller lists them as ignored.
-    """
+def _pairs(matrix: AllowedCollisionMatrix, links: set[str]) -> set[tuple[str, str]]:
+    """Every pair of names the matrix allows to touch, sorted within the pair."""
     names = matrix.entry_names
     if len(matrix.entry_values) != len(names) or any(len(row) != len(names) for row in matrix.entry_values):
         raise MoveItImportError(
@@ -30,6 +27,16 @@ def allowed_pairs(matrix: AllowedCollisionMatrix, links: set[str], objects: set[
     for name, value in zip(matrix.default_entry_names, matrix.default_entry_values, strict=False):
         if value:
             pairs |= {tuple(sorted((name, link))) for link in links if link != name}
+    return {(a, b) for a, b in pairs}
+
+
+def allowed_pairs(matrix: AllowedCollisionMatrix, links: set[str], objects: set[str]) -> list[list[str]]:
+    """The allowed-collision matrix's robot-link pairs; contact with an object of ``objects`` is refused.
+
+    Entries of names that are neither links nor objects change nothing (as in MoveIt); the
+    caller lists them as ignored.
+    """
+    pairs = _pairs(matrix, links)
     touching = sorted(p for p in pairs if (p[0] in objects) != (p[1] in objects))
     if touching:
         raise MoveItImportError(
@@ -37,3 +44,8 @@ def allowed_pairs(matrix: AllowedCollisionMatrix, links: set[str], objects: set[
             "contact with an object is not supported"
         )
     return [list(p) for p in sorted(pairs) if p[0] in links and p[1] in links]
+
+
+def links_allowed_to_touch(matrix: AllowedCollisionMatrix, name: str, links: set[str]) -> set[str]:
+    """The links the matrix allows to touch ``name`` (an attached object's id)."""
+    return {a if b == name else b for a, b in _pairs(matrix, links) if name in (a, b)} & links

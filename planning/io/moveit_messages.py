@@ -93,12 +93,22 @@ class MultiDofJointState(Message):
     wrench: list[dict[str, Any]] = Field(default_factory=list)
 
 
+class AttachedCollisionObject(Message):
+    """``moveit_msgs/AttachedCollisionObject``."""
+
+    link_name: str
+    object: CollisionObject
+    touch_links: list[str] = Field(default_factory=list)
+    detach_posture: dict[str, Any] = Field(default_factory=dict)
+    weight: Number = 0.0
+
+
 class RobotState(Message):
     """``moveit_msgs/RobotState``."""
 
     joint_state: JointState = Field(default_factory=JointState)
     multi_dof_joint_state: MultiDofJointState = Field(default_factory=MultiDofJointState)
-    attached_collision_objects: list[dict[str, Any]] = Field(default_factory=list)
+    attached_collision_objects: list[AttachedCollisionObject] = Field(default_factory=list)
     is_diff: bool = False
 
 

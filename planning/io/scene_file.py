@@ -28,6 +28,7 @@ import yaml
 from pydantic import ValidationError
 
 import cpr_kin as ck
+from cpr_kin.dynamics import PAYLOAD_NAME
 from cpr_kin.user_files import UserFileError, load_yaml
 from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError, SceneError
@@ -192,13 +193,16 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
 
 def payload_to_dict(payload: ck.Payload) -> dict[str, Any]:
     """A payload in the scene file's form (docs/formats.md)."""
-    entry: dict[str, Any] = {"mass_kg": payload.mass_kg, "com_in_tcp": list(payload.com_in_frame_m)}
+    entry: dict[str, Any] = {} if payload.name == PAYLOAD_NAME else {"name": payload.name}
+    entry |= {"mass_kg": payload.mass_kg, "com_in_tcp": list(payload.com_in_frame_m)}
     if payload.inertia_kg_m2 is not None:
         entry["inertia"] = [list(row) for row in payload.inertia_kg_m2]
     if payload.frame is not None:
         entry["frame"] = payload.frame
     if payload.shape is not None:
         entry["shape"] = {k: v for k, v in obstacle_to_dict(payload.shape).items() if k != "name"}
+    if payload.touch_links:
+        entry["touch_links"] = list(payload.touch_links)
     return entry
 
 

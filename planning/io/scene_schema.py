@@ -15,7 +15,7 @@ import numpy as np
 from pydantic import AfterValidator, BaseModel, Field, ValidationError, model_validator
 
 import cpr_kin as ck
-from cpr_kin.dynamics import MAX_COM_OFFSET_M, MAX_PAYLOAD_KG, TORQUE_SCALE_RANGE
+from cpr_kin.dynamics import MAX_COM_OFFSET_M, MAX_PAYLOAD_KG, PAYLOAD_NAME, TORQUE_SCALE_RANGE
 from cpr_kin.obstacles import SCALE_RANGE
 from planning.io.robot_entry import RobotEntry, RobotMapping
 from planning.io.schema_types import (
@@ -163,14 +163,18 @@ class SplineSpec(Strict):
 
 
 Moment = Annotated[float, between(-1e3, 1e3)]
-PayloadShapeSpec = Annotated[BoxSpec | SphereSpec | CylinderSpec | CapsuleSpec, Field(discriminator="shape")]
-"""A payload's collision shape: an obstacle's box, sphere, cylinder or capsule, in its frame."""
+PayloadShapeSpec = Annotated[
+    BoxSpec | SphereSpec | CylinderSpec | CapsuleSpec | MeshSpec, Field(discriminator="shape")
+]
+"""A payload's collision shape: an obstacle's box, sphere, cylinder, capsule or mesh (its convex
+hull), in its frame."""
 
 
 class PayloadSpec(Strict):
-    """The ``payload:`` block; see :class:`cpr_kin.Payload`."""
+    """The ``payload:`` block, an attached object: its mass and its shape; see :class:`cpr_kin.Payload`."""
 
-    mass_kg: Annotated[float, between(0.0, MAX_PAYLOAD_KG)]
+    name: Name | None = None
+    mass_kg: Annotated[float, between(0.0, MAX_PAYLOAD_KG)] = 0.0
     com_in_tcp: Annotated[
         list[Annotated[float, between(-MAX_COM_OFFSET_M, MAX_COM_OFFSET_M)]],
         Field(min_length=3, max_length=3),
@@ -185,6 +189,7 @@ class PayloadSpec(Strict):
     ) = None
     frame: Name | None = None
     shape: PayloadShapeSpec | None = None
+    touch_links: Annotated[list[Name], Field(max_length=64)] = Field(default_factory=list)
 
     def payload(self, shape: ck.Obstacle | None) -> ck.Payload:
         """The :class:`cpr_kin.Payload` with ``shape`` built from :attr:`shape`.
@@ -201,6 +206,8 @@ class PayloadSpec(Strict):
             None if inertia is None else tuple(tuple(row) for row in inertia.tolist()),
             self.frame,
             shape,
+            tuple(self.touch_links),
+            self.name or PAYLOAD_NAME,
         )
 
 
