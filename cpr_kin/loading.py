@@ -45,14 +45,11 @@ from cpr_kin.resources import makers_limits_path
 from cpr_kin.robot import Robot, joint_units
 from cpr_kin.robot_options import check_not_one_name, check_options, check_tcp
 from cpr_kin.self_collision import SrdfPairs, find_srdf, read_srdf, self_pairs
-from cpr_kin.supported import check_joints, check_limits, check_names
+from cpr_kin.supported import check_limits, checked_urdf
 from cpr_kin.urdf_file import (
     collision_names,
-    is_bundled,
     massless_links,
-    parse_urdf,
     prepared_xml,
-    validate_urdf,
 )
 from cpr_kin.urdf_models import VisualModel, build_models, convex_hulls
 
@@ -106,11 +103,7 @@ class RobotSpec:
     def load(self) -> Robot:
         """The robot (module docstring)."""
         path = Path(self.urdf)
-        tree = parse_urdf(path)
-        if self.validate or (self.validate is None and not is_bundled(path)):
-            validate_urdf(path)
-        check_names(tree, path)
-        check_joints(tree, path)
+        tree = checked_urdf(path, self.validate)
         xml = prepared_xml(tree, path, package_roots(path, self.package_dirs))
         arm = arm_chain(tree)
         model, collision = build_models(xml, path)

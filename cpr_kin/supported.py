@@ -116,3 +116,23 @@ def check_limits(limits: JointLimits, units: Sequence[str], path: Path) -> None:
                 f"{acceleration:g} {unit}/s^2, jerk {jerk:g} {unit}/s^3; the planner supports at most "
                 f"{MAX_CROSSING_S:g} s: raise the limits"
             )
+
+
+def checked_urdf(path: Path, validate: bool | None = None) -> etree._ElementTree:
+    """The URDF at ``path`` parsed and checked as the loader checks it, before anything reads it.
+
+    Strict XML (:func:`~cpr_kin.urdf_file.parse_urdf`), yourdfpy's validation (unless
+    ``validate`` is ``False``, or ``None`` and the file is the bundled CPR's), printable
+    names and supported joints.
+
+    Raises:
+        UrdfError: naming the file and the first problem.
+    """
+    from cpr_kin.urdf_file import is_bundled, parse_urdf, validate_urdf
+
+    tree = parse_urdf(path)
+    if validate or (validate is None and not is_bundled(path)):
+        validate_urdf(path)
+    check_names(tree, path)
+    check_joints(tree, path)
+    return tree

@@ -14,6 +14,7 @@ import math
 import os
 import sys
 import tempfile
+import warnings
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
@@ -84,9 +85,11 @@ def validate_urdf(path: Path) -> None:
     import yourdfpy
 
     try:
-        urdf = yourdfpy.URDF.load(
-            str(path), build_scene_graph=False, load_meshes=False, load_collision_meshes=False
-        )
+        with warnings.catch_warnings():  # trimesh's arithmetic on a value that is then refused, by name
+            warnings.simplefilter("ignore", RuntimeWarning)
+            urdf = yourdfpy.URDF.load(
+                str(path), build_scene_graph=False, load_meshes=False, load_collision_meshes=False
+            )
     except Exception as exc:  # yourdfpy raises bare exceptions on structural problems
         raise UrdfError(f"URDF file '{path}' cannot be read ({type(exc).__name__}: {exc})") from None
     found: list[Any] = []

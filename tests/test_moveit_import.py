@@ -817,3 +817,21 @@ def test_an_attached_mesh_is_written_beside_the_scene_with_its_centroid_as_the_m
     payload = load_scene(out).payload
     assert payload is not None and payload.shape is not None and payload.shape.shape == "mesh"
     np.testing.assert_allclose(payload.com_in_frame_m, [0.0, 0.0, 0.12], atol=1e-9)
+
+
+def test_a_urdf_origin_that_is_not_three_numbers_is_named(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # read for the frames and ranges before the robot loads (the SRDF gives the joints): it was a
+    # ValueError, exit 4; the URDF is now checked as the loader checks it first
+    urdf = tmp_path / "panda.urdf"
+    urdf.write_text(
+        PANDA.read_text()
+        .replace("package://example-robot-data/robots/", f"{PANDA.parents[2]}/")
+        .replace('xyz="0 0 0.333"', 'xyz="0 0 zz"', 1)
+    )
+    arguments = write(tmp_path, SCENE, REQUEST)
+    arguments[arguments.index("--urdf") + 1] = str(urdf)
+    assert main(["import-moveit", *arguments, "--out", str(tmp_path / "o.yaml")]) == 2
+    error = capsys.readouterr().err
+    assert f"URDF file '{urdf}' cannot be read (ValueError: could not convert string to float: 'zz')" in error

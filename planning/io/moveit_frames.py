@@ -21,10 +21,25 @@ from planning.io.moveit_messages import MoveItImportError, TransformStamped
 
 
 def _origin(joint: etree._Element) -> np.ndarray:
-    """A URDF joint's ``<origin>``: its child link's frame in its parent link's."""
+    """A URDF joint's ``<origin>``: its child link's frame in its parent link's.
+
+    Raises:
+        MoveItImportError: an ``xyz`` or ``rpy`` that is not three finite numbers.
+    """
     origin = joint.find("origin")
-    xyz = [float(v) for v in (origin.get("xyz", "0 0 0") if origin is not None else "0 0 0").split()]
-    rpy = [float(v) for v in (origin.get("rpy", "0 0 0") if origin is not None else "0 0 0").split()]
+    values = {}
+    for key in ("xyz", "rpy"):
+        text = origin.get(key, "0 0 0") if origin is not None else "0 0 0"
+        try:
+            values[key] = [float(v) for v in text.split()]
+        except ValueError:
+            values[key] = []
+        if len(values[key]) != 3 or not np.all(np.isfinite(values[key])):
+            raise MoveItImportError(
+                f"URDF joint '{joint.get('name', '')}': <origin {key}=\"{cut(text, 40)}\"> "
+                "must be three numbers"
+            )
+    xyz, rpy = values["xyz"], values["rpy"]
     transform = np.eye(4)
     transform[:3, :3] = pin.rpy.rpyToMatrix(*rpy)
     transform[:3, 3] = xyz

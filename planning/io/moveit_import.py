@@ -43,7 +43,7 @@ from cpr_kin.limits import read_limits_file
 from cpr_kin.packages import check_package_dirs
 from cpr_kin.self_collision import parse_srdf
 from cpr_kin.srdf_groups import group_joints
-from cpr_kin.urdf_file import parse_urdf
+from cpr_kin.supported import checked_urdf
 from planning.io.moveit_attached import attached_payload
 from planning.io.moveit_frames import Frames
 from planning.io.moveit_goal import goal_entry
@@ -149,7 +149,7 @@ def import_moveit(
         f"{where} of all zeros read as the identity (as MoveIt does)"
         for where in zero_quaternions(scene, "scene") + zero_quaternions(request, "request")
     ]
-    tree = parse_urdf(robot.urdf)
+    tree = checked_urdf(robot.urdf)  # as the loader reads it: the frames and ranges are read below
     model_name = tree.getroot().get("name", "")
     if scene.robot_model_name and scene.robot_model_name != model_name:  # MoveIt warns, and goes on
         ignored.append(
