@@ -2,9 +2,9 @@
 
 A :class:`CollisionWorld` adds the obstacles to a copy of the robot's Pinocchio geometry
 model and registers robot-obstacle pairs only (the robot never tests itself). Distances are
-signed: negative values are penetration depths. The clearance of a group is the smallest
-distance between any of its geometries and any obstacle. Distances are accurate to about
-1e-6 of their size (coal's default GJK tolerance).
+signed: negative values are penetration depths (into a point cloud's voxels, at most a voxel's).
+The clearance of a group is the smallest distance between any of its geometries and any
+obstacle. Distances are accurate to about 1e-6 of their size (coal's GJK tolerance).
 """
 
 from __future__ import annotations
@@ -130,16 +130,18 @@ class CollisionWorld:
         pairs = []
         group_min = {g: float("inf") for g in GROUPS}
         for (g, k), result in zip(self._pairs, self._all.distanceResults, strict=True):
-            geometry = self.robot.geometries[g]
-            distance = float(result.min_distance)
+            geometry, distance = self.robot.geometries[g], float(result.min_distance)
+            near = [np.array(result.getNearestPoint1()), np.array(result.getNearestPoint2())]
+            if self.obstacles[k].shape == "voxels":  # coal gives an OcTree's point first, as o1 or o2
+                near.reverse()
             pairs.append(
                 PairDistance(
                     robot_geometry=geometry.name,
                     obstacle=self.obstacles[k].name,
                     group=geometry.group,
                     distance_m=distance,
-                    point_on_robot=np.array(result.getNearestPoint1()),
-                    point_on_obstacle=np.array(result.getNearestPoint2()),
+                    point_on_robot=near[0],
+                    point_on_obstacle=near[1],
                 )
             )
             group_min[geometry.group] = min(group_min[geometry.group], distance)
@@ -162,12 +164,10 @@ class CollisionWorld:
         """Clearance [m] of group ``GROUPS[group_index]`` at configurations ``q`` ``(N, nq)``, by coal.
 
         Also the index of the closest pair per configuration; ``inf`` and ``-1`` for a group
-        with no pair. coal's distance of the closest pair, as with every pair computed; the
-        pairs are visited in the order of their bounds and only those that may be closest
-        are computed (:func:`cpr_kin.closest_pairs.closest_pairs`). The bounds are the
-        group's columns of every pair's (each pair's bound is its own): the world builds
-        them once, for :meth:`clearance_lower_bounds` too, where a set of the group's own
-        would be built again in every world.
+        with no pair. coal's distance of the closest pair; the pairs are visited in the
+        order of their bounds and only those that may be closest are computed
+        (:func:`cpr_kin.closest_pairs.closest_pairs`). The bounds are the group's columns of
+        every pair's: the world builds them once, for :meth:`clearance_lower_bounds` too.
         """
         batch = self._check_batch(q)
         columns = self._pair_group == group_index

@@ -16,8 +16,8 @@ from cpr_kin.user_files import UserFileError, read_bytes
 
 FloatArray = NDArray[np.float64]
 
-Shape = Literal["box", "sphere", "cylinder", "capsule", "mesh"]
-SHAPES: tuple[str, ...] = ("box", "sphere", "cylinder", "capsule", "mesh")
+Shape = Literal["box", "sphere", "cylinder", "capsule", "mesh", "voxels"]
+SHAPES: tuple[str, ...] = ("box", "sphere", "cylinder", "capsule", "mesh", "voxels")
 """Supported obstacle shapes."""
 
 
@@ -88,7 +88,9 @@ class Obstacle:
     - ``capsule``: ``radius``, ``length`` of the axis segment (local z), centred;
     - ``mesh``: ``mesh`` file (any format trimesh reads), ``scale``; with ``convex = True``
       (the default) its convex hull is used, which gives a signed distance and errs on the
-      safe side; with ``convex = False`` the triangle surface, whose inside coal cannot see.
+      safe side; with ``convex = False`` the triangle surface, whose inside coal cannot see;
+    - ``voxels``: ``points``, the centres of the occupied cubes of side ``resolution`` (a
+      point cloud's, :mod:`cpr_kin.point_clouds`), in the obstacle's frame, a coal OcTree.
 
     Use the constructors :meth:`box`, :meth:`sphere`, :meth:`cylinder`, :meth:`capsule` and
     :meth:`from_mesh`; every value is validated on construction.
@@ -111,6 +113,8 @@ class Obstacle:
     mesh: Path | None = None
     scale: float = 1.0
     convex: bool = True
+    points: FloatArray | None = None
+    resolution: float | None = None
 
     def __post_init__(self) -> None:
         if self.shape not in SHAPES:
@@ -137,6 +141,11 @@ class Obstacle:
             object.__setattr__(self, "radius", _number(self.radius, f"{what} radius", *SIZE_RANGE_M, "m"))
         if self.shape in ("cylinder", "capsule"):
             object.__setattr__(self, "length", _number(self.length, f"{what} length", *SIZE_RANGE_M, "m"))
+        if self.shape == "voxels":
+            from cpr_kin.point_clouds import checked_voxels
+
+            object.__setattr__(self, "resolution", checked_voxels(self.points, self.resolution, what))
+            object.__setattr__(self, "points", np.array(self.points, dtype=float).reshape(-1, 3))
         if self.shape == "mesh":
             if self.mesh is None:
                 raise ObstacleError(f"{what}: a mesh obstacle needs a mesh file")
@@ -162,6 +171,8 @@ class Obstacle:
             None if self.mesh is None else str(self.mesh),
             self.scale,
             self.convex,
+            None if self.points is None else hash(np.asarray(self.points).tobytes()),
+            self.resolution,
         )
 
     def __eq__(self, other: object) -> bool:
@@ -252,47 +263,10 @@ class Obstacle:
             return coal.Cylinder(self.radius, self.length)
         if self.shape == "capsule":
             return coal.Capsule(self.radius, self.length)
-        return self._mesh_geometry()
+        if self.shape == "voxels":
+            from cpr_kin.point_clouds import voxel_geometry
 
-    def _mesh_geometry(self) -> Any:
-        import coal
-        import trimesh  # only needed for mesh obstacles
+            return voxel_geometry(np.asarray(self.points), float(self.resolution or 0.0))
+        from cpr_kin.mesh_geometry import mesh_geometry
 
-        what = f"obstacle '{self.name}': mesh '{Path(str(self.mesh)).name}'"
-        try:
-            mesh: Any = trimesh.load(str(self.mesh), force="mesh")
-        except Exception as exc:  # trimesh raises many types for unreadable files
-            raise ObstacleError(f"{what} cannot be read: {_shown(str(exc))}") from None
-        vertices = np.asarray(getattr(mesh, "vertices", np.empty((0, 3))), dtype=np.float64)
-        faces = np.asarray(getattr(mesh, "faces", np.empty((0, 3))), dtype=np.int64)
-        if len(faces) == 0:
-            raise ObstacleError(f"{what} has no triangles")
-        if len(vertices) > MAX_MESH_VERTICES:
-            raise ObstacleError(f"{what} has {len(vertices)} vertices; at most {MAX_MESH_VERTICES}")
-        if not np.all(np.isfinite(vertices)) or np.abs(vertices * self.scale).max() > MAX_COORDINATE_M:
-            raise ObstacleError(f"{what} has vertices that are not finite or beyond {MAX_COORDINATE_M:g} m")
-        if self.convex:
-            # the hull of a flat (or line-like) mesh has no volume: Qhull refuses it
-            spread = np.linalg.svd(vertices - vertices.mean(axis=0), compute_uv=False)
-            if len(vertices) < 4 or spread[-1] <= 1e-9 * max(spread[0], 1e-300):
-                raise ObstacleError(
-                    f"{what} is flat (its vertices span no volume), so it has no convex hull; "
-                    "give a solid mesh, or convex: false to use its surface"
-                )
-            try:
-                hull = mesh.convex_hull
-            except Exception as exc:  # Qhull's errors for degenerate input
-                raise ObstacleError(f"{what} has no convex hull: {_shown(str(exc))}") from None
-            vertices, faces = (
-                np.asarray(hull.vertices, dtype=np.float64),
-                np.asarray(hull.faces, dtype=np.int64),
-            )
-        bvh = coal.BVHModelOBBRSS()
-        bvh.beginModel(len(faces), len(vertices))
-        bvh.addVertices(vertices * self.scale)
-        bvh.addTriangles(faces)
-        bvh.endModel()
-        if self.convex:
-            bvh.buildConvexRepresentation(False)
-            return bvh.convex
-        return bvh
+        return mesh_geometry(self)

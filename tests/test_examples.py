@@ -17,6 +17,12 @@ EXPECTED = {
     "inspect_clearance.py": ["certified clearance 0.1", "the straight swing: accepted False"],
     "batch_a_folder.py": ["6/6 planned"],
     "bring_your_own_robot.py": ["tool 'panda_hand_tcp'", "goal met by forward kinematics: True"],
+    "plan_through_a_point_cloud.py": [
+        "blocks of voxels from 100000 points",
+        "primitives: ",
+        "point cloud: ",
+        "wrote out/examples/cloud/trajectory.json",
+    ],
     "check_a_trajectory.py": [
         "theirs.json: verified",
         "edited.json: FAILS: is not continuous (C3) at t = 1 s (knot 1): the position of joint 'd2' jumps",

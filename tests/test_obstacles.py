@@ -49,7 +49,7 @@ import cpr_kin as ck
         ),
         (
             lambda: ck.Obstacle(shape="cone", xyz=np.zeros(3)),  # type: ignore[arg-type]
-            r"unknown shape 'cone'; allowed: \['box', 'sphere', 'cylinder', 'capsule', 'mesh'\]",
+            r"unknown shape 'cone'; allowed: \['box', 'sphere', 'cylinder', 'capsule', 'mesh', 'voxels'\]",
         ),
         (
             lambda: ck.Obstacle.from_mesh("/no/such/file.stl", (0, 0, 0)),

@@ -29,6 +29,7 @@ from pydantic import ValidationError
 
 import cpr_kin as ck
 from cpr_kin.dynamics import PAYLOAD_NAME
+from cpr_kin.point_clouds import checked_points, read_points, voxel_obstacles
 from cpr_kin.user_files import UserFileError, load_yaml
 from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError, SceneError
@@ -39,12 +40,13 @@ from planning.io.scene_schema import (
     CapsuleSpec,
     CylinderSpec,
     MeshSpec,
+    PointCloudSpec,
     SceneSpec,
     SphereSpec,
     describe_errors,
 )
 from planning.io.target_entry import target_entry
-from planning.pipeline.scene import DEFAULT_SELF_MARGIN_M, Scene
+from planning.pipeline.scene import DEFAULT_SELF_MARGIN_M, MAX_OBSTACLES, Scene
 from planning.pipeline.settings import PlannerSettings
 
 MAX_SCENE_BYTES = 1_000_000
@@ -73,12 +75,21 @@ def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> S
     except ValidationError as exc:
         raise SceneError(f"{source}: {describe_errors(exc)}") from None
     base = base or Path.cwd()
-    obstacles = []
+    obstacles: list[ck.Obstacle] = []
     for index, item in enumerate(spec.obstacles):
         try:
-            obstacles.append(_obstacle(item, item.name or f"{item.shape}_{index}", base))
+            name = item.name or f"{item.shape}_{index}"
+            if isinstance(item, PointCloudSpec):
+                obstacles += cloud_obstacles(item, name, base)
+            else:
+                obstacles.append(_obstacle(item, name, base))
         except ck.CprKinError as exc:
             raise SceneError(f"{source}: obstacles[{index}]: {exc}") from None
+    if len(obstacles) > MAX_OBSTACLES:  # a cloud's blocks count
+        raise SceneError(
+            f"{source}: obstacles: {len(obstacles)}, point clouds' blocks included; at most {MAX_OBSTACLES}: "
+            "crop a point cloud to the robot's workspace, or give fewer obstacles"
+        )
     names = [o.name for o in obstacles]
     duplicated = sorted({n for n in names if names.count(n) > 1})
     if duplicated:
@@ -117,6 +128,19 @@ def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> S
         )
     except PlanningError as exc:
         raise SceneError(f"{source}: {exc}") from None
+
+
+def cloud_obstacles(item: PointCloudSpec, name: str, base: Path) -> list[ck.Obstacle]:
+    """A cloud's blocks of voxels (:func:`cpr_kin.point_clouds.voxel_obstacles`); a file relative to ``base``.
+
+    Raises:
+        cpr_kin.CprKinError: an unreadable file, bad points.
+    """
+    if item.file is not None:
+        points = read_points((base / item.file).resolve())
+    else:
+        points = checked_points(np.asarray(item.points, dtype=float), f"point cloud '{name}'")
+    return voxel_obstacles(points, item.resolution, name, item.xyz, item.rpy)
 
 
 def _obstacle(
@@ -166,6 +190,10 @@ def obstacle_to_dict(obstacle: ck.Obstacle) -> dict[str, Any]:
         entry["length"] = obstacle.length
     if obstacle.shape == "mesh":
         entry.update(mesh=str(obstacle.mesh), scale=obstacle.scale, convex=obstacle.convex)
+    if obstacle.shape == "voxels":  # the voxel centres: they read back as the same voxels
+        entry.update(
+            shape="point_cloud", points=np.asarray(obstacle.points).tolist(), resolution=obstacle.resolution
+        )
     entry.update(xyz=obstacle.xyz.tolist(), rpy=obstacle.rpy.tolist())
     return entry
 

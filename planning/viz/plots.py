@@ -79,18 +79,24 @@ def joint_figure(trajectory: Trajectory, joint_names: tuple[str, ...], units: tu
 
 
 def _box_faces(obstacle: ck.Obstacle, grow: float) -> list[FloatArray]:
-    half = (
-        (np.asarray(obstacle.size) / 2 + grow)
-        if obstacle.shape == "box"
-        else np.full(3, (obstacle.radius or 0.1) + grow)
-    )
-    if obstacle.shape in ("cylinder", "capsule"):
-        half[2] = (
-            (obstacle.length or 0.0) / 2
-            + grow
-            + ((obstacle.radius or 0.0) if obstacle.shape == "capsule" else 0.0)
+    """The six faces of the obstacle's bounding box grown by ``grow`` [m], in the world."""
+    if obstacle.shape == "voxels":  # the voxels' bounding box, about their own centre
+        points, half_side = np.asarray(obstacle.points), float(obstacle.resolution or 0.0) / 2 + grow
+        low, high = points.min(axis=0) - half_side, points.max(axis=0) + half_side
+    else:
+        half = (
+            (np.asarray(obstacle.size) / 2 + grow)
+            if obstacle.shape == "box"
+            else np.full(3, (obstacle.radius or 0.1) + grow)
         )
-    corners = np.array(list(itertools.product(*[(-h, h) for h in half])))
+        if obstacle.shape in ("cylinder", "capsule"):
+            half[2] = (
+                (obstacle.length or 0.0) / 2
+                + grow
+                + ((obstacle.radius or 0.0) if obstacle.shape == "capsule" else 0.0)
+            )
+        low, high = -half, half
+    corners = np.array(list(itertools.product(*zip(low, high, strict=True))))
     placement = obstacle.placement
     world = corners @ np.asarray(placement.rotation).T + np.asarray(placement.translation)
     faces = [[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5]]

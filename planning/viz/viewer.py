@@ -65,6 +65,9 @@ def _shape_objects(obstacle: ck.Obstacle, grow: float) -> list[tuple[Any, FloatA
     if obstacle.shape == "capsule":
         ends = [tf.translation_matrix([0, 0, s * length / 2]) for s in (-1, 1)]
         return [(g.Cylinder(length, radius), to_y), *[(g.Sphere(radius), end) for end in ends]]
+    if obstacle.shape == "voxels":
+        vertices, faces = _cubes(np.asarray(obstacle.points), float(obstacle.resolution or 0.0) / 2 + grow)
+        return [(g.TriangularMeshGeometry(vertices, faces), np.eye(4))]
     import trimesh
 
     mesh: Any = trimesh.load(str(obstacle.mesh), force="mesh")
@@ -72,6 +75,33 @@ def _shape_objects(obstacle: ck.Obstacle, grow: float) -> list[tuple[Any, FloatA
         mesh = mesh.convex_hull
     vertices = np.asarray(mesh.vertices) * obstacle.scale + grow * np.asarray(mesh.vertex_normals)
     return [(g.TriangularMeshGeometry(vertices, np.asarray(mesh.faces)), np.eye(4))]
+
+
+CUBE_CORNERS = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
+CUBE_FACES = np.array(
+    [
+        [0, 1, 3],
+        [0, 3, 2],
+        [4, 6, 7],
+        [4, 7, 5],
+        [0, 4, 5],
+        [0, 5, 1],
+        [2, 3, 7],
+        [2, 7, 6],
+        [0, 2, 6],
+        [0, 6, 4],
+        [1, 5, 7],
+        [1, 7, 3],
+    ]
+)
+"""A cube's eight corners (index: 4 x + 2 y + z of their signs) and its twelve triangles."""
+
+
+def _cubes(centres: FloatArray, half_m: float) -> tuple[FloatArray, NDArray[np.int64]]:
+    """One triangle mesh of the cubes of half side ``half_m`` about ``centres`` (a cloud's voxels)."""
+    vertices = (centres[:, None, :] + half_m * CUBE_CORNERS[None]).reshape(-1, 3)
+    faces = (CUBE_FACES[None] + 8 * np.arange(len(centres))[:, None, None]).reshape(-1, 3)
+    return vertices, faces
 
 
 def _clearance_colors(clearance: FloatArray, margin_m: float) -> FloatArray:
