@@ -15,6 +15,8 @@ paragraph separators (Zl, Zp).
 from __future__ import annotations
 
 import unicodedata
+from collections import Counter
+from collections.abc import Sequence
 
 UNPRINTABLE_CATEGORIES = frozenset({"Cc", "Cf", "Cs", "Co", "Cn", "Zl", "Zp"})
 """Unicode general categories that are never printed as they are."""
@@ -57,3 +59,9 @@ def escaped(text: str) -> str:
     return "".join(
         c if c == "\n" or not _unprintable(c) else c.encode("unicode_escape").decode("ascii") for c in text
     )
+
+
+def repeated(names: Sequence[str]) -> list[str]:
+    """The names that ``names`` gives more than once, sorted (a duplicate joint, obstacle, file)."""
+    counts = Counter(names)
+    return sorted(name for name, count in counts.items() if count > 1)

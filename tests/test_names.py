@@ -26,3 +26,10 @@ def test_escaped_shows_every_unprintable_character_and_keeps_the_rest() -> None:
     assert escaped("a\u202eb\x1bc\nd") == "a\\u202eb\\x1bc\nd"  # newlines stay: they separate lines
     for text in ("x\u202ey", "\x07bell", "a\u2066b\u2069"):
         assert unprintable(escaped(text)) is None
+
+
+def test_repeated_names_each_name_given_more_than_once_in_order() -> None:
+    from cpr_kin.names import repeated
+
+    assert repeated(["b", "a", "b", "c", "a", "b"]) == ["a", "b"]
+    assert repeated(["a", "b"]) == [] and repeated([]) == []

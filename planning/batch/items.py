@@ -34,7 +34,7 @@ from pathlib import Path
 from typing import Any, Protocol
 
 import cpr_kin as ck  # lazy (lazy_loader): its modules load in the workers, where they are used
-from cpr_kin.names import escaped
+from cpr_kin.names import escaped, repeated
 from planning.errors import PlanningError
 from planning.outcome import STATUS_EXIT, classify
 
@@ -151,7 +151,7 @@ def scene_files(folder: Path) -> list[Path]:
     if not files:
         raise PlanningError(f"scene folder '{folder}' holds no .yaml scene files")
     stems = [p.stem for p in files]
-    clashing = sorted({s for s in stems if stems.count(s) > 1})
+    clashing = repeated(stems)
     if clashing:
         raise PlanningError(f"scene files {clashing[:5]} share a stem (and so an output folder); rename one")
     return files

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from cpr_kin.names import repeated
 from planning.io.moveit_frames import Frames
 from planning.io.moveit_messages import MotionPlanRequest, MoveItImportError
 from planning.io.moveit_poses import rotation_matrix
@@ -32,8 +33,7 @@ def _joint_goal(request: MotionPlanRequest, planned: tuple[str, ...]) -> dict[st
     goal = request.goal_constraints[0]
     if goal.position_constraints or goal.orientation_constraints:
         raise MoveItImportError(f"{GOAL}: a goal of joint and pose constraints together is not supported")
-    names = [c.joint_name for c in goal.joint_constraints]
-    twice = sorted({n for n in names if names.count(n) > 1})
+    twice = repeated([c.joint_name for c in goal.joint_constraints])
     if twice:
         raise MoveItImportError(f"{GOAL}.joint_constraints constrain {twice} more than once; each joint once")
     values = {c.joint_name: c.position for c in goal.joint_constraints}

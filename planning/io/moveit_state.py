@@ -12,6 +12,7 @@ import math
 
 from lxml import etree
 
+from cpr_kin.names import repeated
 from planning.io.moveit_messages import MoveItImportError, RobotState
 
 
@@ -28,7 +29,7 @@ def joint_values(*states: RobotState) -> dict[str, float]:
             raise MoveItImportError(
                 f"joint_state has {len(joint_state.name)} names and {len(joint_state.position)} positions"
             )
-        twice = sorted({n for n in joint_state.name if joint_state.name.count(n) > 1})
+        twice = repeated(joint_state.name)
         if twice:
             raise MoveItImportError(f"joint_state.name gives {twice} more than once; each joint once")
         values.update(zip(joint_state.name, joint_state.position, strict=True))

@@ -29,6 +29,7 @@ from pydantic import ValidationError
 
 import cpr_kin as ck
 from cpr_kin.dynamics import PAYLOAD_NAME
+from cpr_kin.names import repeated
 from cpr_kin.point_clouds import checked_points, read_points, voxel_obstacles
 from cpr_kin.user_files import UserFileError, load_yaml
 from planning.curves.spline_settings import SplineSettings
@@ -91,7 +92,7 @@ def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> S
             "crop a point cloud to the robot's workspace, or give fewer obstacles"
         )
     names = [o.name for o in obstacles]
-    duplicated = sorted({n for n in names if names.count(n) > 1})
+    duplicated = repeated(names)
     if duplicated:
         raise SceneError(
             f"{source}: obstacles: names {duplicated} appear more than once; names must be unique"

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
+from cpr_kin.names import repeated
 from cpr_kin.user_files import UserFileError, read_bytes
 from planning.curves.continuity import discontinuity
 from planning.curves.hermite import ORDER
@@ -91,7 +92,7 @@ class TrajectoryFile:
 def _consistent(document: _Document) -> str | None:
     """The first inconsistency between knots, segments, coefficients and waypoints, if any."""
     knots, segments, joints = document.knots, document.segments, len(document.joint_names)
-    twice = sorted({n for n in document.joint_names if document.joint_names.count(n) > 1})
+    twice = repeated(document.joint_names)
     if twice:
         return f"joint_names = {document.joint_names} names {twice} more than once; each joint once"
     if len(segments) != len(knots) - 1:
