@@ -144,8 +144,9 @@ class Obstacle:
         if self.shape == "voxels":
             from cpr_kin.point_clouds import checked_voxels
 
-            object.__setattr__(self, "resolution", checked_voxels(self.points, self.resolution, what))
-            object.__setattr__(self, "points", np.array(self.points, dtype=float).reshape(-1, 3))
+            points, resolution = checked_voxels(self.points, self.resolution, what)
+            object.__setattr__(self, "points", points)
+            object.__setattr__(self, "resolution", resolution)
         if self.shape == "mesh":
             if self.mesh is None:
                 raise ObstacleError(f"{what}: a mesh obstacle needs a mesh file")

@@ -16,18 +16,18 @@ it is read whole.
 
 from __future__ import annotations
 
+import io
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import ObstacleError
 from cpr_kin.names import shown
-
-if TYPE_CHECKING:
-    from cpr_kin.obstacles import Obstacle
+from cpr_kin.obstacles import MAX_COORDINATE_M, Obstacle
+from cpr_kin.user_files import UserFileError, read_bytes
 
 FloatArray = NDArray[np.float64]
 
@@ -37,8 +37,6 @@ MAX_CLOUD_BYTES = 100_000_000
 """Largest point-cloud file [bytes]."""
 RESOLUTION_RANGE_M = (1e-3, 0.5)
 """Allowed voxel sides [m]."""
-MAX_COORDINATE_M = 100.0
-"""Largest |coordinate| of a point in its cloud's frame [m] (as an obstacle's centre)."""
 BLOCK_M = 0.25
 """Side of the blocks a cloud's voxels are split into, one obstacle each [m]."""
 SUFFIXES = (".npy", ".xyz", ".txt", ".ply", ".pcd")
@@ -69,8 +67,8 @@ def checked_points(values: ArrayLike, what: str) -> FloatArray:
     return points
 
 
-def checked_voxels(points: Any, resolution: Any, what: str) -> float:
-    """The voxel side of a ``voxels`` obstacle, its centres checked; raises :class:`ObstacleError`."""
+def checked_voxels(points: Any, resolution: Any, what: str) -> tuple[FloatArray, float]:
+    """A ``voxels`` obstacle's points (:func:`checked_points`) and side; raises :class:`ObstacleError`."""
     low, high = RESOLUTION_RANGE_M
     if (
         isinstance(resolution, bool)
@@ -82,8 +80,7 @@ def checked_voxels(points: Any, resolution: Any, what: str) -> float:
         )
     if points is None:
         raise ObstacleError(f"{what}: a voxels obstacle needs its points")
-    checked_points(points, what)
-    return float(resolution)
+    return checked_points(points, what), float(resolution)
 
 
 def voxel_centres(points: FloatArray, resolution_m: float) -> FloatArray:
@@ -95,10 +92,9 @@ def voxel_centres(points: FloatArray, resolution_m: float) -> FloatArray:
 def voxel_blocks(centres: FloatArray, block_m: float = BLOCK_M) -> list[FloatArray]:
     """The voxel centres grouped by the block of side ``block_m`` [m] that holds them, in block order."""
     blocks = np.floor(centres / block_m).astype(np.int64)
-    _, first, inverse = np.unique(blocks, axis=0, return_index=True, return_inverse=True)
+    _, inverse, counts = np.unique(blocks, axis=0, return_inverse=True, return_counts=True)
     order = np.argsort(inverse.ravel(), kind="stable")
-    bounds = np.cumsum(np.bincount(inverse.ravel(), minlength=len(first)))[:-1]
-    return [np.asarray(part) for part in np.split(centres[order], bounds)]
+    return [np.asarray(part) for part in np.split(centres[order], np.cumsum(counts)[:-1])]
 
 
 def voxel_obstacles(
@@ -121,10 +117,8 @@ def voxel_obstacles(
     Raises:
         ObstacleError: bad points, a resolution outside :data:`RESOLUTION_RANGE_M`.
     """
-    from cpr_kin.obstacles import Obstacle
-
-    checked_voxels(points, resolution_m, f"point cloud '{name}'")
-    blocks = voxel_blocks(voxel_centres(np.asarray(points, dtype=float), resolution_m))
+    checked, resolution_m = checked_voxels(points, resolution_m, f"point cloud '{name}'")
+    blocks = voxel_blocks(voxel_centres(checked, resolution_m))
     names = [name] if len(blocks) == 1 else [f"{name}.{k}" for k in range(len(blocks))]
     return [
         Obstacle(
@@ -156,12 +150,12 @@ def read_points(path: Path) -> FloatArray:
     what = f"point cloud '{path}'"
     if path.suffix.lower() not in SUFFIXES:
         raise ObstacleError(f"{what}: a point cloud is one of {list(SUFFIXES)}, not '{path.suffix}'")
-    if not path.is_file():
-        raise ObstacleError(f"{what} {'does not exist' if not path.exists() else 'is not a regular file'}")
-    if path.stat().st_size > MAX_CLOUD_BYTES:
-        raise ObstacleError(f"{what} has {path.stat().st_size} bytes; at most {MAX_CLOUD_BYTES}")
+    try:  # the same words as for every other file a user gives
+        data = read_bytes(path, MAX_CLOUD_BYTES, "point cloud")
+    except UserFileError as exc:
+        raise ObstacleError(str(exc)) from None
     try:
-        points = _read(path, path.suffix.lower())
+        points = _read(data, path, path.suffix.lower())
     except ObstacleError:
         raise
     except Exception as exc:  # numpy, trimesh and the parsers raise many kinds on a broken file
@@ -169,9 +163,10 @@ def read_points(path: Path) -> FloatArray:
     return checked_points(points, what)
 
 
-def _read(path: Path, suffix: str) -> FloatArray:
+def _read(data: bytes, path: Path, suffix: str) -> FloatArray:
+    """The points of the file ``path``'s bytes ``data``, by its ``suffix``."""
     if suffix == ".npy":
-        with path.open("rb") as stream:  # the header's shape, before any data is read
+        with io.BytesIO(data) as stream:  # the header's shape, before the array is made
             major, _ = np.lib.format.read_magic(stream)
             read_header = (
                 np.lib.format.read_array_header_1_0 if major == 1 else np.lib.format.read_array_header_2_0
@@ -182,20 +177,21 @@ def _read(path: Path, suffix: str) -> FloatArray:
                 f"point cloud '{path}' holds an array of shape {shape}; expected (N, 3), "
                 f"N at most {MAX_POINTS}"
             )
-        return np.asarray(np.load(path, allow_pickle=False), dtype=float)
+        return np.asarray(np.load(io.BytesIO(data), allow_pickle=False), dtype=float)
     if suffix in (".xyz", ".txt"):
-        return np.loadtxt(path, usecols=(0, 1, 2), ndmin=2, comments="#", max_rows=MAX_POINTS + 1)
+        lines = data.decode("utf-8").splitlines()
+        return np.loadtxt(lines, usecols=(0, 1, 2), ndmin=2, comments="#", max_rows=MAX_POINTS + 1)
     if suffix == ".ply":
         import trimesh
 
-        loaded: Any = trimesh.load(path)  # a PointCloud, or a Trimesh whose vertices are the points
+        # a PointCloud, or a Trimesh whose vertices are the points
+        loaded: Any = trimesh.load(io.BytesIO(data), file_type="ply")
         return np.array(loaded.vertices, dtype=np.float64)
-    return _read_pcd(path)
+    return _read_pcd(data, path)
 
 
-def _read_pcd(path: Path) -> FloatArray:
-    """The ``x y z`` of a PCD file, ASCII or binary (``binary_compressed`` refused)."""
-    data = path.read_bytes()
+def _read_pcd(data: bytes, path: Path) -> FloatArray:
+    """The ``x y z`` of a PCD file's bytes, ASCII or binary (``binary_compressed`` refused)."""
     header: dict[str, list[str]] = {}
     offset = 0
     while offset < len(data):

@@ -30,7 +30,7 @@ from pydantic import ValidationError
 import cpr_kin as ck
 from cpr_kin.dynamics import PAYLOAD_NAME
 from cpr_kin.names import repeated
-from cpr_kin.point_clouds import checked_points, read_points, voxel_obstacles
+from cpr_kin.point_clouds import read_points, voxel_obstacles
 from cpr_kin.user_files import UserFileError, load_yaml
 from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError, SceneError
@@ -137,11 +137,12 @@ def cloud_obstacles(item: PointCloudSpec, name: str, base: Path) -> list[ck.Obst
     Raises:
         cpr_kin.CprKinError: an unreadable file, bad points.
     """
-    if item.file is not None:
-        points = read_points((base / item.file).resolve())
-    else:
-        points = checked_points(np.asarray(item.points, dtype=float), f"point cloud '{name}'")
-    return voxel_obstacles(points, item.resolution, name, item.xyz, item.rpy)
+    points = (
+        np.asarray(item.points, dtype=float)
+        if item.file is None
+        else read_points((base / item.file).resolve())
+    )
+    return voxel_obstacles(points, item.resolution, name, item.xyz, item.rpy)  # the points checked there
 
 
 def _obstacle(
