@@ -11,6 +11,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cpr_kin.errors import CprKinError, UrdfError
+from cpr_kin.names import shown
 from cpr_kin.packages import installed
 from cpr_kin.user_files import UserFileError, load_yaml
 
@@ -223,9 +224,9 @@ def read_dynamic_limits(
         values: dict[str, Any] = {kind: entry.get(kind, defaults[kind]) for kind in _KINDS}
         for kind, value in values.items():
             if isinstance(value, bool) or not isinstance(value, int | float) or not 0 < value < math.inf:
-                shown = repr(value) if len(repr(value)) <= 40 else repr(value)[:37] + "..."
                 raise UrdfError(
-                    f"joint limits file '{path}': joint '{name}' {kind} = {shown} must be a finite number > 0"
+                    f"joint limits file '{path}': joint '{name}' {kind} = {shown(value)} "
+                    "must be a finite number > 0"
                 )
         acc[i], jerk[i], vel = float(values["acceleration"]), float(values["jerk"]), float(values["velocity"])
         if not np.isclose(vel, velocity[i]):

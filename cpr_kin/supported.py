@@ -31,6 +31,7 @@ from lxml import etree
 from cpr_kin.errors import UrdfError
 from cpr_kin.limits import JointLimits
 from cpr_kin.names import escaped, unprintable
+from cpr_kin.urdf_file import is_bundled, parse_urdf, validate_urdf
 
 SUPPORTED_TYPES = ("revolute", "prismatic", "continuous", "fixed")
 """Joint types the planner plans (``fixed`` joints join links rigidly)."""
@@ -128,8 +129,6 @@ def checked_urdf(path: Path, validate: bool | None = None) -> etree._ElementTree
     Raises:
         UrdfError: naming the file and the first problem.
     """
-    from cpr_kin.urdf_file import is_bundled, parse_urdf, validate_urdf
-
     tree = parse_urdf(path)
     if validate or (validate is None and not is_bundled(path)):
         validate_urdf(path)

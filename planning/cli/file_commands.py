@@ -78,6 +78,8 @@ def cmd_show(args: argparse.Namespace) -> int:
     from planning.io.trajectory_reader import read_trajectory
     from planning.viz import artifacts
 
+    if args.html is not None:
+        check_not_inputs([args.html], {"trajectory file": args.trajectory, "URDF": args.urdf})
     document = read_trajectory(args.trajectory)
     jump = discontinuity(document.trajectory, document.joint_names)
     if jump is not None:  # shown all the same: seeing it is what show is for
@@ -90,7 +92,6 @@ def cmd_show(args: argparse.Namespace) -> int:
         )
     world = ck.CollisionWorld(robot, scene.obstacles)
     if args.html is not None:
-        check_not_inputs([args.html], {"trajectory file": args.trajectory, "URDF": args.urdf})
         html = artifacts.viewer_html(
             world, scene.safety_margin, document.trajectory, document.waypoints, args.collision
         )

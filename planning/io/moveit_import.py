@@ -158,11 +158,11 @@ def import_moveit(
     check_package_dirs(robot.urdf, robot.package_dirs)
     if robot.limits is not None:  # a file that is not there, or no limits file, is named now
         read_limits_file(robot.limits)
-    planned = (
-        group_joints(robot.srdf, request.group_name, tree).joints
-        if robot.srdf is not None and request.group_name
-        else replace(ck.robot_spec(robot.urdf), package_dirs=robot.package_dirs).load().joint_names
-    )
+    if robot.srdf is not None and request.group_name:
+        planned = group_joints(robot.srdf, request.group_name, tree).joints
+    else:  # the URDF was checked above: not validated twice
+        spec = replace(ck.robot_spec(robot.urdf), package_dirs=robot.package_dirs, validate=False)
+        planned = spec.load().joint_names
     if request.group_name and robot.srdf is None:
         ignored.append(
             f"request.group_name '{request.group_name}' (no SRDF to look it up in): planned {planned}"
