@@ -106,34 +106,39 @@ def _yaml_float(value: float) -> str:
     return text.replace("e", ".0e", 1) if "e" in text and "." not in text else text
 
 
+def _in_chunks(texts: Iterator[str]) -> Iterator[str]:
+    """``texts`` joined :data:`CHUNK_POINTS` at a time: few writes, and never the whole file in memory."""
+    chunk: list[str] = []
+    for text in texts:
+        chunk.append(text)
+        if len(chunk) == CHUNK_POINTS:
+            yield "".join(chunk)
+            chunk = []
+    yield "".join(chunk)
+
+
+def _yaml_point(point: dict[str, Any]) -> str:
+    """One point as a YAML list item, block style with flow-style lists (as ``yaml.safe_dump`` writes it)."""
+    rows = [f"[{', '.join(map(_yaml_float, point[key]))}]" for key in POINT_KEYS]
+    stamp = point["time_from_start"]
+    return (
+        f"- positions: {rows[0]}\n  velocities: {rows[1]}\n  accelerations: {rows[2]}\n  effort: []\n"
+        f"  time_from_start: {{sec: {stamp['sec']}, nanosec: {stamp['nanosec']}}}\n"
+    )
+
+
 def _yaml_parts(header: dict[str, Any], points: Iterator[dict[str, Any]]) -> Iterator[str]:
-    """The document as YAML, in block style with flow-style lists (as ``yaml.safe_dump`` writes it)."""
+    """The document as YAML, as ``yaml.safe_dump`` would write it."""
     yield yaml.safe_dump(header, sort_keys=False, default_flow_style=None, width=1000)
     yield "points:\n"
-    lines = []
-    for point in points:
-        rows = [f"[{', '.join(map(_yaml_float, point[key]))}]" for key in POINT_KEYS]
-        stamp = point["time_from_start"]
-        lines.append(
-            f"- positions: {rows[0]}\n  velocities: {rows[1]}\n  accelerations: {rows[2]}\n  effort: []\n"
-            f"  time_from_start: {{sec: {stamp['sec']}, nanosec: {stamp['nanosec']}}}\n"
-        )
-        if len(lines) == CHUNK_POINTS:
-            yield "".join(lines)
-            lines = []
-    yield "".join(lines)
+    yield from _in_chunks(map(_yaml_point, points))
 
 
 def _json_parts(header: dict[str, Any], points: Iterator[dict[str, Any]]) -> Iterator[str]:
     """The document as JSON, one point a line."""
     yield json.dumps(header)[:-1] + ', "points": [\n'
-    lines = []
-    for k, point in enumerate(points):
-        lines.append(("" if k == 0 else ",\n") + json.dumps(point))
-        if len(lines) == CHUNK_POINTS:
-            yield "".join(lines)
-            lines = []
-    yield "".join(lines) + "\n]}\n"
+    yield from _in_chunks(("" if k == 0 else ",\n") + json.dumps(point) for k, point in enumerate(points))
+    yield "\n]}\n"
 
 
 def write_joint_trajectory(
