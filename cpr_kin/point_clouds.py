@@ -149,7 +149,10 @@ def read_points(path: Path) -> FloatArray:
     path = Path(path)
     what = f"point cloud '{path}'"
     if path.suffix.lower() not in SUFFIXES:
-        raise ObstacleError(f"{what}: a point cloud is one of {list(SUFFIXES)}, not '{path.suffix}'")
+        raise ObstacleError(
+            f"{what}: a point cloud is one of {list(SUFFIXES)} (or an OctoMap file, '.bt' or '.ot'), "
+            f"not '{path.suffix}'"
+        )
     try:  # the same words as for every other file a user gives
         data = read_bytes(path, MAX_CLOUD_BYTES, "point cloud")
     except UserFileError as exc:

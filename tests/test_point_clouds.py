@@ -143,10 +143,13 @@ def test_a_cloud_scene_plans_certified_and_reads_back_as_the_same_voxels(
             f"holds an array of shape (100000000, 3); expected (N, 3), N at most {MAX_POINTS}",
         ),
         ({"file": "none.npy"}, "none.npy' does not exist"),
-        ({"file": "a.las"}, "a point cloud is one of ['.npy', '.xyz', '.txt', '.ply', '.pcd'], not '.las'"),
+        (
+            {"file": "a.las"},
+            "a point cloud is one of ['.npy', '.xyz', '.txt', '.ply', '.pcd'] (or an OctoMap file",
+        ),
         (
             {"file": "c.npy", "points": [[0, 0, 0]]},
-            "give exactly one of 'file' (a point-cloud file) or 'points'",
+            "give exactly one of 'file' (a point-cloud or octree file) or 'points'",
         ),
     ],
 )

@@ -54,6 +54,7 @@ from planning.io.moveit_messages import (
     PlanningScene,
 )
 from planning.io.moveit_objects import ConvertedObject, convert_object
+from planning.io.moveit_octomap import convert_octomap
 from planning.io.moveit_poses import Pose, zero_quaternions
 from planning.io.moveit_state import joint_values, position_ranges, within_ranges, wrapped
 from planning.io.moveit_support import refuse_unsupported
@@ -87,11 +88,13 @@ class ImportedScene:
             them relative to the file).
         meshes: mesh files the obstacles name, by file name.
         ignored: what the conversion left out or adjusted, each in a few words.
+        files: other files the obstacles name (an octomap's), by file name.
     """
 
     document: dict[str, Any]
     meshes: dict[str, trimesh.Trimesh] = field(default_factory=dict)
     ignored: tuple[str, ...] = ()
+    files: dict[str, bytes] = field(default_factory=dict)
 
 
 def convert_objects(scene: PlanningScene, frames: Frames) -> ConvertedObject:
@@ -173,8 +176,11 @@ def import_moveit(
     frames.add_transforms(scene.fixed_frame_transforms)
     converted = convert_objects(scene, frames)
     obstacles, meshes = list(converted.obstacles), converted.meshes
+    octomap = convert_octomap(scene.world.octomap, frames, ignored)
+    if octomap is not None:
+        obstacles.append(octomap.entry)
     if not obstacles:
-        ignored.append("no collision objects in the PlanningScene: the scene has no obstacles")
+        ignored.append("no collision objects and no octomap in the PlanningScene: the scene has no obstacles")
     goal, tcp = goal_entry(request, planned, frames, ignored)
     joints = tree.getroot().findall("joint")
     movable = {j.get("name", "") for j in joints if j.get("type") != "fixed"}
@@ -225,7 +231,8 @@ def import_moveit(
         document["payload"] = payload.entry
     if request.allowed_planning_time > 0:
         document["planner"] = {"time_limit_s": min(float(request.allowed_planning_time), MAX_TIME_LIMIT_S)}
-    return ImportedScene(document=document, meshes=meshes, ignored=tuple(ignored))
+    files = {} if octomap is None else octomap.files
+    return ImportedScene(document=document, meshes=meshes, ignored=tuple(ignored), files=files)
 
 
 def _robot_entry(

@@ -129,11 +129,29 @@ class AllowedCollisionMatrix(Message):
     default_entry_values: list[bool] = Field(default_factory=list)
 
 
+class Octomap(Message):
+    """``octomap_msgs/Octomap``: ``data`` the tree's bytes (int8, or 0 to 255), ``binary`` their encoding."""
+
+    header: Header = Field(default_factory=Header)
+    binary: bool = False
+    id: str = ""
+    resolution: Number = 0.0
+    data: list[Annotated[int, Field(ge=-128, le=255)]] = Field(default_factory=list)
+
+
+class OctomapWithPose(Message):
+    """``octomap_msgs/OctomapWithPose``: the tree's frame at ``origin`` in ``header.frame_id``."""
+
+    header: Header = Field(default_factory=Header)
+    origin: Pose = Field(default_factory=Pose)
+    octomap: Octomap = Field(default_factory=Octomap)
+
+
 class PlanningSceneWorld(Message):
     """``moveit_msgs/PlanningSceneWorld``."""
 
     collision_objects: list[CollisionObject] = Field(default_factory=list)
-    octomap: dict[str, Any] = Field(default_factory=dict)
+    octomap: OctomapWithPose = Field(default_factory=OctomapWithPose)
 
 
 class PlanningScene(Message):

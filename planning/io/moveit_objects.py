@@ -47,7 +47,8 @@ class ConvertedObject:
     meshes: dict[str, trimesh.Trimesh]
 
 
-def _placement(transform: np.ndarray) -> dict[str, list[float]]:
+def placement(transform: np.ndarray) -> dict[str, list[float]]:
+    """``xyz`` [m] and ``rpy`` [rad] of a ``(4, 4)`` transform, as a scene file places a shape."""
     return {
         "xyz": [float(v) for v in transform[:3, 3]],
         "rpy": [float(v) for v in pin.rpy.matrixToRpy(transform[:3, :3])],
@@ -157,12 +158,12 @@ def convert_object(obj: CollisionObject, where: str, frame_in_base: np.ndarray) 
         parts.append((_mesh(mesh, f"{where}.meshes[{k}]", name, meshes), pose))
     obstacles = []
     for k, (name, (entry, pose)) in enumerate(zip(names, parts, strict=True)):
-        placement = _placement(object_in_base @ pose.matrix())
-        if not max(map(abs, placement["xyz"])) <= MAX_COORDINATE_M:
+        placed = placement(object_in_base @ pose.matrix())
+        if not max(map(abs, placed["xyz"])) <= MAX_COORDINATE_M:
             part = f"primitives[{k}]" if k < len(obj.primitives) else f"meshes[{k - len(obj.primitives)}]"
             raise MoveItImportError(
-                f"{where}.{part}: placed at {[round(v, 3) for v in placement['xyz']]} m in the robot's base "
+                f"{where}.{part}: placed at {[round(v, 3) for v in placed['xyz']]} m in the robot's base "
                 f"frame; a scene's coordinates are within +-{MAX_COORDINATE_M:g} m"
             )
-        obstacles.append({"name": name, **entry, **placement})
+        obstacles.append({"name": name, **entry, **placed})
     return ConvertedObject(obstacles=tuple(obstacles), meshes=meshes)

@@ -1,6 +1,6 @@
 """What of a MoveIt problem has no counterpart in a scene file: refused by name, or listed as ignored.
 
-Refused, because it would change the problem: an octomap, padding and
+Refused, because it would change the problem: padding and
 scaling of links, path and trajectory constraints, reference trajectories, velocity or
 acceleration scaling other than 0 or 1 (the full limits), a robot base placed away from the
 world's origin. Listed as ignored, because only MoveIt's own planner reads it: the planner id,
@@ -21,7 +21,6 @@ def refuse_unsupported(scene: PlanningScene, request: MotionPlanRequest) -> list
         MoveItImportError: naming the first field that would change the problem.
     """
     refusals = {
-        "scene.world.octomap": scene.world.octomap.get("octomap", {}).get("data"),
         "scene.link_padding": [p for p in scene.link_padding if p.get("padding", 0.0) != 0.0],
         "scene.link_scale": [s for s in scene.link_scale if s.get("scale", 1.0) != 1.0],
         "request.path_constraints": request.path_constraints != Constraints(),

@@ -1,6 +1,7 @@
 """Writing a converted MoveIt problem: the scene file and its meshes, all or nothing.
 
-The meshes go to ``<stem>_meshes/`` beside the scene file; every path is made relative to
+The meshes go to ``<stem>_meshes/`` beside the scene file, an octomap's tree to
+``<stem>_octomap.bt`` (or ``.ot``); every path is made relative to
 the scene file. Nothing is written over an input, and a scene that is refused or cannot be
 written leaves no mesh behind.
 """
@@ -61,14 +62,19 @@ def write_imported(
     mesh_folder = f"{out.stem}_meshes"
 
     def in_folder(shape: dict[str, Any]) -> dict[str, Any]:
+        if shape["shape"] == "point_cloud":  # an octomap's tree, beside the scene
+            return {**shape, "file": f"{out.stem}_{shape['file']}"}
         return {**shape, "mesh": f"{mesh_folder}/{shape['mesh']}"} if shape["shape"] == "mesh" else shape
 
     document["obstacles"] = [in_folder(obstacle) for obstacle in document["obstacles"]]
     if "payload" in document:
         document["payload"] = {**document["payload"], "shape": in_folder(document["payload"]["shape"])}
-    check_not_inputs([out, *(folder / mesh_folder / file for file in imported.meshes)], inputs or {})
+    others = {folder / f"{out.stem}_{file}": content for file, content in imported.files.items()}
+    check_not_inputs([out, *(folder / mesh_folder / file for file in imported.meshes), *others], inputs or {})
     written: list[Path] = []
     try:
+        for path, content in others.items():
+            written.append(write_file(path, content))
         for file, mesh in imported.meshes.items():
             written.append(
                 write_file(folder / mesh_folder / file, bytes(trimesh.exchange.stl.export_stl(mesh)))

@@ -20,6 +20,7 @@ no bound on the node deviation; ``spline``: p = 1e6, a = [0, 0, 1],
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -30,10 +31,10 @@ from pydantic import ValidationError
 import cpr_kin as ck
 from cpr_kin.dynamics import PAYLOAD_NAME
 from cpr_kin.names import repeated
-from cpr_kin.point_clouds import read_points, voxel_obstacles
 from cpr_kin.user_files import UserFileError, load_yaml
 from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError, SceneError
+from planning.io.cloud_entry import PointCloudSpec, RobotAtStart, cloud_obstacles
 from planning.io.publish import write_file
 from planning.io.robot_entry import robot_entry, robot_spec_of
 from planning.io.scene_schema import (
@@ -41,7 +42,6 @@ from planning.io.scene_schema import (
     CapsuleSpec,
     CylinderSpec,
     MeshSpec,
-    PointCloudSpec,
     SceneSpec,
     SphereSpec,
     describe_errors,
@@ -49,6 +49,7 @@ from planning.io.scene_schema import (
 from planning.io.target_entry import target_entry
 from planning.pipeline.scene import DEFAULT_SELF_MARGIN_M, MAX_OBSTACLES, Scene
 from planning.pipeline.settings import PlannerSettings
+from planning.pipeline.target import Target
 
 MAX_SCENE_BYTES = 1_000_000
 """Largest scene file [bytes]: the largest valid scene (500 obstacles) takes about 60 kB."""
@@ -76,12 +77,25 @@ def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> S
     except ValidationError as exc:
         raise SceneError(f"{source}: {describe_errors(exc)}") from None
     base = base or Path.cwd()
+    try:
+        robot = robot_spec_of(spec.robot, base)
+    except ck.CprKinError as exc:
+        raise SceneError(f"{source}: robot: {exc}") from None
+    try:
+        payload = None
+        if spec.payload is not None:
+            shape = spec.payload.shape
+            payload = spec.payload.payload(None if shape is None else _obstacle(shape, "payload", base))
+    except ck.CprKinError as exc:
+        raise SceneError(f"{source}: payload: {exc}") from None
+    start = spec.start.target()
+    at_start = _robot_at_start(spec, robot, payload, start, source)
     obstacles: list[ck.Obstacle] = []
     for index, item in enumerate(spec.obstacles):
         try:
             name = item.name or f"{item.shape}_{index}"
             if isinstance(item, PointCloudSpec):
-                obstacles += cloud_obstacles(item, name, base)
+                obstacles += cloud_obstacles(item, name, base, at_start)
             else:
                 obstacles.append(_obstacle(item, name, base))
         except ck.CprKinError as exc:
@@ -101,24 +115,13 @@ def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> S
     if planner["moving_joints"] is not None:
         planner["moving_joints"] = tuple(planner["moving_joints"])
     try:
-        robot = robot_spec_of(spec.robot, base)
-    except ck.CprKinError as exc:
-        raise SceneError(f"{source}: robot: {exc}") from None
-    try:
-        payload = None
-        if spec.payload is not None:
-            shape = spec.payload.shape
-            payload = spec.payload.payload(None if shape is None else _obstacle(shape, "payload", base))
-    except ck.CprKinError as exc:
-        raise SceneError(f"{source}: payload: {exc}") from None
-    try:
         return Scene(
             name=spec.name or source,
             robot=robot,
             safety_margin=spec.safety_margin,
             self_margin=spec.self_margin,
             allowed_collisions=tuple((a, b) for a, b in spec.allowed_collisions),
-            start=spec.start.target(),
+            start=start,
             goal=spec.goal.target(),
             duration=spec.duration,
             obstacles=tuple(obstacles),
@@ -131,18 +134,32 @@ def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> S
         raise SceneError(f"{source}: {exc}") from None
 
 
-def cloud_obstacles(item: PointCloudSpec, name: str, base: Path) -> list[ck.Obstacle]:
-    """A cloud's blocks of voxels (:func:`cpr_kin.point_clouds.voxel_obstacles`); a file relative to ``base``.
+def _robot_at_start(
+    spec: SceneSpec, robot: ck.RobotSpec | None, payload: ck.Payload | None, start: Target, source: str
+) -> RobotAtStart | None:
+    """The robot at the start if a point cloud filters it out, else ``None`` (nothing loaded).
 
     Raises:
-        cpr_kin.CprKinError: an unreadable file, bad points.
+        SceneError: the start is not joint values, or not the robot's.
     """
-    points = (
-        np.asarray(item.points, dtype=float)
-        if item.file is None
-        else read_points((base / item.file).resolve())
-    )
-    return voxel_obstacles(points, item.resolution, name, item.xyz, item.rpy)  # the points checked there
+    filtered = [i for i, o in enumerate(spec.obstacles) if isinstance(o, PointCloudSpec) and o.filter_robot]
+    if not filtered:
+        return None
+    if start.q is None:
+        given = "a tcp" if start.tcp is not None else "a pose"
+        raise SceneError(
+            f"{source}: obstacles[{filtered[0]}]: filter_robot needs the start as joint values "
+            f"('start: {{q: [...]}}'), where the robot stands in the cloud; the start is {given}"
+        )
+    try:
+        loaded = ck.carrying(ck.load_cpr() if robot is None else robot.load(), payload)
+    except ck.CprKinError as exc:
+        raise SceneError(f"{source}: robot: {exc}") from None
+    try:
+        q = loaded.configuration(dict(start.q) if isinstance(start.q, Mapping) else start.q)
+    except ck.CprKinError as exc:
+        raise SceneError(f"{source}: start: {exc}") from None
+    return RobotAtStart(loaded, q, spec.safety_margin)
 
 
 def _obstacle(

@@ -17,7 +17,7 @@ from pydantic import AfterValidator, BaseModel, Field, ValidationError, model_va
 import cpr_kin as ck
 from cpr_kin.dynamics import MAX_COM_OFFSET_M, MAX_PAYLOAD_KG, PAYLOAD_NAME, TORQUE_SCALE_RANGE
 from cpr_kin.obstacles import SCALE_RANGE
-from cpr_kin.point_clouds import MAX_POINTS, RESOLUTION_RANGE_M
+from planning.io.cloud_entry import PointCloudSpec
 from planning.io.robot_entry import RobotEntry, RobotMapping
 from planning.io.schema_types import (
     UNION_TAGS,
@@ -103,30 +103,6 @@ class MeshSpec(_Placed):
     mesh: FilePath
     scale: Annotated[float, between(*SCALE_RANGE)] = 1.0
     convex: bool = True
-
-
-class PointCloudSpec(Strict):
-    """``{shape: point_cloud, file: FILE | points: [[x, y, z], ...], resolution, xyz, rpy}``.
-
-    The points are in the cloud's frame, placed by ``xyz`` and ``rpy`` (default: the world's);
-    FILE relative to the scene (:mod:`cpr_kin.point_clouds`).
-    """
-
-    shape: Literal["point_cloud"]
-    name: Name | None = None
-    file: FilePath | None = None
-    points: Annotated[list[Point], Field(min_length=1, max_length=MAX_POINTS)] | None = None
-    resolution: Annotated[float, between(*RESOLUTION_RANGE_M)]
-    xyz: Point = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-    rpy: Turn = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-
-    @model_validator(mode="after")
-    def _one_source(self) -> PointCloudSpec:
-        if (self.file is None) == (self.points is None):
-            raise ValueError(
-                "give exactly one of 'file' (a point-cloud file) or 'points' ([[x, y, z], ...] [m])"
-            )
-        return self
 
 
 ObstacleSpec = Annotated[

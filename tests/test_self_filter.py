@@ -1,0 +1,149 @@
+"""The robot filtered out of a cloud: the voxels kept and left out, against coal on every voxel; scenes."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+import yaml
+
+import cpr_kin as ck
+from cpr_kin.point_clouds import voxel_centres
+from cpr_kin.self_filter import clear_of_robot
+from planning.cli import main
+
+Q = np.array([0.4, 0.25, 0.3, 0.5, -0.4])
+RESOLUTION_M = 0.02
+
+
+def robot_points(robot: ck.Robot, q: np.ndarray, count: int, seed: int) -> np.ndarray:
+    """Points inside the robot's collision shapes at ``q`` (drawn in each bounding box, kept by coal)."""
+    import coal
+
+    data, geometry_data = robot.model.createData(), robot.collision_model.createData()
+    pin.updateGeometryPlacements(robot.model, data, robot.collision_model, geometry_data, q)
+    rng = np.random.default_rng(seed)
+    points = []
+    for geometry in robot.geometries:
+        shape = robot.collision_model.geometryObjects[geometry.index].geometry
+        shape.computeLocalAABB()
+        drawn = rng.uniform(shape.aabb_local.min_, shape.aabb_local.max_, (count, 3))
+        dot = coal.Sphere(1e-9)
+        inside = [
+            p
+            for p in drawn
+            if coal.distance(
+                shape,
+                coal.Transform3s(),
+                dot,
+                coal.Transform3s(np.eye(3), p),
+                coal.DistanceRequest(),
+                coal.DistanceResult(),
+            )
+            < 0
+        ]
+        placement = geometry_data.oMg[geometry.index]
+        points.append(np.asarray(inside) @ placement.rotation.T + placement.translation)
+    return np.vstack(points)
+
+
+def test_the_voxels_kept_are_those_coal_finds_beyond_the_padding() -> None:
+    robot = ck.load_cpr()
+    rng = np.random.default_rng(3)
+    around = rng.uniform(-0.8, 0.8, (3000, 3)) + np.array([0.0, 0.0, 0.5])
+    centres = voxel_centres(np.vstack([around, robot_points(robot, Q, 300, seed=4)]), RESOLUTION_M)
+    cloud_in_world = pin.SE3(pin.rpy.rpyToMatrix(0.1, -0.2, 0.3), np.array([0.05, -0.02, 0.01]))
+    padding_m = 0.03
+    keep = clear_of_robot(robot, Q, centres, RESOLUTION_M, padding_m, cloud_in_world)
+    # the oracle: coal on every voxel and every shape, no bounding box to skip a query
+    import coal
+
+    data, geometry_data = robot.model.createData(), robot.collision_model.createData()
+    pin.updateGeometryPlacements(robot.model, data, robot.collision_model, geometry_data, Q)
+    voxel = coal.Box(RESOLUTION_M, RESOLUTION_M, RESOLUTION_M)
+    distance = np.array(
+        [
+            min(
+                coal.distance(
+                    robot.collision_model.geometryObjects[g.index].geometry,
+                    coal.Transform3s(
+                        geometry_data.oMg[g.index].rotation, geometry_data.oMg[g.index].translation
+                    ),
+                    voxel,
+                    coal.Transform3s(cloud_in_world.rotation, cloud_in_world.act(centre)),
+                    coal.DistanceRequest(),
+                    coal.DistanceResult(),
+                )
+                for g in robot.geometries
+            )
+            for centre in centres
+        ]
+    )
+    assert (~keep).sum() > 100 and keep.sum() > 1000  # both kinds are there
+    np.testing.assert_array_equal(keep, distance > padding_m)
+
+
+def test_a_negative_padding_is_refused() -> None:
+    with pytest.raises(ck.CprKinError, match=r"padding = -0.01 m must be a finite distance >= 0"):
+        clear_of_robot(ck.load_cpr(), Q, np.zeros((1, 3)), 0.01, -0.01)
+
+
+def scene_with_cloud(tmp_path: Path, cloud: dict[str, object], start: dict[str, object]) -> Path:
+    shelf = np.random.default_rng(5).uniform([0.4, 0.4, 0.0], [0.6, 0.6, 0.5], (2000, 3))
+    np.save(tmp_path / "camera.npy", np.vstack([shelf, robot_points(ck.load_cpr(), Q, 300, seed=6)]))
+    entry = {"name": "camera", "shape": "point_cloud", "file": "camera.npy", "resolution": 0.01, **cloud}
+    document = {
+        "start": start,
+        "goal": {"q": [-1.0, 0.3, 0.35, 0.0, 0.0]},
+        "safety_margin": 0.03,
+        "obstacles": [entry],
+    }
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(document))
+    return path
+
+
+@pytest.mark.slow
+def test_a_cloud_with_the_robot_in_it_plans_once_the_robot_is_filtered_out(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    start = {"q": Q.tolist()}
+    scene = scene_with_cloud(tmp_path, {}, start)
+    assert main(["plan", str(scene), "--out", str(tmp_path / "raw")]) == 2
+    assert "is inside the safety margin" in capsys.readouterr().err
+    scene = scene_with_cloud(tmp_path, {"filter_robot": True}, start)
+    assert main(["plan", str(scene), "--out", str(tmp_path / "out")]) == 0, capsys.readouterr().err
+    assert main(["check", str(scene), str(tmp_path / "out" / "trajectory.json")]) == 0
+
+
+@pytest.mark.parametrize(
+    ("cloud", "start", "message"),
+    [
+        (
+            {"filter_robot": True},
+            {"tcp": [0.5, 0.0, 0.3]},
+            "obstacles[0]: filter_robot needs the start as joint values ('start: {q: [...]}'), where the "
+            "robot stands in the cloud; the start is a tcp",
+        ),
+        ({"filter_padding": 0.02}, {"q": Q.tolist()}, "'filter_padding' goes with 'filter_robot: true'"),
+        (
+            {"filter_robot": True, "filter_padding": -0.1},
+            {"q": Q.tolist()},
+            "obstacles[0].filter_padding = -0.1",
+        ),
+    ],
+)
+def test_a_filter_that_cannot_work_is_refused_naming_it(
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    cloud: dict[str, object],
+    start: dict[str, object],
+    message: str,
+) -> None:
+    scene = scene_with_cloud(tmp_path, cloud, start)
+    assert main(["plan", str(scene), "--out", str(tmp_path / "out")]) == 2
+    error = capsys.readouterr().err
+    assert message in error and len(error.strip().splitlines()) == 1, error
+    assert not (tmp_path / "out").exists()
