@@ -451,7 +451,8 @@ def test_an_empty_file_is_refused_and_a_scene_without_objects_said(
 ) -> None:
     arguments = write(tmp_path, {"robot_state": SCENE["robot_state"]}, REQUEST)
     assert main(["import-moveit", *arguments, "--out", str(tmp_path / "free.yaml")]) == 0
-    assert "no collision objects and no octomap in the PlanningScene: the scene has no obstacles" in capsys.readouterr().out
+    said = "no collision objects and no octomap in the PlanningScene: the scene has no obstacles"
+    assert said in capsys.readouterr().out
     (tmp_path / "scene.yaml").write_text("# nothing\n")
     assert main(["import-moveit", *arguments, "--out", str(tmp_path / "none.yaml")]) == 2
     assert "PlanningScene file" in capsys.readouterr().err and not (tmp_path / "none.yaml").exists()
