@@ -1,7 +1,8 @@
-"""MotionBenchMaker: our planner beside OMPL's RRT-Connect pipeline, problem by problem, in one run.
+"""MotionBenchMaker: our planner beside a peer's RRT-Connect pipeline, problem by problem, in one run.
 
     python scripts/bench_mbm.py [--robots panda ur5] [--classes ...] [--limit N [--sample-seed S]]
                                 [--timeout S] [--out DIR] [--workers N] [--time-limit S]
+                                [--peer ompl|roboplan]
     python scripts/bench_mbm.py --scenes out/arms/ur3 out/arms/panda/*.yaml [--timeout S] [--out DIR]
 
 Each problem goes the way a user's does (``import-moveit``, :mod:`planning.io.moveit_import`,
@@ -11,19 +12,25 @@ margins 0 as in MoveIt), then, alternating, is planned warm by
   limit (``time_limit_s``, ``--time-limit``, default 0.8 of the timeout: what a user with that
   budget sets; the plan returns what it verified by then), in a worker process (robot loaded,
   kernels compiled) stopped after ``--timeout`` seconds;
-- OMPL RRT-Connect + simplification + TOPP-RA (:mod:`planning.peers.ompl_rrt`) on the same
-  collision model (obstacles and self pairs), 1 s per attempt, new seeds up to ``--timeout``.
+- the peer (``--peer``), on the same collision model (obstacles and self pairs): OMPL's
+  RRT-Connect + simplification + TOPP-RA through Python callbacks
+  (:mod:`planning.peers.ompl_rrt`), 1 s per attempt, new seeds up to ``--timeout`` (the
+  default); or roboplan's RRT-Connect + shortcutting + TOPP-RA, compiled
+  (:mod:`planning.peers.roboplan_rrt`), one search of up to ``--timeout``, whose path is then
+  checked, untimed, by our certified checks: the table counts the paths that fail them at the
+  scene's steps (as ``cpr-plan check``) and, in brackets, those that fail even at a tenth of
+  them (in contact, or within half a millimetre of it).
 
-Both are verified by the same certified checks. Printed per class: problems whose start and
-goal are valid in our model, solved by each, median and p95 warm planning time of each over
-the problems it solved and the ratio of those medians, then the ratio of the medians over the
-problems both solved (the same problems) and over every valid problem (a failure counted at
-the time it took, up to the timeout), ours' median duration over Ruckig's jerk-limited bound
-for the straight line, OMPL's median jerk over the limit, how many of OMPL's trajectories
-drive a joint's torque beyond its effort limit (RNEA every millisecond with the scene's
-payload, untimed; TOPP-RA's timing knows neither jerk nor torque limits, ours keeps both), and
-how many of ours pass ``cpr-plan check`` (the trajectory file read back and verified anew,
-untimed). Rows go to
+Printed per class: problems whose start and goal are valid in our model, solved by each,
+median and p95 warm planning time of each over the problems it solved and the ratio of those
+medians, then the ratio of the medians over the problems both solved (the same problems) and
+over every valid problem (a failure counted at the time it took, up to the timeout), each
+one's median duration over Ruckig's jerk-limited bound for the straight line, the peer's
+median jerk over the limit, how many of the peer's trajectories drive a joint's torque beyond
+its effort limit (RNEA every millisecond with the scene's payload, untimed; TOPP-RA's timing
+knows neither jerk nor torque limits, ours keeps both), how many of ours pass ``cpr-plan
+check`` (the trajectory file read back and verified anew, untimed), and how many of the
+peer's paths fail our checks (OMPL's are verified in its pipeline: none). Rows go to
 ``DIR/mbm.csv``, the table as markdown to ``DIR/mbm.md``. Needs the ``bench`` extra; the
 problems are downloaded once (:mod:`planning.io.mbm`).
 
@@ -54,9 +61,10 @@ import statistics
 import sys
 import tempfile
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from concurrent.futures import TimeoutError as FutureTimeout
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -174,15 +182,80 @@ def theirs(scene_path: str, timeout_s: float) -> dict[str, Any]:
             return {"ok": False, "time_s": time.perf_counter() - started, "why": str(exc)[:100]}
         if result.success:
             elapsed = time.perf_counter() - started
+            from planning.peers.ruckig_bound import free_space_bound
+            from planning.pipeline.problem import build_problem
+
             return {
                 "ok": True,
                 "time_s": elapsed,
                 "duration_s": result.duration,
+                "over_bound": result.duration / free_space_bound(build_problem(scene, robot)),
                 "jerk": result.jerk_over_limit,
                 "torque": torque_over_limit(scene, robot, result.timed, result.duration),
             }
         seed += 1
     return {"ok": False, "time_s": time.perf_counter() - started}
+
+
+_PEER_SCENES: dict[str, Any] = {}
+
+
+def warm_roboplan(scene_path: str) -> None:
+    """:func:`warm`, and roboplan's scene of the file with our collision model, built once (untimed)."""
+    from planning.peers.roboplan_rrt import RoboplanPeer
+
+    scene, robot = _robot(scene_path)
+    if scene_path not in _PEER_SCENES:
+        _PEER_SCENES.clear()  # one problem at a time
+        _PEER_SCENES[scene_path] = RoboplanPeer(scene, robot)
+
+
+def theirs_roboplan(scene_path: str, timeout_s: float) -> dict[str, Any]:
+    """Roboplan on one scene file, warm: RRT-Connect within ``timeout_s``, shortcutting, TOPP-RA.
+
+    Untimed after it: the duration over Ruckig's bound, the jerk and torques of its trajectory
+    (roboplan's samples, linearly interpolated), and our certified checks of its path.
+    """
+    from planning.peers.ruckig_bound import free_space_bound
+
+    scene, robot = _robot(scene_path)
+    peer = _PEER_SCENES[scene_path]
+    result = peer.plan(timeout_s, seed=0)
+    if not result.success:
+        return {"ok": False, "time_s": result.planning_time_s, "why": result.reason}
+    times, *values = result.samples
+
+    def timed(t: np.ndarray, order: int) -> np.ndarray:
+        return np.column_stack([np.interp(t, times, column) for column in values[order].T])
+
+    jerk = np.abs(np.diff(values[2], axis=0) / np.diff(times)[:, None]) / robot.limits.jerk
+    return {
+        "ok": True,
+        "time_s": result.planning_time_s,
+        "duration_s": result.duration_s,
+        "over_bound": result.duration_s / free_space_bound(peer.problem),
+        "jerk": float(jerk.max()) if len(jerk) else 0.0,
+        "torque": torque_over_limit(scene, robot, timed, result.duration_s),
+        "checked": result.certified,
+        "clear": result.certified_fine,
+    }
+
+
+@dataclass(frozen=True)
+class Peer:
+    """A peer planner of the benchmark: its name (the rows' prefix), label and worker functions."""
+
+    name: str
+    label: str
+    warm: Callable[[str], None]
+    run: Callable[[str, float], dict[str, Any]]
+
+
+PEERS = {
+    "ompl": Peer("ompl", "OMPL", warm_peer, theirs),
+    "roboplan": Peer("roboplan", "roboplan", warm_roboplan, theirs_roboplan),
+}
+"""The peers ``--peer`` chooses from: OMPL's RRT-Connect through Python callbacks, roboplan's in C++."""
 
 
 def torque_over_limit(scene: Any, robot: ck.Robot, timed: Any, duration_s: float) -> float:
@@ -203,10 +276,10 @@ def valid(scene_path: Path) -> str | None:
     return next(iter(endpoint_violations(scene, robot)), None)
 
 
-def summary(row: dict[str, Any]) -> str:
+def summary(row: dict[str, Any], peer: str) -> str:
     """One problem's outcome for the progress line."""
     ours_text = f"ours {row.get('ours_ok')} {row.get('ours_time_s', 0):.2f} s"
-    return f"{ours_text}, ompl {row.get('ompl_ok')} {row.get('ompl_time_s', 0):.2f} s"
+    return f"{ours_text}, {peer} {row.get(f'{peer}_ok')} {row.get(f'{peer}_time_s', 0):.2f} s"
 
 
 def percentile(values: list[float], q: float) -> float:
@@ -219,17 +292,17 @@ def median_ratio(mine: list[float], peer: list[float]) -> float:
 
 
 class Lane:
-    """One problem at a time: ours in a worker process (killed at the timeout), OMPL's in another."""
+    """One problem at a time: ours in a worker process (killed at the timeout), the peer's in another."""
 
-    def __init__(self, context: Any, threads: int | None = None) -> None:
-        self.context, self.threads = context, threads
+    def __init__(self, context: Any, peer: Peer, threads: int | None = None) -> None:
+        self.context, self.peer, self.threads = context, peer, threads
         self.ours, self.theirs = self._pool(), self._pool()
 
     def _pool(self) -> ProcessPoolExecutor:
         return ProcessPoolExecutor(1, mp_context=self.context)
 
     def run(self, path: Path, timeout_s: float, time_limit_s: float) -> dict[str, Any]:
-        """Both planners on the scene file ``path``, warm: the row's ``ours_*`` and ``ompl_*`` values."""
+        """Both planners on the scene file ``path``, warm: the row's ``ours_*`` and peer's values."""
         row: dict[str, Any] = {}
         self.ours.submit(warm, str(path)).result()  # loaded once per robot and process, untimed
         future = self.ours.submit(ours, str(path), time_limit_s, self.threads)
@@ -243,8 +316,9 @@ class Lane:
             row |= {"ours_ok": False, "ours_time_s": timeout_s, "ours_why": "timeout"}
             self._kill(self.ours)
             self.ours = self._pool()
-        self.theirs.submit(warm_peer, str(path)).result()
-        row |= {f"ompl_{k}": v for k, v in self.theirs.submit(theirs, str(path), timeout_s).result().items()}
+        self.theirs.submit(self.peer.warm, str(path)).result()
+        found = self.theirs.submit(self.peer.run, str(path), timeout_s).result()
+        row |= {f"{self.peer.name}_{k}": v for k, v in found.items()}
         return row
 
     def close(self) -> None:
@@ -280,6 +354,60 @@ def scene_paths(given: list[Path]) -> list[Path]:
     return [found for path in given for found in (scene_files(path) if path.is_dir() else [path])]
 
 
+def table(rows: list[dict[str, Any]], peer: Peer) -> list[str]:
+    """The markdown table of ``rows`` per robot and class (module docstring); each row printed too."""
+    name, label = peer.name, peer.label
+    print(f"\n{'robot':6s} {'class':17s} {'valid':>5s} {'ours':>4s} {name[:8]:>8s}", end="")
+    print(f"  {'ours med/p95 s':>15s}  {'peer med/p95 s':>15s}  ratio  both   all  dur/bound", end="")
+    print("  peer dur/bound  jerk/lim  >effort  checked  peer failing (touching)")
+    lines = [
+        f"| robot | class | valid | solved ours | solved {label} | ours median (p95) [s] "
+        f"| {label} median (p95) [s] | ratio | ratio, both solved | ratio, all "
+        f"| ours duration / Ruckig bound | {label} duration / Ruckig bound | {label} jerk / limit "
+        f"| {label} beyond an effort limit | ours passing `check` "
+        f"| {label} paths failing `check` (touching) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for robot_name in dict.fromkeys(r["robot"] for r in rows):
+        for problem_class in [*dict.fromkeys(r["class"] for r in rows if r["robot"] == robot_name), "all"]:
+            group = [r for r in rows if r["robot"] == robot_name and problem_class in ("all", r["class"])]
+            group = [r for r in group if not r["invalid"]]
+            if not group:
+                continue
+            solved = [r for r in group if r.get(f"{name}_ok")]
+            mine = [r["ours_time_s"] for r in group if r.get("ours_ok")]
+            theirs_s = [r[f"{name}_time_s"] for r in solved]
+            bounds = [r["ours_over_bound"] for r in group if r.get("ours_ok")]
+            peer_bounds = [r[f"{name}_over_bound"] for r in solved if f"{name}_over_bound" in r]
+            jerks = [r[f"{name}_jerk"] for r in solved]
+            ratio = median_ratio(mine, theirs_s)
+            both = [r for r in group if r.get("ours_ok") and r.get(f"{name}_ok")]
+            ratio_both = median_ratio([r["ours_time_s"] for r in both], [r[f"{name}_time_s"] for r in both])
+            ratio_all = median_ratio([r["ours_time_s"] for r in group], [r[f"{name}_time_s"] for r in group])
+            checked = sum(1 for r in group if r.get("ours_checked"))
+            beyond = sum(1 for r in solved if r[f"{name}_torque"] > 1.0 + 1e-9)
+            failing = sum(1 for r in solved if not r.get(f"{name}_checked", True))  # OMPL's: verified
+            touching = sum(1 for r in solved if not r.get(f"{name}_clear", True))
+            print(
+                f"{robot_name:6s} {problem_class:17s} {len(group):5d} {len(mine):4d} {len(solved):8d}  "
+                f"{percentile(mine, 50):6.2f} / {percentile(mine, 95):6.2f}  "
+                f"{percentile(theirs_s, 50):6.2f} / {percentile(theirs_s, 95):6.2f}"
+                f"  {ratio:5.2f} {ratio_both:5.2f} {ratio_all:5.2f}  {percentile(bounds, 50):9.3f}"
+                f"  {percentile(peer_bounds, 50):14.3f}  {percentile(jerks, 50):8.1f}"
+                f"  {beyond:7d}  {checked:7d}"
+                f"  {failing:12d} ({touching})"
+            )
+            lines.append(
+                f"| {robot_name} | {problem_class} | {len(group)} | {len(mine)} | {len(solved)} "
+                f"| {percentile(mine, 50):.3f} ({percentile(mine, 95):.3f}) "
+                f"| {percentile(theirs_s, 50):.3f} ({percentile(theirs_s, 95):.3f}) | {ratio:.2f} "
+                f"| {ratio_both:.2f} ({len(both)}) | {ratio_all:.2f} | {percentile(bounds, 50):.3f} "
+                f"| {percentile(peer_bounds, 50):.3f} | {percentile(jerks, 50):.1f} | {beyond} | {checked} "
+                f"| {failing} ({touching}) |"
+            )
+    return lines
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     add_selection(parser)
@@ -298,8 +426,15 @@ def main() -> int:
     parser.add_argument(
         "--workers", type=COUNT, default=1, help="problems planned at once (each by both planners in turn)"
     )
+    parser.add_argument(
+        "--peer",
+        choices=sorted(PEERS),
+        default="ompl",
+        help="the peer: OMPL's RRT-Connect through Python callbacks, or roboplan's, compiled",
+    )
     parser.add_argument("--out", type=Path, default=Path("out/bench_mbm"))
     args = parser.parse_args()
+    peer = PEERS[args.peer]
     check_selection(parser, args)
     if args.time_limit is not None and not 0 < args.time_limit <= args.timeout:
         parser.error(f"--time-limit {args.time_limit:g} s must be in (0, --timeout = {args.timeout:g}] s")
@@ -322,7 +457,7 @@ def main() -> int:
     # ours far more than OMPL's one-state checks, and the ratio with it: docs/benchmarks.md)
     threads = None if args.workers == 1 else max(1, (os.cpu_count() or 1) // args.workers)
     for _ in range(args.workers):
-        lanes.put(Lane(context, threads))
+        lanes.put(Lane(context, peer, threads))
     finished = itertools.count(1)
 
     def solve(number: int) -> None:
@@ -333,7 +468,7 @@ def main() -> int:
                 row |= lane.run(path, args.timeout, time_limit_s)
             finally:
                 lanes.put(lane)
-        mark = "-" if row["invalid"] else summary(row)
+        mark = "-" if row["invalid"] else summary(row, peer.name)
         print(f"[{next(finished)}/{len(chosen)}] {row['robot']} {path.stem}: {mark}", flush=True)
 
     with ThreadPoolExecutor(args.workers) as pool:
@@ -345,51 +480,13 @@ def main() -> int:
         writer = csv.DictWriter(out, fieldnames=keys)
         writer.writeheader()
         writer.writerows(rows)
-    print(f"\n{'robot':6s} {'class':17s} {'valid':>5s} {'ours':>4s} {'ompl':>4s}", end="")
-    print(f"  {'ours med/p95 s':>15s}  {'ompl med/p95 s':>15s}  ratio  both   all  dur/bound", end="")
-    print("  ompl jerk/lim  ompl >effort  checked")
     drawn = f" drawn with seed {args.sample_seed}" if args.sample_seed is not None and not args.scenes else ""
-    report = [
+    title = (
         f"{'Scene files' if args.scenes else f'MotionBenchMaker, {args.limit or 100} problem(s) per class'}"
-        f"{drawn}, "
-        f"timeout {args.timeout:g} s (ours: time_limit_s {time_limit_s:g} s), "
-        "warm (`scripts/bench_mbm.py`)",
-        "",
-        "| robot | class | valid | solved ours | solved OMPL | ours median (p95) [s] | OMPL median (p95) [s] "
-        "| ratio | ratio, both solved | ratio, all | ours duration / Ruckig bound | OMPL jerk / limit "
-        "| OMPL beyond an effort limit | ours passing `check` |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
-    ]
-    for robot_name in dict.fromkeys(r["robot"] for r in rows):
-        for problem_class in [*dict.fromkeys(r["class"] for r in rows if r["robot"] == robot_name), "all"]:
-            group = [r for r in rows if r["robot"] == robot_name and problem_class in ("all", r["class"])]
-            group = [r for r in group if not r["invalid"]]
-            if not group:
-                continue
-            mine = [r["ours_time_s"] for r in group if r.get("ours_ok")]
-            peer = [r["ompl_time_s"] for r in group if r.get("ompl_ok")]
-            bounds = [r["ours_over_bound"] for r in group if r.get("ours_ok")]
-            jerks = [r["ompl_jerk"] for r in group if r.get("ompl_ok")]
-            ratio = median_ratio(mine, peer)
-            both = [r for r in group if r.get("ours_ok") and r.get("ompl_ok")]
-            ratio_both = median_ratio([r["ours_time_s"] for r in both], [r["ompl_time_s"] for r in both])
-            ratio_all = median_ratio([r["ours_time_s"] for r in group], [r["ompl_time_s"] for r in group])
-            checked = sum(1 for r in group if r.get("ours_checked"))
-            beyond = sum(1 for r in group if r.get("ompl_ok") and r["ompl_torque"] > 1.0 + 1e-9)
-            print(
-                f"{robot_name:6s} {problem_class:17s} {len(group):5d} {len(mine):4d} {len(peer):4d}  "
-                f"{percentile(mine, 50):6.2f} / {percentile(mine, 95):6.2f}  "
-                f"{percentile(peer, 50):6.2f} / {percentile(peer, 95):6.2f}"
-                f"  {ratio:5.2f} {ratio_both:5.2f} {ratio_all:5.2f}"
-                f"  {percentile(bounds, 50):9.3f}  {percentile(jerks, 50):13.1f}  {beyond:11d}  {checked:7d}"
-            )
-            report.append(
-                f"| {robot_name} | {problem_class} | {len(group)} | {len(mine)} | {len(peer)} "
-                f"| {percentile(mine, 50):.2f} ({percentile(mine, 95):.2f}) "
-                f"| {percentile(peer, 50):.2f} ({percentile(peer, 95):.2f}) | {ratio:.2f} "
-                f"| {ratio_both:.2f} ({len(both)}) | {ratio_all:.2f} "
-                f"| {percentile(bounds, 50):.3f} | {percentile(jerks, 50):.1f} | {beyond} | {checked} |"
-            )
+        f"{drawn}, timeout {args.timeout:g} s (ours: time_limit_s {time_limit_s:g} s), "
+        "warm (`scripts/bench_mbm.py`)"
+    )
+    report = [title, "", *table(rows, peer)]
     (args.out / "mbm.md").write_text("\n".join(report) + "\n")
     print(f"\nrows: {args.out / 'mbm.csv'}; table: {args.out / 'mbm.md'}")
     return 0

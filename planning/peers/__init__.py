@@ -1,6 +1,7 @@
 """Peers for the benchmarks: RRT-Connect pipelines and Ruckig's jerk-limited bound.
 
-OMPL's and pyroboplan's RRT-Connect with TOPP-RA timing; Ruckig's time-optimal jerk-limited
+OMPL's and pyroboplan's RRT-Connect with TOPP-RA timing; roboplan's, compiled, on our
+collision model; Ruckig's time-optimal jerk-limited
 duration, the lower bound of the timing benchmarks.
 
 Optional (``pip install '.[bench]'``); the core never imports this package.
