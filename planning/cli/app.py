@@ -14,6 +14,7 @@ from planning.cli.batch_command import cmd_batch
 from planning.cli.file_commands import EXPORTERS, cmd_check, cmd_export, cmd_show
 from planning.cli.moveit_command import cmd_import_moveit
 from planning.cli.plan_commands import cmd_paper, cmd_plan
+from planning.cli.robot_command import cmd_robot_info
 from planning.cli.signals import interrupts
 from planning.outcome import EXIT_INTERRUPTED, Interrupted, classify
 
@@ -165,6 +166,21 @@ def build_parser() -> argparse.ArgumentParser:
         "--out", type=Path, required=True, metavar="FILE", help="file to write (.yaml, .yml, .json)"
     )
     sub.set_defaults(run=cmd_export)
+
+    sub = commands.add_parser(
+        "robot-info",
+        help="show what the planner makes of a robot",
+        description="Load ROBOT as a scene's robot: would, and print its files, planned and held joints with "
+        "their limits, tool frame, collision shapes with how far each reaches beyond its link's mesh "
+        "(a convex hull fills a concave link's hollows), and its self-collision pairs.",
+    )
+    sub.add_argument(
+        "robot",
+        metavar="ROBOT",
+        help="a URDF file, an example-robot-data arm's name (panda, ur5, ...), or 'cpr' (the bundled CPR)",
+    )
+    sub.add_argument("--json", action="store_true", help="print the report as JSON")
+    sub.set_defaults(run=cmd_robot_info)
 
     sub = commands.add_parser(
         "batch",

@@ -1,0 +1,90 @@
+"""How far each collision shape of a robot reaches beyond the link mesh it stands for.
+
+A link's mesh is checked as its convex hull (:func:`cpr_kin.urdf_models.convex_hulls`): it
+contains the mesh, so a configuration it accepts is clear, but a concave link's hull fills its
+hollows and refuses what the mesh would allow. The excess of a shape is the largest distance
+from a point of its surface to the mesh: :data:`SAMPLES` points drawn on the hull's surface by
+area (trimesh, seeded), each measured by coal to the mesh's triangles as coal's loader reads
+them (the same file and scale the hull was built from). A distance moves by at most as much as
+the point does, so the sampled largest is below the true one by at most the spacing of the
+samples (reported: the side of a square of the surface's area over the count).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from cpr_kin.robot import Robot
+
+SAMPLES = 20_000
+"""Points drawn on each hull's surface."""
+
+
+@dataclass(frozen=True)
+class ShapeExcess:
+    """One collision shape beside the mesh it stands for.
+
+    Attributes:
+        geometry: the collision geometry's name.
+        link: its link.
+        kind: ``"convex hull"`` of a mesh, ``"bounding capsule"`` of one (coal cannot hold
+            its hull, :attr:`cpr_kin.Robot.capsule_meshes`), or the URDF's primitive
+            (``"box"``, ``"cylinder"``, ...: exact).
+        mesh: the mesh file, or ``""`` for a primitive.
+        excess_m: the largest distance of the shape's surface from the mesh [m], sampled; 0
+            for a primitive; NaN where not measured (a capsule).
+        spacing_m: how far below the true largest the sampled one may be [m].
+    """
+
+    geometry: str
+    link: str
+    kind: str
+    mesh: str
+    excess_m: float
+    spacing_m: float = 0.0
+
+
+def shape_excess(robot: Robot, samples: int = SAMPLES, seed: int = 0) -> tuple[ShapeExcess, ...]:
+    """The excess of each of ``robot``'s collision shapes (module docstring), in geometry order."""
+    import coal
+    import trimesh
+
+    loader = coal.MeshLoader()
+    request, point = coal.DistanceRequest(), coal.Sphere(1e-12)
+    found = []
+    for geometry in robot.geometries:
+        obj = robot.collision_model.geometryObjects[geometry.index]
+        kind = type(obj.geometry).__name__.lower()
+        if geometry.name in robot.capsule_meshes:
+            found.append(
+                ShapeExcess(geometry.name, geometry.link, "bounding capsule", obj.meshPath, math.nan)
+            )
+            continue
+        if kind != "convex" or not obj.meshPath:
+            found.append(ShapeExcess(geometry.name, geometry.link, kind, "", 0.0))
+            continue
+        mesh = loader.load(obj.meshPath, np.asarray(obj.meshScale, dtype=float))
+        vertices = np.asarray(mesh.vertices(), dtype=float)
+        hull = trimesh.Trimesh(vertices=vertices).convex_hull
+        on_hull = trimesh.sample.sample_surface(hull, samples, seed=seed)[0]
+        identity = coal.Transform3s()
+        distances = [
+            coal.distance(
+                mesh, identity, point, coal.Transform3s(np.eye(3), p), request, coal.DistanceResult()
+            )
+            for p in on_hull
+        ]
+        found.append(
+            ShapeExcess(
+                geometry.name,
+                geometry.link,
+                "convex hull",
+                obj.meshPath,
+                max(0.0, float(np.max(distances))),
+                math.sqrt(float(hull.area) / samples),
+            )
+        )
+    return tuple(found)
