@@ -130,3 +130,32 @@ def test_the_peer_s_imports_are_done_before_its_first_timed_call() -> None:
 
     import_peer()
     assert {"ompl.geometric", "toppra.algorithm", "toppra.constraint"} <= set(sys.modules)
+
+
+@pytest.mark.slow
+def test_roboplan_runs_beside_ours_and_its_path_is_checked(tmp_path: Path) -> None:
+    import csv
+    import subprocess
+    import sys
+
+    pytest.importorskip("roboplan.core", reason="the bench extra's roboplan")
+    run = subprocess.run(
+        [
+            *(sys.executable, str(SCRIPT), "--scenes", str(SHELF), "--peer", "roboplan"),
+            *("--timeout", "10", "--out", str(tmp_path / "bench")),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+    assert run.returncode == 0, run.stderr[-2000:]
+    with (tmp_path / "bench" / "mbm.csv").open() as rows:
+        (row,) = list(csv.DictReader(rows))
+    assert row["ours_ok"] == "True" and row["roboplan_ok"] == "True"
+    assert 0 < float(row["roboplan_time_s"]) < 10 and float(row["roboplan_over_bound"]) > 0  # no jerk limit
+    assert row["roboplan_checked"] in ("True", "False") and row["roboplan_clear"] in ("True", "False")
+    table = (tmp_path / "bench" / "mbm.md").read_text()
+    assert (
+        "| roboplan paths failing `check` (touching) |" in table and "| scenes | all | 1 | 1 | 1 " in table
+    )

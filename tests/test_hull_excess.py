@@ -1,4 +1,4 @@
-"""How far a link's convex hull reaches beyond its mesh: an analytic case, trimesh's distances, the command."""
+"""How far a link's hull reaches beyond its mesh: an analytic case, trimesh's distances, the command."""
 
 from __future__ import annotations
 

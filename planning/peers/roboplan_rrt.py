@@ -2,14 +2,15 @@
 
 The peer is given our collision model (:class:`RoboplanPeer`, built once per scene and
 untimed): the robot's URDF with every link mesh replaced by its convex hull (the shape our
-robot checks, written to a temporary folder), the scene's boxes, spheres, cylinders and
-convex meshes, the SRDF's disabled pairs, the scene's allowed pairs and the pairs our robot
-leaves unchecked (touching by design); our joint velocity and acceleration limits; the held
-joints at their values. :meth:`RoboplanPeer.plan` times what a roboplan user runs: RRT-Connect,
-the shortcutter and TOPP-RA (Hermite: at rest at each waypoint, on the path). Its path is then
-checked, untimed, by our certified continuous checks (each straight segment, the obstacles
-at the scene's margin and the robot's own pairs at its self margin): roboplan checks
-configurations a step apart. Needs the ``bench`` extra (``roboplan``).
+robot checks, written to a temporary folder); the scene's boxes, spheres, cylinders and
+convex meshes; exactly our robot's self pairs (those its SRDF disables, the scene allows,
+adjacent links and links touching by design left out); our joint velocity, acceleration and
+jerk limits; the held joints at their values. :meth:`RoboplanPeer.plan` times what a roboplan
+user runs: RRT-Connect, the shortcutter and TOPP-RA (Hermite: at rest at each waypoint, on
+the path). Its path is then checked, untimed, by our certified continuous checks (each
+straight segment, the obstacles at the scene's margin and the robot's own pairs at its self
+margin): roboplan checks configurations a step apart, without a margin. Needs the ``bench``
+extra (``roboplan``).
 """
 
 from __future__ import annotations
@@ -89,8 +90,6 @@ class RoboplanPeer:
         spec, robot = scene.robot, self.problem.robot
         xml = _hull_urdf(spec.urdf, spec.package_dirs, folder)
         self.scene = PeerScene("peer", loadUrdfSceneDescriptionFromXml(xml))
-        if robot.srdf_path is not None:
-            self.scene.importSrdf(Path(robot.srdf_path).read_text())
         limits = robot.limits
         config = {
             name: {"max_velocity": [float(v)], "max_acceleration": [float(a)], "max_jerk": [float(j)]}
@@ -101,9 +100,14 @@ class RoboplanPeer:
         (folder / "limits.yaml").write_text(yaml.safe_dump({"joint_limits": config}))
         self.scene.importJointLimitsFromConfig(loadJointLimitsConfig(folder / "limits.yaml"))
         self.scene.addGroup(GROUP, list(limits.names))
-        allowed = [*scene.allowed_collisions, *robot.overlapping_links]
-        if allowed:
-            self.scene.setCollisions([(a, b) for a, b in allowed], False)
+        links = sorted({g.link for g in robot.geometries})
+        checked = {
+            frozenset((robot.geometries[a].link, robot.geometries[b].link)) for a, b in robot.self_pairs
+        }
+        checked -= {frozenset(pair) for pair in scene.allowed_collisions}
+        unchecked = [(a, b) for a, b in itertools.combinations(links, 2) if frozenset((a, b)) not in checked]
+        if unchecked:  # ours: the SRDF's, the scene's, adjacent links, pairs touching by design
+            self.scene.setCollisions(unchecked, False)
         for obstacle in scene.obstacles:
             _add_obstacle(self.scene, obstacle, folder)
         names = [f"obstacle:{o.name}" for o in scene.obstacles]
@@ -131,10 +135,13 @@ class RoboplanPeer:
         planner = RRT(self.scene, options)
         planner.setRngSeed(seed)
         self.scene.setRngSeed(seed)
-        path = planner.plan(
-            JointConfiguration(names, np.asarray(motion.q_start)),
-            JointConfiguration(names, np.asarray(motion.q_goal)),
-        )
+        try:
+            path = planner.plan(
+                JointConfiguration(names, np.asarray(motion.q_start)),
+                JointConfiguration(names, np.asarray(motion.q_goal)),
+            )
+        except RuntimeError as exc:  # e.g. "Start configuration is in collision, cannot plan!"
+            return PeerResult(False, str(exc), time.perf_counter() - started, np.empty((0, len(names))))
         if not path.positions:
             return PeerResult(False, "no path", time.perf_counter() - started, np.empty((0, len(names))))
         path = PathShortcutter(self.scene, PathShortcuttingOptions(group_name=GROUP, seed=seed)).shortcut(
