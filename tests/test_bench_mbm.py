@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib.util
+import sys
 from pathlib import Path
 from types import ModuleType, SimpleNamespace
 
@@ -22,6 +23,7 @@ def bench() -> ModuleType:
     spec = importlib.util.spec_from_file_location("bench_mbm", SCRIPT)
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # importlib's recipe: a dataclass looks its module up there
     spec.loader.exec_module(module)
     return module
 
@@ -156,6 +158,4 @@ def test_roboplan_runs_beside_ours_and_its_path_is_checked(tmp_path: Path) -> No
     assert 0 < float(row["roboplan_time_s"]) < 10 and float(row["roboplan_over_bound"]) > 0  # no jerk limit
     assert row["roboplan_checked"] in ("True", "False") and row["roboplan_clear"] in ("True", "False")
     table = (tmp_path / "bench" / "mbm.md").read_text()
-    assert (
-        "| roboplan paths failing `check` (touching) |" in table and "| scenes | all | 1 | 1 | 1 " in table
-    )
+    assert "| roboplan paths failing `check` (touching) |" in table and "| scenes | all | 1 | 1 | 1 " in table
