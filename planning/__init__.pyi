@@ -20,7 +20,7 @@ from .io.trajectory_io import write_samples, write_trajectory
 from .io.trajectory_reader import TrajectoryFileError, read_trajectory
 from .pipeline.metrics import Metrics
 from .pipeline.objective import Breakdown, WaypointObjective
-from .pipeline.planner import plan, solve, warm_up
+from .pipeline.planner import plan, solve
 from .pipeline.problem import Problem, build_problem, with_planner
 from .pipeline.result import PlanResult
 from .pipeline.scene import DEFAULT_SAFETY_MARGIN_M, DEFAULT_SPLINE, Scene
@@ -35,6 +35,7 @@ from .search.firefly_settings import FireflySettings
 from .search.optimizer import Optimizer, SearchResult
 from .search.refined_firefly import RefinedFirefly
 from .search.refinement_settings import RefinementSettings
+from .warming import warm_up
 
 __all__ = [
     "DEFAULT_FIREFLY",

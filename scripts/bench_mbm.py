@@ -93,7 +93,7 @@ def _robot(scene_path: str) -> tuple[Any, ck.Robot]:
     scene = load_scene(Path(scene_path))
     key = str(scene.robot) if scene.robot is not None else "cpr"
     if key not in _ROBOTS:
-        from planning.pipeline.planner import warm_up
+        from planning.warming import warm_up
 
         _ROBOTS[key] = scene.robot.load() if scene.robot is not None else ck.load_cpr()
         warm_up(_ROBOTS[key])

@@ -40,7 +40,7 @@ from planning.peers.ompl_rrt import plan_rrt_connect
 from planning.peers.pyroboplan_rrt import plan_pyroboplan_rrt_connect
 from planning.peers.toppra_timing import SamplingResult
 from planning.pipeline.objective import WaypointObjective
-from planning.pipeline.planner import plan, warm_up
+from planning.pipeline.planner import plan
 from planning.pipeline.problem import build_problem, with_planner
 from planning.pipeline.scene import Scene
 from planning.pipeline.search import planner_search
@@ -48,6 +48,7 @@ from planning.pipeline.seeding import SEEDINGS
 from planning.pipeline.settings import DEFAULT_FIREFLY
 from planning.search import baselines
 from planning.search.optimizer import BatchObjective, Optimizer, SearchResult
+from planning.warming import warm_up
 
 FloatArray = NDArray[np.float64]
 DEFAULT_SEARCH = "firefly (our defaults: seeded, n = 30, early stop, CMA-ES refinement)"

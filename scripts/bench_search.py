@@ -51,9 +51,10 @@ from planning.io.scene_file import dump_scene
 from planning.io.scene_generator import generate_scenes
 from planning.peers.ompl_rrt import plan_rrt_connect
 from planning.peers.ruckig_bound import free_space_bound
-from planning.pipeline.planner import plan, warm_up
+from planning.pipeline.planner import plan
 from planning.pipeline.problem import build_problem
 from planning.pipeline.scene import Scene
+from planning.warming import warm_up
 
 CLI_TARGET_S = 1.5
 B1_TARGET = 1.10

@@ -47,10 +47,11 @@ from planning.io.report import markdown_table, text_table
 from planning.io.scene_generator import generate_scenes
 from planning.peers.ompl_rrt import plan_rrt_connect
 from planning.peers.ruckig_bound import free_space_bound
-from planning.pipeline.planner import plan, warm_up
+from planning.pipeline.planner import plan
 from planning.pipeline.problem import build_problem
 from planning.pipeline.scene import Scene
 from planning.pipeline.timing import narrowed_timings, uniform_scale
+from planning.warming import warm_up
 
 
 @dataclass(frozen=True)

@@ -50,9 +50,10 @@ from planning.io.report import markdown_table
 from planning.io.scene_file import load_scene
 from planning.io.scene_generator import generate_scenes
 from planning.peers.ruckig_bound import free_space_bound
-from planning.pipeline.planner import plan, warm_up
+from planning.pipeline.planner import plan
 from planning.pipeline.scene import Scene
 from planning.pipeline.torques import torque_profile
+from planning.warming import warm_up
 
 PAYLOADS_KG = {"cpr": (0.0, 2.0, 5.0), "panda": (0.0, 1.5, 3.0), "ur5": (0.0, 2.5, 5.0)}
 """The payloads of the issue, per robot [kg]."""

@@ -20,9 +20,10 @@ from planning.io.bundled import paper_scene
 from planning.io.outputs import plan_files
 from planning.io.publish import OutputFolder
 from planning.io.report import paper_rows, text_table
-from planning.pipeline.planner import plan, warm_up
+from planning.pipeline.planner import plan
 from planning.pipeline.result import PlanResult
 from planning.viz import artifacts
+from planning.warming import warm_up
 
 
 def seed_summary(robot: ck.Robot, seeds: int) -> tuple[list[tuple[int, str]], list[PlanResult]]:
@@ -79,7 +80,7 @@ def main(argv: list[str] | None = None) -> int:
     if times:
         print(f"  median planning time {statistics.median(times):.3f} s")
 
-    files = plan_files(result, paper=True, plots=True, html=True)
+    files = plan_files(result, paper=True) | artifacts.drawn_files(result)
     seeds = [
         f"## Seeds 0..{args.seeds - 1}: {count} verified",
         "",

@@ -26,10 +26,11 @@ import cpr_kin as ck
 from planning.cli.arguments import COUNT, SEED, integer_at_least
 from planning.errors import NoSolutionError
 from planning.io.scene_generator import generate_scenes
-from planning.pipeline.planner import plan, warm_up
+from planning.pipeline.planner import plan
 from planning.pipeline.scene import Scene
 from planning.pipeline.tuning import SearchTuning, SeedingTuning
 from planning.search.refinement_settings import RefinementSettings
+from planning.warming import warm_up
 
 PAPER_SEARCH = {"fireflies": 50, "stall_iterations": 0, "seeding": "none", "refine": "none"}
 

@@ -10,11 +10,13 @@ Layers (README, "How it fits together"): ``planning.curves`` is pure mathematics
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
+ARCHITECTURE = ROOT / "docs" / "architecture.md"
 PACKAGES = ("cpr_kin", "planning")
 MAX_LINES = 300
 
@@ -153,3 +155,65 @@ def test_the_checker_sees_what_it_checks() -> None:
     assert ("planning.pipeline.planner", False) in found and ("planning.outcome", True) in found
     stub_reader = imports("planning.curves", ROOT / "planning" / "curves" / "__init__.py")
     assert ("lazy_loader", True) in stub_reader
+
+
+def layer_rows() -> dict[str, tuple[str, str]]:
+    """docs/architecture.md's "Packages and layers" table: ``{package: (holds, may import)}``."""
+    text = ARCHITECTURE.read_text().split("## Packages and layers", 1)[1].split("\n## ", 1)[0]
+    rows = {}
+    for line in text.splitlines():
+        cells = [cell.strip() for cell in line.strip().strip("|").split("|")]
+        named = re.match(r"`([a-z_.]+)`", cells[0]) if len(cells) == 3 else None
+        if named:
+            rows[named.group(1)] = (cells[1], cells[2])
+    return rows
+
+
+def row_of(name: str, rows: dict[str, tuple[str, str]]) -> str:
+    """The row that holds module ``name``: its package's, the longest that contains it."""
+    return max((row for row in rows if within(name, row)), key=len)
+
+
+def may_import(row: str, rows: dict[str, tuple[str, str]]) -> set[str]:
+    """What the modules of ``row`` may import: rows or modules by name, and what those may, in turn."""
+    text = rows[row][1]
+    named = set(re.findall(r"`([a-z_.]+)`", text)) | (
+        {"planning.pipeline"} if "the pipeline" in text else set()
+    )
+    if text.startswith("nothing of"):
+        named = set()
+    elif text.startswith(("anything", "every package")):
+        named = set(rows) - {n for n in named if n in rows or f"planning.{n}" in rows}
+        named -= {f"planning.{n}" for n in re.findall(r"but `([a-z_.]+)`", text)}
+    resolved = {n if n in rows or "." in n else f"planning.{n}" for n in named}
+    allowed = set(resolved)
+    for other in resolved & set(rows):
+        if other != row:
+            allowed |= may_import(other, rows)
+    return allowed
+
+
+def test_every_import_follows_its_row_of_the_layer_table() -> None:
+    rows = layer_rows()
+    offenders = []
+    for name, path in modules().items():
+        row = row_of(name, rows)
+        allowed = may_import(row, rows)
+        for imported, _ in imports(name, path):  # module level, in functions, for the type checker
+            if not any(within(imported, p) for p in PACKAGES):
+                continue
+            target = row_of(imported, rows)  # a row allows its own modules; a module name, that module
+            single = any(within(imported, a) for a in allowed if a not in rows)
+            if target != row and target not in allowed and not single:
+                offenders.append(f"{name} -> {imported}")
+    assert offenders == [], f"imports beyond docs/architecture.md's rows: {sorted(set(offenders))}"
+
+
+def test_the_layer_table_names_every_module() -> None:
+    rows = layer_rows()
+    missing = [
+        name
+        for name in modules()
+        if name not in rows and f"`{name.rpartition('.')[2]}`" not in rows[row_of(name, rows)][0]
+    ]
+    assert missing == [], f"modules docs/architecture.md does not list in their package's row: {missing}"

@@ -29,7 +29,8 @@ def test_the_hull_of_two_cubes_exceeds_them_by_half_their_gap(tmp_path: Path) ->
     cubes = [trimesh.creation.box(extents=(0.1, 0.1, 0.1)) for _ in range(2)]
     cubes[0].apply_translation([0.05, 0.05, 0.05])
     cubes[1].apply_translation([0.35, 0.05, 0.05])
-    trimesh.util.concatenate(cubes).export(tmp_path / "dumbbell.stl")
+    dumbbell: trimesh.Trimesh = trimesh.util.concatenate(cubes)  # type: ignore[assignment]
+    dumbbell.export(tmp_path / "dumbbell.stl")
     (tmp_path / "dumbbell.urdf").write_text(URDF.format(mesh=tmp_path / "dumbbell.stl"))
     base, arm = shape_excess(ck.load_robot(tmp_path / "dumbbell.urdf"))
     assert base.kind == "convex hull" and base.mesh.endswith("dumbbell.stl")
@@ -40,10 +41,10 @@ def test_the_hull_of_two_cubes_exceeds_them_by_half_their_gap(tmp_path: Path) ->
 def test_coal_s_distances_are_trimesh_s() -> None:
     robot = ck.load_robot(example_robot("ur5"))
     (forearm,) = [s for s in shape_excess(robot, samples=2000, seed=4) if s.link == "forearm_link"]
-    mesh = trimesh.load(forearm.mesh, force="mesh")
+    mesh: trimesh.Trimesh = trimesh.load(forearm.mesh, force="mesh")  # type: ignore[assignment]
     hull = trimesh.Trimesh(vertices=mesh.vertices).convex_hull
     points = trimesh.sample.sample_surface(hull, 2000, seed=4)[0]
-    distances = trimesh.proximity.ProximityQuery(mesh).on_surface(points)[1]
+    distances = trimesh.proximity.ProximityQuery(mesh).on_surface(points)[1]  # type: ignore[no-untyped-call]
     assert forearm.excess_m == pytest.approx(float(np.max(distances)), abs=1e-6)
     assert forearm.excess_m > 0.02  # the UR forearm's hollow: why its hull refuses what it can do
 

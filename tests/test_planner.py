@@ -14,7 +14,7 @@ import cpr_kin as ck
 from cpr_kin.packages import example_robot_data_share
 from planning.errors import NoTrajectoryFoundError, PlanningError, TargetOutOfReachError
 from planning.io.bundled import paper_scene
-from planning.pipeline.planner import plan, solve, warm_up
+from planning.pipeline.planner import plan, solve
 from planning.pipeline.problem import build_problem
 from planning.pipeline.result import PlanResult
 from planning.pipeline.scene import Scene
@@ -25,6 +25,7 @@ from planning.pipeline.tuning import SearchTuning
 from planning.search.firefly import FireflyProgress
 from planning.search.firefly_settings import FireflySettings
 from planning.search.refinement_settings import RefinementSettings
+from planning.warming import warm_up
 
 from .conftest import PAPER_GOAL_TCP, PAPER_START_TCP
 
@@ -236,7 +237,7 @@ from cpr_kin.bound_kernels import pair_bounds
 from cpr_kin.self_bounds import self_bounds
 from planning.curves.horner import evaluate
 from planning.io.mbm import vamp_resources
-from planning.pipeline.planner import warm_up
+from planning.warming import warm_up
 from planning.search.firefly import _move
 ur5 = ck.load_robot(vamp_resources("ur5") / "ur5.urdf", srdf=vamp_resources("ur5") / "ur5.srdf")
 warm_up(ur5)
@@ -280,7 +281,8 @@ import cpr_kin as ck
 from cpr_kin.packages import example_robot_data_share
 from planning.io.arm_scenes import blocked_scene
 from planning.io.scene_file import parse_scene
-from planning.pipeline.planner import plan, solve, warm_up
+from planning.pipeline.planner import plan, solve
+from planning.warming import warm_up
 
 baxter = example_robot_data_share() / "example-robot-data" / "robots" / "baxter_description"
 entry = {
@@ -295,7 +297,8 @@ CPR_SCENES = """
 import dataclasses
 import cpr_kin as ck
 from planning.io.scene_generator import generate_scenes
-from planning.pipeline.planner import plan, solve, warm_up
+from planning.pipeline.planner import plan, solve
+from planning.warming import warm_up
 
 robot = None
 cpr = ck.load_cpr()

@@ -58,8 +58,11 @@ def _plan_and_write(scene: Scene, out: str, args: argparse.Namespace, paper: boo
         try:
             result = plan(scene, progress=_checked(update))
             close()
-            extras = {"plots": paper or args.plots, "html": paper or args.html}
-            files = plan_files(result, paper=paper, timings=args.timings, **extras)
+            files = plan_files(result, paper=paper, timings=args.timings)
+            if paper or args.plots or args.html:
+                from planning.viz.artifacts import drawn_files
+
+                files |= drawn_files(result, plots=paper or args.plots, page=paper or args.html)
             checkpoint()  # a signal something swallowed still stops the command before it writes
             outputs = folder.publish(files)
             if args.json:

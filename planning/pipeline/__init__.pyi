@@ -5,7 +5,7 @@ from .metrics import Elapsed, Metrics
 from .motion import Motion
 from .objective import Breakdown, WaypointObjective
 from .offered import Offered, Timing
-from .planner import plan, solve, warm_up
+from .planner import plan, solve
 from .problem import Problem, build_problem, with_planner
 from .result import PlanResult
 from .scene import DEFAULT_SAFETY_MARGIN_M, DEFAULT_SPLINE, Scene
@@ -49,6 +49,5 @@ __all__ = [
     "seed_search",
     "solve",
     "verify_trajectory",
-    "warm_up",
     "with_planner",
 ]

@@ -18,6 +18,16 @@ from planning.pipeline.result import PlanResult
 PLOT_FILES = ("joints.png", "tcp_path.png", "clearance.png", "utilisation.png", "convergence.png")
 
 
+def drawn_files(result: PlanResult, plots: bool = True, page: bool = True) -> dict[str, str | bytes]:
+    """The files that draw a plan, those asked for: the plots (:func:`plot_files`), ``viewer.html``."""
+    files: dict[str, str | bytes] = dict(plot_files(result)) if plots else {}
+    if page:
+        files["viewer.html"] = viewer_html(
+            result.problem.world, result.scene.safety_margin, result.trajectory, result.waypoints
+        )
+    return files
+
+
 def plot_files(result: PlanResult) -> dict[str, bytes]:
     """PNG bytes of the joint, TCP-path, clearance, limit-usage and convergence plots, by file name."""
     from planning.utilisation import limit_usage

@@ -1,0 +1,129 @@
+"""The compiled kernels loaded before a timed plan: :func:`warm_up`.
+
+Planning compiles its numba kernels (or loads them from their on-disk cache) on its first
+call in a process; :func:`warm_up` moves that one-time cost out of a plan that is timed, by
+planning the bundled paper case small and a motion of the robot's own. It reads the bundled
+scene, so it sits above the pipeline and the files (docs/architecture.md).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import copy
+import dataclasses
+import time
+
+import numpy as np
+from numpy.typing import NDArray
+
+import cpr_kin as ck
+from planning.errors import NoSolutionError, PlanningError
+from planning.io.bundled import paper_scene
+from planning.pipeline.path_terms import SplinePaths
+from planning.pipeline.planner import plan, solve
+from planning.pipeline.problem import Problem, build_problem
+from planning.pipeline.scene import Scene
+from planning.pipeline.target import Target
+from planning.pipeline.torques import held
+from planning.search.rrt_connect import rrt_connect
+
+FloatArray = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
+
+
+def warm_up(robot: ck.Robot | None = None) -> float:
+    """Compile the numba kernels, or load them from their on-disk cache; seconds spent.
+
+    Planning does it anyway on its first call; this moves the one-time cost (several
+    seconds on a new machine, a fraction of a second per process afterwards) out of a plan
+    that is timed. It plans the paper case with two fireflies for one iteration and a small
+    motion of the robot (the CPR if none is given) in its joint space, runs the search's
+    duration estimates with and without the torques, and asks its collision world every
+    kind of query once (:func:`_warm_own_motion`).
+    """
+    started = time.perf_counter()
+    small = paper_scene(fireflies=2, iterations=1)
+    # a search this small may find nothing; a robot of its own may reach the paper's poses
+    # inside the paper's crate, or not at all: the motion of its own below warms the rest
+    expected: tuple[type[Exception], ...] = (NoSolutionError,)
+    if robot is not None:
+        expected = (NoSolutionError, PlanningError)
+    with contextlib.suppress(*expected):
+        plan(small, robot, threads=1)
+    _warm_own_motion(robot if robot is not None else ck.load_cpr(), small)
+    _warm_sampling()
+    return time.perf_counter() - started
+
+
+def _warm_sampling() -> None:
+    """Run RRT-Connect once through a slot in a wall of the unit square: its kernels load.
+
+    The warm-up's own motions are clear on their straight line and draw no sample.
+    """
+
+    def beside_the_wall(q: FloatArray) -> BoolArray:
+        return np.asarray((np.abs(q[:, 0] - 0.5) > 0.05) | (np.abs(q[:, 1] - 0.5) < 0.1))
+
+    start, goal, ones = np.array([0.1, 0.1]), np.array([0.9, 0.1]), np.ones(2)
+    rrt_connect(beside_the_wall, start, goal, 0.0 * ones, ones, ones, np.random.default_rng(0))
+
+
+def _warm_own_motion(robot: ck.Robot, small: Scene) -> None:
+    """Plan a small motion of ``robot`` in its joint space, run its estimates, ask every query.
+
+    The paper's small search may find nothing (its timing then never runs), and a robot of
+    its own may reach the paper's poses inside the paper's crate, or not at all. The motion
+    starts at the sampled configuration farthest from itself that the motors can hold still.
+    """
+    world = ck.CollisionWorld(robot, [ck.Obstacle.box((0.1, 0.1, 0.1), (0.0, 0.0, 10.0))])
+    q = ck.sampled_configurations(robot.model, 64, np.random.default_rng(0))
+    if world.self_collision:  # the configuration farthest from itself first
+        q = q[np.argsort(-world.self_collision.distances(q)[0])]
+    ends = np.stack([q, np.minimum(robot.model.upperPositionLimit, q + 0.1)])
+    # ends the motors can hold still, or the plan stops before its timing is compiled
+    dynamics = ck.robot_dynamics(robot)
+    first = int(np.argmax(held(dynamics, ends[0]) & held(dynamics, ends[1])))
+    start, goal = Target(q=tuple(ends[0, first])), Target(q=tuple(ends[1, first]))
+    own = dataclasses.replace(
+        small, start=start, goal=goal, obstacles=world.obstacles, self_margin=0.0, duration=None
+    )
+    with contextlib.suppress(PlanningError, NoSolutionError):  # what ran, ran
+        problem = build_problem(own, robot, threads=1)
+        _estimate_durations(problem, dynamics)  # before the plan, which may find nothing
+        solve(problem)
+    # an obstacle at the tool, so that the pairs' bounds leave it in doubt and coal decides
+    tool = ck.frame_poses(robot, ends[0, first][None])[0][:3, 3]
+    _query_collisions(ck.CollisionWorld(robot, [ck.Obstacle.sphere(0.05, tuple(tool))]), ends[:, first])
+
+
+def _estimate_durations(problem: Problem, dynamics: ck.Dynamics) -> None:
+    """Run the search's estimates of ``problem``'s straight line: durations, the averages' foresight.
+
+    The duration estimates kinematic and torque-limited; the samples the choice's foresight
+    averages (:func:`~planning.pipeline.choose.foreseen_clear`). A plan keeps the torques in
+    its estimate only where they bind on its straight line
+    (:func:`~planning.pipeline.torques.search_torque`), which a warm-up motion seldom does;
+    the choice foresees the averages only behind a feasible best.
+    """
+    objective = problem.objective
+    paths = objective.paths
+    if not isinstance(paths, SplinePaths):  # point to point: no estimate
+        return
+    samples = paths(objective.nodes(objective.straight_line())).samples
+    for torque in (None, dynamics):
+        estimate = copy.copy(paths)
+        estimate.torque = torque
+        estimate.durations(samples)
+        estimate.averaged(samples)  # the kinematic one's; None where torque-limited
+
+
+def _query_collisions(world: ck.CollisionWorld, q: FloatArray) -> None:
+    """Ask ``world`` every kind of query once at configurations ``q``, its robot's own pairs too.
+
+    A compiled kernel loads from its cache on its first call in a process.
+    """
+    world.margin_violated(q, 0.01)
+    world.min_clearance_batch(q)
+    if world.self_collision:
+        world.self_collision.violated(q, 0.01)
+        world.self_collision.distances(q)
