@@ -1,10 +1,11 @@
 """The package layout holds: small modules, and imports that follow the layers.
 
-Layers (README, "How it fits together"): ``planning.curves`` is pure mathematics (no robot),
-``planning.search`` knows only objectives over boxes, the core (the top-level modules and
-``planning.io``) never imports a peer, and drawing libraries are imported only by
-``planning.viz`` (lazily elsewhere). The import graph is read from the source, every
-``import`` statement counted, including those inside functions.
+The layers are docs/architecture.md's "Packages and layers" table: each row's package may
+import what its "may import" cell names and, in turn, what those may. Every import statement
+is counted: at module level, inside functions and under ``if TYPE_CHECKING:``. A few rules
+are also written out here: ``planning.curves`` is pure mathematics (no robot),
+``planning.search`` knows only objectives over boxes, the core never imports a peer, and
+drawing libraries are imported only by ``planning.viz`` (lazily elsewhere).
 """
 
 from __future__ import annotations
