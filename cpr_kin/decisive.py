@@ -77,3 +77,16 @@ def propagated_bounds(values: FloatArray, known: NDArray[np.bool_], reach_m: Flo
     left = np.maximum.accumulate(np.where(known, values + reach_m, -np.inf)) - reach_m
     right = np.maximum.accumulate(np.where(known, values - reach_m, -np.inf)[::-1])[::-1] + reach_m
     return np.asarray(np.where(known, values, np.maximum(left, right)))
+
+
+def with_neighbours(
+    values: FloatArray, known: NDArray[np.bool_], bounds: FloatArray, reach_m: FloatArray, tolerance_m: float
+) -> FloatArray:
+    """``(K,)`` a sampled distance: exact at the ``known`` samples, else the best lower bound there is.
+
+    Elsewhere the larger of the cheap bound (``bounds``) and what the exact samples give
+    (:func:`propagated_bounds`), the latter less ``tolerance_m``, how far the exact values
+    (coal's) may be above the true ones [m]. Every certified check updates its samples by this rule.
+    """
+    propagated = propagated_bounds(values, known, reach_m) - tolerance_m
+    return np.asarray(np.where(known, values, np.maximum(bounds, propagated)))

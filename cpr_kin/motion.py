@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.clearance import BatchClearance
 from cpr_kin.collision import CollisionWorld
-from cpr_kin.decisive import certified, propagated_bounds, undecided
+from cpr_kin.decisive import certified, undecided, with_neighbours
 from cpr_kin.errors import CprKinError
 from cpr_kin.interval_motion import IntervalSpeed, interval_motion
 from cpr_kin.pair_bounds import BOUND_TOLERANCE_M
@@ -203,11 +203,13 @@ def decisive_clearance(world: CollisionWorld, q: FloatArray, slack_m: float | Fl
                     q[rows], group_index
                 )
                 known[rows, group_index] = True
-                # coal's values are accurate to BOUND_TOLERANCE_M: a neighbour's bound keeps that much below
-                column, exact = values[:, group_index], known[:, group_index]
-                propagated = propagated_bounds(column, exact, reach) - BOUND_TOLERANCE_M
-                lowest = np.maximum(bounds[:, group_index], propagated)
-                values[:, group_index] = np.where(exact, column, lowest)
+                values[:, group_index] = with_neighbours(
+                    values[:, group_index],
+                    known[:, group_index],
+                    bounds[:, group_index],
+                    reach,
+                    BOUND_TOLERANCE_M,
+                )
     return BatchClearance(clearance_m=values, closest_pair=closest)
 
 

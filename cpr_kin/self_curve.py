@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from cpr_kin.decisive import certified, propagated_bounds, undecided
+from cpr_kin.decisive import certified, undecided, with_neighbours
 from cpr_kin.errors import CprKinError
 from cpr_kin.pair_bounds import BOUND_TOLERANCE_M
 
@@ -260,9 +260,7 @@ def _decisive_values(
     while rows.size:
         values[rows] = collision.pair_distances(pair.q[rows], pair.index)
         known[rows] = True
-        # exact where known; a neighbour's bound keeps coal's own tolerance below (as the obstacles')
-        propagated = propagated_bounds(values, known, reach)
-        values = np.where(known, propagated, np.maximum(pair.bounds, propagated - BOUND_TOLERANCE_M))
+        values = with_neighbours(values, known, pair.bounds, reach, BOUND_TOLERANCE_M)
         needed = undecided(values[:, None], known[:, None], pair.slack, certified_ceiling, sampled_ceiling)
         rows = np.flatnonzero(needed[:, 0])
     return values, known

@@ -1,0 +1,27 @@
+"""The rule every certified check updates its samples by: exact where known, else a true lower bound."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cpr_kin.decisive import propagated_bounds, with_neighbours
+
+
+def test_the_samples_stay_below_a_distance_that_moves_no_faster_than_the_slack() -> None:
+    rng = np.random.default_rng(5)
+    for _ in range(200):
+        count = int(rng.integers(2, 60))
+        slack = rng.uniform(0.0, 0.01, count - 1)  # how far the distance may move per interval [m]
+        reach = np.concatenate([[0.0], np.cumsum(slack)])
+        true = np.concatenate([[rng.uniform(-0.05, 0.2)], rng.uniform(-1, 1, count - 1) * slack]).cumsum()
+        known = rng.random(count) < 0.3
+        bounds = true - rng.uniform(0.0, 0.05, count)  # the cheap bounds: below the truth
+        tolerance = 1e-6
+        exact = np.where(known, true + rng.uniform(0.0, tolerance, count), bounds)  # coal's, a hair above
+        values = with_neighbours(exact, known, bounds, reach, tolerance)
+        np.testing.assert_array_equal(values[known], exact[known])
+        assert np.all(values[~known] <= true[~known] + 1e-12)  # never above the truth
+        assert np.all(values >= bounds)  # never worse than the cheap bound
+        # and exactly the better of the two where both exist (the rule's definition)
+        best = np.maximum(bounds, propagated_bounds(exact, known, reach) - tolerance)
+        np.testing.assert_array_equal(values[~known], best[~known])
