@@ -76,6 +76,13 @@ def _number(value: float | None, what: str, low: float, high: float, unit: str) 
     return x
 
 
+def placement(xyz: ArrayLike, rpy: ArrayLike) -> Any:
+    """The ``pinocchio.SE3`` of a frame at ``xyz`` [m], turned by ``rpy`` about fixed x, y, z [rad]."""
+    import pinocchio as pin  # imported when geometry is built: reading a scene needs neither
+
+    return pin.SE3(pin.rpy.rpyToMatrix(*np.asarray(rpy, dtype=float)), np.array(xyz, dtype=float))
+
+
 @dataclass(frozen=True, eq=False)
 class Obstacle:
     """A static obstacle: a shape, its dimensions and its pose in the world frame.
@@ -247,10 +254,7 @@ class Obstacle:
     @property
     def placement(self) -> Any:
         """Pose ``obstacle_in_world`` as a ``pinocchio.SE3``."""
-        import pinocchio as pin  # imported when geometry is built: reading a scene needs neither
-
-        rotation = pin.rpy.rpyToMatrix(*self.rpy)
-        return pin.SE3(rotation, np.array(self.xyz))
+        return placement(self.xyz, self.rpy)
 
     def geometry(self) -> Any:
         """A new coal collision geometry of this obstacle in its local frame."""

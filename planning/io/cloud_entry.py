@@ -14,11 +14,11 @@ from pathlib import Path
 from typing import Annotated, Literal
 
 import numpy as np
-import pinocchio as pin
 from pydantic import Field, model_validator
 
 import cpr_kin as ck
 from cpr_kin.errors import ObstacleError
+from cpr_kin.obstacles import placement
 from cpr_kin.octree_files import SUFFIXES as OCTREE_SUFFIXES
 from cpr_kin.octree_files import read_octree
 from cpr_kin.point_clouds import (
@@ -125,7 +125,7 @@ def cloud_obstacles(
         points, resolution_m = checked_voxels(points, resolution_m, f"point cloud '{name}'")
         centres = voxel_centres(points, resolution_m)
         padding_m = robot_at_start.padding_m if item.filter_padding is None else item.filter_padding
-        cloud_in_world = pin.SE3(pin.rpy.rpyToMatrix(*item.rpy), np.asarray(item.xyz, dtype=float))
+        cloud_in_world = placement(item.xyz, item.rpy)  # as each block of it is placed
         keep = clear_of_robot(
             robot_at_start.robot, robot_at_start.q, centres, resolution_m, padding_m, cloud_in_world
         )
