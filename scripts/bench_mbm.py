@@ -217,6 +217,7 @@ def theirs_roboplan(scene_path: str, timeout_s: float) -> dict[str, Any]:
     (roboplan's samples, linearly interpolated), and our certified checks of its path.
     """
     from planning.peers.ruckig_bound import free_space_bound
+    from planning.peers.toppra_timing import sampled_jerk
 
     scene, robot = _robot(scene_path)
     peer = _PEER_SCENES[scene_path]
@@ -228,7 +229,7 @@ def theirs_roboplan(scene_path: str, timeout_s: float) -> dict[str, Any]:
     def timed(t: np.ndarray, order: int) -> np.ndarray:
         return np.column_stack([np.interp(t, times, column) for column in values[order].T])
 
-    jerk = np.abs(np.diff(values[2], axis=0) / np.diff(times)[:, None]) / robot.limits.jerk
+    jerk = np.abs(sampled_jerk(times, values[2])) / robot.limits.jerk
     return {
         "ok": True,
         "time_s": result.planning_time_s,

@@ -178,17 +178,16 @@ class RoboplanPeer:
         world, scene = self.problem.world, self.problem.scene
         steps_m = (scene.planner.verify_step_m * step_share, scene.planner.self_step_m * step_share)
         for a, b in itertools.pairwise(waypoints):
-            speed = np.abs(b - a)
+            if not ck.check_segment(world, a, b, scene.safety_margin, steps_m[0]).accepted:
+                return False
 
             def segment(t: FloatArray, a: FloatArray = a, b: FloatArray = b) -> FloatArray:
                 return np.asarray(a + np.asarray(t)[:, None] * (b - a))
 
-            if not ck.check_curve(world, segment, 0.0, 1.0, speed, scene.safety_margin, steps_m[0]).accepted:
-                return False
             if (
                 world.self_collision
                 and not check_self_curve(
-                    world.self_collision, segment, (0.0, 1.0), speed, scene.self_margin, steps_m[1]
+                    world.self_collision, segment, (0.0, 1.0), np.abs(b - a), scene.self_margin, steps_m[1]
                 ).accepted
             ):
                 return False

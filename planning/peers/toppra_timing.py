@@ -155,7 +155,7 @@ def time_and_verify(
         )
         if not self_check.accepted:
             check = dataclasses.replace(check, accepted=False, certified_min_m=self_check.certified_min_m)
-    jerk = np.diff(np.asarray(timed(dense, 2)), axis=0) / np.diff(dense)[:, None]
+    jerk = sampled_jerk(dense, np.asarray(timed(dense, 2)))
     length = float(np.linalg.norm(np.diff(positions / limits.range, axis=0), axis=1).sum())
     inside = bool(np.all(positions >= limits.lower - 1e-9) and np.all(positions <= limits.upper + 1e-9))
     reason = (
@@ -179,6 +179,15 @@ def time_and_verify(
         planning_time_s=time.perf_counter() - started,
         timed=timed,
     )
+
+
+def sampled_jerk(times: FloatArray, accelerations: FloatArray) -> FloatArray:
+    """``(K - 1, nq)`` the jerk between samples ``times`` ``(K,)`` [s] of ``accelerations`` ``(K, nq)``.
+
+    Finite differences: a TOPP-RA trajectory's acceleration jumps at its knots, and this
+    measures its finite pieces (the peers' "jerk over the limit").
+    """
+    return np.asarray(np.diff(accelerations, axis=0) / np.diff(times)[:, None])
 
 
 class PchipPath:
