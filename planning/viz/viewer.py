@@ -77,30 +77,14 @@ def _shape_objects(obstacle: ck.Obstacle, grow: float) -> list[tuple[Any, FloatA
     return [(g.TriangularMeshGeometry(vertices, np.asarray(mesh.faces)), np.eye(4))]
 
 
-CUBE_CORNERS = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
-CUBE_FACES = np.array(
-    [
-        [0, 1, 3],
-        [0, 3, 2],
-        [4, 6, 7],
-        [4, 7, 5],
-        [0, 4, 5],
-        [0, 5, 1],
-        [2, 3, 7],
-        [2, 7, 6],
-        [0, 2, 6],
-        [0, 6, 4],
-        [1, 5, 7],
-        [1, 7, 3],
-    ]
-)
-"""A cube's eight corners (index: 4 x + 2 y + z of their signs) and its twelve triangles."""
-
-
 def _cubes(centres: FloatArray, half_m: float) -> tuple[FloatArray, NDArray[np.int64]]:
     """One triangle mesh of the cubes of half side ``half_m`` about ``centres`` (a cloud's voxels)."""
-    vertices = (centres[:, None, :] + half_m * CUBE_CORNERS[None]).reshape(-1, 3)
-    faces = (CUBE_FACES[None] + 8 * np.arange(len(centres))[:, None, None]).reshape(-1, 3)
+    import trimesh
+
+    cube = trimesh.creation.box(extents=(2 * half_m,) * 3)  # 8 corners, 12 triangles facing out
+    corners, triangles = np.asarray(cube.vertices), np.asarray(cube.faces)
+    vertices = (centres[:, None, :] + corners[None]).reshape(-1, 3)
+    faces = (triangles[None] + len(corners) * np.arange(len(centres))[:, None, None]).reshape(-1, 3)
     return vertices, faces
 
 
