@@ -8,11 +8,12 @@ obstacle.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from cpr_kin.robot import GROUPS
+from cpr_kin.robot import GROUPS, RobotGeometry
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -38,6 +39,19 @@ class PairDistance:
     distance_m: float
     point_on_robot: FloatArray
     point_on_obstacle: FloatArray
+
+    @classmethod
+    def of(
+        cls, result: Any, geometry: RobotGeometry, obstacle: str, distance_m: float, voxels: bool
+    ) -> PairDistance:
+        """The pair's distance from coal's ``DistanceResult`` of robot (first) and obstacle.
+
+        coal gives an OcTree's point first, as first or second shape: for ``voxels`` they swap.
+        """
+        near = [np.array(result.getNearestPoint1()), np.array(result.getNearestPoint2())]
+        if voxels:
+            near.reverse()
+        return cls(geometry.name, obstacle, geometry.group, distance_m, near[0], near[1])
 
 
 @dataclass(frozen=True)

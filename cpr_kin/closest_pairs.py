@@ -19,6 +19,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
+from cpr_kin.exact_pairs import ExactPairs
 from cpr_kin.pair_bounds import BOUND_TOLERANCE_M
 
 FloatArray = NDArray[np.float64]
@@ -35,6 +36,8 @@ def closest_pairs(
     pair_index: IntArray,
     below_m: float = np.inf,
     offsets_m: FloatArray | None = None,
+    exact: ExactPairs | None = None,
+    exact_below_m: float = np.inf,
 ) -> tuple[FloatArray, IntArray]:
     """Smallest coal distance [m] over the pairs at each configuration, and its pair.
 
@@ -49,9 +52,16 @@ def closest_pairs(
         pair_index: ``(P,)`` the pairs' indices in ``geometry_model.collisionPairs``.
         below_m: only distances below this matter [m]: pairs bounded above it are not
             computed, and where the smallest distance is not below it, ``inf`` and ``-1``
-            are returned.
+            are returned (a distance below it on a pair's meshes is one on its hulls: the
+            depth is the hulls').
         offsets_m: ``(P,)`` added to each pair's coal distance [m] (its bound includes it);
             a pair with a positive offset is always computed.
+        exact: the geometry model's pairs on the robot's exact meshes: a pair that may be
+            the closest is measured on them where it has one
+            (:meth:`cpr_kin.exact_pairs.ExactPairs.settled`); its distance is no smaller, so the
+            bounds still hold.
+        exact_below_m: distances at or above this [m] need not be exact: a pair whose meshes
+            are that far apart counts as that far (a lower bound).
 
     Returns:
         The distance and the pair's index in ``geometry_model.collisionPairs`` (``-1``: none
@@ -68,6 +78,8 @@ def closest_pairs(
     certain = np.take_along_axis(bounds, order, axis=1) - BOUND_TOLERANCE_M
     certain[certain <= 0.0] = -np.inf
     pairs, extra = pair_index.tolist(), offsets.tolist()
+    refined = exact.refined.tolist() if exact else []
+    on_meshes = exact.settled if exact else None
     place, compute = pin.updateGeometryPlacements, pin.computeDistance
     for k in range(len(batch)):
         row = certain[k]
@@ -78,9 +90,14 @@ def closest_pairs(
         for bound, column in zip(row.tolist(), order[k].tolist(), strict=True):
             if bound >= limit:
                 break  # no pair left can be closer
-            found = compute(geometry_model, geometry_data, pairs[column]).min_distance + extra[column]
+            pair = pairs[column]
+            found = compute(geometry_model, geometry_data, pair).min_distance
+            ceiling = min(limit, exact_below_m) - extra[column]
+            if on_meshes is not None and refined[pair] and found < ceiling:
+                found = on_meshes(geometry_data, pair, found, ceiling, below_m - extra[column])
+            found += extra[column]
             if found < best:
-                best, which, limit = found, pairs[column], min(found, below_m)
+                best, which, limit = found, pair, min(found, below_m)
         if best < below_m:
             distance[k], closest[k] = best, which
     return distance, closest

@@ -3,14 +3,16 @@
 A :class:`CollisionWorld` adds the obstacles to a copy of the robot's Pinocchio geometry
 model and registers robot-obstacle pairs only (the robot never tests itself). Distances are
 signed: negative values are penetration depths (into a point cloud's voxels, at most a voxel's).
+A concave link is measured on its exact mesh where its hull comes near (:mod:`cpr_kin.exact_pairs`).
 The clearance of a group is the smallest distance between any of its geometries and any
 obstacle. Distances are accurate to about 1e-6 of their size (coal's GJK tolerance).
 """
 
 from __future__ import annotations
 
+import copy
+import dataclasses
 import os
-from collections import Counter
 from collections.abc import Sequence
 
 import numpy as np
@@ -20,13 +22,13 @@ from numpy.typing import ArrayLike, NDArray
 from cpr_kin.clearance import BatchClearance, Clearance, PairDistance
 from cpr_kin.closest_pairs import closest_pairs
 from cpr_kin.errors import CprKinError
+from cpr_kin.exact_pairs import ExactPairs
 from cpr_kin.obstacle_pools import ObstaclePools
-from cpr_kin.obstacles import Obstacle
+from cpr_kin.obstacles import Obstacle, checked_obstacles
 from cpr_kin.pair_bounds import BOUND_TOLERANCE_M, PairBounds
-from cpr_kin.reach import pair_reach_distances, robot_reach
+from cpr_kin.reach import pair_reach_distances
 from cpr_kin.robot import GROUPS, Robot
-from cpr_kin.self_collision import SelfCollision
-from cpr_kin.self_screen import robot_self_screen
+from cpr_kin.world_self_pairs import world_self_collision
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -63,17 +65,8 @@ class CollisionWorld:
     ) -> None:
         if not (np.isfinite(self_margin_m) and self_margin_m >= 0.0):
             raise CprKinError(f"self_margin_m = {self_margin_m} m must be a finite distance >= 0")
-        strangers = [type(o).__name__ for o in obstacles if not isinstance(o, Obstacle)]
-        if strangers:  # e.g. names or dicts, which failed deep inside
-            raise CprKinError(
-                f"obstacles hold {len(strangers)} item(s) that are not cpr_kin.Obstacle "
-                f"(a {strangers[0]}); make them with Obstacle.box, .sphere, .cylinder, ..."
-            )
-        duplicated = sorted(n for n, count in Counter(o.name for o in obstacles).items() if count > 1)
-        if duplicated:
-            raise CprKinError(f"obstacle names must be unique; {duplicated} appear more than once")
         self.robot = robot
-        self.obstacles = tuple(obstacles)
+        self.obstacles = checked_obstacles(obstacles)
         self.num_threads = num_threads or min(2, os.cpu_count() or 1)
         model = robot.collision_model.copy()
         obstacle_ids = []
@@ -94,28 +87,23 @@ class CollisionWorld:
         )
         self._data = robot.model.createData()
         self._all = model.createData()
+        self._exact = ExactPairs(model, robot.exact_meshes)
         self._pools = ObstaclePools(
-            robot.model, model, np.array([k for _, k in pairs], dtype=np.int64), self.num_threads
+            robot.model, model, np.array([k for _, k in pairs], dtype=np.int64), self.num_threads, self._exact
         )
         self._reach_distance = pair_reach_distances(robot, self.obstacles, self._pairs)
         self._pair_bounds: dict[tuple[bool, ...], PairBounds] = {}
         self._within: dict[float, tuple[BoolArray, PairBounds | None]] = {}
-        allowed = {frozenset(pair) for pair in allowed_pairs}
-        links = [g.link for g in robot.geometries]
-        kept = tuple((a, b) for a, b in robot.self_pairs if frozenset((links[a], links[b])) not in allowed)
-        names = [g.name for g in robot.geometries]
-        radii = np.array([r.radii for r in robot_reach(robot)])
-        contact_only = {c.geometries for c in robot.close_pairs if c.held_to_contact(self_margin_m)}
-        self.self_collision = SelfCollision(
-            robot.model,
-            robot.collision_model,
-            kept,
-            names,
-            self.num_threads,
-            geometry_radii=radii,
-            allowance_m=np.array([self_margin_m if pair in contact_only else 0.0 for pair in kept]),
-            screen=robot_self_screen(robot, kept) if kept else None,
-        )
+        self.self_collision = world_self_collision(robot, allowed_pairs, self_margin_m, self.num_threads)
+
+    def on_hulls(self) -> CollisionWorld:
+        """The world with its robot's hulls deciding alone, sharing its data (use one at a time)."""
+        hulls = copy.copy(self)
+        hulls.robot = dataclasses.replace(self.robot, exact_meshes={})
+        hulls._exact = ExactPairs(self.geometry_model, {})
+        hulls._pools = self._pools.on_hulls()
+        hulls.self_collision = self.self_collision.on_hulls()
+        return hulls
 
     @property
     def pairs(self) -> tuple[tuple[str, str, str], ...]:
@@ -124,26 +112,23 @@ class CollisionWorld:
         return tuple((geoms[g].name, self.obstacles[k].name, geoms[g].group) for g, k in self._pairs)
 
     def clearance(self, q: ArrayLike) -> Clearance:
-        """Signed distance of every robot-obstacle pair at configuration ``q`` [rad, m]."""
+        """Signed distance of every robot-obstacle pair at configuration ``q`` [rad, m].
+
+        On the exact meshes for each pair that may be its group's closest; the others' the hulls'.
+        """
         q_arr = self.robot.configuration(q, check_limits=False)
         pin.computeDistances(self.robot.model, self._data, self.geometry_model, self._all, q_arr)
         pairs = []
         group_min = {g: float("inf") for g in GROUPS}
-        for (g, k), result in zip(self._pairs, self._all.distanceResults, strict=True):
+        hulls = np.array([r.min_distance for r in self._all.distanceResults])
+        ask = self._exact.may_be_closest(hulls, self._pair_group)
+        for p, ((g, k), result) in enumerate(zip(self._pairs, self._all.distanceResults, strict=True)):
             geometry, distance = self.robot.geometries[g], float(result.min_distance)
-            near = [np.array(result.getNearestPoint1()), np.array(result.getNearestPoint2())]
-            if self.obstacles[k].shape == "voxels":  # coal gives an OcTree's point first, as o1 or o2
-                near.reverse()
-            pairs.append(
-                PairDistance(
-                    robot_geometry=geometry.name,
-                    obstacle=self.obstacles[k].name,
-                    group=geometry.group,
-                    distance_m=distance,
-                    point_on_robot=near[0],
-                    point_on_obstacle=near[1],
-                )
-            )
+            measured = self._exact.measured(self._all, p, distance) if ask[p] else None
+            if measured is not None:
+                result, distance = measured, max(float(measured.min_distance), distance)
+            voxels = self.obstacles[k].shape == "voxels"
+            pairs.append(PairDistance.of(result, geometry, self.obstacles[k].name, distance, voxels))
             group_min[geometry.group] = min(group_min[geometry.group], distance)
         return Clearance(q=q_arr, pairs=tuple(pairs), group_clearance_m=group_min)
 
@@ -160,14 +145,17 @@ class CollisionWorld:
             clearance[:, group_index], closest[:, group_index] = self.group_clearance(batch, group_index)
         return BatchClearance(clearance_m=clearance, closest_pair=closest)
 
-    def group_clearance(self, q: ArrayLike, group_index: int) -> tuple[FloatArray, IntArray]:
+    def group_clearance(
+        self, q: ArrayLike, group_index: int, exact_below_m: float = np.inf
+    ) -> tuple[FloatArray, IntArray]:
         """Clearance [m] of group ``GROUPS[group_index]`` at configurations ``q`` ``(N, nq)``, by coal.
 
         Also the index of the closest pair per configuration; ``inf`` and ``-1`` for a group
         with no pair. coal's distance of the closest pair; the pairs are visited in the
         order of their bounds and only those that may be closest are computed
         (:func:`cpr_kin.closest_pairs.closest_pairs`). The bounds are the group's columns of
-        every pair's: the world builds them once, for :meth:`clearance_lower_bounds` too.
+        every pair's: the world builds them once, for :meth:`clearance_lower_bounds` too. A
+        distance at or above ``exact_below_m`` [m] may be reported as that (a lower bound).
         """
         batch = self._check_batch(q)
         columns = self._pair_group == group_index
@@ -175,7 +163,17 @@ class CollisionWorld:
             return np.full(len(batch), np.inf), np.full(len(batch), -1, dtype=np.int64)
         bounds = self._every_pair_bounds()(batch)[:, columns]
         model, data, pairs = self.robot.model, self._data, np.flatnonzero(columns)
-        return closest_pairs(model, data, self.geometry_model, self._all, batch, bounds, pairs)
+        return closest_pairs(
+            model,
+            data,
+            self.geometry_model,
+            self._all,
+            batch,
+            bounds,
+            pairs,
+            exact=self._exact,
+            exact_below_m=exact_below_m,
+        )
 
     def clearance_lower_bounds(self, q: ArrayLike) -> FloatArray:
         """``(N, len(GROUPS))`` lower bounds [m] of each group's clearance at ``q`` ``(N, nq)``.
@@ -213,15 +211,9 @@ class CollisionWorld:
             raise CprKinError(f"distance bound {below_m} m must be finite")
         near, bounds = self._pairs_within(below_m)
         values = np.empty((len(batch), 0)) if bounds is None else bounds(batch)
+        model, data, pairs = self.robot.model, self._data, np.flatnonzero(near)
         return closest_pairs(
-            self.robot.model,
-            self._data,
-            self.geometry_model,
-            self._all,
-            batch,
-            values,
-            np.flatnonzero(near),
-            below_m,
+            model, data, self.geometry_model, self._all, batch, values, pairs, below_m, exact=self._exact
         )
 
     def _check_batch(self, q: ArrayLike) -> FloatArray:
@@ -291,9 +283,7 @@ class CollisionWorld:
     def _bounds(self, active: tuple[bool, ...]) -> PairBounds:
         """The pair bounds of the ``active`` pairs, built once per set of pairs."""
         if active not in self._pair_bounds:
-            pairs = [
-                pair for pair, on in zip(self._pairs, active, strict=True) if on
-            ]  # (geometry index, obstacle)
+            pairs = [pair for pair, on in zip(self._pairs, active, strict=True) if on]  # (geometry, obstacle)
             robot = self.robot
             self._pair_bounds[active] = PairBounds(robot.model, robot.collision_model, self.obstacles, pairs)
         return self._pair_bounds[active]

@@ -18,6 +18,8 @@ Loading, in order:
    :attr:`Robot.limits_defaulted`);
 6. every mesh of the collision model becomes its convex hull, which contains it (a clearance
    to the hull is at most the clearance to the mesh: safe) and gives coal signed distances;
+   where a hull reaches beyond its mesh by more than a millimetre, the mesh is kept and decides
+   wherever the hull comes within a margin (:mod:`cpr_kin.exact_meshes`);
 7. the collision geometries form two groups: ``effector`` (the links given, by default those
    the last planned joint before the tool frame moves alone, or the nearest joint above it
    whose links have collision geometry) and ``links`` (the rest).
@@ -37,6 +39,7 @@ from lxml import etree
 from cpr_kin.arm import ArmChain, arm_chain, default_joints
 from cpr_kin.close_pairs import close_pairs
 from cpr_kin.errors import UrdfError
+from cpr_kin.exact_meshes import exact_meshes
 from cpr_kin.geometry_groups import carried_alone, grouped_geometries
 from cpr_kin.limits import LIMITS_NAMES, JointLimits, find_limits_file, read_dynamic_limits
 from cpr_kin.overlapping_pairs import overlapping_pairs
@@ -141,7 +144,7 @@ class RobotSpec:
             effort=np.array(model.effortLimit, dtype=float),
         )
         check_limits(limits, joint_units(model), path)
-        capsule_meshes = convex_hulls(collision)
+        meshes = convex_hulls(collision)
         srdf = self.srdf or find_srdf(path, tree.getroot().get("name")) or self.default_srdf
         links = {f.name for f in model.frames}
         srdf_pairs = read_srdf(srdf, links) if srdf is not None else SrdfPairs(frozenset())
@@ -175,7 +178,8 @@ class RobotSpec:
             close_pairs=close_pairs(model, collision, kept, [g.link for g in geometries]),
             srdf_unknown_links=srdf_pairs.unknown_links,
             massless_links=massless_links(tree, model),
-            capsule_meshes=capsule_meshes,
+            capsule_meshes=tuple(collision.geometryObjects[m.geometry].name for m in meshes if not m.hull),
+            exact_meshes=exact_meshes(meshes),
         )
 
     def _planned(self, model: Any, tree: etree._ElementTree, path: Path, arm: ArmChain) -> tuple[str, ...]:

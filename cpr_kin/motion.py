@@ -147,7 +147,7 @@ def check_curve(
         )
     times = np.linspace(t0, t1, max(count, 2))  # at least both ends
     slack = interval_motion(times, point_speed, interval_speed)
-    batch = decisive_clearance(world, curve(times), slack)
+    batch = decisive_clearance(world, curve(times), slack, margin_m + float(np.max(slack, initial=0.0)))
     per_group = batch.clearance_m
     # lower bound between neighbouring samples: distances change no faster than the robot moves
     group_bound = certified(per_group, slack).min(axis=0)
@@ -172,7 +172,9 @@ def check_curve(
     )
 
 
-def decisive_clearance(world: CollisionWorld, q: FloatArray, slack_m: float | FloatArray) -> BatchClearance:
+def decisive_clearance(
+    world: CollisionWorld, q: FloatArray, slack_m: float | FloatArray, exact_below_m: float = np.inf
+) -> BatchClearance:
     """Per-group clearance of the samples ``q`` ``(K, nq)`` of a curve, exact where it decides the check.
 
     :func:`check_curve` needs, per group, the smallest certified value
@@ -186,7 +188,10 @@ def decisive_clearance(world: CollisionWorld, q: FloatArray, slack_m: float | Fl
     and each exact value bounds its neighbours (its value less the motion between them, less
     coal's own tolerance), until the minima are exact. Values computed from lower bounds are
     at most the true ones, so a minimum found exactly is the true minimum. Elsewhere
-    :attr:`clearance_m` holds the best lower bound and :attr:`closest_pair` ``-1``.
+    :attr:`clearance_m` holds the best lower bound and :attr:`closest_pair` ``-1``. A value at
+    or above ``exact_below_m`` [m] need not be exact (a link's exact mesh that far from an
+    obstacle counts as that far, :meth:`~cpr_kin.CollisionWorld.group_clearance`): a check whose
+    margin plus slack is below it decides the same.
     """
     bounds = world.clearance_lower_bounds(q)
     values = bounds.copy()
@@ -200,7 +205,7 @@ def decisive_clearance(world: CollisionWorld, q: FloatArray, slack_m: float | Fl
             rows = rows[:: COARSE_STRIDE if rows.size >= COARSE_BELOW else 1]
             if rows.size:
                 values[rows, group_index], closest[rows, group_index] = world.group_clearance(
-                    q[rows], group_index
+                    q[rows], group_index, exact_below_m
                 )
                 known[rows, group_index] = True
                 values[:, group_index] = with_neighbours(

@@ -7,16 +7,21 @@ most of coal's time went to pairs the bounds had already cleared. So each obstac
 own Pinocchio ``GeometryPool`` with only its pairs active, built the first time a
 configuration is uncertain about it, and a configuration goes only to the pools of the
 obstacles its bounds are uncertain about. The answer is the same: a pair of another
-obstacle is certainly farther than the margin.
+obstacle is certainly farther than the margin. Where a pool's pairs include a link whose exact
+mesh decides (:mod:`cpr_kin.exact_pairs`), the configurations its hull test flags are decided
+again with the meshes.
 """
 
 from __future__ import annotations
 
+import copy
 from typing import Any
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
+
+from cpr_kin.exact_pairs import ExactPairs
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -47,14 +52,30 @@ class ObstaclePools:
         geometry_model: the world's geometry model (robot and obstacles, every pair added).
         pair_obstacle: ``(P,)`` the obstacle of each of its collision pairs.
         num_threads: threads of coal's batches.
+        exact: the pairs on the robot's exact meshes (default: none decides).
     """
 
-    def __init__(self, model: Any, geometry_model: Any, pair_obstacle: IntArray, num_threads: int) -> None:
+    def __init__(
+        self,
+        model: Any,
+        geometry_model: Any,
+        pair_obstacle: IntArray,
+        num_threads: int,
+        exact: ExactPairs | None = None,
+    ) -> None:
         self.model, self.geometry_model, self.num_threads = model, geometry_model, num_threads
         self._pair_obstacle = pair_obstacle
+        self._exact = exact if exact else None
         self._data = model.createData()
+        self._exact_data: Any = None
         self._pools: dict[int, Any] = {}
         self._margin_m: dict[int, float] = {}
+
+    def on_hulls(self) -> ObstaclePools:
+        """The pools with the hulls deciding alone (:meth:`cpr_kin.CollisionWorld.on_hulls`)."""
+        hulls = copy.copy(self)
+        hulls._exact = None
+        return hulls
 
     def violated(
         self,
@@ -88,19 +109,29 @@ class ObstaclePools:
         for obstacle in np.flatnonzero(uncertain.any(axis=0)).tolist():
             rows = np.flatnonzero(uncertain[:, obstacle] & ~violated)
             if rows.size:
-                pool = self._prepared(obstacle, margin_m, near)
-                violated[rows] = pool_collisions(
-                    pool, self.model, self._data, self.geometry_model, batch[rows], self.num_threads
-                )
+                violated[rows] = self._tested(obstacle, batch[rows], margin_m, near, self.num_threads)
         return violated
 
     def _one_violated(self, one: FloatArray, obstacles: list[int], margin_m: float, near: BoolArray) -> bool:
         """Whether the configuration ``one`` ``(1, nq)`` violates the margin of one of ``obstacles``."""
-        for obstacle in obstacles:
-            pool = self._prepared(obstacle, margin_m, near)
-            if pool_collisions(pool, self.model, self._data, self.geometry_model, one, 1)[0]:
-                return True
-        return False
+        return any(self._tested(obstacle, one, margin_m, near, 1)[0] for obstacle in obstacles)
+
+    def _tested(
+        self, obstacle: int, batch: FloatArray, margin_m: float, near: BoolArray, num_threads: int
+    ) -> BoolArray:
+        """``(N,)`` coal's test of ``obstacle``'s pairs at ``batch``: the hulls flag, the meshes decide."""
+        pool = self._prepared(obstacle, margin_m, near)
+        flagged = pool_collisions(pool, self.model, self._data, self.geometry_model, batch, num_threads)
+        active = np.flatnonzero(near & (self._pair_obstacle == obstacle))
+        if self._exact is None or not flagged.any() or not self._exact.refined[active].any():
+            return flagged
+        if self._exact_data is None:
+            self._exact_data = self.geometry_model.createData()
+        rows = np.flatnonzero(flagged)
+        margins = np.full(len(self._pair_obstacle), margin_m)
+        found = (self.model, self._data, self.geometry_model, self._exact_data, batch[rows])
+        flagged[rows] = self._exact.violated(*found, active.tolist(), margins)
+        return flagged
 
     def _prepared(self, obstacle: int, margin_m: float, near: BoolArray) -> Any:
         """The obstacle's pool, built once, its margin and active pairs set when the margin changes."""

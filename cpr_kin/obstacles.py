@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+from collections import Counter
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
@@ -10,7 +12,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from cpr_kin.errors import ObstacleError
+from cpr_kin.errors import CprKinError, ObstacleError
 from cpr_kin.names import shown, unprintable
 from cpr_kin.user_files import UserFileError, read_bytes
 
@@ -275,3 +277,22 @@ class Obstacle:
         from cpr_kin.mesh_geometry import mesh_geometry
 
         return mesh_geometry(self)
+
+
+def checked_obstacles(obstacles: Sequence[Obstacle]) -> tuple[Obstacle, ...]:
+    """``obstacles`` as a tuple, each an :class:`Obstacle` and each name once.
+
+    Raises:
+        CprKinError: an item that is no obstacle (names or dicts, which fail deep inside), or
+            a name given twice.
+    """
+    strangers = [type(o).__name__ for o in obstacles if not isinstance(o, Obstacle)]
+    if strangers:
+        raise CprKinError(
+            f"obstacles hold {len(strangers)} item(s) that are not cpr_kin.Obstacle "
+            f"(a {strangers[0]}); make them with Obstacle.box, .sphere, .cylinder, ..."
+        )
+    duplicated = sorted(n for n, count in Counter(o.name for o in obstacles).items() if count > 1)
+    if duplicated:
+        raise CprKinError(f"obstacle names must be unique; {duplicated} appear more than once")
+    return tuple(obstacles)

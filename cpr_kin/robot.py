@@ -22,6 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.close_pairs import ClosePair
 from cpr_kin.errors import CprKinError, JointLimitError
+from cpr_kin.exact_meshes import ExactMesh
 from cpr_kin.frames import frame_index
 from cpr_kin.limits import JointLimits
 
@@ -82,6 +83,9 @@ class Robot:
             (massless, the URDF's rule; :mod:`cpr_kin.dynamics`).
         capsule_meshes: collision geometries whose convex hull coal cannot hold (a vertex
             with more than 255 neighbours), checked as their bounding capsule instead.
+        exact_meshes: by geometry index, the link meshes their shapes (hulls, capsules) exceed
+            by more than :data:`cpr_kin.exact_meshes.REFINED_ABOVE_M`: those shapes are bounds,
+            and the meshes decide where they come within a margin (:mod:`cpr_kin.exact_pairs`).
 
     """
 
@@ -104,6 +108,7 @@ class Robot:
     close_pairs: tuple[ClosePair, ...] = ()
     massless_links: tuple[str, ...] = ()
     capsule_meshes: tuple[str, ...] = ()
+    exact_meshes: Mapping[int, ExactMesh] = field(default_factory=dict)
 
     @cached_property
     def visual_model(self) -> Any:

@@ -15,7 +15,8 @@ a curve counts (:mod:`cpr_kin.self_curve`).
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+import copy
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -26,6 +27,8 @@ from lxml import etree
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import CprKinError, UrdfError
+from cpr_kin.exact_meshes import ExactMesh
+from cpr_kin.exact_pairs import ExactPairs
 from cpr_kin.names import cut
 from cpr_kin.reach import geometry_reach
 from cpr_kin.self_curve import relative_radii
@@ -174,6 +177,9 @@ class SelfCollision:
             bound or margin is asked (:attr:`allowance_m`); default none.
         screen: the pairs' near/far split and bounds (:class:`~cpr_kin.self_screen.SelfScreen`);
             by default built on the first query.
+        exact_meshes: the robot's exact link meshes by geometry index
+            (:attr:`cpr_kin.Robot.exact_meshes`): where a hull comes within a margin, the mesh
+            decides (:mod:`cpr_kin.exact_pairs`). Default: none.
     """
 
     def __init__(
@@ -186,6 +192,7 @@ class SelfCollision:
         geometry_radii: FloatArray | None = None,
         allowance_m: FloatArray | None = None,
         screen: SelfScreen | None = None,
+        exact_meshes: Mapping[int, ExactMesh] | None = None,
     ) -> None:
         self.model = model
         self.geometry_model = collision_model.copy()
@@ -213,6 +220,7 @@ class SelfCollision:
         self._names = names
         self.num_threads = num_threads
         self._screen = screen
+        self._exact = ExactPairs(self.geometry_model, exact_meshes or {})
         self._test: ScreenedSelfTest | None = None  # built on the first query
 
     @property
@@ -234,9 +242,13 @@ class SelfCollision:
             return np.full(len(batch), np.inf), np.full(len(batch), -1, dtype=np.int64)
         return self._screened().distances(batch)
 
-    def pair_distances(self, q: FloatArray, pair: int) -> FloatArray:
-        """``(N,)`` coal's distance [m] of pair ``pair`` (index in :attr:`pairs`) at ``q`` ``(N, nq)``."""
-        return self._screened().pair_distances(np.atleast_2d(np.asarray(q, dtype=float)), pair)
+    def pair_distances(self, q: FloatArray, pair: int, exact_below_m: float = np.inf) -> FloatArray:
+        """``(N,)`` coal's distance [m] of pair ``pair`` (index in :attr:`pairs`) at ``q`` ``(N, nq)``.
+
+        Measured on the exact meshes (:mod:`cpr_kin.exact_pairs`) where the hulls' distance is
+        below ``exact_below_m`` [m]; above it, the hulls' (a lower bound).
+        """
+        return self._screened().pair_distances(np.atleast_2d(np.asarray(q, dtype=float)), pair, exact_below_m)
 
     def bounds(self, q: FloatArray) -> FloatArray:
         """``(N, P)`` lower bounds [m] of every pair's distance at ``q`` ``(N, nq)`` (:meth:`pair_bounds`)."""
@@ -263,10 +275,24 @@ class SelfCollision:
             return np.zeros(len(batch), dtype=bool)
         return self._screened().violated(batch, margin_m)
 
+    def on_hulls(self) -> SelfCollision:
+        """The pairs with the hulls deciding alone (:meth:`cpr_kin.CollisionWorld.on_hulls`)."""
+        hulls = copy.copy(self)
+        hulls._exact = ExactPairs(self.geometry_model, {})
+        if self._pairs:
+            hulls._test = self._screened().on_hulls()
+        return hulls
+
     def _screened(self) -> ScreenedSelfTest:
         """The screened coal queries of the pairs, built on first use."""
         if self._test is None:
             self._test = ScreenedSelfTest(
-                self.model, self.geometry_model, self._pairs, self.num_threads, self.allowance_m, self._screen
+                self.model,
+                self.geometry_model,
+                self._pairs,
+                self.num_threads,
+                self.allowance_m,
+                self._screen,
+                self._exact,
             )
         return self._test

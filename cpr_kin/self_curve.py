@@ -175,7 +175,9 @@ def check_self_curve(
         pair = sampled(int(p), int(counts[p]))
         if pair.certified_bound >= certified_min and pair.bounds.min() >= sampled_min:
             continue
-        values, known = _decisive_values(collision, pair, certified_min, sampled_min)
+        # where the hulls keep the margin plus a sample's slack, their distance decides as the mesh's would
+        exact_below = margin_m + float(pair.slack.max(initial=0.0))
+        values, known = _decisive_values(collision, pair, certified_min, sampled_min, exact_below)
         computed += int(known.sum())
         certified_min = min(certified_min, float(np.min(certified(values, pair.slack))))
         lowest = int(np.argmin(values))
@@ -238,13 +240,19 @@ def _samples(
 
 
 def _decisive_values(
-    collision: SelfCollision, pair: _PairSamples, certified_ceiling: float, sampled_ceiling: float
+    collision: SelfCollision,
+    pair: _PairSamples,
+    certified_ceiling: float,
+    sampled_ceiling: float,
+    exact_below_m: float = np.inf,
 ) -> tuple[FloatArray, NDArray[np.bool_]]:
     """The pair's distances [m] at its samples, exact where they decide, else lower bounds; which are exact.
 
     Decide: could lower the pair's smallest certified or sampled value below the ceilings
     (the check's minima so far) [m]. The capsules' bounds and the exact values' neighbours
-    (distances change by at most the slack per interval) bound the others.
+    (distances change by at most the slack per interval) bound the others. A value counts as
+    exact where the hulls' distance is at or above ``exact_below_m`` [m]: the meshes' distance is
+    no smaller, and the check cannot fail there.
     """
     count = len(pair.times)
     values, known = pair.bounds.copy(), np.zeros(count, dtype=bool)
@@ -258,7 +266,7 @@ def _decisive_values(
     coarse[-1] = True
     rows = np.flatnonzero(doubtful & coarse)
     while rows.size:
-        values[rows] = collision.pair_distances(pair.q[rows], pair.index)
+        values[rows] = collision.pair_distances(pair.q[rows], pair.index, exact_below_m)
         known[rows] = True
         values = with_neighbours(values, known, pair.bounds, reach, BOUND_TOLERANCE_M)
         needed = undecided(values[:, None], known[:, None], pair.slack, certified_ceiling, sampled_ceiling)

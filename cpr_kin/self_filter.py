@@ -6,7 +6,9 @@ before they become obstacles (MoveIt's self filter, roboplan's, mplib's); here a
 farther than ``padding`` [m] from every collision geometry of the robot (its carried object
 included) at the given configuration, measured by coal between the voxel's cube and the
 geometry. A voxel's centre more than ``padding`` plus its half diagonal outside a geometry's
-bounding box is clear of it without a query.
+bounding box is clear of it without a query. Where a link's exact mesh decides
+(:mod:`cpr_kin.exact_meshes`), a voxel near its hull is the robot's only if it is near the mesh
+or its centre inside it: a voxel in a concave link's hollow stays an obstacle.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.errors import CprKinError
+from cpr_kin.exact_meshes import as_transform
 from cpr_kin.robot import Robot
 
 FloatArray = NDArray[np.float64]
@@ -69,10 +72,21 @@ def clear_of_robot(
         box = shape.aabb_local
         local = (in_world - shape_in_world.translation) @ shape_in_world.rotation
         near = keep & np.all((local >= box.min_ - reach) & (local <= box.max_ + reach), axis=1)
-        shape_pose = coal.Transform3s(shape_in_world.rotation, shape_in_world.translation)
+        shape_pose = as_transform(shape_in_world)
+        mesh = robot.exact_meshes.get(geometry.index)
+        mesh_in_world = shape_in_world * mesh.mesh_in_shape if mesh is not None else None
         for k in np.flatnonzero(near):
-            result = coal.DistanceResult()
             voxel_pose = coal.Transform3s(placement.rotation, in_world[k])
-            if coal.distance(shape, shape_pose, voxel, voxel_pose, request, result) <= padding_m:
-                keep[k] = False
+            if (
+                coal.distance(shape, shape_pose, voxel, voxel_pose, request, coal.DistanceResult())
+                > padding_m
+            ):
+                continue
+            if mesh is not None and mesh_in_world is not None:
+                on_mesh = coal.distance(
+                    mesh.bvh, as_transform(mesh_in_world), voxel, voxel_pose, request, coal.DistanceResult()
+                )
+                if on_mesh > padding_m and not mesh.holds(mesh_in_world.actInv(in_world[k])[None])[0]:
+                    continue
+            keep[k] = False
     return keep

@@ -10,6 +10,7 @@ hundred pairs: ``docs/benchmarks.md``).
 
 from __future__ import annotations
 
+import copy
 import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -20,6 +21,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from cpr_kin.closest_pairs import closest_pairs
+from cpr_kin.exact_pairs import ExactPairs
 from cpr_kin.limits import sampled_configurations
 from cpr_kin.obstacle_pools import configure_pool, pool_collisions
 from cpr_kin.pair_bounds import BOUND_TOLERANCE_M
@@ -109,6 +111,8 @@ class ScreenedSelfTest:
         allowance_m: ``(P,)`` each pair's allowance [m] (default: none).
         screen: the pairs' split and bounds (default: built for them; a robot's own is
             built once, :func:`robot_self_screen`).
+        exact: the pairs on the robot's exact meshes (:mod:`cpr_kin.exact_pairs`): what the
+            hulls flag, the meshes decide; default: none decides.
     """
 
     def __init__(
@@ -119,8 +123,10 @@ class ScreenedSelfTest:
         num_threads: int,
         allowance_m: FloatArray | None = None,
         screen: SelfScreen | None = None,
+        exact: ExactPairs | None = None,
     ) -> None:
         self.model, self.geometry_model, self.num_threads = model, geometry_model, num_threads
+        self._exact = exact if exact else None
         self.allowance_m = (
             np.zeros(len(pairs)) if allowance_m is None else np.asarray(allowance_m, dtype=float)
         )
@@ -135,6 +141,12 @@ class ScreenedSelfTest:
         self._data: Any = None
         self._distance_data: Any = None
         self._margin_m = float("nan")
+
+    def on_hulls(self) -> ScreenedSelfTest:
+        """The test with the hulls deciding alone, sharing its pools and data."""
+        hulls = copy.copy(self)
+        hulls._exact = None
+        return hulls
 
     def violated(self, batch: FloatArray, margin_m: float) -> NDArray[np.bool_]:
         """``(N,)`` whether any pair is closer than ``margin_m`` [m] at configurations ``batch``."""
@@ -179,21 +191,38 @@ class ScreenedSelfTest:
         """``(N,)`` lower bounds [m] of pair ``pair``'s distance (its capsules') at ``batch``."""
         return self.all_bounds.column(batch, pair) + float(self.allowance_m[pair])
 
-    def pair_distances(self, batch: FloatArray, pair: int) -> FloatArray:
-        """``(N,)`` coal's distance [m] of pair ``pair`` (index among all pairs) at ``batch``."""
-        return self._closest(batch, np.full((len(batch), 1), -np.inf), np.array([pair], dtype=np.int64))[0]
+    def pair_distances(self, batch: FloatArray, pair: int, exact_below_m: float = np.inf) -> FloatArray:
+        """``(N,)`` coal's distance [m] of pair ``pair`` (index among all pairs) at ``batch``.
 
-    def _closest(self, batch: FloatArray, bounds: FloatArray, pairs: IntArray) -> tuple[FloatArray, IntArray]:
+        On the exact meshes where the hulls' distance is below ``exact_below_m`` [m].
+        """
+        unbounded, pairs = np.full((len(batch), 1), -np.inf), np.array([pair], dtype=np.int64)
+        return self._closest(batch, unbounded, pairs, exact_below_m)[0]
+
+    def _closest(
+        self, batch: FloatArray, bounds: FloatArray, pairs: IntArray, exact_below_m: float = np.inf
+    ) -> tuple[FloatArray, IntArray]:
         """:func:`~cpr_kin.closest_pairs.closest_pairs` of ``pairs`` (bounded by ``bounds``) at ``batch``."""
         self._prepare(float("nan"))
         data = (self.model, self._data, self.geometry_model, self._distance_data)
-        return closest_pairs(*data, batch, bounds, pairs, offsets_m=self.allowance_m[pairs])
+        offsets = self.allowance_m[pairs]
+        return closest_pairs(
+            *data, batch, bounds, pairs, offsets_m=offsets, exact=self._exact, exact_below_m=exact_below_m
+        )
 
     def _coal(self, tier: int, batch: FloatArray) -> NDArray[np.bool_]:
-        """Coal's test of the pairs of ``tier`` (0 near, 1 far) at configurations ``batch``."""
-        return pool_collisions(
+        """Coal's test of ``tier``'s pairs (0 near, 1 far) at ``batch``: the hulls flag, the meshes decide."""
+        flagged = pool_collisions(
             self._pools[tier], self.model, self._data, self.geometry_model, batch, self.num_threads
         )
+        active = np.flatnonzero(self._near if tier == 0 else self._far_on)
+        if self._exact is None or not flagged.any() or not self._exact.refined[active].any():
+            return flagged
+        rows = np.flatnonzero(flagged)
+        margins = np.maximum(self._margin_m - self.allowance_m, 0.0)
+        found = (self.model, self._data, self.geometry_model, self._distance_data, batch[rows])
+        flagged[rows] = self._exact.violated(*found, active.tolist(), margins)
+        return flagged
 
     def _prepare(self, margin_m: float) -> None:
         """Build the two pools and distance data once; set their margin and pairs when the margin changes.

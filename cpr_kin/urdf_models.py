@@ -3,7 +3,8 @@
 Every mesh of the collision model becomes its convex hull (:func:`convex_hulls`), which
 contains it: a clearance to the hull is at most the clearance to the mesh (safe), and coal
 gives signed distances between convex shapes. A hull coal cannot hold becomes the mesh's
-bounding capsule, which contains it as well.
+bounding capsule, which contains it as well. The meshes are kept: where a shape reaches far
+beyond its mesh, the mesh decides (:mod:`cpr_kin.exact_meshes`).
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from lxml import etree
 
 from cpr_kin.capsule_fit import frame_about
 from cpr_kin.errors import UrdfError
+from cpr_kin.exact_meshes import MeshSource
 from cpr_kin.pair_bounds import bounding_capsule
 from cpr_kin.urdf_file import captured_stderr
 
@@ -78,8 +80,8 @@ class VisualModel:
         return visual
 
 
-def convex_hulls(collision: Any) -> tuple[str, ...]:
-    """Replace every mesh of ``collision`` by its convex hull (module docstring, step 6).
+def convex_hulls(collision: Any) -> tuple[MeshSource, ...]:
+    """Replace every mesh of ``collision`` by its convex hull (module docstring).
 
     coal's convex shapes give a vertex at most 255 neighbours. A hull whose triangles put
     more around a vertex (a fine fan, as Centauro's pelvis has: 566) is built of polygons
@@ -88,25 +90,30 @@ def convex_hulls(collision: Any) -> tuple[str, ...]:
     (:func:`cpr_kin.pair_bounds.bounding_capsule`), which contains it too.
 
     Returns:
-        The names of the geometries replaced by a capsule.
+        Each replaced mesh (:class:`~cpr_kin.exact_meshes.MeshSource`), in geometry order;
+        ``hull`` false where a capsule replaced it.
     """
-    capsules = []
-    for obj in collision.geometryObjects:
+    sources = []
+    for index, obj in enumerate(collision.geometryObjects):
         geometry = obj.geometry
         if not isinstance(geometry, coal.BVHModelBase):
             continue
+        scale = tuple(float(s) for s in obj.meshScale)
         for keep_triangles, qhull_options in ((True, "Qt"), (False, "Qx")):
             try:
                 geometry.buildConvexHull(keep_triangles, qhull_options)
             except RuntimeError:  # "Too many neighbors."
                 continue
             obj.geometry = geometry.convex
+            sources.append(MeshSource(index, geometry, pin.SE3.Identity(), obj.meshPath, scale))
             break
         else:
             obj.geometry, in_geometry = _capsule(geometry)
             obj.placement = obj.placement * in_geometry
-            capsules.append(obj.name)
-    return tuple(capsules)
+            sources.append(
+                MeshSource(index, geometry, in_geometry.inverse(), obj.meshPath, scale, hull=False)
+            )
+    return tuple(sources)
 
 
 def _capsule(mesh: Any) -> tuple[Any, Any]:

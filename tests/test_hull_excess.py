@@ -33,8 +33,8 @@ def test_the_hull_of_two_cubes_exceeds_them_by_half_their_gap(tmp_path: Path) ->
     dumbbell.export(tmp_path / "dumbbell.stl")
     (tmp_path / "dumbbell.urdf").write_text(URDF.format(mesh=tmp_path / "dumbbell.stl"))
     base, arm = shape_excess(ck.load_robot(tmp_path / "dumbbell.urdf"))
-    assert base.kind == "convex hull" and base.mesh.endswith("dumbbell.stl")
-    assert 0.1 - base.spacing_m <= base.excess_m <= 0.1 + 1e-9
+    assert base.kind == "exact mesh" and base.mesh.endswith("dumbbell.stl")  # its hull is a bound only
+    assert 0.1 - base.spacing_m <= base.bound_excess_m <= 0.1 + 1e-9 and base.excess_m == 0.0
     assert (arm.kind, arm.excess_m) == ("box", 0.0)
 
 
@@ -45,8 +45,9 @@ def test_coal_s_distances_are_trimesh_s() -> None:
     hull = trimesh.Trimesh(vertices=mesh.vertices).convex_hull
     points = trimesh.sample.sample_surface(hull, 2000, seed=4)[0]
     distances = trimesh.proximity.ProximityQuery(mesh).on_surface(points)[1]  # type: ignore[no-untyped-call]
-    assert forearm.excess_m == pytest.approx(float(np.max(distances)), abs=1e-6)
-    assert forearm.excess_m > 0.02  # the UR forearm's hollow: why its hull refuses what it can do
+    assert forearm.bound_excess_m == pytest.approx(float(np.max(distances)), abs=1e-6)
+    assert forearm.bound_excess_m > 0.02  # the UR forearm's hollow: why its hull would refuse what it can do
+    assert (forearm.kind, forearm.excess_m) == ("exact mesh", 0.0)  # so its mesh decides
 
 
 def test_primitives_are_exact() -> None:

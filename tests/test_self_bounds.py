@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -66,7 +68,7 @@ def test_the_bounds_are_below_coals_distances(arm: ck.Robot) -> None:
 @pytest.mark.parametrize("margin_m", [0.0, 0.01, 0.05])
 def test_the_screen_gives_coals_answer(arm: ck.Robot, margin_m: float) -> None:
     collision = ck.CollisionWorld(arm, []).self_collision
-    test = ScreenedSelfTest(arm.model, collision.geometry_model, collision._pairs, 2)
+    test = ScreenedSelfTest(arm.model, collision.geometry_model, collision._pairs, 2, exact=collision._exact)
     assert len(test.near_pairs) + test.far_bounds.n_pairs == len(collision._pairs)
     q = np.random.default_rng(2).uniform(arm.limits.lower, arm.limits.upper, (500, arm.nq))
     distance, _ = collision.distances(q)
@@ -83,6 +85,8 @@ def test_the_screen_gives_coals_answer(arm: ck.Robot, margin_m: float) -> None:
 
 
 def test_the_screened_distances_are_coals_over_every_pair(arm: ck.Robot) -> None:
+    # on the hulls alone (test_exact_pairs holds the meshes to another library)
+    arm = dataclasses.replace(arm, exact_meshes={})
     collision = ck.CollisionWorld(arm, []).self_collision
     q = np.random.default_rng(3).uniform(arm.limits.lower, arm.limits.upper, (300, arm.nq))
     model, geometry_model = arm.model, collision.geometry_model

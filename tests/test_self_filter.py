@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -10,6 +11,7 @@ import pytest
 import yaml
 
 import cpr_kin as ck
+from cpr_kin.packages import example_robot
 from cpr_kin.point_clouds import voxel_centres
 from cpr_kin.self_filter import clear_of_robot
 from planning.cli import main
@@ -147,3 +149,57 @@ def test_a_filter_that_cannot_work_is_refused_naming_it(
     error = capsys.readouterr().err
     assert message in error and len(error.strip().splitlines()) == 1, error
     assert not (tmp_path / "out").exists()
+
+
+def test_a_voxel_in_a_concave_links_hollow_stays_an_obstacle() -> None:
+    # the UR5's forearm hull reaches ~40 mm beyond its mesh: voxels between them are not the robot's
+    import coal
+    import trimesh
+
+    robot = ck.load_robot(example_robot("ur5"))
+    q = np.array([0.3, -1.2, 1.4, -0.5, 0.8, 0.0])
+    data, geometry_data = robot.model.createData(), robot.collision_model.createData()
+    pin.updateGeometryPlacements(robot.model, data, robot.collision_model, geometry_data, q)
+    meshes = []
+    for index in robot.exact_meshes:
+        obj = robot.collision_model.geometryObjects[index]
+        loaded: trimesh.Trimesh = trimesh.load(obj.meshPath, force="mesh")  # type: ignore[assignment]
+        mesh = trimesh.Trimesh(loaded.vertices * obj.meshScale, loaded.faces)
+        meshes.append(mesh.apply_transform(geometry_data.oMg[index].homogeneous))
+    (forearm,) = [g.index for g in robot.geometries if g.link == "forearm_link"]
+    assert forearm in robot.exact_meshes
+    bounds = meshes[list(robot.exact_meshes).index(forearm)].bounds
+    centres = voxel_centres(
+        np.random.default_rng(8).uniform(bounds[0] - 0.05, bounds[1] + 0.05, (3000, 3)), 0.002
+    )
+    padding_m, half_diagonal = 0.01, 0.002 * np.sqrt(3.0) / 2.0
+    keep = clear_of_robot(robot, q, centres, 0.002, padding_m)
+    # the oracle: trimesh's distance from each centre to each exact mesh and its ray test of
+    # inside; coal's to the other shapes (exact already); away from the band the cube decides in
+    to_robot = np.min([trimesh.proximity.closest_point(m, centres)[1] for m in meshes], axis=0)  # type: ignore[no-untyped-call]
+    inside = np.any([m.contains(centres) for m in meshes], axis=0)
+    for g in robot.geometries:
+        if g.index not in robot.exact_meshes:
+            at = geometry_data.oMg[g.index]
+            shape, pose = (
+                robot.collision_model.geometryObjects[g.index].geometry,
+                coal.Transform3s(at.rotation, at.translation),
+            )
+            dot = coal.Sphere(1e-9)
+            to_shape = [
+                coal.distance(
+                    shape,
+                    pose,
+                    dot,
+                    coal.Transform3s(np.eye(3), c),
+                    coal.DistanceRequest(),
+                    coal.DistanceResult(),
+                )
+                for c in centres
+            ]
+            to_robot = np.minimum(to_robot, to_shape)
+    robots = inside | (to_robot < padding_m)
+    clear = ~inside & (to_robot > padding_m + half_diagonal)
+    assert not keep[robots].any() and keep[clear].all()
+    on_hulls = clear_of_robot(dataclasses.replace(robot, exact_meshes={}), q, centres, 0.002, padding_m)
+    assert (clear & ~on_hulls).sum() > 100  # what the hulls took for the robot's

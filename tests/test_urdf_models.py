@@ -43,7 +43,8 @@ def test_a_hull_coal_cannot_hold_becomes_a_capsule_containing_the_mesh() -> None
         geometry_model.addGeometryObject(
             pin.GeometryObject(name, joint, placement, mesh(vertices, triangles))
         )
-    assert convex_hulls(geometry_model) == ("fan",)
+    replaced = convex_hulls(geometry_model)
+    assert [geometry_model.geometryObjects[s.geometry].name for s in replaced if not s.hull] == ["fan"]
     fan, plain = geometry_model.geometryObjects
     assert isinstance(plain.geometry, coal.Convex) and plain.placement.isApprox(placement)
     assert isinstance(fan.geometry, coal.Capsule)

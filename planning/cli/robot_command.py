@@ -44,8 +44,9 @@ def robot_report(robot: ck.Robot) -> dict[str, Any]:
                 "link": s.link,
                 "kind": s.kind,
                 "mesh": s.mesh,
-                "excess_m": None if math.isnan(s.excess_m) else s.excess_m,
+                "excess_m": s.excess_m,
                 "spacing_m": s.spacing_m,
+                "bound_excess_m": None if math.isnan(s.bound_excess_m) else s.bound_excess_m,
             }
             for s in shape_excess(robot)
         ],
@@ -90,8 +91,11 @@ def cmd_robot_info(args: argparse.Namespace) -> int:
 
 def _shape_line(shape: dict[str, Any]) -> str:
     """One collision shape's line: geometry, link, kind, excess."""
-    if shape["excess_m"] is None:
-        excess = "excess not measured"
+    if shape["kind"] == "exact mesh":
+        bound = shape["bound_excess_m"]
+        excess = "exact, its " + (
+            "bounding capsule a bound" if bound is None else f"hull ({bound * 1000:.1f} mm beyond it) a bound"
+        )
     elif shape["kind"] == "convex hull":
         excess = f"excess {shape['excess_m'] * 1000:.1f} mm (spacing {shape['spacing_m'] * 1000:.1f} mm)"
     else:

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 import cpr_kin as ck
+from cpr_kin.disk_cache import cache_folder
 from planning.errors import PlanningError
 from planning.pipeline.settings import MAX_SEED
 from planning.validation import integer_in
@@ -45,14 +46,6 @@ CLASSES = (
 )
 """MotionBenchMaker's problem classes, in the order its papers list them."""
 ROBOTS = ("panda", "ur5", "fetch")
-
-
-def cache_folder() -> Path:
-    """Where downloads are kept (module docstring)."""
-    if os.environ.get("CPR_FIREFLY_CACHE"):
-        return Path(os.environ["CPR_FIREFLY_CACHE"])
-    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
-    return Path(base) / "cpr-firefly"
 
 
 def _download(target: Path) -> None:

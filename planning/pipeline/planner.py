@@ -1,6 +1,9 @@
 """The planner: scene -> problem -> (attempt -> search -> choose) -> result.
 
-``plan(scene)`` is ``solve(build_problem(scene))``. :func:`solve` reads as the pipeline:
+``plan(scene)`` is ``solve(build_problem(scene))``. A robot whose concave links are checked
+on their exact meshes (:mod:`cpr_kin.exact_pairs`) is planned on their convex hulls first,
+which contain them and cost no triangle query (:func:`~planning.pipeline.problem.on_hulls`),
+and on the meshes where the hulls find no trajectory. :func:`solve` reads as the pipeline:
 each attempt (the seeding rule decides the first and the next,
 :mod:`planning.pipeline.seeding`) is searched (:mod:`planning.pipeline.search`), its
 candidates are timed and verified best first (:mod:`planning.pipeline.choose`), and the
@@ -22,13 +25,14 @@ import numpy as np
 
 import cpr_kin as ck
 from planning.curves.trajectory import Trajectory
+from planning.errors import NoTrajectoryFoundError
 from planning.pipeline.blas_threads import one_blas_thread
 from planning.pipeline.choose import Choice, Refusal, choose, verify
 from planning.pipeline.deadline import Deadline
 from planning.pipeline.metrics import Elapsed
 from planning.pipeline.offered import Timing
 from planning.pipeline.path_following import follow_path
-from planning.pipeline.problem import Problem, build_problem
+from planning.pipeline.problem import Problem, build_problem, on_hulls
 from planning.pipeline.result import PlanResult, assemble
 from planning.pipeline.scene import Scene
 from planning.pipeline.search import search
@@ -52,6 +56,7 @@ def solve(
         optimizer: another :class:`~planning.search.optimizer.Optimizer` on the same
             objective and evaluation budget (``fireflies x (iterations + 1)``), searched
             once from a random population; default: the planner's seeded search.
+            (The hulls first, :func:`~planning.pipeline.problem.on_hulls`, with the planner's own.)
 
     Raises:
         NoTrajectoryFoundError: no candidate passes the verification (its message names
@@ -62,6 +67,24 @@ def solve(
     if problem.stands_still:
         return stand_still(problem, started)
     deadline = Deadline.after(problem.scene.planner.time_limit_s, started)
+    hulls = on_hulls(problem) if optimizer is None else None
+    if hulls is not None:
+        try:
+            return _solved(hulls, deadline, started, progress, optimizer)
+        except NoTrajectoryFoundError:
+            if deadline.passed():
+                raise
+    return _solved(problem, deadline, started, progress, optimizer)
+
+
+def _solved(
+    problem: Problem,
+    deadline: Deadline,
+    started: float,
+    progress: Callable[[FireflyProgress], None] | None,
+    optimizer: Optimizer | None,
+) -> PlanResult:
+    """:func:`solve`'s pipeline on ``problem`` by ``deadline`` (its clock started at ``started`` [s])."""
     problem = dataclasses.replace(problem, deadline=deadline)
     seeding = SEEDINGS[problem.scene.planner.seeding] if optimizer is None else NoSeeding()
     attempt = seeding.first(problem)

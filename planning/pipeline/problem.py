@@ -22,7 +22,7 @@ import cpr_kin as ck
 from planning.curves.spline import SepticSplineSolver, uniform_knots
 from planning.errors import PlanningError
 from planning.pipeline.deadline import Deadline
-from planning.pipeline.endpoints import endpoint
+from planning.pipeline.endpoints import endpoint, margin_violation
 from planning.pipeline.motion import Motion
 from planning.pipeline.objective import PathRules, WaypointObjective
 from planning.pipeline.scene import Scene
@@ -250,6 +250,23 @@ def finer_step_m(problem: Problem) -> float:
         excess = min(excess, float(world.self_collision.distances(ends)[0].min()) - scene.self_margin)
     finer = scene.planner.finer_verify_step_m
     return finer if excess > finer else max(excess / 2, VERIFY_STEP_RANGE_M[0])
+
+
+def on_hulls(problem: Problem) -> Problem | None:
+    """``problem`` on its robot's convex hulls alone, where its start and goal keep the margins there.
+
+    ``None`` for a robot whose meshes are all their own hulls, within a millimetre
+    (:attr:`cpr_kin.Robot.exact_meshes` empty), or ends that only the exact meshes clear. A
+    hull contains its mesh, so a trajectory certified on the hulls is certified on the meshes;
+    and the hulls ask coal no triangle query.
+    """
+    if not problem.robot.exact_meshes:
+        return None
+    world = problem.world.on_hulls()
+    if any(margin_violation(world, problem.scene, q) for q in (problem.q_start, problem.q_goal)):
+        return None
+    solver, objective = _search_space(problem.scene, world, problem.motion, problem.duration, problem.gravity)
+    return dataclasses.replace(problem, robot=world.robot, world=world, solver=solver, objective=objective)
 
 
 def _search_space(

@@ -1,0 +1,94 @@
+"""The exact meshes kept beside their hulls: excess against geometry, containment against trimesh."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import coal
+import numpy as np
+import pinocchio as pin
+import pytest
+import trimesh
+
+from cpr_kin.disk_cache import cache_folder
+from cpr_kin.exact_meshes import ExactMesh, MeshSource, exact_meshes, hull_excess, hull_planes
+
+
+def bvh_of(mesh: trimesh.Trimesh) -> coal.BVHModelOBBRSS:
+    """coal's triangle model of ``mesh``."""
+    bvh = coal.BVHModelOBBRSS()
+    bvh.beginModel(len(mesh.faces), len(mesh.vertices))
+    bvh.addVertices(np.asarray(mesh.vertices, dtype=float))
+    bvh.addTriangles(np.asarray(mesh.faces, dtype=np.int64))
+    bvh.endModel()
+    return bvh
+
+
+def l_shape() -> trimesh.Trimesh:
+    """Two boxes, 1 x 0.5 and 0.5 x 0.5 (x, y) and 0.1 high, in an L: its hull fills the notch."""
+    long = trimesh.creation.box(extents=(1.0, 0.5, 0.1))
+    long.apply_translation((0.5, 0.25, 0.05))
+    short = trimesh.creation.box(extents=(0.5, 0.5, 0.1))
+    short.apply_translation((0.25, 0.75, 0.05))
+    joined: trimesh.Trimesh = trimesh.util.concatenate([long, short])  # type: ignore[assignment]
+    return joined
+
+
+def source_of(mesh: trimesh.Trimesh, tmp_path: Path, name: str) -> MeshSource:
+    path = tmp_path / f"{name}.stl"
+    mesh.export(path)
+    return MeshSource(0, bvh_of(mesh), pin.SE3.Identity(), str(path), (1.0, 1.0, 1.0))
+
+
+@pytest.fixture(autouse=True)
+def own_cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("CPR_FIREFLY_CACHE", str(tmp_path / "cache"))
+
+
+def test_an_ls_hull_exceeds_it_by_the_notchs_depth(tmp_path: Path) -> None:
+    # the hull's face across the notch, x + y = 1.5, is farthest from the L at its middle
+    # (0.75, 0.75): 0.25 m from both inner faces; the sampled largest is below that, by little
+    found = hull_excess(source_of(l_shape(), tmp_path, "l"), samples=4000)
+    assert 0.23 < found["excess_m"] <= 0.25 + 1e-9
+    meshes = exact_meshes([source_of(l_shape(), tmp_path, "l")])
+    assert set(meshes) == {0} and 0.23 < meshes[0].excess_m <= 0.25 + 1e-9  # the default sample count
+    assert meshes[0].piece_points is not None and len(meshes[0].piece_points) == 2  # two boxes
+
+
+def test_a_convex_mesh_is_its_own_hull_and_is_not_kept(tmp_path: Path) -> None:
+    box = trimesh.creation.box(extents=(0.3, 0.2, 0.1))
+    assert hull_excess(source_of(box, tmp_path, "box"))["excess_m"] < 1e-9
+    assert exact_meshes([source_of(box, tmp_path, "box")]) == {}
+
+
+def test_the_excess_is_computed_once_per_file_and_kept_on_disk(tmp_path: Path) -> None:
+    source = source_of(l_shape(), tmp_path, "l")
+    first = hull_excess(source, samples=500)
+    kept = list((cache_folder() / "hull-excess").glob("*.json"))
+    assert len(kept) == 1
+    kept[0].write_text('{"excess_m": 0.125, "spacing_m": 0.01}')  # what is kept is what is read
+    assert hull_excess(source, samples=500)["excess_m"] == 0.125
+    kept[0].write_text("{cut sho")  # a broken entry is computed again
+    assert hull_excess(source, samples=500) == first
+    doubled = l_shape()
+    doubled.vertices *= 2.0
+    other = source_of(doubled, tmp_path, "l2")  # another file: its own entry
+    assert hull_excess(other, samples=500)["excess_m"] == pytest.approx(2 * first["excess_m"], rel=0.1)
+
+
+@pytest.mark.parametrize("flipped", [False, True])
+def test_holds_agrees_with_trimesh_on_a_torus_whichever_way_it_faces(flipped: bool) -> None:
+    torus = trimesh.creation.torus(major_radius=0.2, minor_radius=0.05, major_sections=48, minor_sections=24)
+    if flipped:
+        torus.invert()
+    triangles = np.asarray(torus.triangles)
+    mesh = ExactMesh(0, bvh_of(torus), pin.SE3.Identity(), math.inf, triangles, None, hull_planes(triangles))
+    points = np.random.default_rng(4).uniform(-0.3, 0.3, (3000, 3)) * (1.0, 1.0, 0.3)
+    expected = trimesh.Trimesh(torus.vertices, torus.faces).contains(points)  # ray tests
+    found = mesh.holds(points)
+    assert 100 < expected.sum() < 2900
+    # the faceted surface and trimesh's rays may differ within a hair of it
+    near_surface = np.abs(trimesh.proximity.signed_distance(torus, points)) < 1e-3  # type: ignore[no-untyped-call]
+    np.testing.assert_array_equal(found[~near_surface], expected[~near_surface])
+    assert not mesh.holds(np.zeros((1, 3)))[0]  # the hole is outside

@@ -1,0 +1,62 @@
+"""A robot with exact meshes plans on its hulls first, and on the meshes where only they clear the ends."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import cpr_kin as ck
+from cpr_kin.packages import example_robot
+from planning import build_problem, plan
+from planning.io.scene_file import parse_scene
+from planning.pipeline.problem import on_hulls
+from planning.pipeline.verification import verify_for_scene
+
+# UR10 configurations (self margin 10 mm): its hulls clear, and only its exact meshes clear
+CLEAR_ON_HULLS = [-1.57, 2.81, -0.98, -2.02, -0.94, -1.69]
+CLEAR_ON_MESHES = [2.5, 0.0, -0.16, 1.17, 0.73, -0.4]
+GOAL = [-2.47, -1.52, -0.26, -0.29, -0.2, 2.69]
+
+
+@pytest.fixture(scope="module")
+def ur10() -> ck.Robot:
+    return ck.load_robot(example_robot("ur10"))
+
+
+def ur10_scene(start: list[float]) -> dict[str, object]:
+    return {"robot": "ur10", "start": {"q": start}, "goal": {"q": GOAL}, "self_margin": 0.01, "obstacles": []}
+
+
+def test_the_hulls_view_answers_as_a_robot_without_meshes(ur10: ck.Robot) -> None:
+    world = ck.CollisionWorld(ur10, [ck.Obstacle.box((0.3, 0.3, 0.3), (0.6, 0.0, 0.4))], self_margin_m=0.01)
+    view = world.on_hulls()
+    q = np.random.default_rng(7).uniform(ur10.limits.lower / 2, ur10.limits.upper / 2, (300, ur10.nq))
+    alone = ck.CollisionWorld(dataclasses.replace(ur10, exact_meshes={}), world.obstacles, self_margin_m=0.01)
+    np.testing.assert_array_equal(
+        view.self_collision.violated(q, 0.01), alone.self_collision.violated(q, 0.01)
+    )
+    np.testing.assert_array_equal(view.margin_violated(q, 0.02), alone.margin_violated(q, 0.02))
+    np.testing.assert_allclose(view.min_clearance_batch(q)[0], alone.min_clearance_batch(q)[0], atol=1e-9)
+    # the world itself still asks its meshes: fewer configurations refused
+    assert world.self_collision.violated(q, 0.01).sum() < view.self_collision.violated(q, 0.01).sum()
+    assert view.robot.exact_meshes == {} and world.robot.exact_meshes
+
+
+def test_ends_clear_on_the_hulls_plan_there_and_pass_on_the_meshes(ur10: ck.Robot) -> None:
+    scene = parse_scene(ur10_scene(CLEAR_ON_HULLS))
+    problem = build_problem(scene, ur10)
+    assert on_hulls(problem) is not None
+    result = plan(scene, ur10)
+    assert result.problem.robot.exact_meshes == {}  # planned on the hulls
+    assert not verify_for_scene(build_problem(scene, ur10), result.trajectory).problems  # `check`: the meshes
+
+
+def test_ends_only_the_meshes_clear_plan_on_the_meshes(ur10: ck.Robot) -> None:
+    scene = parse_scene(ur10_scene(CLEAR_ON_MESHES))
+    problem = build_problem(scene, ur10)  # the hulls alone would refuse its start
+    assert on_hulls(problem) is None
+    result = plan(scene, ur10)
+    assert result.problem.robot.exact_meshes
+    assert not verify_for_scene(build_problem(scene, ur10), result.trajectory).problems
