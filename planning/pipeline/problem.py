@@ -22,7 +22,7 @@ import cpr_kin as ck
 from planning.curves.spline import SepticSplineSolver, uniform_knots
 from planning.errors import PlanningError
 from planning.pipeline.deadline import Deadline
-from planning.pipeline.endpoints import endpoint, margin_violation
+from planning.pipeline.endpoints import endpoint
 from planning.pipeline.motion import Motion
 from planning.pipeline.objective import PathRules, WaypointObjective
 from planning.pipeline.scene import Scene
@@ -262,11 +262,14 @@ def on_hulls(problem: Problem) -> Problem | None:
     """
     if not problem.robot.exact_meshes:
         return None
-    world = problem.world.on_hulls()
-    if any(margin_violation(world, problem.scene, q) for q in (problem.q_start, problem.q_goal)):
+    world, scene = problem.world.on_hulls(), problem.scene
+    ends = np.stack([problem.q_start, problem.q_goal])
+    if not world.keeps_clearance(ends, scene.safety_margin, scene.self_margin).all():
         return None
-    solver, objective = _search_space(problem.scene, world, problem.motion, problem.duration, problem.gravity)
-    return dataclasses.replace(problem, robot=world.robot, world=world, solver=solver, objective=objective)
+    rules = PathRules(scene.safety_margin, scene.self_margin, problem.gravity)
+    solver, duration = problem.solver, problem.duration  # the search's knots: not the world's
+    objective = WaypointObjective(world, problem.motion, rules, scene.planner, solver, duration)
+    return dataclasses.replace(problem, robot=world.robot, world=world, objective=objective)
 
 
 def _search_space(
