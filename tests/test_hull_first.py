@@ -3,15 +3,18 @@
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 
 import cpr_kin as ck
 from cpr_kin.packages import example_robot
 from planning import build_problem, plan
+from planning.cli import main
 from planning.io.scene_file import parse_scene
-from planning.pipeline.problem import on_hulls
+from planning.pipeline.problem import HULLS_SHARE, on_hulls
 from planning.pipeline.verification import verify_for_scene
 
 # UR10 configurations (self margin 10 mm): its hulls clear, and only its exact meshes clear
@@ -60,3 +63,23 @@ def test_ends_only_the_meshes_clear_plan_on_the_meshes(ur10: ck.Robot) -> None:
     result = plan(scene, ur10)
     assert result.problem.robot.exact_meshes
     assert not verify_for_scene(build_problem(scene, ur10), result.trajectory).problems
+
+
+def test_the_hulls_search_draws_a_share_of_the_samples(ur10: ck.Robot) -> None:
+    problem = build_problem(parse_scene(ur10_scene(CLEAR_ON_HULLS)), ur10)
+    hulls = on_hulls(problem)
+    assert hulls is not None
+    drawn = hulls.scene.planner.tuning.seeding.max_samples
+    assert drawn == int(problem.scene.planner.tuning.seeding.max_samples * HULLS_SHARE) < 50_000
+    assert hulls.objective.world is hulls.world and not hulls.world.robot.exact_meshes
+
+
+def test_check_says_which_model_it_certified_on(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    scene = tmp_path / "ur10.yaml"
+    scene.write_text(yaml.safe_dump(ur10_scene(CLEAR_ON_HULLS)))
+    assert main(["plan", str(scene), "--out", str(tmp_path / "out")]) == 0
+    capsys.readouterr()
+    assert main(["check", str(scene), str(tmp_path / "out" / "trajectory.json")]) == 0
+    said = capsys.readouterr().out
+    assert "verified against" in said and "on the exact meshes of 5 links" in said
+    assert "coal's tolerance: 1e-6 of a distance" in said

@@ -36,12 +36,17 @@ def cmd_check(args: argparse.Namespace) -> int:
     elif problems:
         print(escaped(f"{args.trajectory}: FAILS {args.scene}:\n  " + "\n  ".join(problems)))
     else:
+        exact = len(problem.robot.exact_meshes)
+        model = (
+            f"; on the exact meshes of {exact} links, the other shapes within 1 mm of theirs" if exact else ""
+        )
         print(
             escaped(
                 f"{args.trajectory}: verified against {args.scene}: "
                 f"certified clearance {check.certified_min_m:.4f} m "
                 f">= {scene.safety_margin} m over {len(check.times)} checks, joints within range and limits"
                 f"{', torques within effort limits' if problem.dynamics.limited else ''}"
+                f"{model} (coal's tolerance: 1e-6 of a distance)"
             )
         )
     return EXIT_OK if not problems else EXIT_NO_TRAJECTORY

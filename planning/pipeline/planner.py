@@ -2,8 +2,9 @@
 
 ``plan(scene)`` is ``solve(build_problem(scene))``. A robot whose concave links are checked
 on their exact meshes (:mod:`cpr_kin.exact_pairs`) is planned on their convex hulls first,
-which contain them and cost no triangle query (:func:`~planning.pipeline.problem.on_hulls`),
-and on the meshes where the hulls find no trajectory. :func:`solve` reads as the pipeline:
+which contain them and cost no triangle query (:func:`~planning.pipeline.problem.on_hulls`,
+with a share of the samples and of a time limit), and on the meshes where the hulls find no
+trajectory. :func:`solve` reads as the pipeline:
 each attempt (the seeding rule decides the first and the next,
 :mod:`planning.pipeline.seeding`) is searched (:mod:`planning.pipeline.search`), its
 candidates are timed and verified best first (:mod:`planning.pipeline.choose`), and the
@@ -32,7 +33,7 @@ from planning.pipeline.deadline import Deadline
 from planning.pipeline.metrics import Elapsed
 from planning.pipeline.offered import Timing
 from planning.pipeline.path_following import follow_path
-from planning.pipeline.problem import Problem, build_problem, on_hulls
+from planning.pipeline.problem import HULLS_SHARE, Problem, build_problem, on_hulls
 from planning.pipeline.result import PlanResult, assemble
 from planning.pipeline.scene import Scene
 from planning.pipeline.search import search
@@ -69,11 +70,12 @@ def solve(
     deadline = Deadline.after(problem.scene.planner.time_limit_s, started)
     hulls = on_hulls(problem) if optimizer is None else None
     if hulls is not None:
+        limit_s = problem.scene.planner.time_limit_s
+        share = Deadline.after(None if limit_s is None else limit_s * HULLS_SHARE, started)
         try:
-            return _solved(hulls, deadline, started, progress, optimizer)
+            return _solved(hulls, share, started, progress, optimizer)
         except NoTrajectoryFoundError:
-            if deadline.passed():
-                raise
+            pass  # the meshes' turn, in the time left
     return _solved(problem, deadline, started, progress, optimizer)
 
 

@@ -252,13 +252,19 @@ def finer_step_m(problem: Problem) -> float:
     return finer if excess > finer else max(excess / 2, VERIFY_STEP_RANGE_M[0])
 
 
+HULLS_SHARE = 0.25
+"""The share of RRT-Connect's samples (``max_samples``) and of a time limit that a plan on the
+hulls alone may take (:func:`on_hulls`); where it finds nothing in them, the meshes' turn."""
+
+
 def on_hulls(problem: Problem) -> Problem | None:
     """``problem`` on its robot's convex hulls alone, where its start and goal keep the margins there.
 
     ``None`` for a robot whose meshes are all their own hulls, within a millimetre
     (:attr:`cpr_kin.Robot.exact_meshes` empty), or ends that only the exact meshes clear. A
     hull contains its mesh, so a trajectory certified on the hulls is certified on the meshes;
-    and the hulls ask coal no triangle query.
+    and the hulls ask coal no triangle query. Its sampling planner draws :data:`HULLS_SHARE`
+    of the samples: a passage that only the meshes open is not searched for long on the hulls.
     """
     if not problem.robot.exact_meshes:
         return None
@@ -266,10 +272,15 @@ def on_hulls(problem: Problem) -> Problem | None:
     ends = np.stack([problem.q_start, problem.q_goal])
     if not world.keeps_clearance(ends, scene.safety_margin, scene.self_margin).all():
         return None
+    tuning = scene.planner.tuning
+    fewer = max(1, int(tuning.seeding.max_samples * HULLS_SHARE))
+    seeding = dataclasses.replace(tuning.seeding, max_samples=fewer)
+    planner = scene.planner.updated(tuning=dataclasses.replace(tuning, seeding=seeding))
     rules = PathRules(scene.safety_margin, scene.self_margin, problem.gravity)
     solver, duration = problem.solver, problem.duration  # the search's knots: not the world's
-    objective = WaypointObjective(world, problem.motion, rules, scene.planner, solver, duration)
-    return dataclasses.replace(problem, robot=world.robot, world=world, objective=objective)
+    objective = WaypointObjective(world, problem.motion, rules, planner, solver, duration)
+    scene = dataclasses.replace(scene, planner=planner)
+    return dataclasses.replace(problem, scene=scene, robot=world.robot, world=world, objective=objective)
 
 
 def _search_space(
