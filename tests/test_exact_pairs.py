@@ -119,7 +119,7 @@ def test_a_urs_clearance_to_balls_is_trimeshs_distance_to_its_link_meshes() -> N
     }
     by_name = {g.name: g.index for g in robot.geometries}
     compared = 0
-    for q in rng.uniform(robot.limits.lower, robot.limits.upper, (25, robot.nq)):
+    for q in rng.uniform(robot.limits.lower, robot.limits.upper, (12, robot.nq)):
         pin.updateGeometryPlacements(robot.model, data, robot.collision_model, geometry_data, q)
         clearance = world.clearance(q)
         expected_min = dict.fromkeys(clearance.group_clearance_m, np.inf)
@@ -129,17 +129,24 @@ def test_a_urs_clearance_to_balls_is_trimeshs_distance_to_its_link_meshes() -> N
             if g in files:
                 scale = robot.collision_model.geometryObjects[g].meshScale
                 mesh = trimesh.Trimesh(files[g].vertices * scale, files[g].faces)
+                mesh.fix_normals()  # outward, for the sign of signed_distance
                 mesh.apply_transform(geometry_data.oMg[g].homogeneous)
                 centre = centres[int(pair.obstacle[4:])]
-                if mesh.contains(centre[None])[0]:
+                by_rays = bool(mesh.contains(centre[None])[0])
+                if by_rays != (trimesh.proximity.signed_distance(mesh, centre[None])[0] > 0.0):  # type: ignore[no-untyped-call]
+                    expected_min[pair.group] = np.nan  # trimesh's two tests differ: not an oracle here
+                    continue
+                if by_rays:
                     expected = -np.inf
                 else:
                     to_surface = trimesh.proximity.closest_point(mesh, centre[None])[1][0]  # type: ignore[no-untyped-call]
                     expected = to_surface - 0.04
                 compared += 1
                 assert pair.distance_m <= max(expected, 0.0) + 1e-6
-            expected_min[pair.group] = min(expected_min[pair.group], expected)
+            expected_min[pair.group] = min(expected_min[pair.group], expected)  # nan stays nan
         for group, found in clearance.group_clearance_m.items():
+            if np.isnan(expected_min[group]):
+                continue
             if expected_min[group] > 0.0:
                 assert found == pytest.approx(expected_min[group], abs=1e-6)
             else:

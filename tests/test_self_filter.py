@@ -165,6 +165,7 @@ def test_a_voxel_in_a_concave_links_hollow_stays_an_obstacle() -> None:
         obj = robot.collision_model.geometryObjects[index]
         loaded: trimesh.Trimesh = trimesh.load(obj.meshPath, force="mesh")  # type: ignore[assignment]
         mesh = trimesh.Trimesh(loaded.vertices * obj.meshScale, loaded.faces)
+        mesh.fix_normals()  # outward, for the sign of signed_distance
         meshes.append(mesh.apply_transform(geometry_data.oMg[index].homogeneous))
     (forearm,) = [g.index for g in robot.geometries if g.link == "forearm_link"]
     assert forearm in robot.exact_meshes
@@ -174,10 +175,14 @@ def test_a_voxel_in_a_concave_links_hollow_stays_an_obstacle() -> None:
     )
     padding_m, half_diagonal = 0.01, 0.002 * np.sqrt(3.0) / 2.0
     keep = clear_of_robot(robot, q, centres, 0.002, padding_m)
-    # the oracle: trimesh's distance from each centre to each exact mesh and its ray test of
-    # inside; coal's to the other shapes (exact already); away from the band the cube decides in
+    # the oracle: trimesh's distance from each centre to each exact mesh, inside where its ray
+    # test and its signed distance agree (a centre where they differ is left out); coal's to the
+    # other shapes (exact already); away from the band where the cube decides
     to_robot = np.min([trimesh.proximity.closest_point(m, centres)[1] for m in meshes], axis=0)  # type: ignore[no-untyped-call]
-    inside = np.any([m.contains(centres) for m in meshes], axis=0)
+    by_rays = np.array([m.contains(centres) for m in meshes])
+    by_sign = np.array([trimesh.proximity.signed_distance(m, centres) > 0.0 for m in meshes])  # type: ignore[no-untyped-call]
+    known = np.all(by_rays == by_sign, axis=0)
+    inside = np.any(by_rays, axis=0)
     for g in robot.geometries:
         if g.index not in robot.exact_meshes:
             at = geometry_data.oMg[g.index]
@@ -198,8 +203,8 @@ def test_a_voxel_in_a_concave_links_hollow_stays_an_obstacle() -> None:
                 for c in centres
             ]
             to_robot = np.minimum(to_robot, to_shape)
-    robots = inside | (to_robot < padding_m)
-    clear = ~inside & (to_robot > padding_m + half_diagonal)
+    robots = known & (inside | (to_robot < padding_m))
+    clear = known & ~inside & (to_robot > padding_m + half_diagonal)
     assert not keep[robots].any() and keep[clear].all()
     on_hulls = clear_of_robot(dataclasses.replace(robot, exact_meshes={}), q, centres, 0.002, padding_m)
     assert (clear & ~on_hulls).sum() > 100  # what the hulls took for the robot's
