@@ -31,7 +31,7 @@ import numpy as np
 import cpr_kin as ck
 from planning.cli.arguments import SECONDS
 from planning.cli.problem_selection import add_selection, check_selection, selected_problems
-from planning.errors import PlanningError
+from planning.errors import CprPlanError
 from planning.io.mbm import endpoint_violations, import_problem
 from planning.io.scene_file import load_scene
 from planning.pipeline.planner import plan
@@ -47,7 +47,7 @@ def planned(scene: Any, robot: ck.Robot, exact: ck.Robot) -> dict[str, Any]:
     started = time.perf_counter()
     try:
         result = plan(scene, robot)
-    except (PlanningError, ck.CprKinError):
+    except (CprPlanError, ck.CprKinError):  # no trajectory, an end out of reach, ...: not planned
         return {"ok": False, "time_s": time.perf_counter() - started, "checked": False}
     time_s = time.perf_counter() - started
     checked = not verify_for_scene(build_problem(scene, exact), result.trajectory).problems
