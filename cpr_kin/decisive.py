@@ -28,6 +28,16 @@ def certified(values: FloatArray, slack_m: float | FloatArray) -> FloatArray:
     return np.asarray(0.5 * (values[:-1] + values[1:] - slack))
 
 
+def exact_below(margin_m: float, slack_m: FloatArray) -> float:
+    """The value [m] below which a certified check of ``margin_m`` [m] needs its samples exact.
+
+    A sample at or above the margin plus the largest slack of an interval (``slack_m``) [m]
+    certifies both its intervals whatever its neighbours above the margin are: counted as that
+    value, a lower bound, it decides the check the same.
+    """
+    return margin_m + float(np.max(slack_m, initial=0.0))
+
+
 def undecided(
     values: FloatArray,
     known: NDArray[np.bool_],

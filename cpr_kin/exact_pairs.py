@@ -32,6 +32,7 @@ from numpy.typing import NDArray
 from cpr_kin.exact_meshes import ExactMesh, as_transform
 
 FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
 
 
@@ -53,7 +54,11 @@ class ExactPairs:
         self._pairs = [(int(p.first), int(p.second)) for p in geometry_model.collisionPairs]
         self._meshes = dict(meshes)
         self._shapes = [obj.geometry for obj in objects]
-        self._inner = [_inner_points(obj.geometry, self._meshes.get(g)) for g, obj in enumerate(objects)]
+        self._inner = (
+            [_inner_points(obj.geometry, self._meshes.get(g)) for g, obj in enumerate(objects)]
+            if meshes
+            else []
+        )
         excess = {g: mesh.excess_m for g, mesh in self._meshes.items()}
         self.excess_m = np.array([excess.get(a, 0.0) + excess.get(b, 0.0) for a, b in self._pairs])
         self.refined = np.array([a in excess or b in excess for a, b in self._pairs], dtype=bool)
@@ -113,7 +118,7 @@ class ExactPairs:
         coal.distance(shape_a, as_transform(at_a), shape_b, as_transform(at_b), self._request, result)
         if hull_m >= 0.0:
             return result
-        if result.min_distance <= 0.0 or self._held(a, at_a, b, at_b) or self._held(b, at_b, a, at_a):
+        if result.min_distance <= 0.0 or self._one_holds_other(a, at_a, b, at_b):
             return None
         return result
 
@@ -127,7 +132,31 @@ class ExactPairs:
         )
         if hit:
             return True
-        return hull_m < 0.0 and (self._held(a, at_a, b, at_b) or self._held(b, at_b, a, at_a))
+        return hull_m < 0.0 and self._one_holds_other(a, at_a, b, at_b)
+
+    def recheck(
+        self,
+        flagged: BoolArray,
+        model: Any,
+        data: Any,
+        geometry_model: Any,
+        geometry_data: Any,
+        batch: FloatArray,
+        active: IntArray,
+        margins_m: FloatArray,
+    ) -> BoolArray:
+        """``flagged`` ``(N,)``, what a margin test on the hulls flagged at ``batch``, decided again.
+
+        Where some of the ``active`` pairs has a mesh, each flagged configuration is decided by
+        :meth:`violated` (``margins_m`` ``(P,)`` per collision pair [m]); elsewhere the hulls' answer
+        stands. Updated in place and returned.
+        """
+        if flagged.any() and self.refined[active].any():
+            rows = np.flatnonzero(flagged)
+            flagged[rows] = self.violated(
+                model, data, geometry_model, geometry_data, batch[rows], active.tolist(), margins_m
+            )
+        return flagged
 
     def violated(
         self,
@@ -174,6 +203,10 @@ class ExactPairs:
         if mesh is None:
             return self._shapes[geometry], placement
         return mesh.bvh, placement * mesh.mesh_in_shape
+
+    def _one_holds_other(self, a: int, at_a: Any, b: int, at_b: Any) -> bool:
+        """Whether ``a``'s mesh may hold ``b`` whole or ``b``'s ``a`` (:meth:`_held` both ways)."""
+        return self._held(a, at_a, b, at_b) or self._held(b, at_b, a, at_a)
 
     def _held(self, outer: int, at_outer: Any, inner: int, at_inner: Any) -> bool:
         """Whether ``outer``'s mesh may hold ``inner`` whole (module docstring); ``False`` if it has none.

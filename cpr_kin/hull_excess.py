@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from cpr_kin.exact_meshes import MeshSource, hull_excess
 from cpr_kin.robot import Robot
 
 SAMPLES = 20_000
@@ -55,10 +56,9 @@ class ShapeExcess:
 def shape_excess(robot: Robot, samples: int = SAMPLES, seed: int = 0) -> tuple[ShapeExcess, ...]:
     """The excess of each of ``robot``'s collision shapes (module docstring), in geometry order."""
     import coal
-    import trimesh
+    import pinocchio as pin
 
     loader = coal.MeshLoader()
-    request, point = coal.DistanceRequest(), coal.Sphere(1e-12)
     found = []
     for geometry in robot.geometries:
         obj = robot.collision_model.geometryObjects[geometry.index]
@@ -72,27 +72,15 @@ def shape_excess(robot: Robot, samples: int = SAMPLES, seed: int = 0) -> tuple[S
         if kind != "convex" or not obj.meshPath:
             found.append(ShapeExcess(geometry.name, geometry.link, kind, "", 0.0))
             continue
-        mesh = loader.load(obj.meshPath, np.asarray(obj.meshScale, dtype=float))
-        vertices = np.asarray(mesh.vertices(), dtype=float)
-        hull = trimesh.Trimesh(vertices=vertices).convex_hull
-        on_hull = trimesh.sample.sample_surface(hull, samples, seed=seed)[0]
-        identity = coal.Transform3s()
-        distances = [
-            coal.distance(
-                mesh, identity, point, coal.Transform3s(np.eye(3), p), request, coal.DistanceResult()
-            )
-            for p in on_hull
-        ]
-        hull_m = max(0.0, float(np.max(distances)))
+        scale = tuple(float(s) for s in obj.meshScale)
+        mesh = loader.load(obj.meshPath, np.asarray(scale))
+        source = MeshSource(geometry.index, mesh, pin.SE3.Identity(), obj.meshPath, scale)
+        measured = hull_excess(source, samples, seed)
+        hull_m, spacing_m = measured["excess_m"], measured["spacing_m"]
+        kind = "exact mesh" if exact else "convex hull"
         found.append(
             ShapeExcess(
-                geometry.name,
-                geometry.link,
-                "exact mesh" if exact else "convex hull",
-                obj.meshPath,
-                0.0 if exact else hull_m,
-                math.sqrt(float(hull.area) / samples),
-                hull_m,
+                geometry.name, geometry.link, kind, obj.meshPath, 0.0 if exact else hull_m, spacing_m, hull_m
             )
         )
     return tuple(found)

@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.clearance import BatchClearance
 from cpr_kin.collision import CollisionWorld
-from cpr_kin.decisive import certified, undecided, with_neighbours
+from cpr_kin.decisive import certified, exact_below, undecided, with_neighbours
 from cpr_kin.errors import CprKinError
 from cpr_kin.interval_motion import IntervalSpeed, interval_motion
 from cpr_kin.pair_bounds import BOUND_TOLERANCE_M
@@ -147,7 +147,7 @@ def check_curve(
         )
     times = np.linspace(t0, t1, max(count, 2))  # at least both ends
     slack = interval_motion(times, point_speed, interval_speed)
-    batch = decisive_clearance(world, curve(times), slack, margin_m + float(np.max(slack, initial=0.0)))
+    batch = decisive_clearance(world, curve(times), slack, exact_below(margin_m, slack))
     per_group = batch.clearance_m
     # lower bound between neighbouring samples: distances change no faster than the robot moves
     group_bound = certified(per_group, slack).min(axis=0)

@@ -122,16 +122,14 @@ class ObstaclePools:
         """``(N,)`` coal's test of ``obstacle``'s pairs at ``batch``: the hulls flag, the meshes decide."""
         pool = self._prepared(obstacle, margin_m, near)
         flagged = pool_collisions(pool, self.model, self._data, self.geometry_model, batch, num_threads)
-        active = np.flatnonzero(near & (self._pair_obstacle == obstacle))
-        if self._exact is None or not flagged.any() or not self._exact.refined[active].any():
+        if self._exact is None:
             return flagged
         if self._exact_data is None:
             self._exact_data = self.geometry_model.createData()
-        rows = np.flatnonzero(flagged)
+        active = np.flatnonzero(near & (self._pair_obstacle == obstacle))
         margins = np.full(len(self._pair_obstacle), margin_m)
-        found = (self.model, self._data, self.geometry_model, self._exact_data, batch[rows])
-        flagged[rows] = self._exact.violated(*found, active.tolist(), margins)
-        return flagged
+        data = (self.model, self._data, self.geometry_model, self._exact_data)
+        return self._exact.recheck(flagged, *data, batch, active, margins)
 
     def _prepared(self, obstacle: int, margin_m: float, near: BoolArray) -> Any:
         """The obstacle's pool, built once, its margin and active pairs set when the margin changes."""

@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from cpr_kin.decisive import certified, undecided, with_neighbours
+from cpr_kin.decisive import certified, exact_below, undecided, with_neighbours
 from cpr_kin.errors import CprKinError
 from cpr_kin.pair_bounds import BOUND_TOLERANCE_M
 
@@ -175,9 +175,8 @@ def check_self_curve(
         pair = sampled(int(p), int(counts[p]))
         if pair.certified_bound >= certified_min and pair.bounds.min() >= sampled_min:
             continue
-        # where the hulls keep the margin plus a sample's slack, their distance decides as the mesh's would
-        exact_below = margin_m + float(pair.slack.max(initial=0.0))
-        values, known = _decisive_values(collision, pair, certified_min, sampled_min, exact_below)
+        ceiling = exact_below(margin_m, pair.slack)
+        values, known = _decisive_values(collision, pair, certified_min, sampled_min, ceiling)
         computed += int(known.sum())
         certified_min = min(certified_min, float(np.min(certified(values, pair.slack))))
         lowest = int(np.argmin(values))

@@ -141,6 +141,7 @@ class ScreenedSelfTest:
         self._data: Any = None
         self._distance_data: Any = None
         self._margin_m = float("nan")
+        self._pair_margins = np.zeros(len(pairs))  # each pair's coal margin: the margin less its allowance
 
     def on_hulls(self) -> ScreenedSelfTest:
         """The test with the hulls deciding alone, sharing its pools and data."""
@@ -215,14 +216,11 @@ class ScreenedSelfTest:
         flagged = pool_collisions(
             self._pools[tier], self.model, self._data, self.geometry_model, batch, self.num_threads
         )
-        active = np.flatnonzero(self._near if tier == 0 else self._far_on)
-        if self._exact is None or not flagged.any() or not self._exact.refined[active].any():
+        if self._exact is None:
             return flagged
-        rows = np.flatnonzero(flagged)
-        margins = np.maximum(self._margin_m - self.allowance_m, 0.0)
-        found = (self.model, self._data, self.geometry_model, self._distance_data, batch[rows])
-        flagged[rows] = self._exact.violated(*found, active.tolist(), margins)
-        return flagged
+        active = np.flatnonzero(self._near if tier == 0 else self._far_on)
+        data = (self.model, self._data, self.geometry_model, self._distance_data)
+        return self._exact.recheck(flagged, *data, batch, active, self._pair_margins)
 
     def _prepare(self, margin_m: float) -> None:
         """Build the two pools and distance data once; set their margin and pairs when the margin changes.
@@ -236,7 +234,8 @@ class ScreenedSelfTest:
                 pin.GeometryPool(self.model, self.geometry_model, self.num_threads) for _ in range(2)
             ]
         if margin_m != self._margin_m and not np.isnan(margin_m):
-            margins = np.maximum(margin_m - self.allowance_m, 0.0) if self.allowance_m.any() else margin_m
+            self._pair_margins = np.maximum(margin_m - self.allowance_m, 0.0)
+            margins = self._pair_margins if self.allowance_m.any() else margin_m
             for pool, active in zip(self._pools, (self._near, self._far_on), strict=True):
                 configure_pool(pool, self.geometry_model, margins, active)
                 for gdata in pool.getGeometryDatas():

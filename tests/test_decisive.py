@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cpr_kin.decisive import propagated_bounds, with_neighbours
+from cpr_kin.decisive import certified, exact_below, propagated_bounds, with_neighbours
 
 
 def test_the_samples_stay_below_a_distance_that_moves_no_faster_than_the_slack() -> None:
@@ -25,3 +25,22 @@ def test_the_samples_stay_below_a_distance_that_moves_no_faster_than_the_slack()
         # and exactly the better of the two where both exist (the rule's definition)
         best = np.maximum(bounds, propagated_bounds(exact, known, reach) - tolerance)
         np.testing.assert_array_equal(values[~known], best[~known])
+
+
+def test_samples_counted_at_the_exact_ceiling_decide_the_check_as_their_values_do() -> None:
+    # values at or above exact_below(margin, slack) may be replaced by that ceiling (a lower
+    # bound): the certified minimum stays on the same side of the margin
+    rng = np.random.default_rng(9)
+    for _ in range(300):
+        count = int(rng.integers(2, 40))
+        slack = rng.uniform(0.0, 0.01, count - 1)
+        margin = float(rng.uniform(0.0, 0.02))
+        # a distance moves by at most the slack over each interval
+        steps = rng.uniform(-1, 1, count - 1) * slack
+        values = rng.uniform(margin - 0.01, margin + 0.05) + np.concatenate([[0.0], steps.cumsum()])
+        ceiling = exact_below(margin, slack)
+        assert ceiling == margin + slack.max()
+        counted = np.minimum(values, ceiling)
+        exact_ok = certified(values, slack).min() >= margin
+        counted_ok = certified(counted, slack).min() >= margin
+        assert exact_ok == counted_ok
