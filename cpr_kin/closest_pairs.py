@@ -92,9 +92,10 @@ def closest_pairs(
                 break  # no pair left can be closer
             pair = pairs[column]
             found = compute(geometry_model, geometry_data, pair).min_distance
-            ceiling = min(limit, exact_below_m) - extra[column]
-            if on_meshes is not None and refined[pair] and found < ceiling:
-                found = on_meshes(geometry_data, pair, found, ceiling, below_m - extra[column])
+            if on_meshes is not None and refined[pair]:
+                ceiling = min(limit, exact_below_m) - extra[column]
+                if found < ceiling:
+                    found = on_meshes(geometry_data, pair, found, ceiling, below_m - extra[column])
             found += extra[column]
             if found < best:
                 best, which, limit = found, pair, min(found, below_m)
