@@ -35,7 +35,7 @@ def load_cpr(
     """Load the CPR: the bundled URDF, or a variant of it with the same joint names.
 
     Args:
-        urdf_path: the URDF; default: the bundled ``cpr_kin/urdf/cpr.urdf``.
+        urdf_path: the URDF; default: the bundled ``urdf/cpr.urdf``.
         limits_path: acceleration and jerk limits; default: see the module docstring.
         validate: as :func:`~cpr_kin.robot.load_robot`'s.
 

@@ -1,20 +1,21 @@
-"""Paths of the files bundled with the project: the CPR's URDF and its limits.
+"""Paths of the files bundled with the project: the CPR's URDF and its limits, the makers' limits.
 
-They are the package data ``cpr_kin/urdf/``, the same folder in a checkout, an editable
-install and an installed wheel.
+They are the package ``cpr_kin.urdf``: the repository's top-level ``urdf/`` folder, which
+``pyproject.toml`` maps to that package in an editable install and in the wheel.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
+from importlib import import_module
 from pathlib import Path
 
 import yaml
 
 
 def bundled_urdf_dir() -> Path:
-    """Folder that holds ``cpr.urdf`` and ``cpr_limits.yaml``."""
-    return Path(__file__).resolve().parent / "urdf"
+    """Folder that holds ``cpr.urdf``, ``cpr_limits.yaml`` and ``makers/`` (the package ``cpr_kin.urdf``)."""
+    return Path(import_module("cpr_kin.urdf").__file__ or "").resolve().parent
 
 
 def cpr_urdf_path() -> Path:
@@ -30,7 +31,7 @@ def cpr_limits_path() -> Path:
 def makers_limits_path(robot_name: str, joints: Iterable[str]) -> Path | None:
     """The limits file shipped for a URDF whose ``<robot name>`` is ``robot_name``, if any.
 
-    ``cpr_kin/urdf/makers/<name>_limits.yaml``: acceleration and jerk limits from an arm
+    ``urdf/makers/<name>_limits.yaml``: acceleration and jerk limits from an arm
     maker's datasheet (the Panda's), used when no limits file lies beside the URDF and the
     URDF has every joint the file names (``joints``: the URDF's).
     """

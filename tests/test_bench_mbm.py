@@ -105,7 +105,7 @@ def test_a_bad_scene_file_is_named_before_anything_runs(
 ) -> None:
     scene = tmp_path / "scene_1.yaml"
     if content is not None and content.startswith("robot:"):
-        scene.write_text(SHELF.read_text().replace("robot: ../../cpr_kin/urdf/cpr.urdf", content))
+        scene.write_text(SHELF.read_text().replace("robot: ../../urdf/cpr.urdf", content))
     elif content is not None:
         scene.write_text(content)
     monkeypatch.setattr("sys.argv", ["bench_mbm.py", "--scenes", str(scene), "--out", str(tmp_path / "out")])

@@ -97,13 +97,18 @@ def test_an_installed_wheel_carries_its_data_and_stubs(tmp_path: Path) -> None:
     subprocess.run([*pip, "wheel", str(source), "--no-deps", "-w", str(tmp_path / "dist")], check=True)
     wheel = next((tmp_path / "dist").glob("cpr_firefly-*.whl"))
     # every package of the checkout is in the wheel (a hand-written list once missed planning.cli)
-    packed = {str(Path(name).parent) for name in zipfile.ZipFile(wheel).namelist() if name.endswith(".py")}
+    names = zipfile.ZipFile(wheel).namelist()
+    packed = {str(Path(name).parent) for name in names if name.endswith(".py")}
     packages = {
         str(init.parent.relative_to(root))
         for top in ("cpr_kin", "planning")
         for init in (root / top).rglob("__init__.py")
     }
     assert packages <= packed, sorted(packages - packed)
+    # the top-level urdf/ folder is the package cpr_kin.urdf (pyproject's package-dir), every file of it
+    bundled = {f"cpr_kin/urdf/{p.relative_to(root / 'urdf')}" for p in (root / "urdf").rglob("*.*")}
+    bundled = {name for name in bundled if "__pycache__" not in name}
+    assert bundled and bundled <= set(names), sorted(bundled - set(names))
     site = tmp_path / "site"
     subprocess.run([*pip, "install", "--no-deps", "--target", str(site), str(wheel)], check=True)
     code = (
