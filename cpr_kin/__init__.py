@@ -1,8 +1,10 @@
-"""cpr_kin: the CPR cylindrical manipulator (R-P-P:R-R) as a Pinocchio/coal model.
+"""cpr_kin: any serial robot from its URDF and SRDF as a Pinocchio/coal model.
 
-Kinematics, analytic inverse kinematics of the tool-centre point, and signed clearance of
-the robot's collision groups to static obstacles, for single configurations, batches and
-whole joint-space curves. Nothing here draws or plans.
+Loading (:class:`RobotSpec`, :func:`load_robot`), kinematics, verified inverse kinematics of
+the tool frame, and signed clearance of the robot's collision groups to obstacles and to
+itself, for single configurations, batches and whole joint-space curves, certified between
+samples. The CPR of the paper (R-P-P:R-R) is a preset (:mod:`cpr_kin.presets`). Nothing here
+draws or plans.
 """
 
 import lazy_loader

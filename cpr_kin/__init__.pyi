@@ -4,10 +4,8 @@ from .carried import carrying
 from .clearance import BatchClearance, Clearance, PairDistance
 from .close_pairs import ClosePair
 from .collision import CollisionWorld
-from .cpr import CPR_JOINTS, TCP_FRAME, cpr_spec, load_cpr, robot_spec
 from .dynamics import Dynamics, Payload, robot_dynamics
 from .errors import CprKinError, IkMissError, JointLimitError, ObstacleError, UnreachableError, UrdfError
-from .ik import tcp_ik
 from .interval_motion import IntervalSpeed
 from .kinematics import frame_poses, frame_positions
 from .limits import JointLimits, sampled_configurations
@@ -15,8 +13,17 @@ from .loading import RobotSpec, load_robot
 from .motion import CurveCheck, check_curve, check_segment, motion_radii, path_weights
 from .numerical_ik import IkSettings, IkTarget, solve_ik
 from .obstacles import SHAPES, Obstacle
-from .resources import cpr_limits_path, cpr_urdf_path
-from .robot import GROUPS, Robot, RobotGeometry
+from .presets import (
+    CPR_JOINTS,
+    TCP_FRAME,
+    cpr_limits_path,
+    cpr_spec,
+    cpr_urdf_path,
+    load_cpr,
+    robot_spec,
+    tcp_ik,
+)
+from .robot import GROUPS, PositionIk, Robot, RobotGeometry
 
 __all__ = [
     "CPR_JOINTS",
@@ -40,6 +47,7 @@ __all__ = [
     "ObstacleError",
     "PairDistance",
     "Payload",
+    "PositionIk",
     "Robot",
     "RobotGeometry",
     "RobotSpec",

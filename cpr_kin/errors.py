@@ -13,7 +13,7 @@ class CprKinError(ValueError):
 
 
 class UrdfError(CprKinError):
-    """The URDF is missing, malformed, or does not describe the CPR."""
+    """The URDF is missing, malformed, or asks what the planner does not support."""
 
 
 class JointLimitError(CprKinError):

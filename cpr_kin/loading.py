@@ -2,8 +2,8 @@
 
 Loading, in order:
 
-1. the URDF is read as strict XML, validated by yourdfpy (but the bundled CPR's, which the
-   tests validate), and checked for what the planner supports (:mod:`cpr_kin.supported`);
+1. the URDF is read as strict XML, validated by yourdfpy (but a preset's bundled file, which
+   the tests validate), and checked for what the planner supports (:mod:`cpr_kin.supported`);
 2. its mesh paths (``package://NAME/...``, relative, absolute) are resolved
    (:mod:`cpr_kin.packages`) and its ``continuous`` joints bounded
    (:func:`~cpr_kin.urdf_file.prepared_xml`);
@@ -45,7 +45,7 @@ from cpr_kin.limits import LIMITS_NAMES, JointLimits, find_limits_file, read_dyn
 from cpr_kin.overlapping_pairs import overlapping_pairs
 from cpr_kin.packages import package_roots
 from cpr_kin.resources import makers_limits_path
-from cpr_kin.robot import Robot, joint_units
+from cpr_kin.robot import PositionIk, Robot, joint_units
 from cpr_kin.robot_options import check_not_one_name, check_options, check_tcp
 from cpr_kin.self_collision import SrdfPairs, find_srdf, read_srdf, self_pairs
 from cpr_kin.supported import check_limits, checked_urdf
@@ -79,11 +79,13 @@ class RobotSpec:
             has one, else the arm's tool link (:func:`arm_chain`).
         held: ``(joint, value)`` pairs of held joints [rad or m].
         effector_links: links of the ``effector`` collision group; default: module docstring.
-        wrist_joints: joints a plan holds unless its start and goal differ in them.
+        wrist_joints: joints a plan holds unless its start and goal differ in them (and a
+            ``tcp`` goal at 0 unless it names them).
+        position_ik: a preset's IK of a tool position (:class:`~cpr_kin.robot.PositionIk`).
         limits_names: the limits file names looked for beside the URDF.
         default_limits: the limits file used when none is found beside the URDF.
         default_srdf: the SRDF used when none is given or found (a preset's).
-        validate: validate the URDF with yourdfpy; default: every URDF but the bundled CPR's.
+        validate: validate the URDF with yourdfpy (a preset skips its own bundled file).
     """
 
     urdf: Path
@@ -95,10 +97,11 @@ class RobotSpec:
     held: tuple[tuple[str, float], ...] = ()
     effector_links: tuple[str, ...] | None = None
     wrist_joints: tuple[str, ...] = ()
+    position_ik: PositionIk | None = None
     limits_names: tuple[str, ...] = LIMITS_NAMES
     default_limits: Path | None = None
     default_srdf: Path | None = None
-    validate: bool | None = field(default=None, compare=False)
+    validate: bool = field(default=True, compare=False)
 
     def __post_init__(self) -> None:
         check_options(self)
@@ -167,6 +170,7 @@ class RobotSpec:
             _data=model.createData(),
             tcp_frame=tcp,
             wrist_joints=self.wrist_joints,
+            position_ik=self.position_ik,
             limits_path=dynamic.source,
             limits_defaulted=dynamic.defaulted,
             held=held,
@@ -273,7 +277,7 @@ def _refuse_fixed(tree: etree._ElementTree, given: list[str], key: str, names: A
         )
 
 
-def _range(model: Any, joint: str) -> tuple[float, float]:
+def _range(model: Any, joint: str) -> tuple[float, float]:  # a joint's position range [rad or m]
     i = model.joints[model.getJointId(joint)].idx_q
     return float(model.lowerPositionLimit[i]), float(model.upperPositionLimit[i])
 
@@ -285,9 +289,8 @@ def load_robot(urdf_path: str | Path, **options: Any) -> Robot:
         UrdfError: a missing, malformed or unsupported URDF, a mesh not found, an unknown
             planned or held joint, a limits file that does not fit.
     """
-    for key in ("srdf", "limits", "default_limits"):
-        if options.get(key) is not None:
-            options[key] = Path(options[key])
+    for key in (k for k in ("srdf", "limits", "default_limits") if options.get(k) is not None):
+        options[key] = Path(options[key])
     for key in ("package_dirs", "joints", "effector_links", "wrist_joints", "limits_names"):
         check_not_one_name(key, options.get(key))
         if key in options and options[key] is not None:

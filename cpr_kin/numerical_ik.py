@@ -207,7 +207,7 @@ def solve_ik(
         seed_q: the configuration to start from and stay near; default: mid-range.
         accept: a test a preferred solution passes (e.g. clear of obstacles).
         settings: the search's parameters.
-        held: joints kept at their ``seed_q`` values (the CPR's wrist angles of a ``tcp`` goal).
+        held: joints kept at their ``seed_q`` values (the joints a ``tcp`` goal holds).
 
     Raises:
         IkMissError: the target lies beyond :func:`tool_reach_m`, or no start reaches it

@@ -18,16 +18,6 @@ def bundled_urdf_dir() -> Path:
     return Path(import_module("cpr_kin.urdf").__file__ or "").resolve().parent
 
 
-def cpr_urdf_path() -> Path:
-    """Path of the bundled CPR URDF."""
-    return bundled_urdf_dir() / "cpr.urdf"
-
-
-def cpr_limits_path() -> Path:
-    """Path of the bundled acceleration and jerk limits of the CPR."""
-    return bundled_urdf_dir() / "cpr_limits.yaml"
-
-
 def makers_limits_path(robot_name: str, joints: Iterable[str]) -> Path | None:
     """The limits file shipped for a URDF whose ``<robot name>`` is ``robot_name``, if any.
 

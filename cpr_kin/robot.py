@@ -1,8 +1,8 @@
 """A loaded robot: Pinocchio models, joint limits and collision groups, built once.
 
 :func:`cpr_kin.load_robot` (:mod:`cpr_kin.loading`) builds one from any serial URDF; a
-preset (:mod:`cpr_kin.cpr` for the CPR) names its joints, tool frame, effector links and
-wrist joints. The collision geometry forms two groups:
+preset (:mod:`cpr_kin.presets`) names its joints, tool frame, effector links, wrist joints
+and its own IK of a tool position. The collision geometry forms two groups:
 
 - ``effector``: the wrist and the tool (the links a preset names, by default those the last
   planned joint moves alone);
@@ -15,7 +15,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -27,6 +27,21 @@ from cpr_kin.frames import frame_index
 from cpr_kin.limits import JointLimits
 
 FloatArray = NDArray[np.float64]
+
+
+class PositionIk(Protocol):
+    """A robot's own IK of a tool position (a preset's analytic solver).
+
+    Called as ``ik(robot, tcp_in_base, held)``: the configuration [rad, m] that puts the tool
+    frame at ``tcp_in_base`` [m] with the joints ``held`` names at those values (the robot's
+    wrist joints at 0 unless named). It raises :class:`~cpr_kin.errors.UnreachableError`
+    where it finds none; its answer is verified by forward kinematics before it is used.
+    """
+
+    def __call__(self, robot: Robot, tcp_in_base: FloatArray, held: Mapping[str, float]) -> FloatArray:
+        """The configuration [rad, m] (class docstring)."""
+        ...
+
 
 GROUPS = ("effector", "links")
 """Collision group names, in the order used by every per-group array."""
@@ -54,7 +69,7 @@ class RobotGeometry:
 class Robot:
     """A robot's Pinocchio models, limits and collision groups.
 
-    Build it with :func:`cpr_kin.load_robot` (or a preset such as :func:`cpr_kin.load_cpr`).
+    Build it with :func:`cpr_kin.load_robot` (or a preset's loader, :mod:`cpr_kin.presets`).
 
     Attributes:
         urdf_path: the URDF it was built from.
@@ -65,7 +80,9 @@ class Robot:
         limits: joint limits, in configuration order.
         geometries: the robot's collision geometries with their groups.
         tcp_frame: the tool-centre-point frame (the default frame of the kinematics).
-        wrist_joints: joints a plan holds unless its start and goal differ in them.
+        wrist_joints: joints a plan holds unless its start and goal differ in them, and a
+            ``tcp`` goal holds at the values it gives (default 0).
+        position_ik: the robot's own IK of a tool position, or ``None`` (:class:`PositionIk`).
         limits_path: the file the acceleration and jerk limits were read from (``None``:
             the documented defaults, :func:`cpr_kin.limits.default_limits`).
         limits_defaulted: the joints whose acceleration or jerk limit is a default.
@@ -98,6 +115,7 @@ class Robot:
     _data: Any = field(repr=False)
     tcp_frame: str = "tcp"
     wrist_joints: tuple[str, ...] = ()
+    position_ik: PositionIk | None = field(default=None, repr=False)
     limits_path: Path | None = None
     limits_defaulted: tuple[str, ...] = ()
     held: Mapping[str, float] = field(default_factory=dict)

@@ -31,7 +31,7 @@ from lxml import etree
 from cpr_kin.errors import UrdfError
 from cpr_kin.limits import JointLimits
 from cpr_kin.names import escaped, unprintable
-from cpr_kin.urdf_file import is_bundled, parse_urdf, validate_urdf
+from cpr_kin.urdf_file import parse_urdf, validate_urdf
 
 SUPPORTED_TYPES = ("revolute", "prismatic", "continuous", "fixed")
 """Joint types the planner plans (``fixed`` joints join links rigidly)."""
@@ -119,18 +119,18 @@ def check_limits(limits: JointLimits, units: Sequence[str], path: Path) -> None:
             )
 
 
-def checked_urdf(path: Path, validate: bool | None = None) -> etree._ElementTree:
+def checked_urdf(path: Path, validate: bool = True) -> etree._ElementTree:
     """The URDF at ``path`` parsed and checked as the loader checks it, before anything reads it.
 
     Strict XML (:func:`~cpr_kin.urdf_file.parse_urdf`), yourdfpy's validation (unless
-    ``validate`` is ``False``, or ``None`` and the file is the bundled CPR's), printable
-    names and supported joints.
+    ``validate`` is ``False``: a file the caller knows, such as a preset's), printable names
+    and supported joints.
 
     Raises:
         UrdfError: naming the file and the first problem.
     """
     tree = parse_urdf(path)
-    if validate or (validate is None and not is_bundled(path)):
+    if validate:
         validate_urdf(path)
     check_names(tree, path)
     check_joints(tree, path)

@@ -23,7 +23,6 @@ from lxml import etree
 
 from cpr_kin.errors import UrdfError
 from cpr_kin.packages import resolve_mesh
-from cpr_kin.resources import cpr_urdf_path
 
 MAX_URDF_BYTES = 10_000_000
 """Largest URDF file [bytes] (the CPR's takes 6 kB)."""
@@ -177,11 +176,6 @@ def prepared_xml(tree: etree._ElementTree, path: Path, roots: Sequence[Path]) ->
         if filename:
             mesh.set("filename", str(resolve_mesh(filename, path, roots)))
     return str(etree.tostring(root, encoding="unicode"))
-
-
-def is_bundled(path: Path) -> bool:
-    """Whether ``path`` is the bundled CPR URDF, which the test suite validates with yourdfpy."""
-    return path.resolve() == cpr_urdf_path().resolve()
 
 
 def massless_links(tree: etree._ElementTree, model: Any) -> tuple[str, ...]:

@@ -98,7 +98,11 @@ BAD_INPUTS = [
         {**PANDA, "start": {"q": [0.0, -0.6, 0.0, 0.5, 0.0, 1.6, 0.8]}},
         "joint 'panda_joint4' = 0.5 rad is outside [-3.0718, -0.0698] rad",
     ),
-    ("panda: wrist angles", {**PANDA, "goal": {"tcp": [0.4, 0.0, 0.4], "theta4": 1.0}}, "theta4 = 1.0"),
+    (
+        "panda: a held joint it does not plan",
+        {**PANDA, "goal": {"tcp": [0.4, 0.0, 0.4], "hold": {"theta4": 1.0}}},
+        "['theta4'] not planned joint(s) of this robot",
+    ),
     (
         "unknown robot",
         {**PANDA, "robot": "no_such_robot"},
@@ -165,7 +169,7 @@ def test_an_unreachable_tcp_exits_3_with_the_distance(
     assert code == 3 and stdout == "" and len(stderr.strip().splitlines()) == 1
     assert "goal is out of reach: no configuration puts frame 'tcp' at [1.2, 0.0, 0.3] m" in stderr
     assert "m from the position (tolerance 0.0001 m)" in stderr
-    assert "the analytic IK: TCP target [1.2, 0.0, 0.3] is out of reach: joint 'd3' = 0.9 m" in stderr
+    assert "the robot's analytic IK: TCP target [1.2, 0.0, 0.3] is out of reach: joint 'd3' = 0.9 m" in stderr
     assert not out.exists()
 
 

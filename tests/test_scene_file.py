@@ -98,8 +98,12 @@ def test_every_shape_and_relative_mesh_path(tmp_path: Path) -> None:
             "start: give exactly one of 'q' (joint values), 'tcp'",
         ),
         (
-            {"goal": {"q": [0, 0, 0, 0, 0], "theta4": 1.0}},
-            "theta4 and theta5 (the CPR's wrist angles) go with 'tcp'",
+            {"goal": {"q": [0, 0, 0, 0, 0], "hold": {"theta4": 1.0}}},
+            "'hold' (joints held at values) goes with 'tcp'",
+        ),
+        (
+            {"goal": {"tcp": [0.5, 0.45, 0.25], "theta4": 1.0}},
+            "['theta4'] not key(s) of a start or goal",
         ),
         ({"planner": {"mode": "parallel"}}, "planner.mode = 'parallel'"),
         ({"planner": {"refine": "bfgs"}}, "planner.refine = 'bfgs'"),
@@ -166,7 +170,14 @@ obstacles = st.fixed_dictionaries(
     },
 )
 targets = st.one_of(
-    st.fixed_dictionaries({}, optional={"tcp": vectors, "q": vectors, "theta4": numbers, "theta5": numbers}),
+    st.fixed_dictionaries(
+        {},
+        optional={
+            "tcp": vectors,
+            "q": vectors,
+            "hold": st.dictionaries(st.sampled_from(["theta4", "d2", "x"]), numbers),
+        },
+    ),
     values,
 )
 scenes = st.fixed_dictionaries(

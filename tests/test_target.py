@@ -28,7 +28,7 @@ def tilted_cpr(tmp_path_factory: pytest.TempPathFactory) -> ck.Robot:
 
 
 def test_the_cprs_analytic_ik_is_used_and_verified(robot: ck.Robot) -> None:
-    target = Target(tcp=PAPER_START_TCP, theta4=0.3, theta5=-0.2)
+    target = Target(tcp=PAPER_START_TCP, hold={"theta4": 0.3, "theta5": -0.2})
     q = target.configuration(robot)
     np.testing.assert_array_equal(q, ck.tcp_ik(robot, PAPER_START_TCP, 0.3, -0.2))
     assert target.miss(robot, q) is None
@@ -37,7 +37,7 @@ def test_the_cprs_analytic_ik_is_used_and_verified(robot: ck.Robot) -> None:
 
 def test_a_variant_the_analytic_ik_misses_is_solved_numerically(tilted_cpr: ck.Robot) -> None:
     goal = (0.45, 0.35, 0.3)
-    target = Target(tcp=goal, theta4=0.2, theta5=0.1)
+    target = Target(tcp=goal, hold={"theta4": 0.2, "theta5": 0.1})
     analytic = ck.tcp_ik(tilted_cpr, goal, 0.2, 0.1)
     miss = target.miss(tilted_cpr, analytic)
     assert miss is not None and "m from the position" in miss  # the analytic answer is millimetres off
@@ -48,9 +48,9 @@ def test_a_variant_the_analytic_ik_misses_is_solved_numerically(tilted_cpr: ck.R
 
 
 def test_a_tcp_the_variant_cannot_reach_names_both_answers(tilted_cpr: ck.Robot) -> None:
-    with pytest.raises(ck.IkMissError, match=r"came .* m from the position .*; the analytic IK: "):
+    with pytest.raises(ck.IkMissError, match=r"came .* m from the position .*; the robot's analytic IK: "):
         Target(tcp=(1.6, 0.0, 0.3)).configuration(tilted_cpr)  # within the reach bound, out of reach
-    with pytest.raises(ck.IkMissError, match=r"beyond the 1\.8 m its links reach; the analytic IK: "):
+    with pytest.raises(ck.IkMissError, match=r"beyond the 1\.8 m its links reach; the robot's analytic IK: "):
         Target(tcp=(3.0, 0.0, 0.3)).configuration(tilted_cpr)
 
 
@@ -80,10 +80,28 @@ def test_a_pose_goal_is_met_within_its_tolerances() -> None:
     )
 
 
-def test_the_cprs_wrist_angles_are_refused_on_other_robots() -> None:
+def test_a_held_joint_the_robot_does_not_plan_is_refused() -> None:
     ur5 = ck.load_robot(example_robot("ur5"))
-    with pytest.raises(PlanningError, match=r"theta4 = 0.5, theta5 = 0.0: these are the CPR's wrist angles"):
-        Target(tcp=(0.4, 0.1, 0.4), theta4=0.5).configuration(ur5)
+    with pytest.raises(PlanningError, match=r"hold = \{'theta4': 0.5\}: \['theta4'\] not planned joint\(s\)"):
+        Target(tcp=(0.4, 0.1, 0.4), hold={"theta4": 0.5}).configuration(ur5)
+    with pytest.raises(PlanningError, match="joints are held with a 'tcp' target only"):
+        Target(q=(0.0,) * 6, hold={"wrist_3_joint": 0.5})
+
+
+def test_any_robot_holds_the_joints_a_tcp_target_names(robot: ck.Robot) -> None:
+    # the numerical IK holds a UR5's last joint where the target says; the CPR's analytic IK its wrist
+    ur5 = ck.load_robot(example_robot("ur5"))
+    target = Target(tcp=(0.4, 0.1, 0.4), hold={"wrist_3_joint": 0.7, "wrist_1_joint": -1.2})
+    q = target.configuration(ur5)
+    assert target.miss(ur5, q) is None
+    assert q[ur5.limits.index("wrist_3_joint")] == pytest.approx(0.7, abs=1e-9)
+    assert q[ur5.limits.index("wrist_1_joint")] == pytest.approx(-1.2, abs=1e-9)
+    assert np.linalg.norm(tool_position(ur5, q) - (0.4, 0.1, 0.4)) <= target.tolerance_m
+    moved = q.copy()
+    moved[ur5.limits.index("wrist_3_joint")] += 0.01  # the position is kept (the last joint spins the tool)
+    assert "held joints are off their values by {'wrist_3_joint': 0.01}" in (target.miss(ur5, moved) or "")
+    with pytest.raises(ck.JointLimitError, match=r"joint 'theta4' = 9 rad is outside"):
+        Target(tcp=PAPER_START_TCP, hold={"theta4": 9.0}).configuration(robot)
 
 
 @pytest.mark.parametrize(

@@ -22,7 +22,8 @@ from planning.outcome import EXIT_INTERRUPTED, Interrupted, classify
 def build_parser() -> argparse.ArgumentParser:
     """The parser of every command; each sets `run`, the function that runs it."""
     parser = argparse.ArgumentParser(
-        prog="cpr-plan", description="Collision-free, jerk-continuous trajectories for the CPR."
+        prog="cpr-plan",
+        description="Collision-free, jerk-continuous trajectories for any serial arm (the CPR by default)",
     )
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 

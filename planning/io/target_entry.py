@@ -4,6 +4,7 @@
 start: {q: [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785]}     # the planned joints, in order
 start: {q: {panda_joint1: 0.0, panda_joint2: -0.785, ...}}     # or every one by name
 goal:  {tcp: [0.5, 0.2, 0.4]}                                  # a position of the tool frame [m]
+goal:  {tcp: [0.5, 0.2, 0.4], hold: {panda_joint7: 0.785}}     # with joints held [rad, m]
 goal:  {pose: {xyz: [0.5, 0.2, 0.4], quat_xyzw: [1, 0, 0, 0]}, tolerance_m: 0.001}
 goal:  {pose: {xyz: [0.5, 0.2, 0.4], rpy: [3.1416, 0, 0]}, tolerance_rad: 0.01}
 ```
@@ -77,10 +78,22 @@ class TargetSpec(Strict):
     q: Joints | None = None
     tcp: Point | None = None
     pose: PoseSpec | None = None
-    theta4: Angle = 0.0
-    theta5: Angle = 0.0
+    hold: JointMap | None = None
     tolerance_m: Annotated[float, between(*TOLERANCE_M_RANGE)] = DEFAULT_TOLERANCE_M
     tolerance_rad: Annotated[float, between(*TOLERANCE_RAD_RANGE)] = DEFAULT_TOLERANCE_RAD
+
+    @model_validator(mode="before")
+    @classmethod
+    def _held_joint_by_name(cls, data: Any) -> Any:
+        """A joint named beside ``tcp`` (``{tcp: [...], theta4: 0.1}``): say where it goes."""
+        if isinstance(data, dict) and "tcp" in data:
+            strays = [key for key in data if key not in cls.model_fields]
+            if strays:
+                raise ValueError(
+                    f"{strays} not key(s) of a start or goal ({sorted(cls.model_fields)}); joints held "
+                    f"with 'tcp' go in 'hold', e.g. hold: {{{strays[0]}: 0.0}}"
+                )
+        return data
 
     @model_validator(mode="after")
     def _one_of(self) -> TargetSpec:
@@ -89,8 +102,8 @@ class TargetSpec(Strict):
             raise ValueError(
                 "give exactly one of 'q' (joint values), 'tcp' (x, y, z) [m] or 'pose' (xyz and rotation)"
             )
-        if self.tcp is None and (self.theta4 or self.theta5):
-            raise ValueError("theta4 and theta5 (the CPR's wrist angles) go with 'tcp'")
+        if self.tcp is None and self.hold:
+            raise ValueError("'hold' (joints held at values) goes with 'tcp'")
         return self
 
     def target(self) -> Target:
@@ -102,8 +115,7 @@ class TargetSpec(Strict):
         if self.tcp is not None:
             return Target(
                 tcp=(self.tcp[0], self.tcp[1], self.tcp[2]),
-                theta4=self.theta4,
-                theta5=self.theta5,
+                hold=dict(self.hold or {}),
                 tolerance_m=tolerance_m,
                 tolerance_rad=tolerance_rad,
             )
@@ -121,8 +133,8 @@ def target_entry(target: Target) -> dict[str, Any]:
         entry = {"q": {k: float(v) for k, v in q.items()} if isinstance(q, dict) else [float(v) for v in q]}
     elif target.tcp is not None:
         entry = {"tcp": [float(v) for v in target.tcp]}
-        if target.theta4 or target.theta5:
-            entry.update(theta4=target.theta4, theta5=target.theta5)
+        if target.hold:
+            entry["hold"] = {name: float(value) for name, value in target.hold.items()}
     else:
         assert target.pose is not None  # exactly one (Target)
         position, rotation = target.pose

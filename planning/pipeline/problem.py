@@ -108,7 +108,7 @@ def moving_joints(robot: ck.Robot, scene: Scene, q_start: FloatArray, q_goal: Fl
     """Indices of the joints a plan moves.
 
     ``scene.planner.moving_joints``, or every joint but the robot's wrist joints
-    (:attr:`cpr_kin.Robot.wrist_joints`; the CPR's theta4 and theta5) whose start and goal
+    (:attr:`cpr_kin.Robot.wrist_joints`, a preset's) whose start and goal
     values agree.
 
     Raises:

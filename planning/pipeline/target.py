@@ -2,14 +2,16 @@
 
 - ``q``: the planned joints' values [rad, m], as a list in their order or a
   ``{joint: value}`` map naming every one;
-- ``tcp``: the tool frame's position [m] (a position goal); on the CPR its analytic IK with
-  the wrist angles ``theta4``, ``theta5`` held, else the numerical IK;
+- ``tcp``: the tool frame's position [m] (a position goal), with the joints ``hold`` names
+  at those values and the robot's wrist joints (:attr:`cpr_kin.Robot.wrist_joints`) at 0
+  unless named: the robot's own IK (:attr:`cpr_kin.Robot.position_ik`, a preset's analytic
+  one) where it has one, else the numerical IK;
 - ``pose``: the tool frame's position [m] and orientation (a pose goal), by the numerical IK
   (:func:`cpr_kin.solve_ik`).
 
 Every IK result is checked by forward kinematics against the target and its tolerance
-(``tolerance_m``, ``tolerance_rad``); the analytic IK's too (a CPR variant whose axes it does
-not model falls back to the numerical one).
+(``tolerance_m``, ``tolerance_rad``) and the held joints; the robot's own IK's too (a variant
+whose axes it does not model falls back to the numerical one).
 """
 
 from __future__ import annotations
@@ -46,8 +48,8 @@ class Target:
         tcp: ``(x, y, z)`` of the tool frame [m], or ``None``.
         q: the planned joints' values [rad, m], a tuple in their order or a ``{joint: value}``
             map, or ``None``.
-        theta4: the CPR's wrist roll held with ``tcp`` [rad].
-        theta5: the CPR's tool pitch held with ``tcp`` [rad].
+        hold: planned joints held at these values by a ``tcp`` target [rad, m] (the robot's
+            wrist joints at 0 unless named here).
         pose: ``(position (3,), rotation (3, 3))`` of the tool frame [m], or ``None``.
         tolerance_m: largest position error of an IK solution [m].
         tolerance_rad: largest rotation error of a pose's IK solution [rad].
@@ -55,8 +57,7 @@ class Target:
 
     tcp: tuple[float, float, float] | None = None
     q: tuple[float, ...] | Mapping[str, float] | None = None
-    theta4: float = 0.0
-    theta5: float = 0.0
+    hold: Mapping[str, float] = field(default_factory=dict)
     pose: tuple[tuple[float, ...], tuple[tuple[float, ...], ...]] | None = field(default=None)
     tolerance_m: float = DEFAULT_TOLERANCE_M
     tolerance_rad: float = DEFAULT_TOLERANCE_RAD
@@ -67,6 +68,8 @@ class Target:
             raise PlanningError(
                 f"a start or goal needs exactly one of 'q' (joint values), 'tcp' (x, y, z), 'pose': {given}"
             )
+        if self.hold and self.tcp is None:
+            raise PlanningError(f"hold = {dict(self.hold)}: joints are held with a 'tcp' target only")
         if not (self.tolerance_m > 0 and self.tolerance_rad > 0):
             raise PlanningError(f"tolerances {self.tolerance_m} m, {self.tolerance_rad} rad must be > 0")
 
@@ -95,39 +98,55 @@ class Target:
                 naming the wrong joints.
             cpr_kin.IkMissError: a ``tcp`` or ``pose`` no configuration reaches within the
                 tolerance (the message says how close the IK came).
-            PlanningError: ``theta4``/``theta5`` given for a robot without the CPR's joints.
+            PlanningError: ``hold`` names a joint the robot does not plan.
         """
         if self.q is not None:
             values = dict(self.q) if isinstance(self.q, Mapping) else np.asarray(self.q, dtype=float)
             return robot.configuration(values)
         target = self.ik_target
         assert target is not None  # exactly one of q, tcp, pose (__post_init__)
-        if self.tcp is None or robot.joint_names != ck.CPR_JOINTS:
-            if self.theta4 or self.theta5:
-                raise PlanningError(
-                    f"theta4 = {self.theta4}, theta5 = {self.theta5}: these are the CPR's wrist angles; "
-                    f"this robot's joints are {list(robot.joint_names)} (give a 'pose' or 'q' instead)"
-                )
+        held = self.held(robot) if self.tcp is not None else {}
+        own = ""
+        if self.tcp is not None and robot.position_ik is not None:  # the robot's own IK, verified
+            try:
+                q = robot.position_ik(robot, np.asarray(self.tcp, dtype=float), held)
+                own = self.miss(robot, q) or ""
+            except ck.UnreachableError as exc:
+                own = str(exc)
+            if not own:
+                return q
+        if not held:
             return ck.solve_ik(robot, target, seed_q, accept)
-        try:  # the CPR's analytic IK, verified; else (a variant it does not model) the numerical one
-            q = ck.tcp_ik(robot, self.tcp, self.theta4, self.theta5)
-            analytic = self.miss(robot, q)
-        except ck.UnreachableError as exc:
-            analytic = str(exc)
-        if analytic is None:
-            return q
         seed = np.array(seed_q if seed_q is not None else (robot.limits.lower + robot.limits.upper) / 2)
-        seed[_wrist(robot)] = (self.theta4, self.theta5)
+        for name, value in held.items():
+            seed[robot.limits.index(name)] = value
         try:
-            return ck.solve_ik(robot, target, seed, accept, held=robot.wrist_joints)
+            return ck.solve_ik(robot, target, seed, accept, held=tuple(held))
         except ck.IkMissError as exc:
-            raise ck.IkMissError(f"{exc}; the analytic IK: {analytic}") from None
+            raise ck.IkMissError(f"{exc}; the robot's analytic IK: {own}" if own else str(exc)) from None
+
+    def held(self, robot: ck.Robot) -> dict[str, float]:
+        """The joints a ``tcp`` target holds [rad, m]: ``hold``, and the robot's wrist joints at 0.
+
+        Raises:
+            PlanningError: ``hold`` names a joint the robot does not plan.
+            cpr_kin.JointLimitError: a held value outside its joint's range.
+        """
+        unknown = sorted(set(self.hold) - set(robot.joint_names))
+        if unknown:
+            raise PlanningError(
+                f"hold = {dict(self.hold)}: {unknown} not planned joint(s) of this robot; "
+                f"its planned joints are {list(robot.joint_names)}"
+            )
+        for name, value in self.hold.items():
+            robot.check_joint(name, value)
+        return {name: 0.0 for name in robot.wrist_joints} | {k: float(v) for k, v in self.hold.items()}
 
     def miss(self, robot: ck.Robot, q: FloatArray) -> str | None:
         """How ``q`` misses this target, or ``None`` if it meets it (forward kinematics for a tool target).
 
         A joint vector is met within :data:`SAME_Q_TOLERANCE` per joint; a ``tcp`` or ``pose``
-        within the target's tolerances, and a ``tcp`` on the CPR holds the wrist angles too.
+        within the target's tolerances, and a ``tcp`` holds its held joints (:meth:`held`) too.
         """
         q = np.asarray(q, dtype=float)
         if self.q is not None:
@@ -139,13 +158,10 @@ class Target:
         placement = pin.SE3(ck.frame_poses(robot, q[None])[0])
         if not target.reached(placement):
             return f"{target.miss(placement)} of frame '{robot.tcp_frame}'"
-        if self.tcp is not None and robot.joint_names == ck.CPR_JOINTS:
-            gap = float(np.abs(q[_wrist(robot)] - (self.theta4, self.theta5)).max())
-            if gap > SAME_Q_TOLERANCE:
-                return f"its wrist angles {list(robot.wrist_joints)} are {gap:.3g} rad from the target's"
+        if self.tcp is not None:
+            held = self.held(robot)
+            gaps = {name: abs(q[robot.limits.index(name)] - value) for name, value in held.items()}
+            off = {name: round(float(gap), 6) for name, gap in gaps.items() if gap > SAME_Q_TOLERANCE}
+            if off:
+                return f"its held joints are off their values by {off}"
         return None
-
-
-def _wrist(robot: ck.Robot) -> list[int]:
-    """Indices of the CPR preset's wrist joints (:attr:`cpr_kin.Robot.wrist_joints`) in ``q``."""
-    return [robot.limits.index(name) for name in robot.wrist_joints]

@@ -1,4 +1,4 @@
-"""meshcat display of the CPR, its obstacles, the safety margin and a trajectory.
+"""meshcat display of the robot, its obstacles, the safety margin and a trajectory.
 
 Imported only when a display is asked for: ``import planning`` never loads meshcat. The
 viewer talks to a loopback-only meshcat server (:mod:`planning.viz.viewer_server`) that it

@@ -15,7 +15,8 @@ from pathlib import Path
 
 from cpr_kin.limits import LIMITS_NAMES
 from cpr_kin.loading import RobotSpec
-from cpr_kin.resources import cpr_limits_path, cpr_urdf_path
+from cpr_kin.presets.cpr_ik import WRIST_JOINTS, position_ik
+from cpr_kin.resources import bundled_urdf_dir
 from cpr_kin.robot import Robot
 from cpr_kin.urdf_file import parse_urdf
 
@@ -25,8 +26,16 @@ TCP_FRAME = "tcp"
 """Name of the tool-centre-point frame."""
 EFFECTOR_LINKS = ("wrist_link", "tool_link")
 """Links whose collision geometry forms the ``effector`` group; the rest form ``links``."""
-WRIST_JOINTS = ("theta4", "theta5")
-"""Joints a plan holds unless its start and goal differ in them (the paper holds both at 0)."""
+
+
+def cpr_urdf_path() -> Path:
+    """Path of the bundled CPR URDF."""
+    return bundled_urdf_dir() / "cpr.urdf"
+
+
+def cpr_limits_path() -> Path:
+    """Path of the bundled acceleration and jerk limits of the CPR."""
+    return bundled_urdf_dir() / "cpr_limits.yaml"
 
 
 def load_cpr(
@@ -37,7 +46,8 @@ def load_cpr(
     Args:
         urdf_path: the URDF; default: the bundled ``urdf/cpr.urdf``.
         limits_path: acceleration and jerk limits; default: see the module docstring.
-        validate: as :func:`~cpr_kin.robot.load_robot`'s.
+        validate: validate the URDF with yourdfpy; default: yes, but the bundled file (which
+            the test suite validates).
 
     Raises:
         UrdfError: the file is missing, malformed or unsupported, or lacks a CPR joint or
@@ -50,17 +60,20 @@ def cpr_spec(
     urdf_path: str | Path | None = None, limits_path: str | Path | None = None, validate: bool | None = None
 ) -> RobotSpec:
     """The :class:`~cpr_kin.loading.RobotSpec` of the CPR preset (see :func:`load_cpr`)."""
+    urdf = Path(urdf_path) if urdf_path is not None else cpr_urdf_path()
+    bundled = urdf.resolve() == cpr_urdf_path().resolve()
     return RobotSpec(
-        urdf=Path(urdf_path) if urdf_path is not None else cpr_urdf_path(),
+        urdf=urdf,
         limits=None if limits_path is None else Path(limits_path),
         joints=CPR_JOINTS,
         tcp=TCP_FRAME,
         effector_links=EFFECTOR_LINKS,
         wrist_joints=WRIST_JOINTS,
+        position_ik=position_ik,
         limits_names=(*LIMITS_NAMES, "cpr_limits.yaml"),
         default_limits=cpr_limits_path(),
         default_srdf=cpr_limits_path().with_name("cpr.srdf"),
-        validate=validate,
+        validate=validate if validate is not None else not bundled,
     )
 
 
@@ -69,9 +82,3 @@ def has_cpr_joints(urdf_path: Path) -> bool:
     tree = parse_urdf(urdf_path)
     moving = tuple(j.get("name") for j in tree.getroot().findall("joint") if j.get("type") != "fixed")
     return moving == CPR_JOINTS
-
-
-def robot_spec(urdf_path: str | Path) -> RobotSpec:
-    """The spec of the robot of a URDF: the CPR preset for a CPR variant, else the generic rules."""
-    path = Path(urdf_path)
-    return cpr_spec(path) if path.is_file() and has_cpr_joints(path) else RobotSpec(urdf=path)

@@ -19,6 +19,7 @@ it is returned only when it is within the limits and the first is not.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -28,6 +29,10 @@ from cpr_kin.kinematics import frame_positions
 from cpr_kin.robot import Robot
 
 FloatArray = NDArray[np.float64]
+
+WRIST_JOINTS = ("theta4", "theta5")
+"""The CPR's wrist roll and tool pitch: held by a plan unless its start and goal differ in them, and
+by a ``tcp`` goal at the values it gives (default 0; the paper holds both at 0)."""
 
 
 def _wrap(angle: float) -> float:
@@ -87,3 +92,16 @@ def tcp_ik(robot: Robot, tcp_in_world: ArrayLike, theta4: float = 0.0, theta5: f
         except JointLimitError as exc:
             first_error = first_error or exc
     raise UnreachableError(f"TCP target {target.tolist()} is out of reach: {first_error}") from None
+
+
+def position_ik(robot: Robot, tcp_in_base: FloatArray, held: Mapping[str, float]) -> FloatArray:
+    """:func:`tcp_ik` as the CPR preset's :class:`~cpr_kin.robot.PositionIk` (held wrist angles, default 0).
+
+    Raises:
+        UnreachableError: the target is out of reach, or ``held`` names a joint other than the
+            wrist's (this IK holds only those: the caller falls back to the numerical IK).
+    """
+    others = sorted(set(held) - set(WRIST_JOINTS))
+    if others:
+        raise UnreachableError(f"the CPR's analytic IK holds only {list(WRIST_JOINTS)}, not {others}")
+    return tcp_ik(robot, tcp_in_base, held.get("theta4", 0.0), held.get("theta5", 0.0))
