@@ -4,7 +4,7 @@ import argparse
 
 import pytest
 
-from planning.cli.problem_selection import PER_CLASS, add_selection, check_selection
+from planning.cli.problem_selection import PER_CLASS, add_selection, check_selection, selected_problems
 from planning.io.mbm import CLASSES
 
 
@@ -39,6 +39,8 @@ def test_a_sample_is_a_limit_and_a_seed() -> None:
         (["--limit", "0"], "argument --limit: 0 must be an integer >= 1"),
         (["--robots", "kuka"], "argument --robots: invalid choice: 'kuka'"),
         (["--classes", "shelf"], "argument --classes: invalid choice: 'shelf'"),
+        (["--names", "box_0020", "shelf_0001"], "--names shelf_0001: a problem is <class>_<number 1-100>"),
+        (["--names", "box_0101"], "--names box_0101: a problem is <class>_<number 1-100>"),
     ],
 )
 def test_a_bad_selection_is_one_line_and_exit_2(
@@ -48,3 +50,9 @@ def test_a_bad_selection_is_one_line_and_exit_2(
         parsed(arguments)
     assert info.value.code == 2
     assert message in capsys.readouterr().err
+
+
+def test_names_keep_only_the_problems_named() -> None:
+    args = parsed(["--robots", "ur5", "--names", "box_0020", "cage_0003", "--classes", "box"])
+    chosen = [p.name for p in selected_problems(args, "ur5")]
+    assert chosen == ["box_0020"]  # the classes still select: cage is not among them

@@ -1,4 +1,6 @@
-"""Which MotionBenchMaker problems a script runs: ``--robots``, ``--classes``, ``--limit``, ``--sample-seed``.
+"""Which MotionBenchMaker problems a script runs: ``--robots``, ``--classes``, ``--limit``, ``--names``.
+
+``--sample-seed`` draws the ``--limit`` at random; ``--names`` keeps only the problems named.
 
 ``scripts/bench_mbm.py`` and ``scripts/import_mbm.py`` take the same selection::
 
@@ -21,7 +23,7 @@ PER_CLASS = 100
 
 
 def add_selection(parser: argparse.ArgumentParser) -> None:
-    """Add ``--robots`` (default: panda, ur5), ``--classes``, ``--limit``, ``--sample-seed`` to ``parser``."""
+    """Add ``--robots`` (default: panda, ur5), ``--classes``, ``--limit``, ``--sample-seed``, ``--names``."""
     parser.add_argument("--robots", nargs="+", default=["panda", "ur5"], choices=list(ROBOTS))
     parser.add_argument("--classes", nargs="+", default=list(CLASSES), choices=list(CLASSES))
     parser.add_argument("--limit", type=COUNT, help=f"problems per class (default: all {PER_CLASS})")
@@ -30,6 +32,7 @@ def add_selection(parser: argparse.ArgumentParser) -> None:
         type=SEED,
         help="draw --limit problems of each class at random with this seed (default: the first --limit)",
     )
+    parser.add_argument("--names", nargs="+", help="only these problems, e.g. box_0020 table_pick_0061")
 
 
 def check_selection(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
@@ -37,6 +40,12 @@ def check_selection(parser: argparse.ArgumentParser, args: argparse.Namespace) -
     check_limit(parser, args.limit)
     if args.sample_seed is not None and args.limit is None:
         parser.error(f"--sample-seed {args.sample_seed} goes with --limit (the sample's size per class)")
+    for name in args.names or ():
+        kind, _, number = name.rpartition("_")
+        if kind not in CLASSES or not number.isdigit() or not 1 <= int(number) <= PER_CLASS:
+            parser.error(
+                f"--names {name}: a problem is <class>_<number 1-{PER_CLASS}>, class one of {list(CLASSES)}"
+            )
 
 
 def check_limit(parser: argparse.ArgumentParser, limit: int | None) -> None:
@@ -47,4 +56,5 @@ def check_limit(parser: argparse.ArgumentParser, limit: int | None) -> None:
 
 def selected_problems(args: argparse.Namespace, robot: str) -> Iterator[Problem]:
     """``robot``'s problems of the selection in ``args`` (:func:`planning.io.mbm.problems`)."""
-    return problems(robot, tuple(args.classes), args.limit, args.sample_seed)
+    chosen = problems(robot, tuple(args.classes), args.limit, args.sample_seed)
+    return (p for p in chosen if p.name in args.names) if getattr(args, "names", None) else chosen
