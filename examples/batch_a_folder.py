@@ -11,7 +11,7 @@ from pathlib import Path
 
 from planning import dump_scene
 from planning.batch import run_batch, scene_files, summary_csv
-from planning.io.scene_generator import generate_scenes
+from planning.bench.scene_generator import generate_scenes
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else "out/examples/batch")
 (out / "scenes").mkdir(parents=True, exist_ok=True)

@@ -18,10 +18,10 @@ from pathlib import Path
 
 import cpr_kin as ck
 from cpr_kin.point_clouds import sampled_surfaces, voxel_obstacles
+from planning.bench.scene_generator import generate_scenes
 from planning.cli.arguments import COUNT, SEED, number_above
 from planning.errors import NoSolutionError
 from planning.io.scene_file import load_scene
-from planning.io.scene_generator import generate_scenes
 from planning.pipeline.planner import plan
 from planning.pipeline.scene import Scene
 

@@ -3,13 +3,13 @@
     python scripts/bench_exact_meshes.py [--robots ur5 panda] [--limit N --sample-seed S]
                                          [--time-limit SECONDS] [--out DIR] [--models meshes]
 
-Each problem is imported as ``import-moveit`` writes it (:func:`planning.io.mbm.import_problem`)
+Each problem is imported as ``import-moveit`` writes it (:func:`planning.bench.mbm.import_problem`)
 and planned warm, in this one process, twice, in alternating order: by the robot as it loads
 (its concave links' exact meshes deciding, planned on the hulls first:
 :func:`planning.pipeline.problem.on_hulls`) and by the same robot with the exact meshes
 removed (the hulls alone: the collision model before the meshes). A problem counts as valid
 on a model when its start and goal clear the margins there
-(:func:`planning.io.mbm.endpoint_violations`); every trajectory is checked as ``cpr-plan check``
+(:func:`planning.bench.mbm.endpoint_violations`); every trajectory is checked as ``cpr-plan check``
 checks it, on the exact meshes. Prints per class: problems, valid on each model, planned,
 passing the check, median and p95 planning time on each, and the ratio of the medians on the
 problems valid on both. ``--models meshes`` plans on the meshes alone (validity is still counted
@@ -30,10 +30,10 @@ from typing import Any
 import numpy as np
 
 import cpr_kin as ck
+from planning.bench.mbm import endpoint_violations, import_problem
+from planning.bench.problem_selection import add_selection, check_selection, selected_problems
 from planning.cli.arguments import SECONDS
-from planning.cli.problem_selection import add_selection, check_selection, selected_problems
 from planning.errors import CprPlanError
-from planning.io.mbm import endpoint_violations, import_problem
 from planning.io.scene_file import load_scene
 from planning.pipeline.planner import plan
 from planning.pipeline.problem import build_problem

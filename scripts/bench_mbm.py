@@ -14,9 +14,9 @@ margins 0 as in MoveIt), then, alternating, is planned warm by
   kernels compiled) stopped after ``--timeout`` seconds;
 - the peer (``--peer``), on the same collision model (obstacles and self pairs): OMPL's
   RRT-Connect + simplification + TOPP-RA through Python callbacks
-  (:mod:`planning.peers.ompl_rrt`), 1 s per attempt, new seeds up to ``--timeout`` (the
+  (:mod:`planning.bench.ompl_rrt`), 1 s per attempt, new seeds up to ``--timeout`` (the
   default); or roboplan's RRT-Connect + shortcutting + TOPP-RA, compiled
-  (:mod:`planning.peers.roboplan_rrt`), one search of up to ``--timeout``, whose path is then
+  (:mod:`planning.bench.roboplan_rrt`), one search of up to ``--timeout``, whose path is then
   checked, untimed, by our certified checks: the table counts the paths that fail them at the
   scene's steps (as ``cpr-plan check``) and, in brackets, those that fail even at a tenth of
   them (in contact, or within half a millimetre of it).
@@ -32,7 +32,7 @@ knows neither jerk nor torque limits, ours keeps both), how many of ours pass ``
 check`` (the trajectory file read back and verified anew, untimed), and how many of the
 peer's paths fail our checks (OMPL's are verified in its pipeline: none). Rows go to
 ``DIR/mbm.csv``, the table as markdown to ``DIR/mbm.md``. Needs the ``bench`` extra; the
-problems are downloaded once (:mod:`planning.io.mbm`).
+problems are downloaded once (:mod:`planning.bench.mbm`).
 
 ``--limit N`` takes the first N problems of each class, those the development looked at most;
 with ``--sample-seed S`` it draws N of each class at random instead (the same seed, the same
@@ -72,10 +72,10 @@ import numpy as np
 
 import cpr_kin as ck
 from planning.batch import scene_files
+from planning.bench.mbm import endpoint_violations, import_problem
+from planning.bench.problem_selection import add_selection, check_selection, selected_problems
 from planning.cli.arguments import COUNT, SECONDS
-from planning.cli.problem_selection import add_selection, check_selection, selected_problems
 from planning.errors import NoSolutionError, PlanningError
-from planning.io.mbm import endpoint_violations, import_problem
 from planning.io.scene_file import load_scene
 from planning.io.trajectory_io import trajectory_json
 from planning.outcome import classify
@@ -105,7 +105,7 @@ def ours(scene_path: str, time_limit_s: float, threads: int | None = None) -> di
 
     ``threads``: of its parallel collision checks (``None``: the planner's default, up to 2).
     """
-    from planning.peers.ruckig_bound import free_space_bound
+    from planning.bench.ruckig_bound import free_space_bound
     from planning.pipeline.planner import plan
 
     scene, robot = _robot(scene_path)
@@ -161,7 +161,7 @@ def warm_peer(scene_path: str) -> None:
     Its first call in a process would otherwise count the imports, TOPP-RA's above all:
     0.32 s against 0.035 s warm on the bundled shelf.
     """
-    from planning.peers.ompl_rrt import import_peer
+    from planning.bench.ompl_rrt import import_peer
 
     warm(scene_path)
     import_peer()
@@ -169,7 +169,7 @@ def warm_peer(scene_path: str) -> None:
 
 def theirs(scene_path: str, timeout_s: float) -> dict[str, Any]:
     """OMPL's pipeline on one scene file, warm: 1 s attempts with new seeds until ``timeout_s``."""
-    from planning.peers.ompl_rrt import plan_rrt_connect
+    from planning.bench.ompl_rrt import plan_rrt_connect
 
     scene, robot = _robot(scene_path)
     started = time.perf_counter()
@@ -182,7 +182,7 @@ def theirs(scene_path: str, timeout_s: float) -> dict[str, Any]:
             return {"ok": False, "time_s": time.perf_counter() - started, "why": str(exc)[:100]}
         if result.success:
             elapsed = time.perf_counter() - started
-            from planning.peers.ruckig_bound import free_space_bound
+            from planning.bench.ruckig_bound import free_space_bound
             from planning.pipeline.problem import build_problem
 
             return {
@@ -202,7 +202,7 @@ _PEER_SCENES: dict[str, Any] = {}
 
 def warm_roboplan(scene_path: str) -> None:
     """:func:`warm`, and roboplan's scene of the file with our collision model, built once (untimed)."""
-    from planning.peers.roboplan_rrt import RoboplanPeer
+    from planning.bench.roboplan_rrt import RoboplanPeer
 
     scene, robot = _robot(scene_path)
     if scene_path not in _PEER_SCENES:
@@ -216,8 +216,8 @@ def theirs_roboplan(scene_path: str, timeout_s: float) -> dict[str, Any]:
     Untimed after it: the duration over Ruckig's bound, the jerk and torques of its trajectory
     (roboplan's samples, linearly interpolated), and our certified checks of its path.
     """
-    from planning.peers.ruckig_bound import free_space_bound
-    from planning.peers.toppra_timing import sampled_jerk
+    from planning.bench.ruckig_bound import free_space_bound
+    from planning.bench.toppra_timing import sampled_jerk
 
     scene, robot = _robot(scene_path)
     peer = _PEER_SCENES[scene_path]

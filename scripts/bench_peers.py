@@ -31,14 +31,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
+from planning.bench.ompl_rrt import plan_rrt_connect
+from planning.bench.pyroboplan_rrt import plan_pyroboplan_rrt_connect
+from planning.bench.scene_generator import generate_scenes
+from planning.bench.toppra_timing import SamplingResult
 from planning.cli.arguments import COUNT, SECONDS, SEED, integer_at_least
 from planning.errors import NoSolutionError, PlanningError
 from planning.io.bundled import paper_scene
 from planning.io.report import markdown_table
-from planning.io.scene_generator import generate_scenes
-from planning.peers.ompl_rrt import plan_rrt_connect
-from planning.peers.pyroboplan_rrt import plan_pyroboplan_rrt_connect
-from planning.peers.toppra_timing import SamplingResult
 from planning.pipeline.objective import WaypointObjective
 from planning.pipeline.planner import plan
 from planning.pipeline.problem import build_problem, with_planner

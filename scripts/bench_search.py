@@ -6,7 +6,7 @@ Issue 17's benchmark, one run, side by side. On ``--scenes`` seeded scenes of wh
 
 - ours: :func:`planning.pipeline.planner.plan` with the scene's (default) settings, warm (one process,
   kernels loaded, robot loaded; the collision world is built in the call);
-- OMPL RRT-Connect + simplification + TOPP-RA (:mod:`planning.peers.ompl_rrt`), ``--budget``
+- OMPL RRT-Connect + simplification + TOPP-RA (:mod:`planning.bench.ompl_rrt`), ``--budget``
   seconds for RRT-Connect, warm likewise, its trajectory verified by the same certified check;
 
 the two alternating scene by scene, so that the machine's drift hits both alike. It prints
@@ -43,14 +43,14 @@ from typing import NamedTuple
 import numpy as np
 
 import cpr_kin as ck
+from planning.bench.narrow_passages import ALL_KINDS, KINDS
+from planning.bench.ompl_rrt import plan_rrt_connect
+from planning.bench.ruckig_bound import free_space_bound
+from planning.bench.scene_generator import generate_scenes
 from planning.cli.arguments import COUNT, SECONDS, SEED, integer_at_least
 from planning.errors import NoSolutionError, PlanningError
 from planning.io.bundled import duration_free_scenes
-from planning.io.narrow_passages import ALL_KINDS, KINDS
 from planning.io.scene_file import dump_scene
-from planning.io.scene_generator import generate_scenes
-from planning.peers.ompl_rrt import plan_rrt_connect
-from planning.peers.ruckig_bound import free_space_bound
 from planning.pipeline.planner import plan
 from planning.pipeline.problem import build_problem
 from planning.pipeline.scene import Scene
@@ -82,7 +82,7 @@ class Row:
     ours: Outcome
     theirs: Outcome
     bound_s: float
-    """Ruckig's jerk-limited free-space bound [s] (:func:`~planning.peers.ruckig_bound.free_space_bound`)."""
+    """Ruckig's jerk-limited free-space bound [s] (:func:`~planning.bench.ruckig_bound.free_space_bound`)."""
 
 
 @dataclass(frozen=True)

@@ -37,6 +37,9 @@ from pathlib import Path
 import numpy as np
 
 import cpr_kin as ck
+from planning.bench.ompl_rrt import plan_rrt_connect
+from planning.bench.ruckig_bound import free_space_bound
+from planning.bench.scene_generator import generate_scenes
 from planning.cli.arguments import COUNT, SECONDS, SEED
 from planning.curves.path_timing import time_path
 from planning.curves.spline import SepticSplineSolver, uniform_knots
@@ -44,9 +47,6 @@ from planning.curves.spline_settings import SplineSettings
 from planning.errors import NoSolutionError, PlanningError
 from planning.io.bundled import duration_free_scenes
 from planning.io.report import markdown_table, text_table
-from planning.io.scene_generator import generate_scenes
-from planning.peers.ompl_rrt import plan_rrt_connect
-from planning.peers.ruckig_bound import free_space_bound
 from planning.pipeline.planner import plan
 from planning.pipeline.problem import build_problem
 from planning.pipeline.scene import Scene

@@ -20,7 +20,7 @@ and one process (warm library calls):
 
 Problems: ``--scenes`` generated CPR scenes (``generate_scenes``, seed ``--scene-seed``) and
 the first ``--limit`` problems of each MotionBenchMaker class whose start and goal are valid
-(:mod:`planning.io.mbm`, downloaded once). Prints per robot and payload: plans, share within
+(:mod:`planning.bench.mbm`, downloaded once). Prints per robot and payload: plans, share within
 the effort limits, median duration / TOPP-RA bound, median duration over the same problem's
 without payload, and the timing's median and p95 wall time with and without torque limits;
 writes ``torque.csv`` and ``torque.md`` to ``--out``. Needs the ``bench`` extra (toppra).
@@ -40,16 +40,16 @@ from typing import Any
 import numpy as np
 
 import cpr_kin as ck
+from planning.bench.mbm import CLASSES, endpoint_violations, import_problem, problems
+from planning.bench.problem_selection import check_limit
+from planning.bench.ruckig_bound import free_space_bound
+from planning.bench.scene_generator import generate_scenes
 from planning.cli.arguments import COUNT, SEED
-from planning.cli.problem_selection import check_limit
 from planning.curves.path_timing import time_path
 from planning.curves.trajectory import Trajectory
 from planning.errors import NoSolutionError
-from planning.io.mbm import CLASSES, endpoint_violations, import_problem, problems
 from planning.io.report import markdown_table
 from planning.io.scene_file import load_scene
-from planning.io.scene_generator import generate_scenes
-from planning.peers.ruckig_bound import free_space_bound
 from planning.pipeline.planner import plan
 from planning.pipeline.scene import Scene
 from planning.pipeline.torques import torque_profile

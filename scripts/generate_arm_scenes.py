@@ -5,7 +5,7 @@
     python scripts/generate_arm_scenes.py --robot path/to/baxter.urdf --tcp left_gripper
         --srdf path/to/baxter_manipulation.srdf ...   (an SRDF its name does not find)
 
-The scenes of :func:`planning.io.arm_scenes.blocked_scene`, seeds ``--seed`` to
+The scenes of :func:`planning.bench.arm_scenes.blocked_scene`, seeds ``--seed`` to
 ``--seed + --count - 1``, named ``<robot>_<seed>``.
 """
 
@@ -20,9 +20,9 @@ import yaml
 
 import cpr_kin as ck
 from cpr_kin.packages import EXAMPLE_ROBOTS, example_robot
+from planning.bench.arm_scenes import blocked_scene
 from planning.cli.arguments import COUNT, SEED, number_above, number_at_least
 from planning.errors import PlanningError
-from planning.io.arm_scenes import blocked_scene
 
 
 def main() -> int:

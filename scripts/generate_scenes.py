@@ -5,11 +5,11 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from planning.bench.narrow_passages import ALL_KINDS, KINDS
+from planning.bench.scene_generator import generate_scenes
 from planning.cli.arguments import COUNT, SEED
 from planning.errors import PlanningError
-from planning.io.narrow_passages import ALL_KINDS, KINDS
 from planning.io.scene_file import dump_scene
-from planning.io.scene_generator import generate_scenes
 
 
 def main() -> None:

@@ -11,7 +11,7 @@ mesh, else the exact mesh (:mod:`cpr_kin.exact_meshes`); the SRDF's and the scen
 pairs). Prints per class: problems, converted, start and goal valid, and why the others are not.
 ``--limit N --sample-seed S`` converts N problems of each class drawn at random (the same seed,
 the same problems): written with ``--out``, a held-out set for ``bench_mbm.py --scenes``.
-The archive is downloaded once from PyPI and cached (:mod:`planning.io.mbm`).
+The archive is downloaded once from PyPI and cached (:mod:`planning.bench.mbm`).
 """
 
 from __future__ import annotations
@@ -25,9 +25,9 @@ import time
 from pathlib import Path
 
 import cpr_kin as ck
-from planning.cli.problem_selection import add_selection, check_selection, selected_problems
+from planning.bench.mbm import endpoint_violations, import_problem
+from planning.bench.problem_selection import add_selection, check_selection, selected_problems
 from planning.errors import PlanningError
-from planning.io.mbm import endpoint_violations, import_problem
 from planning.io.scene_file import load_scene
 
 

@@ -21,9 +21,9 @@ from typing import Any
 
 import cpr_kin as ck
 from planning import NoSolutionError, Optimizer, PlannerSettings, Scene, load_scene, plan, warm_up
+from planning.bench.scene_generator import generate_scenes
 from planning.cli.arguments import integer_at_least
 from planning.io.bundled import bundled_scene_paths, paper_scene_path
-from planning.io.scene_generator import generate_scenes
 from planning.io.trajectory_io import trajectory_json
 from planning.search import baselines
 

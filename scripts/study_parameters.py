@@ -23,9 +23,9 @@ from typing import Any, NamedTuple
 import numpy as np
 
 import cpr_kin as ck
+from planning.bench.scene_generator import generate_scenes
 from planning.cli.arguments import COUNT, SEED, integer_at_least
 from planning.errors import NoSolutionError
-from planning.io.scene_generator import generate_scenes
 from planning.pipeline.planner import plan
 from planning.pipeline.scene import Scene
 from planning.pipeline.tuning import SearchTuning, SeedingTuning

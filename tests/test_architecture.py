@@ -81,9 +81,9 @@ def test_the_core_never_imports_a_peer() -> None:
     offenders = [
         (name, imported)
         for name, path in modules().items()
-        if not within(name, "planning.peers")
+        if not within(name, "planning.bench")
         for imported, _ in imports(name, path)
-        if within(imported, "planning.peers")
+        if within(imported, "planning.bench")
     ]
     assert offenders == []
 
@@ -108,7 +108,7 @@ def test_curves_are_pure_mathematics_and_search_knows_no_robot() -> None:
 def test_the_pipeline_knows_no_file_command_line_or_drawing() -> None:
     # scene -> problem -> search -> choose -> result: what reads and writes files, the command
     # line, the batch and the viewer are built on it, never under it
-    outside = ("planning.io", "planning.cli", "planning.batch", "planning.viz", "planning.peers")
+    outside = ("planning.io", "planning.cli", "planning.batch", "planning.viz", "planning.bench")
     offenders = [
         (name, imported)
         for name, path in modules().items()

@@ -14,9 +14,9 @@ import yaml
 
 import cpr_kin as ck
 from cpr_kin.packages import example_robot, example_robot_data_share
+from planning.bench.arm_scenes import blocked_scene
+from planning.bench.mbm import endpoint_violations
 from planning.errors import PlanningError
-from planning.io.arm_scenes import blocked_scene
-from planning.io.mbm import endpoint_violations
 from planning.io.scene_file import parse_scene
 from planning.pipeline.endpoints import margin_violation
 from planning.pipeline.problem import build_problem

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
+from planning.bench.narrow_passages import ALL_KINDS
+from planning.bench.scene_generator import generate_scenes
 from planning.curves.averaged_path import QUADRATURE, averaged_samples, trapezoid_kernel
 from planning.curves.velocity_caps import ROUNDS, TOLERANCE
-from planning.io.narrow_passages import ALL_KINDS
-from planning.io.scene_generator import generate_scenes
 from planning.pipeline.choose import foreseen_clear, verify
 from planning.pipeline.planner import plan
 from planning.pipeline.result import PlanResult

@@ -78,9 +78,9 @@ def test_rrt_connect_pipelines(robot: ck.Robot, peer: str) -> None:
     pytest.importorskip(peer)
     pytest.importorskip("toppra")
     if peer == "ompl":
-        from planning.peers.ompl_rrt import plan_rrt_connect as planner
+        from planning.bench.ompl_rrt import plan_rrt_connect as planner
     else:
-        from planning.peers.pyroboplan_rrt import plan_pyroboplan_rrt_connect as planner
+        from planning.bench.pyroboplan_rrt import plan_pyroboplan_rrt_connect as planner
 
     state = np.random.get_state()
     result = planner(paper_scene(), robot, seed=0)
@@ -123,7 +123,7 @@ def test_benchmark_script_runs(tmp_path: Path, scenes: int) -> None:
 
 
 def test_shortcut_path_keeps_ends_and_checks_every_new_segment() -> None:
-    from planning.peers.pyroboplan_rrt import shortcut_path
+    from planning.bench.pyroboplan_rrt import shortcut_path
 
     def clear(a: np.ndarray, b: np.ndarray) -> bool:
         """A wall at x = 0.5 blocks |y| < 0.2: is the segment a-b free of it?"""
@@ -171,7 +171,7 @@ def test_the_peers_timing_stays_within_the_joint_ranges_along_a_limit(robot: ck.
     import dataclasses
     import time
 
-    from planning.peers.toppra_timing import PchipPath, _geometric_path, time_and_verify
+    from planning.bench.toppra_timing import PchipPath, _geometric_path, time_and_verify
 
     waypoints = np.array(
         [

@@ -128,7 +128,7 @@ def test_a_scene_without_a_robot_is_the_cpr_s(bench: ModuleType, tmp_path: Path)
 def test_the_peer_s_imports_are_done_before_its_first_timed_call() -> None:
     import sys
 
-    from planning.peers import import_peer
+    from planning.bench import import_peer
 
     import_peer()
     assert {"ompl.geometric", "toppra.algorithm", "toppra.constraint"} <= set(sys.modules)

@@ -8,11 +8,11 @@ import pytest
 import cpr_kin as ck
 from cpr_kin.packages import example_robot
 from planning import build_problem
+from planning.bench.arm_scenes import blocked_scene
+from planning.bench.scene_generator import generate_scenes
 from planning.curves.trajectory import Trajectory
-from planning.io.arm_scenes import blocked_scene
 from planning.io.bundled import paper_scene
 from planning.io.scene_file import parse_scene
-from planning.io.scene_generator import generate_scenes
 from planning.pipeline import choose as choose_module
 from planning.pipeline.choose import Choice, Refusal, choose, distinct, verify
 from planning.pipeline.deadline import Deadline

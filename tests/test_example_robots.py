@@ -3,7 +3,7 @@
 (the SO-100's wrist roll and gripper carry no collision mesh: a path must still move them).
 
 Each scene is drawn at random (seeded) in the robot's own workspace
-(:func:`planning.io.arm_scenes.blocked_scene`): a start configuration, a goal pose of the
+(:func:`planning.bench.arm_scenes.blocked_scene`): a start configuration, a goal pose of the
 tool, and a sphere on the tool's straight joint-space way between them, so that the plan must
 go around it. The goal is a pose, solved by the numerical IK.
 """
@@ -18,8 +18,8 @@ import yaml
 
 import cpr_kin as ck
 from cpr_kin.packages import example_robot
+from planning.bench.arm_scenes import blocked_scene
 from planning.cli import main
-from planning.io.arm_scenes import blocked_scene
 
 ARMS = ("so100", "so101", "ur5", "panda", "xarm7")
 MARGIN_M = 0.02

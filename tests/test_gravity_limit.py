@@ -8,7 +8,7 @@ import pytest
 
 import cpr_kin as ck
 from cpr_kin.packages import example_robot, example_robot_data_share
-from planning.io.arm_scenes import blocked_scene
+from planning.bench.arm_scenes import blocked_scene
 from planning.io.scene_file import parse_scene
 from planning.pipeline.planner import plan
 from planning.pipeline.problem import build_problem, with_planner

@@ -1,11 +1,11 @@
-"""MotionBenchMaker's problems: which ones ``problems`` gives, first or drawn (planning.io.mbm)."""
+"""MotionBenchMaker's problems: which ones ``problems`` gives, first or drawn (planning.bench.mbm)."""
 
 from __future__ import annotations
 
 import pytest
 
+from planning.bench.mbm import CLASSES, problems
 from planning.errors import PlanningError
-from planning.io.mbm import CLASSES, problems
 
 
 def indices(

@@ -166,7 +166,7 @@ def test_lower_bound_of_the_ptp_time_is_the_direct_move(
 
 
 def test_lower_bound_of_the_duration_estimate_is_the_straight_lines(robot: ck.Robot) -> None:
-    from planning.peers.ruckig_bound import free_space_bound
+    from planning.bench.ruckig_bound import free_space_bound
     from planning.pipeline.problem import build_problem
 
     problem = build_problem(dataclasses.replace(paper_scene(), duration=None, obstacles=()), robot)

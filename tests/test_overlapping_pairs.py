@@ -8,7 +8,7 @@ import cpr_kin as ck
 from cpr_kin.overlapping_pairs import overlapping_pairs
 from cpr_kin.packages import example_robot_data_share
 from cpr_kin.self_collision import SelfCollision
-from planning.io.arm_scenes import blocked_scene
+from planning.bench.arm_scenes import blocked_scene
 from planning.io.report import report_markdown
 from planning.io.scene_file import parse_scene
 from planning.pipeline.planner import plan

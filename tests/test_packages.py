@@ -23,7 +23,7 @@ import pytest
         "planning.search",
         "planning.io",
         "planning.viz",
-        "planning.peers",
+        "planning.bench",
     ],
 )
 def test_every_export_resolves_to_its_module_object(package: str) -> None:
@@ -82,6 +82,18 @@ def test_a_plan_among_primitives_imports_no_scipy_module_it_does_not_use() -> No
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.split() == ["False", "False"]
+
+
+@pytest.mark.slow
+def test_cpr_plan_plan_imports_no_benchmark_module(tmp_path: Path) -> None:
+    # the generators, MotionBenchMaker and the peers live in planning.bench, outside what a plan needs
+    code = (
+        "import sys; from planning.cli import main; from planning.io.bundled import bundled_scene_paths; "
+        f"code = main(['plan', str(bundled_scene_paths()[1]), '--out', {str(tmp_path / 'out')!r}]); "
+        "print(code, sorted(m for m in sys.modules if m.startswith('planning.bench')))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.split("\n")[-2] == "0 []"
 
 
 @pytest.mark.slow

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
+from planning.bench.narrow_passages import narrow_scene
+from planning.bench.scene_generator import generate_scenes
 from planning.curves.trajectory import Trajectory
-from planning.io.narrow_passages import narrow_scene
-from planning.io.scene_generator import generate_scenes
 from planning.pipeline.choose import Choice, Refusal
 from planning.pipeline.path_following import follow_path
 from planning.pipeline.path_seeds import sampled_path

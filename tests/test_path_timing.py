@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
+from planning.bench.ruckig_bound import ruckig_duration
 from planning.curves import path_timing
 from planning.curves.path_timing import (
     MIN_NODE_STEP_S,
@@ -14,7 +15,6 @@ from planning.curves.path_timing import (
 )
 from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
-from planning.peers.ruckig_bound import ruckig_duration
 
 from .conftest import LIFT, PAPER_GOAL_TCP, PAPER_START_TCP, limits_of, spline_path
 

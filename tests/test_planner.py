@@ -236,7 +236,7 @@ import cpr_kin as ck
 from cpr_kin.bound_kernels import pair_bounds
 from cpr_kin.self_bounds import self_bounds
 from planning.curves.horner import evaluate
-from planning.io.mbm import vamp_resources
+from planning.bench.mbm import vamp_resources
 from planning.warming import warm_up
 from planning.search.firefly import _move
 ur5 = ck.load_robot(vamp_resources("ur5") / "ur5.urdf", srdf=vamp_resources("ur5") / "ur5.srdf")
@@ -279,7 +279,7 @@ print("new:", sorted(k for k, n in signatures().items() if n != warm.get(k, 0)))
 BAXTER_SCENE = """
 import cpr_kin as ck
 from cpr_kin.packages import example_robot_data_share
-from planning.io.arm_scenes import blocked_scene
+from planning.bench.arm_scenes import blocked_scene
 from planning.io.scene_file import parse_scene
 from planning.pipeline.planner import plan, solve
 from planning.warming import warm_up
@@ -296,7 +296,7 @@ scenes = [parse_scene(blocked_scene("baxter_700", entry, robot, 700, self_cleara
 CPR_SCENES = """
 import dataclasses
 import cpr_kin as ck
-from planning.io.scene_generator import generate_scenes
+from planning.bench.scene_generator import generate_scenes
 from planning.pipeline.planner import plan, solve
 from planning.warming import warm_up
 
@@ -338,7 +338,7 @@ def test_a_goal_at_the_start_gives_the_trajectory_that_stands_still(
 
 
 def test_narrow_passages_are_planned_through_by_the_seeded_search(robot: ck.Robot) -> None:
-    from planning.io.scene_generator import generate_scenes
+    from planning.bench.scene_generator import generate_scenes
 
     scenes = generate_scenes(6, seed=0, robot=robot, narrow=6)
     unseeded = 0
@@ -356,7 +356,7 @@ def test_narrow_passages_are_planned_through_by_the_seeded_search(robot: ck.Robo
 
 
 def test_early_stop_and_seeds_keep_a_plan_byte_identical(robot: ck.Robot) -> None:
-    from planning.io.scene_generator import generate_scenes
+    from planning.bench.scene_generator import generate_scenes
 
     scene = generate_scenes(1, seed=0, robot=robot, narrow=1)[0]  # seeded by a sampled path
     first, second = plan(scene, robot), plan(scene, robot)
@@ -372,7 +372,7 @@ def record_iteration(seen: list[int], progress: FireflyProgress) -> None:
 
 
 def test_refinement_continues_the_firefly_and_only_improves(robot: ck.Robot) -> None:
-    from planning.io.scene_generator import generate_scenes
+    from planning.bench.scene_generator import generate_scenes
 
     exploring = SearchTuning(explore_feasible_seed=True, explore_path_seed=True)  # the firefly runs first
     for scene in generate_scenes(4, seed=2, robot=robot, narrow=1):
@@ -396,7 +396,7 @@ def test_refinement_continues_the_firefly_and_only_improves(robot: ck.Robot) -> 
 
 
 def test_a_feasible_or_path_seed_is_refined_without_the_firefly(robot: ck.Robot) -> None:
-    from planning.io.scene_generator import generate_scenes
+    from planning.bench.scene_generator import generate_scenes
 
     refined_at_once = 0
     for scene in generate_scenes(4, seed=2, robot=robot, narrow=1):
@@ -418,7 +418,7 @@ def test_a_feasible_or_path_seed_is_refined_without_the_firefly(robot: ck.Robot)
 
 def test_refine_stall_zero_runs_the_same_refinement_on_to_the_budget(robot: ck.Robot) -> None:
     """The early stop only cuts the refinement short: without it, the same run goes on."""
-    from planning.io.scene_generator import generate_scenes
+    from planning.bench.scene_generator import generate_scenes
 
     for scene in generate_scenes(3, seed=2, robot=robot, narrow=1):
         stopped = plan(scene, robot).optimiser
@@ -434,7 +434,7 @@ def test_refine_stall_zero_runs_the_same_refinement_on_to_the_budget(robot: ck.R
 
 def test_the_refinement_stops_early_only_near_the_objectives_lower_bound(robot: ck.Robot) -> None:
     """Far above the bound the refinement runs on: the same run as counting every stall, longer."""
-    from planning.io.scene_generator import generate_scenes
+    from planning.bench.scene_generator import generate_scenes
 
     scenes = generate_scenes(8, seed=2, robot=robot, narrow=2)
     everywhere = SearchTuning(refinement=RefinementSettings(near_bound=np.inf))  # every stall counts

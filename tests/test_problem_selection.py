@@ -4,8 +4,8 @@ import argparse
 
 import pytest
 
-from planning.cli.problem_selection import PER_CLASS, add_selection, check_selection, selected_problems
-from planning.io.mbm import CLASSES
+from planning.bench.mbm import CLASSES
+from planning.bench.problem_selection import PER_CLASS, add_selection, check_selection, selected_problems
 
 
 def parsed(arguments: list[str]) -> argparse.Namespace:

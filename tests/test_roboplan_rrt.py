@@ -7,8 +7,8 @@ import itertools
 import numpy as np
 import pytest
 
+from planning.bench.roboplan_rrt import RoboplanPeer
 from planning.io.scene_file import parse_scene
-from planning.peers.roboplan_rrt import RoboplanPeer
 
 pytest.importorskip("roboplan.core", reason="the bench extra's roboplan")
 

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
+from planning.bench.ruckig_bound import free_space_bound, ruckig_duration
 from planning.errors import PlanningError
 from planning.io.bundled import paper_scene
-from planning.peers.ruckig_bound import free_space_bound, ruckig_duration
 from planning.pipeline.planner import plan
 
 

@@ -15,6 +15,7 @@ from hypothesis import strategies as st
 
 import cpr_kin as ck
 from cpr_kin.user_files import StrictLoader
+from planning.bench.scene_generator import generate_scenes
 from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError, SceneError
 from planning.io.bundled import bundled_scene_paths, duration_free_scenes, paper_scene, paper_scene_path
@@ -23,7 +24,6 @@ from planning.io.scene_file import (
     load_scene,
     parse_scene,
 )
-from planning.io.scene_generator import generate_scenes
 from planning.pipeline.settings import PlannerSettings
 from planning.pipeline.target import Target
 

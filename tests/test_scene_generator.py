@@ -4,8 +4,7 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
-from planning.errors import PlanningError
-from planning.io.narrow_passages import (
+from planning.bench.narrow_passages import (
     ARM_ABOVE_AXIS_M,
     KINDS,
     PLAY_RANGE_M,
@@ -13,8 +12,9 @@ from planning.io.narrow_passages import (
     TOOL_BELOW_AXIS_M,
     narrow_scene,
 )
+from planning.bench.scene_generator import generate_scenes
+from planning.errors import PlanningError
 from planning.io.scene_file import parse_scene, scene_document
-from planning.io.scene_generator import generate_scenes
 
 
 def test_generated_scenes_are_reproducible_and_valid(robot: ck.Robot) -> None:

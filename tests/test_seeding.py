@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
+from planning.bench.narrow_passages import narrow_scene
 from planning.errors import PlanningError
-from planning.io.narrow_passages import narrow_scene
 from planning.pipeline.path_seeds import sampled_path
 from planning.pipeline.problem import Problem, build_problem, finer_step_m, with_planner
 from planning.pipeline.scene import Scene
@@ -207,7 +207,7 @@ def test_a_passage_narrower_than_margin_plus_step_is_found_with_a_finer_step(rob
     certified step clear in 10,000 samples (its way passes 2 mm outside the margin; in more,
     an edge checked every 4 cm may slip through); its trees go on at a 1 mm step's
     clearance, and the plan is searched and certified at it."""
-    from planning.io.scene_generator import generate_scenes
+    from planning.bench.scene_generator import generate_scenes
     from planning.pipeline.planner import plan
 
     scene = generate_scenes(100, seed=13, robot=robot, narrow=33)[43]
@@ -224,7 +224,7 @@ def test_after_finer_after_samples_the_trees_keep_the_finer_clearance(robot: ck.
     """Scene 43 of seed 13 again: after ``finer_after`` samples the trees go on keeping the
     finer step's clearance, and the path found so (relaxed) holds it, not the whole step's;
     with no finer step to go to (the step already the smallest allowed), they never do."""
-    from planning.io.scene_generator import generate_scenes
+    from planning.bench.scene_generator import generate_scenes
     from planning.pipeline.seeding import finer_problem
     from planning.pipeline.settings import VERIFY_STEP_RANGE_M
 
@@ -270,7 +270,7 @@ def test_a_passage_rrt_connect_needs_thousands_of_samples_for_is_planned(robot: 
     """Generated scene 70 of seed 12 (24 narrow): RRT-Connect on uniform samples needs just over
     3000 for it, the former budget, after which the search had only the blocked straight line;
     with a fifth of its samples drawn about its trees' nodes (the default) it needs fewer."""
-    from planning.io.scene_generator import generate_scenes
+    from planning.bench.scene_generator import generate_scenes
     from planning.pipeline.planner import plan
 
     scene = {s.name: s for s in generate_scenes(100, seed=12, robot=robot, narrow=24)}["scene_070"]
@@ -290,7 +290,7 @@ def test_a_passage_rrt_connect_needs_tens_of_thousands_of_samples_for_is_planned
     """Generated scene 25 of seed 85: RRT-Connect needs more than 10,000 samples (the former
     budget, after which the plan said "no solution" though OMPL's RRT-Connect finds a path in
     its 5 s); within the default budget it finds one, and the plan is certified."""
-    from planning.io.scene_generator import generate_scenes
+    from planning.bench.scene_generator import generate_scenes
     from planning.pipeline.planner import plan
 
     scene = generate_scenes(26, seed=85, robot=robot)[25]
@@ -304,7 +304,7 @@ def test_a_passage_rrt_connect_needs_tens_of_thousands_of_samples_for_is_planned
 
 def test_a_goal_within_margin_plus_step_plans_with_the_finer_step_at_once(robot: ck.Robot) -> None:
     """A goal 2 mm from a ball, margin 0 (a grasp): RRT-Connect at margin plus 5 mm cannot end there."""
-    from planning.io.scene_generator import generate_scenes
+    from planning.bench.scene_generator import generate_scenes
     from planning.pipeline.planner import plan
 
     corners = PlannerSettings(waypoints=THREE, tuning=SearchTuning(seeding=SeedingTuning(placements=(0.0,))))
@@ -331,7 +331,7 @@ def test_a_goal_within_margin_plus_step_plans_with_the_finer_step_at_once(robot:
 
 def test_a_goal_closer_than_the_finer_step_plans_with_half_its_clearance(robot: ck.Robot) -> None:
     """A goal 0.6 mm from a ball, margin 0: even 1 mm beyond the margin leaves it no path."""
-    from planning.io.scene_generator import generate_scenes
+    from planning.bench.scene_generator import generate_scenes
     from planning.pipeline.planner import plan
 
     corners = PlannerSettings(tuning=SearchTuning(seeding=SeedingTuning(placements=(0.0,))))
@@ -416,7 +416,7 @@ def test_samples_near_the_trees_lead_a_goal_out_of_its_shelf(tmp_path: Any) -> N
     RRT-Connect finds no path keeping the clearance in 3,000 samples. Drawing a fifth of the
     samples about the trees' own nodes (the default) finds one within them, for every seed.
     """
-    from planning.io.mbm import import_problem, problems
+    from planning.bench.mbm import import_problem, problems
     from planning.io.scene_file import load_scene
     from planning.pipeline.seeding import lazy_finer_problem
     from planning.search.rrt_settings import RrtSettings

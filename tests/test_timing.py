@@ -8,9 +8,9 @@ import pytest
 
 import cpr_kin as ck
 from planning import build_problem
+from planning.bench.scene_generator import generate_scenes
 from planning.errors import NoSolutionError, PlanningError
 from planning.io.bundled import paper_scene
-from planning.io.scene_generator import generate_scenes
 from planning.io.trajectory_io import trajectory_document
 from planning.pipeline.choose import Choice, choose, verify
 from planning.pipeline.planner import plan, solve

@@ -109,7 +109,7 @@ def test_check_certifies_what_the_planner_certified_at_its_finer_self_step(tmp_p
     ``cpr-plan check``, reading the file back onto a problem built anew, must too, not only
     the obstacle clearance.
     """
-    from planning.io.mbm import import_problem, problems
+    from planning.bench.mbm import import_problem, problems
     from planning.io.scene_file import load_scene
     from planning.io.trajectory_io import write_trajectory
     from planning.io.trajectory_reader import read_trajectory

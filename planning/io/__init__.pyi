@@ -1,13 +1,10 @@
 """Type stub of the package: what it exports, and from which module (read by ``lazy_loader``)."""
 
-from .arm_scenes import blocked_scene
 from .bundled import bundled_scene_paths, paper_scene, paper_scene_path
-from .narrow_passages import narrow_scene
 from .outputs import plan_files
 from .publish import FolderLock, OutputError, OutputFolder, write_file
 from .report import plan_record, report_markdown, summary
 from .scene_file import dump_scene, load_scene, parse_scene, scene_document
-from .scene_generator import generate_scenes, random_scene
 from .trajectory_io import write_samples, write_trajectory
 from .trajectory_reader import TrajectoryFile, TrajectoryFileError, parse_trajectory, read_trajectory
 
@@ -17,19 +14,15 @@ __all__ = [
     "OutputFolder",
     "TrajectoryFile",
     "TrajectoryFileError",
-    "blocked_scene",
     "bundled_scene_paths",
     "dump_scene",
-    "generate_scenes",
     "load_scene",
-    "narrow_scene",
     "paper_scene",
     "paper_scene_path",
     "parse_scene",
     "parse_trajectory",
     "plan_files",
     "plan_record",
-    "random_scene",
     "read_trajectory",
     "report_markdown",
     "scene_document",

@@ -1,7 +1,7 @@
 """A scene's start and goal as configurations: solved by IK where given as a pose, verified, refused.
 
 :func:`endpoint` gives :func:`~planning.pipeline.problem.build_problem` (and the benchmarks'
-validity test, :func:`planning.io.mbm.endpoint_violations`) the configuration of a start or
+validity test, :func:`planning.bench.mbm.endpoint_violations`) the configuration of a start or
 goal: a joint vector as it is, a ``tcp`` or ``pose`` by the IK solution nearest the seed of
 those clear of the margins that the motors can hold still. :func:`margin_violation` says
 what at a configuration comes inside the safety or self margin.

@@ -15,8 +15,8 @@ from __future__ import annotations
 import argparse
 from collections.abc import Iterator
 
+from planning.bench.mbm import CLASSES, ROBOTS, Problem, problems
 from planning.cli.arguments import COUNT, SEED
-from planning.io.mbm import CLASSES, ROBOTS, Problem, problems
 
 PER_CLASS = 100
 """Problems in each MotionBenchMaker class: the largest ``--limit``."""
@@ -55,6 +55,6 @@ def check_limit(parser: argparse.ArgumentParser, limit: int | None) -> None:
 
 
 def selected_problems(args: argparse.Namespace, robot: str) -> Iterator[Problem]:
-    """``robot``'s problems of the selection in ``args`` (:func:`planning.io.mbm.problems`)."""
+    """``robot``'s problems of the selection in ``args`` (:func:`planning.bench.mbm.problems`)."""
     chosen = problems(robot, tuple(args.classes), args.limit, args.sample_seed)
     return (p for p in chosen if p.name in args.names) if getattr(args, "names", None) else chosen

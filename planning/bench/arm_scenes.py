@@ -1,6 +1,6 @@
 """Seeded random scenes for any arm: a start, a goal pose, and a ball across the way between them.
 
-:mod:`planning.io.scene_generator` draws the CPR's scenes from its geometry; an arm someone
+:mod:`planning.bench.scene_generator` draws the CPR's scenes from its geometry; an arm someone
 brings (a URDF, an example-robot-data name) has none we know. So :func:`blocked_scene` draws
 in the robot's own joint space: a start configuration and a goal configuration in the middle
 60 % of every joint's range whose tool positions lie at least half the arm's reach apart,

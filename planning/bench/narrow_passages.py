@@ -19,12 +19,12 @@ the arm is a 0.05 m beam at height ``z_c = 0.25 + d2`` whose flange, at radius
 - ``overhang``: the goal lies under a board (a shelf above it, on a post beyond it): the arm
   must come in at the goal's height or below, not over the top.
 
-:data:`KINDS` are the kinds :func:`~planning.io.scene_generator.generate_scenes` draws by
+:data:`KINDS` are the kinds :func:`~planning.bench.scene_generator.generate_scenes` draws by
 default (the first three, so that earlier seeds give the same scenes); :data:`ALL_KINDS`
 adds the other two.
 
 The "play" (how much wider the passage is than the robot needs) is drawn from
-:data:`PLAY_RANGE_M`. Start and goal are drawn as in :mod:`planning.io.scene_generator` and
+:data:`PLAY_RANGE_M`. Start and goal are drawn as in :mod:`planning.bench.scene_generator` and
 kept ``margin + 0.02 m`` from every obstacle. Nothing guarantees that the passage can be
 traversed within the joint ranges: that is for the planners to find out.
 """

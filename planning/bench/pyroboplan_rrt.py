@@ -4,10 +4,10 @@ pyroboplan (``pip install --no-deps pyroboplan``, see the README) plans on a Pin
 and collision model. It gets the CPR reduced to the moving joints
 (``pinocchio.buildReducedModel`` locks the others at their start values) and our collision
 world's geometry, robot-obstacle pairs only, with the planning clearance
-(:func:`planning.peers.toppra_timing.planning_clearance_m`) as its distance padding.
+(:func:`planning.bench.toppra_timing.planning_clearance_m`) as its distance padding.
 Its own shortcutting checks collisions without that padding, so the path is shortcut here,
 against that clearance; TOPP-RA timing and the certified verification are those of
-:func:`planning.peers.toppra_timing.time_and_verify`.
+:func:`planning.bench.toppra_timing.time_and_verify`.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from planning.peers.toppra_timing import SamplingResult, planning_clearance_m, time_and_verify
+from planning.bench.toppra_timing import SamplingResult, planning_clearance_m, time_and_verify
 from planning.pipeline.blas_threads import one_blas_thread
 from planning.pipeline.problem import build_problem
 from planning.pipeline.scene import Scene

@@ -27,7 +27,7 @@ MAX_SCENES = 100_000
 """Most scenes one call generates."""
 
 if TYPE_CHECKING:
-    from planning.io.narrow_passages import Kind
+    from planning.bench.narrow_passages import Kind
 
 
 def _tcp(theta1: float, radius: float, height: float) -> tuple[float, float, float]:
@@ -96,15 +96,15 @@ def generate_scenes(
 ) -> list[Scene]:
     """``count`` random scenes from ``seed``; scene ``i`` plans with seed ``i``.
 
-    The last ``narrow`` of them are narrow passages (:mod:`planning.io.narrow_passages`),
-    of ``kinds`` in turn (default: :data:`~planning.io.narrow_passages.KINDS`), drawn from a
+    The last ``narrow`` of them are narrow passages (:mod:`planning.bench.narrow_passages`),
+    of ``kinds`` in turn (default: :data:`~planning.bench.narrow_passages.KINDS`), drawn from a
     stream of their own: the other scenes are the same whatever ``narrow`` and ``kinds`` are.
 
     Raises:
         PlanningError: ``count`` is no integer in [0, :data:`MAX_SCENES`], ``seed`` no
             non-negative integer, ``narrow`` not within [0, ``count``], or an unknown kind.
     """
-    from planning.io.narrow_passages import ALL_KINDS, KINDS, narrow_scene
+    from planning.bench.narrow_passages import ALL_KINDS, KINDS, narrow_scene
 
     integer_in("count", count, 0, MAX_SCENES)
     integer_in("seed", seed, 0, MAX_SEED)

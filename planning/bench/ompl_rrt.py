@@ -5,7 +5,7 @@ The same scene, URDF, collision world and limits as the firefly planner
 coal margin checks as state validity (the margin, and the self margin between the robot's own
 checked pairs, each plus the verification step, the clearances the firefly's fitness asks of
 its samples; with a start or goal inside those, the seeding's finer step, as ours), the path
-is simplified, and :func:`planning.peers.toppra_timing.time_and_verify` times and verifies it. The peer is
+is simplified, and :func:`planning.bench.toppra_timing.time_and_verify` times and verifies it. The peer is
 optional (``pip install '.[bench]'``).
 """
 
@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from planning.peers.toppra_timing import SamplingResult, import_toppra, time_and_verify
+from planning.bench.toppra_timing import SamplingResult, import_toppra, time_and_verify
 from planning.pipeline.blas_threads import one_blas_thread
 from planning.pipeline.problem import build_problem, finer_step_m, with_planner
 from planning.pipeline.scene import Scene
