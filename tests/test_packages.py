@@ -8,6 +8,7 @@ import os
 import shutil
 import subprocess
 import sys
+import tomllib
 import zipfile
 from pathlib import Path
 
@@ -44,6 +45,20 @@ def test_every_export_resolves_to_its_module_object(package: str) -> None:
         assert getattr(module, name) is expected, name
     with pytest.raises(AttributeError, match="no_such_name"):
         _ = module.no_such_name
+
+
+def test_pyproject_names_every_package_of_the_tree() -> None:
+    # the packages are listed by name (one is mapped from the top-level urdf/): a new one must be named
+    root = Path(__file__).resolve().parents[1]
+    listed = set(tomllib.loads((root / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"])
+    folders = [f for top in ("cpr_kin", "planning") for f in [root / top, *(root / top).rglob("*")]]
+    tree = {
+        ".".join(folder.relative_to(root).parts)
+        for folder in folders
+        if folder.is_dir() and folder.name != "__pycache__" and any(folder.glob("*.*"))
+    }
+    tree |= {"cpr_kin.urdf", "cpr_kin.urdf.makers"}  # package-dir: urdf/ and urdf/makers/
+    assert listed == tree, f"not listed: {sorted(tree - listed)}; no such folder: {sorted(listed - tree)}"
 
 
 @pytest.mark.slow
