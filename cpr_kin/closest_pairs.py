@@ -19,8 +19,8 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
+from cpr_kin.decisive import below_coal
 from cpr_kin.exact_pairs import ExactPairs
-from cpr_kin.pair_bounds import BOUND_TOLERANCE_M
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -48,7 +48,7 @@ def closest_pairs(
         geometry_data: its data (placements and distance results are written into it).
         batch: ``(N, nq)`` configurations.
         bounds: ``(N, P)`` lower bounds [m] of the pairs' distances at those configurations
-            (at most coal's distance plus :data:`~cpr_kin.pair_bounds.BOUND_TOLERANCE_M`).
+            (at most coal's distance plus its error, :func:`~cpr_kin.decisive.coal_error_m`).
         pair_index: ``(P,)`` the pairs' indices in ``geometry_model.collisionPairs``.
         below_m: only distances below this matter [m]: pairs bounded above it are not
             computed, and where the smallest distance is not below it, ``inf`` and ``-1``
@@ -75,7 +75,7 @@ def closest_pairs(
     order = np.argsort(bounds, axis=1, kind="stable")
     # each pair's bound less the tolerance, certain where positive; where the bounding shapes
     # overlap, coal's signed distance (a penetration depth) may be any negative value: -inf
-    certain = np.take_along_axis(bounds, order, axis=1) - BOUND_TOLERANCE_M
+    certain = below_coal(np.take_along_axis(bounds, order, axis=1))
     certain[certain <= 0.0] = -np.inf
     pairs, extra = pair_index.tolist(), offsets.tolist()
     refined = exact.refined.tolist() if exact else []

@@ -21,11 +21,12 @@ from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.clearance import BatchClearance, Clearance, PairDistance
 from cpr_kin.closest_pairs import closest_pairs
+from cpr_kin.decisive import below_coal, coal_error_m
 from cpr_kin.errors import CprKinError
 from cpr_kin.exact_pairs import ExactPairs
 from cpr_kin.obstacle_pools import ObstaclePools
 from cpr_kin.obstacles import Obstacle, checked_obstacles
-from cpr_kin.pair_bounds import BOUND_TOLERANCE_M, PairBounds
+from cpr_kin.pair_bounds import PairBounds
 from cpr_kin.reach import pair_reach_distances
 from cpr_kin.robot import GROUPS, Robot
 from cpr_kin.world_self_pairs import world_self_collision
@@ -179,7 +180,7 @@ class CollisionWorld:
         """``(N, len(GROUPS))`` lower bounds [m] of each group's clearance at ``q`` ``(N, nq)``.
 
         From the pair bounds (:mod:`cpr_kin.pair_bounds`), a fraction of coal's cost, less
-        :data:`BOUND_TOLERANCE_M` for coal's own tolerance: a positive bound is at most
+        coal's own error (:func:`cpr_kin.decisive.below_coal`): a positive bound is at most
         :meth:`clearance_batch`'s value; where the geometries' bounding shapes overlap nothing
         is known and the bound is ``-inf``. ``inf`` for a group with no pair.
         """
@@ -191,7 +192,7 @@ class CollisionWorld:
         for group_index in range(len(GROUPS)):
             columns = self._pair_group == group_index
             if columns.any():
-                bounds[:, group_index] = per_pair[:, columns].min(axis=1) - BOUND_TOLERANCE_M
+                bounds[:, group_index] = below_coal(per_pair[:, columns].min(axis=1))
         bounds[bounds <= 0.0] = -np.inf
         return bounds
 
@@ -234,8 +235,8 @@ class CollisionWorld:
         see :mod:`cpr_kin.reach`) are not tested, and a configuration goes to coal only for
         the obstacles of which some pair is not certainly farther than the margin by a cheap
         bound (:mod:`cpr_kin.pair_bounds`, computed for the whole batch at once;
-        :mod:`cpr_kin.obstacle_pools`). Distances within :data:`BOUND_TOLERANCE_M` of the
-        margin always go to coal.
+        :mod:`cpr_kin.obstacle_pools`). Distances within coal's error of the margin
+        (:func:`~cpr_kin.decisive.coal_error_m`) always go to coal.
 
         With ``ordered``, the configurations are decided in order up to the first violated
         one, and those after it are reported violated without a test: what an edge check
@@ -247,7 +248,7 @@ class CollisionWorld:
         near, bounds = self._pairs_within(margin_m)
         if bounds is None or not len(batch):
             return np.zeros(len(batch), dtype=bool)
-        uncertain = bounds.obstacles_below(batch, margin_m + BOUND_TOLERANCE_M)
+        uncertain = bounds.obstacles_below(batch, float(margin_m + coal_error_m(margin_m)))
         return self._pools.violated(batch, uncertain, margin_m, near, ordered)
 
     def keeps_clearance(

@@ -15,6 +15,24 @@ from numpy.typing import NDArray
 
 FloatArray = NDArray[np.float64]
 
+COAL_RELATIVE_ERROR = 1e-6
+"""How far coal's distance may fall below the truth, relative to its size (coal's distances are
+accurate to about 1e-6 of their size; below a metre, to 1e-6 m): :func:`coal_error_m`."""
+
+
+def coal_error_m(distance_m: float | FloatArray) -> FloatArray:
+    """Coal's error at ``distance_m`` [m]: :data:`COAL_RELATIVE_ERROR` of ``max(1 m, |distance|)``.
+
+    A configuration goes to coal unless its bounds clear a margin by this much, and a bound
+    rules a pair out, or stands for coal's value, only less this much.
+    """
+    return np.asarray(COAL_RELATIVE_ERROR * np.maximum(1.0, np.abs(distance_m)))
+
+
+def below_coal(bounds_m: FloatArray) -> FloatArray:
+    """``bounds_m`` [m] less coal's error at their size: at most coal's value where they bound the truth."""
+    return np.asarray(bounds_m - coal_error_m(bounds_m))
+
 
 def certified(values: FloatArray, slack_m: float | FloatArray) -> FloatArray:
     """``(c_k + c_{k+1} - slack_k) / 2`` per interval: the least the distance can be between samples.
@@ -90,13 +108,13 @@ def propagated_bounds(values: FloatArray, known: NDArray[np.bool_], reach_m: Flo
 
 
 def with_neighbours(
-    values: FloatArray, known: NDArray[np.bool_], bounds: FloatArray, reach_m: FloatArray, tolerance_m: float
+    values: FloatArray, known: NDArray[np.bool_], bounds: FloatArray, reach_m: FloatArray
 ) -> FloatArray:
     """``(K,)`` a sampled distance: exact at the ``known`` samples, else the best lower bound there is.
 
     Elsewhere the larger of the cheap bound (``bounds``) and what the exact samples give
-    (:func:`propagated_bounds`), the latter less ``tolerance_m``, how far the exact values
-    (coal's) may be above the true ones [m]. Every certified check updates its samples by this rule.
+    (:func:`propagated_bounds`), the latter less coal's error (:func:`below_coal`: how far the
+    exact values may be above the true ones). Every certified check updates its samples by this rule.
     """
-    propagated = propagated_bounds(values, known, reach_m) - tolerance_m
+    propagated = below_coal(propagated_bounds(values, known, reach_m))
     return np.asarray(np.where(known, values, np.maximum(bounds, propagated)))

@@ -26,7 +26,6 @@ from cpr_kin.collision import CollisionWorld
 from cpr_kin.decisive import certified, exact_below, undecided, with_neighbours
 from cpr_kin.errors import CprKinError
 from cpr_kin.interval_motion import IntervalSpeed, interval_motion
-from cpr_kin.pair_bounds import BOUND_TOLERANCE_M
 from cpr_kin.reach import robot_reach
 from cpr_kin.robot import GROUPS, Robot
 
@@ -209,11 +208,7 @@ def decisive_clearance(
                 )
                 known[rows, group_index] = True
                 values[:, group_index] = with_neighbours(
-                    values[:, group_index],
-                    known[:, group_index],
-                    bounds[:, group_index],
-                    reach,
-                    BOUND_TOLERANCE_M,
+                    values[:, group_index], known[:, group_index], bounds[:, group_index], reach
                 )
     return BatchClearance(clearance_m=values, closest_pair=closest)
 

@@ -31,11 +31,6 @@ FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
 
-BOUND_TOLERANCE_M = 1e-6
-"""How far coal's distance may fall below a pair's bound [m] (coal's distances are accurate
-to about 1e-6 of their size): a configuration goes to coal unless its bounds clear a margin
-by this much, and a bound rules a pair out only by this much."""
-
 
 def bounding_capsule(geometry: Any) -> tuple[FloatArray, float]:
     """A capsule containing a coal geometry: segment end points ``(2, 3)`` [m] and radius [m].

@@ -258,7 +258,7 @@ class SelfCollision:
         """``(N,)`` lower bounds [m] of pair ``pair``'s distance at configurations ``q`` ``(N, nq)``, cheaply.
 
         Its capsules' distance (:class:`~cpr_kin.self_bounds.SelfPairBounds`), at most coal's
-        plus :data:`~cpr_kin.pair_bounds.BOUND_TOLERANCE_M`.
+        plus coal's error (:func:`~cpr_kin.decisive.coal_error_m`).
         """
         return self._screened().pair_bounds(np.atleast_2d(np.asarray(q, dtype=float)), pair)
 

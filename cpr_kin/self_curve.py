@@ -28,9 +28,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from cpr_kin.decisive import certified, exact_below, undecided, with_neighbours
+from cpr_kin.decisive import below_coal, certified, exact_below, undecided, with_neighbours
 from cpr_kin.errors import CprKinError
-from cpr_kin.pair_bounds import BOUND_TOLERANCE_M
 
 if TYPE_CHECKING:
     from cpr_kin.self_collision import SelfCollision
@@ -212,7 +211,7 @@ def _screen(
     speed = np.broadcast_to(pair_speed, (count - 1, len(pair_speed)))
     if interval_joint_speed is not None:
         speed = np.minimum(speed, interval_joint_speed(times) @ collision.pair_radii.T)
-    bounds = collision.bounds(curve(times)) - BOUND_TOLERANCE_M
+    bounds = below_coal(collision.bounds(curve(times)))
     return np.asarray(np.min(certified(bounds, speed * np.diff(times)[:, None]), axis=0))
 
 
@@ -234,7 +233,7 @@ def _samples(
     if interval_joint_speed is not None:
         interval_speed = np.minimum(interval_speed, interval_joint_speed(times) @ collision.pair_radii[index])
     slack = interval_speed * np.diff(times)
-    bounds = collision.pair_bounds(q, index) - BOUND_TOLERANCE_M  # at most coal's distance
+    bounds = below_coal(collision.pair_bounds(q, index))  # at most coal's distance
     return _PairSamples(index, times, q, slack, bounds)
 
 
@@ -267,7 +266,7 @@ def _decisive_values(
     while rows.size:
         values[rows] = collision.pair_distances(pair.q[rows], pair.index, exact_below_m)
         known[rows] = True
-        values = with_neighbours(values, known, pair.bounds, reach, BOUND_TOLERANCE_M)
+        values = with_neighbours(values, known, pair.bounds, reach)
         needed = undecided(values[:, None], known[:, None], pair.slack, certified_ceiling, sampled_ceiling)
         rows = np.flatnonzero(needed[:, 0])
     return values, known

@@ -21,10 +21,10 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from cpr_kin.closest_pairs import closest_pairs
+from cpr_kin.decisive import coal_error_m
 from cpr_kin.exact_pairs import ExactPairs
 from cpr_kin.limits import sampled_configurations
 from cpr_kin.obstacle_pools import configure_pool, pool_collisions
-from cpr_kin.pair_bounds import BOUND_TOLERANCE_M
 from cpr_kin.self_bounds import SelfPairBounds
 
 if TYPE_CHECKING:
@@ -157,7 +157,7 @@ class ScreenedSelfTest:
             hits[:] = self._coal(0, batch)
         if self.far_bounds.n_pairs:
             open_rows = np.flatnonzero(~hits)
-            threshold = margin_m + BOUND_TOLERANCE_M
+            threshold = float(margin_m + coal_error_m(margin_m))
             doubtful = open_rows[self.far_bounds.any_below(batch[open_rows], threshold)]
             if doubtful.size:
                 within = self.far_bounds(batch[doubtful], threshold) <= threshold

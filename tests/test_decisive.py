@@ -4,7 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from cpr_kin.decisive import certified, exact_below, propagated_bounds, with_neighbours
+from cpr_kin.decisive import (
+    below_coal,
+    certified,
+    coal_error_m,
+    exact_below,
+    propagated_bounds,
+    with_neighbours,
+)
 
 
 def test_the_samples_stay_below_a_distance_that_moves_no_faster_than_the_slack() -> None:
@@ -16,14 +23,14 @@ def test_the_samples_stay_below_a_distance_that_moves_no_faster_than_the_slack()
         true = np.concatenate([[rng.uniform(-0.05, 0.2)], rng.uniform(-1, 1, count - 1) * slack]).cumsum()
         known = rng.random(count) < 0.3
         bounds = true - rng.uniform(0.0, 0.05, count)  # the cheap bounds: below the truth
-        tolerance = 1e-6
-        exact = np.where(known, true + rng.uniform(0.0, tolerance, count), bounds)  # coal's, a hair above
-        values = with_neighbours(exact, known, bounds, reach, tolerance)
+        error = coal_error_m(true)
+        exact = np.where(known, true + rng.uniform(0.0, 1.0, count) * error, bounds)  # coal's, a hair above
+        values = with_neighbours(exact, known, bounds, reach)
         np.testing.assert_array_equal(values[known], exact[known])
         assert np.all(values[~known] <= true[~known] + 1e-12)  # never above the truth
         assert np.all(values >= bounds)  # never worse than the cheap bound
         # and exactly the better of the two where both exist (the rule's definition)
-        best = np.maximum(bounds, propagated_bounds(exact, known, reach) - tolerance)
+        best = np.maximum(bounds, below_coal(propagated_bounds(exact, known, reach)))
         np.testing.assert_array_equal(values[~known], best[~known])
 
 
@@ -44,3 +51,10 @@ def test_samples_counted_at_the_exact_ceiling_decide_the_check_as_their_values_d
         exact_ok = certified(values, slack).min() >= margin
         counted_ok = certified(counted, slack).min() >= margin
         assert exact_ok == counted_ok
+
+
+def test_coal_error_is_a_micrometre_below_a_metre_and_relative_above() -> None:
+    np.testing.assert_allclose(
+        coal_error_m(np.array([0.0, -0.3, 0.999, 2.0, -5.0])), [1e-6, 1e-6, 1e-6, 2e-6, 5e-6]
+    )
+    np.testing.assert_allclose(below_coal(np.array([0.1, 3.0])), [0.1 - 1e-6, 3.0 - 3e-6])
