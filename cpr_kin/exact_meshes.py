@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cpr_kin.compiled import njit
-from cpr_kin.disk_cache import cached_json
+from cpr_kin.disk_cache import cached_array, cached_json
 
 FloatArray = NDArray[np.float64]
 
@@ -152,7 +152,7 @@ def exact_meshes(sources: Sequence[MeshSource], samples: int = EXCESS_SAMPLES) -
     for source in sources:
         excess = hull_excess(source, samples)["excess_m"] if source.hull else math.inf
         if excess > REFINED_ABOVE_M:
-            triangles, pieces = _triangles(source.bvh)
+            triangles, pieces, corners = _triangles(source)
             found[source.geometry] = ExactMesh(
                 source.geometry,
                 source.bvh,
@@ -160,7 +160,7 @@ def exact_meshes(sources: Sequence[MeshSource], samples: int = EXCESS_SAMPLES) -
                 excess,
                 triangles,
                 pieces,
-                hull_planes(triangles),
+                hull_planes(corners),
             )
     return found
 
@@ -173,7 +173,7 @@ def hull_excess(source: MeshSource, samples: int = EXCESS_SAMPLES, seed: int = 0
         ``spacing_m``: the side of a square of the hull's area over ``samples`` [m], about how
         far below the true largest that may be.
     """
-    digest = hashlib.sha256(_content(source)).hexdigest()
+    digest = hashlib.sha256(_content(source, b"hull-excess-1")).hexdigest()
 
     def compute() -> dict[str, float]:
         import trimesh  # only a first load of a mesh needs it
@@ -195,38 +195,48 @@ def hull_excess(source: MeshSource, samples: int = EXCESS_SAMPLES, seed: int = 0
     return cached_json("hull-excess", f"{digest}-{samples}-{seed}", compute)
 
 
-def _content(source: MeshSource) -> bytes:
-    """What a mesh's excess depends on: its file's bytes (its vertices where unreadable) and scale."""
+def _content(source: MeshSource, what: bytes) -> bytes:
+    """What a mesh's value ``what`` depends on: its file's bytes (its vertices where unreadable), scale."""
     try:
         body = Path(source.path).read_bytes()
     except OSError:
         body = np.asarray(source.bvh.vertices(), dtype=float).tobytes()
-    return body + np.asarray(source.scale, dtype=float).tobytes() + b"hull-excess-1"
+    return body + np.asarray(source.scale, dtype=float).tobytes() + what
 
 
-def _triangles(bvh: Any) -> tuple[FloatArray, FloatArray | None]:
-    """``bvh``'s triangles' corners ``(F, 3, 3)``, a vertex of each connected piece (``None``: too many)."""
+def _triangles(source: MeshSource) -> tuple[FloatArray, FloatArray | None, FloatArray]:
+    """The mesh's triangles' corners ``(F, 3, 3)``, a vertex of each connected piece (``None``: too many).
+
+    And the vertices of its triangles ``(V, 3)``, each once. The triangles' vertex indices are
+    kept on disk by the mesh's file and vertices (coal hands them out one by one).
+    """
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
+    bvh = source.bvh
     vertices = np.asarray(bvh.vertices(), dtype=float)
-    faces = np.array(
-        [[t[0], t[1], t[2]] for t in (bvh.tri_indices(i) for i in range(bvh.num_tris))], dtype=np.int64
-    ).reshape(-1, 3)
+
+    def indices() -> NDArray[np.int64]:
+        return np.array(
+            [[t[0], t[1], t[2]] for t in (bvh.tri_indices(i) for i in range(bvh.num_tris))], dtype=np.int64
+        ).reshape(-1, 3)
+
+    digest = hashlib.sha256(_content(source, b"faces-1") + vertices.tobytes()).hexdigest()
+    faces = cached_array("mesh-faces", f"{digest}-{bvh.num_tris}", indices)
     edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]]])
     graph = coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(len(vertices),) * 2)
     _, label = connected_components(graph, directed=False)
     used = np.unique(faces)
     pieces = np.unique(label[used], return_index=True)[1]
     points = vertices[used[pieces]] if len(pieces) <= MAX_PIECES else None
-    return vertices[faces], points
+    return vertices[faces], points, vertices[used]
 
 
-def hull_planes(triangles: FloatArray) -> FloatArray:
-    """``(H, 4)`` the facets' planes of the convex hull of the triangles' corners (:class:`ExactMesh`)."""
+def hull_planes(points: FloatArray) -> FloatArray:
+    """``(H, 4)`` the facets' planes of the convex hull of ``points`` ``(..., 3)`` (:class:`ExactMesh`)."""
     from scipy.spatial import ConvexHull
 
-    equations: FloatArray = ConvexHull(triangles.reshape(-1, 3), qhull_options="Qt").equations
+    equations: FloatArray = ConvexHull(points.reshape(-1, 3), qhull_options="Qt").equations
     return equations
 
 

@@ -10,7 +10,8 @@ clear. Every cheap bound of the hulls (:mod:`cpr_kin.pair_bounds`, :mod:`cpr_kin
 the meshes too.
 
 Where the hulls are apart, coal's distance of the meshes (triangle models) is ``d_x``, and a
-margin test is coal's collision test of the meshes with the margin as security margin. Where
+margin test is coal's collision test of the meshes with the margin as security margin (its
+distance, for a margin above :data:`COLLIDE_MARGIN_UP_TO_M`). Where
 the hulls penetrate, the meshes may be apart: coal says so then, unless one holds the other
 whole without their surfaces meeting, which is tested by winding number
 (:meth:`cpr_kin.exact_meshes.ExactMesh.holds`): a point of the other shape (of a primitive or
@@ -34,6 +35,10 @@ from cpr_kin.exact_meshes import ExactMesh, as_transform
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
+
+COLLIDE_MARGIN_UP_TO_M = 0.01
+"""The largest margin [m] coal's collision test is asked with; a larger one goes to its distance
+(:meth:`ExactPairs.closer_than`)."""
 
 
 class ExactPairs:
@@ -123,13 +128,25 @@ class ExactPairs:
         return result
 
     def closer_than(self, geometry_data: Any, pair: int, hull_m: float, margin_m: float) -> bool:
-        """Whether pair ``pair`` is within ``margin_m`` >= 0 [m] on its meshes, hulls ``hull_m`` apart."""
+        """Whether pair ``pair`` is within ``margin_m`` >= 0 [m] on its meshes, hulls ``hull_m`` apart.
+
+        coal's collision test with the margin as security margin descends into every pair of
+        bounding volumes within the margin: fast for a margin of millimetres, where it stops at
+        the first pair of triangles within it; for a margin near a link's size (dense meshes a
+        few centimetres apart), seconds. So the test takes a margin up to
+        :data:`COLLIDE_MARGIN_UP_TO_M`, and above it coal's distance decides, which prunes by the
+        nearest pair found so far.
+        """
         a, b = self._pairs[pair]
         (shape_a, at_a), (shape_b, at_b) = self._placed(geometry_data, a), self._placed(geometry_data, b)
-        self._collision.security_margin = margin_m
+        self._collision.security_margin = min(margin_m, COLLIDE_MARGIN_UP_TO_M)
         hit = coal.collide(
             shape_a, as_transform(at_a), shape_b, as_transform(at_b), self._collision, coal.CollisionResult()
         )
+        if not hit and margin_m > COLLIDE_MARGIN_UP_TO_M:
+            result = coal.DistanceResult()
+            coal.distance(shape_a, as_transform(at_a), shape_b, as_transform(at_b), self._request, result)
+            hit = result.min_distance < margin_m
         if hit:
             return True
         return hull_m < 0.0 and self._one_holds_other(a, at_a, b, at_b)

@@ -77,6 +77,21 @@ def test_the_excess_is_computed_once_per_file_and_kept_on_disk(tmp_path: Path) -
     assert hull_excess(other, samples=500)["excess_m"] == pytest.approx(2 * first["excess_m"], rel=0.1)
 
 
+def test_the_triangles_are_the_meshs_from_the_first_load_and_from_the_disk(tmp_path: Path) -> None:
+    mesh = l_shape()
+    corners = np.sort(np.asarray(mesh.triangles).reshape(len(mesh.faces), -1), axis=0)  # trimesh's
+    first = exact_meshes([source_of(mesh, tmp_path, "l")])[0]
+    kept = list((cache_folder() / "mesh-faces").glob("*.npy"))
+    assert len(kept) == 1
+    again = exact_meshes([source_of(mesh, tmp_path, "l")])[0]  # read from the disk
+    for found in (first, again):
+        assert np.array_equal(np.sort(found.triangles.reshape(len(mesh.faces), -1), axis=0), corners)
+    kept[0].write_bytes(b"\x93NUMPY cut sho")  # a broken entry is computed again
+    assert np.array_equal(exact_meshes([source_of(mesh, tmp_path, "l")])[0].triangles, first.triangles)
+    assert np.array_equal(first.piece_points, again.piece_points)
+    assert np.allclose(first.hull_planes, again.hull_planes)
+
+
 @pytest.mark.parametrize("flipped", [False, True])
 def test_holds_agrees_with_trimeshs_signed_distance_on_a_torus_whichever_way_it_faces(flipped: bool) -> None:
     torus = trimesh.creation.torus(major_radius=0.2, minor_radius=0.05, major_sections=48, minor_sections=24)
