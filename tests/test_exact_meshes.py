@@ -88,6 +88,7 @@ def test_the_triangles_are_the_meshs_from_the_first_load_and_from_the_disk(tmp_p
         assert np.array_equal(np.sort(found.triangles.reshape(len(mesh.faces), -1), axis=0), corners)
     kept[0].write_bytes(b"\x93NUMPY cut sho")  # a broken entry is computed again
     assert np.array_equal(exact_meshes([source_of(mesh, tmp_path, "l")])[0].triangles, first.triangles)
+    assert first.piece_points is not None and again.piece_points is not None
     assert np.array_equal(first.piece_points, again.piece_points)
     assert np.allclose(first.hull_planes, again.hull_planes)
 
