@@ -207,7 +207,7 @@ def test_distances_against_independent_oracle(robot: ck.Robot, rng: np.random.Ge
     checked = 0
     data = robot.model.createData()
     gdata = robot.collision_model.createData()
-    for trial in range(16):
+    for trial in range(8):  # two obstacles of each shape, every link against each
         shape = ("box", "sphere", "cylinder", "capsule")[trial % 4]
         obstacle = random_obstacle(shape, rng)
         world = ck.CollisionWorld(robot, [obstacle])
@@ -225,7 +225,7 @@ def test_distances_against_independent_oracle(robot: ck.Robot, rng: np.random.Ge
             # coal's GJK stops at its default tolerance of 1e-6 (relative to the distance)
             assert found.distance_m == pytest.approx(expected, abs=2e-6), (shape, g.name)
             checked += 1
-    assert checked >= 60
+    assert checked >= 30
 
 
 def test_reach_distance_bounds_every_pair_from_below(robot: ck.Robot, rng: np.random.Generator) -> None:
