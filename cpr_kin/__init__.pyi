@@ -1,18 +1,26 @@
 """Type stub of the package: what it exports, and from which module (read by ``lazy_loader``)."""
 
-from .carried import carrying
-from .clearance import BatchClearance, Clearance, PairDistance
-from .close_pairs import ClosePair
-from .collision import CollisionWorld
-from .dynamics import Dynamics, Payload, robot_dynamics
-from .errors import CprKinError, IkMissError, JointLimitError, ObstacleError, UnreachableError, UrdfError
-from .interval_motion import IntervalSpeed
-from .kinematics import frame_poses, frame_positions
-from .limits import JointLimits, sampled_configurations
-from .loading import RobotSpec, load_robot
-from .motion import CurveCheck, check_curve, check_segment, motion_radii, path_weights
-from .numerical_ik import IkSettings, IkTarget, solve_ik
-from .obstacles import SHAPES, Obstacle
+from .bounds.batch_kinematics import sampled_configurations
+from .bounds.close_pairs import ClosePair
+from .certified.interval_motion import IntervalSpeed
+from .certified.motion import CurveCheck, check_curve, check_segment, motion_radii, path_weights
+from .collision.clearance import BatchClearance, Clearance, PairDistance
+from .collision.world import CollisionWorld
+from .common.errors import (
+    CprKinError,
+    IkMissError,
+    JointLimitError,
+    ObstacleError,
+    UnreachableError,
+    UrdfError,
+)
+from .description.loading import RobotSpec, load_robot
+from .kinematics.carried import carrying
+from .kinematics.dynamics import Dynamics, Payload, robot_dynamics
+from .kinematics.forward import frame_poses, frame_positions
+from .kinematics.numerical_ik import IkSettings, IkTarget, solve_ik
+from .model.limits import JointLimits
+from .model.robot import GROUPS, PositionIk, Robot, RobotGeometry
 from .presets import (
     CPR_JOINTS,
     TCP_FRAME,
@@ -23,7 +31,7 @@ from .presets import (
     robot_spec,
     tcp_ik,
 )
-from .robot import GROUPS, PositionIk, Robot, RobotGeometry
+from .shapes.obstacles import SHAPES, Obstacle
 
 __all__ = [
     "CPR_JOINTS",

@@ -15,7 +15,7 @@ import sys
 import numpy as np
 
 import cpr_kin as ck
-from cpr_kin.packages import example_robot
+from cpr_kin.model.packages import example_robot
 from planning import PlannerSettings, Scene, Target, dump_scene, plan, write_trajectory
 
 HOMES = {  # a start of each arm [rad]: its maker's ready pose, or one above the table

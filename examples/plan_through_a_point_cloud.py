@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cpr_kin.point_clouds import sampled_surfaces
+from cpr_kin.shapes.cloud_obstacles import sampled_surfaces
 from planning import load_scene, plan, write_trajectory
 from planning.io.scene_file import parse_scene, scene_document
 

@@ -22,8 +22,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from cpr_kin.errors import CprKinError
-from cpr_kin.names import escaped
+from cpr_kin.common.errors import CprKinError
+from cpr_kin.common.names import escaped
 from planning.errors import NoSolutionError, PlanningError
 
 EXIT_OK, EXIT_INVALID, EXIT_NO_TRAJECTORY, EXIT_INTERNAL = 0, 2, 3, 4

@@ -15,8 +15,8 @@ from typing import Any, get_args
 import numpy as np
 from pydantic import BaseModel, ValidationError
 
-from cpr_kin.names import cut
-from cpr_kin.names import shown as shown  # re-exported: the search's settings use it, not cpr_kin
+from cpr_kin.common.names import cut
+from cpr_kin.common.names import shown as shown  # re-exported: the search's settings use it, not cpr_kin
 from planning.errors import PlanningError
 
 

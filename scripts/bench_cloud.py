@@ -2,7 +2,7 @@
 
 Each scene (the shelf of ``examples/scenes/``, and ``--scenes`` generated CPR scenes) is planned
 twice in one warm process, alternated ``--runs`` times: with its primitives, and with a cloud of
-``--points`` points sampled on their surfaces (``cpr_kin.point_clouds.sampled_surfaces``) as
+``--points`` points sampled on their surfaces (``cpr_kin.shapes.cloud_obstacles.sampled_surfaces``) as
 ``--resolution`` voxels. Prints, per scene, the median warm planning time of each, their ratio
 (cloud / primitives), and whether both trajectories were certified; then the median ratio.
 Target (issue 69): the cloud at most 3x the primitives.
@@ -17,7 +17,7 @@ import time
 from pathlib import Path
 
 import cpr_kin as ck
-from cpr_kin.point_clouds import sampled_surfaces, voxel_obstacles
+from cpr_kin.shapes.cloud_obstacles import sampled_surfaces, voxel_obstacles
 from planning.bench.scene_generator import generate_scenes
 from planning.cli.arguments import COUNT, SEED, number_above
 from planning.errors import NoSolutionError

@@ -10,7 +10,8 @@ start runs all its steps, the rule before it). The two alternate target by targe
 one process. It prints per arm: the targets each solves, the mean time per target [ms], the
 targets where both choose the same configuration, where they differ the geometric mean of
 the distance to the seed (new over old, in robot motion ``sum_j R_j |dq_j|``), and the time
-to refuse a target out of reach: 5 m away, beyond :func:`cpr_kin.numerical_ik.tool_reach_m` (refused
+to refuse a target out of reach: 5 m away, beyond
+:func:`cpr_kin.kinematics.numerical_ik.tool_reach_m` (refused
 before any start), and 10 % beyond the farthest of 20,000 random configurations' tool positions
 but within that bound (every start runs).
 """
@@ -25,8 +26,8 @@ import time
 import numpy as np
 
 import cpr_kin as ck
-from cpr_kin.motion import path_weights
-from cpr_kin.packages import EXAMPLE_ROBOTS, example_robot
+from cpr_kin.certified.motion import path_weights
+from cpr_kin.model.packages import EXAMPLE_ROBOTS, example_robot
 from planning.cli.arguments import COUNT, SEED
 
 

@@ -19,7 +19,7 @@ from typing import Any
 import yaml
 
 import cpr_kin as ck
-from cpr_kin.packages import EXAMPLE_ROBOTS, example_robot
+from cpr_kin.model.packages import EXAMPLE_ROBOTS, example_robot
 from planning.bench.arm_scenes import blocked_scene
 from planning.cli.arguments import COUNT, SEED, number_above, number_at_least
 from planning.errors import PlanningError

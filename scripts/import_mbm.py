@@ -7,7 +7,7 @@ on vamp-planner 0.6.4's URDF and SRDF, margins 0 as in MoveIt), the scene file w
 read back (:func:`planning.io.scene_file.load_scene`); then its start and goal are checked
 against the obstacles and the robot's own links (:func:`planning.pipeline.endpoints.margin_violation`,
 on our collision model: the URDF's meshes as convex hulls where a hull is within 1 mm of its
-mesh, else the exact mesh (:mod:`cpr_kin.exact_meshes`); the SRDF's and the scene's allowed
+mesh, else the exact mesh (:mod:`cpr_kin.shapes.exact_meshes`); the SRDF's and the scene's allowed
 pairs). Prints per class: problems, converted, start and goal valid, and why the others are not.
 ``--limit N --sample-seed S`` converts N problems of each class drawn at random (the same seed,
 the same problems): written with ``--out``, a held-out set for ``bench_mbm.py --scenes``.

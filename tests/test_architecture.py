@@ -90,8 +90,18 @@ def test_the_core_never_imports_a_peer() -> None:
 
 def test_curves_are_pure_mathematics_and_search_knows_no_robot() -> None:
     allowed = {
-        "planning.curves": ("planning.curves", "planning.errors", "planning.validation", "cpr_kin.compiled"),
-        "planning.search": ("planning.search", "planning.errors", "planning.validation", "cpr_kin.compiled"),
+        "planning.curves": (
+            "planning.curves",
+            "planning.errors",
+            "planning.validation",
+            "cpr_kin.common.compiled",
+        ),
+        "planning.search": (
+            "planning.search",
+            "planning.errors",
+            "planning.validation",
+            "cpr_kin.common.compiled",
+        ),
     }
     offenders = []
     for name, path in modules().items():
@@ -218,3 +228,72 @@ def test_the_layer_table_names_every_module() -> None:
         if name not in rows and f"`{name.rpartition('.')[2]}`" not in rows[row_of(name, rows)][0]
     ]
     assert missing == [], f"modules docs/architecture.md does not list in their package's row: {missing}"
+
+
+def import_graph(package: str) -> dict[str, set[str]]:
+    """``{module: the modules it imports}`` for the modules of ``package``, every import counted."""
+    found = modules()
+    graph = {}
+    for name, path in found.items():
+        if not within(name, package):
+            continue
+        targets = set()
+        for imported, _ in imports(name, path):
+            while imported and imported not in found:  # a name imported from a module: that module
+                imported = imported.rpartition(".")[0]
+            if imported and imported != name:
+                targets.add(imported)
+        graph[name] = targets
+    return graph
+
+
+def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The groups of modules that import one another, round a circle (Tarjan's components)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    found: list[list[str]] = []
+
+    def visit(node: str) -> None:
+        index[node] = low[node] = len(index)
+        stack.append(node)
+        for target in graph.get(node, ()):
+            if target not in index:
+                visit(target)
+                low[node] = min(low[node], low[target])
+            elif target in stack:
+                low[node] = min(low[node], index[target])
+        if low[node] == index[node]:
+            group: list[str] = []
+            while not group or group[-1] != node:
+                group.append(stack.pop())
+            if len(group) > 1:
+                found.append(sorted(group))
+
+    for node in graph:
+        if node not in index:
+            visit(node)
+    return found
+
+
+def test_the_robot_package_has_no_import_circle() -> None:
+    # at module level, inside functions and for the type checker: a circle closed only under
+    # TYPE_CHECKING is still two modules that cannot be read one without the other
+    assert cycles(import_graph("cpr_kin")) == []
+    assert cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]  # the finder finds
+
+
+def test_the_robot_packages_rooms_import_downwards() -> None:
+    # each sub-package of cpr_kin imports only the rooms below it: the rooms form no circle either
+    graph = import_graph("cpr_kin")
+    rooms = {
+        room: {
+            ".".join(t.split(".")[:2])
+            for name, targets in graph.items()
+            if within(name, room)
+            for t in targets
+        }
+        - {room}
+        for room in {".".join(name.split(".")[:2]) for name in graph if name.count(".") >= 1}
+    }
+    assert cycles(rooms) == []

@@ -13,7 +13,7 @@ import pytest
 import yaml
 
 import cpr_kin as ck
-from cpr_kin.packages import example_robot, example_robot_data_share
+from cpr_kin.model.packages import example_robot, example_robot_data_share
 from planning.bench.arm_scenes import blocked_scene
 from planning.bench.mbm import endpoint_violations
 from planning.errors import PlanningError

@@ -5,7 +5,7 @@ import pinocchio as pin
 import pytest
 
 import cpr_kin as ck
-from cpr_kin.batch_kinematics import KinematicChain
+from cpr_kin.bounds.batch_kinematics import KinematicChain
 
 from .conftest import random_configurations
 

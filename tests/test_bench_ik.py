@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from cpr_kin.packages import EXAMPLE_ROBOTS
+from cpr_kin.model.packages import EXAMPLE_ROBOTS
 
 SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "bench_ik.py"
 

@@ -12,7 +12,7 @@ import pinocchio as pin
 import pytest
 
 import cpr_kin as ck
-from cpr_kin.packages import example_robot
+from cpr_kin.model.packages import example_robot
 
 SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "bench_mbm.py"
 SHELF = Path(__file__).resolve().parents[1] / "examples" / "scenes" / "shelf.yaml"

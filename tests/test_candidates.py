@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
-from cpr_kin.packages import example_robot
+from cpr_kin.model.packages import example_robot
 from planning import build_problem
 from planning.bench.arm_scenes import blocked_scene
 from planning.bench.scene_generator import generate_scenes

@@ -8,8 +8,8 @@ import pytest
 import trimesh
 from scipy.spatial.transform import Rotation
 
-from cpr_kin.capsule_fit import Capsule, capsule_along, enclosing_circle, fitted_capsule, frame_about
-from cpr_kin.pair_bounds import bounding_capsule
+from cpr_kin.bounds.capsule_fit import Capsule, capsule_along, enclosing_circle, fitted_capsule, frame_about
+from cpr_kin.bounds.pair_bounds import bounding_capsule
 
 
 def soup(vertices: np.ndarray, faces: np.ndarray) -> coal.BVHModelOBBRSS:

@@ -10,8 +10,8 @@ import pytest
 import yaml
 
 import cpr_kin as ck
-from cpr_kin.carried import PAYLOAD_GEOMETRY
-from cpr_kin.motion import motion_radii
+from cpr_kin.certified.motion import motion_radii
+from cpr_kin.kinematics.carried import PAYLOAD_GEOMETRY
 from planning.cli import main
 from planning.io.scene_file import parse_scene, scene_document
 

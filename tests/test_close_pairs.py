@@ -9,9 +9,9 @@ import pinocchio as pin
 import pytest
 
 import cpr_kin as ck
-from cpr_kin.close_pairs import CLOSE_LIMIT_M, close_pairs
-from cpr_kin.packages import example_robot_data_share
-from cpr_kin.self_collision import SelfCollision
+from cpr_kin.bounds.close_pairs import CLOSE_LIMIT_M, close_pairs
+from cpr_kin.collision.self_collision import SelfCollision
+from cpr_kin.model.packages import example_robot_data_share
 from planning.bench.arm_scenes import blocked_scene
 from planning.io.report import report_markdown
 from planning.io.scene_file import parse_scene

@@ -9,7 +9,7 @@ import pinocchio as pin
 import pytest
 
 import cpr_kin as ck
-from cpr_kin.closest_pairs import closest_pairs
+from cpr_kin.collision.closest_pairs import closest_pairs
 from tests.conftest import random_configurations
 
 

@@ -258,7 +258,7 @@ def test_reach_distance_of_the_turning_column_is_exact(robot: ck.Robot) -> None:
 
 def test_an_ordered_check_is_exact_up_to_the_first_failure(rng: np.random.Generator) -> None:
     """What an edge check needs: ordered, the answer up to the first failure, the rest failed."""
-    from cpr_kin.packages import example_robot
+    from cpr_kin.model.packages import example_robot
 
     panda = ck.load_robot(example_robot("panda"))
     world = ck.CollisionWorld(
@@ -288,7 +288,7 @@ def test_an_ordered_check_is_exact_up_to_the_first_failure(rng: np.random.Genera
 
 def test_keeps_clearance_is_both_margins_from_distances(rng: np.random.Generator) -> None:
     """The Panda among a ball: clear of it by the margin and of its own links by the self margin."""
-    from cpr_kin.packages import example_robot
+    from cpr_kin.model.packages import example_robot
 
     panda = ck.load_robot(example_robot("panda"))
     world = ck.CollisionWorld(panda, [ck.Obstacle.sphere(0.15, (0.45, 0.0, 0.4), name="ball")])

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cpr_kin.decisive import (
+from cpr_kin.collision.decisive import (
     below_coal,
     certified,
     coal_error_m,

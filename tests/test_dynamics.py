@@ -10,7 +10,7 @@ import pinocchio as pin
 import pytest
 
 import cpr_kin as ck
-from cpr_kin.dynamics import MAX_PAYLOAD_KG
+from cpr_kin.kinematics.dynamics import MAX_PAYLOAD_KG
 
 GRAVITY = 9.81
 

@@ -11,8 +11,8 @@ import pinocchio as pin
 import pytest
 import trimesh
 
-from cpr_kin.disk_cache import cache_folder
-from cpr_kin.exact_meshes import ExactMesh, MeshSource, exact_meshes, hull_excess, hull_planes
+from cpr_kin.common.disk_cache import cache_folder
+from cpr_kin.shapes.exact_meshes import ExactMesh, MeshSource, exact_meshes, hull_excess, hull_planes
 
 
 def bvh_of(mesh: trimesh.Trimesh) -> coal.BVHModelOBBRSS:

@@ -11,9 +11,9 @@ import pytest
 import trimesh
 
 import cpr_kin as ck
-from cpr_kin.exact_meshes import MeshSource, exact_meshes
-from cpr_kin.exact_pairs import ExactPairs
-from cpr_kin.packages import example_robot_data_share
+from cpr_kin.model.packages import example_robot_data_share
+from cpr_kin.shapes.exact_meshes import MeshSource, exact_meshes
+from cpr_kin.shapes.exact_pairs import ExactPairs
 from tests.test_exact_meshes import bvh_of, l_shape
 
 SHARE = example_robot_data_share()

@@ -17,7 +17,7 @@ import pytest
 import yaml
 
 import cpr_kin as ck
-from cpr_kin.packages import example_robot
+from cpr_kin.model.packages import example_robot
 from planning.bench.arm_scenes import blocked_scene
 from planning.cli import main
 

@@ -7,7 +7,7 @@ import pinocchio as pin
 import pytest
 
 import cpr_kin as ck
-from cpr_kin.packages import example_robot, example_robot_data_share
+from cpr_kin.model.packages import example_robot, example_robot_data_share
 from planning.bench.arm_scenes import blocked_scene
 from planning.io.scene_file import parse_scene
 from planning.pipeline.planner import plan

@@ -10,8 +10,8 @@ import pytest
 import trimesh
 
 import cpr_kin as ck
-from cpr_kin.hull_excess import SAMPLES, shape_excess
-from cpr_kin.packages import example_robot
+from cpr_kin.model.hull_excess import SAMPLES, shape_excess
+from cpr_kin.model.packages import example_robot
 from planning.cli import main
 
 URDF = """<robot name="dumbbell">

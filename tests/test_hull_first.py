@@ -10,7 +10,7 @@ import pytest
 import yaml
 
 import cpr_kin as ck
-from cpr_kin.packages import example_robot
+from cpr_kin.model.packages import example_robot
 from planning import build_problem, plan
 from planning.cli import main
 from planning.io.scene_file import parse_scene

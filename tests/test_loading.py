@@ -18,8 +18,8 @@ import pytest
 import yourdfpy
 
 import cpr_kin as ck
-from cpr_kin.packages import example_robot, example_robot_data_share
-from cpr_kin.resources import makers_limits_path
+from cpr_kin.description.resources import makers_limits_path
+from cpr_kin.model.packages import example_robot, example_robot_data_share
 
 SHARE = example_robot_data_share()
 assert SHARE is not None, "example-robot-data is part of the robots extra, which make installs"
@@ -346,7 +346,7 @@ def test_a_limits_file_value_that_is_no_positive_number_names_the_file_and_joint
 
 
 def test_a_zero_velocity_of_an_installed_urdf_suggests_a_limits_file_only(tmp_path: Path) -> None:
-    from cpr_kin.packages import installed
+    from cpr_kin.model.packages import installed
 
     def stopped(text: str) -> str:
         return text.replace('velocity="2.175"', 'velocity="0"', 1)
@@ -356,7 +356,7 @@ def test_a_zero_velocity_of_an_installed_urdf_suggests_a_limits_file_only(tmp_pa
         ck.load_robot(own)
     assert installed(ARMS["panda"][0]) and not installed(own)
     # the installed URDF's own zero: a limits file is the only thing the user should edit
-    from cpr_kin.limits import read_dynamic_limits
+    from cpr_kin.model.limits import read_dynamic_limits
 
     with pytest.raises(ck.UrdfError) as info:
         read_dynamic_limits(None, ("panda_joint1",), np.zeros(1), urdf=ARMS["panda"][0])

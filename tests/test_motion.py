@@ -8,8 +8,8 @@ import pytest
 import trimesh
 
 import cpr_kin as ck
-from cpr_kin.motion import PATH_WEIGHT_FLOOR
-from cpr_kin.packages import example_robot
+from cpr_kin.certified.motion import PATH_WEIGHT_FLOOR
+from cpr_kin.model.packages import example_robot
 
 from .conftest import PAPER_GOAL_TCP, PAPER_START_TCP, random_configurations
 
@@ -58,7 +58,8 @@ def test_path_weights_are_the_radii_with_no_zero(robot: ck.Robot) -> None:
 
 
 def test_reach_is_computed_once_per_robot(robot: ck.Robot) -> None:
-    from cpr_kin.reach import geometry_reach, robot_reach
+    from cpr_kin.bounds.reach import geometry_reach
+    from cpr_kin.collision.robot_reach import robot_reach
 
     cached = robot_reach(robot)
     assert robot_reach(robot) is cached
@@ -164,7 +165,7 @@ def test_clearance_lower_bounds_are_below_coal(
 def test_decisive_clearance_finds_the_minima_of_the_full_evaluation(
     robot: ck.Robot, cluttered_world: ck.CollisionWorld, rng: np.random.Generator, samples: int
 ) -> None:
-    from cpr_kin.motion import decisive_clearance
+    from cpr_kin.certified.motion import decisive_clearance
 
     saved = 0
     for _ in range(8):  # random joint-space segments, sampled densely

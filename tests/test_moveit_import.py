@@ -16,7 +16,7 @@ import pytest
 import yaml
 from scipy.spatial.transform import Rotation
 
-from cpr_kin.packages import example_robot
+from cpr_kin.model.packages import example_robot
 from planning.cli import main
 from planning.io.moveit_objects import CONE_SIDES
 from planning.io.scene_file import load_scene

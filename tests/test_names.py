@@ -2,7 +2,7 @@ from __future__ import annotations
 
 import pytest
 
-from cpr_kin.names import escaped, unprintable
+from cpr_kin.common.names import escaped, unprintable
 
 
 @pytest.mark.parametrize(
@@ -29,7 +29,7 @@ def test_escaped_shows_every_unprintable_character_and_keeps_the_rest() -> None:
 
 
 def test_repeated_names_each_name_given_more_than_once_in_order() -> None:
-    from cpr_kin.names import repeated
+    from cpr_kin.common.names import repeated
 
     assert repeated(["b", "a", "b", "c", "a", "b"]) == ["a", "b"]
     assert repeated(["a", "b"]) == [] and repeated([]) == []

@@ -10,8 +10,8 @@ import pytest
 import yourdfpy
 
 import cpr_kin as ck
-from cpr_kin.numerical_ik import tool_reach_m
-from cpr_kin.packages import example_robot
+from cpr_kin.kinematics.numerical_ik import tool_reach_m
+from cpr_kin.model.packages import example_robot
 
 ARMS = ("so101", "ur5", "panda", "xarm7")
 

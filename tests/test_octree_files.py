@@ -9,8 +9,8 @@ import octomap
 import pytest
 import yaml
 
-from cpr_kin.errors import ObstacleError
-from cpr_kin.octree_files import MAX_VOXELS, octree_voxels, read_octree
+from cpr_kin.common.errors import ObstacleError
+from cpr_kin.shapes.octree_files import MAX_VOXELS, octree_voxels, read_octree
 from planning.cli import main
 from planning.io.scene_file import parse_scene
 

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 import cpr_kin as ck
-from cpr_kin.overlapping_pairs import overlapping_pairs
-from cpr_kin.packages import example_robot_data_share
-from cpr_kin.self_collision import SelfCollision
+from cpr_kin.bounds.overlapping_pairs import overlapping_pairs
+from cpr_kin.collision.self_collision import SelfCollision
+from cpr_kin.model.packages import example_robot_data_share
 from planning.bench.arm_scenes import blocked_scene
 from planning.io.report import report_markdown
 from planning.io.scene_file import parse_scene

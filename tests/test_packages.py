@@ -76,6 +76,19 @@ def test_the_batch_parent_imports_no_planner_robot_or_compiler() -> None:
 
 
 @pytest.mark.slow
+def test_the_shared_helpers_load_no_robot() -> None:
+    # planning shows values, reads user files and raises the robot's errors through
+    # cpr_kin.common, which loads no robot module and none of the libraries a robot needs
+    heavy = ["numpy", "numba", "coal", "pinocchio", "cpr_kin.model", "cpr_kin.shapes", "cpr_kin.description"]
+    code = (
+        "import sys, cpr_kin.common.names, cpr_kin.common.user_files, cpr_kin.common.errors; "
+        f"print(*[m in sys.modules for m in {heavy!r}])"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert dict(zip(heavy, out.split(), strict=True)) == dict.fromkeys(heavy, "False")
+
+
+@pytest.mark.slow
 def test_loading_a_robot_imports_what_it_needs() -> None:
     # attribute access imports the module behind it; the bundled URDF, which the tests
     # validate, loads without yourdfpy (and trimesh)

@@ -9,8 +9,8 @@ import pytest
 import trimesh
 
 import cpr_kin as ck
-from cpr_kin.bound_kernels import CAPSULE
-from cpr_kin.pair_bounds import PairBounds, _obstacle_bound, bounding_capsule
+from cpr_kin.bounds.bound_kernels import CAPSULE
+from cpr_kin.bounds.pair_bounds import PairBounds, _obstacle_bound, bounding_capsule
 
 from .conftest import random_configurations
 from .test_collision import random_obstacle

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
-from cpr_kin.packages import example_robot_data_share
+from cpr_kin.model.packages import example_robot_data_share
 from planning.errors import NoTrajectoryFoundError, PlanningError, TargetOutOfReachError
 from planning.io.bundled import paper_scene
 from planning.pipeline.planner import plan, solve
@@ -208,7 +208,7 @@ def test_objects_of_the_wrong_kind_are_named_at_the_entry_points(robot: ck.Robot
 
 
 def test_warm_up_compiles_the_kernels_and_returns_its_time(robot: ck.Robot) -> None:
-    from cpr_kin.bound_kernels import groups_below
+    from cpr_kin.bounds.bound_kernels import groups_below
     from planning.search.firefly import _move
 
     seconds = warm_up(robot)
@@ -233,8 +233,8 @@ def test_warm_up_prepares_a_robot_that_reaches_the_paper_poses_inside_its_crate(
 
 WARM_UR5 = """
 import cpr_kin as ck
-from cpr_kin.bound_kernels import pair_bounds
-from cpr_kin.self_bounds import self_bounds
+from cpr_kin.bounds.bound_kernels import pair_bounds
+from cpr_kin.bounds.self_bounds import self_bounds
 from planning.curves.horner import evaluate
 from planning.bench.mbm import vamp_resources
 from planning.warming import warm_up
@@ -278,7 +278,7 @@ print("new:", sorted(k for k, n in signatures().items() if n != warm.get(k, 0)))
 """
 BAXTER_SCENE = """
 import cpr_kin as ck
-from cpr_kin.packages import example_robot_data_share
+from cpr_kin.model.packages import example_robot_data_share
 from planning.bench.arm_scenes import blocked_scene
 from planning.io.scene_file import parse_scene
 from planning.pipeline.planner import plan, solve

@@ -11,7 +11,7 @@ import trimesh
 import yaml
 
 import cpr_kin as ck
-from cpr_kin.point_clouds import MAX_POINTS, read_points, voxel_blocks, voxel_centres, voxel_geometry
+from cpr_kin.shapes.point_clouds import MAX_POINTS, read_points, voxel_blocks, voxel_centres, voxel_geometry
 from planning.cli import main
 from planning.io.scene_file import parse_scene, scene_document
 

@@ -57,7 +57,7 @@ def test_the_readmes_scene_is_the_example_file_and_plans_from_where_it_lies(tmp_
     loaded = load_scene(example)  # robot: resolves relative to the scene file, from any folder
     assert loaded.robot is not None
     assert loaded.robot.urdf == (ROOT / "urdf" / "cpr.urdf").resolve()
-    from cpr_kin.user_files import load_yaml
+    from cpr_kin.common.user_files import load_yaml
     from planning.io.scene_file import parse_scene
 
     (tmp_path / "carried.yaml").write_text(scene + payload)

@@ -12,7 +12,7 @@ import pytest
 import yaml
 
 import cpr_kin as ck
-from cpr_kin.packages import example_robot
+from cpr_kin.model.packages import example_robot
 from planning.errors import SceneError
 from planning.io.robot_entry import RobotMapping, robot_entry, robot_spec_of
 from planning.io.scene_file import dump_scene, load_scene, parse_scene

@@ -14,7 +14,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import cpr_kin as ck
-from cpr_kin.user_files import StrictLoader
+from cpr_kin.common.user_files import StrictLoader
 from planning.bench.scene_generator import generate_scenes
 from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError, SceneError

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
-from cpr_kin.packages import example_robot_data_share
-from cpr_kin.pair_bounds import JointCapsules, joint_capsules
-from cpr_kin.self_blocks import CLUSTER_RADIUS_M, PairBlocks
-from cpr_kin.self_bounds import SelfPairBounds
+from cpr_kin.bounds.pair_bounds import JointCapsules, joint_capsules
+from cpr_kin.bounds.self_blocks import CLUSTER_RADIUS_M, PairBlocks
+from cpr_kin.bounds.self_bounds import SelfPairBounds
+from cpr_kin.model.packages import example_robot_data_share
 
 SHARE = example_robot_data_share()
 assert SHARE is not None, "example-robot-data is part of the robots extra, which make installs"

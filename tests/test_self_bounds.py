@@ -9,11 +9,11 @@ import pinocchio as pin
 import pytest
 
 import cpr_kin as ck
-from cpr_kin.packages import example_robot_data_share
-from cpr_kin.segments import segment_distance
-from cpr_kin.self_bounds import SelfPairBounds
-from cpr_kin.self_collision import SelfCollision
-from cpr_kin.self_screen import ScreenedSelfTest, SelfScreen, robot_self_screen
+from cpr_kin.bounds.segments import segment_distance
+from cpr_kin.bounds.self_bounds import SelfPairBounds
+from cpr_kin.collision.self_collision import SelfCollision
+from cpr_kin.collision.self_screen import ScreenedSelfTest, SelfScreen, robot_self_screen
+from cpr_kin.model.packages import example_robot_data_share
 
 SHARE = example_robot_data_share()
 assert SHARE is not None, "example-robot-data is part of the robots extra, which make installs"

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
-from cpr_kin.packages import example_robot_data_share
-from cpr_kin.self_collision import SelfCollision, read_srdf, self_pairs
-from cpr_kin.self_curve import check_self_curve
+from cpr_kin.certified.self_curve import check_self_curve
+from cpr_kin.collision.self_collision import SelfCollision, read_srdf, self_pairs
+from cpr_kin.model.packages import example_robot_data_share
 from planning import Scene, Target, plan
 from planning.errors import PlanningError
 from planning.pipeline.problem import build_problem, with_planner

@@ -11,9 +11,9 @@ import pytest
 import yaml
 
 import cpr_kin as ck
-from cpr_kin.packages import example_robot
-from cpr_kin.point_clouds import voxel_centres
-from cpr_kin.self_filter import clear_of_robot
+from cpr_kin.collision.self_filter import clear_of_robot
+from cpr_kin.model.packages import example_robot
+from cpr_kin.shapes.point_clouds import voxel_centres
 from planning.cli import main
 
 Q = np.array([0.4, 0.25, 0.3, 0.5, -0.4])

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
-from cpr_kin.limits import DEFAULT_ACCELERATION_PER_S, DEFAULT_JERK_PER_S
-from cpr_kin.supported import MAX_CROSSING_S, crossing_time
+from cpr_kin.description.supported import MAX_CROSSING_S, crossing_time
+from cpr_kin.model.limits import DEFAULT_ACCELERATION_PER_S, DEFAULT_JERK_PER_S
 from planning import PlannerSettings, paper_scene, plan
 from planning.cli import main
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
-from cpr_kin.packages import example_robot
+from cpr_kin.model.packages import example_robot
 from planning import PlanningError, Target
 from tests.conftest import PAPER_START_TCP
 

@@ -7,8 +7,8 @@ import numpy as np
 import pinocchio as pin
 
 import cpr_kin as ck
-from cpr_kin.packages import example_robot_data_share
-from cpr_kin.urdf_models import convex_hulls
+from cpr_kin.description.urdf_models import convex_hulls
+from cpr_kin.model.packages import example_robot_data_share
 
 SHARE = example_robot_data_share()
 assert SHARE is not None, "example-robot-data is part of the robots extra, which make installs"

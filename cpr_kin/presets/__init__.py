@@ -1,4 +1,4 @@
-"""Robots the toolkit knows by name: a preset is a :class:`~cpr_kin.loading.RobotSpec` with its files.
+"""Robots the toolkit knows by name: a preset is a :class:`~cpr_kin.RobotSpec` with its files.
 
 The CPR (:mod:`cpr_kin.presets.cpr`): the bundled 5-DOF cylindrical arm of the paper, its
 spec, default limits and analytic IK of a tool position (:mod:`cpr_kin.presets.cpr_ik`).
@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from cpr_kin.loading import RobotSpec
+from cpr_kin.description.loading import RobotSpec
 from cpr_kin.presets.cpr import (
     CPR_JOINTS,
     TCP_FRAME,

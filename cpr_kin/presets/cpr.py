@@ -1,9 +1,9 @@
-"""The CPR preset: the bundled 5-DOF cylindrical arm (R-P-P:R-R) as a :class:`~cpr_kin.robot.Robot`.
+"""The CPR preset: the bundled 5-DOF cylindrical arm (R-P-P:R-R) as a :class:`~cpr_kin.model.robot.Robot`.
 
 What makes a URDF the CPR: joints ``theta1 d2 d3 theta4 theta5`` in this order, a ``tcp``
 frame at the tool tip, and the wrist and tool links that form the ``effector`` group. A CPR
 variant (other lengths, ranges or limits) is a URDF with the same names. Its acceleration
-and jerk limits: the file :func:`~cpr_kin.limits.find_limits_file` finds beside the URDF,
+and jerk limits: the file :func:`~cpr_kin.model.limits.find_limits_file` finds beside the URDF,
 then ``cpr_limits.yaml`` beside it, else the bundled CPR's. Its self-collision pairs: an
 SRDF beside it, else the bundled ``cpr.srdf`` (which disables every pair: the CPR cannot
 meet itself).
@@ -13,12 +13,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from cpr_kin.limits import LIMITS_NAMES
-from cpr_kin.loading import RobotSpec
+from cpr_kin.description.loading import RobotSpec
+from cpr_kin.description.resources import bundled_urdf_dir
+from cpr_kin.description.urdf_file import parse_urdf
+from cpr_kin.model.limits import LIMITS_NAMES
+from cpr_kin.model.robot import Robot
 from cpr_kin.presets.cpr_ik import WRIST_JOINTS, position_ik
-from cpr_kin.resources import bundled_urdf_dir
-from cpr_kin.robot import Robot
-from cpr_kin.urdf_file import parse_urdf
 
 CPR_JOINTS = ("theta1", "d2", "d3", "theta4", "theta5")
 """Joint names of the CPR, in configuration order."""
@@ -59,7 +59,7 @@ def load_cpr(
 def cpr_spec(
     urdf_path: str | Path | None = None, limits_path: str | Path | None = None, validate: bool | None = None
 ) -> RobotSpec:
-    """The :class:`~cpr_kin.loading.RobotSpec` of the CPR preset (see :func:`load_cpr`)."""
+    """The :class:`~cpr_kin.description.loading.RobotSpec` of the CPR preset (see :func:`load_cpr`)."""
     urdf = Path(urdf_path) if urdf_path is not None else cpr_urdf_path()
     bundled = urdf.resolve() == cpr_urdf_path().resolve()
     return RobotSpec(

@@ -24,9 +24,9 @@ from collections.abc import Mapping
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from cpr_kin.errors import CprKinError, JointLimitError, UnreachableError
-from cpr_kin.kinematics import frame_positions
-from cpr_kin.robot import Robot
+from cpr_kin.common.errors import CprKinError, JointLimitError, UnreachableError
+from cpr_kin.kinematics.forward import frame_positions
+from cpr_kin.model.robot import Robot
 
 FloatArray = NDArray[np.float64]
 
@@ -95,7 +95,7 @@ def tcp_ik(robot: Robot, tcp_in_world: ArrayLike, theta4: float = 0.0, theta5: f
 
 
 def position_ik(robot: Robot, tcp_in_base: FloatArray, held: Mapping[str, float]) -> FloatArray:
-    """:func:`tcp_ik` as the CPR preset's :class:`~cpr_kin.robot.PositionIk` (held wrist angles, default 0).
+    """:func:`tcp_ik` as the CPR preset's :class:`~cpr_kin.PositionIk` (held wrist angles, default 0).
 
     Raises:
         UnreachableError: the target is out of reach, or ``held`` names a joint other than the

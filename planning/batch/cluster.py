@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import urlsplit
 
-from cpr_kin.names import escaped, shown
+from cpr_kin.common.names import escaped, shown
 from planning.batch.items import BatchItem, finished_items
 from planning.errors import PlanningError
 

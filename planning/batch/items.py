@@ -34,7 +34,7 @@ from pathlib import Path
 from typing import Any, Protocol
 
 import cpr_kin as ck  # lazy (lazy_loader): its modules load in the workers, where they are used
-from cpr_kin.names import escaped, repeated
+from cpr_kin.common.names import escaped, repeated
 from planning.errors import PlanningError
 from planning.outcome import STATUS_EXIT, classify
 

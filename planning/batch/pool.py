@@ -23,7 +23,7 @@ from concurrent.futures import FIRST_COMPLETED, Future, wait
 from dataclasses import dataclass
 from pathlib import Path
 
-from cpr_kin.names import shown
+from cpr_kin.common.names import shown
 from planning.batch.cluster import run_on_cluster
 from planning.batch.items import BatchItem, finished_items, plan_scene_file
 from planning.errors import PlanningError

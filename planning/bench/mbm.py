@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 import cpr_kin as ck
-from cpr_kin.disk_cache import cache_folder
+from cpr_kin.common.disk_cache import cache_folder
 from planning.errors import PlanningError
 from planning.pipeline.settings import MAX_SEED
 from planning.validation import integer_in

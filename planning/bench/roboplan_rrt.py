@@ -28,9 +28,9 @@ from lxml import etree
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from cpr_kin.packages import package_roots
-from cpr_kin.supported import checked_urdf
-from cpr_kin.urdf_file import prepared_xml
+from cpr_kin.description.supported import checked_urdf
+from cpr_kin.description.urdf_file import prepared_xml
+from cpr_kin.model.packages import package_roots
 from planning.errors import PlanningError
 from planning.pipeline.problem import Problem, build_problem
 from planning.pipeline.scene import Scene
@@ -173,7 +173,7 @@ class RoboplanPeer:
 
         ``step_share``: of the scene's steps (the obstacles' and the robot's own pairs').
         """
-        from cpr_kin.self_curve import check_self_curve
+        from cpr_kin.certified.self_curve import check_self_curve
 
         world, scene = self.problem.world, self.problem.scene
         steps_m = (scene.planner.verify_step_m * step_share, scene.planner.self_step_m * step_share)

@@ -142,7 +142,7 @@ def time_and_verify(
         interval_speed,
     )
     if check.accepted and world.self_collision:  # the robot's own pairs, certified as ours are
-        from cpr_kin.self_curve import check_self_curve
+        from cpr_kin.certified.self_curve import check_self_curve
 
         self_check = check_self_curve(
             world.self_collision,

@@ -8,7 +8,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from cpr_kin.names import escaped
+from cpr_kin.common.names import escaped
 from planning.cli.arguments import integer_at_least
 from planning.cli.batch_command import cmd_batch
 from planning.cli.file_commands import EXPORTERS, cmd_check, cmd_export, cmd_show

@@ -9,7 +9,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from cpr_kin.names import escaped
+from cpr_kin.common.names import escaped
 from planning.cli.terminal import terminal_bar
 from planning.outcome import EXIT_INTERRUPTED
 

@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import cpr_kin as ck  # lazy (lazy_loader): only the modules a command uses are imported
-from cpr_kin.names import escaped
+from cpr_kin.common.names import escaped
 from planning.cli.plan_commands import load
 from planning.errors import PlanningError
 from planning.outcome import EXIT_NO_TRAJECTORY, EXIT_OK

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from cpr_kin.names import escaped
+from cpr_kin.common.names import escaped
 from planning.errors import PlanningError
 from planning.outcome import EXIT_OK
 

@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from cpr_kin.names import escaped
+from cpr_kin.common.names import escaped
 from planning.cli.signals import checkpoint
 from planning.cli.terminal import firefly_progress
 from planning.outcome import EXIT_OK, Interrupted, interruption

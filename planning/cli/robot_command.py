@@ -9,13 +9,13 @@ from pathlib import Path
 from typing import Any
 
 import cpr_kin as ck
-from cpr_kin.names import escaped
+from cpr_kin.common.names import escaped
 from planning.outcome import EXIT_OK
 
 
 def robot_report(robot: ck.Robot) -> dict[str, Any]:
     """The robot as the planner loaded it: files, joints and limits, tool, shapes, pairs (JSON-ready)."""
-    from cpr_kin.hull_excess import SAMPLES, shape_excess
+    from cpr_kin.model.hull_excess import SAMPLES, shape_excess
 
     limits = robot.limits
     return {

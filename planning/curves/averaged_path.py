@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from cpr_kin.compiled import njit
+from cpr_kin.common.compiled import njit
 from planning.curves.jerk_window import profile_window
 from planning.curves.phase_plane import kept_samples, phase_plane_profile, sampled_derivatives
 

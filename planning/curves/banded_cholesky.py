@@ -13,7 +13,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from cpr_kin.compiled import njit
+from cpr_kin.common.compiled import njit
 
 FloatArray = NDArray[np.float64]
 

@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from cpr_kin.compiled import njit
+from cpr_kin.common.compiled import njit
 from planning.curves.phase_plane import phase_plane_profile, profile_instants, sampled_derivatives
 
 FloatArray = NDArray[np.float64]

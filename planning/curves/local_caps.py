@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from cpr_kin.compiled import njit
+from cpr_kin.common.compiled import njit
 from planning.curves.arc_length import ArcLengthPath
 from planning.curves.moving_average import arc_at_times, averaged_motion, positions_at, scaled_duration
 from planning.curves.phase_plane import phase_plane_profile, profile_instants

@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from cpr_kin.compiled import njit, njit_inline
+from cpr_kin.common.compiled import njit, njit_inline
 
 FloatArray = NDArray[np.float64]
 

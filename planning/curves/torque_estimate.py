@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from cpr_kin.compiled import njit
+from cpr_kin.common.compiled import njit
 from planning.curves.jerk_window import jerk_limited_duration, profile_window, sampled_path_durations
 from planning.curves.phase_plane import kept_samples, phase_plane_profile, sampled_derivatives
 from planning.curves.torque_limits import HEADROOM, TorqueModel

@@ -10,7 +10,7 @@ limits less :data:`HEADROOM`.
 Run uniformly ``k`` times slower, a trajectory's torques are ``d / k^2 + g``, with ``g`` the
 gravity torque and ``d`` the rest (inertia, Coriolis): :func:`torque_time_scale` gives the
 least ``k`` that keeps every sample within the limits, in closed form. This module knows no
-robot: a :class:`TorqueModel` (:class:`cpr_kin.dynamics.Dynamics`) computes the torques.
+robot: a :class:`TorqueModel` (:class:`cpr_kin.kinematics.dynamics.Dynamics`) computes the torques.
 """
 
 from __future__ import annotations
@@ -41,7 +41,7 @@ UNBOUND_SHARE = 0.9
 
 
 class TorqueModel(Protocol):
-    """The joint torques of a robot (:class:`cpr_kin.dynamics.Dynamics`)."""
+    """The joint torques of a robot (:class:`cpr_kin.kinematics.dynamics.Dynamics`)."""
 
     @property
     def effort(self) -> FloatArray:

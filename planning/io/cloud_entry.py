@@ -3,8 +3,8 @@
 ``{shape: point_cloud, file: FILE | points: [[x, y, z], ...], resolution, xyz, rpy,
 filter_robot, filter_padding}``: the points (or an OctoMap file's occupied voxels) in the
 cloud's frame, placed by ``xyz`` and ``rpy``, become the voxels of
-:mod:`cpr_kin.point_clouds`; with ``filter_robot`` the voxels the robot stands in at the
-start are left out (:mod:`cpr_kin.self_filter`).
+:mod:`cpr_kin.shapes.point_clouds`; with ``filter_robot`` the voxels the robot stands in at the
+start are left out (:mod:`cpr_kin.collision.self_filter`).
 """
 
 from __future__ import annotations
@@ -17,19 +17,19 @@ import numpy as np
 from pydantic import Field, model_validator
 
 import cpr_kin as ck
-from cpr_kin.errors import ObstacleError
-from cpr_kin.obstacles import placement
-from cpr_kin.octree_files import SUFFIXES as OCTREE_SUFFIXES
-from cpr_kin.octree_files import read_octree
-from cpr_kin.point_clouds import (
+from cpr_kin.collision.self_filter import clear_of_robot
+from cpr_kin.common.errors import ObstacleError
+from cpr_kin.shapes.cloud_obstacles import voxel_obstacles
+from cpr_kin.shapes.obstacles import placement
+from cpr_kin.shapes.octree_files import SUFFIXES as OCTREE_SUFFIXES
+from cpr_kin.shapes.octree_files import read_octree
+from cpr_kin.shapes.point_clouds import (
     MAX_POINTS,
     RESOLUTION_RANGE_M,
     checked_voxels,
     read_points,
     voxel_centres,
-    voxel_obstacles,
 )
-from cpr_kin.self_filter import clear_of_robot
 from planning.io.schema_types import FilePath, Name, Point, Strict, Turn, between
 from planning.pipeline.scene import MAX_SAFETY_MARGIN_M
 
@@ -90,7 +90,7 @@ class RobotAtStart:
 def cloud_obstacles(
     item: PointCloudSpec, name: str, base: Path, robot_at_start: RobotAtStart | None = None
 ) -> list[ck.Obstacle]:
-    """A cloud's blocks of voxels (:func:`cpr_kin.point_clouds.voxel_obstacles`); a file relative to ``base``.
+    """A cloud's voxel blocks (:func:`~cpr_kin.shapes.cloud_obstacles.voxel_obstacles`); files from ``base``.
 
     Args:
         item: the validated entry.

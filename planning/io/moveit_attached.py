@@ -19,7 +19,7 @@ import numpy as np
 import pinocchio as pin
 import trimesh
 
-from cpr_kin.dynamics import MAX_PAYLOAD_KG
+from cpr_kin.kinematics.dynamics import MAX_PAYLOAD_KG
 from planning.io.moveit_matrix import links_allowed_to_touch
 from planning.io.moveit_messages import (
     AttachedCollisionObject,

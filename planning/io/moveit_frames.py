@@ -16,7 +16,7 @@ import numpy as np
 import pinocchio as pin
 from lxml import etree
 
-from cpr_kin.names import cut
+from cpr_kin.common.names import cut
 from planning.io.moveit_messages import MoveItImportError, TransformStamped
 
 

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from cpr_kin.names import repeated
+from cpr_kin.common.names import repeated
 from planning.io.moveit_frames import Frames
 from planning.io.moveit_messages import MotionPlanRequest, MoveItImportError
 from planning.io.moveit_poses import rotation_matrix

@@ -39,11 +39,11 @@ from typing import Any
 import trimesh
 
 import cpr_kin as ck
-from cpr_kin.limits import read_limits_file
-from cpr_kin.packages import check_package_dirs
-from cpr_kin.self_collision import parse_srdf
-from cpr_kin.srdf_groups import group_joints
-from cpr_kin.supported import checked_urdf
+from cpr_kin.collision.self_collision import parse_srdf
+from cpr_kin.description.srdf_groups import group_joints
+from cpr_kin.description.supported import checked_urdf
+from cpr_kin.model.limits import read_limits_file
+from cpr_kin.model.packages import check_package_dirs
 from planning.io.moveit_attached import attached_payload
 from planning.io.moveit_frames import Frames
 from planning.io.moveit_goal import goal_entry

@@ -13,7 +13,7 @@ from typing import Annotated, Any, TypeVar
 
 from pydantic import BaseModel, Field, ValidationError
 
-from cpr_kin.user_files import load_yaml
+from cpr_kin.common.user_files import load_yaml
 from planning.errors import PlanningError
 from planning.io.moveit_poses import (
     Message,

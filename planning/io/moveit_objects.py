@@ -22,8 +22,8 @@ import numpy as np
 import pinocchio as pin
 import trimesh
 
-from cpr_kin.names import unprintable
-from cpr_kin.obstacles import MAX_COORDINATE_M, MAX_NAME_CHARS, SIZE_RANGE_M
+from cpr_kin.common.names import unprintable
+from cpr_kin.shapes.obstacle_ranges import MAX_COORDINATE_M, MAX_NAME_CHARS, SIZE_RANGE_M
 from planning.io.moveit_messages import CollisionObject, Mesh, MoveItImportError
 from planning.io.moveit_poses import Pose
 

@@ -5,7 +5,7 @@ tree's bytes (``binary: true``: OctoMap's ``.bt`` encoding, else ``.ot``), its r
 the pose of its frame (``origin`` in ``header.frame_id``, a frame fixed to the world). The
 import writes the bytes under OctoMap's own header, so the file opens in OctoMap's tools too,
 and the scene names it as a ``point_cloud`` obstacle placed at that pose. The tree is read
-before anything is written (:mod:`cpr_kin.octree_files`): a broken one is refused naming the
+before anything is written (:mod:`cpr_kin.shapes.octree_files`): a broken one is refused naming the
 field.
 """
 
@@ -14,9 +14,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from cpr_kin.errors import ObstacleError
-from cpr_kin.octree_files import octree_voxels
-from cpr_kin.point_clouds import RESOLUTION_RANGE_M
+from cpr_kin.common.errors import ObstacleError
+from cpr_kin.shapes.octree_files import octree_voxels
+from cpr_kin.shapes.point_clouds import RESOLUTION_RANGE_M
 from planning.io.moveit_frames import Frames
 from planning.io.moveit_messages import MoveItImportError, OctomapWithPose
 from planning.io.moveit_objects import placement

@@ -12,7 +12,7 @@ import math
 
 from lxml import etree
 
-from cpr_kin.names import repeated
+from cpr_kin.common.names import repeated
 from planning.io.moveit_messages import MoveItImportError, RobotState
 
 

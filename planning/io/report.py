@@ -143,7 +143,7 @@ def report_markdown(result: PlanResult, paper: bool = False) -> str:
 
 def limits_section(result: PlanResult) -> list[str]:
     """``report.md``'s lines on limits that are defaults, joints held and SRDF entries skipped; or none."""
-    from cpr_kin.limits import DEFAULT_ACCELERATION_PER_S, DEFAULT_JERK_PER_S
+    from cpr_kin.model.limits import DEFAULT_ACCELERATION_PER_S, DEFAULT_JERK_PER_S
 
     robot, lines = result.robot, []
     if robot.limits_defaulted:

@@ -1,6 +1,6 @@
 """A scene file's ``robot:`` entry: a name, a URDF path, or a mapping, to and from :class:`cpr_kin.RobotSpec`.
 
-- a name of example-robot-data's arms (``robot: panda``, :data:`cpr_kin.packages.EXAMPLE_ROBOTS`);
+- a name of example-robot-data's arms (``robot: panda``, :data:`cpr_kin.model.packages.EXAMPLE_ROBOTS`);
 - a URDF path, relative to the scene file (``robot: ../urdf/my_arm.urdf``): the CPR preset
   for a URDF with the CPR's joints, else the generic rules (:func:`cpr_kin.robot_spec`);
 - a mapping ``{urdf, srdf, packages, limits, joints, tcp, fixed}``: ``urdf`` as above (a
@@ -21,7 +21,7 @@ from typing import Annotated, Any
 from pydantic import Field, Tag
 
 import cpr_kin as ck
-from cpr_kin.packages import EXAMPLE_ROBOTS, example_robot
+from cpr_kin.model.packages import EXAMPLE_ROBOTS, example_robot
 from planning.io.schema_types import BY_KIND, MAPPING_TAG, OTHER_TAG, Angle, FilePath, Name, Strict
 
 

@@ -29,9 +29,9 @@ import yaml
 from pydantic import ValidationError
 
 import cpr_kin as ck
-from cpr_kin.dynamics import PAYLOAD_NAME
-from cpr_kin.names import repeated
-from cpr_kin.user_files import UserFileError, load_yaml
+from cpr_kin.common.names import repeated
+from cpr_kin.common.user_files import UserFileError, load_yaml
+from cpr_kin.kinematics.dynamics import PAYLOAD_NAME
 from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError, SceneError
 from planning.io.cloud_entry import PointCloudSpec, RobotAtStart, cloud_obstacles
@@ -187,7 +187,7 @@ def _obstacle(
 def load_scene(path: str | Path) -> Scene:
     """Read and validate a scene file; raises :class:`SceneError` naming what is wrong.
 
-    The file is read by :func:`cpr_kin.user_files.load_yaml`: at most
+    The file is read by :func:`cpr_kin.common.user_files.load_yaml`: at most
     :data:`MAX_SCENE_BYTES`, no anchors or aliases, no duplicate keys, bounded nesting.
     """
     path = Path(path)

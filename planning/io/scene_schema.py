@@ -15,8 +15,8 @@ import numpy as np
 from pydantic import AfterValidator, BaseModel, Field, ValidationError, model_validator
 
 import cpr_kin as ck
-from cpr_kin.dynamics import MAX_COM_OFFSET_M, MAX_PAYLOAD_KG, PAYLOAD_NAME, TORQUE_SCALE_RANGE
-from cpr_kin.obstacles import SCALE_RANGE
+from cpr_kin.kinematics.dynamics import MAX_COM_OFFSET_M, MAX_PAYLOAD_KG, PAYLOAD_NAME, TORQUE_SCALE_RANGE
+from cpr_kin.shapes.obstacle_ranges import SCALE_RANGE
 from planning.io.cloud_entry import PointCloudSpec
 from planning.io.robot_entry import RobotEntry, RobotMapping
 from planning.io.schema_types import (

@@ -6,8 +6,8 @@ from typing import Annotated, Any
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Discriminator, Field
 
-from cpr_kin.names import unprintable
-from cpr_kin.obstacles import MAX_ANGLE_RAD, MAX_COORDINATE_M, MAX_NAME_CHARS, SIZE_RANGE_M
+from cpr_kin.common.names import unprintable
+from cpr_kin.shapes.obstacle_ranges import MAX_ANGLE_RAD, MAX_COORDINATE_M, MAX_NAME_CHARS, SIZE_RANGE_M
 from planning.pipeline.scene import SPLINE_A_RANGE
 
 

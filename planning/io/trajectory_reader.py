@@ -20,8 +20,8 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
-from cpr_kin.names import repeated
-from cpr_kin.user_files import UserFileError, read_bytes
+from cpr_kin.common.names import repeated
+from cpr_kin.common.user_files import UserFileError, read_bytes
 from planning.curves.continuity import discontinuity
 from planning.curves.hermite import ORDER
 from planning.curves.trajectory import Trajectory

@@ -1,7 +1,7 @@
 """The planner: scene -> problem -> (attempt -> search -> choose) -> result.
 
 ``plan(scene)`` is ``solve(build_problem(scene))``. A robot whose concave links are checked
-on their exact meshes (:mod:`cpr_kin.exact_pairs`) is planned on their convex hulls first,
+on their exact meshes (:mod:`cpr_kin.shapes.exact_pairs`) is planned on their convex hulls first,
 which contain them and cost no triangle query (:func:`~planning.pipeline.problem.on_hulls`,
 with a share of the samples and of a time limit), and on the meshes where the hulls find no
 trajectory. :func:`solve` reads as the pipeline:

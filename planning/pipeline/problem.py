@@ -148,7 +148,7 @@ def scene_world(scene: Scene, robot: ck.Robot, threads: int | None = None) -> ck
     """``robot`` among ``scene``'s obstacles, its pairs held as the scene holds them.
 
     The scene's ``allowed_collisions`` may touch; a pair close by design is held to contact
-    only where the scene's self margin exceeds its gap (:mod:`cpr_kin.close_pairs`).
+    only where the scene's self margin exceeds its gap (:mod:`cpr_kin.bounds.close_pairs`).
     ``threads``: those of the parallel collision checks (default: up to 2).
 
     Raises:

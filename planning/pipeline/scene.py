@@ -16,8 +16,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from cpr_kin.dynamics import TORQUE_SCALE_RANGE
-from cpr_kin.names import shown, unprintable
+from cpr_kin.common.names import shown, unprintable
+from cpr_kin.kinematics.dynamics import TORQUE_SCALE_RANGE
 from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError
 from planning.pipeline.settings import PlannerSettings
@@ -79,7 +79,7 @@ class Scene:
         name: a name for reports.
         payload: a load the robot carries (:class:`cpr_kin.Payload`), part of its torques.
         torque_scale: share of the URDF's effort limits the torques may use, in
-            :data:`cpr_kin.dynamics.TORQUE_SCALE_RANGE`.
+            :data:`cpr_kin.kinematics.dynamics.TORQUE_SCALE_RANGE`.
     """
 
     start: Target

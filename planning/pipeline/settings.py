@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
-from cpr_kin.names import shown
+from cpr_kin.common.names import shown
 from planning.errors import PlanningError
 from planning.pipeline.tuning import SearchTuning
 from planning.search.firefly_settings import MAX_ITERATIONS, FireflySettings

@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from cpr_kin.robot import joint_units
+from cpr_kin.model.robot import joint_units
 from planning.curves.phase_plane import (
     kept_samples,
     path_acceleration,

@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from cpr_kin.self_curve import check_self_curve
+from cpr_kin.certified.self_curve import check_self_curve
 from planning.curves.continuity import discontinuity
 from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
@@ -161,7 +161,7 @@ def verify_trajectory(
     - the certified clearance (:func:`cpr_kin.check_curve`, robot motion between checks at
       most ``step_m``) is at least ``margin_m`` [m];
     - the certified self-clearance of the robot's checked pairs
-      (:func:`cpr_kin.self_curve.check_self_curve`, a pair's motion between checks at most
+      (:func:`cpr_kin.certified.self_curve.check_self_curve`, a pair's motion between checks at most
       ``self_step_m``) is at least ``self_margin_m`` [m];
     - every joint stays within its range, and within its velocity, acceleration and jerk
       limits (exact extrema);

@@ -20,7 +20,7 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from cpr_kin.compiled import njit
+from cpr_kin.common.compiled import njit
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]

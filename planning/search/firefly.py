@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from cpr_kin.compiled import njit
+from cpr_kin.common.compiled import njit
 from planning.errors import PlanningError
 from planning.search.firefly_settings import FireflySettings
 from planning.search.optimizer import BatchObjective, EarlyStop, History, SearchResult, evaluate_in_box

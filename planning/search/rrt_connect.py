@@ -50,7 +50,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from cpr_kin.compiled import njit
+from cpr_kin.common.compiled import njit
 from planning.errors import PlanningError
 from planning.search.edges import Edges, Validity, shortcut
 from planning.search.rrt_settings import RANGE_FRACTION, RrtSettings

@@ -1,0 +1,223 @@
+"""Compiled lower bounds of the distance between a robot capsule and an obstacle.
+
+What :class:`cpr_kin.bounds.pair_bounds.PairBounds` runs, configuration by configuration: the
+kinematic chain places every robot capsule (:func:`cpr_kin.bounds.batch_kinematics.place_joints`),
+then each robot-obstacle pair is bounded from below.
+
+Obstacle bounds, in the obstacle's frame, for the robot's segment (before subtracting the
+robot capsule's radius):
+
+- sphere (radius ``R``): the exact distance from its centre to the segment, minus ``R``;
+- cylinder and capsule (axis along local z, half length ``h``, radius ``R``): with ``d`` the
+  segment's distance from the z axis and ``g`` its gap to the slab ``|z| <= h``,
+  ``sqrt(max(d - R, 0)^2 + g^2)`` for the cylinder and ``sqrt(d^2 + g^2) - R`` for the capsule
+  (for any point of the segment, its distance from the axis is at least ``d`` and from the
+  slab at least ``g``);
+- box, and any other shape by its local bounding box (half sides ``h``): the larger of the
+  distance between the box and the segment's bounding box, and the distance from the box's
+  centre to the segment minus ``|h|``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from cpr_kin.bounds.batch_kinematics import ChainArrays, place_joints
+from cpr_kin.common.compiled import njit
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+BoolArray = NDArray[np.bool_]
+
+SPHERE, CYLINDER, CAPSULE, BOX = 0, 1, 2, 3
+"""Obstacle bound kinds, as the compiled code reads them."""
+
+
+@njit
+def _point_segment(ax: float, ay: float, az: float, dx: float, dy: float, dz: float) -> float:
+    """Distance from the origin to the segment from ``a`` along ``d`` (``d`` may be zero)."""
+    length2 = dx * dx + dy * dy + dz * dz
+    t = 0.0
+    if length2 > 0.0:
+        t = min(max(-(ax * dx + ay * dy + az * dz) / length2, 0.0), 1.0)
+    x, y, z = ax + t * dx, ay + t * dy, az + t * dz
+    return float(np.sqrt(x * x + y * y + z * z))
+
+
+@njit
+def _gap(low: float, high: float, half: float) -> float:
+    """Gap between the intervals ``[low, high]`` and ``[-half, half]`` (0 where they overlap)."""
+    return max(low - half, -half - high, 0.0)
+
+
+@njit
+def pair_bounds(
+    q: FloatArray,
+    out: FloatArray,
+    chain: ChainArrays,
+    capsule_joint: IntArray,
+    capsule_ends: FloatArray,
+    capsule_radius: FloatArray,
+    pair_capsule: IntArray,
+    pair_obstacle: IntArray,
+    kind: IntArray,
+    obstacle_rotation: FloatArray,
+    obstacle_origin: FloatArray,
+    obstacle_radius: FloatArray,
+    obstacle_half: FloatArray,
+) -> None:
+    """Write into ``out[n, p]`` a lower bound of pair ``p``'s distance at configuration ``q[n]`` [m].
+
+    Pair ``p`` is capsule ``pair_capsule[p]`` (fixed to joint ``capsule_joint``, segment
+    ``capsule_ends`` in that joint's frame, radius ``capsule_radius``) and obstacle
+    ``pair_obstacle[p]`` (bound ``kind``, placed by ``obstacle_rotation`` and
+    ``obstacle_origin``, with its radius and half sides or half length).
+    """
+    joints = len(chain[0])
+    rotation, translation = np.empty((joints, 3, 3)), np.empty((joints, 3))
+    world = np.empty((len(capsule_joint), 2, 3))
+    local, scratch = np.empty((2, 3)), np.empty((4, 3))
+    for n in range(len(q)):
+        place_joints(q[n], chain, rotation, translation, scratch)
+        for c in range(len(capsule_joint)):
+            j = capsule_joint[c]
+            for e in range(2):
+                for r in range(3):
+                    if j < 0:
+                        world[c, e, r] = capsule_ends[c, e, r]
+                    else:
+                        world[c, e, r] = (
+                            translation[j, r]
+                            + rotation[j, r, 0] * capsule_ends[c, e, 0]
+                            + rotation[j, r, 1] * capsule_ends[c, e, 1]
+                            + rotation[j, r, 2] * capsule_ends[c, e, 2]
+                        )
+        for p in range(len(pair_capsule)):
+            c, o = pair_capsule[p], pair_obstacle[p]
+            for e in range(2):  # the capsule's end points in the obstacle's frame
+                for r in range(3):
+                    local[e, r] = (
+                        obstacle_rotation[o, 0, r] * (world[c, e, 0] - obstacle_origin[o, 0])
+                        + obstacle_rotation[o, 1, r] * (world[c, e, 1] - obstacle_origin[o, 1])
+                        + obstacle_rotation[o, 2, r] * (world[c, e, 2] - obstacle_origin[o, 2])
+                    )
+            ax, ay, az = local[0, 0], local[0, 1], local[0, 2]
+            dx, dy, dz = local[1, 0] - ax, local[1, 1] - ay, local[1, 2] - az
+            radius = obstacle_radius[o]  # (no array views here: each costs reference counting)
+            if kind[o] == SPHERE:
+                bound = _point_segment(ax, ay, az, dx, dy, dz) - radius
+            elif kind[o] == BOX:
+                gap2 = 0.0
+                for r in range(3):
+                    g = _gap(
+                        min(local[0, r], local[1, r]), max(local[0, r], local[1, r]), obstacle_half[o, r]
+                    )
+                    gap2 += g * g
+                bound = max(np.sqrt(gap2), _point_segment(ax, ay, az, dx, dy, dz) - radius)
+            else:
+                axis_distance = _point_segment(ax, ay, 0.0, dx, dy, 0.0)
+                gap = _gap(min(local[0, 2], local[1, 2]), max(local[0, 2], local[1, 2]), obstacle_half[o, 2])
+                if kind[o] == CYLINDER:
+                    radial = max(axis_distance - radius, 0.0)
+                    bound = np.sqrt(radial * radial + gap * gap)
+                else:
+                    bound = np.sqrt(axis_distance * axis_distance + gap * gap) - radius
+            out[n, p] = bound - capsule_radius[c]
+
+
+# The kernel below repeats the capsule placement and pair bound of ``pair_bounds``: factored into
+# compiled helpers (even with Numba's inline="always"), both kernels ran slower (docs/tuning.md).
+@njit
+def groups_below(
+    q: FloatArray,
+    threshold: float,
+    out: BoolArray,
+    pair_group: IntArray,
+    chain: ChainArrays,
+    capsule_joint: IntArray,
+    capsule_ends: FloatArray,
+    capsule_radius: FloatArray,
+    capsule_reach: FloatArray,
+    pair_capsule: IntArray,
+    pair_obstacle: IntArray,
+    kind: IntArray,
+    obstacle_rotation: FloatArray,
+    obstacle_origin: FloatArray,
+    obstacle_radius: FloatArray,
+    obstacle_half: FloatArray,
+    obstacle_reach: FloatArray,
+) -> None:
+    """Write into ``out[n, g]`` whether a pair of group ``g`` has a bound below ``threshold`` [m] at ``q[n]``.
+
+    The arguments are :func:`pair_bounds`', plus each pair's group (``pair_group``, ``(P,)``
+    in ``[0, G)`` for ``out`` of shape ``(N, G)``) and the bounding-sphere radii of the
+    capsules (``capsule_reach``) and obstacles (``obstacle_reach``): a pair whose spheres
+    are farther apart than ``threshold`` needs no finer bound, a pair whose group is already
+    below none, and a configuration stops once every group is.
+    """
+    joints = len(chain[0])
+    rotation, translation = np.empty((joints, 3, 3)), np.empty((joints, 3))
+    world = np.empty((len(capsule_joint), 2, 3))
+    local, scratch = np.empty((2, 3)), np.empty((4, 3))
+    for n in range(len(q)):
+        place_joints(q[n], chain, rotation, translation, scratch)
+        for c in range(len(capsule_joint)):
+            j = capsule_joint[c]
+            for e in range(2):
+                for r in range(3):
+                    if j < 0:
+                        world[c, e, r] = capsule_ends[c, e, r]
+                    else:
+                        world[c, e, r] = (
+                            translation[j, r]
+                            + rotation[j, r, 0] * capsule_ends[c, e, 0]
+                            + rotation[j, r, 1] * capsule_ends[c, e, 1]
+                            + rotation[j, r, 2] * capsule_ends[c, e, 2]
+                        )
+        out[n, :] = False
+        open_groups = out.shape[1]
+        for p in range(len(pair_capsule)):
+            group = pair_group[p]
+            if out[n, group]:
+                continue
+            c, o = pair_capsule[p], pair_obstacle[p]
+            x = 0.5 * (world[c, 0, 0] + world[c, 1, 0]) - obstacle_origin[o, 0]
+            y = 0.5 * (world[c, 0, 1] + world[c, 1, 1]) - obstacle_origin[o, 1]
+            z = 0.5 * (world[c, 0, 2] + world[c, 1, 2]) - obstacle_origin[o, 2]
+            apart = threshold + capsule_reach[c] + obstacle_reach[o]
+            if x * x + y * y + z * z > apart * apart:
+                continue
+            for e in range(2):  # the capsule's end points in the obstacle's frame
+                for r in range(3):
+                    local[e, r] = (
+                        obstacle_rotation[o, 0, r] * (world[c, e, 0] - obstacle_origin[o, 0])
+                        + obstacle_rotation[o, 1, r] * (world[c, e, 1] - obstacle_origin[o, 1])
+                        + obstacle_rotation[o, 2, r] * (world[c, e, 2] - obstacle_origin[o, 2])
+                    )
+            ax, ay, az = local[0, 0], local[0, 1], local[0, 2]
+            dx, dy, dz = local[1, 0] - ax, local[1, 1] - ay, local[1, 2] - az
+            radius = obstacle_radius[o]  # (no array views here: each costs reference counting)
+            if kind[o] == SPHERE:
+                bound = _point_segment(ax, ay, az, dx, dy, dz) - radius
+            elif kind[o] == BOX:
+                gap2 = 0.0
+                for r in range(3):
+                    g = _gap(
+                        min(local[0, r], local[1, r]), max(local[0, r], local[1, r]), obstacle_half[o, r]
+                    )
+                    gap2 += g * g
+                bound = max(np.sqrt(gap2), _point_segment(ax, ay, az, dx, dy, dz) - radius)
+            else:
+                axis_distance = _point_segment(ax, ay, 0.0, dx, dy, 0.0)
+                gap = _gap(min(local[0, 2], local[1, 2]), max(local[0, 2], local[1, 2]), obstacle_half[o, 2])
+                if kind[o] == CYLINDER:
+                    radial = max(axis_distance - radius, 0.0)
+                    bound = np.sqrt(radial * radial + gap * gap)
+                else:
+                    bound = np.sqrt(axis_distance * axis_distance + gap * gap) - radius
+            if bound - capsule_radius[c] <= threshold:
+                out[n, group] = True
+                open_groups -= 1
+                if open_groups == 0:
+                    break

@@ -1,0 +1,248 @@
+"""Cheap lower bounds of robot-obstacle distances, for many configurations at once.
+
+Each robot geometry is enclosed in a capsule (a segment grown by a radius) fixed to its
+joint; each obstacle is bounded in its own frame by a shape whose distance to a segment is
+a few lines of arithmetic. Compiled code places the capsules with the kinematic chain
+(:mod:`cpr_kin.bounds.batch_kinematics`) and bounds every pair, several times faster than coal's
+yes/no test (``docs/benchmarks.md``). A positive bound is at most coal's
+distance (shapes that overlap get a bound <= 0), so a configuration whose bounds all exceed
+a margin keeps it for certain: :meth:`cpr_kin.CollisionWorld.margin_violated` sends coal only
+the others. That check asks :meth:`PairBounds.any_below`, which first compares the bounding
+spheres of each capsule and obstacle (most pairs are far apart) and stops at a
+configuration's first uncertain pair.
+The bounds themselves are compiled (:mod:`cpr_kin.bounds.bound_kernels`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any, NamedTuple
+
+import coal
+import numpy as np
+from numpy.typing import NDArray
+
+from cpr_kin.bounds.batch_kinematics import KinematicChain
+from cpr_kin.bounds.bound_kernels import BOX, CAPSULE, CYLINDER, SPHERE, groups_below, pair_bounds
+from cpr_kin.bounds.capsule_fit import Capsule, fitted_capsule, frame_about
+from cpr_kin.shapes.obstacles import Obstacle
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+BoolArray = NDArray[np.bool_]
+
+
+def bounding_capsule(geometry: Any) -> tuple[FloatArray, float]:
+    """A capsule containing a coal geometry: segment end points ``(2, 3)`` [m] and radius [m].
+
+    In the geometry's own frame. Spheres, capsules and cylinders keep their axis and radius
+    (the capsule's caps cover a cylinder's rims). A mesh (a convex one or a triangle soup)
+    gets the capsule fitted to its vertices (:func:`cpr_kin.bounds.capsule_fit.fitted_capsule`)
+    or its bounding box's, whichever is smaller; any other shape its bounding box's: the
+    box's longest axis, with the box's half diagonal across that axis as radius. A swept
+    sphere radius grows the capsule by as much.
+    """
+    if isinstance(geometry, coal.Sphere):
+        return np.zeros((2, 3)), float(geometry.radius)
+    if isinstance(geometry, coal.Capsule | coal.Cylinder):
+        half_length = float(geometry.halfLength)
+        return np.array([[0.0, 0.0, -half_length], [0.0, 0.0, half_length]]), float(geometry.radius)
+    centre, half = _local_box(geometry)
+    axis = int(np.argmax(half))
+    ends = np.array([centre, centre])
+    ends[0, axis] -= half[axis]
+    ends[1, axis] += half[axis]
+    boxed = Capsule(ends, float(np.linalg.norm(np.delete(half, axis))))
+    vertices = _vertices(geometry)
+    if vertices is None:
+        return boxed.ends, boxed.radius
+    fitted = fitted_capsule(vertices)
+    swept = float(geometry.getSweptSphereRadius()) if hasattr(geometry, "getSweptSphereRadius") else 0.0
+    fitted = Capsule(fitted.ends, fitted.radius + swept)
+    best = min((boxed, fitted), key=lambda capsule: capsule.volume)
+    return best.ends, best.radius
+
+
+def _vertices(geometry: Any) -> FloatArray | None:
+    """``(N, 3)`` a mesh's vertices in its own frame [m]; ``None`` for another shape or an empty mesh."""
+    if isinstance(geometry, coal.ConvexBase):
+        points = np.asarray(geometry.points(), dtype=float)
+    elif isinstance(geometry, coal.BVHModelBase):
+        points = np.asarray(geometry.vertices(), dtype=float)
+    else:
+        return None
+    return points.reshape(-1, 3) if points.size else None
+
+
+class JointCapsules(NamedTuple):
+    """Capsules enclosing geometries, each fixed to its joint (the compiled kernels' arguments).
+
+    Attributes:
+        joint: ``(G,)`` the joint each moves with, ``-1``: fixed to the world.
+        ends: ``(G, 2, 3)`` its segment's end points in that joint's frame [m].
+        radius: ``(G,)`` its radius [m].
+        reach: ``(G,)`` the radius of its bounding sphere about the segment's middle [m].
+    """
+
+    joint: IntArray
+    ends: FloatArray
+    radius: FloatArray
+    reach: FloatArray
+
+
+def joint_capsules(collision_model: Any, geometries: Sequence[int]) -> JointCapsules:
+    """The capsules (:func:`bounding_capsule`) of ``collision_model``'s ``geometries``, in joint frames."""
+    ends, radii, joints = [], [], []
+    for g in geometries:
+        obj = collision_model.geometryObjects[g]
+        local, radius = bounding_capsule(obj.geometry)
+        placement = obj.placement  # geometry in its joint's frame
+        ends.append(local @ np.asarray(placement.rotation).T + np.asarray(placement.translation))
+        radii.append(radius)
+        joints.append(int(obj.parentJoint) - 1)  # -1: fixed to the world
+    capsule_ends = np.array(ends, dtype=float).reshape(-1, 2, 3)
+    capsule_radius = np.array(radii, dtype=float)
+    reach = np.linalg.norm(capsule_ends[:, 1] - capsule_ends[:, 0], axis=1) / 2 + capsule_radius
+    return JointCapsules(np.array(joints, dtype=np.int64), capsule_ends, capsule_radius, reach)
+
+
+def _local_box(geometry: Any) -> tuple[FloatArray, FloatArray]:
+    """Centre and half sides [m] of a coal geometry's bounding box in its own frame."""
+    geometry.computeLocalAABB()
+    low = np.asarray(geometry.aabb_local.min_, dtype=float)
+    high = np.asarray(geometry.aabb_local.max_, dtype=float)
+    return (low + high) / 2, (high - low) / 2
+
+
+class PairBounds:
+    """Lower bounds of robot-obstacle pair distances, for batches of configurations.
+
+    Args:
+        model: the robot's Pinocchio model (one-degree-of-freedom joints).
+        collision_model: the robot's Pinocchio geometry model.
+        obstacles: the obstacles.
+        pairs: ``(robot geometry index, obstacle index)`` per output column.
+    """
+
+    def __init__(
+        self,
+        model: Any,
+        collision_model: Any,
+        obstacles: Sequence[Obstacle],
+        pairs: Sequence[tuple[int, int]],
+    ) -> None:
+        self._chain = KinematicChain.from_model(model)
+        geometries = sorted({g for g, _ in pairs})
+        slot = {g: k for k, g in enumerate(geometries)}
+        capsules = joint_capsules(collision_model, geometries)
+        self._capsules = (capsules.joint, capsules.ends, capsules.radius)
+        self._pairs = (
+            np.array([slot[g] for g, _ in pairs], dtype=np.int64),
+            np.array([k for _, k in pairs], dtype=np.int64),
+        )
+        bounds = [_obstacle_bound(obstacle) for obstacle in obstacles]
+        self.n_obstacles = len(bounds)
+        self._obstacles = (
+            np.array([b[0] for b in bounds], dtype=np.int64),
+            np.array([b[1] for b in bounds], dtype=float).reshape(-1, 3, 3),
+            np.array([b[2] for b in bounds], dtype=float).reshape(-1, 3),
+            np.array([b[3] for b in bounds], dtype=float),
+            np.array([b[4] for b in bounds], dtype=float).reshape(-1, 3),
+        )
+        obstacle_reach = np.array([b[5] for b in bounds], dtype=float)
+        # the compiled kernels' arguments after the configurations (and threshold) and the output
+        self._arguments: tuple[Any, ...] = (
+            self._chain.arrays,
+            *self._capsules,
+            *self._pairs,
+            *self._obstacles,
+        )
+        self._any_arguments: tuple[Any, ...] = (
+            self._chain.arrays,
+            *self._capsules,
+            capsules.reach,
+            *self._pairs,
+            *self._obstacles,
+            obstacle_reach,
+        )
+
+    @property
+    def n_pairs(self) -> int:
+        """Number of pairs (output columns)."""
+        return len(self._pairs[0])
+
+    def __call__(self, q: FloatArray) -> FloatArray:
+        """``(N, P)`` lower bounds [m] of each pair's distance at configurations ``q`` ``(N, nq)``."""
+        batch = np.ascontiguousarray(q, dtype=float)
+        out = np.empty((len(batch), self.n_pairs))
+        pair_bounds(batch, out, *self._arguments)
+        return out
+
+    def any_below(self, q: FloatArray, threshold_m: float) -> BoolArray:
+        """``(N,)`` whether some pair may be within ``threshold_m`` [m] at configurations ``q``.
+
+        False only where every pair is certainly farther: by its bound of :meth:`__call__`
+        or by the bounding spheres of the robot capsule and the obstacle, whichever is
+        tested first. So it is at most ``(self(q) <= threshold_m).any(axis=1)``, and faster:
+        far pairs cost only the spheres' test, and a configuration stops at its first
+        uncertain pair.
+        """
+        return self._below(q, threshold_m, np.zeros(self.n_pairs, dtype=np.int64), 1)[:, 0]
+
+    def obstacles_below(self, q: FloatArray, threshold_m: float) -> BoolArray:
+        """``(N, O)`` whether some pair with obstacle ``o`` may be within ``threshold_m`` [m] at ``q``.
+
+        :meth:`any_below` per obstacle (``O`` the obstacles given), each configuration's
+        test stopping once every obstacle has an uncertain pair.
+        """
+        return self._below(q, threshold_m, self._pairs[1], self.n_obstacles)
+
+    def _below(self, q: FloatArray, threshold_m: float, pair_group: IntArray, groups: int) -> BoolArray:
+        batch = np.ascontiguousarray(q, dtype=float)
+        out = np.empty((len(batch), groups), dtype=np.bool_)
+        groups_below(batch, float(threshold_m), out, pair_group, *self._any_arguments)
+        return out
+
+
+def _obstacle_bound(obstacle: Obstacle) -> tuple[int, FloatArray, FloatArray, float, FloatArray, float]:
+    """Kind, rotation, centre [m], radius [m], half sides (z: half length) [m] and reach [m] of a bound.
+
+    A box's radius is its half diagonal (the radius of its bounding sphere); the reach is
+    the radius of the obstacle's bounding sphere about the centre. A mesh is bounded by its
+    bounding box or by the capsule fitted to its vertices
+    (:func:`cpr_kin.bounds.capsule_fit.fitted_capsule`), whichever is smaller.
+    """
+    placement = obstacle.placement
+    rotation = np.asarray(placement.rotation, dtype=float)
+    origin = np.asarray(placement.translation, dtype=float)
+    radius = float(obstacle.radius or 0.0)
+    if obstacle.shape == "sphere":
+        return SPHERE, rotation, origin, radius, np.zeros(3), radius
+    if obstacle.shape in ("cylinder", "capsule"):
+        half_length = float(obstacle.length or 0.0) / 2
+        half = np.array([0.0, 0.0, half_length])
+        if obstacle.shape == "cylinder":
+            return CYLINDER, rotation, origin, radius, half, float(np.hypot(radius, half_length))
+        return CAPSULE, rotation, origin, radius, half, radius + half_length
+    geometry = obstacle.geometry()
+    centre, half = _local_box(geometry)  # a box, or a mesh's bounding box
+    diagonal = float(np.linalg.norm(half))
+    vertices = _vertices(geometry)
+    if vertices is not None:  # a mesh: the capsule fitted to it where that is smaller than its box
+        fitted = fitted_capsule(vertices)
+        if fitted.volume < 8.0 * float(np.prod(half)):
+            return _capsule_bound(fitted, rotation, origin)
+    return BOX, rotation, origin + rotation @ centre, diagonal, half, diagonal
+
+
+def _capsule_bound(
+    capsule: Capsule, rotation: FloatArray, origin: FloatArray
+) -> tuple[int, FloatArray, FloatArray, float, FloatArray, float]:
+    """:func:`_obstacle_bound`'s values of a capsule given in the obstacle's frame (its axis as z)."""
+    middle = capsule.ends.mean(axis=0)
+    along = capsule.ends[1] - capsule.ends[0]
+    half_length = float(np.linalg.norm(along)) / 2
+    axes = frame_about(along if half_length > 0.0 else np.array([0.0, 0.0, 1.0]))  # in the obstacle's frame
+    half = np.array([0.0, 0.0, half_length])
+    reach = capsule.radius + half_length
+    return CAPSULE, rotation @ axes, origin + rotation @ middle, capsule.radius, half, reach

@@ -1,0 +1,161 @@
+"""Cheap lower bounds of the distances between a robot's own link pairs, for many configurations.
+
+The self-collision test (:meth:`cpr_kin.collision.self_collision.SelfCollision.violated`) asks coal
+about every checked pair at every configuration; most pairs of a serial arm are far apart
+most of the time. As for obstacles (:mod:`cpr_kin.bounds.pair_bounds`), each geometry is enclosed
+in a capsule fixed to its joint (:func:`~cpr_kin.bounds.pair_bounds.bounding_capsule`), placed by
+the compiled kinematic chain; a pair's capsules are first compared by their bounding
+spheres, then by the exact distance between their segments less both radii. Both are at
+most coal's distance between the geometries, so a configuration whose every pair is bounded
+above a margin keeps it for certain, and only the others go to coal
+(:class:`cpr_kin.collision.self_screen.ScreenedSelfTest`).
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import NDArray
+
+from cpr_kin.bounds.batch_kinematics import ChainArrays, KinematicChain, place_joints
+from cpr_kin.bounds.pair_bounds import joint_capsules
+from cpr_kin.bounds.segments import segment_distance
+from cpr_kin.bounds.self_blocks import PairBlocks, blocks_below
+from cpr_kin.common.compiled import njit
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+BoolArray = NDArray[np.bool_]
+
+
+@njit
+def self_bounds(
+    q: FloatArray,
+    threshold: float,
+    out: FloatArray,
+    chain: ChainArrays,
+    capsule_joint: IntArray,
+    capsule_ends: FloatArray,
+    capsule_radius: FloatArray,
+    capsule_reach: FloatArray,
+    pair_a: IntArray,
+    pair_b: IntArray,
+) -> None:
+    """Write into ``out[n, p]`` a lower bound [m] of pair ``p``'s distance at ``q[n]``.
+
+    A pair whose bounding spheres are more than ``threshold`` apart gets that sphere bound
+    (cheaper, looser); the others the capsules' distance.
+    """
+    joints = len(chain[0])
+    rotation, translation = np.empty((joints, 3, 3)), np.empty((joints, 3))
+    world = np.empty((len(capsule_joint), 2, 3))
+    scratch = np.empty((4, 3))
+    for n in range(len(q)):
+        place_joints(q[n], chain, rotation, translation, scratch)
+        for c in range(len(capsule_joint)):
+            j = capsule_joint[c]
+            for e in range(2):
+                for r in range(3):
+                    if j < 0:
+                        world[c, e, r] = capsule_ends[c, e, r]
+                    else:
+                        world[c, e, r] = (
+                            translation[j, r]
+                            + rotation[j, r, 0] * capsule_ends[c, e, 0]
+                            + rotation[j, r, 1] * capsule_ends[c, e, 1]
+                            + rotation[j, r, 2] * capsule_ends[c, e, 2]
+                        )
+        for k in range(len(pair_a)):
+            a, b = pair_a[k], pair_b[k]
+            x = 0.5 * (world[a, 0, 0] + world[a, 1, 0] - world[b, 0, 0] - world[b, 1, 0])
+            y = 0.5 * (world[a, 0, 1] + world[a, 1, 1] - world[b, 0, 1] - world[b, 1, 1])
+            z = 0.5 * (world[a, 0, 2] + world[a, 1, 2] - world[b, 0, 2] - world[b, 1, 2])
+            spheres = np.sqrt(x * x + y * y + z * z) - capsule_reach[a] - capsule_reach[b]
+            if spheres > threshold:
+                out[n, k] = spheres
+            else:
+                out[n, k] = segment_distance(world[a], world[b]) - capsule_radius[a] - capsule_radius[b]
+
+
+class SelfPairBounds:
+    """Lower bounds of a robot's own pair distances, for batches of configurations.
+
+    Args:
+        model: the robot's Pinocchio model (one-degree-of-freedom joints).
+        collision_model: the robot's Pinocchio geometry model.
+        pairs: ``(geometry index, geometry index)`` per output column.
+    """
+
+    def __init__(self, model: Any, collision_model: Any, pairs: Sequence[tuple[int, int]]) -> None:
+        self._chain = KinematicChain.from_model(model)
+        geometries = sorted({g for pair in pairs for g in pair})
+        slot = {g: k for k, g in enumerate(geometries)}
+        self._capsules = joint_capsules(collision_model, geometries)
+        self._slot_pairs = [(slot[a], slot[b]) for a, b in pairs]  # capsule slots
+        self._arguments: tuple[Any, ...] = (
+            self._chain.arrays,
+            *self._capsules,
+            np.array([a for a, _ in self._slot_pairs], dtype=np.int64),
+            np.array([b for _, b in self._slot_pairs], dtype=np.int64),
+        )
+        self.n_pairs = len(pairs)
+
+    @functools.cached_property
+    def _blocks(self) -> tuple[Any, ...]:
+        """:func:`~cpr_kin.bounds.self_blocks.blocks_below`'s capsules and blocks, built on the first call."""
+        return (tuple(self._capsules), PairBlocks.build(self._capsules, self._slot_pairs).arrays)
+
+    def __call__(self, q: FloatArray, threshold_m: float = np.inf) -> FloatArray:
+        """``(N, P)`` lower bounds [m] of each pair's distance at configurations ``q`` ``(N, nq)``.
+
+        Pairs whose bounding spheres are more than ``threshold_m`` apart get the spheres'
+        bound; the others (all, by default) the capsules'.
+        """
+        batch = np.ascontiguousarray(np.atleast_2d(q), dtype=float)
+        out = np.empty((len(batch), self.n_pairs))
+        self_bounds(batch, float(threshold_m), out, *self._arguments)
+        return out
+
+    def column(self, q: FloatArray, pair: int) -> FloatArray:
+        """``(N,)`` the capsules' lower bound [m] of the distance of pair ``pair`` (a column) alone."""
+        batch = np.ascontiguousarray(np.atleast_2d(q), dtype=float)
+        out = np.empty((len(batch), 1))
+        chain, joint, ends, radius, reach, pair_a, pair_b = self._arguments
+        one = slice(pair, pair + 1)
+        self_bounds(batch, np.inf, out, chain, joint, ends, radius, reach, pair_a[one], pair_b[one])
+        return out[:, 0]
+
+    def any_below(self, q: FloatArray, threshold_m: float) -> BoolArray:
+        """``(N,)`` whether some pair may be within ``threshold_m`` [m] at configurations ``q``.
+
+        Whether some column of ``self(q, threshold_m)`` is at most ``threshold_m``, found by
+        blocks of pairs (:mod:`cpr_kin.bounds.self_blocks`).
+        """
+        batch = np.ascontiguousarray(np.atleast_2d(q), dtype=float)
+        out = np.empty(len(batch), dtype=bool)
+        blocks_below(batch, float(threshold_m), out, self._chain.arrays, *self._blocks)
+        return out
+
+
+def bounded_pairs(
+    model: Any, collision_model: Any, pairs: Sequence[tuple[int, int]], q: FloatArray, at_most_m: float
+) -> tuple[list[tuple[int, int]], Any]:
+    """The ``pairs`` bounded by at most ``at_most_m`` [m] at every configuration ``q``, and their model.
+
+    The bound is their capsules'; a pair bounded above it somewhere is certainly farther
+    there, and coal decides the others, in the copy of ``collision_model`` returned, holding
+    them as its only collision pairs, in order.
+    """
+    bounds = SelfPairBounds(model, collision_model, pairs)(q)
+    candidates = [
+        pair for pair, below in zip(pairs, np.all(bounds <= at_most_m, axis=0), strict=True) if below
+    ]
+    geometry_model = collision_model.copy()
+    geometry_model.removeAllCollisionPairs()
+    for a, b in candidates:
+        geometry_model.addCollisionPair(pin.CollisionPair(a, b))
+    return candidates, geometry_model

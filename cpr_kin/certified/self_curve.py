@@ -1,0 +1,243 @@
+"""The certified self-collision check of a curve, pair by pair, each at its own relative speed.
+
+The joints that carry both geometries of a pair move them together and leave their distance
+as it is; only a joint that carries one and not the other changes it, at most as fast as
+that geometry's points turn about the joint's axis (its *motion radius* about the joint,
+:class:`cpr_kin.bounds.reach.GeometryReach`). So pair ``p``'s distance changes at most as fast as
+``sum_j R_pj |q'_j|`` (:func:`cpr_kin.bounds.reach.relative_radii`): a forearm and the wrist two
+joints down the
+chain, always a centimetre apart, move against each other many times slower than the hand
+moves in the world. Each pair is sampled at its own rate, every ``2 step_m`` of its relative
+motion, and between its samples ``k`` and ``k + 1`` its distance is at least
+``(c_k + c_{k+1} - slack_k) / 2``, at most ``step_m`` below the smaller sample, as in the
+obstacle check (:func:`cpr_kin.check_curve`).
+
+The pairs are first screened by their capsules
+(:meth:`cpr_kin.collision.self_collision.SelfCollision.bounds`) on one coarser grid, and visited from
+the lowest bound the screen gives; a pair that cannot lower the minima found so far is
+skipped, and within a pair coal computes only the samples that decide
+(:func:`cpr_kin.collision.decisive.undecided`). The minima reported are those of computing every
+sample of every pair.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from cpr_kin.collision.decisive import below_coal, certified, exact_below, undecided, with_neighbours
+from cpr_kin.common.errors import CprKinError
+
+if TYPE_CHECKING:
+    from cpr_kin.collision.self_collision import SelfCollision
+
+FloatArray = NDArray[np.float64]
+
+JointSpeeds = Callable[[FloatArray], FloatArray]
+"""Sample times ``(K,)`` [s] -> ``(K - 1, nj)`` bounds on ``|q'_j|`` over each interval between
+them [rad/s, m/s] (e.g. :meth:`~planning.curves.trajectory.Trajectory.speed_bounds`)."""
+
+MAX_SELF_CHECKS = 200_000
+"""Most samples the certified self-collision check of a curve takes of one pair."""
+COARSE_STRIDE = 8
+"""Of a pair's samples its capsules leave in doubt, every this many are computed first."""
+SCREEN_STRIDE = 8
+"""The screen's grid is this many times coarser than the fastest pair's samples."""
+
+
+@dataclass(frozen=True)
+class SelfCheck:
+    """Result of :func:`check_self_curve`.
+
+    Attributes:
+        accepted: the certified self-clearance is at least the margin everywhere.
+        margin_m: the self-clearance required [m].
+        checks: samples taken, summed over the pairs (each pair at its own rate).
+        computed: those whose distance coal computed, the others bounded.
+        certified_min_m: lower bound of the self-clearance over the whole curve [m]
+            (``inf`` without pairs).
+        worst_time: instant of the smallest sampled self-clearance [s].
+        worst_pair: the geometry pair closest then, or ``None``.
+    """
+
+    accepted: bool
+    margin_m: float
+    checks: int
+    computed: int
+    certified_min_m: float
+    worst_time: float
+    worst_pair: tuple[str, str] | None
+
+
+@dataclass(frozen=True)
+class _PairSamples:
+    """One pair's samples: index, times ``(K,)`` [s], configurations, slack per interval [m], bounds [m]."""
+
+    index: int
+    times: FloatArray
+    q: FloatArray
+    slack: FloatArray
+    bounds: FloatArray
+
+    @property
+    def certified_bound(self) -> float:
+        """The lowest certified value the capsule bounds allow [m]."""
+        return float(np.min(certified(self.bounds, self.slack)))
+
+
+def check_self_curve(
+    collision: SelfCollision,
+    curve: Callable[[FloatArray], FloatArray],
+    interval: tuple[float, float],
+    joint_speed: ArrayLike,
+    margin_m: float,
+    step_m: float,
+    interval_joint_speed: JointSpeeds | None = None,
+) -> SelfCheck:
+    """Certify that the curve ``q(t)`` over ``interval`` keeps ``margin_m`` between the robot's own pairs.
+
+    Args:
+        collision: the robot's pairs.
+        curve: vectorised ``q(t)``: times ``(K,)`` [s] -> configurations ``(K, nq)``.
+        interval: ``(t0, t1)`` [s].
+        joint_speed: ``(nj,)`` bounds on ``|q'_j|`` over the interval [rad/s, m/s].
+        margin_m: the self-clearance required [m].
+        step_m: largest relative motion of a pair between two of its samples [m].
+        interval_joint_speed: tighter bounds per interval between samples
+            (:data:`JointSpeeds`); each interval's slack uses the lower of both.
+
+    Raises:
+        CprKinError: bad arguments, or a pair needing more than :data:`MAX_SELF_CHECKS` samples.
+    """
+    t0, t1 = interval
+    if not collision:
+        return SelfCheck(True, float(margin_m), 0, 0, np.inf, t0, None)
+    speed = np.asarray(joint_speed, dtype=float)
+    radii = collision.pair_radii
+    if speed.shape != radii.shape[1:] or not np.all(np.isfinite(speed) & (speed >= 0)):
+        raise CprKinError(f"joint speed bound {speed.tolist()} must be {radii.shape[1]} finite numbers >= 0")
+    if not (np.isfinite(step_m) and step_m > 0):
+        raise CprKinError(f"motion step {step_m} m must be a finite number > 0")
+    pair_speed = radii @ speed  # [m/s]
+    counts = np.maximum(np.ceil((t1 - t0) * pair_speed / (2.0 * step_m)).astype(np.int64) + 1, 2)
+    if counts.max() > MAX_SELF_CHECKS:
+        p = int(np.argmax(counts))
+        raise CprKinError(
+            f"the self-collision check of {collision.pairs[p]} needs {counts[p]} samples ({t1 - t0:.4g} s "
+            f"of motion at up to {pair_speed[p]:.3g} m/s, step {step_m:g} m); at most {MAX_SELF_CHECKS}: "
+            "use a larger step"
+        )
+
+    def sampled(p: int, count: int) -> _PairSamples:
+        times = np.linspace(t0, t1, count)
+        return _samples(collision, p, curve, times, pair_speed[p], interval_joint_speed)
+
+    screen = _screen(collision, curve, (t0, t1), pair_speed, step_m, interval_joint_speed)
+    certified_min, sampled_min, worst_time, worst_pair, computed = np.inf, np.inf, t0, -1, 0
+    for p in np.argsort(screen, kind="stable"):
+        # the screen bounds the pair's distance everywhere, its samples' certified value to step_m less
+        if screen[p] - step_m >= certified_min and screen[p] >= sampled_min:
+            continue  # neither minimum can come from this pair
+        pair = sampled(int(p), int(counts[p]))
+        if pair.certified_bound >= certified_min and pair.bounds.min() >= sampled_min:
+            continue
+        ceiling = exact_below(margin_m, pair.slack)
+        values, known = _decisive_values(collision, pair, certified_min, sampled_min, ceiling)
+        computed += int(known.sum())
+        certified_min = min(certified_min, float(np.min(certified(values, pair.slack))))
+        lowest = int(np.argmin(values))
+        if known[lowest] and values[lowest] < sampled_min:
+            sampled_min, worst_time, worst_pair = float(values[lowest]), float(pair.times[lowest]), pair.index
+    return SelfCheck(
+        accepted=bool(certified_min >= margin_m),
+        margin_m=float(margin_m),
+        checks=int(counts.sum()),
+        computed=computed,
+        certified_min_m=certified_min,
+        worst_time=worst_time,
+        worst_pair=collision.pairs[worst_pair] if worst_pair >= 0 else None,
+    )
+
+
+def _screen(
+    collision: SelfCollision,
+    curve: Callable[[FloatArray], FloatArray],
+    interval: tuple[float, float],
+    pair_speed: FloatArray,
+    step_m: float,
+    interval_joint_speed: JointSpeeds | None,
+) -> FloatArray:
+    """``(P,)`` lower bounds [m] of each pair's distance over the whole curve, from its capsules.
+
+    One grid for every pair, every ``2 SCREEN_STRIDE step_m`` of the fastest pair's relative
+    motion; each pair's bound is its smallest ``(b_k + b_{k+1} - slack_k) / 2``.
+    """
+    t0, t1 = interval
+    count = max(int(np.ceil((t1 - t0) * pair_speed.max() / (2.0 * SCREEN_STRIDE * step_m))) + 1, 2)
+    times = np.linspace(t0, t1, count)
+    speed = np.broadcast_to(pair_speed, (count - 1, len(pair_speed)))
+    if interval_joint_speed is not None:
+        speed = np.minimum(speed, interval_joint_speed(times) @ collision.pair_radii.T)
+    bounds = below_coal(collision.bounds(curve(times)))
+    return np.asarray(np.min(certified(bounds, speed * np.diff(times)[:, None]), axis=0))
+
+
+def _samples(
+    collision: SelfCollision,
+    index: int,
+    curve: Callable[[FloatArray], FloatArray],
+    times: FloatArray,
+    speed: float,
+    interval_joint_speed: JointSpeeds | None,
+) -> _PairSamples:
+    """Pair ``index``'s samples at ``times``: configurations, slack, capsule bounds.
+
+    The slack of an interval is its duration times ``speed`` [m/s] or the interval's own
+    bound, the lower.
+    """
+    q = np.asarray(curve(times), dtype=float)
+    interval_speed = np.full(len(times) - 1, speed)
+    if interval_joint_speed is not None:
+        interval_speed = np.minimum(interval_speed, interval_joint_speed(times) @ collision.pair_radii[index])
+    slack = interval_speed * np.diff(times)
+    bounds = below_coal(collision.pair_bounds(q, index))  # at most coal's distance
+    return _PairSamples(index, times, q, slack, bounds)
+
+
+def _decisive_values(
+    collision: SelfCollision,
+    pair: _PairSamples,
+    certified_ceiling: float,
+    sampled_ceiling: float,
+    exact_below_m: float = np.inf,
+) -> tuple[FloatArray, NDArray[np.bool_]]:
+    """The pair's distances [m] at its samples, exact where they decide, else lower bounds; which are exact.
+
+    Decide: could lower the pair's smallest certified or sampled value below the ceilings
+    (the check's minima so far) [m]. The capsules' bounds and the exact values' neighbours
+    (distances change by at most the slack per interval) bound the others. A value counts as
+    exact where the hulls' distance is at or above ``exact_below_m`` [m]: the meshes' distance is
+    no smaller, and the check cannot fail there.
+    """
+    count = len(pair.times)
+    values, known = pair.bounds.copy(), np.zeros(count, dtype=bool)
+    reach = np.concatenate([[0.0], np.cumsum(pair.slack)])
+    doubtful = np.zeros(count, dtype=bool)
+    low = certified(values, pair.slack) < certified_ceiling
+    doubtful[:-1] |= low
+    doubtful[1:] |= low
+    coarse = np.zeros(count, dtype=bool)
+    coarse[::COARSE_STRIDE] = True
+    coarse[-1] = True
+    rows = np.flatnonzero(doubtful & coarse)
+    while rows.size:
+        values[rows] = collision.pair_distances(pair.q[rows], pair.index, exact_below_m)
+        known[rows] = True
+        values = with_neighbours(values, known, pair.bounds, reach)
+        needed = undecided(values[:, None], known[:, None], pair.slack, certified_ceiling, sampled_ceiling)
+        rows = np.flatnonzero(needed[:, 0])
+    return values, known

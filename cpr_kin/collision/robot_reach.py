@@ -1,0 +1,95 @@
+"""A robot's reach bounds (:mod:`cpr_kin.bounds.reach`), once per robot, and its least distances to obstacles.
+
+The least distance of each robot geometry and obstacle pair over every configuration bounds
+what a world's margin test needs to ask of that pair.
+"""
+
+from __future__ import annotations
+
+import weakref
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from cpr_kin.bounds.reach import GeometryReach, geometry_reach
+
+if TYPE_CHECKING:
+    from cpr_kin.model.robot import Robot
+    from cpr_kin.shapes.obstacles import Obstacle
+
+FloatArray = NDArray[np.float64]
+
+
+_ROBOT_REACH: weakref.WeakKeyDictionary[Robot, tuple[GeometryReach, ...]] = weakref.WeakKeyDictionary()
+
+
+def robot_reach(robot: Robot) -> tuple[GeometryReach, ...]:
+    """:func:`geometry_reach` of ``robot``'s collision geometries within its joint ranges.
+
+    Computed once per robot (a few milliseconds, asked for by every problem built, edge
+    checked and trajectory verified); a :class:`~cpr_kin.Robot` does not change.
+    """
+    if robot not in _ROBOT_REACH:
+        limits = robot.limits
+        reach = geometry_reach(robot.model, robot.collision_model, limits.lower, limits.upper)
+        _ROBOT_REACH[robot] = tuple(reach)
+    return _ROBOT_REACH[robot]
+
+
+_ROBOT_SWEPT: weakref.WeakKeyDictionary[Robot, tuple[tuple[tuple[Any, Any], ...], ...]] = (
+    weakref.WeakKeyDictionary()
+)
+
+
+def _robot_swept(robot: Robot) -> tuple[tuple[tuple[Any, Any], ...], ...]:
+    """Per robot geometry (``robot.geometries``' order), its swept capsules as coal shapes, placed.
+
+    Built once per robot, as :func:`robot_reach`: every problem's world asks for them.
+    """
+    import coal
+    import pinocchio as pin
+
+    if robot not in _ROBOT_SWEPT:
+        reach, swept = robot_reach(robot), []
+        for geometry in robot.geometries:
+            placed = []
+            for hull in reach[geometry.index].hulls:
+                centre, axis, half, radius = hull.capsule()
+                rotation = pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), axis).matrix()
+                placed.append((coal.Capsule(radius, 2 * half), coal.Transform3s(rotation, centre)))
+            swept.append(tuple(placed))
+        _ROBOT_SWEPT[robot] = tuple(swept)
+    return _ROBOT_SWEPT[robot]
+
+
+def pair_reach_distances(
+    robot: Robot, obstacles: Sequence[Obstacle], pairs: Sequence[tuple[int, int]]
+) -> FloatArray:
+    """Per ``(geometry index, obstacle index)`` pair, a lower bound of its distance in any configuration [m].
+
+    Each robot geometry stays inside a capsule around the first joint's axis
+    (:func:`geometry_reach`); the distance from that capsule to the obstacle, by coal,
+    bounds the pair's distance from below, whatever the joints do.
+    """
+    import coal
+
+    swept = _robot_swept(robot)
+    placed = {
+        k: (
+            obstacles[k].geometry(),
+            coal.Transform3s(obstacles[k].placement.rotation, obstacles[k].placement.translation),
+        )
+        for k in {k for _, k in pairs}
+    }
+    request, distances = coal.DistanceRequest(), []
+    for g, k in pairs:
+        shape, placement = placed[k]
+        bound = -np.inf  # every hull gives a lower bound: keep the largest
+        for capsule, transform in swept[g]:
+            result = coal.DistanceResult()
+            coal.distance(capsule, transform, shape, placement, request, result)
+            bound = max(bound, result.min_distance)
+        distances.append(bound)
+    return np.array(distances)

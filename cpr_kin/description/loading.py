@@ -1,0 +1,300 @@
+"""Any serial robot from its URDF: :class:`RobotSpec` says what to load, :func:`load_robot` loads it.
+
+Loading, in order:
+
+1. the URDF is read as strict XML, validated by yourdfpy (but a preset's bundled file, which
+   the tests validate), and checked for what the planner supports (:mod:`cpr_kin.description.supported`);
+2. its mesh paths (``package://NAME/...``, relative, absolute) are resolved
+   (:mod:`cpr_kin.model.packages`) and its ``continuous`` joints bounded
+   (:func:`~cpr_kin.description.urdf_file.prepared_xml`);
+3. Pinocchio builds the kinematic, collision and visual models (what its URDF parser prints
+   stays off the terminal);
+4. the joints that are not planned are held: at the value given in ``held``, a ``mimic``
+   joint at ``multiplier x leader + offset`` of its (held) leader, any other at 0 clipped into
+   its range; Pinocchio's reduced model keeps the planned joints only;
+5. velocity limits come from the URDF, acceleration and jerk limits from the limits file
+   (given, or found beside the URDF, :func:`~cpr_kin.model.limits.find_limits_file`), the
+   documented defaults where it gives none (:func:`~cpr_kin.model.limits.default_limits`, listed in
+   :attr:`Robot.limits_defaulted`);
+6. every mesh of the collision model becomes its convex hull, which contains it (a clearance
+   to the hull is at most the clearance to the mesh: safe) and gives coal signed distances;
+   where a hull reaches beyond its mesh by more than a millimetre, the mesh is kept and decides
+   wherever the hull comes within a margin (:mod:`cpr_kin.shapes.exact_meshes`);
+7. the collision geometries form two groups: ``effector`` (the links given, by default those
+   the last planned joint before the tool frame moves alone, or the nearest joint above it
+   whose links have collision geometry) and ``links`` (the rest).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+from lxml import etree
+
+from cpr_kin.bounds.close_pairs import close_pairs
+from cpr_kin.bounds.overlapping_pairs import overlapping_pairs
+from cpr_kin.collision.self_collision import SrdfPairs, find_srdf, read_srdf, self_pairs
+from cpr_kin.common.errors import UrdfError
+from cpr_kin.description.resources import makers_limits_path
+from cpr_kin.description.robot_options import check_not_one_name, check_options, check_tcp
+from cpr_kin.description.supported import check_limits, checked_urdf
+from cpr_kin.description.urdf_file import (
+    collision_names,
+    massless_links,
+    prepared_xml,
+)
+from cpr_kin.description.urdf_models import VisualModel, build_models, convex_hulls
+from cpr_kin.model.arm import ArmChain, arm_chain, default_joints
+from cpr_kin.model.geometry_groups import carried_alone, grouped_geometries
+from cpr_kin.model.limits import LIMITS_NAMES, JointLimits, find_limits_file, read_dynamic_limits
+from cpr_kin.model.packages import package_roots
+from cpr_kin.model.robot import PositionIk, Robot, joint_units
+from cpr_kin.shapes.exact_meshes import exact_meshes
+
+
+@dataclass(frozen=True)
+class RobotSpec:
+    """What robot to load, from which files; hashable (a batch worker loads each spec once).
+
+    Attributes:
+        urdf: the URDF file.
+        srdf: its SRDF, whose ``disable_collisions`` the self-collision checks leave out;
+            default: found by :func:`~cpr_kin.collision.self_collision.find_srdf` (``<urdf name>.srdf``
+            or ``<robot name>.srdf`` beside the URDF or in ``robot_description/srdf/``).
+        package_dirs: folders that hold the packages its ``package://`` meshes name.
+        limits: its acceleration and jerk limits file; default: found beside the URDF by
+            ``limits_names``, else ``default_limits``, else a maker's file shipped for the
+            URDF's robot name (:func:`cpr_kin.description.resources.makers_limits_path`), else the
+            documented defaults.
+        joints: the planned joints, in configuration order; default: those from the root
+            to ``tcp`` when it is named, else the arm's (:func:`arm_chain`: from the root
+            until the tree branches, as a hand into its fingers), but mimic joints. The
+            others are held.
+        tcp: the tool-centre-point frame (a link or joint name); default: ``tcp`` if the URDF
+            has one, else the arm's tool link (:func:`arm_chain`).
+        held: ``(joint, value)`` pairs of held joints [rad or m].
+        effector_links: links of the ``effector`` collision group; default: module docstring.
+        wrist_joints: joints a plan holds unless its start and goal differ in them (and a
+            ``tcp`` goal at 0 unless it names them).
+        position_ik: a preset's IK of a tool position (:class:`~cpr_kin.model.robot.PositionIk`).
+        limits_names: the limits file names looked for beside the URDF.
+        default_limits: the limits file used when none is found beside the URDF.
+        default_srdf: the SRDF used when none is given or found (a preset's).
+        validate: validate the URDF with yourdfpy (a preset skips its own bundled file).
+    """
+
+    urdf: Path
+    srdf: Path | None = None
+    package_dirs: tuple[Path, ...] = ()
+    limits: Path | None = None
+    joints: tuple[str, ...] | None = None
+    tcp: str | None = None
+    held: tuple[tuple[str, float], ...] = ()
+    effector_links: tuple[str, ...] | None = None
+    wrist_joints: tuple[str, ...] = ()
+    position_ik: PositionIk | None = None
+    limits_names: tuple[str, ...] = LIMITS_NAMES
+    default_limits: Path | None = None
+    default_srdf: Path | None = None
+    validate: bool = field(default=True, compare=False)
+
+    def __post_init__(self) -> None:
+        check_options(self)
+
+    def load(self) -> Robot:
+        """The robot (module docstring)."""
+        path = Path(self.urdf)
+        tree = checked_urdf(path, self.validate)
+        xml = prepared_xml(tree, path, package_roots(path, self.package_dirs))
+        arm = arm_chain(tree)
+        model, collision = build_models(xml, path)
+        check_tcp(self.tcp, model, path)
+        planned = self._planned(model, tree, path, arm)
+        held = self._held_values(model, tree, planned, path)
+        visual = VisualModel(xml, path)
+        if held:
+            lock = [model.getJointId(name) for name in held]
+            q_ref = pin.neutral(model)
+            for name, value in held.items():
+                q_ref[model.joints[model.getJointId(name)].idx_q] = value
+            model, (collision,) = pin.buildReducedModel(model, [collision], lock, q_ref)
+            visual = VisualModel(xml, path, tuple(lock), tuple(q_ref))
+        names = tuple(model.names[1:])
+        tcp = self._tcp_frame(model, arm)
+        velocity = np.array(model.velocityLimit, dtype=float)
+        known = tuple(j.get("name", "") for j in tree.getroot().findall("joint"))
+        limits_file = (
+            self.limits
+            or find_limits_file(path, self.default_limits, self.limits_names)
+            or makers_limits_path(tree.getroot().get("name", ""), known)
+        )
+        dynamic = read_dynamic_limits(limits_file, names, velocity, known, path)
+        if dynamic.velocity is not None:  # the file's, where the URDF gives none
+            velocity = dynamic.velocity
+            model.velocityLimit = velocity
+        limits = JointLimits(
+            names=names,
+            lower=np.array(model.lowerPositionLimit, dtype=float),
+            upper=np.array(model.upperPositionLimit, dtype=float),
+            velocity=velocity,
+            acceleration=dynamic.acceleration,
+            jerk=dynamic.jerk,
+            effort=np.array(model.effortLimit, dtype=float),
+        )
+        check_limits(limits, joint_units(model), path)
+        meshes = convex_hulls(collision)
+        srdf = self.srdf or find_srdf(path, tree.getroot().get("name")) or self.default_srdf
+        links = {f.name for f in model.frames}
+        srdf_pairs = read_srdf(srdf, links) if srdf is not None else SrdfPairs(frozenset())
+        effector = (
+            set(self.effector_links)
+            if self.effector_links is not None
+            else carried_alone(model, collision, tcp)
+        )
+        geometries = grouped_geometries(model, collision, collision_names(tree), effector, path)
+        checked = self_pairs(model, collision, srdf_pairs.disabled)
+        overlapping = overlapping_pairs(model, collision, checked)
+        kept = tuple(pair for pair in checked if pair not in overlapping)
+        return Robot(
+            urdf_path=path,
+            model=model,
+            collision_model=collision,
+            build_visual_model=visual,
+            limits=limits,
+            geometries=geometries,
+            _data=model.createData(),
+            tcp_frame=tcp,
+            wrist_joints=self.wrist_joints,
+            position_ik=self.position_ik,
+            limits_path=dynamic.source,
+            limits_defaulted=dynamic.defaulted,
+            held=held,
+            srdf_path=srdf,
+            self_pairs=kept,
+            overlapping_links=tuple(
+                dict.fromkeys((geometries[a].link, geometries[b].link) for a, b in overlapping)
+            ),
+            close_pairs=close_pairs(model, collision, kept, [g.link for g in geometries]),
+            srdf_unknown_links=srdf_pairs.unknown_links,
+            massless_links=massless_links(tree, model),
+            capsule_meshes=tuple(collision.geometryObjects[m.geometry].name for m in meshes if not m.hull),
+            exact_meshes=exact_meshes(meshes),
+        )
+
+    def _planned(self, model: Any, tree: etree._ElementTree, path: Path, arm: ArmChain) -> tuple[str, ...]:
+        """The planned joints, checked against the URDF's."""
+        names = tuple(model.names[1:])
+        mimics = {j.get("name") for j in tree.getroot().findall("joint") if j.find("mimic") is not None}
+        if self.joints is None:
+            return default_joints(model, arm, self.tcp, mimics, path)
+        unknown = [j for j in self.joints if j not in names]
+        _refuse_fixed(tree, unknown, "joints", names, path)
+        if unknown:
+            raise UrdfError(f"URDF '{path}' has no joint(s) {unknown}; its joints are {list(names)}")
+        order = [j for j in names if j in self.joints]
+        if tuple(order) != tuple(self.joints) or len(set(self.joints)) != len(self.joints):
+            raise UrdfError(
+                f"URDF '{path}': joints = {list(self.joints)}; give each once, in the URDF's "
+                f"chain order {order}"
+            )
+        planned_mimics = sorted(mimics & set(self.joints))
+        if planned_mimics:
+            raise UrdfError(f"URDF '{path}': joint(s) {planned_mimics} mimic another; they cannot be planned")
+        return tuple(self.joints)
+
+    def _held_values(
+        self, model: Any, tree: etree._ElementTree, planned: tuple[str, ...], path: Path
+    ) -> dict[str, float]:
+        """The value of each held joint [rad or m], checked against its range."""
+        given = dict(self.held)
+        names = tuple(model.names[1:])
+        unknown = sorted(set(given) - set(names))
+        _refuse_fixed(tree, unknown, "held", names, path)
+        if unknown or set(given) & set(planned):
+            problem = (
+                f"no joint(s) {unknown}"
+                if unknown
+                else f"planned joint(s) {sorted(set(given) & set(planned))}"
+            )
+            raise UrdfError(f"URDF '{path}': held names {problem}; hold joints of {list(names)} not planned")
+        mimic = {
+            j.get("name"): j.find("mimic")
+            for j in tree.getroot().findall("joint")
+            if j.find("mimic") is not None
+        }
+        values: dict[str, float] = {}
+        for name in (n for n in names if n not in planned):
+            i = model.joints[model.getJointId(name)].idx_q
+            low, high = float(model.lowerPositionLimit[i]), float(model.upperPositionLimit[i])
+            value = float(given.get(name, np.clip(0.0, low, high)))
+            leader = mimic[name].get("joint", "") if name in mimic else ""
+            if name in mimic and (name not in given or leader in names):
+                if leader not in names:
+                    raise UrdfError(
+                        f"URDF '{path}': joint '{name}' mimics joint '{leader}', which the URDF does not "
+                        f"have; name one of its joints in the <mimic>, or hold '{name}' (held={{...}})"
+                    )
+                if leader in planned:
+                    raise UrdfError(f"URDF '{path}': joint '{name}' mimics planned joint '{leader}'")
+                multiplier = float(mimic[name].get("multiplier", "1"))
+                offset = float(mimic[name].get("offset", "0"))
+                lead = given.get(leader, float(np.clip(0.0, *_range(model, leader))))
+                follows = multiplier * lead + offset
+                if name in given and abs(value - follows) > 1e-9:
+                    raise UrdfError(
+                        f"URDF '{path}': held joint '{name}' = {value:g} mimics '{leader}' = {lead:g} "
+                        f"({multiplier:g} x '{leader}' + {offset:g} = {follows:g}); hold '{leader}' "
+                        f"and leave '{name}' to follow it"
+                    )
+                value = follows
+            if not low - 1e-9 <= value <= high + 1e-9:
+                raise UrdfError(
+                    f"URDF '{path}': held joint '{name}' = {value:g} is outside [{low:g}, {high:g}]"
+                )
+            values[name] = value
+        return values
+
+    def _tcp_frame(self, model: Any, arm: ArmChain) -> str:
+        """The tool-centre-point frame (attribute ``tcp``, checked by :func:`check_tcp`)."""
+        if self.tcp is not None:
+            return self.tcp
+        if model.existFrame("tcp"):
+            return "tcp"
+        return arm.tool
+
+
+def _refuse_fixed(tree: etree._ElementTree, given: list[str], key: str, names: Any, path: Path) -> None:
+    """Refuse names in ``given`` (of option ``key``) of the URDF's fixed joints, which never move."""
+    fixed = sorted(set(given) & {j.get("name") for j in tree.getroot().findall("joint")})
+    if fixed:
+        raise UrdfError(
+            f"URDF '{path}': {key} names fixed joint(s) {fixed}; its movable joints: {list(names)}"
+        )
+
+
+def _range(model: Any, joint: str) -> tuple[float, float]:  # a joint's position range [rad or m]
+    i = model.joints[model.getJointId(joint)].idx_q
+    return float(model.lowerPositionLimit[i]), float(model.upperPositionLimit[i])
+
+
+def load_robot(urdf_path: str | Path, **options: Any) -> Robot:
+    """Load the robot of ``urdf_path``: ``RobotSpec(urdf_path, **options).load()``.
+
+    Raises:
+        UrdfError: a missing, malformed or unsupported URDF, a mesh not found, an unknown
+            planned or held joint, a limits file that does not fit.
+    """
+    for key in (k for k in ("srdf", "limits", "default_limits") if options.get(k) is not None):
+        options[key] = Path(options[key])
+    for key in ("package_dirs", "joints", "effector_links", "wrist_joints", "limits_names"):
+        check_not_one_name(key, options.get(key))
+        if key in options and options[key] is not None:
+            options[key] = tuple(options[key])
+    if isinstance(options.get("held"), Mapping):
+        options["held"] = tuple(options["held"].items())
+    return RobotSpec(Path(urdf_path), **options).load()

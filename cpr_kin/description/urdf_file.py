@@ -1,0 +1,195 @@
+"""Reading a URDF file: strict, bounded XML, and yourdfpy's structural validation.
+
+Pinocchio builds the models from the file (:meth:`cpr_kin.Robot.load`); this module makes
+sure first that the file is one: a regular file of bounded size, well-formed XML parsed
+without entity expansion or network access, and (for a user's URDF) a structure yourdfpy
+accepts, so that a broken file gets a message naming the problem.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import copy
+import math
+import os
+import sys
+import tempfile
+import warnings
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+from lxml import etree
+
+from cpr_kin.common.errors import UrdfError
+from cpr_kin.model.packages import resolve_mesh
+
+MAX_URDF_BYTES = 10_000_000
+"""Largest URDF file [bytes] (the CPR's takes 6 kB)."""
+
+
+def parse_urdf(path: Path) -> etree._ElementTree:
+    """Parse ``path`` as strict XML; raise :class:`UrdfError` if it is missing or malformed.
+
+    Entities are not expanded and nothing is fetched from the network: a URDF that defines
+    entities (an "XML bomb", or a reference to a local file) is parsed as written.
+    """
+    if not path.exists():
+        raise UrdfError(f"URDF file '{path}' does not exist; pass the path of a .urdf file")
+    if not path.is_file():
+        raise UrdfError(f"URDF file '{path}' is not a regular file (a folder or a device)")
+    if path.stat().st_size > MAX_URDF_BYTES:
+        raise UrdfError(f"URDF file '{path}' has {path.stat().st_size} bytes; at most {MAX_URDF_BYTES}")
+    parser = etree.XMLParser(recover=False, resolve_entities=False, no_network=True, huge_tree=False)
+    try:
+        tree = etree.parse(str(path), parser)
+    except etree.XMLSyntaxError as exc:
+        message = str(exc) if len(str(exc)) <= 120 else str(exc)[:117] + "..."
+        raise UrdfError(f"URDF file '{path}' is not well-formed XML: {message}") from None
+    root = tree.getroot()  # a named robot with links, or the parsers' complaints name neither file nor fix
+    if root.tag != "robot":
+        raise UrdfError(
+            f"URDF file '{path}' has root element <{root.tag}>; a URDF's root is <robot name=...>"
+        )
+    if root.find("link") is None and root.find("group") is not None:
+        raise UrdfError(
+            f"URDF file '{path}' holds <group>s and no <link>: it is an SRDF; give the robot's URDF"
+        )
+    if root.find("link") is None:
+        raise UrdfError(
+            f"URDF file '{path}' has no <link>: an empty robot; a URDF "
+            "written by xacro without its arguments can be (run xacro with them)"
+        )
+    if not root.get("name"):
+        raise UrdfError(
+            f"URDF file '{path}': <robot> has no name attribute; the URDF specification requires one"
+        )
+    return tree
+
+
+SPEC_OPTIONAL = frozenset(
+    f"Tag <limit> of joint is missing attribute '{bound}'." for bound in ("lower", "upper")
+)
+"""yourdfpy's complaints about what the URDF specification makes optional: a revolute or
+prismatic joint's ``lower`` and ``upper`` default to 0 (as urdfdom, Pinocchio's parser, reads
+them); a planned joint with such a range is refused by its own check, naming the joint."""
+
+
+def validate_urdf(path: Path) -> None:
+    """Validate the URDF at ``path`` with yourdfpy; raise :class:`UrdfError` naming the problems.
+
+    yourdfpy is imported here, not with the package: it imports trimesh, about 0.7 s, which
+    a process that loads only the bundled (tested) URDF need not pay.
+    """
+    import yourdfpy
+
+    try:
+        with warnings.catch_warnings():  # trimesh's arithmetic on a value that is then refused, by name
+            warnings.simplefilter("ignore", RuntimeWarning)
+            urdf = yourdfpy.URDF.load(
+                str(path), build_scene_graph=False, load_meshes=False, load_collision_meshes=False
+            )
+    except Exception as exc:  # yourdfpy raises bare exceptions on structural problems
+        raise UrdfError(f"URDF file '{path}' cannot be read ({type(exc).__name__}: {exc})") from None
+    found: list[Any] = []
+
+    def keep(errors: list[Any]) -> bool:
+        found.extend(e for e in errors if getattr(e, "msg", None) not in SPEC_OPTIONAL)
+        return not found
+
+    if not urdf.validate(keep):
+        problems = "; ".join(str(e) for e in found)
+        raise UrdfError(f"URDF file '{path}' is invalid: {problems}")
+
+
+@contextlib.contextmanager
+def captured_stderr() -> Iterator[list[str]]:
+    """Capture what native code writes to the process's standard error (file descriptor 2).
+
+    Pinocchio's URDF parser (urdfdom) prints its complaints there, e.g. "Error: Material
+    [grey] color has no rgba", about details the planner does not use. Within the context
+    they go to a temporary file instead of the user's terminal; the yielded list holds its
+    lines once the context ends, for a caller that wants to report them in its own words.
+    """
+    lines: list[str] = []
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile() as sink:
+        os.dup2(sink.fileno(), 2)
+        try:
+            yield lines
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            sink.seek(0)
+            lines.extend(sink.read(10_000).decode("utf-8", errors="replace").splitlines())
+
+
+def collision_names(tree: etree._ElementTree) -> dict[str, list[str]]:
+    """Collision element names per link, as written in the URDF (or ``link`` / ``link_i`` if unnamed)."""
+    names: dict[str, list[str]] = {}
+    for link in tree.getroot().findall("link"):
+        collisions = link.findall("collision")
+        link_name = link.get("name", "")
+        names[link_name] = [
+            c.get("name") or (link_name if len(collisions) == 1 else f"{link_name}_{i}")
+            for i, c in enumerate(collisions)
+        ]
+    return names
+
+
+CONTINUOUS_RANGE_RAD = math.pi
+"""The range a ``continuous`` joint is planned within: ``[-pi, pi]`` rad, one turn. A
+continuous joint turns without end; a plan between two poses never needs more than a turn
+of it, and a bounded range keeps the search's box and the trajectories bounded."""
+
+
+def prepared_xml(tree: etree._ElementTree, path: Path, roots: Sequence[Path]) -> str:
+    """The URDF's text as the models are built from it.
+
+    Every ``continuous`` joint becomes a ``revolute`` one within
+    :data:`CONTINUOUS_RANGE_RAD` (its velocity and effort kept; where the URDF gives none, as
+    its specification allows for a continuous joint, they are 0: unknown, so that a planned
+    joint without a velocity limit is refused by name at load, naming the two places to give
+    one, while a joint the planner only holds, such as a mobile base's caster wheel, loads),
+    and every mesh file name is made absolute (:func:`cpr_kin.model.packages.resolve_mesh`), so
+    that a missing mesh is named before Pinocchio reads anything.
+
+    Raises:
+        UrdfError: a mesh not found.
+    """
+    root = copy.deepcopy(tree.getroot())
+    for joint in root.findall("joint"):
+        if joint.get("type") != "continuous":
+            continue
+        joint.set("type", "revolute")
+        limit = joint.find("limit")
+        if limit is None:
+            limit = etree.SubElement(joint, "limit")
+        for unknown in ("velocity", "effort"):
+            if limit.get(unknown) is None:
+                limit.set(unknown, "0")
+        limit.set("lower", repr(-CONTINUOUS_RANGE_RAD))
+        limit.set("upper", repr(CONTINUOUS_RANGE_RAD))
+    for mesh in root.iter("mesh"):
+        filename = mesh.get("filename")
+        if filename:
+            mesh.set("filename", str(resolve_mesh(filename, path, roots)))
+    return str(etree.tostring(root, encoding="unicode"))
+
+
+def massless_links(tree: etree._ElementTree, model: Any) -> tuple[str, ...]:
+    """Links that a planned joint of ``model`` moves which have a shape but no ``<inertial>``."""
+    import pinocchio as pin  # the model is Pinocchio's; reading a URDF alone needs none
+
+    links = tree.getroot().findall("link")
+    weighed = {link.get("name") for link in links if link.find("inertial") is not None}
+    shaped = {
+        link.get("name")
+        for link in links
+        if link.find("collision") is not None or link.find("visual") is not None
+    }
+    moved = {
+        frame.name for frame in model.frames if frame.type == pin.FrameType.BODY and frame.parentJoint > 0
+    }
+    return tuple(sorted((moved & shaped) - weighed))

@@ -1,0 +1,126 @@
+"""Pinocchio's models of a prepared URDF: kinematic and collision now, the visual one on first use.
+
+Every mesh of the collision model becomes its convex hull (:func:`convex_hulls`), which
+contains it: a clearance to the hull is at most the clearance to the mesh (safe), and coal
+gives signed distances between convex shapes. A hull coal cannot hold becomes the mesh's
+bounding capsule, which contains it as well. The meshes are kept: where a shape reaches far
+beyond its mesh, the mesh decides (:mod:`cpr_kin.shapes.exact_meshes`).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import coal
+import numpy as np
+import pinocchio as pin
+from lxml import etree
+
+from cpr_kin.bounds.capsule_fit import frame_about
+from cpr_kin.bounds.pair_bounds import bounding_capsule
+from cpr_kin.common.errors import UrdfError
+from cpr_kin.description.urdf_file import captured_stderr
+from cpr_kin.shapes.exact_meshes import MeshSource
+
+
+def build_models(xml: str, path: Path, kind: Any = pin.GeometryType.COLLISION) -> tuple[Any, Any]:
+    """Pinocchio's kinematic model and the ``kind`` geometry model of the prepared URDF text."""
+    try:
+        with captured_stderr() as complaints:  # urdfdom prints to fd 2; a model that builds needs none
+            model = pin.buildModelFromXML(xml)
+            geometry = pin.buildGeomFromUrdfString(model, xml, kind)
+    except Exception as exc:  # Pinocchio reports C++ exceptions as RuntimeError/ValueError
+        unread = re.search(r"Could not load resource (.+?)\s*(?:\n|$)", str(exc))
+        if unread is not None:  # coal's loader names its own source file; the link is what helps
+            raise UrdfError(_unreadable_mesh(xml, path, unread.group(1))) from None
+        said = " ".join(line.strip() for line in complaints[:2])
+        raise UrdfError(f"Pinocchio cannot build a model from '{path}': {exc} {said}".strip()) from None
+    return model, geometry
+
+
+def _unreadable_mesh(xml: str, path: Path, mesh: str) -> str:
+    """The message for a mesh file coal (assimp) cannot read: the link, the file, the formats."""
+    root = etree.fromstring(xml.encode(), etree.XMLParser(resolve_entities=False, no_network=True))
+    links = [
+        link.get("name", "")
+        for link in root.findall("link")
+        if any(m.get("filename") == mesh for m in link.iter("mesh"))
+    ]
+    named = f"link '{links[0]}': " if links else ""
+    return (
+        f"URDF '{path}': {named}mesh '{mesh}' is not a mesh file coal can read "
+        "(STL, OBJ, DAE, PLY, ... as assimp reads them); give a mesh file, or fix its path"
+    )
+
+
+@dataclass(frozen=True)
+class VisualModel:
+    """Builds the visual geometry model of a prepared URDF, with the held joints locked as loaded.
+
+    Attributes:
+        xml: the prepared URDF text (mesh paths resolved).
+        path: the URDF file, for messages.
+        locked: Pinocchio ids of the held joints in the full model.
+        q_ref: the full model's configuration the held joints are locked at.
+    """
+
+    xml: str
+    path: Path
+    locked: tuple[int, ...] = ()
+    q_ref: tuple[float, ...] = ()
+
+    def __call__(self) -> Any:
+        """The visual geometry model, reduced to the planned joints."""
+        model, visual = build_models(self.xml, self.path, pin.GeometryType.VISUAL)
+        if self.locked:
+            _, (visual,) = pin.buildReducedModel(model, [visual], list(self.locked), np.array(self.q_ref))
+        return visual
+
+
+def convex_hulls(collision: Any) -> tuple[MeshSource, ...]:
+    """Replace every mesh of ``collision`` by its convex hull (module docstring).
+
+    coal's convex shapes give a vertex at most 255 neighbours. A hull whose triangles put
+    more around a vertex (a fine fan, as Centauro's pelvis has: 566) is built of polygons
+    instead (qhull's merged facets, the same hull); one whose polygons still do (a cone's
+    apex) is replaced by the mesh's bounding capsule
+    (:func:`cpr_kin.bounds.pair_bounds.bounding_capsule`), which contains it too.
+
+    Returns:
+        Each replaced mesh (:class:`~cpr_kin.shapes.exact_meshes.MeshSource`), in geometry order;
+        ``hull`` false where a capsule replaced it.
+    """
+    sources = []
+    for index, obj in enumerate(collision.geometryObjects):
+        geometry = obj.geometry
+        if not isinstance(geometry, coal.BVHModelBase):
+            continue
+        scale = tuple(float(s) for s in obj.meshScale)
+        for keep_triangles, qhull_options in ((True, "Qt"), (False, "Qx")):
+            try:
+                geometry.buildConvexHull(keep_triangles, qhull_options)
+            except RuntimeError:  # "Too many neighbors."
+                continue
+            obj.geometry = geometry.convex
+            sources.append(MeshSource(index, geometry, pin.SE3.Identity(), obj.meshPath, scale))
+            break
+        else:
+            obj.geometry, in_geometry = _capsule(geometry)
+            obj.placement = obj.placement * in_geometry
+            sources.append(
+                MeshSource(index, geometry, in_geometry.inverse(), obj.meshPath, scale, hull=False)
+            )
+    return tuple(sources)
+
+
+def _capsule(mesh: Any) -> tuple[Any, Any]:
+    """The bounding capsule of ``mesh`` (a coal shape) and its placement in the mesh's frame."""
+    ends, radius = bounding_capsule(mesh)
+    axis = ends[1] - ends[0]
+    length = float(np.linalg.norm(axis))
+    rotation = frame_about(axis) if length > 0.0 else np.eye(3)
+    shape = coal.Capsule(radius, length) if length > 0.0 else coal.Sphere(radius)
+    return shape, pin.SE3(rotation, ends.mean(axis=0))

@@ -1,0 +1,87 @@
+"""A robot carrying its payload's collision shape: an attached object, checked like the robot's own links.
+
+:func:`carrying` returns a new :class:`~cpr_kin.Robot` whose collision model (and visual
+model, for the viewer) holds the payload's shape attached to its frame, in the ``effector``
+group: every clearance query, the certified checks (its motion radii included) and the
+self-collision pairs then see it. Its self pairs follow the URDF rule: against every link
+but those on its own joint and the joint next to it (the hand that holds it), and but its
+``touch_links`` (the fingers that grip it, as MoveIt's attached objects).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from cpr_kin.collision.self_collision import adjacent
+from cpr_kin.common.errors import CprKinError
+from cpr_kin.kinematics.dynamics import PAYLOAD_NAME, Payload
+from cpr_kin.model.robot import Robot, RobotGeometry
+from cpr_kin.shapes.obstacles import Obstacle
+
+PAYLOAD_GEOMETRY = PAYLOAD_NAME
+"""Name of the payload's collision geometry unless the payload has a name of its own."""
+PAYLOAD_COLOR = np.array([0.9, 0.6, 0.1, 0.8])
+"""RGBA colour of the payload's shape in the viewer."""
+
+
+def carrying(robot: Robot, payload: Payload | None) -> Robot:
+    """``robot`` with ``payload``'s collision shape on its frame; ``robot`` itself without one.
+
+    A mesh shape is its convex hull, as the robot's own link meshes are.
+
+    Raises:
+        CprKinError: the payload's frame, or a link it may touch, is not the robot's.
+    """
+    if payload is None or payload.shape is None:
+        return robot
+    frame_id = robot.frame_id(payload.frame or robot.tcp_frame)
+    links = {f.name for f in robot.model.frames if f.type == pin.FrameType.BODY}
+    unknown = sorted(set(payload.touch_links) - links)
+    if unknown:
+        raise CprKinError(
+            f"payload touch_links {unknown} are not links of the robot; its links with shapes: "
+            f"{sorted({g.link for g in robot.geometries})}"
+        )
+    collision = robot.collision_model.copy()
+    shape = (
+        payload.shape if payload.shape.shape != "mesh" else dataclasses.replace(payload.shape, convex=True)
+    )
+    index = collision.addGeometryObject(_shape_object(robot, shape, payload.name, frame_id))
+    joint = robot.model.frames[frame_id].parentJoint
+    objects = collision.geometryObjects
+    pairs = [
+        (g.index, index)
+        for g in robot.geometries
+        if not adjacent(robot.model, objects[g.index].parentJoint, joint)
+        and g.link not in payload.touch_links
+    ]
+    build_visual = robot.build_visual_model
+
+    def visual_model() -> Any:
+        visual = build_visual().copy()
+        visual.addGeometryObject(_shape_object(robot, shape, payload.name, frame_id))
+        return visual
+
+    link = robot.model.frames[frame_id].name
+    return dataclasses.replace(
+        robot,
+        collision_model=collision,
+        build_visual_model=visual_model,
+        geometries=(*robot.geometries, RobotGeometry(payload.name, link, "effector", index)),
+        _data=robot.model.createData(),
+        self_pairs=tuple(sorted((*robot.self_pairs, *pairs))),
+    )
+
+
+def _shape_object(robot: Robot, shape: Obstacle, name: str, frame_id: int) -> Any:
+    """``shape`` (placed in frame ``frame_id``) as a ``GeometryObject`` ``name`` on the frame's joint."""
+    frame = robot.model.frames[frame_id]
+    found = pin.GeometryObject(
+        name, frame.parentJoint, frame_id, frame.placement * shape.placement, shape.geometry()
+    )
+    found.meshColor = PAYLOAD_COLOR
+    return found

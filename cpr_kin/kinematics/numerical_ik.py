@@ -1,0 +1,256 @@
+"""Inverse kinematics of any robot: damped least squares on Pinocchio's Jacobians, verified by FK.
+
+:func:`solve_ik` puts the tool frame at a position, or at a pose (position and orientation),
+within a tolerance. From the seed configuration first, then from seeded random ones
+(``restarts``), it iterates ``dq = J^T (J J^T + lambda^2 I)^-1 e`` on the frame's error ``e``
+(the position difference; for a pose, also the rotation's logarithm, in the world-aligned
+frame), each step at most ``max_step`` [rad or m] per joint and clipped into the joint
+ranges. Every solution is checked by forward kinematics against the target and its
+tolerance; of those that pass, the ones the ``accept`` test allows (collision-free, say) come
+first, then the one nearest the seed (in robot motion, ``sum_j R_j |dq_j|``). A target that
+no start reaches is an :class:`~cpr_kin.common.errors.IkMissError` naming the closest the solver
+came.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import ArrayLike, NDArray
+
+from cpr_kin.certified.motion import path_weights
+from cpr_kin.common.errors import CprKinError, IkMissError
+from cpr_kin.model.robot import Robot, joint_units
+
+FloatArray = NDArray[np.float64]
+
+
+PROGRESS = 0.05
+"""The relative decrease of a start's least error that counts as progress (:attr:`IkSettings.patience`)."""
+
+
+@dataclass(frozen=True)
+class IkSettings:
+    """How :func:`solve_ik` searches.
+
+    Attributes:
+        restarts: random starts after the seed.
+        iterations: steps per start.
+        damping: ``lambda`` of the damped least squares [m or rad].
+        max_step: largest change of a joint per step [rad or m].
+        seed: seed of the random starts.
+        choices: solutions found (that ``accept`` allows) before the nearest is chosen.
+        patience: steps in a row that leave a start's least error (:meth:`IkTarget.excess`)
+            not :data:`PROGRESS` smaller that end that start: it is stuck (at a joint limit,
+            or circling), and a converging start steps far faster (``docs/tuning.md``).
+        more_restarts: random starts after those when none of them found a solution that
+            ``accept`` allows: near the edge of the workspace some branches of an arm's
+            solutions fall short of a pose, and every start may have descended into those
+            (``docs/tuning.md``).
+    """
+
+    restarts: int = 30
+    iterations: int = 150
+    damping: float = 1e-3
+    max_step: float = 0.3
+    seed: int = 0
+    choices: int = 4
+    patience: int = 20
+    more_restarts: int = 70
+
+    def __post_init__(self) -> None:
+        counts = (("restarts", 0), ("iterations", 1), ("choices", 1), ("patience", 1), ("more_restarts", 0))
+        for name, low in counts:
+            value = getattr(self, name)
+            if not isinstance(value, int) or isinstance(value, bool) or not low <= value <= 100_000:
+                raise CprKinError(f"IkSettings.{name} = {value!r} must be an integer in [{low}, 100000]")
+        for name in ("damping", "max_step"):
+            value = getattr(self, name)
+            if not (isinstance(value, int | float) and 0 < value <= 10):
+                raise CprKinError(f"IkSettings.{name} = {value!r} must be a number in (0, 10]")
+
+
+@dataclass(frozen=True)
+class IkTarget:
+    """Where the tool frame must go.
+
+    Attributes:
+        position: ``(3,)`` position in the base frame [m].
+        rotation: ``(3, 3)`` orientation, or ``None`` for a position goal.
+        tolerance_m: largest position error accepted [m].
+        tolerance_rad: largest rotation error accepted [rad] (a pose goal).
+    """
+
+    position: FloatArray
+    rotation: FloatArray | None = None
+    tolerance_m: float = 1e-4
+    tolerance_rad: float = 1e-3
+
+    def __post_init__(self) -> None:
+        position = np.asarray(self.position, dtype=float)
+        if position.shape != (3,) or not np.all(np.isfinite(position)):
+            raise CprKinError(
+                f"IK target position {np.asarray(self.position).tolist()} must be three finite numbers [m]"
+            )
+        object.__setattr__(self, "position", position)
+        if self.rotation is not None:
+            rotation = np.asarray(self.rotation, dtype=float)
+            if rotation.shape != (3, 3) or not np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-6):
+                raise CprKinError("IK target rotation must be a 3 x 3 rotation matrix")
+            object.__setattr__(self, "rotation", rotation)
+        if not (self.tolerance_m > 0 and self.tolerance_rad > 0):
+            raise CprKinError(f"IK tolerances {self.tolerance_m} m, {self.tolerance_rad} rad must be > 0")
+
+    def errors(self, placement: pin.SE3) -> tuple[float, float]:
+        """Position [m] and rotation [rad] error of a frame placement."""
+        position = float(np.linalg.norm(placement.translation - self.position))
+        if self.rotation is None:
+            return position, 0.0
+        rotation = float(np.linalg.norm(pin.log3(self.rotation.T @ placement.rotation)))
+        return position, rotation
+
+    def reached(self, placement: pin.SE3) -> bool:
+        """Whether ``placement`` is within the tolerances."""
+        position, rotation = self.errors(placement)
+        return position <= self.tolerance_m and rotation <= self.tolerance_rad
+
+    def miss(self, placement: pin.SE3) -> str:
+        """How far ``placement`` is from the target, against the tolerances, in words."""
+        position, rotation = self.errors(placement)
+        text = f"{position:.4g} m from the position (tolerance {self.tolerance_m:g} m)"
+        if self.rotation is not None:
+            text += f", {rotation:.4g} rad from the orientation (tolerance {self.tolerance_rad:g} rad)"
+        return text
+
+    def excess(self, placement: pin.SE3) -> float:
+        """The larger of the position and rotation errors, each over its tolerance (<= 1: reached)."""
+        position, rotation = self.errors(placement)
+        return max(position / self.tolerance_m, rotation / self.tolerance_rad)
+
+
+def _descend(
+    robot: Robot, target: IkTarget, q: FloatArray, free: NDArray[np.bool_], settings: IkSettings
+) -> FloatArray:
+    """One start's damped least squares descent, moving the ``free`` joints; the configuration it ends at.
+
+    It ends where the target is reached, after ``settings.iterations`` steps, or once
+    ``settings.patience`` steps in a row have not made progress.
+    """
+    model, data, frame = robot.model, robot.data, robot.frame_id(robot.tcp_frame)
+    lower, upper = robot.limits.lower, robot.limits.upper
+    frame_type = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+    least, stuck = math.inf, 0
+    for _ in range(settings.iterations):
+        pin.framesForwardKinematics(model, data, q)
+        placement = data.oMf[frame]
+        excess = target.excess(placement)
+        if excess <= 1.0:  # reached
+            break
+        if excess < (1.0 - PROGRESS) * least:
+            least, stuck = excess, 0
+        else:
+            stuck += 1
+            if stuck >= settings.patience:
+                break
+        jacobian = pin.computeFrameJacobian(model, data, q, frame, frame_type)
+        error = target.position - placement.translation
+        if target.rotation is not None:
+            rotation_error = placement.rotation @ pin.log3(placement.rotation.T @ target.rotation)
+            error = np.concatenate([error, rotation_error])
+        else:
+            jacobian = jacobian[:3]
+        jacobian = jacobian * free  # a held joint's column is zero: it does not move
+        system = jacobian @ jacobian.T + settings.damping**2 * np.eye(len(error))
+        step = jacobian.T @ np.linalg.solve(system, error)
+        step = np.clip(step, -settings.max_step, settings.max_step)
+        q = np.clip(q + step, lower, upper)
+    return q
+
+
+def tool_reach_m(robot: Robot) -> float:
+    """An upper bound of the tool frame's distance from the model's origin, in any configuration [m].
+
+    The offsets along the chain from the origin to the tool frame, added up (a joint turns an
+    offset, never lengthens it), plus each prismatic joint's largest travel.
+    """
+    model = robot.model
+    frame = model.frames[robot.frame_id(robot.tcp_frame)]
+    units = joint_units(model)
+    reach = float(np.linalg.norm(frame.placement.translation))
+    joint = frame.parentJoint
+    while joint > 0:
+        reach += float(np.linalg.norm(model.jointPlacements[joint].translation))
+        if units[joint - 1] == "m":  # prismatic
+            index = model.joints[joint].idx_q
+            reach += float(max(abs(model.lowerPositionLimit[index]), abs(model.upperPositionLimit[index])))
+        joint = model.parents[joint]
+    return reach
+
+
+def solve_ik(
+    robot: Robot,
+    target: IkTarget,
+    seed_q: ArrayLike | None = None,
+    accept: Callable[[FloatArray], bool] | None = None,
+    settings: IkSettings | None = None,
+    held: Sequence[str] = (),
+) -> FloatArray:
+    """A configuration that puts the robot's tool frame at ``target`` (module docstring).
+
+    Args:
+        robot: the robot.
+        target: the position or pose, with its tolerance.
+        seed_q: the configuration to start from and stay near; default: mid-range.
+        accept: a test a preferred solution passes (e.g. clear of obstacles).
+        settings: the search's parameters.
+        held: joints kept at their ``seed_q`` values (the joints a ``tcp`` goal holds).
+
+    Raises:
+        IkMissError: the target lies beyond :func:`tool_reach_m`, or no start reaches it
+            within its tolerance.
+        JointLimitError: ``held`` names a joint the robot does not plan.
+    """
+    settings = settings or IkSettings()
+    missed = f"no configuration puts frame '{robot.tcp_frame}' at {np.round(target.position, 4).tolist()} m"
+    distance, reach = float(np.linalg.norm(target.position)), tool_reach_m(robot)
+    if distance > reach + target.tolerance_m:  # no start can reach it: say so at once
+        raise IkMissError(
+            f"{missed}: it lies {distance:.4g} m from the robot's base, "
+            f"beyond the {reach:.4g} m its links reach"
+        )
+    lower, upper = robot.limits.lower, robot.limits.upper
+    seed = (lower + upper) / 2 if seed_q is None else np.clip(np.asarray(seed_q, dtype=float), lower, upper)
+    free = np.ones(robot.nq, dtype=bool)
+    free[[robot.limits.index(name) for name in held]] = False
+    rng = np.random.default_rng(settings.seed)
+    found: list[FloatArray] = []
+    accepted: list[FloatArray] = []  # ``accept`` asked once per solution
+    closest: pin.SE3 | None = None
+    frame = robot.frame_id(robot.tcp_frame)
+    draws = [seed, *rng.uniform(lower, upper, (settings.restarts, robot.nq))]
+    tried = 0
+    while tried < len(draws):
+        start = np.where(free, draws[tried], seed)
+        tried += 1
+        q = _descend(robot, target, start, free, settings)
+        pin.framesForwardKinematics(robot.model, robot.data, q)
+        placement = pin.SE3(robot.data.oMf[frame])
+        if closest is None or target.excess(placement) < target.excess(closest):
+            closest = placement
+        if target.reached(placement):  # verified by forward kinematics
+            found.append(q)
+            if accept is None or accept(q):
+                accepted.append(q)
+                if len(accepted) >= settings.choices:
+                    break
+        if tried == settings.restarts + 1 and not accepted:  # then more, drawn only now
+            draws += list(rng.uniform(lower, upper, (settings.more_restarts, robot.nq)))
+    if not found:
+        assert closest is not None  # the seed is always tried
+        raise IkMissError(f"{missed}: the closest of {tried} IK starts came {target.miss(closest)}")
+    weights = path_weights(robot)
+    return min(accepted or found, key=lambda q: float(weights @ np.abs(q - seed)))

@@ -1,0 +1,245 @@
+"""The exact triangle meshes of a robot's concave links, kept beside the convex shapes that bound them.
+
+Every link mesh is checked as its convex hull (:func:`cpr_kin.description.urdf_models.convex_hulls`): it
+contains the mesh, so what it accepts is clear, and coal measures it fast. A concave link's hull
+fills its hollows (a UR forearm's by 40 mm) and refuses what the robot can do. Where a hull
+reaches beyond its mesh by more than :data:`REFINED_ABOVE_M`, the hull is kept as a bound only
+and the mesh decides wherever the hull comes within a margin (:mod:`cpr_kin.shapes.exact_pairs`);
+elsewhere the hull is the model, within that much of the mesh.
+
+A hull's excess (how far it reaches beyond the mesh) is sampled: the largest distance to the
+mesh's triangles (coal's) of :data:`EXCESS_SAMPLES` points drawn by area on the hull's surface
+(seeded). It is computed once per mesh file and scale and kept on disk
+(:mod:`cpr_kin.common.disk_cache`). The sampled largest is below the true one by at most about the
+samples' spacing; an excess taken too small only makes a margin test refuse where the mesh
+might have passed (:mod:`cpr_kin.shapes.exact_pairs`), never accept what the mesh does not.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import coal
+import numpy as np
+from numpy.typing import NDArray
+
+from cpr_kin.common.compiled import njit
+from cpr_kin.common.disk_cache import cached_array, cached_json
+
+FloatArray = NDArray[np.float64]
+
+REFINED_ABOVE_M = 1e-3
+"""A hull reaching beyond its mesh by more than this [m] is a bound, and the mesh decides."""
+EXCESS_SAMPLES = 2_000
+"""Points drawn on a hull's surface to measure its excess when a robot is loaded."""
+MAX_PIECES = 64
+"""A mesh of more connected pieces than this is not tested for holding another shape (module
+:mod:`cpr_kin.shapes.exact_pairs`): where its hull is penetrated, the hull decides."""
+
+
+@dataclass(frozen=True)
+class MeshSource:
+    """A link mesh that :func:`~cpr_kin.description.urdf_models.convex_hulls` replaced by a convex shape.
+
+    Attributes:
+        geometry: the geometry's index in the collision model.
+        bvh: coal's triangle model of the mesh (a ``BVHModelOBBRSS``), in the mesh's frame.
+        mesh_in_shape: the mesh's frame in the replacing shape's frame (identity for a hull;
+            a bounding capsule is placed at the mesh's axis).
+        path: the mesh file, with ``scale``, what the excess is cached by.
+        hull: the shape is the mesh's convex hull (else its bounding capsule, whose excess is
+            not measured: the mesh always decides).
+    """
+
+    geometry: int
+    bvh: Any
+    mesh_in_shape: Any
+    path: str
+    scale: tuple[float, ...]
+    hull: bool = True
+
+
+@dataclass(frozen=True)
+class ExactMesh:
+    """A link mesh that decides where its bounding shape comes within a margin.
+
+    Attributes:
+        geometry: its geometry's index in the robot's collision model.
+        bvh: coal's triangle model, in the mesh's frame.
+        mesh_in_shape: the mesh's frame in its geometry's (the bounding shape's) frame.
+        excess_m: how far the bounding shape reaches beyond the mesh [m], sampled: a distance
+            to the shape is about at most this much below the distance to the mesh (``inf``:
+            not measured).
+        triangles: ``(F, 3, 3)`` the mesh's triangles' corners, in the mesh's frame [m].
+        piece_points: ``(K, 3)`` a vertex of each connected piece of the mesh [m], ``None``
+            for more than :data:`MAX_PIECES` pieces.
+        hull_planes: ``(H, 4)`` the facets of the mesh's convex hull, ``n . x + d <= 0`` inside
+            (unit ``n``, ``d`` [m]).
+    """
+
+    geometry: int
+    bvh: Any = field(repr=False)
+    mesh_in_shape: Any = field(repr=False)
+    excess_m: float
+    triangles: FloatArray = field(repr=False)
+    piece_points: FloatArray | None = field(repr=False)
+    hull_planes: FloatArray = field(repr=False)
+
+    def holds(self, points_in_mesh: FloatArray) -> NDArray[np.bool_]:
+        """``(M,)`` which of ``points_in_mesh`` ``(M, 3)`` [m] lie inside the mesh.
+
+        By the generalised winding number (the solid angle the triangles subtend, Jacobson et
+        al. 2013): about 1 inside a closed surface, 0 outside, whichever way it is oriented;
+        a point counts as inside above one half, which tolerates small holes. A point outside
+        the mesh's convex hull (its facets' planes) is outside without it.
+        """
+        points = np.ascontiguousarray(points_in_mesh, dtype=float)
+        in_hull = np.all(points @ self.hull_planes[:, :3].T + self.hull_planes[:, 3] <= 1e-9, axis=1)
+        inside = np.zeros(len(points), dtype=bool)
+        if in_hull.any():
+            inside[in_hull] = np.abs(_winding_numbers(self.triangles, points[in_hull])) > 0.5
+        return inside
+
+
+@njit
+def _winding_numbers(triangles: FloatArray, points: FloatArray) -> FloatArray:
+    """``(M,)`` the winding number of the triangles ``(F, 3, 3)`` about each of ``points`` ``(M, 3)``.
+
+    Van Oosterom and Strackee's solid angle of each triangle, summed over 4 pi.
+    """
+    found = np.zeros(points.shape[0])
+    for m in range(points.shape[0]):
+        total = 0.0
+        for f in range(triangles.shape[0]):
+            ax, ay, az = (
+                triangles[f, 0, 0] - points[m, 0],
+                triangles[f, 0, 1] - points[m, 1],
+                triangles[f, 0, 2] - points[m, 2],
+            )
+            bx, by, bz = (
+                triangles[f, 1, 0] - points[m, 0],
+                triangles[f, 1, 1] - points[m, 1],
+                triangles[f, 1, 2] - points[m, 2],
+            )
+            cx, cy, cz = (
+                triangles[f, 2, 0] - points[m, 0],
+                triangles[f, 2, 1] - points[m, 1],
+                triangles[f, 2, 2] - points[m, 2],
+            )
+            la = math.sqrt(ax * ax + ay * ay + az * az)
+            lb = math.sqrt(bx * bx + by * by + bz * bz)
+            lc = math.sqrt(cx * cx + cy * cy + cz * cz)
+            det = ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx)
+            den = (
+                la * lb * lc
+                + (ax * bx + ay * by + az * bz) * lc
+                + (bx * cx + by * cy + bz * cz) * la
+                + (cx * ax + cy * ay + cz * az) * lb
+            )
+            total += math.atan2(det, den)
+        found[m] = total / (2.0 * math.pi)
+    return found
+
+
+def exact_meshes(sources: Sequence[MeshSource], samples: int = EXCESS_SAMPLES) -> dict[int, ExactMesh]:
+    """The meshes of ``sources`` their shapes exceed by more than :data:`REFINED_ABOVE_M`, by geometry."""
+    found = {}
+    for source in sources:
+        excess = hull_excess(source, samples)["excess_m"] if source.hull else math.inf
+        if excess > REFINED_ABOVE_M:
+            triangles, pieces, corners = _triangles(source)
+            found[source.geometry] = ExactMesh(
+                source.geometry,
+                source.bvh,
+                source.mesh_in_shape,
+                excess,
+                triangles,
+                pieces,
+                hull_planes(corners),
+            )
+    return found
+
+
+def hull_excess(source: MeshSource, samples: int = EXCESS_SAMPLES, seed: int = 0) -> dict[str, float]:
+    """How far the convex hull of ``source``'s mesh reaches beyond it, sampled (module docstring).
+
+    Returns:
+        ``excess_m``: the largest distance of a sampled hull point from the mesh [m];
+        ``spacing_m``: the side of a square of the hull's area over ``samples`` [m], about how
+        far below the true largest that may be.
+    """
+    digest = hashlib.sha256(_content(source, b"hull-excess-1")).hexdigest()
+
+    def compute() -> dict[str, float]:
+        import trimesh  # only a first load of a mesh needs it
+
+        vertices = np.asarray(source.bvh.vertices(), dtype=float)
+        hull = trimesh.Trimesh(vertices=vertices).convex_hull
+        on_hull = trimesh.sample.sample_surface(hull, samples, seed=seed)[0]
+        request, point, identity = coal.DistanceRequest(), coal.Sphere(1e-12), coal.Transform3s()
+        largest = max(
+            coal.distance(
+                source.bvh, identity, point, coal.Transform3s(np.eye(3), p), request, coal.DistanceResult()
+            )
+            for p in on_hull
+        )
+        spacing = math.sqrt(float(hull.area) / samples)
+        excess = max(0.0, float(largest))
+        return {"excess_m": excess, "spacing_m": spacing}
+
+    return cached_json("hull-excess", f"{digest}-{samples}-{seed}", compute)
+
+
+def _content(source: MeshSource, what: bytes) -> bytes:
+    """What a mesh's value ``what`` depends on: its file's bytes (its vertices where unreadable), scale."""
+    try:
+        body = Path(source.path).read_bytes()
+    except OSError:
+        body = np.asarray(source.bvh.vertices(), dtype=float).tobytes()
+    return body + np.asarray(source.scale, dtype=float).tobytes() + what
+
+
+def _triangles(source: MeshSource) -> tuple[FloatArray, FloatArray | None, FloatArray]:
+    """The mesh's triangles' corners ``(F, 3, 3)``, a vertex of each connected piece (``None``: too many).
+
+    And the vertices of its triangles ``(V, 3)``, each once. The triangles' vertex indices are
+    kept on disk by the mesh's file and vertices (coal hands them out one by one).
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    bvh = source.bvh
+    vertices = np.asarray(bvh.vertices(), dtype=float)
+
+    def indices() -> NDArray[np.int64]:
+        return np.array(
+            [[t[0], t[1], t[2]] for t in (bvh.tri_indices(i) for i in range(bvh.num_tris))], dtype=np.int64
+        ).reshape(-1, 3)
+
+    digest = hashlib.sha256(_content(source, b"faces-1") + vertices.tobytes()).hexdigest()
+    faces = cached_array("mesh-faces", f"{digest}-{bvh.num_tris}", indices)
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]]])
+    graph = coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(len(vertices),) * 2)
+    _, label = connected_components(graph, directed=False)
+    used = np.unique(faces)
+    pieces = np.unique(label[used], return_index=True)[1]
+    points = vertices[used[pieces]] if len(pieces) <= MAX_PIECES else None
+    return vertices[faces], points, vertices[used]
+
+
+def hull_planes(points: FloatArray) -> FloatArray:
+    """``(H, 4)`` the facets' planes of the convex hull of ``points`` ``(..., 3)`` (:class:`ExactMesh`)."""
+    from scipy.spatial import ConvexHull
+
+    equations: FloatArray = ConvexHull(points.reshape(-1, 3), qhull_options="Qt").equations
+    return equations
+
+
+def as_transform(placement: Any) -> Any:
+    """The ``coal.Transform3s`` of a Pinocchio placement."""
+    return coal.Transform3s(np.asarray(placement.rotation), np.asarray(placement.translation))

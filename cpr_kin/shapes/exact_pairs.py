@@ -1,0 +1,261 @@
+"""Geometry pairs measured on the robot's exact link meshes where their convex hulls are only bounds.
+
+A concave link is checked as its convex hull, and where the hull exceeds the mesh by more than
+:data:`cpr_kin.shapes.exact_meshes.REFINED_ABOVE_M` the mesh decides (:mod:`cpr_kin.shapes.exact_meshes`).
+For a pair of such a link with another shape, with ``d_h`` coal's distance of the hulls (signed)
+and ``e`` the pair's excess (its shapes' together), the meshes' distance ``d_x`` satisfies
+``d_h <= d_x <= d_h + e``. So a margin test asks the meshes only where
+``margin - e <= d_h < margin``; below that the pair is too close whatever the meshes, above it
+clear. Every cheap bound of the hulls (:mod:`cpr_kin.bounds.pair_bounds`, :mod:`cpr_kin.bounds.reach`) bounds
+the meshes too.
+
+Where the hulls are apart, coal's distance of the meshes (triangle models) is ``d_x``, and a
+margin test is coal's collision test of the meshes with the margin as security margin (its
+distance, for a margin above :data:`COLLIDE_MARGIN_UP_TO_M`). Where
+the hulls penetrate, the meshes may be apart: coal says so then, unless one holds the other
+whole without their surfaces meeting, which is tested by winding number
+(:meth:`cpr_kin.shapes.exact_meshes.ExactMesh.holds`): a point of the other shape (of a primitive or
+convex shape, one; of a mesh, a vertex of every piece) inside the mesh. Where that cannot be
+told (an obstacle of voxels or loose triangles, a mesh of many pieces), or the meshes meet, the
+hulls' (negative) distance stands: the meshes' depth is not measured.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import coal
+import numpy as np
+import pinocchio as pin
+from numpy.typing import NDArray
+
+from cpr_kin.shapes.exact_meshes import ExactMesh, as_transform
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+BoolArray = NDArray[np.bool_]
+
+COLLIDE_MARGIN_UP_TO_M = 0.01
+"""The largest margin [m] coal's collision test is asked with; a larger one goes to its distance
+(:meth:`ExactPairs.closer_than`)."""
+
+
+class ExactPairs:
+    """The collision pairs of a geometry model, with the exact meshes of some of its geometries.
+
+    Args:
+        geometry_model: a geometry model whose first geometries are the robot's, pairs added.
+        meshes: the robot's exact meshes by geometry index (:attr:`cpr_kin.Robot.exact_meshes`).
+
+    Attributes:
+        excess_m: ``(P,)`` per collision pair, how far its distance on the shapes may be below
+            its distance on the meshes [m] (0 where no mesh refines it).
+        refined: ``(P,)`` the pairs with an exact mesh.
+    """
+
+    def __init__(self, geometry_model: Any, meshes: Mapping[int, ExactMesh]) -> None:
+        objects = geometry_model.geometryObjects
+        self._pairs = [(int(p.first), int(p.second)) for p in geometry_model.collisionPairs]
+        self._meshes = dict(meshes)
+        self._shapes = [obj.geometry for obj in objects]
+        self._inner = (
+            [_inner_points(obj.geometry, self._meshes.get(g)) for g, obj in enumerate(objects)]
+            if meshes
+            else []
+        )
+        excess = {g: mesh.excess_m for g, mesh in self._meshes.items()}
+        self.excess_m = np.array([excess.get(a, 0.0) + excess.get(b, 0.0) for a, b in self._pairs])
+        self.refined = np.array([a in excess or b in excess for a, b in self._pairs], dtype=bool)
+        self._request = coal.DistanceRequest()
+        self._collision = coal.CollisionRequest()
+        self._collision.enable_contact = False
+
+    def __bool__(self) -> bool:
+        return bool(self.refined.any())
+
+    def may_be_closest(self, hull_m: FloatArray, group: NDArray[np.int64]) -> BoolArray:
+        """``(P,)`` the refined pairs whose mesh distance may be the smallest of their ``group``.
+
+        ``hull_m`` ``(P,)`` the pairs' hull distances [m]: a pair's mesh distance is at most its
+        hull distance plus its excess, so one whose hull distance is above that for another
+        pair of its group cannot be the group's closest.
+        """
+        ceiling = np.full(len(hull_m), np.inf)
+        for g in np.unique(group):
+            members = group == g
+            ceiling[members] = np.min(hull_m[members] + self.excess_m[members])
+        return np.asarray(self.refined & (hull_m < ceiling))
+
+    def distance(self, geometry_data: Any, pair: int, hull_m: float) -> float:
+        """Pair ``pair``'s distance [m] on the meshes, placed in ``geometry_data``, hulls ``hull_m`` apart."""
+        found = self.measured(geometry_data, pair, hull_m)
+        return hull_m if found is None else max(float(found.min_distance), hull_m)
+
+    def settled(
+        self, geometry_data: Any, pair: int, hull_m: float, ceiling_m: float, below_m: float
+    ) -> float:
+        """Pair ``pair``'s distance [m] as a search for the closest pair needs it, its hulls ``hull_m`` apart.
+
+        Exact on the meshes where it is below ``ceiling_m`` and ``below_m`` is infinite; at least
+        ``ceiling_m`` where the meshes are that far apart (coal's collision test); where
+        ``below_m`` is finite and the meshes are nearer than it, the hulls' distance (the
+        pair is below it; its depth is not measured). The cheapest query that answers.
+        """
+        finite = np.isfinite(below_m)
+        if finite and hull_m + self.excess_m[pair] < below_m:
+            return hull_m  # the meshes cannot reach below_m: below it for sure
+        if np.isfinite(ceiling_m):  # coal's test takes no negative margin: apart is at least as far
+            if not self.closer_than(geometry_data, pair, hull_m, max(ceiling_m, 0.0)):
+                return max(hull_m, ceiling_m)
+            if finite:
+                return hull_m
+        return self.distance(geometry_data, pair, hull_m)
+
+    def measured(self, geometry_data: Any, pair: int, hull_m: float) -> Any:
+        """The ``coal.DistanceResult`` of pair ``pair`` on the meshes, ``None`` where the hulls' stands.
+
+        The shapes are placed as in ``geometry_data``, ``hull_m`` apart [m] (module docstring).
+        """
+        a, b = self._pairs[pair]
+        (shape_a, at_a), (shape_b, at_b) = self._placed(geometry_data, a), self._placed(geometry_data, b)
+        result = coal.DistanceResult()
+        coal.distance(shape_a, as_transform(at_a), shape_b, as_transform(at_b), self._request, result)
+        if hull_m >= 0.0:
+            return result
+        if result.min_distance <= 0.0 or self._one_holds_other(a, at_a, b, at_b):
+            return None
+        return result
+
+    def closer_than(self, geometry_data: Any, pair: int, hull_m: float, margin_m: float) -> bool:
+        """Whether pair ``pair`` is within ``margin_m`` >= 0 [m] on its meshes, hulls ``hull_m`` apart.
+
+        coal's collision test with the margin as security margin descends into every pair of
+        bounding volumes within the margin: fast for a margin of millimetres, where it stops at
+        the first pair of triangles within it; for a margin near a link's size (dense meshes a
+        few centimetres apart), seconds. So the test takes a margin up to
+        :data:`COLLIDE_MARGIN_UP_TO_M`, and above it coal's distance decides, which prunes by the
+        nearest pair found so far.
+        """
+        a, b = self._pairs[pair]
+        (shape_a, at_a), (shape_b, at_b) = self._placed(geometry_data, a), self._placed(geometry_data, b)
+        self._collision.security_margin = min(margin_m, COLLIDE_MARGIN_UP_TO_M)
+        hit = coal.collide(
+            shape_a, as_transform(at_a), shape_b, as_transform(at_b), self._collision, coal.CollisionResult()
+        )
+        if not hit and margin_m > COLLIDE_MARGIN_UP_TO_M:
+            result = coal.DistanceResult()
+            coal.distance(shape_a, as_transform(at_a), shape_b, as_transform(at_b), self._request, result)
+            hit = result.min_distance < margin_m
+        if hit:
+            return True
+        return hull_m < 0.0 and self._one_holds_other(a, at_a, b, at_b)
+
+    def recheck(
+        self,
+        flagged: BoolArray,
+        model: Any,
+        data: Any,
+        geometry_model: Any,
+        geometry_data: Any,
+        batch: FloatArray,
+        active: IntArray,
+        margins_m: FloatArray,
+    ) -> BoolArray:
+        """``flagged`` ``(N,)``, what a margin test on the hulls flagged at ``batch``, decided again.
+
+        Where some of the ``active`` pairs has a mesh, each flagged configuration is decided by
+        :meth:`violated` (``margins_m`` ``(P,)`` per collision pair [m]); elsewhere the hulls' answer
+        stands. Updated in place and returned.
+        """
+        if flagged.any() and self.refined[active].any():
+            rows = np.flatnonzero(flagged)
+            flagged[rows] = self.violated(
+                model, data, geometry_model, geometry_data, batch[rows], active.tolist(), margins_m
+            )
+        return flagged
+
+    def violated(
+        self,
+        model: Any,
+        data: Any,
+        geometry_model: Any,
+        geometry_data: Any,
+        batch: FloatArray,
+        pairs: Sequence[int],
+        margins_m: FloatArray,
+    ) -> BoolArray:
+        """``(N,)`` whether some of ``pairs`` is closer than its margin at configurations ``batch``.
+
+        ``margins_m`` ``(P,)`` one margin per collision pair [m]. The pairs without a mesh are
+        asked first; a pair with one goes to its meshes only in its margin's band (module docstring).
+        """
+        order = sorted(pairs, key=lambda p: bool(self.refined[p]))
+        margins, excess, refined = margins_m.tolist(), self.excess_m.tolist(), self.refined.tolist()
+        every = 4 * len(order) >= len(self._pairs)  # coal on every pair in one call, for most of them
+        found = np.zeros(len(batch), dtype=bool)
+        for row, q in enumerate(batch):
+            if every:
+                pin.computeDistances(model, data, geometry_model, geometry_data, q)
+                hulls = [geometry_data.distanceResults[p].min_distance for p in order]
+            else:
+                pin.updateGeometryPlacements(model, data, geometry_model, geometry_data, q)
+                hulls = [pin.computeDistance(geometry_model, geometry_data, p).min_distance for p in order]
+            for p, hull in zip(order, hulls, strict=True):
+                if hull >= margins[p]:
+                    continue
+                if (
+                    not refined[p]
+                    or hull + excess[p] < margins[p]
+                    or self.closer_than(geometry_data, p, hull, margins[p])
+                ):
+                    found[row] = True
+                    break
+        return found
+
+    def _placed(self, geometry_data: Any, geometry: int) -> tuple[Any, Any]:
+        """The geometry's decisive shape (its mesh, if it has one) and its placement in the world."""
+        placement = geometry_data.oMg[geometry]
+        mesh = self._meshes.get(geometry)
+        if mesh is None:
+            return self._shapes[geometry], placement
+        return mesh.bvh, placement * mesh.mesh_in_shape
+
+    def _one_holds_other(self, a: int, at_a: Any, b: int, at_b: Any) -> bool:
+        """Whether ``a``'s mesh may hold ``b`` whole or ``b``'s ``a`` (:meth:`_held` both ways)."""
+        return self._held(a, at_a, b, at_b) or self._held(b, at_b, a, at_a)
+
+    def _held(self, outer: int, at_outer: Any, inner: int, at_inner: Any) -> bool:
+        """Whether ``outer``'s mesh may hold ``inner`` whole (module docstring); ``False`` if it has none.
+
+        ``at_outer`` and ``at_inner`` place their decisive shapes (:meth:`_placed`) in the world.
+        """
+        mesh = self._meshes.get(outer)
+        if mesh is None:
+            return False
+        points = self._inner[inner]
+        if points is None:
+            return True  # voxels, loose triangles, a mesh of many pieces: cannot be told
+        if not len(points):
+            return False
+        inner_in_outer = at_outer.actInv(at_inner)
+        return bool(mesh.holds(points @ inner_in_outer.rotation.T + inner_in_outer.translation).any())
+
+
+def _inner_points(shape: Any, mesh: ExactMesh | None) -> FloatArray | None:
+    """Points of a shape in its frame, one in each piece: inside an outer mesh if the shape is held whole.
+
+    An exact mesh's piece points; one point of a bounded primitive or convex shape; none of a
+    half-space or a plane (no bounded mesh holds one); ``None`` where the pieces are not known.
+    """
+    if mesh is not None:
+        return mesh.piece_points
+    if isinstance(shape, coal.ConvexBase):
+        return np.asarray([shape.point(0)], dtype=float)
+    if isinstance(shape, (coal.Halfspace, coal.Plane)):
+        return np.zeros((0, 3))
+    if isinstance(shape, coal.TriangleP):
+        return np.asarray([shape.a], dtype=float)
+    if isinstance(shape, coal.ShapeBase):
+        return np.zeros((1, 3))  # a box, sphere, cylinder, capsule, cone or ellipsoid: centred on its origin
+    return None

@@ -1,0 +1,64 @@
+"""A mesh obstacle's coal geometry, read from its file: its convex hull, or its triangle surface."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from cpr_kin.common.errors import ObstacleError
+from cpr_kin.common.names import shown
+from cpr_kin.shapes.obstacle_ranges import MAX_COORDINATE_M, MAX_MESH_VERTICES
+
+
+def mesh_geometry(path: Path, scale: float, convex: bool, name: str) -> Any:
+    """The coal geometry of mesh obstacle ``name``: its convex hull (``convex``) or its triangles.
+
+    ``path`` the mesh file, its vertices multiplied by ``scale``.
+
+    Raises:
+        ObstacleError: a file that is no mesh, has no triangles, too many vertices, vertices
+            not finite or too far, or (``convex``) no volume to make a hull of.
+    """
+    import coal
+    import trimesh  # only needed for mesh obstacles
+
+    what = f"obstacle '{name}': mesh '{Path(str(path)).name}'"
+    try:
+        mesh: Any = trimesh.load(str(path), force="mesh")
+    except Exception as exc:  # trimesh raises many types for unreadable files
+        raise ObstacleError(f"{what} cannot be read: {shown(str(exc))}") from None
+    vertices = np.asarray(getattr(mesh, "vertices", np.empty((0, 3))), dtype=np.float64)
+    faces = np.asarray(getattr(mesh, "faces", np.empty((0, 3))), dtype=np.int64)
+    if len(faces) == 0:
+        raise ObstacleError(f"{what} has no triangles")
+    if len(vertices) > MAX_MESH_VERTICES:
+        raise ObstacleError(f"{what} has {len(vertices)} vertices; at most {MAX_MESH_VERTICES}")
+    if not np.all(np.isfinite(vertices)) or np.abs(vertices * scale).max() > MAX_COORDINATE_M:
+        raise ObstacleError(f"{what} has vertices that are not finite or beyond {MAX_COORDINATE_M:g} m")
+    if convex:
+        # the hull of a flat (or line-like) mesh has no volume: Qhull refuses it
+        spread = np.linalg.svd(vertices - vertices.mean(axis=0), compute_uv=False)
+        if len(vertices) < 4 or spread[-1] <= 1e-9 * max(spread[0], 1e-300):
+            raise ObstacleError(
+                f"{what} is flat (its vertices span no volume), so it has no convex hull; "
+                "give a solid mesh, or convex: false to use its surface"
+            )
+        try:
+            hull = mesh.convex_hull
+        except Exception as exc:  # Qhull's errors for degenerate input
+            raise ObstacleError(f"{what} has no convex hull: {shown(str(exc))}") from None
+        vertices, faces = (
+            np.asarray(hull.vertices, dtype=np.float64),
+            np.asarray(hull.faces, dtype=np.int64),
+        )
+    bvh = coal.BVHModelOBBRSS()
+    bvh.beginModel(len(faces), len(vertices))
+    bvh.addVertices(vertices * scale)
+    bvh.addTriangles(faces)
+    bvh.endModel()
+    if convex:
+        bvh.buildConvexRepresentation(False)
+        return bvh.convex
+    return bvh
