@@ -37,7 +37,7 @@ def warm_up(robot: ck.Robot | None = None) -> float:
     Planning does it anyway on its first call; this moves the one-time cost (several
     seconds on a new machine, a fraction of a second per process afterwards) out of a plan
     that is timed. It plans the paper case with two fireflies for one iteration and a small
-    motion of the robot (the CPR if none is given) in its joint space, runs the search's
+    motion of the robot (the paper's, the CPR, if none is given) in its joint space, runs the search's
     duration estimates with and without the torques, and asks its collision world every
     kind of query once (:func:`_warm_own_motion`).
     """
@@ -50,7 +50,7 @@ def warm_up(robot: ck.Robot | None = None) -> float:
         expected = (NoSolutionError, PlanningError)
     with contextlib.suppress(*expected):
         plan(small, robot, threads=1)
-    _warm_own_motion(robot if robot is not None else ck.load_cpr(), small)
+    _warm_own_motion(robot if robot is not None else small.robot_spec().load(), small)
     _warm_sampling()
     return time.perf_counter() - started
 

@@ -121,7 +121,7 @@ def test_a_scene_without_a_robot_is_the_cpr_s(bench: ModuleType, tmp_path: Path)
     text = "\n".join(line for line in SHELF.read_text().splitlines() if not line.startswith("robot:"))
     (tmp_path / "shelf.yaml").write_text(text + "\n")
     scene, robot = bench._robot(str(tmp_path / "shelf.yaml"))
-    assert scene.robot is None
+    assert scene.robot == ck.cpr_spec()
     assert robot.limits.names == ck.load_cpr().limits.names
 
 

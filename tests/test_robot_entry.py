@@ -15,7 +15,7 @@ import cpr_kin as ck
 from cpr_kin.model.packages import example_robot
 from planning.errors import SceneError
 from planning.io.robot_entry import RobotMapping, robot_entry, robot_spec_of
-from planning.io.scene_file import dump_scene, load_scene, parse_scene
+from planning.io.scene_file import dump_scene, load_scene, parse_scene, scene_to_dict
 
 PANDA_START = {"q": [0.0, -0.6, 0.0, -2.2, 0.0, 1.6, 0.8]}
 PANDA_GOAL = {"pose": {"xyz": [0.45, 0.35, 0.25], "rpy": [3.14159, 0.0, 0.0]}}
@@ -183,3 +183,20 @@ def test_bad_entries_name_the_key_and_value(change: dict[str, Any], pattern: str
     with pytest.raises(SceneError) as info:
         parse_scene({"robot": "panda", "start": PANDA_START, "goal": PANDA_GOAL, **change}, source="s.yaml")
     assert pattern in str(info.value)
+
+
+def test_a_scene_without_a_robot_reads_as_the_cpr_and_is_written_without_one() -> None:
+    scene = parse_scene({"start": {"q": [0.0, 0.3, 0.3, 0.0, 0.0]}, "goal": {"q": [0.5, 0.3, 0.3, 0.0, 0.0]}})
+    assert scene.robot == ck.cpr_spec() == ck.robot_spec(ck.cpr_urdf_path())
+    assert "robot" not in scene_to_dict(scene)  # read back, the same default
+    named = parse_scene({"robot": "panda", "start": PANDA_START, "goal": PANDA_GOAL})
+    assert named.robot is not None and scene_to_dict(named)["robot"] == robot_entry(named.robot)
+
+
+def test_a_scene_made_without_a_robot_is_planned_only_with_one_given() -> None:
+    from planning import Scene, Target, plan
+    from planning.errors import PlanningError
+
+    scene = Scene(start=Target(q=(0.0, 0.3, 0.3, 0.0, 0.0)), goal=Target(q=(0.5, 0.3, 0.3, 0.0, 0.0)))
+    with pytest.raises(PlanningError, match=r"scene 'scene' names no robot: give Scene\(robot=...\)"):
+        plan(scene)

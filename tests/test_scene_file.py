@@ -48,7 +48,8 @@ def test_bundled_paper_scene_is_the_paper_case_of_the_design() -> None:
 def test_documented_defaults() -> None:
     scene = parse_scene(MINIMAL)
     assert scene.safety_margin == 0.1
-    assert scene.duration is None and scene.robot is None and scene.obstacles == ()
+    assert scene.duration is None and scene.obstacles == ()
+    assert scene.robot == ck.cpr_spec()  # no robot: the CPR preset, chosen where the file is read
     assert scene.planner == PlannerSettings()
     assert scene.spline == SplineSettings(p=1e6, a=(0.0, 0.0, 1.0), ends="rest")
     assert parse_scene({**MINIMAL, "planner": {"refine_stall": 0}}).planner.refine_stall == 0

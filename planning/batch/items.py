@@ -78,9 +78,9 @@ class BatchItem:
 
 
 @lru_cache(maxsize=8)
-def _robot(spec: ck.RobotSpec | None) -> ck.Robot:
-    """The robot, loaded once per worker process and spec (``None``: the bundled CPR)."""
-    return ck.load_cpr() if spec is None else spec.load()
+def _robot(spec: ck.RobotSpec) -> ck.Robot:
+    """The robot, loaded once per worker process and spec."""
+    return spec.load()
 
 
 class Gate(Protocol):
@@ -116,7 +116,7 @@ def plan_scene_file(path: Path, out: Path, threads: int | None = 1, gate: Gate =
     try:
         scene = load_scene(path)
         with OutputFolder(out) as folder:
-            result = plan(scene, _robot(scene.robot), threads=threads)
+            result = plan(scene, _robot(scene.robot_spec()), threads=threads)
             files = plan_files(result)
             item = BatchItem(
                 escaped(name), "ok", 0, record=plan_record(result), task_time_s=time.perf_counter() - started

@@ -182,6 +182,7 @@ def narrow_scene(
         if clearance.min() >= margin_m + 0.02:
             return Scene(
                 name=name,
+                robot=ck.robot_spec(robot.urdf_path),
                 start=start,
                 goal=goal,
                 obstacles=tuple(obstacles),

@@ -79,6 +79,7 @@ def random_scene(
         if len(placed) == count:
             return Scene(
                 name=name,
+                robot=ck.robot_spec(robot.urdf_path),
                 start=start,
                 goal=goal,
                 obstacles=tuple(placed),

@@ -56,22 +56,26 @@ def shown_robot(document: TrajectoryFile, scene: Scene, urdf: Path | None) -> ck
     """The robot to draw: ``urdf`` if given, else the robot the trajectory file records.
 
     The file's scene section records the robot entry (URDF, SRDF, meshes' folders, planned
-    joints, tool) of a robot other than the bundled CPR; the file's ``robot`` key its URDF.
+    joints, tool) of a robot other than the default (read as a scene file reads it); the
+    file's ``robot`` key the URDF that planned, which decides where the scene section names
+    none (a robot given to ``plan`` loaded).
 
     Raises:
         PlanningError: the recorded robot's files are not on this machine (and no ``urdf`` given).
     """
+    from planning.io.robot_entry import default_robot
+
     if urdf is not None:
         return ck.load_cpr() if str(urdf) == "cpr" else ck.robot_spec(urdf).load()
-    recorded = scene.robot.urdf if scene.robot is not None else Path(document.robot)
-    if str(recorded) != "cpr" and not recorded.is_file():
+    spec = scene.robot_spec()
+    if spec == default_robot() and document.robot not in ("cpr", str(spec.urdf)):
+        spec = ck.robot_spec(Path(document.robot))
+    if not Path(spec.urdf).is_file():
         raise PlanningError(
-            f"the trajectory's robot URDF '{recorded}' is not on this machine; "
+            f"the trajectory's robot URDF '{spec.urdf}' is not on this machine; "
             "pass the robot with --urdf PATH (the bundled CPR: --urdf cpr)"
         )
-    if scene.robot is not None:
-        return scene.robot.load()
-    return ck.load_cpr() if str(recorded) == "cpr" else ck.robot_spec(recorded).load()
+    return spec.load()
 
 
 def cmd_show(args: argparse.Namespace) -> int:

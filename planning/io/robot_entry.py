@@ -9,7 +9,9 @@
   ``fixed`` the values of held joints ``{joint: value}``. Paths are relative to the scene
   file.
 
-The scene holds absolute paths; :func:`robot_entry` writes a spec back in the mapping form.
+No ``robot:`` is the CPR (:func:`default_robot`): the default is chosen here, where a scene
+file is read, and a scene of that robot is written without the entry. The scene holds
+absolute paths; :func:`robot_entry` writes a spec back in the mapping form.
 """
 
 from __future__ import annotations
@@ -56,10 +58,15 @@ def _urdf(value: str, base: Path) -> Path:
     return path
 
 
-def robot_spec_of(entry: str | RobotMapping | None, base: Path) -> ck.RobotSpec | None:
-    """The :class:`cpr_kin.RobotSpec` of a ``robot:`` entry (module docstring); ``None``: the CPR."""
+def default_robot() -> ck.RobotSpec:
+    """The robot of a scene file without ``robot:``: the CPR preset (:func:`cpr_kin.cpr_spec`)."""
+    return ck.cpr_spec()
+
+
+def robot_spec_of(entry: str | RobotMapping | None, base: Path) -> ck.RobotSpec:
+    """The :class:`cpr_kin.RobotSpec` of a ``robot:`` entry (module docstring); none: the default."""
     if entry is None:
-        return None
+        return default_robot()
     if isinstance(entry, str):
         return ck.robot_spec(_urdf(entry, base))
     spec = ck.robot_spec(_urdf(entry.urdf, base))

@@ -36,7 +36,7 @@ from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError, SceneError
 from planning.io.cloud_entry import PointCloudSpec, RobotAtStart, cloud_obstacles
 from planning.io.publish import write_file
-from planning.io.robot_entry import robot_entry, robot_spec_of
+from planning.io.robot_entry import default_robot, robot_entry, robot_spec_of
 from planning.io.scene_schema import (
     BoxSpec,
     CapsuleSpec,
@@ -135,7 +135,7 @@ def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> S
 
 
 def _robot_at_start(
-    spec: SceneSpec, robot: ck.RobotSpec | None, payload: ck.Payload | None, start: Target, source: str
+    spec: SceneSpec, robot: ck.RobotSpec, payload: ck.Payload | None, start: Target, source: str
 ) -> RobotAtStart | None:
     """The robot at the start if a point cloud filters it out, else ``None`` (nothing loaded).
 
@@ -152,7 +152,7 @@ def _robot_at_start(
             f"('start: {{q: [...]}}'), where the robot stands in the cloud; the start is {given}"
         )
     try:
-        loaded = ck.carrying(ck.load_cpr() if robot is None else robot.load(), payload)
+        loaded = ck.carrying(robot.load(), payload)
     except ck.CprKinError as exc:
         raise SceneError(f"{source}: robot: {exc}") from None
     try:
@@ -218,10 +218,10 @@ def obstacle_to_dict(obstacle: ck.Obstacle) -> dict[str, Any]:
 
 
 def scene_to_dict(scene: Scene) -> dict[str, Any]:
-    """The scene as planned: robot (unless the bundled CPR), obstacles, margins, start, goal, duration."""
+    """The scene as planned: robot (unless the default), obstacles, margins, start, goal, duration."""
     return {
         "name": scene.name,
-        **({} if scene.robot is None else {"robot": robot_entry(scene.robot)}),
+        **({} if scene.robot in (None, default_robot()) else {"robot": robot_entry(scene.robot)}),
         "safety_margin": scene.safety_margin,
         **({} if scene.self_margin == DEFAULT_SELF_MARGIN_M else {"self_margin": scene.self_margin}),
         **(

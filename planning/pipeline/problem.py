@@ -188,7 +188,7 @@ def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | No
     instance_of("scene", scene, Scene, "planning.Scene (load_scene, paper_scene, Scene(start=..., goal=...))")
     if robot is not None:
         instance_of("robot", robot, ck.Robot, "cpr_kin.Robot (load_robot, load_cpr), or None: the scene's")
-    robot = scene_robot(scene, robot or (scene.robot.load() if scene.robot is not None else ck.load_cpr()))
+    robot = scene_robot(scene, robot or scene.robot_spec().load())
     world = scene_world(scene, robot, threads)
     dynamics = scene_dynamics(robot, scene, world.num_threads)
     q_start = endpoint(robot, world, scene, "start", dynamics=dynamics)

@@ -68,7 +68,9 @@ class Scene:
             :data:`MAX_IPO_SAMPLES` IPO periods; ``None``: the fastest timing within the
             joints' velocity, acceleration and jerk limits.
         robot: the robot (:class:`cpr_kin.RobotSpec`; a URDF path becomes
-            :func:`cpr_kin.robot_spec` of it); ``None``: the bundled CPR.
+            :func:`cpr_kin.robot_spec` of it); ``None``: the one given to
+            :func:`~planning.pipeline.planner.plan` (a scene file without ``robot:`` reads as
+            the CPR preset, :func:`planning.io.robot_entry.default_robot`).
         self_margin: required clearance between the robot's own checked link pairs [m], at
             most :data:`MAX_SAFETY_MARGIN_M`.
         allowed_collisions: link pairs allowed to touch, beyond the robot's SRDF (a MoveIt
@@ -137,6 +139,19 @@ class Scene:
                     f"duration / planner.ipo = {samples:.0f} IPO samples; at most {MAX_IPO_SAMPLES}: "
                     "lengthen ipo or shorten the duration"
                 )
+
+    def robot_spec(self) -> ck.RobotSpec:
+        """The robot the scene names.
+
+        Raises:
+            PlanningError: it names none, and no loaded robot was given with it.
+        """
+        if self.robot is None:
+            raise PlanningError(
+                f"scene '{self.name}' names no robot: give Scene(robot=...) (cpr_kin.cpr_spec() for the "
+                "CPR, cpr_kin.robot_spec(urdf) for another arm) or the loaded robot, plan(scene, robot)"
+            )
+        return self.robot
 
     def with_planner(self, **changes: Any) -> Scene:
         """The scene with planner settings changed, by their scene-file keys (e.g. ``seed=1``).
