@@ -33,7 +33,7 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	@sh scripts/ensure_chromium.sh
-	$(PY) -m pytest
+	$(PY) -m pytest --numprocesses auto --maxprocesses 2
 
 test-fast: $(STAMP)
 	$(PY) -m pytest -m "not slow"

@@ -138,6 +138,21 @@ def test_missing_scene_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) 
     assert not (tmp_path / "out").exists()
 
 
+def test_an_error_about_a_long_path_keeps_its_start_and_its_reason(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the line is capped (a hostile input must not flood the terminal); what is cut is the
+    # middle, where a long path runs, not the end that says what is wrong and what is allowed
+    deep = tmp_path / ("folder_" * 30)
+    deep.mkdir()
+    missing = deep / "nope.yaml"
+    code, _, stderr = run(["plan", str(missing), "--out", str(tmp_path / "out")], capsys)
+    line = stderr.strip()
+    assert code == 2 and len(line.splitlines()) == 1 and len(line) <= 300
+    assert line.startswith("cpr-plan plan: error: ") and line.endswith("nope.yaml' does not exist")
+    assert " ... " in line and len(f"cpr-plan plan: error: scene file '{missing}' does not exist") > 300
+
+
 def test_infeasible_scene_exits_3_writing_nothing(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     wall = {"name": "wall", "shape": "box", "size": [0.05, 1.3, 2.0], "xyz": [0.0, 0.95, 1.0]}
     scene = write_scene(tmp_path, with_changes(obstacles=[wall], planner={"fireflies": 10, "iterations": 5}))

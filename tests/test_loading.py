@@ -328,7 +328,7 @@ def test_a_mesh_that_is_not_a_mesh_names_its_link_and_file(tmp_path: Path) -> No
         ck.load_robot(urdf)
     message = str(info.value)
     assert f"link 'panda_link3': mesh '{tmp_path / 'link3.stl'}' is not a mesh file coal can read" in message
-    assert ".cpp" not in message and len(message) < 300
+    assert ".cpp" not in message and len(message.replace(str(tmp_path), "")) < 250  # no C++ source named
 
 
 @pytest.mark.parametrize(("value", "shown"), [(".nan", "nan"), ("-5", "-5"), (".inf", "inf")])

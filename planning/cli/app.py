@@ -208,11 +208,17 @@ def build_parser() -> argparse.ArgumentParser:
 
 MAX_ERROR_CHARS = 300
 """Longest error line the CLI prints (a hostile input must not flood the terminal)."""
+KEPT_HEAD_CHARS = 100
+"""Of a longer line, the start kept (the command and the file); the rest of the room goes to its
+end, which says what is wrong and what is allowed: a long path in the middle is what is cut."""
 
 
 def _one_line(text: str) -> str:
     text = escaped(" ".join(text.split()))
-    return text if len(text) <= MAX_ERROR_CHARS else text[: MAX_ERROR_CHARS - 3] + "..."
+    if len(text) <= MAX_ERROR_CHARS:
+        return text
+    tail = MAX_ERROR_CHARS - KEPT_HEAD_CHARS - len(" ... ")
+    return f"{text[:KEPT_HEAD_CHARS]} ... {text[-tail:]}"
 
 
 def main(argv: Sequence[str] | None = None, *, restore_signals: bool = True) -> int:
