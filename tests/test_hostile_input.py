@@ -1,9 +1,9 @@
 """Hostile and careless input: one short line, the right exit code, nothing written, no hang.
 
 Every case runs through ``cpr-plan`` as a user meets it. Each asserts the exit code, one line
-on stderr under 300 characters that names the field, no traceback, no output folder, and
-that the refusal comes before any search starts (the unguarded code searched for minutes;
-``scripts/bench_hostile.py`` prints the actual times).
+on stderr under 400 characters (the test's folder apart) that names the field, no traceback,
+no output folder, and that the refusal comes before any search starts (the unguarded code
+searched for minutes; ``scripts/bench_hostile.py`` prints the actual times).
 """
 
 from __future__ import annotations
@@ -193,7 +193,8 @@ def test_a_hostile_scene_exits_2_at_once_naming_the_field(
     code, stdout, stderr = run(["plan", str(scene), "--out", str(out)], capsys)
     assert code == 2, label
     assert message.search(stderr) if isinstance(message, re.Pattern) else message in stderr, stderr
-    assert stderr.count("\n") == 1 and len(stderr) < 400 and "Traceback" not in stderr and stdout == ""
+    short = len(stderr.replace(str(tmp_path), "")) < 400  # each value cut where shown
+    assert stderr.count("\n") == 1 and short and "Traceback" not in stderr and stdout == ""
     assert not out.exists()
 
 

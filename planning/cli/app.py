@@ -206,19 +206,15 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-MAX_ERROR_CHARS = 300
-"""Longest error line the CLI prints (a hostile input must not flood the terminal)."""
-KEPT_HEAD_CHARS = 100
-"""Of a longer line, the start kept (the command and the file); the rest of the room goes to its
-end, which says what is wrong and what is allowed: a long path in the middle is what is cut."""
+MAX_ERROR_CHARS = 1000
+"""Longest error line the CLI prints: a hostile input must not flood the terminal. Each value a
+message shows is cut where it is shown (:func:`cpr_kin.common.names.shown`); what is left long
+is a file's path, which may take a few hundred characters before the message says what is wrong."""
 
 
 def _one_line(text: str) -> str:
     text = escaped(" ".join(text.split()))
-    if len(text) <= MAX_ERROR_CHARS:
-        return text
-    tail = MAX_ERROR_CHARS - KEPT_HEAD_CHARS - len(" ... ")
-    return f"{text[:KEPT_HEAD_CHARS]} ... {text[-tail:]}"
+    return text if len(text) <= MAX_ERROR_CHARS else text[: MAX_ERROR_CHARS - 3] + "..."
 
 
 def main(argv: Sequence[str] | None = None, *, restore_signals: bool = True) -> int:
