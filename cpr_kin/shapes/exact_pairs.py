@@ -119,8 +119,7 @@ class ExactPairs:
         """
         a, b = self._pairs[pair]
         (shape_a, at_a), (shape_b, at_b) = self._placed(geometry_data, a), self._placed(geometry_data, b)
-        result = coal.DistanceResult()
-        coal.distance(shape_a, as_transform(at_a), shape_b, as_transform(at_b), self._request, result)
+        result = self._distance(shape_a, as_transform(at_a), shape_b, as_transform(at_b))
         if hull_m >= 0.0:
             return result
         if result.min_distance <= 0.0 or self._one_holds_other(a, at_a, b, at_b):
@@ -139,14 +138,11 @@ class ExactPairs:
         """
         a, b = self._pairs[pair]
         (shape_a, at_a), (shape_b, at_b) = self._placed(geometry_data, a), self._placed(geometry_data, b)
+        placed = (shape_a, as_transform(at_a), shape_b, as_transform(at_b))
         self._collision.security_margin = min(margin_m, COLLIDE_MARGIN_UP_TO_M)
-        hit = coal.collide(
-            shape_a, as_transform(at_a), shape_b, as_transform(at_b), self._collision, coal.CollisionResult()
-        )
+        hit = coal.collide(*placed, self._collision, coal.CollisionResult())
         if not hit and margin_m > COLLIDE_MARGIN_UP_TO_M:
-            result = coal.DistanceResult()
-            coal.distance(shape_a, as_transform(at_a), shape_b, as_transform(at_b), self._request, result)
-            hit = result.min_distance < margin_m
+            hit = self._distance(*placed).min_distance < margin_m
         if hit:
             return True
         return hull_m < 0.0 and self._one_holds_other(a, at_a, b, at_b)
@@ -212,6 +208,12 @@ class ExactPairs:
                     found[row] = True
                     break
         return found
+
+    def _distance(self, shape_a: Any, at_a: Any, shape_b: Any, at_b: Any) -> Any:
+        """The ``coal.DistanceResult`` of two shapes at their ``coal.Transform3s`` placements."""
+        result = coal.DistanceResult()
+        coal.distance(shape_a, at_a, shape_b, at_b, self._request, result)
+        return result
 
     def _placed(self, geometry_data: Any, geometry: int) -> tuple[Any, Any]:
         """The geometry's decisive shape (its mesh, if it has one) and its placement in the world."""
