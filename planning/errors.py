@@ -65,3 +65,16 @@ class NoTrajectoryFoundError(NoSolutionError):
 
 class PayloadTooHeavyError(NoSolutionError):
     """Holding the start or goal still takes more than a joint's effort limit (joint, torque, limit named)."""
+
+
+class ToolLineBrokenError(NoSolutionError):
+    """A tool line cannot be followed to its end: the share achieved and why.
+
+    Attributes:
+        fraction: the share of the line (its progress, 0 to 1) the tool follows before it
+            breaks, as MoveIt's Cartesian path reports it.
+    """
+
+    def __init__(self, reason: str, fraction: float) -> None:
+        super().__init__(f"the tool line breaks after {fraction:.1%} of its length: {reason}")
+        self.fraction = fraction

@@ -95,16 +95,7 @@ def time_path(
     Raises:
         PlanningError: the path does not move, or a limit is not finite and positive.
     """
-    given = [np.asarray(x, dtype=float) for x in (velocity, acceleration, jerk)]
-    shapes = [x.shape for x in given]
-    if any(shape != (path.n_joints,) for shape in shapes):
-        raise PlanningError(
-            f"velocity, acceleration and jerk limits of shapes {shapes}; {path.n_joints} values each, "
-            "one per joint of the path"
-        )
-    limits = np.stack(given)
-    if not np.all(np.isfinite(limits) & (limits > 0)):
-        raise PlanningError(f"limits {limits.tolist()} must be finite and > 0 for {path.n_joints} joints")
+    limits = checked_limits(path.n_joints, velocity, acceleration, jerk)
     arc = arc_length_path(path, limits[0])
     smoothing = smoothing_limits(limits, node_step_s)
     uncapped = None
@@ -114,8 +105,31 @@ def time_path(
         uncapped = uncapped if arc.torque is None else None  # the rows change it
     fastest = fastest_motion(arc, smoothing.limits, smoothing.second_share, uncapped)
     ends = path(path.knots[[0, -1]])
-    trajectory = _septic(fastest.motion, fastest.step_s, smoothing.step_s, ends, 4 if still_jerk else 3)
+    trajectory = septic_through(
+        fastest.motion, fastest.step_s, smoothing.step_s, ends, 4 if still_jerk else 3
+    )
     return trajectory.time_scaled(limits_time_scale(trajectory, limits, torque))
+
+
+def checked_limits(
+    n_joints: int, velocity: FloatArray, acceleration: FloatArray, jerk: FloatArray
+) -> FloatArray:
+    """``(3, nj)`` velocity, acceleration and jerk limits, each ``n_joints`` finite values > 0.
+
+    Raises:
+        PlanningError: a shape other than ``(n_joints,)``, or a value not finite and positive.
+    """
+    given = [np.asarray(x, dtype=float) for x in (velocity, acceleration, jerk)]
+    shapes = [x.shape for x in given]
+    if any(shape != (n_joints,) for shape in shapes):
+        raise PlanningError(
+            f"velocity, acceleration and jerk limits of shapes {shapes}; {n_joints} values each, "
+            "one per joint of the path"
+        )
+    limits = np.stack(given)
+    if not np.all(np.isfinite(limits) & (limits > 0)):
+        raise PlanningError(f"limits {limits.tolist()} must be finite and > 0 for {n_joints} joints")
+    return limits
 
 
 class Smoothing(NamedTuple):
@@ -166,7 +180,7 @@ def limits_time_scale(trajectory: Trajectory, limits: FloatArray, torque: Torque
     return max(scale, torque_scale) if np.isfinite(torque_scale) else scale
 
 
-def _septic(
+def septic_through(
     motion: FloatArray, step_s: float, node_step_s: float, ends: FloatArray, still: int = 3
 ) -> Trajectory:
     """Septic Hermite segments whose knots take the motion's position and derivatives.

@@ -139,7 +139,7 @@ def locally_capped(
     ``profile``: the uncapped profile itself, if the caller has it.
     """
     _, acceleration_cap = _caps(limits, 1.0, np.inf)
-    step_s = _time_step_s(limits)
+    step_s = time_step_s(limits)
     duration_s, motion = locally_capped_motion(
         path,
         limits,
@@ -192,8 +192,8 @@ def duration_lower_bound(
     profile's accelerations need (:func:`_window_s`; a widening only adds), less the time
     grid's rounding (three steps); the final uniform scaling only stretches it.
     """
-    window_s = _window_s(path, x, limits[2])
-    return profile_time(x, path.ds) + (1.0 + second_share) * window_s - 3.0 * _time_step_s(limits)
+    window_s = jerk_window_s(path, x, limits[2])
+    return profile_time(x, path.ds) + (1.0 + second_share) * window_s - 3.0 * time_step_s(limits)
 
 
 def capped_profile(
@@ -219,9 +219,9 @@ def capped_motion(
     Positions along the path are interpolated in its table at the profile's arc lengths.
     """
     x = capped_profile(path, limits, share, ramp_s) if profile is None else profile
-    window = _window_s(path, x, limits[2])
+    window = jerk_window_s(path, x, limits[2])
     peak = float(np.max(np.abs(path.dq) * np.sqrt(np.maximum(x, 0.0))[:, None] / limits[0]))
-    step_s = _time_step_s(limits)
+    step_s = time_step_s(limits)
     s = arc_at_times(x, path.ds, step_s)
     positions = positions_at(s, path.length, path.table)
     motion, used = jerk_limited_motion(positions, window, step_s, limits[2], ROUNDS, TOLERANCE, second_share)
@@ -229,7 +229,7 @@ def capped_motion(
     return CappedMotion(duration_s, used > window, peak, window, motion, step_s)
 
 
-def _time_step_s(limits: FloatArray) -> float:
+def time_step_s(limits: FloatArray) -> float:
     """The time step [s] of the grid the joints' motion is averaged on: :data:`STEPS_PER_RAMP` a ramp."""
     return float(np.max(limits[1] / limits[2])) / STEPS_PER_RAMP
 
@@ -247,7 +247,7 @@ def _caps(limits: FloatArray, share: float, ramp_s: float) -> tuple[FloatArray, 
     return velocity_cap, np.minimum(limits[1], reachable)
 
 
-def _window_s(path: ArcLengthPath, x: FloatArray, jerk: FloatArray) -> float:
+def jerk_window_s(path: ArcLengthPath, x: FloatArray, jerk: FloatArray) -> float:
     """The moving average's width [s]: what the jerk limits need to ramp the profile's accelerations.
 
     Each joint's largest acceleration in the profile ``x`` (``q'' s'^2 + q' s''``) over its

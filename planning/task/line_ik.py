@@ -1,0 +1,246 @@
+"""The joint path that holds a tool frame on a straight line: inverse kinematics by continuation.
+
+From the start configuration the line is walked in small steps (:data:`STEP_M`,
+:data:`STEP_RAD`): each step predicts the joints by the Jacobian's damped pseudo-inverse of
+the line's constant twist, then Newton's method with damped least squares puts the frame on
+the line's pose there, to :data:`IK_SHARE` of the tolerance, within the joint ranges. The
+samples are joined by a quintic spline in the progress ``sigma`` (C4: the jerk of the timed
+motion is continuous) and the spline's midpoints are checked against the line by forward
+kinematics; where the spline strays, the steps are halved.
+
+Where the walk cannot go on, :class:`~planning.errors.ToolLineBrokenError` names the share of the
+line achieved and why: a joint at its limit, a singularity (a joint would have to move
+:data:`LARGEST_JOINT_STEP` for one small step of the tool), or a pose the arm cannot take
+(out of reach, or an orientation a 5-joint arm cannot hold).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import NDArray
+from scipy.interpolate import BSpline, make_interp_spline
+
+import cpr_kin as ck
+from planning.curves.trajectory import Trajectory
+from planning.errors import ToolLineBrokenError
+from planning.task.tool_line import LineGeometry, LineTolerance
+
+FloatArray = NDArray[np.float64]
+
+STEP_M = 0.002
+"""Largest move of the tool between two samples of the walk [m]."""
+STEP_RAD = 0.02
+"""Largest turn of the tool between two samples of the walk [rad]."""
+FEWEST_STEPS = 16
+"""Fewest steps of a walk."""
+MOST_STEPS = 8192
+"""Most steps of a walk (a 16 m line at :data:`STEP_M`)."""
+IK_SHARE = 1e-3
+"""How close each sample is put to the line, as a share of the tolerance."""
+REACH_SHARE = 0.5
+"""How far a sample may stay from the line's pose where the arm cannot take it exactly (a 5-joint
+arm holding an orientation), as a share of the tolerance; the timed motion's certified
+deviation must still be within the whole tolerance."""
+PROGRESS = 1e-3
+"""The relative decrease of a Newton step's error below which it has settled."""
+SPLINE_DEGREE = 5
+"""Degree of the spline through the samples: C4, so that the timed motion's jerk is continuous."""
+SPLINE_SHARE = 0.05
+"""How far the spline may stray from the line between samples, as a share of the tolerance."""
+NEWTON_STEPS = 40
+"""Most Newton steps per sample."""
+DAMPING = 1e-5
+"""Damping of the least squares, relative to the size of the tolerance-weighted Jacobian."""
+LARGEST_JOINT_STEP = 0.25
+"""Most a joint may move between two samples [rad or m]: more means a singularity."""
+SINGULAR = 1e-4
+"""Smallest singular value of the tolerance-weighted Jacobian, relative to its largest."""
+
+
+@dataclass(frozen=True)
+class JointLine:
+    """A joint path that keeps the tool frame on its line (:func:`joint_line`).
+
+    Attributes:
+        frame: the tool frame.
+        geometry: the line.
+        sigma: ``(n,)`` the progress of each sample, 0 to 1.
+        samples: ``(n, nq)`` the configurations at ``sigma`` [rad, m].
+        path: the quintic spline through the samples, in ``sigma`` (knots 0 to 1).
+    """
+
+    frame: str
+    geometry: LineGeometry
+    sigma: FloatArray
+    samples: FloatArray
+    path: Trajectory
+
+
+def joint_line(
+    robot: ck.Robot, q_start: FloatArray, frame: str, geometry: LineGeometry, tolerance: LineTolerance
+) -> JointLine:
+    """The joint path from ``q_start`` that holds ``frame`` on ``geometry`` within ``tolerance``.
+
+    Raises:
+        ToolLineBrokenError: the walk stops before the end (the share achieved and why).
+    """
+    steps = _step_count(geometry)
+    while True:
+        sigma = np.linspace(0.0, 1.0, steps + 1)
+        samples, residual = _walk(robot, np.asarray(q_start, dtype=float), frame, geometry, tolerance, sigma)
+        path = _spline(sigma, samples)
+        middles = 0.5 * (sigma[1:] + sigma[:-1])
+        excess = _excess(robot, frame, geometry, tolerance, middles, path(middles))
+        if excess <= residual + SPLINE_SHARE or 2 * steps > MOST_STEPS:
+            return JointLine(frame, geometry, sigma, samples, path)
+        steps *= 2
+
+
+def _step_count(geometry: LineGeometry) -> int:
+    moves = max(
+        float(np.linalg.norm(geometry.shift_m)) / STEP_M, float(np.linalg.norm(geometry.turn)) / STEP_RAD
+    )
+    return int(np.clip(math.ceil(moves), FEWEST_STEPS, MOST_STEPS))
+
+
+def _weights(tolerance: LineTolerance) -> FloatArray:
+    return np.array([1.0 / tolerance.position_m] * 3 + [1.0 / tolerance.angle_rad] * 3)
+
+
+def _error(placement: pin.SE3, target: pin.SE3) -> FloatArray:
+    """``(6,)`` position and rotation error to ``target``, world-aligned [m, rad]."""
+    rotation = placement.rotation @ pin.log3(placement.rotation.T @ target.rotation)
+    return np.concatenate([target.translation - placement.translation, rotation])
+
+
+def _size(weighted: FloatArray) -> float:
+    """The larger of the position and the rotation error, each over its tolerance."""
+    return max(float(np.linalg.norm(weighted[:3])), float(np.linalg.norm(weighted[3:])))
+
+
+def _walk(
+    robot: ck.Robot,
+    q: FloatArray,
+    frame: str,
+    geometry: LineGeometry,
+    tolerance: LineTolerance,
+    sigma: FloatArray,
+) -> tuple[FloatArray, float]:
+    """The samples of the walk at ``sigma`` and their largest error, over the tolerance."""
+    model, data, fid = robot.model, robot.data, robot.frame_id(frame)
+    weights = _weights(tolerance)
+    twist = np.concatenate([geometry.shift_m, geometry.start.rotation @ geometry.turn]) * weights
+    samples, residual = [q], 0.0
+    for k in range(1, len(sigma)):
+        jacobian = _jacobian(model, data, fid, q) * weights[:, None]
+        guess = np.clip(q + _solve(jacobian, twist * (sigma[k] - sigma[k - 1])), *_range(robot))
+        found, excess = _newton(robot, fid, guess, geometry.pose(float(sigma[k])), weights)
+        jump = np.abs(found - q)
+        if excess > REACH_SHARE or jump.max() > LARGEST_JOINT_STEP:
+            raise ToolLineBrokenError(_why(robot, found, jump, excess, jacobian), float(sigma[k - 1]))
+        q, residual = found, max(residual, excess)
+        samples.append(q)
+    return np.array(samples), residual
+
+
+def _range(robot: ck.Robot) -> tuple[FloatArray, FloatArray]:
+    return robot.limits.lower, robot.limits.upper
+
+
+def _jacobian(model: object, data: object, fid: int, q: FloatArray) -> FloatArray:
+    pin.computeJointJacobians(model, data, q)
+    pin.updateFramePlacements(model, data)
+    return np.asarray(pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED))
+
+
+def _solve(jacobian: FloatArray, error: FloatArray) -> FloatArray:
+    """The damped least-squares step ``J^T (J J^T + lambda^2 I)^-1 e``."""
+    square = jacobian @ jacobian.T
+    system = square + DAMPING**2 * max(float(np.trace(square)), 1.0) * np.eye(len(error))
+    return np.asarray(jacobian.T @ np.linalg.solve(system, error))
+
+
+def _newton(
+    robot: ck.Robot, fid: int, q: FloatArray, target: pin.SE3, weights: FloatArray
+) -> tuple[FloatArray, float]:
+    """The configuration near ``q`` that puts the frame at ``target``, and its weighted error."""
+    model, data = robot.model, robot.data
+    excess = math.inf
+    for _ in range(NEWTON_STEPS):
+        pin.framesForwardKinematics(model, data, q)
+        error = _error(data.oMf[fid], target) * weights
+        if _size(error) > (1.0 - PROGRESS) * excess:  # settled: the least-squares pose, not the line's
+            break
+        excess = _size(error)
+        if excess <= IK_SHARE:
+            break
+        jacobian = _jacobian(model, data, fid, q) * weights[:, None]
+        q = np.clip(q + _solve(jacobian, error), *_range(robot))
+    return q, excess
+
+
+def _why(robot: ck.Robot, q: FloatArray, jump: FloatArray, excess: float, jacobian: FloatArray) -> str:
+    """Why the walk stops at ``q``, in words."""
+    names, lower, upper = robot.joint_names, *_range(robot)
+    if jump.max() > LARGEST_JOINT_STEP:
+        j = int(np.argmax(jump))
+        return (
+            f"it passes near a singularity: joint '{names[j]}' would move {jump[j]:.3g} "
+            f"{robot.joint_unit(names[j])} for one step of the tool (at most {LARGEST_JOINT_STEP:g})"
+        )
+    at_limit = np.flatnonzero((q <= lower + 1e-9) | (q >= upper - 1e-9))
+    if at_limit.size:
+        j = int(at_limit[0])
+        return (
+            f"joint '{names[j]}' reaches its limit ({q[j]:.4g} {robot.joint_unit(names[j])}, "
+            f"range [{lower[j]:g}, {upper[j]:g}])"
+        )
+    values = np.linalg.svd(jacobian, compute_uv=False)
+    if values[-1] < SINGULAR * values[0]:
+        return "it passes through a singularity of the arm"
+    return (
+        f"the arm cannot take the line's pose there (it stays {excess:.3g} x the tolerance away: "
+        "out of reach, or an orientation its joints cannot hold)"
+    )
+
+
+def _spline(sigma: FloatArray, samples: FloatArray) -> Trajectory:
+    """The quintic interpolating spline through ``samples`` at ``sigma``, as a septic-layout trajectory."""
+    spline = make_interp_spline(sigma, samples, k=SPLINE_DEGREE, axis=0)
+    breaks = np.unique(spline.t)
+    middles = 0.5 * (breaks[1:] + breaks[:-1])
+    coefficients = np.zeros((len(middles), samples.shape[1], 8))
+    width = middles - breaks[:-1]
+    for p in range(SPLINE_DEGREE + 1):  # each piece's Taylor series about its left end, from its middle
+        coefficients[:, :, p] = _taylor(spline, middles, -width, p)
+    return Trajectory(breaks, coefficients)
+
+
+def _taylor(spline: BSpline, at: FloatArray, shift: FloatArray, p: int) -> FloatArray:
+    """``(n, nq)`` the p-th Taylor coefficient at ``at + shift`` of the polynomial pieces around ``at``."""
+    total = np.zeros((len(at), spline.c.shape[1]))
+    for r in range(p, SPLINE_DEGREE + 1):
+        total += spline(at, nu=r) * (shift[:, None] ** (r - p) / (math.factorial(p) * math.factorial(r - p)))
+    return total
+
+
+def _excess(
+    robot: ck.Robot,
+    frame: str,
+    geometry: LineGeometry,
+    tolerance: LineTolerance,
+    sigma: FloatArray,
+    configurations: FloatArray,
+) -> float:
+    """The largest error of ``configurations`` from the line's poses at ``sigma``, over the tolerance."""
+    poses = ck.frame_poses(robot, configurations, frame)
+    worst = 0.0
+    for s, pose in zip(sigma, poses, strict=True):
+        target = geometry.pose(float(s))
+        error = _error(pin.SE3(pose[:3, :3], pose[:3, 3]), target) * _weights(tolerance)
+        worst = max(worst, _size(error))
+    return worst

@@ -1,0 +1,152 @@
+"""Straight tool lines on the CPR, a Panda and a UR5, checked by an independent sampling every ms.
+
+The oracle does not use the planner's deviation or verification: it evaluates the trajectory
+every millisecond, puts the tool frame there by Pinocchio's forward kinematics, and measures
+its distance from the segment between the start and goal poses and its rotation from the
+slerp at the same progress, the joints' ranges, their speeds by finite differences of the
+positions, and the joint torques by Pinocchio's RNEA with the payload.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import cpr_kin as ck
+from cpr_kin.model.packages import example_robot
+from planning.errors import PlanningError, ToolLineBrokenError
+from planning.pipeline.verification import Requirements
+from planning.task import LineMotion, LineTolerance, ToolLine, ToolPose, plan_line
+
+NO_MARGIN = Requirements(margin_m=0.0, step_m=0.01)
+
+
+def sampled(motion: LineMotion, robot: ck.Robot) -> dict[str, float]:
+    """The oracle: the largest deviations and limit usages every ms of the trajectory."""
+    trajectory = motion.trajectory
+    times = np.arange(trajectory.knots[0], trajectory.knots[-1], 1e-3)
+    q = trajectory(times)
+    model, data = robot.model, robot.model.createData()
+    fid = model.getFrameId(motion.frame)
+    start, goal = motion.start.placement(), motion.goal.placement()
+    shift = goal.translation - start.translation
+    turn = pin.log3(start.rotation.T @ goal.rotation)
+    distance, angle = [], []
+    for qk in q:
+        pin.framesForwardKinematics(model, data, qk)
+        pose = data.oMf[fid]
+        sigma = np.clip((pose.translation - start.translation) @ shift / (shift @ shift), 0.0, 1.0)
+        distance.append(np.linalg.norm(pose.translation - start.translation - sigma * shift))
+        reference = start.rotation @ pin.exp3(sigma * turn)
+        angle.append(np.linalg.norm(pin.log3(reference.T @ pose.rotation)))
+    speed = np.abs(np.diff(q, axis=0)) / 1e-3 / robot.limits.velocity
+    inside = (q >= robot.limits.lower - 1e-9) & (q <= robot.limits.upper + 1e-9)
+    return {
+        "distance_m": float(max(distance)),
+        "angle_rad": float(max(angle)),
+        "speed_usage": float(speed.max()),
+        "inside": float(inside.all()),
+    }
+
+
+def test_a_cpr_line_lifts_straight_up_and_one_along_its_arm() -> None:
+    robot = ck.load_cpr()
+    world = ck.CollisionWorld(robot, [])
+    q = robot.configuration([0.3, 0.3, 0.25, 0.2, 0.5])
+    radial = 0.1 * np.array([np.cos(0.3), np.sin(0.3), 0.0])
+    for by in ((0.0, 0.0, 0.12), tuple(radial)):
+        motion = plan_line(world, q, ToolLine(by=by, offset_frame="base"), NO_MARGIN)
+        found = sampled(motion, robot)
+        assert found["distance_m"] <= 1e-3 and found["angle_rad"] <= 0.01
+        assert found["distance_m"] <= motion.deviation.position_m  # the certified bound holds
+        assert found["speed_usage"] <= 1.0 + 1e-6 and found["inside"]
+        np.testing.assert_allclose(motion.trajectory(motion.trajectory.knots[0]), q, atol=1e-12)
+        end = ck.frame_poses(robot, motion.trajectory(motion.trajectory.knots[-1]))
+        np.testing.assert_allclose(end[:3, 3], motion.start.xyz + np.array(by), atol=1e-4)
+        assert motion.verification.accepted
+
+
+def test_a_panda_approaches_along_its_tool_axis_within_a_tight_tolerance() -> None:
+    robot = ck.load_robot(example_robot("panda"))
+    world = ck.CollisionWorld(robot, [])
+    q = robot.configuration([0.1, 0.1, 0.1, -1.47, 0.1, 1.97, 0.1])
+    tolerance = LineTolerance(position_m=2e-4, angle_rad=2e-3)
+    line = ToolLine(by=(0.0, 0.0, 0.15), offset_frame="tool", tolerance=tolerance, tool_speed_m_s=0.25)
+    motion = plan_line(world, q, line, NO_MARGIN)
+    found = sampled(motion, robot)
+    assert found["distance_m"] <= 2e-4 and found["angle_rad"] <= 2e-3
+    start = ck.frame_poses(robot, q)
+    end = ck.frame_poses(robot, motion.trajectory(motion.trajectory.knots[-1]))
+    np.testing.assert_allclose(end[:3, 3] - start[:3, 3], start[:3, :3] @ [0.0, 0.0, 0.15], atol=2e-4)
+    assert motion.deviation.tool_speed_m_s <= 0.25 + 1e-9
+    assert motion.trajectory.duration >= 0.15 / 0.25  # the tool speed binds
+
+
+def test_a_ur5_carrying_two_kilograms_turns_while_it_moves_within_its_torques() -> None:
+    robot = ck.load_robot(example_robot("ur5"))
+    world = ck.CollisionWorld(robot, [])
+    q = robot.configuration([0.0, -1.57, 1.57, -1.57, -1.57, 0.0])
+    start = ck.frame_poses(robot, q)
+    turned = start[:3, :3] @ pin.exp3(np.array([0.0, 0.0, 0.4]))
+    goal = pin.SE3(turned, start[:3, 3] + np.array([0.12, -0.08, 0.05]))
+    dynamics = ck.robot_dynamics(robot, ck.Payload(mass_kg=2.0))
+    required = Requirements(margin_m=0.0, step_m=0.01, dynamics=dynamics)
+    motion = plan_line(world, q, ToolLine(to=ToolPose.of(goal)), required)
+    found = sampled(motion, robot)
+    assert found["distance_m"] <= 1e-3 and found["angle_rad"] <= 0.01
+    times = np.arange(motion.trajectory.knots[0], motion.trajectory.knots[-1], 1e-3)
+    trajectory = motion.trajectory
+    torques = dynamics.torques(trajectory(times), trajectory.velocity(times), trajectory.acceleration(times))
+    assert np.all(np.abs(torques) <= dynamics.effort * (1 + 1e-6))
+    end = pin.SE3(ck.frame_poses(robot, trajectory(trajectory.knots[-1])))
+    assert np.linalg.norm(pin.log6(goal.actInv(end)).vector) < 1e-3
+
+
+def test_a_line_out_of_the_joint_range_breaks_at_the_share_it_reaches() -> None:
+    robot = ck.load_cpr()
+    world = ck.CollisionWorld(robot, [])
+    q = robot.configuration([0.3, 0.3, 0.25, 0.2, 0.5])
+    with pytest.raises(ToolLineBrokenError, match="joint 'd2' reaches its limit") as broken:
+        plan_line(world, q, ToolLine(by=(0.0, 0.0, 0.5), offset_frame="base"), NO_MARGIN)
+    assert broken.value.fraction == pytest.approx(0.3 / 0.5, abs=0.01)  # d2 has 0.3 m to its limit
+
+
+def test_a_five_joint_arm_cannot_hold_its_orientation_across_its_arm() -> None:
+    robot = ck.load_cpr()
+    world = ck.CollisionWorld(robot, [])
+    q = robot.configuration([0.3, 0.3, 0.25, 0.2, 0.5])
+    sideways = 0.1 * np.array([-np.sin(0.3), np.cos(0.3), 0.0])  # the base turns, and the tool with it
+    with pytest.raises(ToolLineBrokenError, match="cannot take the line's pose") as broken:
+        plan_line(world, q, ToolLine(by=tuple(sideways), offset_frame="base"), NO_MARGIN)
+    assert 0.0 <= broken.value.fraction < 0.5
+
+
+def test_an_obstacle_on_the_line_breaks_it_where_the_margin_is_first_crossed() -> None:
+    robot = ck.load_cpr()
+    q = robot.configuration([0.3, 0.3, 0.25, 0.2, 0.5])
+    tcp = ck.frame_poses(robot, q)[:3, 3]
+    ball = ck.Obstacle.sphere(0.02, tcp - np.array([0.0, 0.0, 0.1]), name="ball")
+    world = ck.CollisionWorld(robot, [ball])
+    required = Requirements(margin_m=0.01, step_m=0.01)
+    with pytest.raises(ToolLineBrokenError, match="'ball'") as broken:
+        plan_line(world, q, ToolLine(by=(0.0, 0.0, -0.15), offset_frame="base"), required)
+    assert 0.2 < broken.value.fraction < 0.1 / 0.15  # stopped before the ball's surface less the margin
+
+
+def test_bad_lines_are_refused_naming_the_field() -> None:
+    with pytest.raises(PlanningError, match="exactly one of 'to'"):
+        ToolLine()
+    with pytest.raises(PlanningError, match="offset frame 'world'"):
+        ToolLine(by=(0.0, 0.0, 0.1), offset_frame="world")
+    with pytest.raises(PlanningError, match=r"position_m = 0.0 m must be a number in \(0, 0.1\] m"):
+        LineTolerance(position_m=0.0)
+    with pytest.raises(PlanningError, match="quat_xyzw"):
+        ToolPose((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 0.0))
+    robot = ck.load_cpr()
+    world = ck.CollisionWorld(robot, [])
+    q = robot.configuration([0.3, 0.3, 0.25, 0.2, 0.5])
+    with pytest.raises(PlanningError, match=r"moves 0 m and turns .* rad; it must move at least 0\.0001 m"):
+        plan_line(world, q, ToolLine(by=(0.0, 0.0, 0.0)), NO_MARGIN)
+    with pytest.raises(ck.CprKinError, match="unknown frame 'gripper'"):
+        plan_line(world, q, ToolLine(frame="gripper", by=(0.0, 0.0, 0.1)), NO_MARGIN)
