@@ -23,7 +23,7 @@ EXPECTED = {
         "point cloud: ",
         "wrote out/examples/cloud/trajectory.json",
     ],
-    "tool_lines.py": ["approach: 0.", "certified deviation 0.0", "straight down: ", "% achieved"],
+    "tool_lines.py": ["approach: 0.", "certified deviation 0.", "straight down: ", "% achieved"],
     "check_a_trajectory.py": [
         "theirs.json: verified",
         "edited.json: FAILS: is not continuous (C3) at t = 1 s (knot 1): the position of joint 'd2' jumps",

@@ -16,8 +16,9 @@ import pytest
 import cpr_kin as ck
 from cpr_kin.model.packages import example_robot
 from planning.errors import PlanningError, ToolLineBrokenError
+from planning.outcome import classify
 from planning.pipeline.verification import Requirements
-from planning.task import LineMotion, LineTolerance, ToolLine, ToolPose, plan_line
+from planning.task import LineMotion, LineTolerance, ToolLine, ToolPose, line_ik, plan_line
 
 NO_MARGIN = Requirements(margin_m=0.0, step_m=0.01)
 
@@ -103,6 +104,18 @@ def test_a_ur5_carrying_two_kilograms_turns_while_it_moves_within_its_torques() 
     assert np.linalg.norm(pin.log6(goal.actInv(end)).vector) < 1e-3
 
 
+def test_a_redundant_arm_walks_its_null_space_away_from_a_joint_limit() -> None:
+    robot = ck.load_robot(example_robot("panda"))
+    world = ck.CollisionWorld(robot, [])
+    q = robot.configuration([0.8074, 1.0755, 2.6868, -2.6199, -0.1031, 3.3556, -0.4478])
+    line = ToolLine(by=(0.1181, 0.0398, 0.1406), offset_frame="base")
+    motion = plan_line(world, q, line, NO_MARGIN)  # joint 3 starts 0.21 rad from its limit
+    found = sampled(motion, robot)
+    assert found["distance_m"] <= 1e-3 and found["angle_rad"] <= 0.01 and found["inside"]
+    with pytest.raises(ToolLineBrokenError, match="'panda_joint3' reaches its limit"):  # the plain walk
+        line_ik._walk(robot, q, motion.frame, motion.geometry, line.tolerance, motion.path.sigma)
+
+
 def test_a_line_out_of_the_joint_range_breaks_at_the_share_it_reaches() -> None:
     robot = ck.load_cpr()
     world = ck.CollisionWorld(robot, [])
@@ -150,3 +163,9 @@ def test_bad_lines_are_refused_naming_the_field() -> None:
         plan_line(world, q, ToolLine(by=(0.0, 0.0, 0.0)), NO_MARGIN)
     with pytest.raises(ck.CprKinError, match="unknown frame 'gripper'"):
         plan_line(world, q, ToolLine(frame="gripper", by=(0.0, 0.0, 0.1)), NO_MARGIN)
+
+
+def test_a_broken_line_is_a_no_solution_outcome_exit_3_naming_the_share() -> None:
+    outcome = classify(ToolLineBrokenError("joint 'd2' reaches its limit", 0.6))
+    assert outcome.exit_code == 3
+    assert "breaks after 60.0% of its length: joint 'd2' reaches its limit" in outcome.message

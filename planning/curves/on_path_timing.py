@@ -9,6 +9,8 @@ length: ``q(t) = path(u(s_avg(t)))``. The motion never leaves the path; only the
 between the trajectory's knots can, by the interpolation's error (``h^8``), which the caller
 measures (:mod:`planning.task.line_deviation`).
 
+As in :func:`~planning.curves.velocity_caps.fastest_motion`, the profile is also tried under
+caps of its velocity (:data:`CAPS`), and the motion shortest once scaled to its limits is kept.
 The averages bound the jerk of ``s``, not of each joint: a joint's jerk adds the path's
 curvature terms (``3 q_ss s' s'' + q_sss s'^3``). The final uniform time scaling by the exact
 extrema, as in :func:`~planning.curves.path_timing.time_path`, holds every joint to its
@@ -22,10 +24,11 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.interpolate import BSpline, make_interp_spline
 
-from planning.curves.arc_length import FINE, arc_length_path
-from planning.curves.moving_average import arc_at_times, averaged_motion
+from planning.curves.arc_length import FINE, ArcLengthPath, arc_length_path
+from planning.curves.moving_average import arc_at_times, averaged_motion, scaled_duration
 from planning.curves.path_timing import (
     NODE_STEP_S,
+    Smoothing,
     checked_limits,
     limits_time_scale,
     septic_through,
@@ -36,6 +39,14 @@ from planning.curves.trajectory import Trajectory
 from planning.curves.velocity_caps import capped_profile, jerk_window_s, time_step_s
 
 FloatArray = NDArray[np.float64]
+
+CAPS = (0.9, 0.8, 0.7, 0.6, 0.5)
+"""Caps of the phase-plane profile's velocity tried besides none, as shares of the limits.
+
+A short motion switches from accelerating to braking at once, and a joint's jerk through that
+switch, on a curved path its curvature terms too, makes the final scaling stretch the whole;
+cruising a little below the peak is often faster (docs/tuning.md, "Tool lines"). The motion
+of each cap is scaled to meet every limit at its samples, and the shortest is kept."""
 
 
 def time_on_path(
@@ -69,16 +80,31 @@ def time_on_path(
     if torque is not None:
         uncapped = capped_profile(arc, smoothing.limits, 1.0)
         arc = arc._replace(torque=torque_rows(path(arc.u), arc.dq, arc.ddq, arc.ds, torque, uncapped))
-    profile = capped_profile(arc, smoothing.limits, 1.0)
-    window_s = jerk_window_s(arc, profile, smoothing.limits[2])
     step_s = time_step_s(smoothing.limits)
-    s = arc_at_times(profile, arc.ds, step_s)
-    averaged = averaged_motion(s[:, None], window_s, step_s, smoothing.second_share)[0, :, 0]
-    u = path_parameter(path, arc.length)(np.clip(averaged, 0.0, arc.length[-1]))
-    motion = _derivatives(path(u), step_s)
+    parameter = path_parameter(path, arc.length)
+    motions = [_capped(path, arc, parameter, smoothing, share, step_s) for share in (1.0, *CAPS)]
+    durations = [scaled_duration(motion, step_s, *limits) for motion in motions]
+    motion = motions[int(np.argmin(durations))]
     ends = path(path.knots[[0, -1]])
     trajectory = septic_through(motion, step_s, smoothing.step_s, ends, still=4)
     return trajectory.time_scaled(limits_time_scale(trajectory, limits, torque))
+
+
+def _capped(
+    path: Trajectory,
+    arc: ArcLengthPath,
+    parameter: BSpline,
+    smoothing: Smoothing,
+    share: float,
+    step_s: float,
+) -> FloatArray:
+    """``(4, T, nj)`` the motion on the path under a velocity cap of ``share`` of the limits."""
+    profile = capped_profile(arc, smoothing.limits, share)
+    window_s = jerk_window_s(arc, profile, smoothing.limits[2])
+    s = arc_at_times(profile, arc.ds, step_s)
+    averaged = averaged_motion(s[:, None], window_s, step_s, smoothing.second_share)[0, :, 0]
+    u = parameter(np.clip(averaged, 0.0, arc.length[-1]))
+    return _derivatives(path(u), step_s)
 
 
 def path_parameter(path: Trajectory, length: FloatArray) -> BSpline:

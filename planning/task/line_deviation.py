@@ -28,8 +28,9 @@ from planning.task.tool_line import SHORTEST_LINE_M, LineGeometry, LineTolerance
 
 FloatArray = NDArray[np.float64]
 
-SLACK_SHARE = 0.1
-"""The largest change of the deviation between two samples, as a share of the tolerance."""
+SLACK_SHARE = 0.5
+"""The largest change of the deviation between two samples, as a share of the tolerance: the
+certified bound is at most the samples' deviation plus half of it."""
 LONGEST_STEP_S = 1e-3
 """The samples' spacing at most [s] (every millisecond, as a robot controller sees the motion)."""
 MOST_SAMPLES = 400_000

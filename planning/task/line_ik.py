@@ -17,14 +17,15 @@ line achieved and why: a joint at its limit, a singularity (a joint would have t
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
-from scipy.interpolate import BSpline, make_interp_spline
 
 import cpr_kin as ck
+from planning.curves.interpolating_spline import spline_through
 from planning.curves.trajectory import Trajectory
 from planning.errors import ToolLineBrokenError
 from planning.task.tool_line import LineGeometry, LineTolerance
@@ -57,6 +58,11 @@ DAMPING = 1e-5
 """Damping of the least squares, relative to the size of the tolerance-weighted Jacobian."""
 LARGEST_JOINT_STEP = 0.25
 """Most a joint may move between two samples [rad or m]: more means a singularity."""
+LIMIT_ZONE = 0.2
+"""The outer share of a joint's range where a redundant arm's null space pulls it back."""
+LIMIT_GAIN = 0.01
+"""Share of a joint's distance from the middle of its range that one step pulls back, at the limit
+(docs/tuning.md, "Tool lines")."""
 SINGULAR = 1e-4
 """Smallest singular value of the tolerance-weighted Jacobian, relative to its largest."""
 
@@ -89,15 +95,41 @@ def joint_line(
         ToolLineBrokenError: the walk stops before the end (the share achieved and why).
     """
     steps = _step_count(geometry)
+    q = np.asarray(q_start, dtype=float)
     while True:
         sigma = np.linspace(0.0, 1.0, steps + 1)
-        samples, residual = _walk(robot, np.asarray(q_start, dtype=float), frame, geometry, tolerance, sigma)
-        path = _spline(sigma, samples)
+
+        def walk(gain: float, sigma: FloatArray = sigma) -> tuple[FloatArray, float]:
+            return _walk(robot, q, frame, geometry, tolerance, sigma, gain)
+
+        samples, residual = _pulled_if_broken(robot, walk)
+        path = spline_through(sigma, samples, SPLINE_DEGREE)
         middles = 0.5 * (sigma[1:] + sigma[:-1])
         excess = _excess(robot, frame, geometry, tolerance, middles, path(middles))
         if excess <= residual + SPLINE_SHARE or 2 * steps > MOST_STEPS:
             return JointLine(frame, geometry, sigma, samples, path)
         steps *= 2
+
+
+def _pulled_if_broken(
+    robot: ck.Robot, walk: Callable[[float], tuple[FloatArray, float]]
+) -> tuple[FloatArray, float]:
+    """``walk(0)``, and where it breaks on a redundant arm, ``walk(LIMIT_GAIN)``.
+
+    An arm of more joints than the tool's six directions walks again with its null space
+    pulling joints from their limits (:func:`_away_from_limits`). Only on a break: the pull
+    lengthens the joints' motion on lines that need none. Of two breaks, the one further
+    along is raised.
+    """
+    try:
+        return walk(0.0)
+    except ToolLineBrokenError as plain:
+        if robot.nq <= 6:
+            raise
+        try:
+            return walk(LIMIT_GAIN)
+        except ToolLineBrokenError as pulled:
+            raise (pulled if pulled.fraction > plain.fraction else plain) from None
 
 
 def _step_count(geometry: LineGeometry) -> int:
@@ -129,15 +161,22 @@ def _walk(
     geometry: LineGeometry,
     tolerance: LineTolerance,
     sigma: FloatArray,
+    limit_gain: float = 0.0,
 ) -> tuple[FloatArray, float]:
-    """The samples of the walk at ``sigma`` and their largest error, over the tolerance."""
+    """The samples of the walk at ``sigma`` and their largest error, over the tolerance.
+
+    ``limit_gain``: of :func:`_away_from_limits`'s pull, none by default.
+    """
     model, data, fid = robot.model, robot.data, robot.frame_id(frame)
     weights = _weights(tolerance)
     twist = np.concatenate([geometry.shift_m, geometry.start.rotation @ geometry.turn]) * weights
     samples, residual = [q], 0.0
     for k in range(1, len(sigma)):
         jacobian = _jacobian(model, data, fid, q) * weights[:, None]
-        guess = np.clip(q + _solve(jacobian, twist * (sigma[k] - sigma[k - 1])), *_range(robot))
+        step = _solve(jacobian, twist * (sigma[k] - sigma[k - 1]))
+        if limit_gain:
+            step += _away_from_limits(robot, q, jacobian, limit_gain)
+        guess = np.clip(q + step, *_range(robot))
         found, excess = _newton(robot, fid, guess, geometry.pose(float(sigma[k])), weights)
         jump = np.abs(found - q)
         if excess > REACH_SHARE or jump.max() > LARGEST_JOINT_STEP:
@@ -145,6 +184,23 @@ def _walk(
         q, residual = found, max(residual, excess)
         samples.append(q)
     return np.array(samples), residual
+
+
+def _away_from_limits(robot: ck.Robot, q: FloatArray, jacobian: FloatArray, gain: float) -> FloatArray:
+    """A step in the Jacobian's null space that moves joints near a limit back toward the middle.
+
+    Only a redundant arm (a Panda's seven joints for six task directions) has such a null
+    space; the tool does not move by it (to first order, the Newton steps correct the rest).
+    A joint in the outer :data:`LIMIT_ZONE` of its range is pulled toward the middle by
+    ``gain`` of its distance from it, more the closer it is to the limit.
+    """
+    lower, upper = _range(robot)
+    middle, half = 0.5 * (lower + upper), 0.5 * (upper - lower)
+    depth = np.clip((np.abs(q - middle) / half - (1.0 - LIMIT_ZONE)) / LIMIT_ZONE, 0.0, 1.0)
+    if not depth.any():
+        return np.zeros_like(q)
+    projector = np.eye(len(q)) - _solve(jacobian, jacobian)
+    return np.asarray(gain * projector @ (depth * (middle - q)))
 
 
 def _range(robot: ck.Robot) -> tuple[FloatArray, FloatArray]:
@@ -206,26 +262,6 @@ def _why(robot: ck.Robot, q: FloatArray, jump: FloatArray, excess: float, jacobi
         f"the arm cannot take the line's pose there (it stays {excess:.3g} x the tolerance away: "
         "out of reach, or an orientation its joints cannot hold)"
     )
-
-
-def _spline(sigma: FloatArray, samples: FloatArray) -> Trajectory:
-    """The quintic interpolating spline through ``samples`` at ``sigma``, as a septic-layout trajectory."""
-    spline = make_interp_spline(sigma, samples, k=SPLINE_DEGREE, axis=0)
-    breaks = np.unique(spline.t)
-    middles = 0.5 * (breaks[1:] + breaks[:-1])
-    coefficients = np.zeros((len(middles), samples.shape[1], 8))
-    width = middles - breaks[:-1]
-    for p in range(SPLINE_DEGREE + 1):  # each piece's Taylor series about its left end, from its middle
-        coefficients[:, :, p] = _taylor(spline, middles, -width, p)
-    return Trajectory(breaks, coefficients)
-
-
-def _taylor(spline: BSpline, at: FloatArray, shift: FloatArray, p: int) -> FloatArray:
-    """``(n, nq)`` the p-th Taylor coefficient at ``at + shift`` of the polynomial pieces around ``at``."""
-    total = np.zeros((len(at), spline.c.shape[1]))
-    for r in range(p, SPLINE_DEGREE + 1):
-        total += spline(at, nu=r) * (shift[:, None] ** (r - p) / (math.factorial(p) * math.factorial(r - p)))
-    return total
 
 
 def _excess(

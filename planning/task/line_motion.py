@@ -88,8 +88,9 @@ def plan_line(
     trajectory, deviation = _timed(robot, frame, path, line, required)
     verification = verify_trajectory(world, trajectory, required)
     if not verification.accepted:
-        worst = verification.check.worst_time
-        when = float(trajectory.knots[0]) if not np.isfinite(worst) else float(worst)
+        check = verification.check  # where the clearance fails, else from the start (a limit, a torque)
+        failed = not check.accepted and np.isfinite(check.worst_time)
+        when = float(check.worst_time) if failed else float(trajectory.knots[0])
         raise ToolLineBrokenError(
             "; ".join(verification.problems), _progress_at(robot, frame, path, trajectory, when)
         )

@@ -1,0 +1,38 @@
+"""``scripts/bench_lines.py``: our tool lines beside roboplan's Cartesian planner, as a user runs it."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "bench_lines.py"
+
+
+def run(*arguments: str) -> subprocess.CompletedProcess[str]:
+    """The script in a new process with ``arguments``."""
+    return subprocess.run(
+        [sys.executable, str(SCRIPT), *arguments], capture_output=True, text=True, timeout=600, check=False
+    )
+
+
+@pytest.mark.slow
+def test_the_benchmark_prints_a_row_per_robot_with_both_planners() -> None:
+    completed = run("--lines", "3", "--seed", "2", "--robots", "cpr", "panda")
+    assert completed.returncode == 0, completed.stderr[-2000:]
+    rows = [line.split("|")[1:-1] for line in completed.stdout.splitlines() if line.startswith("| ")]
+    assert [row[0].strip() for row in rows[1:]] == ["cpr", "panda"]
+    for row in rows[1:]:
+        ours, peer = (int(v) for v in row[2].split("/"))
+        assert 0 <= ours <= 3 and 0 <= peer <= 3
+        largest = row[5].split("/")[0].strip()
+        assert largest == "nan" or float(largest) <= 1.0  # ours: sampled deviation [mm] within 1 mm
+
+
+def test_a_bad_line_count_is_one_line_naming_it() -> None:
+    completed = run("--lines", "0")
+    assert completed.returncode == 2
+    assert "argument --lines: 0 must be an integer >= 1" in completed.stderr
+    assert "Traceback" not in completed.stderr
