@@ -152,8 +152,12 @@ def test_bad_lines_are_refused_naming_the_field() -> None:
         ToolLine()
     with pytest.raises(PlanningError, match="offset frame 'world'"):
         ToolLine(by=(0.0, 0.0, 0.1), offset_frame="world")
-    with pytest.raises(PlanningError, match=r"position_m = 0.0 m must be a number in \(0, 0.1\] m"):
+    with pytest.raises(PlanningError, match=r"position_m = 0.0 m must be a number in \[1e-06, 0.1\] m"):
         LineTolerance(position_m=0.0)
+    with pytest.raises(PlanningError, match=r"angle_rad = nan rad must be a number in \[1e-05, 0.785398\]"):
+        LineTolerance(angle_rad=float("nan"))
+    with pytest.raises(PlanningError, match=r"line offset by = \[0.0, nan, 0.0\]; expected three"):
+        ToolLine(by=(0.0, float("nan"), 0.0))
     with pytest.raises(PlanningError, match="quat_xyzw"):
         ToolPose((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 0.0))
     robot = ck.load_cpr()
@@ -161,6 +165,9 @@ def test_bad_lines_are_refused_naming_the_field() -> None:
     q = robot.configuration([0.3, 0.3, 0.25, 0.2, 0.5])
     with pytest.raises(PlanningError, match=r"moves 0 m and turns .* rad; it must move at least 0\.0001 m"):
         plan_line(world, q, ToolLine(by=(0.0, 0.0, 0.0)), NO_MARGIN)
+    crate = ck.Obstacle.box(size=(0.4, 0.4, 0.4), xyz=tuple(ck.frame_poses(robot, q)[:3, 3]), name="crate")
+    with pytest.raises(PlanningError, match="start configuration does not keep the clearances: 'tool' is"):
+        plan_line(ck.CollisionWorld(robot, [crate]), q, ToolLine(by=(0.0, 0.0, 0.1)), NO_MARGIN)
     with pytest.raises(ck.CprKinError, match="unknown frame 'gripper'"):
         plan_line(world, q, ToolLine(frame="gripper", by=(0.0, 0.0, 0.1)), NO_MARGIN)
 

@@ -20,7 +20,7 @@ import cpr_kin as ck
 from planning.curves.on_path_timing import time_on_path
 from planning.curves.path_timing import NODE_STEP_S
 from planning.curves.trajectory import Trajectory
-from planning.errors import ToolLineBrokenError
+from planning.errors import PlanningError, ToolLineBrokenError
 from planning.pipeline.verification import Requirements, Verification, verify_trajectory
 from planning.task.line_deviation import LineDeviation, line_deviation
 from planning.task.line_ik import JointLine, joint_line
@@ -72,7 +72,7 @@ def plan_line(
 
     Raises:
         CprKinError: ``q_start`` is not a configuration of the robot, or the frame is unknown.
-        PlanningError: the line neither moves nor turns.
+        PlanningError: the line neither moves nor turns, or its start does not keep the clearances.
         ToolLineBrokenError: the line cannot be followed to its end (the share achieved and
             why: a joint limit, a singularity, a pose out of reach, an obstacle, a limit).
     """
@@ -83,8 +83,9 @@ def plan_line(
     geometry = LineGeometry(
         pin.SE3(start[:3, :3], start[:3, 3]), line.goal(pin.SE3(start[:3, :3], start[:3, 3]))
     )
+    _refuse_blocked(world, q[None], np.zeros(1), required)  # the start first: bad input
     path = joint_line(robot, q, frame, geometry, line.tolerance)
-    _refuse_blocked(world, path, required)
+    _refuse_blocked(world, path.samples, path.sigma, required)
     trajectory, deviation = _timed(robot, frame, path, line, required)
     verification = verify_trajectory(world, trajectory, required)
     if not verification.accepted:
@@ -97,20 +98,28 @@ def plan_line(
     return LineMotion(line, frame, geometry, path, trajectory, deviation, verification)
 
 
-def _refuse_blocked(world: ck.CollisionWorld, path: JointLine, required: Requirements) -> None:
-    """Raise where the first sample of the path does not keep the clearances, naming the obstacle."""
-    kept = world.keeps_clearance(path.samples, required.margin_m, required.self_margin_m, ordered=True)
+def _refuse_blocked(
+    world: ck.CollisionWorld, samples: FloatArray, sigma: FloatArray, required: Requirements
+) -> None:
+    """Raise where the first of ``samples`` (at progress ``sigma``) does not keep the clearances.
+
+    A start that does not keep them is bad input, as a scene's start is (a
+    :class:`~planning.errors.PlanningError`); a later sample breaks the line there.
+    """
+    kept = world.keeps_clearance(samples, required.margin_m, required.self_margin_m, ordered=True)
     if kept.all():
         return
     first = int(np.argmin(kept))
-    closest = world.clearance(path.samples[first]).closest
+    closest = world.clearance(samples[first]).closest
     what = (
         f"the robot comes closer to itself than its self margin {required.self_margin_m} m"
         if closest is None or closest.distance_m >= required.margin_m
         else f"'{closest.robot_geometry}' is {closest.distance_m:.4f} m from '{closest.obstacle}' "
         f"(margin {required.margin_m} m)"
     )
-    raise ToolLineBrokenError(what, float(path.sigma[max(first - 1, 0)]))
+    if first == 0:
+        raise PlanningError(f"the line's start configuration does not keep the clearances: {what}")
+    raise ToolLineBrokenError(what, float(sigma[first - 1]))
 
 
 def _timed(

@@ -27,6 +27,11 @@ SHORTEST_LINE_M = 1e-4
 """Shortest translation of a line [m]; a pure rotation must turn at least :data:`SHORTEST_TURN_RAD`."""
 SHORTEST_TURN_RAD = 1e-3
 """Smallest rotation of a line without translation [rad]."""
+FINEST_POSITION_M = 1e-6
+"""The finest position tolerance of a line [m]: its samples are put on the line to a thousandth
+of the tolerance, and the certified check's samples come closer the finer it is."""
+FINEST_ANGLE_RAD = 1e-5
+"""The finest angle tolerance of a line [rad]."""
 TOOL_FRAME = "tool"
 """``ToolLine.offset_frame``: the offset is in the tool frame at the start."""
 BASE_FRAME = "base"
@@ -91,8 +96,8 @@ class LineTolerance:
     angle_rad: float = 0.01
 
     def __post_init__(self) -> None:
-        number_in("line tolerance position_m", self.position_m, 0.0, 0.1, "m", low_open=True)
-        number_in("line tolerance angle_rad", self.angle_rad, 0.0, math.pi / 4, "rad", low_open=True)
+        number_in("line tolerance position_m", self.position_m, FINEST_POSITION_M, 0.1, "m")
+        number_in("line tolerance angle_rad", self.angle_rad, FINEST_ANGLE_RAD, math.pi / 4, "rad")
 
 
 @dataclass(frozen=True)
