@@ -78,3 +78,17 @@ class ToolLineBrokenError(NoSolutionError):
     def __init__(self, reason: str, fraction: float) -> None:
         super().__init__(f"the tool line breaks after {fraction:.1%} of its length: {reason}")
         self.fraction = fraction
+
+
+class TaskSegmentError(NoSolutionError):
+    """A segment of a task has no solution: which one, and its own error.
+
+    Attributes:
+        segment: the segment's index in the task.
+        cause: the segment's own error (a free motion not found, a tool line that breaks).
+    """
+
+    def __init__(self, segment: int, kind: str, cause: NoSolutionError) -> None:
+        super().__init__(f"task segment {segment} ({kind}): {cause}")
+        self.segment = segment
+        self.cause = cause

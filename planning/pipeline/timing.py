@@ -189,11 +189,16 @@ class FreeDuration:
         search_torque: the robot's torques, when they bind on the straight path from start to
             goal (:func:`~planning.pipeline.torques.search_torque`): the search's duration
             estimate keeps them too.
+        still_jerk: the trajectory ends still in jerk too, not only in velocity and
+            acceleration, so that it joins another motion at rest C3 (a task's segments):
+            only the fastest and narrowed timings (``time_path(still_jerk=True)``), no uniform
+            one (the spline's own ends move in jerk).
     """
 
     limits_bind_candidates: bool = False
     still_method: Method = "fastest"
     search_torque: ck.Dynamics | None = None
+    still_jerk: bool = False
 
     def nominal_duration(self, segments: int) -> float:  # noqa: D102 - the protocol's
         return float(segments)
@@ -214,9 +219,16 @@ class FreeDuration:
         started = time.perf_counter()
         fit = problem.solver.solve(nodes)
         trajectory = time_path(
-            fit.trajectory, limits.velocity, limits.acceleration, limits.jerk, torque=problem.dynamics
+            fit.trajectory,
+            limits.velocity,
+            limits.acceleration,
+            limits.jerk,
+            torque=problem.dynamics,
+            still_jerk=self.still_jerk,
         )
         fastest = Timing(trajectory, "fastest", fit, False, time.perf_counter() - started)
+        if self.still_jerk:  # the spline's own ends move in jerk: no uniform timing
+            return Offered(fastest)
 
         def uniform() -> Timing:
             begun = time.perf_counter()
@@ -234,14 +246,20 @@ class FreeDuration:
         ``None`` when it is not shorter than the path's uniform timing.
         """
         uniform = offered.of("uniform")
-        if uniform is None:
+        reference = offered.of("fastest") if self.still_jerk else uniform
+        if reference is None:
             return None
-        limits, fit = problem.robot.limits, uniform.fit
+        limits, fit = problem.robot.limits, reference.fit
         started = time.perf_counter()
         trajectory = time_path(
-            fit.trajectory, limits.velocity, share * limits.acceleration, limits.jerk, torque=problem.dynamics
+            fit.trajectory,
+            limits.velocity,
+            share * limits.acceleration,
+            limits.jerk,
+            torque=problem.dynamics,
+            still_jerk=self.still_jerk,
         )
-        if trajectory.duration >= uniform.trajectory.duration:
+        if uniform is not None and trajectory.duration >= uniform.trajectory.duration:
             return None
         return Timing(trajectory, "narrowed", fit, False, time.perf_counter() - started)
 

@@ -3,6 +3,7 @@
 from .line_deviation import LineDeviation, line_deviation, tool_levers
 from .line_ik import JointLine, joint_line
 from .line_motion import LineMotion, plan_line
+from .task_plan import Move, SegmentMotion, TaskMotion, Wait, plan_task
 from .tool_line import LineGeometry, LineTolerance, ToolLine, ToolPose
 
 __all__ = [
@@ -11,10 +12,15 @@ __all__ = [
     "LineGeometry",
     "LineMotion",
     "LineTolerance",
+    "Move",
+    "SegmentMotion",
+    "TaskMotion",
     "ToolLine",
     "ToolPose",
+    "Wait",
     "joint_line",
     "line_deviation",
     "plan_line",
+    "plan_task",
     "tool_levers",
 ]

@@ -1,0 +1,115 @@
+"""A task on the CPR among the shelf's obstacles: move, lower the tool, wait, lift it, move on.
+
+Checked independently of the planner's own verification: the segments tile the trajectory,
+the robot is at rest (velocity, acceleration and jerk zero) at every junction, it stands
+still while it waits, the jerk is continuous at every knot (left and right limits), and the
+tool stays on each line every millisecond (Pinocchio's forward kinematics).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import cpr_kin as ck
+from planning.errors import PlanningError, TaskSegmentError, ToolLineBrokenError
+from planning.io.scene_file import load_scene
+from planning.pipeline.planner import solve
+from planning.pipeline.problem import build_problem
+from planning.pipeline.scene import Scene
+from planning.pipeline.target import Target
+from planning.pipeline.timing import FreeDuration
+from planning.task import Move, TaskMotion, ToolLine, Wait, plan_task
+
+SHELF = Path(__file__).resolve().parents[1] / "examples" / "scenes" / "shelf.yaml"
+
+
+@pytest.fixture(scope="module")
+def shelf() -> Scene:
+    return load_scene(SHELF)
+
+
+@pytest.fixture(scope="module")
+def task(shelf: Scene) -> TaskMotion:
+    return plan_task(
+        shelf,
+        [
+            Move(Target(tcp=(-0.1, 0.55, 0.45))),
+            ToolLine(by=(0.0, 0.0, -0.08), offset_frame="base"),
+            Wait(0.3),
+            ToolLine(by=(0.0, 0.0, 0.08), offset_frame="base"),
+            Move(shelf.goal),
+        ],
+    )
+
+
+def test_the_segments_tile_the_trajectory_at_rest_at_every_junction(task: TaskMotion) -> None:
+    trajectory = task.trajectory
+    assert [s.kind for s in task.segments] == ["free", "line", "wait", "line", "free"]
+    assert task.segments[0].t0 == 0.0 and task.segments[-1].t1 == pytest.approx(trajectory.duration)
+    for before, after in zip(task.segments[:-1], task.segments[1:], strict=True):
+        assert before.t1 == pytest.approx(after.t0, abs=1e-12)
+        for side in (-1e-9, 1e-9):
+            for r in (1, 2, 3):
+                assert np.abs(trajectory(before.t1 + side, r)).max() < 1e-5
+    wait = task.segments[2]
+    still = trajectory(np.linspace(wait.t0, wait.t1, 50))
+    assert np.abs(still - still[0]).max() <= 1e-12
+    assert task.verification.accepted, task.verification.problems
+
+
+def test_the_jerk_is_continuous_at_every_knot(task: TaskMotion) -> None:
+    trajectory = task.trajectory
+    inner = trajectory.knots[1:-1]
+    left, right = trajectory(inner - 1e-9, 3), trajectory(inner + 1e-9, 3)
+    assert np.abs(left - right).max() < 1e-3 * np.abs(trajectory.extrema(3).peak).max()
+
+
+def test_the_tool_stays_on_each_line_every_millisecond(task: TaskMotion) -> None:
+    robot = ck.load_cpr()
+    model, data = robot.model, robot.model.createData()
+    fid = model.getFrameId(robot.tcp_frame)
+    for segment in (s for s in task.segments if s.kind == "line"):
+        assert segment.line is not None
+        start, goal = segment.line.start.placement(), segment.line.goal.placement()
+        shift = goal.translation - start.translation
+        for q in task.trajectory(np.arange(segment.t0, segment.t1, 1e-3)):
+            pin.framesForwardKinematics(model, data, q)
+            point = data.oMf[fid].translation
+            sigma = np.clip((point - start.translation) @ shift / (shift @ shift), 0.0, 1.0)
+            assert np.linalg.norm(point - start.translation - sigma * shift) <= 1e-3
+        np.testing.assert_allclose(shift, [0.0, 0.0, -0.08 if segment.t0 < 3.0 else 0.08], atol=1e-9)
+
+
+def test_a_free_motion_asked_to_end_still_in_jerk_does(shelf: Scene) -> None:
+    problem = build_problem(shelf)
+    free = solve(problem).trajectory
+    assert np.abs(free(free.knots[-1], 3)).max() > 1e-3  # the planner's own ends move in jerk
+    assert isinstance(problem.duration, FreeDuration)
+    still = dataclasses.replace(problem.duration, still_jerk=True)
+    trajectory = solve(dataclasses.replace(problem, duration=still)).trajectory
+    for r in (1, 2, 3):
+        assert np.abs(trajectory(trajectory.knots[[0, -1]], r)).max() < 1e-9
+
+
+def test_bad_tasks_are_refused_naming_the_segment(shelf: Scene) -> None:
+    with pytest.raises(PlanningError, match="at least one segment"):
+        plan_task(shelf, [])
+    with pytest.raises(PlanningError, match=r"wait seconds = 0 s must be a number in \(0, 3600\] s"):
+        Wait(0)
+    inside = Target(tcp=(0.35, 0.35, 0.15))  # in the crate
+    with pytest.raises(PlanningError, match=r"task segment 1 \(Move\): "):
+        plan_task(shelf, [Wait(0.1), Move(inside)])
+
+
+def test_a_line_that_breaks_in_a_task_names_its_segment_and_share(shelf: Scene) -> None:
+    with pytest.raises(
+        TaskSegmentError, match=r"task segment 1 \(ToolLine\): the tool line breaks after"
+    ) as err:
+        plan_task(shelf, [Wait(0.1), ToolLine(by=(0.0, 0.0, -0.5), offset_frame="base")])
+    assert err.value.segment == 1
+    assert isinstance(err.value.cause, ToolLineBrokenError) and 0.0 < err.value.cause.fraction < 1.0
