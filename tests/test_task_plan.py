@@ -23,7 +23,7 @@ from planning.pipeline.problem import build_problem
 from planning.pipeline.scene import Scene
 from planning.pipeline.target import Target
 from planning.pipeline.timing import FreeDuration
-from planning.task import Move, TaskMotion, ToolLine, Wait, plan_task
+from planning.task import Attach, Detach, Move, TaskMotion, ToolLine, Wait, plan_task
 
 SHELF = Path(__file__).resolve().parents[1] / "examples" / "scenes" / "shelf.yaml"
 
@@ -59,7 +59,8 @@ def test_the_segments_tile_the_trajectory_at_rest_at_every_junction(task: TaskMo
     wait = task.segments[2]
     still = trajectory(np.linspace(wait.t0, wait.t1, 50))
     assert np.abs(still - still[0]).max() <= 1e-12
-    assert task.verification.accepted, task.verification.problems
+    assert task.accepted, task.problems
+    assert all(s.verification is not None and s.verification.accepted for s in task.segments)
 
 
 def test_the_jerk_is_continuous_at_every_knot(task: TaskMotion) -> None:
@@ -113,3 +114,42 @@ def test_a_line_that_breaks_in_a_task_names_its_segment_and_share(shelf: Scene) 
         plan_task(shelf, [Wait(0.1), ToolLine(by=(0.0, 0.0, -0.5), offset_frame="base")])
     assert err.value.segment == 1
     assert isinstance(err.value.cause, ToolLineBrokenError) and 0.0 < err.value.cause.fraction < 1.0
+
+
+def test_an_attached_part_adds_its_weight_to_the_vertical_axis_and_its_shape_to_the_checks(
+    shelf: Scene,
+) -> None:
+    part = ck.Payload(
+        mass_kg=1.5,
+        shape=ck.Obstacle.box(size=(0.04, 0.04, 0.04), xyz=(0.0, 0.0, 0.03)),
+        touch_links=("tool_link",),
+        name="part",
+    )
+    above = Move(Target(tcp=(-0.1, 0.55, 0.45)))
+    down = ToolLine(by=(0.0, 0.0, -0.08), offset_frame="base")
+    task = plan_task(shelf, [above, down, Wait(0.2), Attach(part), Wait(0.2), Move(shelf.goal), Detach()])
+    assert task.accepted, task.problems
+    assert [s.kind for s in task.segments] == ["free", "line", "wait", "attach", "wait", "free", "detach"]
+    assert task.segments[3].t0 == task.segments[3].t1 == task.segments[2].t1  # an attach takes no time
+    held = []
+    for wait in (task.segments[2], task.segments[4]):
+        assert wait.verification is not None and wait.verification.torques is not None
+        held.append(float(np.median(wait.verification.torques.torques[:, 1])))  # d2, the vertical axis [N]
+    assert held[1] - held[0] == pytest.approx(1.5 * 9.81, rel=1e-3)  # the part's weight, m g
+    ball = ck.Payload(
+        mass_kg=0.5, shape=ck.Obstacle.sphere(0.25, (0.0, 0.0, 0.0)), touch_links=("tool_link",)
+    )
+    with pytest.raises(PlanningError, match=r"task segment 3 \(Attach\): .* from obstacle 'pipe'"):
+        plan_task(shelf, [above, down, Wait(0.2), Attach(ball)])
+
+
+def test_attach_and_detach_out_of_turn_are_refused(shelf: Scene) -> None:
+    with pytest.raises(
+        PlanningError, match=r"task segment 1 \(Detach\): detach: the robot carries nothing here"
+    ):
+        plan_task(shelf, [Wait(0.1), Detach()])
+    part = ck.Payload(mass_kg=0.2, name="part")
+    with pytest.raises(
+        PlanningError, match=r"task segment 1 \(Attach\): attach: the robot already carries 'part'"
+    ):
+        plan_task(shelf, [Attach(part), Attach(part)])

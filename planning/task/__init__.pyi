@@ -3,10 +3,12 @@
 from .line_deviation import LineDeviation, line_deviation, tool_levers
 from .line_ik import JointLine, joint_line
 from .line_motion import LineMotion, plan_line
-from .task_plan import Move, SegmentMotion, TaskMotion, Wait, plan_task
+from .task_plan import Attach, Detach, Move, SegmentMotion, TaskMotion, Wait, plan_task
 from .tool_line import LineGeometry, LineTolerance, ToolLine, ToolPose
 
 __all__ = [
+    "Attach",
+    "Detach",
     "JointLine",
     "LineDeviation",
     "LineGeometry",

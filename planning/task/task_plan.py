@@ -9,7 +9,10 @@ starts and ends at rest, still in jerk too (the free motions' timing is asked fo
 C3 at every junction; the whole is verified as every trajectory of the planner is. The scene's
 own goal is neither planned to nor needed: the segments say where the robot goes.
 
-Not yet (issue 71): junctions that do not stop, attach and detach, the scene file's ``task:``.
+:class:`Attach` and :class:`Detach` change what the robot carries from there on: its mass in
+the torques, its shape in the clearance checks, the links it may touch.
+
+Not yet (issue 71): junctions that do not stop, the scene file's ``task:``.
 """
 
 from __future__ import annotations
@@ -22,6 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
+from planning.curves.continuity import discontinuity
 from planning.curves.stop_and_go import joined
 from planning.curves.trajectory import Trajectory
 from planning.errors import NoSolutionError, PlanningError, TaskSegmentError
@@ -62,7 +66,26 @@ class Wait:
         number_in("wait seconds", self.seconds, 0.0, LONGEST_WAIT_S, "s", low_open=True)
 
 
-Segment = Move | ToolLine | Wait
+@dataclass(frozen=True)
+class Attach:
+    """From here on the robot carries ``payload``: its mass in the torques, its shape in the checks.
+
+    Attributes:
+        payload: the object grasped (its frame, shape and the links it may touch, its
+            ``touch_links``, as a scene's payload).
+    """
+
+    payload: ck.Payload
+
+
+@dataclass(frozen=True)
+class Detach:
+    """From here on the robot carries nothing (the object released)."""
+
+
+Segment = Move | ToolLine | Wait | Attach | Detach
+KINDS = {Move: "free", ToolLine: "line", Wait: "wait", Attach: "attach", Detach: "detach"}
+"""Each segment's kind, as a task's record names it."""
 
 
 @dataclass(frozen=True)
@@ -70,15 +93,18 @@ class SegmentMotion:
     """One segment of a planned task.
 
     Attributes:
-        kind: ``free``, ``line`` or ``wait``.
+        kind: ``free``, ``line``, ``wait``, ``attach`` or ``detach``.
         t0: when it starts in the task's trajectory [s].
-        t1: when it ends [s].
+        t1: when it ends [s] (an attach or detach takes no time).
+        verification: its trajectory's verification with what the robot carries then
+            (``None`` for an attach or detach, which does not move).
         line: the planned line, for a ``line``.
     """
 
     kind: str
     t0: float
     t1: float
+    verification: Verification | None = None
     line: LineMotion | None = None
 
 
@@ -87,68 +113,128 @@ class TaskMotion:
     """A planned task (:func:`plan_task`).
 
     Attributes:
-        segments: each segment's kind and times, in order.
-        trajectory: the whole motion, C3, at rest at each junction.
-        verification: the planner's verification of the whole (clearance, C3, limits, torques).
+        segments: each segment's kind, times and verification, in order.
+        trajectory: the whole motion, at rest at each junction.
+        continuity: where the whole is not C3 (``None``: it is, at every knot).
     """
 
     segments: tuple[SegmentMotion, ...]
     trajectory: Trajectory
-    verification: Verification
+    continuity: str | None
+
+    @property
+    def problems(self) -> tuple[str, ...]:
+        """Every failed condition, each with its segment (empty when accepted)."""
+        found = [] if self.continuity is None else [self.continuity]
+        for index, segment in enumerate(self.segments):
+            if segment.verification is not None:
+                found += [f"segment {index} ({segment.kind}) {p}" for p in segment.verification.problems]
+        return tuple(found)
+
+    @property
+    def accepted(self) -> bool:
+        """Every segment passes its verification and the whole is C3."""
+        return not self.problems
+
+    @property
+    def certified_min_clearance_m(self) -> float:
+        """The least certified clearance from the obstacles over the whole motion [m]."""
+        return min(s.verification.check.certified_min_m for s in self.segments if s.verification is not None)
+
+
+@dataclass(frozen=True)
+class _Carrying:
+    """The scene as the robot meets it while it carries what it carries (at ``q``)."""
+
+    scene: Scene
+    problem: Problem
+    required: Requirements
 
 
 def plan_task(scene: Scene, segments: Sequence[Segment], robot: ck.Robot | None = None) -> TaskMotion:
     """The task's ``segments`` planned from the scene's start, joined and verified.
 
+    Each segment is verified with what the robot carries during it (the scene's payload at
+    the start, then what :class:`Attach` and :class:`Detach` say); the whole must be C3.
+
     Raises:
         PlanningError: no segment, a bad segment, or a segment's bad input (a goal inside a
-            margin, a line of zero length), naming the segment.
+            margin, a line of zero length, a detach of nothing), naming the segment.
         TaskSegmentError: a segment has no solution (a ``NoSolutionError``: exit 3), naming
             it, with its own error as ``cause`` (a free motion not found; a line that breaks,
             with its ``fraction``).
     """
     if not segments:
-        raise PlanningError("a task needs at least one segment (a Move, a ToolLine or a Wait)")
-    problem = build_problem(dataclasses.replace(scene, goal=scene.start), robot)  # its goal: not the task's
-    required = Requirements.of(problem)
-    q = problem.q_start
-    pieces: list[tuple[str, Trajectory, LineMotion | None]] = []
+        raise PlanningError("a task needs at least one segment (a Move, a ToolLine, a Wait, an Attach)")
+    base = robot or scene.robot_spec().load()
+    carrying = _carrying(scene, base, None)
+    q = carrying.problem.q_start
+    records, pieces, now = [], [], 0.0
     for index, segment in enumerate(segments):
+        kind = KINDS.get(type(segment), type(segment).__name__)
         try:
-            kind, trajectory, line = _planned(problem, required, q, segment)
+            if isinstance(segment, Attach | Detach):
+                carrying = _carried(carrying, base, q, segment)
+                records.append(SegmentMotion(kind, now, now))
+                continue
+            trajectory, line = _planned(carrying, base, q, segment)
         except (PlanningError, ck.CprKinError) as exc:
             raise PlanningError(f"task segment {index} ({type(segment).__name__}): {exc}") from exc
         except NoSolutionError as exc:
             raise TaskSegmentError(index, type(segment).__name__, exc) from exc
-        pieces.append((kind, trajectory, line))
+        checked = verify_trajectory(carrying.problem.world, trajectory, carrying.required)
+        records.append(SegmentMotion(kind, now, now + trajectory.duration, checked, line))
+        pieces.append(trajectory)
+        now += trajectory.duration
         q = trajectory(trajectory.knots[-1])
-    whole = joined([trajectory for _, trajectory, _ in pieces])
-    starts = np.cumsum([0.0] + [trajectory.duration for _, trajectory, _ in pieces])
-    records = tuple(
-        SegmentMotion(kind, float(t0), float(t1), line)
-        for (kind, _, line), t0, t1 in zip(pieces, starts[:-1], starts[1:], strict=True)
-    )
-    return TaskMotion(records, whole, verify_trajectory(problem.world, whole, required))
+    if not pieces:
+        raise PlanningError("a task needs a segment that moves or waits, not only attach and detach")
+    whole = joined(pieces)
+    robot_names = carrying.problem.robot.joint_names
+    units = [carrying.problem.robot.joint_unit(n) for n in robot_names]
+    return TaskMotion(tuple(records), whole, discontinuity(whole, robot_names, units))
+
+
+def _carrying(scene: Scene, base: ck.Robot, q: FloatArray | None) -> _Carrying:
+    """The scene at ``q`` (``None``: its start) with its payload, checked as a scene's start is."""
+    start = scene.start if q is None else Target(q=tuple(q.tolist()))
+    at = dataclasses.replace(scene, start=start, goal=start)  # its goal: not the task's
+    problem = build_problem(at, base)
+    return _Carrying(at, problem, Requirements.of(problem))
+
+
+def _carried(carrying: _Carrying, base: ck.Robot, q: FloatArray, segment: Attach | Detach) -> _Carrying:
+    """What the robot carries after ``segment``, checked at ``q``."""
+    held = carrying.scene.payload
+    if isinstance(segment, Detach):
+        if held is None:
+            raise PlanningError("detach: the robot carries nothing here (attach a payload first)")
+        return _carrying(dataclasses.replace(carrying.scene, payload=None), base, q)
+    if held is not None:
+        raise PlanningError(f"attach: the robot already carries '{held.name}' (detach it first)")
+    return _carrying(dataclasses.replace(carrying.scene, payload=segment.payload), base, q)
 
 
 def _planned(
-    problem: Problem, required: Requirements, q: FloatArray, segment: Segment
-) -> tuple[str, Trajectory, LineMotion | None]:
-    """One segment from ``q``: its kind, its trajectory from time 0, and the line if it is one."""
+    carrying: _Carrying, base: ck.Robot, q: FloatArray, segment: Segment
+) -> tuple[Trajectory, LineMotion | None]:
+    """One segment from ``q``: its trajectory from time 0, and the line if it is one."""
     if isinstance(segment, ToolLine):
-        line = plan_line(problem.world, q, segment, required)
-        return "line", line.trajectory, line
+        line = plan_line(carrying.problem.world, q, segment, carrying.required)
+        return line.trajectory, line
     if isinstance(segment, Wait):
         coefficients = np.zeros((1, len(q), 8))
         coefficients[0, :, 0] = q
-        return "wait", Trajectory(np.array([0.0, segment.seconds]), coefficients), None
+        return Trajectory(np.array([0.0, segment.seconds]), coefficients), None
     if isinstance(segment, Move):
-        scene = dataclasses.replace(problem.scene, start=Target(q=tuple(q.tolist())), goal=segment.goal)
-        moving = build_problem(scene, problem.robot)
+        scene = dataclasses.replace(carrying.scene, start=Target(q=tuple(q.tolist())), goal=segment.goal)
+        moving = build_problem(scene, base)
         if not isinstance(moving.duration, FreeDuration):
             raise PlanningError(
                 "a task's free motion is timed as fast as the limits allow: leave duration out"
             )
         still = dataclasses.replace(moving.duration, still_jerk=True)
-        return "free", solve(dataclasses.replace(moving, duration=still)).trajectory, None
-    raise PlanningError(f"a task segment is a Move, a ToolLine or a Wait, not a {type(segment).__name__}")
+        return solve(dataclasses.replace(moving, duration=still)).trajectory, None
+    raise PlanningError(
+        f"a task segment is a Move, a ToolLine, a Wait, an Attach or a Detach, not a {type(segment).__name__}"
+    )
