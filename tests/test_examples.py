@@ -83,5 +83,6 @@ def test_the_notebook_plans_and_shows_the_viewer_inline(tmp_path: Path) -> None:
     printed = "".join(o.get("text", "") for o in outputs if o.output_type == "stream")
     assert "certified clearance 0.1" in printed and "closest: ('tool', 'crate')" in printed
     assert "point cloud: " in printed and "blocks of voxels" in printed  # planned through the cloud too
+    assert "line   0.00 -> " in printed and "wait " in printed and "verified True" in printed  # the task
     shown = outputs[-1]["data"]["text/html"]
     assert shown.startswith("<div") and "<iframe srcdoc=" in shown and "meshcat" in shown

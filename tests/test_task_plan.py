@@ -100,6 +100,8 @@ def test_a_free_motion_asked_to_end_still_in_jerk_does(shelf: Scene) -> None:
 def test_bad_tasks_are_refused_naming_the_segment(shelf: Scene) -> None:
     with pytest.raises(PlanningError, match="at least one segment"):
         plan_task(shelf, [])
+    with pytest.raises(PlanningError, match=r"the scene fixes duration = 4 s; .* leave the duration out"):
+        plan_task(dataclasses.replace(shelf, duration=4.0), [Wait(0.1)])
     with pytest.raises(PlanningError, match=r"wait seconds = 0 s must be a number in \(0, 3600\] s"):
         Wait(0)
     inside = Target(tcp=(0.35, 0.35, 0.15))  # in the crate

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
@@ -43,6 +43,10 @@ FloatArray = NDArray[np.float64]
 
 LONGEST_WAIT_S = 3600.0
 """The longest wait of a task [s]."""
+_FIXED_DURATION = (
+    "the scene fixes duration = {seconds:g} s; a task times each of its motions as fast as the limits "
+    "allow: leave the duration out (duration=None)"
+)
 
 
 @dataclass(frozen=True)
@@ -116,11 +120,22 @@ class TaskMotion:
         segments: each segment's kind, times and verification, in order.
         trajectory: the whole motion, at rest at each junction.
         continuity: where the whole is not C3 (``None``: it is, at every knot).
+        world: the robot among the scene's obstacles, carrying what it carries at the start
+            (for drawing).
+        margin_m: the scene's safety margin [m].
     """
 
     segments: tuple[SegmentMotion, ...]
     trajectory: Trajectory
     continuity: str | None
+    world: ck.CollisionWorld = field(repr=False)
+    margin_m: float = 0.0
+
+    @property
+    def junctions(self) -> FloatArray:
+        """``(k, nq)`` the configurations where the segments meet, the start and end included."""
+        times = sorted({0.0, *(s.t1 for s in self.segments)})
+        return np.asarray(self.trajectory(np.array(times)))
 
     @property
     def problems(self) -> tuple[str, ...]:
@@ -166,9 +181,11 @@ def plan_task(scene: Scene, segments: Sequence[Segment], robot: ck.Robot | None 
     """
     if not segments:
         raise PlanningError("a task needs at least one segment (a Move, a ToolLine, a Wait, an Attach)")
+    if scene.duration is not None:
+        raise PlanningError(_FIXED_DURATION.format(seconds=scene.duration))
     base = robot or scene.robot_spec().load()
     carrying = _carrying(scene, base, None)
-    q = carrying.problem.q_start
+    q, start_world = carrying.problem.q_start, carrying.problem.world
     records, pieces, now = [], [], 0.0
     for index, segment in enumerate(segments):
         kind = KINDS.get(type(segment), type(segment).__name__)
@@ -192,7 +209,8 @@ def plan_task(scene: Scene, segments: Sequence[Segment], robot: ck.Robot | None 
     whole = joined(pieces)
     robot_names = carrying.problem.robot.joint_names
     units = [carrying.problem.robot.joint_unit(n) for n in robot_names]
-    return TaskMotion(tuple(records), whole, discontinuity(whole, robot_names, units))
+    continuity = discontinuity(whole, robot_names, units)
+    return TaskMotion(tuple(records), whole, continuity, start_world, scene.safety_margin)
 
 
 def _carrying(scene: Scene, base: ck.Robot, q: FloatArray | None) -> _Carrying:
@@ -230,9 +248,7 @@ def _planned(
         scene = dataclasses.replace(carrying.scene, start=Target(q=tuple(q.tolist())), goal=segment.goal)
         moving = build_problem(scene, base)
         if not isinstance(moving.duration, FreeDuration):
-            raise PlanningError(
-                "a task's free motion is timed as fast as the limits allow: leave duration out"
-            )
+            raise PlanningError(_FIXED_DURATION.format(seconds=scene.duration))
         still = dataclasses.replace(moving.duration, still_jerk=True)
         return solve(dataclasses.replace(moving, duration=still)).trajectory, None
     raise PlanningError(

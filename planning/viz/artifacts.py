@@ -6,7 +6,7 @@ The drawing libraries (matplotlib, meshcat) are imported here only when these ar
 from __future__ import annotations
 
 import html
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -14,6 +14,9 @@ from numpy.typing import NDArray
 import cpr_kin as ck
 from planning.curves.trajectory import Trajectory
 from planning.pipeline.result import PlanResult
+
+if TYPE_CHECKING:  # a task is drawn only in a notebook: the task planner is imported there
+    from planning.task.task_plan import TaskMotion
 
 PLOT_FILES = ("joints.png", "tcp_path.png", "clearance.png", "utilisation.png", "convergence.png")
 
@@ -71,17 +74,25 @@ def viewer_html(
         return viewer.static_html()
 
 
-def notebook_viewer(result: PlanResult, height_px: int = 480, collision: bool = False) -> Any:
-    """The plan's animated meshcat viewer for a Jupyter cell: an ``IPython.display.HTML``.
+def notebook_viewer(result: PlanResult | TaskMotion, height_px: int = 480, collision: bool = False) -> Any:
+    """The plan's or the task's animated meshcat viewer for a Jupyter cell: an ``IPython.display.HTML``.
+
+    A task shows the robot as it starts (without what it attaches later) and, as waypoints,
+    the configurations where its segments meet.
 
     The self-contained page of :func:`viewer_html` in an iframe (``srcdoc``), so it needs no
     server once drawn and survives in the saved notebook. ``height_px``: the frame's height.
     """
     from IPython.display import HTML
 
-    page = viewer_html(
-        result.problem.world, result.scene.safety_margin, result.trajectory, result.waypoints, collision
-    )
+    from planning.task.task_plan import TaskMotion
+
+    if isinstance(result, TaskMotion):
+        page = viewer_html(result.world, result.margin_m, result.trajectory, result.junctions, collision)
+    else:
+        page = viewer_html(
+            result.problem.world, result.scene.safety_margin, result.trajectory, result.waypoints, collision
+        )
     source = html.escape(page, quote=True)
     return HTML(  # type: ignore[no-untyped-call]
         f'<div style="height: {int(height_px)}px; width: 100%; resize: both; overflow: hidden">'
