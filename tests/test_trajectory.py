@@ -140,3 +140,14 @@ def test_speed_bounds_hold_on_every_interval_and_never_exceed_the_peak(trajector
     assert np.all(bounds <= trajectory.extrema(1).peak)
     # at rest at both ends: the first and last intervals far below the peak
     assert np.all(bounds[[0, -1]] < 0.5 * trajectory.extrema(1).peak)
+
+
+def test_a_piece_between_two_knots_is_the_trajectory_there(trajectory: Trajectory) -> None:
+    t0, t1 = float(trajectory.knots[1]), float(trajectory.knots[3])
+    piece = trajectory.between(t0, t1)
+    times = np.linspace(t0, t1, 101)
+    for r in range(4):
+        np.testing.assert_allclose(piece(times, r), trajectory(times, r), rtol=1e-9, atol=1e-9)
+    assert piece.knots[0] == t0 and piece.knots[-1] == t1
+    with pytest.raises(PlanningError, match="are not two knots of the trajectory"):
+        trajectory.between(t0 + 1e-3, t1)

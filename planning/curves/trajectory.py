@@ -246,6 +246,13 @@ class Trajectory:
         integral = (square * h**powers / powers).sum(axis=2)
         return np.asarray(integral.sum(axis=0))
 
+    def between(self, t0: float, t1: float) -> Trajectory:
+        """The piece over ``[t0, t1]`` [s], two of its knots (within 1e-9 s): a task's segment."""
+        first, last = (int(np.argmin(np.abs(self.knots - t))) for t in (t0, t1))
+        if max(abs(self.knots[first] - t0), abs(self.knots[last] - t1)) > 1e-9 or last <= first:
+            raise PlanningError(f"[{t0:g}, {t1:g}] s are not two knots of the trajectory, in order")
+        return Trajectory(self.knots[first : last + 1], self.coefficients[first:last])
+
     def time_scaled(self, scale: float) -> Trajectory:
         """The same path run ``scale`` times slower: ``q'(t) = q(t0 + (t - t0) / scale)``.
 

@@ -4,6 +4,7 @@ from .line_deviation import LineDeviation, line_deviation, tool_levers
 from .line_ik import JointLine, joint_line
 from .line_motion import LineMotion, plan_line
 from .task_plan import Attach, Detach, Move, SegmentMotion, TaskMotion, Wait, plan_task
+from .task_record import record_problems, task_record
 from .tool_line import LineGeometry, LineTolerance, ToolLine, ToolPose
 
 __all__ = [
@@ -24,5 +25,7 @@ __all__ = [
     "line_deviation",
     "plan_line",
     "plan_task",
+    "record_problems",
+    "task_record",
     "tool_levers",
 ]

@@ -103,6 +103,7 @@ class SegmentMotion:
         verification: its trajectory's verification with what the robot carries then
             (``None`` for an attach or detach, which does not move).
         line: the planned line, for a ``line``.
+        attached: the payload, for an ``attach``.
     """
 
     kind: str
@@ -110,6 +111,7 @@ class SegmentMotion:
     t1: float
     verification: Verification | None = None
     line: LineMotion | None = None
+    attached: ck.Payload | None = None
 
 
 @dataclass(frozen=True)
@@ -192,7 +194,8 @@ def plan_task(scene: Scene, segments: Sequence[Segment], robot: ck.Robot | None 
         try:
             if isinstance(segment, Attach | Detach):
                 carrying = _carried(carrying, base, q, segment)
-                records.append(SegmentMotion(kind, now, now))
+                attached = segment.payload if isinstance(segment, Attach) else None
+                records.append(SegmentMotion(kind, now, now, attached=attached))
                 continue
             trajectory, line = _planned(carrying, base, q, segment)
         except (PlanningError, ck.CprKinError) as exc:

@@ -1,0 +1,137 @@
+"""What a task promised, as plain JSON types, and a check of those promises from the record alone.
+
+:func:`task_record` gives one entry per segment in time order, the layout issue 71 fixes for
+the trajectory file's ``task`` list: ``kind`` (``free``, ``line``, ``wait``, ``attach``,
+``detach``), ``t0`` and ``t1`` [s]; a ``line`` also ``frame`` (the tool frame), ``from`` and
+``to`` (each ``{xyz, quat_xyzw}`` in the robot's base frame) and ``tolerance:
+{position_m, angle_rad}``; an ``attach`` the object's ``object`` name and ``frame``.
+
+:func:`record_problems` checks a trajectory against such a list without the planner: the
+entries tile the trajectory in time, a ``wait`` stands still, and over each ``line`` the
+tool stays within its tolerance at every instant (:func:`~planning.task.line_deviation.line_deviation`'s
+certified bound on the line the entry names).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import NDArray
+
+import cpr_kin as ck
+from planning.curves.trajectory import Trajectory
+from planning.errors import PlanningError
+from planning.task.line_deviation import line_deviation
+from planning.task.task_plan import TaskMotion
+from planning.task.tool_line import LineGeometry, LineTolerance, ToolPose
+
+FloatArray = NDArray[np.float64]
+
+TIME_TOLERANCE_S = 1e-9
+"""How far entries' times may miss each other or the trajectory's ends [s] (rounding)."""
+STILL_TOLERANCE = 1e-9
+"""How far a joint may move while the robot waits [rad or m]."""
+
+
+def task_record(task: TaskMotion) -> list[dict[str, Any]]:
+    """The task's promises, one entry per segment (module docstring)."""
+    entries = []
+    for segment in task.segments:
+        entry: dict[str, Any] = {"kind": segment.kind, "t0": segment.t0, "t1": segment.t1}
+        if segment.line is not None:
+            line = segment.line
+            entry |= {
+                "frame": line.frame,
+                "from": _pose(line.start),
+                "to": _pose(line.goal),
+                "tolerance": {
+                    "position_m": line.line.tolerance.position_m,
+                    "angle_rad": line.line.tolerance.angle_rad,
+                },
+            }
+        if segment.attached is not None:
+            frame = segment.attached.frame or task.world.robot.tcp_frame
+            entry |= {"object": segment.attached.name, "frame": frame}
+        entries.append(entry)
+    return entries
+
+
+def _pose(pose: ToolPose) -> dict[str, list[float]]:
+    return {"xyz": list(pose.xyz), "quat_xyzw": list(pose.quat_xyzw)}
+
+
+def record_problems(
+    robot: ck.Robot, trajectory: Trajectory, entries: Sequence[Mapping[str, Any]]
+) -> tuple[str, ...]:
+    """Each broken promise of ``entries`` by ``trajectory``, in words (empty: every one kept).
+
+    Raises:
+        PlanningError: an entry that is not one (a missing or wrong field, named).
+    """
+    problems = []
+    end = float(trajectory.knots[0])
+    for index, entry in enumerate(entries):
+        kind, t0, t1 = (
+            _field(entry, "kind", index),
+            float(_field(entry, "t0", index)),
+            float(_field(entry, "t1", index)),
+        )
+        if abs(t0 - end) > TIME_TOLERANCE_S or t1 < t0:
+            problems.append(
+                f"task entry {index} ({kind}) runs [{t0:g}, {t1:g}] s after the last ended at {end:g} s"
+            )
+        end = t1
+        if kind == "wait":
+            held = trajectory(np.linspace(t0, t1, 64))
+            if np.abs(held - held[0]).max() > STILL_TOLERANCE:
+                problems.append(f"task entry {index} (wait) moves during [{t0:g}, {t1:g}] s")
+        elif kind == "line":
+            problems += _line_problems(robot, trajectory, entry, index, (t0, t1))
+    if abs(end - float(trajectory.knots[-1])) > TIME_TOLERANCE_S:
+        problems.append(
+            f"the task's entries end at {end:g} s, the trajectory at {float(trajectory.knots[-1]):g} s"
+        )
+    return tuple(problems)
+
+
+def _line_problems(
+    robot: ck.Robot, trajectory: Trajectory, entry: Mapping[str, Any], index: int, span: tuple[float, float]
+) -> list[str]:
+    """The line's promise over ``span`` [s]: the certified deviation within the tolerance."""
+    start, goal = (
+        _placement(_field(entry, key, index), f"task entry {index} {key}") for key in ("from", "to")
+    )
+    tolerance = _field(entry, "tolerance", index)
+    limit = LineTolerance(float(tolerance["position_m"]), float(tolerance["angle_rad"]))
+    piece = trajectory.between(*span)
+    deviation = line_deviation(
+        robot, str(_field(entry, "frame", index)), LineGeometry(start, goal), piece, limit
+    )
+    if deviation.within(limit):
+        return []
+    return [
+        f"task entry {index} (line) leaves its line by {deviation.position_m:.3g} m and "
+        f"{deviation.angle_rad:.3g} rad (certified; tolerance {limit.position_m:g} m, "
+        f"{limit.angle_rad:g} rad)"
+    ]
+
+
+def _field(entry: Mapping[str, Any], key: str, index: int) -> Any:
+    if not isinstance(entry, Mapping) or key not in entry:
+        raise PlanningError(
+            f"task entry {index} has no '{key}'; an entry has kind, t0, t1 "
+            "(a line also frame, from, to, tolerance)"
+        )
+    return entry[key]
+
+
+def _placement(pose: Any, where: str) -> pin.SE3:
+    try:
+        return ToolPose(tuple(pose["xyz"]), tuple(pose["quat_xyzw"])).placement()
+    except (KeyError, TypeError) as exc:
+        raise PlanningError(
+            f"{where}: expected {{xyz: [x, y, z], quat_xyzw: [x, y, z, w]}} ({exc})"
+        ) from None
