@@ -242,13 +242,24 @@ def verify_for_scene(
     Raises:
         PlanningError: ``joint_names`` are not the robot's.
     """
-    from planning.pipeline.problem import finer_step_m
-
     robot_names = list(problem.robot.joint_names)
     if joint_names is not None and list(joint_names) != robot_names:
         raise PlanningError(f"trajectory joints {list(joint_names)} are not the robot's {robot_names}")
 
-    required = Requirements.of(problem, endpoints=True)
+    return verify_finer_where_needed(problem, trajectory, Requirements.of(problem, endpoints=True))
+
+
+def verify_finer_where_needed(
+    problem: Problem, trajectory: Trajectory, required: Requirements
+) -> Verification:
+    """:func:`verify_trajectory` at ``required``'s steps, then where they cannot certify it at the finer step.
+
+    The finer step is the one the planner falls back to where margin plus step leaves no way
+    (:func:`~planning.pipeline.problem.finer_step_m`); it only tightens the certified bound
+    (more checks, less slack between them), the margins are ``required``'s.
+    """
+    from planning.pipeline.problem import finer_step_m
+
     verification = verify_trajectory(problem.world, trajectory, required)
     if verification.accepted:
         return verification

@@ -79,10 +79,9 @@ def plan_line(
     robot = world.robot
     q = robot.configuration(q_start)
     frame = robot.tcp_frame if line.frame is None else line.frame
-    start = ck.frame_poses(robot, q, frame)
-    geometry = LineGeometry(
-        pin.SE3(start[:3, :3], start[:3, 3]), line.goal(pin.SE3(start[:3, :3], start[:3, 3]))
-    )
+    pose = ck.frame_poses(robot, q, frame)
+    start = pin.SE3(pose[:3, :3], pose[:3, 3])
+    geometry = LineGeometry(start, line.goal(start))
     _refuse_blocked(world, q[None], np.zeros(1), required)  # the start first: bad input
     path = joint_line(robot, q, frame, geometry, line.tolerance)
     _refuse_blocked(world, path.samples, path.sigma, required)

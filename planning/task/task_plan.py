@@ -34,7 +34,7 @@ from planning.pipeline.problem import Problem, build_problem
 from planning.pipeline.scene import Scene
 from planning.pipeline.target import Target
 from planning.pipeline.timing import FreeDuration
-from planning.pipeline.verification import Requirements, Verification, verify_trajectory
+from planning.pipeline.verification import Requirements, Verification, verify_finer_where_needed
 from planning.task.line_motion import LineMotion, plan_line
 from planning.task.tool_line import ToolLine
 from planning.validation import number_in
@@ -197,12 +197,12 @@ def plan_task(scene: Scene, segments: Sequence[Segment], robot: ck.Robot | None 
                 attached = segment.payload if isinstance(segment, Attach) else None
                 records.append(SegmentMotion(kind, now, now, attached=attached))
                 continue
-            trajectory, line = _planned(carrying, base, q, segment)
+            trajectory, line, problem = _planned(carrying, base, q, segment)
         except (PlanningError, ck.CprKinError) as exc:
             raise PlanningError(f"task segment {index} ({type(segment).__name__}): {exc}") from exc
         except NoSolutionError as exc:
             raise TaskSegmentError(index, type(segment).__name__, exc) from exc
-        checked = verify_trajectory(carrying.problem.world, trajectory, carrying.required)
+        checked = verify_finer_where_needed(problem, trajectory, carrying.required)
         records.append(SegmentMotion(kind, now, now + trajectory.duration, checked, line))
         pieces.append(trajectory)
         now += trajectory.duration
@@ -238,22 +238,27 @@ def _carried(carrying: _Carrying, base: ck.Robot, q: FloatArray, segment: Attach
 
 def _planned(
     carrying: _Carrying, base: ck.Robot, q: FloatArray, segment: Segment
-) -> tuple[Trajectory, LineMotion | None]:
-    """One segment from ``q``: its trajectory from time 0, and the line if it is one."""
+) -> tuple[Trajectory, LineMotion | None, Problem]:
+    """One segment from ``q``: its trajectory from time 0, the line if it is one, and a problem.
+
+    The problem is the one whose finer step may certify the segment
+    (:func:`~planning.pipeline.verification.verify_finer_where_needed`): a free motion's own,
+    else the carrying scene's.
+    """
     if isinstance(segment, ToolLine):
         line = plan_line(carrying.problem.world, q, segment, carrying.required)
-        return line.trajectory, line
+        return line.trajectory, line, carrying.problem
     if isinstance(segment, Wait):
         coefficients = np.zeros((1, len(q), 8))
         coefficients[0, :, 0] = q
-        return Trajectory(np.array([0.0, segment.seconds]), coefficients), None
+        return Trajectory(np.array([0.0, segment.seconds]), coefficients), None, carrying.problem
     if isinstance(segment, Move):
         scene = dataclasses.replace(carrying.scene, start=Target(q=tuple(q.tolist())), goal=segment.goal)
         moving = build_problem(scene, base)
         if not isinstance(moving.duration, FreeDuration):
             raise PlanningError(_FIXED_DURATION.format(seconds=scene.duration))
         still = dataclasses.replace(moving.duration, still_jerk=True)
-        return solve(dataclasses.replace(moving, duration=still)).trajectory, None
+        return solve(dataclasses.replace(moving, duration=still)).trajectory, None, moving
     raise PlanningError(
         f"a task segment is a Move, a ToolLine, a Wait, an Attach or a Detach, not a {type(segment).__name__}"
     )
