@@ -1,12 +1,14 @@
-"""Forward kinematics of any frame, for one configuration or a batch."""
+"""Forward kinematics of any frame, for one configuration or a batch, and how far each joint moves it."""
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
-from cpr_kin.model.robot import Robot
+from cpr_kin.model.robot import Robot, joint_units
 
 FloatArray = NDArray[np.float64]
 
@@ -48,3 +50,44 @@ def frame_positions(robot: Robot, q: ArrayLike, frame: str | None = None) -> Flo
     """Positions ``frame_in_world`` [m] of ``frame``: ``(3,)`` or ``(N, 3)``."""
     poses = frame_poses(robot, q, frame)
     return poses[..., :3, 3]
+
+
+@dataclass(frozen=True)
+class FrameLevers:
+    """How far each joint can move a frame's origin (:func:`frame_levers`).
+
+    Attributes:
+        levers: ``(nq,)`` per joint, a bound of the origin's speed per unit of the joint's:
+            a revolute joint's distance to the origin at most [m/rad], 1 for a prismatic one
+            [m/m], 0 off the frame's chain.
+        turns: ``(nq,)`` 1 where a revolute joint of the chain turns the frame, else 0.
+        reach_m: a bound of the origin's distance from the model's origin, in any configuration [m].
+    """
+
+    levers: FloatArray
+    turns: FloatArray
+    reach_m: float
+
+
+def frame_levers(robot: Robot, frame: str) -> FrameLevers:
+    """Each joint's lever to ``frame``'s origin, and the origin's reach (:class:`FrameLevers`).
+
+    The offsets along the chain from a joint to the frame, added up (a joint turns an offset,
+    never lengthens it), plus each prismatic joint's largest travel between them; from the
+    model's origin, the reach.
+    """
+    model = robot.model
+    placed = model.frames[robot.frame_id(frame)]
+    units = joint_units(model)
+    levers, turns = np.zeros(robot.nq), np.zeros(robot.nq)
+    reach = float(np.linalg.norm(placed.placement.translation))
+    joint = placed.parentJoint
+    while joint > 0:
+        index = model.joints[joint].idx_q
+        prismatic = units[joint - 1] == "m"
+        levers[index], turns[index] = (1.0, 0.0) if prismatic else (reach, 1.0)
+        reach += float(np.linalg.norm(model.jointPlacements[joint].translation))
+        if prismatic:
+            reach += float(max(abs(model.lowerPositionLimit[index]), abs(model.upperPositionLimit[index])))
+        joint = model.parents[joint]
+    return FrameLevers(levers, turns, reach)

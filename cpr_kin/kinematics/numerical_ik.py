@@ -24,7 +24,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.certified.motion import path_weights
 from cpr_kin.common.errors import CprKinError, IkMissError
-from cpr_kin.model.robot import Robot, joint_units
+from cpr_kin.kinematics.forward import frame_levers
+from cpr_kin.model.robot import Robot
 
 FloatArray = NDArray[np.float64]
 
@@ -175,20 +176,10 @@ def tool_reach_m(robot: Robot) -> float:
     """An upper bound of the tool frame's distance from the model's origin, in any configuration [m].
 
     The offsets along the chain from the origin to the tool frame, added up (a joint turns an
-    offset, never lengthens it), plus each prismatic joint's largest travel.
+    offset, never lengthens it), plus each prismatic joint's largest travel
+    (:func:`~cpr_kin.kinematics.forward.frame_levers`).
     """
-    model = robot.model
-    frame = model.frames[robot.frame_id(robot.tcp_frame)]
-    units = joint_units(model)
-    reach = float(np.linalg.norm(frame.placement.translation))
-    joint = frame.parentJoint
-    while joint > 0:
-        reach += float(np.linalg.norm(model.jointPlacements[joint].translation))
-        if units[joint - 1] == "m":  # prismatic
-            index = model.joints[joint].idx_q
-            reach += float(max(abs(model.lowerPositionLimit[index]), abs(model.upperPositionLimit[index])))
-        joint = model.parents[joint]
-    return reach
+    return frame_levers(robot, robot.tcp_frame).reach_m
 
 
 def solve_ik(

@@ -1,6 +1,6 @@
 """Type stub of the package: what it exports, and from which module (read by ``lazy_loader``)."""
 
-from .line_deviation import LineDeviation, line_deviation, tool_levers
+from .line_deviation import LineDeviation, line_deviation
 from .line_ik import JointLine, joint_line
 from .line_motion import LineMotion, plan_line
 from .task_plan import Attach, Detach, Move, SegmentMotion, TaskMotion, Wait, plan_task
@@ -27,5 +27,4 @@ __all__ = [
     "plan_task",
     "record_problems",
     "task_record",
-    "tool_levers",
 ]

@@ -5,11 +5,12 @@ the angle between the tool frame's orientation and the line's at the same progre
 (the origin's projection on the segment; for a line that only turns, the orientation's
 projection on its turn). Both are measured by forward kinematics at samples ``dt`` apart,
 and bounded between them by how fast they can change: the tool's origin moves at most
-``sum_j L_j |q'_j|`` (:func:`tool_levers`: each joint's lever to the tool frame, 1 for a
-prismatic one), its orientation turns at most ``sum_j |q'_j|`` over the revolute joints of its
-chain, with each joint's speed bounded over the interval by the trajectory's own
-(:meth:`~planning.curves.trajectory.Trajectory.speed_bounds`). A distance that changes at most
-at rate ``V`` and is ``d_k``, ``d_k+1`` at the interval's ends stays below
+``sum_j L_j |q'_j|`` (each joint's lever to the tool frame, 1 for a prismatic one:
+:func:`cpr_kin.kinematics.forward.frame_levers`), its orientation turns at most
+``sum_j |q'_j|`` over the revolute joints of its chain, with each joint's speed bounded over
+the interval by the trajectory's own
+(:meth:`~planning.curves.trajectory.Trajectory.speed_bounds`). A distance that changes at
+most at rate ``V`` and is ``d_k``, ``d_k+1`` at the interval's ends stays below
 ``(d_k + d_k+1 + V dt) / 2``: the certified bound. ``dt`` is chosen so that ``V dt`` is
 :data:`SLACK_SHARE` of the tolerance.
 """
@@ -23,6 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
+from cpr_kin.kinematics.forward import frame_levers
 from planning.curves.trajectory import Trajectory
 from planning.task.tool_line import SHORTEST_LINE_M, LineGeometry, LineTolerance
 
@@ -64,35 +66,12 @@ class LineDeviation:
         return self.position_m <= tolerance.position_m and self.angle_rad <= tolerance.angle_rad
 
 
-def tool_levers(robot: ck.Robot, frame: str) -> tuple[FloatArray, FloatArray]:
-    """``(nq,)`` each joint's lever to ``frame``'s origin [m/rad, m/m], and ``(nq,)`` 1 where it turns it.
-
-    A revolute joint's lever bounds the distance from its axis to the frame's origin: the
-    offsets along the chain below it added up, with each prismatic joint's largest travel. A
-    prismatic joint moves the origin as fast as it moves (lever 1); a joint off the chain not at all.
-    """
-    model = robot.model
-    lever, turns = np.zeros(robot.nq), np.zeros(robot.nq)
-    placed = model.frames[robot.frame_id(frame)]
-    reach = float(np.linalg.norm(placed.placement.translation))
-    joint = placed.parentJoint
-    while joint > 0:
-        index = model.joints[joint].idx_q
-        if robot.joint_unit(robot.joint_names[index]) == "m":
-            lever[index] = 1.0
-            reach += max(abs(robot.limits.lower[index]), abs(robot.limits.upper[index]))
-        else:
-            lever[index], turns[index] = reach, 1.0
-        reach += float(np.linalg.norm(model.jointPlacements[joint].translation))
-        joint = model.parents[joint]
-    return lever, turns
-
-
 def line_deviation(
     robot: ck.Robot, frame: str, geometry: LineGeometry, trajectory: Trajectory, tolerance: LineTolerance
 ) -> LineDeviation:
     """The certified deviation of ``trajectory`` from ``geometry`` (the module's rule)."""
-    lever, turns = tool_levers(robot, frame)
+    levers = frame_levers(robot, frame)
+    lever, turns = levers.levers, levers.turns
     peak = trajectory.extrema(1).peak
     shift = float(np.linalg.norm(geometry.shift_m))
     turn = float(np.linalg.norm(geometry.turn))
