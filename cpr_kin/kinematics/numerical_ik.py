@@ -160,16 +160,29 @@ def _descend(
         jacobian = pin.computeFrameJacobian(model, data, q, frame, frame_type)
         error = target.position - placement.translation
         if target.rotation is not None:
-            rotation_error = placement.rotation @ pin.log3(placement.rotation.T @ target.rotation)
-            error = np.concatenate([error, rotation_error])
+            error = np.concatenate([error, rotation_error(placement.rotation, target.rotation)])
         else:
             jacobian = jacobian[:3]
         jacobian = jacobian * free  # a held joint's column is zero: it does not move
-        system = jacobian @ jacobian.T + settings.damping**2 * np.eye(len(error))
-        step = jacobian.T @ np.linalg.solve(system, error)
+        step = damped_step(jacobian, error, settings.damping)
         step = np.clip(step, -settings.max_step, settings.max_step)
         q = np.clip(q + step, lower, upper)
     return q
+
+
+def rotation_error(rotation: FloatArray, target: FloatArray) -> FloatArray:
+    """``(3,)`` the rotation from ``rotation`` to ``target`` (``(3, 3)`` each), world-aligned [rad].
+
+    The logarithm of the relative rotation, in the axes of the world: what a
+    ``LOCAL_WORLD_ALIGNED`` Jacobian's angular rows move.
+    """
+    return np.asarray(rotation @ pin.log3(rotation.T @ target))
+
+
+def damped_step(jacobian: FloatArray, error: FloatArray, damping: float) -> FloatArray:
+    """The damped least-squares step ``J^T (J J^T + lambda^2 I)^-1 e`` with ``lambda = damping``."""
+    system = jacobian @ jacobian.T + damping**2 * np.eye(len(error))
+    return np.asarray(jacobian.T @ np.linalg.solve(system, error))
 
 
 def tool_reach_m(robot: Robot) -> float:

@@ -25,6 +25,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 import cpr_kin as ck
+from cpr_kin.kinematics.numerical_ik import damped_step, rotation_error
 from planning.curves.interpolating_spline import spline_through
 from planning.curves.trajectory import Trajectory
 from planning.errors import ToolLineBrokenError
@@ -145,7 +146,7 @@ def _weights(tolerance: LineTolerance) -> FloatArray:
 
 def _error(placement: pin.SE3, target: pin.SE3) -> FloatArray:
     """``(6,)`` position and rotation error to ``target``, world-aligned [m, rad]."""
-    rotation = placement.rotation @ pin.log3(placement.rotation.T @ target.rotation)
+    rotation = rotation_error(placement.rotation, target.rotation)
     return np.concatenate([target.translation - placement.translation, rotation])
 
 
@@ -208,16 +209,17 @@ def _range(robot: ck.Robot) -> tuple[FloatArray, FloatArray]:
 
 
 def _jacobian(model: object, data: object, fid: int, q: FloatArray) -> FloatArray:
-    pin.computeJointJacobians(model, data, q)
-    pin.updateFramePlacements(model, data)
-    return np.asarray(pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED))
+    return np.asarray(pin.computeFrameJacobian(model, data, q, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED))
 
 
 def _solve(jacobian: FloatArray, error: FloatArray) -> FloatArray:
-    """The damped least-squares step ``J^T (J J^T + lambda^2 I)^-1 e``."""
-    square = jacobian @ jacobian.T
-    system = square + DAMPING**2 * max(float(np.trace(square)), 1.0) * np.eye(len(error))
-    return np.asarray(jacobian.T @ np.linalg.solve(system, error))
+    """The damped least-squares step, its damping :data:`DAMPING` of the Jacobian's size.
+
+    :func:`~cpr_kin.kinematics.numerical_ik.damped_step`, with ``lambda^2`` that share squared
+    of the trace of ``J J^T`` (at least 1).
+    """
+    size = max(float(np.sum(jacobian * jacobian)), 1.0)  # the trace of J J^T
+    return damped_step(jacobian, error, DAMPING * math.sqrt(size))
 
 
 def _newton(
