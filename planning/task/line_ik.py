@@ -29,6 +29,7 @@ from cpr_kin.kinematics.numerical_ik import damped_step, rotation_error
 from planning.curves.interpolating_spline import spline_through
 from planning.curves.trajectory import Trajectory
 from planning.errors import ToolLineBrokenError
+from planning.task.line_deviation import rotation_angles
 from planning.task.tool_line import LineGeometry, LineTolerance
 
 FloatArray = NDArray[np.float64]
@@ -274,11 +275,13 @@ def _excess(
     sigma: FloatArray,
     configurations: FloatArray,
 ) -> float:
-    """The largest error of ``configurations`` from the line's poses at ``sigma``, over the tolerance."""
+    """The largest error of ``configurations`` from the line's poses at ``sigma``, over the tolerance.
+
+    As :func:`_size` of :func:`_error` weighted, for all at once: the rotation error's norm is
+    the relative rotation's angle.
+    """
     poses = ck.frame_poses(robot, configurations, frame)
-    worst = 0.0
-    for s, pose in zip(sigma, poses, strict=True):
-        target = geometry.pose(float(s))
-        error = _error(pin.SE3(pose[:3, :3], pose[:3, 3]), target) * _weights(tolerance)
-        worst = max(worst, _size(error))
-    return worst
+    on_line = geometry.start.translation + sigma[:, None] * geometry.shift_m
+    distance = np.linalg.norm(poses[:, :3, 3] - on_line, axis=1) / tolerance.position_m
+    relative = np.einsum("nji,njk->nik", poses[:, :3, :3], geometry.rotations(sigma))
+    return float(max(distance.max(), (rotation_angles(relative) / tolerance.angle_rad).max()))
