@@ -15,7 +15,7 @@ from .errors import (
     TargetOutOfReachError,
 )
 from .io.bundled import paper_scene
-from .io.scene_file import dump_scene, load_scene
+from .io.scene_file import dump_scene, load_scene, load_scene_file
 from .io.trajectory_io import write_samples, write_trajectory
 from .io.trajectory_reader import TrajectoryFileError, read_trajectory
 from .pipeline.metrics import Metrics
@@ -81,6 +81,7 @@ __all__ = [
     "firefly_minimize",
     "fit_septic_spline",
     "load_scene",
+    "load_scene_file",
     "paper_scene",
     "plan",
     "ptp_time",

@@ -89,6 +89,6 @@ class TaskSegmentError(NoSolutionError):
     """
 
     def __init__(self, segment: int, kind: str, cause: NoSolutionError) -> None:
-        super().__init__(f"task segment {segment} ({kind}): {cause}")
+        super().__init__(f"task[{segment}] ({kind}): {cause}")
         self.segment = segment
         self.cause = cause

@@ -23,7 +23,13 @@ EXPECTED = {
         "point cloud: ",
         "wrote out/examples/cloud/trajectory.json",
     ],
-    "pick_and_place.py": ["free    0.000 -> ", "attach ", "detach ", "verified True, certified clearance 0."],
+    "pick_and_place.py": [
+        "free    0.000 -> ",
+        "attach ",
+        "detach ",
+        "verified True, certified clearance 0.",
+        "against the task: kept",
+    ],
     "tool_lines.py": ["approach: 0.", "certified deviation 0.", "straight down: ", "% achieved"],
     "check_a_trajectory.py": [
         "theirs.json: verified",

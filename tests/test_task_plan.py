@@ -105,14 +105,12 @@ def test_bad_tasks_are_refused_naming_the_segment(shelf: Scene) -> None:
     with pytest.raises(PlanningError, match=r"wait seconds = 0 s must be a number in \(0, 3600\] s"):
         Wait(0)
     inside = Target(tcp=(0.35, 0.35, 0.15))  # in the crate
-    with pytest.raises(PlanningError, match=r"task segment 1 \(Move\): "):
+    with pytest.raises(PlanningError, match=r"task\[1\] \(move\): "):
         plan_task(shelf, [Wait(0.1), Move(inside)])
 
 
 def test_a_line_that_breaks_in_a_task_names_its_segment_and_share(shelf: Scene) -> None:
-    with pytest.raises(
-        TaskSegmentError, match=r"task segment 1 \(ToolLine\): the tool line breaks after"
-    ) as err:
+    with pytest.raises(TaskSegmentError, match=r"task\[1\] \(line\): the tool line breaks after") as err:
         plan_task(shelf, [Wait(0.1), ToolLine(by=(0.0, 0.0, -0.5), offset_frame="base")])
     assert err.value.segment == 1
     assert isinstance(err.value.cause, ToolLineBrokenError) and 0.0 < err.value.cause.fraction < 1.0
@@ -141,17 +139,15 @@ def test_an_attached_part_adds_its_weight_to_the_vertical_axis_and_its_shape_to_
     ball = ck.Payload(
         mass_kg=0.5, shape=ck.Obstacle.sphere(0.25, (0.0, 0.0, 0.0)), touch_links=("tool_link",)
     )
-    with pytest.raises(PlanningError, match=r"task segment 3 \(Attach\): .* from obstacle 'pipe'"):
+    with pytest.raises(PlanningError, match=r"task\[3\] \(attach\): .* from obstacle 'pipe'"):
         plan_task(shelf, [above, down, Wait(0.2), Attach(ball)])
 
 
 def test_attach_and_detach_out_of_turn_are_refused(shelf: Scene) -> None:
-    with pytest.raises(
-        PlanningError, match=r"task segment 1 \(Detach\): detach: the robot carries nothing here"
-    ):
+    with pytest.raises(PlanningError, match=r"task\[1\] \(detach\): detach: the robot carries nothing here"):
         plan_task(shelf, [Wait(0.1), Detach()])
     part = ck.Payload(mass_kg=0.2, name="part")
     with pytest.raises(
-        PlanningError, match=r"task segment 1 \(Attach\): attach: the robot already carries 'part'"
+        PlanningError, match=r"task\[1\] \(attach\): attach: the robot already carries 'part'"
     ):
         plan_task(shelf, [Attach(part), Attach(part)])

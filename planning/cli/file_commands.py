@@ -26,8 +26,13 @@ def cmd_check(args: argparse.Namespace) -> int:
     from planning.pipeline.problem import build_problem
     from planning.pipeline.verification import verify_for_scene
 
-    scene = load(args.scene)
+    read = load(args.scene)
     document = read_trajectory(args.trajectory)
+    if read.task or document.task is not None:
+        from planning.cli.task_check_command import check_task_file
+
+        return check_task_file(read, document, args)
+    scene = read.scene
     problem = build_problem(scene)
     verification = verify_for_scene(problem, document.trajectory, document.joint_names)
     check, problems = verification.check, verification.problems
@@ -80,10 +85,11 @@ def shown_robot(document: TrajectoryFile, scene: Scene, urdf: Path | None) -> ck
 
 def cmd_show(args: argparse.Namespace) -> int:
     """Show a trajectory file in a live meshcat viewer, or write it as one HTML page."""
+    from planning.cli.task_check_command import timeline
     from planning.curves.continuity import discontinuity
     from planning.io.output_paths import check_not_inputs
     from planning.io.publish import write_file
-    from planning.io.scene_file import parse_scene
+    from planning.io.scene_file import parse_scene_file
     from planning.io.trajectory_reader import read_trajectory
     from planning.viz import artifacts
 
@@ -93,7 +99,9 @@ def cmd_show(args: argparse.Namespace) -> int:
     jump = discontinuity(document.trajectory, document.joint_names)
     if jump is not None:  # shown all the same: seeing it is what show is for
         print(escaped(f"warning: {args.trajectory} {jump}; `cpr-plan check` fails it"), file=sys.stderr)
-    scene = parse_scene(document.scene, source=f"{args.trajectory} (scene)")
+    scene = parse_scene_file(document.scene, source=f"{args.trajectory} (scene)").scene
+    if document.task is not None:
+        print(escaped(timeline(document.task)), flush=True)
     robot = ck.carrying(shown_robot(document, scene, args.urdf), scene.payload)  # its shape drawn too
     if robot.joint_names != document.joint_names:
         raise PlanningError(

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -16,6 +17,8 @@ from planning.outcome import EXIT_OK, Interrupted, interruption
 if TYPE_CHECKING:
     from collections.abc import Callable
 
+    from planning.io.publish import OutputFolder
+    from planning.io.scene_file import SceneFile
     from planning.pipeline.scene import Scene
     from planning.search.firefly import FireflyProgress
 
@@ -23,11 +26,11 @@ OVERRIDES = ("seed", "fitness", "fireflies", "iterations", "time_limit_s")
 """Planner settings the command line may change, by their scene-file keys."""
 
 
-def load(path: Path) -> Scene:
-    """The scene file at ``path`` (a :class:`~planning.errors.SceneError` names what is wrong)."""
-    from planning.io.scene_file import load_scene
+def load(path: Path) -> SceneFile:
+    """The scene file at ``path``, its task too (a :class:`~planning.errors.SceneError` names the fault)."""
+    from planning.io.scene_file import load_scene_file
 
-    return load_scene(path)
+    return load_scene_file(path)
 
 
 def _checked(update: Callable[[FireflyProgress], None] | None) -> Callable[[FireflyProgress], None]:
@@ -41,21 +44,28 @@ def _checked(update: Callable[[FireflyProgress], None] | None) -> Callable[[Fire
     return progress
 
 
-def _plan_and_write(scene: Scene, out: str, args: argparse.Namespace, paper: bool) -> int:
-    from planning.io.outputs import plan_files
-    from planning.io.publish import OutputFolder
-    from planning.io.report import paper_rows, summary, summary_line, text_table
-    from planning.pipeline.planner import plan
+def _with_overrides(scene: Scene, args: argparse.Namespace) -> Scene:
+    """``scene`` with the planner settings the command line changes."""
     from planning.pipeline.settings import PAPER_SEARCH
 
     overrides = {k: getattr(args, k) for k in OVERRIDES if getattr(args, k, None) is not None}
     if getattr(args, "paper_search", False):
         overrides = {**PAPER_SEARCH, **overrides}  # a --fireflies or --iterations given still wins
-    if overrides:
-        scene = scene.with_planner(**overrides)
+    return scene.with_planner(**overrides) if overrides else scene
+
+
+def _plan_and_write(read: SceneFile, out: str, args: argparse.Namespace, paper: bool) -> int:
+    from planning.io.outputs import plan_files
+    from planning.io.publish import OutputFolder
+    from planning.io.report import paper_rows, summary, summary_line, text_table
+    from planning.pipeline.planner import plan
+
+    scene = _with_overrides(read.scene, args)
     update, close = firefly_progress(sys.stdout.isatty() and not args.json)
     with OutputFolder(out) as folder:  # locked from here: a second writer is refused at once
         try:
+            if read.task:
+                return _task_planned_and_written(scene, read, folder, args, update, close)
             result = plan(scene, progress=_checked(update))
             close()
             files = plan_files(result, paper=paper, timings=args.timings)
@@ -78,6 +88,40 @@ def _plan_and_write(scene: Scene, out: str, args: argparse.Namespace, paper: boo
             raise
         finally:
             close()
+    return EXIT_OK
+
+
+def _task_planned_and_written(
+    scene: Scene,
+    read: SceneFile,
+    folder: OutputFolder,
+    args: argparse.Namespace,
+    update: Callable[[FireflyProgress], None] | None,
+    close: Callable[[], None],
+) -> int:
+    """Plan the scene file's task and publish its files (:mod:`planning.io.task_outputs`)."""
+    from planning.errors import NoSolutionError
+    from planning.io.task_outputs import task_files, task_summary, task_summary_line
+    from planning.task import plan_task
+
+    began = time.perf_counter()
+    task = plan_task(scene, read.task, progress=_checked(update))
+    elapsed = time.perf_counter() - began
+    close()
+    if not task.accepted:  # each segment verified, the junctions C3: a failure here is a bug's
+        raise NoSolutionError("the planned task fails its verification: " + "; ".join(task.problems))
+    files = task_files(task, elapsed if args.timings else None)
+    if args.plots or args.html:
+        from planning.viz.artifacts import task_drawn_files
+
+        files |= task_drawn_files(task, plots=args.plots, page=args.html)
+    checkpoint()
+    outputs = folder.publish(files)
+    if args.json:
+        print(json.dumps({**task_summary(task, elapsed), "outputs": [str(p) for p in outputs]}, indent=1))
+    else:
+        print(task_summary_line(task, elapsed))
+        print(escaped("wrote " + ", ".join(str(p) for p in outputs)))
     return EXIT_OK
 
 

@@ -16,47 +16,75 @@ CMA-ES, 3 waypoints, clearance
 fitness, seed 0, spline path, IPO 0.012 s, 64 fitness samples, verification step 0.005 m,
 no bound on the node deviation; ``spline``: p = 1e6, a = [0, 0, 1],
 ``ends: rest``. They are read from :mod:`planning.pipeline.scene`, the one place they are set.
+
+A scene file holds a ``goal`` (one motion, :func:`load_scene`) or a ``task`` (segments,
+:mod:`planning.io.task_entry`; :func:`load_scene_file` reads both).
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import yaml
 from pydantic import ValidationError
 
 import cpr_kin as ck
 from cpr_kin.common.names import repeated
 from cpr_kin.common.user_files import UserFileError, load_yaml
-from cpr_kin.kinematics.dynamics import PAYLOAD_NAME
 from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError, SceneError
 from planning.io.cloud_entry import PointCloudSpec, RobotAtStart, cloud_obstacles
 from planning.io.publish import write_file
 from planning.io.robot_entry import default_robot, robot_entry, robot_spec_of
-from planning.io.scene_schema import (
-    BoxSpec,
-    CapsuleSpec,
-    CylinderSpec,
-    MeshSpec,
-    SceneSpec,
-    SphereSpec,
-    describe_errors,
-)
+from planning.io.scene_schema import SceneSpec, describe_errors
+from planning.io.shape_entry import obstacle_of, obstacle_to_dict, payload_to_dict
 from planning.io.target_entry import target_entry
+from planning.io.task_entry import task_entries, task_segments
 from planning.pipeline.scene import DEFAULT_SELF_MARGIN_M, MAX_OBSTACLES, Scene
 from planning.pipeline.settings import PlannerSettings
 from planning.pipeline.target import Target
+from planning.task.segments import Segment
 
 MAX_SCENE_BYTES = 1_000_000
 """Largest scene file [bytes]: the largest valid scene (500 obstacles) takes about 60 kB."""
 
 
+@dataclass(frozen=True)
+class SceneFile:
+    """A scene file read: its scene, and its task if it holds one.
+
+    Attributes:
+        scene: the scene; where the file holds a task, its goal is its start (a task's
+            segments say where the robot goes).
+        task: the task's segments in order (:mod:`planning.task`); empty: the scene's one motion.
+    """
+
+    scene: Scene
+    task: tuple[Segment, ...] = ()
+
+
 def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> Scene:
-    """Validate a scene given as parsed YAML and build the :class:`Scene`.
+    """Validate a scene given as parsed YAML and build the :class:`Scene` (not a task's: see below).
+
+    Raises:
+        SceneError: anything wrong, with the field path, the value and what is allowed; a
+            scene that holds a task (:func:`parse_scene_file` reads it).
+    """
+    read = parse_scene_file(data, source, base)
+    if read.task:
+        raise SceneError(
+            f"{source} holds a task of {len(read.task)} segments, not one motion to a goal: plan it with "
+            "`cpr-plan plan`, or read it with planning.io.load_scene_file and plan it with "
+            "planning.task.plan_task"
+        )
+    return read.scene
+
+
+def parse_scene_file(data: Any, source: str = "scene", base: Path | None = None) -> SceneFile:
+    """Validate a scene given as parsed YAML and build the :class:`SceneFile` (its scene and task).
 
     Args:
         data: the parsed document (must be a mapping).
@@ -85,7 +113,7 @@ def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> S
         payload = None
         if spec.payload is not None:
             shape = spec.payload.shape
-            payload = spec.payload.payload(None if shape is None else _obstacle(shape, "payload", base))
+            payload = spec.payload.payload(None if shape is None else obstacle_of(shape, "payload", base))
     except ck.CprKinError as exc:
         raise SceneError(f"{source}: payload: {exc}") from None
     start = spec.start.target()
@@ -97,7 +125,7 @@ def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> S
             if isinstance(item, PointCloudSpec):
                 obstacles += cloud_obstacles(item, name, base, at_start)
             else:
-                obstacles.append(_obstacle(item, name, base))
+                obstacles.append(obstacle_of(item, name, base))
         except ck.CprKinError as exc:
             raise SceneError(f"{source}: obstacles[{index}]: {exc}") from None
     if len(obstacles) > MAX_OBSTACLES:  # a cloud's blocks count
@@ -114,15 +142,16 @@ def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> S
     planner = spec.planner.model_dump()
     if planner["moving_joints"] is not None:
         planner["moving_joints"] = tuple(planner["moving_joints"])
+    task = () if spec.task is None else task_segments(spec.task, payload, base, source)
     try:
-        return Scene(
+        scene = Scene(
             name=spec.name or source,
             robot=robot,
             safety_margin=spec.safety_margin,
             self_margin=spec.self_margin,
             allowed_collisions=tuple((a, b) for a, b in spec.allowed_collisions),
             start=start,
-            goal=spec.goal.target(),
+            goal=start if spec.goal is None else spec.goal.target(),
             duration=spec.duration,
             obstacles=tuple(obstacles),
             planner=PlannerSettings.from_flat(planner),
@@ -132,6 +161,7 @@ def parse_scene(data: Any, source: str = "scene", base: Path | None = None) -> S
         )
     except PlanningError as exc:
         raise SceneError(f"{source}: {exc}") from None
+    return SceneFile(scene, task)
 
 
 def _robot_at_start(
@@ -162,63 +192,32 @@ def _robot_at_start(
     return RobotAtStart(loaded, q, spec.safety_margin)
 
 
-def _obstacle(
-    item: BoxSpec | SphereSpec | CylinderSpec | CapsuleSpec | MeshSpec, name: str, base: Path
-) -> ck.Obstacle:
-    """The obstacle (or payload shape) of a validated entry; a mesh relative to ``base``.
-
-    Raises:
-        cpr_kin.CprKinError: a shape coal cannot build, a mesh that cannot be read.
-    """
-    if isinstance(item, BoxSpec):
-        return ck.Obstacle.box(item.size, item.xyz, item.rpy, name=name)
-    if isinstance(item, SphereSpec):
-        return ck.Obstacle.sphere(item.radius, item.xyz, name=name)
-    if isinstance(item, CylinderSpec):
-        return ck.Obstacle.cylinder(item.radius, item.length, item.xyz, item.rpy, name=name)
-    if isinstance(item, CapsuleSpec):
-        return ck.Obstacle.capsule(item.radius, item.length, item.xyz, item.rpy, name=name)
-    mesh = (base / item.mesh).resolve()  # absolute: the scene may be planned elsewhere
-    obstacle = ck.Obstacle.from_mesh(mesh, item.xyz, item.rpy, item.scale, item.convex, name=name)
-    obstacle.geometry()  # read the file now: a broken mesh is a scene error
-    return obstacle
-
-
 def load_scene(path: str | Path) -> Scene:
-    """Read and validate a scene file; raises :class:`SceneError` naming what is wrong.
+    """Read and validate a scene file of one motion; raises :class:`SceneError` naming what is wrong.
 
     The file is read by :func:`cpr_kin.common.user_files.load_yaml`: at most
-    :data:`MAX_SCENE_BYTES`, no anchors or aliases, no duplicate keys, bounded nesting.
+    :data:`MAX_SCENE_BYTES`, no anchors or aliases, no duplicate keys, bounded nesting. A file
+    that holds a task is refused (:func:`load_scene_file` reads it).
     """
     path = Path(path)
+    return parse_scene(_read(path), source=str(path), base=path.parent)
+
+
+def load_scene_file(path: str | Path) -> SceneFile:
+    """Read and validate a scene file, a task's too (see :func:`load_scene`)."""
+    path = Path(path)
+    return parse_scene_file(_read(path), source=str(path), base=path.parent)
+
+
+def _read(path: Path) -> Any:
     try:
-        data = load_yaml(path, MAX_SCENE_BYTES, "scene file")
+        return load_yaml(path, MAX_SCENE_BYTES, "scene file")
     except UserFileError as exc:
         raise SceneError(str(exc)) from None
-    return parse_scene(data, source=str(path), base=path.parent)
 
 
-def obstacle_to_dict(obstacle: ck.Obstacle) -> dict[str, Any]:
-    """An obstacle in the scene file's form (docs/formats.md)."""
-    entry: dict[str, Any] = {"name": obstacle.name, "shape": obstacle.shape}
-    if obstacle.shape == "box":
-        entry["size"] = np.asarray(obstacle.size).tolist()
-    if obstacle.shape in ("sphere", "cylinder", "capsule"):
-        entry["radius"] = obstacle.radius
-    if obstacle.shape in ("cylinder", "capsule"):
-        entry["length"] = obstacle.length
-    if obstacle.shape == "mesh":
-        entry.update(mesh=str(obstacle.mesh), scale=obstacle.scale, convex=obstacle.convex)
-    if obstacle.shape == "voxels":  # the voxel centres: they read back as the same voxels
-        entry.update(
-            shape="point_cloud", points=np.asarray(obstacle.points).tolist(), resolution=obstacle.resolution
-        )
-    entry.update(xyz=obstacle.xyz.tolist(), rpy=obstacle.rpy.tolist())
-    return entry
-
-
-def scene_to_dict(scene: Scene) -> dict[str, Any]:
-    """The scene as planned: robot (unless the default), obstacles, margins, start, goal, duration."""
+def scene_to_dict(scene: Scene, task: Sequence[Segment] = ()) -> dict[str, Any]:
+    """The scene as planned: robot (unless the default), obstacles, margins, start, goal or task, duration."""
     return {
         "name": scene.name,
         **({} if scene.robot in (None, default_robot()) else {"robot": robot_entry(scene.robot)}),
@@ -230,7 +229,7 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
             else {}
         ),
         "start": target_entry(scene.start),
-        "goal": target_entry(scene.goal),
+        **({"task": task_entries(task)} if task else {"goal": target_entry(scene.goal)}),
         "duration": scene.duration,
         "obstacles": [obstacle_to_dict(o) for o in scene.obstacles],
         **({} if scene.payload is None else {"payload": payload_to_dict(scene.payload)}),
@@ -238,27 +237,12 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
     }
 
 
-def payload_to_dict(payload: ck.Payload) -> dict[str, Any]:
-    """A payload in the scene file's form (docs/formats.md)."""
-    entry: dict[str, Any] = {} if payload.name == PAYLOAD_NAME else {"name": payload.name}
-    entry |= {"mass_kg": payload.mass_kg, "com_in_tcp": list(payload.com_in_frame_m)}
-    if payload.inertia_kg_m2 is not None:
-        entry["inertia"] = [list(row) for row in payload.inertia_kg_m2]
-    if payload.frame is not None:
-        entry["frame"] = payload.frame
-    if payload.shape is not None:
-        entry["shape"] = {k: v for k, v in obstacle_to_dict(payload.shape).items() if k != "name"}
-    if payload.touch_links:
-        entry["touch_links"] = list(payload.touch_links)
-    return entry
-
-
-def scene_document(scene: Scene) -> dict[str, Any]:
-    """The scene file's document for ``scene`` (the inverse of :func:`parse_scene`)."""
+def scene_document(scene: Scene, task: Sequence[Segment] = ()) -> dict[str, Any]:
+    """The scene file's document for ``scene`` and its ``task`` (the inverse of :func:`parse_scene_file`)."""
     planner = scene.planner.flat()
     if planner["moving_joints"] is not None:
         planner["moving_joints"] = list(planner["moving_joints"])
-    document = scene_to_dict(scene)
+    document = scene_to_dict(scene, task)
     if document["duration"] is None:
         del document["duration"]
     document["planner"] = planner

@@ -11,26 +11,29 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal
 
-import numpy as np
 from pydantic import AfterValidator, BaseModel, Field, ValidationError, model_validator
 
-import cpr_kin as ck
-from cpr_kin.kinematics.dynamics import MAX_COM_OFFSET_M, MAX_PAYLOAD_KG, PAYLOAD_NAME, TORQUE_SCALE_RANGE
-from cpr_kin.shapes.obstacle_ranges import SCALE_RANGE
+from cpr_kin.kinematics.dynamics import TORQUE_SCALE_RANGE
 from planning.io.cloud_entry import PointCloudSpec
 from planning.io.robot_entry import RobotEntry, RobotMapping
 from planning.io.schema_types import (
     UNION_TAGS,
-    FilePath,
     Name,
-    Point,
-    Size,
     Strict,
-    Turn,
     between,
     printable,
 )
+from planning.io.shape_entry import (
+    BoxSpec,
+    CapsuleSpec,
+    CylinderSpec,
+    MeshSpec,
+    ObstacleSpec,
+    PayloadSpec,
+    SphereSpec,
+)
 from planning.io.target_entry import PoseSpec, TargetSpec
+from planning.io.task_entry import TaskSpec, task_model_at
 from planning.pipeline.scene import (
     DEFAULT_SAFETY_MARGIN_M,
     DEFAULT_SELF_MARGIN_M,
@@ -58,58 +61,6 @@ from planning.search.firefly_settings import (
     MAX_STEP,
 )
 from planning.validation import describe_validation
-
-
-class _Placed(Strict):
-    name: Name | None = None
-    xyz: Point
-    rpy: Turn = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-
-
-class BoxSpec(_Placed):
-    """``{shape: box, size: [x, y, z], xyz, rpy}``: full side lengths [m]."""
-
-    shape: Literal["box"]
-    size: Annotated[list[Size], Field(min_length=3, max_length=3)]
-
-
-class SphereSpec(_Placed):
-    """``{shape: sphere, radius, xyz}`` [m]."""
-
-    shape: Literal["sphere"]
-    radius: Size
-
-
-class CylinderSpec(_Placed):
-    """``{shape: cylinder, radius, length, xyz, rpy}``: axis along the local z [m]."""
-
-    shape: Literal["cylinder"]
-    radius: Size
-    length: Size
-
-
-class CapsuleSpec(_Placed):
-    """``{shape: capsule, radius, length, xyz, rpy}``: segment along the local z [m]."""
-
-    shape: Literal["capsule"]
-    radius: Size
-    length: Size
-
-
-class MeshSpec(_Placed):
-    """``{shape: mesh, mesh: FILE, scale, convex, xyz, rpy}``; FILE relative to the scene."""
-
-    shape: Literal["mesh"]
-    mesh: FilePath
-    scale: Annotated[float, between(*SCALE_RANGE)] = 1.0
-    convex: bool = True
-
-
-ObstacleSpec = Annotated[
-    BoxSpec | SphereSpec | CylinderSpec | CapsuleSpec | MeshSpec | PointCloudSpec,
-    Field(discriminator="shape"),
-]
-
 
 _F, _P = DEFAULT_FIREFLY, PlannerSettings  # the defaults are the settings' own
 
@@ -164,55 +115,6 @@ class SplineSpec(Strict):
         return self
 
 
-Moment = Annotated[float, between(-1e3, 1e3)]
-PayloadShapeSpec = Annotated[
-    BoxSpec | SphereSpec | CylinderSpec | CapsuleSpec | MeshSpec, Field(discriminator="shape")
-]
-"""A payload's collision shape: an obstacle's box, sphere, cylinder, capsule or mesh (its convex
-hull), in its frame."""
-
-
-class PayloadSpec(Strict):
-    """The ``payload:`` block, an attached object: its mass and its shape; see :class:`cpr_kin.Payload`."""
-
-    name: Name | None = None
-    mass_kg: Annotated[float, between(0.0, MAX_PAYLOAD_KG)] = 0.0
-    com_in_tcp: Annotated[
-        list[Annotated[float, between(-MAX_COM_OFFSET_M, MAX_COM_OFFSET_M)]],
-        Field(min_length=3, max_length=3),
-    ] = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-    inertia: (
-        Annotated[list[Moment], Field(min_length=3, max_length=3)]
-        | Annotated[
-            list[Annotated[list[Moment], Field(min_length=3, max_length=3)]],
-            Field(min_length=3, max_length=3),
-        ]
-        | None
-    ) = None
-    frame: Name | None = None
-    shape: PayloadShapeSpec | None = None
-    touch_links: Annotated[list[Name], Field(max_length=64)] = Field(default_factory=list)
-
-    def payload(self, shape: ck.Obstacle | None) -> ck.Payload:
-        """The :class:`cpr_kin.Payload` with ``shape`` built from :attr:`shape`.
-
-        Raises:
-            cpr_kin.CprKinError: an unphysical inertia.
-        """
-        inertia = None
-        if self.inertia is not None:
-            inertia = np.diag(self.inertia) if np.ndim(self.inertia) == 1 else np.array(self.inertia)
-        return ck.Payload(
-            self.mass_kg,
-            (self.com_in_tcp[0], self.com_in_tcp[1], self.com_in_tcp[2]),
-            None if inertia is None else tuple(tuple(row) for row in inertia.tolist()),
-            self.frame,
-            shape,
-            tuple(self.touch_links),
-            self.name or PAYLOAD_NAME,
-        )
-
-
 class SceneSpec(Strict):
     """A whole scene file."""
 
@@ -224,13 +126,28 @@ class SceneSpec(Strict):
         list[Annotated[list[Name], Field(min_length=2, max_length=2)]], Field(max_length=10_000)
     ] = Field(default_factory=list)
     start: TargetSpec
-    goal: TargetSpec
+    goal: TargetSpec | None = None
+    task: TaskSpec | None = None
     duration: Annotated[float, between(*DURATION_RANGE_S)] | None = None
     obstacles: Annotated[list[ObstacleSpec], Field(max_length=MAX_OBSTACLES)] = Field(default_factory=list)
     planner: PlannerSpec = Field(default_factory=PlannerSpec)
     spline: SplineSpec = Field(default_factory=SplineSpec)
     payload: PayloadSpec | None = None
     torque_scale: Annotated[float, between(*TORQUE_SCALE_RANGE)] = 1.0
+
+    @model_validator(mode="after")
+    def _goal_or_task(self) -> SceneSpec:
+        if (self.goal is None) == (self.task is None):
+            raise ValueError(
+                "give exactly one of 'goal' (where one motion goes) or 'task' (a list of segments: move, "
+                "line, wait, attach, detach)"
+            )
+        if self.task is not None and self.duration is not None:
+            raise ValueError(
+                f"duration = {self.duration:g} s: a task times each of its motions as fast as the limits "
+                "allow; leave the duration out"
+            )
+        return self
 
 
 _SHAPE_SPECS: dict[str, type[BaseModel]] = {
@@ -258,6 +175,8 @@ def _model_at(location: tuple[int | str, ...]) -> type[BaseModel] | None:
         return _SHAPE_SPECS.get(str(location[2]))
     if location[:2] == ("payload", "shape") and len(location) >= 4:
         return _SHAPE_SPECS.get(str(location[2]))
+    if location[0] == "task" and len(location) >= 3:
+        return task_model_at(location[1:])
     if location[0] == "robot":
         return RobotMapping
     if location[0] in ("start", "goal") and location[1] == "pose":

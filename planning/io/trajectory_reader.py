@@ -37,6 +37,8 @@ MAX_SEGMENTS = 100_000
 """Most segments of a trajectory."""
 MIN_SEGMENT_S = 1e-6
 """Shortest segment [s]: below it the local powers of time lose their digits."""
+MAX_TASK_ENTRIES = 1000
+"""Most entries of a trajectory file's ``task`` list."""
 MAX_POSITION = 1e6
 """Largest |position| a segment's coefficients may reach, ``sum_k |a_k| h^k`` [rad or m]."""
 
@@ -66,6 +68,7 @@ class _Document(BaseModel):
     knots: Annotated[list[Number], Field(min_length=2, max_length=MAX_SEGMENTS + 1)]
     segments: Annotated[list[_Segment], Field(min_length=1, max_length=MAX_SEGMENTS)]
     metrics: dict[str, Any] = Field(default_factory=dict)
+    task: Annotated[list[dict[str, Any]], Field(max_length=MAX_TASK_ENTRIES)] | None = None
 
 
 @dataclass(frozen=True)
@@ -79,6 +82,8 @@ class TrajectoryFile:
         robot: URDF path recorded in the file.
         scene: the scene section as written.
         metrics: the metrics section as written.
+        task: the ``task`` list, what each segment of a task promised (``None``: not a task's);
+            :func:`planning.task.check_task` reads its entries.
     """
 
     trajectory: Trajectory
@@ -87,6 +92,7 @@ class TrajectoryFile:
     robot: str
     scene: dict[str, Any]
     metrics: dict[str, Any]
+    task: list[dict[str, Any]] | None = None
 
 
 def _consistent(document: _Document) -> str | None:
@@ -148,6 +154,7 @@ def parse_trajectory(data: bytes, source: str = "trajectory file") -> Trajectory
         robot=document.robot,
         scene=document.scene,
         metrics=document.metrics,
+        task=document.task,
     )
 
 

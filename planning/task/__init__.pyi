@@ -3,7 +3,9 @@
 from .line_deviation import LineDeviation, line_deviation
 from .line_ik import JointLine, joint_line
 from .line_motion import LineMotion, plan_line
-from .task_plan import Attach, Detach, Move, SegmentMotion, TaskMotion, Wait, plan_task
+from .segments import Attach, Detach, Move, Segment, Wait, segment_name
+from .task_check import TaskCheck, check_task
+from .task_plan import SegmentMotion, TaskMotion, plan_task
 from .task_record import record_problems, task_record
 from .tool_line import LineGeometry, LineTolerance, ToolLine, ToolPose
 
@@ -16,15 +18,19 @@ __all__ = [
     "LineMotion",
     "LineTolerance",
     "Move",
+    "Segment",
     "SegmentMotion",
+    "TaskCheck",
     "TaskMotion",
     "ToolLine",
     "ToolPose",
     "Wait",
+    "check_task",
     "joint_line",
     "line_deviation",
     "plan_line",
     "plan_task",
     "record_problems",
+    "segment_name",
     "task_record",
 ]

@@ -12,14 +12,16 @@ own goal is neither planned to nor needed: the segments say where the robot goes
 :class:`Attach` and :class:`Detach` change what the robot carries from there on: its mass in
 the torques, its shape in the clearance checks, the links it may touch.
 
-Not yet (issue 71): junctions that do not stop, the scene file's ``task:``.
+A scene file's ``task:`` holds the same segments (:mod:`planning.io.task_entry`). Not yet
+(issue 71): junctions that do not stop.
 """
 
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -36,60 +38,18 @@ from planning.pipeline.target import Target
 from planning.pipeline.timing import FreeDuration
 from planning.pipeline.verification import Requirements, Verification, verify_finer_where_needed
 from planning.task.line_motion import LineMotion, plan_line
+from planning.task.segments import KINDS, Attach, Detach, Move, Segment, Wait, segment_name
 from planning.task.tool_line import ToolLine
-from planning.validation import number_in
+
+if TYPE_CHECKING:
+    from planning.search.firefly import FireflyProgress
 
 FloatArray = NDArray[np.float64]
 
-LONGEST_WAIT_S = 3600.0
-"""The longest wait of a task [s]."""
 _FIXED_DURATION = (
     "the scene fixes duration = {seconds:g} s; a task times each of its motions as fast as the limits "
     "allow: leave the duration out (duration=None)"
 )
-
-
-@dataclass(frozen=True)
-class Move:
-    """A free motion to ``goal``, around the scene's obstacles (the planner's search).
-
-    Attributes:
-        goal: a joint, ``tcp`` or pose goal, as a scene's.
-    """
-
-    goal: Target
-
-
-@dataclass(frozen=True)
-class Wait:
-    """Standing still for ``seconds`` [s] (a grasp closing, a part settling)."""
-
-    seconds: float
-
-    def __post_init__(self) -> None:
-        number_in("wait seconds", self.seconds, 0.0, LONGEST_WAIT_S, "s", low_open=True)
-
-
-@dataclass(frozen=True)
-class Attach:
-    """From here on the robot carries ``payload``: its mass in the torques, its shape in the checks.
-
-    Attributes:
-        payload: the object grasped (its frame, shape and the links it may touch, its
-            ``touch_links``, as a scene's payload).
-    """
-
-    payload: ck.Payload
-
-
-@dataclass(frozen=True)
-class Detach:
-    """From here on the robot carries nothing (the object released)."""
-
-
-Segment = Move | ToolLine | Wait | Attach | Detach
-KINDS = {Move: "free", ToolLine: "line", Wait: "wait", Attach: "attach", Detach: "detach"}
-"""Each segment's kind, as a task's record names it."""
 
 
 @dataclass(frozen=True)
@@ -103,7 +63,7 @@ class SegmentMotion:
         verification: its trajectory's verification with what the robot carries then
             (``None`` for an attach or detach, which does not move).
         line: the planned line, for a ``line``.
-        attached: the payload, for an ``attach``.
+        payload: the object attached, for an ``attach``; released, for a ``detach``.
     """
 
     kind: str
@@ -111,7 +71,7 @@ class SegmentMotion:
     t1: float
     verification: Verification | None = None
     line: LineMotion | None = None
-    attached: ck.Payload | None = None
+    payload: ck.Payload | None = None
 
 
 @dataclass(frozen=True)
@@ -124,14 +84,21 @@ class TaskMotion:
         continuity: where the whole is not C3 (``None``: it is, at every knot).
         world: the robot among the scene's obstacles, carrying what it carries at the start
             (for drawing).
-        margin_m: the scene's safety margin [m].
+        scene: the scene planned in (its start, obstacles, margins, payload at the start).
+        task: the segments asked for, in order (``segments`` says how each was planned).
     """
 
     segments: tuple[SegmentMotion, ...]
     trajectory: Trajectory
     continuity: str | None
     world: ck.CollisionWorld = field(repr=False)
-    margin_m: float = 0.0
+    scene: Scene = field(repr=False)
+    task: tuple[Segment, ...] = ()
+
+    @property
+    def margin_m(self) -> float:
+        """The scene's safety margin [m]."""
+        return self.scene.safety_margin
 
     @property
     def junctions(self) -> FloatArray:
@@ -168,11 +135,17 @@ class _Carrying:
     required: Requirements
 
 
-def plan_task(scene: Scene, segments: Sequence[Segment], robot: ck.Robot | None = None) -> TaskMotion:
+def plan_task(
+    scene: Scene,
+    segments: Sequence[Segment],
+    robot: ck.Robot | None = None,
+    progress: Callable[[FireflyProgress], None] | None = None,
+) -> TaskMotion:
     """The task's ``segments`` planned from the scene's start, joined and verified.
 
     Each segment is verified with what the robot carries during it (the scene's payload at
     the start, then what :class:`Attach` and :class:`Detach` say); the whole must be C3.
+    ``progress`` is called after each iteration of each free motion's search.
 
     Raises:
         PlanningError: no segment, a bad segment, or a segment's bad input (a goal inside a
@@ -193,15 +166,16 @@ def plan_task(scene: Scene, segments: Sequence[Segment], robot: ck.Robot | None 
         kind = KINDS.get(type(segment), type(segment).__name__)
         try:
             if isinstance(segment, Attach | Detach):
+                held = carrying.scene.payload
                 carrying = _carried(carrying, base, q, segment)
-                attached = segment.payload if isinstance(segment, Attach) else None
-                records.append(SegmentMotion(kind, now, now, attached=attached))
+                payload = segment.payload if isinstance(segment, Attach) else held
+                records.append(SegmentMotion(kind, now, now, payload=payload))
                 continue
-            trajectory, line, problem = _planned(carrying, base, q, segment)
+            trajectory, line, problem = _planned(carrying, base, q, segment, progress)
         except (PlanningError, ck.CprKinError) as exc:
-            raise PlanningError(f"task segment {index} ({type(segment).__name__}): {exc}") from exc
+            raise PlanningError(f"task[{index}] ({segment_name(segment)}): {exc}") from exc
         except NoSolutionError as exc:
-            raise TaskSegmentError(index, type(segment).__name__, exc) from exc
+            raise TaskSegmentError(index, segment_name(segment), exc) from exc
         checked = verify_finer_where_needed(problem, trajectory, carrying.required)
         records.append(SegmentMotion(kind, now, now + trajectory.duration, checked, line))
         pieces.append(trajectory)
@@ -213,7 +187,7 @@ def plan_task(scene: Scene, segments: Sequence[Segment], robot: ck.Robot | None 
     robot_names = carrying.problem.robot.joint_names
     units = [carrying.problem.robot.joint_unit(n) for n in robot_names]
     continuity = discontinuity(whole, robot_names, units)
-    return TaskMotion(tuple(records), whole, continuity, start_world, scene.safety_margin)
+    return TaskMotion(tuple(records), whole, continuity, start_world, scene, tuple(segments))
 
 
 def _carrying(scene: Scene, base: ck.Robot, q: FloatArray | None) -> _Carrying:
@@ -230,6 +204,11 @@ def _carried(carrying: _Carrying, base: ck.Robot, q: FloatArray, segment: Attach
     if isinstance(segment, Detach):
         if held is None:
             raise PlanningError("detach: the robot carries nothing here (attach a payload first)")
+        if segment.name is not None and segment.name != held.name:
+            raise PlanningError(
+                f"detach: name = {segment.name!r}, but the robot carries {held.name!r}; name it, or leave "
+                "the name out"
+            )
         return _carrying(dataclasses.replace(carrying.scene, payload=None), base, q)
     if held is not None:
         raise PlanningError(f"attach: the robot already carries '{held.name}' (detach it first)")
@@ -237,7 +216,11 @@ def _carried(carrying: _Carrying, base: ck.Robot, q: FloatArray, segment: Attach
 
 
 def _planned(
-    carrying: _Carrying, base: ck.Robot, q: FloatArray, segment: Segment
+    carrying: _Carrying,
+    base: ck.Robot,
+    q: FloatArray,
+    segment: Segment,
+    progress: Callable[[FireflyProgress], None] | None,
 ) -> tuple[Trajectory, LineMotion | None, Problem]:
     """One segment from ``q``: its trajectory from time 0, the line if it is one, and a problem.
 
@@ -258,7 +241,7 @@ def _planned(
         if not isinstance(moving.duration, FreeDuration):
             raise PlanningError(_FIXED_DURATION.format(seconds=scene.duration))
         still = dataclasses.replace(moving.duration, still_jerk=True)
-        return solve(dataclasses.replace(moving, duration=still)).trajectory, None, moving
+        return solve(dataclasses.replace(moving, duration=still), progress).trajectory, None, moving
     raise PlanningError(
         f"a task segment is a Move, a ToolLine, a Wait, an Attach or a Detach, not a {type(segment).__name__}"
     )

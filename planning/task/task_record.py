@@ -52,9 +52,9 @@ def task_record(task: TaskMotion) -> list[dict[str, Any]]:
                     "angle_rad": line.line.tolerance.angle_rad,
                 },
             }
-        if segment.attached is not None:
-            frame = segment.attached.frame or task.world.robot.tcp_frame
-            entry |= {"object": segment.attached.name, "frame": frame}
+        if segment.payload is not None:
+            frame = segment.payload.frame or task.world.robot.tcp_frame
+            entry |= {"object": segment.payload.name, "frame": frame}
         entries.append(entry)
     return entries
 

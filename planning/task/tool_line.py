@@ -32,6 +32,12 @@ FINEST_POSITION_M = 1e-6
 of the tolerance, and the certified check's samples come closer the finer it is."""
 FINEST_ANGLE_RAD = 1e-5
 """The finest angle tolerance of a line [rad]."""
+COARSEST_POSITION_M = 0.1
+"""The coarsest position tolerance of a line [m]."""
+COARSEST_ANGLE_RAD = math.pi / 4
+"""The coarsest angle tolerance of a line [rad]."""
+FASTEST_TOOL_M_S = 100.0
+"""The largest tool speed limit of a line [m/s]."""
 TOOL_FRAME = "tool"
 """``ToolLine.offset_frame``: the offset is in the tool frame at the start."""
 BASE_FRAME = "base"
@@ -96,8 +102,8 @@ class LineTolerance:
     angle_rad: float = 0.01
 
     def __post_init__(self) -> None:
-        number_in("line tolerance position_m", self.position_m, FINEST_POSITION_M, 0.1, "m")
-        number_in("line tolerance angle_rad", self.angle_rad, FINEST_ANGLE_RAD, math.pi / 4, "rad")
+        number_in("line tolerance position_m", self.position_m, FINEST_POSITION_M, COARSEST_POSITION_M, "m")
+        number_in("line tolerance angle_rad", self.angle_rad, FINEST_ANGLE_RAD, COARSEST_ANGLE_RAD, "rad")
 
 
 @dataclass(frozen=True)
@@ -137,7 +143,7 @@ class ToolLine:
                 f"line offset frame {self.offset_frame!r} is not one of {TOOL_FRAME!r}, {BASE_FRAME!r}"
             )
         if self.tool_speed_m_s is not None:
-            number_in("line tool_speed_m_s", self.tool_speed_m_s, 0.0, 100.0, "m/s", low_open=True)
+            number_in("line tool_speed_m_s", self.tool_speed_m_s, 0.0, FASTEST_TOOL_M_S, "m/s", low_open=True)
 
     def goal(self, start: pin.SE3) -> pin.SE3:
         """The goal placement of the line that starts at ``start`` (the tool frame's placement).

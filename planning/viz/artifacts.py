@@ -15,7 +15,7 @@ import cpr_kin as ck
 from planning.curves.trajectory import Trajectory
 from planning.pipeline.result import PlanResult
 
-if TYPE_CHECKING:  # a task is drawn only in a notebook: the task planner is imported there
+if TYPE_CHECKING:  # the task planner is imported where a task is drawn
     from planning.task.task_plan import TaskMotion
 
 PLOT_FILES = ("joints.png", "tcp_path.png", "clearance.png", "utilisation.png", "convergence.png")
@@ -28,6 +28,30 @@ def drawn_files(result: PlanResult, plots: bool = True, page: bool = True) -> di
         files["viewer.html"] = viewer_html(
             result.problem.world, result.scene.safety_margin, result.trajectory, result.waypoints
         )
+    return files
+
+
+TASK_PLOT_FILES = ("joints.png", "tcp_path.png")
+
+
+def task_drawn_files(task: TaskMotion, plots: bool = True, page: bool = True) -> dict[str, str | bytes]:
+    """The files that draw a task: its joints and tool path (:data:`TASK_PLOT_FILES`), ``viewer.html``.
+
+    The junctions are drawn as its waypoints.
+    """
+    from planning.viz import plots as drawing
+
+    files: dict[str, str | bytes] = {}
+    robot, trajectory, scene = task.world.robot, task.trajectory, task.scene
+    if plots:
+        units = tuple(robot.joint_unit(n) for n in robot.joint_names)
+        figures = (
+            drawing.joint_figure(trajectory, robot.joint_names, units),
+            drawing.tcp_path_figure(robot, trajectory, task.junctions, scene.obstacles, scene.safety_margin),
+        )
+        files |= {n: drawing.png_bytes(f) for n, f in zip(TASK_PLOT_FILES, figures, strict=True)}
+    if page:
+        files["viewer.html"] = viewer_html(task.world, scene.safety_margin, trajectory, task.junctions)
     return files
 
 

@@ -1,0 +1,179 @@
+"""A task's trajectory checked against the task it was planned for: what ``cpr-plan check`` does.
+
+:func:`check_task` holds a trajectory and its record (:func:`~planning.task.task_record.task_record`,
+the trajectory file's ``task`` list) to the scene's task:
+
+- the record's segments are the task's, kind by kind, and keep their promises
+  (:func:`~planning.task.task_record.record_problems`: they tile the trajectory, a wait stands
+  still, a line stays within its tolerance at every instant);
+- a line is the task's line: it starts where the tool is at its start and ends where the
+  task's line from there ends;
+- the trajectory starts at the scene's start, is C3 at every knot, and each free motion ends
+  at its goal;
+- each segment that moves or waits is verified as every trajectory of the planner is, with
+  what the robot carries then (the scene's payload, then what ``attach`` and ``detach`` say):
+  certified clearance, joint ranges and limits, torques.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+import cpr_kin as ck
+from planning.curves.continuity import discontinuity
+from planning.curves.trajectory import Trajectory
+from planning.errors import NoSolutionError, PlanningError
+from planning.pipeline.problem import build_problem
+from planning.pipeline.scene import Scene
+from planning.pipeline.target import Target
+from planning.pipeline.verification import Requirements, Verification, verify_finer_where_needed
+from planning.task.segments import KINDS, Attach, Detach, Move, Segment, Wait
+from planning.task.task_record import TIME_TOLERANCE_S, record_problems
+from planning.task.tool_line import ToolLine, ToolPose
+
+POSE_TOLERANCE = 1e-6
+"""How far a recorded line's ends may be from the task's [m, rad] (rounding)."""
+
+
+@dataclass(frozen=True)
+class TaskCheck:
+    """A task's trajectory checked (:func:`check_task`).
+
+    Attributes:
+        verifications: each segment's verification, ``None`` for an attach or detach (or a
+            segment whose ends could not be set up: see :attr:`problems`).
+        problems: every broken promise, each naming its segment (empty: all kept).
+    """
+
+    verifications: tuple[Verification | None, ...]
+    problems: tuple[str, ...]
+
+    @property
+    def accepted(self) -> bool:
+        """Every promise kept."""
+        return not self.problems
+
+    @property
+    def certified_min_clearance_m(self) -> float:
+        """The least certified clearance from the obstacles over the segments verified [m]."""
+        found = [v.check.certified_min_m for v in self.verifications if v is not None]
+        return min(found) if found else float("nan")
+
+    @property
+    def checks(self) -> int:
+        """How many configurations the certified checks measured."""
+        return sum(len(v.check.times) for v in self.verifications if v is not None)
+
+
+def check_task(
+    scene: Scene,
+    segments: Sequence[Segment],
+    trajectory: Trajectory,
+    entries: Sequence[Mapping[str, Any]],
+    robot: ck.Robot | None = None,
+) -> TaskCheck:
+    """``trajectory`` and its record ``entries`` held to the task ``segments`` in ``scene`` (see above).
+
+    Raises:
+        PlanningError: an entry that is not one (a missing or wrong field, named).
+    """
+    base = robot or scene.robot_spec().load()
+    kinds = [KINDS[type(s)] for s in segments]
+    recorded = [str(e.get("kind")) if isinstance(e, Mapping) else "?" for e in entries]
+    if recorded != kinds:
+        return TaskCheck((), (f"the trajectory's task is {recorded}; the scene's is {kinds}",))
+    problems = list(record_problems(base, trajectory, entries))
+    names = base.joint_names
+    jump = discontinuity(trajectory, names, [base.joint_unit(n) for n in names])
+    problems += [] if jump is None else [jump]
+    miss = scene.start.miss(base, trajectory(trajectory.knots[0]))
+    problems += [] if miss is None else [f"its start is {miss} of the scene's start"]
+    payload, verifications = scene.payload, list[Verification | None]()
+    for index, (segment, entry) in enumerate(zip(segments, entries, strict=True)):
+        where = f"task[{index}] ({KINDS[type(segment)]})"
+        if isinstance(segment, Attach | Detach):
+            payload, wrong = _carried_after(payload, segment, entry)
+            problems += [f"{where} {w}" for w in wrong]
+            verifications.append(None)
+            continue
+        span = (float(entry["t0"]), float(entry["t1"]))
+        piece = trajectory.between(*span)
+        if isinstance(segment, ToolLine):
+            try:
+                problems += [f"{where} {p}" for p in _line_ends(base, segment, trajectory(span[0]), entry)]
+            except PlanningError as exc:
+                raise PlanningError(f"task entry {index}: {exc}") from None
+        if isinstance(segment, Wait) and abs(span[1] - span[0] - segment.seconds) > TIME_TOLERANCE_S:
+            waited = span[1] - span[0]
+            problems.append(f"{where} waits {waited:g} s; the task's wait is {segment.seconds:g} s")
+        verification, wrong = _verified(dataclasses.replace(scene, payload=payload), base, segment, piece)
+        problems += [f"{where} {w}" for w in wrong]
+        verifications.append(verification)
+    return TaskCheck(tuple(verifications), tuple(problems))
+
+
+def _carried_after(
+    held: ck.Payload | None, segment: Attach | Detach, entry: Mapping[str, Any]
+) -> tuple[ck.Payload | None, list[str]]:
+    """What the robot carries after ``segment``, and where the record names another object."""
+    named = segment.payload if isinstance(segment, Attach) else held
+    expected = None if named is None else named.name
+    wrong = [] if entry.get("object") == expected else [f"names {entry.get('object')!r}, not {expected!r}"]
+    frame = None if named is None else named.frame
+    if frame is not None and entry.get("frame") != frame:
+        wrong.append(f"holds it at frame {entry.get('frame')!r}, not at {frame!r}")
+    return (segment.payload if isinstance(segment, Attach) else None), wrong
+
+
+def _line_ends(robot: ck.Robot, line: ToolLine, q_start: np.ndarray, entry: Mapping[str, Any]) -> list[str]:
+    """Where the recorded line is not the task's line from ``q_start``: its frame, ends, tolerance."""
+    frame = line.frame or robot.tcp_frame
+    if entry.get("frame") != frame:
+        return [f"holds frame {entry.get('frame')!r} on its line; the task's line holds {frame!r}"]
+    pose = ck.frame_poses(robot, q_start, frame)
+    start = pin.SE3(pose[:3, :3], pose[:3, 3])
+    wrong = []
+    for key, wanted in (("from", start), ("to", line.goal(start))):
+        given = _placement(entry, key)
+        moved = float(np.linalg.norm(given.translation - wanted.translation))
+        turned = float(np.linalg.norm(pin.log3(given.rotation.T @ wanted.rotation)))
+        if moved > POSE_TOLERANCE or turned > POSE_TOLERANCE:
+            xyz = ", ".join(f"{v:.6g}" for v in wanted.translation)
+            wrong.append(
+                f"records its '{key}' pose {moved:.3g} m and {turned:.3g} rad from the task's line, "
+                f"whose '{key}' is at xyz [{xyz}] m"
+            )
+    tolerance = entry.get("tolerance")
+    asked = {"position_m": line.tolerance.position_m, "angle_rad": line.tolerance.angle_rad}
+    if tolerance != asked:
+        wrong.append(f"records tolerance {tolerance}; the task's line asks {asked}")
+    return wrong
+
+
+def _placement(entry: Mapping[str, Any], key: str) -> pin.SE3:
+    try:
+        return ToolPose(tuple(entry[key]["xyz"]), tuple(entry[key]["quat_xyzw"])).placement()
+    except (KeyError, TypeError):
+        raise PlanningError(f"'{key}' is not {{xyz: [x, y, z], quat_xyzw: [x, y, z, w]}}") from None
+
+
+def _verified(
+    scene: Scene, robot: ck.Robot, segment: Segment, piece: Trajectory
+) -> tuple[Verification | None, list[str]]:
+    """``piece`` verified in ``scene`` (with its payload), a free motion's end against its goal."""
+    q0, q1 = (tuple(piece(t).tolist()) for t in (piece.knots[0], piece.knots[-1]))
+    try:
+        problem = build_problem(dataclasses.replace(scene, start=Target(q=q0), goal=Target(q=q1)), robot)
+    except (PlanningError, NoSolutionError) as exc:  # an end inside a margin, a load it cannot hold
+        return None, [f"cannot be verified from where it starts and ends: {exc}"]
+    required = Requirements.of(problem)
+    if isinstance(segment, Move):
+        required = dataclasses.replace(required, endpoints=(Target(q=q0), segment.goal))
+    verification = verify_finer_where_needed(problem, piece, required)
+    return verification, list(verification.problems)

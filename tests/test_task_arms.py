@@ -1,0 +1,167 @@
+"""Pick-and-place tasks from scene files on arms no issue names here (a Panda, a UR5), checked independently.
+
+Every millisecond of the planned trajectory, without the planner's code: the tool on each
+line (Pinocchio's forward kinematics), joints within range and limits (finite differences of
+the samples are left to the planner's exact extrema; the samples themselves are checked),
+the torques within the URDF's effort limits with the part's mass where it is carried
+(Pinocchio's RNEA on a model with the part appended as a body); and every few milliseconds
+the clearance of the URDF's exact link meshes and of the carried part from the obstacles
+(coal on Pinocchio's own collision model: the planner checks convex hulls that contain them).
+"""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+from typing import Any
+
+import coal
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from cpr_kin.model.packages import package_roots
+from planning.io.scene_file import SceneFile, parse_scene_file
+from planning.task import TaskMotion, check_task, plan_task, task_record
+
+DOWN = [3.14159265, 0.0, 0.0]
+TASK: list[dict[str, Any]] = [
+    {"move": {"pose": {"xyz": [0.5, -0.25, 0.3], "rpy": DOWN}}},
+    {"line": {"by": [0.0, 0.0, 0.12]}},  # along the tool's axis: down
+    {"wait": 0.2},
+    {
+        "attach": {
+            "name": "can",
+            "mass_kg": 2.0,
+            "com_in_tcp": [0.0, 0.0, 0.04],
+            "shape": {"shape": "cylinder", "radius": 0.03, "length": 0.1, "xyz": [0.0, 0.0, 0.06]},
+        }
+    },
+    {"line": {"by": [0.0, 0.0, -0.12]}},
+    {"move": {"pose": {"xyz": [0.45, 0.3, 0.3], "rpy": DOWN}}},
+    {"line": {"by": [0.0, 0.0, -0.1], "frame": "base"}},
+    {"detach": {"name": "can"}},
+    {"line": {"by": [0.0, 0.0, 0.1], "frame": "base"}},
+]
+ARMS: dict[str, dict[str, Any]] = {
+    "panda": {
+        "start": [0.0, -0.6, 0.0, -2.2, 0.0, 1.6, 0.8],
+        "touch_links": ["panda_hand", "panda_leftfinger", "panda_rightfinger"],
+        "mass_kg": 2.0,
+    },
+    "ur5": {"start": [-1.0, -1.57, 1.57, -1.57, -1.57, 0.0], "touch_links": ["wrist_3_link"], "mass_kg": 3.0},
+}
+POST = {"name": "post", "shape": "box", "size": [0.08, 0.08, 0.5], "xyz": [0.55, 0.03, 0.25]}
+
+
+def scene_file(arm: str) -> SceneFile:
+    task = copy.deepcopy(TASK)
+    task[3]["attach"] |= {"touch_links": ARMS[arm]["touch_links"], "mass_kg": ARMS[arm]["mass_kg"]}
+    document = {
+        "name": f"{arm}_pick_and_place",
+        "robot": arm,
+        "safety_margin": 0.02,
+        "start": {"q": ARMS[arm]["start"]},
+        "task": task,
+        "obstacles": [POST],
+    }
+    return parse_scene_file(document, f"{arm} task")
+
+
+@pytest.fixture(scope="module", params=sorted(ARMS))
+def planned(request: pytest.FixtureRequest) -> tuple[SceneFile, TaskMotion]:
+    read = scene_file(request.param)
+    return read, plan_task(read.scene, read.task)
+
+
+def test_the_task_plans_and_passes_its_own_check(planned: tuple[SceneFile, TaskMotion]) -> None:
+    read, task = planned
+    assert task.accepted, task.problems
+    kinds = ["free", "line", "wait", "attach", "line", "free", "line", "detach", "line"]
+    assert [s.kind for s in task.segments] == kinds
+    checked = check_task(read.scene, read.task, task.trajectory, task_record(task))
+    assert checked.accepted, checked.problems
+
+
+def test_every_millisecond_the_tool_keeps_its_lines_and_the_joints_their_ranges(
+    planned: tuple[SceneFile, TaskMotion],
+) -> None:
+    _, task = planned
+    robot = task.world.robot
+    model = robot.model
+    data, fid = model.createData(), model.getFrameId(robot.tcp_frame)
+    trajectory = task.trajectory
+    for segment in (s for s in task.segments if s.line is not None):
+        assert segment.line is not None
+        start, goal = segment.line.start.placement(), segment.line.goal.placement()
+        shift = goal.translation - start.translation
+        assert 0.05 <= np.linalg.norm(shift) <= 0.2
+        for q in trajectory(np.arange(segment.t0, segment.t1, 1e-3)):
+            pin.framesForwardKinematics(model, data, q)
+            pose = data.oMf[fid]
+            sigma = np.clip((pose.translation - start.translation) @ shift / (shift @ shift), 0.0, 1.0)
+            assert np.linalg.norm(pose.translation - start.translation - sigma * shift) <= 1e-3
+            assert np.linalg.norm(pin.log3(start.rotation.T @ pose.rotation)) <= 0.01  # a line keeps it
+    q = trajectory(np.arange(0.0, trajectory.duration, 1e-3))
+    assert np.all(q >= model.lowerPositionLimit - 1e-9) and np.all(q <= model.upperPositionLimit + 1e-9)
+
+
+def test_every_millisecond_the_torques_are_within_the_effort_limits_with_the_part(
+    planned: tuple[SceneFile, TaskMotion],
+) -> None:
+    read, task = planned
+    robot, trajectory = task.world.robot, task.trajectory
+    attach, detach = task.segments[3], task.segments[7]
+    part = read.task[3].payload  # type: ignore[union-attr]
+    carrying = robot.model.copy()
+    frame = carrying.frames[carrying.getFrameId(robot.tcp_frame)]
+    body = pin.Inertia.FromSphere(part.mass_kg, 1e-3)  # a point mass, as the payload without inertia
+    carrying.appendBodyToJoint(
+        frame.parentJoint, body, frame.placement * pin.SE3(np.eye(3), np.array([0, 0, 0.04]))
+    )
+    for model, (t0, t1) in (
+        (robot.model, (0.0, attach.t0)),
+        (carrying, (attach.t0, detach.t0)),
+        (robot.model, (detach.t0, trajectory.duration)),
+    ):
+        data = model.createData()
+        times = np.arange(t0, t1, 1e-3)
+        q, v, a = trajectory(times), trajectory(times, 1), trajectory(times, 2)
+        tau = np.array([pin.rnea(model, data, *state) for state in zip(q, v, a, strict=True)])
+        assert np.all(np.abs(tau) <= model.effortLimit * (1 + 1e-6))
+
+
+def test_the_exact_link_meshes_and_the_part_keep_the_margin(planned: tuple[SceneFile, TaskMotion]) -> None:
+    read, task = planned
+    robot, trajectory = task.world.robot, task.trajectory
+    urdf = Path(robot.urdf_path)
+    geometry = pin.buildGeomFromUrdf(
+        robot.model, str(urdf), pin.COLLISION, package_dirs=[str(p) for p in package_roots(urdf)]
+    )
+    data, geometry_data = robot.model.createData(), geometry.createData()
+    post = coal.Box(*POST["size"])
+    post_in_world = coal.Transform3s(np.eye(3), np.array(POST["xyz"]))
+    can = coal.Cylinder(0.03, 0.1)
+    attach, detach = task.segments[3], task.segments[7]
+    fid = robot.model.getFrameId(robot.tcp_frame)
+    least = np.inf
+    for t in np.arange(0.0, trajectory.duration, 4e-3):
+        q = trajectory(t)
+        pin.framesForwardKinematics(robot.model, data, q)
+        pin.updateGeometryPlacements(robot.model, data, geometry, geometry_data)
+        shapes = [(g.geometry, geometry_data.oMg[k]) for k, g in enumerate(geometry.geometryObjects)]
+        if attach.t0 <= t <= detach.t0:
+            shapes.append((can, data.oMf[fid] * pin.SE3(np.eye(3), np.array([0.0, 0.0, 0.06]))))
+        for shape, placement in shapes:
+            result = coal.DistanceResult()
+            coal.distance(
+                shape,
+                coal.Transform3s(placement.rotation, placement.translation),
+                post,
+                post_in_world,
+                coal.DistanceRequest(),
+                result,
+            )
+            least = min(least, result.min_distance)
+    assert least >= read.scene.safety_margin - 1e-6
+    assert least <= task.certified_min_clearance_m + 0.05  # the same motion: near the certified figure

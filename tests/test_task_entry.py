@@ -1,0 +1,149 @@
+"""A scene file's ``task:``: read into the segments of planning.task, written back, and refused when wrong."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+
+from planning.errors import SceneError
+from planning.io.scene_file import load_scene, load_scene_file, parse_scene_file, scene_document
+from planning.pipeline.target import Target
+from planning.task import Attach, Detach, Move, ToolLine, Wait
+
+PICK = Path(__file__).resolve().parents[1] / "examples" / "scenes" / "pick_and_place.yaml"
+
+BASE: dict[str, Any] = {
+    "start": {"q": [0.3, 0.3, 0.25, 0.2, 0.5]},
+    "task": [{"line": {"by": [0.0, 0.0, 0.05], "frame": "base"}}, {"wait": 0.2}],
+}
+
+
+def with_task(*entries: Any, **keys: Any) -> dict[str, Any]:
+    document = copy.deepcopy(BASE)
+    document["task"] = list(entries)
+    document.update(keys)
+    return document
+
+
+def test_the_example_task_reads_as_its_segments() -> None:
+    read = load_scene_file(PICK)
+    kinds = [type(s) for s in read.task]
+    assert kinds == [Move, ToolLine, Wait, Attach, ToolLine, Move, Detach]
+    move, down, wait, attach = read.task[:4]
+    assert isinstance(move, Move) and move.goal == Target(tcp=(-0.1, 0.55, 0.45))
+    assert isinstance(down, ToolLine) and down.by == (0.0, 0.0, -0.08) and down.offset_frame == "base"
+    assert isinstance(wait, Wait) and wait.seconds == 0.3
+    assert isinstance(attach, Attach) and attach.payload.mass_kg == 1.5 and attach.payload.name == "part"
+    assert attach.payload.shape is not None and attach.payload.shape.shape == "box"
+    assert read.scene.goal == read.scene.start  # a task's scene: its segments say where it goes
+
+
+def test_a_task_written_back_reads_as_the_same_task() -> None:
+    read = load_scene_file(PICK)
+    document = yaml.safe_load(yaml.safe_dump(scene_document(read.scene, read.task)))
+    assert "goal" not in document
+    again = parse_scene_file(document, "again", PICK.parent)
+    assert again.task == read.task and again.scene == read.scene
+
+
+def test_a_line_to_a_pose_reads_its_quaternion_or_rpy() -> None:
+    to = {"xyz": [0.4, 0.2, 0.3], "rpy": [3.141592653589793, 0.0, 0.0]}
+    read = parse_scene_file(with_task({"line": {"to": to, "tolerance": {"position_m": 2e-4}}}))
+    line = read.task[0]
+    assert isinstance(line, ToolLine) and line.to is not None and line.by is None
+    assert line.to.xyz == (0.4, 0.2, 0.3)
+    assert abs(abs(line.to.quat_xyzw[0]) - 1.0) < 1e-12  # a half turn about x
+    assert line.tolerance.position_m == 2e-4 and line.tolerance.angle_rad == 0.01
+
+
+def test_load_scene_refuses_a_task_and_says_how_to_plan_it() -> None:
+    with pytest.raises(SceneError, match=r"holds a task of 7 segments.*cpr-plan plan"):
+        load_scene(PICK)
+
+
+BAD: list[tuple[str, dict[str, Any], str]] = [
+    ("goal and task", {**BASE, "goal": {"tcp": [0.4, 0.2, 0.3]}}, r"exactly one of 'goal' .* or 'task'"),
+    ("neither", {"start": BASE["start"]}, r"exactly one of 'goal' .* or 'task'"),
+    ("empty task", with_task(), r"task: 0 items; needs at least 1"),
+    ("duration", with_task({"wait": 1.0}, duration=3.0), r"duration = 3 s: a task times each"),
+    ("two keys", with_task({"wait": 1.0, "detach": {}}), r"task\[0\]: an entry of task has exactly one key"),
+    (
+        "unknown key",
+        with_task({"jump": 1.0}),
+        r"task\[0\]\.jump: unknown key; allowed here: move, line, wait",
+    ),
+    (
+        "unknown line key",
+        with_task({"line": {"by": [0, 0, 0.1], "speed": 1}}),
+        r"task\[0\]\.line\.speed: unknown key; allowed here: to, by, frame, tool_frame",
+    ),
+    (
+        "zero line",
+        with_task({"line": {"by": [0, 0, 0]}}),
+        r"task\[0\]\.line: by = \[0.0, 0.0, 0.0\] m .*zero",
+    ),
+    ("no end", with_task({"line": {"frame": "base"}}), r"task\[0\]\.line: give exactly one of 'to'"),
+    (
+        "frame with to",
+        with_task({"line": {"to": {"xyz": [0.4, 0.2, 0.3], "rpy": [0, 0, 0]}, "frame": "base"}}),
+        r"'frame' is the frame of 'by'",
+    ),
+    (
+        "bad frame",
+        with_task({"line": {"by": [0, 0, 0.1], "frame": "world"}}),
+        r"task\[0\]\.line\.frame = 'world'",
+    ),
+    (
+        "tolerance",
+        with_task({"line": {"by": [0, 0, 0.1], "tolerance": {"position_m": 0.5}}}),
+        r"task\[0\]\.line\.tolerance\.position_m = 0\.5",
+    ),
+    ("long wait", with_task({"wait": 7200}), r"task\[0\]\.wait = 7200"),
+    (
+        "detach nothing",
+        with_task({"wait": 1.0}, {"detach": {}}),
+        r"task\[1\]\.detach: the robot carries nothing",
+    ),
+    (
+        "attach twice",
+        with_task({"attach": {"name": "a", "mass_kg": 1}}, {"attach": {"name": "b", "mass_kg": 1}}),
+        r"task\[1\]\.attach: the robot already carries 'a' here; detach it first",
+    ),
+    (
+        "detach another",
+        with_task({"attach": {"name": "a", "mass_kg": 1}}, {"detach": {"name": "b"}}),
+        r"task\[1\]\.detach\.name = 'b', but the robot carries 'a' here",
+    ),
+    (
+        "heavy part",
+        with_task({"attach": {"mass_kg": 5000}}),
+        r"task\[0\]\.attach\.mass_kg = 5000",
+    ),
+]
+
+
+@pytest.mark.parametrize(("label", "document", "message"), BAD, ids=[b[0] for b in BAD])
+def test_a_bad_task_is_refused_naming_the_entry_and_the_field(
+    label: str, document: dict[str, Any], message: str
+) -> None:
+    with pytest.raises(SceneError, match=message):
+        parse_scene_file(document, "scene.yaml")
+
+
+def test_detaching_the_scenes_own_payload_is_allowed() -> None:
+    document = with_task({"detach": {"name": "tool"}}, payload={"name": "tool", "mass_kg": 0.5})
+    assert parse_scene_file(document).task == (Detach("tool"),)
+
+
+def test_the_formats_documents_task_reads_as_written() -> None:
+    formats = (Path(__file__).resolve().parents[1] / "docs" / "formats.md").read_text()
+    block = next(b for b in formats.split("```yaml\n")[1:] if b.startswith("task:")).split("```")[0]
+    read = parse_scene_file({"start": BASE["start"], **yaml.safe_load(block)})
+    kinds = [type(s) for s in read.task]
+    assert kinds == [Move, ToolLine, ToolLine, Wait, Attach, Detach]
+    line = read.task[2]
+    assert isinstance(line, ToolLine) and line.tool_speed_m_s == 0.1 and line.frame == "tcp"
