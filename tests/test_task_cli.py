@@ -110,6 +110,12 @@ BAD: list[tuple[str, dict[str, Any], str, int]] = [
     ),
     ("unknown frame", {"line": {"by": [0, 0, 0.05], "tool_frame": "gripper"}}, "task[1] (line): ", 2),
     (
+        "a constraint the start breaks",
+        {"move": {"tcp": [-0.2, 0.6, 0.35], "constraint": {"rpy": [1.0, 0.0, 0.0]}}},
+        "task[1] (move): the motion's start holds 'tcp' 1 rad from the constraint's orientation",
+        2,
+    ),
+    (
         "a line into the floor",
         {"line": {"by": [0, 0, -1.0], "frame": "base"}},
         "task[1] (line): the tool line breaks after",

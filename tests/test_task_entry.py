@@ -144,6 +144,44 @@ def test_the_formats_documents_task_reads_as_written() -> None:
     block = next(b for b in formats.split("```yaml\n")[1:] if b.startswith("task:")).split("```")[0]
     read = parse_scene_file({"start": BASE["start"], **yaml.safe_load(block)})
     kinds = [type(s) for s in read.task]
-    assert kinds == [Move, ToolLine, ToolLine, Wait, Attach, Detach]
-    line = read.task[2]
+    assert kinds == [Move, Move, ToolLine, ToolLine, Wait, Attach, Detach]
+    upright = read.task[1]
+    assert (
+        isinstance(upright, Move) and upright.constraint is not None and upright.constraint.axes == ("x", "y")
+    )
+    line = read.task[3]
     assert isinstance(line, ToolLine) and line.tool_speed_m_s == 0.1 and line.frame == "tcp"
+
+
+def test_a_move_may_keep_the_tool_upright_and_reads_back_the_same() -> None:
+    upright = {"axes": ["y", "x"], "angle_rad": 0.05, "rpy": [3.141592653589793, 0.0, 0.0]}
+    read = parse_scene_file(with_task({"move": {"tcp": [0.4, 0.2, 0.3], "constraint": upright}}))
+    move = read.task[0]
+    assert isinstance(move, Move) and move.constraint is not None
+    assert move.constraint.axes == ("x", "y") and move.constraint.angle_rad == 0.05
+    assert move.constraint.quat_xyzw is not None and abs(abs(move.constraint.quat_xyzw[0]) - 1.0) < 1e-12
+    default = parse_scene_file(with_task({"move": {"tcp": [0.4, 0.2, 0.3], "constraint": {}}})).task[0]
+    assert isinstance(default, Move) and default.constraint is not None
+    assert default.constraint.axes == ("x", "y") and default.constraint.quat_xyzw is None  # the start's
+    document = scene_document(read.scene, read.task)
+    assert parse_scene_file(yaml.safe_load(yaml.safe_dump(document))).task == read.task
+
+
+BAD_CONSTRAINTS: list[tuple[dict[str, Any], str]] = [
+    ({"axes": ["x"]}, r"task\[0\]\.move\.constraint\.axes: 1 item; needs at least 2"),
+    ({"axes": ["x", "x"]}, r"task\[0\]\.move\.constraint: axes = \['x', 'x'\] names an axis twice"),
+    ({"axes": ["x", "w"]}, r"task\[0\]\.move\.constraint\.axes\[1\] = 'w'"),
+    ({"angle_rad": 1.0}, r"task\[0\]\.move\.constraint\.angle_rad = 1"),
+    ({"rpy": [0, 0, 0], "quat_xyzw": [0, 0, 0, 1]}, r"give at most one of 'quat_xyzw' and 'rpy'"),
+    ({"quat_xyzw": [0, 0, 0, 0]}, r"task\[0\]\.move\.constraint\.quat_xyzw"),
+    (
+        {"roll": 0.1},
+        r"task\[0\]\.move\.constraint\.roll: unknown key; allowed here: axes, angle_rad, quat_xyzw",
+    ),
+]
+
+
+@pytest.mark.parametrize(("constraint", "message"), BAD_CONSTRAINTS, ids=[m for _, m in BAD_CONSTRAINTS])
+def test_a_bad_constraint_is_refused_naming_its_field(constraint: dict[str, Any], message: str) -> None:
+    with pytest.raises(SceneError, match=message):
+        parse_scene_file(with_task({"move": {"tcp": [0.4, 0.2, 0.3], "constraint": constraint}}))

@@ -3,6 +3,8 @@
 ```yaml
 task:                       # in order; each entry has exactly one key
   - move: {tcp: [0.4, 0.2, 0.3]}                      # a free motion to a start's or goal's target
+  - move: {pose: {xyz: [0.4, 0.2, 0.3], rpy: [3.1416, 0, 0]},
+           constraint: {axes: [x, y], angle_rad: 0.0873}}   # the tool kept upright on the way
   - line: {by: [0, 0, -0.08], frame: base}            # a straight tool line by an offset [m]
   - wait: 0.5                                         # standing still [s]
   - attach: {name: part, mass_kg: 1.5, shape: {shape: box, size: [0.04, 0.04, 0.04], xyz: [0, 0, 0.03]},
@@ -26,13 +28,14 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 import pinocchio as pin
-from pydantic import BaseModel, Field, model_validator
+from pydantic import AfterValidator, BaseModel, Field, model_validator
 
 import cpr_kin as ck
 from planning.errors import SceneError
-from planning.io.schema_types import Name, Point, Strict, between
+from planning.io.schema_types import Name, Point, Strict, Turn, between
 from planning.io.shape_entry import PayloadSpec, obstacle_of, payload_to_dict
 from planning.io.target_entry import PoseSpec, TargetSpec, target_entry
+from planning.task.orientation import UPRIGHT_RAD, OrientationConstraint
 from planning.task.segments import LONGEST_WAIT_S, Attach, Detach, Move, Segment, Wait, segment_name
 from planning.task.tool_line import (
     COARSEST_ANGLE_RAD,
@@ -45,6 +48,7 @@ from planning.task.tool_line import (
     ToolLine,
     ToolPose,
 )
+from planning.validation import unit_quaternion
 
 MAX_TASK_SEGMENTS = 200
 """Most segments of a task."""
@@ -102,6 +106,53 @@ class LineSpec(Strict):
         )
 
 
+Axis = Literal["x", "y", "z"]
+
+
+def _upright() -> list[Axis]:
+    return ["x", "y"]
+
+
+Quaternion = Annotated[
+    list[Annotated[float, Field(allow_inf_nan=False)]],
+    Field(min_length=4, max_length=4),
+    AfterValidator(lambda xyzw: list(unit_quaternion(xyzw))),
+]
+
+
+class ConstraintSpec(Strict):
+    """``constraint:`` of a ``move``: the tool's orientation held about ``axes`` within ``angle_rad``."""
+
+    axes: Annotated[list[Axis], Field(min_length=2, max_length=3)] = Field(default_factory=_upright)
+    angle_rad: Annotated[float, between(FINEST_ANGLE_RAD, COARSEST_ANGLE_RAD)] = UPRIGHT_RAD
+    quat_xyzw: Quaternion | None = None
+    rpy: Turn | None = None
+    frame: Name | None = None
+
+    @model_validator(mode="after")
+    def _one_reference(self) -> ConstraintSpec:
+        if self.quat_xyzw is not None and self.rpy is not None:
+            raise ValueError("give at most one of 'quat_xyzw' and 'rpy' (neither: the tool's at the start)")
+        if len(set(self.axes)) != len(self.axes):
+            raise ValueError(f"axes = {self.axes} names an axis twice; give two or three different axes")
+        return self
+
+    def constraint(self) -> OrientationConstraint:
+        """The :class:`~planning.task.orientation.OrientationConstraint`."""
+        quat = None
+        if self.quat_xyzw is not None:
+            quat = (self.quat_xyzw[0], self.quat_xyzw[1], self.quat_xyzw[2], self.quat_xyzw[3])
+        elif self.rpy is not None:
+            quat = ToolPose.of(pin.SE3(pin.rpy.rpyToMatrix(*self.rpy), np.zeros(3))).quat_xyzw
+        return OrientationConstraint(tuple(self.axes), self.angle_rad, quat, self.frame)
+
+
+class MoveSpec(TargetSpec):
+    """``move:``: a goal's keys, and an optional orientation ``constraint``."""
+
+    constraint: ConstraintSpec | None = None
+
+
 class DetachSpec(Strict):
     """``detach: {}`` or ``detach: {name: NAME}`` (the object released, checked)."""
 
@@ -111,7 +162,7 @@ class DetachSpec(Strict):
 class TaskStepSpec(Strict):
     """One entry of ``task:``: exactly one of its keys."""
 
-    move: TargetSpec | None = None
+    move: MoveSpec | None = None
     line: LineSpec | None = None
     wait: Annotated[float, Field(gt=0, le=LONGEST_WAIT_S)] | None = None
     attach: PayloadSpec | None = None
@@ -128,7 +179,7 @@ class TaskStepSpec(Strict):
 TaskSpec = Annotated[list[TaskStepSpec], Field(min_length=1, max_length=MAX_TASK_SEGMENTS)]
 
 _STEP_MODELS: dict[str, type[BaseModel]] = {
-    "move": TargetSpec,
+    "move": MoveSpec,
     "line": LineSpec,
     "attach": PayloadSpec,
     "detach": DetachSpec,
@@ -143,6 +194,8 @@ def task_model_at(location: tuple[int | str, ...]) -> type[BaseModel] | None:
         return LineToleranceSpec
     if location[1:3] in (("line", "to"), ("move", "pose")):
         return PoseSpec
+    if location[1:3] == ("move", "constraint"):
+        return ConstraintSpec
     return _STEP_MODELS.get(str(location[1]))
 
 
@@ -175,7 +228,8 @@ def task_segments(
 
 def _segment(step: TaskStepSpec, base: Path, where: str) -> Segment:
     if step.move is not None:
-        return Move(step.move.target())
+        constraint = None if step.move.constraint is None else step.move.constraint.constraint()
+        return Move(step.move.target(), constraint)
     if step.line is not None:
         return step.line.line()
     if step.wait is not None:
@@ -198,7 +252,15 @@ def task_entries(segments: Sequence[Segment]) -> list[dict[str, Any]]:
 
 def _entry(segment: Segment) -> Any:
     if isinstance(segment, Move):
-        return target_entry(segment.goal)
+        if segment.constraint is None:
+            return target_entry(segment.goal)
+        held = segment.constraint
+        constraint: dict[str, Any] = {"axes": list(held.axes), "angle_rad": held.angle_rad}
+        if held.quat_xyzw is not None:
+            constraint["quat_xyzw"] = list(held.quat_xyzw)
+        if held.frame is not None:
+            constraint["frame"] = held.frame
+        return {**target_entry(segment.goal), "constraint": constraint}
     if isinstance(segment, Wait):
         return segment.seconds
     if isinstance(segment, Attach):

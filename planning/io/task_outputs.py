@@ -98,6 +98,12 @@ def task_report_markdown(task: TaskMotion) -> str:
             else f"{line.deviation.position_m * 1e3:.3f} mm, {line.deviation.angle_rad * 1e3:.3f} mrad"
         )
         what = "" if segment.payload is None else f" '{segment.payload.name}'"
+        if segment.held is not None:
+            held = segment.held
+            what = (
+                f", {list(held.constraint.axes)} held within {held.constraint.angle_rad:.4g} rad "
+                f"(certified {held.deviation.angle_rad:.4g})"
+            )
         rows.append(
             (
                 str(index),

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import cpr_kin as ck
 from planning.pipeline.target import Target
+from planning.task.orientation import OrientationConstraint
 from planning.task.tool_line import ToolLine
 from planning.validation import number_in
 
@@ -24,9 +25,12 @@ class Move:
 
     Attributes:
         goal: a joint, ``tcp`` or pose goal, as a scene's.
+        constraint: an orientation the tool keeps all the way (an upright carry), if any;
+            start and goal must keep it (:mod:`planning.task.held_orientation`).
     """
 
     goal: Target
+    constraint: OrientationConstraint | None = None
 
 
 @dataclass(frozen=True)

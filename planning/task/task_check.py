@@ -104,11 +104,14 @@ def check_task(
             continue
         span = (float(entry["t0"]), float(entry["t1"]))
         piece = trajectory.between(*span)
-        if isinstance(segment, ToolLine):
-            try:
-                problems += [f"{where} {p}" for p in _line_ends(base, segment, trajectory(span[0]), entry)]
-            except PlanningError as exc:
-                raise PlanningError(f"task entry {index}: {exc}") from None
+        q_start = trajectory(span[0])
+        try:
+            if isinstance(segment, ToolLine):
+                problems += [f"{where} {p}" for p in _line_ends(base, segment, q_start, entry)]
+            if isinstance(segment, Move):
+                problems += [f"{where} {p}" for p in _constraint_kept(base, segment, q_start, entry)]
+        except PlanningError as exc:
+            raise PlanningError(f"task entry {index}: {exc}") from None
         if isinstance(segment, Wait) and abs(span[1] - span[0] - segment.seconds) > TIME_TOLERANCE_S:
             waited = span[1] - span[0]
             problems.append(f"{where} waits {waited:g} s; the task's wait is {segment.seconds:g} s")
@@ -154,6 +157,35 @@ def _line_ends(robot: ck.Robot, line: ToolLine, q_start: np.ndarray, entry: Mapp
     if tolerance != asked:
         wrong.append(f"records tolerance {tolerance}; the task's line asks {asked}")
     return wrong
+
+
+def _constraint_kept(robot: ck.Robot, move: Move, q_start: np.ndarray, entry: Mapping[str, Any]) -> list[str]:
+    """Where the recorded constraint is not the task's: absent, present, or another one."""
+    recorded, constraint = entry.get("constraint"), move.constraint
+    if constraint is None:
+        return [] if recorded is None else ["records a constraint; the task's motion has none"]
+    if not isinstance(recorded, Mapping):
+        return [f"records no constraint; the task's motion keeps {list(constraint.axes)} within the limit"]
+    frame = constraint.frame or robot.tcp_frame
+    if constraint.quat_xyzw is None:  # the frame's orientation at the start
+        pose = ck.frame_poses(robot, q_start, frame)
+        start = ToolPose.of(pin.SE3(pose[:3, :3], pose[:3, 3]))
+        constraint = dataclasses.replace(constraint, quat_xyzw=start.quat_xyzw)
+    wrong = []
+    asked = {"frame": frame, "axes": list(constraint.axes), "angle_rad": constraint.angle_rad}
+    if {key: recorded.get(key) for key in asked} != asked:
+        wrong.append(f"records constraint {dict(recorded)}; the task's motion asks {asked}")
+    try:
+        turned = float(np.linalg.norm(pin.log3(_rotation(recorded).T @ constraint.reference())))
+    except (KeyError, TypeError, ValueError, PlanningError):
+        raise PlanningError("'constraint' has no quat_xyzw [x, y, z, w]") from None
+    if turned > POSE_TOLERANCE:
+        wrong.append(f"records its constraint's orientation {turned:.3g} rad from the task's")
+    return wrong
+
+
+def _rotation(recorded: Mapping[str, Any]) -> np.ndarray:
+    return np.asarray(ToolPose((0.0, 0.0, 0.0), tuple(recorded["quat_xyzw"])).placement().rotation)
 
 
 def _placement(entry: Mapping[str, Any], key: str) -> pin.SE3:

@@ -31,12 +31,12 @@ from planning.curves.continuity import discontinuity
 from planning.curves.stop_and_go import joined
 from planning.curves.trajectory import Trajectory
 from planning.errors import NoSolutionError, PlanningError, TaskSegmentError
-from planning.pipeline.planner import solve
 from planning.pipeline.problem import Problem, build_problem
 from planning.pipeline.scene import Scene
 from planning.pipeline.target import Target
-from planning.pipeline.timing import FreeDuration
 from planning.pipeline.verification import Requirements, Verification, verify_finer_where_needed
+from planning.task.free_motion import FIXED_DURATION, plan_free
+from planning.task.held_orientation import HeldMotion
 from planning.task.line_motion import LineMotion, plan_line
 from planning.task.segments import KINDS, Attach, Detach, Move, Segment, Wait, segment_name
 from planning.task.tool_line import ToolLine
@@ -45,11 +45,6 @@ if TYPE_CHECKING:
     from planning.search.firefly import FireflyProgress
 
 FloatArray = NDArray[np.float64]
-
-_FIXED_DURATION = (
-    "the scene fixes duration = {seconds:g} s; a task times each of its motions as fast as the limits "
-    "allow: leave the duration out (duration=None)"
-)
 
 
 @dataclass(frozen=True)
@@ -64,6 +59,7 @@ class SegmentMotion:
             (``None`` for an attach or detach, which does not move).
         line: the planned line, for a ``line``.
         payload: the object attached, for an ``attach``; released, for a ``detach``.
+        held: the motion that keeps an orientation constraint, for a ``free`` one under one.
     """
 
     kind: str
@@ -72,6 +68,7 @@ class SegmentMotion:
     verification: Verification | None = None
     line: LineMotion | None = None
     payload: ck.Payload | None = None
+    held: HeldMotion | None = None
 
 
 @dataclass(frozen=True)
@@ -157,7 +154,7 @@ def plan_task(
     if not segments:
         raise PlanningError("a task needs at least one segment (a Move, a ToolLine, a Wait, an Attach)")
     if scene.duration is not None:
-        raise PlanningError(_FIXED_DURATION.format(seconds=scene.duration))
+        raise PlanningError(FIXED_DURATION.format(seconds=scene.duration))
     base = robot or scene.robot_spec().load()
     carrying = _carrying(scene, base, None)
     q, start_world = carrying.problem.q_start, carrying.problem.world
@@ -171,13 +168,15 @@ def plan_task(
                 payload = segment.payload if isinstance(segment, Attach) else held
                 records.append(SegmentMotion(kind, now, now, payload=payload))
                 continue
-            trajectory, line, problem = _planned(carrying, base, q, segment, progress)
+            planned = _planned(carrying, base, q, segment, progress)
         except (PlanningError, ck.CprKinError) as exc:
             raise PlanningError(f"task[{index}] ({segment_name(segment)}): {exc}") from exc
         except NoSolutionError as exc:
             raise TaskSegmentError(index, segment_name(segment), exc) from exc
-        checked = verify_finer_where_needed(problem, trajectory, carrying.required)
-        records.append(SegmentMotion(kind, now, now + trajectory.duration, checked, line))
+        trajectory = planned.trajectory
+        checked = verify_finer_where_needed(planned.problem, trajectory, carrying.required)
+        end = now + trajectory.duration
+        records.append(SegmentMotion(kind, now, end, checked, planned.line, held=planned.held))
         pieces.append(trajectory)
         now += trajectory.duration
         q = trajectory(trajectory.knots[-1])
@@ -215,33 +214,40 @@ def _carried(carrying: _Carrying, base: ck.Robot, q: FloatArray, segment: Attach
     return _carrying(dataclasses.replace(carrying.scene, payload=segment.payload), base, q)
 
 
+@dataclass(frozen=True)
+class _Planned:
+    """One segment planned from time 0.
+
+    ``problem`` is the one whose finer step may certify it
+    (:func:`~planning.pipeline.verification.verify_finer_where_needed`): a free motion's own,
+    else the carrying scene's.
+    """
+
+    trajectory: Trajectory
+    problem: Problem
+    line: LineMotion | None = None
+    held: HeldMotion | None = None
+
+
 def _planned(
     carrying: _Carrying,
     base: ck.Robot,
     q: FloatArray,
     segment: Segment,
     progress: Callable[[FireflyProgress], None] | None,
-) -> tuple[Trajectory, LineMotion | None, Problem]:
-    """One segment from ``q``: its trajectory from time 0, the line if it is one, and a problem.
-
-    The problem is the one whose finer step may certify the segment
-    (:func:`~planning.pipeline.verification.verify_finer_where_needed`): a free motion's own,
-    else the carrying scene's.
-    """
+) -> _Planned:
+    """One segment from ``q``: a line, a wait, a free motion (bent onto its constraint if it has one)."""
     if isinstance(segment, ToolLine):
         line = plan_line(carrying.problem.world, q, segment, carrying.required)
-        return line.trajectory, line, carrying.problem
+        return _Planned(line.trajectory, carrying.problem, line=line)
     if isinstance(segment, Wait):
         coefficients = np.zeros((1, len(q), 8))
         coefficients[0, :, 0] = q
-        return Trajectory(np.array([0.0, segment.seconds]), coefficients), None, carrying.problem
+        return _Planned(Trajectory(np.array([0.0, segment.seconds]), coefficients), carrying.problem)
     if isinstance(segment, Move):
         scene = dataclasses.replace(carrying.scene, start=Target(q=tuple(q.tolist())), goal=segment.goal)
-        moving = build_problem(scene, base)
-        if not isinstance(moving.duration, FreeDuration):
-            raise PlanningError(_FIXED_DURATION.format(seconds=scene.duration))
-        still = dataclasses.replace(moving.duration, still_jerk=True)
-        return solve(dataclasses.replace(moving, duration=still), progress).trajectory, None, moving
+        free = plan_free(scene, base, segment.constraint, carrying.required, progress)
+        return _Planned(free.trajectory, free.problem, held=free.held)
     raise PlanningError(
         f"a task segment is a Move, a ToolLine, a Wait, an Attach or a Detach, not a {type(segment).__name__}"
     )

@@ -4,12 +4,15 @@
 the trajectory file's ``task`` list: ``kind`` (``free``, ``line``, ``wait``, ``attach``,
 ``detach``), ``t0`` and ``t1`` [s]; a ``line`` also ``frame`` (the tool frame), ``from`` and
 ``to`` (each ``{xyz, quat_xyzw}`` in the robot's base frame) and ``tolerance:
-{position_m, angle_rad}``; an ``attach`` the object's ``object`` name and ``frame``.
+{position_m, angle_rad}``; a free motion under an orientation constraint ``constraint:
+{frame, quat_xyzw, axes, angle_rad}``; an ``attach`` or ``detach`` the object's ``object``
+name and ``frame``.
 
 :func:`record_problems` checks a trajectory against such a list without the planner: the
 entries tile the trajectory in time, a ``wait`` stands still, and over each ``line`` the
 tool stays within its tolerance at every instant (:func:`~planning.task.line_deviation.line_deviation`'s
-certified bound on the line the entry names).
+certified bound on the line the entry names), and under a ``constraint`` the frame keeps it
+(:func:`~planning.task.orientation.orientation_deviation`'s certified bound).
 """
 
 from __future__ import annotations
@@ -25,6 +28,7 @@ import cpr_kin as ck
 from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
 from planning.task.line_deviation import line_deviation
+from planning.task.orientation import OrientationConstraint, orientation_deviation
 from planning.task.task_plan import TaskMotion
 from planning.task.tool_line import LineGeometry, LineTolerance, ToolPose
 
@@ -52,11 +56,24 @@ def task_record(task: TaskMotion) -> list[dict[str, Any]]:
                     "angle_rad": line.line.tolerance.angle_rad,
                 },
             }
+        if segment.held is not None:
+            entry["constraint"] = constraint_entry(segment.held.constraint, segment.held.frame)
         if segment.payload is not None:
             frame = segment.payload.frame or task.world.robot.tcp_frame
             entry |= {"object": segment.payload.name, "frame": frame}
         entries.append(entry)
     return entries
+
+
+def constraint_entry(constraint: OrientationConstraint, frame: str) -> dict[str, Any]:
+    """A resolved orientation constraint as the record holds it: ``{frame, quat_xyzw, axes, angle_rad}``."""
+    assert constraint.quat_xyzw is not None  # resolved where it was planned
+    return {
+        "frame": frame,
+        "quat_xyzw": list(constraint.quat_xyzw),
+        "axes": list(constraint.axes),
+        "angle_rad": constraint.angle_rad,
+    }
 
 
 def _pose(pose: ToolPose) -> dict[str, list[float]]:
@@ -90,6 +107,8 @@ def record_problems(
                 problems.append(f"task entry {index} (wait) moves during [{t0:g}, {t1:g}] s")
         elif kind == "line":
             problems += _line_problems(robot, trajectory, entry, index, (t0, t1))
+        if "constraint" in entry:
+            problems += _constraint_problems(robot, trajectory, entry, index, (t0, t1))
     if abs(end - float(trajectory.knots[-1])) > TIME_TOLERANCE_S:
         problems.append(
             f"the task's entries end at {end:g} s, the trajectory at {float(trajectory.knots[-1]):g} s"
@@ -116,6 +135,28 @@ def _line_problems(
         f"task entry {index} (line) leaves its line by {deviation.position_m:.3g} m and "
         f"{deviation.angle_rad:.3g} rad (certified; tolerance {limit.position_m:g} m, "
         f"{limit.angle_rad:g} rad)"
+    ]
+
+
+def _constraint_problems(
+    robot: ck.Robot, trajectory: Trajectory, entry: Mapping[str, Any], index: int, span: tuple[float, float]
+) -> list[str]:
+    """The orientation constraint's promise over ``span`` [s]: its certified angle within the allowed one."""
+    where = f"task entry {index} constraint"
+    given = entry["constraint"]
+    try:
+        axes, angle, quat = tuple(given["axes"]), float(given["angle_rad"]), tuple(given["quat_xyzw"])
+        constraint = OrientationConstraint(axes, angle, quat)
+        frame = str(given["frame"])
+    except (KeyError, TypeError, ValueError, PlanningError) as exc:
+        raise PlanningError(f"{where}: expected {{frame, quat_xyzw, axes, angle_rad}} ({exc})") from None
+    reference = constraint.reference()
+    deviation = orientation_deviation(robot, frame, constraint, reference, trajectory.between(*span))
+    if deviation.angle_rad <= constraint.angle_rad:
+        return []
+    return [
+        f"task entry {index} ({entry['kind']}) turns '{frame}' {deviation.angle_rad:.3g} rad from its "
+        f"constraint about {list(constraint.axes)} (certified; allowed {constraint.angle_rad:g} rad)"
     ]
 
 

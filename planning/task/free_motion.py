@@ -1,0 +1,82 @@
+"""A task's free motion: the planner's search, timed to end still, bent onto an orientation constraint.
+
+A free motion of a task starts and ends at rest, still in jerk too
+(:class:`~planning.pipeline.timing.FreeDuration`'s ``still_jerk``), so that the segments join
+C3. Under an :class:`~planning.task.orientation.OrientationConstraint` its path is bent onto
+the constraint, or one is planned on it (:func:`~planning.task.held_orientation.hold_orientation`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import cpr_kin as ck
+from planning.curves.trajectory import Trajectory
+from planning.errors import PlanningError
+from planning.pipeline.planner import solve
+from planning.pipeline.problem import Problem, build_problem
+from planning.pipeline.scene import Scene
+from planning.pipeline.timing import FreeDuration
+from planning.pipeline.verification import Requirements
+from planning.task.held_orientation import HeldMotion, hold_orientation
+from planning.task.orientation import OrientationConstraint
+
+if TYPE_CHECKING:
+    from planning.search.firefly import FireflyProgress
+
+FIXED_DURATION = (
+    "the scene fixes duration = {seconds:g} s; a task times each of its motions as fast as the limits "
+    "allow: leave the duration out (duration=None)"
+)
+
+
+@dataclass(frozen=True)
+class FreeMotion:
+    """A task's free motion (:func:`plan_free`).
+
+    Attributes:
+        trajectory: the motion from time 0, at rest at both ends.
+        problem: the scene's problem (its margin), whose finer step may certify it.
+        held: the bent motion, under a constraint.
+    """
+
+    trajectory: Trajectory
+    problem: Problem
+    held: HeldMotion | None = None
+
+
+def plan_free(
+    scene: Scene,
+    robot: ck.Robot,
+    constraint: OrientationConstraint | None,
+    required: Requirements,
+    progress: Callable[[FireflyProgress], None] | None = None,
+) -> FreeMotion:
+    """The free motion from ``scene``'s start to its goal, keeping ``constraint`` if given.
+
+    Raises:
+        PlanningError: bad input: a start or goal inside a margin, or that does not keep the
+            constraint; a fixed duration.
+        NoSolutionError: no motion found, or none that keeps the constraint.
+    """
+    problem = free_problem(scene, robot)
+    free = solve(problem, progress).trajectory
+    if constraint is None:
+        return FreeMotion(free, problem)
+    held = hold_orientation(problem.world, free, constraint, required, scene.planner.seed)
+    return FreeMotion(held.trajectory, problem, held)
+
+
+def free_problem(scene: Scene, robot: ck.Robot) -> Problem:
+    """The problem of a task's free motion: timed to end still in jerk too.
+
+    Raises:
+        PlanningError: the scene fixes a duration; a start or goal inside a margin.
+    """
+    problem = build_problem(scene, robot)
+    if not isinstance(problem.duration, FreeDuration):
+        raise PlanningError(FIXED_DURATION.format(seconds=scene.duration))
+    return dataclasses.replace(problem, duration=dataclasses.replace(problem.duration, still_jerk=True))

@@ -1,0 +1,192 @@
+"""RRT-Connect on an orientation constraint's manifold: a path that keeps it where a free path cannot be bent.
+
+Projection-based constrained planning (as OMPL's ``ProjectedStateSpace``): every node is
+a configuration projected onto the constraint (:class:`~planning.task.orientation_projection.Projector`),
+and every edge is walked in steps of at most :data:`STEP_M` of robot motion (``sum_j R_j
+|dq_j|``, :func:`cpr_kin.motion_radii`), each step projected and checked: it keeps the
+margins plus :data:`STEP_M` (so that the motion between two steps cannot reach them), it
+moves no more than twice a step from the last (the projection did not jump), and it comes
+closer to where the edge aims. Two trees grow from start and goal toward uniform samples
+projected onto the manifold, each extension followed by the other tree's greedy connection,
+roles swapped every sample (Kuffner & LaValle 2000). The path found is shortened by random
+shortcuts walked the same way. Its steps are the samples the caller joins and times.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+import cpr_kin as ck
+from planning.errors import NoSolutionError
+from planning.pipeline.verification import Requirements
+from planning.task.orientation_projection import Projector
+
+FloatArray = NDArray[np.float64]
+
+STEP_M = 0.01
+"""Largest robot motion between two steps of an edge [m]."""
+RANGE_M = 0.3
+"""Longest extension toward a sample [m]."""
+MAX_SAMPLES = 1500
+"""Most samples the trees grow toward before the search gives up."""
+SHORTCUTS = 100
+"""Shortcuts tried on the path found."""
+BATCH = 16
+"""Steps projected before their clearance is checked together."""
+
+
+class _Tree:
+    """Nodes in a growing array (the nearest one found without copying a list) and their parents."""
+
+    def __init__(self, root: FloatArray) -> None:
+        self._nodes = np.empty((64, len(root)))
+        self._nodes[0] = root
+        self.size = 1
+        self.parents = [-1]
+
+    @property
+    def nodes(self) -> FloatArray:
+        return self._nodes[: self.size]
+
+    def add(self, q: FloatArray, parent: int) -> int:
+        if self.size == len(self._nodes):
+            self._nodes = np.concatenate([self._nodes, np.empty_like(self._nodes)])
+        self._nodes[self.size] = q
+        self.parents.append(parent)
+        self.size += 1
+        return self.size - 1
+
+    def branch(self, index: int) -> list[FloatArray]:
+        """The nodes from the root to ``index``."""
+        found = []
+        while index >= 0:
+            found.append(self._nodes[index].copy())
+            index = self.parents[index]
+        return found[::-1]
+
+
+class _Walker:
+    """Walks edges on the manifold, step by step (module docstring)."""
+
+    def __init__(self, world: ck.CollisionWorld, projector: Projector, required: Requirements) -> None:
+        self.world, self.projector = world, projector
+        self.weights = ck.motion_radii(world.robot)
+        self.margin_m = required.margin_m + STEP_M
+        self.self_margin_m = required.self_margin_m + STEP_M / 2
+
+    def distance(self, a: FloatArray, b: FloatArray) -> float:
+        return float(self.weights @ np.abs(a - b))
+
+    def walk(self, start: FloatArray, aim: FloatArray, range_m: float = np.inf) -> list[FloatArray]:
+        """The steps from ``start`` (left out) toward ``aim``, as far as they go.
+
+        Steps are projected :data:`BATCH` at a time, then checked for clearance together.
+        """
+        steps: list[FloatArray] = []
+        q, left, travelled = start, self.distance(start, aim), 0.0
+        while left > 1e-9 and travelled < range_m:
+            batch: list[FloatArray] = []
+            while len(batch) < BATCH and left > 1e-9 and travelled < range_m:
+                guess = aim if left <= STEP_M else q + (aim - q) * (STEP_M / left)
+                stepped, angle = self.projector.project(guess)
+                moved, remaining = self.distance(q, stepped), self.distance(stepped, aim)
+                if angle > self.projector.aim_rad or moved > 2 * STEP_M or remaining >= left:
+                    left = 0.0  # stuck: the batch so far is the walk's end
+                    break
+                batch.append(stepped)
+                q, left, travelled = stepped, remaining, travelled + moved
+            if not batch:
+                break
+            kept = self.world.keeps_clearance(
+                np.array(batch), self.margin_m, self.self_margin_m, ordered=True
+            )
+            valid = int(np.argmin(kept)) if not kept.all() else len(batch)
+            steps += batch[:valid]
+            if valid < len(batch):
+                break
+        return steps
+
+    def reaches(self, steps: list[FloatArray], aim: FloatArray) -> bool:
+        return bool(steps) and self.distance(steps[-1], aim) <= 1e-9
+
+
+def orientation_path(
+    world: ck.CollisionWorld,
+    projector: Projector,
+    q_start: FloatArray,
+    q_goal: FloatArray,
+    required: Requirements,
+    rng: np.random.Generator,
+) -> FloatArray:
+    """``(n, nq)`` the steps of a path from ``q_start`` to ``q_goal`` on the manifold (module docstring).
+
+    Raises:
+        NoSolutionError: no path within :data:`MAX_SAMPLES` samples.
+    """
+    walker = _Walker(world, projector, required)
+    direct = walker.walk(q_start, q_goal)
+    if walker.reaches(direct, q_goal):
+        return np.array([q_start, *direct])
+    trees = (_Tree(q_start), _Tree(q_goal))
+    lower, upper = world.robot.limits.lower, world.robot.limits.upper
+    for sample in range(MAX_SAMPLES):
+        grow, other = trees if sample % 2 == 0 else trees[::-1]
+        aim, angle = projector.project(rng.uniform(lower, upper))
+        if angle > projector.aim_rad:
+            continue
+        near = _nearest(grow, aim, walker)
+        steps = walker.walk(grow.nodes[near], aim, RANGE_M)
+        if not steps:
+            continue
+        for q in steps:
+            near = grow.add(q, near)
+        toward = _nearest(other, steps[-1], walker)
+        joined = walker.walk(other.nodes[toward], steps[-1])
+        for q in joined:
+            toward = other.add(q, toward)
+        if walker.reaches(joined, steps[-1]) or walker.distance(other.nodes[toward], steps[-1]) <= 1e-9:
+            first, second = grow.branch(near), other.branch(toward)
+            path = first + second[::-1][1:] if grow is trees[0] else second + first[::-1][1:]
+            return _shortened(np.array(path), walker, rng)
+    raise NoSolutionError(
+        f"no path keeps '{projector.frame}' within {projector.constraint.angle_rad:.4g} rad about "
+        f"{list(projector.constraint.axes)} and the margins (RRT-Connect on the constraint, "
+        f"{MAX_SAMPLES} samples)"
+    )
+
+
+def _nearest(tree: _Tree, q: FloatArray, walker: _Walker) -> int:
+    return int(np.argmin(np.abs(tree.nodes - q) @ walker.weights))
+
+
+def _shortened(path: FloatArray, walker: _Walker, rng: np.random.Generator) -> FloatArray:
+    """``path`` with random pieces replaced by direct walks that reach, then its corners cut greedily."""
+    for _ in range(SHORTCUTS):
+        if len(path) < 3:
+            break
+        i, j = sorted(rng.choice(len(path), size=2, replace=False))
+        if j - i < 2:
+            continue
+        steps = walker.walk(path[i], path[j])
+        if walker.reaches(steps, path[j]) and len(steps) < j - i:
+            path = np.concatenate([path[: i + 1], np.array(steps), path[j + 1 :]])
+    return _greedy(path, walker)
+
+
+def _greedy(path: FloatArray, walker: _Walker) -> FloatArray:
+    """From each kept point, the direct walk to the farthest point of ``path`` it reaches (halving)."""
+    kept, i = [path[0]], 0
+    while i < len(path) - 1:
+        j = len(path) - 1
+        while j > i + 1:
+            steps = walker.walk(path[i], path[j])
+            if walker.reaches(steps, path[j]):
+                break
+            j = i + (j - i) // 2
+        if j == i + 1:
+            kept.append(path[j])
+        else:
+            kept += steps
+        i = j
+    return np.array(kept)

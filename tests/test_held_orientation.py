@@ -1,0 +1,135 @@
+"""An upright carry: a free motion that keeps the tool's z axis within 5 degrees, on a UR5 and a Panda.
+
+Checked every
+millisecond without the planner's code: the angle between the tool's z axis and the
+reference's (Pinocchio's forward kinematics, ``arccos``), the record's constraint, and the
+record kept and checked.
+"""
+
+from __future__ import annotations
+
+import copy
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import cpr_kin as ck
+from cpr_kin.kinematics.numerical_ik import IkTarget, solve_ik
+from cpr_kin.model.packages import example_robot
+from planning.errors import PlanningError
+from planning.io.scene_file import SceneFile, parse_scene_file
+from planning.pipeline.verification import Requirements
+from planning.task import Move, TaskMotion, check_task, plan_task, record_problems, task_record
+from planning.task.orientation import OrientationConstraint
+from planning.task.orientation_projection import Projector
+from planning.task.orientation_rrt import STEP_M, orientation_path
+
+UPRIGHT = {"axes": ["x", "y"], "angle_rad": 0.0873}
+DOWN = [3.14159265, 0.0, 0.0]
+ARMS: dict[str, dict[str, Any]] = {
+    "panda": {"start": [0.0, -0.6, 0.0, -2.2, 0.0, 1.6, 0.8]},
+    "ur5": {"start": [-1.0, -1.57, 1.57, -1.57, -1.57, 0.0]},
+}
+
+
+def scene_file(arm: str, constraint: dict[str, Any] = UPRIGHT) -> SceneFile:
+    document = {
+        "robot": arm,
+        "safety_margin": 0.02,
+        "start": {"q": ARMS[arm]["start"]},
+        "task": [
+            {"move": {"pose": {"xyz": [0.5, -0.25, 0.3], "rpy": DOWN}}},
+            {
+                "attach": {
+                    "name": "glass",
+                    "mass_kg": 0.5,
+                    "shape": {"shape": "cylinder", "radius": 0.03, "length": 0.1, "xyz": [0, 0, 0.06]},
+                }
+            },
+            {"move": {"pose": {"xyz": [0.45, 0.3, 0.3], "rpy": DOWN}, "constraint": constraint}},
+            {"detach": {}},
+        ],
+        "obstacles": [{"name": "post", "shape": "box", "size": [0.08, 0.08, 0.5], "xyz": [0.55, 0.03, 0.25]}],
+    }
+    return parse_scene_file(document, f"{arm} upright carry")
+
+
+@pytest.fixture(scope="module", params=sorted(ARMS))
+def carried(request: pytest.FixtureRequest) -> tuple[str, SceneFile, TaskMotion]:
+    read = scene_file(request.param)
+    return request.param, read, plan_task(read.scene, read.task)
+
+
+def test_the_glass_stays_upright_every_millisecond(carried: tuple[str, SceneFile, TaskMotion]) -> None:
+    _, _, task = carried
+    assert task.accepted, task.problems
+    carry = task.segments[2]
+    assert carry.held is not None
+    robot = task.world.robot
+    model, data = robot.model, robot.model.createData()
+    fid = model.getFrameId(robot.tcp_frame)
+    pin.framesForwardKinematics(model, data, task.trajectory(carry.t0))
+    upright = data.oMf[fid].rotation[:, 2].copy()  # the tool's z axis where the carry starts
+    tilts = []
+    for q in task.trajectory(np.arange(carry.t0, carry.t1, 1e-3)):
+        pin.framesForwardKinematics(model, data, q)
+        tilts.append(np.arccos(np.clip(data.oMf[fid].rotation[:, 2] @ upright, -1.0, 1.0)))
+    assert max(tilts) <= 0.0873
+    assert max(tilts) <= carry.held.deviation.angle_rad + 1e-9  # the certified bound bounds them
+    free = task.segments[0]  # the motion to the glass has no constraint: it tilts the tool freely
+    assert free.held is None
+
+
+def test_the_record_holds_the_constraint_and_a_tighter_one_is_caught(
+    carried: tuple[str, SceneFile, TaskMotion],
+) -> None:
+    _, read, task = carried
+    record = task_record(task)
+    constraint = record[2]["constraint"]
+    assert constraint["axes"] == ["x", "y"] and constraint["angle_rad"] == 0.0873
+    assert constraint["frame"] == task.world.robot.tcp_frame and len(constraint["quat_xyzw"]) == 4
+    assert check_task(read.scene, read.task, task.trajectory, record).accepted
+    tighter = copy.deepcopy(record)
+    tighter[2]["constraint"]["angle_rad"] = 1e-4
+    found = record_problems(task.world.robot, task.trajectory, tighter)
+    assert any(p.startswith("task entry 2 (free) turns") for p in found)
+    checked = check_task(read.scene, read.task, task.trajectory, tighter).problems
+    assert any(p.startswith("task[2] (free) records constraint") for p in checked)
+    unconstrained = list(read.task)
+    move = unconstrained[2]
+    assert isinstance(move, Move)
+    unconstrained[2] = Move(move.goal)
+    found = check_task(read.scene, unconstrained, task.trajectory, record).problems
+    assert found == ("task[2] (free) records a constraint; the task's motion has none",)
+
+
+def test_a_constraint_the_start_breaks_is_refused_naming_the_segment() -> None:
+    up = {**UPRIGHT, "rpy": [0.0, 0.0, 0.0]}  # the tool's z axis up, where it points down
+    read = scene_file("ur5", up)
+    with pytest.raises(PlanningError, match=r"task\[2\] \(move\): the motion's start holds 'tool0' 3\.14"):
+        plan_task(read.scene, read.task)
+
+
+def test_rrt_on_the_constraint_finds_an_upright_way_around_a_post_where_the_straight_one_is_blocked() -> None:
+    robot = ck.load_robot(example_robot("panda"))
+    post = ck.Obstacle.box((0.08, 0.08, 0.5), (0.55, 0.03, 0.25), name="post")
+    world = ck.CollisionWorld(robot, [post])
+    down = pin.rpy.rpyToMatrix(3.14159265, 0.0, 0.0)
+    ends = []
+    for xyz in ((0.5, -0.25, 0.3), (0.45, 0.3, 0.3)):
+        target = IkTarget(position=np.array(xyz), rotation=np.asarray(down))
+        ends.append(solve_ik(robot, target, seed_q=[0.0, -0.6, 0.0, -2.2, 0.0, 1.6, 0.8]))
+    constraint = OrientationConstraint(("x", "y"), 0.0873)
+    reference = ck.frame_poses(robot, ends[0])[:3, :3]
+    projector = Projector(robot, robot.tcp_frame, constraint, reference)
+    required = Requirements(margin_m=0.02, step_m=0.005)
+    straight = ends[0] + np.linspace(0.0, 1.0, 50)[:, None] * (ends[1] - ends[0])
+    assert not world.keeps_clearance(straight, 0.02, 0.01).all()  # the straight way hits the post
+    path = orientation_path(world, projector, ends[0], ends[1], required, np.random.default_rng(0))
+    np.testing.assert_allclose(path[[0, -1]], ends, atol=1e-12)
+    assert projector.angles(path).max() <= projector.aim_rad + 1e-9
+    assert world.keeps_clearance(path, 0.02 + STEP_M, 0.01).all()
+    radii = ck.motion_radii(robot)
+    assert (np.abs(np.diff(path, axis=0)) @ radii).max() <= 2 * STEP_M + 1e-9
