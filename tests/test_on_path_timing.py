@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
-from planning.curves.on_path_timing import time_on_path
+from planning.curves.on_path_timing import time_on_path, time_on_path_marked
 from planning.curves.path_timing import time_path
 from planning.curves.trajectory import Trajectory
 from tests.conftest import LIFT, limits_of, spline_path
@@ -62,3 +62,18 @@ def test_a_straight_path_is_timed_as_the_free_timing_times_it(robot: ck.Robot) -
     on_path = time_on_path(straight, *limits_of(robot))
     free = time_path(straight, *limits_of(robot))
     assert on_path.duration == pytest.approx(free.duration, rel=0.15)
+
+
+def test_a_marked_motion_passes_each_mark_at_its_time_and_is_the_same_motion(
+    robot: ck.Robot, curved: Trajectory
+) -> None:
+    plain = time_on_path(curved, *limits_of(robot))
+    u0, u1 = curved.knots[0], curved.knots[-1]
+    marks = u0 + np.array([0.2, 0.5, 0.9]) * (u1 - u0)
+    marked = time_on_path_marked(curved, limits_of(robot), marks)
+    assert np.all(np.diff(marked.times) > 0) and marked.times[0] > 0 and marked.times[-1] < plain.duration
+    for t in marked.times:
+        assert np.min(np.abs(marked.trajectory.knots - t)) < 1e-12  # a knot at each mark
+    np.testing.assert_allclose(marked.trajectory(marked.times), curved(marks), atol=1e-6)
+    times = np.linspace(0.0, plain.duration, 301)
+    np.testing.assert_allclose(marked.trajectory(times), plain(times), atol=1e-9)

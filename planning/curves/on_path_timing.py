@@ -20,12 +20,15 @@ way by both functions, up to the rounding of the grids.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from numpy.typing import NDArray
 from scipy.interpolate import BSpline, make_interp_spline
 
 from planning.curves.arc_length import FINE, ArcLengthPath, arc_length_path
 from planning.curves.moving_average import arc_at_times, averaged_motion, scaled_duration
+from planning.curves.path_pieces import split_at
 from planning.curves.path_timing import (
     NODE_STEP_S,
     Smoothing,
@@ -74,20 +77,70 @@ def time_on_path(
     Raises:
         PlanningError: the path does not move, or a limit is not finite and positive.
     """
-    limits = checked_limits(path.n_joints, velocity, acceleration, jerk)
-    arc = arc_length_path(path, limits[0])
-    smoothing = smoothing_limits(limits, node_step_s)
+    return _timed(path, (velocity, acceleration, jerk), node_step_s, torque).trajectory
+
+
+@dataclass(frozen=True)
+class MarkedMotion:
+    """A motion along a path (:func:`time_on_path_marked`) and when it passes given points of it.
+
+    Attributes:
+        trajectory: the motion, with a knot at each of ``times`` too.
+        times: ``(m,)`` when it passes the marks [s].
+    """
+
+    trajectory: Trajectory
+    times: FloatArray
+
+
+def time_on_path_marked(
+    path: Trajectory,
+    limits: tuple[FloatArray, FloatArray, FloatArray],
+    marks: FloatArray,
+    node_step_s: float = NODE_STEP_S,
+    torque: TorqueModel | None = None,
+) -> MarkedMotion:
+    """:func:`time_on_path`'s motion (``limits``: velocity, acceleration, jerk), and when it passes ``marks``.
+
+    ``marks`` ``(m,)``: values of the path's parameter strictly inside it. The time of each is
+    found on the motion's own grid of arc lengths, and the trajectory is cut there exactly
+    (:func:`~planning.curves.path_pieces.split_at`): its pieces between marks are the motion
+    over each part of the path.
+    """
+    timed = _timed(path, limits, node_step_s, torque)
+    times = np.interp(np.asarray(marks, dtype=float), timed.u, timed.grid_s) * timed.scale
+    return MarkedMotion(split_at(timed.trajectory, times.tolist()), times)
+
+
+@dataclass(frozen=True)
+class _Timed:
+    trajectory: Trajectory
+    u: FloatArray  # the path parameter at each grid time, before the final scaling
+    grid_s: FloatArray
+    scale: float
+
+
+def _timed(
+    path: Trajectory,
+    limits: tuple[FloatArray, FloatArray, FloatArray],
+    node_step_s: float,
+    torque: TorqueModel | None,
+) -> _Timed:
+    checked = checked_limits(path.n_joints, *limits)
+    arc = arc_length_path(path, checked[0])
+    smoothing = smoothing_limits(checked, node_step_s)
     if torque is not None:
         uncapped = capped_profile(arc, smoothing.limits, 1.0)
         arc = arc._replace(torque=torque_rows(path(arc.u), arc.dq, arc.ddq, arc.ds, torque, uncapped))
     step_s = time_step_s(smoothing.limits)
     parameter = path_parameter(path, arc.length)
     motions = [_capped(path, arc, parameter, smoothing, share, step_s) for share in (1.0, *CAPS)]
-    durations = [scaled_duration(motion, step_s, *limits) for motion in motions]
-    motion = motions[int(np.argmin(durations))]
+    durations = [scaled_duration(motion[0], step_s, *checked) for motion in motions]
+    motion, u = motions[int(np.argmin(durations))]
     ends = path(path.knots[[0, -1]])
     trajectory = septic_through(motion, step_s, smoothing.step_s, ends, still=4)
-    return trajectory.time_scaled(limits_time_scale(trajectory, limits, torque))
+    scale = limits_time_scale(trajectory, checked, torque)
+    return _Timed(trajectory.time_scaled(scale), u, np.arange(len(u), dtype=float) * step_s, scale)
 
 
 def _capped(
@@ -97,14 +150,14 @@ def _capped(
     smoothing: Smoothing,
     share: float,
     step_s: float,
-) -> FloatArray:
-    """``(4, T, nj)`` the motion on the path under a velocity cap of ``share`` of the limits."""
+) -> tuple[FloatArray, FloatArray]:
+    """``(4, T, nj)`` the motion on the path under a velocity cap of ``share`` of the limits, and ``u``."""
     profile = capped_profile(arc, smoothing.limits, share)
     window_s = jerk_window_s(arc, profile, smoothing.limits[2])
     s = arc_at_times(profile, arc.ds, step_s)
     averaged = averaged_motion(s[:, None], window_s, step_s, smoothing.second_share)[0, :, 0]
     u = parameter(np.clip(averaged, 0.0, arc.length[-1]))
-    return _derivatives(path(u), step_s)
+    return _derivatives(path(u), step_s), np.asarray(u)
 
 
 def path_parameter(path: Trajectory, length: FloatArray) -> BSpline:

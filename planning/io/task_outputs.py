@@ -121,7 +121,7 @@ def task_report_markdown(task: TaskMotion) -> str:
         "",
         f"{len(task.segments)} segments in one trajectory of {task.trajectory.duration:.3f} s, {verdict}; "
         f"certified clearance {task.certified_min_clearance_m:.4f} m (margin {task.scene.safety_margin} m); "
-        "jerk continuous at every knot, at rest where the segments meet.",
+        "jerk continuous at every knot, at rest only at its ends, waits, attaches and detaches.",
         "",
         markdown_table(rows, headers),
         "",

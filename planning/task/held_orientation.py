@@ -58,7 +58,8 @@ class HeldMotion:
     Attributes:
         constraint: the constraint, its reference resolved (the frame's at the start if none given).
         frame: the constrained frame.
-        samples: ``(n, nq)`` the bent path's samples [rad, m].
+        samples: ``(n, nq)`` the path's samples [rad, m].
+        path: the quintic spline through them, the geometric path (parameter 0 to 1).
         trajectory: the timed motion, at rest at both ends.
         deviation: its certified angle from the constraint.
         bent: the free path bent onto the constraint (``False``: a path planned on it).
@@ -67,6 +68,7 @@ class HeldMotion:
     constraint: OrientationConstraint
     frame: str
     samples: FloatArray
+    path: Trajectory
     trajectory: Trajectory
     deviation: OrientationDeviation
     bent: bool = True
@@ -114,7 +116,7 @@ def hold_orientation(
     samples, path = _joined(projector, samples)
     _refuse_blocked(world, samples, required)
     trajectory, deviation = _timed(projector, path, required)
-    return HeldMotion(constraint, frame, samples, trajectory, deviation, bent)
+    return HeldMotion(constraint, frame, samples, path, trajectory, deviation, bent)
 
 
 def _with_reference(constraint: OrientationConstraint, pose: FloatArray) -> OrientationConstraint:

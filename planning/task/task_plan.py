@@ -3,17 +3,16 @@
 :func:`plan_task` starts at the scene's start and plans each segment from where the one
 before ends: a :class:`Move` by the planner's search (to a joint, ``tcp`` or pose goal, the
 scene's obstacles, margins and payload), a :class:`~planning.task.tool_line.ToolLine` by
-:func:`~planning.task.line_motion.plan_line`, a :class:`Wait` standing still. Every segment
-starts and ends at rest, still in jerk too (the free motions' timing is asked for it,
-:class:`~planning.pipeline.timing.FreeDuration`'s ``still_jerk``), so the joined trajectory is
-C3 at every junction; the whole is verified as every trajectory of the planner is. The scene's
-own goal is neither planned to nor needed: the segments say where the robot goes.
+:func:`~planning.task.line_motion.plan_line`, a :class:`Wait` standing still. Each is planned
+from rest to rest; then motions that follow each other without a wait, an attach or a detach
+are joined into one path and timed as one, so that the robot stops only where the task says
+(:mod:`planning.task.task_timing`). The whole is C3 and each segment verified as every
+trajectory of the planner is. The scene's own goal is neither planned to nor needed: the
+segments say where the robot goes.
 
 :class:`Attach` and :class:`Detach` change what the robot carries from there on: its mass in
-the torques, its shape in the clearance checks, the links it may touch.
-
-A scene file's ``task:`` holds the same segments (:mod:`planning.io.task_entry`). Not yet
-(issue 71): junctions that do not stop.
+the torques, its shape in the clearance checks, the links it may touch. A scene file's
+``task:`` holds the same segments (:mod:`planning.io.task_entry`).
 """
 
 from __future__ import annotations
@@ -34,11 +33,12 @@ from planning.errors import NoSolutionError, PlanningError, TaskSegmentError
 from planning.pipeline.problem import Problem, build_problem
 from planning.pipeline.scene import Scene
 from planning.pipeline.target import Target
-from planning.pipeline.verification import Requirements, Verification, verify_finer_where_needed
+from planning.pipeline.verification import Requirements, Verification
 from planning.task.free_motion import FIXED_DURATION, plan_free
 from planning.task.held_orientation import HeldMotion
 from planning.task.line_motion import LineMotion, plan_line
 from planning.task.segments import KINDS, Attach, Detach, Move, Segment, Wait, segment_name
+from planning.task.task_timing import PlannedMotion, timed_motions
 from planning.task.tool_line import ToolLine
 
 if TYPE_CHECKING:
@@ -77,7 +77,7 @@ class TaskMotion:
 
     Attributes:
         segments: each segment's kind, times and verification, in order.
-        trajectory: the whole motion, at rest at each junction.
+        trajectory: the whole motion, at rest at its ends, its waits, attaches and detaches.
         continuity: where the whole is not C3 (``None``: it is, at every knot).
         world: the robot among the scene's obstacles, carrying what it carries at the start
             (for drawing).
@@ -158,30 +158,35 @@ def plan_task(
     base = robot or scene.robot_spec().load()
     carrying = _carrying(scene, base, None)
     q, start_world = carrying.problem.q_start, carrying.problem.world
-    records, pieces, now = [], [], 0.0
+    kinds, payloads, planned = [], [], list[PlannedMotion | None]()
     for index, segment in enumerate(segments):
-        kind = KINDS.get(type(segment), type(segment).__name__)
+        kinds.append(KINDS.get(type(segment), type(segment).__name__))
         try:
             if isinstance(segment, Attach | Detach):
                 held = carrying.scene.payload
                 carrying = _carried(carrying, base, q, segment)
-                payload = segment.payload if isinstance(segment, Attach) else held
-                records.append(SegmentMotion(kind, now, now, payload=payload))
+                payloads.append(segment.payload if isinstance(segment, Attach) else held)
+                planned.append(None)
                 continue
-            planned = _planned(carrying, base, q, segment, progress)
+            motion = _planned(carrying, base, q, segment, progress)
         except (PlanningError, ck.CprKinError) as exc:
             raise PlanningError(f"task[{index}] ({segment_name(segment)}): {exc}") from exc
         except NoSolutionError as exc:
             raise TaskSegmentError(index, segment_name(segment), exc) from exc
-        trajectory = planned.trajectory
-        checked = verify_finer_where_needed(planned.problem, trajectory, carrying.required)
-        end = now + trajectory.duration
-        records.append(SegmentMotion(kind, now, end, checked, planned.line, held=planned.held))
-        pieces.append(trajectory)
-        now += trajectory.duration
-        q = trajectory(trajectory.knots[-1])
-    if not pieces:
+        payloads.append(None)
+        planned.append(motion)
+        q = motion.trajectory(motion.trajectory.knots[-1])
+    if all(motion is None for motion in planned):
         raise PlanningError("a task needs a segment that moves or waits, not only attach and detach")
+    records, pieces, now = [], [], 0.0
+    for kind, payload, timed in zip(kinds, payloads, timed_motions(planned, base), strict=True):
+        if timed is None:
+            records.append(SegmentMotion(kind, now, now, payload=payload))
+            continue
+        end = now + timed.trajectory.duration
+        records.append(SegmentMotion(kind, now, end, timed.verification, timed.line, held=timed.held))
+        pieces.append(timed.trajectory)
+        now = end
     whole = joined(pieces)
     robot_names = carrying.problem.robot.joint_names
     units = [carrying.problem.robot.joint_unit(n) for n in robot_names]
@@ -214,40 +219,27 @@ def _carried(carrying: _Carrying, base: ck.Robot, q: FloatArray, segment: Attach
     return _carrying(dataclasses.replace(carrying.scene, payload=segment.payload), base, q)
 
 
-@dataclass(frozen=True)
-class _Planned:
-    """One segment planned from time 0.
-
-    ``problem`` is the one whose finer step may certify it
-    (:func:`~planning.pipeline.verification.verify_finer_where_needed`): a free motion's own,
-    else the carrying scene's.
-    """
-
-    trajectory: Trajectory
-    problem: Problem
-    line: LineMotion | None = None
-    held: HeldMotion | None = None
-
-
 def _planned(
     carrying: _Carrying,
     base: ck.Robot,
     q: FloatArray,
     segment: Segment,
     progress: Callable[[FireflyProgress], None] | None,
-) -> _Planned:
+) -> PlannedMotion:
     """One segment from ``q``: a line, a wait, a free motion (bent onto its constraint if it has one)."""
+    required = carrying.required
     if isinstance(segment, ToolLine):
-        line = plan_line(carrying.problem.world, q, segment, carrying.required)
-        return _Planned(line.trajectory, carrying.problem, line=line)
+        line = plan_line(carrying.problem.world, q, segment, required)
+        return PlannedMotion(line.trajectory, carrying.problem, required, line=line)
     if isinstance(segment, Wait):
         coefficients = np.zeros((1, len(q), 8))
         coefficients[0, :, 0] = q
-        return _Planned(Trajectory(np.array([0.0, segment.seconds]), coefficients), carrying.problem)
+        still = Trajectory(np.array([0.0, segment.seconds]), coefficients)
+        return PlannedMotion(still, carrying.problem, required, still=True)
     if isinstance(segment, Move):
         scene = dataclasses.replace(carrying.scene, start=Target(q=tuple(q.tolist())), goal=segment.goal)
-        free = plan_free(scene, base, segment.constraint, carrying.required, progress)
-        return _Planned(free.trajectory, free.problem, held=free.held)
+        free = plan_free(scene, base, segment.constraint, required, progress)
+        return PlannedMotion(free.trajectory, free.problem, required, held=free.held)
     raise PlanningError(
         f"a task segment is a Move, a ToolLine, a Wait, an Attach or a Detach, not a {type(segment).__name__}"
     )
