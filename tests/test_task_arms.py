@@ -20,7 +20,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+import cpr_kin as ck
 from cpr_kin.model.packages import package_roots
+from planning.io.robot_entry import robot_spec_of
 from planning.io.scene_file import SceneFile, parse_scene_file
 from planning.task import TaskMotion, check_task, plan_task, task_record
 
@@ -165,3 +167,49 @@ def test_the_exact_link_meshes_and_the_part_keep_the_margin(planned: tuple[Scene
             least = min(least, result.min_distance)
     assert least >= read.scene.safety_margin - 1e-6
     assert least <= task.certified_min_clearance_m + 0.05  # the same motion: near the certified figure
+
+
+@pytest.mark.parametrize("arm", ["xarm7", "z1", "ur10"])
+def test_a_task_about_a_random_start_plans_and_checks_on_arms_no_task_test_was_written_for(arm: str) -> None:
+    """A grasp and an upright carry near a seeded start of each arm; the z1's tool lines drive its
+    last joint to its limit, where the spline through the line's samples once passed it."""
+    robot = robot_spec_of(arm, Path(".")).load()
+    rng = np.random.default_rng(0)
+    world = ck.CollisionWorld(robot, [])
+    middle = 0.5 * (robot.limits.lower + robot.limits.upper)
+    for _ in range(200):  # the first seeded draw 2 cm clear of itself, else the last (the z1's
+        q = 0.6 * rng.uniform(robot.limits.lower, robot.limits.upper) + 0.4 * middle  # gripper is
+        if world.keeps_clearance(q[None], 0.0, 0.02)[0]:  # within 2 cm of its wrist in every draw)
+            break
+    pose = ck.frame_poses(robot, q)
+    quat = pin.Quaternion(pose[:3, :3]).coeffs().tolist()
+
+    def near(offset: list[float]) -> dict[str, Any]:
+        return {"pose": {"xyz": (pose[:3, 3] + np.array(offset)).tolist(), "quat_xyzw": quat}}
+
+    document = {
+        "robot": arm,
+        "safety_margin": 0.01,
+        "start": {"q": q.tolist()},
+        "task": [
+            {"move": near([0.03, -0.06, 0.0])},
+            {"line": {"by": [0, 0, 0.05]}},
+            {"wait": 0.2},
+            {
+                "attach": {
+                    "name": "part",
+                    "mass_kg": 0.3,
+                    "shape": {"shape": "sphere", "radius": 0.02, "xyz": [0, 0, 0.03]},
+                }
+            },
+            {"line": {"by": [0, 0, -0.05]}},
+            {"move": {**near([0.03, 0.06, 0.02]), "constraint": {"axes": ["x", "y"], "angle_rad": 0.0873}}},
+            {"detach": {}},
+        ],
+    }
+    read = parse_scene_file(document, f"{arm} task")
+    task = plan_task(read.scene, read.task)
+    assert task.accepted, task.problems
+    assert check_task(read.scene, read.task, task.trajectory, task_record(task)).accepted
+    positions = task.trajectory(np.arange(0.0, task.trajectory.duration, 1e-3))
+    assert (positions >= robot.limits.lower - 1e-9).all() and (positions <= robot.limits.upper + 1e-9).all()

@@ -29,6 +29,13 @@ from cpr_kin.kinematics.numerical_ik import damped_step, rotation_error
 from planning.curves.interpolating_spline import spline_through
 from planning.curves.trajectory import Trajectory
 from planning.errors import ToolLineBrokenError
+from planning.task.joint_ranges import (
+    LIMIT_GAIN,
+    RANGE_INSETS,
+    away_from_limits,
+    beyond_range,
+    joint_range,
+)
 from planning.task.line_deviation import rotation_angles
 from planning.task.tool_line import LineGeometry, LineTolerance
 
@@ -60,11 +67,6 @@ DAMPING = 1e-5
 """Damping of the least squares, relative to the size of the tolerance-weighted Jacobian."""
 LARGEST_JOINT_STEP = 0.25
 """Most a joint may move between two samples [rad or m]: more means a singularity."""
-LIMIT_ZONE = 0.2
-"""The outer share of a joint's range where a redundant arm's null space pulls it back."""
-LIMIT_GAIN = 0.01
-"""Share of a joint's distance from the middle of its range that one step pulls back, at the limit
-(docs/tuning.md, "Tool lines")."""
 SINGULAR = 1e-4
 """Smallest singular value of the tolerance-weighted Jacobian, relative to its largest."""
 
@@ -98,14 +100,21 @@ def joint_line(
     """
     steps = _step_count(geometry)
     q = np.asarray(q_start, dtype=float)
+    inset, insets = np.zeros(robot.nq), 0
     while True:
         sigma = np.linspace(0.0, 1.0, steps + 1)
 
-        def walk(gain: float, sigma: FloatArray = sigma) -> tuple[FloatArray, float]:
-            return _walk(robot, q, frame, geometry, tolerance, sigma, gain)
+        def walk(
+            gain: float, sigma: FloatArray = sigma, inset: FloatArray = inset
+        ) -> tuple[FloatArray, float]:
+            return _walk(robot, q, frame, geometry, tolerance, sigma, gain, inset)
 
         samples, residual = _pulled_if_broken(robot, walk)
         path = spline_through(sigma, samples, SPLINE_DEGREE)
+        beyond = beyond_range(robot, path)
+        if beyond.any() and insets < RANGE_INSETS:  # samples at a limit, the spline past it
+            inset, insets = inset + 2.0 * beyond, insets + 1
+            continue
         middles = 0.5 * (sigma[1:] + sigma[:-1])
         excess = _excess(robot, frame, geometry, tolerance, middles, path(middles))
         if excess <= residual + SPLINE_SHARE or 2 * steps > MOST_STEPS:
@@ -119,9 +128,9 @@ def _pulled_if_broken(
     """``walk(0)``, and where it breaks on a redundant arm, ``walk(LIMIT_GAIN)``.
 
     An arm of more joints than the tool's six directions walks again with its null space
-    pulling joints from their limits (:func:`_away_from_limits`). Only on a break: the pull
-    lengthens the joints' motion on lines that need none. Of two breaks, the one further
-    along is raised.
+    pulling joints from their limits (:func:`~planning.task.joint_ranges.away_from_limits`).
+    Only on a break: the pull lengthens the joints' motion on lines that need none. Of two
+    breaks, the one further along is raised.
     """
     try:
         return walk(0.0)
@@ -164,12 +173,14 @@ def _walk(
     tolerance: LineTolerance,
     sigma: FloatArray,
     limit_gain: float = 0.0,
+    inset: FloatArray | float = 0.0,
 ) -> tuple[FloatArray, float]:
     """The samples of the walk at ``sigma`` and their largest error, over the tolerance.
 
-    ``limit_gain``: of :func:`_away_from_limits`'s pull, none by default.
+    ``limit_gain``: of :func:`~planning.task.joint_ranges.away_from_limits`'s pull, none by default.
     """
     model, data, fid = robot.model, robot.data, robot.frame_id(frame)
+    bounds = joint_range(robot, inset)
     weights = _weights(tolerance)
     twist = np.concatenate([geometry.shift_m, geometry.start.rotation @ geometry.turn]) * weights
     samples, residual = [q], 0.0
@@ -177,36 +188,16 @@ def _walk(
         jacobian = _jacobian(model, data, fid, q) * weights[:, None]
         step = _solve(jacobian, twist * (sigma[k] - sigma[k - 1]))
         if limit_gain:
-            step += _away_from_limits(robot, q, jacobian, limit_gain)
-        guess = np.clip(q + step, *_range(robot))
-        found, excess = _newton(robot, fid, guess, geometry.pose(float(sigma[k])), weights)
+            null_space = np.eye(len(q)) - _solve(jacobian, jacobian)
+            step += away_from_limits(robot, q, null_space, limit_gain)
+        guess = np.clip(q + step, *bounds)
+        found, excess = _newton(robot, fid, guess, geometry.pose(float(sigma[k])), weights, bounds)
         jump = np.abs(found - q)
         if excess > REACH_SHARE or jump.max() > LARGEST_JOINT_STEP:
             raise ToolLineBrokenError(_why(robot, found, jump, excess, jacobian), float(sigma[k - 1]))
         q, residual = found, max(residual, excess)
         samples.append(q)
     return np.array(samples), residual
-
-
-def _away_from_limits(robot: ck.Robot, q: FloatArray, jacobian: FloatArray, gain: float) -> FloatArray:
-    """A step in the Jacobian's null space that moves joints near a limit back toward the middle.
-
-    Only a redundant arm (a Panda's seven joints for six task directions) has such a null
-    space; the tool does not move by it (to first order, the Newton steps correct the rest).
-    A joint in the outer :data:`LIMIT_ZONE` of its range is pulled toward the middle by
-    ``gain`` of its distance from it, more the closer it is to the limit.
-    """
-    lower, upper = _range(robot)
-    middle, half = 0.5 * (lower + upper), 0.5 * (upper - lower)
-    depth = np.clip((np.abs(q - middle) / half - (1.0 - LIMIT_ZONE)) / LIMIT_ZONE, 0.0, 1.0)
-    if not depth.any():
-        return np.zeros_like(q)
-    projector = np.eye(len(q)) - _solve(jacobian, jacobian)
-    return np.asarray(gain * projector @ (depth * (middle - q)))
-
-
-def _range(robot: ck.Robot) -> tuple[FloatArray, FloatArray]:
-    return robot.limits.lower, robot.limits.upper
 
 
 def _jacobian(model: object, data: object, fid: int, q: FloatArray) -> FloatArray:
@@ -224,9 +215,14 @@ def _solve(jacobian: FloatArray, error: FloatArray) -> FloatArray:
 
 
 def _newton(
-    robot: ck.Robot, fid: int, q: FloatArray, target: pin.SE3, weights: FloatArray
+    robot: ck.Robot,
+    fid: int,
+    q: FloatArray,
+    target: pin.SE3,
+    weights: FloatArray,
+    bounds: tuple[FloatArray, FloatArray],
 ) -> tuple[FloatArray, float]:
-    """The configuration near ``q`` that puts the frame at ``target``, and its weighted error."""
+    """The configuration near ``q`` within ``bounds`` that puts the frame at ``target``, and its error."""
     model, data = robot.model, robot.data
     excess = math.inf
     for _ in range(NEWTON_STEPS):
@@ -238,13 +234,13 @@ def _newton(
         if excess <= IK_SHARE:
             break
         jacobian = _jacobian(model, data, fid, q) * weights[:, None]
-        q = np.clip(q + _solve(jacobian, error), *_range(robot))
+        q = np.clip(q + _solve(jacobian, error), *bounds)
     return q, excess
 
 
 def _why(robot: ck.Robot, q: FloatArray, jump: FloatArray, excess: float, jacobian: FloatArray) -> str:
     """Why the walk stops at ``q``, in words."""
-    names, lower, upper = robot.joint_names, *_range(robot)
+    names, lower, upper = robot.joint_names, *joint_range(robot)
     if jump.max() > LARGEST_JOINT_STEP:
         j = int(np.argmax(jump))
         return (
