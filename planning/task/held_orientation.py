@@ -30,6 +30,7 @@ from planning.curves.on_path_timing import time_on_path
 from planning.curves.trajectory import Trajectory
 from planning.errors import NoSolutionError, PlanningError
 from planning.pipeline.verification import Requirements
+from planning.task.line_motion import first_blocked, why_blocked
 from planning.task.orientation import OrientationConstraint, OrientationDeviation, orientation_deviation
 from planning.task.orientation_projection import Projector
 from planning.task.orientation_rrt import orientation_path
@@ -182,18 +183,10 @@ def _joined(projector: Projector, samples: FloatArray) -> tuple[FloatArray, Traj
 
 def _refuse_blocked(world: ck.CollisionWorld, samples: FloatArray, required: Requirements) -> None:
     """Raise where the first sample does not keep the clearances, with its share of the path."""
-    kept = world.keeps_clearance(samples, required.margin_m, required.self_margin_m, ordered=True)
-    if kept.all():
-        return
-    first = int(np.argmin(kept))
-    closest = world.clearance(samples[first]).closest
-    what = (
-        f"the robot comes closer to itself than its self margin {required.self_margin_m} m"
-        if closest is None or closest.distance_m >= required.margin_m
-        else f"'{closest.robot_geometry}' comes {closest.distance_m:.4f} m from '{closest.obstacle}' "
-        f"(margin {required.margin_m} m)"
-    )
-    raise NoSolutionError(f"{what} at {100 * _chord(samples)[first]:.0f} % of the path")
+    first = first_blocked(world, samples, required)
+    if first is not None:
+        what = why_blocked(world, samples[first], required)
+        raise NoSolutionError(f"{what} at {100 * _chord(samples)[first]:.0f} % of the path")
 
 
 def _timed(

@@ -105,20 +105,30 @@ def _refuse_blocked(
     A start that does not keep them is bad input, as a scene's start is (a
     :class:`~planning.errors.PlanningError`); a later sample breaks the line there.
     """
-    kept = world.keeps_clearance(samples, required.margin_m, required.self_margin_m, ordered=True)
-    if kept.all():
+    first = first_blocked(world, samples, required)
+    if first is None:
         return
-    first = int(np.argmin(kept))
-    closest = world.clearance(samples[first]).closest
-    what = (
-        f"the robot comes closer to itself than its self margin {required.self_margin_m} m"
-        if closest is None or closest.distance_m >= required.margin_m
-        else f"'{closest.robot_geometry}' is {closest.distance_m:.4f} m from '{closest.obstacle}' "
-        f"(margin {required.margin_m} m)"
-    )
+    what = why_blocked(world, samples[first], required)
     if first == 0:
         raise PlanningError(f"the line's start configuration does not keep the clearances: {what}")
     raise ToolLineBrokenError(what, float(sigma[first - 1]))
+
+
+def first_blocked(world: ck.CollisionWorld, samples: FloatArray, required: Requirements) -> int | None:
+    """The index of the first of ``samples`` that does not keep the clearances, ``None``: all do."""
+    kept = world.keeps_clearance(samples, required.margin_m, required.self_margin_m, ordered=True)
+    return None if kept.all() else int(np.argmin(kept))
+
+
+def why_blocked(world: ck.CollisionWorld, q: FloatArray, required: Requirements) -> str:
+    """Why ``q`` does not keep the clearances: the closest obstacle, else the robot itself."""
+    closest = world.clearance(q).closest
+    if closest is None or closest.distance_m >= required.margin_m:
+        return f"the robot comes closer to itself than its self margin {required.self_margin_m} m"
+    return (
+        f"'{closest.robot_geometry}' is {closest.distance_m:.4f} m from '{closest.obstacle}' "
+        f"(margin {required.margin_m} m)"
+    )
 
 
 def _timed(
