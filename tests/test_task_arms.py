@@ -4,7 +4,7 @@ Every millisecond of the planned trajectory, without the planner's code: the too
 line (Pinocchio's forward kinematics), joints within range and limits (finite differences of
 the samples are left to the planner's exact extrema; the samples themselves are checked),
 the torques within the URDF's effort limits with the part's mass where it is carried
-(Pinocchio's RNEA on a model with the part appended as a body); and every few milliseconds
+(Pinocchio's RNEA on a model with the part appended as a body); and every millisecond
 the clearance of the URDF's exact link meshes and of the carried part from the obstacles
 (coal on Pinocchio's own collision model: the planner checks convex hulls that contain them).
 """
@@ -147,7 +147,7 @@ def test_the_exact_link_meshes_and_the_part_keep_the_margin(planned: tuple[Scene
     attach, detach = task.segments[3], task.segments[7]
     fid = robot.model.getFrameId(robot.tcp_frame)
     least = np.inf
-    for t in np.arange(0.0, trajectory.duration, 4e-3):
+    for t in np.arange(0.0, trajectory.duration, 1e-3):
         q = trajectory(t)
         pin.framesForwardKinematics(robot.model, data, q)
         pin.updateGeometryPlacements(robot.model, data, geometry, geometry_data)
