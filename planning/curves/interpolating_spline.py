@@ -37,6 +37,17 @@ def spline_through(parameter: FloatArray, samples: FloatArray, degree: int = 5) 
     return Trajectory(breaks, coefficients)
 
 
+def chord_lengths(samples: FloatArray) -> FloatArray:
+    """``(n,)`` the length of the polyline through ``samples`` ``(n, nq)`` up to each, from 0."""
+    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(samples, axis=0), axis=1))])
+
+
+def chord_parameter(samples: FloatArray) -> FloatArray:
+    """``(n,)`` the samples' normalised chord lengths, 0 to 1 (evenly spaced if they do not move)."""
+    lengths = chord_lengths(samples)
+    return lengths / lengths[-1] if lengths[-1] > 0 else np.linspace(0.0, 1.0, len(samples))
+
+
 def _taylor(spline: BSpline, at: FloatArray, shift: FloatArray, power: int) -> FloatArray:
     """``(n, nq)`` the ``power``-th Taylor coefficient at ``at + shift`` of the pieces around ``at``."""
     degree = int(spline.k)

@@ -25,7 +25,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from planning.curves.interpolating_spline import spline_through
+from planning.curves.interpolating_spline import chord_parameter, spline_through
 from planning.curves.on_path_timing import time_on_path
 from planning.curves.trajectory import Trajectory
 from planning.errors import NoSolutionError, PlanningError
@@ -136,12 +136,6 @@ def _raw_samples(free: Trajectory) -> FloatArray:
     return np.asarray(free(times))
 
 
-def _chord(samples: FloatArray) -> FloatArray:
-    """The samples' normalised chord length: the spline's parameter, 0 to 1."""
-    lengths = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(samples, axis=0), axis=1))])
-    return lengths / lengths[-1] if lengths[-1] > 0 else np.linspace(0.0, 1.0, len(samples))
-
-
 def _bent(projector: Projector, raw: FloatArray) -> FloatArray:
     """Each inner sample of ``raw`` moved the least onto the constraint, the tool kept on the free path."""
     samples = [raw[0]]
@@ -169,7 +163,7 @@ def _bent(projector: Projector, raw: FloatArray) -> FloatArray:
 def _joined(projector: Projector, samples: FloatArray) -> tuple[FloatArray, Trajectory]:
     """The samples, with projected midpoints where the quintic spline through them strays, and the spline."""
     for _ in range(SPLINE_ROUNDS):
-        sigma = _chord(samples)
+        sigma = chord_parameter(samples)
         path = spline_through(sigma, samples)
         middles = 0.5 * (sigma[1:] + sigma[:-1])
         strays = projector.angles(path(middles)) > SPLINE_SHARE * projector.constraint.angle_rad
@@ -186,7 +180,7 @@ def _refuse_blocked(world: ck.CollisionWorld, samples: FloatArray, required: Req
     first = first_blocked(world, samples, required)
     if first is not None:
         what = why_blocked(world, samples[first], required)
-        raise NoSolutionError(f"{what} at {100 * _chord(samples)[first]:.0f} % of the path")
+        raise NoSolutionError(f"{what} at {100 * chord_parameter(samples)[first]:.0f} % of the path")
 
 
 def _timed(

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from planning.curves.interpolating_spline import spline_through
+from planning.curves.interpolating_spline import chord_lengths, chord_parameter, spline_through
 from planning.curves.on_path_timing import MarkedMotion, time_on_path_marked
 from planning.curves.path_pieces import bridge, ends, joined_paths, piece, rescaled
 from planning.curves.path_timing import NODE_STEP_S
@@ -124,14 +124,12 @@ def by_chord(path: Trajectory, samples: int = CHORD_SAMPLES) -> Trajectory:
     chords = np.linalg.norm(np.diff(points, axis=0), axis=1)
     keep = np.concatenate([[True], chords > 1e-12 * max(float(chords.sum()), 1.0)])
     points = points[keep]
-    length = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
-    return spline_through(length / length[-1], points)
+    return spline_through(chord_parameter(points), points)
 
 
 def _length(path: Trajectory) -> float:
     """The path's length in joint space, summed over 64 chords (its parameter's scale in the joined path)."""
-    samples = path(np.linspace(path.knots[0], path.knots[-1], 65))
-    return max(float(np.linalg.norm(np.diff(samples, axis=0), axis=1).sum()), 1e-9)
+    return max(float(chord_lengths(path(np.linspace(path.knots[0], path.knots[-1], 65)))[-1]), 1e-9)
 
 
 def _bridge_in(
