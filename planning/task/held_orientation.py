@@ -16,12 +16,10 @@ certified angle (:func:`~planning.task.orientation.orientation_deviation`) keeps
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass
 
 import numpy as np
-import pinocchio as pin
 from numpy.typing import NDArray
 
 import cpr_kin as ck
@@ -34,7 +32,6 @@ from planning.task.line_motion import first_blocked, why_blocked
 from planning.task.orientation import OrientationConstraint, OrientationDeviation, orientation_deviation
 from planning.task.orientation_projection import Projector
 from planning.task.orientation_rrt import orientation_path
-from planning.task.tool_line import ToolPose
 
 FloatArray = NDArray[np.float64]
 
@@ -93,8 +90,7 @@ def hold_orientation(
     frame = constraint.frame or robot.tcp_frame
     ends = free(free.knots[[0, -1]])
     poses = ck.frame_poses(robot, ends, frame)
-    if constraint.quat_xyzw is None:
-        constraint = _with_reference(constraint, poses[0])
+    constraint = constraint.about(poses[0][:3, :3])
     projector = Projector(robot, frame, constraint, constraint.reference())
     for label, angle in zip(("start", "goal"), projector.angles(ends), strict=True):
         if angle > constraint.angle_rad:
@@ -118,12 +114,6 @@ def hold_orientation(
     _refuse_blocked(world, samples, required)
     trajectory, deviation = _timed(projector, path, required)
     return HeldMotion(constraint, frame, samples, path, trajectory, deviation, bent)
-
-
-def _with_reference(constraint: OrientationConstraint, pose: FloatArray) -> OrientationConstraint:
-    """``constraint`` about the orientation of ``pose`` ``(4, 4)``."""
-    quat = ToolPose.of(pin.SE3(pose[:3, :3], pose[:3, 3])).quat_xyzw
-    return dataclasses.replace(constraint, quat_xyzw=quat)
 
 
 def _raw_samples(free: Trajectory) -> FloatArray:

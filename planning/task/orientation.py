@@ -17,6 +17,7 @@ line's deviation, :mod:`planning.task.line_deviation`).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from functools import cached_property
@@ -71,6 +72,13 @@ class OrientationConstraint:
         if self.quat_xyzw is not None:
             quat = ToolPose((0.0, 0.0, 0.0), self.quat_xyzw).quat_xyzw  # checked and normalised
             object.__setattr__(self, "quat_xyzw", quat)
+
+    def about(self, rotation: FloatArray) -> OrientationConstraint:
+        """The constraint about ``rotation`` ``(3, 3)`` where it names no reference (a start's)."""
+        if self.quat_xyzw is not None:
+            return self
+        quat = ToolPose.of(pin.SE3(np.asarray(rotation), np.zeros(3))).quat_xyzw
+        return dataclasses.replace(self, quat_xyzw=quat)
 
     def reference(self) -> FloatArray:
         """``(3, 3)`` the reference orientation (:attr:`quat_xyzw`, which must be given)."""

@@ -34,8 +34,8 @@ from planning.pipeline.scene import Scene
 from planning.pipeline.target import Target
 from planning.pipeline.verification import Requirements, Verification, verify_finer_where_needed
 from planning.task.segments import KINDS, Attach, Detach, Move, Segment, Wait
-from planning.task.task_record import TIME_TOLERANCE_S, record_problems
-from planning.task.tool_line import ToolLine, ToolPose
+from planning.task.task_record import TIME_TOLERANCE_S, record_problems, recorded_constraint, recorded_pose
+from planning.task.tool_line import ToolLine
 
 POSE_TOLERANCE = 1e-6
 """How far a recorded line's ends may be from the task's [m, rad] (rounding)."""
@@ -143,7 +143,7 @@ def _line_ends(robot: ck.Robot, line: ToolLine, q_start: np.ndarray, entry: Mapp
     start = pin.SE3(pose[:3, :3], pose[:3, 3])
     wrong = []
     for key, wanted in (("from", start), ("to", line.goal(start))):
-        given = _placement(entry, key)
+        given = recorded_pose(entry.get(key), f"'{key}'")
         moved = float(np.linalg.norm(given.translation - wanted.translation))
         turned = float(np.linalg.norm(pin.log3(given.rotation.T @ wanted.rotation)))
         if moved > POSE_TOLERANCE or turned > POSE_TOLERANCE:
@@ -167,32 +167,16 @@ def _constraint_kept(robot: ck.Robot, move: Move, q_start: np.ndarray, entry: Ma
     if not isinstance(recorded, Mapping):
         return [f"records no constraint; the task's motion keeps {list(constraint.axes)} within the limit"]
     frame = constraint.frame or robot.tcp_frame
-    if constraint.quat_xyzw is None:  # the frame's orientation at the start
-        pose = ck.frame_poses(robot, q_start, frame)
-        start = ToolPose.of(pin.SE3(pose[:3, :3], pose[:3, 3]))
-        constraint = dataclasses.replace(constraint, quat_xyzw=start.quat_xyzw)
+    constraint = constraint.about(ck.frame_poses(robot, q_start, frame)[:3, :3])  # none given: the start's
     wrong = []
     asked = {"frame": frame, "axes": list(constraint.axes), "angle_rad": constraint.angle_rad}
     if {key: recorded.get(key) for key in asked} != asked:
         wrong.append(f"records constraint {dict(recorded)}; the task's motion asks {asked}")
-    try:
-        turned = float(np.linalg.norm(pin.log3(_rotation(recorded).T @ constraint.reference())))
-    except (KeyError, TypeError, ValueError, PlanningError):
-        raise PlanningError("'constraint' has no quat_xyzw [x, y, z, w]") from None
+    given, _ = recorded_constraint(recorded, "'constraint'")
+    turned = float(np.linalg.norm(pin.log3(given.reference().T @ constraint.reference())))
     if turned > POSE_TOLERANCE:
         wrong.append(f"records its constraint's orientation {turned:.3g} rad from the task's")
     return wrong
-
-
-def _rotation(recorded: Mapping[str, Any]) -> np.ndarray:
-    return np.asarray(ToolPose((0.0, 0.0, 0.0), tuple(recorded["quat_xyzw"])).placement().rotation)
-
-
-def _placement(entry: Mapping[str, Any], key: str) -> pin.SE3:
-    try:
-        return ToolPose(tuple(entry[key]["xyz"]), tuple(entry[key]["quat_xyzw"])).placement()
-    except (KeyError, TypeError):
-        raise PlanningError(f"'{key}' is not {{xyz: [x, y, z], quat_xyzw: [x, y, z, w]}}") from None
 
 
 def _verified(

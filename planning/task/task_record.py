@@ -121,7 +121,7 @@ def _line_problems(
 ) -> list[str]:
     """The line's promise over ``span`` [s]: the certified deviation within the tolerance."""
     start, goal = (
-        _placement(_field(entry, key, index), f"task entry {index} {key}") for key in ("from", "to")
+        recorded_pose(_field(entry, key, index), f"task entry {index} {key}") for key in ("from", "to")
     )
     tolerance = _field(entry, "tolerance", index)
     limit = LineTolerance(float(tolerance["position_m"]), float(tolerance["angle_rad"]))
@@ -142,14 +142,7 @@ def _constraint_problems(
     robot: ck.Robot, trajectory: Trajectory, entry: Mapping[str, Any], index: int, span: tuple[float, float]
 ) -> list[str]:
     """The orientation constraint's promise over ``span`` [s]: its certified angle within the allowed one."""
-    where = f"task entry {index} constraint"
-    given = entry["constraint"]
-    try:
-        axes, angle, quat = tuple(given["axes"]), float(given["angle_rad"]), tuple(given["quat_xyzw"])
-        constraint = OrientationConstraint(axes, angle, quat)
-        frame = str(given["frame"])
-    except (KeyError, TypeError, ValueError, PlanningError) as exc:
-        raise PlanningError(f"{where}: expected {{frame, quat_xyzw, axes, angle_rad}} ({exc})") from None
+    constraint, frame = recorded_constraint(entry["constraint"], f"task entry {index} constraint")
     reference = constraint.reference()
     deviation = orientation_deviation(robot, frame, constraint, reference, trajectory.between(*span))
     if deviation.angle_rad <= constraint.angle_rad:
@@ -169,7 +162,25 @@ def _field(entry: Mapping[str, Any], key: str, index: int) -> Any:
     return entry[key]
 
 
-def _placement(pose: Any, where: str) -> pin.SE3:
+def recorded_constraint(given: Any, where: str) -> tuple[OrientationConstraint, str]:
+    """A record's ``constraint`` entry as the constraint it names, and its frame.
+
+    Raises:
+        PlanningError: not ``{frame, quat_xyzw, axes, angle_rad}`` of valid values, named by ``where``.
+    """
+    try:
+        axes, angle, quat = tuple(given["axes"]), float(given["angle_rad"]), tuple(given["quat_xyzw"])
+        return OrientationConstraint(axes, angle, quat), str(given["frame"])
+    except (KeyError, TypeError, ValueError, PlanningError) as exc:
+        raise PlanningError(f"{where}: expected {{frame, quat_xyzw, axes, angle_rad}} ({exc})") from None
+
+
+def recorded_pose(pose: Any, where: str) -> pin.SE3:
+    """A record's ``{xyz, quat_xyzw}`` as a placement.
+
+    Raises:
+        PlanningError: not such a pose, named by ``where``.
+    """
     try:
         return ToolPose(tuple(pose["xyz"]), tuple(pose["quat_xyzw"])).placement()
     except (KeyError, TypeError) as exc:
