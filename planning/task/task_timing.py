@@ -113,21 +113,22 @@ def _joined(robot: ck.Robot, run: list[PlannedMotion]) -> list[TimedMotion] | No
     parts = []
     for k, motion in enumerate(run):
         part = trajectory.between(times[k], times[k + 1])
-        verification = verify_finer_where_needed(motion.problem, part, motion.required)
         line, held = motion.line, motion.held
-        if line is not None:
+        if line is not None:  # the geometric promises first: cheaper than the certified checks
             deviation = line_deviation(robot, line.frame, line.geometry, part, line.line.tolerance)
             if not deviation.within(line.line.tolerance):
                 return None
-            line = dataclasses.replace(line, trajectory=part, deviation=deviation, verification=verification)
         if held is not None:
             constraint = held.constraint
             angle = orientation_deviation(robot, held.frame, constraint, constraint.reference(), part)
             if angle.angle_rad > constraint.angle_rad:
                 return None
             held = dataclasses.replace(held, trajectory=part, deviation=angle)
+        verification = verify_finer_where_needed(motion.problem, part, motion.required)
         if not verification.accepted:
             return None
+        if line is not None:
+            line = dataclasses.replace(line, trajectory=part, deviation=deviation, verification=verification)
         parts.append(TimedMotion(part, verification, line, held))
     return parts
 
