@@ -15,7 +15,10 @@ import cpr_kin as ck
 from planning.cli.app import main
 from planning.errors import NoTrajectoryFoundError, PlanningError
 from planning.io.bundled import paper_scene
+from planning.pipeline import planner
+from planning.pipeline.choose import choose
 from planning.pipeline.deadline import Deadline
+from planning.pipeline.path_following import follow_path
 from planning.pipeline.planner import plan
 from planning.pipeline.problem import build_problem
 from planning.pipeline.scene import Scene
@@ -27,6 +30,7 @@ from planning.search.firefly_settings import FireflySettings
 from planning.search.refinement import cma_refine
 from planning.search.rrt_connect import rrt_connect
 
+from .test_path_following import spline_touching_scene
 from .test_rrt_connect import LOWER, UPPER, WEIGHTS, wall_with_slot
 
 
@@ -104,6 +108,35 @@ def test_a_plan_cut_short_returns_what_it_verified(robot: ck.Robot) -> None:
     result = plan(scene, robot)
     assert result.verification.accepted
     assert result.optimiser.evaluations <= scene.planner.firefly.fireflies  # no iteration after the seeds
+
+
+def test_past_the_limit_the_last_resort_is_not_run(robot: ck.Robot, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A scene only the last resort plans (its path followed vertex to vertex): once time is up
+    after the search's choice, the plan stops there, saying that a path was found."""
+    scene = spline_touching_scene(robot).with_planner(refine="none", time_limit_s=3600.0)
+    assert plan(scene, robot).metrics.timing == "stop_and_go"  # within the limit: the last resort
+    chosen: list[int] = []
+    followed: list[int] = []
+
+    class SpentAfterTheChoice(Deadline):
+        def passed(self) -> bool:
+            return bool(chosen)
+
+    def counted(calls: list[int], function: Callable[..., Any]) -> Callable[..., Any]:
+        def call(*args: Any) -> Any:
+            calls.append(1)
+            return function(*args)
+
+        return call
+
+    monkeypatch.setattr(planner, "Deadline", SpentAfterTheChoice)
+    monkeypatch.setattr(planner, "choose", counted(chosen, choose))
+    monkeypatch.setattr(planner, "follow_path", counted(followed, follow_path))
+    found = r"RRT-Connect found a path, but the time limit passed before it was followed"
+    with pytest.raises(NoTrajectoryFoundError, match=found) as error:
+        plan(scene, robot)
+    assert "by the time limit time_limit_s = 3600 s" in str(error.value)
+    assert chosen == [1] and not followed
 
 
 def test_a_callers_optimizer_is_stopped_through_its_objective(robot: ck.Robot) -> None:

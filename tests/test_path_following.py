@@ -16,6 +16,7 @@ from planning.pipeline.path_following import follow_path
 from planning.pipeline.path_seeds import sampled_path
 from planning.pipeline.planner import plan
 from planning.pipeline.problem import Problem, build_problem
+from planning.pipeline.scene import Scene
 from planning.pipeline.timing import FixedDuration, FreeDuration
 
 
@@ -60,6 +61,19 @@ def test_a_fixed_duration_holds_a_motion_that_fits_and_reports_one_that_does_not
     assert FreeDuration().held(motion) == (motion, False)
 
 
+def spline_touching_scene(robot: ck.Robot) -> Scene:
+    """A narrow scene whose splines all touch the passage without the refinement (issue 33, B.3).
+
+    RRT-Connect's path is drawn from uniform samples only, as when the scene was found, and
+    seeded by its corners' placement alone.
+    """
+    scene = next(s for s in generate_scenes(40, 77, robot, narrow=10) if s.name == "scene_028")
+    tuning = scene.planner.tuning
+    seeding = dataclasses.replace(tuning.seeding, local_share=0.0, placements=(0.0,))
+    uniform = dataclasses.replace(tuning, seeding=seeding)
+    return dataclasses.replace(scene, planner=dataclasses.replace(scene.planner, tuning=uniform))
+
+
 def test_a_scene_whose_splines_all_touch_the_passage_is_planned_not_refused(robot: ck.Robot) -> None:
     """A false "no solution" of issue 33 (B.3): the splines near the passage failed; the path did not.
 
@@ -68,11 +82,7 @@ def test_a_scene_whose_splines_all_touch_the_passage_is_planned_not_refused(robo
     path drawn from uniform samples only, as when the scene was found, and seeded by its
     corners' placement alone: the firefly finds a spline through the evenly spaced one).
     """
-    scene = next(s for s in generate_scenes(40, 77, robot, narrow=10) if s.name == "scene_028")
-    tuning = scene.planner.tuning
-    seeding = dataclasses.replace(tuning.seeding, local_share=0.0, placements=(0.0,))
-    uniform = dataclasses.replace(tuning, seeding=seeding)
-    scene = dataclasses.replace(scene, planner=dataclasses.replace(scene.planner, tuning=uniform))
+    scene = spline_touching_scene(robot)
     for planner in (scene.planner, scene.planner.updated(refine="none")):
         result = plan(dataclasses.replace(scene, planner=planner), robot)
         assert result.verification.accepted

@@ -9,10 +9,11 @@ CMA-ES refinement between generations (each returns its best so far), a caller's
 optimiser through its objective (:mod:`planning.pipeline.search`), the choice between
 the timings it verifies (:mod:`planning.pipeline.choose`: past the limit, none after one
 that failed), the planner between attempts (failing those, it follows the sampling
-planner's path as its last resort, then stops). So a plan ends after its limit by what its
-last stages take to finish: the stage under way when it passed, at most one timing and
-certified check of the best candidate, and the last resort's (on a 7-joint arm among
-shelves a certified check takes up to about a second).
+planner's path as its last resort, then stops), and the last resort itself (past the limit
+the plan stops without it). So a plan ends after its limit by what its last stages take to
+finish: the stage under way when it passed and at most one timing and certified check, of
+the best candidate or of the followed path (on a 7-joint arm among shelves, on its exact
+meshes, a certified check takes up to several seconds).
 """
 
 from __future__ import annotations

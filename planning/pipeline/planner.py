@@ -13,7 +13,7 @@ attempt is left and the seeding found a sampling planner's path, that path is fo
 is (:mod:`planning.pipeline.path_following`) before the plan says "no solution". With a
 ``time_limit_s`` the stages stop where it passes (:mod:`planning.pipeline.deadline`): the
 plan times and verifies what its last search found and, failing that, follows the path
-found, with no attempt after it.
+found, with no attempt after it, while the time limit has not passed.
 """
 
 from __future__ import annotations
@@ -73,10 +73,10 @@ def solve(
         limit_s = problem.scene.planner.time_limit_s
         share = Deadline.after(None if limit_s is None else limit_s * HULLS_SHARE, started)
         try:
-            return _solved(hulls, share, started, progress, optimizer)
+            return _solved(hulls, share, started, progress, optimizer, deadline)
         except NoTrajectoryFoundError:
             pass  # the meshes' turn, in the time left
-    return _solved(problem, deadline, started, progress, optimizer)
+    return _solved(problem, deadline, started, progress, optimizer, deadline)
 
 
 def _solved(
@@ -85,8 +85,13 @@ def _solved(
     started: float,
     progress: Callable[[FireflyProgress], None] | None,
     optimizer: Optimizer | None,
+    last_resort_by: Deadline,
 ) -> PlanResult:
-    """:func:`solve`'s pipeline on ``problem`` by ``deadline`` (its clock started at ``started`` [s])."""
+    """:func:`solve`'s pipeline on ``problem`` by ``deadline`` (its clock started at ``started`` [s]).
+
+    The last resort runs only before ``last_resort_by``: the plan's own deadline, which
+    ``deadline`` is where it is a share of it (the hulls').
+    """
     problem = dataclasses.replace(problem, deadline=deadline)
     seeding = SEEDINGS[problem.scene.planner.seeding] if optimizer is None else NoSeeding()
     attempt = seeding.first(problem)
@@ -104,6 +109,10 @@ def _solved(
     stopped = deadline.reason(time.perf_counter() - started) if deadline.passed() else ""
     if attempt.path is None:
         raise chosen.error(attempt.tried, stopped)
+    if last_resort_by.passed():
+        elapsed_s = time.perf_counter() - started
+        found = "RRT-Connect found a path, but the time limit passed before it was followed"
+        raise chosen.error(attempt.tried, last_resort_by.reason(elapsed_s), found)
     problem, followed = follow_path(attempt.problem, attempt.path)  # the last resort
     if isinstance(followed, Refusal):
         raise chosen.error(attempt.tried, stopped, f"RRT-Connect found a path, but {followed.cause}")
