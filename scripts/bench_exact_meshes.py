@@ -6,7 +6,7 @@
 Each problem is imported as ``import-moveit`` writes it (:func:`planning.bench.mbm.import_problem`)
 and planned warm, in this one process, twice, in alternating order: by the robot as it loads
 (its concave links' exact meshes deciding, planned on the hulls first:
-:func:`planning.pipeline.problem.on_hulls`) and by the same robot with the exact meshes
+:func:`planning.pipeline.hulls_first.on_hulls`) and by the same robot with the exact meshes
 removed (the hulls alone: the collision model before the meshes). A problem counts as valid
 on a model when its start and goal clear the margins there
 (:func:`planning.bench.mbm.endpoint_violations`); every trajectory is checked as ``cpr-plan check``

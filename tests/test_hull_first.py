@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -14,13 +15,18 @@ from cpr_kin.model.packages import example_robot
 from planning import build_problem, plan
 from planning.cli import main
 from planning.io.scene_file import parse_scene
-from planning.pipeline.problem import HULLS_SHARE, on_hulls
+from planning.pipeline import path_seeds, planner
+from planning.pipeline.hulls_first import HULLS_SHARE, on_hulls
 from planning.pipeline.verification import verify_for_scene
+from planning.search.rrt_connect import rrt_connect
+from planning.search.rrt_trees import GrownTrees
 
 # UR10 configurations (self margin 10 mm): its hulls clear, and only its exact meshes clear
 CLEAR_ON_HULLS = [-1.57, 2.81, -0.98, -2.02, -0.94, -1.69]
 CLEAR_ON_MESHES = [2.5, 0.0, -0.16, 1.17, 0.73, -0.4]
 GOAL = [-2.47, -1.52, -0.26, -0.29, -0.2, 2.69]
+BALL = {"name": "ball", "shape": "sphere", "radius": 0.4, "xyz": [-0.3, -1.0, -0.3]}
+"""Across the way from CLEAR_ON_HULLS to GOAL: RRT-Connect needs a few hundred samples."""
 
 
 @pytest.fixture(scope="module")
@@ -83,3 +89,34 @@ def test_check_says_which_model_it_certified_on(tmp_path: Path, capsys: pytest.C
     said = capsys.readouterr().out
     assert "verified against" in said and "on the exact meshes of 5 links" in said
     assert "coal's tolerance: 1e-6 of a distance" in said
+
+
+def test_the_meshes_draw_goes_on_with_the_trees_the_hulls_grew(
+    ur10: ck.Robot, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A ball across the way: the hulls' quarter of the samples finds no path, the meshes' draw
+    goes on from the hulls' trees and needs fewer samples than from its ends; certified on the meshes."""
+    scene = parse_scene({**ur10_scene(CLEAR_ON_HULLS), "obstacles": [BALL]})
+    tuning = scene.planner.tuning
+    tuning = dataclasses.replace(tuning, seeding=dataclasses.replace(tuning.seeding, max_samples=400))
+    scene = dataclasses.replace(scene, planner=dataclasses.replace(scene.planner, tuning=tuning))
+    draws: list[tuple[int, int, int | None]] = []  # trees' nodes taken, nodes left, samples of a path
+
+    def recorded(*args: Any) -> Any:
+        grown: GrownTrees | None = args[10]
+        taken = 0 if grown is None else grown.nodes
+        found = rrt_connect(*args)
+        draws.append((taken, 0 if grown is None else grown.nodes, None if found is None else found.samples))
+        return found
+
+    monkeypatch.setattr(path_seeds, "rrt_connect", recorded)
+    result = plan(scene, ur10)
+    (_, left, none), (taken, _, samples) = draws  # the hulls' draw, then the meshes'
+    assert none is None and left > 2 and taken == left and samples is not None
+    assert result.problem.robot.exact_meshes  # planned on the meshes
+    assert not verify_for_scene(build_problem(scene, ur10), result.trajectory).problems
+    draws.clear()
+    monkeypatch.setattr(planner, "shared_trees", lambda hulls, meshes: None)  # each draw from its ends
+    plan(scene, ur10)
+    (_, _, none), (taken, _, fresh) = draws
+    assert none is None and taken == 0 and fresh is not None and samples < fresh

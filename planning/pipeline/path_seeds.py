@@ -73,7 +73,9 @@ def sampled_path(
     the start where an end is too close for ``problem``'s; the path is then ``relaxed``.
     ``finer`` is called only then.
     ``max_samples``: the draw's budget, in place of ``settings``' (``None``: theirs; the
-    default settings take :func:`draw_samples`).
+    default settings take :func:`draw_samples`). The trees start from the problem's
+    :attr:`~planning.pipeline.problem.Problem.grown` trees where an earlier draw between its
+    ends left them, and are left there when no path is found.
     """
     robot, moving = problem.robot, problem.moving
 
@@ -114,6 +116,7 @@ def sampled_path(
         settings,
         problem.deadline.passed,
         relaxation,
+        problem.grown,
     )
 
 

@@ -2,9 +2,9 @@
 
 ``plan(scene)`` is ``solve(build_problem(scene))``. A robot whose concave links are checked
 on their exact meshes (:mod:`cpr_kin.shapes.exact_pairs`) is planned on their convex hulls first,
-which contain them and cost no triangle query (:func:`~planning.pipeline.problem.on_hulls`,
+which contain them and cost no triangle query (:func:`~planning.pipeline.hulls_first.on_hulls`,
 with a share of the samples and of a time limit), and on the meshes where the hulls find no
-trajectory. :func:`solve` reads as the pipeline:
+trajectory (RRT-Connect going on with the trees the hulls grew). :func:`solve` reads as the pipeline:
 each attempt (the seeding rule decides the first and the next,
 :mod:`planning.pipeline.seeding`) is searched (:mod:`planning.pipeline.search`), its
 candidates are timed and verified best first (:mod:`planning.pipeline.choose`), and the
@@ -30,10 +30,11 @@ from planning.errors import NoTrajectoryFoundError
 from planning.pipeline.blas_threads import one_blas_thread
 from planning.pipeline.choose import Choice, Refusal, choose, verify
 from planning.pipeline.deadline import Deadline
+from planning.pipeline.hulls_first import HULLS_SHARE, on_hulls, shared_trees
 from planning.pipeline.metrics import Elapsed
 from planning.pipeline.offered import Timing
 from planning.pipeline.path_following import follow_path
-from planning.pipeline.problem import HULLS_SHARE, Problem, build_problem, on_hulls
+from planning.pipeline.problem import Problem, build_problem
 from planning.pipeline.result import PlanResult, assemble
 from planning.pipeline.scene import Scene
 from planning.pipeline.search import search
@@ -57,7 +58,7 @@ def solve(
         optimizer: another :class:`~planning.search.optimizer.Optimizer` on the same
             objective and evaluation budget (``fireflies x (iterations + 1)``), searched
             once from a random population; default: the planner's seeded search.
-            (The hulls first, :func:`~planning.pipeline.problem.on_hulls`, with the planner's own.)
+            (The hulls first, :func:`~planning.pipeline.hulls_first.on_hulls`, with the planner's own.)
 
     Raises:
         NoTrajectoryFoundError: no candidate passes the verification (its message names
@@ -70,6 +71,8 @@ def solve(
     deadline = Deadline.after(problem.scene.planner.time_limit_s, started)
     hulls = on_hulls(problem) if optimizer is None else None
     if hulls is not None:
+        grown = shared_trees(hulls, problem)  # the hulls' trees, for the meshes' draw to go on with
+        hulls, problem = (dataclasses.replace(p, grown=grown) for p in (hulls, problem))
         limit_s = problem.scene.planner.time_limit_s
         share = Deadline.after(None if limit_s is None else limit_s * HULLS_SHARE, started)
         try:

@@ -29,6 +29,7 @@ from planning.pipeline.scene import Scene
 from planning.pipeline.settings import VERIFY_STEP_RANGE_M
 from planning.pipeline.timing import FixedDuration, FreeDuration, duration_rule
 from planning.pipeline.torques import GravityLimit, gravity_limit, scene_dynamics, search_torque
+from planning.search.rrt_trees import GrownTrees
 from planning.validation import instance_of
 
 FloatArray = NDArray[np.float64]
@@ -58,6 +59,9 @@ class Problem:
         build_time_s: wall time of :func:`build_problem` [s].
         deadline: when its plan must stop (:func:`~planning.pipeline.planner.solve` sets it
             from the planner's ``time_limit_s``; default: never).
+        grown: where RRT-Connect's draw for its plan finds and leaves the trees of a draw that
+            found no path (:func:`~planning.pipeline.planner.solve` sets one for the hulls and
+            the meshes of a plan; default: none, each draw grows its own).
     """
 
     scene: Scene
@@ -71,6 +75,7 @@ class Problem:
     gravity: GravityLimit | None = field(default=None, repr=False)
     build_time_s: float = 0.0
     deadline: Deadline = field(default_factory=Deadline)
+    grown: GrownTrees | None = field(default=None, repr=False)
 
     @property
     def q_start(self) -> FloatArray:
@@ -250,37 +255,6 @@ def finer_step_m(problem: Problem) -> float:
         excess = min(excess, float(world.self_collision.distances(ends)[0].min()) - scene.self_margin)
     finer = scene.planner.finer_verify_step_m
     return finer if excess > finer else max(excess / 2, VERIFY_STEP_RANGE_M[0])
-
-
-HULLS_SHARE = 0.25
-"""The share of RRT-Connect's samples (``max_samples``) and of a time limit that a plan on the
-hulls alone may take (:func:`on_hulls`); where it finds nothing in them, the meshes' turn."""
-
-
-def on_hulls(problem: Problem) -> Problem | None:
-    """``problem`` on its robot's convex hulls alone, where its start and goal keep the margins there.
-
-    ``None`` for a robot whose meshes are all their own hulls, within a millimetre
-    (:attr:`cpr_kin.Robot.exact_meshes` empty), or ends that only the exact meshes clear. A
-    hull contains its mesh, so a trajectory certified on the hulls is certified on the meshes;
-    and the hulls ask coal no triangle query. Its sampling planner draws :data:`HULLS_SHARE`
-    of the samples: a passage that only the meshes open is not searched for long on the hulls.
-    """
-    if not problem.robot.exact_meshes:
-        return None
-    world, scene = problem.world.on_hulls(), problem.scene
-    ends = np.stack([problem.q_start, problem.q_goal])
-    if not world.keeps_clearance(ends, scene.safety_margin, scene.self_margin).all():
-        return None
-    tuning = scene.planner.tuning
-    fewer = max(1, int(tuning.seeding.max_samples * HULLS_SHARE))
-    seeding = dataclasses.replace(tuning.seeding, max_samples=fewer)
-    planner = scene.planner.updated(tuning=dataclasses.replace(tuning, seeding=seeding))
-    rules = PathRules(scene.safety_margin, scene.self_margin, problem.gravity)
-    solver, duration = problem.solver, problem.duration  # the search's knots: not the world's
-    objective = WaypointObjective(world, problem.motion, rules, planner, solver, duration)
-    scene = dataclasses.replace(scene, planner=planner)
-    return dataclasses.replace(problem, scene=scene, robot=world.robot, world=world, objective=objective)
 
 
 def _search_space(

@@ -37,6 +37,11 @@ A :class:`Relaxation` lets the trees go on under a looser validity after some sa
 smaller clearance, where a passage is narrower than the one asked): what they grew holds
 under it too, so no sample is drawn again; where start or goal fails the strict validity,
 the looser one holds from the start. A path found under it is marked ``relaxed``.
+
+A draw given :class:`~planning.search.rrt_trees.GrownTrees` goes on growing the trees an
+earlier draw between the same ends left there when it found no path (the hulls' draw, for
+the meshes'; under its relaxation at once where they grew under the earlier one's), and
+leaves its own there when it finds none (not where its ends asked for the relaxation).
 """
 
 from __future__ import annotations
@@ -50,10 +55,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from cpr_kin.common.compiled import njit
 from planning.errors import PlanningError
 from planning.search.edges import Edges, Validity, shortcut
 from planning.search.rrt_settings import RANGE_FRACTION, RrtSettings
+from planning.search.rrt_trees import GrownTrees, Tree
 
 FloatArray = NDArray[np.float64]
 
@@ -88,34 +93,6 @@ class Relaxation:
     after_samples: int
 
 
-class _Tree:
-    """Nodes and parents, grown in place (arrays doubled when full)."""
-
-    def __init__(self, root: FloatArray) -> None:
-        self.nodes = np.empty((64, root.size))
-        self.parents = np.empty(64, dtype=np.intp)
-        self.nodes[0], self.parents[0], self.size = root, -1, 1
-
-    def add(self, q: FloatArray, parent: int) -> int:
-        if self.size == len(self.nodes):
-            self.nodes = np.concatenate([self.nodes, np.empty_like(self.nodes)])
-            self.parents = np.concatenate([self.parents, np.empty_like(self.parents)])
-        self.nodes[self.size], self.parents[self.size] = q, parent
-        self.size += 1
-        return self.size - 1
-
-    def nearest(self, q: FloatArray, weights: FloatArray) -> int:
-        return nearest_node(self.nodes, self.size, q, weights)
-
-    def branch(self, index: int) -> FloatArray:
-        """The nodes from ``index`` back to the root."""
-        chain = []
-        while index >= 0:
-            chain.append(self.nodes[index])
-            index = int(self.parents[index])
-        return np.array(chain)
-
-
 def rrt_connect(
     valid: Validity,
     start: FloatArray,
@@ -127,6 +104,7 @@ def rrt_connect(
     settings: RrtSettings | None = None,
     stop: Callable[[], bool] | None = None,
     relaxation: Relaxation | None = None,
+    grown: GrownTrees | None = None,
 ) -> RrtPath | None:
     """A valid path from ``start`` to ``goal`` in the box ``[lower, upper]``, or ``None``.
 
@@ -147,6 +125,9 @@ def rrt_connect(
             limit). ``None``: never.
         relaxation: the looser validity the trees go on with after its samples (``None``:
             none; module docstring).
+        grown: the trees an earlier draw between the same ends left, under a validity
+            ``valid`` accepts too, to go on growing; and where this draw leaves its own when it
+            finds no path (:class:`~planning.search.rrt_trees.GrownTrees`). ``None``: new trees.
     """
     settings = settings or RrtSettings()
     start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
@@ -165,16 +146,21 @@ def rrt_connect(
         diagonal = float(np.linalg.norm(weights * (np.asarray(upper) - np.asarray(lower))))
         step_m = max(explore_m, RANGE_FRACTION * diagonal)
     if explore_m > settings.resolution_m:
-        found = _lazy(valid, start, goal, (lower, upper), weights, rng, settings, step_m, stop, relaxation)
+        keeping = None if relaxed else grown  # the ends' relaxation is not the coarse draw's to tell
+        box = (lower, upper)
+        found = _lazy(valid, start, goal, box, weights, rng, settings, step_m, stop, relaxation, keeping)
         return found if found is None or not relaxed else dataclasses.replace(found, relaxed=True)
+    kept = None if grown is None else grown.take(start, goal, settings.resolution_m, relaxation is not None)
+    if kept is not None and grown is not None and grown.relaxed and relaxation is not None:
+        valid, relaxation, relaxed = relaxation.valid, None, True  # the trees hold under it only
     edges = Edges(valid, weights, settings.resolution_m)
     if edges.free_fraction(start, goal) == 1.0:
         return RrtPath(np.array([start, goal]), 0, edges.checks, relaxed)
-    trees, strict_checks = (_Tree(start), _Tree(goal)), 0
+    trees, strict_checks = kept or (Tree(start), Tree(goal)), 0
     draw = _Sampler(lower, upper, settings)
     for sample in range(1, settings.max_samples + 1):
         if stop is not None and stop():
-            return None
+            break
         if relaxation is not None and sample > relaxation.after_samples:  # the trees hold under it
             strict_checks, edges = edges.checks, Edges(relaxation.valid, weights, settings.resolution_m)
             relaxation, relaxed = None, True
@@ -200,20 +186,9 @@ def rrt_connect(
                 path = path[::-1]
             path = shortcut(path, edges, rng, settings.shortcuts)
             return RrtPath(path, sample, strict_checks + edges.checks, relaxed)
+    if grown is not None:  # no path: the trees, for the next draw
+        grown.keep(trees, start, goal, settings.resolution_m, relaxed)
     return None
-
-
-@njit
-def nearest_node(nodes: FloatArray, size: int, q: FloatArray, weights: FloatArray) -> int:
-    """Index of the first of ``nodes[:size]`` nearest to ``q`` by the motion bound ``sum_j w_j |dq_j|``."""
-    best, index = np.inf, 0
-    for i in range(size):
-        distance = 0.0
-        for j in range(len(q)):
-            distance += abs(nodes[i, j] - q[j]) * weights[j]
-        if distance < best:
-            best, index = distance, i
-    return index
 
 
 class _Sampler:
@@ -223,7 +198,7 @@ class _Sampler:
         self.lower, self.upper, self.share = lower, upper, settings.local_share
         self.spread = settings.local_spread * (upper - lower)
 
-    def __call__(self, tree: _Tree, rng: np.random.Generator) -> FloatArray:
+    def __call__(self, tree: Tree, rng: np.random.Generator) -> FloatArray:
         """A sample for ``tree``, drawn from ``rng``."""
         if self.share and rng.uniform() < self.share:
             node: FloatArray = tree.nodes[rng.integers(tree.size)]
@@ -243,11 +218,15 @@ def _lazy(
     step_m: float,
     stop: Callable[[], bool] | None,
     relaxation: Relaxation | None,
+    grown: GrownTrees | None,
 ) -> RrtPath | None:
-    """RRT-Connect on coarse edge checks, its path then held at ``resolution_m`` (module docstring)."""
+    """RRT-Connect on coarse edge checks, its path then held at ``resolution_m`` (module docstring).
+
+    ``grown`` serves the coarse draw: its trees are the ones a later draw can go on with.
+    """
     fine = dataclasses.replace(settings, explore_resolution_m=None, step_m=step_m)
     coarse = dataclasses.replace(fine, resolution_m=settings.explore_resolution_m or settings.resolution_m)
-    found = rrt_connect(valid, start, goal, *box, weights, rng, coarse, stop, relaxation)
+    found = rrt_connect(valid, start, goal, *box, weights, rng, coarse, stop, relaxation, grown)
     if found is None:
         return None
     if found.relaxed and relaxation is not None:  # the path holds at the looser validity only
@@ -275,7 +254,7 @@ def _lazy(
 
 
 def _connect(
-    tree: _Tree, near: int, target: FloatArray, fraction: float, step_m: float, weights: FloatArray
+    tree: Tree, near: int, target: FloatArray, fraction: float, step_m: float, weights: FloatArray
 ) -> int | None:
     """Grow ``tree`` from node ``near`` along the valid ``fraction`` of the way to ``target``.
 

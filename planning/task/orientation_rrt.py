@@ -20,6 +20,7 @@ from numpy.typing import NDArray
 import cpr_kin as ck
 from planning.errors import NoSolutionError
 from planning.pipeline.verification import Requirements
+from planning.search.rrt_trees import Tree
 from planning.task.orientation_projection import Projector
 
 FloatArray = NDArray[np.float64]
@@ -34,36 +35,6 @@ SHORTCUTS = 100
 """Shortcuts tried on the path found."""
 BATCH = 16
 """Steps projected before their clearance is checked together."""
-
-
-class _Tree:
-    """Nodes in a growing array (the nearest one found without copying a list) and their parents."""
-
-    def __init__(self, root: FloatArray) -> None:
-        self._nodes = np.empty((64, len(root)))
-        self._nodes[0] = root
-        self.size = 1
-        self.parents = [-1]
-
-    @property
-    def nodes(self) -> FloatArray:
-        return self._nodes[: self.size]
-
-    def add(self, q: FloatArray, parent: int) -> int:
-        if self.size == len(self._nodes):
-            self._nodes = np.concatenate([self._nodes, np.empty_like(self._nodes)])
-        self._nodes[self.size] = q
-        self.parents.append(parent)
-        self.size += 1
-        return self.size - 1
-
-    def branch(self, index: int) -> list[FloatArray]:
-        """The nodes from the root to ``index``."""
-        found = []
-        while index >= 0:
-            found.append(self._nodes[index].copy())
-            index = self.parents[index]
-        return found[::-1]
 
 
 class _Walker:
@@ -128,36 +99,32 @@ def orientation_path(
     direct = walker.walk(q_start, q_goal)
     if walker.reaches(direct, q_goal):
         return np.array([q_start, *direct])
-    trees = (_Tree(q_start), _Tree(q_goal))
+    trees = (Tree(q_start), Tree(q_goal))
     lower, upper = world.robot.limits.lower, world.robot.limits.upper
     for sample in range(MAX_SAMPLES):
         grow, other = trees if sample % 2 == 0 else trees[::-1]
         aim, angle = projector.project(rng.uniform(lower, upper))
         if angle > projector.aim_rad:
             continue
-        near = _nearest(grow, aim, walker)
+        near = grow.nearest(aim, walker.weights)
         steps = walker.walk(grow.nodes[near], aim, RANGE_M)
         if not steps:
             continue
         for q in steps:
             near = grow.add(q, near)
-        toward = _nearest(other, steps[-1], walker)
+        toward = other.nearest(steps[-1], walker.weights)
         joined = walker.walk(other.nodes[toward], steps[-1])
         for q in joined:
             toward = other.add(q, toward)
         if walker.reaches(joined, steps[-1]) or walker.distance(other.nodes[toward], steps[-1]) <= 1e-9:
-            first, second = grow.branch(near), other.branch(toward)
-            path = first + second[::-1][1:] if grow is trees[0] else second + first[::-1][1:]
-            return _shortened(np.array(path), walker, rng)
+            ends = (grow.branch(near), other.branch(toward))  # each from its node back to its root
+            first, second = ends if grow is trees[0] else ends[::-1]
+            return _shortened(np.concatenate([first[::-1], second[1:]]), walker, rng)
     raise NoSolutionError(
         f"no path keeps '{projector.frame}' within {projector.constraint.angle_rad:.4g} rad about "
         f"{list(projector.constraint.axes)} and the margins (RRT-Connect on the constraint, "
         f"{MAX_SAMPLES} samples)"
     )
-
-
-def _nearest(tree: _Tree, q: FloatArray, walker: _Walker) -> int:
-    return int(np.argmin(np.abs(tree.nodes - q) @ walker.weights))
 
 
 def _shortened(path: FloatArray, walker: _Walker, rng: np.random.Generator) -> FloatArray:

@@ -1,0 +1,63 @@
+"""The hulls first: a robot with exact link meshes is planned on their convex hulls, then on the meshes.
+
+Where a link's convex hull reaches beyond its mesh (:mod:`cpr_kin.shapes.exact_meshes`), the
+collision model decides on the mesh, which costs triangle queries; the hulls contain the
+meshes, so a trajectory certified on them is certified on the meshes too, and they ask coal
+no triangle query. :func:`~planning.pipeline.planner.solve` therefore plans a problem whose
+start and goal keep the margins on the hulls there first (:func:`on_hulls`), with
+:data:`HULLS_SHARE` of the samples and of a time limit; where that finds no trajectory, the
+meshes plan it in the time left, RRT-Connect going on with the trees the hulls' draw grew
+(:class:`~planning.search.rrt_trees.GrownTrees`). Why a quarter: ``docs/tuning.md``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from planning.pipeline.objective import PathRules, WaypointObjective
+from planning.pipeline.problem import Problem, finer_step_m
+from planning.search.rrt_trees import GrownTrees
+
+HULLS_SHARE = 0.25
+"""The share of RRT-Connect's samples (``max_samples``) and of a time limit that a plan on the
+hulls alone may take (:func:`on_hulls`); where it finds nothing in them, the meshes' turn."""
+
+
+def on_hulls(problem: Problem) -> Problem | None:
+    """``problem`` on its robot's convex hulls alone, where its start and goal keep the margins there.
+
+    ``None`` for a robot whose meshes are all their own hulls, within a millimetre
+    (:attr:`cpr_kin.Robot.exact_meshes` empty), or ends that only the exact meshes clear. A
+    hull contains its mesh, so a trajectory certified on the hulls is certified on the meshes;
+    and the hulls ask coal no triangle query. Its sampling planner draws :data:`HULLS_SHARE`
+    of the samples: a passage that only the meshes open is not searched for long on the hulls.
+    """
+    if not problem.robot.exact_meshes:
+        return None
+    world, scene = problem.world.on_hulls(), problem.scene
+    ends = np.stack([problem.q_start, problem.q_goal])
+    if not world.keeps_clearance(ends, scene.safety_margin, scene.self_margin).all():
+        return None
+    tuning = scene.planner.tuning
+    fewer = max(1, int(tuning.seeding.max_samples * HULLS_SHARE))
+    seeding = dataclasses.replace(tuning.seeding, max_samples=fewer)
+    planner = scene.planner.updated(tuning=dataclasses.replace(tuning, seeding=seeding))
+    rules = PathRules(scene.safety_margin, scene.self_margin, problem.gravity)
+    solver, duration = problem.solver, problem.duration  # the search's knots: not the world's
+    objective = WaypointObjective(world, problem.motion, rules, planner, solver, duration)
+    scene = dataclasses.replace(scene, planner=planner)
+    return dataclasses.replace(problem, scene=scene, robot=world.robot, world=world, objective=objective)
+
+
+def shared_trees(hulls: Problem, meshes: Problem) -> GrownTrees | None:
+    """Where the meshes' RRT-Connect draw may go on with the trees of the hulls', or ``None``.
+
+    The hulls' trees keep the clearance on the hulls, so on the meshes they contain; trees
+    that grew on under the finer step's clearance (a relaxation,
+    :mod:`planning.pipeline.seeding`) keep that step's, which depends on how near the ends
+    come to the margins (:func:`~planning.pipeline.problem.finer_step_m`), nearer on the
+    hulls: shared only where both finer steps are one.
+    """
+    return GrownTrees() if finer_step_m(hulls) == finer_step_m(meshes) else None

@@ -1,0 +1,119 @@
+"""RRT-Connect's trees (:mod:`planning.search.rrt_connect`), and those a draw leaves when it finds no path.
+
+A robot with exact link meshes is planned on their convex hulls first
+(:mod:`planning.pipeline.hulls_first`): RRT-Connect's trees grow there under a validity stricter
+than the meshes', since every configuration and edge clear of the hulls is clear of the
+meshes they contain. When the hulls' draw ends without a path (its share of the samples or
+of a time limit spent), the meshes' draw between the same ends goes on growing its trees
+(:class:`GrownTrees`) rather than growing new ones from its ends: nothing the hulls found is
+drawn again.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from cpr_kin.common.compiled import njit
+
+FloatArray = NDArray[np.float64]
+
+
+class Tree:
+    """Nodes and parents, grown in place (arrays doubled when full)."""
+
+    def __init__(self, root: FloatArray) -> None:
+        self.nodes = np.empty((64, root.size))
+        self.parents = np.empty(64, dtype=np.intp)
+        self.nodes[0], self.parents[0], self.size = root, -1, 1
+
+    def add(self, q: FloatArray, parent: int) -> int:
+        """Add node ``q`` under node ``parent``; its index."""
+        if self.size == len(self.nodes):
+            self.nodes = np.concatenate([self.nodes, np.empty_like(self.nodes)])
+            self.parents = np.concatenate([self.parents, np.empty_like(self.parents)])
+        self.nodes[self.size], self.parents[self.size] = q, parent
+        self.size += 1
+        return self.size - 1
+
+    def nearest(self, q: FloatArray, weights: FloatArray) -> int:
+        """Index of the node nearest to ``q`` by the motion bound with ``weights``."""
+        return nearest_node(self.nodes, self.size, q, weights)
+
+    def branch(self, index: int) -> FloatArray:
+        """The nodes from ``index`` back to the root."""
+        chain = []
+        while index >= 0:
+            chain.append(self.nodes[index])
+            index = int(self.parents[index])
+        return np.array(chain)
+
+
+@njit
+def nearest_node(nodes: FloatArray, size: int, q: FloatArray, weights: FloatArray) -> int:
+    """Index of the first of ``nodes[:size]`` nearest to ``q`` by the motion bound ``sum_j w_j |dq_j|``."""
+    best, index = np.inf, 0
+    for i in range(size):
+        distance = 0.0
+        for j in range(len(q)):
+            distance += abs(nodes[i, j] - q[j]) * weights[j]
+        if distance < best:
+            best, index = distance, i
+    return index
+
+
+class GrownTrees:
+    """Where a draw that found no path leaves its two trees, for the next draw between the same ends.
+
+    :func:`~planning.search.rrt_connect.rrt_connect` given one starts from the trees kept here
+    (and takes them: a draw that finds a path leaves none) where they grew between the same
+    start and goal, their edges checked at the same spacing; trees that grew on under a
+    relaxation (:class:`~planning.search.rrt_connect.Relaxation`) are taken only by a draw
+    with one, which goes on under it at once. Its caller promises that the draw's validity
+    accepts every configuration the earlier draw's did, and its relaxation the earlier
+    relaxation's (the meshes after their hulls, at the same clearances). A draw that ends
+    without a path keeps its trees here.
+    """
+
+    def __init__(self) -> None:
+        self._trees: tuple[Tree, Tree] | None = None
+        self._key: tuple[bytes, bytes, float] | None = None
+        self.relaxed = False
+
+    def take(
+        self, start: FloatArray, goal: FloatArray, resolution_m: float, relaxable: bool
+    ) -> tuple[Tree, Tree] | None:
+        """The trees kept between ``start`` and ``goal`` at edge spacing ``resolution_m`` [m], or ``None``.
+
+        ``relaxable``: the draw has a relaxation to go on under (else trees kept relaxed are
+        not taken). :attr:`relaxed` then says whether they grew under one.
+        """
+        trees, key = self._trees, self._key
+        self._trees = self._key = None
+        if key != _key(start, goal, resolution_m) or (self.relaxed and not relaxable):
+            return None
+        return trees
+
+    def keep(
+        self,
+        trees: tuple[Tree, Tree],
+        start: FloatArray,
+        goal: FloatArray,
+        resolution_m: float,
+        relaxed: bool,
+    ) -> None:
+        """Keep ``trees`` grown from ``start`` and ``goal``, edges every ``resolution_m`` [m]."""
+        self._trees, self._key, self.relaxed = trees, _key(start, goal, resolution_m), relaxed
+
+    @property
+    def nodes(self) -> int:
+        """The nodes of the trees kept (0: none)."""
+        return 0 if self._trees is None else sum(tree.size for tree in self._trees)
+
+
+def _key(start: FloatArray, goal: FloatArray, resolution_m: float) -> tuple[bytes, bytes, float]:
+    return (
+        np.asarray(start, dtype=float).tobytes(),
+        np.asarray(goal, dtype=float).tobytes(),
+        float(resolution_m),
+    )
