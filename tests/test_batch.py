@@ -169,3 +169,17 @@ def test_batch_command(scenes: Path, tmp_path: Path, capsys: pytest.CaptureFixtu
     (tmp_path / "file").write_text("")
     code = main(["batch", str(scenes), "--out", str(tmp_path / "file")])
     assert code == 2 and "output folder" in capsys.readouterr().err and (tmp_path / "file").read_text() == ""
+
+
+def test_a_row_about_a_long_path_says_what_is_wrong(tmp_path: Path) -> None:
+    """The row's message is one line, cut as the CLI's errors are: not before a long path has left room."""
+    deep = tmp_path.joinpath(*["folder_" * 20] * 4)  # 560 characters below tmp_path
+    deep.mkdir(parents=True)
+    scene = deep / "odd.yaml"
+    scene.write_text(paper_scene_path().read_text())
+    out = deep / "odd"
+    out.mkdir()
+    (out / "keep.txt").write_text("the user's file")
+    item = plan_scene_file(scene, out)
+    assert item.status == "invalid" and len(item.message) <= 1000 and "\n" not in item.message
+    assert item.message.endswith("holds files a plan does not write (keep.txt); name a new or empty folder")

@@ -2,7 +2,7 @@ from __future__ import annotations
 
 import pytest
 
-from cpr_kin.common.names import escaped, unprintable
+from cpr_kin.common.names import MAX_LINE_CHARS, escaped, one_line, unprintable
 
 
 @pytest.mark.parametrize(
@@ -33,3 +33,10 @@ def test_repeated_names_each_name_given_more_than_once_in_order() -> None:
 
     assert repeated(["b", "a", "b", "c", "a", "b"]) == ["a", "b"]
     assert repeated(["a", "b"]) == [] and repeated([]) == []
+
+
+def test_one_line_joins_escapes_and_cuts() -> None:
+    assert one_line("a  file\n\tis\u202emissing") == "a file is\\u202emissing"
+    long = one_line("x " * 2000)
+    assert len(long) == MAX_LINE_CHARS and long.endswith("...") and long.startswith("x x")
+    assert one_line("short", limit=4) == "s..."

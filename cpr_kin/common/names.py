@@ -24,6 +24,18 @@ MAX_SHOWN_CHARS = 40
 """Longest rendering of a value in a message: a hostile value must not flood the terminal."""
 
 
+MAX_LINE_CHARS = 1000
+"""Longest message line printed or written (the CLI's errors, a batch summary's row): a hostile
+input must not flood a terminal or a file. Each value a message shows is cut where it is shown
+(:func:`shown`); what is left long is a file's path, which may take a few hundred characters
+before the message says what is wrong."""
+
+
+def one_line(text: str, limit: int = MAX_LINE_CHARS) -> str:
+    """``text`` as one line: whitespace runs as one space, :func:`escaped`, cut to ``limit`` characters."""
+    return cut(escaped(" ".join(text.split())), limit)
+
+
 def cut(text: str, limit: int = MAX_SHOWN_CHARS) -> str:
     """``text``, cut to ``limit`` characters with an ellipsis."""
     return text if len(text) <= limit else text[: limit - 3] + "..."

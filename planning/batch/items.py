@@ -34,15 +34,13 @@ from pathlib import Path
 from typing import Any, Protocol
 
 import cpr_kin as ck  # lazy (lazy_loader): its modules load in the workers, where they are used
-from cpr_kin.common.names import escaped, repeated
+from cpr_kin.common.names import escaped, one_line, repeated
 from planning.errors import PlanningError
 from planning.outcome import STATUS_EXIT, classify
 
 RECORD_FIELDS = ("duration", "min_clearance", "t_sol", "fitness", "evaluations", "planning_time_s")
 """The plan record's fields (:func:`planning.io.report.plan_record`) that ``summary.csv`` shows."""
 SUMMARY_FIELDS = ("scene", "status", "exit_class", *RECORD_FIELDS, "task_time_s", "message")
-MAX_MESSAGE_CHARS = 300
-"""Longest message of a row (a hostile scene must not flood the summary)."""
 
 
 @dataclass(frozen=True)
@@ -54,7 +52,8 @@ class BatchItem:
         status: ``ok``, ``invalid``, ``no_trajectory``, ``error`` or ``crashed`` (see the
             module docstring).
         exit_class: the status's exit code, :data:`STATUS_EXIT`.
-        message: what went wrong, empty when ok (at most :data:`MAX_MESSAGE_CHARS`).
+        message: what went wrong, empty when ok (one line, at most
+            :data:`~cpr_kin.common.names.MAX_LINE_CHARS`).
         record: the plan's record (:func:`planning.io.report.plan_record`, the trajectory
             file's metrics), ``None`` for a failed scene.
         task_time_s: wall time of the task: loading, planning and writing [s].
@@ -70,11 +69,8 @@ class BatchItem:
     @classmethod
     def failed(cls, scene: str, status: str, message: str, started: float | None = None) -> BatchItem:
         """A failed scene's row; ``started`` is the task's ``time.perf_counter()`` at its start."""
-        message = escaped(" ".join(message.split()))
-        if len(message) > MAX_MESSAGE_CHARS:
-            message = message[: MAX_MESSAGE_CHARS - 3] + "..."
         elapsed = 0.0 if started is None else time.perf_counter() - started
-        return cls(escaped(scene), status, STATUS_EXIT[status], message, None, elapsed)
+        return cls(escaped(scene), status, STATUS_EXIT[status], one_line(message), None, elapsed)
 
 
 @lru_cache(maxsize=8)

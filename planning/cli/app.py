@@ -8,7 +8,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from cpr_kin.common.names import escaped
+from cpr_kin.common.names import one_line
 from planning.cli.arguments import integer_at_least
 from planning.cli.batch_command import cmd_batch
 from planning.cli.file_commands import EXPORTERS, cmd_check, cmd_export, cmd_show
@@ -206,17 +206,6 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-MAX_ERROR_CHARS = 1000
-"""Longest error line the CLI prints: a hostile input must not flood the terminal. Each value a
-message shows is cut where it is shown (:func:`cpr_kin.common.names.shown`); what is left long
-is a file's path, which may take a few hundred characters before the message says what is wrong."""
-
-
-def _one_line(text: str) -> str:
-    text = escaped(" ".join(text.split()))
-    return text if len(text) <= MAX_ERROR_CHARS else text[: MAX_ERROR_CHARS - 3] + "..."
-
-
 def main(argv: Sequence[str] | None = None, *, restore_signals: bool = True) -> int:
     """Entry point of ``cpr-plan``; returns the exit code.
 
@@ -238,15 +227,15 @@ def main(argv: Sequence[str] | None = None, *, restore_signals: bool = True) -> 
             outcome = classify(exc)
             if outcome.status == "interrupted" or signalled():
                 said = str(exc) if isinstance(exc, Interrupted) else "interrupted; nothing written"
-                print(_one_line(f"{label}: {said}"), file=sys.stderr)
+                print(one_line(f"{label}: {said}"), file=sys.stderr)
                 return EXIT_INTERRUPTED
             if outcome.status == "error":
                 if os.environ.get("CPR_PLAN_TRACEBACK"):
                     raise
                 bug = f"{label}: internal error (a bug; please report it with the input)"
-                print(_one_line(f"{bug}: {outcome.message}"), file=sys.stderr)
+                print(one_line(f"{bug}: {outcome.message}"), file=sys.stderr)
             else:
-                print(_one_line(f"{label}: error: {outcome.message}"), file=sys.stderr)
+                print(one_line(f"{label}: error: {outcome.message}"), file=sys.stderr)
             return outcome.exit_code
     return code
 
