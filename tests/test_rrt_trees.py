@@ -125,3 +125,22 @@ def test_the_trees_of_ends_that_need_the_relaxation_are_kept_as_relaxed() -> Non
     coarse, grown = dataclasses.replace(RrtSettings(), explore_resolution_m=0.04), GrownTrees()
     assert draw(strict, grown, settings=coarse, stop=stopped_after(20), relaxation=relaxation) is None
     assert grown.nodes == 0
+
+
+def test_agreement_is_asked_only_when_there_are_trees_to_take() -> None:
+    asked: list[bool] = []
+
+    def agree(answer: bool) -> Callable[[], bool]:
+        def said() -> bool:
+            asked.append(answer)
+            return answer
+
+        return said
+
+    grown = GrownTrees(agree(False))
+    assert grown.take(START, GOAL, 0.01, relaxable=True) is None and asked == []  # nothing kept: not asked
+    grown.keep((Tree(START), Tree(GOAL)), START, GOAL, 0.01, relaxed=False)
+    assert grown.take(START, GOAL, 0.01, relaxable=True) is None and asked == [False]
+    grown = GrownTrees(agree(True))
+    grown.keep((Tree(START), Tree(GOAL)), START, GOAL, 0.01, relaxed=False)
+    assert grown.take(START, GOAL, 0.01, relaxable=True) is not None and asked == [False, True]

@@ -51,13 +51,14 @@ def on_hulls(problem: Problem) -> Problem | None:
     return dataclasses.replace(problem, scene=scene, robot=world.robot, world=world, objective=objective)
 
 
-def shared_trees(hulls: Problem, meshes: Problem) -> GrownTrees | None:
-    """Where the meshes' RRT-Connect draw may go on with the trees of the hulls', or ``None``.
+def shared_trees(hulls: Problem, meshes: Problem) -> GrownTrees:
+    """Where the meshes' RRT-Connect draw goes on with the trees of the hulls' draw, where they agree.
 
     The hulls' trees keep the clearance on the hulls, so on the meshes they contain; trees
     that grew on under the finer step's clearance (a relaxation,
     :mod:`planning.pipeline.seeding`) keep that step's, which depends on how near the ends
     come to the margins (:func:`~planning.pipeline.problem.finer_step_m`), nearer on the
-    hulls: shared only where both finer steps are one.
+    hulls: taken only where both finer steps are one, asked only when the hulls' draw left
+    trees (the steps cost distance queries on the meshes).
     """
-    return GrownTrees() if finer_step_m(hulls) == finer_step_m(meshes) else None
+    return GrownTrees(lambda: finer_step_m(hulls) == finer_step_m(meshes))

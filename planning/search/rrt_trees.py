@@ -11,6 +11,8 @@ drawn again.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -71,13 +73,16 @@ class GrownTrees:
     relaxation (:class:`~planning.search.rrt_connect.Relaxation`) are taken only by a draw
     with one, which goes on under it at once. Its caller promises that the draw's validity
     accepts every configuration the earlier draw's did, and its relaxation the earlier
-    relaxation's (the meshes after their hulls, at the same clearances). A draw that ends
+    relaxation's (the meshes after their hulls, at the same clearances), or gives ``agree``:
+    asked only when there are trees to take, it says whether that promise holds (a check that
+    costs queries no plan whose first draw finds its path should pay). A draw that ends
     without a path keeps its trees here.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, agree: Callable[[], bool] | None = None) -> None:
         self._trees: tuple[Tree, Tree] | None = None
         self._key: tuple[bytes, bytes, float] | None = None
+        self._agree = agree
         self.relaxed = False
 
     def take(
@@ -92,7 +97,7 @@ class GrownTrees:
         self._trees = self._key = None
         if key != _key(start, goal, resolution_m) or (self.relaxed and not relaxable):
             return None
-        return trees
+        return trees if self._agree is None or self._agree() else None
 
     def keep(
         self,
