@@ -7,6 +7,7 @@ from .certified.motion import CurveCheck, check_curve, check_segment, motion_rad
 from .collision.clearance import BatchClearance, Clearance, PairDistance
 from .collision.world import CollisionWorld
 from .common.errors import (
+    CheckStoppedError,
     CprKinError,
     IkMissError,
     JointLimitError,
@@ -39,6 +40,7 @@ __all__ = [
     "SHAPES",
     "TCP_FRAME",
     "BatchClearance",
+    "CheckStoppedError",
     "Clearance",
     "ClosePair",
     "CollisionWorld",

@@ -12,12 +12,15 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
+from cpr_kin.model.packages import example_robot
 from planning.cli.app import main
 from planning.errors import NoTrajectoryFoundError, PlanningError
 from planning.io.bundled import paper_scene
+from planning.io.scene_file import parse_scene
 from planning.pipeline import planner
-from planning.pipeline.choose import choose
-from planning.pipeline.deadline import Deadline
+from planning.pipeline.choose import Choice, Refusal, choose
+from planning.pipeline.deadline import MIN_OVERRUN_S, Deadline, overrun_s
+from planning.pipeline.hulls_first import HULLS_SHARE
 from planning.pipeline.path_following import follow_path
 from planning.pipeline.planner import plan
 from planning.pipeline.problem import build_problem
@@ -25,11 +28,13 @@ from planning.pipeline.scene import Scene
 from planning.pipeline.search import search
 from planning.pipeline.seeding import Attempt
 from planning.pipeline.settings import PlannerSettings
+from planning.pipeline.verification import STOPPED
 from planning.search.firefly import firefly_minimize
 from planning.search.firefly_settings import FireflySettings
 from planning.search.refinement import cma_refine
 from planning.search.rrt_connect import rrt_connect
 
+from .test_hull_first import BALL, CLEAR_ON_HULLS, ur10_scene
 from .test_path_following import spline_touching_scene
 from .test_rrt_connect import LOWER, UPPER, WEIGHTS, wall_with_slot
 
@@ -56,6 +61,44 @@ def test_a_deadline_passes_at_its_limit() -> None:
     assert Deadline.after(1e-9, now - 1.0).passed()
     assert not Deadline.after(3600.0, now).passed()
     assert "after 2.1 s by the time limit time_limit_s = 2 s" in Deadline.after(2.0, now).reason(2.1)
+
+
+def test_a_check_under_way_is_cut_an_overrun_after_the_limit() -> None:
+    now = time.perf_counter()
+    assert overrun_s(10.0) == 2.5 and overrun_s(2.0) == MIN_OVERRUN_S == 1.0  # a quarter, at least 1 s
+    ten = Deadline.after(10.0, now)
+    assert ten.cut_at_s == pytest.approx(now + 12.5) and not ten.cut() and ten.stop == ten.cut
+    assert Deadline().stop is None and Deadline(0.0, 1.0).stop is None  # nothing cut: no question asked
+    assert Deadline(0.0, 1.0, 0.0).cut()
+
+
+def test_past_the_cut_the_check_under_way_stops_and_its_candidate_is_refused(robot: ck.Robot) -> None:
+    problem = build_problem(paper_scene(), robot)
+    searched = search(Attempt(problem), None, None)
+    late = choose(dataclasses.replace(problem, deadline=Deadline(0.0, 1.0)), searched)
+    assert isinstance(late, Choice)  # the oracle: past the limit, before the cut, the best passes
+    cut = choose(dataclasses.replace(problem, deadline=Deadline(0.0, 1.0, 0.0)), searched)
+    assert isinstance(cut, Refusal) and cut.verified == "1 candidate verified"
+    assert cut.cause == f"the best candidate {STOPPED}" and not cut.check.times.size
+    message = str(cut.error())
+    assert "its check was stopped by the time limit before its verdict" in message
+
+
+def test_the_hulls_share_of_a_limit_is_cut_where_the_plan_is(monkeypatch: pytest.MonkeyPatch) -> None:
+    ur10 = ck.load_robot(example_robot("ur10"))
+    scene = parse_scene({**ur10_scene(CLEAR_ON_HULLS), "obstacles": [BALL]}).with_planner(time_limit_s=600.0)
+    deadlines: list[tuple[Deadline, Deadline]] = []
+
+    def recorded(problem: Any, deadline: Deadline, *args: Any) -> Any:
+        deadlines.append((deadline, args[-1]))
+        return solved(problem, deadline, *args)
+
+    solved = planner._solved
+    monkeypatch.setattr(planner, "_solved", recorded)
+    plan(scene, ur10)
+    hulls, whole = deadlines[0]
+    assert hulls.limit_s == 600.0 * HULLS_SHARE and whole.limit_s == 600.0
+    assert hulls.at_s < whole.at_s and hulls.cut_at_s == whole.cut_at_s == whole.at_s + 150.0
 
 
 def test_rrt_connect_stops_without_a_path() -> None:

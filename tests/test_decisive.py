@@ -1,12 +1,19 @@
-"""The rule every certified check updates its samples by: exact where known, else a true lower bound."""
+"""The rule every certified check updates its samples by: exact where known, else a true lower bound;
+and how a check is stopped between its pieces of work."""
 
 from __future__ import annotations
 
-import numpy as np
+from collections.abc import Callable
 
+import numpy as np
+import pytest
+
+import cpr_kin as ck
 from cpr_kin.collision.decisive import (
+    ask,
     below_coal,
     certified,
+    chunked,
     coal_error_m,
     exact_below,
     propagated_bounds,
@@ -58,3 +65,35 @@ def test_coal_error_is_a_micrometre_below_a_metre_and_relative_above() -> None:
         coal_error_m(np.array([0.0, -0.3, 0.999, 2.0, -5.0])), [1e-6, 1e-6, 1e-6, 2e-6, 5e-6]
     )
     np.testing.assert_allclose(below_coal(np.array([0.1, 3.0])), [0.1 - 1e-6, 3.0 - 3e-6])
+
+
+def stop_after(count: int) -> tuple[list[int], Callable[[], bool]]:
+    """A stop that says ``True`` from its ``count + 1``-th question on, and the list of its questions."""
+    asked: list[int] = []
+
+    def stop() -> bool:
+        asked.append(1)
+        return len(asked) > count
+
+    return asked, stop
+
+
+def test_a_check_in_chunks_is_the_check_in_one_call_and_stops_between_chunks() -> None:
+    q = np.random.default_rng(4).normal(size=(1000, 3))
+
+    def rows(batch: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # each row its own: as coal's queries
+        return np.linalg.norm(batch, axis=1), np.argmax(batch, axis=1)
+
+    whole = rows(q)
+    asked, never = stop_after(10**9)
+    for got, expected in zip(chunked(rows, q, never, rows=64), whole, strict=True):
+        np.testing.assert_array_equal(got, expected)
+    assert len(asked) == 16  # before each of the 1000 / 64 pieces
+    np.testing.assert_array_equal(chunked(lambda b: b.sum(axis=1), q, never, rows=64), q.sum(axis=1))
+    asked, third = stop_after(2)
+    with pytest.raises(ck.CheckStoppedError, match="stopped by its caller before its verdict"):
+        chunked(rows, q, third, rows=64)
+    assert len(asked) == 3  # two pieces computed, stopped before the third
+    ask(None)  # no stop: nothing asked
+    with pytest.raises(ck.CheckStoppedError):
+        ask(lambda: True)

@@ -1,5 +1,6 @@
 from __future__ import annotations
 
+import dataclasses
 import re
 
 import numpy as np
@@ -12,6 +13,7 @@ from cpr_kin.certified.motion import PATH_WEIGHT_FLOOR
 from cpr_kin.model.packages import example_robot
 
 from .conftest import PAPER_GOAL_TCP, PAPER_START_TCP, random_configurations
+from .test_decisive import stop_after
 
 
 @pytest.fixture(scope="module")
@@ -262,3 +264,30 @@ def test_each_interval_bounded_by_its_own_speed_certifies_an_approach_to_rest_ne
     assert uniform.certified_min_m <= local.certified_min_m <= local.sampled_min_m
     dense = world.clearance_batch(curve(np.linspace(0.0, 1.0, 50 * len(local.times)))).min_clearance_m
     assert local.certified_min_m <= dense.min() + 1e-9
+
+
+def test_a_stoppable_check_decides_as_one_that_is_not_until_stopped(
+    rng: np.random.Generator,
+) -> None:
+    # a UR5 on its exact meshes among balls: the samples in doubt go to coal in pieces, with the
+    # stop asked before each; never stopped, the check is the one-call check to the bit
+    ur5 = ck.load_robot(example_robot("ur5"))
+    balls = [ck.Obstacle.sphere(0.12, tuple(rng.uniform(-0.5, 0.5, 3)), name=f"ball{k}") for k in range(6)]
+    world = ck.CollisionWorld(ur5, balls)
+    assert ur5.exact_meshes
+    a, b = random_configurations(ur5, rng, 2)
+
+    def line(t: np.ndarray) -> np.ndarray:
+        return np.asarray(a + np.asarray(t)[:, None] * (b - a))
+
+    args = (world, line, 0.0, 1.0, np.abs(b - a), 0.01, 0.0005)
+    plain = ck.check_curve(*args)
+    asked, never = stop_after(10**9)
+    stoppable = ck.check_curve(*args, stop=never)
+    assert len(plain.times) > 4096 and len(asked) > 3  # in pieces
+    for field in dataclasses.fields(plain):
+        np.testing.assert_array_equal(getattr(stoppable, field.name), getattr(plain, field.name))
+    asked, second = stop_after(1)
+    with pytest.raises(ck.CheckStoppedError):
+        ck.check_curve(*args, stop=second)
+    assert len(asked) == 2

@@ -18,6 +18,8 @@ from planning.errors import PlanningError
 from planning.pipeline.problem import build_problem, with_planner
 from planning.pipeline.settings import PlannerSettings
 
+from .test_decisive import stop_after
+
 SHARE = example_robot_data_share()
 assert SHARE is not None, "example-robot-data is part of the robots extra, which make installs"
 PANDA = SHARE / "example-robot-data" / "robots" / "panda_description" / "urdf" / "panda.urdf"
@@ -283,3 +285,20 @@ def test_an_end_inside_the_self_margin_of_a_robot_without_an_srdf_says_so() -> N
         build_problem(scene, bare)
     listed = ck.load_robot(urdf, tcp="left_gripper", srdf=srdf)
     assert build_problem(scene, listed).robot.srdf_path == srdf
+
+
+def test_a_stoppable_self_check_decides_as_one_that_is_not_until_stopped(panda: ck.Robot) -> None:
+    collision = ck.CollisionWorld(panda, []).self_collision
+    assert collision is not None
+    for a, b in random_curves(panda, 3, 11):
+
+        def line(t: np.ndarray, a: np.ndarray = a, b: np.ndarray = b) -> np.ndarray:
+            return np.asarray(a + np.asarray(t)[:, None] * (b - a))
+
+        args = (collision, line, (0.0, 1.0), np.abs(b - a), 0.0, 0.0005)
+        asked, never = stop_after(10**9)
+        assert check_self_curve(*args, stop=never) == check_self_curve(*args)
+        assert len(asked) > 1  # asked before the screen and each pair and piece it computes
+        asked, at_once = stop_after(len(asked) - 1)  # stopped at its last question
+        with pytest.raises(ck.CheckStoppedError):
+            check_self_curve(*args, stop=at_once)

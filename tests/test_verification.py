@@ -13,7 +13,7 @@ from planning.io.bundled import paper_scene
 from planning.pipeline.planner import plan
 from planning.pipeline.result import PlanResult
 from planning.pipeline.target import Target
-from planning.pipeline.verification import Requirements, verify_for_scene, verify_trajectory
+from planning.pipeline.verification import STOPPED, Requirements, verify_for_scene, verify_trajectory
 
 
 @pytest.fixture(scope="module")
@@ -26,6 +26,27 @@ def test_planned_trajectory_is_accepted(result: PlanResult, paper_world: ck.Coll
     verification = verify_trajectory(paper_world, result.trajectory, Requirements(0.1, 0.005, endpoints=ends))
     assert verification.accepted and verification.problems == ()
     assert verification.check.certified_min_m == pytest.approx(result.metrics.min_clearance_m)
+
+
+def test_a_verification_stopped_before_its_verdict_accepts_nothing(
+    result: PlanResult, paper_world: ck.CollisionWorld
+) -> None:
+    required = Requirements(0.1, 0.005)
+    asked: list[int] = []
+
+    def never() -> bool:
+        asked.append(1)
+        return False
+
+    kept = verify_trajectory(paper_world, result.trajectory, required, stop=never)
+    assert kept.accepted and asked  # asked, never stopped: the verdict of a check without a stop
+    assert (
+        kept.check.certified_min_m
+        == verify_trajectory(paper_world, result.trajectory, required).check.certified_min_m
+    )
+    stopped = verify_trajectory(paper_world, result.trajectory, required, stop=lambda: True)
+    assert not stopped.accepted and stopped.problems == (STOPPED,)
+    assert stopped.check.certified_min_m == -np.inf and not stopped.check.accepted
 
 
 def test_a_file_in_another_joint_order_is_refused_by_name(result: PlanResult) -> None:

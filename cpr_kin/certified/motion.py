@@ -17,13 +17,14 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.certified.interval_motion import IntervalSpeed, interval_motion
 from cpr_kin.collision.clearance import BatchClearance
-from cpr_kin.collision.decisive import certified, exact_below, undecided, with_neighbours
+from cpr_kin.collision.decisive import Stop, certified, chunked, exact_below, undecided, with_neighbours
 from cpr_kin.collision.robot_reach import robot_reach
 from cpr_kin.collision.world import CollisionWorld
 from cpr_kin.common.errors import CprKinError
@@ -36,6 +37,8 @@ COARSE_STRIDE = 8
 neighbours' (a distance changes no faster than the robot moves), which may then need none."""
 COARSE_BELOW = 64
 """Fewer samples in doubt than this are computed at once (another round costs more than they)."""
+LOWER_BOUND_ROWS = 4096
+"""Configurations a stoppable check bounds in one call (a few tenths of a second on meshes)."""
 MAX_CURVE_CHECKS = 1_000_000
 """Most configurations one continuous check queries (about 10 to 20 s of coal on 2 cores)."""
 
@@ -109,6 +112,8 @@ def check_curve(
     margin_m: float,
     step_m: float = 0.005,
     interval_speed: IntervalSpeed | None = None,
+    *,
+    stop: Stop | None = None,
 ) -> CurveCheck:
     """Certify that the curve ``q(t)``, ``t0 <= t <= t1``, keeps ``margin_m`` everywhere.
 
@@ -124,9 +129,11 @@ def check_curve(
             sample times (:data:`cpr_kin.certified.interval_motion.IntervalSpeed`); each interval's
             certified bound uses the lower of it and ``speed_bound``'s. The samples are
             those of ``speed_bound``.
+        stop: asked between the check's pieces of work (:data:`cpr_kin.collision.decisive.Stop`).
 
     Raises:
         CprKinError: bad arguments, or more than :data:`MAX_CURVE_CHECKS` samples needed.
+        CheckStoppedError: ``stop`` said so before the verdict.
 
     """
     speed = np.asarray(speed_bound, dtype=float)
@@ -146,7 +153,7 @@ def check_curve(
         )
     times = np.linspace(t0, t1, max(count, 2))  # at least both ends
     slack = interval_motion(times, point_speed, interval_speed)
-    batch = decisive_clearance(world, curve(times), slack, exact_below(margin_m, slack))
+    batch = decisive_clearance(world, curve(times), slack, exact_below(margin_m, slack), stop=stop)
     per_group = batch.clearance_m
     # lower bound between neighbouring samples: distances change no faster than the robot moves
     group_bound = certified(per_group, slack).min(axis=0)
@@ -172,7 +179,12 @@ def check_curve(
 
 
 def decisive_clearance(
-    world: CollisionWorld, q: FloatArray, slack_m: float | FloatArray, exact_below_m: float = np.inf
+    world: CollisionWorld,
+    q: FloatArray,
+    slack_m: float | FloatArray,
+    exact_below_m: float = np.inf,
+    *,
+    stop: Stop | None = None,
 ) -> BatchClearance:
     """Per-group clearance of the samples ``q`` ``(K, nq)`` of a curve, exact where it decides the check.
 
@@ -190,9 +202,10 @@ def decisive_clearance(
     :attr:`clearance_m` holds the best lower bound and :attr:`closest_pair` ``-1``. A value at
     or above ``exact_below_m`` [m] need not be exact (a link's exact mesh that far from an
     obstacle counts as that far, :meth:`~cpr_kin.CollisionWorld.group_clearance`): a check whose
-    margin plus slack is below it decides the same.
+    margin plus slack is below it decides the same. ``stop`` is asked between pieces of
+    :data:`~cpr_kin.collision.decisive.CHUNK_ROWS` configurations (:class:`~cpr_kin.CheckStoppedError`).
     """
-    bounds = world.clearance_lower_bounds(q)
+    bounds = chunked(world.clearance_lower_bounds, q, stop, LOWER_BOUND_ROWS)
     values = bounds.copy()
     known = np.isinf(values) & (values > 0)  # groups without pairs: nothing to compute
     closest = np.full(values.shape, -1, dtype=np.int64)
@@ -203,9 +216,8 @@ def decisive_clearance(
             rows = np.flatnonzero(needed[:, group_index])
             rows = rows[:: COARSE_STRIDE if rows.size >= COARSE_BELOW else 1]
             if rows.size:
-                values[rows, group_index], closest[rows, group_index] = world.group_clearance(
-                    q[rows], group_index, exact_below_m
-                )
+                exact = partial(world.group_clearance, group_index=group_index, exact_below_m=exact_below_m)
+                values[rows, group_index], closest[rows, group_index] = chunked(exact, q[rows], stop)
                 known[rows, group_index] = True
                 values[:, group_index] = with_neighbours(
                     values[:, group_index], known[:, group_index], bounds[:, group_index], reach

@@ -24,12 +24,22 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from cpr_kin.collision.decisive import below_coal, certified, exact_below, undecided, with_neighbours
+from cpr_kin.collision.decisive import (
+    Stop,
+    ask,
+    below_coal,
+    certified,
+    chunked,
+    exact_below,
+    undecided,
+    with_neighbours,
+)
 from cpr_kin.common.errors import CprKinError
 
 if TYPE_CHECKING:
@@ -97,6 +107,8 @@ def check_self_curve(
     margin_m: float,
     step_m: float,
     interval_joint_speed: JointSpeeds | None = None,
+    *,
+    stop: Stop | None = None,
 ) -> SelfCheck:
     """Certify that the curve ``q(t)`` over ``interval`` keeps ``margin_m`` between the robot's own pairs.
 
@@ -109,9 +121,11 @@ def check_self_curve(
         step_m: largest relative motion of a pair between two of its samples [m].
         interval_joint_speed: tighter bounds per interval between samples
             (:data:`JointSpeeds`); each interval's slack uses the lower of both.
+        stop: asked between the check's pieces of work (:data:`cpr_kin.collision.decisive.Stop`).
 
     Raises:
         CprKinError: bad arguments, or a pair needing more than :data:`MAX_SELF_CHECKS` samples.
+        CheckStoppedError: ``stop`` said so before the verdict.
     """
     t0, t1 = interval
     if not collision:
@@ -136,17 +150,19 @@ def check_self_curve(
         times = np.linspace(t0, t1, count)
         return _samples(collision, p, curve, times, pair_speed[p], interval_joint_speed)
 
+    ask(stop)
     screen = _screen(collision, curve, (t0, t1), pair_speed, step_m, interval_joint_speed)
     certified_min, sampled_min, worst_time, worst_pair, computed = np.inf, np.inf, t0, -1, 0
     for p in np.argsort(screen, kind="stable"):
         # the screen bounds the pair's distance everywhere, its samples' certified value to step_m less
         if screen[p] - step_m >= certified_min and screen[p] >= sampled_min:
             continue  # neither minimum can come from this pair
+        ask(stop)
         pair = sampled(int(p), int(counts[p]))
         if pair.certified_bound >= certified_min and pair.bounds.min() >= sampled_min:
             continue
         ceiling = exact_below(margin_m, pair.slack)
-        values, known = _decisive_values(collision, pair, certified_min, sampled_min, ceiling)
+        values, known = _decisive_values(collision, pair, (certified_min, sampled_min), ceiling, stop)
         computed += int(known.sum())
         certified_min = min(certified_min, float(np.min(certified(values, pair.slack))))
         lowest = int(np.argmin(values))
@@ -211,18 +227,20 @@ def _samples(
 def _decisive_values(
     collision: SelfCollision,
     pair: _PairSamples,
-    certified_ceiling: float,
-    sampled_ceiling: float,
-    exact_below_m: float = np.inf,
+    ceilings: tuple[float, float],
+    exact_below_m: float,
+    stop: Stop | None,
 ) -> tuple[FloatArray, NDArray[np.bool_]]:
     """The pair's distances [m] at its samples, exact where they decide, else lower bounds; which are exact.
 
-    Decide: could lower the pair's smallest certified or sampled value below the ceilings
-    (the check's minima so far) [m]. The capsules' bounds and the exact values' neighbours
-    (distances change by at most the slack per interval) bound the others. A value counts as
-    exact where the hulls' distance is at or above ``exact_below_m`` [m]: the meshes' distance is
-    no smaller, and the check cannot fail there.
+    Decide: could lower the pair's smallest certified or sampled value below the ``ceilings``
+    (the check's minima so far, certified and sampled) [m]. The capsules' bounds and the
+    exact values' neighbours (distances change by at most the slack per interval) bound the
+    others. A value counts as exact where the hulls' distance is at or above ``exact_below_m``
+    [m]: the meshes' distance is no smaller, and the check cannot fail there. ``stop`` is
+    asked before each call to coal.
     """
+    certified_ceiling, sampled_ceiling = ceilings
     count = len(pair.times)
     values, known = pair.bounds.copy(), np.zeros(count, dtype=bool)
     reach = np.concatenate([[0.0], np.cumsum(pair.slack)])
@@ -235,7 +253,8 @@ def _decisive_values(
     coarse[-1] = True
     rows = np.flatnonzero(doubtful & coarse)
     while rows.size:
-        values[rows] = collision.pair_distances(pair.q[rows], pair.index, exact_below_m)
+        exact = partial(collision.pair_distances, pair=pair.index, exact_below_m=exact_below_m)
+        values[rows] = chunked(exact, pair.q[rows], stop)
         known[rows] = True
         values = with_neighbours(values, known, pair.bounds, reach)
         needed = undecided(values[:, None], known[:, None], pair.slack, certified_ceiling, sampled_ceiling)

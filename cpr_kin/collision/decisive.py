@@ -6,14 +6,28 @@ the smallest sampled value. Where a cheap lower bound of ``c_k`` is known, only 
 whose exact value could still lower one of those minima need coal: :func:`undecided` names
 them, and a check computes them and asks again until none is left. Values computed from lower
 bounds are at most the true ones, so a minimum found from exact values is the true minimum.
+
+A check's caller may stop it before its verdict (a plan past its time limit): the check asks
+its ``stop`` (:data:`Stop`) between its pieces of work (:func:`ask`, :func:`chunked`).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 from numpy.typing import NDArray
 
+from cpr_kin.common.errors import CheckStoppedError
+
 FloatArray = NDArray[np.float64]
+
+Stop = Callable[[], bool]
+"""Asked between a certified check's pieces of work: ``True`` stops it (:class:`CheckStoppedError`)."""
+CHUNK_ROWS = 256
+"""Configurations a stoppable check gives coal in one call (:func:`chunked`): a few tenths of a
+second at most, on meshes of thousands of triangles."""
 
 COAL_RELATIVE_ERROR = 1e-6
 """How far coal's distance may fall below the truth, relative to its size (coal's distances are
@@ -118,3 +132,30 @@ def with_neighbours(
     """
     propagated = below_coal(propagated_bounds(values, known, reach_m))
     return np.asarray(np.where(known, values, np.maximum(bounds, propagated)))
+
+
+def ask(stop: Stop | None) -> None:
+    """Raise :class:`CheckStoppedError` where ``stop`` says so (never for ``None``)."""
+    if stop is not None and stop():
+        raise CheckStoppedError("the certified check was stopped by its caller before its verdict")
+
+
+def chunked(
+    function: Callable[[FloatArray], Any], q: FloatArray, stop: Stop | None, rows: int = CHUNK_ROWS
+) -> Any:
+    """``function(q)`` computed ``rows`` configurations at a time, ``stop`` asked before each (:func:`ask`).
+
+    ``function`` takes configurations ``(N, nq)`` and returns an array or a tuple of arrays,
+    one row per configuration, each row its configuration's alone: the pieces are joined as
+    one call would return them. Without ``stop``, one call.
+    """
+    ask(stop)
+    if stop is None or len(q) <= rows:
+        return function(q)
+    parts = [function(q[:rows])]
+    for first in range(rows, len(q), rows):
+        ask(stop)
+        parts.append(function(q[first : first + rows]))
+    if isinstance(parts[0], tuple):
+        return tuple(np.concatenate(column) for column in zip(*parts, strict=True))
+    return np.concatenate(parts)

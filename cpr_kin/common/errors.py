@@ -2,7 +2,8 @@
 
 Every error caused by user input (a URDF, a joint vector, a pose, an obstacle) is a
 :class:`CprKinError`, whose message names the offending value, what is allowed, and,
-where there is one, the fix. Callers catch this one base class.
+where there is one, the fix. Callers catch this one base class; :class:`CheckStoppedError`, a
+check its caller stopped, derives from it too.
 """
 
 from __future__ import annotations
@@ -30,3 +31,11 @@ class ObstacleError(CprKinError):
 
 class IkMissError(UnreachableError):
     """A numerical inverse kinematics found no configuration within the target's tolerance."""
+
+
+class CheckStoppedError(CprKinError):
+    """A certified check was stopped by its caller (its ``stop`` said so) before its verdict.
+
+    Nothing is certified: the caller treats the curve as not verified (a plan past its time
+    limit, :mod:`planning.pipeline.deadline`).
+    """

@@ -27,7 +27,9 @@ Each candidate is timed once, however often the search returns it. A best candid
 comes deeper inside the margin than one verification step at one of its samples
 (:func:`beyond_margin`) is verified in its first timing only: every timing follows its path.
 Once the problem's deadline has passed, no further timing is tried after one that failed:
-past its time limit a plan verifies only the timing in hand (the best's first, at least).
+past its time limit a plan verifies only the timing in hand (the best's first, at least),
+and a certified check still under way where the deadline cuts it stops there, refused
+(:mod:`planning.pipeline.deadline`).
 """
 
 from __future__ import annotations
@@ -98,9 +100,15 @@ class Refusal:
 
 
 def verify(problem: Problem, trajectory: Trajectory, fit: SplineFit) -> Verification:
-    """The scene's verification, plus the node-deviation bound of the planner settings."""
+    """The scene's verification, plus the node-deviation bound of the planner settings.
+
+    Its certified checks stop where the problem's deadline cuts them
+    (:meth:`~planning.pipeline.deadline.Deadline.cut`).
+    """
     scene = problem.scene
-    verification = verify_trajectory(problem.world, trajectory, Requirements.of(problem))
+    verification = verify_trajectory(
+        problem.world, trajectory, Requirements.of(problem), stop=problem.deadline.cut
+    )
     bound = scene.planner.max_node_deviation
     if bound is not None and fit.max_node_deviation > bound:
         problem_text = (

@@ -12,15 +12,33 @@ that failed), the planner between attempts (failing those, it follows the sampli
 planner's path as its last resort, then stops), and the last resort itself (past the limit
 the plan stops without it). So a plan ends after its limit by what its last stages take to
 finish: the stage under way when it passed and at most one timing and certified check, of
-the best candidate or of the followed path (on a 7-joint arm among shelves, on its exact
-meshes, a certified check takes up to several seconds).
+the best candidate or of the followed path. A certified check may take seconds (a 7-joint
+arm among shelves, on its exact meshes): one still under way at :attr:`Deadline.cut_at_s`,
+the limit plus :func:`overrun_s` of it, is stopped there (:meth:`Deadline.cut`), its curve
+not certified. A plan therefore ends by its limit plus that overrun, give or take a piece of
+a check's work (:data:`cpr_kin.collision.decisive.CHUNK_ROWS` configurations).
 """
 
 from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
+
+OVERRUN_SHARE = 0.25
+"""The share of a time limit that the work under way when it passes may still take (:func:`overrun_s`)."""
+MIN_OVERRUN_S = 1.0
+"""The least time [s] the work under way when a limit passes may still take: the check of one
+timing on a generated scene takes milliseconds, of a long trajectory on exact meshes a second."""
+
+
+def overrun_s(limit_s: float) -> float:
+    """How long past ``limit_s`` [s] a certified check under way may go on [s].
+
+    The larger of :data:`OVERRUN_SHARE` of the limit and :data:`MIN_OVERRUN_S`.
+    """
+    return max(OVERRUN_SHARE * limit_s, MIN_OVERRUN_S)
 
 
 @dataclass(frozen=True)
@@ -30,19 +48,35 @@ class Deadline:
     Attributes:
         at_s: the clock's reading at which time is up [s].
         limit_s: the limit it was set from [s] (``None``: none), for messages.
+        cut_at_s: the clock's reading at which a certified check still under way is stopped [s].
     """
 
     at_s: float = math.inf
     limit_s: float | None = None
+    cut_at_s: float = math.inf
 
     @classmethod
     def after(cls, limit_s: float | None, started_s: float) -> Deadline:
-        """The deadline ``limit_s`` [s] after the clock read ``started_s`` [s] (never when ``None``)."""
-        return cls() if limit_s is None else cls(started_s + limit_s, limit_s)
+        """The deadline ``limit_s`` [s] after the clock read ``started_s`` [s] (never when ``None``).
+
+        Its checks are cut :func:`overrun_s` later.
+        """
+        if limit_s is None:
+            return cls()
+        return cls(started_s + limit_s, limit_s, started_s + limit_s + overrun_s(limit_s))
 
     def passed(self) -> bool:
         """Whether time is up."""
         return self.at_s != math.inf and time.perf_counter() >= self.at_s
+
+    @property
+    def stop(self) -> Callable[[], bool] | None:
+        """:meth:`cut`, for a certified check to ask; ``None`` where nothing is cut (no limit)."""
+        return None if self.cut_at_s == math.inf else self.cut
+
+    def cut(self) -> bool:
+        """Whether a certified check still under way must stop (a :data:`cpr_kin.collision.decisive.Stop`)."""
+        return self.cut_at_s != math.inf and time.perf_counter() >= self.cut_at_s
 
     def reason(self, elapsed_s: float) -> str:
         """Why a plan stopped at ``elapsed_s`` [s] of its ``limit_s``: for a "no solution" message."""

@@ -15,6 +15,7 @@ from numpy.typing import NDArray
 
 import cpr_kin as ck
 from cpr_kin.certified.self_curve import check_self_curve
+from cpr_kin.collision.decisive import Stop
 from planning.curves.continuity import discontinuity
 from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
@@ -58,6 +59,8 @@ class Verification:
         }
 
 
+STOPPED = "was not certified: its check was stopped by the time limit before its verdict"
+"""The problem a verification stopped by its caller reports (:func:`verify_trajectory`)."""
 LIMIT_TOLERANCE = 1e-9
 """Relative excess of a joint's range or limit that still passes (rounding)."""
 
@@ -85,9 +88,13 @@ def _interval_speed(trajectory: Trajectory, radii: FloatArray) -> ck.IntervalSpe
 
 
 def _self_problems(
-    world: ck.CollisionWorld, trajectory: Trajectory, margin_m: float, step_m: float
+    world: ck.CollisionWorld, trajectory: Trajectory, margin_m: float, step_m: float, stop: Stop | None
 ) -> list[str]:
-    """The certified self-collision check's verdict, as problems (none for a robot without pairs)."""
+    """The certified self-collision check's verdict, as problems (none for a robot without pairs).
+
+    Raises:
+        CheckStoppedError: ``stop`` said so before the verdict.
+    """
     if not world.self_collision:
         return []
     interval = (float(trajectory.knots[0]), float(trajectory.knots[-1]))
@@ -100,7 +107,10 @@ def _self_problems(
             margin_m,
             step_m,
             trajectory.speed_bounds,
+            stop=stop,
         )
+    except ck.CheckStoppedError:
+        raise
     except ck.CprKinError as exc:
         return [f"cannot be certified clear of itself: {exc}"]
     if check.accepted:
@@ -153,7 +163,7 @@ class Requirements:
 
 
 def verify_trajectory(
-    world: ck.CollisionWorld, trajectory: Trajectory, required: Requirements
+    world: ck.CollisionWorld, trajectory: Trajectory, required: Requirements, *, stop: Stop | None = None
 ) -> Verification:
     """Check a timed trajectory for everything a robot needs of it (``required``'s values).
 
@@ -170,7 +180,20 @@ def verify_trajectory(
       tolerance);
     - with ``dynamics``: every joint torque (RNEA, :func:`~planning.pipeline.torques.torque_profile`)
       within its effort limit every millisecond and at every knot.
+
+    ``stop`` is asked between the certified checks' pieces of work: where it says so, the
+    verification ends there, not accepted, saying that its check was stopped (:data:`STOPPED`).
     """
+    try:
+        return _verified(world, trajectory, required, stop)
+    except ck.CheckStoppedError:
+        return Verification(check=_unchecked(required.margin_m, required.step_m), problems=(STOPPED,))
+
+
+def _verified(
+    world: ck.CollisionWorld, trajectory: Trajectory, required: Requirements, stop: Stop | None
+) -> Verification:
+    """:func:`verify_trajectory`'s verdict; :class:`~cpr_kin.CheckStoppedError` where ``stop`` says so."""
     margin_m, step_m, endpoints = required.margin_m, required.step_m, required.endpoints
     robot = world.robot
     limits = robot.limits
@@ -180,7 +203,11 @@ def verify_trajectory(
     radii = ck.motion_radii(robot)
     try:
         speeds, local = trajectory.extrema(1).peak, _interval_speed(trajectory, radii)
-        check = ck.check_curve(world, trajectory.position, start, end, speeds, margin_m, step_m, local)
+        check = ck.check_curve(
+            world, trajectory.position, start, end, speeds, margin_m, step_m, local, stop=stop
+        )
+    except ck.CheckStoppedError:
+        raise
     except ck.CprKinError as exc:  # too fast to certify: a verdict, not a crash
         problems.append(f"cannot be certified clear of obstacles: {exc}")
         check = _unchecked(margin_m, step_m)
@@ -197,7 +224,7 @@ def verify_trajectory(
             f"comes within {check.certified_min_m:.4f} m (certified) of an obstacle, margin {margin_m} m: "
             f"closest at t = {check.worst_time:.2f} s between {check.worst_pair} ({check.worst_group})"
         )
-    problems += _self_problems(world, trajectory, required.self_margin_m, required.self_check_step_m)
+    problems += _self_problems(world, trajectory, required.self_margin_m, required.self_check_step_m, stop)
     positions = trajectory.extrema(0)
     for i, name in enumerate(robot.joint_names):
         low, high = positions.minimum[i], positions.maximum[i]
