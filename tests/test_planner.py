@@ -14,6 +14,7 @@ import cpr_kin as ck
 from cpr_kin.model.packages import example_robot_data_share
 from planning.errors import NoTrajectoryFoundError, PlanningError, TargetOutOfReachError
 from planning.io.bundled import paper_scene
+from planning.pipeline.deadline import Deadline
 from planning.pipeline.planner import plan, solve
 from planning.pipeline.problem import build_problem
 from planning.pipeline.result import PlanResult
@@ -170,6 +171,12 @@ def test_a_best_candidate_deep_inside_the_margin_is_verified_in_one_timing_only(
     chosen = choosing.choose(problem, searched)
     assert isinstance(chosen, choosing.Refusal) and len(verified) == 1
     assert "wall" in chosen.cause
+    # past the deadline, not verified at all: the refusal names the deepest sample (the oracle's)
+    late = choosing.choose(dataclasses.replace(problem, deadline=Deadline(0.0, 1.0)), searched)
+    assert isinstance(late, choosing.Refusal) and len(verified) == 1 and late.verified == ""
+    assert late.cause.startswith("no candidate was feasible; the best: ")
+    assert f"to 'wall' {deepest:.3f} m at a sample of its path" in late.cause
+    assert not late.check.times.size and late.check.certified_min_m == -np.inf
     paper = build_problem(paper_scene(0), robot)
     assert not choosing.beyond_margin(paper, search(SEEDINGS["none"].first(paper)))
 

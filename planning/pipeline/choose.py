@@ -25,7 +25,9 @@ and returns the first whose timed trajectory passes the certified continuous che
 
 Each candidate is timed once, however often the search returns it. A best candidate that
 comes deeper inside the margin than one verification step at one of its samples
-(:func:`beyond_margin`) is verified in its first timing only: every timing follows its path.
+(:func:`beyond_margin`) is verified in its first timing only: every timing follows its path;
+and past the deadline not at all (its check would only say why it fails: the refusal names
+the deepest sample instead).
 Once the problem's deadline has passed, no further timing is tried after one that failed:
 past its time limit a plan verifies only the timing in hand (the best's first, at least),
 and a certified check still under way where the deadline cuts it stops there, refused
@@ -47,7 +49,7 @@ from planning.errors import NoTrajectoryFoundError
 from planning.pipeline.objective import Breakdown
 from planning.pipeline.offered import Offered, Timing
 from planning.pipeline.problem import Problem
-from planning.pipeline.verification import Requirements, Verification, verify_trajectory
+from planning.pipeline.verification import Requirements, Verification, unchecked, verify_trajectory
 from planning.search.optimizer import SearchResult
 
 FloatArray = NDArray[np.float64]
@@ -157,8 +159,8 @@ def infeasibility(breakdown: Breakdown, problem: Problem, besides_check: bool = 
     return ", ".join(reasons) or "infeasible"
 
 
-def beyond_margin(problem: Problem, searched: SearchResult) -> bool:
-    """The search's best is infeasible and, at one of its samples, deeper inside a margin than a step.
+def beyond_margin(problem: Problem, searched: SearchResult) -> str | None:
+    """Where the search's best is infeasible and, at one of its samples, deeper inside a margin than a step.
 
     The fitness asks ``safety_margin + verify_step_m`` at its samples, and a candidate short
     of that only within the step may still pass the certified check, which asks the margin.
@@ -166,20 +168,28 @@ def beyond_margin(problem: Problem, searched: SearchResult) -> bool:
     (from an obstacle, or inside the self margin from its own links) cannot: each of its
     timings follows that path to within the millimetres its moving averages cut off bends.
     All the samples count, also those the fitness left unchecked once the candidate was
-    infeasible (:meth:`~planning.pipeline.objective.WaypointObjective.breakdown`).
+    infeasible (:meth:`~planning.pipeline.objective.WaypointObjective.breakdown`). Returns
+    the deepest such sample's pair and distance in words, ``None`` where none is that deep.
     """
     objective, scene, world = problem.objective, problem.scene, problem.world
     if objective.feasible(searched.fitness):
-        return False
+        return None
     paths = objective.paths(objective.nodes(searched.x[None]))
     samples = objective.checked_configurations(paths.samples[0])
     step = scene.planner.verify_step_m
-    inside, _ = world.min_clearance_batch(samples, below_m=scene.safety_margin - step)
+    inside, pairs = world.min_clearance_batch(samples, below_m=scene.safety_margin - step)
     if np.isfinite(inside).any():
-        return True
+        k = int(np.argmin(inside))
+        part, obstacle = world.pairs[int(pairs[k])][:2]
+        return f"{part} to '{obstacle}' {inside[k]:.3f} m at a sample of its path"
     if not world.self_collision:
-        return False
-    return bool(world.self_collision.distances(samples)[0].min() < scene.self_margin - step)
+        return None
+    own, own_pairs = world.self_collision.distances(samples)
+    k = int(np.argmin(own))
+    if own[k] >= scene.self_margin - step:
+        return None
+    first, second = world.self_collision.pairs[int(own_pairs[k])]
+    return f"{first} to {second} {own[k]:.3f} m at a sample of its path (self margin {scene.self_margin:g} m)"
 
 
 def foreseen_clear(problem: Problem, candidates: FloatArray) -> BoolArray:
@@ -221,6 +231,10 @@ def choose(problem: Problem, searched: SearchResult) -> Choice | Refusal:
     timed: dict[int, Offered] = {}
     verified: dict[int, Verification] = {}  # each candidate's first verification
     hopeless = beyond_margin(problem, searched)
+    if hopeless is not None and problem.deadline.passed():  # its check would only say why it fails
+        why = infeasibility(objective.breakdown(searched.x[None]), problem)
+        cause = f"no candidate was feasible; the best: {hopeless}, {why}"
+        return Refusal(cause, unchecked(problem.scene.safety_margin, problem.scene.planner.verify_step_m))
     # an infeasible best is verified first, whatever its foresight: its check says why
     foresee = bool(objective.feasible(searched.fitness)) and not problem.deadline.passed()
     for k, timing in _attempts(problem, candidates, timed, foresee):

@@ -65,7 +65,7 @@ LIMIT_TOLERANCE = 1e-9
 """Relative excess of a joint's range or limit that still passes (rounding)."""
 
 
-def _unchecked(margin_m: float, step_m: float) -> ck.CurveCheck:
+def unchecked(margin_m: float, step_m: float) -> ck.CurveCheck:
     """The record of a continuous check that could not be run: nothing certified."""
     return ck.CurveCheck(
         accepted=False,
@@ -187,7 +187,7 @@ def verify_trajectory(
     try:
         return _verified(world, trajectory, required, stop)
     except ck.CheckStoppedError:
-        return Verification(check=_unchecked(required.margin_m, required.step_m), problems=(STOPPED,))
+        return Verification(check=unchecked(required.margin_m, required.step_m), problems=(STOPPED,))
 
 
 def _verified(
@@ -210,7 +210,7 @@ def _verified(
         raise
     except ck.CprKinError as exc:  # too fast to certify: a verdict, not a crash
         problems.append(f"cannot be certified clear of obstacles: {exc}")
-        check = _unchecked(margin_m, step_m)
+        check = unchecked(margin_m, step_m)
     jumps = discontinuity(trajectory, robot.joint_names, [robot.joint_unit(n) for n in robot.joint_names])
     if jumps is not None:
         problems.append(jumps)
