@@ -203,3 +203,46 @@ def test_core_imports_no_drawing_libraries() -> None:
         [sys.executable, "-c", code], capture_output=True, text=True, check=True, env=dict(os.environ)
     )
     assert completed.stdout.strip() == "[]"
+
+
+def test_a_tasks_page_moves_what_it_carries_and_leaves_it_where_released(tmp_path: Path) -> None:
+    from planning.io.scene_file import load_scene_file
+    from planning.task import plan_task
+    from planning.viz.artifacts import task_drawn_files
+
+    read = load_scene_file(
+        Path(__file__).resolve().parents[1] / "examples" / "scenes" / "pick_and_place.yaml"
+    )
+    task = plan_task(read.scene, read.task)
+    page = task_drawn_files(task, plots=False)["viewer.html"]
+    assert isinstance(page, str)
+    commands = b"".join(base64.b64decode(m) for m in re.findall(r"base64,([A-Za-z0-9+/=]+)", page))
+    assert commands.count(b"scene/carried/part") >= 2  # drawn, and a track of the animation
+    assert b"set_animation" in commands
+    # the robot's own model carries no part: before the attach it rests where it is taken
+    assert b"cpr/visuals/part" not in commands
+    html = tmp_path / "task.html"
+    html.write_text(page)
+    image = screenshot(html, tmp_path / "task.png", tmp_path / "profile")  # a real browser plays it
+    assert len(np.unique((image * 255).astype(int).reshape(-1, 3), axis=0)) > 100  # not a blank canvas
+    assert obstacle_red(image) > 500
+
+
+def test_a_start_payload_released_is_drawn_apart_from_the_robot(robot: ck.Robot, result: PlanResult) -> None:
+    from planning.viz.carried_objects import carried_spans
+
+    payload = ck.Payload(mass_kg=0.5, shape=ck.Obstacle.sphere(0.03, (0.0, 0.0, 0.04)), name="ball")
+    carrying = ck.carrying(robot, payload)
+    spans = carried_spans(payload, [(1.0, None)], result.trajectory.duration)  # released at 1 s
+    drawn = []
+    for shown in ((), spans):
+        with Viewer(ck.CollisionWorld(carrying, ()), 0.1) as viewer:
+            viewer.show_carried(result.trajectory, shown)
+            viewer.animate(result.trajectory, fps=10)
+            html = viewer.static_html()
+        drawn.append(b"".join(base64.b64decode(m) for m in re.findall(r"base64,([A-Za-z0-9+/=]+)", html)))
+    alone, apart = drawn
+    assert b"cpr/visuals/ball" in alone and b"scene/carried/ball" not in alone  # the control: on the robot
+    # drawn apart, the robot model's own ball gone (it would go on moving with the tool)
+    assert b"scene/carried/ball" in apart and b"cpr/visuals/ball" not in apart
+    assert carrying.collision_model.existGeometryName("ball")  # the robot itself still carries it

@@ -92,6 +92,7 @@ def cmd_show(args: argparse.Namespace) -> int:
     from planning.io.scene_file import parse_scene_file
     from planning.io.trajectory_reader import read_trajectory
     from planning.viz import artifacts
+    from planning.viz.carried_objects import carried_spans, recorded_changes
 
     if args.html is not None:
         check_not_inputs([args.html], {"trajectory file": args.trajectory, "URDF": args.urdf})
@@ -99,9 +100,12 @@ def cmd_show(args: argparse.Namespace) -> int:
     jump = discontinuity(document.trajectory, document.joint_names)
     if jump is not None:  # shown all the same: seeing it is what show is for
         print(escaped(f"warning: {args.trajectory} {jump}; `cpr-plan check` fails it"), file=sys.stderr)
-    scene = parse_scene_file(document.scene, source=f"{args.trajectory} (scene)").scene
+    read = parse_scene_file(document.scene, source=f"{args.trajectory} (scene)")
+    scene, changes = read.scene, []
     if document.task is not None:
         print(escaped(timeline(document.task)), flush=True)
+        changes = recorded_changes(read.task, document.task)
+    carried = carried_spans(scene.payload, changes, float(document.trajectory.knots[-1]))
     robot = ck.carrying(shown_robot(document, scene, args.urdf), scene.payload)  # its shape drawn too
     if robot.joint_names != document.joint_names:
         raise PlanningError(
@@ -110,7 +114,7 @@ def cmd_show(args: argparse.Namespace) -> int:
     world = ck.CollisionWorld(robot, scene.obstacles)
     if args.html is not None:
         html = artifacts.viewer_html(
-            world, scene.safety_margin, document.trajectory, document.waypoints, args.collision
+            world, scene.safety_margin, document.trajectory, document.waypoints, args.collision, carried
         )
         written = write_file(args.html, html)
         print(escaped(f"wrote {written} (self-contained; open it in a browser)"))
@@ -119,6 +123,7 @@ def cmd_show(args: argparse.Namespace) -> int:
 
     with Viewer(world, scene.safety_margin) as viewer:
         viewer.show_geometry(visual=not args.collision, collision=args.collision)
+        viewer.show_carried(document.trajectory, carried)
         viewer.show_plan(document.trajectory, document.waypoints)
         viewer.animate(document.trajectory)
         print(f"meshcat viewer at {viewer.url}  (127.0.0.1 only; Ctrl-C to stop)", flush=True)

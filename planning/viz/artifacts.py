@@ -14,6 +14,7 @@ from numpy.typing import NDArray
 import cpr_kin as ck
 from planning.curves.trajectory import Trajectory
 from planning.pipeline.result import PlanResult
+from planning.viz.carried_objects import CarriedSpan, carried_spans
 
 if TYPE_CHECKING:  # the task planner is imported where a task is drawn
     from planning.task.task_plan import TaskMotion
@@ -51,8 +52,20 @@ def task_drawn_files(task: TaskMotion, plots: bool = True, page: bool = True) ->
         )
         files |= {n: drawing.png_bytes(f) for n, f in zip(TASK_PLOT_FILES, figures, strict=True)}
     if page:
-        files["viewer.html"] = viewer_html(task.world, scene.safety_margin, trajectory, task.junctions)
+        files["viewer.html"] = viewer_html(
+            task.world, scene.safety_margin, trajectory, task.junctions, carried=task_carried(task)
+        )
     return files
+
+
+def task_carried(task: TaskMotion) -> tuple[CarriedSpan, ...]:
+    """What a task carries, object by object: its scene's payload from the start, then what it attaches."""
+    changes = [
+        (segment.t0, segment.payload if segment.kind == "attach" else None)
+        for segment in task.segments
+        if segment.kind in ("attach", "detach")
+    ]
+    return carried_spans(task.scene.payload, changes, float(task.trajectory.knots[-1]))
 
 
 def plot_files(result: PlanResult) -> dict[str, bytes]:
@@ -83,16 +96,19 @@ def viewer_html(
     trajectory: Trajectory,
     waypoints: NDArray[np.float64],
     collision: bool = False,
+    carried: tuple[CarriedSpan, ...] = (),
 ) -> str:
     """One self-contained HTML page of the plan, animated.
 
-    It shows the world's robot and obstacles, the margin, waypoints, TCP path and the trajectory; a loopback
+    It shows the world's robot and obstacles, the margin, waypoints, TCP path and the trajectory,
+    and what it ``carried`` (:meth:`~planning.viz.viewer.Viewer.show_carried`); a loopback
     meshcat server runs while it is made.
     """
     from planning.viz.viewer import Viewer
 
     with Viewer(world, margin_m) as viewer:
         viewer.show_geometry(visual=not collision, collision=collision)
+        viewer.show_carried(trajectory, carried)
         viewer.show_plan(trajectory, waypoints)
         viewer.animate(trajectory)
         return viewer.static_html()
@@ -101,8 +117,8 @@ def viewer_html(
 def notebook_viewer(result: PlanResult | TaskMotion, height_px: int = 480, collision: bool = False) -> Any:
     """The plan's or the task's animated meshcat viewer for a Jupyter cell: an ``IPython.display.HTML``.
 
-    A task shows the robot as it starts (without what it attaches later) and, as waypoints,
-    the configurations where its segments meet.
+    A task shows, as waypoints, the configurations where its segments meet, and what it
+    attaches and releases moving with the robot (:func:`task_carried`).
 
     The self-contained page of :func:`viewer_html` in an iframe (``srcdoc``), so it needs no
     server once drawn and survives in the saved notebook. ``height_px``: the frame's height.
@@ -112,7 +128,10 @@ def notebook_viewer(result: PlanResult | TaskMotion, height_px: int = 480, colli
     from planning.task.task_plan import TaskMotion
 
     if isinstance(result, TaskMotion):
-        page = viewer_html(result.world, result.margin_m, result.trajectory, result.junctions, collision)
+        carried = task_carried(result)
+        page = viewer_html(
+            result.world, result.margin_m, result.trajectory, result.junctions, collision, carried
+        )
     else:
         page = viewer_html(
             result.problem.world, result.scene.safety_margin, result.trajectory, result.waypoints, collision

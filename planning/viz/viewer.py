@@ -9,8 +9,9 @@ default), ``/scene/obstacles/<name>``, ``/scene/margin/<name>`` (translucent she
 obstacle grown by the margin; a box's shell is the box grown by the margin on every side,
 which contains the exact rounded shell), ``/scene/waypoints/<i>`` (TCP at each node),
 ``/scene/tcp_path`` (coloured by clearance: red at or below the margin, green from
-``margin + 0.1 m``) and ``/scene/closest`` (the closest robot-obstacle pair at the instant
-of smallest clearance).
+``margin + 0.1 m``), ``/scene/closest`` (the closest robot-obstacle pair at the instant
+of smallest clearance) and ``/scene/carried/<name>`` (what a task attaches and releases,
+moving with its frame while carried, :mod:`planning.viz.carried_objects`).
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ from pinocchio.visualize import MeshcatVisualizer
 
 import cpr_kin as ck
 from planning.curves.trajectory import Trajectory
+from planning.viz.carried_objects import CarriedSpan, carried_poses
 from planning.viz.viewer_server import ServerProcess, start_server
 
 FloatArray = NDArray[np.float64]
@@ -43,6 +45,8 @@ OBSTACLE_COLOR = 0xD9534F
 MARGIN_OPACITY = 0.22
 WAYPOINT_COLOR = 0xF0AD4E
 CLOSEST_COLOR = 0xE83E8C
+CARRIED_COLOR = 0xE69919
+"""The colour of what the robot carries (the robot model's own payload colour, ``PAYLOAD_COLOR``)."""
 
 
 def _material(color: int, opacity: float = 1.0) -> g.MeshLambertMaterial:
@@ -125,6 +129,7 @@ class Viewer:
         self.world = world
         self.margin_m = margin_m
         self._own_server = server is None
+        self._carried: tuple[CarriedSpan, ...] = ()
         self.server = server or start_server()
         with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints the URL; callers decide
             window = _Window(zmq_url=self.server.zmq_url, start_server=False, server_args=[])
@@ -209,17 +214,53 @@ class Viewer:
             "worst_time": times[worst],
         }
 
+    def show_carried(self, trajectory: Trajectory, spans: tuple[CarriedSpan, ...]) -> None:
+        """Draw the objects ``trajectory`` carries over ``spans``, each where it is at the start.
+
+        :meth:`animate` then moves each with its frame while it is carried. An object that the
+        robot's model carries as its own geometry (the start payload) is drawn only here, so
+        that it stays where the trajectory releases it.
+        """
+        start = np.array([trajectory.knots[0]])
+        for span in spans:
+            self._forget(span.name)
+            pose = carried_poses(self.robot, trajectory, span, start)[0]
+            for k, (shape, local) in enumerate(_shape_objects(span.shape, 0.0)):
+                node = self.vis["scene/carried"][span.name][str(k)]
+                node.set_object(shape, _material(CARRIED_COLOR))
+                node.set_transform(pose @ local)
+        self._carried = (*self._carried, *spans)
+
+    def _forget(self, name: str) -> None:
+        """Take geometry ``name`` out of the robot's view (copies of its models: the robot's stay)."""
+        view = self._robot_view
+        for kind, group in (("visual", "visuals"), ("collision", "collisions")):
+            model = getattr(view, f"{kind}_model")
+            if model is not None and model.existGeometryName(name):
+                model = model.copy()
+                model.removeGeometryObject(name)
+                setattr(view, f"{kind}_model", model)
+                setattr(view, f"{kind}_data", model.createData())
+                self.vis["cpr"][group][name].delete()
+
     def animate(self, trajectory: Trajectory, fps: int = 30, repetitions: int = 0) -> int:
         """Record the trajectory at real time (``fps`` frames per second); returns the frame count.
 
-        ``repetitions = 0`` loops forever in the browser.
+        What :meth:`show_carried` drew moves with it. ``repetitions = 0`` loops forever in the browser.
         """
         animation = Animation(default_framerate=fps)
         count = int(np.ceil(trajectory.duration * fps)) + 1
-        for frame in range(count):
-            t = min(trajectory.knots[0] + frame / fps, trajectory.knots[-1])
+        times = np.minimum(trajectory.knots[0] + np.arange(count) / fps, trajectory.knots[-1])
+        carried = [
+            (span.name, carried_poses(self.robot, trajectory, span, times), _shape_objects(span.shape, 0.0))
+            for span in self._carried
+        ]
+        for frame, t in enumerate(times):
             with animation.at_frame(self.vis, frame) as frame_view:
                 self._place(frame_view, trajectory(t))
+                for name, poses, shapes in carried:
+                    for k, (_, local) in enumerate(shapes):
+                        frame_view["scene/carried"][name][str(k)].set_transform(poses[frame] @ local)
         self.vis.set_animation(
             animation, play=True, repetitions=repetitions if repetitions > 0 else 1_000_000
         )
