@@ -161,6 +161,16 @@ def test_clearance_lower_bounds_are_below_coal(
     assert np.isneginf(bounds).any() and np.isfinite(bounds).mean() > 0.5  # informative mostly
     alone = ck.CollisionWorld(robot, [])
     assert np.all(alone.clearance_lower_bounds(q) == np.inf)
+    # the pairs' bounds computed once and handed on give the same answers as computed anew
+    per_pair = cluttered_world.pair_bounds(q)
+    assert per_pair.shape == (len(q), len(cluttered_world.pairs))
+    assert alone.pair_bounds(q).shape == (len(q), 0)
+    np.testing.assert_array_equal(cluttered_world.clearance_lower_bounds(q, per_pair), bounds)
+    for group in range(len(ck.GROUPS)):
+        distance, pair = cluttered_world.group_clearance(q[:50], group, per_pair_m=per_pair[:50])
+        anew, pair_anew = cluttered_world.group_clearance(q[:50], group)
+        np.testing.assert_array_equal(pair, pair_anew)
+        np.testing.assert_allclose(distance, anew, atol=2e-6)  # coal's GJK starts warm from the query before
 
 
 @pytest.mark.parametrize("samples", [60, 300, 1500])

@@ -31,6 +31,7 @@ from cpr_kin.common.errors import CprKinError
 from cpr_kin.model.robot import GROUPS, Robot
 
 FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
 
 COARSE_STRIDE = 8
 """Of the samples in doubt, every how many coal computes first: its exact values bound their
@@ -205,7 +206,8 @@ def decisive_clearance(
     margin plus slack is below it decides the same. ``stop`` is asked between pieces of
     :data:`~cpr_kin.collision.decisive.CHUNK_ROWS` configurations (:class:`~cpr_kin.CheckStoppedError`).
     """
-    bounds = chunked(world.clearance_lower_bounds, q, stop, LOWER_BOUND_ROWS)
+    per_pair = chunked(world.pair_bounds, q, stop, LOWER_BOUND_ROWS)  # once: the rounds take their rows
+    bounds = world.clearance_lower_bounds(q, per_pair)
     values = bounds.copy()
     known = np.isinf(values) & (values > 0)  # groups without pairs: nothing to compute
     closest = np.full(values.shape, -1, dtype=np.int64)
@@ -216,13 +218,25 @@ def decisive_clearance(
             rows = np.flatnonzero(needed[:, group_index])
             rows = rows[:: COARSE_STRIDE if rows.size >= COARSE_BELOW else 1]
             if rows.size:
-                exact = partial(world.group_clearance, group_index=group_index, exact_below_m=exact_below_m)
-                values[rows, group_index], closest[rows, group_index] = chunked(exact, q[rows], stop)
+                exact = partial(_group_clearance, world, q, per_pair, group_index, exact_below_m)
+                values[rows, group_index], closest[rows, group_index] = chunked(exact, rows, stop)
                 known[rows, group_index] = True
                 values[:, group_index] = with_neighbours(
                     values[:, group_index], known[:, group_index], bounds[:, group_index], reach
                 )
     return BatchClearance(clearance_m=values, closest_pair=closest)
+
+
+def _group_clearance(
+    world: CollisionWorld,
+    q: FloatArray,
+    per_pair_m: FloatArray,
+    group: int,
+    exact_below_m: float,
+    rows: IntArray,
+) -> tuple[FloatArray, IntArray]:
+    """:meth:`~cpr_kin.CollisionWorld.group_clearance` at samples ``rows`` of ``q``, their bounds known."""
+    return world.group_clearance(q[rows], group, exact_below_m, per_pair_m[rows])
 
 
 def check_segment(

@@ -141,13 +141,13 @@ def ask(stop: Stop | None) -> None:
 
 
 def chunked(
-    function: Callable[[FloatArray], Any], q: FloatArray, stop: Stop | None, rows: int = CHUNK_ROWS
+    function: Callable[[NDArray[Any]], Any], q: NDArray[Any], stop: Stop | None, rows: int = CHUNK_ROWS
 ) -> Any:
     """``function(q)`` computed ``rows`` configurations at a time, ``stop`` asked before each (:func:`ask`).
 
-    ``function`` takes configurations ``(N, nq)`` and returns an array or a tuple of arrays,
-    one row per configuration, each row its configuration's alone: the pieces are joined as
-    one call would return them. Without ``stop``, one call.
+    ``function`` takes configurations ``(N, nq)`` (or their indices ``(N,)``) and returns an
+    array or a tuple of arrays, one row per configuration, each row its configuration's alone:
+    the pieces are joined as one call would return them. Without ``stop``, one call.
     """
     ask(stop)
     if stop is None or len(q) <= rows:

@@ -147,7 +147,11 @@ class CollisionWorld:
         return BatchClearance(clearance_m=clearance, closest_pair=closest)
 
     def group_clearance(
-        self, q: ArrayLike, group_index: int, exact_below_m: float = np.inf
+        self,
+        q: ArrayLike,
+        group_index: int,
+        exact_below_m: float = np.inf,
+        per_pair_m: FloatArray | None = None,
     ) -> tuple[FloatArray, IntArray]:
         """Clearance [m] of group ``GROUPS[group_index]`` at configurations ``q`` ``(N, nq)``, by coal.
 
@@ -155,14 +159,14 @@ class CollisionWorld:
         with no pair. coal's distance of the closest pair; the pairs are visited in the
         order of their bounds and only those that may be closest are computed
         (:func:`cpr_kin.collision.closest_pairs.closest_pairs`). The bounds are the group's columns of
-        every pair's: the world builds them once, for :meth:`clearance_lower_bounds` too. A
+        every pair's (:meth:`pair_bounds`, ``per_pair_m`` where the caller has them at ``q``). A
         distance at or above ``exact_below_m`` [m] may be reported as that (a lower bound).
         """
         batch = self._check_batch(q)
         columns = self._pair_group == group_index
         if not columns.any():
             return np.full(len(batch), np.inf), np.full(len(batch), -1, dtype=np.int64)
-        bounds = self._every_pair_bounds()(batch)[:, columns]
+        bounds = (self.pair_bounds(batch) if per_pair_m is None else per_pair_m)[:, columns]
         model, data, pairs = self.robot.model, self._data, np.flatnonzero(columns)
         return closest_pairs(
             model,
@@ -176,11 +180,17 @@ class CollisionWorld:
             exact_below_m=exact_below_m,
         )
 
-    def clearance_lower_bounds(self, q: ArrayLike) -> FloatArray:
+    def pair_bounds(self, q: ArrayLike) -> FloatArray:
+        """``(N, P)`` every pair's lower bound [m] at ``q`` ``(N, nq)``: :mod:`cpr_kin.bounds.pair_bounds`."""
+        batch = self._check_batch(q)
+        return self._every_pair_bounds()(batch) if self._pairs else np.empty((len(batch), 0))
+
+    def clearance_lower_bounds(self, q: ArrayLike, per_pair_m: FloatArray | None = None) -> FloatArray:
         """``(N, len(GROUPS))`` lower bounds [m] of each group's clearance at ``q`` ``(N, nq)``.
 
-        From the pair bounds (:mod:`cpr_kin.bounds.pair_bounds`), a fraction of coal's cost, less
-        coal's own error (:func:`cpr_kin.collision.decisive.below_coal`): a positive bound is at most
+        From the pair bounds (:meth:`pair_bounds`, ``per_pair_m`` where the caller has them),
+        a fraction of coal's cost, less coal's own error
+        (:func:`cpr_kin.collision.decisive.below_coal`): a positive bound is at most
         :meth:`clearance_batch`'s value; where the geometries' bounding shapes overlap nothing
         is known and the bound is ``-inf``. ``inf`` for a group with no pair.
         """
@@ -188,7 +198,7 @@ class CollisionWorld:
         bounds = np.full((len(batch), len(GROUPS)), np.inf)
         if not self._pairs:
             return bounds
-        per_pair = self._every_pair_bounds()(batch)
+        per_pair = self.pair_bounds(batch) if per_pair_m is None else per_pair_m
         for group_index in range(len(GROUPS)):
             columns = self._pair_group == group_index
             if columns.any():
