@@ -63,6 +63,8 @@ def test_the_bounds_are_below_coals_distances(arm: ck.Robot) -> None:
         np.testing.assert_array_less(below[:, k], exact + 1e-9)
     far = bounds(q, threshold_m=0.0)  # the spheres' bound where they are apart: looser, still below
     assert np.all(far <= below + 1e-12)
+    for k in range(len(pairs)):  # one pair's column, its two capsules alone placed: the same bits
+        np.testing.assert_array_equal(bounds.column(q, k), below[:, k])
 
 
 @pytest.mark.parametrize("margin_m", [0.0, 0.01, 0.05])
