@@ -1,6 +1,11 @@
-"""Shared fixtures: the bundled CPR, the paper's scene and geometric paths to time."""
+"""Shared fixtures: the bundled CPR, the paper's scene, geometric paths to time, the example pick
+and place planned once, and a stop that says yes after a count of questions."""
 
 from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
 
 import coal
 import numpy as np
@@ -11,6 +16,8 @@ import cpr_kin as ck
 from planning.curves.spline import SepticSplineSolver, uniform_knots
 from planning.curves.spline_settings import SplineSettings
 from planning.curves.trajectory import Trajectory
+from planning.io.scene_file import SceneFile, load_scene_file
+from planning.task import TaskMotion, plan_task
 
 PAPER_START_TCP = (0.5, 0.45, 0.25)
 PAPER_GOAL_TCP = (-0.5, 0.45, 0.25)
@@ -44,6 +51,35 @@ def crate() -> ck.Obstacle:
 @pytest.fixture(scope="session")
 def paper_world(robot: ck.Robot, crate: ck.Obstacle) -> ck.CollisionWorld:
     return ck.CollisionWorld(robot, [crate])
+
+
+@dataclass(frozen=True)
+class PlannedTask:
+    """A scene file's task and its plan."""
+
+    read: SceneFile
+    task: TaskMotion
+
+
+PICK = Path(__file__).resolve().parents[1] / "examples" / "scenes" / "pick_and_place.yaml"
+
+
+@pytest.fixture(scope="session")
+def pick_and_place() -> PlannedTask:
+    """The example pick and place (examples/scenes/pick_and_place.yaml), planned once a session."""
+    read = load_scene_file(PICK)
+    return PlannedTask(read, plan_task(read.scene, read.task))
+
+
+def after_calls(count: int) -> tuple[list[int], Callable[[], bool]]:
+    """A stop that says ``True`` from its ``count + 1``-th call on, and the list of its calls."""
+    calls: list[int] = []
+
+    def stop() -> bool:
+        calls.append(1)
+        return len(calls) > count
+
+    return calls, stop
 
 
 @pytest.fixture()

@@ -2,35 +2,20 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
-import pytest
 
 import cpr_kin as ck
-from planning.io.scene_file import SceneFile, load_scene_file
-from planning.task import TaskMotion, plan_task, task_record
+from planning.task import task_record
 from planning.viz.artifacts import task_carried
 from planning.viz.carried_objects import CarriedSpan, carried_poses, carried_spans, recorded_changes
 
-from .conftest import LIFT, spline_path
+from .conftest import LIFT, PlannedTask, spline_path
 
-PICK = Path(__file__).resolve().parents[1] / "examples" / "scenes" / "pick_and_place.yaml"
 BOX = ck.Obstacle.box((0.04, 0.04, 0.04), (0.0, 0.0, 0.03), rpy=(0.0, 0.2, 0.0), name="part")
 
 
 def part(name: str = "part", shape: ck.Obstacle | None = BOX) -> ck.Payload:
     return ck.Payload(mass_kg=1.0, shape=shape, name=name)
-
-
-@pytest.fixture(scope="module")
-def read() -> SceneFile:
-    return load_scene_file(PICK)
-
-
-@pytest.fixture(scope="module")
-def task(read: SceneFile) -> TaskMotion:
-    return plan_task(read.scene, read.task)
 
 
 def test_each_object_is_carried_from_its_attach_to_its_release() -> None:
@@ -59,9 +44,8 @@ def test_it_moves_with_its_frame_while_carried_and_rests_before_and_after(robot:
     np.testing.assert_array_equal(poses[20], poses[30])  # and where it is left
 
 
-def test_a_planned_tasks_record_gives_its_own_attaches_and_releases(
-    read: SceneFile, task: TaskMotion
-) -> None:
+def test_a_planned_tasks_record_gives_its_own_attaches_and_releases(pick_and_place: PlannedTask) -> None:
+    read, task = pick_and_place.read, pick_and_place.task
     record = task_record(task)
     changes = recorded_changes(read.task, record)
     attach = next(s for s in task.segments if s.kind == "attach")

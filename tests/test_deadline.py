@@ -34,20 +34,10 @@ from planning.search.firefly_settings import FireflySettings
 from planning.search.refinement import cma_refine
 from planning.search.rrt_connect import rrt_connect
 
+from .conftest import after_calls
 from .test_hull_first import BALL, CLEAR_ON_HULLS, ur10_scene
 from .test_path_following import spline_touching_scene
 from .test_rrt_connect import LOWER, UPPER, WEIGHTS, wall_with_slot
-
-
-def after_calls(count: int) -> tuple[list[int], Callable[[], bool]]:
-    """A stop that says ``True`` from its ``count + 1``-th call on, and the list of its calls."""
-    calls: list[int] = []
-
-    def stop() -> bool:
-        calls.append(1)
-        return len(calls) > count
-
-    return calls, stop
 
 
 def sphere(x: np.ndarray) -> np.ndarray:

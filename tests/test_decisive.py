@@ -3,8 +3,6 @@ and how a check is stopped between its pieces of work."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 import numpy as np
 import pytest
 
@@ -19,6 +17,8 @@ from cpr_kin.collision.decisive import (
     propagated_bounds,
     with_neighbours,
 )
+
+from .conftest import after_calls
 
 
 def test_the_samples_stay_below_a_distance_that_moves_no_faster_than_the_slack() -> None:
@@ -67,17 +67,6 @@ def test_coal_error_is_a_micrometre_below_a_metre_and_relative_above() -> None:
     np.testing.assert_allclose(below_coal(np.array([0.1, 3.0])), [0.1 - 1e-6, 3.0 - 3e-6])
 
 
-def stop_after(count: int) -> tuple[list[int], Callable[[], bool]]:
-    """A stop that says ``True`` from its ``count + 1``-th question on, and the list of its questions."""
-    asked: list[int] = []
-
-    def stop() -> bool:
-        asked.append(1)
-        return len(asked) > count
-
-    return asked, stop
-
-
 def test_a_check_in_chunks_is_the_check_in_one_call_and_stops_between_chunks() -> None:
     q = np.random.default_rng(4).normal(size=(1000, 3))
 
@@ -85,12 +74,12 @@ def test_a_check_in_chunks_is_the_check_in_one_call_and_stops_between_chunks() -
         return np.linalg.norm(batch, axis=1), np.argmax(batch, axis=1)
 
     whole = rows(q)
-    asked, never = stop_after(10**9)
+    asked, never = after_calls(10**9)
     for got, expected in zip(chunked(rows, q, never, rows=64), whole, strict=True):
         np.testing.assert_array_equal(got, expected)
     assert len(asked) == 16  # before each of the 1000 / 64 pieces
     np.testing.assert_array_equal(chunked(lambda b: b.sum(axis=1), q, never, rows=64), q.sum(axis=1))
-    asked, third = stop_after(2)
+    asked, third = after_calls(2)
     with pytest.raises(ck.CheckStoppedError, match="stopped by its caller before its verdict"):
         chunked(rows, q, third, rows=64)
     assert len(asked) == 3  # two pieces computed, stopped before the third

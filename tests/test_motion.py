@@ -12,8 +12,7 @@ import cpr_kin as ck
 from cpr_kin.certified.motion import PATH_WEIGHT_FLOOR
 from cpr_kin.model.packages import example_robot
 
-from .conftest import PAPER_GOAL_TCP, PAPER_START_TCP, random_configurations
-from .test_decisive import stop_after
+from .conftest import PAPER_GOAL_TCP, PAPER_START_TCP, after_calls, random_configurations
 
 
 @pytest.fixture(scope="module")
@@ -292,12 +291,12 @@ def test_a_stoppable_check_decides_as_one_that_is_not_until_stopped(
 
     args = (world, line, 0.0, 1.0, np.abs(b - a), 0.01, 0.0005)
     plain = ck.check_curve(*args)
-    asked, never = stop_after(10**9)
+    asked, never = after_calls(10**9)
     stoppable = ck.check_curve(*args, stop=never)
     assert len(plain.times) > 4096 and len(asked) > 3  # in pieces
     for field in dataclasses.fields(plain):
         np.testing.assert_array_equal(getattr(stoppable, field.name), getattr(plain, field.name))
-    asked, second = stop_after(1)
+    asked, second = after_calls(1)
     with pytest.raises(ck.CheckStoppedError):
         ck.check_curve(*args, stop=second)
     assert len(asked) == 2

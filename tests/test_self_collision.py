@@ -18,7 +18,7 @@ from planning.errors import PlanningError
 from planning.pipeline.problem import build_problem, with_planner
 from planning.pipeline.settings import PlannerSettings
 
-from .test_decisive import stop_after
+from .conftest import after_calls
 
 SHARE = example_robot_data_share()
 assert SHARE is not None, "example-robot-data is part of the robots extra, which make installs"
@@ -296,9 +296,9 @@ def test_a_stoppable_self_check_decides_as_one_that_is_not_until_stopped(panda: 
             return np.asarray(a + np.asarray(t)[:, None] * (b - a))
 
         args = (collision, line, (0.0, 1.0), np.abs(b - a), 0.0, 0.0005)
-        asked, never = stop_after(10**9)
+        asked, never = after_calls(10**9)
         assert check_self_curve(*args, stop=never) == check_self_curve(*args)
         assert len(asked) > 1  # asked before the screen and each pair and piece it computes
-        asked, at_once = stop_after(len(asked) - 1)  # stopped at its last question
+        asked, at_once = after_calls(len(asked) - 1)  # stopped at its last question
         with pytest.raises(ck.CheckStoppedError):
             check_self_curve(*args, stop=at_once)

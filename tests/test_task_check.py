@@ -4,26 +4,25 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-from pathlib import Path
 
 import pytest
 
 import cpr_kin as ck
-from planning.io.scene_file import SceneFile, load_scene_file
+from planning.io.scene_file import SceneFile
 from planning.pipeline.target import Target
-from planning.task import Attach, Move, TaskMotion, ToolLine, Wait, check_task, plan_task, task_record
+from planning.task import Attach, Move, TaskMotion, ToolLine, Wait, check_task, task_record
 
-PICK = Path(__file__).resolve().parents[1] / "examples" / "scenes" / "pick_and_place.yaml"
-
-
-@pytest.fixture(scope="module")
-def read() -> SceneFile:
-    return load_scene_file(PICK)
+from .conftest import PlannedTask
 
 
 @pytest.fixture(scope="module")
-def task(read: SceneFile) -> TaskMotion:
-    return plan_task(read.scene, read.task)
+def read(pick_and_place: PlannedTask) -> SceneFile:
+    return pick_and_place.read
+
+
+@pytest.fixture(scope="module")
+def task(pick_and_place: PlannedTask) -> TaskMotion:
+    return pick_and_place.task
 
 
 def test_the_planned_task_passes_its_check_with_the_planners_clearance(

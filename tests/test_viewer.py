@@ -24,6 +24,8 @@ from planning.viz.artifacts import viewer_html
 from planning.viz.viewer import Viewer
 from planning.viz.viewer_server import start_server
 
+from .conftest import PlannedTask
+
 pytestmark = pytest.mark.slow  # every test here starts processes
 
 CHROMIUM_FLAGS = [
@@ -205,16 +207,12 @@ def test_core_imports_no_drawing_libraries() -> None:
     assert completed.stdout.strip() == "[]"
 
 
-def test_a_tasks_page_moves_what_it_carries_and_leaves_it_where_released(tmp_path: Path) -> None:
-    from planning.io.scene_file import load_scene_file
-    from planning.task import plan_task
+def test_a_tasks_page_moves_what_it_carries_and_leaves_it_where_released(
+    pick_and_place: PlannedTask, tmp_path: Path
+) -> None:
     from planning.viz.artifacts import task_drawn_files
 
-    read = load_scene_file(
-        Path(__file__).resolve().parents[1] / "examples" / "scenes" / "pick_and_place.yaml"
-    )
-    task = plan_task(read.scene, read.task)
-    page = task_drawn_files(task, plots=False)["viewer.html"]
+    page = task_drawn_files(pick_and_place.task, plots=False)["viewer.html"]
     assert isinstance(page, str)
     commands = b"".join(base64.b64decode(m) for m in re.findall(r"base64,([A-Za-z0-9+/=]+)", page))
     assert commands.count(b"scene/carried/part") >= 2  # drawn, and a track of the animation
