@@ -74,6 +74,26 @@ def test_past_the_cut_the_check_under_way_stops_and_its_candidate_is_refused(rob
     assert "its check was stopped by the time limit before its verdict" in message
 
 
+def test_only_a_plan_with_a_limit_gives_its_checks_a_stop(
+    robot: ck.Robot, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import planning.pipeline.choose as choosing
+    from planning.pipeline.verification import verify_trajectory as original
+
+    stops: list[Any] = []
+
+    def recorded(*args: Any, stop: Any = None) -> Any:
+        stops.append(stop)
+        return original(*args, stop=stop)
+
+    monkeypatch.setattr(choosing, "verify_trajectory", recorded)
+    plan(paper_scene(), robot)
+    assert stops and all(stop is None for stop in stops)  # nothing asked, nothing cut in pieces
+    stops.clear()
+    plan(limited(paper_scene(), 3600.0), robot)
+    assert stops and all(callable(stop) and not stop() for stop in stops)
+
+
 def test_the_hulls_share_of_a_limit_is_cut_where_the_plan_is(monkeypatch: pytest.MonkeyPatch) -> None:
     ur10 = ck.load_robot(example_robot("ur10"))
     scene = parse_scene({**ur10_scene(CLEAR_ON_HULLS), "obstacles": [BALL]}).with_planner(time_limit_s=600.0)

@@ -109,7 +109,7 @@ def verify(problem: Problem, trajectory: Trajectory, fit: SplineFit) -> Verifica
     """
     scene = problem.scene
     verification = verify_trajectory(
-        problem.world, trajectory, Requirements.of(problem), stop=problem.deadline.cut
+        problem.world, trajectory, Requirements.of(problem), stop=problem.deadline.stop
     )
     bound = scene.planner.max_node_deviation
     if bound is not None and fit.max_node_deviation > bound:
