@@ -183,3 +183,22 @@ def test_a_row_about_a_long_path_says_what_is_wrong(tmp_path: Path) -> None:
     item = plan_scene_file(scene, out)
     assert item.status == "invalid" and len(item.message) <= 1000 and "\n" not in item.message
     assert item.message.endswith("holds files a plan does not write (keep.txt); name a new or empty folder")
+
+
+def test_a_task_scene_is_planned_as_plan_plans_it(tmp_path: Path) -> None:
+    task = tmp_path / "task.yaml"
+    task.write_text(
+        "start: {tcp: [0.6, -0.2, 0.3]}\n"
+        "task:\n  - move: {tcp: [-0.1, 0.55, 0.45]}\n  - wait: 0.2\n"
+        "  - line: {by: [0, 0, -0.05], frame: base}\n"
+        "obstacles:\n  - {name: crate, shape: box, size: [0.2, 0.2, 0.3], xyz: [0.35, 0.35, 0.15]}\n"
+    )
+    item = plan_scene_file(task, tmp_path / "out" / "task")
+    assert item.status == "ok" and item.record is not None, item.message
+    assert item.record["segments"] == 3 and item.record["min_clearance"] >= 0.1
+    written = json.loads((tmp_path / "out" / "task" / "trajectory.json").read_text())
+    assert [entry["kind"] for entry in written["task"]] == ["free", "wait", "line"]
+    assert written["metrics"]["duration"] == pytest.approx(item.record["duration"])
+    assert main(["check", str(task), str(tmp_path / "out" / "task" / "trajectory.json")]) == 0  # the oracle
+    (row,) = csv.DictReader(summary_csv([item]).splitlines())
+    assert row["status"] == "ok" and row["duration"] and row["t_sol"] == "" and row["evaluations"] == ""

@@ -4,7 +4,9 @@
 it never raises: every outcome, an unexpected exception included, becomes a
 :class:`BatchItem`. :mod:`planning.batch.pool` runs the tasks in parallel and turns a worker
 that dies (a crash in a native library) into the row of the scene that killed it.
-:func:`summary_csv` writes one row per scene.
+:func:`summary_csv` writes one row per scene. A scene file that holds a task (moves, lines,
+waits, attach and detach: :mod:`planning.task`) is planned as ``cpr-plan plan`` plans it; its
+row has the task's duration, clearance and planning time (no ``t_sol``, fitness or evaluations).
 
 Statuses and their exit classes are those of :mod:`planning.outcome` (the batch exits with
 the worst one):
@@ -31,12 +33,15 @@ from contextlib import AbstractContextManager
 from dataclasses import asdict, dataclass
 from functools import lru_cache
 from pathlib import Path
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 import cpr_kin as ck  # lazy (lazy_loader): its modules load in the workers, where they are used
 from cpr_kin.common.names import escaped, one_line, repeated
 from planning.errors import PlanningError
 from planning.outcome import STATUS_EXIT, classify
+
+if TYPE_CHECKING:  # the scene reader is imported in the workers, where scenes are planned
+    from planning.io.scene_file import SceneFile
 
 RECORD_FIELDS = ("duration", "min_clearance", "t_sol", "fitness", "evaluations", "planning_time_s")
 """The plan record's fields (:func:`planning.io.report.plan_record`) that ``summary.csv`` shows."""
@@ -94,29 +99,26 @@ def _open(item: BatchItem) -> Iterator[bool]:
 
 
 def plan_scene_file(path: Path, out: Path, threads: int | None = 1, gate: Gate = _open) -> BatchItem:
-    """Plan one scene file and publish its outputs into ``out``; never raises.
+    """Plan one scene file (one motion, or a task) and publish its outputs into ``out``; never raises.
 
     ``threads = 1`` by default: the batch runs scenes in parallel, not the checks of one.
     The files are published within ``gate``; a closed gate (an interrupted cluster batch)
     makes the row ``interrupted`` and writes nothing. It imports the planner itself, in the
     worker: the process that dispatches the scenes never needs it.
     """
-    from planning.io.outputs import plan_files
     from planning.io.publish import OutputFolder
-    from planning.io.report import plan_record
-    from planning.io.scene_file import load_scene
-    from planning.pipeline.planner import plan
+    from planning.io.scene_file import load_scene_file
 
     started = time.perf_counter()
     name = path.stem
     try:
-        scene = load_scene(path)
+        read = load_scene_file(path)
         with OutputFolder(out) as folder:
-            result = plan(scene, _robot(scene.robot_spec()), threads=threads)
-            files = plan_files(result)
-            item = BatchItem(
-                escaped(name), "ok", 0, record=plan_record(result), task_time_s=time.perf_counter() - started
+            robot = _robot(read.scene.robot_spec())
+            record, files = (
+                _task_outputs(read, robot, threads) if read.task else _plan_outputs(read, robot, threads)
             )
+            item = BatchItem(escaped(name), "ok", 0, record=record, task_time_s=time.perf_counter() - started)
             with gate(item) as open_:
                 if not open_:
                     stopped = "the batch was interrupted before this scene's files were written"
@@ -126,6 +128,30 @@ def plan_scene_file(path: Path, out: Path, threads: int | None = 1, gate: Gate =
         outcome = classify(exc)
         return BatchItem.failed(name, outcome.status, outcome.message, started)
     return item
+
+
+Outputs = tuple[dict[str, Any], dict[str, str | bytes]]
+"""A planned scene's record (its summary row's fields) and its files by name."""
+
+
+def _plan_outputs(read: SceneFile, robot: ck.Robot, threads: int | None) -> Outputs:
+    """The plan of a scene of one motion: its record and files (``cpr-plan plan``'s)."""
+    from planning.io.outputs import plan_files
+    from planning.io.report import plan_record
+    from planning.pipeline.planner import plan
+
+    result = plan(read.scene, robot, threads=threads)
+    return plan_record(result), plan_files(result)
+
+
+def _task_outputs(read: SceneFile, robot: ck.Robot, threads: int | None) -> Outputs:
+    """The plan of a task: its metrics as the record and its files (``cpr-plan plan``'s for a task)."""
+    from planning.io.task_outputs import task_files, task_metrics
+    from planning.task import plan_task
+
+    began = time.perf_counter()
+    task = plan_task(read.scene, read.task, robot, threads=threads).verified()
+    return task_metrics(task, time.perf_counter() - began), task_files(task)
 
 
 def finished_items(futures: dict[Any, int]) -> Iterator[tuple[int, BatchItem]]:

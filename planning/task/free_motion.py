@@ -54,15 +54,18 @@ def plan_free(
     constraint: OrientationConstraint | None,
     required: Requirements,
     progress: Callable[[FireflyProgress], None] | None = None,
+    threads: int | None = None,
 ) -> FreeMotion:
     """The free motion from ``scene``'s start to its goal, keeping ``constraint`` if given.
+
+    ``threads``: those of the parallel collision checks (default: up to 2).
 
     Raises:
         PlanningError: bad input: a start or goal inside a margin, or that does not keep the
             constraint; a fixed duration.
         NoSolutionError: no motion found, or none that keeps the constraint.
     """
-    problem = free_problem(scene, robot)
+    problem = free_problem(scene, robot, threads)
     free = solve(problem, progress).trajectory
     if constraint is None:
         return FreeMotion(free, problem)
@@ -70,13 +73,13 @@ def plan_free(
     return FreeMotion(held.trajectory, problem, held)
 
 
-def free_problem(scene: Scene, robot: ck.Robot) -> Problem:
-    """The problem of a task's free motion: timed to end still in jerk too.
+def free_problem(scene: Scene, robot: ck.Robot, threads: int | None = None) -> Problem:
+    """The problem of a task's free motion: timed to end still in jerk too (``threads``: its checks').
 
     Raises:
         PlanningError: the scene fixes a duration; a start or goal inside a margin.
     """
-    problem = build_problem(scene, robot)
+    problem = build_problem(scene, robot, threads)
     if not isinstance(problem.duration, FreeDuration):
         raise PlanningError(FIXED_DURATION.format(seconds=scene.duration))
     return dataclasses.replace(problem, duration=dataclasses.replace(problem.duration, still_jerk=True))

@@ -117,6 +117,17 @@ class TaskMotion:
         """Every segment passes its verification and the whole is C3."""
         return not self.problems
 
+    def verified(self) -> TaskMotion:
+        """The task, where it is :attr:`accepted` (what is written and reported).
+
+        Raises:
+            NoSolutionError: it is not (each segment was verified as planned: a failure here
+                is a bug's), naming every problem.
+        """
+        if not self.accepted:
+            raise NoSolutionError("the planned task fails its verification: " + "; ".join(self.problems))
+        return self
+
     @property
     def certified_min_clearance_m(self) -> float:
         """The least certified clearance from the obstacles over the whole motion [m]."""
@@ -131,18 +142,26 @@ class _Carrying:
     problem: Problem
     required: Requirements
 
+    @property
+    def threads(self) -> int:
+        """The threads of its parallel collision checks, for the next segment's problems."""
+        return self.problem.world.num_threads
+
 
 def plan_task(
     scene: Scene,
     segments: Sequence[Segment],
     robot: ck.Robot | None = None,
     progress: Callable[[FireflyProgress], None] | None = None,
+    threads: int | None = None,
 ) -> TaskMotion:
     """The task's ``segments`` planned from the scene's start, joined and verified.
 
     Each segment is verified with what the robot carries during it (the scene's payload at
     the start, then what :class:`Attach` and :class:`Detach` say); the whole must be C3.
-    ``progress`` is called after each iteration of each free motion's search.
+    ``progress`` is called after each iteration of each free motion's search; ``threads``
+    are those of the parallel collision checks (default: up to 2; a batch runs tasks in
+    parallel, not the checks of one).
 
     Raises:
         PlanningError: no segment, a bad segment, or a segment's bad input (a goal inside a
@@ -156,7 +175,7 @@ def plan_task(
     if scene.duration is not None:
         raise PlanningError(FIXED_DURATION.format(seconds=scene.duration))
     base = robot or scene.robot_spec().load()
-    carrying = _carrying(scene, base, None)
+    carrying = _carrying(scene, base, None, threads)
     q, start_world = carrying.problem.q_start, carrying.problem.world
     kinds, payloads, planned = [], [], list[PlannedMotion | None]()
     for index, segment in enumerate(segments):
@@ -194,11 +213,14 @@ def plan_task(
     return TaskMotion(tuple(records), whole, continuity, start_world, scene, tuple(segments))
 
 
-def _carrying(scene: Scene, base: ck.Robot, q: FloatArray | None) -> _Carrying:
-    """The scene at ``q`` (``None``: its start) with its payload, checked as a scene's start is."""
+def _carrying(scene: Scene, base: ck.Robot, q: FloatArray | None, threads: int | None) -> _Carrying:
+    """The scene at ``q`` (``None``: its start) with its payload, checked as a scene's start is.
+
+    ``threads``: those of its checks (:func:`~planning.pipeline.problem.build_problem`).
+    """
     start = scene.start if q is None else Target(q=tuple(q.tolist()))
     at = dataclasses.replace(scene, start=start, goal=start)  # its goal: not the task's
-    problem = build_problem(at, base)
+    problem = build_problem(at, base, threads)
     return _Carrying(at, problem, Requirements.of(problem))
 
 
@@ -213,10 +235,10 @@ def _carried(carrying: _Carrying, base: ck.Robot, q: FloatArray, segment: Attach
                 f"detach: name = {segment.name!r}, but the robot carries {held.name!r}; name it, or leave "
                 "the name out"
             )
-        return _carrying(dataclasses.replace(carrying.scene, payload=None), base, q)
+        return _carrying(dataclasses.replace(carrying.scene, payload=None), base, q, carrying.threads)
     if held is not None:
         raise PlanningError(f"attach: the robot already carries '{held.name}' (detach it first)")
-    return _carrying(dataclasses.replace(carrying.scene, payload=segment.payload), base, q)
+    return _carrying(dataclasses.replace(carrying.scene, payload=segment.payload), base, q, carrying.threads)
 
 
 def _planned(
@@ -238,7 +260,7 @@ def _planned(
         return PlannedMotion(still, carrying.problem, required, still=True)
     if isinstance(segment, Move):
         scene = dataclasses.replace(carrying.scene, start=Target(q=tuple(q.tolist())), goal=segment.goal)
-        free = plan_free(scene, base, segment.constraint, required, progress)
+        free = plan_free(scene, base, segment.constraint, required, progress, carrying.threads)
         return PlannedMotion(free.trajectory, free.problem, required, held=free.held)
     raise PlanningError(
         f"a task segment is a Move, a ToolLine, a Wait, an Attach or a Detach, not a {type(segment).__name__}"
