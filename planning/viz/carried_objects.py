@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 
 import cpr_kin as ck
 from planning.curves.trajectory import Trajectory
-from planning.task.segments import Attach, Detach, Segment
+from planning.task.segments import KINDS, Attach, Detach, Segment
 
 FloatArray = NDArray[np.float64]
 
@@ -84,15 +84,14 @@ def recorded_changes(
     list, entry by entry the segments' (their times ``t0`` [s]). None where the two are not
     one task's (other lengths or kinds: ``cpr-plan check`` says why).
     """
-    kinds = {Attach: "attach", Detach: "detach"}
     if len(task) != len(record):
         return []
     changes: list[tuple[float, ck.Payload | None]] = []
     for segment, entry in zip(task, record, strict=True):
-        kind, t0 = kinds.get(type(segment)), entry.get("t0")
-        if kind is None:
+        if not isinstance(segment, Attach | Detach):
             continue
-        if entry.get("kind") != kind or not isinstance(t0, int | float):
+        t0 = entry.get("t0")
+        if entry.get("kind") != KINDS[type(segment)] or not isinstance(t0, int | float):
             return []
         changes.append((float(t0), segment.payload if isinstance(segment, Attach) else None))
     return changes

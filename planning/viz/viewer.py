@@ -129,7 +129,7 @@ class Viewer:
         self.world = world
         self.margin_m = margin_m
         self._own_server = server is None
-        self._carried: tuple[CarriedSpan, ...] = ()
+        self._carried: list[tuple[CarriedSpan, list[FloatArray]]] = []  # each with its shapes' poses in it
         self.server = server or start_server()
         with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints the URL; callers decide
             window = _Window(zmq_url=self.server.zmq_url, start_server=False, server_args=[])
@@ -225,11 +225,12 @@ class Viewer:
         for span in spans:
             self._forget(span.name)
             pose = carried_poses(self.robot, trajectory, span, start)[0]
-            for k, (shape, local) in enumerate(_shape_objects(span.shape, 0.0)):
+            shapes = _shape_objects(span.shape, 0.0)
+            for k, (shape, local) in enumerate(shapes):
                 node = self.vis["scene/carried"][span.name][str(k)]
                 node.set_object(shape, _material(CARRIED_COLOR))
                 node.set_transform(pose @ local)
-        self._carried = (*self._carried, *spans)
+            self._carried.append((span, [local for _, local in shapes]))
 
     def _forget(self, name: str) -> None:
         """Take geometry ``name`` out of the robot's view (copies of its models: the robot's stay)."""
@@ -252,14 +253,14 @@ class Viewer:
         count = int(np.ceil(trajectory.duration * fps)) + 1
         times = np.minimum(trajectory.knots[0] + np.arange(count) / fps, trajectory.knots[-1])
         carried = [
-            (span.name, carried_poses(self.robot, trajectory, span, times), _shape_objects(span.shape, 0.0))
-            for span in self._carried
+            (span.name, carried_poses(self.robot, trajectory, span, times), locals_)
+            for span, locals_ in self._carried
         ]
         for frame, t in enumerate(times):
             with animation.at_frame(self.vis, frame) as frame_view:
                 self._place(frame_view, trajectory(t))
-                for name, poses, shapes in carried:
-                    for k, (_, local) in enumerate(shapes):
+                for name, poses, locals_ in carried:
+                    for k, local in enumerate(locals_):
                         frame_view["scene/carried"][name][str(k)].set_transform(poses[frame] @ local)
         self.vis.set_animation(
             animation, play=True, repetitions=repetitions if repetitions > 0 else 1_000_000
