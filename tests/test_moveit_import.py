@@ -16,6 +16,7 @@ import pytest
 import yaml
 from scipy.spatial.transform import Rotation
 
+import cpr_kin as ck
 from cpr_kin.model.packages import example_robot
 from planning.cli import main
 from planning.io.moveit_objects import CONE_SIDES
@@ -292,12 +293,6 @@ REFUSALS = [
         "camera",
         "world.collision_objects[0] ('post').header.frame_id: frame 'camera' is not known; the frames "
         "fixed to the world here: 'panda_link0'",
-    ),
-    (
-        "scene",
-        "allowed_collision_matrix.entry_values",
-        [[False, False, True], [False, False, False], [True, False, False]],
-        "contact with an object is not supported",
     ),
     (
         "scene",
@@ -727,6 +722,41 @@ PART: dict[str, Any] = {  # a part held between the Panda's fingers, sticking ou
     "touch_links": ["panda_leftfinger", "panda_rightfinger"],
     "weight": 0.4,
 }
+
+
+def test_links_the_matrix_lets_touch_a_world_object_are_its_obstacles_touch_links(tmp_path: Path) -> None:
+    scene = changed(  # panda_link0 may touch the post: both of its primitives' obstacles say so
+        SCENE,
+        "allowed_collision_matrix.entry_values",
+        [[False, True, True], [True, False, False], [True, False, False]],
+    )
+    out = tmp_path / "touch.yaml"
+    assert main(["import-moveit", *write(tmp_path, scene, REQUEST), "--out", str(out)]) == 0
+    touching = {o.name: o.touch_links for o in load_scene(out).obstacles}
+    assert touching == {"post_0": ("panda_link0",), "post_1": ("panda_link0",), "lamp_0": (), "lamp_1": ()}
+    scene_read = load_scene(out)
+    robot = scene_read.robot_spec().load()
+    link = {g.name: g.link for g in robot.geometries}
+    checked = {(link[g], o) for g, o, _ in ck.CollisionWorld(robot, scene_read.obstacles).pairs}
+    assert ("panda_link0", "post_0") not in checked and ("panda_link0", "lamp_0") in checked
+    assert ("panda_link1", "post_0") in checked
+
+
+def test_contact_between_the_attached_object_and_a_world_object_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = changed(SCENE, "robot_state.attached_collision_objects", [PART])
+    scene = changed(scene, "allowed_collision_matrix.entry_names", ["panda_link0", "post", "part"])
+    scene = changed(
+        scene,
+        "allowed_collision_matrix.entry_values",
+        [[False, False, False], [False, False, True], [False, True, False]],
+    )
+    out = tmp_path / "refused.yaml"
+    assert main(["import-moveit", *write(tmp_path, scene, REQUEST), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "allows ['part', 'post'] to touch; contact between what the robot carries and an obstacle" in err
+    assert not out.exists()
 
 
 def test_an_attached_object_becomes_the_payload_and_plans_certified(

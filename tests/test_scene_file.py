@@ -14,7 +14,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import cpr_kin as ck
-from cpr_kin.common.user_files import StrictLoader
+from cpr_kin.common.user_files import StrictLoader, UserFileError, dump_yaml, load_yaml
 from planning.bench.scene_generator import generate_scenes
 from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError, SceneError
@@ -76,6 +76,27 @@ def test_every_shape_and_relative_mesh_path(tmp_path: Path) -> None:
     assert [o.name for o in scene.obstacles][:2] == ["box_0", "sphere_1"]
     assert scene.obstacles[4].mesh == tmp_path / "part.stl"
     ck.CollisionWorld(ck.load_cpr(), scene.obstacles)  # every shape builds a coal geometry
+
+
+def test_an_obstacles_touch_links_are_read_written_and_read_back_the_same(tmp_path: Path) -> None:
+    fingers = ["tool_link", "wrist_link"]
+    obstacles = [
+        {
+            "name": "part",
+            "shape": "box",
+            "size": [0.04, 0.04, 0.04],
+            "xyz": [0.5, 0, 0.2],
+            "touch_links": fingers,
+        },
+        {"name": "cap", "shape": "sphere", "radius": 0.02, "xyz": [0.5, 0, 0.3], "touch_links": fingers},
+    ]
+    scene = parse_scene({**MINIMAL, "obstacles": obstacles}, source="s.yaml")
+    assert [o.touch_links for o in scene.obstacles] == [("tool_link", "wrist_link")] * 2
+    dump_scene(scene, tmp_path / "again.yaml")
+    assert load_scene(tmp_path / "again.yaml").obstacles == scene.obstacles
+    shape = {"shape": "box", "size": [0.04, 0.04, 0.04], "xyz": [0, 0, 0.03], "touch_links": fingers}
+    with pytest.raises(SceneError, match="not its shape's"):
+        parse_scene({**MINIMAL, "payload": {"mass_kg": 1.0, "shape": shape}}, source="s.yaml")
 
 
 @pytest.mark.parametrize(
@@ -333,3 +354,16 @@ def test_with_planner_changes_the_settings_named_and_nothing_else() -> None:
     assert dataclasses.replace(changed, planner=scene.planner) == scene
     with pytest.raises(PlanningError, match="fireflies"):
         scene.with_planner(fireflies=0)
+
+
+def test_what_the_writers_dump_the_reader_takes_however_often_a_value_is_shared(tmp_path: Path) -> None:
+    links = ["tool_link", "wrist_link"]  # one list in two places: PyYAML's safe_dump writes &id001 / *id001
+    document = {"a": {"touch_links": links}, "b": {"touch_links": links}, "xyz": [0.1, 0.2, 0.3]}
+    text = dump_yaml(document)
+    assert "&" not in text and "*" not in text
+    (tmp_path / "shared.yaml").write_text(text)
+    assert load_yaml(tmp_path / "shared.yaml", 10_000) == document
+    assert "xyz: [0.1, 0.2, 0.3]" in text  # scalars' lists in flow style, as before
+    (tmp_path / "aliased.yaml").write_text(yaml.safe_dump(document))
+    with pytest.raises(UserFileError, match="anchors"):  # what the reader refuses: the writer must not
+        load_yaml(tmp_path / "aliased.yaml", 10_000)

@@ -25,6 +25,7 @@ from cpr_kin.collision.closest_pairs import closest_pairs
 from cpr_kin.collision.decisive import below_coal, coal_error_m
 from cpr_kin.collision.obstacle_pools import ObstaclePools
 from cpr_kin.collision.robot_reach import pair_reach_distances
+from cpr_kin.collision.touch_links import checked_pairs
 from cpr_kin.collision.world_self_pairs import world_self_collision
 from cpr_kin.common.errors import CprKinError
 from cpr_kin.model.robot import GROUPS, Robot
@@ -43,7 +44,8 @@ class CollisionWorld:
         robot: the robot (its collision geometry model is copied, never modified).
         obstacles: the obstacles; their names must be unique.
         num_threads: threads for :meth:`margin_violated` (default: up to 2).
-        allowed_pairs: link pairs of the robot allowed to touch (a scene's), beyond its SRDF's.
+        allowed_pairs: link pairs of the robot allowed to touch (a scene's), beyond its SRDF's;
+            an obstacle's own ``touch_links`` may touch it (:mod:`cpr_kin.collision.touch_links`).
         self_margin_m: the self margin the world's user holds the robot's own pairs to [m]: a
             pair closer than it by design (:attr:`cpr_kin.Robot.close_pairs`, its largest
             distance below it) is held to contact only, its distance counting the margin as
@@ -76,11 +78,9 @@ class CollisionWorld:
                 f"obstacle:{obstacle.name}", 0, 0, obstacle.placement, obstacle.geometry()
             )
             obstacle_ids.append(model.addGeometryObject(obj))
-        pairs: list[tuple[int, int]] = []
-        for geometry in robot.geometries:
-            for k, oid in enumerate(obstacle_ids):
-                model.addCollisionPair(pin.CollisionPair(geometry.index, oid))
-                pairs.append((geometry.index, k))
+        pairs = checked_pairs(robot, self.obstacles)  # but each obstacle's touch_links
+        for g, k in pairs:
+            model.addCollisionPair(pin.CollisionPair(g, obstacle_ids[k]))
         self.geometry_model = model
         self._pairs = pairs
         self._pair_group = np.array(

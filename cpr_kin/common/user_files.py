@@ -171,3 +171,19 @@ def load_yaml(path: Path, max_bytes: int, what: str = "YAML file") -> Any:
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
         problem = getattr(exc, "problem", None) or " ".join(str(exc).split())
         raise UserFileError(f"{source} is not valid YAML{where}: {cut(str(problem), 120)}") from None
+
+
+class _PlainDumper(yaml.SafeDumper):
+    """``yaml.SafeDumper`` that writes a value met twice out again instead of as an alias."""
+
+    def ignore_aliases(self, data: Any) -> bool:
+        return True
+
+
+def dump_yaml(document: Any, width: int = 80) -> str:
+    """``document`` as YAML that :func:`load_yaml` reads back, keys in their order.
+
+    Lists of scalars in flow style; no anchors or aliases (which it refuses), however often a
+    list is shared. ``width``: the preferred line length [characters].
+    """
+    return yaml.dump(document, Dumper=_PlainDumper, sort_keys=False, default_flow_style=None, width=width)

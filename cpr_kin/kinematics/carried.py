@@ -71,7 +71,7 @@ def carrying(robot: Robot, payload: Payload | None) -> Robot:
         robot,
         collision_model=collision,
         build_visual_model=visual_model,
-        geometries=(*robot.geometries, RobotGeometry(payload.name, link, "effector", index)),
+        geometries=(*robot.geometries, RobotGeometry(payload.name, link, "effector", index, carried=True)),
         _data=robot.model.createData(),
         self_pairs=tuple(sorted((*robot.self_pairs, *pairs))),
     )

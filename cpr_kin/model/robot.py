@@ -56,6 +56,7 @@ class RobotGeometry:
         link: URDF link it belongs to.
         group: ``"effector"`` or ``"links"``.
         index: index in the Pinocchio geometry model.
+        carried: an object the robot carries (:func:`cpr_kin.carrying`), not one of its links.
 
     """
 
@@ -63,6 +64,7 @@ class RobotGeometry:
     link: str
     group: str
     index: int
+    carried: bool = False
 
 
 @dataclass(frozen=True, eq=False)

@@ -100,6 +100,9 @@ class Obstacle:
         xyz: position of the shape's centre in the world [m].
         rpy: orientation as roll, pitch, yaw about fixed x, y, z axes [rad].
         name: a name for messages and displays.
+        touch_links: links of the robot that may touch it (a gripper's fingers at a part it
+            grasps or leaves, MoveIt's allowed contacts of a world object): their pairs with
+            it are not checked. What the robot carries is checked against it all the same.
 
     """
 
@@ -115,6 +118,7 @@ class Obstacle:
     convex: bool = True
     points: FloatArray | None = None
     resolution: float | None = None
+    touch_links: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if self.shape not in SHAPES:
@@ -129,6 +133,10 @@ class Obstacle:
                 f"obstacle name {_shown(self.name)} holds {character}; names must be printable text"
             )
         what = f"obstacle '{self.name}'"
+        links = self.touch_links
+        if isinstance(links, str) or not all(isinstance(n, str) and unprintable(n) is None for n in links):
+            raise ObstacleError(f"{what} touch_links = {_shown(links)} must be a sequence of link names")
+        object.__setattr__(self, "touch_links", tuple(links))
         bound = MAX_COORDINATE_M
         object.__setattr__(self, "xyz", _vector(self.xyz, f"{what} xyz", 3, -bound, bound, "m"))
         object.__setattr__(
@@ -174,6 +182,7 @@ class Obstacle:
             self.convex,
             None if self.points is None else hash(np.asarray(self.points).tobytes()),
             self.resolution,
+            self.touch_links,
         )
 
     def __eq__(self, other: object) -> bool:

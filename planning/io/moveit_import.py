@@ -16,7 +16,8 @@
   (:mod:`planning.io.moveit_frames`). An orientation of all zeros is the identity, as in MoveIt.
 - **Obstacles:** :mod:`planning.io.moveit_objects`, at most
   :data:`~planning.pipeline.scene.MAX_OBSTACLES`; object ids unique.
-- **Allowed collisions:** the matrix's robot-link pairs marked ``true``.
+- **Allowed collisions:** the matrix's robot-link pairs marked ``true``; a link allowed to touch a
+  world object is in that object's obstacles' ``touch_links`` (:mod:`planning.io.moveit_matrix`).
 - **Time:** ``allowed_planning_time`` (when > 0) becomes the planner's ``time_limit_s`` (at
   most :data:`~planning.pipeline.settings.MAX_TIME_LIMIT_S`).
 
@@ -25,13 +26,15 @@
 
 What would change the problem and has no counterpart (path or trajectory
 constraints, an octomap, padding, velocity scaling other than 0 or 1, a robot base placed
-away from the world's origin, allowed contact with an object) is refused naming it; what only
+away from the world's origin, allowed contact between the attached object and a world object) is
+refused naming it; what only
 steers MoveIt's own planner (planner id, pipeline, attempts, workspace) is listed as ignored
 (:mod:`planning.io.moveit_support`). :mod:`planning.io.moveit_write` writes the result.
 """
 
 from __future__ import annotations
 
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -47,7 +50,7 @@ from cpr_kin.model.packages import check_package_dirs
 from planning.io.moveit_attached import attached_payload
 from planning.io.moveit_frames import Frames
 from planning.io.moveit_goal import goal_entry
-from planning.io.moveit_matrix import allowed_pairs
+from planning.io.moveit_matrix import allowed_pairs, links_allowed_to_touch
 from planning.io.moveit_messages import (
     MotionPlanRequest,
     MoveItImportError,
@@ -97,8 +100,12 @@ class ImportedScene:
     files: dict[str, bytes] = field(default_factory=dict)
 
 
-def convert_objects(scene: PlanningScene, frames: Frames) -> ConvertedObject:
+def convert_objects(
+    scene: PlanningScene, frames: Frames, touching: Mapping[str, Collection[str]] | None = None
+) -> ConvertedObject:
     """The obstacles of every collision object, in the base frame; each object's id becomes a frame.
+
+    ``touching``: the links that may touch each object, by id (its obstacles' ``touch_links``).
 
     Raises:
         MoveItImportError: an id given twice, an object in a frame that moves or is unknown,
@@ -122,7 +129,8 @@ def convert_objects(scene: PlanningScene, frames: Frames) -> ConvertedObject:
             raise MoveItImportError(
                 f"{where}: its mesh file {clash[0]} is another object's; rename the object"
             )
-        obstacles += converted.obstacles
+        links = sorted((touching or {}).get(obj.id, ()))
+        obstacles += [{**entry, "touch_links": links} if links else entry for entry in converted.obstacles]
         meshes.update(converted.meshes)
         if obj.id not in frames.fixed:  # MoveIt names an object's frame by its id
             frames.fixed[obj.id] = frame_in_base @ (obj.pose or Pose()).matrix()
@@ -174,7 +182,10 @@ def import_moveit(
     if robot.srdf is not None:
         frames.add_virtual_joints(parse_srdf(robot.srdf))
     frames.add_transforms(scene.fixed_frame_transforms)
-    converted = convert_objects(scene, frames)
+    links = {link.get("name", "") for link in tree.getroot().findall("link")}
+    matrix = scene.allowed_collision_matrix
+    touching = {o.id: links_allowed_to_touch(matrix, o.id, links) for o in scene.world.collision_objects}
+    converted = convert_objects(scene, frames, touching)
     obstacles, meshes = list(converted.obstacles), converted.meshes
     octomap = convert_octomap(scene.world.octomap, frames, ignored)
     if octomap is not None:
@@ -203,14 +214,12 @@ def import_moveit(
     following = sorted(set(values) & mimics - set(planned))
     if following:  # MoveIt sets a mimic joint from its leader, whatever the state says
         ignored.append(f"start values of mimic joint(s) {following}: each follows the joint it mimics")
-    links = {link.get("name", "") for link in tree.getroot().findall("link")}
     objects = {obj.id for obj in scene.world.collision_objects}
     payload = attached_payload(scene, request, links, ignored)
     clash = sorted(set(payload.meshes) & set(meshes))
     if clash:
         raise MoveItImportError(f"the attached object's mesh file {clash[0]} is a world object's; rename one")
     meshes |= payload.meshes
-    matrix = scene.allowed_collision_matrix
     attached = {payload.entry["name"]} if payload.entry else set()
     unknown = sorted((set(matrix.entry_names) | set(matrix.default_entry_names)) - links - objects - attached)
     if unknown:
@@ -222,7 +231,7 @@ def import_moveit(
         "robot": robot_entry,
         "safety_margin": margins_m[0],
         "self_margin": margins_m[1],
-        "allowed_collisions": allowed_pairs(scene.allowed_collision_matrix, links, objects),
+        "allowed_collisions": allowed_pairs(matrix, links, objects, attached),
         "start": {"q": {j: values[j] for j in planned}},
         "goal": goal,
         "obstacles": obstacles,

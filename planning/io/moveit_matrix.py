@@ -1,9 +1,10 @@
 """A MoveIt allowed-collision matrix as a scene file's ``allowed_collisions``: robot-link pairs.
 
 A pair is allowed when either of its two entries is ``true``; a default entry ``true`` allows
-its name with every link. Contact between a link and an object of the world has no
-counterpart (the scene's obstacles are always checked) and is refused; contact with the
-attached object is its ``touch_links`` (:func:`links_allowed_to_touch`).
+its name with every link. Contact between a link and an object, of the world or attached, is
+the object's ``touch_links`` (:func:`links_allowed_to_touch`); contact between the attached
+object and one of the world has no counterpart (what the robot carries is checked against
+every obstacle) and is refused; two objects of the world are never checked against each other.
 """
 
 from __future__ import annotations
@@ -30,18 +31,20 @@ def _pairs(matrix: AllowedCollisionMatrix, links: set[str]) -> set[tuple[str, st
     return {(a, b) for a, b in pairs}
 
 
-def allowed_pairs(matrix: AllowedCollisionMatrix, links: set[str], objects: set[str]) -> list[list[str]]:
-    """The allowed-collision matrix's robot-link pairs; contact with an object of ``objects`` is refused.
+def allowed_pairs(
+    matrix: AllowedCollisionMatrix, links: set[str], objects: set[str], attached: set[str]
+) -> list[list[str]]:
+    """The allowed-collision matrix's robot-link pairs; an ``attached`` object touching ``objects`` refused.
 
     Entries of names that are neither links nor objects change nothing (as in MoveIt); the
     caller lists them as ignored.
     """
     pairs = _pairs(matrix, links)
-    touching = sorted(p for p in pairs if (p[0] in objects) != (p[1] in objects))
+    touching = sorted(p for p in pairs if {p[0], p[1]} & objects and {p[0], p[1]} & attached)
     if touching:
         raise MoveItImportError(
-            f"allowed_collision_matrix allows {list(touching[0])} to touch; "
-            "contact with an object is not supported"
+            f"allowed_collision_matrix allows {list(touching[0])} to touch; contact between what the "
+            "robot carries and an obstacle is not supported (it is checked against every obstacle)"
         )
     return [list(p) for p in sorted(pairs) if p[0] in links and p[1] in links]
 

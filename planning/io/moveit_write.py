@@ -15,8 +15,8 @@ from pathlib import Path
 from typing import Any
 
 import trimesh
-import yaml
 
+from cpr_kin.common.user_files import dump_yaml
 from planning.io.moveit_import import ImportedScene
 from planning.io.output_paths import check_not_inputs
 from planning.io.publish import write_file
@@ -80,7 +80,7 @@ def write_imported(
                 write_file(folder / mesh_folder / file, bytes(trimesh.exchange.stl.export_stl(mesh)))
             )
         parse_scene(document, source=source, base=folder)
-        return write_file(out, yaml.safe_dump(document, sort_keys=False, default_flow_style=None, width=100))
+        return write_file(out, dump_yaml(document, width=100))
     except BaseException:  # refused, unwritable or interrupted: no mesh is left without its scene
         for path in written:
             path.unlink(missing_ok=True)

@@ -28,12 +28,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import yaml
 from pydantic import ValidationError
 
 import cpr_kin as ck
 from cpr_kin.common.names import repeated
-from cpr_kin.common.user_files import UserFileError, load_yaml
+from cpr_kin.common.user_files import UserFileError, dump_yaml, load_yaml
 from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError, SceneError
 from planning.io.cloud_entry import PointCloudSpec, RobotAtStart, cloud_obstacles
@@ -252,4 +251,4 @@ def scene_document(scene: Scene, task: Sequence[Segment] = ()) -> dict[str, Any]
 
 def dump_scene(scene: Scene, path: str | Path) -> None:
     """Write ``scene`` as a scene file, atomically."""
-    write_file(Path(path), yaml.safe_dump(scene_document(scene), sort_keys=False, default_flow_style=None))
+    write_file(Path(path), dump_yaml(scene_document(scene)))

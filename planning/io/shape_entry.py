@@ -4,17 +4,19 @@
 obstacles:
   - {shape: box, size: [0.2, 0.3, 0.4], xyz: [0.5, 0.0, 0.2], rpy: [0, 0, 0.3]}
   - {shape: mesh, mesh: meshes/part.stl, scale: 0.001, convex: true, xyz: [0.4, 0.2, 0.0]}
+  - {name: part, shape: box, size: [0.04, 0.04, 0.04], xyz: [0.3, 0.2, 0.02], touch_links: [finger]}
 payload: {mass_kg: 1.5, com_in_tcp: [0, 0, 0.05], shape: {shape: sphere, radius: 0.04, xyz: [0, 0, 0.05]}}
 ```
 """
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, model_validator
 
 import cpr_kin as ck
 from cpr_kin.kinematics.dynamics import MAX_COM_OFFSET_M, MAX_PAYLOAD_KG, PAYLOAD_NAME
@@ -27,6 +29,7 @@ class _Placed(Strict):
     name: Name | None = None
     xyz: Point
     rpy: Turn = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    touch_links: Annotated[list[Name], Field(max_length=64)] = Field(default_factory=list)
 
 
 class BoxSpec(_Placed):
@@ -103,6 +106,12 @@ class PayloadSpec(Strict):
     shape: PayloadShapeSpec | None = None
     touch_links: Annotated[list[Name], Field(max_length=64)] = Field(default_factory=list)
 
+    @model_validator(mode="after")
+    def _links_once(self) -> PayloadSpec:
+        if self.shape is not None and self.shape.touch_links:
+            raise ValueError("the links a payload may touch are its own 'touch_links', not its shape's")
+        return self
+
     def payload(self, shape: ck.Obstacle | None) -> ck.Payload:
         """The :class:`cpr_kin.Payload` with ``shape`` built from :attr:`shape`.
 
@@ -131,18 +140,20 @@ def obstacle_of(
     Raises:
         cpr_kin.CprKinError: a shape coal cannot build, a mesh that cannot be read.
     """
+    links = tuple(item.touch_links)
     if isinstance(item, BoxSpec):
-        return ck.Obstacle.box(item.size, item.xyz, item.rpy, name=name)
-    if isinstance(item, SphereSpec):
-        return ck.Obstacle.sphere(item.radius, item.xyz, name=name)
-    if isinstance(item, CylinderSpec):
-        return ck.Obstacle.cylinder(item.radius, item.length, item.xyz, item.rpy, name=name)
-    if isinstance(item, CapsuleSpec):
-        return ck.Obstacle.capsule(item.radius, item.length, item.xyz, item.rpy, name=name)
-    mesh = (base / item.mesh).resolve()  # absolute: the scene may be planned elsewhere
-    obstacle = ck.Obstacle.from_mesh(mesh, item.xyz, item.rpy, item.scale, item.convex, name=name)
-    obstacle.geometry()  # read the file now: a broken mesh is a scene error
-    return obstacle
+        obstacle = ck.Obstacle.box(item.size, item.xyz, item.rpy, name=name)
+    elif isinstance(item, SphereSpec):
+        obstacle = ck.Obstacle.sphere(item.radius, item.xyz, name=name)
+    elif isinstance(item, CylinderSpec):
+        obstacle = ck.Obstacle.cylinder(item.radius, item.length, item.xyz, item.rpy, name=name)
+    elif isinstance(item, CapsuleSpec):
+        obstacle = ck.Obstacle.capsule(item.radius, item.length, item.xyz, item.rpy, name=name)
+    else:
+        mesh = (base / item.mesh).resolve()  # absolute: the scene may be planned elsewhere
+        obstacle = ck.Obstacle.from_mesh(mesh, item.xyz, item.rpy, item.scale, item.convex, name=name)
+        obstacle.geometry()  # read the file now: a broken mesh is a scene error
+    return dataclasses.replace(obstacle, touch_links=links) if links else obstacle
 
 
 def obstacle_to_dict(obstacle: ck.Obstacle) -> dict[str, Any]:
@@ -161,6 +172,8 @@ def obstacle_to_dict(obstacle: ck.Obstacle) -> dict[str, Any]:
             shape="point_cloud", points=np.asarray(obstacle.points).tolist(), resolution=obstacle.resolution
         )
     entry.update(xyz=obstacle.xyz.tolist(), rpy=obstacle.rpy.tolist())
+    if obstacle.touch_links:
+        entry["touch_links"] = list(obstacle.touch_links)
     return entry
 
 
