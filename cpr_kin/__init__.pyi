@@ -16,7 +16,7 @@ from .common.errors import (
     UrdfError,
 )
 from .description.loading import RobotSpec, load_robot
-from .kinematics.carried import carrying
+from .kinematics.carried import carrying, holding_links, left_at, taken_from
 from .kinematics.dynamics import Dynamics, Payload, robot_dynamics
 from .kinematics.forward import frame_poses, frame_positions
 from .kinematics.numerical_ik import IkSettings, IkTarget, solve_ik
@@ -71,6 +71,8 @@ __all__ = [
     "cpr_urdf_path",
     "frame_poses",
     "frame_positions",
+    "holding_links",
+    "left_at",
     "load_cpr",
     "load_robot",
     "motion_radii",
@@ -79,5 +81,6 @@ __all__ = [
     "robot_spec",
     "sampled_configurations",
     "solve_ik",
+    "taken_from",
     "tcp_ik",
 ]

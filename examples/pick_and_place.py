@@ -1,14 +1,16 @@
-"""A pick and place as one task: move, lower the tool, grasp, lift, carry, release.
+"""A pick and place as one task: move, lower the tool, grasp, lift, carry, release, rise.
 
     python examples/pick_and_place.py
 
 ``examples/scenes/pick_and_place.yaml`` holds the task: the CPR among the shelf's obstacles
-moves above the part, lowers the tool 8 cm on a straight line, waits while the gripper
-closes, attaches the part (its 1.5 kg in the torques, its shape in the checks from there on),
-lifts it straight back up, carries it to the far side and releases it. Each segment starts
-where the one before ends, at rest; the whole trajectory is C3 (jerk continuous), within
-every joint limit and torque, its clearance certified along its whole length, and each line's
-deviation certified at every instant. ``cpr-plan plan`` plans the same file from the shell.
+moves above the part (an obstacle of the scene that the tool may touch), lowers the tool 8 cm
+on a straight line, waits while the gripper closes, attaches the part (taken from the world:
+its 1.5 kg in the torques, its shape in the checks from there on), lifts it straight back up,
+carries it to the far side, releases it (an obstacle again, where it is left) and rises
+clear. Each segment starts where the one before ends, at rest; the whole trajectory is C3
+(jerk continuous), within every joint limit and torque, its clearance certified along its
+whole length, and each line's deviation certified at every instant. ``cpr-plan plan`` plans
+the same file from the shell.
 """
 
 from pathlib import Path

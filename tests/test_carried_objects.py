@@ -47,13 +47,24 @@ def test_it_moves_with_its_frame_while_carried_and_rests_before_and_after(robot:
 def test_a_planned_tasks_record_gives_its_own_attaches_and_releases(pick_and_place: PlannedTask) -> None:
     read, task = pick_and_place.read, pick_and_place.task
     record = task_record(task)
-    changes = recorded_changes(read.task, record)
+    robot, trajectory = task.world.robot, task.trajectory
+    changes = recorded_changes(read.scene, robot, trajectory, read.task, record)
     attach = next(s for s in task.segments if s.kind == "attach")
     detach = next(s for s in task.segments if s.kind == "detach")
     assert [(t, p.name if p else None) for t, p in changes] == [(attach.t0, "part"), (detach.t0, None)]
     (span,) = task_carried(task)
     assert (span.name, span.attached_s, span.released_s) == ("part", attach.t0, detach.t0)
-    assert carried_spans(read.scene.payload, changes, task.trajectory.duration) == (span,)
-    assert recorded_changes(read.task[:-1], record) == []  # another task's record: nothing
+    (again,) = carried_spans(read.scene.payload, changes, task.trajectory.duration)
+    assert (again.name, again.frame, again.attached_s, again.released_s) == (
+        span.name,
+        None,
+        attach.t0,
+        detach.t0,
+    )
+    # the part taken from the world: placed in the tool as the record's configuration at the attach holds it
+    np.testing.assert_allclose(
+        again.shape.placement.homogeneous, span.shape.placement.homogeneous, atol=1e-12
+    )
+    assert recorded_changes(read.scene, robot, trajectory, read.task[:-1], record) == []  # another task's
     swapped = [{**entry, "kind": "free"} if entry["kind"] == "attach" else entry for entry in record]
-    assert recorded_changes(read.task, swapped) == []
+    assert recorded_changes(read.scene, robot, trajectory, read.task, swapped) == []

@@ -33,15 +33,15 @@ def test_the_planned_task_passes_its_check_with_the_planners_clearance(
     assert checked.certified_min_clearance_m == pytest.approx(task.certified_min_clearance_m, abs=1e-9)
     assert checked.checks > 100
     moving = [v for v in checked.verifications if v is not None]
-    assert len(moving) == 5  # two free motions, two lines, a wait
+    assert len(moving) == 6  # two free motions, three lines, a wait
 
 
 def test_a_record_of_another_task_is_refused_segment_by_segment(read: SceneFile, task: TaskMotion) -> None:
     record = task_record(task)
     shorter = check_task(read.scene, read.task[:-1], task.trajectory, record)
     assert shorter.problems == (
-        "the trajectory's task is ['free', 'line', 'wait', 'attach', 'line', 'free', 'detach']; "
-        "the scene's is ['free', 'line', 'wait', 'attach', 'line', 'free']",
+        "the trajectory's task is ['free', 'line', 'wait', 'attach', 'line', 'free', 'detach', 'line']; "
+        "the scene's is ['free', 'line', 'wait', 'attach', 'line', 'free', 'detach']",
     )
     renamed = copy.deepcopy(record)
     renamed[3]["object"] = "bolt"

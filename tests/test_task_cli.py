@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import base64
 import copy
 import itertools
 import json
+import re
 from pathlib import Path
 from typing import Any
 
@@ -35,7 +37,7 @@ def planned(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def test_a_task_plans_into_one_file_that_says_what_it_promised(planned: Path) -> None:
     document = json.loads((planned / "trajectory.json").read_text())
     task = document["task"]
-    assert [e["kind"] for e in task] == ["free", "line", "wait", "attach", "line", "free", "detach"]
+    assert [e["kind"] for e in task] == ["free", "line", "wait", "attach", "line", "free", "detach", "line"]
     assert task[0]["t0"] == 0.0 and task[-1]["t1"] == document["knots"][-1]
     for before, after in itertools.pairwise(task):
         assert before["t1"] == after["t0"]
@@ -61,7 +63,7 @@ def test_check_verifies_a_task_and_names_a_broken_promise(
 ) -> None:
     trajectory = planned / "trajectory.json"
     code, stdout, _ = run(["check", str(PICK), str(trajectory)], capsys)
-    assert code == 0 and "a task of 7 segments" in stdout and "every line within its tolerance" in stdout
+    assert code == 0 and "a task of 8 segments" in stdout and "every line within its tolerance" in stdout
     document = json.loads(trajectory.read_text())
     tampered = copy.deepcopy(document)
     tampered["task"][4]["to"]["xyz"][0] += 0.004  # the lift the file names is 4 mm off the one followed
@@ -83,6 +85,9 @@ def test_show_prints_the_timeline_and_export_takes_the_task(
     page = tmp_path / "viewer.html"
     code, stdout, _ = run(["show", str(planned / "trajectory.json"), "--html", str(page)], capsys)
     assert code == 0 and page.stat().st_size > 10_000
+    drawn = b"".join(base64.b64decode(m) for m in re.findall(r"base64,([A-Za-z0-9+/=]+)", page.read_text()))
+    assert b"scene/carried/part" in drawn  # the obstacle the task takes: drawn as what it carries, once
+    assert b"scene/obstacles/part" not in drawn and b"scene/obstacles/crate" in drawn
     lines = stdout.splitlines()
     assert (
         lines[0] == "task:"
@@ -143,3 +148,18 @@ def test_a_bad_task_exits_naming_the_segment_and_writes_nothing(
     assert code == exit_code and stdout == "", stderr
     assert message in stderr and "Traceback" not in stderr and len(stderr.strip().splitlines()) == 1
     assert not out.exists()
+
+
+def test_a_link_an_obstacle_names_that_the_robot_lacks_is_exit_2_and_nothing_written(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    document = yaml.safe_load(PICK.read_text())
+    document["robot"] = str(PICK.parent / document["robot"])
+    part = next(o for o in document["obstacles"] if o["name"] == "part")
+    part["touch_links"] = ["tool_link", "finger"]
+    scene = tmp_path / "typo.yaml"
+    scene.write_text(yaml.safe_dump(document))
+    code, _, err = run(["plan", str(scene), "--out", str(tmp_path / "out")], capsys)
+    assert code == 2 and "Traceback" not in err
+    assert "obstacle 'part' touch_links ['finger'] are not links of the robot" in err and "tool_link" in err
+    assert not (tmp_path / "out").exists()

@@ -32,13 +32,16 @@ def with_task(*entries: Any, **keys: Any) -> dict[str, Any]:
 def test_the_example_task_reads_as_its_segments() -> None:
     read = load_scene_file(PICK)
     kinds = [type(s) for s in read.task]
-    assert kinds == [Move, ToolLine, Wait, Attach, ToolLine, Move, Detach]
+    assert kinds == [Move, ToolLine, Wait, Attach, ToolLine, Move, Detach, ToolLine]
     move, down, wait, attach = read.task[:4]
     assert isinstance(move, Move) and move.goal == Target(tcp=(-0.1, 0.55, 0.45))
     assert isinstance(down, ToolLine) and down.by == (0.0, 0.0, -0.08) and down.offset_frame == "base"
     assert isinstance(wait, Wait) and wait.seconds == 0.3
     assert isinstance(attach, Attach) and attach.payload.mass_kg == 1.5 and attach.payload.name == "part"
-    assert attach.payload.shape is not None and attach.payload.shape.shape == "box"
+    assert attach.payload.shape is None  # it takes the obstacle 'part' (planning.task.holding)
+    assert any(
+        o.name == "part" and o.touch_links == ("tool_link", "wrist_link") for o in read.scene.obstacles
+    )
     assert read.scene.goal == read.scene.start  # a task's scene: its segments say where it goes
 
 
@@ -61,7 +64,7 @@ def test_a_line_to_a_pose_reads_its_quaternion_or_rpy() -> None:
 
 
 def test_load_scene_refuses_a_task_and_says_how_to_plan_it() -> None:
-    with pytest.raises(SceneError, match=r"holds a task of 7 segments.*cpr-plan plan"):
+    with pytest.raises(SceneError, match=r"holds a task of 8 segments.*cpr-plan plan"):
         load_scene(PICK)
 
 

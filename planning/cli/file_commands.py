@@ -91,6 +91,7 @@ def cmd_show(args: argparse.Namespace) -> int:
     from planning.io.publish import write_file
     from planning.io.scene_file import parse_scene_file
     from planning.io.trajectory_reader import read_trajectory
+    from planning.task.holding import untaken
     from planning.viz import artifacts
     from planning.viz.carried_objects import carried_spans, recorded_changes
 
@@ -102,16 +103,17 @@ def cmd_show(args: argparse.Namespace) -> int:
         print(escaped(f"warning: {args.trajectory} {jump}; `cpr-plan check` fails it"), file=sys.stderr)
     read = parse_scene_file(document.scene, source=f"{args.trajectory} (scene)")
     scene, changes = read.scene, []
+    base = shown_robot(document, scene, args.urdf)
+    if base.joint_names != document.joint_names:
+        raise PlanningError(
+            f"trajectory joints {list(document.joint_names)} are not the robot's {list(base.joint_names)}"
+        )
     if document.task is not None:
         print(escaped(timeline(document.task)), flush=True)
-        changes = recorded_changes(read.task, document.task)
+        changes = recorded_changes(scene, base, document.trajectory, read.task, document.task)
     carried = carried_spans(scene.payload, changes, float(document.trajectory.knots[-1]))
-    robot = ck.carrying(shown_robot(document, scene, args.urdf), scene.payload)  # its shape drawn too
-    if robot.joint_names != document.joint_names:
-        raise PlanningError(
-            f"trajectory joints {list(document.joint_names)} are not the robot's {list(robot.joint_names)}"
-        )
-    world = ck.CollisionWorld(robot, scene.obstacles)
+    robot = ck.carrying(base, scene.payload)  # its shape drawn too
+    world = ck.CollisionWorld(robot, untaken(scene.obstacles, (p for _, p in changes)))
     if args.html is not None:
         html = artifacts.viewer_html(
             world, scene.safety_margin, document.trajectory, document.waypoints, args.collision, carried

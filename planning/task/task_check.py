@@ -11,8 +11,9 @@ the trajectory file's ``task`` list) to the scene's task:
 - the trajectory starts at the scene's start, is C3 at every knot, and each free motion ends
   at its goal;
 - each segment that moves or waits is verified as every trajectory of the planner is, with
-  what the robot carries then (the scene's payload, then what ``attach`` and ``detach`` say):
-  certified clearance, joint ranges and limits, torques.
+  what the robot carries then and the world as it is then (the scene's payload and obstacles,
+  then what ``attach`` and ``detach`` change, :mod:`planning.task.holding`): certified
+  clearance, joint ranges and limits, torques.
 """
 
 from __future__ import annotations
@@ -33,6 +34,7 @@ from planning.pipeline.problem import build_problem
 from planning.pipeline.scene import Scene
 from planning.pipeline.target import Target
 from planning.pipeline.verification import Requirements, Verification, verify_finer_where_needed
+from planning.task.holding import scene_after
 from planning.task.segments import KINDS, Attach, Detach, Move, Segment, Wait
 from planning.task.task_record import TIME_TOLERANCE_S, record_problems, recorded_constraint, recorded_pose
 from planning.task.tool_line import ToolLine
@@ -94,12 +96,17 @@ def check_task(
     problems += [] if jump is None else [jump]
     miss = scene.start.miss(base, trajectory(trajectory.knots[0]))
     problems += [] if miss is None else [f"its start is {miss} of the scene's start"]
-    payload, verifications = scene.payload, list[Verification | None]()
+    current, verifications = scene, list[Verification | None]()
     for index, (segment, entry) in enumerate(zip(segments, entries, strict=True)):
         where = f"task[{index}] ({KINDS[type(segment)]})"
         if isinstance(segment, Attach | Detach):
-            payload, wrong = _carried_after(payload, segment, entry)
-            problems += [f"{where} {w}" for w in wrong]
+            before = current
+            try:
+                current = scene_after(current, base, trajectory(float(entry["t0"])), segment)
+            except PlanningError as exc:
+                problems.append(f"{where} {exc}")
+            named = current.payload if isinstance(segment, Attach) else before.payload
+            problems += [f"{where} {w}" for w in _recorded_object(named, entry)]
             verifications.append(None)
             continue
         span = (float(entry["t0"]), float(entry["t1"]))
@@ -115,23 +122,20 @@ def check_task(
         if isinstance(segment, Wait) and abs(span[1] - span[0] - segment.seconds) > TIME_TOLERANCE_S:
             waited = span[1] - span[0]
             problems.append(f"{where} waits {waited:g} s; the task's wait is {segment.seconds:g} s")
-        verification, wrong = _verified(dataclasses.replace(scene, payload=payload), base, segment, piece)
+        verification, wrong = _verified(current, base, segment, piece)
         problems += [f"{where} {w}" for w in wrong]
         verifications.append(verification)
     return TaskCheck(tuple(verifications), tuple(problems))
 
 
-def _carried_after(
-    held: ck.Payload | None, segment: Attach | Detach, entry: Mapping[str, Any]
-) -> tuple[ck.Payload | None, list[str]]:
-    """What the robot carries after ``segment``, and where the record names another object."""
-    named = segment.payload if isinstance(segment, Attach) else held
+def _recorded_object(named: ck.Payload | None, entry: Mapping[str, Any]) -> list[str]:
+    """Where an attach's or detach's record names another object, or another frame, than ``named``."""
     expected = None if named is None else named.name
     wrong = [] if entry.get("object") == expected else [f"names {entry.get('object')!r}, not {expected!r}"]
     frame = None if named is None else named.frame
     if frame is not None and entry.get("frame") != frame:
         wrong.append(f"holds it at frame {entry.get('frame')!r}, not at {frame!r}")
-    return (segment.payload if isinstance(segment, Attach) else None), wrong
+    return wrong
 
 
 def _line_ends(robot: ck.Robot, line: ToolLine, q_start: np.ndarray, entry: Mapping[str, Any]) -> list[str]:

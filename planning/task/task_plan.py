@@ -11,7 +11,8 @@ trajectory of the planner is. The scene's own goal is neither planned to nor nee
 segments say where the robot goes.
 
 :class:`Attach` and :class:`Detach` change what the robot carries from there on: its mass in
-the torques, its shape in the clearance checks, the links it may touch. A scene file's
+the torques, its shape in the clearance checks, the links it may touch; an attach may take an
+obstacle from the world and a detach leaves the object in it (:mod:`planning.task.holding`). A scene file's
 ``task:`` holds the same segments (:mod:`planning.io.task_entry`).
 """
 
@@ -36,6 +37,7 @@ from planning.pipeline.target import Target
 from planning.pipeline.verification import Requirements, Verification
 from planning.task.free_motion import FIXED_DURATION, plan_free
 from planning.task.held_orientation import HeldMotion
+from planning.task.holding import scene_after, untaken
 from planning.task.line_motion import LineMotion, plan_line
 from planning.task.segments import KINDS, Attach, Detach, Move, Segment, Wait, segment_name
 from planning.task.task_timing import PlannedMotion, timed_motions
@@ -80,7 +82,7 @@ class TaskMotion:
         trajectory: the whole motion, at rest at its ends, its waits, attaches and detaches.
         continuity: where the whole is not C3 (``None``: it is, at every knot).
         world: the robot among the scene's obstacles, carrying what it carries at the start
-            (for drawing).
+            (for drawing: without the obstacles the task takes, drawn as what it carries).
         scene: the scene planned in (its start, obstacles, margins, payload at the start).
         task: the segments asked for, in order (``segments`` says how each was planned).
     """
@@ -182,9 +184,9 @@ def plan_task(
         kinds.append(KINDS.get(type(segment), type(segment).__name__))
         try:
             if isinstance(segment, Attach | Detach):
-                held = carrying.scene.payload
+                before = carrying.scene
                 carrying = _carried(carrying, base, q, segment)
-                payloads.append(segment.payload if isinstance(segment, Attach) else held)
+                payloads.append(carrying.scene.payload if isinstance(segment, Attach) else before.payload)
                 planned.append(None)
                 continue
             motion = _planned(carrying, base, q, segment, progress)
@@ -210,6 +212,9 @@ def plan_task(
     robot_names = carrying.problem.robot.joint_names
     units = [carrying.problem.robot.joint_unit(n) for n in robot_names]
     continuity = discontinuity(whole, robot_names, units)
+    drawn = untaken(start_world.obstacles, payloads)
+    if len(drawn) < len(start_world.obstacles):  # the task takes some: drawn as what it carries
+        start_world = ck.CollisionWorld(start_world.robot, drawn, num_threads=start_world.num_threads)
     return TaskMotion(tuple(records), whole, continuity, start_world, scene, tuple(segments))
 
 
@@ -225,20 +230,8 @@ def _carrying(scene: Scene, base: ck.Robot, q: FloatArray | None, threads: int |
 
 
 def _carried(carrying: _Carrying, base: ck.Robot, q: FloatArray, segment: Attach | Detach) -> _Carrying:
-    """What the robot carries after ``segment``, checked at ``q``."""
-    held = carrying.scene.payload
-    if isinstance(segment, Detach):
-        if held is None:
-            raise PlanningError("detach: the robot carries nothing here (attach a payload first)")
-        if segment.name is not None and segment.name != held.name:
-            raise PlanningError(
-                f"detach: name = {segment.name!r}, but the robot carries {held.name!r}; name it, or leave "
-                "the name out"
-            )
-        return _carrying(dataclasses.replace(carrying.scene, payload=None), base, q, carrying.threads)
-    if held is not None:
-        raise PlanningError(f"attach: the robot already carries '{held.name}' (detach it first)")
-    return _carrying(dataclasses.replace(carrying.scene, payload=segment.payload), base, q, carrying.threads)
+    """What it carries after ``segment``, the world it leaves (:func:`scene_after`), checked at ``q``."""
+    return _carrying(scene_after(carrying.scene, base, q, segment), base, q, carrying.threads)
 
 
 def _planned(

@@ -18,6 +18,9 @@ from numpy.typing import NDArray
 
 import cpr_kin as ck
 from planning.curves.trajectory import Trajectory
+from planning.errors import PlanningError
+from planning.pipeline.scene import Scene
+from planning.task.holding import scene_after
 from planning.task.segments import KINDS, Attach, Detach, Segment
 
 FloatArray = NDArray[np.float64]
@@ -76,13 +79,19 @@ def carried_poses(
 
 
 def recorded_changes(
-    task: Sequence[Segment], record: Sequence[Mapping[str, Any]]
+    scene: Scene,
+    robot: ck.Robot,
+    trajectory: Trajectory,
+    task: Sequence[Segment],
+    record: Sequence[Mapping[str, Any]],
 ) -> list[tuple[float, ck.Payload | None]]:
     """A task's attaches and releases, ``(t, payload)`` as :func:`carried_spans` takes them.
 
-    ``task``: its segments (the objects' shapes); ``record``: the trajectory file's ``task``
-    list, entry by entry the segments' (their times ``t0`` [s]). None where the two are not
-    one task's (other lengths or kinds: ``cpr-plan check`` says why).
+    ``task``: its segments in ``scene``; ``record``: the trajectory file's ``task`` list, entry
+    by entry the segments' (their times ``t0`` [s]). An attach of an obstacle carries its
+    shape as placed where ``trajectory`` takes it (:func:`planning.task.holding.scene_after`,
+    ``robot`` placing it). None where the two are not one task's (other lengths or kinds, an
+    attach or release the task cannot make: ``cpr-plan check`` says why).
     """
     if len(task) != len(record):
         return []
@@ -93,5 +102,9 @@ def recorded_changes(
         t0 = entry.get("t0")
         if entry.get("kind") != KINDS[type(segment)] or not isinstance(t0, int | float):
             return []
-        changes.append((float(t0), segment.payload if isinstance(segment, Attach) else None))
+        try:
+            scene = scene_after(scene, robot, trajectory(float(t0)), segment)
+        except PlanningError:
+            return []
+        changes.append((float(t0), scene.payload))
     return changes
