@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 import pytest
+import trimesh
 
 import cpr_kin as ck
 from planning.errors import PlanningError
@@ -50,6 +52,13 @@ def test_a_detach_leaves_the_object_where_its_frame_holds_it_for_the_hand_to_tou
     assert set(left.touch_links) == {"tool_link", "wrist_link", "arm_link"} == ck.holding_links(base, held)
     mass_only = scene_after(_scene(payload=ck.Payload(0.5, name="load")), base, Q, Detach())
     assert mass_only.obstacles == () and mass_only.payload is None
+
+
+def test_a_mesh_is_left_as_it_was_carried_its_convex_hull(base: ck.Robot, tmp_path: Path) -> None:
+    trimesh.creation.box(extents=(0.04, 0.04, 0.04)).export(tmp_path / "part.stl")
+    surface = ck.Obstacle.from_mesh(tmp_path / "part.stl", (0, 0, 0.03), convex=False, name="part")
+    left = ck.left_at(base, ck.Payload(0.5, shape=surface, name="part"), Q)
+    assert left.shape == "mesh" and left.convex and left.mesh == surface.mesh
 
 
 def test_an_attach_takes_the_obstacle_where_it_is_and_a_detach_gives_it_back(base: ck.Robot) -> None:

@@ -54,9 +54,7 @@ def carrying(robot: Robot, payload: Payload | None) -> Robot:
             f"{sorted({g.link for g in robot.geometries})}"
         )
     collision = robot.collision_model.copy()
-    shape = (
-        payload.shape if payload.shape.shape != "mesh" else dataclasses.replace(payload.shape, convex=True)
-    )
+    shape = _hull(payload.shape)
     index = collision.addGeometryObject(_shape_object(robot, shape, payload.name, frame_id))
     held_by = holding_links(robot, payload)
     pairs = [(g.index, index) for g in robot.geometries if g.link not in held_by]
@@ -89,7 +87,8 @@ def holding_links(robot: Robot, payload: Payload) -> frozenset[str]:
 def left_at(robot: Robot, payload: Payload, q: ArrayLike) -> Obstacle:
     """``payload``'s shape as an obstacle where it is with the robot at ``q`` [rad, m], named after it.
 
-    Its :func:`holding_links` may touch it (the hand that let it go).
+    Its :func:`holding_links` may touch it (the hand that let it go); a mesh is its convex hull,
+    as it was carried.
 
     Raises:
         CprKinError: the payload has no shape (nothing is left), or a frame not the robot's.
@@ -99,7 +98,7 @@ def left_at(robot: Robot, payload: Payload, q: ArrayLike) -> Obstacle:
     frame_in_world = frame_poses(robot, q, payload.frame or robot.tcp_frame)
     shape_in_world = pin.SE3(frame_in_world) * payload.shape.placement
     return dataclasses.replace(
-        payload.shape,
+        _hull(payload.shape),
         name=payload.name,
         xyz=shape_in_world.translation,
         rpy=pin.rpy.matrixToRpy(shape_in_world.rotation),
@@ -132,6 +131,11 @@ def taken_from(robot: Robot, payload: Payload, obstacle: Obstacle, q: ArrayLike)
     )
     links = tuple(dict.fromkeys((*payload.touch_links, *obstacle.touch_links)))
     return dataclasses.replace(payload, shape=shape, touch_links=links)
+
+
+def _hull(shape: Obstacle) -> Obstacle:
+    """``shape`` as a carried object is checked: a mesh by its convex hull."""
+    return dataclasses.replace(shape, convex=True) if shape.shape == "mesh" else shape
 
 
 def _shape_object(robot: Robot, shape: Obstacle, name: str, frame_id: int) -> Any:
