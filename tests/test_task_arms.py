@@ -24,6 +24,7 @@ import cpr_kin as ck
 from cpr_kin.model.packages import package_roots
 from planning.io.robot_entry import robot_spec_of
 from planning.io.scene_file import SceneFile, parse_scene_file
+from planning.io.shape_entry import obstacle_to_dict
 from planning.task import TaskMotion, check_task, plan_task, task_record
 
 DOWN = [3.14159265, 0.0, 0.0]
@@ -167,6 +168,63 @@ def test_the_exact_link_meshes_and_the_part_keep_the_margin(planned: tuple[Scene
             least = min(least, result.min_distance)
     assert least >= read.scene.safety_margin - 1e-6
     assert least <= task.certified_min_clearance_m + 0.05  # the same motion: near the certified figure
+
+
+def test_the_can_taken_from_where_it_stands_and_left_is_kept_clear_of_every_other_link(
+    planned: tuple[SceneFile, TaskMotion],
+) -> None:
+    """The same task with the can an obstacle until the attach takes it and again where it is left."""
+    read, task = planned
+    arm = read.scene.name.removesuffix("_pick_and_place")
+    robot, attach = task.world.robot, task.segments[3]
+    assert attach.payload is not None
+    standing = ck.left_at(robot, attach.payload, task.trajectory(attach.t0))  # where the gripper finds it
+    holding = sorted(ck.holding_links(robot, attach.payload))  # the hand's links, as while it carries the can
+    can = obstacle_to_dict(standing) | {"name": "can", "touch_links": holding}
+    document = copy.deepcopy(TASK)
+    document[3]["attach"] = {"name": "can", "mass_kg": ARMS[arm]["mass_kg"], "com_in_tcp": [0.0, 0.0, 0.04]}
+    scene = {"robot": arm, "safety_margin": 0.02, "start": {"q": ARMS[arm]["start"]}, "task": document}
+    taking = parse_scene_file(scene | {"obstacles": [POST, can]}, f"{arm} task")
+    planned_again = plan_task(taking.scene, taking.task)
+    assert planned_again.accepted, planned_again.problems
+    assert check_task(
+        taking.scene, taking.task, planned_again.trajectory, task_record(planned_again)
+    ).accepted
+    # independently: coal on the URDF's exact meshes of every link but the gripper's, against the can
+    # where it stands before the attach and where it is left after the detach
+    trajectory, taken, left = planned_again.trajectory, planned_again.segments[3], planned_again.segments[7]
+    released = ck.left_at(robot, taken.payload, trajectory(left.t0))  # type: ignore[arg-type]
+    urdf = Path(robot.urdf_path)
+    geometry = pin.buildGeomFromUrdf(
+        robot.model, str(urdf), pin.COLLISION, package_dirs=[str(p) for p in package_roots(urdf)]
+    )
+    data, geometry_data = robot.model.createData(), geometry.createData()
+    others = [
+        k
+        for k, g in enumerate(geometry.geometryObjects)
+        if robot.model.frames[g.parentFrame].name not in holding
+    ]
+    least = np.inf
+    for t in np.arange(0.0, trajectory.duration, 2e-3):
+        if taken.t0 <= t <= left.t0:
+            continue  # carried: the planner's own check of what it carries (the tests above)
+        where = standing if t < taken.t0 else released
+        pin.framesForwardKinematics(robot.model, data, trajectory(t))
+        pin.updateGeometryPlacements(robot.model, data, geometry, geometry_data)
+        at = where.placement
+        for k in others:
+            placement = geometry_data.oMg[k]
+            result = coal.DistanceResult()
+            coal.distance(
+                geometry.geometryObjects[k].geometry,
+                coal.Transform3s(placement.rotation, placement.translation),
+                where.geometry(),
+                coal.Transform3s(at.rotation, at.translation),
+                coal.DistanceRequest(),
+                result,
+            )
+            least = min(least, result.min_distance)
+    assert least >= taking.scene.safety_margin - 1e-6
 
 
 @pytest.mark.parametrize("arm", ["xarm7", "z1", "ur10"])
