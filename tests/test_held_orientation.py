@@ -18,7 +18,7 @@ import pytest
 import cpr_kin as ck
 from cpr_kin.kinematics.numerical_ik import IkTarget, solve_ik
 from cpr_kin.model.packages import example_robot
-from planning.errors import PlanningError
+from planning.errors import NoSolutionError, PlanningError
 from planning.io.scene_file import SceneFile, parse_scene_file
 from planning.pipeline.verification import Requirements
 from planning.task import Move, TaskMotion, check_task, plan_task, record_problems, task_record
@@ -133,3 +133,25 @@ def test_rrt_on_the_constraint_finds_an_upright_way_around_a_post_where_the_stra
     assert world.keeps_clearance(path, 0.02 + STEP_M, 0.01).all()
     radii = ck.motion_radii(robot)
     assert (np.abs(np.diff(path, axis=0)) @ radii).max() <= 2 * STEP_M + 1e-9
+
+
+def test_a_bent_path_that_cannot_be_timed_gives_way_to_one_planned_on_the_constraint(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """As a UR5's bent path did on one machine: a corner it can pass only at rest (MemoryError before)."""
+    import planning.task.held_orientation as held
+
+    timed, calls = held._timed, []
+
+    def first_fails(projector: Projector, path: Any, required: Requirements) -> Any:
+        calls.append(path)
+        if len(calls) == 1:
+            raise NoSolutionError("the path cannot be timed: at the limits it takes 6.5e+09 s")
+        return timed(projector, path, required)
+
+    monkeypatch.setattr(held, "_timed", first_fails)
+    read = scene_file("ur5")  # its free path bends onto the constraint clear of the post
+    task = plan_task(read.scene, read.task)
+    carry = task.segments[2].held
+    assert task.accepted and carry is not None and not carry.bent and len(calls) >= 2
+    assert check_task(read.scene, read.task, task.trajectory, task_record(task)).accepted

@@ -17,12 +17,17 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cpr_kin.common.compiled import njit
-from planning.curves.phase_plane import profile_instants
+from planning.curves.phase_plane import profile_instants, profile_time
+from planning.errors import NoSolutionError
 
 FloatArray = NDArray[np.float64]
 
 
-@njit
+LONGEST_MOTION_S = 3600.0
+"""Longest motion along a path that is sampled [s]: a profile slower than this stops (or all but
+stops) somewhere inside the path, at a point it can pass only at rest (a corner)."""
+
+
 def arc_at_times(x: FloatArray, ds: FloatArray, step_s: float) -> FloatArray:
     """Arc length ``s`` every ``step_s`` along a phase-plane profile, and at its end.
 
@@ -32,7 +37,23 @@ def arc_at_times(x: FloatArray, ds: FloatArray, step_s: float) -> FloatArray:
         step_s: time step [s].
 
     Between grid points the path acceleration ``s''`` is constant, so ``s(t)`` is exact.
+
+    Raises:
+        NoSolutionError: the profile takes more than :data:`LONGEST_MOTION_S` (its samples
+            would not fit in memory; the path cannot be passed without stopping inside it).
     """
+    total_s = profile_time(x, ds)
+    if not total_s <= LONGEST_MOTION_S:
+        raise NoSolutionError(
+            f"the path cannot be timed: at the limits it takes {total_s:.3g} s, more than "
+            f"{LONGEST_MOTION_S:g} s (it stops inside, at a point it can pass only at rest, such as a corner)"
+        )
+    return _arc_at_times(x, ds, step_s)
+
+
+@njit
+def _arc_at_times(x: FloatArray, ds: FloatArray, step_s: float) -> FloatArray:
+    """:func:`arc_at_times`, compiled."""
     count = len(x)
     speed = np.sqrt(np.maximum(x, 0.0))
     starts = profile_instants(x, ds)  # time at each grid point

@@ -99,21 +99,27 @@ def hold_orientation(
                 f"about {list(constraint.axes)}; allowed {constraint.angle_rad:.4g} rad: give a {label} that "
                 "keeps it (a pose goal with that orientation)"
             )
-    bent = True
     try:
-        samples = _bent(projector, _raw_samples(free))
-        _refuse_blocked(world, samples, required)
-    except NoSolutionError as why:
-        bent = False
+        bent = _bent(projector, _raw_samples(free))
+        _refuse_blocked(world, bent, required)
+        return _held(world, projector, bent, required, bent=True)
+    except NoSolutionError as why:  # blocked, or it cannot be joined or timed (a corner it made)
         try:
             rng = np.random.default_rng(seed)
-            samples = orientation_path(world, projector, ends[0], ends[1], required, rng)
-        except NoSolutionError as planned:
-            raise NoSolutionError(f"the free path bent onto the constraint: {why}; {planned}") from None
+            planned = orientation_path(world, projector, ends[0], ends[1], required, rng)
+        except NoSolutionError as failed:
+            raise NoSolutionError(f"the free path bent onto the constraint: {why}; {failed}") from None
+    return _held(world, projector, planned, required, bent=False)
+
+
+def _held(
+    world: ck.CollisionWorld, projector: Projector, samples: FloatArray, required: Requirements, bent: bool
+) -> HeldMotion:
+    """The samples joined by a spline on it, refused where blocked, timed; ``bent``: how found."""
     samples, path = _joined(projector, samples)
     _refuse_blocked(world, samples, required)
     trajectory, deviation = _timed(projector, path, required)
-    return HeldMotion(constraint, frame, samples, path, trajectory, deviation, bent)
+    return HeldMotion(projector.constraint, projector.frame, samples, path, trajectory, deviation, bent)
 
 
 def _raw_samples(free: Trajectory) -> FloatArray:
