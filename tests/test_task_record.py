@@ -60,3 +60,6 @@ def test_the_promises_hold_and_a_tampered_one_is_caught(task: TaskMotion) -> Non
     assert any("(wait) moves during" in p for p in found) and any("after the last ended" in p for p in found)
     with pytest.raises(PlanningError, match="task entry 0 has no 't1'"):
         record_problems(robot, task.trajectory, [{"kind": "free", "t0": 0.0}])
+    for hostile in ("x", None, True, float("nan"), [0.0]):  # before: an internal error
+        with pytest.raises(PlanningError, match=r"task entry 0 't0' = .*; it must be a finite time \[s\]"):
+            record_problems(robot, task.trajectory, [{"kind": "free", "t0": hostile, "t1": 1.0}])

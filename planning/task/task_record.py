@@ -25,6 +25,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 import cpr_kin as ck
+from cpr_kin.common.names import shown
 from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
 from planning.task.line_deviation import line_deviation
@@ -91,11 +92,8 @@ def record_problems(
     problems = []
     end = float(trajectory.knots[0])
     for index, entry in enumerate(entries):
-        kind, t0, t1 = (
-            _field(entry, "kind", index),
-            float(_field(entry, "t0", index)),
-            float(_field(entry, "t1", index)),
-        )
+        kind = _field(entry, "kind", index)
+        t0, t1 = _seconds(entry, "t0", index), _seconds(entry, "t1", index)
         if abs(t0 - end) > TIME_TOLERANCE_S or t1 < t0:
             problems.append(
                 f"task entry {index} ({kind}) runs [{t0:g}, {t1:g}] s after the last ended at {end:g} s"
@@ -160,6 +158,14 @@ def _field(entry: Mapping[str, Any], key: str, index: int) -> Any:
             "(a line also frame, from, to, tolerance)"
         )
     return entry[key]
+
+
+def _seconds(entry: Mapping[str, Any], key: str, index: int) -> float:
+    """An entry's time ``key`` [s]: a finite number, else the entry's error naming the value."""
+    value = _field(entry, key, index)
+    if isinstance(value, bool) or not isinstance(value, int | float) or not np.isfinite(value):
+        raise PlanningError(f"task entry {index} '{key}' = {shown(value)}; it must be a finite time [s]")
+    return float(value)
 
 
 def recorded_constraint(given: Any, where: str) -> tuple[OrientationConstraint, str]:
