@@ -244,3 +244,17 @@ def test_a_start_payload_released_is_drawn_apart_from_the_robot(robot: ck.Robot,
     # drawn apart, the robot model's own ball gone (it would go on moving with the tool)
     assert b"scene/carried/ball" in apart and b"cpr/visuals/ball" not in apart
     assert carrying.collision_model.existGeometryName("ball")  # the robot itself still carries it
+
+
+def test_a_tasks_path_is_coloured_by_what_its_checks_measured(pick_and_place: PlannedTask) -> None:
+    from planning.viz.measured_clearance import task_clearance
+
+    task = pick_and_place.task
+    measured = task_clearance(task)
+    with Viewer(task.world, task.margin_m) as viewer:
+        drawn = viewer.show_plan(task.trajectory, task.junctions, measured=measured)
+        own = viewer.show_plan(task.trajectory, task.junctions)  # the drawn world's, without the part
+    np.testing.assert_array_equal(drawn["clearance"], measured.at(drawn["times"]))
+    # the part, waiting and left behind, comes closest: the drawn world alone would colour it clearer
+    assert drawn["clearance"].min() < own["clearance"].min() - 0.01
+    assert drawn["clearance"].min() >= task.margin_m

@@ -15,6 +15,7 @@ import cpr_kin as ck
 from planning.curves.trajectory import Trajectory
 from planning.pipeline.result import PlanResult
 from planning.viz.carried_objects import CarriedSpan, carried_spans
+from planning.viz.measured_clearance import MeasuredClearance, task_clearance
 
 if TYPE_CHECKING:  # the task planner is imported where a task is drawn
     from planning.task.task_plan import TaskMotion
@@ -53,7 +54,12 @@ def task_drawn_files(task: TaskMotion, plots: bool = True, page: bool = True) ->
         files |= {n: drawing.png_bytes(f) for n, f in zip(TASK_PLOT_FILES, figures, strict=True)}
     if page:
         files["viewer.html"] = viewer_html(
-            task.world, scene.safety_margin, trajectory, task.junctions, carried=task_carried(task)
+            task.world,
+            scene.safety_margin,
+            trajectory,
+            task.junctions,
+            carried=task_carried(task),
+            measured=task_clearance(task),
         )
     return files
 
@@ -97,19 +103,22 @@ def viewer_html(
     waypoints: NDArray[np.float64],
     collision: bool = False,
     carried: tuple[CarriedSpan, ...] = (),
+    *,
+    measured: MeasuredClearance | None = None,
 ) -> str:
     """One self-contained HTML page of the plan, animated.
 
     It shows the world's robot and obstacles, the margin, waypoints, TCP path and the trajectory,
-    and what it ``carried`` (:meth:`~planning.viz.viewer.Viewer.show_carried`); a loopback
-    meshcat server runs while it is made.
+    and what it ``carried`` (:meth:`~planning.viz.viewer.Viewer.show_carried`); the path is
+    coloured by the ``measured`` clearance where given (a task's), else by the world's. A
+    loopback meshcat server runs while it is made.
     """
     from planning.viz.viewer import Viewer
 
     with Viewer(world, margin_m) as viewer:
         viewer.show_geometry(visual=not collision, collision=collision)
         viewer.show_carried(trajectory, carried)
-        viewer.show_plan(trajectory, waypoints)
+        viewer.show_plan(trajectory, waypoints, measured=measured)
         viewer.animate(trajectory)
         return viewer.static_html()
 
@@ -128,9 +137,14 @@ def notebook_viewer(result: PlanResult | TaskMotion, height_px: int = 480, colli
     from planning.task.task_plan import TaskMotion
 
     if isinstance(result, TaskMotion):
-        carried = task_carried(result)
         page = viewer_html(
-            result.world, result.margin_m, result.trajectory, result.junctions, collision, carried
+            result.world,
+            result.margin_m,
+            result.trajectory,
+            result.junctions,
+            collision,
+            task_carried(result),
+            measured=task_clearance(result),
         )
     else:
         page = viewer_html(

@@ -37,6 +37,7 @@ from pinocchio.visualize import MeshcatVisualizer
 import cpr_kin as ck
 from planning.curves.trajectory import Trajectory
 from planning.viz.carried_objects import CarriedSpan, carried_poses
+from planning.viz.measured_clearance import MeasuredClearance
 from planning.viz.viewer_server import ServerProcess, start_server
 
 FloatArray = NDArray[np.float64]
@@ -175,16 +176,26 @@ class Viewer:
         finally:
             view.viewer = previous
 
-    def show_plan(self, trajectory: Trajectory, waypoints: FloatArray, samples: int = 400) -> dict[str, Any]:
+    def show_plan(
+        self,
+        trajectory: Trajectory,
+        waypoints: FloatArray,
+        samples: int = 400,
+        *,
+        measured: MeasuredClearance | None = None,
+    ) -> dict[str, Any]:
         """Draw the waypoints, the TCP path coloured by clearance and the closest pair.
 
-        Returns what was drawn: ``times``, ``tcp`` positions, ``clearance`` and the
+        The clearance: the world's at each sample, or what the certified checks ``measured``
+        (a task's, each segment's in its own world: :mod:`planning.viz.measured_clearance`).
+        Returns what was drawn: ``times``, ``tcp`` positions, ``clearance`` and the world's
         ``closest`` pair at the instant of smallest clearance.
         """
         times = np.linspace(trajectory.knots[0], trajectory.knots[-1], samples)
         configurations = trajectory(times)
         tcp = ck.frame_positions(self.robot, configurations)
-        clearance = self.world.clearance_batch(configurations).min_clearance_m
+        world = self.world.clearance_batch
+        clearance = world(configurations).min_clearance_m if measured is None else measured.at(times)
         for i, q in enumerate(np.atleast_2d(waypoints)):
             marker = self.vis["scene/waypoints"][str(i)]
             marker.set_object(g.Sphere(0.015), _material(WAYPOINT_COLOR))
