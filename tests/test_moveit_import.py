@@ -740,6 +740,18 @@ def test_links_the_matrix_lets_touch_a_world_object_are_its_obstacles_touch_link
     checked = {(link[g], o) for g, o, _ in ck.CollisionWorld(robot, scene_read.obstacles).pairs}
     assert ("panda_link0", "post_0") not in checked and ("panda_link0", "lamp_0") in checked
     assert ("panda_link1", "post_0") in checked
+    # a link's default entry true: it may touch anything, every object too (MoveIt's rule)
+    scene = changed(scene, "allowed_collision_matrix.default_entry_names", ["panda_link1"])
+    scene = changed(scene, "allowed_collision_matrix.default_entry_values", [True])
+    out = tmp_path / "default.yaml"
+    assert main(["import-moveit", *write(tmp_path, scene, REQUEST), "--out", str(out)]) == 0
+    touching = {o.name: o.touch_links for o in load_scene(out).obstacles}
+    assert touching == {
+        "post_0": ("panda_link0", "panda_link1"),
+        "post_1": ("panda_link0", "panda_link1"),
+        "lamp_0": ("panda_link1",),
+        "lamp_1": ("panda_link1",),
+    }
 
 
 def test_contact_between_the_attached_object_and_a_world_object_is_refused(

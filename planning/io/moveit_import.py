@@ -24,12 +24,11 @@
 - **Attached object:** the robot state's one attached collision object becomes the scene's
   ``payload`` (:mod:`planning.io.moveit_attached`).
 
-What would change the problem and has no counterpart (path or trajectory
-constraints, an octomap, padding, velocity scaling other than 0 or 1, a robot base placed
-away from the world's origin, allowed contact between the attached object and a world object) is
-refused naming it; what only
-steers MoveIt's own planner (planner id, pipeline, attempts, workspace) is listed as ignored
-(:mod:`planning.io.moveit_support`). :mod:`planning.io.moveit_write` writes the result.
+What would change the problem and has no counterpart (path or trajectory constraints,
+padding, velocity scaling other than 0 or 1, a robot base placed away from the world's origin,
+allowed contact between the attached object and a world object) is refused naming it; what
+only steers MoveIt's own planner (planner id, pipeline, attempts, workspace) is listed as
+ignored (:mod:`planning.io.moveit_support`). :mod:`planning.io.moveit_write` writes the result.
 """
 
 from __future__ import annotations

@@ -50,5 +50,6 @@ def allowed_pairs(
 
 
 def links_allowed_to_touch(matrix: AllowedCollisionMatrix, name: str, links: set[str]) -> set[str]:
-    """The links the matrix allows to touch ``name`` (an attached object's id)."""
-    return {a if b == name else b for a, b in _pairs(matrix, links) if name in (a, b)} & links
+    """The links the matrix allows to touch ``name`` (an object's id), a link's default entry ``true`` too."""
+    anything = {n for n, v in zip(matrix.default_entry_names, matrix.default_entry_values, strict=False) if v}
+    return ({a if b == name else b for a, b in _pairs(matrix, links) if name in (a, b)} | anything) & links
