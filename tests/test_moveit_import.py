@@ -740,15 +740,16 @@ def test_links_the_matrix_lets_touch_a_world_object_are_its_obstacles_touch_link
     checked = {(link[g], o) for g, o, _ in ck.CollisionWorld(robot, scene_read.obstacles).pairs}
     assert ("panda_link0", "post_0") not in checked and ("panda_link0", "lamp_0") in checked
     assert ("panda_link1", "post_0") in checked
-    # a link's default entry true: it may touch anything, every object too (MoveIt's rule)
+    # a link's default entry true: it may touch what the matrix has no entry with (the lamp), not the
+    # post, whose entry with it says false (MoveIt's rule: the pair's entry comes first)
     scene = changed(scene, "allowed_collision_matrix.default_entry_names", ["panda_link1"])
     scene = changed(scene, "allowed_collision_matrix.default_entry_values", [True])
     out = tmp_path / "default.yaml"
     assert main(["import-moveit", *write(tmp_path, scene, REQUEST), "--out", str(out)]) == 0
     touching = {o.name: o.touch_links for o in load_scene(out).obstacles}
     assert touching == {
-        "post_0": ("panda_link0", "panda_link1"),
-        "post_1": ("panda_link0", "panda_link1"),
+        "post_0": ("panda_link0",),
+        "post_1": ("panda_link0",),
         "lamp_0": ("panda_link1",),
         "lamp_1": ("panda_link1",),
     }
@@ -878,3 +879,20 @@ def test_a_urdf_origin_that_is_not_three_numbers_is_named(
     assert main(["import-moveit", *arguments, "--out", str(tmp_path / "o.yaml")]) == 2
     error = capsys.readouterr().err
     assert f"URDF file '{urdf}' cannot be read (ValueError: could not convert string to float: 'zz')" in error
+
+
+def test_a_default_entry_yields_to_the_pairs_own_entry_as_in_moveit() -> None:
+    from planning.io.moveit_matrix import allowed_pairs, links_allowed_to_touch
+    from planning.io.moveit_messages import AllowedCollisionMatrix
+
+    matrix = AllowedCollisionMatrix(
+        entry_names=["a", "b", "box"],
+        entry_values=[[False, False, False], [False, False, True], [False, True, False]],
+        default_entry_names=["a"],
+        default_entry_values=[True],
+    )
+    links = {"a", "b", "c"}
+    # a touches c (no entry: its default), not b (their entry says false); b touches the box (entry)
+    assert allowed_pairs(matrix, links, {"box", "ball"}, set()) == [["a", "c"]]
+    assert links_allowed_to_touch(matrix, "box", links) == {"b"}
+    assert links_allowed_to_touch(matrix, "ball", links) == {"a"}  # no entry with a: its default

@@ -1,7 +1,8 @@
 """A MoveIt allowed-collision matrix as a scene file's ``allowed_collisions``: robot-link pairs.
 
 A pair is allowed when either of its two entries is ``true``; a default entry ``true`` allows
-its name with every link. Contact between a link and an object, of the world or attached, is
+its name with every other name the matrix has no entry with (MoveIt's rule: an entry of the
+pair comes first). Contact between a link and an object, of the world or attached, is
 the object's ``touch_links`` (:func:`links_allowed_to_touch`); contact between the attached
 object and one of the world has no counterpart (what the robot carries is checked against
 every obstacle) and is refused; two objects of the world are never checked against each other.
@@ -12,8 +13,8 @@ from __future__ import annotations
 from planning.io.moveit_messages import AllowedCollisionMatrix, MoveItImportError
 
 
-def _pairs(matrix: AllowedCollisionMatrix, links: set[str]) -> set[tuple[str, str]]:
-    """Every pair of names the matrix allows to touch, sorted within the pair."""
+def _pairs(matrix: AllowedCollisionMatrix, others: set[str]) -> set[tuple[str, str]]:
+    """Every pair of names the matrix allows to touch, sorted within the pair; defaults with ``others``."""
     names = matrix.entry_names
     if len(matrix.entry_values) != len(names) or any(len(row) != len(names) for row in matrix.entry_values):
         raise MoveItImportError(
@@ -25,9 +26,10 @@ def _pairs(matrix: AllowedCollisionMatrix, links: set[str]) -> set[tuple[str, st
         for j in range(i + 1, len(names))
         if matrix.entry_values[i][j] or matrix.entry_values[j][i]
     }
+    listed = set(names)
     for name, value in zip(matrix.default_entry_names, matrix.default_entry_values, strict=False):
-        if value:
-            pairs |= {tuple(sorted((name, link))) for link in links if link != name}
+        if value:  # but where the matrix has an entry of the pair
+            pairs |= {tuple(sorted((name, o))) for o in others if o != name and not {name, o} <= listed}
     return {(a, b) for a, b in pairs}
 
 
@@ -50,6 +52,5 @@ def allowed_pairs(
 
 
 def links_allowed_to_touch(matrix: AllowedCollisionMatrix, name: str, links: set[str]) -> set[str]:
-    """The links the matrix allows to touch ``name`` (an object's id), a link's default entry ``true`` too."""
-    anything = {n for n, v in zip(matrix.default_entry_names, matrix.default_entry_values, strict=False) if v}
-    return ({a if b == name else b for a, b in _pairs(matrix, links) if name in (a, b)} | anything) & links
+    """The links the matrix allows to touch ``name`` (an object's id), by their entries or defaults."""
+    return {a if b == name else b for a, b in _pairs(matrix, links | {name}) if name in (a, b)} & links
