@@ -896,3 +896,6 @@ def test_a_default_entry_yields_to_the_pairs_own_entry_as_in_moveit() -> None:
     assert allowed_pairs(matrix, links, {"box", "ball"}, set()) == [["a", "c"]]
     assert links_allowed_to_touch(matrix, "box", links) == {"b"}
     assert links_allowed_to_touch(matrix, "ball", links) == {"a"}  # no entry with a: its default
+    defaults = {"default_entry_names": ["a", "c"], "default_entry_values": [True, False]}
+    never = matrix.model_copy(update=defaults)
+    assert allowed_pairs(never, links, set(), set()) == []  # of two defaults, false wins

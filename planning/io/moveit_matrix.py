@@ -1,11 +1,12 @@
 """A MoveIt allowed-collision matrix as a scene file's ``allowed_collisions``: robot-link pairs.
 
 A pair is allowed when either of its two entries is ``true``; a default entry ``true`` allows
-its name with every other name the matrix has no entry with (MoveIt's rule: an entry of the
-pair comes first). Contact between a link and an object, of the world or attached, is
-the object's ``touch_links`` (:func:`links_allowed_to_touch`); contact between the attached
-object and one of the world has no counterpart (what the robot carries is checked against
-every obstacle) and is refused; two objects of the world are never checked against each other.
+its name with every other name the matrix has no entry with, but one whose default is ``false``
+(MoveIt's rule: the pair's entry comes first, and of two defaults ``false`` wins). Contact
+between a link and an object, of the world or attached, is the object's ``touch_links``
+(:func:`links_allowed_to_touch`); contact between the attached object and one of the world
+has no counterpart (what the robot carries is checked against every obstacle) and is refused;
+two objects of the world are never checked against each other.
 """
 
 from __future__ import annotations
@@ -27,9 +28,13 @@ def _pairs(matrix: AllowedCollisionMatrix, others: set[str]) -> set[tuple[str, s
         if matrix.entry_values[i][j] or matrix.entry_values[j][i]
     }
     listed = set(names)
-    for name, value in zip(matrix.default_entry_names, matrix.default_entry_values, strict=False):
-        if value:  # but where the matrix has an entry of the pair
-            pairs |= {tuple(sorted((name, o))) for o in others if o != name and not {name, o} <= listed}
+    default = dict(zip(matrix.default_entry_names, matrix.default_entry_values, strict=False))
+    for name in (n for n, allowed in default.items() if allowed):  # not where the pair has an entry,
+        pairs |= {  # nor where the other's default is false
+            tuple(sorted((name, o)))
+            for o in others
+            if o != name and not {name, o} <= listed and default.get(o, True)
+        }
     return {(a, b) for a, b in pairs}
 
 
