@@ -755,7 +755,7 @@ def test_links_the_matrix_lets_touch_a_world_object_are_its_obstacles_touch_link
     }
 
 
-def test_contact_between_the_attached_object_and_a_world_object_is_refused(
+def test_world_objects_the_attached_one_may_touch_are_the_payloads_touch_obstacles(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     scene = changed(SCENE, "robot_state.attached_collision_objects", [PART])
@@ -765,11 +765,14 @@ def test_contact_between_the_attached_object_and_a_world_object_is_refused(
         "allowed_collision_matrix.entry_values",
         [[False, False, False], [False, False, True], [False, True, False]],
     )
-    out = tmp_path / "refused.yaml"
-    assert main(["import-moveit", *write(tmp_path, scene, REQUEST), "--out", str(out)]) == 2
-    err = capsys.readouterr().err
-    assert "allows ['part', 'post'] to touch; contact between what the robot carries and an obstacle" in err
-    assert not out.exists()
+    out = tmp_path / "touching.yaml"
+    assert main(["import-moveit", *write(tmp_path, scene, REQUEST), "--out", str(out)]) == 0
+    payload = load_scene(out).payload
+    assert payload is not None and payload.touch_obstacles == ("post_0", "post_1")  # both of its shapes
+    robot = load_scene(out).robot_spec().load()
+    world = ck.CollisionWorld(ck.carrying(robot, payload), load_scene(out).obstacles)
+    assert {(g, o) for g, o, _ in world.pairs if g == "part"} == {("part", "lamp_0"), ("part", "lamp_1")}
+    capsys.readouterr()
 
 
 def test_an_attached_object_becomes_the_payload_and_plans_certified(
@@ -882,7 +885,7 @@ def test_a_urdf_origin_that_is_not_three_numbers_is_named(
 
 
 def test_a_default_entry_yields_to_the_pairs_own_entry_as_in_moveit() -> None:
-    from planning.io.moveit_matrix import allowed_pairs, links_allowed_to_touch
+    from planning.io.moveit_matrix import allowed_pairs, allowed_with
     from planning.io.moveit_messages import AllowedCollisionMatrix
 
     matrix = AllowedCollisionMatrix(
@@ -893,9 +896,9 @@ def test_a_default_entry_yields_to_the_pairs_own_entry_as_in_moveit() -> None:
     )
     links = {"a", "b", "c"}
     # a touches c (no entry: its default), not b (their entry says false); b touches the box (entry)
-    assert allowed_pairs(matrix, links, {"box", "ball"}, set()) == [["a", "c"]]
-    assert links_allowed_to_touch(matrix, "box", links) == {"b"}
-    assert links_allowed_to_touch(matrix, "ball", links) == {"a"}  # no entry with a: its default
+    assert allowed_pairs(matrix, links) == [["a", "c"]]
+    assert allowed_with(matrix, "box", links) == {"b"}
+    assert allowed_with(matrix, "ball", links) == {"a"}  # no entry with a: its default
     defaults = {"default_entry_names": ["a", "c"], "default_entry_values": [True, False]}
     never = matrix.model_copy(update=defaults)
-    assert allowed_pairs(never, links, set(), set()) == []  # of two defaults, false wins
+    assert allowed_pairs(never, links) == []  # of two defaults, false wins

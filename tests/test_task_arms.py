@@ -12,6 +12,7 @@ the clearance of the URDF's exact link meshes and of the carried part from the o
 from __future__ import annotations
 
 import copy
+import dataclasses
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +23,7 @@ import pytest
 
 import cpr_kin as ck
 from cpr_kin.model.packages import package_roots
+from planning.errors import TaskSegmentError
 from planning.io.robot_entry import robot_spec_of
 from planning.io.scene_file import SceneFile, parse_scene_file
 from planning.io.shape_entry import obstacle_to_dict
@@ -271,3 +273,43 @@ def test_a_task_about_a_random_start_plans_and_checks_on_arms_no_task_test_was_w
     assert check_task(read.scene, read.task, task.trajectory, task_record(task)).accepted
     positions = task.trajectory(np.arange(0.0, task.trajectory.duration, 1e-3))
     assert (positions >= robot.limits.lower - 1e-9).all() and (positions <= robot.limits.upper + 1e-9).all()
+
+
+@pytest.mark.parametrize("touching", [True, False])
+def test_a_can_set_down_on_a_table_touches_it_only_where_the_payload_says_so(
+    planned: tuple[SceneFile, TaskMotion], touching: bool
+) -> None:
+    """The can lowered until it stands on a table (MoveIt's allowed contact of an attached object)."""
+    read, task = planned
+    arm = read.scene.name.removesuffix("_pick_and_place")
+    robot, attach, detach = task.world.robot, task.segments[3], task.segments[7]
+    assert attach.payload is not None
+    standing = ck.left_at(robot, attach.payload, task.trajectory(detach.t0))  # where it is set down
+    axis = standing.placement.rotation[:, 2]
+    bottom = standing.xyz[2] - 0.05 * abs(axis[2]) - 0.03 * np.hypot(axis[0], axis[1])  # its lowest point
+    table = {"name": "table", "shape": "box", "size": [0.3, 0.3, 0.04]}
+    table["xyz"] = [float(standing.xyz[0]), float(standing.xyz[1]), float(bottom - 0.02)]
+    document = copy.deepcopy(TASK)
+    document[3]["attach"] |= {"touch_links": ARMS[arm]["touch_links"], "mass_kg": ARMS[arm]["mass_kg"]}
+    if touching:
+        document[3]["attach"]["touch_obstacles"] = ["table"]
+    scene = {"robot": arm, "safety_margin": 0.02, "start": {"q": ARMS[arm]["start"]}, "task": document}
+    read = parse_scene_file(scene | {"obstacles": [POST, table]}, f"{arm} place")
+    if not touching:  # the can would stand inside the table's margin: the line down breaks
+        with pytest.raises(TaskSegmentError, match=r"task\[6\] \(line\).*'can' is .* from 'table'"):
+            plan_task(read.scene, read.task)
+        return
+    placed = plan_task(read.scene, read.task)
+    assert placed.accepted, placed.problems
+    assert check_task(read.scene, read.task, placed.trajectory, task_record(placed)).accepted
+    payload = read.task[3].payload  # type: ignore[union-attr]
+    end = placed.trajectory(placed.segments[7].t0)  # set down
+    allowed = ck.CollisionWorld(ck.carrying(robot, payload), read.scene.obstacles)
+    assert allowed.clearance(end).min_clearance_m >= read.scene.safety_margin  # every pair but the can's
+    bare = dataclasses.replace(payload, touch_obstacles=())
+    every = ck.CollisionWorld(ck.carrying(robot, bare), [table_of(read)])
+    assert every.clearance(end).min_clearance_m < 0.005  # the can stands on the table
+
+
+def table_of(read: SceneFile) -> ck.Obstacle:
+    return next(o for o in read.scene.obstacles if o.name == "table")

@@ -84,3 +84,20 @@ def test_a_link_the_robot_does_not_have_is_refused_by_name(robot: ck.Robot, arou
         ck.CollisionWorld(robot, [dataclasses.replace(around_tool, touch_links=("tool_link", "fingr"))])
     with pytest.raises(ck.ObstacleError, match="must be a sequence of link names"):
         dataclasses.replace(around_tool, touch_links="tool_link")  # type: ignore[arg-type]
+
+
+def test_what_the_robot_carries_may_touch_the_obstacles_its_payload_names_and_no_other(
+    robot: ck.Robot, around_tool: ck.Obstacle
+) -> None:
+    table = ck.Obstacle.box((0.5, 0.5, 0.02), (0.0, 0.0, -2.0), name="table")
+    ball = ck.Payload(1.0, shape=ck.Obstacle.sphere(0.01, (0, 0, 0)), name="ball", touch_obstacles=("part",))
+    world = ck.CollisionWorld(ck.carrying(robot, ball), [around_tool, table])
+    assert ("ball", "part", "effector") not in world.pairs and ("ball", "table", "effector") in world.pairs
+    assert ("tool", "part", "effector") in world.pairs  # the links that hold it are not excused
+    bare = ck.carrying(robot, dataclasses.replace(ball, touch_obstacles=()))
+    full = ck.CollisionWorld(bare, [around_tool, table])
+    kept = {(p.robot_geometry, p.obstacle): p.distance_m for p in world.clearance(Q).pairs}
+    every = {(p.robot_geometry, p.obstacle): p.distance_m for p in full.clearance(Q).pairs}
+    assert kept == {pair: d for pair, d in every.items() if pair != ("ball", "part")}  # the oracle
+    with pytest.raises(ck.CprKinError, match=r"payload 'ball' touch_obstacles \['tabel'\] are not obstacles"):
+        ck.CollisionWorld(ck.carrying(robot, dataclasses.replace(ball, touch_obstacles=("tabel",))), [table])

@@ -66,11 +66,12 @@ def carrying(robot: Robot, payload: Payload | None) -> Robot:
         return visual
 
     link = robot.model.frames[frame_id].name
+    held = RobotGeometry(payload.name, link, "effector", index, carried=True, touches=payload.touch_obstacles)
     return dataclasses.replace(
         robot,
         collision_model=collision,
         build_visual_model=visual_model,
-        geometries=(*robot.geometries, RobotGeometry(payload.name, link, "effector", index, carried=True)),
+        geometries=(*robot.geometries, held),
         _data=robot.model.createData(),
         self_pairs=tuple(sorted((*robot.self_pairs, *pairs))),
     )

@@ -58,6 +58,9 @@ class Payload:
         touch_links: links of the robot the shape may touch (the fingers that hold it): no
             self-clearance is required between them, as MoveIt's ``touch_links``.
         name: what messages and reports call it (MoveIt's object id).
+        touch_obstacles: obstacles the shape may touch (the table it is set down on): no
+            clearance is required between them, as MoveIt's allowed contacts between an
+            attached object and a world object.
     """
 
     mass_kg: float
@@ -67,6 +70,7 @@ class Payload:
     shape: Obstacle | None = None
     touch_links: tuple[str, ...] = ()
     name: str = PAYLOAD_NAME
+    touch_obstacles: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         mass = self.mass_kg
@@ -81,9 +85,11 @@ class Payload:
                 f"within {MAX_COM_OFFSET_M:g} m of its frame"
             )
         object.__setattr__(self, "com_in_frame_m", tuple(float(c) for c in com))
-        if isinstance(self.touch_links, str) or not all(isinstance(n, str) for n in self.touch_links):
-            raise CprKinError(f"payload touch_links = {self.touch_links!r} must be a sequence of link names")
-        object.__setattr__(self, "touch_links", tuple(self.touch_links))
+        for key in ("touch_links", "touch_obstacles"):
+            names = getattr(self, key)
+            if isinstance(names, str) or not all(isinstance(n, str) for n in names):
+                raise CprKinError(f"payload {key} = {names!r} must be a sequence of names")
+            object.__setattr__(self, key, tuple(names))
         if not isinstance(self.name, str) or not self.name or unprintable(self.name) is not None:
             raise CprKinError(f"payload name = {self.name!r} must be printable text")
         if self.inertia_kg_m2 is not None:

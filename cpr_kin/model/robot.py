@@ -57,6 +57,7 @@ class RobotGeometry:
         group: ``"effector"`` or ``"links"``.
         index: index in the Pinocchio geometry model.
         carried: an object the robot carries (:func:`cpr_kin.carrying`), not one of its links.
+        touches: the obstacles a carried object may touch (its payload's ``touch_obstacles``).
 
     """
 
@@ -65,6 +66,7 @@ class RobotGeometry:
     group: str
     index: int
     carried: bool = False
+    touches: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True, eq=False)

@@ -102,7 +102,8 @@ class Obstacle:
         name: a name for messages and displays.
         touch_links: links of the robot that may touch it (a gripper's fingers at a part it
             grasps or leaves, MoveIt's allowed contacts of a world object): their pairs with
-            it are not checked. What the robot carries is checked against it all the same.
+            it are not checked. What the robot carries is checked against it all the same
+            (unless its payload's ``touch_obstacles`` name it).
 
     """
 

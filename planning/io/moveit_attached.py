@@ -20,7 +20,7 @@ import pinocchio as pin
 import trimesh
 
 from cpr_kin.kinematics.dynamics import MAX_PAYLOAD_KG
-from planning.io.moveit_matrix import links_allowed_to_touch
+from planning.io.moveit_matrix import allowed_with
 from planning.io.moveit_messages import (
     AttachedCollisionObject,
     MotionPlanRequest,
@@ -107,9 +107,7 @@ def attached_payload(
     if shape["shape"] == "mesh":
         mesh = converted.meshes[shape["mesh"]]
         com = com + pin.rpy.rpyToMatrix(*shape["rpy"]) @ np.asarray(mesh.centroid, dtype=float)
-    touching = set(item.touch_links) | links_allowed_to_touch(
-        scene.allowed_collision_matrix, item.object.id, links
-    )
+    touching = set(item.touch_links) | allowed_with(scene.allowed_collision_matrix, item.object.id, links)
     entry = {
         "name": item.object.id,
         "mass_kg": float(item.weight),

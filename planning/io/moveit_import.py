@@ -17,7 +17,8 @@
 - **Obstacles:** :mod:`planning.io.moveit_objects`, at most
   :data:`~planning.pipeline.scene.MAX_OBSTACLES`; object ids unique.
 - **Allowed collisions:** the matrix's robot-link pairs marked ``true``; a link allowed to touch a
-  world object is in that object's obstacles' ``touch_links`` (:mod:`planning.io.moveit_matrix`).
+  world object is in that object's obstacles' ``touch_links``, a world object the attached one
+  may touch in the payload's ``touch_obstacles`` (:mod:`planning.io.moveit_matrix`).
 - **Time:** ``allowed_planning_time`` (when > 0) becomes the planner's ``time_limit_s`` (at
   most :data:`~planning.pipeline.settings.MAX_TIME_LIMIT_S`).
 
@@ -25,10 +26,10 @@
   ``payload`` (:mod:`planning.io.moveit_attached`).
 
 What would change the problem and has no counterpart (path or trajectory constraints,
-padding, velocity scaling other than 0 or 1, a robot base placed away from the world's origin,
-allowed contact between the attached object and a world object) is refused naming it; what
-only steers MoveIt's own planner (planner id, pipeline, attempts, workspace) is listed as
-ignored (:mod:`planning.io.moveit_support`). :mod:`planning.io.moveit_write` writes the result.
+padding, velocity scaling other than 0 or 1, a robot base placed away from the world's origin)
+is refused naming it; what only steers MoveIt's own planner (planner id, pipeline, attempts,
+workspace) is listed as ignored (:mod:`planning.io.moveit_support`).
+:mod:`planning.io.moveit_write` writes the result.
 """
 
 from __future__ import annotations
@@ -49,13 +50,13 @@ from cpr_kin.model.packages import check_package_dirs
 from planning.io.moveit_attached import attached_payload
 from planning.io.moveit_frames import Frames
 from planning.io.moveit_goal import goal_entry
-from planning.io.moveit_matrix import allowed_pairs, links_allowed_to_touch
+from planning.io.moveit_matrix import allowed_pairs, allowed_with
 from planning.io.moveit_messages import (
     MotionPlanRequest,
     MoveItImportError,
     PlanningScene,
 )
-from planning.io.moveit_objects import ConvertedObject, convert_object
+from planning.io.moveit_objects import ConvertedObject, convert_object, obstacle_names
 from planning.io.moveit_octomap import convert_octomap
 from planning.io.moveit_poses import Pose, zero_quaternions
 from planning.io.moveit_state import joint_values, position_ranges, within_ranges, wrapped
@@ -183,7 +184,7 @@ def import_moveit(
     frames.add_transforms(scene.fixed_frame_transforms)
     links = {link.get("name", "") for link in tree.getroot().findall("link")}
     matrix = scene.allowed_collision_matrix
-    touching = {o.id: links_allowed_to_touch(matrix, o.id, links) for o in scene.world.collision_objects}
+    touching = {o.id: allowed_with(matrix, o.id, links) for o in scene.world.collision_objects}
     converted = convert_objects(scene, frames, touching)
     obstacles, meshes = list(converted.obstacles), converted.meshes
     octomap = convert_octomap(scene.world.octomap, frames, ignored)
@@ -220,6 +221,11 @@ def import_moveit(
         raise MoveItImportError(f"the attached object's mesh file {clash[0]} is a world object's; rename one")
     meshes |= payload.meshes
     attached = {payload.entry["name"]} if payload.entry else set()
+    if payload.entry is not None:  # the world objects it may touch: the payload's touch_obstacles
+        allowed = allowed_with(matrix, payload.entry["name"], objects)
+        names = [n for o in scene.world.collision_objects if o.id in allowed for n in obstacle_names(o)]
+        if names:
+            payload.entry["touch_obstacles"] = sorted(names)
     unknown = sorted((set(matrix.entry_names) | set(matrix.default_entry_names)) - links - objects - attached)
     if unknown:
         ignored.append(f"allowed-collision entries of {unknown}, neither links of the URDF nor objects")
@@ -230,7 +236,7 @@ def import_moveit(
         "robot": robot_entry,
         "safety_margin": margins_m[0],
         "self_margin": margins_m[1],
-        "allowed_collisions": allowed_pairs(matrix, links, objects, attached),
+        "allowed_collisions": allowed_pairs(matrix, links),
         "start": {"q": {j: values[j] for j in planned}},
         "goal": goal,
         "obstacles": obstacles,

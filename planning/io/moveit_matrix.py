@@ -3,10 +3,9 @@
 A pair is allowed when either of its two entries is ``true``; a default entry ``true`` allows
 its name with every other name the matrix has no entry with, but one whose default is ``false``
 (MoveIt's rule: the pair's entry comes first, and of two defaults ``false`` wins). Contact
-between a link and an object, of the world or attached, is the object's ``touch_links``
-(:func:`links_allowed_to_touch`); contact between the attached object and one of the world
-has no counterpart (what the robot carries is checked against every obstacle) and is refused;
-two objects of the world are never checked against each other.
+between a link and an object, of the world or attached, is the object's ``touch_links``;
+between the attached object and one of the world, the payload's ``touch_obstacles``
+(:func:`allowed_with`); two objects of the world are never checked against each other.
 """
 
 from __future__ import annotations
@@ -38,24 +37,17 @@ def _pairs(matrix: AllowedCollisionMatrix, others: set[str]) -> set[tuple[str, s
     return {(a, b) for a, b in pairs}
 
 
-def allowed_pairs(
-    matrix: AllowedCollisionMatrix, links: set[str], objects: set[str], attached: set[str]
-) -> list[list[str]]:
-    """The allowed-collision matrix's robot-link pairs; an ``attached`` object touching ``objects`` refused.
+def allowed_pairs(matrix: AllowedCollisionMatrix, links: set[str]) -> list[list[str]]:
+    """The allowed-collision matrix's robot-link pairs.
 
     Entries of names that are neither links nor objects change nothing (as in MoveIt); the
     caller lists them as ignored.
     """
     pairs = _pairs(matrix, links)
-    touching = sorted(p for p in pairs if {p[0], p[1]} & objects and {p[0], p[1]} & attached)
-    if touching:
-        raise MoveItImportError(
-            f"allowed_collision_matrix allows {list(touching[0])} to touch; contact between what the "
-            "robot carries and an obstacle is not supported (it is checked against every obstacle)"
-        )
     return [list(p) for p in sorted(pairs) if p[0] in links and p[1] in links]
 
 
-def links_allowed_to_touch(matrix: AllowedCollisionMatrix, name: str, links: set[str]) -> set[str]:
-    """The links the matrix allows to touch ``name`` (an object's id), by their entries or defaults."""
-    return {a if b == name else b for a, b in _pairs(matrix, links | {name}) if name in (a, b)} & links
+def allowed_with(matrix: AllowedCollisionMatrix, name: str, candidates: set[str]) -> set[str]:
+    """The ``candidates`` (links, or objects) the matrix allows to touch ``name`` (an object's id)."""
+    pairs = _pairs(matrix, candidates | {name})
+    return {a if b == name else b for a, b in pairs if name in (a, b)} & candidates

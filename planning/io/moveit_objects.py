@@ -146,8 +146,7 @@ def convert_object(obj: CollisionObject, where: str, frame_in_base: np.ndarray) 
     object_in_base = frame_in_base @ (obj.pose or Pose()).matrix()
     parts: list[tuple[dict[str, Any], Pose]] = []
     meshes: dict[str, trimesh.Trimesh] = {}
-    count = len(obj.primitives) + len(obj.meshes)
-    names = [obj.id if count == 1 else f"{obj.id}_{k}" for k in range(count)]
+    names = obstacle_names(obj)
     for k, (primitive, pose) in enumerate(zip(obj.primitives, obj.primitive_poses, strict=True)):
         kind = _kind(primitive.type, f"{where}.primitives[{k}]")
         parts.append(
@@ -167,3 +166,9 @@ def convert_object(obj: CollisionObject, where: str, frame_in_base: np.ndarray) 
             )
         obstacles.append({"name": name, **entry, **placed})
     return ConvertedObject(obstacles=tuple(obstacles), meshes=meshes)
+
+
+def obstacle_names(obj: CollisionObject) -> list[str]:
+    """The names of the obstacles ``obj`` makes: its id for one shape, ``<id>_<k>`` for several."""
+    count = len(obj.primitives) + len(obj.meshes)
+    return [obj.id if count == 1 else f"{obj.id}_{k}" for k in range(count)]

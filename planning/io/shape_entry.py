@@ -105,6 +105,7 @@ class PayloadSpec(Strict):
     frame: Name | None = None
     shape: PayloadShapeSpec | None = None
     touch_links: Annotated[list[Name], Field(max_length=64)] = Field(default_factory=list)
+    touch_obstacles: Annotated[list[Name], Field(max_length=64)] = Field(default_factory=list)
 
     @model_validator(mode="after")
     def _links_once(self) -> PayloadSpec:
@@ -129,6 +130,7 @@ class PayloadSpec(Strict):
             shape,
             tuple(self.touch_links),
             self.name or PAYLOAD_NAME,
+            tuple(self.touch_obstacles),
         )
 
 
@@ -189,4 +191,6 @@ def payload_to_dict(payload: ck.Payload) -> dict[str, Any]:
         entry["shape"] = {k: v for k, v in obstacle_to_dict(payload.shape).items() if k != "name"}
     if payload.touch_links:
         entry["touch_links"] = list(payload.touch_links)
+    if payload.touch_obstacles:
+        entry["touch_obstacles"] = list(payload.touch_obstacles)
     return entry
