@@ -53,6 +53,21 @@ def test_an_example_script_runs_from_any_folder(script: str, tmp_path: Path) -> 
     assert done.stderr == ""
 
 
+def test_the_pick_and_place_example_sets_a_pandas_can_down_on_a_table(tmp_path: Path) -> None:
+    scene = EXAMPLES / "scenes" / "panda_pick_and_place.yaml"
+    done = subprocess.run(
+        [sys.executable, str(EXAMPLES / "pick_and_place.py"), str(scene)],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr
+    kinds = [line.split()[0] for line in done.stdout.splitlines()[:9]]
+    assert kinds == ["free", "line", "wait", "attach", "line", "free", "line", "detach", "line"]
+    assert "verified True" in done.stdout and "against the task: kept" in done.stdout
+
+
 @pytest.mark.parametrize("robot", ["so101", "ur5", "panda", "xarm7"])
 def test_the_own_robot_example_runs_for_every_arm_and_passes_the_cli_check(
     robot: str, tmp_path: Path
