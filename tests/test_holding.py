@@ -123,3 +123,21 @@ def test_the_example_checks_the_part_where_it_waits_and_where_it_is_left(pick_an
     )
     assert check.certified_min_m <= oracle.min_clearance_m + 1e-9
     assert check.sampled_min_m == pytest.approx(oracle.min_clearance_m, abs=1e-6)
+
+
+def test_an_attach_touching_no_object_of_the_task_is_refused_before_anything_is_planned(
+    pick_and_place: PlannedTask, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import planning.task.task_plan as task_plan
+
+    def nothing_planned(*args: object, **kwargs: object) -> None:
+        raise AssertionError("a segment was planned before the task's names were checked")
+
+    monkeypatch.setattr(task_plan, "build_problem", nothing_planned)
+    read = pick_and_place.read
+    segments = list(read.task)
+    attach = next(i for i, s in enumerate(segments) if isinstance(s, Attach))
+    payload = segments[attach].payload  # type: ignore[union-attr]
+    segments[attach] = Attach(dataclasses.replace(payload, touch_obstacles=("crate", "tabel")))
+    with pytest.raises(PlanningError, match=r"task\[3\] \(attach\): touch_obstacles \['tabel'\] are"):
+        task_plan.plan_task(read.scene, segments)

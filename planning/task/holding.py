@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 import cpr_kin as ck
 from planning.errors import PlanningError
 from planning.pipeline.scene import Scene
-from planning.task.segments import Attach, Detach
+from planning.task.segments import Attach, Detach, Segment
 
 FloatArray = NDArray[np.float64]
 _T = TypeVar("_T")
@@ -69,6 +69,27 @@ def scene_after(scene: Scene, robot: ck.Robot, q: FloatArray, change: Attach | D
     taken = _checked(lambda: ck.taken_from(robot, payload, found, q), "attach")
     rest = tuple(o for o in scene.obstacles if o is not found)
     return dataclasses.replace(scene, payload=taken, obstacles=rest)
+
+
+def checked_touches(scene: Scene, segments: Sequence[Segment]) -> None:
+    """Refuse, before anything is planned, an attach whose ``touch_obstacles`` names no object of the task.
+
+    The names a task can meet: the scene's obstacles and what its payloads leave behind. That
+    the one named is there when the object is carried is checked where it is carried.
+
+    Raises:
+        PlanningError: the first attach naming an unknown obstacle, with the names known.
+    """
+    payloads = [scene.payload, *(s.payload for s in segments if isinstance(s, Attach))]
+    known = {o.name for o in scene.obstacles} | {p.name for p in payloads if p is not None}
+    for index, segment in enumerate(segments):
+        if isinstance(segment, Attach):
+            unknown = sorted(set(segment.payload.touch_obstacles) - known)
+            if unknown:
+                raise PlanningError(
+                    f"task[{index}] (attach): touch_obstacles {unknown} are neither obstacles of the scene "
+                    f"nor objects the task leaves; those: {sorted(known)}"
+                )
 
 
 def untaken(obstacles: Sequence[ck.Obstacle], carried: Iterable[ck.Payload | None]) -> list[ck.Obstacle]:

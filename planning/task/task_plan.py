@@ -37,7 +37,7 @@ from planning.pipeline.target import Target
 from planning.pipeline.verification import Requirements, Verification
 from planning.task.free_motion import FIXED_DURATION, plan_free
 from planning.task.held_orientation import HeldMotion
-from planning.task.holding import scene_after, untaken
+from planning.task.holding import checked_touches, scene_after, untaken
 from planning.task.line_motion import LineMotion, plan_line
 from planning.task.segments import KINDS, Attach, Detach, Move, Segment, Wait, segment_name
 from planning.task.task_timing import PlannedMotion, timed_motions
@@ -176,6 +176,7 @@ def plan_task(
         raise PlanningError("a task needs at least one segment (a Move, a ToolLine, a Wait, an Attach)")
     if scene.duration is not None:
         raise PlanningError(FIXED_DURATION.format(seconds=scene.duration))
+    checked_touches(scene, segments)
     base = robot or scene.robot_spec().load()
     carrying = _carrying(scene, base, None, threads)
     q, start_world = carrying.problem.q_start, carrying.problem.world
