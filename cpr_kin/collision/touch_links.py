@@ -13,8 +13,6 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-import pinocchio as pin
-
 from cpr_kin.common.errors import CprKinError
 from cpr_kin.model.robot import Robot
 from cpr_kin.shapes.obstacles import Obstacle
@@ -28,14 +26,8 @@ def checked_pairs(robot: Robot, obstacles: Sequence[Obstacle]) -> list[tuple[int
             carried object's ``touch_obstacles`` an obstacle that is not there (a typo would
             leave the pair checked, silently).
     """
-    links = {f.name for f in robot.model.frames if f.type == pin.FrameType.BODY}
     for obstacle in obstacles:
-        unknown = sorted(set(obstacle.touch_links) - links)
-        if unknown:
-            raise CprKinError(
-                f"obstacle '{obstacle.name}' touch_links {unknown} are not links of the robot; its links "
-                f"with shapes: {sorted({g.link for g in robot.geometries if not g.carried})}"
-            )
+        robot.check_links(obstacle.touch_links, f"obstacle '{obstacle.name}' touch_links")
     names = {o.name for o in obstacles}
     for geometry in robot.geometries:
         unknown = sorted(set(geometry.touches) - names)

@@ -46,13 +46,7 @@ def carrying(robot: Robot, payload: Payload | None) -> Robot:
     if payload is None or payload.shape is None:
         return robot
     frame_id = robot.frame_id(payload.frame or robot.tcp_frame)
-    links = {f.name for f in robot.model.frames if f.type == pin.FrameType.BODY}
-    unknown = sorted(set(payload.touch_links) - links)
-    if unknown:
-        raise CprKinError(
-            f"payload touch_links {unknown} are not links of the robot; its links with shapes: "
-            f"{sorted({g.link for g in robot.geometries})}"
-        )
+    robot.check_links(payload.touch_links, "payload touch_links")
     collision = robot.collision_model.copy()
     shape = _hull(payload.shape)
     index = collision.addGeometryObject(_shape_object(robot, shape, payload.name, frame_id))

@@ -28,3 +28,8 @@ def frame_index(model: Any, name: str) -> int:
         if model.existFrame(name, kind):
             return int(model.getFrameId(name, kind))
     return -1
+
+
+def link_names(model: Any) -> set[str]:
+    """The names of ``model``'s links (its ``BODY`` frames)."""
+    return {f.name for f in model.frames if f.type == pin.FrameType.BODY}

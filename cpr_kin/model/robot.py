@@ -11,7 +11,7 @@ and its own IK of a tool position. The collision geometry forms two groups:
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.bounds.close_pairs import ClosePair
 from cpr_kin.common.errors import CprKinError, JointLimitError
-from cpr_kin.model.frames import frame_index
+from cpr_kin.model.frames import frame_index, link_names
 from cpr_kin.model.limits import JointLimits
 from cpr_kin.shapes.exact_meshes import ExactMesh
 
@@ -151,6 +151,17 @@ class Robot:
     def data(self) -> Any:
         """A Pinocchio ``Data`` of :attr:`model`, shared by this robot's own computations."""
         return self._data
+
+    def check_links(self, names: Iterable[str], what: str) -> None:
+        """Raise :class:`CprKinError` where ``names`` holds one that is no link of the robot.
+
+        ``what`` says whose names they are (``"payload touch_links"``); the message lists the
+        links with shapes (a typo would leave a pair checked, or excused, silently).
+        """
+        unknown = sorted(set(names) - link_names(self.model))
+        if unknown:
+            shaped = sorted({g.link for g in self.geometries if not g.carried})
+            raise CprKinError(f"{what} {unknown} are not links of the robot; its links with shapes: {shaped}")
 
     def frame_id(self, frame: str) -> int:
         """Pinocchio id of ``frame``; raises :class:`CprKinError` naming the known frames."""
