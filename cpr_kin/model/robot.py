@@ -158,7 +158,8 @@ class Robot:
         ``what`` says whose names they are (``"payload touch_links"``); the message lists the
         links with shapes (a typo would leave a pair checked, or excused, silently).
         """
-        unknown = sorted(set(names) - link_names(self.model))
+        given = set(names)
+        unknown = sorted(given - link_names(self.model)) if given else []
         if unknown:
             shaped = sorted({g.link for g in self.geometries if not g.carried})
             raise CprKinError(f"{what} {unknown} are not links of the robot; its links with shapes: {shaped}")
