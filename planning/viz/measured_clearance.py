@@ -53,5 +53,6 @@ def task_clearance(task: TaskMotion) -> MeasuredClearance:
             instants = np.asarray(check.times)
             times.append(segment.t0 + (instants - instants[0]))
             clearance.append(np.asarray(check.clearance_m).min(axis=1))
-    order = np.argsort(np.concatenate(times), kind="stable")
-    return MeasuredClearance(np.concatenate(times)[order], np.concatenate(clearance)[order])
+    instants = np.concatenate(times)
+    order = np.argsort(instants, kind="stable")
+    return MeasuredClearance(instants[order], np.concatenate(clearance)[order])
