@@ -108,3 +108,20 @@ def test_holds_agrees_with_trimeshs_signed_distance_on_a_torus_whichever_way_it_
     near_surface = np.abs(signed) < 1e-3  # within a hair of the faceted surface either may say either
     np.testing.assert_array_equal(found[~near_surface], expected[~near_surface])
     assert not mesh.holds(np.zeros((1, 3)))[0]  # the hole is outside
+
+
+def test_holds_any_is_holds_of_the_moved_points_any() -> None:
+    torus = trimesh.creation.torus(major_radius=0.2, minor_radius=0.05, major_sections=24, minor_sections=12)
+    triangles = np.asarray(torus.triangles)
+    mesh = ExactMesh(0, bvh_of(torus), pin.SE3.Identity(), math.inf, triangles, None, hull_planes(triangles))
+    rng = np.random.default_rng(7)
+    answers = []
+    for _ in range(200):  # a few points in another frame, placed at random about the torus
+        placement = pin.SE3(pin.exp3(rng.normal(size=3)), rng.uniform(-0.25, 0.25, 3) * (1.0, 1.0, 0.2))
+        points = rng.uniform(-0.05, 0.05, (int(rng.integers(1, 4)), 3))
+        moved = points @ placement.rotation.T + placement.translation
+        answer = mesh.holds_any(points, placement.rotation, placement.translation)
+        assert answer == bool(mesh.holds(moved).any())
+        answers.append(answer)
+    assert 20 < sum(answers) < 180  # both answers met
+    assert not mesh.holds_any(np.zeros((0, 3)), np.eye(3), np.zeros(3))

@@ -105,6 +105,41 @@ class ExactMesh:
             inside[in_hull] = np.abs(_winding_numbers(self.triangles, points[in_hull])) > 0.5
         return inside
 
+    def holds_any(self, points: FloatArray, rotation: FloatArray, translation: FloatArray) -> bool:
+        """Whether the mesh holds one of ``points`` ``(M, 3)`` [m], given in a frame placed in the mesh's.
+
+        ``rotation`` ``(3, 3)`` and ``translation`` ``(3,)`` [m] place that frame in the mesh's:
+        :meth:`holds` of the points moved there, ``.any()``, in one compiled call that stops at
+        the first point inside (a pair test asks it for a few points, many times).
+        """
+        return bool(_any_inside(self.triangles, self.hull_planes, points, rotation, translation))
+
+
+@njit
+def _any_inside(
+    triangles: FloatArray,
+    planes: FloatArray,
+    points: FloatArray,
+    rotation: FloatArray,
+    translation: FloatArray,
+) -> bool:
+    """Whether one of ``points``, rotated and translated, is inside (:meth:`ExactMesh.holds`)."""
+    moved = np.empty((1, 3))
+    for m in range(points.shape[0]):
+        for i in range(3):
+            moved[0, i] = (
+                points[m, 0] * rotation[i, 0] + points[m, 1] * rotation[i, 1] + points[m, 2] * rotation[i, 2]
+            ) + translation[i]
+        in_hull = True
+        for h in range(planes.shape[0]):
+            offset = moved[0, 0] * planes[h, 0] + moved[0, 1] * planes[h, 1] + moved[0, 2] * planes[h, 2]
+            if offset + planes[h, 3] > 1e-9:
+                in_hull = False
+                break
+        if in_hull and abs(_winding_numbers(triangles, moved)[0]) > 0.5:
+            return True
+    return False
+
 
 @njit
 def _winding_numbers(triangles: FloatArray, points: FloatArray) -> FloatArray:

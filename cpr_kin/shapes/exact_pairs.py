@@ -241,7 +241,7 @@ class ExactPairs:
         if not len(points):
             return False
         inner_in_outer = at_outer.actInv(at_inner)
-        return bool(mesh.holds(points @ inner_in_outer.rotation.T + inner_in_outer.translation).any())
+        return mesh.holds_any(points, inner_in_outer.rotation, inner_in_outer.translation)
 
 
 def _inner_points(shape: Any, mesh: ExactMesh | None) -> FloatArray | None:
