@@ -99,11 +99,7 @@ class ExactMesh:
         the mesh's convex hull (its facets' planes) is outside without it.
         """
         points = np.ascontiguousarray(points_in_mesh, dtype=float)
-        in_hull = np.all(points @ self.hull_planes[:, :3].T + self.hull_planes[:, 3] <= 1e-9, axis=1)
-        inside = np.zeros(len(points), dtype=bool)
-        if in_hull.any():
-            inside[in_hull] = np.abs(_winding_numbers(self.triangles, points[in_hull])) > 0.5
-        return inside
+        return np.asarray(_inside(self.triangles, self.hull_planes, points, np.eye(3), np.zeros(3), False))
 
     def holds_any(self, points: FloatArray, rotation: FloatArray, translation: FloatArray) -> bool:
         """Whether the mesh holds one of ``points`` ``(M, 3)`` [m], given in a frame placed in the mesh's.
@@ -112,33 +108,40 @@ class ExactMesh:
         :meth:`holds` of the points moved there, ``.any()``, in one compiled call that stops at
         the first point inside (a pair test asks it for a few points, many times).
         """
-        return bool(_any_inside(self.triangles, self.hull_planes, points, rotation, translation))
+        return bool(_inside(self.triangles, self.hull_planes, points, rotation, translation, True).any())
 
 
 @njit
-def _any_inside(
+def _inside(
     triangles: FloatArray,
     planes: FloatArray,
     points: FloatArray,
     rotation: FloatArray,
     translation: FloatArray,
-) -> bool:
-    """Whether one of ``points``, rotated and translated, is inside (:meth:`ExactMesh.holds`)."""
+    first_only: bool,
+) -> NDArray[np.bool_]:
+    """``(M,)`` which of ``points``, rotated and translated, are inside (:meth:`ExactMesh.holds`).
+
+    With ``first_only``, none after the first inside is tested (reported outside).
+    """
+    inside = np.zeros(points.shape[0], dtype=np.bool_)
     moved = np.empty((1, 3))
     for m in range(points.shape[0]):
         for i in range(3):
             moved[0, i] = (
                 points[m, 0] * rotation[i, 0] + points[m, 1] * rotation[i, 1] + points[m, 2] * rotation[i, 2]
             ) + translation[i]
-        in_hull = True
+        in_hull = True  # outside a facet's plane of the convex hull: outside the mesh
         for h in range(planes.shape[0]):
             offset = moved[0, 0] * planes[h, 0] + moved[0, 1] * planes[h, 1] + moved[0, 2] * planes[h, 2]
             if offset + planes[h, 3] > 1e-9:
                 in_hull = False
                 break
         if in_hull and abs(_winding_numbers(triangles, moved)[0]) > 0.5:
-            return True
-    return False
+            inside[m] = True
+            if first_only:
+                break
+    return inside
 
 
 @njit
