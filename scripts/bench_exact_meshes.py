@@ -109,7 +109,7 @@ def table(robot_name: str, rows: list[dict[str, Any]], within_s: float | None = 
             if both
             else float("nan")
         )
-        cells += [f"{ratio:.2f} ({len(both)})"]
+        cells += [f"{ratio:.2f} ({len(both)})" if both else "-"]  # one model planned: no ratio
         lines.append("| " + " | ".join(cells) + " |")
     return lines
 
