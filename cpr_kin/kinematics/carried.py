@@ -45,7 +45,7 @@ def carrying(robot: Robot, payload: Payload | None) -> Robot:
     """
     if payload is None or payload.shape is None:
         return robot
-    frame_id = robot.frame_id(payload.frame or robot.tcp_frame)
+    frame_id = robot.frame_id(payload.frame_on(robot))
     robot.check_links(payload.touch_links, "payload touch_links")
     collision = robot.collision_model.copy()
     shape = _hull(payload.shape)
@@ -73,7 +73,7 @@ def carrying(robot: Robot, payload: Payload | None) -> Robot:
 
 def holding_links(robot: Robot, payload: Payload) -> frozenset[str]:
     """Links that may touch ``payload``'s shape: on its frame's joint and the next; its ``touch_links``."""
-    joint = robot.model.frames[robot.frame_id(payload.frame or robot.tcp_frame)].parentJoint
+    joint = robot.model.frames[robot.frame_id(payload.frame_on(robot))].parentJoint
     objects = robot.collision_model.geometryObjects
     near = {g.link for g in robot.geometries if adjacent(robot.model, objects[g.index].parentJoint, joint)}
     return frozenset(near | set(payload.touch_links))
@@ -90,7 +90,7 @@ def left_at(robot: Robot, payload: Payload, q: ArrayLike) -> Obstacle:
     """
     if payload.shape is None:
         raise CprKinError(f"payload '{payload.name}' has no shape to leave in the world")
-    frame_in_world = frame_poses(robot, q, payload.frame or robot.tcp_frame)
+    frame_in_world = frame_poses(robot, q, payload.frame_on(robot))
     shape_in_world = pin.SE3(frame_in_world) * payload.shape.placement
     return dataclasses.replace(
         _hull(payload.shape),
@@ -116,7 +116,7 @@ def taken_from(robot: Robot, payload: Payload, obstacle: Obstacle, q: ArrayLike)
         )
     if obstacle.shape == "voxels":
         raise CprKinError(f"obstacle '{obstacle.name}' is a point cloud's voxels; only shapes can be carried")
-    frame_in_world = frame_poses(robot, q, payload.frame or robot.tcp_frame)
+    frame_in_world = frame_poses(robot, q, payload.frame_on(robot))
     shape_in_frame = pin.SE3(frame_in_world).actInv(obstacle.placement)
     shape = dataclasses.replace(
         obstacle,

@@ -96,6 +96,10 @@ class Payload:
             inertia = _checked_inertia(self.inertia_kg_m2)
             object.__setattr__(self, "inertia_kg_m2", tuple(tuple(float(v) for v in row) for row in inertia))
 
+    def frame_on(self, robot: Robot) -> str:
+        """The frame that holds the payload on ``robot``: its :attr:`frame`, else the robot's tool frame."""
+        return self.frame or robot.tcp_frame
+
     def inertia(self) -> Any:
         """The payload as a ``pinocchio.Inertia`` in its frame."""
         rotational = np.zeros((3, 3)) if self.inertia_kg_m2 is None else np.array(self.inertia_kg_m2)
@@ -232,7 +236,7 @@ def robot_dynamics(
         )
     model = robot.model.copy()
     if payload is not None and payload.mass_kg > 0.0:
-        frame = model.frames[robot.frame_id(payload.frame or robot.tcp_frame)]
+        frame = model.frames[robot.frame_id(payload.frame_on(robot))]
         model.inertias[frame.parentJoint] += frame.placement.act(payload.inertia())
     effort = np.array(model.effortLimit, dtype=float) * float(torque_scale)
     effort[~(effort > 0.0)] = np.inf

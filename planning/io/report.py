@@ -230,7 +230,7 @@ def torque_lines(result: PlanResult) -> list[str]:
         "no payload"
         if payload is None
         else f"a {payload.mass_kg:g} kg payload at {list(payload.com_in_frame_m)} m in "
-        f"'{payload.frame or result.robot.tcp_frame}'"
+        f"'{payload.frame_on(result.robot)}'"
     )
     peaks = ", ".join(f"{name} {value:.2f}" for name, value in utilisation.items())
     lines = [

@@ -60,7 +60,7 @@ def task_record(task: TaskMotion) -> list[dict[str, Any]]:
         if segment.held is not None:
             entry["constraint"] = constraint_entry(segment.held.constraint, segment.held.frame)
         if segment.payload is not None:
-            frame = segment.payload.frame or task.world.robot.tcp_frame
+            frame = segment.payload.frame_on(task.world.robot)
             entry |= {"object": segment.payload.name, "frame": frame}
         entries.append(entry)
     return entries
