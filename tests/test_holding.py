@@ -15,7 +15,7 @@ from planning.errors import PlanningError
 from planning.pipeline.scene import Scene
 from planning.pipeline.target import Target
 from planning.task import Attach, Detach
-from planning.task.holding import scene_after, untaken
+from planning.task.holding import changed_object, scene_after, untaken
 from planning.viz.artifacts import task_carried
 from planning.viz.carried_objects import carried_poses
 
@@ -141,3 +141,14 @@ def test_an_attach_touching_no_object_of_the_task_is_refused_before_anything_is_
     segments[attach] = Attach(dataclasses.replace(payload, touch_obstacles=("crate", "tabel")))
     with pytest.raises(PlanningError, match=r"task\[3\] \(attach\): touch_obstacles \['tabel'\] are"):
         task_plan.plan_task(read.scene, segments)
+
+
+def test_the_object_a_change_concerns_is_the_one_taken_or_the_one_let_go(base: ck.Robot) -> None:
+    placed = dataclasses.replace(BOX, xyz=ck.frame_positions(base, Q) + 0.02)
+    before = _scene((placed,))
+    attach = Attach(ck.Payload(1.5, name="part"))
+    taken = scene_after(before, base, Q, attach)
+    assert changed_object(attach, before, taken) is taken.payload is not None  # with the obstacle's shape
+    assert taken.payload.shape is not None
+    released = scene_after(taken, base, Q, Detach())
+    assert changed_object(Detach(), taken, released) is taken.payload and released.payload is None

@@ -71,6 +71,14 @@ def scene_after(scene: Scene, robot: ck.Robot, q: FloatArray, change: Attach | D
     return dataclasses.replace(scene, payload=taken, obstacles=rest)
 
 
+def changed_object(change: Attach | Detach, before: Scene, after: Scene) -> ck.Payload | None:
+    """The object ``change`` concerns: what an attach makes the robot carry, what a detach lets go.
+
+    ``before`` and ``after``: the scenes on either side of it (:func:`scene_after`).
+    """
+    return after.payload if isinstance(change, Attach) else before.payload
+
+
 def checked_touches(scene: Scene, segments: Sequence[Segment]) -> None:
     """Refuse, before anything is planned, an attach whose ``touch_obstacles`` names no object of the task.
 

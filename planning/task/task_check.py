@@ -34,7 +34,7 @@ from planning.pipeline.problem import build_problem
 from planning.pipeline.scene import Scene
 from planning.pipeline.target import Target
 from planning.pipeline.verification import Requirements, Verification, verify_finer_where_needed
-from planning.task.holding import scene_after
+from planning.task.holding import changed_object, scene_after
 from planning.task.segments import KINDS, Attach, Detach, Move, Segment, Wait
 from planning.task.task_record import TIME_TOLERANCE_S, record_problems, recorded_constraint, recorded_pose
 from planning.task.tool_line import ToolLine
@@ -105,7 +105,7 @@ def check_task(
                 current = scene_after(current, base, trajectory(float(entry["t0"])), segment)
             except PlanningError as exc:
                 problems.append(f"{where} {exc}")
-            named = current.payload if isinstance(segment, Attach) else before.payload
+            named = changed_object(segment, before, current)
             problems += [f"{where} {w}" for w in _recorded_object(named, entry)]
             verifications.append(None)
             continue

@@ -37,7 +37,7 @@ from planning.pipeline.target import Target
 from planning.pipeline.verification import Requirements, Verification
 from planning.task.free_motion import FIXED_DURATION, plan_free
 from planning.task.held_orientation import HeldMotion
-from planning.task.holding import checked_touches, scene_after, untaken
+from planning.task.holding import changed_object, checked_touches, scene_after, untaken
 from planning.task.line_motion import LineMotion, plan_line
 from planning.task.segments import KINDS, Attach, Detach, Move, Segment, Wait, segment_name
 from planning.task.task_timing import PlannedMotion, timed_motions
@@ -187,7 +187,7 @@ def plan_task(
             if isinstance(segment, Attach | Detach):
                 before = carrying.scene
                 carrying = _carried(carrying, base, q, segment)
-                payloads.append(carrying.scene.payload if isinstance(segment, Attach) else before.payload)
+                payloads.append(changed_object(segment, before, carrying.scene))
                 planned.append(None)
                 continue
             motion = _planned(carrying, base, q, segment, progress)
