@@ -885,7 +885,7 @@ def test_a_urdf_origin_that_is_not_three_numbers_is_named(
 
 
 def test_a_default_entry_yields_to_the_pairs_own_entry_as_in_moveit() -> None:
-    from planning.io.moveit_matrix import allowed_pairs, allowed_with
+    from planning.io.moveit_matrix import AllowedContacts
     from planning.io.moveit_messages import AllowedCollisionMatrix
 
     matrix = AllowedCollisionMatrix(
@@ -896,9 +896,10 @@ def test_a_default_entry_yields_to_the_pairs_own_entry_as_in_moveit() -> None:
     )
     links = {"a", "b", "c"}
     # a touches c (no entry: its default), not b (their entry says false); b touches the box (entry)
-    assert allowed_pairs(matrix, links) == [["a", "c"]]
-    assert allowed_with(matrix, "box", links) == {"b"}
-    assert allowed_with(matrix, "ball", links) == {"a"}  # no entry with a: its default
+    contacts = AllowedContacts(matrix)
+    assert contacts.link_pairs(links) == [["a", "c"]]
+    assert contacts.allowed_with("box", links) == {"b"}
+    assert contacts.allowed_with("ball", links) == {"a"}  # no entry with a: its default
     defaults = {"default_entry_names": ["a", "c"], "default_entry_values": [True, False]}
     never = matrix.model_copy(update=defaults)
-    assert allowed_pairs(never, links) == []  # of two defaults, false wins
+    assert AllowedContacts(never).link_pairs(links) == []  # of two defaults, false wins

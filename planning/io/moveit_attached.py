@@ -20,7 +20,7 @@ import pinocchio as pin
 import trimesh
 
 from cpr_kin.kinematics.dynamics import MAX_PAYLOAD_KG
-from planning.io.moveit_matrix import allowed_with
+from planning.io.moveit_matrix import AllowedContacts
 from planning.io.moveit_messages import (
     AttachedCollisionObject,
     MotionPlanRequest,
@@ -58,7 +58,11 @@ def attached_objects(
 
 
 def attached_payload(
-    scene: PlanningScene, request: MotionPlanRequest, links: set[str], notes: list[str]
+    scene: PlanningScene,
+    request: MotionPlanRequest,
+    links: set[str],
+    contacts: AllowedContacts,
+    notes: list[str],
 ) -> AttachedPayload:
     """The ``payload`` of the one attached object, if any (module docstring).
 
@@ -66,6 +70,7 @@ def attached_payload(
         scene: the planning scene.
         request: the request.
         links: the URDF's links.
+        contacts: the scene's allowed-collision matrix (the links it lets the object touch).
         notes: what the conversion ignored is appended here.
 
     Raises:
@@ -107,7 +112,7 @@ def attached_payload(
     if shape["shape"] == "mesh":
         mesh = converted.meshes[shape["mesh"]]
         com = com + pin.rpy.rpyToMatrix(*shape["rpy"]) @ np.asarray(mesh.centroid, dtype=float)
-    touching = set(item.touch_links) | allowed_with(scene.allowed_collision_matrix, item.object.id, links)
+    touching = set(item.touch_links) | contacts.allowed_with(item.object.id, links)
     entry = {
         "name": item.object.id,
         "mass_kg": float(item.weight),

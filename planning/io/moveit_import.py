@@ -50,7 +50,7 @@ from cpr_kin.model.packages import check_package_dirs
 from planning.io.moveit_attached import attached_payload
 from planning.io.moveit_frames import Frames
 from planning.io.moveit_goal import goal_entry
-from planning.io.moveit_matrix import allowed_pairs, allowed_with
+from planning.io.moveit_matrix import AllowedContacts
 from planning.io.moveit_messages import (
     MotionPlanRequest,
     MoveItImportError,
@@ -184,7 +184,8 @@ def import_moveit(
     frames.add_transforms(scene.fixed_frame_transforms)
     links = {link.get("name", "") for link in tree.getroot().findall("link")}
     matrix = scene.allowed_collision_matrix
-    touching = {o.id: allowed_with(matrix, o.id, links) for o in scene.world.collision_objects}
+    contacts = AllowedContacts(matrix)  # the matrix read once, for every object
+    touching = {o.id: contacts.allowed_with(o.id, links) for o in scene.world.collision_objects}
     converted = convert_objects(scene, frames, touching)
     obstacles, meshes = list(converted.obstacles), converted.meshes
     octomap = convert_octomap(scene.world.octomap, frames, ignored)
@@ -215,14 +216,14 @@ def import_moveit(
     if following:  # MoveIt sets a mimic joint from its leader, whatever the state says
         ignored.append(f"start values of mimic joint(s) {following}: each follows the joint it mimics")
     objects = {obj.id for obj in scene.world.collision_objects}
-    payload = attached_payload(scene, request, links, ignored)
+    payload = attached_payload(scene, request, links, contacts, ignored)
     clash = sorted(set(payload.meshes) & set(meshes))
     if clash:
         raise MoveItImportError(f"the attached object's mesh file {clash[0]} is a world object's; rename one")
     meshes |= payload.meshes
     attached = {payload.entry["name"]} if payload.entry else set()
     if payload.entry is not None:  # the world objects it may touch: the payload's touch_obstacles
-        allowed = allowed_with(matrix, payload.entry["name"], objects)
+        allowed = contacts.allowed_with(payload.entry["name"], objects)
         names = [n for o in scene.world.collision_objects if o.id in allowed for n in obstacle_names(o)]
         if names:
             payload.entry["touch_obstacles"] = sorted(names)
@@ -236,7 +237,7 @@ def import_moveit(
         "robot": robot_entry,
         "safety_margin": margins_m[0],
         "self_margin": margins_m[1],
-        "allowed_collisions": allowed_pairs(matrix, links),
+        "allowed_collisions": contacts.link_pairs(links),
         "start": {"q": {j: values[j] for j in planned}},
         "goal": goal,
         "obstacles": obstacles,

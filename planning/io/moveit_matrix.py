@@ -5,7 +5,7 @@ its name with every other name the matrix has no entry with, but one whose defau
 (MoveIt's rule: the pair's entry comes first, and of two defaults ``false`` wins). Contact
 between a link and an object, of the world or attached, is the object's ``touch_links``;
 between the attached object and one of the world, the payload's ``touch_obstacles``
-(:func:`allowed_with`); two objects of the world are never checked against each other.
+(:class:`AllowedContacts`); two objects of the world are never checked against each other.
 """
 
 from __future__ import annotations
@@ -13,41 +13,54 @@ from __future__ import annotations
 from planning.io.moveit_messages import AllowedCollisionMatrix, MoveItImportError
 
 
-def _pairs(matrix: AllowedCollisionMatrix, others: set[str]) -> set[tuple[str, str]]:
-    """Every pair of names the matrix allows to touch, sorted within the pair; defaults with ``others``."""
-    names = matrix.entry_names
-    if len(matrix.entry_values) != len(names) or any(len(row) != len(names) for row in matrix.entry_values):
-        raise MoveItImportError(
-            f"allowed_collision_matrix: {len(names)} names need a {len(names)} x {len(names)} matrix"
-        )
-    pairs = {
-        tuple(sorted((names[i], names[j])))
-        for i in range(len(names))
-        for j in range(i + 1, len(names))
-        if matrix.entry_values[i][j] or matrix.entry_values[j][i]
-    }
-    listed = set(names)
-    default = dict(zip(matrix.default_entry_names, matrix.default_entry_values, strict=False))
-    for name in (n for n, allowed in default.items() if allowed):  # not where the pair has an entry,
-        pairs |= {  # nor where the other's default is false
-            tuple(sorted((name, o)))
-            for o in others
-            if o != name and not {name, o} <= listed and default.get(o, True)
-        }
-    return {(a, b) for a, b in pairs}
+class AllowedContacts:
+    """The pairs of names a matrix allows to touch (module docstring), read once.
 
+    Its entries' pairs are gathered when it is built (the matrix's size squared, once); a pair
+    without an entry is decided by the defaults when asked. An import asks it for every object
+    of the scene: the matrix is not read again for each.
 
-def allowed_pairs(matrix: AllowedCollisionMatrix, links: set[str]) -> list[list[str]]:
-    """The allowed-collision matrix's robot-link pairs.
-
-    Entries of names that are neither links nor objects change nothing (as in MoveIt); the
-    caller lists them as ignored.
+    Raises:
+        MoveItImportError: the entries' values are not a square matrix of its names.
     """
-    pairs = _pairs(matrix, links)
-    return [list(p) for p in sorted(pairs) if p[0] in links and p[1] in links]
 
+    def __init__(self, matrix: AllowedCollisionMatrix) -> None:
+        names = matrix.entry_names
+        if len(matrix.entry_values) != len(names) or any(
+            len(row) != len(names) for row in matrix.entry_values
+        ):
+            raise MoveItImportError(
+                f"allowed_collision_matrix: {len(names)} names need a {len(names)} x {len(names)} matrix"
+            )
+        self._entries = {
+            (names[i], names[j])
+            for i in range(len(names))
+            for j in range(i + 1, len(names))
+            if matrix.entry_values[i][j] or matrix.entry_values[j][i]
+        }
+        self._listed = set(names)
+        self._default = dict(zip(matrix.default_entry_names, matrix.default_entry_values, strict=False))
 
-def allowed_with(matrix: AllowedCollisionMatrix, name: str, candidates: set[str]) -> set[str]:
-    """The ``candidates`` (links, or objects) the matrix allows to touch ``name`` (an object's id)."""
-    pairs = _pairs(matrix, candidates | {name})
-    return {a if b == name else b for a, b in pairs if name in (a, b)} & candidates
+    def allows(self, a: str, b: str) -> bool:
+        """Whether ``a`` and ``b`` may touch: the pair's entry, else the defaults (``false`` wins)."""
+        if a == b:
+            return False
+        if a in self._listed and b in self._listed:  # the pair's own entry comes first
+            return (a, b) in self._entries or (b, a) in self._entries
+        default = self._default
+        return bool(default.get(a) and default.get(b, True)) or bool(default.get(b) and default.get(a, True))
+
+    def allowed_with(self, name: str, candidates: set[str]) -> set[str]:
+        """The ``candidates`` (links, or objects) allowed to touch ``name`` (an object's id)."""
+        return {c for c in candidates if self.allows(name, c)}
+
+    def link_pairs(self, links: set[str]) -> list[list[str]]:
+        """The robot-link pairs allowed to touch, each sorted, in order: a scene's ``allowed_collisions``.
+
+        Entries of names that are neither links nor objects change nothing (as in MoveIt); the
+        caller lists them as ignored.
+        """
+        pairs = {tuple(sorted(pair)) for pair in self._entries if set(pair) <= links}
+        for name in (n for n in links if self._default.get(n)):  # a default true, with the others
+            pairs |= {tuple(sorted((name, o))) for o in links if self.allows(name, o)}
+        return [list(pair) for pair in sorted(pairs)]
