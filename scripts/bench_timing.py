@@ -99,7 +99,9 @@ def measure(scene: Scene, robot: ck.Robot, rrt_time_s: float) -> Row:
         started = time.perf_counter()
         offered = result.problem.duration.timings(result.problem, result.waypoints)  # the step again, alone
         if method != "fastest":  # the fastest timing failed the check: the fallbacks were computed
-            narrowed_timings(result.problem, offered)
+            narrowed_timings(
+                result.problem, offered, result.problem.scene.planner.tuning.narrowed_acceleration
+            )
         timing_ms = 1e3 * (time.perf_counter() - started)
     except (PlanningError, NoSolutionError):
         pass

@@ -19,7 +19,7 @@ from planning.pipeline.deadline import Deadline
 from planning.pipeline.offered import Offered
 from planning.pipeline.planner import solve
 from planning.pipeline.problem import Problem
-from planning.pipeline.timing import FixedDuration
+from planning.pipeline.timing import FixedDuration, TimedProblem
 from planning.pipeline.tuning import SearchTuning
 from planning.pipeline.verification import Verification
 from planning.search.optimizer import SearchResult
@@ -34,7 +34,7 @@ class CountingDuration(FixedDuration):
 
     timed: list[np.ndarray] = field(default_factory=list)
 
-    def timings(self, problem: Problem, nodes: np.ndarray) -> Offered:
+    def timings(self, problem: TimedProblem, nodes: np.ndarray) -> Offered:
         self.timed.append(nodes)
         return super().timings(problem, nodes)
 

@@ -112,7 +112,7 @@ def test_narrowed_timings_meet_the_lowered_acceleration_and_beat_the_uniform_one
     result = free_results[0]
     offered = result.problem.duration.timings(result.problem, result.waypoints)
     uniform = next(t for t in offered.all if t.method == "uniform").trajectory
-    narrowed = narrowed_timings(result.problem, offered)
+    narrowed = narrowed_timings(result.problem, offered, NARROWED_ACCELERATION)
     assert narrowed, "a share of 0.7 costs well under the uniform timing's 15-35 %"
     durations = [timing.trajectory.duration for timing in narrowed]
     assert durations == sorted(durations) and durations[-1] < uniform.duration
@@ -128,7 +128,10 @@ def test_narrowed_timings_meet_the_lowered_acceleration_and_beat_the_uniform_one
             trajectory(trajectory.knots[[0, -1]]), [result.problem.q_start, result.problem.q_goal], atol=1e-12
         )
     fixed = build_problem(paper_scene(0), robot)
-    assert narrowed_timings(fixed, fixed.duration.timings(fixed, solve(fixed).waypoints)) == []
+    assert (
+        narrowed_timings(fixed, fixed.duration.timings(fixed, solve(fixed).waypoints), NARROWED_ACCELERATION)
+        == []
+    )
 
 
 def _alone(x: np.ndarray, fitness: float) -> SearchResult:
@@ -149,7 +152,7 @@ def test_a_path_whose_fastest_timing_cuts_into_the_margin_runs_narrowed(
     for result in free_results:
         problem = result.problem
         offered = problem.duration.timings(problem, result.waypoints)
-        narrowed = narrowed_timings(problem, offered)
+        narrowed = narrowed_timings(problem, offered, NARROWED_ACCELERATION)
         fastest_m = verify(problem, offered.first.trajectory, offered.first.fit).check.certified_min_m
         narrowed_m = verify(problem, narrowed[0].trajectory, narrowed[0].fit).check.certified_min_m
         if narrowed_m < fastest_m + 5e-4:

@@ -10,24 +10,22 @@ depends on it:
   break a limit. A duration shorter than the least time the joint limits allow from start to
   goal is refused up front (:meth:`FixedDuration.check_reachable`).
 - :class:`FreeDuration`: two timings of the geometric path (the spline through the
-  candidate's nodes that the fitness checked), the shorter offered first:
-
-  - *fastest*: :func:`planning.curves.path_timing.time_path`;
-  - *uniform*: the spline on its nominal knots scaled until its worst peak meets a limit.
-
-  The planner verifies them in that order, so a trajectory is never longer than the uniform
-  timing of its path. The uniform timing is computed only when it is needed
-  (:class:`~planning.pipeline.offered.Offered`):
+  candidate's nodes that the fitness checked), the shorter offered first: *fastest*
+  (:func:`planning.curves.path_timing.time_path`) and *uniform* (the spline on its nominal
+  knots scaled until its worst peak meets a limit). The planner verifies them in that order,
+  so a trajectory is never longer than the uniform timing of its path, which is computed only
   when a sampled lower bound of its duration does not show the fastest one shorter, or once
-  the fastest one has failed. Once a fastest timing has failed the certified check, *narrowed*
-  timings (:meth:`FreeDuration.narrowed`) try the fastest timing under lowered acceleration
-  limits: the jerk filter's window is ``a / j``, a lower acceleration narrows it, and the
-  corners it cuts shrink with it, while the velocity limit still holds the cruise.
+  the fastest one has failed (:class:`~planning.pipeline.offered.Offered`). Once a fastest
+  timing has failed the certified check, *narrowed* timings (:meth:`FreeDuration.narrowed`)
+  try the fastest timing under lowered acceleration limits: the jerk filter's window is
+  ``a / j``, a lower acceleration narrows it, and the corners it cuts shrink with it, while
+  the velocity limit still holds the cruise.
 """
 
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Protocol
 
@@ -36,35 +34,57 @@ from numpy.typing import NDArray
 
 from planning.curves.path_timing import limits_time_scale, time_path
 from planning.curves.ptp import trapezoid_time
-from planning.curves.spline import SplineFit
+from planning.curves.spline import SepticSplineSolver, SplineFit
 from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
 from planning.pipeline.offered import Method, Offered, Timing
 
 if TYPE_CHECKING:
     import cpr_kin as ck
-    from planning.pipeline.problem import Problem
 
 FloatArray = NDArray[np.float64]
+
+
+class TimedProblem(Protocol):
+    """What a timing asks of the problem it times (a :class:`~planning.pipeline.problem.Problem` is one)."""
+
+    @property
+    def solver(self) -> SepticSplineSolver:
+        """The spline solver through a candidate's nodes."""
+        ...
+
+    @property
+    def robot(self) -> ck.Robot:
+        """The robot, whose joint limits bind the timing."""
+        ...
+
+    @property
+    def dynamics(self) -> ck.Dynamics:
+        """The robot's torques with the scene's payload, and their limits."""
+        ...
+
+    @property
+    def duration(self) -> DurationRule:
+        """Its duration rule (fixed or free)."""
+        ...
 
 
 SAMPLES_PER_SEGMENT = 16
 """Samples per spline segment of :func:`least_uniform_scale`."""
 
 
-def uniform_scale(fit: SplineFit, problem: Problem) -> float:
+def uniform_scale(fit: SplineFit, problem: TimedProblem) -> float:
     """The factor that stretches ``fit`` uniformly until its worst peak meets a limit (torques too)."""
     limits = problem.robot.limits
     kinematic = np.stack([limits.velocity, limits.acceleration, limits.jerk])
     return limits_time_scale(fit.trajectory, kinematic, problem.dynamics)
 
 
-def least_uniform_scale(fit: SplineFit, problem: Problem) -> float:
+def least_uniform_scale(fit: SplineFit, problem: TimedProblem) -> float:
     """A lower bound of :func:`uniform_scale`, from the kinematic peaks at samples of ``fit``.
 
-    The samples' peaks are within the exact extrema, and the torques can only raise the
-    scale; :data:`SAMPLES_PER_SEGMENT` per segment come within a fraction of a per cent of it
-    on the planner's splines, for a few hundredths of its cost.
+    Samples' peaks are within the exact extrema and torques only raise the scale;
+    :data:`SAMPLES_PER_SEGMENT` a segment come within a fraction of a per cent of it.
     """
     limits, trajectory = problem.robot.limits, fit.trajectory
     times = np.linspace(
@@ -103,7 +123,7 @@ class DurationRule(Protocol):
         """Duration of a trajectory that stands still [s]."""
         ...
 
-    def timings(self, problem: Problem, nodes: FloatArray) -> Offered:
+    def timings(self, problem: TimedProblem, nodes: FloatArray) -> Offered:
         """The timings of a candidate's ``nodes`` ``(p + 2, nq)`` to verify, in order of preference."""
         ...
 
@@ -111,7 +131,7 @@ class DurationRule(Protocol):
         """A trajectory timed as fast as the limits allow, held to the rule, and whether it was stretched."""
         ...
 
-    def narrowed(self, problem: Problem, offered: Offered, share: float) -> Timing | None:
+    def narrowed(self, problem: TimedProblem, offered: Offered, share: float) -> Timing | None:
         """The path of ``offered`` timed under ``share`` of the acceleration limits, if that helps."""
         ...
 
@@ -149,10 +169,8 @@ class FixedDuration:
         """
         limits = robot.limits
         distance = np.abs(q_goal - q_start)
-        if rest_ends:
-            least = trapezoid_time(distance, limits.velocity, limits.acceleration)
-        else:
-            least = distance / limits.velocity
+        v, a = limits.velocity, limits.acceleration
+        least = trapezoid_time(distance, v, a) if rest_ends else distance / v
         j = int(np.argmax(least))
         if self.seconds < least[j]:
             name = limits.names[j]
@@ -164,14 +182,14 @@ class FixedDuration:
                 "for the fastest timing"
             )
 
-    def timings(self, problem: Problem, nodes: FloatArray) -> Offered:  # noqa: D102
+    def timings(self, problem: TimedProblem, nodes: FloatArray) -> Offered:  # noqa: D102
         started = time.perf_counter()
         fit = problem.solver.solve(nodes)
         scale = uniform_scale(fit, problem)
         trajectory = fit.trajectory.time_scaled(max(scale, 1.0))
         return Offered(Timing(trajectory, "fixed", fit, scale > 1.0, time.perf_counter() - started))
 
-    def narrowed(self, problem: Problem, offered: Offered, share: float) -> Timing | None:  # noqa: D102
+    def narrowed(self, problem: TimedProblem, offered: Offered, share: float) -> Timing | None:  # noqa: D102
         return None
 
     def held(self, trajectory: Trajectory) -> tuple[Trajectory, bool]:
@@ -209,23 +227,15 @@ class FreeDuration:
     def held(self, trajectory: Trajectory) -> tuple[Trajectory, bool]:  # noqa: D102 - the protocol's
         return trajectory, False
 
-    def timings(self, problem: Problem, nodes: FloatArray) -> Offered:
+    def timings(self, problem: TimedProblem, nodes: FloatArray) -> Offered:
         """The fastest timing of ``nodes``' path, then the uniform one; the uniform one first if shorter.
 
         The uniform timing is computed at once only when the fastest one is not shorter than
         a lower bound of its duration (:func:`least_uniform_scale`); else when asked for.
         """
-        limits = problem.robot.limits
         started = time.perf_counter()
         fit = problem.solver.solve(nodes)
-        trajectory = time_path(
-            fit.trajectory,
-            limits.velocity,
-            limits.acceleration,
-            limits.jerk,
-            torque=problem.dynamics,
-            still_jerk=self.still_jerk,
-        )
+        trajectory = self._fastest(problem, fit, 1.0)
         fastest = Timing(trajectory, "fastest", fit, False, time.perf_counter() - started)
         if self.still_jerk:  # the spline's own ends move in jerk: no uniform timing
             return Offered(fastest)
@@ -240,7 +250,20 @@ class FreeDuration:
         first, *others = sorted([fastest, uniform()], key=lambda timing: timing.trajectory.duration)
         return Offered(first, lambda: others)
 
-    def narrowed(self, problem: Problem, offered: Offered, share: float) -> Timing | None:
+    def _fastest(self, problem: TimedProblem, fit: SplineFit, share: float) -> Trajectory:
+        """``fit``'s path timed as fast as the limits allow, its acceleration limits at ``share``."""
+        limits = problem.robot.limits
+        acceleration = share * limits.acceleration
+        return time_path(
+            fit.trajectory,
+            limits.velocity,
+            acceleration,
+            limits.jerk,
+            torque=problem.dynamics,
+            still_jerk=self.still_jerk,
+        )
+
+    def narrowed(self, problem: TimedProblem, offered: Offered, share: float) -> Timing | None:
         """The path of ``offered`` timed under ``share`` of the acceleration limits.
 
         ``None`` when it is not shorter than the path's uniform timing.
@@ -249,16 +272,8 @@ class FreeDuration:
         reference = offered.of("fastest") if self.still_jerk else uniform
         if reference is None:
             return None
-        limits, fit = problem.robot.limits, reference.fit
-        started = time.perf_counter()
-        trajectory = time_path(
-            fit.trajectory,
-            limits.velocity,
-            share * limits.acceleration,
-            limits.jerk,
-            torque=problem.dynamics,
-            still_jerk=self.still_jerk,
-        )
+        fit, started = reference.fit, time.perf_counter()
+        trajectory = self._fastest(problem, fit, share)
         if uniform is not None and trajectory.duration >= uniform.trajectory.duration:
             return None
         return Timing(trajectory, "narrowed", fit, False, time.perf_counter() - started)
@@ -271,16 +286,14 @@ def duration_rule(
     return FreeDuration(search_torque=search_torque) if duration_s is None else FixedDuration(duration_s)
 
 
-def narrowed_timings(problem: Problem, offered: Offered) -> list[Timing]:
-    """The narrowed timings of the path of ``offered`` at each share of ``narrowed_acceleration``.
+def narrowed_timings(problem: TimedProblem, offered: Offered, shares: Sequence[float]) -> list[Timing]:
+    """The narrowed timings of ``offered``'s path at the falling ``shares`` of the acceleration limits.
 
-    Those shorter than its uniform timing: the shares down to the first that is not (a lower
-    share is slower still, as the timing is monotone in the limits to a few per cent);
-    none for a fixed duration.
+    Down to the first share not shorter than the uniform timing (a lower share is slower still,
+    the timing being monotone in the limits to a few per cent); none for a fixed duration.
     """
     found = []
-    for share in problem.scene.planner.tuning.narrowed_acceleration:
-        timing = problem.duration.narrowed(problem, offered, share)
+    for timing in (problem.duration.narrowed(problem, offered, share) for share in shares):
         if timing is None:
             break
         found.append(timing)
