@@ -1,0 +1,203 @@
+"""Where a warm plan's time goes, stage by stage, per class: MotionBenchMaker problems or scene files.
+
+    python scripts/profile_stages.py [--robots panda ur5] [--classes ...] [--limit N [--sample-seed S]]
+                                     [--names ...] [--time-limit S] [--out DIR]
+    python scripts/profile_stages.py --scenes FILE_OR_FOLDER ... [--time-limit S]
+
+Each problem is imported as ``scripts/bench_mbm.py`` imports it (``import-moveit``) and planned
+warm (robot loaded, kernels compiled, one process) by :func:`planning.pipeline.planner.plan`
+with the scene's settings and a time limit, as the benchmark plans it. For the run, the
+functions of the pipeline that do each stage are wrapped in a timer (nothing else changes):
+
+- ``build``: :func:`~planning.pipeline.problem.build_problem` (the ends' checks, the collision
+  world, the objective);
+- ``path``: the sampling planner's path (:func:`~planning.pipeline.path_seeds.followable_path`:
+  RRT-Connect and its shortcuts);
+- ``seeding``: the rest of the seeding (:func:`~planning.pipeline.seeding.seed_search`: the
+  straight line's and the path's candidates evaluated);
+- ``firefly``: the search (:func:`~planning.pipeline.search.search`) but its refinement;
+- ``refine``: the CMA-ES refinement (:func:`~planning.search.refinement.refine_search`);
+- ``timing``: the timings of the candidates (:func:`~planning.curves.path_timing.time_path`);
+- ``verify``: the certified checks, torques and limits of each timed candidate
+  (:func:`~planning.pipeline.verification.verify_trajectory`);
+- ``other``: the rest of the plan (the hulls' problem, the choice's bookkeeping, the result).
+
+A stage's time excludes the stages it calls (a path found inside the seeding is the path's),
+so the stages and ``other`` add up to the plan's wall time. Printed per robot and class: the
+problems planned, their median plan [ms], then each stage's median [ms] and its share of the
+class's summed time; the table as markdown to ``DIR/stages.md``. Needs the ``bench`` extra
+for MotionBenchMaker's problems (downloaded once, :mod:`planning.bench.mbm`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import statistics
+import sys
+import tempfile
+import time
+from collections import defaultdict
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import cpr_kin as ck
+from planning.batch import scene_files
+from planning.bench.mbm import import_problem
+from planning.bench.problem_selection import add_selection, check_selection, selected_problems
+from planning.cli.arguments import SECONDS
+from planning.errors import NoSolutionError
+from planning.io.scene_file import load_scene
+from planning.pipeline.planner import plan
+from planning.warming import warm_up
+
+STAGES: dict[str, tuple[str, str]] = {
+    "build": ("planning.pipeline.problem", "build_problem"),
+    "path": ("planning.pipeline.path_seeds", "followable_path"),
+    "seeding": ("planning.pipeline.seeding", "seed_search"),
+    "firefly": ("planning.pipeline.search", "search"),
+    "refine": ("planning.search.refinement", "refine_search"),
+    "timing": ("planning.curves.path_timing", "time_path"),
+    "verify": ("planning.pipeline.verification", "verify_trajectory"),
+}
+"""Each stage's function, by module and name (the module docstring)."""
+
+
+class StageClock:
+    """Exclusive wall times of the wrapped stages: a stage's time less that of the stages it calls.
+
+    ``clock``: the time [s] (default: ``time.perf_counter``).
+    """
+
+    def __init__(self, clock: Callable[[], float] = time.perf_counter) -> None:
+        self.clock = clock
+        self.spent_s: dict[str, float] = defaultdict(float)
+        self._children_s: list[float] = []  # per open stage: its nested stages' time so far
+
+    def wrapped(self, stage: str, function: Callable[..., Any]) -> Callable[..., Any]:
+        """``function`` whose calls are charged to ``stage``."""
+
+        @functools.wraps(function)
+        def timed(*args: Any, **kwargs: Any) -> Any:
+            self._children_s.append(0.0)
+            started = self.clock()
+            try:
+                return function(*args, **kwargs)
+            finally:
+                whole = self.clock() - started
+                nested = self._children_s.pop()
+                self.spent_s[stage] += whole - nested
+                if self._children_s:
+                    self._children_s[-1] += whole
+
+        return timed
+
+    def install(self) -> None:
+        """Wrap every stage's function, in its module and wherever a module imported it by name."""
+        for stage, (module_name, name) in STAGES.items():
+            original = getattr(sys.modules[module_name], name)
+            timed = self.wrapped(stage, original)
+            for module in list(sys.modules.values()):
+                if getattr(module, "__dict__", {}).get(name) is original:
+                    setattr(module, name, timed)
+
+    def lap(self) -> dict[str, float]:
+        """The stages' times since the last lap [s], and reset."""
+        spent = {stage: self.spent_s.get(stage, 0.0) for stage in STAGES}
+        self.spent_s.clear()
+        return spent
+
+
+def cases(args: argparse.Namespace, out: Path) -> Iterator[tuple[str, str, Path]]:
+    """``(robot, class, scene file)`` of each problem: MotionBenchMaker's, or ``--scenes``."""
+    if args.scenes:
+        for given in args.scenes:
+            for path in scene_files(given) if given.is_dir() else [given]:
+                group, _, number = path.stem.rpartition("_")
+                yield path.resolve().parent.name, group if group and number.isdigit() else path.stem, path
+        return
+    for robot_name in args.robots:
+        for problem in selected_problems(args, robot_name):
+            path = out / "scenes" / robot_name / f"{problem.name}.yaml"
+            import_problem(problem, path)
+            yield robot_name, problem.problem_class, path
+
+
+def table(rows: list[tuple[str, str, float, dict[str, float]]]) -> list[str]:
+    """Markdown rows per robot and class, then per robot (module docstring)."""
+    columns = [*STAGES, "other"]
+    lines = [
+        "| robot | class | planned | median plan [ms] | "
+        + " | ".join(f"{c} [ms] (share)" for c in columns)
+        + " |",
+        "|---|---|---|---|" + "---|" * len(columns),
+    ]
+    groups: dict[tuple[str, str], list[tuple[float, dict[str, float]]]] = defaultdict(list)
+    for robot_name, group, total_s, stages in rows:
+        for key in ((robot_name, group), (robot_name, "all")):
+            groups[key].append((total_s, {**stages, "other": total_s - sum(stages.values())}))
+    for (robot_name, group), planned in sorted(groups.items(), key=lambda kv: (kv[0][0], kv[0][1] == "all")):
+        summed = sum(total for total, _ in planned)
+        cells = [
+            f"{1000 * statistics.median(s[c] for _, s in planned):.1f} "
+            f"({sum(s[c] for _, s in planned) / summed:.0%})"
+            for c in columns
+        ]
+        median_ms = 1000 * statistics.median(total for total, _ in planned)
+        lines.append(
+            f"| {robot_name} | {group} | {len(planned)} | {median_ms:.1f} | " + " | ".join(cells) + " |"
+        )
+    return lines
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    add_selection(parser)
+    parser.add_argument(
+        "--scenes", type=Path, nargs="+", help="scene files or folders instead of MotionBenchMaker"
+    )
+    parser.add_argument(
+        "--time-limit", type=SECONDS, default=8.0, help="each plan's time_limit_s (default: 8)"
+    )
+    parser.add_argument(
+        "--out", type=Path, help="folder of the scenes and stages.md (default: a temporary one)"
+    )
+    args = parser.parse_args()
+    check_selection(parser, args)
+    for given in args.scenes or ():
+        if not given.exists():
+            parser.error(f"--scenes {given}: no such file or folder")
+    out = args.out or Path(tempfile.mkdtemp(prefix="profile_stages_"))
+    clock = StageClock()
+    clock.install()
+    robots: dict[str, ck.Robot] = {}
+    rows = []
+    for robot_name, group, path in cases(args, out):
+        scene = load_scene(path).with_planner(time_limit_s=args.time_limit)
+        key = str(scene.robot)
+        if key not in robots:
+            robots[key] = scene.robot.load() if scene.robot is not None else ck.load_cpr()
+            warm_up(robots[key])
+        clock.lap()
+        started = time.perf_counter()
+        try:
+            plan(scene, robots[key])
+        except NoSolutionError as exc:
+            print(f"{robot_name} {path.stem}: not planned ({type(exc).__name__}), left out", flush=True)
+            continue
+        total_s, stages = time.perf_counter() - started, clock.lap()
+        rows.append((robot_name, group, total_s, stages))
+        shown = " ".join(f"{stage} {1000 * spent:.0f}" for stage, spent in stages.items())
+        print(f"{robot_name} {path.stem}: {1000 * total_s:.0f} ms ({shown})", flush=True)
+    lines = table(rows)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "stages.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

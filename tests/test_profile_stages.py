@@ -1,0 +1,101 @@
+"""``scripts/profile_stages.py``: exclusive stage times that add up to the plan's."""
+
+from __future__ import annotations
+
+import importlib.util
+import re
+import subprocess
+import sys
+from pathlib import Path
+from types import ModuleType
+
+import pytest
+
+SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "profile_stages.py"
+SHELF = Path(__file__).resolve().parents[1] / "examples" / "scenes" / "shelf.yaml"
+
+
+@pytest.fixture(scope="module")
+def script() -> ModuleType:
+    spec = importlib.util.spec_from_file_location("profile_stages", SCRIPT)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_a_stage_is_charged_its_own_time_not_that_of_the_stages_it_calls(script: ModuleType) -> None:
+    now = [0.0]
+
+    def tick(seconds: float) -> None:
+        now[0] += seconds
+
+    clock = script.StageClock(clock=lambda: now[0])
+
+    def inner() -> None:
+        tick(2.0)
+
+    timed_inner = clock.wrapped("inner", inner)
+
+    def outer() -> str:
+        tick(1.0)
+        timed_inner()
+        tick(0.5)
+        timed_inner()
+        return "done"
+
+    timed_outer = clock.wrapped("outer", outer)
+    assert timed_outer() == "done" and timed_outer.__name__ == "outer"
+    timed_inner()  # called alone: all its own
+    assert clock.spent_s == {"outer": 1.5, "inner": 6.0}
+    assert sum(clock.spent_s.values()) == now[0]  # the stages add up to the wall time
+
+
+def test_the_table_gives_each_stage_s_median_and_share(script: ModuleType) -> None:
+    stages = dict.fromkeys(script.STAGES, 0.0)
+    rows = [
+        ("arm", "box", 1.0, {**stages, "refine": 0.5, "verify": 0.25}),
+        ("arm", "box", 3.0, {**stages, "refine": 1.5, "verify": 0.75}),
+    ]
+    lines = script.table(rows)
+    box = next(line for line in lines if line.startswith("| arm | box |"))
+    cells = [cell.strip() for cell in box.strip("|").split("|")]
+    columns = [*script.STAGES, "other"]
+    assert cells[2:4] == ["2", "2000.0"]  # planned, median plan [ms]
+    by_stage = dict(zip(columns, cells[4:], strict=True))
+    assert by_stage["refine"] == "1000.0 (50%)" and by_stage["verify"] == "500.0 (25%)"
+    assert by_stage["other"] == "500.0 (25%)"  # what no stage took
+    assert any(line.startswith("| arm | all | 2 |") for line in lines)
+
+
+@pytest.mark.slow
+def test_the_script_profiles_a_scene_file_and_its_stages_add_up(script: ModuleType, tmp_path: Path) -> None:
+    run = subprocess.run(
+        [sys.executable, str(SCRIPT), "--scenes", str(SHELF), "--out", str(tmp_path)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+    assert run.returncode == 0, run.stderr[-2000:]
+    line = next(line for line in run.stdout.splitlines() if line.startswith("scenes shelf:"))
+    total = float(re.search(r": (\d+) ms", line).group(1))  # type: ignore[union-attr]
+    spent = {name: float(ms) for name, ms in re.findall(r"(\w+) (\d+)(?= |\))", line.split("(", 1)[1])}
+    assert set(spent) == set(script.STAGES)
+    assert spent["build"] > 0 and spent["verify"] > 0 and spent["timing"] > 0  # the wrapped functions ran
+    assert sum(spent.values()) <= total + len(spent)  # each rounded to a millisecond
+    assert "| scenes | shelf | 1 |" in (tmp_path / "stages.md").read_text()
+
+
+@pytest.mark.slow
+def test_a_missing_scene_is_refused_in_one_line() -> None:
+    run = subprocess.run(
+        [sys.executable, str(SCRIPT), "--scenes", "no/such/scene.yaml"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert run.returncode == 2 and "--scenes no/such/scene.yaml: no such file or folder" in run.stderr
+    assert "Traceback" not in run.stderr
