@@ -49,7 +49,14 @@ def task_drawn_files(task: TaskMotion, plots: bool = True, page: bool = True) ->
         units = tuple(robot.joint_unit(n) for n in robot.joint_names)
         figures = (
             drawing.joint_figure(trajectory, robot.joint_names, units),
-            drawing.tcp_path_figure(robot, trajectory, task.junctions, scene.obstacles, scene.safety_margin),
+            drawing.tcp_path_figure(
+                robot,
+                trajectory,
+                task.junctions,
+                task.world.obstacles,
+                scene.safety_margin,
+                moved_objects(task),
+            ),
         )
         files |= {n: drawing.png_bytes(f) for n, f in zip(TASK_PLOT_FILES, figures, strict=True)}
     if page:
@@ -62,6 +69,16 @@ def task_drawn_files(task: TaskMotion, plots: bool = True, page: bool = True) ->
             measured=task_clearance(task),
         )
     return files
+
+
+def moved_objects(task: TaskMotion) -> tuple[ck.Obstacle, ...]:
+    """What a task takes and leaves, each object where it rests: taken from, and left at."""
+    changes = [s for s in task.segments if s.kind in ("attach", "detach") and s.payload is not None]
+    return tuple(
+        ck.left_at(task.world.robot, s.payload, task.trajectory(s.t0))
+        for s in changes
+        if s.payload is not None and s.payload.shape is not None
+    )
 
 
 def task_carried(task: TaskMotion) -> tuple[CarriedSpan, ...]:

@@ -78,29 +78,28 @@ def joint_figure(trajectory: Trajectory, joint_names: tuple[str, ...], units: tu
     return figure
 
 
-def _box_faces(obstacle: ck.Obstacle, grow: float) -> list[FloatArray]:
-    """The six faces of the obstacle's bounding box grown by ``grow`` [m], in the world."""
-    if obstacle.shape == "voxels":  # the voxels' bounding box, about their own centre
-        points, half_side = np.asarray(obstacle.points), float(obstacle.resolution or 0.0) / 2 + grow
+def _box_corners(obstacle: ck.Obstacle, grow: float) -> FloatArray:
+    """``(8, 3)`` the corners of the obstacle's bounding box grown by ``grow`` [m], in the world.
+
+    The box about coal's geometry in the obstacle's frame (a mesh's, a round shape's), or about
+    the occupied voxels' centres.
+    """
+    if obstacle.shape == "voxels":  # coal's octree is bounded by its root cube, not by what it holds
+        points, half_side = np.asarray(obstacle.points), float(obstacle.resolution or 0.0) / 2
         low, high = points.min(axis=0) - half_side, points.max(axis=0) + half_side
     else:
-        half = (
-            (np.asarray(obstacle.size) / 2 + grow)
-            if obstacle.shape == "box"
-            else np.full(3, (obstacle.radius or 0.1) + grow)
-        )
-        if obstacle.shape in ("cylinder", "capsule"):
-            half[2] = (
-                (obstacle.length or 0.0) / 2
-                + grow
-                + ((obstacle.radius or 0.0) if obstacle.shape == "capsule" else 0.0)
-            )
-        low, high = -half, half
-    corners = np.array(list(itertools.product(*zip(low, high, strict=True))))
+        geometry = obstacle.geometry()
+        geometry.computeLocalAABB()
+        low, high = np.asarray(geometry.aabb_local.min_), np.asarray(geometry.aabb_local.max_)
+    corners = np.array(list(itertools.product(*zip(low - grow, high + grow, strict=True))))
     placement = obstacle.placement
-    world = corners @ np.asarray(placement.rotation).T + np.asarray(placement.translation)
+    return np.asarray(corners @ np.asarray(placement.rotation).T + np.asarray(placement.translation))
+
+
+def _box_faces(corners: FloatArray) -> list[FloatArray]:
+    """The six faces of a box from its ``(8, 3)`` corners (:func:`_box_corners`' order)."""
     faces = [[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5]]
-    return [world[f] for f in faces]
+    return [corners[f] for f in faces]
 
 
 def tcp_path_figure(
@@ -109,10 +108,12 @@ def tcp_path_figure(
     waypoints: FloatArray,
     obstacles: tuple[ck.Obstacle, ...],
     margin_m: float,
+    moved: tuple[ck.Obstacle, ...] = (),
 ) -> Figure:
     """The TCP path in 3-D with the obstacles and the margin as translucent shells.
 
-    Obstacles are drawn as boxes (round shapes as their bounding boxes).
+    Obstacles are drawn as their bounding boxes; ``moved`` (what a task takes or leaves) in
+    another colour, where each rests. The axes span what is drawn, at one scale [m].
     """
     times = np.linspace(trajectory.knots[0], trajectory.knots[-1], 400)
     tcp = ck.frame_positions(robot, trajectory(times))
@@ -121,20 +122,25 @@ def tcp_path_figure(
     ax: Any = figure.add_subplot(projection="3d")
     ax.plot(*tcp.T, color="C0", label="TCP path")
     ax.scatter(*nodes.T, color="C1", s=25, label="waypoints", depthshade=False)
-    for obstacle in obstacles:
-        ax.add_collection3d(
-            Poly3DCollection(_box_faces(obstacle, 0.0), facecolor="#d9534f", alpha=0.7, edgecolor="k")
-        )
-        if margin_m > 0:
-            ax.add_collection3d(
-                Poly3DCollection(_box_faces(obstacle, margin_m), facecolor="#d9534f", alpha=0.12)
-            )
+    drawn = [tcp, nodes]
+    for group, colour, label in ((obstacles, "#d9534f", "obstacles"), (moved, "#5b8fd9", "objects moved")):
+        for k, obstacle in enumerate(group):
+            solid, shell = _box_corners(obstacle, 0.0), _box_corners(obstacle, margin_m)
+            faces = Poly3DCollection(_box_faces(solid), facecolor=colour, alpha=0.7, edgecolor="k")
+            faces.set_label(label if k == 0 else None)
+            ax.add_collection3d(faces)
+            if margin_m > 0:
+                ax.add_collection3d(Poly3DCollection(_box_faces(shell), facecolor=colour, alpha=0.12))
+            drawn.append(shell)
+    low, high = np.min([d.min(axis=0) for d in drawn], axis=0), np.max([d.max(axis=0) for d in drawn], axis=0)
+    pad = 0.05 * float(np.max(high - low)) + 1e-3
+    ax.set_xlim(low[0] - pad, high[0] + pad)
+    ax.set_ylim(low[1] - pad, high[1] + pad)
+    ax.set_zlim(low[2] - pad, high[2] + pad)
+    ax.set_box_aspect(high - low + 2 * pad)  # one metre as long on every axis
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_zlabel("z [m]")
-    ax.set_xlim(-0.9, 0.9)
-    ax.set_ylim(-0.9, 0.9)
-    ax.set_zlim(0.0, 1.0)
     ax.legend(loc="upper left")
     ax.set_title("TCP path, obstacles and safety margin")
     return figure
