@@ -194,8 +194,8 @@ class Viewer:
         times = np.linspace(trajectory.knots[0], trajectory.knots[-1], samples)
         configurations = trajectory(times)
         tcp = ck.frame_positions(self.robot, configurations)
-        world = self.world.clearance_batch
-        clearance = world(configurations).min_clearance_m if measured is None else measured.at(times)
+        clearance_of = self.world.clearance_batch
+        clearance = clearance_of(configurations).min_clearance_m if measured is None else measured.at(times)
         for i, q in enumerate(np.atleast_2d(waypoints)):
             marker = self.vis["scene/waypoints"][str(i)]
             marker.set_object(g.Sphere(0.015), _material(WAYPOINT_COLOR))
