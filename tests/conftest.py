@@ -1,11 +1,15 @@
 """Shared fixtures: the bundled CPR, the paper's scene, geometric paths to time, the example pick
-and place planned once, and a stop that says yes after a count of questions."""
+and place planned once, a stop that says yes after a count of questions, and a script loaded
+as a module."""
 
 from __future__ import annotations
 
+import importlib.util
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from types import ModuleType
 
 import coal
 import numpy as np
@@ -25,6 +29,19 @@ PAPER_GOAL_TCP = (-0.5, 0.45, 0.25)
 REST = SplineSettings(p=1e6, a=(0.0, 0.0, 1.0), ends="rest")
 LIFT = np.array([0.4, 0.25, -0.1, 0.0, 0.0])
 """An offset of the middle waypoints: the path lifts over something, a curved path."""
+
+
+SCRIPTS = Path(__file__).resolve().parents[1] / "scripts"
+
+
+def load_script(name: str) -> ModuleType:
+    """``scripts/<name>.py`` as a module, in ``sys.modules`` (where a dataclass looks its module up)."""
+    spec = importlib.util.spec_from_file_location(name, SCRIPTS / f"{name}.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
 
 
 def spline_path(nodes: np.ndarray) -> Trajectory:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
 import sys
 from pathlib import Path
 from types import ModuleType, SimpleNamespace
@@ -13,6 +12,7 @@ import pytest
 
 import cpr_kin as ck
 from cpr_kin.model.packages import example_robot
+from tests.conftest import load_script
 
 SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "bench_mbm.py"
 SHELF = Path(__file__).resolve().parents[1] / "examples" / "scenes" / "shelf.yaml"
@@ -20,12 +20,7 @@ SHELF = Path(__file__).resolve().parents[1] / "examples" / "scenes" / "shelf.yam
 
 @pytest.fixture(scope="module")
 def bench() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("bench_mbm", SCRIPT)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # importlib's recipe: a dataclass looks its module up there
-    spec.loader.exec_module(module)
-    return module
+    return load_script("bench_mbm")
 
 
 def test_the_torque_over_the_limit_is_pinocchio_s_rnea_along_the_trajectory(bench: ModuleType) -> None:
@@ -126,7 +121,6 @@ def test_a_scene_without_a_robot_is_the_cpr_s(bench: ModuleType, tmp_path: Path)
 
 
 def test_the_peer_s_imports_are_done_before_its_first_timed_call() -> None:
-    import sys
 
     from planning.bench import import_peer
 
@@ -138,7 +132,6 @@ def test_the_peer_s_imports_are_done_before_its_first_timed_call() -> None:
 def test_roboplan_runs_beside_ours_and_its_path_is_checked(tmp_path: Path) -> None:
     import csv
     import subprocess
-    import sys
 
     pytest.importorskip("roboplan.core", reason="the bench extra's roboplan")
     run = subprocess.run(
