@@ -258,3 +258,12 @@ def test_a_tasks_path_is_coloured_by_what_its_checks_measured(pick_and_place: Pl
     # the part, waiting and left behind, comes closest: the drawn world alone would colour it clearer
     assert drawn["clearance"].min() < own["clearance"].min() - 0.01
     assert drawn["clearance"].min() >= task.margin_m
+    # and the closest pair drawn is the one the checks met, found in that segment's world: the
+    # part's, at the least measured clearance (exact there: coal decides a check's minimum)
+    closest = drawn["closest"]
+    assert closest.obstacle == "part" and drawn["worst_time"] == measured.worst_time_s
+    assert closest.distance_m == pytest.approx(float(measured.clearance_m.min()), abs=1e-6)
+    assert np.linalg.norm(closest.point_on_robot - closest.point_on_obstacle) == pytest.approx(
+        closest.distance_m, abs=1e-6
+    )
+    assert own["closest"].obstacle != "part"  # the drawn world has no part to be close to

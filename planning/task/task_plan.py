@@ -62,6 +62,8 @@ class SegmentMotion:
         line: the planned line, for a ``line``.
         payload: the object attached, for an ``attach``; released, for a ``detach``.
         held: the motion that keeps an orientation constraint, for a ``free`` one under one.
+        world: the world its trajectory was verified in: the robot with what it carries then,
+            among the obstacles then (``None`` for an attach or detach).
     """
 
     kind: str
@@ -71,6 +73,7 @@ class SegmentMotion:
     line: LineMotion | None = None
     payload: ck.Payload | None = None
     held: HeldMotion | None = None
+    world: ck.CollisionWorld | None = field(default=None, repr=False)
 
 
 @dataclass(frozen=True)
@@ -201,12 +204,16 @@ def plan_task(
     if all(motion is None for motion in planned):
         raise PlanningError("a task needs a segment that moves or waits, not only attach and detach")
     records, pieces, now = [], [], 0.0
-    for kind, payload, timed in zip(kinds, payloads, timed_motions(planned, base), strict=True):
-        if timed is None:
+    timed_ones = timed_motions(planned, base)
+    for kind, payload, source, timed in zip(kinds, payloads, planned, timed_ones, strict=True):
+        if source is None or timed is None:
             records.append(SegmentMotion(kind, now, now, payload=payload))
             continue
         end = now + timed.trajectory.duration
-        records.append(SegmentMotion(kind, now, end, timed.verification, timed.line, held=timed.held))
+        world = source.problem.world
+        records.append(
+            SegmentMotion(kind, now, end, timed.verification, timed.line, held=timed.held, world=world)
+        )
         pieces.append(timed.trajectory)
         now = end
     whole = joined(pieces)

@@ -3,17 +3,20 @@
 A task changes its world as it goes (:mod:`planning.task.holding`: what the robot carries, an
 obstacle taken, an object left), so no one world measures its whole path. Each segment's
 verification measured it with the world as it was then; :func:`task_clearance` puts those
-samples on the task's clock for the viewer (:meth:`planning.viz.viewer.Viewer.show_plan`).
-Headless.
+samples on the task's clock for the viewer (:meth:`planning.viz.viewer.Viewer.show_plan`),
+with the closest pair at the least of them found in that segment's world. Headless.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
+
+import cpr_kin as ck
 
 if TYPE_CHECKING:
     from planning.task.task_plan import TaskMotion
@@ -29,10 +32,18 @@ class MeasuredClearance:
         times_s: ``(K,)`` increasing instants [s].
         clearance_m: ``(K,)`` the least clearance of the robot (and what it carries) from the
             obstacles there [m].
+        closest: the robot-obstacle pair closest at the least of them (:attr:`worst_time_s`),
+            in the world that measured it; ``None``: not known.
     """
 
     times_s: FloatArray
     clearance_m: FloatArray
+    closest: ck.PairDistance | None = None
+
+    @property
+    def worst_time_s(self) -> float:
+        """The instant of the least measured clearance [s]."""
+        return float(self.times_s[int(np.argmin(self.clearance_m))])
 
     def at(self, times_s: FloatArray) -> FloatArray:
         """The clearance at ``times_s`` [s], linear between the measured instants [m]."""
@@ -40,19 +51,28 @@ class MeasuredClearance:
 
 
 def task_clearance(task: TaskMotion) -> MeasuredClearance:
-    """The samples of every segment's certified check, on the task's clock.
+    """The samples of every segment's certified check, on the task's clock, and the closest pair.
 
     A check's instants are on the clock of the motion it is part of (motions the task does not
     stop between are timed as one, :mod:`planning.task.task_timing`), its first the segment's
-    start: each is moved to start at the segment's ``t0``.
+    start: each is moved to start at the segment's ``t0``. The closest pair at the least
+    clearance is that segment's world's (what the robot carries then, among the obstacles then).
     """
-    times, clearance = [], []
+    times, clearance, worlds = [], [], []
     for segment in task.segments:
         if segment.verification is not None:
             check = segment.verification.check
             instants = np.asarray(check.times)
             times.append(segment.t0 + (instants - instants[0]))
             clearance.append(np.asarray(check.clearance_m).min(axis=1))
+            worlds.append(segment.world)
+    least = [float(np.min(c)) for c in clearance]
+    worst = int(np.argmin(least))
+    world = worlds[worst]
     instants = np.concatenate(times)
     order = np.argsort(instants, kind="stable")
-    return MeasuredClearance(instants[order], np.concatenate(clearance)[order])
+    measured = MeasuredClearance(instants[order], np.concatenate(clearance)[order])
+    if world is None:
+        return measured
+    q_worst = task.trajectory(np.array([times[worst][int(np.argmin(clearance[worst]))]]))[0]
+    return dataclasses.replace(measured, closest=world.clearance(q_worst).closest)

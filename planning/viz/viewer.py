@@ -188,8 +188,8 @@ class Viewer:
 
         The clearance: the world's at each sample, or what the certified checks ``measured``
         (a task's, each segment's in its own world: :mod:`planning.viz.measured_clearance`).
-        Returns what was drawn: ``times``, ``tcp`` positions, ``clearance`` and the world's
-        ``closest`` pair at the instant of smallest clearance.
+        Returns ``times``, ``tcp`` positions, ``clearance``, the instant of the least
+        (``worst_time``) and the ``closest`` pair then: the measuring world's where known.
         """
         times = np.linspace(trajectory.knots[0], trajectory.knots[-1], samples)
         configurations = trajectory(times)
@@ -205,8 +205,11 @@ class Viewer:
         self.vis["scene/tcp_path"].set_object(
             g.Line(path, g.LineBasicMaterial(vertexColors=True, linewidth=3))
         )
-        worst = int(np.argmin(finite))
-        closest = self.world.clearance(configurations[worst]).closest
+        if measured is None or measured.closest is None:
+            worst_time = float(times[int(np.argmin(finite))])
+            closest = self.world.clearance(trajectory(worst_time)).closest
+        else:  # found in the world that measured it
+            worst_time, closest = measured.worst_time_s, measured.closest
         if closest is not None:
             ends = np.column_stack([closest.point_on_robot, closest.point_on_obstacle])
             node = self.vis["scene/closest"]
@@ -216,14 +219,8 @@ class Viewer:
             for name, point in (("robot", closest.point_on_robot), ("obstacle", closest.point_on_obstacle)):
                 node[name].set_object(g.Sphere(0.01), _material(CLOSEST_COLOR))
                 node[name].set_transform(tf.translation_matrix(point))
-        self.show_configuration(configurations[worst])
-        return {
-            "times": times,
-            "tcp": tcp,
-            "clearance": clearance,
-            "closest": closest,
-            "worst_time": times[worst],
-        }
+        self.show_configuration(trajectory(worst_time))
+        return dict(times=times, tcp=tcp, clearance=clearance, closest=closest, worst_time=worst_time)
 
     def show_carried(self, trajectory: Trajectory, spans: tuple[CarriedSpan, ...]) -> None:
         """Draw the objects ``trajectory`` carries over ``spans``, each where it is at the start.
