@@ -118,7 +118,7 @@ def test_viewer_scene_contents(robot: ck.Robot, result: PlanResult) -> None:
         "scene/waypoints/4",
         "scene/tcp_path",
         "scene/closest",
-        "/cpr",
+        "/robot",
     ):
         assert path.encode() in commands, path
     assert b"set_animation" in commands
@@ -218,7 +218,7 @@ def test_a_tasks_page_moves_what_it_carries_and_leaves_it_where_released(
     assert commands.count(b"scene/carried/part") >= 2  # drawn, and a track of the animation
     assert b"set_animation" in commands
     # the robot's own model carries no part: before the attach it rests where it is taken
-    assert b"cpr/visuals/part" not in commands
+    assert b"robot/visuals/part" not in commands
     html = tmp_path / "task.html"
     html.write_text(page)
     image = screenshot(html, tmp_path / "task.png", tmp_path / "profile")  # a real browser plays it
@@ -240,9 +240,9 @@ def test_a_start_payload_released_is_drawn_apart_from_the_robot(robot: ck.Robot,
             html = viewer.static_html()
         drawn.append(b"".join(base64.b64decode(m) for m in re.findall(r"base64,([A-Za-z0-9+/=]+)", html)))
     alone, apart = drawn
-    assert b"cpr/visuals/ball" in alone and b"scene/carried/ball" not in alone  # the control: on the robot
+    assert b"robot/visuals/ball" in alone and b"scene/carried/ball" not in alone  # the control: on the robot
     # drawn apart, the robot model's own ball gone (it would go on moving with the tool)
-    assert b"scene/carried/ball" in apart and b"cpr/visuals/ball" not in apart
+    assert b"scene/carried/ball" in apart and b"robot/visuals/ball" not in apart
     assert carrying.collision_model.existGeometryName("ball")  # the robot itself still carries it
 
 

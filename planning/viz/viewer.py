@@ -4,7 +4,7 @@ Imported only when a display is asked for: ``import planning`` never loads meshc
 viewer talks to a loopback-only meshcat server (:mod:`planning.viz.viewer_server`) that it
 starts, and can export everything, animation included, as one self-contained HTML file.
 
-Scene tree: ``/cpr`` (the robot, visual and collision geometry, the latter hidden by
+Scene tree: ``/robot`` (the robot, visual and collision geometry, the latter hidden by
 default), ``/scene/obstacles/<name>``, ``/scene/margin/<name>`` (translucent shells: the
 obstacle grown by the margin; a box's shell is the box grown by the margin on every side,
 which contains the exact rounded shell), ``/scene/waypoints/<i>`` (TCP at each node),
@@ -42,6 +42,7 @@ from planning.viz.viewer_server import ServerProcess, start_server
 
 FloatArray = NDArray[np.float64]
 
+ROBOT_NODE = "robot"
 OBSTACLE_COLOR = 0xD9534F
 MARGIN_OPACITY = 0.22
 WAYPOINT_COLOR = 0xF0AD4E
@@ -137,7 +138,7 @@ class Viewer:
             self.vis = meshcat.Visualizer(window=window)
         self._robot_view = MeshcatVisualizer(robot.model, robot.collision_model, robot.visual_model)
         self._robot_view.initViewer(viewer=self.vis, open=False)
-        self._robot_view.loadViewerModel(rootNodeName="cpr")
+        self._robot_view.loadViewerModel(rootNodeName=ROBOT_NODE)
         self._robot_view.displayCollisions(False)
         self._robot_view.displayVisuals(True)
         for obstacle in obstacles:
@@ -250,7 +251,7 @@ class Viewer:
                 model.removeGeometryObject(name)
                 setattr(view, f"{kind}_model", model)
                 setattr(view, f"{kind}_data", model.createData())
-                self.vis["cpr"][group][name].delete()
+                self.vis[ROBOT_NODE][group][name].delete()
 
     def animate(self, trajectory: Trajectory, fps: int = 30, repetitions: int = 0) -> int:
         """Record the trajectory at real time (``fps`` frames per second); returns the frame count.
