@@ -73,11 +73,10 @@ def task_drawn_files(task: TaskMotion, plots: bool = True, page: bool = True) ->
 
 def moved_objects(task: TaskMotion) -> tuple[ck.Obstacle, ...]:
     """What a task takes and leaves, each object where it rests: taken from, and left at."""
-    changes = [s for s in task.segments if s.kind in ("attach", "detach") and s.payload is not None]
     return tuple(
         ck.left_at(task.world.robot, s.payload, task.trajectory(s.t0))
-        for s in changes
-        if s.payload is not None and s.payload.shape is not None
+        for s in task.segments
+        if s.kind in ("attach", "detach") and s.payload is not None and s.payload.shape is not None
     )
 
 

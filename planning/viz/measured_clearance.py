@@ -9,7 +9,6 @@ with the closest pair at the least of them found in that segment's world. Headle
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -66,13 +65,9 @@ def task_clearance(task: TaskMotion) -> MeasuredClearance:
             times.append(segment.t0 + (instants - instants[0]))
             clearance.append(np.asarray(check.clearance_m).min(axis=1))
             worlds.append(segment.world)
-    least = [float(np.min(c)) for c in clearance]
-    worst = int(np.argmin(least))
-    world = worlds[worst]
+    worst = int(np.argmin([float(np.min(c)) for c in clearance]))  # the segment of the least
+    world, q_worst = worlds[worst], task.trajectory(times[worst][[int(np.argmin(clearance[worst]))]])[0]
     instants = np.concatenate(times)
     order = np.argsort(instants, kind="stable")
-    measured = MeasuredClearance(instants[order], np.concatenate(clearance)[order])
-    if world is None:
-        return measured
-    q_worst = task.trajectory(np.array([times[worst][int(np.argmin(clearance[worst]))]]))[0]
-    return dataclasses.replace(measured, closest=world.clearance(q_worst).closest)
+    closest = None if world is None else world.clearance(q_worst).closest
+    return MeasuredClearance(instants[order], np.concatenate(clearance)[order], closest)
