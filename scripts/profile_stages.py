@@ -25,8 +25,10 @@ functions of the pipeline that do each stage are wrapped in a timer (nothing els
 A stage's time excludes the stages it calls (a path found inside the seeding is the path's),
 so the stages and ``other`` add up to the plan's wall time. Printed per robot and class: the
 problems planned, their median plan [ms], then each stage's median [ms] and its share of the
-class's summed time; the table as markdown to ``DIR/stages.md``. Needs the ``bench`` extra
-for MotionBenchMaker's problems (downloaded once, :mod:`planning.bench.mbm`).
+class's summed time; the table as markdown to ``DIR/stages.md``. Every scene and robot is loaded
+before anything runs: a missing or malformed file, a task (not one motion), or a robot that does
+not load is named in one line. Needs the ``bench`` extra for MotionBenchMaker's problems
+(downloaded once, :mod:`planning.bench.mbm`).
 """
 
 from __future__ import annotations
@@ -47,7 +49,7 @@ from planning.batch import scene_files
 from planning.bench.mbm import import_problem
 from planning.bench.problem_selection import add_selection, check_selection, selected_problems
 from planning.cli.arguments import SECONDS
-from planning.errors import NoSolutionError
+from planning.errors import CprPlanError
 from planning.io.scene_file import load_scene
 from planning.pipeline.planner import plan
 from planning.warming import warm_up
@@ -171,21 +173,28 @@ def main() -> int:
         if not given.exists():
             parser.error(f"--scenes {given}: no such file or folder")
     out = args.out or Path(tempfile.mkdtemp(prefix="profile_stages_"))
+    robots: dict[str, ck.Robot] = {}
+    try:  # every scene and robot loaded before anything runs: a fault named in one line
+        loaded = [
+            (*case, load_scene(case[2]).with_planner(time_limit_s=args.time_limit))
+            for case in cases(args, out)
+        ]
+        for scene in (case[3] for case in loaded):
+            if str(scene.robot) not in robots:
+                robots[str(scene.robot)] = scene.robot.load() if scene.robot is not None else ck.load_cpr()
+    except (CprPlanError, ck.CprKinError) as exc:
+        parser.error(str(exc))
+    for robot in robots.values():
+        warm_up(robot)
     clock = StageClock()
     clock.install()
-    robots: dict[str, ck.Robot] = {}
     rows = []
-    for robot_name, group, path in cases(args, out):
-        scene = load_scene(path).with_planner(time_limit_s=args.time_limit)
-        key = str(scene.robot)
-        if key not in robots:
-            robots[key] = scene.robot.load() if scene.robot is not None else ck.load_cpr()
-            warm_up(robots[key])
+    for robot_name, group, path, scene in loaded:
         clock.lap()
         started = time.perf_counter()
         try:
-            plan(scene, robots[key])
-        except NoSolutionError as exc:
+            plan(scene, robots[str(scene.robot)])
+        except CprPlanError as exc:
             print(f"{robot_name} {path.stem}: not planned ({type(exc).__name__}), left out", flush=True)
             continue
         total_s, stages = time.perf_counter() - started, clock.lap()

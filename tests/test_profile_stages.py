@@ -14,6 +14,7 @@ from tests.conftest import load_script
 
 SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "profile_stages.py"
 SHELF = Path(__file__).resolve().parents[1] / "examples" / "scenes" / "shelf.yaml"
+TASK = SHELF.with_name("pick_and_place.yaml")
 
 
 @pytest.fixture(scope="module")
@@ -85,13 +86,20 @@ def test_the_script_profiles_a_scene_file_and_its_stages_add_up(script: ModuleTy
 
 
 @pytest.mark.slow
-def test_a_missing_scene_is_refused_in_one_line() -> None:
+@pytest.mark.parametrize(
+    ("scene", "message"),
+    [
+        ("no/such/scene.yaml", "--scenes no/such/scene.yaml: no such file or folder"),
+        (str(TASK), "holds a task of 8 segments, not one motion to a goal"),
+    ],
+)
+def test_a_scene_it_cannot_profile_is_refused_in_one_line(scene: str, message: str) -> None:
     run = subprocess.run(
-        [sys.executable, str(SCRIPT), "--scenes", "no/such/scene.yaml"],
+        [sys.executable, str(SCRIPT), "--scenes", scene],
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=300,
         check=False,
     )
-    assert run.returncode == 2 and "--scenes no/such/scene.yaml: no such file or folder" in run.stderr
+    assert run.returncode == 2 and message in run.stderr
     assert "Traceback" not in run.stderr
