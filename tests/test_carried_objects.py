@@ -7,7 +7,7 @@ import numpy as np
 import cpr_kin as ck
 from planning.task import task_record
 from planning.viz.artifacts import task_carried
-from planning.viz.carried_objects import CarriedSpan, carried_poses, carried_spans, recorded_changes
+from planning.viz.carried_objects import CarriedSpan, carried_poses, carried_spans, recorded_scenes
 
 from .conftest import LIFT, PlannedTask, spline_path
 
@@ -48,7 +48,8 @@ def test_a_planned_tasks_record_gives_its_own_attaches_and_releases(pick_and_pla
     read, task = pick_and_place.read, pick_and_place.task
     record = task_record(task)
     robot, trajectory = task.world.robot, task.trajectory
-    changes = recorded_changes(read.scene, robot, trajectory, read.task, record)
+    scenes = recorded_scenes(read.scene, robot, trajectory, read.task, record)
+    changes = [(t, after.payload) for t, after in scenes]
     attach = next(s for s in task.segments if s.kind == "attach")
     detach = next(s for s in task.segments if s.kind == "detach")
     assert [(t, p.name if p else None) for t, p in changes] == [(attach.t0, "part"), (detach.t0, None)]
@@ -65,6 +66,8 @@ def test_a_planned_tasks_record_gives_its_own_attaches_and_releases(pick_and_pla
     np.testing.assert_allclose(
         again.shape.placement.homogeneous, span.shape.placement.homogeneous, atol=1e-12
     )
-    assert recorded_changes(read.scene, robot, trajectory, read.task[:-1], record) == []  # another task's
+    assert [o.name for o in scenes[0][1].obstacles] == ["crate", "lamp", "pipe"]  # the part taken
+    assert [o.name for o in scenes[1][1].obstacles][-1] == "part"  # and left, an obstacle again
+    assert recorded_scenes(read.scene, robot, trajectory, read.task[:-1], record) == []  # another task's
     swapped = [{**entry, "kind": "free"} if entry["kind"] == "attach" else entry for entry in record]
-    assert recorded_changes(read.scene, robot, trajectory, read.task, swapped) == []
+    assert recorded_scenes(read.scene, robot, trajectory, read.task, swapped) == []

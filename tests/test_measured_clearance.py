@@ -6,7 +6,9 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
-from planning.viz.measured_clearance import task_clearance
+from planning.task.task_record import task_record
+from planning.viz.carried_objects import recorded_scenes
+from planning.viz.measured_clearance import sampled_clearance, task_clearance
 
 from .conftest import PlannedTask
 
@@ -54,3 +56,19 @@ def _left_part(task: object, detach: int) -> ck.Obstacle:
     released = task.segments[detach].payload
     assert released is not None
     return ck.left_at(task.world.robot, released, task.trajectory(task.segments[detach].t0))
+
+
+def test_a_task_read_back_is_sampled_each_instant_in_its_own_world(pick_and_place: PlannedTask) -> None:
+    """What `cpr-plan show` colours a task's file by: no checks to read, so its path sampled in the
+    world of each instant (the part waiting, then carried, then left), against the plan's checks."""
+    read, task = pick_and_place.read, pick_and_place.task
+    start = (float(task.trajectory.knots[0]), read.scene)
+    scenes = recorded_scenes(read.scene, task.world.robot, task.trajectory, read.task, task_record(task))
+    sampled = sampled_clearance(task.world.robot, task.trajectory, [start, *scenes], samples=800)
+    checked = task_clearance(task)
+    assert sampled.clearance_m.min() >= task.certified_min_clearance_m - 1e-9  # the bound is below
+    assert sampled.clearance_m.min() == pytest.approx(checked.clearance_m.min(), abs=2e-3)  # 5 ms apart
+    assert sampled.closest is not None and sampled.closest.obstacle == "part"
+    assert sampled.closest.distance_m == pytest.approx(sampled.clearance_m.min(), abs=1e-9)
+    alone = sampled_clearance(task.world.robot, task.trajectory, [start], samples=800)  # one world
+    assert alone.clearance_m.min() < sampled.clearance_m.min() - 1e-3  # the part would be in the way

@@ -93,7 +93,8 @@ def cmd_show(args: argparse.Namespace) -> int:
     from planning.io.trajectory_reader import read_trajectory
     from planning.task.holding import untaken
     from planning.viz import artifacts
-    from planning.viz.carried_objects import carried_spans, recorded_changes
+    from planning.viz.carried_objects import carried_spans, recorded_scenes
+    from planning.viz.measured_clearance import sampled_clearance
 
     if args.html is not None:
         check_not_inputs([args.html], {"trajectory file": args.trajectory, "URDF": args.urdf})
@@ -102,7 +103,7 @@ def cmd_show(args: argparse.Namespace) -> int:
     if jump is not None:  # shown all the same: seeing it is what show is for
         print(escaped(f"warning: {args.trajectory} {jump}; `cpr-plan check` fails it"), file=sys.stderr)
     read = parse_scene_file(document.scene, source=f"{args.trajectory} (scene)")
-    scene, changes = read.scene, []
+    scene, changes, measured = read.scene, [], None
     base = shown_robot(document, scene, args.urdf)
     if base.joint_names != document.joint_names:
         raise PlanningError(
@@ -110,13 +111,22 @@ def cmd_show(args: argparse.Namespace) -> int:
         )
     if document.task is not None:
         print(escaped(timeline(document.task)), flush=True)
-        changes = recorded_changes(scene, base, document.trajectory, read.task, document.task)
+        scenes = recorded_scenes(scene, base, document.trajectory, read.task, document.task)
+        changes = [(t, after.payload) for t, after in scenes]
+        start = (float(document.trajectory.knots[0]), scene)
+        measured = sampled_clearance(base, document.trajectory, [start, *scenes])  # each in its world
     carried = carried_spans(scene.payload, changes, float(document.trajectory.knots[-1]))
     robot = ck.carrying(base, scene.payload)  # its shape drawn too
     world = ck.CollisionWorld(robot, untaken(scene.obstacles, (p for _, p in changes)))
     if args.html is not None:
         html = artifacts.viewer_html(
-            world, scene.safety_margin, document.trajectory, document.waypoints, args.collision, carried
+            world,
+            scene.safety_margin,
+            document.trajectory,
+            document.waypoints,
+            args.collision,
+            carried,
+            measured=measured,
         )
         written = write_file(args.html, html)
         print(escaped(f"wrote {written} (self-contained; open it in a browser)"))
@@ -126,7 +136,7 @@ def cmd_show(args: argparse.Namespace) -> int:
     with Viewer(world, scene.safety_margin) as viewer:
         viewer.show_geometry(visual=not args.collision, collision=args.collision)
         viewer.show_carried(document.trajectory, carried)
-        viewer.show_plan(document.trajectory, document.waypoints)
+        viewer.show_plan(document.trajectory, document.waypoints, measured=measured)
         viewer.animate(document.trajectory)
         print(f"meshcat viewer at {viewer.url}  (127.0.0.1 only; Ctrl-C to stop)", flush=True)
         try:

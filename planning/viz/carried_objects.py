@@ -78,24 +78,25 @@ def carried_poses(
     return np.asarray(frame_in_world @ span.shape.placement.homogeneous)
 
 
-def recorded_changes(
+def recorded_scenes(
     scene: Scene,
     robot: ck.Robot,
     trajectory: Trajectory,
     task: Sequence[Segment],
     record: Sequence[Mapping[str, Any]],
-) -> list[tuple[float, ck.Payload | None]]:
-    """A task's attaches and releases, ``(t, payload)`` as :func:`carried_spans` takes them.
+) -> list[tuple[float, Scene]]:
+    """A task's scene after each of its attaches and releases, ``(t, scene)`` in time order.
 
     ``task``: its segments in ``scene``; ``record``: the trajectory file's ``task`` list, entry
-    by entry the segments' (their times ``t0`` [s]). An attach of an obstacle carries its
-    shape as placed where ``trajectory`` takes it (:func:`planning.task.holding.scene_after`,
-    ``robot`` placing it). None where the two are not one task's (other lengths or kinds, an
-    attach or release the task cannot make: ``cpr-plan check`` says why).
+    by entry the segments' (their times ``t0`` [s]). From ``t`` on, the robot carries the
+    scene's payload among its obstacles (:func:`planning.task.holding.scene_after`, ``robot``
+    placing what it takes as ``trajectory`` holds it). None where the two are not one task's
+    (other lengths or kinds, an attach or release the task cannot make: ``cpr-plan check``
+    says why).
     """
     if len(task) != len(record):
         return []
-    changes: list[tuple[float, ck.Payload | None]] = []
+    scenes: list[tuple[float, Scene]] = []
     for segment, entry in zip(task, record, strict=True):
         if not isinstance(segment, Attach | Detach):
             continue
@@ -106,5 +107,5 @@ def recorded_changes(
             scene = scene_after(scene, robot, trajectory(float(t0)), segment)
         except PlanningError:
             return []
-        changes.append((float(t0), scene.payload))
-    return changes
+        scenes.append((float(t0), scene))
+    return scenes

@@ -1,10 +1,12 @@
-"""The clearance a task's certified checks measured, segment by segment: what colours its path.
+"""The clearance a task's path keeps, segment by segment in its own world: what colours its path.
 
 A task changes its world as it goes (:mod:`planning.task.holding`: what the robot carries, an
 obstacle taken, an object left), so no one world measures its whole path. Each segment's
 verification measured it with the world as it was then; :func:`task_clearance` puts those
 samples on the task's clock for the viewer (:meth:`planning.viz.viewer.Viewer.show_plan`),
-with the closest pair at the least of them found in that segment's world. Headless.
+with the closest pair at the least of them found in that segment's world. A task read back
+from its trajectory file has no checks to show: :func:`sampled_clearance` samples it in the
+world of each instant instead. Headless.
 """
 
 from __future__ import annotations
@@ -16,8 +18,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
+from planning.pipeline.problem import scene_robot, scene_world
 
 if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    from planning.curves.trajectory import Trajectory
+    from planning.pipeline.scene import Scene
     from planning.task.task_plan import TaskMotion
 
 FloatArray = NDArray[np.float64]
@@ -71,3 +78,28 @@ def task_clearance(task: TaskMotion) -> MeasuredClearance:
     order = np.argsort(instants, kind="stable")
     closest = None if world is None else world.clearance(q_worst).closest
     return MeasuredClearance(instants[order], np.concatenate(clearance)[order], closest)
+
+
+def sampled_clearance(
+    robot: ck.Robot, trajectory: Trajectory, scenes: Sequence[tuple[float, Scene]], samples: int = 400
+) -> MeasuredClearance:
+    """The clearance of ``trajectory`` at ``samples`` instants, each in the world of its time.
+
+    ``scenes``: ``(t, scene)`` in time order, the first at the trajectory's start: from ``t``
+    [s] on, ``robot`` (as loaded, carrying nothing) carries that scene's payload among its
+    obstacles (a task's: its start, then :func:`planning.viz.carried_objects.recorded_scenes`).
+    The closest pair at the least clearance is that instant's world's.
+    """
+    times = np.linspace(trajectory.knots[0], trajectory.knots[-1], samples)
+    state = np.searchsorted([t for t, _ in scenes], times, side="right") - 1
+    clearance, closest, least = np.full(samples, np.inf), None, np.inf
+    for k, (_, scene) in enumerate(scenes):
+        rows = np.flatnonzero(state == k)
+        if rows.size:
+            world = scene_world(scene, scene_robot(scene, robot))
+            q = trajectory(times[rows])
+            clearance[rows] = world.clearance_batch(q).min_clearance_m
+            lowest = int(np.argmin(clearance[rows]))
+            if clearance[rows][lowest] < least:
+                least, closest = float(clearance[rows][lowest]), world.clearance(q[lowest]).closest
+    return MeasuredClearance(times, clearance, closest)
