@@ -1,6 +1,8 @@
-"""Files users exchange, and the seeded scene generator.
+"""Files users exchange.
 
-Scene files (YAML), trajectory files (``cpr-trajectory/1``), CSV samples and reports.
+Scene files (YAML), trajectory files (``cpr-trajectory/1``), CSV samples, reports, MoveIt's
+planning scenes and requests read, ROS joint trajectories written. The benchmarks' scene
+generators are :mod:`planning.bench`'s.
 """
 
 import lazy_loader
