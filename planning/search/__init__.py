@@ -1,4 +1,4 @@
-"""Box-constrained batch optimisers behind one interface.
+"""Box-constrained batch optimisers behind one interface, and the sampling planner that seeds them.
 
 The firefly algorithm (Yang 2010), the CMA-ES that refines its best (:mod:`.refinement`) and
 the baselines they are compared with (:mod:`.baselines`);
