@@ -61,7 +61,7 @@ import statistics
 import sys
 import tempfile
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from concurrent.futures import TimeoutError as FutureTimeout
 from dataclasses import dataclass
@@ -71,9 +71,8 @@ from typing import Any
 import numpy as np
 
 import cpr_kin as ck
-from planning.batch import scene_files
-from planning.bench.mbm import endpoint_violations, import_problem
-from planning.bench.problem_selection import add_selection, check_selection, selected_problems
+from planning.bench.mbm import endpoint_violations
+from planning.bench.problem_selection import add_selection, check_selection, selected_cases
 from planning.cli.arguments import COUNT, SECONDS
 from planning.errors import NoSolutionError, PlanningError
 from planning.io.scene_file import load_scene
@@ -334,27 +333,6 @@ class Lane:
         pool.shutdown(wait=False, cancel_futures=True)
 
 
-def cases(args: argparse.Namespace) -> Iterator[tuple[str, str, int, Path]]:
-    """``(robot, class, number, scene file)`` of each problem: MotionBenchMaker's, or ``--scenes``."""
-    if args.scenes:
-        for path in scene_paths(args.scenes):
-            group, _, number = path.stem.rpartition("_")
-            if not (group and number.isdigit()):
-                group, number = path.stem, "0"
-            yield path.resolve().parent.name, group, int(number), path
-        return
-    for robot_name in args.robots:
-        for problem in selected_problems(args, robot_name):
-            path = args.out / "scenes" / robot_name / f"{problem.name}.yaml"
-            import_problem(problem, path)
-            yield robot_name, problem.problem_class, problem.index, path
-
-
-def scene_paths(given: list[Path]) -> list[Path]:
-    """The scene files of ``--scenes``: each file as given, each folder's ``*.yaml`` files by name."""
-    return [found for path in given for found in (scene_files(path) if path.is_dir() else [path])]
-
-
 def table(rows: list[dict[str, Any]], peer: Peer) -> list[str]:
     """The markdown table of ``rows`` per robot and class (module docstring); each row printed too."""
     name, label = peer.name, peer.label
@@ -441,10 +419,10 @@ def main() -> int:
         parser.error(f"--time-limit {args.time_limit:g} s must be in (0, --timeout = {args.timeout:g}] s")
     time_limit_s = args.time_limit or TIME_LIMIT_SHARE * args.timeout
     try:  # every scene and robot loaded before anything runs: a bad file is one line
-        chosen = list(cases(args))
+        chosen = list(selected_cases(args, args.out))
         rows: list[dict[str, Any]] = [
-            {"robot": robot, "class": group, "problem": index, "invalid": valid(path) or ""}
-            for robot, group, index, path in chosen
+            {"robot": c.robot, "class": c.group, "problem": c.number, "invalid": valid(c.path) or ""}
+            for c in chosen
         ]
     except Exception as exc:  # bad input is named in one line (the project's one rule for it)
         outcome = classify(exc)
@@ -462,7 +440,7 @@ def main() -> int:
     finished = itertools.count(1)
 
     def solve(number: int) -> None:
-        row, path = rows[number], chosen[number][3]
+        row, path = rows[number], chosen[number].path
         if not row["invalid"]:
             lane = lanes.get()
             try:

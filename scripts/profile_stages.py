@@ -40,17 +40,16 @@ import sys
 import tempfile
 import time
 from collections import defaultdict
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import cpr_kin as ck
-from planning.batch import scene_files
-from planning.bench.mbm import import_problem
-from planning.bench.problem_selection import add_selection, check_selection, selected_problems
+from planning.bench.problem_selection import add_selection, check_selection, selected_cases
 from planning.cli.arguments import SECONDS
 from planning.errors import CprPlanError
 from planning.io.scene_file import load_scene
+from planning.outcome import classify
 from planning.pipeline.planner import plan
 from planning.warming import warm_up
 
@@ -111,21 +110,6 @@ class StageClock:
         return spent
 
 
-def cases(args: argparse.Namespace, out: Path) -> Iterator[tuple[str, str, Path]]:
-    """``(robot, class, scene file)`` of each problem: MotionBenchMaker's, or ``--scenes``."""
-    if args.scenes:
-        for given in args.scenes:
-            for path in scene_files(given) if given.is_dir() else [given]:
-                group, _, number = path.stem.rpartition("_")
-                yield path.resolve().parent.name, group if group and number.isdigit() else path.stem, path
-        return
-    for robot_name in args.robots:
-        for problem in selected_problems(args, robot_name):
-            path = out / "scenes" / robot_name / f"{problem.name}.yaml"
-            import_problem(problem, path)
-            yield robot_name, problem.problem_class, path
-
-
 def table(rows: list[tuple[str, str, float, dict[str, float]]]) -> list[str]:
     """Markdown rows per robot and class, then per robot (module docstring)."""
     columns = [*STAGES, "other"]
@@ -176,31 +160,34 @@ def main() -> int:
     robots: dict[str, ck.Robot] = {}
     try:  # every scene and robot loaded before anything runs: a fault named in one line
         loaded = [
-            (*case, load_scene(case[2]).with_planner(time_limit_s=args.time_limit))
-            for case in cases(args, out)
+            (c, load_scene(c.path).with_planner(time_limit_s=args.time_limit))
+            for c in selected_cases(args, out)
         ]
-        for scene in (case[3] for case in loaded):
+        for _, scene in loaded:
             if str(scene.robot) not in robots:
                 robots[str(scene.robot)] = scene.robot.load() if scene.robot is not None else ck.load_cpr()
-    except (CprPlanError, ck.CprKinError) as exc:
-        parser.error(str(exc))
+    except Exception as exc:  # bad input is named in one line (the project's one rule for it)
+        outcome = classify(exc)
+        if outcome.status != "invalid":
+            raise
+        parser.error(outcome.message)
     for robot in robots.values():
         warm_up(robot)
     clock = StageClock()
     clock.install()
     rows = []
-    for robot_name, group, path, scene in loaded:
+    for case, scene in loaded:
         clock.lap()
         started = time.perf_counter()
         try:
             plan(scene, robots[str(scene.robot)])
         except CprPlanError as exc:
-            print(f"{robot_name} {path.stem}: not planned ({type(exc).__name__}), left out", flush=True)
+            print(f"{case.robot} {case.path.stem}: not planned ({type(exc).__name__}), left out", flush=True)
             continue
         total_s, stages = time.perf_counter() - started, clock.lap()
-        rows.append((robot_name, group, total_s, stages))
+        rows.append((case.robot, case.group, total_s, stages))
         shown = " ".join(f"{stage} {1000 * spent:.0f}" for stage, spent in stages.items())
-        print(f"{robot_name} {path.stem}: {1000 * total_s:.0f} ms ({shown})", flush=True)
+        print(f"{case.robot} {case.path.stem}: {1000 * total_s:.0f} ms ({shown})", flush=True)
     lines = table(rows)
     out.mkdir(parents=True, exist_ok=True)
     (out / "stages.md").write_text("\n".join(lines) + "\n")

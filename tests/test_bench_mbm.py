@@ -72,16 +72,6 @@ def test_a_bad_sample_is_named_before_anything_runs(
     assert not (tmp_path / "out").exists()  # nothing written
 
 
-def test_scene_folders_expand_to_their_scene_files_by_name(bench: ModuleType, tmp_path: Path) -> None:
-    folder = tmp_path / "arm"
-    folder.mkdir()
-    for name in ("b_2.yaml", "a_1.yaml", "notes.txt"):
-        (folder / name).write_text("name: x\n")
-    single = tmp_path / "c_3.yaml"
-    single.write_text("name: y\n")
-    assert bench.scene_paths([folder, single]) == [folder / "a_1.yaml", folder / "b_2.yaml", single]
-
-
 @pytest.mark.parametrize(
     ("content", "message"),
     [

@@ -1,11 +1,19 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 import pytest
 
 from planning.bench.mbm import CLASSES
-from planning.bench.problem_selection import PER_CLASS, add_selection, check_selection, selected_problems
+from planning.bench.problem_selection import (
+    PER_CLASS,
+    Case,
+    add_selection,
+    check_selection,
+    selected_cases,
+    selected_problems,
+)
 
 
 def parsed(arguments: list[str]) -> argparse.Namespace:
@@ -56,3 +64,21 @@ def test_names_keep_only_the_problems_named() -> None:
     args = parsed(["--robots", "ur5", "--names", "box_0020", "cage_0003", "--classes", "box"])
     chosen = [p.name for p in selected_problems(args, "ur5")]
     assert chosen == ["box_0020"]  # the classes still select: cage is not among them
+
+
+def test_scene_folders_expand_to_their_scene_files_by_name(tmp_path: Path) -> None:
+    folder = tmp_path / "arm"
+    folder.mkdir()
+    for name in ("b_2.yaml", "a_1.yaml", "notes.txt"):
+        (folder / name).write_text("name: x\n")
+    single = tmp_path / "c_3.yaml"
+    single.write_text("name: y\n")
+    plain = tmp_path / "shelf.yaml"
+    plain.write_text("name: z\n")
+    args = argparse.Namespace(scenes=[folder, single, plain])
+    assert list(selected_cases(args, tmp_path / "out")) == [
+        Case("arm", "a", 1, folder / "a_1.yaml"),
+        Case("arm", "b", 2, folder / "b_2.yaml"),
+        Case(tmp_path.name, "c", 3, single),
+        Case(tmp_path.name, "shelf", 0, plain),  # no number: the whole name is its class
+    ]

@@ -1,6 +1,7 @@
 """Which MotionBenchMaker problems a script runs: ``--robots``, ``--classes``, ``--limit``, ``--names``.
 
-``--sample-seed`` draws the ``--limit`` at random; ``--names`` keeps only the problems named.
+``--sample-seed`` draws the ``--limit`` at random; ``--names`` keeps only the problems named;
+:func:`selected_cases` gives them, or a script's ``--scenes`` files, as scene files.
 
 ``scripts/bench_mbm.py`` and ``scripts/import_mbm.py`` take the same selection::
 
@@ -14,8 +15,11 @@ from __future__ import annotations
 
 import argparse
 from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
 
-from planning.bench.mbm import CLASSES, ROBOTS, Problem, problems
+from planning.batch import scene_files
+from planning.bench.mbm import CLASSES, ROBOTS, Problem, import_problem, problems
 from planning.cli.arguments import COUNT, SEED
 
 PER_CLASS = 100
@@ -58,3 +62,42 @@ def selected_problems(args: argparse.Namespace, robot: str) -> Iterator[Problem]
     """``robot``'s problems of the selection in ``args`` (:func:`planning.bench.mbm.problems`)."""
     chosen = problems(robot, tuple(args.classes), args.limit, args.sample_seed)
     return (p for p in chosen if p.name in args.names) if getattr(args, "names", None) else chosen
+
+
+@dataclass(frozen=True)
+class Case:
+    """One problem a benchmark runs, as a scene file.
+
+    Attributes:
+        robot: the robot's name (MotionBenchMaker's), or the scene file's folder.
+        group: the problem's class, or the file's name without a trailing ``_<number>``.
+        number: its number in the class (0 for a file named without one).
+        path: the scene file.
+    """
+
+    robot: str
+    group: str
+    number: int
+    path: Path
+
+
+def selected_cases(args: argparse.Namespace, out: Path) -> Iterator[Case]:
+    """The cases of a script's arguments: ``args.scenes``' files, else the selection's problems.
+
+    ``args.scenes``: scene files and folders (a folder: its ``*.yaml`` files by name); without
+    them, each selected MotionBenchMaker problem of ``args.robots`` is imported into
+    ``out/scenes/<robot>/<name>.yaml`` (:func:`planning.bench.mbm.import_problem`).
+    """
+    if getattr(args, "scenes", None):
+        for given in args.scenes:
+            for path in scene_files(given) if given.is_dir() else [given]:
+                group, _, number = path.stem.rpartition("_")
+                if not (group and number.isdigit()):
+                    group, number = path.stem, "0"
+                yield Case(path.resolve().parent.name, group, int(number), path)
+        return
+    for robot_name in args.robots:
+        for problem in selected_problems(args, robot_name):
+            path = out / "scenes" / robot_name / f"{problem.name}.yaml"
+            import_problem(problem, path)
+            yield Case(robot_name, problem.problem_class, problem.index, path)
