@@ -94,7 +94,7 @@ def test_the_tcp_path_figure_spans_what_it_draws_at_one_scale(tmp_path: Path) ->
     placed[:3, 3] = [-1.1, 0.4, 0.2]
     corners = trimesh.bounds.corners(part.bounds)  # type: ignore[no-untyped-call]
     oracle = corners @ placed[:3, :3].T + placed[:3, 3]
-    drawn = plots._box_corners(mesh, 0.0)
+    drawn = plots._box_corners(mesh, (0.0,))[0]
     order = [np.lexsort(np.round(corners, 4).T) for corners in (drawn, oracle)]
     np.testing.assert_allclose(drawn[order[0]], oracle[order[1]], atol=1e-6)  # the STL's float32
     figure = plots.tcp_path_figure(panda, trajectory, trajectory(trajectory.knots), (shelf, mesh), 0.05)

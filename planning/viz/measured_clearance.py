@@ -11,6 +11,7 @@ world of each instant instead. Headless.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -64,20 +65,24 @@ def task_clearance(task: TaskMotion) -> MeasuredClearance:
     start: each is moved to start at the segment's ``t0``. The closest pair at the least
     clearance is that segment's world's (what the robot carries then, among the obstacles then).
     """
-    times, clearance, worlds = [], [], []
+    times, clearance, owner = [], [], []
+    worlds: list[ck.CollisionWorld | None] = []
     for segment in task.segments:
         if segment.verification is not None:
             check = segment.verification.check
             instants = np.asarray(check.times)
             times.append(segment.t0 + (instants - instants[0]))
             clearance.append(np.asarray(check.clearance_m).min(axis=1))
+            owner.append(np.full(len(instants), len(worlds)))  # the sample's segment
             worlds.append(segment.world)
-    worst = int(np.argmin([float(np.min(c)) for c in clearance]))  # the segment of the least
-    world, q_worst = worlds[worst], task.trajectory(times[worst][[int(np.argmin(clearance[worst]))]])[0]
     instants = np.concatenate(times)
     order = np.argsort(instants, kind="stable")
-    closest = None if world is None else world.clearance(q_worst).closest
-    return MeasuredClearance(instants[order], np.concatenate(clearance)[order], closest)
+    measured = MeasuredClearance(instants[order], np.concatenate(clearance)[order])
+    world = worlds[int(np.concatenate(owner)[order][int(np.argmin(measured.clearance_m))])]
+    if world is None:
+        return measured
+    q_worst = task.trajectory(measured.worst_time_s)  # where the least was measured, in its world
+    return dataclasses.replace(measured, closest=world.clearance(q_worst).closest)
 
 
 def sampled_clearance(
@@ -92,14 +97,12 @@ def sampled_clearance(
     """
     times = np.linspace(trajectory.knots[0], trajectory.knots[-1], samples)
     state = np.searchsorted([t for t, _ in scenes], times, side="right") - 1
-    clearance, closest, least = np.full(samples, np.inf), None, np.inf
+    clearance, worlds = np.full(samples, np.inf), {}
     for k, (_, scene) in enumerate(scenes):
         rows = np.flatnonzero(state == k)
         if rows.size:
-            world = scene_world(scene, scene_robot(scene, robot))
-            q = trajectory(times[rows])
-            clearance[rows] = world.clearance_batch(q).min_clearance_m
-            lowest = int(np.argmin(clearance[rows]))
-            if clearance[rows][lowest] < least:
-                least, closest = float(clearance[rows][lowest]), world.clearance(q[lowest]).closest
+            worlds[k] = scene_world(scene, scene_robot(scene, robot))
+            clearance[rows] = worlds[k].clearance_batch(trajectory(times[rows])).min_clearance_m
+    worst = int(np.argmin(clearance))
+    closest = worlds[int(state[worst])].clearance(trajectory(times[worst])).closest
     return MeasuredClearance(times, clearance, closest)

@@ -78,11 +78,11 @@ def joint_figure(trajectory: Trajectory, joint_names: tuple[str, ...], units: tu
     return figure
 
 
-def _box_corners(obstacle: ck.Obstacle, grow: float) -> FloatArray:
-    """``(8, 3)`` the corners of the obstacle's bounding box grown by ``grow`` [m], in the world.
+def _box_corners(obstacle: ck.Obstacle, grows: tuple[float, ...]) -> list[FloatArray]:
+    """``(8, 3)`` the corners of the obstacle's bounding box grown by each of ``grows`` [m], in the world.
 
-    The box about coal's geometry in the obstacle's frame (a mesh's, a round shape's), or about
-    the occupied voxels' centres.
+    The box about coal's geometry in the obstacle's frame (a mesh's, a round shape's: built
+    once, a mesh read once), or about the occupied voxels' centres.
     """
     if obstacle.shape == "voxels":  # coal's octree is bounded by its root cube, not by what it holds
         points, half_side = np.asarray(obstacle.points), float(obstacle.resolution or 0.0) / 2
@@ -91,9 +91,13 @@ def _box_corners(obstacle: ck.Obstacle, grow: float) -> FloatArray:
         geometry = obstacle.geometry()
         geometry.computeLocalAABB()
         low, high = np.asarray(geometry.aabb_local.min_), np.asarray(geometry.aabb_local.max_)
-    corners = np.array(list(itertools.product(*zip(low - grow, high + grow, strict=True))))
     placement = obstacle.placement
-    return np.asarray(corners @ np.asarray(placement.rotation).T + np.asarray(placement.translation))
+    rotation, translation = np.asarray(placement.rotation), np.asarray(placement.translation)
+    return [
+        np.array(list(itertools.product(*zip(low - grow, high + grow, strict=True)))) @ rotation.T
+        + translation
+        for grow in grows
+    ]
 
 
 def _box_faces(corners: FloatArray) -> list[FloatArray]:
@@ -125,7 +129,7 @@ def tcp_path_figure(
     drawn = [tcp, nodes]
     for group, colour, label in ((obstacles, "#d9534f", "obstacles"), (moved, "#5b8fd9", "objects moved")):
         for k, obstacle in enumerate(group):
-            solid, shell = _box_corners(obstacle, 0.0), _box_corners(obstacle, margin_m)
+            solid, shell = _box_corners(obstacle, (0.0, margin_m))
             faces = Poly3DCollection(_box_faces(solid), facecolor=colour, alpha=0.7, edgecolor="k")
             faces.set_label(label if k == 0 else None)
             ax.add_collection3d(faces)

@@ -207,10 +207,12 @@ class Viewer:
             g.Line(path, g.LineBasicMaterial(vertexColors=True, linewidth=3))
         )
         if measured is None or measured.closest is None:
-            worst_time = float(times[int(np.argmin(finite))])
-            closest = self.world.clearance(trajectory(worst_time)).closest
+            worst = int(np.argmin(finite))
+            worst_time, q_worst = float(times[worst]), configurations[worst]
+            closest = self.world.clearance(q_worst).closest
         else:  # found in the world that measured it
             worst_time, closest = measured.worst_time_s, measured.closest
+            q_worst = trajectory(worst_time)
         if closest is not None:
             ends = np.column_stack([closest.point_on_robot, closest.point_on_obstacle])
             node = self.vis["scene/closest"]
@@ -220,7 +222,7 @@ class Viewer:
             for name, point in (("robot", closest.point_on_robot), ("obstacle", closest.point_on_obstacle)):
                 node[name].set_object(g.Sphere(0.01), _material(CLOSEST_COLOR))
                 node[name].set_transform(tf.translation_matrix(point))
-        self.show_configuration(trajectory(worst_time))
+        self.show_configuration(q_worst)
         return dict(times=times, tcp=tcp, clearance=clearance, closest=closest, worst_time=worst_time)
 
     def show_carried(self, trajectory: Trajectory, spans: tuple[CarriedSpan, ...]) -> None:
