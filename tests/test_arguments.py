@@ -3,16 +3,12 @@
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import math
-import sys
-from pathlib import Path
 
 import pytest
 
 from planning.cli.arguments import COUNT, SECONDS, SEED, integer_at_least, number_above, number_at_least
-
-SCRIPTS = Path(__file__).resolve().parents[1] / "scripts"
+from tests.conftest import load_script
 
 
 @pytest.mark.parametrize("low", [-3, 0, 1, 7])
@@ -74,11 +70,7 @@ def test_a_script_names_a_bad_value_before_it_runs(
     monkeypatch: pytest.MonkeyPatch,
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    spec = importlib.util.spec_from_file_location(script, SCRIPTS / f"{script}.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    monkeypatch.setitem(sys.modules, script, module)  # its dataclasses look their module up
-    spec.loader.exec_module(module)
+    module = load_script(script)
     monkeypatch.setattr("sys.argv", [f"{script}.py", *arguments])
     with pytest.raises(SystemExit) as info:
         module.main()
