@@ -3,6 +3,7 @@
     python scripts/profile_stages.py [--robots panda ur5] [--classes ...] [--limit N [--sample-seed S]]
                                      [--names ...] [--time-limit S] [--out DIR]
     python scripts/profile_stages.py --scenes FILE_OR_FOLDER ... [--time-limit S]
+    ... [--planner KEY=VALUE ...]   (planner settings, as a scene's ``planner:`` block: ``iterations=0``)
 
 Each problem is imported as ``scripts/bench_mbm.py`` imports it (``import-moveit``) and planned
 warm (robot loaded, kernels compiled, one process) by :func:`planning.pipeline.planner.plan`
@@ -24,8 +25,12 @@ functions of the pipeline that do each stage are wrapped in a timer (nothing els
 
 A stage's time excludes the stages it calls (a path found inside the seeding is the path's),
 so the stages and ``other`` add up to the plan's wall time. Printed per robot and class: the
-problems planned, their median plan [ms], then each stage's median [ms] and its share of the
-class's summed time; the table as markdown to ``DIR/stages.md``. Every scene and robot is loaded
+problems planned, their median plan [ms] and median duration over Ruckig's jerk-limited bound
+for the straight line (:func:`planning.bench.ruckig_bound.free_space_bound`: what each stage's
+time buys), then each stage's median [ms] and its share of the class's summed time; the table
+as markdown to ``DIR/stages.md``. ``--planner`` changes the scenes' planner settings (the keys
+of a scene file's ``planner:`` block, each value read as YAML): ``iterations=0 refine=none``
+profiles the pipeline without its search. Every scene and robot is loaded
 before anything runs: a missing or malformed file, a task (not one motion), or a robot that does
 not load is named in one line. Needs the ``bench`` extra for MotionBenchMaker's problems
 (downloaded once, :mod:`planning.bench.mbm`).
@@ -41,11 +46,15 @@ import tempfile
 import time
 from collections import defaultdict
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import yaml
+
 import cpr_kin as ck
 from planning.bench.problem_selection import add_selection, check_selection, selected_cases
+from planning.bench.ruckig_bound import free_space_bound
 from planning.cli.arguments import SECONDS
 from planning.errors import CprPlanError
 from planning.io.scene_file import load_scene
@@ -110,31 +119,65 @@ class StageClock:
         return spent
 
 
-def table(rows: list[tuple[str, str, float, dict[str, float]]]) -> list[str]:
+@dataclass(frozen=True)
+class Profiled:
+    """One plan's profile.
+
+    Attributes:
+        robot: the robot's name (MotionBenchMaker's, or the scene file's folder).
+        group: the problem's class.
+        total_s: the plan's wall time [s].
+        stages: each stage's exclusive time [s] (:class:`StageClock`).
+        over_bound: its trajectory's duration over Ruckig's bound for the straight line.
+    """
+
+    robot: str
+    group: str
+    total_s: float
+    stages: dict[str, float]
+    over_bound: float
+
+
+def table(rows: list[Profiled]) -> list[str]:
     """Markdown rows per robot and class, then per robot (module docstring)."""
     columns = [*STAGES, "other"]
     lines = [
-        "| robot | class | planned | median plan [ms] | "
+        "| robot | class | planned | median plan [ms] | duration / Ruckig bound (median) | "
         + " | ".join(f"{c} [ms] (share)" for c in columns)
         + " |",
-        "|---|---|---|---|" + "---|" * len(columns),
+        "|---|---|---|---|---|" + "---|" * len(columns),
     ]
-    groups: dict[tuple[str, str], list[tuple[float, dict[str, float]]]] = defaultdict(list)
-    for robot_name, group, total_s, stages in rows:
-        for key in ((robot_name, group), (robot_name, "all")):
-            groups[key].append((total_s, {**stages, "other": total_s - sum(stages.values())}))
+    groups: dict[tuple[str, str], list[Profiled]] = defaultdict(list)
+    for row in rows:
+        for key in ((row.robot, row.group), (row.robot, "all")):
+            groups[key].append(row)
     for (robot_name, group), planned in sorted(groups.items(), key=lambda kv: (kv[0][0], kv[0][1] == "all")):
-        summed = sum(total for total, _ in planned)
+        summed = sum(row.total_s for row in planned)
+        spent = [{**row.stages, "other": row.total_s - sum(row.stages.values())} for row in planned]
         cells = [
-            f"{1000 * statistics.median(s[c] for _, s in planned):.1f} "
-            f"({sum(s[c] for _, s in planned) / summed:.0%})"
+            f"{1000 * statistics.median(s[c] for s in spent):.1f} ({sum(s[c] for s in spent) / summed:.0%})"
             for c in columns
         ]
-        median_ms = 1000 * statistics.median(total for total, _ in planned)
+        median_ms = 1000 * statistics.median(row.total_s for row in planned)
+        over_bound = statistics.median(row.over_bound for row in planned)
         lines.append(
-            f"| {robot_name} | {group} | {len(planned)} | {median_ms:.1f} | " + " | ".join(cells) + " |"
+            f"| {robot_name} | {group} | {len(planned)} | {median_ms:.1f} | {over_bound:.3f} | "
+            + " | ".join(cells)
+            + " |"
         )
     return lines
+
+
+def planner_setting(text: str) -> tuple[str, Any]:
+    """``KEY=VALUE`` of ``--planner``: the key, and its value read as YAML (``3``: an integer)."""
+    key, equals, value = text.partition("=")
+    if not (key and equals and value):
+        raise argparse.ArgumentTypeError(f"'{text}' is not KEY=VALUE (e.g. iterations=0)")
+    try:
+        return key, yaml.safe_load(value)
+    except yaml.YAMLError as exc:
+        first_line = str(exc).splitlines()[0]
+        raise argparse.ArgumentTypeError(f"'{text}': the value is not YAML ({first_line})") from None
 
 
 def main() -> int:
@@ -149,6 +192,14 @@ def main() -> int:
         "--time-limit", type=SECONDS, default=8.0, help="each plan's time_limit_s (default: 8)"
     )
     parser.add_argument(
+        "--planner",
+        type=planner_setting,
+        nargs="+",
+        default=[],
+        metavar="KEY=VALUE",
+        help="planner settings for every scene, as a scene file's planner: block (e.g. iterations=0)",
+    )
+    parser.add_argument(
         "--out", type=Path, help="folder of the scenes and stages.md (default: a temporary one)"
     )
     args = parser.parse_args()
@@ -160,7 +211,7 @@ def main() -> int:
     robots: dict[str, ck.Robot] = {}
     try:  # every scene and robot loaded before anything runs: a fault named in one line
         loaded = [
-            (c, load_scene(c.path).with_planner(time_limit_s=args.time_limit))
+            (c, load_scene(c.path).with_planner(**dict(args.planner), time_limit_s=args.time_limit))
             for c in selected_cases(args, out)
         ]
         for _, scene in loaded:
@@ -180,14 +231,19 @@ def main() -> int:
         clock.lap()
         started = time.perf_counter()
         try:
-            plan(scene, robots[str(scene.robot)])
+            result = plan(scene, robots[str(scene.robot)])
         except CprPlanError as exc:
             print(f"{case.robot} {case.path.stem}: not planned ({type(exc).__name__}), left out", flush=True)
             continue
         total_s, stages = time.perf_counter() - started, clock.lap()
-        rows.append((case.robot, case.group, total_s, stages))
+        over_bound = result.trajectory.duration / free_space_bound(result.problem)
+        rows.append(Profiled(case.robot, case.group, total_s, stages, over_bound))
         shown = " ".join(f"{stage} {1000 * spent:.0f}" for stage, spent in stages.items())
-        print(f"{case.robot} {case.path.stem}: {1000 * total_s:.0f} ms ({shown})", flush=True)
+        print(
+            f"{case.robot} {case.path.stem}: {1000 * total_s:.0f} ms ({shown}), "
+            f"{over_bound:.3f} of Ruckig's bound",
+            flush=True,
+        )
     lines = table(rows)
     out.mkdir(parents=True, exist_ok=True)
     (out / "stages.md").write_text("\n".join(lines) + "\n")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import re
 import subprocess
 import sys
@@ -52,15 +53,15 @@ def test_a_stage_is_charged_its_own_time_not_that_of_the_stages_it_calls(script:
 def test_the_table_gives_each_stage_s_median_and_share(script: ModuleType) -> None:
     stages = dict.fromkeys(script.STAGES, 0.0)
     rows = [
-        ("arm", "box", 1.0, {**stages, "refine": 0.5, "verify": 0.25}),
-        ("arm", "box", 3.0, {**stages, "refine": 1.5, "verify": 0.75}),
+        script.Profiled("arm", "box", 1.0, {**stages, "refine": 0.5, "verify": 0.25}, 1.1),
+        script.Profiled("arm", "box", 3.0, {**stages, "refine": 1.5, "verify": 0.75}, 1.3),
     ]
     lines = script.table(rows)
     box = next(line for line in lines if line.startswith("| arm | box |"))
     cells = [cell.strip() for cell in box.strip("|").split("|")]
     columns = [*script.STAGES, "other"]
-    assert cells[2:4] == ["2", "2000.0"]  # planned, median plan [ms]
-    by_stage = dict(zip(columns, cells[4:], strict=True))
+    assert cells[2:5] == ["2", "2000.0", "1.200"]  # planned, median plan [ms], median duration / bound
+    by_stage = dict(zip(columns, cells[5:], strict=True))
     assert by_stage["refine"] == "1000.0 (50%)" and by_stage["verify"] == "500.0 (25%)"
     assert by_stage["other"] == "500.0 (25%)"  # what no stage took
     assert any(line.startswith("| arm | all | 2 |") for line in lines)
@@ -78,11 +79,25 @@ def test_the_script_profiles_a_scene_file_and_its_stages_add_up(script: ModuleTy
     assert run.returncode == 0, run.stderr[-2000:]
     line = next(line for line in run.stdout.splitlines() if line.startswith("scenes shelf:"))
     total = float(re.search(r": (\d+) ms", line).group(1))  # type: ignore[union-attr]
-    spent = {name: float(ms) for name, ms in re.findall(r"(\w+) (\d+)(?= |\))", line.split("(", 1)[1])}
+    stages = line.split("(", 1)[1].split(")", 1)[0]
+    spent = {name: float(ms) for name, ms in re.findall(r"(\w+) (\d+)", stages)}
     assert set(spent) == set(script.STAGES)
     assert spent["build"] > 0 and spent["verify"] > 0 and spent["timing"] > 0  # the wrapped functions ran
     assert sum(spent.values()) <= total + len(spent)  # each rounded to a millisecond
     assert "| scenes | shelf | 1 |" in (tmp_path / "stages.md").read_text()
+    over_bound = float(re.search(r"\), ([\d.]+) of Ruckig's bound", line).group(1))  # type: ignore[union-attr]
+    assert over_bound >= 1.0  # no trajectory beats the jerk-limited straight line
+
+
+def test_a_planner_setting_is_read_as_a_scene_file_reads_it(script: ModuleType) -> None:
+    assert script.planner_setting("iterations=0") == ("iterations", 0)
+    assert script.planner_setting("refine=none") == ("refine", "none")
+    assert script.planner_setting("near_bound=1.5") == ("near_bound", 1.5)
+    for bad in ("iterations", "=3", "seed="):
+        with pytest.raises(argparse.ArgumentTypeError, match="is not KEY=VALUE"):
+            script.planner_setting(bad)
+    with pytest.raises(argparse.ArgumentTypeError, match="the value is not YAML"):
+        script.planner_setting("seed=[1,")
 
 
 @pytest.mark.slow
@@ -91,11 +106,13 @@ def test_the_script_profiles_a_scene_file_and_its_stages_add_up(script: ModuleTy
     [
         ("no/such/scene.yaml", "--scenes no/such/scene.yaml: no such file or folder"),
         (str(TASK), "holds a task of 8 segments, not one motion to a goal"),
+        (f"{SHELF} --planner iterations=-1", "iterations"),
+        (f"{SHELF} --planner no_such_setting=1", "no_such_setting"),
     ],
 )
 def test_a_scene_it_cannot_profile_is_refused_in_one_line(scene: str, message: str) -> None:
     run = subprocess.run(
-        [sys.executable, str(SCRIPT), "--scenes", scene],
+        [sys.executable, str(SCRIPT), "--scenes", *scene.split()],
         capture_output=True,
         text=True,
         timeout=300,
