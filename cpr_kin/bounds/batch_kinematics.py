@@ -3,7 +3,8 @@
 Pinocchio computes forward kinematics one configuration per call, with about a microsecond
 of Python overhead each. For a pre-check of thousands of configurations
 (:mod:`cpr_kin.bounds.pair_bounds`) the chain is copied into plain arrays (:class:`KinematicChain`)
-that compiled code walks per configuration (:func:`place_joints`). Joints must have one
+that compiled code walks per configuration (:func:`place_joints`), then places the capsules
+fixed to the joints (:func:`place_capsule`). Joints must have one
 degree of freedom (revolute or prismatic, about any fixed axis), as every CPR joint does.
 """
 
@@ -94,6 +95,35 @@ def place_joints(
                 else:
                     for c in range(3):
                         rotation_out[j, r, c] = a0 * local[0, c] + a1 * local[1, c] + a2 * local[2, c]
+
+
+@njit_inline
+def place_capsule(
+    c: int,
+    rotation: FloatArray,
+    translation: FloatArray,
+    capsule_joint: IntArray,
+    capsule_ends: FloatArray,
+    world: FloatArray,
+) -> None:
+    """Write capsule ``c``'s segment in the world frame into ``world[c]`` ``(2, 3)`` [m].
+
+    The capsule is fixed to joint ``capsule_joint[c]`` (``-1``: to the world), its end points
+    ``capsule_ends[c]`` in that joint's frame; ``rotation`` and ``translation`` are the joints'
+    placements (:func:`place_joints`). Every compiled bound places its capsules here.
+    """
+    j = capsule_joint[c]
+    for e in range(2):
+        for r in range(3):
+            if j < 0:
+                world[c, e, r] = capsule_ends[c, e, r]
+            else:
+                world[c, e, r] = (
+                    translation[j, r]
+                    + rotation[j, r, 0] * capsule_ends[c, e, 0]
+                    + rotation[j, r, 1] * capsule_ends[c, e, 1]
+                    + rotation[j, r, 2] * capsule_ends[c, e, 2]
+                )
 
 
 @dataclass(frozen=True)

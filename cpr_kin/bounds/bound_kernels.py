@@ -23,8 +23,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from cpr_kin.bounds.batch_kinematics import ChainArrays, place_joints
-from cpr_kin.common.compiled import njit
+from cpr_kin.bounds.batch_kinematics import ChainArrays, place_capsule, place_joints
+from cpr_kin.common.compiled import njit, njit_inline
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -49,6 +49,60 @@ def _point_segment(ax: float, ay: float, az: float, dx: float, dy: float, dz: fl
 def _gap(low: float, high: float, half: float) -> float:
     """Gap between the intervals ``[low, high]`` and ``[-half, half]`` (0 where they overlap)."""
     return max(low - half, -half - high, 0.0)
+
+
+@njit_inline
+def _in_obstacle(
+    world: FloatArray, c: int, e: int, o: int, obstacle_rotation: FloatArray, obstacle_origin: FloatArray
+) -> tuple[float, float, float]:
+    """End ``e`` of capsule ``c``'s segment ``world[c]`` in obstacle ``o``'s frame [m]."""
+    x = world[c, e, 0] - obstacle_origin[o, 0]
+    y = world[c, e, 1] - obstacle_origin[o, 1]
+    z = world[c, e, 2] - obstacle_origin[o, 2]
+    return (
+        obstacle_rotation[o, 0, 0] * x + obstacle_rotation[o, 1, 0] * y + obstacle_rotation[o, 2, 0] * z,
+        obstacle_rotation[o, 0, 1] * x + obstacle_rotation[o, 1, 1] * y + obstacle_rotation[o, 2, 1] * z,
+        obstacle_rotation[o, 0, 2] * x + obstacle_rotation[o, 1, 2] * y + obstacle_rotation[o, 2, 2] * z,
+    )
+
+
+@njit_inline
+def _segment_obstacle_bound(
+    world: FloatArray,
+    c: int,
+    o: int,
+    kind: IntArray,
+    obstacle_rotation: FloatArray,
+    obstacle_origin: FloatArray,
+    obstacle_radius: FloatArray,
+    obstacle_half: FloatArray,
+) -> float:
+    """A lower bound [m] of the distance from capsule ``c``'s segment ``world[c]`` to obstacle ``o``.
+
+    The module docstring's bound of obstacle ``o``'s ``kind``, the capsule's radius not yet
+    subtracted. Scalars and explicit indices: an array view costs reference counting, and
+    this helper is inlined into the kernels' loops over pairs.
+    """
+    ax, ay, az = _in_obstacle(world, c, 0, o, obstacle_rotation, obstacle_origin)
+    bx, by, bz = _in_obstacle(world, c, 1, o, obstacle_rotation, obstacle_origin)
+    dx, dy, dz = bx - ax, by - ay, bz - az
+    radius = obstacle_radius[o]
+    if kind[o] == SPHERE:
+        bound = _point_segment(ax, ay, az, dx, dy, dz) - radius
+    elif kind[o] == BOX:
+        gx = _gap(min(ax, bx), max(ax, bx), obstacle_half[o, 0])
+        gy = _gap(min(ay, by), max(ay, by), obstacle_half[o, 1])
+        gz = _gap(min(az, bz), max(az, bz), obstacle_half[o, 2])
+        bound = max(np.sqrt(gx * gx + gy * gy + gz * gz), _point_segment(ax, ay, az, dx, dy, dz) - radius)
+    else:
+        axis_distance = _point_segment(ax, ay, 0.0, dx, dy, 0.0)
+        gap = _gap(min(az, bz), max(az, bz), obstacle_half[o, 2])
+        if kind[o] == CYLINDER:
+            radial = max(axis_distance - radius, 0.0)
+            bound = np.sqrt(radial * radial + gap * gap)
+        else:
+            bound = np.sqrt(axis_distance * axis_distance + gap * gap) - radius
+    return float(bound)
 
 
 @njit
@@ -77,57 +131,19 @@ def pair_bounds(
     joints = len(chain[0])
     rotation, translation = np.empty((joints, 3, 3)), np.empty((joints, 3))
     world = np.empty((len(capsule_joint), 2, 3))
-    local, scratch = np.empty((2, 3)), np.empty((4, 3))
+    scratch = np.empty((4, 3))
     for n in range(len(q)):
         place_joints(q[n], chain, rotation, translation, scratch)
         for c in range(len(capsule_joint)):
-            j = capsule_joint[c]
-            for e in range(2):
-                for r in range(3):
-                    if j < 0:
-                        world[c, e, r] = capsule_ends[c, e, r]
-                    else:
-                        world[c, e, r] = (
-                            translation[j, r]
-                            + rotation[j, r, 0] * capsule_ends[c, e, 0]
-                            + rotation[j, r, 1] * capsule_ends[c, e, 1]
-                            + rotation[j, r, 2] * capsule_ends[c, e, 2]
-                        )
+            place_capsule(c, rotation, translation, capsule_joint, capsule_ends, world)
         for p in range(len(pair_capsule)):
             c, o = pair_capsule[p], pair_obstacle[p]
-            for e in range(2):  # the capsule's end points in the obstacle's frame
-                for r in range(3):
-                    local[e, r] = (
-                        obstacle_rotation[o, 0, r] * (world[c, e, 0] - obstacle_origin[o, 0])
-                        + obstacle_rotation[o, 1, r] * (world[c, e, 1] - obstacle_origin[o, 1])
-                        + obstacle_rotation[o, 2, r] * (world[c, e, 2] - obstacle_origin[o, 2])
-                    )
-            ax, ay, az = local[0, 0], local[0, 1], local[0, 2]
-            dx, dy, dz = local[1, 0] - ax, local[1, 1] - ay, local[1, 2] - az
-            radius = obstacle_radius[o]  # (no array views here: each costs reference counting)
-            if kind[o] == SPHERE:
-                bound = _point_segment(ax, ay, az, dx, dy, dz) - radius
-            elif kind[o] == BOX:
-                gap2 = 0.0
-                for r in range(3):
-                    g = _gap(
-                        min(local[0, r], local[1, r]), max(local[0, r], local[1, r]), obstacle_half[o, r]
-                    )
-                    gap2 += g * g
-                bound = max(np.sqrt(gap2), _point_segment(ax, ay, az, dx, dy, dz) - radius)
-            else:
-                axis_distance = _point_segment(ax, ay, 0.0, dx, dy, 0.0)
-                gap = _gap(min(local[0, 2], local[1, 2]), max(local[0, 2], local[1, 2]), obstacle_half[o, 2])
-                if kind[o] == CYLINDER:
-                    radial = max(axis_distance - radius, 0.0)
-                    bound = np.sqrt(radial * radial + gap * gap)
-                else:
-                    bound = np.sqrt(axis_distance * axis_distance + gap * gap) - radius
+            bound = _segment_obstacle_bound(
+                world, c, o, kind, obstacle_rotation, obstacle_origin, obstacle_radius, obstacle_half
+            )
             out[n, p] = bound - capsule_radius[c]
 
 
-# The kernel below repeats the capsule placement and pair bound of ``pair_bounds``: factored into
-# compiled helpers (even with Numba's inline="always"), both kernels ran slower (docs/tuning.md).
 @njit
 def groups_below(
     q: FloatArray,
@@ -159,22 +175,11 @@ def groups_below(
     joints = len(chain[0])
     rotation, translation = np.empty((joints, 3, 3)), np.empty((joints, 3))
     world = np.empty((len(capsule_joint), 2, 3))
-    local, scratch = np.empty((2, 3)), np.empty((4, 3))
+    scratch = np.empty((4, 3))
     for n in range(len(q)):
         place_joints(q[n], chain, rotation, translation, scratch)
         for c in range(len(capsule_joint)):
-            j = capsule_joint[c]
-            for e in range(2):
-                for r in range(3):
-                    if j < 0:
-                        world[c, e, r] = capsule_ends[c, e, r]
-                    else:
-                        world[c, e, r] = (
-                            translation[j, r]
-                            + rotation[j, r, 0] * capsule_ends[c, e, 0]
-                            + rotation[j, r, 1] * capsule_ends[c, e, 1]
-                            + rotation[j, r, 2] * capsule_ends[c, e, 2]
-                        )
+            place_capsule(c, rotation, translation, capsule_joint, capsule_ends, world)
         out[n, :] = False
         open_groups = out.shape[1]
         for p in range(len(pair_capsule)):
@@ -188,34 +193,9 @@ def groups_below(
             apart = threshold + capsule_reach[c] + obstacle_reach[o]
             if x * x + y * y + z * z > apart * apart:
                 continue
-            for e in range(2):  # the capsule's end points in the obstacle's frame
-                for r in range(3):
-                    local[e, r] = (
-                        obstacle_rotation[o, 0, r] * (world[c, e, 0] - obstacle_origin[o, 0])
-                        + obstacle_rotation[o, 1, r] * (world[c, e, 1] - obstacle_origin[o, 1])
-                        + obstacle_rotation[o, 2, r] * (world[c, e, 2] - obstacle_origin[o, 2])
-                    )
-            ax, ay, az = local[0, 0], local[0, 1], local[0, 2]
-            dx, dy, dz = local[1, 0] - ax, local[1, 1] - ay, local[1, 2] - az
-            radius = obstacle_radius[o]  # (no array views here: each costs reference counting)
-            if kind[o] == SPHERE:
-                bound = _point_segment(ax, ay, az, dx, dy, dz) - radius
-            elif kind[o] == BOX:
-                gap2 = 0.0
-                for r in range(3):
-                    g = _gap(
-                        min(local[0, r], local[1, r]), max(local[0, r], local[1, r]), obstacle_half[o, r]
-                    )
-                    gap2 += g * g
-                bound = max(np.sqrt(gap2), _point_segment(ax, ay, az, dx, dy, dz) - radius)
-            else:
-                axis_distance = _point_segment(ax, ay, 0.0, dx, dy, 0.0)
-                gap = _gap(min(local[0, 2], local[1, 2]), max(local[0, 2], local[1, 2]), obstacle_half[o, 2])
-                if kind[o] == CYLINDER:
-                    radial = max(axis_distance - radius, 0.0)
-                    bound = np.sqrt(radial * radial + gap * gap)
-                else:
-                    bound = np.sqrt(axis_distance * axis_distance + gap * gap) - radius
+            bound = _segment_obstacle_bound(
+                world, c, o, kind, obstacle_rotation, obstacle_origin, obstacle_radius, obstacle_half
+            )
             if bound - capsule_radius[c] <= threshold:
                 out[n, group] = True
                 open_groups -= 1

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from cpr_kin.bounds.batch_kinematics import ChainArrays, place_joints
+from cpr_kin.bounds.batch_kinematics import ChainArrays, place_capsule, place_joints
 from cpr_kin.bounds.pair_bounds import JointCapsules
 from cpr_kin.bounds.segments import segment_distance
 from cpr_kin.common.compiled import njit
@@ -185,17 +185,9 @@ def blocks_below(
                 if np.sqrt(x * x + y * y + z * z) - capsule_reach[a] - capsule_reach[b] > threshold:
                     continue
                 for c in (a, b):
-                    j = capsule_joint[c]
                     if not placed[c]:
                         placed[c] = True
-                        for e in range(2):
-                            for r in range(3):
-                                world[c, e, r] = (
-                                    translation[j, r]
-                                    + rotation[j, r, 0] * capsule_ends[c, e, 0]
-                                    + rotation[j, r, 1] * capsule_ends[c, e, 1]
-                                    + rotation[j, r, 2] * capsule_ends[c, e, 2]
-                                )
+                        place_capsule(c, rotation, translation, capsule_joint, capsule_ends, world)
                 if segment_distance(world[a], world[b]) - capsule_radius[a] - capsule_radius[b] <= threshold:
                     out[n] = True
                     break

@@ -21,7 +21,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
-from cpr_kin.bounds.batch_kinematics import ChainArrays, KinematicChain, place_joints
+from cpr_kin.bounds.batch_kinematics import ChainArrays, KinematicChain, place_capsule, place_joints
 from cpr_kin.bounds.pair_bounds import joint_capsules
 from cpr_kin.bounds.segments import segment_distance
 from cpr_kin.bounds.self_blocks import PairBlocks, blocks_below
@@ -57,18 +57,7 @@ def self_bounds(
     for n in range(len(q)):
         place_joints(q[n], chain, rotation, translation, scratch)
         for c in range(len(capsule_joint)):
-            j = capsule_joint[c]
-            for e in range(2):
-                for r in range(3):
-                    if j < 0:
-                        world[c, e, r] = capsule_ends[c, e, r]
-                    else:
-                        world[c, e, r] = (
-                            translation[j, r]
-                            + rotation[j, r, 0] * capsule_ends[c, e, 0]
-                            + rotation[j, r, 1] * capsule_ends[c, e, 1]
-                            + rotation[j, r, 2] * capsule_ends[c, e, 2]
-                        )
+            place_capsule(c, rotation, translation, capsule_joint, capsule_ends, world)
         for k in range(len(pair_a)):
             a, b = pair_a[k], pair_b[k]
             x = 0.5 * (world[a, 0, 0] + world[a, 1, 0] - world[b, 0, 0] - world[b, 1, 0])
