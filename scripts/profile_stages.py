@@ -204,6 +204,9 @@ def main() -> int:
     )
     args = parser.parse_args()
     check_selection(parser, args)
+    settings = dict(args.planner)
+    if "time_limit_s" in settings:
+        parser.error("--planner time_limit_s: give the time limit as --time-limit S")
     for given in args.scenes or ():
         if not given.exists():
             parser.error(f"--scenes {given}: no such file or folder")
@@ -211,7 +214,7 @@ def main() -> int:
     robots: dict[str, ck.Robot] = {}
     try:  # every scene and robot loaded before anything runs: a fault named in one line
         loaded = [
-            (c, load_scene(c.path).with_planner(**dict(args.planner), time_limit_s=args.time_limit))
+            (c, load_scene(c.path).with_planner(**settings, time_limit_s=args.time_limit))
             for c in selected_cases(args, out)
         ]
         for _, scene in loaded:

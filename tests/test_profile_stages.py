@@ -108,6 +108,7 @@ def test_a_planner_setting_is_read_as_a_scene_file_reads_it(script: ModuleType) 
         (str(TASK), "holds a task of 8 segments, not one motion to a goal"),
         (f"{SHELF} --planner iterations=-1", "iterations"),
         (f"{SHELF} --planner no_such_setting=1", "no_such_setting"),
+        (f"{SHELF} --planner time_limit_s=3", "give the time limit as --time-limit S"),
     ],
 )
 def test_a_scene_it_cannot_profile_is_refused_in_one_line(scene: str, message: str) -> None:
