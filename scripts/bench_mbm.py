@@ -46,7 +46,10 @@ any robot (``generate_arm_scenes.py``'s, a user's own; the bundled CPR where a s
 none), the same way; rows are grouped by the file's folder (the "robot" column) and its name
 without a trailing ``_<number>`` (the "class"). Every scene and robot is loaded before
 anything runs: a missing or malformed file, or a robot that does not load, is named in one
-line.
+line. A robot or scene the peer cannot take (roboplan 0.7.0 refuses the Z1 of
+example-robot-data, one of whose links shares its name with a joint) leaves the problem
+unsolved by the peer, its reason on the progress line and in the rows (``<peer>_why``), and
+out of the ratio over every problem; ours is planned and counted all the same.
 """
 
 from __future__ import annotations
@@ -64,6 +67,7 @@ import time
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from concurrent.futures import TimeoutError as FutureTimeout
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -277,9 +281,12 @@ def valid(scene_path: Path) -> str | None:
 
 
 def summary(row: dict[str, Any], peer: str) -> str:
-    """One problem's outcome for the progress line."""
+    """One problem's outcome for the progress line (a peer that could not run it: why)."""
     ours_text = f"ours {row.get('ours_ok')} {row.get('ours_time_s', 0):.2f} s"
-    return f"{ours_text}, {peer} {row.get(f'{peer}_ok')} {row.get(f'{peer}_time_s', 0):.2f} s"
+    peer_time_s = row.get(f"{peer}_time_s", 0)
+    if not np.isfinite(peer_time_s):
+        return f"{ours_text}, {peer} could not run it ({row.get(f'{peer}_why')})"
+    return f"{ours_text}, {peer} {row.get(f'{peer}_ok')} {peer_time_s:.2f} s"
 
 
 def percentile(values: list[float], q: float) -> float:
@@ -316,8 +323,13 @@ class Lane:
             row |= {"ours_ok": False, "ours_time_s": timeout_s, "ours_why": "timeout"}
             self._kill(self.ours)
             self.ours = self._pool()
-        self.theirs.submit(self.peer.warm, str(path)).result()
-        found = self.theirs.submit(self.peer.run, str(path), timeout_s).result()
+        try:
+            self.theirs.submit(self.peer.warm, str(path)).result()
+            found = self.theirs.submit(self.peer.run, str(path), timeout_s).result()
+        except Exception as exc:  # the peer cannot take this robot or scene: unsolved, and why; ours stands
+            found = {"ok": False, "time_s": float("nan"), "why": f"{type(exc).__name__}: {exc}"[:200]}
+            if isinstance(exc, BrokenProcessPool):  # its process died: a new one for the next problem
+                self.theirs = self._pool()
         row |= {f"{self.peer.name}_{k}": v for k, v in found.items()}
         return row
 
@@ -362,7 +374,8 @@ def table(rows: list[dict[str, Any]], peer: Peer) -> list[str]:
             ratio = median_ratio(mine, theirs_s)
             both = [r for r in group if r.get("ours_ok") and r.get(f"{name}_ok")]
             ratio_both = median_ratio([r["ours_time_s"] for r in both], [r[f"{name}_time_s"] for r in both])
-            ratio_all = median_ratio([r["ours_time_s"] for r in group], [r[f"{name}_time_s"] for r in group])
+            timed = [r for r in group if np.isfinite(r[f"{name}_time_s"])]  # not those it could not load
+            ratio_all = median_ratio([r["ours_time_s"] for r in timed], [r[f"{name}_time_s"] for r in timed])
             checked = sum(1 for r in group if r.get("ours_checked"))
             beyond = sum(1 for r in solved if r[f"{name}_torque"] > 1.0 + 1e-9)
             failing = sum(1 for r in solved if not r.get(f"{name}_checked", True))  # OMPL's: verified
