@@ -165,7 +165,7 @@ def test_every_query_gives_one_answer_never_below_the_hulls(urdf: Path) -> None:
     clear_m, hull_clear_m = world.min_clearance_batch(q)[0], on_hulls.min_clearance_batch(q)[0]
     assert np.all(self_m >= hull_self_m - 1e-9) and np.all(clear_m >= hull_clear_m - 1e-9)
     assert np.sum(self_m > hull_self_m + 1e-3) > 30 and np.sum(clear_m > hull_clear_m + 1e-3) > 10
-    for margin_m in (0.0, 0.01, 0.05):
+    for margin_m in (0.0, 0.01, 0.011, 0.05):  # 0.011: the default self margin and the search's step
         np.testing.assert_array_equal(world.self_collision.violated(q, margin_m), self_m < margin_m)
         np.testing.assert_array_equal(world.margin_violated(q, margin_m), clear_m < margin_m)
         one_by_one = [world.margin_violated(x[None], margin_m)[0] for x in q[:60]]

@@ -36,9 +36,10 @@ FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
 
-COLLIDE_MARGIN_UP_TO_M = 0.01
+COLLIDE_MARGIN_UP_TO_M = 0.015
 """The largest margin [m] coal's collision test is asked with; a larger one goes to its distance
-(:meth:`ExactPairs.closer_than`)."""
+(:meth:`ExactPairs.closer_than`). Above the self margin a scene keeps by default (10 mm) plus the
+search's step (1 mm): at 10 mm, each of those tests paid the collision test and the distance."""
 
 
 class ExactPairs:
