@@ -21,7 +21,14 @@ FloatArray = NDArray[np.float64]
 
 
 def margin_violation(world: ck.CollisionWorld, scene: Scene, q: FloatArray) -> str | None:
-    """What at ``q`` comes inside the scene's safety or self margin, or ``None`` if nothing does."""
+    """What at ``q`` comes inside the scene's safety or self margin, or ``None`` if nothing does.
+
+    coal's yes/no margin tests decide (:meth:`cpr_kin.CollisionWorld.keeps_clearance`); the
+    distances that name the closest pair are measured only where they fail (on a robot of dense
+    meshes, the distances of every IK solution tried took most of a plan's build).
+    """
+    if world.keeps_clearance(q[None], scene.safety_margin, scene.self_margin)[0]:
+        return None
     clearance = world.clearance(q)
     closest = clearance.closest
     if closest is not None and clearance.min_clearance_m < scene.safety_margin:
