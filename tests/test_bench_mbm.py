@@ -118,16 +118,16 @@ def test_the_peer_s_imports_are_done_before_its_first_timed_call() -> None:
     assert {"ompl.geometric", "toppra.algorithm", "toppra.constraint"} <= set(sys.modules)
 
 
-@pytest.mark.slow
-def test_roboplan_runs_beside_ours_and_its_path_is_checked(tmp_path: Path) -> None:
+def _beside_roboplan(scenes: Path, out: Path) -> tuple[str, dict[str, str], str]:
+    """``bench_mbm.py --scenes scenes --peer roboplan`` run: its output, its one row and its table."""
     import csv
     import subprocess
 
     pytest.importorskip("roboplan.core", reason="the bench extra's roboplan")
     run = subprocess.run(
         [
-            *(sys.executable, str(SCRIPT), "--scenes", str(SHELF), "--peer", "roboplan"),
-            *("--timeout", "10", "--out", str(tmp_path / "bench")),
+            *(sys.executable, str(SCRIPT), "--scenes", str(scenes), "--peer", "roboplan"),
+            *("--timeout", "10", "--out", str(out)),
         ],
         capture_output=True,
         text=True,
@@ -135,12 +135,17 @@ def test_roboplan_runs_beside_ours_and_its_path_is_checked(tmp_path: Path) -> No
         check=False,
     )
     assert run.returncode == 0, run.stderr[-2000:]
-    with (tmp_path / "bench" / "mbm.csv").open() as rows:
+    with (out / "mbm.csv").open() as rows:
         (row,) = list(csv.DictReader(rows))
+    return run.stdout, row, (out / "mbm.md").read_text()
+
+
+@pytest.mark.slow
+def test_roboplan_runs_beside_ours_and_its_path_is_checked(tmp_path: Path) -> None:
+    _, row, table = _beside_roboplan(SHELF, tmp_path / "bench")
     assert row["ours_ok"] == "True" and row["roboplan_ok"] == "True"
     assert 0 < float(row["roboplan_time_s"]) < 10 and float(row["roboplan_over_bound"]) > 0  # no jerk limit
     assert row["roboplan_checked"] in ("True", "False") and row["roboplan_clear"] in ("True", "False")
-    table = (tmp_path / "bench" / "mbm.md").read_text()
     assert "| roboplan paths failing `check` (touching) |" in table and "| scenes | all | 1 | 1 | 1 " in table
 
 
@@ -149,32 +154,16 @@ def test_a_robot_the_peer_cannot_load_leaves_it_unsolved_with_the_reason_and_our
     tmp_path: Path,
 ) -> None:
     """roboplan 0.7.0 refuses the Z1 of example-robot-data (a link and a joint share a frame name)."""
-    import csv
-    import subprocess
-
     import yaml
 
     from planning.bench.arm_scenes import blocked_scene
 
-    pytest.importorskip("roboplan.core", reason="the bench extra's roboplan")
     robot = ck.load_robot(example_robot("z1"))
     scenes = tmp_path / "held"
     scenes.mkdir()
     (scenes / "z1_0.yaml").write_text(yaml.safe_dump(blocked_scene("z1_0", "z1", robot, seed=0)))
-    run = subprocess.run(
-        [
-            *(sys.executable, str(SCRIPT), "--scenes", str(scenes), "--peer", "roboplan"),
-            *("--timeout", "10", "--out", str(tmp_path / "bench")),
-        ],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        check=False,
-    )
-    assert run.returncode == 0, run.stderr[-2000:]
-    assert "roboplan could not run it (RuntimeError: " in run.stdout
-    with (tmp_path / "bench" / "mbm.csv").open() as rows:
-        (row,) = list(csv.DictReader(rows))
+    output, row, table = _beside_roboplan(scenes, tmp_path / "bench")
+    assert "roboplan could not run it (RuntimeError: " in output
     assert row["ours_ok"] == "True" and row["ours_checked"] == "True"
     assert row["roboplan_ok"] == "False" and row["roboplan_why"].startswith("RuntimeError: ")
-    assert "| held | all | 1 | 1 | 0 " in (tmp_path / "bench" / "mbm.md").read_text()
+    assert "| held | all | 1 | 1 | 0 " in table
