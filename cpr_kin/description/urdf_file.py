@@ -10,17 +10,20 @@ from __future__ import annotations
 
 import contextlib
 import copy
+import hashlib
 import math
 import os
 import sys
 import tempfile
 import warnings
 from collections.abc import Iterator, Sequence
+from importlib import metadata
 from pathlib import Path
 from typing import Any
 
 from lxml import etree
 
+from cpr_kin.common.disk_cache import cached_json
 from cpr_kin.common.errors import UrdfError
 from cpr_kin.model.packages import resolve_mesh
 
@@ -78,9 +81,26 @@ them); a planned joint with such a range is refused by its own check, naming the
 def validate_urdf(path: Path) -> None:
     """Validate the URDF at ``path`` with yourdfpy; raise :class:`UrdfError` naming the problems.
 
-    yourdfpy is imported here, not with the package: it imports trimesh, about 0.7 s, which
-    a process that loads only the bundled (tested) URDF need not pay.
+    yourdfpy is imported here, not with the package: it imports trimesh, about 0.7 s of every
+    new process. The verdict depends only on the file's bytes and yourdfpy's version, so a
+    file found valid is remembered by their digest (:mod:`cpr_kin.common.disk_cache`) and
+    not validated again; an invalid one is, every time, and its message shown.
     """
+    content = path.read_bytes()
+    digest = hashlib.sha256(b"urdf-valid-1 " + _yourdfpy_version().encode() + b" " + content).hexdigest()
+    cached_json("urdf-valid", digest, lambda: _validated(path))
+
+
+def _yourdfpy_version() -> str:
+    """The installed version of yourdfpy, read without importing it ("" if it cannot be read)."""
+    try:
+        return metadata.version("yourdfpy")
+    except metadata.PackageNotFoundError:
+        return ""
+
+
+def _validated(path: Path) -> dict[str, bool]:
+    """Validate the URDF at ``path`` with yourdfpy (:func:`validate_urdf`): ``{"valid": True}``, or raise."""
     import yourdfpy
 
     try:
@@ -100,6 +120,7 @@ def validate_urdf(path: Path) -> None:
     if not urdf.validate(keep):
         problems = "; ".join(str(e) for e in found)
         raise UrdfError(f"URDF file '{path}' is invalid: {problems}")
+    return {"valid": True}
 
 
 @contextlib.contextmanager
