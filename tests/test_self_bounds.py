@@ -86,6 +86,20 @@ def test_the_screen_gives_coals_answer(arm: ck.Robot, margin_m: float) -> None:
     np.testing.assert_array_equal(np.concatenate(in_fives), violated[:200])
 
 
+@pytest.mark.parametrize("hulls_margin_m", [0.001, 0.01, 0.03])
+def test_a_hulls_copy_leaves_the_originals_answers_coals(arm: ck.Robot, hulls_margin_m: float) -> None:
+    # the copy shares coal's pools: what it sets them to (margin, far pairs) the original must know
+    world = ck.CollisionWorld(arm, [])
+    collision = world.self_collision
+    q = np.random.default_rng(4).uniform(arm.limits.lower, arm.limits.upper, (600, arm.nq))
+    distance, _ = collision.distances(q[:300])
+    margin_m = 0.01
+    np.testing.assert_array_equal(collision.violated(q[:300], margin_m), distance < margin_m)
+    hulls = world.on_hulls().self_collision
+    hulls.violated(q[300:], hulls_margin_m)  # another margin, or the same with other far pairs
+    np.testing.assert_array_equal(collision.violated(q[:300], margin_m), distance < margin_m)
+
+
 def test_the_screened_distances_are_coals_over_every_pair(arm: ck.Robot) -> None:
     # on the hulls alone (test_exact_pairs holds the meshes to another library)
     arm = dataclasses.replace(arm, exact_meshes={})

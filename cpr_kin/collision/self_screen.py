@@ -13,7 +13,7 @@ from __future__ import annotations
 import copy
 import weakref
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -136,15 +136,10 @@ class ScreenedSelfTest:
         self.near_pairs = tuple(p for p, is_near in zip(pairs, near, strict=True) if is_near)
         self._near = near
         self._far_index = np.flatnonzero(~near)
-        self._far_on = np.zeros(len(pairs), dtype=bool)  # the far pool's active pairs
-        self._pools: list[Any] = []
-        self._data: Any = None
-        self._distance_data: Any = None
-        self._margin_m = float("nan")
-        self._pair_margins = np.zeros(len(pairs))  # each pair's coal margin: the margin less its allowance
+        self._coal_state = _CoalState(np.zeros(len(pairs), dtype=bool), np.zeros(len(pairs)))
 
     def on_hulls(self) -> ScreenedSelfTest:
-        """The test with the hulls deciding alone, sharing its pools and data."""
+        """The test with the hulls deciding alone, sharing its pools and data (and what they are set to)."""
         hulls = copy.copy(self)
         hulls._exact = None
         return hulls
@@ -167,13 +162,14 @@ class ScreenedSelfTest:
 
     def _switch_far(self, doubtful: BoolArray) -> None:
         """Make the far pool test only the far pairs ``doubtful`` ``(P_far,)``: the rest clear the margin."""
-        wanted = np.zeros_like(self._far_on)
+        state = self._coal_state
+        wanted = np.zeros_like(state.far_on)
         wanted[self._far_index[doubtful]] = True
-        changed = np.flatnonzero(wanted != self._far_on).tolist()
-        for gdata in self._pools[1].getGeometryDatas():
+        changed = np.flatnonzero(wanted != state.far_on).tolist()
+        for gdata in state.pools[1].getGeometryDatas():
             for p in changed:
                 (gdata.activateCollisionPair if wanted[p] else gdata.deactivateCollisionPair)(p)
-        self._far_on = wanted
+        state.far_on = wanted
 
     def distances(self, batch: FloatArray) -> tuple[FloatArray, IntArray]:
         """Smallest self distance [m] and its pair (index among all pairs), ``(N,)`` each, exactly.
@@ -204,8 +200,8 @@ class ScreenedSelfTest:
         self, batch: FloatArray, bounds: FloatArray, pairs: IntArray, exact_below_m: float = np.inf
     ) -> tuple[FloatArray, IntArray]:
         """:func:`~cpr_kin.collision.closest_pairs.closest_pairs` of ``pairs``, bounded by ``bounds``."""
-        self._prepare(float("nan"))
-        data = (self.model, self._data, self.geometry_model, self._distance_data)
+        state = self._prepare(float("nan"))
+        data = (self.model, state.data, self.geometry_model, state.distance_data)
         offsets = self.allowance_m[pairs]
         return closest_pairs(
             *data, batch, bounds, pairs, offsets_m=offsets, exact=self._exact, exact_below_m=exact_below_m
@@ -213,32 +209,55 @@ class ScreenedSelfTest:
 
     def _coal(self, tier: int, batch: FloatArray) -> NDArray[np.bool_]:
         """Coal's test of ``tier``'s pairs (0 near, 1 far) at ``batch``: the hulls flag, the meshes decide."""
+        state = self._coal_state
         flagged = pool_collisions(
-            self._pools[tier], self.model, self._data, self.geometry_model, batch, self.num_threads
+            state.pools[tier], self.model, state.data, self.geometry_model, batch, self.num_threads
         )
         if self._exact is None:
             return flagged
-        active = np.flatnonzero(self._near if tier == 0 else self._far_on)
-        data = (self.model, self._data, self.geometry_model, self._distance_data)
-        return self._exact.recheck(flagged, *data, batch, active, self._pair_margins)
+        active = np.flatnonzero(self._near if tier == 0 else state.far_on)
+        data = (self.model, state.data, self.geometry_model, state.distance_data)
+        return self._exact.recheck(flagged, *data, batch, active, state.pair_margins)
 
-    def _prepare(self, margin_m: float) -> None:
+    def _prepare(self, margin_m: float) -> _CoalState:
         """Build the two pools and distance data once; set their margin and pairs when the margin changes.
 
-        A NaN ``margin_m`` leaves the margin as it is.
+        A NaN ``margin_m`` leaves the margin as it is. The state is the one its copies share
+        (:meth:`on_hulls`): what the pools are set to is known to every test that uses them.
         """
-        if not self._pools:
-            self._data = self.model.createData()
-            self._distance_data = self.geometry_model.createData()
-            self._pools = [
-                pin.GeometryPool(self.model, self.geometry_model, self.num_threads) for _ in range(2)
-            ]
-        if margin_m != self._margin_m and not np.isnan(margin_m):
-            self._pair_margins = np.maximum(margin_m - self.allowance_m, 0.0)
-            margins = self._pair_margins if self.allowance_m.any() else margin_m
-            for pool, active in zip(self._pools, (self._near, self._far_on), strict=True):
+        state = self._coal_state
+        if not state.pools:
+            state.data = self.model.createData()
+            state.distance_data = self.geometry_model.createData()
+            pools = (pin.GeometryPool(self.model, self.geometry_model, self.num_threads) for _ in range(2))
+            state.pools = list(pools)
+        if margin_m != state.margin_m and not np.isnan(margin_m):
+            state.pair_margins = np.maximum(margin_m - self.allowance_m, 0.0)
+            margins = state.pair_margins if self.allowance_m.any() else margin_m
+            for pool, active in zip(state.pools, (self._near, state.far_on), strict=True):
                 configure_pool(pool, self.geometry_model, margins, active)
                 for gdata in pool.getGeometryDatas():
                     for request in gdata.collisionRequests:
                         request.enable_contact = False
-            self._margin_m = margin_m
+            state.margin_m = margin_m
+        return state
+
+
+@dataclass
+class _CoalState:
+    """coal's pools and data of a screened self test and what they are set to, shared by its copies.
+
+    Attributes:
+        far_on: ``(P,)`` the far pool's active pairs.
+        pair_margins: ``(P,)`` each pair's coal margin [m]: the margin less its allowance.
+        pools: the near pairs' ``GeometryPool`` and the far pairs' (built on the first query).
+        data: the model's data of single queries; distance_data: the geometry data of distances.
+        margin_m: the margin [m] the pools test (NaN: none yet).
+    """
+
+    far_on: BoolArray
+    pair_margins: FloatArray
+    pools: list[Any] = field(default_factory=list)
+    data: Any = None
+    distance_data: Any = None
+    margin_m: float = float("nan")
