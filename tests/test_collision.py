@@ -1,5 +1,7 @@
 from __future__ import annotations
 
+import dataclasses
+import functools
 from collections.abc import Callable
 from typing import Any
 
@@ -307,3 +309,47 @@ def test_a_world_of_something_else_is_named(robot: ck.Robot) -> None:
     # a list of names or dicts failed deep inside with an AttributeError
     with pytest.raises(ck.CprKinError, match=r"1 item\(s\) that are not cpr_kin.Obstacle \(a str\)"):
         ck.CollisionWorld(robot, [ck.Obstacle.sphere(0.1, (1.0, 0.0, 0.0)), "crate"])  # type: ignore[list-item]
+
+
+@pytest.mark.parametrize(("arm", "seed"), [("panda", 0), ("z1", 4)])
+def test_a_world_and_its_hulls_view_keep_answering_as_distances_in_any_order(arm: str, seed: int) -> None:
+    """Queries interleaved as a plan interleaves them: the world, then its hulls' view, then the world...
+
+    Each at its margins (0 too), in batches or one at a time, ordered or not, must answer as
+    a fresh world's distances do. Both share coal's pools, which keep what the last query set
+    and coal's warm starts: the Panda's self test once answered at the margin the other had
+    left, and at a margin of 0 coal's warm-started test proved two of the Z1's cylinders
+    apart while 5 cm deep.
+    """
+    from cpr_kin.model.packages import example_robot
+
+    robot = ck.load_robot(example_robot(arm))
+    obstacles = [
+        ck.Obstacle.box((0.3, 0.3, 0.3), (0.6, 0.0, 0.4)),
+        ck.Obstacle.sphere(0.15, (-0.4, 0.3, 0.5)),
+    ]
+    fresh_world = functools.partial(ck.CollisionWorld, obstacles=obstacles, self_margin_m=0.01)
+    rng = np.random.default_rng(seed)
+    q = rng.uniform(robot.limits.lower, robot.limits.upper, (400, robot.nq))
+    world = fresh_world(robot)
+    world.keeps_clearance(q[:5], 0.01, 0.01)  # its pools built before the view, as a plan's ends build them
+    views = {"meshes": world, "hulls": world.on_hulls()}
+    hulls_alone = fresh_world(dataclasses.replace(robot, exact_meshes={}))
+    truth = {
+        name: (fresh.clearance_batch(q).min_clearance_m, fresh.self_collision.distances(q)[0])
+        for name, fresh in (("meshes", fresh_world(robot)), ("hulls", hulls_alone))
+    }
+    wrong = []
+    for step in range(300):
+        name = str(rng.choice(list(views)))
+        margin_m, self_margin_m = rng.choice([0.0, 0.001, 0.01, 0.03], size=2)
+        rows = rng.choice(len(q), int(rng.choice([1, 7, 60])), replace=False)
+        ordered = bool(rng.integers(2)) and len(rows) > 1
+        kept = views[name].keeps_clearance(q[rows], margin_m, self_margin_m, ordered)
+        obstacle_m, own_m = truth[name][0][rows], truth[name][1][rows]
+        expected = (obstacle_m >= margin_m) & (own_m >= self_margin_m)
+        sure = (np.abs(obstacle_m - margin_m) > 1e-6) & (np.abs(own_m - self_margin_m) > 1e-6)
+        upto = int(np.argmax(~expected)) + 1 if ordered and not expected.all() else len(rows)
+        if ((kept != expected) & sure)[:upto].any():
+            wrong.append((step, name, float(margin_m), float(self_margin_m)))
+    assert not wrong, f"(step, view, margin, self margin) answered unlike the distances: {wrong}"

@@ -21,7 +21,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
-from cpr_kin.shapes.exact_pairs import ExactPairs
+from cpr_kin.shapes.exact_pairs import ExactPairs, collide_margin_m
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -145,7 +145,8 @@ class ObstaclePools:
 def configure_pool(pool: Any, geometry_model: Any, margin_m: float | FloatArray, active: BoolArray) -> None:
     """Give each geometry data of ``pool`` the security margin ``margin_m`` [m], only ``active`` pairs on.
 
-    ``margin_m`` is one margin for every pair, or one per collision pair of ``geometry_model``.
+    ``margin_m`` is one margin for every pair, or one per collision pair of ``geometry_model``;
+    coal is asked at least :data:`~cpr_kin.shapes.exact_pairs.COLLIDE_MARGIN_AT_LEAST_M`.
     """
     if np.ndim(margin_m) == 0:
         margins = np.full((geometry_model.ngeoms,) * 2, float(margin_m))
@@ -155,6 +156,7 @@ def configure_pool(pool: Any, geometry_model: Any, margin_m: float | FloatArray,
             geometry_model.collisionPairs, np.asarray(margin_m, dtype=float), strict=True
         ):
             margins[pair.first, pair.second] = margins[pair.second, pair.first] = margin
+    margins = collide_margin_m(margins)
     for gdata in pool.getGeometryDatas():
         gdata.setSecurityMargins(geometry_model, margins, True, True)
         for p, on in enumerate(active):

@@ -42,6 +42,23 @@ COLLIDE_MARGIN_UP_TO_M = 0.015
 search's step (1 mm): at 10 mm, each of those tests paid the collision test and the distance."""
 
 
+COLLIDE_MARGIN_AT_LEAST_M = 1e-6
+"""The least margin [m] coal's collision test is asked with (:func:`collide_margin_m`). At a margin of
+0 its GJK, warm-started from the pair's last query, can prove two shapes apart by a lower bound
+of 1e-12 m while they are 5 cm deep (coal 3.0.3: two cylinders of the Z1, docs/tuning.md); its
+distances are good to 1e-6 m (:data:`cpr_kin.collision.decisive.COAL_RELATIVE_ERROR`), so at
+this margin a test answers within that."""
+
+
+def collide_margin_m(margin_m: float | FloatArray) -> FloatArray:
+    """The margin [m] coal's collision test is asked with for ``margin_m`` [m]: at least the floor.
+
+    :data:`COLLIDE_MARGIN_AT_LEAST_M`: a margin below it (0, or a pair's margin less its
+    allowance) is asked at it.
+    """
+    return np.maximum(margin_m, COLLIDE_MARGIN_AT_LEAST_M)
+
+
 class ExactPairs:
     """The collision pairs of a geometry model, with the exact meshes of some of its geometries.
 
@@ -140,7 +157,7 @@ class ExactPairs:
         a, b = self._pairs[pair]
         (shape_a, at_a), (shape_b, at_b) = self._placed(geometry_data, a), self._placed(geometry_data, b)
         placed = (shape_a, as_transform(at_a), shape_b, as_transform(at_b))
-        self._collision.security_margin = min(margin_m, COLLIDE_MARGIN_UP_TO_M)
+        self._collision.security_margin = float(collide_margin_m(min(margin_m, COLLIDE_MARGIN_UP_TO_M)))
         hit = coal.collide(*placed, self._collision, coal.CollisionResult())
         if not hit and margin_m > COLLIDE_MARGIN_UP_TO_M:
             hit = self._distance(*placed).min_distance < margin_m
