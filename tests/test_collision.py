@@ -353,3 +353,41 @@ def test_a_world_and_its_hulls_view_keep_answering_as_distances_in_any_order(arm
         if ((kept != expected) & sure)[:upto].any():
             wrong.append((step, name, float(margin_m), float(self_margin_m)))
     assert not wrong, f"(step, view, margin, self margin) answered unlike the distances: {wrong}"
+
+
+def test_a_world_and_its_hulls_view_keep_measuring_as_a_fresh_world(rng: np.random.Generator) -> None:
+    """Distances between margin tests, either view in turn: a fresh world's, within coal's error.
+
+    With ``below_m``, a distance below it is exact on the hulls; on a link's exact mesh it may
+    be its hull's, between the two (:meth:`cpr_kin.CollisionWorld.min_clearance_batch`).
+    """
+    from cpr_kin.collision.decisive import coal_error_m
+    from cpr_kin.model.packages import example_robot
+
+    robot = ck.load_robot(example_robot("ur5"))
+    obstacles = [
+        ck.Obstacle.box((0.3, 0.3, 0.3), (0.6, 0.0, 0.4)),
+        ck.Obstacle.sphere(0.15, (-0.4, 0.3, 0.5)),
+    ]
+    q = rng.uniform(robot.limits.lower, robot.limits.upper, (200, robot.nq))
+    world = ck.CollisionWorld(robot, obstacles, self_margin_m=0.01)
+    world.keeps_clearance(q[:5], 0.01, 0.01)
+    views = {"meshes": world, "hulls": world.on_hulls()}
+    truth = {}
+    for name, model in (("meshes", robot), ("hulls", dataclasses.replace(robot, exact_meshes={}))):
+        fresh = ck.CollisionWorld(model, obstacles, self_margin_m=0.01)
+        truth[name] = (fresh.clearance_batch(q).min_clearance_m, fresh.self_collision.distances(q)[0])
+    for _ in range(150):
+        name = str(rng.choice(list(views)))
+        view, (obstacle_m, own_m) = views[name], truth[name]
+        rows = rng.choice(len(q), int(rng.choice([1, 7, 40])), replace=False)
+        view.keeps_clearance(q[rows], *rng.choice([0.0, 0.001, 0.01, 0.03], size=2))
+        np.testing.assert_allclose(view.self_collision.distances(q[rows])[0], own_m[rows], rtol=0, atol=2e-6)
+        np.testing.assert_allclose(view.min_clearance_batch(q[rows])[0], obstacle_m[rows], rtol=0, atol=2e-6)
+        below_m = float(rng.choice([0.001, 0.01, 0.05]))
+        near = view.min_clearance_batch(q[rows], below_m=below_m)[0]
+        lower = truth["hulls"][0][rows] - coal_error_m(1.0)
+        upper = obstacle_m[rows] + coal_error_m(1.0)
+        below = obstacle_m[rows] < below_m - 1e-6
+        assert np.all((near[below] >= lower[below]) & (near[below] <= upper[below]))
+        assert np.all(near[obstacle_m[rows] > below_m + 1e-6] == np.inf)

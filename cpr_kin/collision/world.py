@@ -211,9 +211,9 @@ class CollisionWorld:
 
         Only the pairs that may be closest are computed (:func:`cpr_kin.collision.closest_pairs`, on
         the pair bounds). With ``below_m`` [m], only those closer than that too (of the pairs
-        whose reach, :mod:`cpr_kin.bounds.reach`, comes within it): a distance below ``below_m`` is
-        exact, a larger one is reported as ``inf`` with pair ``-1`` (what a caller wants who
-        asks only where a margin is violated).
+        whose reach, :mod:`cpr_kin.bounds.reach`, comes within it): one below ``below_m`` exact (a link's
+        mesh may give its hull's, a lower bound: :meth:`~cpr_kin.shapes.exact_pairs.ExactPairs.settled`),
+        a larger one ``inf`` with pair ``-1`` (what a caller wants who asks where a margin is violated).
         """
         batch = self._check_batch(q)
         if below_m is None:
