@@ -20,6 +20,7 @@ import pinocchio as pin
 
 from cpr_kin.bounds.batch_kinematics import sampled_configurations
 from cpr_kin.bounds.self_bounds import bounded_pairs
+from cpr_kin.shapes.exact_pairs import COLLIDE_MARGIN_AT_LEAST_M
 
 SAMPLES = 1000
 """Seeded configurations in which a pair must collide to be taken as touching by design."""
@@ -33,7 +34,8 @@ def overlapping_pairs(
     The configurations are drawn uniformly within ``model``'s ranges (seed 0). A pair's
     capsule bound above zero at any of them rules it out
     (:class:`~cpr_kin.bounds.self_bounds.SelfPairBounds`);
-    coal decides the rest, configuration by configuration, until the pair is found apart.
+    coal decides the rest, configuration by configuration, until the pair is found apart (by
+    more than :data:`~cpr_kin.shapes.exact_pairs.COLLIDE_MARGIN_AT_LEAST_M`).
     """
     if not pairs:
         return ()
@@ -42,6 +44,8 @@ def overlapping_pairs(
     if not candidates:
         return ()
     data, geometry_data = model.createData(), geometry_model.createData()
+    margins = np.full((geometry_model.ngeoms,) * 2, COLLIDE_MARGIN_AT_LEAST_M)  # coal's test at 0 may miss
+    geometry_data.setSecurityMargins(geometry_model, margins, True, True)
     touching = np.ones(len(candidates), dtype=bool)
     for x in q:
         pin.computeCollisions(model, data, geometry_model, geometry_data, x, False)
