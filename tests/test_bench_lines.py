@@ -36,3 +36,22 @@ def test_a_bad_line_count_is_one_line_naming_it() -> None:
     assert completed.returncode == 2
     assert "argument --lines: 0 must be an integer >= 1" in completed.stderr
     assert "Traceback" not in completed.stderr
+
+
+@pytest.mark.slow
+def test_a_robot_roboplan_cannot_load_leaves_ours_and_says_why() -> None:
+    """roboplan 0.7.0 refuses the Z1 of example-robot-data (a link and a joint share a frame name)."""
+    pytest.importorskip("roboplan.core", reason="the bench extra's roboplan")
+    completed = run("--lines", "2", "--seed", "87", "--robots", "z1")
+    assert completed.returncode == 0, completed.stderr[-2000:]
+    row = next(line.split("|")[1:-1] for line in completed.stdout.splitlines() if line.startswith("| z1 "))
+    ours, peer = (part.strip() for part in row[2].split("/"))
+    assert int(ours) >= 1 and peer == "0"
+    assert "roboplan could not load z1: RuntimeError: " in completed.stdout
+
+
+def test_a_robot_it_does_not_know_is_one_line_naming_the_choices() -> None:
+    completed = run("--robots", "kuka")
+    assert completed.returncode == 2
+    assert "argument --robots: invalid choice: 'kuka' (choose from 'cpr', 'panda'" in completed.stderr
+    assert "Traceback" not in completed.stderr
