@@ -27,6 +27,7 @@ from __future__ import annotations
 import contextlib
 import csv
 import io
+import threading
 import time
 from collections.abc import Iterator
 from contextlib import AbstractContextManager
@@ -78,9 +79,19 @@ class BatchItem:
         return cls(escaped(scene), status, STATUS_EXIT[status], one_line(message), None, elapsed)
 
 
-@lru_cache(maxsize=8)
 def _robot(spec: ck.RobotSpec) -> ck.Robot:
-    """The robot, loaded once per worker process and spec."""
+    """The robot, loaded once per worker thread and spec.
+
+    A robot's computations share its Pinocchio data (:attr:`cpr_kin.Robot.data`): two scenes
+    planned at once in one process (a Dask worker's threads) must not share a robot, or one
+    may read the other's forward kinematics between two calls.
+    """
+    return _loaded(spec, threading.get_ident())
+
+
+@lru_cache(maxsize=8)
+def _loaded(spec: ck.RobotSpec, thread: int) -> ck.Robot:
+    """``spec``'s robot for the thread ``thread`` (:func:`_robot`)."""
     return spec.load()
 
 
