@@ -149,7 +149,11 @@ class Robot:
 
     @property
     def data(self) -> Any:
-        """A Pinocchio ``Data`` of :attr:`model`, shared by this robot's own computations."""
+        """A Pinocchio ``Data`` of :attr:`model`, shared by this robot's own computations (one thread's).
+
+        Plans run at once in threads of one process each need a robot of their own (as the batch's
+        Dask workers load one per thread): a thread would read another's forward kinematics.
+        """
         return self._data
 
     def check_links(self, names: Iterable[str], what: str) -> None:
