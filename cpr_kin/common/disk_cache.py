@@ -11,6 +11,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import threading
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, BinaryIO, TypeVar
@@ -68,8 +69,8 @@ def _cached(
 ) -> T:
     """The value kept at ``path`` (``read``; unreadable or ``None``: absent), else ``compute``'s, kept whole.
 
-    Written to a temporary file, then renamed: a reader never sees half of one. A folder that
-    cannot be written is no error.
+    Written to a temporary file of the writer's own (process and thread), then renamed: a reader
+    never sees half of one. A folder that cannot be written is no error.
     """
     with contextlib.suppress(OSError, ValueError):
         found = read(path)
@@ -78,7 +79,7 @@ def _cached(
     value = compute()
     with contextlib.suppress(OSError):
         path.parent.mkdir(parents=True, exist_ok=True)
-        partial = path.with_suffix(f".{os.getpid()}.part")
+        partial = path.with_suffix(f".{os.getpid()}.{threading.get_ident()}.part")  # a writer's own
         with partial.open("wb") as stream:
             write(value, stream)
         partial.replace(path)

@@ -1,0 +1,70 @@
+"""The disk cache: computed once, kept whole, recomputed when unreadable, shared by threads and processes."""
+
+from __future__ import annotations
+
+import json
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from cpr_kin.common.disk_cache import cache_folder, cached_array, cached_json
+
+
+@pytest.fixture
+def folder(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    monkeypatch.setenv("CPR_FIREFLY_CACHE", str(tmp_path / "cache"))
+    return tmp_path / "cache"
+
+
+def test_a_value_is_computed_once_and_read_back(folder: Path) -> None:
+    calls: list[int] = []
+
+    def compute() -> dict[str, object]:
+        calls.append(1)
+        return {"excess_m": [0.01, 0.02]}
+
+    assert cache_folder() == folder
+    assert cached_json("kind", "abc", compute) == {"excess_m": [0.01, 0.02]}
+    assert cached_json("kind", "abc", compute) == {"excess_m": [0.01, 0.02]}
+    assert len(calls) == 1
+    assert json.loads((folder / "kind" / "abc.json").read_text()) == {"excess_m": [0.01, 0.02]}
+    array = cached_array("arrays", "def", lambda: np.arange(6.0).reshape(2, 3))
+    np.testing.assert_array_equal(cached_array("arrays", "def", lambda: np.zeros(1)), array)
+
+
+def test_a_file_cut_short_is_computed_again_and_replaced(folder: Path) -> None:
+    (folder / "kind").mkdir(parents=True)
+    (folder / "kind" / "abc.json").write_text('{"excess_m": [0.0')
+    assert cached_json("kind", "abc", lambda: {"v": 1}) == {"v": 1}
+    assert json.loads((folder / "kind" / "abc.json").read_text()) == {"v": 1}
+
+
+def test_threads_writing_one_entry_at_once_leave_it_whole(folder: Path) -> None:
+    # a Dask worker's threads load the same robot at once: each writes a file of its own, then renames
+    value: dict[str, object] = {"points": list(range(20_000))}
+
+    def compute() -> dict[str, object]:
+        time.sleep(0.01)  # all of them past the read, then writing together
+        return value
+
+    found: list[dict[str, object]] = []
+    threads = [
+        threading.Thread(target=lambda: found.append(cached_json("k", "d", compute))) for _ in range(8)
+    ]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert found == [value] * 8
+    assert json.loads((folder / "k" / "d.json").read_text()) == value
+    assert sorted(p.name for p in (folder / "k").iterdir()) == ["d.json"]  # no part left behind
+
+
+def test_a_folder_that_cannot_be_written_is_no_error(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    monkeypatch.setenv("CPR_FIREFLY_CACHE", str(blocker / "cache"))
+    assert cached_json("kind", "abc", lambda: {"v": 2}) == {"v": 2}
