@@ -4,11 +4,21 @@ Hot loops that NumPy can only express as many small array operations (a per-conf
 kinematic chain, the firefly sweep) are compiled with Numba instead. Compiled code is cached
 on disk (``cache=True``), so only the first run on a machine pays for compilation. Setting
 ``NUMBA_DISABLE_JIT=1`` runs the same functions as plain Python, for debugging.
+
+Numba checks a cached function against its own file only: a kernel that calls or inlines a
+function of another file (``batch_kinematics.place_capsule`` in the bound kernels) keeps the
+old code when that file changes, and computes with it, silently. An installed package does not
+change; in a source checkout (a ``.git`` beside the packages) :func:`forget_stale_kernels` drops
+every cached kernel of the checkout when a file that compiles one has changed, before any is loaded.
 """
 
 from __future__ import annotations
 
+import contextlib
+import hashlib
+import os
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any, TypeVar, cast
 
 import numba
@@ -28,3 +38,62 @@ def njit_inline(function: F) -> F:
     counts at every call, which can outweigh its work (``docs/benchmarks.md``, stop 59).
     """
     return cast(F, numba.njit(cache=True, nogil=True, inline="always")(function))
+
+
+CHECKOUT = Path(__file__).resolve().parents[2]
+"""The folder holding the package: a source checkout's root where it holds ``.git``."""
+KERNEL_MARK = b"common.compiled import"
+"""What a file that compiles a kernel holds (its import of this module)."""
+STAMP = Path(__file__).resolve().parent / "__pycache__" / "kernel-sources.txt"
+"""Where the checkout's kernel sources were last seen: their files' stat and their bytes' digest."""
+
+
+def forget_stale_kernels(root: Path = CHECKOUT, stamp: Path = STAMP) -> bool:
+    """In the source checkout ``root``, delete the cached kernels if a kernel's file changed since.
+
+    The files of ``root``'s packages that import this module are hashed (their paths and bytes);
+    the digest is kept in ``stamp``, with the sizes and times of every file of the packages, so
+    that a checkout where none changed costs a few ``stat`` calls. Where the digest differs,
+    every Numba cache file (``__pycache__/*.nbi``, ``*.nbc``) under the packages is deleted, and
+    the kernels compile again on their first call. Whether any was deleted; nothing outside a
+    checkout (no ``root/.git``).
+    """
+    if not (root / ".git").exists():
+        return False
+    files = sorted(_package_files(str(root)))
+    seen = hashlib.sha256(repr([(f, *os.stat(f)[6:9:2]) for f in files]).encode()).hexdigest()
+    try:
+        last_seen, last_digest = stamp.read_text().split()
+    except (OSError, ValueError):
+        last_seen = last_digest = ""
+    if seen == last_seen:
+        return False
+    digest = hashlib.sha256()
+    for file in files:
+        data = Path(file).read_bytes()
+        if KERNEL_MARK in data:
+            digest.update(os.path.relpath(file, root).encode() + b"\0" + data)
+    stale = set() if digest.hexdigest() == last_digest else {os.path.dirname(f) for f in files}
+    deleted = [p for folder in stale for p in Path(folder, "__pycache__").glob("*.nb[ic]")]
+    for path in deleted:
+        path.unlink(missing_ok=True)
+    with contextlib.suppress(OSError):
+        stamp.parent.mkdir(exist_ok=True)
+        stamp.write_text(f"{seen} {digest.hexdigest()}")
+    return bool(deleted)
+
+
+def _package_files(root: str) -> list[str]:
+    """The ``.py`` files of the packages at ``root`` (folders with an ``__init__.py``), bytecode skipped."""
+    found = []
+    for name in os.listdir(root):
+        package = os.path.join(root, name)
+        if not os.path.isfile(os.path.join(package, "__init__.py")):
+            continue
+        for folder, subfolders, names in os.walk(package):
+            subfolders[:] = [sub for sub in subfolders if sub != "__pycache__"]
+            found += [os.path.join(folder, file) for file in names if file.endswith(".py")]
+    return found
+
+
+forget_stale_kernels()
