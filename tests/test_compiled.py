@@ -38,7 +38,7 @@ def test_a_kernels_file_changed_drops_the_cached_kernels(tmp_path: Path) -> None
     (package / "other.py").write_text("LIMIT = 2.0\n")  # a file that compiles nothing
     assert not forget_stale_kernels(tmp_path / "repo", stamp)
     assert all(path.exists() for path in files)
-    (package / "kernels.py").write_text((package / "kernels.py").read_text().replace("x\n", "x + 1\n"))
+    (package / "kernels.py").write_text((package / "kernels.py").read_text().replace("return x", "return 2"))
     assert forget_stale_kernels(tmp_path / "repo", stamp)
     assert not any(path.exists() for path in files)
 
@@ -48,3 +48,9 @@ def test_outside_a_checkout_nothing_is_touched(tmp_path: Path) -> None:
     (tmp_path / "repo" / ".git").rmdir()
     assert not forget_stale_kernels(tmp_path / "repo", tmp_path / "stamp.txt")
     assert all(path.exists() for path in files)
+
+
+def test_a_stamp_that_cannot_be_kept_is_no_error(tmp_path: Path) -> None:
+    checkout(tmp_path / "repo")
+    (tmp_path / "blocker").write_text("a file where the stamp's folder would be")
+    assert not forget_stale_kernels(tmp_path / "repo", tmp_path / "blocker" / "stamp.txt")

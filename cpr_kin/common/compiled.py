@@ -14,7 +14,6 @@ every cached kernel of the checkout when a file that compiles one has changed, b
 
 from __future__ import annotations
 
-import contextlib
 import hashlib
 import os
 from collections.abc import Callable
@@ -56,12 +55,22 @@ def forget_stale_kernels(root: Path = CHECKOUT, stamp: Path = STAMP) -> bool:
     that a checkout where none changed costs a few ``stat`` calls. Where the digest differs,
     every Numba cache file (``__pycache__/*.nbi``, ``*.nbc``) under the packages is deleted, and
     the kernels compile again on their first call. Whether any was deleted; nothing outside a
-    checkout (no ``root/.git``).
+    checkout (no ``root/.git``), and ``False`` where a file cannot be read, deleted or written
+    (the import goes on).
     """
+    try:
+        return _forget_stale_kernels(root, stamp)
+    except OSError:
+        return False
+
+
+def _forget_stale_kernels(root: Path, stamp: Path) -> bool:
+    """:func:`forget_stale_kernels`, its file errors raised."""
     if not (root / ".git").exists():
         return False
     files = sorted(_package_files(str(root)))
-    seen = hashlib.sha256(repr([(f, *os.stat(f)[6:9:2]) for f in files]).encode()).hexdigest()
+    stats = [(f, os.stat(f)) for f in files]
+    seen = hashlib.sha256(repr([(f, st.st_size, st.st_mtime_ns) for f, st in stats]).encode()).hexdigest()
     try:
         last_seen, last_digest = stamp.read_text().split()
     except (OSError, ValueError):
@@ -77,9 +86,8 @@ def forget_stale_kernels(root: Path = CHECKOUT, stamp: Path = STAMP) -> bool:
     deleted = [p for folder in stale for p in Path(folder, "__pycache__").glob("*.nb[ic]")]
     for path in deleted:
         path.unlink(missing_ok=True)
-    with contextlib.suppress(OSError):
-        stamp.parent.mkdir(exist_ok=True)
-        stamp.write_text(f"{seen} {digest.hexdigest()}")
+    stamp.parent.mkdir(exist_ok=True)
+    stamp.write_text(f"{seen} {digest.hexdigest()}")
     return bool(deleted)
 
 
