@@ -59,7 +59,13 @@ def test_a_joint_map_is_a_joint_vector(robot: ck.Robot) -> None:
     by_name = Target(q=dict(zip(robot.joint_names, values, strict=True)))
     np.testing.assert_array_equal(by_name.configuration(robot), values)
     assert Target(q=values).miss(robot, np.array(values)) is None
-    assert by_name.miss(robot, np.array([0.1, 0.2, 0.3, 0.4, 0.6])) == "0.1 away from its joint values"
+    # the joint farthest from its value named, with its unit
+    assert by_name.miss(robot, np.array([0.1, 0.2, 0.3, 0.4, 0.6])) == (
+        f"0.1 rad from the value of joint '{robot.joint_names[4]}' (tolerance 1e-06 rad)"
+    )
+    assert by_name.miss(robot, np.array([0.1, 0.25, 0.3, 0.4, 0.5])) == (
+        f"0.05 m from the value of joint '{robot.joint_names[1]}' (tolerance 1e-06 m)"
+    )
 
 
 def test_a_pose_goal_is_met_within_its_tolerances() -> None:

@@ -65,7 +65,10 @@ def test_each_violation_is_named(result: PlanResult, paper_world: ck.CollisionWo
     verification = verify_trajectory(paper_world, fast, Requirements(0.2, 0.005, endpoints=wrong_ends))
     text = " | ".join(verification.problems)
     assert not verification.accepted
-    assert "its start is 0.1 away from its joint values of the scene's start" in text
+    assert (
+        "its start is 0.1 rad from the value of joint 'theta1' (tolerance 1e-06 rad) of the scene's start"
+        in text
+    )
     assert "certified) of an obstacle, margin 0.2 m" in text
     assert "drives the velocity of joint" in text and "drives the jerk of joint" in text
 

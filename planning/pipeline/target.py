@@ -150,9 +150,14 @@ class Target:
         """
         q = np.asarray(q, dtype=float)
         if self.q is not None:
-            wanted = self.configuration(robot)
-            gap = float(np.abs(q - wanted).max())
-            return None if gap <= SAME_Q_TOLERANCE else f"{gap:.3g} away from its joint values"
+            apart = np.abs(q - self.configuration(robot))
+            worst = int(np.argmax(apart))
+            if apart[worst] <= SAME_Q_TOLERANCE:
+                return None
+            name = robot.limits.names[worst]
+            unit = robot.joint_unit(name)
+            tolerance = f"(tolerance {SAME_Q_TOLERANCE:g} {unit})"
+            return f"{apart[worst]:.4g} {unit} from the value of joint '{name}' {tolerance}"
         target = self.ik_target
         assert target is not None  # exactly one of q, tcp, pose (__post_init__)
         placement = pin.SE3(ck.frame_poses(robot, q[None])[0])
