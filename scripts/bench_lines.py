@@ -31,6 +31,7 @@ import numpy as np
 import pinocchio as pin
 
 import cpr_kin as ck
+from cpr_kin.common.names import one_line
 from cpr_kin.model.packages import EXAMPLE_ROBOTS, example_robot
 from planning.bench.roboplan_lines import RoboplanLines
 from planning.bench.ruckig_bound import ruckig_duration
@@ -142,17 +143,17 @@ def bench_robot(name: str, count: int, seed: int) -> Bench:
     robot = spec.load()
     world = ck.CollisionWorld(robot, [])
     lines = draw_lines(name, robot, world, count, seed)
+    peer: RoboplanLines | None = None
+    refused = ""
     try:
         peer = RoboplanLines(spec, robot, lines[0][0], TOLERANCE)
     except Exception as exc:  # the peer cannot take this robot: ours stand, and why it could not
-        ours = [our_run(robot, world, q, offset) for q, offset in lines]
-        why = f"{type(exc).__name__}: {' '.join(str(exc).split())}"[:200]
-        return Bench(ours, [Run(False, NAN) for _ in lines], why)
+        refused = one_line(f"{type(exc).__name__}: {exc}", 200)
     ours, theirs = [], []
     for q, offset in lines:
         ours.append(our_run(robot, world, q, offset))
-        theirs.append(peer_run(world, peer, q, offset))
-    return Bench(ours, theirs)
+        theirs.append(Run(False, NAN) if peer is None else peer_run(world, peer, q, offset))
+    return Bench(ours, theirs, refused)
 
 
 def our_run(robot: ck.Robot, world: ck.CollisionWorld, q: np.ndarray, offset: np.ndarray) -> Run:

@@ -75,6 +75,7 @@ from typing import Any
 import numpy as np
 
 import cpr_kin as ck
+from cpr_kin.common.names import one_line
 from planning.bench.mbm import endpoint_violations
 from planning.bench.problem_selection import add_selection, check_selection, selected_cases
 from planning.cli.arguments import COUNT, SECONDS
@@ -327,7 +328,11 @@ class Lane:
             self.theirs.submit(self.peer.warm, str(path)).result()
             found = self.theirs.submit(self.peer.run, str(path), timeout_s).result()
         except Exception as exc:  # the peer cannot take this robot or scene: unsolved, and why; ours stands
-            found = {"ok": False, "time_s": float("nan"), "why": f"{type(exc).__name__}: {exc}"[:200]}
+            found = {
+                "ok": False,
+                "time_s": float("nan"),
+                "why": one_line(f"{type(exc).__name__}: {exc}", 200),
+            }
             if isinstance(exc, BrokenProcessPool):  # its process died: a new one for the next problem
                 self.theirs = self._pool()
         row |= {f"{self.peer.name}_{k}": v for k, v in found.items()}

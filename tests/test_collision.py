@@ -311,6 +311,34 @@ def test_a_world_of_something_else_is_named(robot: ck.Robot) -> None:
         ck.CollisionWorld(robot, [ck.Obstacle.sphere(0.1, (1.0, 0.0, 0.0)), "crate"])  # type: ignore[list-item]
 
 
+def _views_and_fresh_distances(
+    arm: str, rng: np.random.Generator, count: int
+) -> tuple[np.ndarray, dict[str, ck.CollisionWorld], dict[str, tuple[np.ndarray, np.ndarray]]]:
+    """An example arm among a box and a ball: ``count`` random configurations, the world and its
+    hulls' view (the world's pools built first, as a plan's ends build them), and for each view a
+    fresh world's obstacle and self distances there."""
+    from cpr_kin.model.packages import example_robot
+
+    robot = ck.load_robot(example_robot(arm))
+    obstacles = [
+        ck.Obstacle.box((0.3, 0.3, 0.3), (0.6, 0.0, 0.4)),
+        ck.Obstacle.sphere(0.15, (-0.4, 0.3, 0.5)),
+    ]
+    fresh_world = functools.partial(ck.CollisionWorld, obstacles=obstacles, self_margin_m=0.01)
+    q = rng.uniform(robot.limits.lower, robot.limits.upper, (count, robot.nq))
+    world = fresh_world(robot)
+    world.keeps_clearance(q[:5], 0.01, 0.01)
+    views = {"meshes": world, "hulls": world.on_hulls()}
+    truth = {
+        name: (fresh.clearance_batch(q).min_clearance_m, fresh.self_collision.distances(q)[0])
+        for name, fresh in (
+            ("meshes", fresh_world(robot)),
+            ("hulls", fresh_world(dataclasses.replace(robot, exact_meshes={}))),
+        )
+    }
+    return q, views, truth
+
+
 @pytest.mark.parametrize(  # every example arm but the SO-101 (dense meshes: 24 s); the Z1 where it failed
     ("arm", "seed"),
     [("panda", 0), ("ur3", 0), ("ur5", 0), ("ur10", 0), ("so100", 0), ("xarm7", 0), ("z1", 4)],
@@ -324,24 +352,8 @@ def test_a_world_and_its_hulls_view_keep_answering_as_distances_in_any_order(arm
     left, and at a margin of 0 coal's warm-started test proved two of the Z1's cylinders
     apart while 5 cm deep.
     """
-    from cpr_kin.model.packages import example_robot
-
-    robot = ck.load_robot(example_robot(arm))
-    obstacles = [
-        ck.Obstacle.box((0.3, 0.3, 0.3), (0.6, 0.0, 0.4)),
-        ck.Obstacle.sphere(0.15, (-0.4, 0.3, 0.5)),
-    ]
-    fresh_world = functools.partial(ck.CollisionWorld, obstacles=obstacles, self_margin_m=0.01)
     rng = np.random.default_rng(seed)
-    q = rng.uniform(robot.limits.lower, robot.limits.upper, (400, robot.nq))
-    world = fresh_world(robot)
-    world.keeps_clearance(q[:5], 0.01, 0.01)  # its pools built before the view, as a plan's ends build them
-    views = {"meshes": world, "hulls": world.on_hulls()}
-    hulls_alone = fresh_world(dataclasses.replace(robot, exact_meshes={}))
-    truth = {
-        name: (fresh.clearance_batch(q).min_clearance_m, fresh.self_collision.distances(q)[0])
-        for name, fresh in (("meshes", fresh_world(robot)), ("hulls", hulls_alone))
-    }
+    q, views, truth = _views_and_fresh_distances(arm, rng, 400)
     wrong = []
     for step in range(300):
         name = str(rng.choice(list(views)))
@@ -365,21 +377,8 @@ def test_a_world_and_its_hulls_view_keep_measuring_as_a_fresh_world(rng: np.rand
     be its hull's, between the two (:meth:`cpr_kin.CollisionWorld.min_clearance_batch`).
     """
     from cpr_kin.collision.decisive import coal_error_m
-    from cpr_kin.model.packages import example_robot
 
-    robot = ck.load_robot(example_robot("ur5"))
-    obstacles = [
-        ck.Obstacle.box((0.3, 0.3, 0.3), (0.6, 0.0, 0.4)),
-        ck.Obstacle.sphere(0.15, (-0.4, 0.3, 0.5)),
-    ]
-    q = rng.uniform(robot.limits.lower, robot.limits.upper, (200, robot.nq))
-    world = ck.CollisionWorld(robot, obstacles, self_margin_m=0.01)
-    world.keeps_clearance(q[:5], 0.01, 0.01)
-    views = {"meshes": world, "hulls": world.on_hulls()}
-    truth = {}
-    for name, model in (("meshes", robot), ("hulls", dataclasses.replace(robot, exact_meshes={}))):
-        fresh = ck.CollisionWorld(model, obstacles, self_margin_m=0.01)
-        truth[name] = (fresh.clearance_batch(q).min_clearance_m, fresh.self_collision.distances(q)[0])
+    q, views, truth = _views_and_fresh_distances("ur5", rng, 200)
     for _ in range(150):
         name = str(rng.choice(list(views)))
         view, (obstacle_m, own_m) = views[name], truth[name]

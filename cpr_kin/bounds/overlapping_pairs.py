@@ -20,7 +20,7 @@ import pinocchio as pin
 
 from cpr_kin.bounds.batch_kinematics import sampled_configurations
 from cpr_kin.bounds.self_bounds import bounded_pairs
-from cpr_kin.shapes.exact_pairs import COLLIDE_MARGIN_AT_LEAST_M
+from cpr_kin.shapes.exact_pairs import collide_margin_m
 
 SAMPLES = 1000
 """Seeded configurations in which a pair must collide to be taken as touching by design."""
@@ -44,7 +44,7 @@ def overlapping_pairs(
     if not candidates:
         return ()
     data, geometry_data = model.createData(), geometry_model.createData()
-    margins = np.full((geometry_model.ngeoms,) * 2, COLLIDE_MARGIN_AT_LEAST_M)  # coal's test at 0 may miss
+    margins = collide_margin_m(np.zeros((geometry_model.ngeoms,) * 2))  # coal's test at 0 may miss
     geometry_data.setSecurityMargins(geometry_model, margins, True, True)
     touching = np.ones(len(candidates), dtype=bool)
     for x in q:
