@@ -361,10 +361,11 @@ def test_where_rrt_connect_found_no_path_the_next_attempts_do_not_ask_again(
 
     With one sample RRT-Connect finds no way through the window, at the whole step nor (its
     trees going on) at the finer one; the attempts after the first search from the straight
-    line without it.
+    line without it: where a search found a feasible candidate the certified check refused,
+    with twice the fitness samples; where it found none, there is no next attempt (below).
     """
     from planning.pipeline import path_seeds
-    from planning.pipeline.search import search
+    from planning.search.optimizer import SearchResult
 
     drawn: list[object] = []
 
@@ -377,8 +378,10 @@ def test_where_rrt_connect_found_no_path_the_next_attempts_do_not_ask_again(
     one_sample = with_planner(window, tuning=SearchTuning(seeding=SeedingTuning(max_samples=1)))
     attempt = PathSeeding().first(one_sample)
     assert drawn == [None] and attempt.no_path and "no RRT-Connect path keeps" in attempt.tried
+    assert attempt.seeds is not None
+    refused = SearchResult.of_point(attempt.seeds[0], 0.5 * attempt.problem.objective.feasible_below, 1)
     for number in (1, 2):  # the retries
-        following = PathSeeding().after(attempt, search(attempt, None, None))
+        following = PathSeeding().after(attempt, refused)
         assert following is not None and following.number == number
         assert following.no_path and following.path is None and following.tried == attempt.tried
         attempt = following
@@ -388,6 +391,22 @@ def test_where_rrt_connect_found_no_path_the_next_attempts_do_not_ask_again(
     assert seed_search(one_sample).no_path and len(drawn) == 2
     few = with_planner(window, tuning=SearchTuning(seeding=SeedingTuning(max_samples=2, finer_after=1)))
     assert "keeps 0.055 m clear (nor 0.051 m after 1) in 2 samples" in PathSeeding().first(few).tried
+
+
+def test_without_a_path_a_search_with_nothing_feasible_is_not_repeated(window: Problem) -> None:
+    """More waypoints need a path to follow: without one the next attempt would search again
+    from the same seeds with the same draws (``default_rng(seed)``) and find the same."""
+    from planning.pipeline.search import search
+
+    tuning = SearchTuning(seeding=SeedingTuning(max_samples=1))
+    attempt = PathSeeding().first(with_planner(window, tuning=tuning, fireflies=4, iterations=1))
+    searched = search(attempt, None, None)
+    assert attempt.no_path and not attempt.problem.objective.feasible(searched.fitness)
+    again = seed_search(attempt.problem, more_waypoints=True, sample=False)  # what a retry would search
+    assert again.problem is attempt.problem and again.candidates.tolist() == attempt.seeds.tolist()
+    repeated = search(dataclasses.replace(attempt, seeds=again.candidates, number=1), None, None)
+    assert repeated.fitness == searched.fitness and repeated.x.tolist() == searched.x.tolist()
+    assert PathSeeding().after(attempt, searched) is None
 
 
 def test_a_time_limit_draws_until_the_limit_rather_than_max_samples(window: Problem) -> None:

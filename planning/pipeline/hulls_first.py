@@ -18,6 +18,7 @@ import numpy as np
 
 from planning.pipeline.objective import PathRules, WaypointObjective
 from planning.pipeline.problem import Problem, finer_step_m
+from planning.pipeline.settings import VERIFY_STEP_RANGE_M
 from planning.search.rrt_trees import GrownTrees
 
 HULLS_SHARE = 0.25
@@ -29,7 +30,11 @@ def on_hulls(problem: Problem) -> Problem | None:
     """``problem`` on its robot's convex hulls alone, where its start and goal keep the margins there.
 
     ``None`` for a robot whose meshes are all their own hulls, within a millimetre
-    (:attr:`cpr_kin.Robot.exact_meshes` empty), or ends that only the exact meshes clear. A
+    (:attr:`cpr_kin.Robot.exact_meshes` empty), or ends that only the exact meshes clear: by
+    the margins plus the finest certified step (:data:`~planning.pipeline.settings.VERIFY_STEP_RANGE_M`),
+    the least clearance beyond the margins that the fitness requires of every sample of a path,
+    its ends too, under any relaxation of the step (:func:`~planning.pipeline.problem.finer_step_m`);
+    ends nearer on the hulls leave their search nothing feasible. A
     hull contains its mesh, so a trajectory certified on the hulls is certified on the meshes;
     and the hulls ask coal no triangle query. Its sampling planner draws :data:`HULLS_SHARE`
     of the samples: a passage that only the meshes open is not searched for long on the hulls.
@@ -37,8 +42,8 @@ def on_hulls(problem: Problem) -> Problem | None:
     if not problem.robot.exact_meshes:
         return None
     world, scene = problem.world.on_hulls(), problem.scene
-    ends = np.stack([problem.q_start, problem.q_goal])
-    if not world.keeps_clearance(ends, scene.safety_margin, scene.self_margin).all():
+    ends, finest_m = np.stack([problem.q_start, problem.q_goal]), VERIFY_STEP_RANGE_M[0]
+    if not world.keeps_clearance(ends, scene.safety_margin + finest_m, scene.self_margin + finest_m).all():
         return None
     tuning = scene.planner.tuning
     fewer = max(1, int(tuning.seeding.max_samples * HULLS_SHARE))

@@ -26,7 +26,10 @@ is a small part of its space, rarely met by a random population. So, with the pl
    spline through them keeps the clearance), or for twice the fitness samples when feasible
    candidates failed the certified check (a violation between two samples escaped the
    fitness); ``retries`` times at most. Where RRT-Connect found no path, they do not ask it
-   again: its draws are seeded and its clearance the same, so it would fail alike.
+   again: its draws are seeded and its clearance the same, so it would fail alike; and
+   where no candidate was feasible without a path, there is none to add waypoints along:
+   the next attempt would be the same search from the same seeds and draws, so there is
+   none.
 
 The clearance required is the margin plus the certified check's step (``verify_step_m``;
 between the robot's own pairs the self margin plus its finer ``self_verify_step_m``): what
@@ -166,6 +169,8 @@ class PathSeeding:
         if attempt.number >= problem.scene.planner.tuning.retries:
             return None
         widen = not problem.objective.feasible(searched.fitness)  # nothing feasible: more waypoints
+        if widen and attempt.path is None:  # no path to follow with more: the same search again
+            return None
         if not widen:  # feasible ones failed the certified check: check twice as many samples
             samples = problem.scene.planner.fitness_samples
             problem = with_planner(problem, fitness_samples=min(2 * samples, MAX_FITNESS_SAMPLES))
