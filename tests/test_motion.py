@@ -300,3 +300,19 @@ def test_a_stoppable_check_decides_as_one_that_is_not_until_stopped(
     with pytest.raises(ck.CheckStoppedError):
         ck.check_curve(*args, stop=second)
     assert len(asked) == 2
+
+
+def test_lower_bounds_piece_by_piece_are_the_whole_batch(
+    robot: ck.Robot, cluttered_world: ck.CollisionWorld, rng: np.random.Generator
+) -> None:
+    """The groups' bounds of a long check, reduced one piece at a time (its pairs' bounds, ``(K, P)``,
+    never whole), are those of one call; the stop is asked before each piece."""
+    from cpr_kin.certified.motion import LOWER_BOUND_ROWS, group_lower_bounds
+
+    q = random_configurations(robot, rng, 2 * LOWER_BOUND_ROWS + 17)
+    whole = cluttered_world.clearance_lower_bounds(q)
+    asked, never = after_calls(10**9)
+    np.testing.assert_array_equal(group_lower_bounds(cluttered_world, q, never), whole)
+    assert len(asked) == 3
+    np.testing.assert_array_equal(group_lower_bounds(cluttered_world, q), whole)
+    assert group_lower_bounds(cluttered_world, q[:0]).shape == (0, len(ck.GROUPS))

@@ -39,7 +39,8 @@ neighbours' (a distance changes no faster than the robot moves), which may then 
 COARSE_BELOW = 64
 """Fewer samples in doubt than this are computed at once (another round costs more than they)."""
 LOWER_BOUND_ROWS = 4096
-"""Configurations a stoppable check bounds in one call (a few tenths of a second on meshes)."""
+"""Configurations bounded in one call (a few tenths of a second on meshes): one piece's pair
+bounds, ``(rows, P)``, are reduced to their groups' minima before the next is computed."""
 MAX_CURVE_CHECKS = 1_000_000
 """Most configurations one continuous check queries (about 10 to 20 s of coal on 2 cores)."""
 
@@ -206,8 +207,7 @@ def decisive_clearance(
     margin plus slack is below it decides the same. ``stop`` is asked between pieces of
     :data:`~cpr_kin.collision.decisive.CHUNK_ROWS` configurations (:class:`~cpr_kin.CheckStoppedError`).
     """
-    per_pair = chunked(world.pair_bounds, q, stop, LOWER_BOUND_ROWS)  # once: the rounds take their rows
-    bounds = world.clearance_lower_bounds(q, per_pair)
+    bounds = group_lower_bounds(world, q, stop)
     values = bounds.copy()
     known = np.isinf(values) & (values > 0)  # groups without pairs: nothing to compute
     closest = np.full(values.shape, -1, dtype=np.int64)
@@ -218,7 +218,7 @@ def decisive_clearance(
             rows = np.flatnonzero(needed[:, group_index])
             rows = rows[:: COARSE_STRIDE if rows.size >= COARSE_BELOW else 1]
             if rows.size:
-                exact = partial(_group_clearance, world, q, per_pair, group_index, exact_below_m)
+                exact = partial(_group_clearance, world, q, group_index, exact_below_m)
                 values[rows, group_index], closest[rows, group_index] = chunked(exact, rows, stop)
                 known[rows, group_index] = True
                 values[:, group_index] = with_neighbours(
@@ -227,16 +227,27 @@ def decisive_clearance(
     return BatchClearance(clearance_m=values, closest_pair=closest)
 
 
+def group_lower_bounds(world: CollisionWorld, q: FloatArray, stop: Stop | None = None) -> FloatArray:
+    """``(K, len(GROUPS))`` :meth:`~cpr_kin.CollisionWorld.clearance_lower_bounds` at ``q`` ``(K, nq)``.
+
+    :data:`LOWER_BOUND_ROWS` configurations at a time, ``stop`` asked before each piece. Every
+    pair's bounds at every sample, kept whole, held hundreds of megabytes for a long check among
+    many obstacles (a Fetch's among MotionBenchMaker's shelves: 225 pairs at up to 400,000
+    samples, the finer step of ends a fraction of a millimetre from a shelf), and a process
+    peaked at 1.6 GB; the rows coal decides get theirs again (:func:`_group_clearance`).
+    """
+    pieces = [
+        chunked(world.clearance_lower_bounds, q[first : first + LOWER_BOUND_ROWS], stop, LOWER_BOUND_ROWS)
+        for first in range(0, len(q), LOWER_BOUND_ROWS)
+    ]
+    return np.concatenate(pieces) if pieces else np.empty((0, len(GROUPS)))
+
+
 def _group_clearance(
-    world: CollisionWorld,
-    q: FloatArray,
-    per_pair_m: FloatArray,
-    group: int,
-    exact_below_m: float,
-    rows: IntArray,
+    world: CollisionWorld, q: FloatArray, group: int, exact_below_m: float, rows: IntArray
 ) -> tuple[FloatArray, IntArray]:
-    """:meth:`~cpr_kin.CollisionWorld.group_clearance` at samples ``rows`` of ``q``, their bounds known."""
-    return world.group_clearance(q[rows], group, exact_below_m, per_pair_m[rows])
+    """:meth:`~cpr_kin.CollisionWorld.group_clearance` at samples ``rows`` of ``q``, bounded anew."""
+    return world.group_clearance(q[rows], group, exact_below_m)
 
 
 def check_segment(
