@@ -27,7 +27,7 @@ hulls alone may take (:func:`on_hulls`); where it finds nothing in them, the mes
 
 
 def on_hulls(problem: Problem) -> Problem | None:
-    """``problem`` on its robot's convex hulls alone, where its start and goal keep the margins there.
+    """``problem`` on its robot's convex hulls alone, where its start and goal clear the margins there.
 
     ``None`` for a robot whose meshes are all their own hulls, within a millimetre
     (:attr:`cpr_kin.Robot.exact_meshes` empty), or ends that only the exact meshes clear: by
