@@ -28,7 +28,7 @@ import cpr_kin as ck
 from planning.curves.trajectory import Trajectory
 from planning.errors import NoTrajectoryFoundError
 from planning.pipeline.blas_threads import one_blas_thread
-from planning.pipeline.choose import Choice, Refusal, choose, verify
+from planning.pipeline.choose import Choice, Refusal, beyond_margin, choose, verify
 from planning.pipeline.deadline import Deadline
 from planning.pipeline.hulls_first import HULLS_SHARE, on_hulls, shared_trees
 from planning.pipeline.metrics import Elapsed
@@ -102,13 +102,18 @@ def _solved(
     while True:
         searched = search(attempt, progress, optimizer)
         search_s = time.perf_counter() - started
-        chosen = choose(attempt.problem, searched)
-        if isinstance(chosen, Choice):
-            elapsed = Elapsed(attempt.problem.build_time_s + time.perf_counter() - started, search_s)
-            return assemble(attempt.problem, searched, chosen, elapsed)
-        following = None if deadline.passed() else seeding.after(attempt, searched)
+        # a best deeper inside a margin than a step fails its check, which only says why: where
+        # another attempt follows, it is not run (on a Fetch among shelves, seconds)
+        hopeless = beyond_margin(attempt.problem, searched) is not None
+        following = None if not hopeless or deadline.passed() else seeding.after(attempt, searched)
         if following is None:
-            break
+            chosen = choose(attempt.problem, searched)
+            if isinstance(chosen, Choice):
+                elapsed = Elapsed(attempt.problem.build_time_s + time.perf_counter() - started, search_s)
+                return assemble(attempt.problem, searched, chosen, elapsed)
+            following = None if hopeless or deadline.passed() else seeding.after(attempt, searched)
+            if following is None:
+                break
         attempt = following
     stopped = deadline.reason(time.perf_counter() - started) if deadline.passed() else ""
     if attempt.path is None:
