@@ -11,7 +11,7 @@ import trimesh
 
 import cpr_kin as ck
 from cpr_kin.model.hull_excess import SAMPLES, shape_excess
-from cpr_kin.model.packages import example_robot
+from cpr_kin.model.packages import example_robot, example_robot_data_share
 from planning.cli import main
 
 URDF = """<robot name="dumbbell">
@@ -70,3 +70,23 @@ def test_robot_info_of_no_robot_is_one_line(capsys: pytest.CaptureFixture[str], 
     assert main(["robot-info", str(tmp_path / "arm.urdf")]) == 2
     error = capsys.readouterr().err
     assert "arm.urdf" in error and len(error.strip().splitlines()) == 1 and "Traceback" not in error
+
+
+def test_robot_info_of_a_branched_robot_names_its_tool_frame(capsys: pytest.CaptureFixture[str]) -> None:
+    """Baxter's tree branches into two arms and a head: loaded only with its tool frame named,
+    as a scene's ``robot: {urdf, tcp, srdf}`` would, the joints from its root to that frame planned."""
+    share = example_robot_data_share()
+    assert share is not None
+    root = share / "example-robot-data" / "robots" / "baxter_description"
+    urdf, srdf = root / "urdf" / "baxter.urdf", root / "srdf" / "baxter_manipulation.srdf"
+    assert main(["robot-info", str(urdf)]) == 2
+    assert "name the tool frame" in capsys.readouterr().err
+    assert main(["robot-info", str(urdf), "--tcp", "left_gripper", "--srdf", str(srdf), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["tcp_frame"] == "left_gripper" and report["srdf"] == str(srdf)
+    assert [j["name"] for j in report["joints"]] == [
+        f"left_{j}" for j in ("s0", "s1", "e0", "e1", "w0", "w1", "w2")
+    ]
+    assert main(["robot-info", "cpr", "--tcp", "tcp"]) == 2
+    error = capsys.readouterr().err
+    assert "drop --tcp and --srdf" in error and len(error.strip().splitlines()) == 1

@@ -180,6 +180,14 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="ROBOT",
         help="a URDF file, an example-robot-data arm's name (panda, ur5, ...), or 'cpr' (the bundled CPR)",
     )
+    sub.add_argument(
+        "--tcp",
+        metavar="FRAME",
+        help="its tool frame: the joints from the root to it are planned (a scene's tcp)",
+    )
+    sub.add_argument(
+        "--srdf", type=Path, metavar="FILE", help="its SRDF (default: found by name beside the URDF)"
+    )
     sub.add_argument("--json", action="store_true", help="print the report as JSON")
     sub.set_defaults(run=cmd_robot_info)
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -57,10 +58,22 @@ def robot_report(robot: ck.Robot) -> dict[str, Any]:
 
 
 def cmd_robot_info(args: argparse.Namespace) -> int:
-    """Print what the planner makes of the robot ``args.robot`` (a scene's ``robot:`` value, or ``cpr``)."""
+    """Print what the planner makes of the robot ``args.robot`` (a scene's ``robot:`` value, or ``cpr``).
+
+    ``--tcp`` and ``--srdf`` are those keys of a scene's ``robot:`` mapping: a robot whose tree
+    branches (a humanoid, a mobile manipulator) loads only with its tool frame named.
+    """
+    from planning.errors import PlanningError
     from planning.io.robot_entry import robot_spec_of
 
+    named = {"tcp": args.tcp, "srdf": None if args.srdf is None else args.srdf.resolve()}
+    if args.robot == "cpr" and any(value is not None for value in named.values()):
+        raise PlanningError(
+            "robot 'cpr' is the bundled preset, its tool frame and SRDF its own: drop --tcp and --srdf"
+        )
     spec = None if args.robot == "cpr" else robot_spec_of(args.robot, Path.cwd())
+    if spec is not None:
+        spec = dataclasses.replace(spec, **{key: value for key, value in named.items() if value is not None})
     report = robot_report(ck.load_cpr() if spec is None else spec.load())
     if args.json:
         print(json.dumps(report, indent=2))
