@@ -478,39 +478,3 @@ def test_an_infeasible_path_seed_is_refined_without_the_firefly(robot: ck.Robot)
     assert at_once.verification.accepted and exploring.verification.accepted
     assert at_once.optimiser.evaluation_history[0] == len(attempt.seeds)  # the seeds, evaluated once
     assert exploring.optimiser.evaluation_history[0] == problem.scene.planner.firefly.fireflies
-
-
-def test_a_hopeless_best_is_not_verified_where_another_attempt_follows(
-    robot: ck.Robot, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """A search's best deeper inside the margin than a step cannot pass the certified check, which
-    would only say why; where another attempt follows (here: more waypoints along RRT-Connect's
-    path), the plan goes on to it without the check, and that attempt's plan is verified."""
-    from planning.pipeline import choose, planner
-    from planning.pipeline import search as search_stage
-    from planning.pipeline.choose import beyond_margin
-    from planning.search.optimizer import SearchResult
-
-    scene = narrow_scene(np.random.default_rng(5), robot, "window")
-    searched_in: list[int] = []
-    verified_in: list[int] = []
-    real_search, real_verify = search_stage.search, choose.verify
-
-    def search(attempt: Any, *args: Any) -> SearchResult:
-        searched_in.append(attempt.number)
-        if attempt.number == 0:  # the straight line, through the wall
-            x = attempt.problem.objective.straight_line()
-            found = SearchResult.of_point(x, float(attempt.problem.objective(x[None])[0]), 1)
-            assert beyond_margin(attempt.problem, found) is not None
-            return found
-        return real_search(attempt, *args)
-
-    def verify(*args: Any) -> Any:
-        verified_in.append(searched_in[-1])
-        return real_verify(*args)
-
-    monkeypatch.setattr(planner, "search", search)
-    monkeypatch.setattr(choose, "verify", verify)
-    result = planner.plan(scene, robot)
-    assert searched_in[:2] == [0, 1] and verified_in and 0 not in verified_in
-    assert result.verification.accepted
