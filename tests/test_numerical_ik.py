@@ -170,3 +170,25 @@ def test_bad_settings_are_refused(changes: dict[str, float], pattern: str) -> No
 def test_bad_targets_are_refused(position: list[float], rotation: np.ndarray | None, pattern: str) -> None:
     with pytest.raises(ck.CprKinError, match=pattern):
         ck.IkTarget(np.array(position), rotation)
+
+
+def test_a_joint_a_turn_away_is_turned_towards_the_seed() -> None:
+    """A UR5's joints span two turns (``[-2 pi, 2 pi]``): the same pose a turn apart. From a restart
+    whose shoulder lies a turn from the seed's, the solution is turned back (yourdfpy's pose the
+    same), and a turn that would leave the range is not made."""
+    from cpr_kin.kinematics.numerical_ik import turned_towards
+
+    robot = ck.load_robot(example_robot("ur5"))
+    reference = yourdfpy.URDF.load(str(example_robot("ur5")), build_scene_graph=True, load_meshes=False)
+    lower, upper = robot.limits.lower, robot.limits.upper
+    revolute = np.ones(robot.nq, dtype=bool)
+    q = np.array([0.3, 4.93, 1.87, -2.09, -1.57, -1.24])
+    seed = np.array([5.6, -1.32, 1.83, -2.08, -1.57, 4.04])
+    turned = turned_towards(q, seed, revolute, lower, upper)
+    np.testing.assert_allclose(turned, [0.3, 4.93 - 2 * np.pi, 1.87, -2.09, -1.57, -1.24 + 2 * np.pi])
+    np.testing.assert_allclose(  # the same pose
+        reference_tool_pose(robot, reference, turned), reference_tool_pose(robot, reference, q), atol=1e-9
+    )
+    assert np.all(np.abs(turned - seed) <= np.abs(q - seed))  # no joint farther from the seed
+    assert turned[0] == q[0]  # 0.3 + 2 pi would leave [-2 pi, 2 pi]
+    np.testing.assert_array_equal(turned_towards(q, seed, ~revolute, lower, upper), q)  # prismatic: as is

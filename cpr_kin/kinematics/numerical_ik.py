@@ -7,7 +7,10 @@ within a tolerance. From the seed configuration first, then from seeded random o
 frame), each step at most ``max_step`` [rad or m] per joint and clipped into the joint
 ranges. Every solution is checked by forward kinematics against the target and its
 tolerance; of those that pass, the ones the ``accept`` test allows (collision-free, say) come
-first, then the one nearest the seed (in robot motion, ``sum_j R_j |dq_j|``). A target that
+first, then the one nearest the seed (in robot motion, ``sum_j R_j |dq_j|``). A revolute joint
+whose range spans more than a turn (a UR's ``[-2 pi, 2 pi]``) reaches the same pose a turn
+apart: each solution is first turned by whole turns towards the seed, within the range, or a
+restart's shoulder a turn away made the robot swing round for nothing. A target that
 no start reaches is an :class:`~cpr_kin.common.errors.IkMissError` naming the closest the solver
 came.
 """
@@ -230,6 +233,7 @@ def solve_ik(
     seed = (lower + upper) / 2 if seed_q is None else np.clip(np.asarray(seed_q, dtype=float), lower, upper)
     free = np.ones(robot.nq, dtype=bool)
     free[[robot.limits.index(name) for name in held]] = False
+    revolute = np.array([robot.joint_unit(name) == "rad" for name in robot.joint_names])
     rng = np.random.default_rng(settings.seed)
     found: list[FloatArray] = []
     accepted: list[FloatArray] = []  # ``accept`` asked once per solution
@@ -240,7 +244,7 @@ def solve_ik(
     while tried < len(draws):
         start = np.where(free, draws[tried], seed)
         tried += 1
-        q = _descend(robot, target, start, free, settings)
+        q = turned_towards(_descend(robot, target, start, free, settings), seed, revolute, lower, upper)
         pin.framesForwardKinematics(robot.model, robot.data, q)
         placement = pin.SE3(robot.data.oMf[frame])
         if closest is None or target.excess(placement) < target.excess(closest):
@@ -258,3 +262,15 @@ def solve_ik(
         raise IkMissError(f"{missed}: the closest of {tried} IK starts came {target.miss(closest)}")
     weights = path_weights(robot)
     return min(accepted or found, key=lambda q: float(weights @ np.abs(q - seed)))
+
+
+def turned_towards(
+    q: FloatArray, seed: FloatArray, revolute: NDArray[np.bool_], lower: FloatArray, upper: FloatArray
+) -> FloatArray:
+    """``q`` [rad, m], each ``revolute`` joint turned by whole turns towards ``seed`` within its range.
+
+    The turns (2 pi each) that bring it nearest ``seed``, where that stays within ``[lower,
+    upper]``; elsewhere it is kept. The same pose (module docstring).
+    """
+    turned = q + 2.0 * math.pi * np.round((seed - q) / (2.0 * math.pi))
+    return np.asarray(np.where(revolute & (turned >= lower) & (turned <= upper), turned, q))
