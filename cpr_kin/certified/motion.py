@@ -10,7 +10,9 @@ at most ``V = sum_j R_j v_j`` [m/s]. Sampling it every ``dt = 2 step_m / V`` lea
 instant farther than ``step_m`` of robot motion from a sample. Since every distance changes
 at most as fast as the robot moves, between samples ``k`` and ``k+1`` the clearance is at
 least ``(c_k + c_{k+1} - V dt) / 2 >= min(c_k, c_{k+1}) - step_m``: that certified lower
-bound, not the sampled value, is compared with the margin.
+bound, not the sampled value, is compared with the margin. A grid of thousands of samples is
+sampled every few samples first, finely only where its minima may lie
+(:mod:`cpr_kin.certified.coarse_first`).
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from functools import partial
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from cpr_kin.certified.coarse_first import GridSampler, coarse_first, fine_slack
 from cpr_kin.certified.interval_motion import IntervalSpeed, interval_motion
 from cpr_kin.collision.clearance import BatchClearance
 from cpr_kin.collision.decisive import Stop, certified, chunked, exact_below, undecided, with_neighbours
@@ -154,15 +157,34 @@ def check_curve(
             f"{point_speed:.3g} m/s, step {step_m:g} m); at most {MAX_CURVE_CHECKS}: use a larger step"
         )
     times = np.linspace(t0, t1, max(count, 2))  # at least both ends
-    slack = interval_motion(times, point_speed, interval_speed)
-    batch = decisive_clearance(world, curve(times), slack, exact_below(margin_m, slack), stop=stop)
-    per_group = batch.clearance_m
+
+    def interval_slack(rows: IntArray) -> FloatArray:
+        return interval_motion(times[rows], point_speed, interval_speed)
+
+    slack, largest_slack_m = fine_slack(
+        len(times), interval_slack, point_speed * float(np.max(np.diff(times)))
+    )
+    exact_m = exact_below(margin_m, largest_slack_m)
+
+    def decide(rows: IntArray, rows_slack: FloatArray) -> tuple[FloatArray, IntArray]:
+        batch = decisive_clearance(world, curve(times[rows]), rows_slack, exact_m, stop=stop)
+        return batch.clearance_m, batch.closest_pair
+
+    def exact(rows: IntArray) -> tuple[FloatArray, IntArray]:
+        q, every = curve(times[rows]), np.arange(len(rows))
+        groups = [
+            chunked(partial(_group_clearance, world, q, g, exact_m), every, stop) for g in range(len(GROUPS))
+        ]
+        return np.stack([g[0] for g in groups], axis=1), np.stack([g[1] for g in groups], axis=1)
+
+    grid = coarse_first(GridSampler(len(times), decide, exact, slack, largest_slack_m))
+    per_group, closest_pair = grid.values, grid.closest
     # lower bound between neighbouring samples: distances change no faster than the robot moves
-    group_bound = certified(per_group, slack).min(axis=0)
+    group_bound = certified(per_group, grid.slack).min(axis=0)
     sample_min = per_group.min(axis=1)
     worst = int(np.argmin(sample_min))
     worst_group_index = int(np.argmin(per_group[worst]))
-    pair_index = int(batch.closest_pair[worst, worst_group_index])
+    pair_index = int(closest_pair[worst, worst_group_index])
     worst_pair = world.pairs[pair_index][:2] if pair_index >= 0 else None
     certified_min = float(group_bound.min())
     return CurveCheck(

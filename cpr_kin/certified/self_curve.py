@@ -16,45 +16,33 @@ The pairs are first screened by their capsules
 (:meth:`cpr_kin.collision.self_collision.SelfCollision.bounds`) on one coarser grid, and visited from
 the lowest bound the screen gives; a pair that cannot lower the minima found so far is
 skipped, and within a pair coal computes only the samples that decide
-(:func:`cpr_kin.collision.decisive.undecided`). The minima reported are those of computing every
-sample of every pair.
+(:func:`cpr_kin.collision.decisive.undecided`), a long grid every few samples first
+(:func:`cpr_kin.certified.coarse_first.coarse_first`). The minima reported are those of
+computing every sample of every pair.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import partial
 from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from cpr_kin.collision.decisive import (
-    Stop,
-    ask,
-    below_coal,
-    certified,
-    chunked,
-    exact_below,
-    undecided,
-    with_neighbours,
-)
+from cpr_kin.certified.coarse_first import coarse_first
+from cpr_kin.certified.pair_samples import JointSpeeds, PairSampler
+from cpr_kin.collision.decisive import Stop, ask, below_coal, certified
 from cpr_kin.common.errors import CprKinError
 
 if TYPE_CHECKING:
     from cpr_kin.collision.self_collision import SelfCollision
 
 FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
 
-JointSpeeds = Callable[[FloatArray], FloatArray]
-"""Sample times ``(K,)`` [s] -> ``(K - 1, nj)`` bounds on ``|q'_j|`` over each interval between
-them [rad/s, m/s] (e.g. :meth:`~planning.curves.trajectory.Trajectory.speed_bounds`)."""
-
-MAX_SELF_CHECKS = 200_000
+MAX_SELF_CHECKS = 1_000_000
 """Most samples the certified self-collision check of a curve takes of one pair."""
-COARSE_STRIDE = 8
-"""Of a pair's samples its capsules leave in doubt, every this many are computed first."""
 SCREEN_STRIDE = 8
 """The screen's grid is this many times coarser than the fastest pair's samples."""
 
@@ -81,22 +69,6 @@ class SelfCheck:
     certified_min_m: float
     worst_time: float
     worst_pair: tuple[str, str] | None
-
-
-@dataclass(frozen=True)
-class _PairSamples:
-    """One pair's samples: index, times ``(K,)`` [s], configurations, slack per interval [m], bounds [m]."""
-
-    index: int
-    times: FloatArray
-    q: FloatArray
-    slack: FloatArray
-    bounds: FloatArray
-
-    @property
-    def certified_bound(self) -> float:
-        """The lowest certified value the capsule bounds allow [m]."""
-        return float(np.min(certified(self.bounds, self.slack)))
 
 
 def check_self_curve(
@@ -146,10 +118,6 @@ def check_self_curve(
             "use a larger step"
         )
 
-    def sampled(p: int, count: int) -> _PairSamples:
-        times = np.linspace(t0, t1, count)
-        return _samples(collision, p, curve, times, pair_speed[p], interval_joint_speed)
-
     ask(stop)
     screen = _screen(collision, curve, (t0, t1), pair_speed, step_m, interval_joint_speed)
     certified_min, sampled_min, worst_time, worst_pair, computed = np.inf, np.inf, t0, -1, 0
@@ -158,16 +126,16 @@ def check_self_curve(
         if screen[p] - step_m >= certified_min and screen[p] >= sampled_min:
             continue  # neither minimum can come from this pair
         ask(stop)
-        pair = sampled(int(p), int(counts[p]))
-        if pair.certified_bound >= certified_min and pair.bounds.min() >= sampled_min:
-            continue
-        ceiling = exact_below(margin_m, pair.slack)
-        values, known = _decisive_values(collision, pair, (certified_min, sampled_min), ceiling, stop)
-        computed += int(known.sum())
-        certified_min = min(certified_min, float(np.min(certified(values, pair.slack))))
+        times = np.linspace(t0, t1, int(counts[p]))
+        ceilings = (certified_min, sampled_min)
+        pair = PairSampler(collision, int(p), curve, times, ceilings, stop)
+        grid = coarse_first(pair.grid(pair_speed[p], interval_joint_speed, margin_m), ceilings)
+        values, known = grid.values[:, 0], grid.closest[:, 0] >= 0
+        computed += pair.computed
+        certified_min = min(certified_min, float(np.min(certified(values, grid.slack))))
         lowest = int(np.argmin(values))
         if known[lowest] and values[lowest] < sampled_min:
-            sampled_min, worst_time, worst_pair = float(values[lowest]), float(pair.times[lowest]), pair.index
+            sampled_min, worst_time, worst_pair = float(values[lowest]), float(times[lowest]), int(p)
     return SelfCheck(
         accepted=bool(certified_min >= margin_m),
         margin_m=float(margin_m),
@@ -200,63 +168,3 @@ def _screen(
         speed = np.minimum(speed, interval_joint_speed(times) @ collision.pair_radii.T)
     bounds = below_coal(collision.bounds(curve(times)))
     return np.asarray(np.min(certified(bounds, speed * np.diff(times)[:, None]), axis=0))
-
-
-def _samples(
-    collision: SelfCollision,
-    index: int,
-    curve: Callable[[FloatArray], FloatArray],
-    times: FloatArray,
-    speed: float,
-    interval_joint_speed: JointSpeeds | None,
-) -> _PairSamples:
-    """Pair ``index``'s samples at ``times``: configurations, slack, capsule bounds.
-
-    The slack of an interval is its duration times ``speed`` [m/s] or the interval's own
-    bound, the lower.
-    """
-    q = np.asarray(curve(times), dtype=float)
-    interval_speed = np.full(len(times) - 1, speed)
-    if interval_joint_speed is not None:
-        interval_speed = np.minimum(interval_speed, interval_joint_speed(times) @ collision.pair_radii[index])
-    slack = interval_speed * np.diff(times)
-    bounds = below_coal(collision.pair_bounds(q, index))  # at most coal's distance
-    return _PairSamples(index, times, q, slack, bounds)
-
-
-def _decisive_values(
-    collision: SelfCollision,
-    pair: _PairSamples,
-    ceilings: tuple[float, float],
-    exact_below_m: float,
-    stop: Stop | None,
-) -> tuple[FloatArray, NDArray[np.bool_]]:
-    """The pair's distances [m] at its samples, exact where they decide, else lower bounds; which are exact.
-
-    Decide: could lower the pair's smallest certified or sampled value below the ``ceilings``
-    (the check's minima so far, certified and sampled) [m]. The capsules' bounds and the
-    exact values' neighbours (distances change by at most the slack per interval) bound the
-    others. A value counts as exact where the hulls' distance is at or above ``exact_below_m``
-    [m]: the meshes' distance is no smaller, and the check cannot fail there. ``stop`` is
-    asked before each call to coal.
-    """
-    certified_ceiling, sampled_ceiling = ceilings
-    count = len(pair.times)
-    values, known = pair.bounds.copy(), np.zeros(count, dtype=bool)
-    reach = np.concatenate([[0.0], np.cumsum(pair.slack)])
-    doubtful = np.zeros(count, dtype=bool)
-    low = certified(values, pair.slack) < certified_ceiling
-    doubtful[:-1] |= low
-    doubtful[1:] |= low
-    coarse = np.zeros(count, dtype=bool)
-    coarse[::COARSE_STRIDE] = True
-    coarse[-1] = True
-    rows = np.flatnonzero(doubtful & coarse)
-    while rows.size:
-        exact = partial(collision.pair_distances, pair=pair.index, exact_below_m=exact_below_m)
-        values[rows] = chunked(exact, pair.q[rows], stop)
-        known[rows] = True
-        values = with_neighbours(values, known, pair.bounds, reach)
-        needed = undecided(values[:, None], known[:, None], pair.slack, certified_ceiling, sampled_ceiling)
-        rows = np.flatnonzero(needed[:, 0])
-    return values, known

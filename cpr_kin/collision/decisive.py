@@ -60,7 +60,7 @@ def certified(values: FloatArray, slack_m: float | FloatArray) -> FloatArray:
     return np.asarray(0.5 * (values[:-1] + values[1:] - slack))
 
 
-def exact_below(margin_m: float, slack_m: FloatArray) -> float:
+def exact_below(margin_m: float, slack_m: float | FloatArray) -> float:
     """The value [m] below which a certified check of ``margin_m`` [m] needs its samples exact.
 
     A sample at or above the margin plus the largest slack of an interval (``slack_m``) [m]

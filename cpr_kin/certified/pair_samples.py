@@ -1,0 +1,166 @@
+"""One pair's samples of a curve for the certified self check: its capsules bound them, coal decides.
+
+:func:`~cpr_kin.certified.self_curve.check_self_curve` samples each pair at its own rate, on a
+grid that :func:`~cpr_kin.certified.coarse_first.coarse_first` may sample coarsely first;
+:class:`PairSampler` gives it the pair's values where it asks: the capsules' lower bound at
+every sample, and coal's distance at those that could still lower the check's minima
+(:func:`~cpr_kin.collision.decisive.undecided`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import partial
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import NDArray
+
+from cpr_kin.certified.coarse_first import GridSampler, fine_slack
+from cpr_kin.certified.interval_motion import IntervalSpeed, interval_motion
+from cpr_kin.collision.decisive import (
+    Stop,
+    below_coal,
+    certified,
+    chunked,
+    exact_below,
+    undecided,
+    with_neighbours,
+)
+
+if TYPE_CHECKING:
+    from cpr_kin.collision.self_collision import SelfCollision
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+JointSpeeds = Callable[[FloatArray], FloatArray]
+"""Sample times ``(K,)`` [s] -> ``(K - 1, nj)`` bounds on ``|q'_j|`` over each interval between
+them [rad/s, m/s] (e.g. :meth:`~planning.curves.trajectory.Trajectory.speed_bounds`)."""
+
+COARSE_STRIDE = 8
+"""Of a pair's samples its capsules leave in doubt, every this many are computed first."""
+
+
+@dataclass(frozen=True)
+class _PairSamples:
+    """One pair's samples: index, times ``(K,)`` [s], configurations, slack per interval [m], bounds [m]."""
+
+    index: int
+    times: FloatArray
+    q: FloatArray
+    slack: FloatArray
+    bounds: FloatArray
+
+    @property
+    def certified_bound(self) -> float:
+        """The lowest certified value the capsule bounds allow [m]."""
+        return float(np.min(certified(self.bounds, self.slack)))
+
+
+def relative_speed(
+    collision: SelfCollision, index: int, interval_joint_speed: JointSpeeds | None
+) -> IntervalSpeed | None:
+    """Bounds on how fast pair ``index``'s geometries move apart over each interval between sample times."""
+    if interval_joint_speed is None:
+        return None
+    radii = collision.pair_radii[index]
+    return lambda times: interval_joint_speed(times) @ radii
+
+
+class PairSampler:
+    """One pair's samples of a curve at ``times``, where the fine grid asks for them.
+
+    The capsules bound every sample, coal computes those that decide (:func:`_decisive_values`)
+    below the ``ceilings``, the check's minima over the pairs before it [m]; ``computed``
+    counts coal's samples. ``stop`` is asked before each call to coal.
+    """
+
+    def __init__(
+        self,
+        collision: SelfCollision,
+        index: int,
+        curve: Callable[[FloatArray], FloatArray],
+        times: FloatArray,
+        ceilings: tuple[float, float],
+        stop: Stop | None,
+    ) -> None:
+        self.collision, self.index, self.curve, self.times = collision, index, curve, times
+        self.ceilings, self.stop = ceilings, stop
+        self.exact_below_m = np.inf
+        self.computed = 0
+
+    def grid(self, speed: float, interval_joint_speed: JointSpeeds | None, margin_m: float) -> GridSampler:
+        """The fine grid's sampler, the pair moving apart at most ``speed`` [m/s] (or its intervals' bounds).
+
+        A value at or above ``margin_m`` [m] plus the largest slack of an interval need not be exact.
+        """
+        times, interval_speed = self.times, relative_speed(self.collision, self.index, interval_joint_speed)
+
+        def slack_of(rows: IntArray) -> FloatArray:
+            return interval_motion(times[rows], speed, interval_speed)
+
+        slack, largest_m = fine_slack(len(times), slack_of, speed * float(np.max(np.diff(times))))
+        self.exact_below_m = exact_below(margin_m, largest_m)
+        return GridSampler(len(times), self.decide, self.exact, slack, largest_m)
+
+    def decide(self, rows: IntArray, slack: FloatArray) -> tuple[FloatArray, IntArray]:
+        """The pair's values at ``rows`` as one curve, exact where they decide; the pair where exact."""
+        q = np.asarray(self.curve(self.times[rows]), dtype=float)
+        bounds = below_coal(self.collision.pair_bounds(q, self.index))  # at most coal's distance
+        pair = _PairSamples(self.index, self.times[rows], q, slack, bounds)
+        certified_ceiling, sampled_ceiling = self.ceilings
+        if pair.certified_bound >= certified_ceiling and bounds.min() >= sampled_ceiling:
+            values, known = bounds, np.zeros(len(rows), dtype=bool)  # cannot lower a minimum
+        else:
+            values, known = _decisive_values(
+                self.collision, pair, self.ceilings, self.exact_below_m, self.stop
+            )
+        self.computed += int(known.sum())
+        return values[:, None], np.where(known, self.index, -1)[:, None]
+
+    def exact(self, rows: IntArray) -> tuple[FloatArray, IntArray]:
+        """The pair's distance at ``rows``, by coal."""
+        q = np.asarray(self.curve(self.times[rows]), dtype=float)
+        distance = partial(self.collision.pair_distances, pair=self.index, exact_below_m=self.exact_below_m)
+        self.computed += len(rows)
+        return chunked(distance, q, self.stop)[:, None], np.full((len(rows), 1), self.index)
+
+
+def _decisive_values(
+    collision: SelfCollision,
+    pair: _PairSamples,
+    ceilings: tuple[float, float],
+    exact_below_m: float,
+    stop: Stop | None,
+) -> tuple[FloatArray, NDArray[np.bool_]]:
+    """The pair's distances [m] at its samples, exact where they decide, else lower bounds; which are exact.
+
+    Decide: could lower the pair's smallest certified or sampled value below the ``ceilings``
+    (the check's minima so far, certified and sampled) [m]. The capsules' bounds and the
+    exact values' neighbours (distances change by at most the slack per interval) bound the
+    others. A value counts as exact where the hulls' distance is at or above ``exact_below_m``
+    [m]: the meshes' distance is no smaller, and the check cannot fail there. ``stop`` is
+    asked before each call to coal.
+    """
+    certified_ceiling, sampled_ceiling = ceilings
+    count = len(pair.times)
+    values, known = pair.bounds.copy(), np.zeros(count, dtype=bool)
+    reach = np.concatenate([[0.0], np.cumsum(pair.slack)])
+    doubtful = np.zeros(count, dtype=bool)
+    low = certified(values, pair.slack) < certified_ceiling
+    doubtful[:-1] |= low
+    doubtful[1:] |= low
+    coarse = np.zeros(count, dtype=bool)
+    coarse[::COARSE_STRIDE] = True
+    coarse[-1] = True
+    rows = np.flatnonzero(doubtful & coarse)
+    while rows.size:
+        exact = partial(collision.pair_distances, pair=pair.index, exact_below_m=exact_below_m)
+        values[rows] = chunked(exact, pair.q[rows], stop)
+        known[rows] = True
+        values = with_neighbours(values, known, pair.bounds, reach)
+        needed = undecided(values[:, None], known[:, None], pair.slack, certified_ceiling, sampled_ceiling)
+        rows = np.flatnonzero(needed[:, 0])
+    return values, known
