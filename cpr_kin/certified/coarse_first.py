@@ -102,7 +102,7 @@ def coarse_first(sampler: GridSampler, ceilings: tuple[float, float] = (np.inf, 
         return FineGrid(*sampler.decide(every, slack), slack)
     coarse = np.unique(np.r_[np.arange(0, count, STRIDE), count - 1])
     slack = sampler.slack(coarse)
-    fine_slack = np.minimum(slack, sampler.largest_slack_m)  # of a fine interval in each
+    fine_bound = np.minimum(slack, sampler.largest_slack_m)  # on a fine interval's slack in each
     values, closest = sampler.decide(coarse, slack)
     known = (closest >= 0) | np.isposinf(values)
     # each sampled value bounds the minima of the fine grid, which holds the sample, from above
@@ -113,7 +113,7 @@ def coarse_first(sampler: GridSampler, ceilings: tuple[float, float] = (np.inf, 
     while True:
         floor = certified(values, slack)  # the clearance anywhere in each coarse interval
         wanted = ~done & np.any(
-            (floor - 0.5 * fine_slack[:, None] < certified_min) | (floor <= sampled_min), axis=1
+            (floor - 0.5 * fine_bound[:, None] < certified_min) | (floor <= sampled_min), axis=1
         )
         ends = np.union1d(np.flatnonzero(wanted), np.flatnonzero(wanted) + 1)
         doubtful = ends[~known[ends].all(axis=1)]
@@ -124,7 +124,7 @@ def coarse_first(sampler: GridSampler, ceilings: tuple[float, float] = (np.inf, 
             certified_min = np.minimum(certified_min, sampled_min)
             continue
         if not wanted.any():
-            return fine.grid(coarse, values, closest, floor, fine_slack)
+            return fine.grid(coarse, values, closest, floor, fine_bound)
         for first, last in _runs(wanted):
             rows = np.arange(coarse[first], coarse[last + 1] + 1)
             run_values, run_slack = fine.sample(rows, sampler)
@@ -153,16 +153,20 @@ class _Fine:
         values: FloatArray,
         closest: IntArray,
         floor: FloatArray,
-        fine_slack: FloatArray,
+        fine_bound: FloatArray,
     ) -> FineGrid:
-        """The whole grid: the runs, the coarse samples, elsewhere each coarse interval's ``floor``."""
+        """The whole grid: the runs, the coarse samples, elsewhere each coarse interval's ``floor``.
+
+        An interval not sampled finely has as its slack ``fine_bound``, its coarse interval's
+        bound on a fine one's.
+        """
         interval = np.minimum(
             np.searchsorted(coarse, np.arange(self.count), side="right") - 1, len(coarse) - 2
         )
         grid = FineGrid(
             floor[interval],
             np.full((self.count, values.shape[1]), -1, dtype=np.int64),
-            fine_slack[interval[:-1]],
+            fine_bound[interval[:-1]],
         )
         for rows, run_values, run_closest, run_slack in self.runs:
             grid.values[rows], grid.closest[rows], grid.slack[rows[:-1]] = run_values, run_closest, run_slack
