@@ -22,6 +22,7 @@ from planning.errors import NoSolutionError, PlanningError
 from planning.io.scene_file import SceneFile, parse_scene_file
 from planning.pipeline.verification import Requirements
 from planning.task import Move, TaskMotion, check_task, plan_task, record_problems, task_record
+from planning.task.held_orientation import goal_on_constraint
 from planning.task.orientation import OrientationConstraint
 from planning.task.orientation_projection import Projector
 from planning.task.orientation_rrt import STEP_M, orientation_path
@@ -155,3 +156,37 @@ def test_a_bent_path_that_cannot_be_timed_gives_way_to_one_planned_on_the_constr
     carry = task.segments[2].held
     assert task.accepted and carry is not None and not carry.bent and len(calls) >= 2
     assert check_task(read.scene, read.task, task.trajectory, task_record(task)).accepted
+
+
+UR10_START = [5.608, -1.324, 1.832, -2.079, -1.57, 4.038]  # tool down, the base 0.68 rad from its limit
+UR10_GOAL = IkTarget(position=np.array([0.65, 0.4, 0.35]), rotation=pin.rpy.rpyToMatrix(*DOWN))
+
+
+def test_a_goal_is_on_the_constraint_where_the_straight_path_to_it_bends_onto_it() -> None:
+    # the UR10's nearest solution of a pose round the other side flips the elbow: bending the
+    # straight path to it leaves the constraint; a solution on the start's branch (elbow and
+    # wrist as they are) bends without a jump
+    ur10 = ck.load_robot(example_robot("ur10"))
+    start = np.array(UR10_START)
+    reached = goal_on_constraint(ur10, OrientationConstraint(("x", "y"), 0.0873), start)
+    nearest = solve_ik(ur10, UR10_GOAL, start)
+    assert nearest[2] < 0 < start[2] and not reached(nearest)  # the elbow flipped
+    on_branch = solve_ik(ur10, UR10_GOAL, start, accept=reached)
+    assert reached(on_branch) and on_branch[2] > 0 and on_branch[4] < 0
+    assert reached(start)  # a goal where it starts
+
+
+def test_a_carry_whose_nearest_goal_flips_the_elbow_ends_on_the_starts_branch() -> None:
+    # before the goal was chosen on the constraint, this carry failed after minutes of search
+    ur10 = ck.load_robot(example_robot("ur10"))
+    document = {
+        "robot": "ur10",
+        "safety_margin": 0.02,
+        "start": {"q": UR10_START},
+        "task": [{"move": {"pose": {"xyz": [0.65, 0.4, 0.35], "rpy": DOWN}, "constraint": UPRIGHT}}],
+    }
+    read = parse_scene_file(document, "ur10 upright carry")
+    task = plan_task(read.scene, read.task, ur10)
+    assert task.accepted, task.problems
+    end = task.trajectory(task.trajectory.knots[-1])
+    assert np.sign(end[2]) == np.sign(UR10_START[2]) and np.sign(end[4]) == np.sign(UR10_START[4])

@@ -190,7 +190,7 @@ def endpoint_violations(scene: Scene, robot: ck.Robot) -> list[str]:
     q_start = None
     for label in ("start", "goal"):
         try:
-            q = endpoint(robot, world, scene, label, seed_q=q_start, dynamics=dynamics)
+            q = endpoint(world, scene, label, seed_q=q_start, dynamics=dynamics)
         except (PlanningError, NoSolutionError, ck.CprKinError) as exc:
             found.append(str(exc) if str(exc).startswith(label) else f"{label} is refused: {exc}")
             continue

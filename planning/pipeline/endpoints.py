@@ -9,6 +9,8 @@ what at a configuration comes inside the safety or self margin.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -54,18 +56,19 @@ def margin_violation(world: ck.CollisionWorld, scene: Scene, q: FloatArray) -> s
 
 
 def endpoint(
-    robot: ck.Robot,
     world: ck.CollisionWorld,
     scene: Scene,
     label: str,
     seed_q: FloatArray | None = None,
     dynamics: ck.Dynamics | None = None,
+    preferred: Callable[[FloatArray], bool] | None = None,
 ) -> FloatArray:
     """The configuration of the scene's start or goal, verified; refused if out of reach or inside a margin.
 
     A ``tcp`` or ``pose`` is solved by IK (:meth:`~planning.pipeline.target.Target.configuration`):
     the solution nearest ``seed_q`` of those clear of the margins and, with ``dynamics``, that
-    the motors can hold still (:func:`~planning.pipeline.torques.check_held`).
+    the motors can hold still (:func:`~planning.pipeline.torques.check_held`); of those, one
+    that passes ``preferred`` where the IK finds one.
 
     Raises:
         PlanningError: a joint vector of the wrong length, naming the wrong joints or outside
@@ -80,8 +83,13 @@ def endpoint(
             return False
         return dynamics is None or bool(held(dynamics, q[None])[0])
 
+    def best(q: FloatArray) -> bool:
+        return accepted(q) and (preferred is None or preferred(q))
+
     try:
-        q = target.configuration(robot, seed_q, accepted)
+        q = target.configuration(world.robot, seed_q, best)
+        if preferred is not None and not best(q):  # none passes it: the nearest clear one
+            q = target.configuration(world.robot, seed_q, accepted)
     except ck.IkMissError as exc:
         raise TargetOutOfReachError(f"{label} is out of reach: {exc}") from None
     except ck.CprKinError as exc:

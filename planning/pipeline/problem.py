@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -173,7 +174,12 @@ def scene_world(scene: Scene, robot: ck.Robot, threads: int | None = None) -> ck
     )
 
 
-def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | None = None) -> Problem:
+def build_problem(
+    scene: Scene,
+    robot: ck.Robot | None = None,
+    threads: int | None = None,
+    preferred_goal: Callable[[FloatArray], bool] | None = None,
+) -> Problem:
     """Everything about ``scene`` that a search needs, checked.
 
     Args:
@@ -181,6 +187,8 @@ def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | No
         robot: a loaded robot (default: ``scene.robot`` loaded, or the bundled CPR).
         threads: threads of the parallel collision checks (default: up to 2); a batch that
             plans scenes in parallel processes gives each 1.
+        preferred_goal: a test of a ``tcp`` or ``pose`` goal's IK solutions: the nearest the
+            start that passes it is chosen where one does (:func:`~planning.pipeline.endpoints.endpoint`).
 
     Raises:
         PlanningError: a bad start or goal, or one inside a margin; a fixed duration
@@ -196,8 +204,8 @@ def build_problem(scene: Scene, robot: ck.Robot | None = None, threads: int | No
     robot = scene_robot(scene, robot or scene.robot_spec().load())
     world = scene_world(scene, robot, threads)
     dynamics = scene_dynamics(robot, scene, world.num_threads)
-    q_start = endpoint(robot, world, scene, "start", dynamics=dynamics)
-    q_goal = endpoint(robot, world, scene, "goal", seed_q=q_start, dynamics=dynamics)
+    q_start = endpoint(world, scene, "start", dynamics=dynamics)
+    q_goal = endpoint(world, scene, "goal", seed_q=q_start, dynamics=dynamics, preferred=preferred_goal)
     motion = Motion(q_start, q_goal, moving_joints(robot, scene, q_start, q_goal))
     duration = duration_rule(scene.duration, search_torque(robot, dynamics, q_start, q_goal))
     if isinstance(duration, FixedDuration):

@@ -13,6 +13,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+import numpy as np
+from numpy.typing import NDArray
+
 import cpr_kin as ck
 from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
@@ -21,11 +24,13 @@ from planning.pipeline.problem import Problem, build_problem
 from planning.pipeline.scene import Scene
 from planning.pipeline.timing import FreeDuration
 from planning.pipeline.verification import Requirements
-from planning.task.held_orientation import HeldMotion, hold_orientation
+from planning.task.held_orientation import HeldMotion, goal_on_constraint, hold_orientation
 from planning.task.orientation import OrientationConstraint
 
 if TYPE_CHECKING:
     from planning.search.firefly import FireflyProgress
+
+FloatArray = NDArray[np.float64]
 
 FIXED_DURATION = (
     "the scene fixes duration = {seconds:g} s; a task times each of its motions as fast as the limits "
@@ -65,21 +70,31 @@ def plan_free(
             constraint; a fixed duration.
         NoSolutionError: no motion found, or none that keeps the constraint.
     """
-    problem = free_problem(scene, robot, threads)
-    free = solve(problem, progress).trajectory
     if constraint is None:
-        return FreeMotion(free, problem)
+        problem = free_problem(scene, robot, threads)
+        return FreeMotion(solve(problem, progress).trajectory, problem)
+    reached = goal_on_constraint(robot, constraint, scene.start.configuration(robot))
+    problem = free_problem(scene, robot, threads, reached)
+    free = solve(problem, progress).trajectory
     held = hold_orientation(problem.world, free, constraint, required, scene.planner.seed)
     return FreeMotion(held.trajectory, problem, held)
 
 
-def free_problem(scene: Scene, robot: ck.Robot, threads: int | None = None) -> Problem:
-    """The problem of a task's free motion: timed to end still in jerk too (``threads``: its checks').
+def free_problem(
+    scene: Scene,
+    robot: ck.Robot,
+    threads: int | None = None,
+    preferred_goal: Callable[[FloatArray], bool] | None = None,
+) -> Problem:
+    """The problem of a task's free motion: timed to end still in jerk too.
+
+    ``threads``: its checks'; ``preferred_goal``: a test its goal passes where an IK
+    solution does (:func:`~planning.pipeline.problem.build_problem`).
 
     Raises:
         PlanningError: the scene fixes a duration; a start or goal inside a margin.
     """
-    problem = build_problem(scene, robot, threads)
+    problem = build_problem(scene, robot, threads, preferred_goal)
     if not isinstance(problem.duration, FreeDuration):
         raise PlanningError(FIXED_DURATION.format(seconds=scene.duration))
     return dataclasses.replace(problem, duration=dataclasses.replace(problem.duration, still_jerk=True))

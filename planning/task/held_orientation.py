@@ -17,6 +17,7 @@ certified angle (:func:`~planning.task.orientation.orientation_deviation`) keeps
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -47,6 +48,8 @@ SPLINE_ROUNDS = 6
 """Most rounds of midpoints inserted where the spline strays."""
 NODE_STEP_S, KNOT_HALVINGS = 0.1, 4
 """The timing's knot spacing [s], and how often it may be halved to keep the constraint."""
+PROBE_STEP = 0.05
+"""Largest move of a joint between two samples of a goal's probe [rad or m] (:func:`goal_on_constraint`)."""
 
 
 @dataclass(frozen=True)
@@ -110,6 +113,35 @@ def hold_orientation(
         except NoSolutionError as failed:
             raise NoSolutionError(f"the free path bent onto the constraint: {why}; {failed}") from None
     return _held(world, projector, planned, required, bent=False)
+
+
+def goal_on_constraint(
+    robot: ck.Robot, constraint: OrientationConstraint, q_start: FloatArray
+) -> Callable[[FloatArray], bool]:
+    """A test of a constrained move's goal: the straight joint path from ``q_start`` bends onto it.
+
+    A pose has several IK solutions, on branches (an elbow up or down, a wrist flipped) that
+    no motion keeping the constraint joins, and the nearest the start may lie on another
+    branch than the start's: a UR whose base is near its limit reaches its goal's branch by
+    turning the other way round, farther than a flip. A goal passes where the straight joint
+    path to it, sampled every :data:`PROBE_STEP` and each sample moved the least onto the
+    constraint (as a free path is bent), keeps it without a jump: a way along the
+    constraint, obstacles aside. Milliseconds a goal.
+    """
+    frame = constraint.frame or robot.tcp_frame
+    held = constraint.about(ck.frame_poses(robot, q_start[None], frame)[0][:3, :3])
+    projector = Projector(robot, frame, held, held.reference())
+
+    def reached(q_goal: FloatArray) -> bool:
+        count = int(np.clip(math.ceil(np.abs(q_goal - q_start).max() / PROBE_STEP) + 1, 3, MOST_SAMPLES))
+        straight = q_start + np.linspace(0.0, 1.0, count)[:, None] * (q_goal - q_start)
+        try:
+            _bent(projector, straight)
+        except NoSolutionError:
+            return False
+        return True
+
+    return reached
 
 
 def _held(
