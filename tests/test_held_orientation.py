@@ -190,3 +190,23 @@ def test_a_carry_whose_nearest_goal_flips_the_elbow_ends_on_the_starts_branch() 
     assert task.accepted, task.problems
     end = task.trajectory(task.trajectory.knots[-1])
     assert np.sign(end[2]) == np.sign(UR10_START[2]) and np.sign(end[4]) == np.sign(UR10_START[4])
+
+
+def test_a_carry_the_constraint_cannot_reach_stops_at_the_time_limit() -> None:
+    # to the elbow-flipped solution, given as joint values: the free path cannot be bent onto the
+    # constraint, and RRT-Connect on it would search its 1,500 samples (minutes); the scene's
+    # time limit stops it, and the message says so
+    ur10 = ck.load_robot(example_robot("ur10"))
+    flipped = solve_ik(ur10, UR10_GOAL, np.array(UR10_START))
+    document = {
+        "robot": "ur10",
+        "safety_margin": 0.02,
+        "start": {"q": UR10_START},
+        "planner": {"time_limit_s": 2.0},
+        "task": [{"move": {"q": flipped.tolist(), "constraint": UPRIGHT}}],
+    }
+    read = parse_scene_file(document, "ur10 carry to a flipped elbow")
+    with pytest.raises(
+        NoSolutionError, match=r"by the time limit \(2 s; RRT-Connect on the constraint stopped"
+    ):
+        plan_task(read.scene, read.task, ur10)

@@ -9,6 +9,7 @@ the constraint, or one is planned on it (:func:`~planning.task.held_orientation.
 from __future__ import annotations
 
 import dataclasses
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -19,6 +20,7 @@ from numpy.typing import NDArray
 import cpr_kin as ck
 from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
+from planning.pipeline.deadline import Deadline
 from planning.pipeline.planner import solve
 from planning.pipeline.problem import Problem, build_problem
 from planning.pipeline.scene import Scene
@@ -68,15 +70,18 @@ def plan_free(
     Raises:
         PlanningError: bad input: a start or goal inside a margin, or that does not keep the
             constraint; a fixed duration.
-        NoSolutionError: no motion found, or none that keeps the constraint.
+        NoSolutionError: no motion found, or none that keeps the constraint (within the
+            scene's ``time_limit_s``, where it sets one, for the search and the path on the
+            constraint together).
     """
     if constraint is None:
         problem = free_problem(scene, robot, threads)
         return FreeMotion(solve(problem, progress).trajectory, problem)
     reached = goal_on_constraint(robot, constraint, scene.start.configuration(robot))
     problem = free_problem(scene, robot, threads, reached)
+    deadline = Deadline.after(scene.planner.time_limit_s, time.perf_counter())  # the search's own clock
     free = solve(problem, progress).trajectory
-    held = hold_orientation(problem.world, free, constraint, required, scene.planner.seed)
+    held = hold_orientation(problem.world, free, constraint, required, scene.planner.seed, deadline)
     return FreeMotion(held.trajectory, problem, held)
 
 

@@ -28,6 +28,7 @@ from planning.curves.interpolating_spline import chord_parameter, spline_through
 from planning.curves.on_path_timing import time_on_path
 from planning.curves.trajectory import Trajectory
 from planning.errors import NoSolutionError, PlanningError
+from planning.pipeline.deadline import Deadline
 from planning.pipeline.verification import Requirements
 from planning.task.line_motion import first_blocked, why_blocked
 from planning.task.orientation import OrientationConstraint, OrientationDeviation, orientation_deviation
@@ -81,8 +82,11 @@ def hold_orientation(
     constraint: OrientationConstraint,
     required: Requirements,
     seed: int = 0,
+    deadline: Deadline | None = None,
 ) -> HeldMotion:
     """``free``'s path bent onto ``constraint``, or one planned on it, timed within ``required``'s limits.
+
+    The planning on the constraint stops where ``deadline`` has passed (:func:`orientation_path`).
 
     Raises:
         PlanningError: the start or the goal does not keep the constraint (bad input).
@@ -109,7 +113,7 @@ def hold_orientation(
     except NoSolutionError as why:  # blocked, or it cannot be joined or timed (a corner it made)
         try:
             rng = np.random.default_rng(seed)
-            planned = orientation_path(world, projector, ends[0], ends[1], required, rng)
+            planned = orientation_path(world, projector, ends[0], ends[1], required, rng, deadline)
         except NoSolutionError as failed:
             raise NoSolutionError(f"the free path bent onto the constraint: {why}; {failed}") from None
     return _held(world, projector, planned, required, bent=False)

@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 
 import cpr_kin as ck
 from planning.errors import NoSolutionError
+from planning.pipeline.deadline import Deadline
 from planning.pipeline.verification import Requirements
 from planning.search.rrt_trees import Tree
 from planning.task.orientation_projection import Projector
@@ -40,8 +41,10 @@ BATCH = 16
 class _Walker:
     """Walks edges on the manifold, step by step (module docstring)."""
 
-    def __init__(self, world: ck.CollisionWorld, projector: Projector, required: Requirements) -> None:
-        self.world, self.projector = world, projector
+    def __init__(
+        self, world: ck.CollisionWorld, projector: Projector, required: Requirements, deadline: Deadline
+    ) -> None:
+        self.world, self.projector, self.deadline = world, projector, deadline
         self.weights = ck.motion_radii(world.robot)
         self.margin_m = required.margin_m + STEP_M
         self.self_margin_m = required.self_margin_m + STEP_M / 2
@@ -52,11 +55,12 @@ class _Walker:
     def walk(self, start: FloatArray, aim: FloatArray, range_m: float = np.inf) -> list[FloatArray]:
         """The steps from ``start`` (left out) toward ``aim``, as far as they go.
 
-        Steps are projected :data:`BATCH` at a time, then checked for clearance together.
+        Steps are projected :data:`BATCH` at a time, then checked for clearance together; the
+        walk ends where the deadline has passed.
         """
         steps: list[FloatArray] = []
         q, left, travelled = start, self.distance(start, aim), 0.0
-        while left > 1e-9 and travelled < range_m:
+        while left > 1e-9 and travelled < range_m and not self.deadline.passed():
             batch: list[FloatArray] = []
             while len(batch) < BATCH and left > 1e-9 and travelled < range_m:
                 guess = aim if left <= STEP_M else q + (aim - q) * (STEP_M / left)
@@ -89,19 +93,33 @@ def orientation_path(
     q_goal: FloatArray,
     required: Requirements,
     rng: np.random.Generator,
+    deadline: Deadline | None = None,
 ) -> FloatArray:
     """``(n, nq)`` the steps of a path from ``q_start`` to ``q_goal`` on the manifold (module docstring).
 
+    ``deadline`` is asked between samples and between an edge's batches of steps
+    (:meth:`~planning.pipeline.deadline.Deadline.passed`).
+
     Raises:
-        NoSolutionError: no path within :data:`MAX_SAMPLES` samples.
+        NoSolutionError: no path within :data:`MAX_SAMPLES` samples, or by ``deadline``.
     """
-    walker = _Walker(world, projector, required)
+    deadline = deadline or Deadline()
+    walker = _Walker(world, projector, required, deadline)
     direct = walker.walk(q_start, q_goal)
     if walker.reaches(direct, q_goal):
         return np.array([q_start, *direct])
     trees = (Tree(q_start), Tree(q_goal))
     lower, upper = world.robot.limits.lower, world.robot.limits.upper
+    unheld = (
+        f"no path keeps '{projector.frame}' within {projector.constraint.angle_rad:.4g} rad about "
+        f"{list(projector.constraint.axes)} and the margins"
+    )
     for sample in range(MAX_SAMPLES):
+        if deadline.passed():
+            raise NoSolutionError(
+                f"{unheld} by the time limit ({deadline.limit_s:g} s; RRT-Connect on the constraint "
+                f"stopped after {sample} samples)"
+            )
         grow, other = trees if sample % 2 == 0 else trees[::-1]
         aim, angle = projector.project(rng.uniform(lower, upper))
         if angle > projector.aim_rad:
@@ -120,11 +138,7 @@ def orientation_path(
             ends = (grow.branch(near), other.branch(toward))  # each from its node back to its root
             first, second = ends if grow is trees[0] else ends[::-1]
             return _shortened(np.concatenate([first[::-1], second[1:]]), walker, rng)
-    raise NoSolutionError(
-        f"no path keeps '{projector.frame}' within {projector.constraint.angle_rad:.4g} rad about "
-        f"{list(projector.constraint.axes)} and the margins (RRT-Connect on the constraint, "
-        f"{MAX_SAMPLES} samples)"
-    )
+    raise NoSolutionError(f"{unheld} (RRT-Connect on the constraint, {MAX_SAMPLES} samples)")
 
 
 def _shortened(path: FloatArray, walker: _Walker, rng: np.random.Generator) -> FloatArray:
