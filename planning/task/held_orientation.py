@@ -130,7 +130,7 @@ def goal_on_constraint(
     turning the other way round, farther than a flip. A goal passes where the straight joint
     path to it, sampled every :data:`PROBE_STEP` and each sample moved the least onto the
     constraint (as a free path is bent), keeps it without a jump: a way along the
-    constraint, obstacles aside. Milliseconds a goal.
+    constraint, obstacles aside.
     """
     frame = constraint.frame or robot.tcp_frame
     held = constraint.about(ck.frame_poses(robot, q_start[None], frame)[0][:3, :3])
