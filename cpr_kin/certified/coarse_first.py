@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from cpr_kin.certified.interval_motion import IntervalSpeed, interval_motion
 from cpr_kin.collision.decisive import certified
 
 FloatArray = NDArray[np.float64]
@@ -76,14 +77,20 @@ class FineGrid:
     slack: FloatArray
 
 
-def fine_slack(count: int, slack: Slack, largest_slack_m: float) -> tuple[Slack, float]:
-    """The slack of a grid of ``count`` samples and a bound on its largest interval's [m].
+def fine_slack(times: FloatArray, speed: float, interval_speed: IntervalSpeed | None) -> tuple[Slack, float]:
+    """The slack of the grid ``times`` [s] (:func:`interval_motion`) and a bound on its largest [m].
 
-    Where :func:`coarse_first` samples the grid whole, its slack computed once and its own
-    largest; else ``slack`` and ``largest_slack_m``, a bound.
+    ``speed`` bounds the motion's speed over the whole curve [m/s], ``interval_speed`` over each
+    interval. Where :func:`coarse_first` samples the grid whole, its slack is computed once and
+    its own largest given; else ``speed`` times the largest interval's duration.
     """
+
+    def slack(rows: IntArray) -> FloatArray:
+        return interval_motion(times[rows], speed, interval_speed)
+
+    count = len(times)
     if count >= FROM_SAMPLES:
-        return slack, largest_slack_m
+        return slack, speed * float(np.max(np.diff(times)))
     whole = slack(np.arange(count))
     return (lambda rows: whole if len(rows) == count else slack(rows)), float(np.max(whole, initial=0.0))
 

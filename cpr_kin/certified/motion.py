@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.certified.coarse_first import GridSampler, coarse_first, fine_slack
-from cpr_kin.certified.interval_motion import IntervalSpeed, interval_motion
+from cpr_kin.certified.interval_motion import IntervalSpeed
 from cpr_kin.collision.clearance import BatchClearance
 from cpr_kin.collision.decisive import Stop, certified, chunked, exact_below, undecided, with_neighbours
 from cpr_kin.collision.robot_reach import robot_reach
@@ -158,12 +158,7 @@ def check_curve(
         )
     times = np.linspace(t0, t1, max(count, 2))  # at least both ends
 
-    def interval_slack(rows: IntArray) -> FloatArray:
-        return interval_motion(times[rows], point_speed, interval_speed)
-
-    slack, largest_slack_m = fine_slack(
-        len(times), interval_slack, point_speed * float(np.max(np.diff(times)))
-    )
+    slack, largest_slack_m = fine_slack(times, point_speed, interval_speed)
     exact_m = exact_below(margin_m, largest_slack_m)
 
     def decide(rows: IntArray, rows_slack: FloatArray) -> tuple[FloatArray, IntArray]:

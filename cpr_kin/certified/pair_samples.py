@@ -17,14 +17,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from cpr_kin.certified.coarse_first import GridSampler, fine_slack
-from cpr_kin.certified.interval_motion import IntervalSpeed, interval_motion
+from cpr_kin.certified.interval_motion import IntervalSpeed
 from cpr_kin.collision.decisive import (
     Stop,
     below_coal,
     certified,
     chunked,
-    exact_below,
     undecided,
     with_neighbours,
 )
@@ -73,8 +71,9 @@ class PairSampler:
     """One pair's samples of a curve at ``times``, where the fine grid asks for them.
 
     The capsules bound every sample, coal computes those that decide (:func:`_decisive_values`)
-    below the ``ceilings``, the check's minima over the pairs before it [m]; ``computed``
-    counts coal's samples. ``stop`` is asked before each call to coal.
+    below the ``ceilings``, the check's minima over the pairs before it [m]; a value at or above
+    ``exact_below_m`` [m] need not be exact. ``computed`` counts coal's samples; ``stop`` is asked
+    before each call to coal.
     """
 
     def __init__(
@@ -83,27 +82,13 @@ class PairSampler:
         index: int,
         curve: Callable[[FloatArray], FloatArray],
         times: FloatArray,
+        exact_below_m: float,
         ceilings: tuple[float, float],
         stop: Stop | None,
     ) -> None:
         self.collision, self.index, self.curve, self.times = collision, index, curve, times
-        self.ceilings, self.stop = ceilings, stop
-        self.exact_below_m = np.inf
+        self.exact_below_m, self.ceilings, self.stop = exact_below_m, ceilings, stop
         self.computed = 0
-
-    def grid(self, speed: float, interval_joint_speed: JointSpeeds | None, margin_m: float) -> GridSampler:
-        """The fine grid's sampler, the pair moving apart at most ``speed`` [m/s] (or its intervals' bounds).
-
-        A value at or above ``margin_m`` [m] plus the largest slack of an interval need not be exact.
-        """
-        times, interval_speed = self.times, relative_speed(self.collision, self.index, interval_joint_speed)
-
-        def slack_of(rows: IntArray) -> FloatArray:
-            return interval_motion(times[rows], speed, interval_speed)
-
-        slack, largest_m = fine_slack(len(times), slack_of, speed * float(np.max(np.diff(times))))
-        self.exact_below_m = exact_below(margin_m, largest_m)
-        return GridSampler(len(times), self.decide, self.exact, slack, largest_m)
 
     def decide(self, rows: IntArray, slack: FloatArray) -> tuple[FloatArray, IntArray]:
         """The pair's values at ``rows`` as one curve, exact where they decide; the pair where exact."""

@@ -30,9 +30,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from cpr_kin.certified.coarse_first import coarse_first
-from cpr_kin.certified.pair_samples import JointSpeeds, PairSampler
-from cpr_kin.collision.decisive import Stop, ask, below_coal, certified
+from cpr_kin.certified.coarse_first import GridSampler, coarse_first, fine_slack
+from cpr_kin.certified.pair_samples import JointSpeeds, PairSampler, relative_speed
+from cpr_kin.collision.decisive import Stop, ask, below_coal, certified, exact_below
 from cpr_kin.common.errors import CprKinError
 
 if TYPE_CHECKING:
@@ -127,9 +127,12 @@ def check_self_curve(
             continue  # neither minimum can come from this pair
         ask(stop)
         times = np.linspace(t0, t1, int(counts[p]))
+        slack, largest_m = fine_slack(
+            times, pair_speed[p], relative_speed(collision, int(p), interval_joint_speed)
+        )
         ceilings = (certified_min, sampled_min)
-        pair = PairSampler(collision, int(p), curve, times, ceilings, stop)
-        grid = coarse_first(pair.grid(pair_speed[p], interval_joint_speed, margin_m), ceilings)
+        pair = PairSampler(collision, int(p), curve, times, exact_below(margin_m, largest_m), ceilings, stop)
+        grid = coarse_first(GridSampler(len(times), pair.decide, pair.exact, slack, largest_m), ceilings)
         values, known = grid.values[:, 0], grid.closest[:, 0] >= 0
         computed += pair.computed
         certified_min = min(certified_min, float(np.min(certified(values, grid.slack))))
