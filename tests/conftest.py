@@ -1,10 +1,11 @@
 """Shared fixtures: the bundled CPR, the paper's scene, geometric paths to time, the example pick
 and place planned once, a stop that says yes after a count of questions, and a script loaded
-as a module."""
+as a module or run for its markdown table."""
 
 from __future__ import annotations
 
 import importlib.util
+import subprocess
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -42,6 +43,24 @@ def load_script(name: str) -> ModuleType:
     sys.modules[name] = module
     spec.loader.exec_module(module)
     return module
+
+
+def script_table(name: str, *arguments: str) -> list[list[str]]:
+    """``scripts/<name>.py`` run in a new process with ``arguments``: its markdown table's rows.
+
+    The header row first, each row's cells stripped; the script must exit 0 (else the end of
+    its standard error is the failure's message).
+    """
+    completed = subprocess.run(
+        [sys.executable, str(SCRIPTS / f"{name}.py"), *arguments],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+    assert completed.returncode == 0, completed.stderr[-2000:]
+    lines = [line for line in completed.stdout.splitlines() if line.startswith("| ")]
+    return [[cell.strip() for cell in line.split("|")[1:-1]] for line in lines]
 
 
 def spline_path(nodes: np.ndarray) -> Trajectory:

@@ -2,27 +2,15 @@
 
 from __future__ import annotations
 
-import subprocess
-import sys
-from pathlib import Path
-
 import pytest
 
-SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "bench_carry.py"
+from .conftest import script_table
 
 
 @pytest.mark.slow
 def test_the_benchmark_prints_a_row_with_both_planners_and_ours_keeps_the_constraint() -> None:
-    completed = subprocess.run(
-        [sys.executable, str(SCRIPT), "--problems", "1", "--robots", "ur5"],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        check=False,
-    )
-    assert completed.returncode == 0, completed.stderr[-2000:]
-    rows = [line.split("|")[1:-1] for line in completed.stdout.splitlines() if line.startswith("| ")]
-    assert [row[0].strip() for row in rows[1:]] == ["ur5"]
+    rows = script_table("bench_carry", "--problems", "1", "--robots", "ur5")
+    assert [row[0] for row in rows[1:]] == ["ur5"]
     ours, peer = (int(v) for v in rows[1][2].split("/"))
     assert ours == 1 and 0 <= peer <= 1
     tilt = float(rows[1][5].split("/")[0])

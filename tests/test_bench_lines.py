@@ -8,6 +8,8 @@ from pathlib import Path
 
 import pytest
 
+from .conftest import script_table
+
 SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "bench_lines.py"
 
 
@@ -20,10 +22,8 @@ def run(*arguments: str) -> subprocess.CompletedProcess[str]:
 
 @pytest.mark.slow
 def test_the_benchmark_prints_a_row_per_robot_with_both_planners() -> None:
-    completed = run("--lines", "3", "--seed", "2", "--robots", "cpr", "panda")
-    assert completed.returncode == 0, completed.stderr[-2000:]
-    rows = [line.split("|")[1:-1] for line in completed.stdout.splitlines() if line.startswith("| ")]
-    assert [row[0].strip() for row in rows[1:]] == ["cpr", "panda"]
+    rows = script_table("bench_lines", "--lines", "3", "--seed", "2", "--robots", "cpr", "panda")
+    assert [row[0] for row in rows[1:]] == ["cpr", "panda"]
     for row in rows[1:]:
         ours, peer = (int(v) for v in row[2].split("/"))
         assert 0 <= ours <= 3 and 0 <= peer <= 3
