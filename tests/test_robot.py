@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import cpr_kin as ck
+from cpr_kin.model.robot import joint_units
 
 URDF_TEXT = ck.cpr_urdf_path().read_text()
 
@@ -21,6 +22,7 @@ def test_joints_and_limits_match_design(robot: ck.Robot) -> None:
     np.testing.assert_array_equal(lim.acceleration, [3.0, 2.0, 2.0, 4.0, 4.0])
     np.testing.assert_array_equal(lim.jerk, [15.0, 10.0, 10.0, 20.0, 20.0])
     assert [robot.joint_unit(n) for n in robot.joint_names] == ["rad", "m", "m", "rad", "rad"]
+    assert robot.joint_units == ("rad", "m", "m", "rad", "rad") == joint_units(robot.model)
 
 
 def test_collision_groups(robot: ck.Robot) -> None:

@@ -233,7 +233,7 @@ def solve_ik(
     seed = (lower + upper) / 2 if seed_q is None else np.clip(np.asarray(seed_q, dtype=float), lower, upper)
     free = np.ones(robot.nq, dtype=bool)
     free[[robot.limits.index(name) for name in held]] = False
-    revolute = np.array([robot.joint_unit(name) == "rad" for name in robot.joint_names])
+    revolute = np.array([unit == "rad" for unit in robot.joint_units])
     rng = np.random.default_rng(settings.seed)
     found: list[FloatArray] = []
     accepted: list[FloatArray] = []  # ``accept`` asked once per solution

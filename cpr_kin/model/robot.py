@@ -234,8 +234,12 @@ class Robot:
 
     def joint_unit(self, name: str) -> str:
         """``"rad"`` for a revolute joint, ``"m"`` for a prismatic one."""
-        joint = self.model.joints[self.limits.index(name) + 1]
-        return "m" if joint.shortname().removeprefix("JointModel").startswith("P") else "rad"
+        return _unit(self.model.joints[self.limits.index(name) + 1])
+
+    @property
+    def joint_units(self) -> tuple[str, ...]:
+        """``"rad"`` or ``"m"`` per planned joint, in configuration order."""
+        return tuple(self.joint_unit(name) for name in self.joint_names)
 
     def group_geometries(self, group: str) -> Sequence[RobotGeometry]:
         """Geometries of collision group ``group`` (one of :data:`GROUPS`)."""
@@ -246,7 +250,9 @@ class Robot:
 
 def joint_units(model: Any) -> tuple[str, ...]:
     """``"rad"`` or ``"m"`` per joint of a Pinocchio ``model``."""
-    return tuple(
-        "m" if joint.shortname().removeprefix("JointModel").startswith("P") else "rad"
-        for joint in model.joints[1:]
-    )
+    return tuple(_unit(joint) for joint in model.joints[1:])
+
+
+def _unit(joint: Any) -> str:
+    """``"m"`` for a Pinocchio prismatic joint model, ``"rad"`` for any other."""
+    return "m" if joint.shortname().removeprefix("JointModel").startswith("P") else "rad"

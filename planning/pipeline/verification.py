@@ -211,7 +211,7 @@ def _verified(
     except ck.CprKinError as exc:  # too fast to certify: a verdict, not a crash
         problems.append(f"cannot be certified clear of obstacles: {exc}")
         check = unchecked(margin_m, step_m)
-    jumps = discontinuity(trajectory, robot.joint_names, [robot.joint_unit(n) for n in robot.joint_names])
+    jumps = discontinuity(trajectory, robot.joint_names, robot.joint_units)
     if jumps is not None:
         problems.append(jumps)
     if endpoints is not None:

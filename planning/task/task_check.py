@@ -91,8 +91,7 @@ def check_task(
     if recorded != kinds:
         return TaskCheck((), (f"the trajectory's task is {recorded}; the scene's is {kinds}",))
     problems = list(record_problems(base, trajectory, entries))
-    names = base.joint_names
-    jump = discontinuity(trajectory, names, [base.joint_unit(n) for n in names])
+    jump = discontinuity(trajectory, base.joint_names, base.joint_units)
     problems += [] if jump is None else [jump]
     miss = scene.start.miss(base, trajectory(trajectory.knots[0]))
     problems += [] if miss is None else [f"its start is {miss} of the scene's start"]

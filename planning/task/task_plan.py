@@ -217,9 +217,8 @@ def plan_task(
         pieces.append(timed.trajectory)
         now = end
     whole = joined(pieces)
-    robot_names = carrying.problem.robot.joint_names
-    units = [carrying.problem.robot.joint_unit(n) for n in robot_names]
-    continuity = discontinuity(whole, robot_names, units)
+    arm = carrying.problem.robot  # the robot as planned (its payload attached)
+    continuity = discontinuity(whole, arm.joint_names, arm.joint_units)
     drawn = untaken(start_world.obstacles, payloads)
     if len(drawn) < len(start_world.obstacles):  # the task takes some: drawn as what it carries
         start_world = ck.CollisionWorld(start_world.robot, drawn, num_threads=start_world.num_threads)

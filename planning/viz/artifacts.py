@@ -46,7 +46,7 @@ def task_drawn_files(task: TaskMotion, plots: bool = True, page: bool = True) ->
     files: dict[str, str | bytes] = {}
     robot, trajectory, scene = task.world.robot, task.trajectory, task.scene
     if plots:
-        units = tuple(robot.joint_unit(n) for n in robot.joint_names)
+        units = robot.joint_units
         figures = (
             drawing.joint_figure(trajectory, robot.joint_names, units),
             drawing.tcp_path_figure(
@@ -96,7 +96,7 @@ def plot_files(result: PlanResult) -> dict[str, bytes]:
     from planning.viz import plots
 
     robot = result.robot
-    units = tuple(robot.joint_unit(n) for n in robot.joint_names)
+    units = robot.joint_units
     world = result.problem.world
     figures = (
         plots.joint_figure(result.trajectory, robot.joint_names, units),

@@ -115,7 +115,7 @@ class _Window(meshcat.visualizer.ViewerWindow):  # type: ignore[misc]
 
 
 class Viewer:
-    """The CPR among its obstacles in meshcat.
+    """A robot among its obstacles in meshcat.
 
     Args:
         world: the robot among its obstacles (its clearance colours the TCP path).
