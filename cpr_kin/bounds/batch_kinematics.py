@@ -126,6 +126,27 @@ def place_capsule(
                 )
 
 
+@njit_inline
+def place_capsules(
+    q: FloatArray,
+    chain: ChainArrays,
+    capsule_joint: IntArray,
+    capsule_ends: FloatArray,
+    rotation: FloatArray,
+    translation: FloatArray,
+    local: FloatArray,
+    world: FloatArray,
+) -> None:
+    """Write every capsule's segment in the world frame at one configuration ``q`` ``(nq,)`` into ``world``.
+
+    :func:`place_joints` (into ``rotation``, ``translation``, with ``local`` its work array),
+    then :func:`place_capsule` of each capsule: what a bound of every capsule does first.
+    """
+    place_joints(q, chain, rotation, translation, local)
+    for c in range(len(capsule_joint)):
+        place_capsule(c, rotation, translation, capsule_joint, capsule_ends, world)
+
+
 @dataclass(frozen=True)
 class KinematicChain:
     """A Pinocchio model's joints as arrays, for compiled code.

@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from cpr_kin.bounds.batch_kinematics import ChainArrays, place_capsule, place_joints
+from cpr_kin.bounds.batch_kinematics import ChainArrays, place_capsules
 from cpr_kin.common.compiled import njit, njit_inline
 
 FloatArray = NDArray[np.float64]
@@ -133,9 +133,7 @@ def pair_bounds(
     world = np.empty((len(capsule_joint), 2, 3))
     scratch = np.empty((4, 3))
     for n in range(len(q)):
-        place_joints(q[n], chain, rotation, translation, scratch)
-        for c in range(len(capsule_joint)):
-            place_capsule(c, rotation, translation, capsule_joint, capsule_ends, world)
+        place_capsules(q[n], chain, capsule_joint, capsule_ends, rotation, translation, scratch, world)
         for p in range(len(pair_capsule)):
             c, o = pair_capsule[p], pair_obstacle[p]
             bound = _segment_obstacle_bound(
@@ -177,9 +175,7 @@ def groups_below(
     world = np.empty((len(capsule_joint), 2, 3))
     scratch = np.empty((4, 3))
     for n in range(len(q)):
-        place_joints(q[n], chain, rotation, translation, scratch)
-        for c in range(len(capsule_joint)):
-            place_capsule(c, rotation, translation, capsule_joint, capsule_ends, world)
+        place_capsules(q[n], chain, capsule_joint, capsule_ends, rotation, translation, scratch, world)
         out[n, :] = False
         open_groups = out.shape[1]
         for p in range(len(pair_capsule)):

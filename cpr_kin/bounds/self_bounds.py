@@ -21,7 +21,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
-from cpr_kin.bounds.batch_kinematics import ChainArrays, KinematicChain, place_capsule, place_joints
+from cpr_kin.bounds.batch_kinematics import ChainArrays, KinematicChain, place_capsules
 from cpr_kin.bounds.pair_bounds import joint_capsules
 from cpr_kin.bounds.segments import segment_distance
 from cpr_kin.bounds.self_blocks import PairBlocks, blocks_below
@@ -55,9 +55,7 @@ def self_bounds(
     world = np.empty((len(capsule_joint), 2, 3))
     scratch = np.empty((4, 3))
     for n in range(len(q)):
-        place_joints(q[n], chain, rotation, translation, scratch)
-        for c in range(len(capsule_joint)):
-            place_capsule(c, rotation, translation, capsule_joint, capsule_ends, world)
+        place_capsules(q[n], chain, capsule_joint, capsule_ends, rotation, translation, scratch, world)
         for k in range(len(pair_a)):
             a, b = pair_a[k], pair_b[k]
             x = 0.5 * (world[a, 0, 0] + world[a, 1, 0] - world[b, 0, 0] - world[b, 1, 0])
