@@ -107,7 +107,7 @@ def _robot(scene_path: str) -> tuple[Any, ck.Robot]:
 def ours(scene_path: str, time_limit_s: float, threads: int | None = None) -> dict[str, Any]:
     """Our planner on one scene file, warm (in the worker): success, time, duration over Ruckig's bound.
 
-    ``threads``: of its parallel collision checks (``None``: the planner's default, up to 2).
+    ``threads``: of its parallel collision checks (``None``: the planner's default, one on 2 cores).
     """
     from planning.bench.ruckig_bound import free_space_bound
     from planning.pipeline.planner import plan

@@ -2,6 +2,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import os
 from collections.abc import Callable
 from typing import Any
 
@@ -11,6 +12,7 @@ import pytest
 from scipy.optimize import minimize
 
 import cpr_kin as ck
+from cpr_kin.collision.obstacle_pools import default_threads
 
 from .conftest import PAPER_GOAL_TCP, PAPER_START_TCP, random_configurations
 
@@ -105,10 +107,14 @@ def test_margin_violated_agrees_with_distances(
         assert 0 < violated.sum() < len(configurations)
 
 
+@pytest.mark.parametrize("threads", [1, 2])
 def test_margin_violated_among_several_obstacles_agrees_with_distances(
-    robot: ck.Robot, rng: np.random.Generator
+    robot: ck.Robot, rng: np.random.Generator, threads: int
 ) -> None:
-    """Each configuration goes to coal only for the obstacles its bounds leave uncertain: same answer."""
+    """Each configuration goes to coal only for the obstacles its bounds leave uncertain: same answer.
+
+    On one thread and on two (coal's parallel batches), whatever the machine's default.
+    """
     world = ck.CollisionWorld(
         robot,
         [
@@ -116,7 +122,9 @@ def test_margin_violated_among_several_obstacles_agrees_with_distances(
             ck.Obstacle.cylinder(radius=0.05, length=0.8, xyz=(0.4, 0.2, 0.4), name="pillar"),
             ck.Obstacle.sphere(radius=0.1, xyz=(-0.3, 0.3, 0.5), name="ball"),
         ],
+        num_threads=threads,
     )
+    assert world.num_threads == threads
     configurations = random_configurations(robot, rng, 1000)
     distances = world.clearance_batch(configurations).min_clearance_m
     for margin in (0.0, 0.05, 0.1, 0.05):  # a margin set again reuses the pools
@@ -126,6 +134,17 @@ def test_margin_violated_among_several_obstacles_agrees_with_distances(
         assert 0 < violated.sum() < len(configurations)
         one_by_one = [world.margin_violated(q[None], margin)[0] for q in configurations[:200]]
         np.testing.assert_array_equal(one_by_one, violated[:200])  # one configuration: no thread pool
+
+
+@pytest.mark.parametrize(("cores", "threads"), [(1, 1), (2, 1), (3, 2), (64, 2)])
+def test_default_threads_leave_a_core_to_the_machine(
+    robot: ck.Robot, monkeypatch: pytest.MonkeyPatch, cores: int, threads: int
+) -> None:
+    """A second thread only where a third core is left: on 2 busy cores it waits time slices."""
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: set(range(cores)), raising=False)
+    assert default_threads() == threads
+    assert ck.CollisionWorld(robot, []).num_threads == threads
+    assert ck.CollisionWorld(robot, [], num_threads=2).num_threads == 2  # asked for: given
 
 
 def test_world_without_obstacles(robot: ck.Robot) -> None:

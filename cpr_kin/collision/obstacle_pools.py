@@ -15,6 +15,7 @@ again with the meshes.
 from __future__ import annotations
 
 import copy
+import os
 from typing import Any
 
 import numpy as np
@@ -26,6 +27,19 @@ from cpr_kin.shapes.exact_pairs import ExactPairs, collide_margin_m
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
+
+
+def default_threads() -> int:
+    """Threads of a world's parallel checks when none are asked for: 2 on 3 cores or more, else 1.
+
+    The cores are those this process may run on. coal's parallel batches (Pinocchio's OpenMP
+    loops) end with their threads waiting for one another. Where every core is busy, a batch's
+    second thread waits for the scheduler: a time slice of milliseconds, for a batch whose work is
+    microseconds. On 2 cores a second thread pays only while nothing else runs, so it is left
+    out there (docs/tuning.md, Threads).
+    """
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+    return 2 if cores >= 3 else 1
 
 
 def pool_collisions(

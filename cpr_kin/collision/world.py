@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import os
 from collections.abc import Sequence
 
 import numpy as np
@@ -23,7 +22,7 @@ from cpr_kin.bounds.pair_bounds import PairBounds
 from cpr_kin.collision.clearance import BatchClearance, Clearance, PairDistance
 from cpr_kin.collision.closest_pairs import closest_pairs
 from cpr_kin.collision.decisive import below_coal, coal_error_m
-from cpr_kin.collision.obstacle_pools import ObstaclePools
+from cpr_kin.collision.obstacle_pools import ObstaclePools, default_threads
 from cpr_kin.collision.robot_reach import pair_reach_distances
 from cpr_kin.collision.touch_links import checked_pairs
 from cpr_kin.collision.world_self_pairs import world_self_collision
@@ -43,7 +42,8 @@ class CollisionWorld:
     Args:
         robot: the robot (its collision geometry model is copied, never modified).
         obstacles: the obstacles; their names must be unique.
-        num_threads: threads for :meth:`margin_violated` (default: up to 2).
+        num_threads: threads of the parallel checks (default:
+            :func:`~cpr_kin.collision.obstacle_pools.default_threads`).
         allowed_pairs: link pairs of the robot allowed to touch (a scene's), beyond its SRDF's;
             an obstacle's own ``touch_links`` may touch it (:mod:`cpr_kin.collision.touch_links`).
         self_margin_m: the self margin the world's user holds the robot's own pairs to [m]: a
@@ -70,7 +70,7 @@ class CollisionWorld:
             raise CprKinError(f"self_margin_m = {self_margin_m} m must be a finite distance >= 0")
         self.robot = robot
         self.obstacles = checked_obstacles(obstacles)
-        self.num_threads = num_threads or min(2, os.cpu_count() or 1)
+        self.num_threads = num_threads or default_threads()
         model = robot.collision_model.copy()
         obstacle_ids = []
         for obstacle in self.obstacles:

@@ -155,7 +155,7 @@ def scene_world(scene: Scene, robot: ck.Robot, threads: int | None = None) -> ck
 
     The scene's ``allowed_collisions`` may touch; a pair close by design is held to contact
     only where the scene's self margin exceeds its gap (:mod:`cpr_kin.bounds.close_pairs`).
-    ``threads``: those of the parallel collision checks (default: up to 2).
+    ``threads``: those of the parallel collision checks (default: one on 2 cores, two on more).
 
     Raises:
         PlanningError: ``allowed_collisions`` names a link the robot does not have (a typo
@@ -185,7 +185,7 @@ def build_problem(
     Args:
         scene: the problem and its settings.
         robot: a loaded robot (default: ``scene.robot`` loaded, or the bundled CPR).
-        threads: threads of the parallel collision checks (default: up to 2); a batch that
+        threads: threads of the parallel collision checks (default: one on 2 cores, two on more); a batch that
             plans scenes in parallel processes gives each 1.
         preferred_goal: a test of a ``tcp`` or ``pose`` goal's IK solutions: the nearest the
             start that passes it is chosen where one does (:func:`~planning.pipeline.endpoints.endpoint`).

@@ -65,7 +65,7 @@ def plan_free(
 ) -> FreeMotion:
     """The free motion from ``scene``'s start to its goal, keeping ``constraint`` if given.
 
-    ``threads``: those of the parallel collision checks (default: up to 2).
+    ``threads``: those of the parallel collision checks (default: one on 2 cores, two on more).
 
     Raises:
         PlanningError: bad input: a start or goal inside a margin, or that does not keep the

@@ -165,8 +165,8 @@ def plan_task(
     Each segment is verified with what the robot carries during it (the scene's payload at
     the start, then what :class:`Attach` and :class:`Detach` say); the whole must be C3.
     ``progress`` is called after each iteration of each free motion's search; ``threads``
-    are those of the parallel collision checks (default: up to 2; a batch runs tasks in
-    parallel, not the checks of one).
+    are those of the parallel collision checks (default: one on 2 cores, two on more; a batch
+    runs tasks in parallel, not the checks of one).
 
     Raises:
         PlanningError: no segment, a bad segment, or a segment's bad input (a goal inside a
