@@ -9,6 +9,7 @@ record kept and checked.
 from __future__ import annotations
 
 import copy
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -22,6 +23,7 @@ from planning.errors import NoSolutionError, PlanningError
 from planning.io.scene_file import SceneFile, parse_scene_file
 from planning.pipeline.verification import Requirements
 from planning.task import Move, TaskMotion, check_task, plan_task, record_problems, task_record
+from planning.task.free_motion import free_problem
 from planning.task.held_orientation import goal_on_constraint
 from planning.task.orientation import OrientationConstraint
 from planning.task.orientation_projection import Projector
@@ -174,6 +176,28 @@ def test_a_goal_is_on_the_constraint_where_the_straight_path_to_it_bends_onto_it
     on_branch = solve_ik(ur10, UR10_GOAL, start, accept=reached)
     assert reached(on_branch) and on_branch[2] > 0 and on_branch[4] < 0
     assert reached(start)  # a goal where it starts
+
+
+def test_the_goal_is_tested_from_the_start_the_plan_takes() -> None:
+    # a start given as a pose is solved by the planner (the nearest IK solution clear of the
+    # margins); the goal's test is built from that configuration, the one the carry leaves from
+    ur10 = ck.load_robot(example_robot("ur10"))
+    tcp_in_base = ck.frame_poses(ur10, np.array([UR10_START]), ur10.tcp_frame)[0]
+    rpy = pin.rpy.matrixToRpy(tcp_in_base[:3, :3]).tolist()
+    start = {"pose": {"xyz": tcp_in_base[:3, 3].tolist(), "rpy": rpy}}
+    goal = {"pose": {"xyz": [0.65, 0.4, 0.35], "rpy": DOWN}}
+    document = {"robot": "ur10", "safety_margin": 0.02, "start": start, "goal": goal}
+    scene = parse_scene_file(document, "ur10 from a pose").scene
+    constraint = OrientationConstraint(("x", "y"), 0.0873)
+    starts: list[np.ndarray] = []
+
+    def goal_test(q_start: np.ndarray) -> Callable[[np.ndarray], bool]:
+        starts.append(q_start)
+        return goal_on_constraint(ur10, constraint, q_start)
+
+    problem = free_problem(scene, ur10, goal_test=goal_test)
+    assert len(starts) == 1 and np.array_equal(starts[0], problem.motion.q_start)
+    assert goal_on_constraint(ur10, constraint, problem.motion.q_start)(problem.motion.q_goal)
 
 
 def test_a_carry_whose_nearest_goal_flips_the_elbow_ends_on_the_starts_branch() -> None:

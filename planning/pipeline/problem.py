@@ -178,17 +178,18 @@ def build_problem(
     scene: Scene,
     robot: ck.Robot | None = None,
     threads: int | None = None,
-    preferred_goal: Callable[[FloatArray], bool] | None = None,
+    goal_test: Callable[[FloatArray], Callable[[FloatArray], bool]] | None = None,
 ) -> Problem:
     """Everything about ``scene`` that a search needs, checked.
 
     Args:
         scene: the problem and its settings.
         robot: a loaded robot (default: ``scene.robot`` loaded, or the bundled CPR).
-        threads: threads of the parallel collision checks (default: one on 2 cores, two on more); a batch that
-            plans scenes in parallel processes gives each 1.
-        preferred_goal: a test of a ``tcp`` or ``pose`` goal's IK solutions: the nearest the
-            start that passes it is chosen where one does (:func:`~planning.pipeline.endpoints.endpoint`).
+        threads: threads of the parallel collision checks (default: one on 2 cores, two on
+            more); a batch that plans scenes in parallel processes gives each 1.
+        goal_test: from the start's configuration, a test of a ``tcp`` or ``pose`` goal's IK
+            solutions: the nearest the start that passes it is chosen where one does
+            (:func:`~planning.pipeline.endpoints.endpoint`).
 
     Raises:
         PlanningError: a bad start or goal, or one inside a margin; a fixed duration
@@ -205,7 +206,8 @@ def build_problem(
     world = scene_world(scene, robot, threads)
     dynamics = scene_dynamics(robot, scene, world.num_threads)
     q_start = endpoint(world, scene, "start", dynamics=dynamics)
-    q_goal = endpoint(world, scene, "goal", seed_q=q_start, dynamics=dynamics, preferred=preferred_goal)
+    preferred = None if goal_test is None else goal_test(q_start)
+    q_goal = endpoint(world, scene, "goal", seed_q=q_start, dynamics=dynamics, preferred=preferred)
     motion = Motion(q_start, q_goal, moving_joints(robot, scene, q_start, q_goal))
     duration = duration_rule(scene.duration, search_torque(robot, dynamics, q_start, q_goal))
     if isinstance(duration, FixedDuration):

@@ -9,6 +9,7 @@ the constraint, or one is planned on it (:func:`~planning.task.held_orientation.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -77,8 +78,7 @@ def plan_free(
     if constraint is None:
         problem = free_problem(scene, robot, threads)
         return FreeMotion(solve(problem, progress).trajectory, problem)
-    reached = goal_on_constraint(robot, constraint, scene.start.configuration(robot))
-    problem = free_problem(scene, robot, threads, reached)
+    problem = free_problem(scene, robot, threads, functools.partial(goal_on_constraint, robot, constraint))
     deadline = Deadline.after(scene.planner.time_limit_s, time.perf_counter())  # the search's own clock
     free = solve(problem, progress).trajectory
     held = hold_orientation(problem.world, free, constraint, required, scene.planner.seed, deadline)
@@ -89,17 +89,17 @@ def free_problem(
     scene: Scene,
     robot: ck.Robot,
     threads: int | None = None,
-    preferred_goal: Callable[[FloatArray], bool] | None = None,
+    goal_test: Callable[[FloatArray], Callable[[FloatArray], bool]] | None = None,
 ) -> Problem:
     """The problem of a task's free motion: timed to end still in jerk too.
 
-    ``threads``: its checks'; ``preferred_goal``: a test its goal passes where an IK
-    solution does (:func:`~planning.pipeline.problem.build_problem`).
+    ``threads``: its checks'; ``goal_test``: from the start's configuration, a test its goal
+    passes where an IK solution does (:func:`~planning.pipeline.problem.build_problem`).
 
     Raises:
         PlanningError: the scene fixes a duration; a start or goal inside a margin.
     """
-    problem = build_problem(scene, robot, threads, preferred_goal)
+    problem = build_problem(scene, robot, threads, goal_test)
     if not isinstance(problem.duration, FreeDuration):
         raise PlanningError(FIXED_DURATION.format(seconds=scene.duration))
     return dataclasses.replace(problem, duration=dataclasses.replace(problem.duration, still_jerk=True))
