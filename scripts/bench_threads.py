@@ -23,10 +23,12 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+import cpr_kin as ck
 from planning.bench.problem_selection import Case, add_selection, check_selection, selected_cases
 from planning.cli.arguments import COUNT
 from planning.io.scene_file import load_scene
 from planning.pipeline.planner import plan
+from planning.pipeline.scene import Scene
 from planning.warming import warm_up
 
 THREADS = (1, 2)
@@ -55,15 +57,19 @@ def busy(processes: int) -> Iterator[None]:
             process.join()
 
 
-def planning_times(cases: list[Case]) -> dict[int, list[float]]:
-    """Warm planning time [s] of each case with each thread count, alternated case by case."""
+def loaded(cases: list[Case]) -> list[tuple[Scene, ck.Robot]]:
+    """Each case's scene with its robot, each robot loaded once and its kernels warmed."""
     scenes = [load_scene(case.path).with_planner(time_limit_s=TIME_LIMIT_S) for case in cases]
     robots = {spec: spec.load() for spec in {scene.robot_spec() for scene in scenes}}
     for robot in robots.values():
         warm_up(robot)
+    return [(scene, robots[scene.robot_spec()]) for scene in scenes]
+
+
+def planning_times(planned: list[tuple[Scene, ck.Robot]]) -> dict[int, list[float]]:
+    """Warm planning time [s] of each scene with each thread count, alternated scene by scene."""
     times: dict[int, list[float]] = {threads: [] for threads in THREADS}
-    for scene in scenes:
-        robot = robots[scene.robot_spec()]
+    for scene, robot in planned:
         for threads in THREADS:
             started = time.perf_counter()
             plan(scene, robot, threads=threads)
@@ -87,9 +93,10 @@ def main() -> int:
     for case in selected_cases(args, out):
         groups.setdefault(case.robot, []).append(case)
     for robot_name, cases in groups.items():
+        planned = loaded(cases)
         for machine, processes in (("no spinner", 0), (f"{args.busy} spinning", args.busy)):
             with busy(processes):
-                times = planning_times(cases)
+                times = planning_times(planned)
             one, two = (times[threads] for threads in THREADS)
             print(
                 f"| {robot_name} | {machine} | {len(cases)} | {statistics.median(one):.3f} ({sum(one):.2f}) "
