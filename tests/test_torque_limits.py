@@ -11,7 +11,13 @@ from planning.curves.path_timing import SECOND_SHARE, time_path
 from planning.curves.phase_plane import phase_plane_profile, sampled_derivatives
 from planning.curves.spline import SepticSplineSolver, uniform_knots
 from planning.curves.torque_estimate import sampled_torque_durations, torque_limited_duration
-from planning.curves.torque_limits import HEADROOM, TorqueRows, phase_plane_rows, torque_time_scale
+from planning.curves.torque_limits import (
+    HEADROOM,
+    TorqueRows,
+    local_peaks,
+    phase_plane_rows,
+    torque_time_scale,
+)
 from planning.curves.trajectory import Trajectory
 from planning.curves.velocity_caps import ROUNDS, TOLERANCE
 from planning.pipeline.scene import DEFAULT_SPLINE
@@ -77,6 +83,25 @@ def test_the_uniform_scale_meets_the_torque_limit_exactly(robot: ck.Robot, path:
     scaled = fast.time_scaled(scale)
     usage = torque_profile(dynamics, scaled, step_s=scaled.duration / 4000).utilisation.max()
     assert usage == pytest.approx(1.0 - HEADROOM, abs=2e-4)
+
+
+@pytest.mark.parametrize(("mass_kg", "speed_up"), [(12.0, 0.5), (15.0, 0.35), (4.0, 0.2)])
+def test_the_uniform_scale_misses_no_peak_between_its_samples(
+    robot: ck.Robot, path: Trajectory, mass_kg: float, speed_up: float
+) -> None:
+    """The oracle: the scaled trajectory's torques every 40 us reach the limit less HEADROOM, to 1e-7."""
+    dynamics = ck.robot_dynamics(robot, ck.Payload(mass_kg, (0.0, 0.0, 0.05)))
+    fast = path.time_scaled(speed_up)
+    scaled = fast.time_scaled(torque_time_scale(fast, dynamics))
+    usage = torque_profile(dynamics, scaled, step_s=4e-5).utilisation.max()
+    assert usage == pytest.approx(1.0 - HEADROOM, abs=1e-7)
+
+
+def test_local_peaks_are_the_maxima_above_the_floor_ends_and_plateaus_included() -> None:
+    values = np.array([3.0, 1.0, 2.0, 2.0, 0.5, 4.0, 1.0, 5.0])
+    assert np.flatnonzero(local_peaks(values, floor=0.0)).tolist() == [0, 2, 3, 5, 7]
+    assert np.flatnonzero(local_peaks(values, floor=3.5)).tolist() == [5, 7]
+    assert not local_peaks(np.linspace(0.0, 1.0, 9)[::-1], floor=2.0).any()
 
 
 @pytest.mark.parametrize("mass_kg", [0.0, 8.0, 15.0])

@@ -32,8 +32,11 @@ COARSE_STEP_S = 1e-2
 """Spacing of the samples at which :func:`torque_time_scale` first evaluates the torques [s]."""
 PRECHECK_STRIDE = 4
 """Every how many grid points :func:`torque_rows` first looks whether the torques bind."""
-FINE_STEP_S = 2.5e-4
-"""Spacing of its samples around the coarse samples that come near the largest scale [s]."""
+FINE_STEP_S = 1e-3
+"""Spacing of its samples around the coarse samples that come near the largest scale [s] (the
+verification's step, ``planning.pipeline.torques.CHECK_STEP_S``)."""
+PEAK_STEP_S = 1e-4
+"""Spacing of its last samples, within a fine step of each peak of the fine samples [s]."""
 UNBOUND_SHARE = 0.9
 """Share of a limit below which a torque is taken not to bind, where a cheaper answer holds:
 :func:`torque_rows` leaves out the rows of a profile whose torques all stay below it, and
@@ -142,11 +145,13 @@ def torque_time_scale(trajectory: Trajectory, model: TorqueModel, at_least: floa
     """The least uniform time scale ``k`` whose trajectory keeps the torques within the limits.
 
     Limits less :data:`HEADROOM`, at samples every :data:`COARSE_STEP_S` and at the knots,
-    then every :data:`FINE_STEP_S` around the samples within :data:`UNBOUND_SHARE` of the
-    largest scale (that or ``at_least``, a scale another limit needs: when every coarse
-    sample needs less than :data:`UNBOUND_SHARE` of it, the torques do not bind and the
-    coarse answer is returned). ``0`` when no torque binds however fast (no known limit, or
-    none moves it); ``inf`` when gravity alone exceeds a limit at a sample (no scale helps).
+    then every :data:`FINE_STEP_S` within a coarse step of the samples within
+    :data:`UNBOUND_SHARE` of the largest scale (that or ``at_least``, a scale another limit
+    needs: when every coarse sample needs less than :data:`UNBOUND_SHARE` of it, the torques
+    do not bind and the coarse answer is returned), and last every :data:`PEAK_STEP_S` within
+    a fine step of the fine samples' peaks (:func:`local_peaks`). ``0`` when no torque binds
+    however fast (no known limit, or none moves it); ``inf`` when gravity alone exceeds a
+    limit at a sample (no scale helps).
     """
     limited = np.isfinite(model.effort)
     if not limited.any():
@@ -159,9 +164,26 @@ def torque_time_scale(trajectory: Trajectory, model: TorqueModel, at_least: floa
     if not np.isfinite(top) or needed.max() < UNBOUND_SHARE * top:
         return float(needed.max())
     near = coarse[needed >= UNBOUND_SHARE * top]
-    offsets = np.arange(-COARSE_STEP_S, COARSE_STEP_S + FINE_STEP_S / 2, FINE_STEP_S)
-    fine = np.unique(np.clip((near[:, None] + offsets).ravel(), start, end))
-    return float(max(needed.max(), _needed_scales(trajectory, model, limited, fine).max()))
+    fine = _around(near, COARSE_STEP_S, FINE_STEP_S, start, end)
+    fine_needed = _needed_scales(trajectory, model, limited, fine)
+    peaks = fine[local_peaks(fine_needed, UNBOUND_SHARE * top)]
+    finest = _needed_scales(trajectory, model, limited, _around(peaks, FINE_STEP_S, PEAK_STEP_S, start, end))
+    return float(max(needed.max(), fine_needed.max(), finest.max(initial=0.0)))
+
+
+def local_peaks(values: FloatArray, floor: float) -> NDArray[np.bool_]:
+    """``(T,)`` where ``values`` ``(T,)`` is a local maximum at least ``floor``.
+
+    A local maximum is at least both its neighbours (an end: its one); a plateau's samples all are.
+    """
+    padded = np.pad(values, 1, constant_values=-np.inf)
+    return np.asarray((values >= padded[:-2]) & (values >= padded[2:]) & (values >= floor))
+
+
+def _around(centres: FloatArray, reach: float, step: float, start: float, end: float) -> FloatArray:
+    """Times every ``step`` within ``reach`` of each of ``centres`` [s] in ``[start, end]``, sorted."""
+    offsets = np.arange(-reach, reach + step / 2, step)
+    return np.unique(np.clip((centres[:, None] + offsets).ravel(), start, end))
 
 
 def _needed_scales(
