@@ -8,17 +8,30 @@ import pytest
 
 import cpr_kin as ck
 from cpr_kin.collision.decisive import (
+    COARSE_BELOW,
+    COARSE_STRIDE,
     ask,
     below_coal,
     certified,
     chunked,
     coal_error_m,
     exact_below,
+    first_rows,
     propagated_bounds,
     with_neighbours,
 )
 
 from .conftest import after_calls
+
+
+@pytest.mark.parametrize("coarse_from", [1, COARSE_BELOW])
+def test_the_first_rows_are_a_stride_of_many_in_doubt_and_all_of_few(coarse_from: int) -> None:
+    rows = np.flatnonzero(np.random.default_rng(8).uniform(size=2000) < 0.3)
+    assert first_rows(rows, coarse_from).tolist() == rows[::COARSE_STRIDE].tolist()
+    few = rows[: coarse_from - 1]
+    assert first_rows(few, coarse_from).tolist() == few.tolist()  # empty where a stride starts at 1
+    assert first_rows(rows[:COARSE_BELOW]).tolist() == rows[:COARSE_BELOW:COARSE_STRIDE].tolist()
+    assert first_rows(rows[: COARSE_BELOW - 1]).tolist() == rows[: COARSE_BELOW - 1].tolist()
 
 
 def test_the_samples_stay_below_a_distance_that_moves_no_faster_than_the_slack() -> None:

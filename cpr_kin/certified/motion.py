@@ -27,7 +27,15 @@ from numpy.typing import ArrayLike, NDArray
 from cpr_kin.certified.coarse_first import GridSampler, coarse_first, fine_slack
 from cpr_kin.certified.interval_motion import IntervalSpeed
 from cpr_kin.collision.clearance import BatchClearance
-from cpr_kin.collision.decisive import Stop, certified, chunked, exact_below, undecided, with_neighbours
+from cpr_kin.collision.decisive import (
+    Stop,
+    certified,
+    chunked,
+    exact_below,
+    first_rows,
+    undecided,
+    with_neighbours,
+)
 from cpr_kin.collision.robot_reach import robot_reach
 from cpr_kin.collision.world import CollisionWorld
 from cpr_kin.common.errors import CprKinError
@@ -36,11 +44,6 @@ from cpr_kin.model.robot import GROUPS, Robot
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
-COARSE_STRIDE = 8
-"""Of the samples in doubt, every how many coal computes first: its exact values bound their
-neighbours' (a distance changes no faster than the robot moves), which may then need none."""
-COARSE_BELOW = 64
-"""Fewer samples in doubt than this are computed at once (another round costs more than they)."""
 LOWER_BOUND_ROWS = 4096
 """Configurations bounded in one call (a few tenths of a second on meshes): one piece's pair
 bounds, ``(rows, P)``, are reduced to their groups' minima before the next is computed."""
@@ -213,10 +216,10 @@ def decisive_clearance(
     moves between neighbouring samples [m], so a clearance changes by at most that much.
     Every sample starts with its cheap lower bound
     (:meth:`~cpr_kin.CollisionWorld.clearance_lower_bounds`); coal then computes, in rounds,
-    the samples that could still be below the smallest exact value (every
-    :data:`COARSE_STRIDE`-th of them first, where :data:`COARSE_BELOW` or more are in doubt),
-    and each exact value bounds its neighbours (its value less the motion between them, less
-    coal's own tolerance), until the minima are exact. Values computed from lower bounds are
+    the samples that could still be below the smallest exact value (a share of them first
+    where many are in doubt, :func:`~cpr_kin.collision.decisive.first_rows`), and each exact
+    value bounds its neighbours (its value less the motion between them, less coal's own
+    tolerance), until the minima are exact. Values computed from lower bounds are
     at most the true ones, so a minimum found exactly is the true minimum. Elsewhere
     :attr:`clearance_m` holds the best lower bound and :attr:`closest_pair` ``-1``. A value at
     or above ``exact_below_m`` [m] need not be exact (a link's exact mesh that far from an
@@ -232,8 +235,7 @@ def decisive_clearance(
     reach = np.concatenate([[0.0], np.cumsum(slack)])
     while (needed := undecided(values, known, slack_m)).any():
         for group_index in range(values.shape[1]):
-            rows = np.flatnonzero(needed[:, group_index])
-            rows = rows[:: COARSE_STRIDE if rows.size >= COARSE_BELOW else 1]
+            rows = first_rows(np.flatnonzero(needed[:, group_index]))
             if rows.size:
                 exact = partial(_group_clearance, world, q, group_index, exact_below_m)
                 values[rows, group_index], closest[rows, group_index] = chunked(exact, rows, stop)

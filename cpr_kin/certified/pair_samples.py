@@ -23,6 +23,7 @@ from cpr_kin.collision.decisive import (
     below_coal,
     certified,
     chunked,
+    first_rows,
     undecided,
     with_neighbours,
 )
@@ -36,9 +37,6 @@ IntArray = NDArray[np.int64]
 JointSpeeds = Callable[[FloatArray], FloatArray]
 """Sample times ``(K,)`` [s] -> ``(K - 1, nj)`` bounds on ``|q'_j|`` over each interval between
 them [rad/s, m/s] (e.g. :meth:`~planning.curves.trajectory.Trajectory.speed_bounds`)."""
-
-COARSE_STRIDE = 8
-"""Of a pair's samples its capsules leave in doubt, every this many are computed first."""
 
 
 @dataclass(frozen=True)
@@ -137,10 +135,7 @@ def _decisive_values(
     low = certified(values, pair.slack) < certified_ceiling
     doubtful[:-1] |= low
     doubtful[1:] |= low
-    coarse = np.zeros(count, dtype=bool)
-    coarse[::COARSE_STRIDE] = True
-    coarse[-1] = True
-    rows = np.flatnonzero(doubtful & coarse)
+    rows = first_rows(np.flatnonzero(doubtful), coarse_from=1)  # then all that are left
     while rows.size:
         exact = partial(collision.pair_distances, pair=pair.index, exact_below_m=exact_below_m)
         values[rows] = chunked(exact, pair.q[rows], stop)

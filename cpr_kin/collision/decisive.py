@@ -22,12 +22,20 @@ from numpy.typing import NDArray
 from cpr_kin.common.errors import CheckStoppedError
 
 FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
 
 Stop = Callable[[], bool]
 """Asked between a certified check's pieces of work: ``True`` stops it (:class:`CheckStoppedError`)."""
 CHUNK_ROWS = 256
 """Configurations a stoppable check gives coal in one call (:func:`chunked`): a few tenths of a
 second at most, on meshes of thousands of triangles."""
+
+COARSE_STRIDE = 8
+"""Of the samples in doubt, every how many coal computes first (:func:`first_rows`): its exact
+values bound their neighbours' (a distance changes no faster than the robot moves), which may
+then need none."""
+COARSE_BELOW = 64
+"""Fewer samples in doubt than this are computed at once (another round costs more than they)."""
 
 COAL_RELATIVE_ERROR = 1e-6
 """How far coal's distance may fall below the truth, relative to its size (coal's distances are
@@ -107,6 +115,19 @@ def undecided(
         else:
             needed[lowest_sample] = True
     return needed & ~known
+
+
+def first_rows(rows: IntArray, coarse_from: int = COARSE_BELOW) -> IntArray:
+    """Of the samples in doubt ``rows`` (increasing), those coal computes in a check's next round.
+
+    Every :data:`COARSE_STRIDE`-th where ``coarse_from`` or more are in doubt, else all; the
+    check then bounds the others by :func:`with_neighbours` and asks :func:`undecided` again.
+    A round of every pair's distances (a group's clearance) is dear: each takes a share where
+    :data:`COARSE_BELOW` or more are in doubt. One pair's round is cheap but its doubt sits in
+    short runs: its first round takes a share of even a few (``coarse_from=1``), the later
+    rounds all that are left (``docs/tuning.md``, Certified checks).
+    """
+    return rows[:: COARSE_STRIDE if rows.size >= coarse_from else 1]
 
 
 def propagated_bounds(values: FloatArray, known: NDArray[np.bool_], reach_m: FloatArray) -> FloatArray:
