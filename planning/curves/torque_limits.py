@@ -167,8 +167,10 @@ def torque_time_scale(trajectory: Trajectory, model: TorqueModel, at_least: floa
     fine = _around(near, COARSE_STEP_S, FINE_STEP_S, start, end)
     fine_needed = _needed_scales(trajectory, model, limited, fine)
     peaks = fine[local_peaks(fine_needed, UNBOUND_SHARE * top)]
+    if not peaks.size:  # no fine peak at or above the floor: nothing to look at closer
+        return float(max(needed.max(), fine_needed.max()))
     finest = _needed_scales(trajectory, model, limited, _around(peaks, FINE_STEP_S, PEAK_STEP_S, start, end))
-    return float(max(needed.max(), fine_needed.max(), finest.max(initial=0.0)))
+    return float(max(needed.max(), fine_needed.max(), finest.max()))
 
 
 def local_peaks(values: FloatArray, floor: float) -> NDArray[np.bool_]:

@@ -184,7 +184,7 @@ def build_problem(
 
     Args:
         scene: the problem and its settings.
-        robot: a loaded robot (default: ``scene.robot`` loaded, or the bundled CPR).
+        robot: a loaded robot (default: ``scene.robot`` loaded; a scene that names none needs one).
         threads: threads of the parallel collision checks (default: one on 2 cores, two on
             more); a batch that plans scenes in parallel processes gives each 1.
         goal_test: from the start's configuration, a test of a ``tcp`` or ``pose`` goal's IK
