@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import itertools
 
 import numpy as np
 import pinocchio as pin
@@ -12,7 +13,13 @@ import cpr_kin as ck
 from cpr_kin.bounds.segments import segment_distance
 from cpr_kin.bounds.self_bounds import SelfPairBounds
 from cpr_kin.collision.self_collision import SelfCollision
-from cpr_kin.collision.self_screen import ScreenedSelfTest, SelfScreen, robot_self_screen
+from cpr_kin.collision.self_screen import (
+    SCREEN_THRESHOLDS_M,
+    ScreenedSelfTest,
+    SelfScreen,
+    robot_self_screen,
+    screen_threshold,
+)
 from cpr_kin.model.packages import example_robot_data_share
 
 SHARE = example_robot_data_share()
@@ -122,13 +129,35 @@ def test_the_screened_distances_are_coals_over_every_pair(arm: ck.Robot) -> None
 
 def test_a_robots_screen_is_built_once_for_each_set_of_pairs(arm: ck.Robot) -> None:
     first, again = (ck.CollisionWorld(arm, []).self_collision for _ in range(2))
-    assert robot_self_screen(arm, first._pairs) is robot_self_screen(arm, again._pairs)
+    assert robot_self_screen(arm, first._pairs, 0.01) is robot_self_screen(arm, again._pairs, 0.01)
     links = [g.link for g in arm.geometries]
     a, b = first._pairs[0]
     fewer = ck.CollisionWorld(arm, [], allowed_pairs=[(links[a], links[b])]).self_collision
-    screen = robot_self_screen(arm, fewer._pairs)
-    assert screen is not robot_self_screen(arm, first._pairs)
+    screen = robot_self_screen(arm, fewer._pairs, 0.01)
+    assert screen is not robot_self_screen(arm, first._pairs, 0.01)
     assert screen.all_bounds.n_pairs == len(fewer._pairs) < len(first._pairs)
     # the same split as one built afresh for those pairs
-    fresh = SelfScreen.build(arm.model, arm.collision_model, fewer._pairs)
+    fresh = SelfScreen.build(arm.model, arm.collision_model, fewer._pairs, screen_threshold(0.01))
     np.testing.assert_array_equal(screen.near, fresh.near)
+    # one screen per threshold: margins that round to the same one share it
+    assert robot_self_screen(arm, first._pairs, 0.006) is robot_self_screen(arm, first._pairs, 0.01)
+    assert robot_self_screen(arm, first._pairs, 0.0) is not robot_self_screen(arm, first._pairs, 0.01)
+
+
+def test_the_screens_threshold_is_twice_the_margin_rounded_up_its_ladder() -> None:
+    assert [screen_threshold(m) for m in (0.0, 0.001, 0.0011, 0.01, 0.03, 0.6)] == [
+        0.002,
+        0.002,
+        0.005,
+        0.02,
+        0.1,
+        SCREEN_THRESHOLDS_M[-1],
+    ]
+    assert all(screen_threshold(t / 2) == t for t in SCREEN_THRESHOLDS_M)
+
+
+def test_a_smaller_threshold_leaves_no_more_pairs_near(arm: ck.Robot) -> None:
+    pairs = ck.CollisionWorld(arm, []).self_collision._pairs
+    near = [SelfScreen.build(arm.model, arm.collision_model, pairs, t).near for t in SCREEN_THRESHOLDS_M]
+    for smaller, larger in itertools.pairwise(near):  # a bound within t is within any larger t
+        assert not np.any(smaller & ~larger)

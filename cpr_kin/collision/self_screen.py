@@ -2,10 +2,10 @@
 
 The self-collision test (:meth:`cpr_kin.collision.self_collision.SelfCollision.violated`) asks coal
 only about the pairs whose cheap bounds (:class:`~cpr_kin.bounds.self_bounds.SelfPairBounds`) leave
-them in doubt. Which pairs are always close is a property of the robot: :class:`SelfScreen`
-finds them, and :func:`robot_self_screen` builds it once per robot and set of pairs (a
-collision world is built per plan, and the split costs milliseconds on a robot of a few
-hundred pairs: ``docs/benchmarks.md``).
+them in doubt. Which pairs are mostly within a margin is a property of the robot: :class:`SelfScreen`
+finds them, and :func:`robot_self_screen` builds it once per robot, set of pairs and
+margin's rung (:func:`screen_threshold`; a collision world is built per plan, and the split
+costs milliseconds on a robot of a few hundred pairs: ``docs/benchmarks.md``).
 """
 
 from __future__ import annotations
@@ -37,10 +37,25 @@ Pairs = tuple[tuple[int, int], ...]
 
 PROBES = 256
 """Random configurations on which :class:`SelfScreen` finds the pairs that are always near."""
-NEAR_SHARE = 0.5
+NEAR_SHARE = 0.3
 """Share of those in which a pair's bound is uncertain that makes it a near pair."""
-PROBE_THRESHOLD_M = 0.05
-"""The distance [m] the probes ask the bounds about (a typical margin and more)."""
+SCREEN_THRESHOLDS_M = (0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0)
+"""The distances [m] the probes may ask the bounds about (:func:`screen_threshold`): a few per
+robot, each screen built once."""
+TYPICAL_MARGIN_M = 0.01
+"""The self margin [m] a :class:`ScreenedSelfTest` given no screen splits its pairs for (the
+planner's default self margin)."""
+
+
+def screen_threshold(margin_m: float) -> float:
+    """The distance [m] a screen's probes ask about for a test of the self margin ``margin_m`` [m].
+
+    Twice the margin (a check asks it plus its step), rounded up to :data:`SCREEN_THRESHOLDS_M`
+    (the largest beyond them): a pair uncertain at a far larger distance than the test's is
+    mostly certain at the test's, and belongs with the far pairs.
+    """
+    wanted = 2.0 * margin_m
+    return next((t for t in SCREEN_THRESHOLDS_M if t >= wanted), SCREEN_THRESHOLDS_M[-1])
 
 
 @dataclass(frozen=True)
@@ -50,8 +65,8 @@ class SelfScreen:
     Some pairs of a serial arm are always close (a link and the one two joints down its
     chain, a few centimetres apart by design): bounding them first would only delay coal.
     The pairs are split on :data:`PROBES` seeded random configurations within the joint
-    ranges: those whose bound is uncertain in more than :data:`NEAR_SHARE` of them are
-    *near*, the others *far*.
+    ranges: those whose bound is within the screen's distance in more than
+    :data:`NEAR_SHARE` of them are *near*, the others *far* (``docs/tuning.md``, Kernels).
 
     Attributes:
         all_bounds: the bounds of every pair, in order.
@@ -64,29 +79,38 @@ class SelfScreen:
     near: BoolArray
 
     @classmethod
-    def build(cls, model: Any, geometry_model: Any, pairs: Sequence[tuple[int, int]]) -> SelfScreen:
-        """The split of ``pairs`` (geometry indices of ``geometry_model``) on ``model``'s ranges."""
+    def build(
+        cls, model: Any, geometry_model: Any, pairs: Sequence[tuple[int, int]], threshold_m: float
+    ) -> SelfScreen:
+        """The split of ``pairs`` (geometry indices of ``geometry_model``) on ``model``'s ranges.
+
+        ``threshold_m``: the distance [m] the probes ask the bounds about (:func:`screen_threshold`).
+        """
         probes = sampled_configurations(model, PROBES, np.random.default_rng(0))
         all_bounds = SelfPairBounds(model, geometry_model, pairs)
-        uncertain = all_bounds(probes, PROBE_THRESHOLD_M) <= PROBE_THRESHOLD_M
+        uncertain = all_bounds(probes, threshold_m) <= threshold_m
         near = uncertain.mean(axis=0) > NEAR_SHARE
         near.setflags(write=False)
         far = SelfPairBounds(model, geometry_model, [p for p, n in zip(pairs, near, strict=True) if not n])
         return cls(all_bounds, far, near)
 
 
-_SCREENS: weakref.WeakKeyDictionary[Robot, dict[Pairs, SelfScreen]] = weakref.WeakKeyDictionary()
+_SCREENS: weakref.WeakKeyDictionary[Robot, dict[tuple[Pairs, float], SelfScreen]] = (
+    weakref.WeakKeyDictionary()
+)
 
 
-def robot_self_screen(robot: Robot, pairs: Pairs) -> SelfScreen:
-    """:meth:`SelfScreen.build` of ``robot``'s ``pairs``, built once per robot and pairs.
+def robot_self_screen(robot: Robot, pairs: Pairs, margin_m: float) -> SelfScreen:
+    """:meth:`SelfScreen.build` of ``robot``'s ``pairs`` for the self margin ``margin_m`` [m], built once.
 
-    A :class:`~cpr_kin.Robot` does not change; its screens go with it.
+    One per robot, pairs and :func:`screen_threshold`. A :class:`~cpr_kin.Robot` does not
+    change; its screens go with it.
     """
     screens = _SCREENS.setdefault(robot, {})
-    if pairs not in screens:
-        screens[pairs] = SelfScreen.build(robot.model, robot.collision_model, pairs)
-    return screens[pairs]
+    key = (pairs, screen_threshold(margin_m))
+    if key not in screens:
+        screens[key] = SelfScreen.build(robot.model, robot.collision_model, pairs, key[1])
+    return screens[key]
 
 
 class ScreenedSelfTest:
@@ -109,8 +133,8 @@ class ScreenedSelfTest:
         pairs: the pairs' geometry indices.
         num_threads: threads of coal's batches.
         allowance_m: ``(P,)`` each pair's allowance [m] (default: none).
-        screen: the pairs' split and bounds (default: built for them; a robot's own is
-            built once, :func:`robot_self_screen`).
+        screen: the pairs' split and bounds (default: built for them at :data:`TYPICAL_MARGIN_M`;
+            a robot's own is built once per margin's threshold, :func:`robot_self_screen`).
         exact: the pairs on the robot's exact meshes (:mod:`cpr_kin.shapes.exact_pairs`): what the
             hulls flag, the meshes decide; default: none decides.
     """
@@ -130,7 +154,7 @@ class ScreenedSelfTest:
         self.allowance_m = (
             np.zeros(len(pairs)) if allowance_m is None else np.asarray(allowance_m, dtype=float)
         )
-        screen = screen or SelfScreen.build(model, geometry_model, pairs)
+        screen = screen or SelfScreen.build(model, geometry_model, pairs, screen_threshold(TYPICAL_MARGIN_M))
         near = screen.near
         self.all_bounds, self.far_bounds = screen.all_bounds, screen.far_bounds
         self.near_pairs = tuple(p for p, is_near in zip(pairs, near, strict=True) if is_near)

@@ -33,6 +33,6 @@ def world_self_collision(
         num_threads,
         geometry_radii=np.array([r.radii for r in robot_reach(robot)]),
         allowance_m=np.array([self_margin_m if pair in contact_only else 0.0 for pair in kept]),
-        screen=robot_self_screen(robot, kept) if kept else None,
+        screen=robot_self_screen(robot, kept, self_margin_m) if kept else None,
         exact_meshes=robot.exact_meshes,
     )
