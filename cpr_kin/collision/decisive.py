@@ -125,7 +125,7 @@ def first_rows(rows: IntArray, coarse_from: int = COARSE_BELOW) -> IntArray:
     A round of every pair's distances (a group's clearance) is dear: each takes a share where
     :data:`COARSE_BELOW` or more are in doubt. One pair's round is cheap but its doubt sits in
     short runs: its first round takes a share of even a few (``coarse_from=1``), the later
-    rounds all that are left (``docs/tuning.md``, Certified checks).
+    rounds all that are left (``docs/tuning.md``, Kernels).
     """
     return rows[:: COARSE_STRIDE if rows.size >= coarse_from else 1]
 
