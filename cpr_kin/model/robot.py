@@ -238,8 +238,8 @@ class Robot:
 
     @property
     def joint_units(self) -> tuple[str, ...]:
-        """``"rad"`` or ``"m"`` per planned joint, in configuration order."""
-        return tuple(self.joint_unit(name) for name in self.joint_names)
+        """``"rad"`` or ``"m"`` per planned joint, in configuration order (the model's joints)."""
+        return joint_units(self.model)
 
     def group_geometries(self, group: str) -> Sequence[RobotGeometry]:
         """Geometries of collision group ``group`` (one of :data:`GROUPS`)."""
