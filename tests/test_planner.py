@@ -508,3 +508,34 @@ def test_a_hopeless_best_is_not_verified_where_another_attempt_follows(
     result = planner.plan(scene, robot)
     assert searched_in[:2] == [0, 1] and verified_in and 0 not in verified_in
     assert result.verification.accepted
+
+
+def test_the_planner_asks_once_per_attempt_how_deep_its_best_is(
+    robot: ck.Robot, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``beyond_margin`` decides both whether another attempt follows and how the choice
+    verifies the best: the planner asks it once per attempt and hands the answer on, and the
+    choice says the same as when it asks itself."""
+    from planning.pipeline import choose, planner
+
+    wall = ck.Obstacle.box((0.05, 1.3, 2.0), (0.0, 0.95, 1.0), name="wall")
+    scene = Scene(
+        start=Target(tcp=PAPER_START_TCP),
+        goal=Target(tcp=PAPER_GOAL_TCP),
+        obstacles=(wall,),
+        duration=4.0,
+        planner=PlannerSettings(firefly=FireflySettings(fireflies=10, iterations=5), seeding="none"),
+    )
+    asked: list[str | None] = []
+    real = choose.beyond_margin
+
+    def counted(*args: Any) -> str | None:
+        asked.append(real(*args))
+        return asked[-1]
+
+    monkeypatch.setattr(planner, "beyond_margin", counted)
+    monkeypatch.setattr(choose, "beyond_margin", counted)
+    with pytest.raises(NoTrajectoryFoundError) as info:
+        planner.plan(scene, robot)
+    assert len(asked) == 1 and asked[0] is not None and "wall" in asked[0]  # one attempt, one answer
+    assert "wall" in str(info.value)

@@ -104,10 +104,11 @@ def _solved(
         search_s = time.perf_counter() - started
         # a best deeper inside a margin than a step fails its check, which only says why: where
         # another attempt follows, it is not run (on a Fetch among shelves, seconds)
-        hopeless = beyond_margin(attempt.problem, searched) is not None
+        deepest = beyond_margin(attempt.problem, searched)
+        hopeless = deepest is not None
         following = None if not hopeless or deadline.passed() else seeding.after(attempt, searched)
         if following is None:
-            chosen = choose(attempt.problem, searched)
+            chosen = choose(attempt.problem, searched, deepest)
             if isinstance(chosen, Choice):
                 elapsed = Elapsed(attempt.problem.build_time_s + time.perf_counter() - started, search_s)
                 return assemble(attempt.problem, searched, chosen, elapsed)
