@@ -71,6 +71,34 @@ def test_accepted_solutions_come_first() -> None:
     assert np.linalg.norm(ck.frame_poses(robot, q[None])[0][:3, 3] - tool[:3, 3]) <= target.tolerance_m
 
 
+def test_preferred_solutions_come_first_among_the_accepted() -> None:
+    """``prefer`` ranks the accepted solutions in the same search: with ``accept`` always true it
+    gives what ``accept`` alone gives; where no accepted solution passes it, the nearest accepted
+    one, asked of no solution ``accept`` refused."""
+    robot = ck.load_robot(example_robot("ur5"))
+    seed = np.array([0.0, -1.2, 1.2, -1.0, 1.0, 0.0])
+    target = ck.IkTarget(ck.frame_poses(robot, seed[None])[0][:3, 3])
+
+    def wrist_up(q: np.ndarray) -> bool:
+        return bool(q[3] > 0.5)
+
+    alone = ck.solve_ik(robot, target, seed, accept=wrist_up)
+    ranked = ck.solve_ik(robot, target, seed, accept=lambda q: True, prefer=wrist_up)
+    np.testing.assert_array_equal(ranked, alone)  # the same draws, the same choice
+    asked: list[np.ndarray] = []
+
+    def never(q: np.ndarray) -> bool:
+        asked.append(q)
+        return False
+
+    fallback = ck.solve_ik(robot, target, seed, accept=wrist_up, prefer=never)
+    assert wrist_up(fallback) and asked and all(wrist_up(q) for q in asked)
+    weights = ck.path_weights(robot)
+    assert any(np.array_equal(fallback, q) for q in asked)  # one of the accepted, the nearest of them
+    assert float(weights @ np.abs(fallback - seed)) == min(float(weights @ np.abs(q - seed)) for q in asked)
+    assert np.linalg.norm(ck.frame_poses(robot, fallback[None])[0][:3, 3] - target.position) <= 1e-4
+
+
 def test_held_joints_stay_at_the_seed(robot: ck.Robot) -> None:
     seed = np.array([0.3, 0.2, 0.2, 0.4, -0.3])
     goal = ck.frame_poses(robot, np.array([[-0.5, 0.3, 0.35, 0.4, -0.3]]))[0][:3, 3]

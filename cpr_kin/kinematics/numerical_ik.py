@@ -7,7 +7,8 @@ within a tolerance. From the seed configuration first, then from seeded random o
 frame), each step at most ``max_step`` [rad or m] per joint and clipped into the joint
 ranges. Every solution is checked by forward kinematics against the target and its
 tolerance; of those that pass, the ones the ``accept`` test allows (collision-free, say) come
-first, then the one nearest the seed (in robot motion, ``sum_j R_j |dq_j|``). A revolute joint
+first, and of those the ones the ``prefer`` test also passes (on a constraint, say) before
+the rest, then the one nearest the seed (in robot motion, ``sum_j R_j |dq_j|``). A revolute joint
 whose range spans more than a turn (a UR's ``[-2 pi, 2 pi]``) reaches the same pose a turn
 apart: each solution is first turned by whole turns towards the seed, within the range, or a
 restart's shoulder a turn away made the robot swing round for nothing. A target that
@@ -205,6 +206,7 @@ def solve_ik(
     accept: Callable[[FloatArray], bool] | None = None,
     settings: IkSettings | None = None,
     held: Sequence[str] = (),
+    prefer: Callable[[FloatArray], bool] | None = None,
 ) -> FloatArray:
     """A configuration that puts the robot's tool frame at ``target`` (module docstring).
 
@@ -212,9 +214,12 @@ def solve_ik(
         robot: the robot.
         target: the position or pose, with its tolerance.
         seed_q: the configuration to start from and stay near; default: mid-range.
-        accept: a test a preferred solution passes (e.g. clear of obstacles).
+        accept: a test an acceptable solution passes (e.g. clear of obstacles).
         settings: the search's parameters.
         held: joints kept at their ``seed_q`` values (the joints a ``tcp`` goal holds).
+        prefer: a test of the acceptable solutions: those that pass it come first, in the
+            same search (the nearest acceptable one where none does). Asked only of
+            acceptable solutions.
 
     Raises:
         IkMissError: the target lies beyond :func:`tool_reach_m`, or no start reaches it
@@ -237,6 +242,7 @@ def solve_ik(
     rng = np.random.default_rng(settings.seed)
     found: list[FloatArray] = []
     accepted: list[FloatArray] = []  # ``accept`` asked once per solution
+    preferred: list[FloatArray] = []  # ``prefer`` asked once per accepted solution
     closest: pin.SE3 | None = None
     frame = robot.frame_id(robot.tcp_frame)
     draws = [seed, *rng.uniform(lower, upper, (settings.restarts, robot.nq))]
@@ -253,15 +259,17 @@ def solve_ik(
             found.append(q)
             if accept is None or accept(q):
                 accepted.append(q)
-                if len(accepted) >= settings.choices:
-                    break
-        if tried == settings.restarts + 1 and not accepted:  # then more, drawn only now
+                if prefer is None or prefer(q):
+                    preferred.append(q)
+                    if len(preferred) >= settings.choices:
+                        break
+        if tried == settings.restarts + 1 and not preferred:  # then more, drawn only now
             draws += list(rng.uniform(lower, upper, (settings.more_restarts, robot.nq)))
     if not found:
         assert closest is not None  # the seed is always tried
         raise IkMissError(f"{missed}: the closest of {tried} IK starts came {target.miss(closest)}")
     weights = path_weights(robot)
-    return min(accepted or found, key=lambda q: float(weights @ np.abs(q - seed)))
+    return min(preferred or accepted or found, key=lambda q: float(weights @ np.abs(q - seed)))
 
 
 def turned_towards(

@@ -83,13 +83,8 @@ def endpoint(
             return False
         return dynamics is None or bool(held(dynamics, q[None])[0])
 
-    def best(q: FloatArray) -> bool:
-        return accepted(q) and (preferred is None or preferred(q))
-
-    try:
-        q = target.configuration(world.robot, seed_q, best)
-        if preferred is not None and not best(q):  # none passes it: the nearest clear one
-            q = target.configuration(world.robot, seed_q, accepted)
+    try:  # of the clear solutions, those ``preferred`` passes first (none does: the nearest clear one)
+        q = target.configuration(world.robot, seed_q, accepted, preferred)
     except ck.IkMissError as exc:
         raise TargetOutOfReachError(f"{label} is out of reach: {exc}") from None
     except ck.CprKinError as exc:

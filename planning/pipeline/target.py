@@ -90,8 +90,13 @@ class Target:
         robot: ck.Robot,
         seed_q: FloatArray | None = None,
         accept: Callable[[FloatArray], bool] | None = None,
+        prefer: Callable[[FloatArray], bool] | None = None,
     ) -> FloatArray:
         """The joint vector [rad, m], verified; IK solutions near ``seed_q``, ``accept``-ed ones first.
+
+        Of the accepted solutions, those ``prefer`` passes come first
+        (:func:`cpr_kin.solve_ik`). The robot's own analytic IK, where it has one, gives its
+        one solution whatever the tests say.
 
         Raises:
             cpr_kin.JointLimitError: a joint vector outside the limits, of the wrong length or
@@ -116,12 +121,12 @@ class Target:
             if not own:
                 return q
         if not held:
-            return ck.solve_ik(robot, target, seed_q, accept)
+            return ck.solve_ik(robot, target, seed_q, accept, prefer=prefer)
         seed = np.array(seed_q if seed_q is not None else (robot.limits.lower + robot.limits.upper) / 2)
         for name, value in held.items():
             seed[robot.limits.index(name)] = value
         try:
-            return ck.solve_ik(robot, target, seed, accept, held=tuple(held))
+            return ck.solve_ik(robot, target, seed, accept, held=tuple(held), prefer=prefer)
         except ck.IkMissError as exc:
             raise ck.IkMissError(f"{exc}; the robot's analytic IK: {own}" if own else str(exc)) from None
 
