@@ -14,7 +14,7 @@ from planning.curves.trajectory import Trajectory
 from planning.io.bundled import paper_scene
 from planning.io.scene_file import parse_scene
 from planning.pipeline import choose as choose_module
-from planning.pipeline.choose import Choice, Refusal, choose, distinct, verify
+from planning.pipeline.choose import Choice, Refusal, beyond_margin, choose, distinct, verify
 from planning.pipeline.deadline import Deadline
 from planning.pipeline.offered import Offered
 from planning.pipeline.planner import solve
@@ -71,7 +71,8 @@ def test_a_refused_point_is_timed_and_verified_once(robot: ck.Robot) -> None:
     problem = build_problem(paper_scene(0), robot)
     result = blocked_then_found(problem)
     counting = CountingDuration(4.0)  # the paper case's duration
-    chosen = choose(replace(problem, duration=counting), result)
+    counted = replace(problem, duration=counting)
+    chosen = choose(counted, result, beyond_margin(counted, result))
     assert isinstance(chosen, Choice)
     np.testing.assert_array_equal(chosen.x, result.population[2])
     assert chosen.verification.accepted
@@ -84,10 +85,10 @@ def test_past_the_deadline_only_the_timing_in_hand_is_verified(robot: ck.Robot) 
     result = blocked_then_found(problem)
     counting = CountingDuration(4.0)
     late = replace(problem, duration=counting, deadline=Deadline(0.0, 1.0))
-    chosen = choose(late, result)
+    chosen = choose(late, result, beyond_margin(late, result))
     assert isinstance(chosen, Refusal) and chosen.verified == "1 candidate verified"
     assert len(counting.timed) == 1
-    in_time = choose(replace(late, deadline=Deadline()), result)
+    in_time = choose(replace(late, deadline=Deadline()), result, beyond_margin(late, result))
     assert isinstance(in_time, Choice)  # the oracle: a later candidate passes
 
 
@@ -124,7 +125,7 @@ def test_once_the_best_is_refused_the_next_candidates_run_at_full_speed_before_a
         return checked
 
     monkeypatch.setattr(choose_module, "verify", refusing)
-    chosen = choose(problem, result)
+    chosen = choose(problem, result, beyond_margin(problem, result))
     assert isinstance(chosen, Choice) and chosen.candidates_timed == 2  # the third not timed
     assert chosen.timing.trajectory.duration == fastest[1].trajectory.duration
 
@@ -136,7 +137,7 @@ def test_once_the_best_is_refused_the_next_candidates_run_at_full_speed_before_a
         if t is not None and verify(problem, t.trajectory, t.fit).accepted
     ]
     assert passing
-    chosen = choose(problem, result)
+    chosen = choose(problem, result, beyond_margin(problem, result))
     assert isinstance(chosen, Choice) and chosen.timing.method == "narrowed"
     assert chosen.timing.trajectory.duration == min(passing)
 
@@ -154,7 +155,8 @@ def test_a_refusal_for_the_robots_own_links_names_them_not_an_obstacle() -> None
     straight = problem.objective.straight_line()
     fitness = float(problem.objective(straight[None])[0])
     assert not problem.objective.feasible(fitness)
-    chosen = choose(problem, SearchResult.of_point(straight, fitness, 1))
+    alone = SearchResult.of_point(straight, fitness, 1)
+    chosen = choose(problem, alone, beyond_margin(problem, alone))
     assert isinstance(chosen, Refusal)
     assert chosen.cause.startswith("no candidate was feasible; the best comes within -")
     assert "(certified) of itself, forearm_link to wrist_" in chosen.cause and "ball" not in chosen.cause
@@ -169,7 +171,8 @@ def test_a_refusal_off_the_obstacles_keeps_the_fixed_durations_advice(robot: ck.
     detour = waypoints.ravel()
     fitness = float(problem.objective(detour[None])[0])
     assert problem.objective.breakdown(detour[None]).limit_excess[0] > 0
-    chosen = choose(problem, SearchResult.of_point(detour, fitness, 1))
+    alone = SearchResult.of_point(detour, fitness, 1)
+    chosen = choose(problem, alone, beyond_margin(problem, alone))
     assert isinstance(chosen, Refusal)
     assert chosen.cause.startswith("no candidate was feasible: limits exceeded by ")
     assert "in 1.2 s (lengthen duration or leave it out); the best " in chosen.cause

@@ -18,7 +18,7 @@ from planning.errors import NoTrajectoryFoundError, PlanningError
 from planning.io.bundled import paper_scene
 from planning.io.scene_file import parse_scene
 from planning.pipeline import planner
-from planning.pipeline.choose import Choice, Refusal, choose
+from planning.pipeline.choose import Choice, Refusal, beyond_margin, choose
 from planning.pipeline.deadline import MIN_OVERRUN_S, Deadline, overrun_s
 from planning.pipeline.hulls_first import HULLS_SHARE
 from planning.pipeline.path_following import follow_path
@@ -65,9 +65,10 @@ def test_a_check_under_way_is_cut_an_overrun_after_the_limit() -> None:
 def test_past_the_cut_the_check_under_way_stops_and_its_candidate_is_refused(robot: ck.Robot) -> None:
     problem = build_problem(paper_scene(), robot)
     searched = search(Attempt(problem), None, None)
-    late = choose(dataclasses.replace(problem, deadline=Deadline(0.0, 1.0)), searched)
+    hopeless = beyond_margin(problem, searched)
+    late = choose(dataclasses.replace(problem, deadline=Deadline(0.0, 1.0)), searched, hopeless)
     assert isinstance(late, Choice)  # the oracle: past the limit, before the cut, the best passes
-    cut = choose(dataclasses.replace(problem, deadline=Deadline(0.0, 1.0, 0.0)), searched)
+    cut = choose(dataclasses.replace(problem, deadline=Deadline(0.0, 1.0, 0.0)), searched, hopeless)
     assert isinstance(cut, Refusal) and cut.verified == "1 candidate verified"
     assert cut.cause == f"the best candidate {STOPPED}" and not cut.check.times.size
     message = str(cut.error())

@@ -12,7 +12,7 @@ from planning.bench.scene_generator import generate_scenes
 from planning.errors import NoSolutionError, PlanningError
 from planning.io.bundled import paper_scene
 from planning.io.trajectory_io import trajectory_document
-from planning.pipeline.choose import Choice, choose, verify
+from planning.pipeline.choose import Choice, beyond_margin, choose, verify
 from planning.pipeline.planner import plan, solve
 from planning.pipeline.result import PlanResult
 from planning.pipeline.timing import least_uniform_scale, narrowed_timings, uniform_scale
@@ -162,7 +162,8 @@ def test_a_path_whose_fastest_timing_cuts_into_the_margin_runs_narrowed(
         raised = build_problem(dataclasses.replace(result.scene, safety_margin=margin_m), robot)
         x = result.waypoints[1:-1][:, raised.moving].ravel()
         np.testing.assert_array_equal(raised.objective.nodes(x[None])[0], result.waypoints)
-        chosen = choose(raised, _alone(x, float(raised.objective(x[None])[0])))
+        alone = _alone(x, float(raised.objective(x[None])[0]))
+        chosen = choose(raised, alone, beyond_margin(raised, alone))
         assert isinstance(chosen, Choice) and chosen.timing.method == "narrowed"
         assert chosen.verification.accepted and chosen.verification.check.certified_min_m >= margin_m
         assert not verify(raised, offered.first.trajectory, offered.first.fit).accepted

@@ -222,30 +222,14 @@ def foreseen_clear(problem: Problem, candidates: FloatArray) -> BoolArray:
     return np.asarray(keeps.reshape(len(candidates), -1).all(axis=1))
 
 
-class _Unasked:
-    """The type of :data:`UNASKED`."""
-
-
-UNASKED = _Unasked()
-"""``choose``'s ``hopeless`` where its caller has not asked :func:`beyond_margin`: it asks."""
-
-
-def choose(
-    problem: Problem, searched: SearchResult, hopeless: str | _Unasked | None = UNASKED
-) -> Choice | Refusal:
-    """The first candidate whose timed trajectory passes the verification (module docstring).
-
-    ``hopeless``: :func:`beyond_margin` of ``problem`` and ``searched``, where the caller has
-    it (the planner asks it to decide whether another attempt follows); by default asked here.
-    """
+def choose(problem: Problem, searched: SearchResult, hopeless: str | None) -> Choice | Refusal:
+    """The first candidate whose timing passes (module docstring); ``hopeless``: :func:`beyond_margin`'s."""
     objective = problem.objective
     order = np.argsort(searched.population_fitness, kind="stable")
     feasible = objective.feasible(searched.population_fitness)
     candidates = distinct([searched.x] + [searched.population[k] for k in order if feasible[k]])
     timed: dict[int, Offered] = {}
     verified: dict[int, Verification] = {}  # each candidate's first verification
-    if isinstance(hopeless, _Unasked):
-        hopeless = beyond_margin(problem, searched)
     if hopeless is not None and problem.deadline.passed():  # its check would only say why it fails
         why = infeasibility(objective.breakdown(searched.x[None]), problem)
         cause = f"no candidate was feasible; the best: {hopeless}, {why}"
