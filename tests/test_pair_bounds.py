@@ -9,7 +9,7 @@ import pytest
 import trimesh
 
 import cpr_kin as ck
-from cpr_kin.bounds.bound_kernels import CAPSULE
+from cpr_kin.bounds.bound_kernels import CAPSULE, _segment_box
 from cpr_kin.bounds.pair_bounds import PairBounds, _obstacle_bound, bounding_capsule
 
 from .conftest import random_configurations
@@ -137,6 +137,44 @@ def test_a_round_mesh_obstacle_is_bounded_by_its_fitted_capsule(
     positive = bounds > 0.0
     assert positive.mean() > 0.5
     assert np.all(bounds[positive] <= exact[positive] + 2e-6)
+
+
+def test_the_box_bound_is_the_segment_s_exact_distance() -> None:
+    """Oracle: coal's distance from a capsule of radius 1 cm to a box, plus that radius, on
+    random segments about boxes (flat boards, bars, cubes), beside, over and through them."""
+    rng = np.random.default_rng(7)
+    request, checked = coal.DistanceRequest(), 0
+    for _ in range(600):
+        half = rng.uniform(0.002, 0.4, 3)
+        a, b = rng.uniform(-0.6, 0.6, (2, 3))
+        if rng.random() < 0.3:  # parallel to a face (one zero step) or to an axis (two)
+            still = rng.choice(3, size=rng.integers(1, 3), replace=False)
+            b[still] = a[still]
+        bound = _segment_box(*a, *(b - a), *half)
+        along = b - a
+        length = float(np.linalg.norm(along))
+        if length < 1e-6:
+            continue
+        rotation = pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), along / length).matrix()
+        segment = coal.Transform3s(rotation, (a + b) / 2)
+        result = coal.DistanceResult()
+        box = (coal.Box(*(2 * half)), coal.Transform3s())
+        coal.distance(coal.Capsule(0.01, length), segment, *box, request, result)
+        exact = result.min_distance + 0.01  # while the segment stays outside the box
+        if exact < 1e-5:  # it touches or enters the box: coal's depth is not the segment's
+            assert bound <= 1e-5 + 2e-6
+            continue
+        assert bound == pytest.approx(exact, abs=2e-6)
+        checked += 1
+    assert checked > 400
+    # and it is the minimum over the segment's points (an independent check, no coal)
+    for _ in range(200):
+        half = rng.uniform(0.01, 0.3, 3)
+        a, b = rng.uniform(-0.5, 0.5, (2, 3))
+        points = a + np.linspace(0.0, 1.0, 20001)[:, None] * (b - a)
+        sampled = np.linalg.norm(np.maximum(np.abs(points) - half, 0.0), axis=1).min()
+        bound = _segment_box(*a, *(b - a), *half)
+        assert sampled - 1e-4 <= bound <= sampled + 1e-12
 
 
 def test_sphere_bound_is_exact_beside_a_cylinder_side(robot: ck.Robot) -> None:
