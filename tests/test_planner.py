@@ -21,7 +21,7 @@ from planning.pipeline.problem import build_problem
 from planning.pipeline.result import PlanResult
 from planning.pipeline.scene import Scene
 from planning.pipeline.seeding import seed_search
-from planning.pipeline.settings import PlannerSettings
+from planning.pipeline.settings import PlannerSettings, Seeding
 from planning.pipeline.target import Target
 from planning.pipeline.tuning import SearchTuning
 from planning.search.firefly import FireflyProgress
@@ -123,16 +123,20 @@ def test_start_inside_the_margin(robot: ck.Robot) -> None:
         plan(scene, robot)
 
 
-def test_infeasible_scene_raises_with_the_best_clearance(robot: ck.Robot) -> None:
-    # a wall taller than the robot across the only way round
-    wall = ck.Obstacle.box((0.05, 1.3, 2.0), (0.0, 0.95, 1.0), name="wall")  # y from 0.3 to 1.6
-    scene = Scene(
+def wall_scene(seeding: Seeding = "paths") -> Scene:
+    """The paper's ends with a wall taller than the robot across the only way round (y from 0.3 to 1.6 m)."""
+    wall = ck.Obstacle.box((0.05, 1.3, 2.0), (0.0, 0.95, 1.0), name="wall")
+    return Scene(
         start=Target(tcp=PAPER_START_TCP),
         goal=Target(tcp=PAPER_GOAL_TCP),
         obstacles=(wall,),
         duration=4.0,
-        planner=PlannerSettings(firefly=FireflySettings(fireflies=10, iterations=5)),
+        planner=PlannerSettings(firefly=FireflySettings(fireflies=10, iterations=5), seeding=seeding),
     )
+
+
+def test_infeasible_scene_raises_with_the_best_clearance(robot: ck.Robot) -> None:
+    scene = wall_scene()
     with pytest.raises(NoTrajectoryFoundError, match=r"no collision-free trajectory found.*wall") as info:
         plan(scene, robot)
     assert info.value.certified_clearance_m < 0.1
@@ -148,14 +152,7 @@ def test_a_best_candidate_deep_inside_the_margin_is_verified_in_one_timing_only(
     from planning.pipeline.search import search
     from planning.pipeline.seeding import SEEDINGS
 
-    wall = ck.Obstacle.box((0.05, 1.3, 2.0), (0.0, 0.95, 1.0), name="wall")
-    scene = Scene(
-        start=Target(tcp=PAPER_START_TCP),
-        goal=Target(tcp=PAPER_GOAL_TCP),
-        obstacles=(wall,),
-        duration=4.0,
-        planner=PlannerSettings(firefly=FireflySettings(fireflies=10, iterations=5), seeding="none"),
-    )
+    scene = wall_scene(seeding="none")
     problem = build_problem(scene, robot)
     searched = search(SEEDINGS["none"].first(problem))
     assert choosing.beyond_margin(problem, searched)
@@ -519,14 +516,7 @@ def test_the_planner_asks_once_per_attempt_how_deep_its_best_is(
     refusal names the wall, as the answer does)."""
     from planning.pipeline import choose, planner
 
-    wall = ck.Obstacle.box((0.05, 1.3, 2.0), (0.0, 0.95, 1.0), name="wall")
-    scene = Scene(
-        start=Target(tcp=PAPER_START_TCP),
-        goal=Target(tcp=PAPER_GOAL_TCP),
-        obstacles=(wall,),
-        duration=4.0,
-        planner=PlannerSettings(firefly=FireflySettings(fireflies=10, iterations=5), seeding="none"),
-    )
+    scene = wall_scene(seeding="none")
     asked: list[str | None] = []
     real = choose.beyond_margin
 
