@@ -89,8 +89,7 @@ def _segment_box(
     (``t = (+-h_i - a_i) / d_i``). The minimum over ``[0, 1]`` lies at an end where the
     derivative does not change sign there, else between the two kinks (or ends) that bracket
     the sign change, where the derivative is linear and its zero is interpolated. Exact up to
-    rounding (1e-16 m at the scale of a robot), where a bound from the segment's bounding box
-    or the centre's distance less the half diagonal is off by centimetres beside a board.
+    rounding (1e-16 m at the scale of a robot); why a box is worth it: ``docs/tuning.md``, Kernels.
     """
     low, high = 0.0, 1.0
     slope_low = _box_slope(low, ax, ay, az, dx, dy, dz, hx, hy, hz)
@@ -162,8 +161,8 @@ def _segment_obstacle_bound(
     if kind[o] == SPHERE:
         bound = _point_segment(ax, ay, az, dx, dy, dz) - radius
     elif kind[o] == BOX:
-        half = obstacle_half
-        bound = _segment_box(ax, ay, az, dx, dy, dz, half[o, 0], half[o, 1], half[o, 2])
+        hx, hy, hz = obstacle_half[o, 0], obstacle_half[o, 1], obstacle_half[o, 2]
+        bound = _segment_box(ax, ay, az, dx, dy, dz, hx, hy, hz)
     else:
         axis_distance = _point_segment(ax, ay, 0.0, dx, dy, 0.0)
         gap = _gap(min(az, bz), max(az, bz), obstacle_half[o, 2])
