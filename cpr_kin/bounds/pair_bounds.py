@@ -207,8 +207,8 @@ class PairBounds:
 def _obstacle_bound(obstacle: Obstacle) -> tuple[int, FloatArray, FloatArray, float, FloatArray, float]:
     """Kind, rotation, centre [m], radius [m], half sides (z: half length) [m] and reach [m] of a bound.
 
-    A box's radius is its half diagonal (the radius of its bounding sphere); the reach is
-    the radius of the obstacle's bounding sphere about the centre. A mesh is bounded by its
+    A box has no radius (its bound reads its half sides); the reach is the radius of the
+    obstacle's bounding sphere about the centre (a box's: its half diagonal). A mesh is bounded by its
     bounding box or by the capsule fitted to its vertices
     (:func:`cpr_kin.bounds.capsule_fit.fitted_capsule`), whichever is smaller.
     """
@@ -232,7 +232,7 @@ def _obstacle_bound(obstacle: Obstacle) -> tuple[int, FloatArray, FloatArray, fl
         fitted = fitted_capsule(vertices)
         if fitted.volume < 8.0 * float(np.prod(half)):
             return _capsule_bound(fitted, rotation, origin)
-    return BOX, rotation, origin + rotation @ centre, diagonal, half, diagonal
+    return BOX, rotation, origin + rotation @ centre, 0.0, half, diagonal
 
 
 def _capsule_bound(
