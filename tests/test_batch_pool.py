@@ -40,6 +40,17 @@ def wait_for(condition: object, what: str, seconds: float = 120.0) -> None:
         time.sleep(0.05)
 
 
+def written_address(address_file: Path) -> str | None:
+    """The scheduler's address from its file, ``None`` until the file is written whole.
+
+    Dask creates the file before it writes it: a reader in between finds it empty.
+    """
+    try:
+        return str(json.loads(address_file.read_text())["address"])
+    except (FileNotFoundError, json.JSONDecodeError, KeyError):
+        return None
+
+
 @pytest.fixture(scope="module")
 def cluster(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
     """A scheduler and one worker (two processes), the worker in a folder of its own."""
@@ -61,8 +72,9 @@ def cluster(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
         cwd=home,
         **quiet,  # type: ignore[call-overload]
     )
-    wait_for(address_file.exists, "the scheduler's address file")
-    address: str = json.loads(address_file.read_text())["address"]
+    wait_for(lambda: written_address(address_file) is not None, "the scheduler's address file")
+    address = written_address(address_file)
+    assert address is not None
     worker = subprocess.Popen(
         [*WORKER, address, "--nworkers", "2", "--nthreads", "1", "--no-dashboard"],
         cwd=worker_home,
