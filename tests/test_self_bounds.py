@@ -13,13 +13,8 @@ import cpr_kin as ck
 from cpr_kin.bounds.segments import segment_distance
 from cpr_kin.bounds.self_bounds import SelfPairBounds
 from cpr_kin.collision.self_collision import SelfCollision
-from cpr_kin.collision.self_screen import (
-    SCREEN_THRESHOLDS_M,
-    ScreenedSelfTest,
-    SelfScreen,
-    robot_self_screen,
-    screen_threshold,
-)
+from cpr_kin.collision.self_screen import ScreenedSelfTest
+from cpr_kin.collision.self_split import SCREEN_THRESHOLDS_M, SelfScreen, robot_self_screen, screen_threshold
 from cpr_kin.model.packages import example_robot_data_share
 
 SHARE = example_robot_data_share()

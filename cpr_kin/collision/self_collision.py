@@ -27,7 +27,8 @@ from lxml import etree
 from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.bounds.reach import geometry_reach, relative_radii
-from cpr_kin.collision.self_screen import ScreenedSelfTest, SelfScreen
+from cpr_kin.collision.self_screen import ScreenedSelfTest
+from cpr_kin.collision.self_split import SelfScreen
 from cpr_kin.common.errors import CprKinError, UrdfError
 from cpr_kin.common.names import cut
 from cpr_kin.common.user_files import read_bytes
@@ -174,7 +175,7 @@ class SelfCollision:
             by default from the model's position limits.
         allowance_m: ``(P,)`` added to each pair's coal distance [m] wherever a distance,
             bound or margin is asked (:attr:`allowance_m`); default none.
-        screen: the pairs' near/far split and bounds (:class:`~cpr_kin.collision.self_screen.SelfScreen`);
+        screen: the pairs' near/far split and bounds (:class:`~cpr_kin.collision.self_split.SelfScreen`);
             by default built on the first query.
         exact_meshes: the robot's exact link meshes by geometry index
             (:attr:`cpr_kin.Robot.exact_meshes`): where a hull comes within a margin, the mesh

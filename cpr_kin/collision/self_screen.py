@@ -1,123 +1,39 @@
-"""A robot's own pairs split into near and far, and coal's test of them screened by their bounds.
+"""coal's test of a robot's own pairs, screened by their bounds and the near pairs' cells.
 
-The self-collision test (:meth:`cpr_kin.collision.self_collision.SelfCollision.violated`) asks coal
-only about the pairs whose cheap bounds (:class:`~cpr_kin.bounds.self_bounds.SelfPairBounds`) leave
-them in doubt. Which pairs are mostly within a margin is a property of the robot: :class:`SelfScreen`
-finds them, and :func:`robot_self_screen` builds it once per robot, set of pairs and
-margin's rung (:func:`screen_threshold`; a collision world is built per plan, and the split
-costs milliseconds on a robot of a few hundred pairs: ``docs/benchmarks.md``).
+The pairs come split into near and far (:class:`~cpr_kin.collision.self_split.SelfScreen`): the
+far go to coal only where their bounds are in doubt, the near only where their cells
+(:class:`~cpr_kin.collision.near_cells.NearCells`) are. The answer is coal's on every pair.
 """
 
 from __future__ import annotations
 
 import copy
-import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
-from cpr_kin.bounds.batch_kinematics import sampled_configurations
-from cpr_kin.bounds.self_bounds import SelfPairBounds
 from cpr_kin.collision.closest_pairs import closest_pairs
 from cpr_kin.collision.decisive import coal_error_m
 from cpr_kin.collision.obstacle_pools import configure_pool, pool_collisions
+from cpr_kin.collision.self_split import TYPICAL_MARGIN_M, SelfScreen, screen_threshold
 from cpr_kin.shapes.exact_pairs import ExactPairs
-
-if TYPE_CHECKING:
-    from cpr_kin.model.robot import Robot
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
-Pairs = tuple[tuple[int, int], ...]
-
-PROBES = 256
-"""Random configurations on which :class:`SelfScreen` finds the pairs that are always near."""
-NEAR_SHARE = 0.3
-"""Share of those in which a pair's bound is uncertain that makes it a near pair."""
-SCREEN_THRESHOLDS_M = (0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0)
-"""The distances [m] the probes may ask the bounds about (:func:`screen_threshold`): a few per
-robot, each screen built once."""
-TYPICAL_MARGIN_M = 0.01
-"""The self margin [m] a :class:`ScreenedSelfTest` given no screen splits its pairs for (the
-planner's default self margin)."""
-
-
-def screen_threshold(margin_m: float) -> float:
-    """The distance [m] a screen's probes ask about for a test of the self margin ``margin_m`` [m].
-
-    Twice the margin (a check asks it plus its step), rounded up to :data:`SCREEN_THRESHOLDS_M`
-    (the largest beyond them): a pair uncertain at a far larger distance than the test's is
-    mostly certain at the test's, and belongs with the far pairs.
-    """
-    wanted = 2.0 * margin_m
-    return next((t for t in SCREEN_THRESHOLDS_M if t >= wanted), SCREEN_THRESHOLDS_M[-1])
-
-
-@dataclass(frozen=True)
-class SelfScreen:
-    """A robot's own pairs split into near and far, with their bounds.
-
-    Some pairs of a serial arm are always close (a link and the one two joints down its
-    chain, a few centimetres apart by design): bounding them first would only delay coal.
-    The pairs are split on :data:`PROBES` seeded random configurations within the joint
-    ranges: those whose bound is within the screen's distance in more than
-    :data:`NEAR_SHARE` of them are *near*, the others *far* (``docs/tuning.md``, Kernels).
-
-    Attributes:
-        all_bounds: the bounds of every pair, in order.
-        far_bounds: the bounds of the far pairs, in order.
-        near: ``(P,)`` which pairs are near.
-    """
-
-    all_bounds: SelfPairBounds
-    far_bounds: SelfPairBounds
-    near: BoolArray
-
-    @classmethod
-    def build(
-        cls, model: Any, geometry_model: Any, pairs: Sequence[tuple[int, int]], threshold_m: float
-    ) -> SelfScreen:
-        """The split of ``pairs`` (geometry indices of ``geometry_model``) on ``model``'s ranges.
-
-        ``threshold_m``: the distance [m] the probes ask the bounds about (:func:`screen_threshold`).
-        """
-        probes = sampled_configurations(model, PROBES, np.random.default_rng(0))
-        all_bounds = SelfPairBounds(model, geometry_model, pairs)
-        uncertain = all_bounds(probes, threshold_m) <= threshold_m
-        near = uncertain.mean(axis=0) > NEAR_SHARE
-        near.setflags(write=False)
-        far = SelfPairBounds(model, geometry_model, [p for p, n in zip(pairs, near, strict=True) if not n])
-        return cls(all_bounds, far, near)
-
-
-_SCREENS: weakref.WeakKeyDictionary[Robot, dict[tuple[Pairs, float], SelfScreen]] = (
-    weakref.WeakKeyDictionary()
-)
-
-
-def robot_self_screen(robot: Robot, pairs: Pairs, margin_m: float) -> SelfScreen:
-    """:meth:`SelfScreen.build` of ``robot``'s ``pairs`` for the self margin ``margin_m`` [m], built once.
-
-    One per robot, pairs and :func:`screen_threshold`. A :class:`~cpr_kin.Robot` does not
-    change; its screens go with it.
-    """
-    screens = _SCREENS.setdefault(robot, {})
-    key = (pairs, screen_threshold(margin_m))
-    if key not in screens:
-        screens[key] = SelfScreen.build(robot.model, robot.collision_model, pairs, key[1])
-    return screens[key]
 
 
 class ScreenedSelfTest:
     """coal's yes/no self-collision test, screened by the pairs' bounds.
 
-    The pairs are split once into near and far (:class:`SelfScreen`): the *near* go to coal
-    at every configuration, the others (*far*) only at configurations
+    The pairs are split once into near and far (:class:`~cpr_kin.collision.self_split.SelfScreen`):
+    the *near* go to coal at every configuration their cells do not clear
+    (:class:`~cpr_kin.collision.near_cells.NearCells`; at every configuration where some near
+    pair has no grid), the others (*far*) only at configurations
     where some far pair's bound is within the margin, and there only the far pairs whose
     bounds are within it in some configuration of the batch (a few of a thousand pairs on an
     arm whose hand has a dozen links). Each group has its own Pinocchio ``GeometryPool``, run
@@ -133,8 +49,9 @@ class ScreenedSelfTest:
         pairs: the pairs' geometry indices.
         num_threads: threads of coal's batches.
         allowance_m: ``(P,)`` each pair's allowance [m] (default: none).
-        screen: the pairs' split and bounds (default: built for them at :data:`TYPICAL_MARGIN_M`;
-            a robot's own is built once per margin's threshold, :func:`robot_self_screen`).
+        screen: the pairs' split, bounds and cells (default: built for them at
+            :data:`~cpr_kin.collision.self_split.TYPICAL_MARGIN_M`; a robot's own is built once
+            per margin's threshold, :func:`~cpr_kin.collision.self_split.robot_self_screen`).
         exact: the pairs on the robot's exact meshes (:mod:`cpr_kin.shapes.exact_pairs`): what the
             hulls flag, the meshes decide; default: none decides.
     """
@@ -159,6 +76,7 @@ class ScreenedSelfTest:
         self.all_bounds, self.far_bounds = screen.all_bounds, screen.far_bounds
         self.near_pairs = tuple(p for p, is_near in zip(pairs, near, strict=True) if is_near)
         self._near = near
+        self._near_cells = screen.near_cells
         self._far_index = np.flatnonzero(~near)
         self._coal_state = _CoalState(np.zeros(len(pairs), dtype=bool), np.zeros(len(pairs)))
 
@@ -172,8 +90,12 @@ class ScreenedSelfTest:
         """``(N,)`` whether any pair is closer than ``margin_m`` [m] at configurations ``batch``."""
         self._prepare(margin_m)
         hits = np.zeros(len(batch), dtype=bool)
-        if self.near_pairs:
+        if self.near_pairs and not self._near_cells:
             hits[:] = self._coal(0, batch)
+        elif self.near_pairs:  # coal where their cells are in doubt
+            doubtful = np.flatnonzero(~self._near_cells.clear(batch, self._coal_state.near_margins))
+            if doubtful.size:
+                hits[doubtful] = self._coal(0, batch[doubtful])
         if self.far_bounds.n_pairs:
             open_rows = np.flatnonzero(~hits)
             threshold = float(margin_m + coal_error_m(margin_m))
@@ -257,6 +179,7 @@ class ScreenedSelfTest:
             state.pools = list(pools)
         if margin_m != state.margin_m and not np.isnan(margin_m):
             state.pair_margins = np.maximum(margin_m - self.allowance_m, 0.0)
+            state.near_margins = state.pair_margins[self._near].tolist()
             margins = state.pair_margins if self.allowance_m.any() else margin_m
             for pool, active in zip(state.pools, (self._near, state.far_on), strict=True):
                 configure_pool(pool, self.geometry_model, margins, active)
@@ -274,6 +197,7 @@ class _CoalState:
     Attributes:
         far_on: ``(P,)`` the far pool's active pairs.
         pair_margins: ``(P,)`` each pair's coal margin [m]: the margin less its allowance.
+        near_margins: the near pairs' coal margins [m], in order (what their cells must clear).
         pools: the near pairs' ``GeometryPool`` and the far pairs' (built on the first query).
         data: the model's data of single queries; distance_data: the geometry data of distances.
         margin_m: the margin [m] the pools test (NaN: none yet).
@@ -281,6 +205,7 @@ class _CoalState:
 
     far_on: BoolArray
     pair_margins: FloatArray
+    near_margins: list[float] = field(default_factory=list)
     pools: list[Any] = field(default_factory=list)
     data: Any = None
     distance_data: Any = None

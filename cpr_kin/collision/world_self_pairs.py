@@ -8,7 +8,7 @@ import numpy as np
 
 from cpr_kin.collision.robot_reach import robot_reach
 from cpr_kin.collision.self_collision import SelfCollision
-from cpr_kin.collision.self_screen import robot_self_screen
+from cpr_kin.collision.self_split import robot_self_screen
 from cpr_kin.model.robot import Robot
 
 

@@ -1,0 +1,181 @@
+"""A near self pair's margin test remembered on a grid over the joints between its geometries.
+
+A robot's *near* pairs (:class:`~cpr_kin.collision.self_split.SelfScreen`) go to coal at every
+configuration: their capsules overlap, although their hulls are mostly a centimetre or more
+apart. Such a pair is a link and the one two joints down the chain, and its distance depends
+only on the joints between them: a grid over those (:mod:`cpr_kin.bounds.pair_cells`) holds
+it, anywhere in a cell, within the pair's slack of its distance at the cell's centre.
+
+The first configuration that falls in a cell has coal test the centre with a margin that much
+larger (and :data:`TESTED_ABOVE_M` more, so that the few margins of a plan share the answer):
+where the centre is clear, every configuration of the cell clears the margin, and the next
+ones need no coal. A cell remembers the largest margin it cleared and the smallest it did not.
+The grids are the robot's, kept across plans (:func:`~cpr_kin.collision.self_split.robot_self_screen`);
+what they gain: ``docs/tuning.md``, Kernels.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import NDArray
+
+from cpr_kin.bounds.batch_kinematics import sampled_configurations
+from cpr_kin.bounds.pair_cells import CLEAR, UNKNOWN, CellGrids, cell_grids, cell_states
+from cpr_kin.bounds.reach import geometry_reach, relative_radii
+from cpr_kin.collision.decisive import coal_error_m
+from cpr_kin.collision.obstacle_pools import configure_pool, pool_collisions
+
+FloatArray = NDArray[np.float64]
+Float32Array = NDArray[np.float32]
+IntArray = NDArray[np.int64]
+BoolArray = NDArray[np.bool_]
+
+SLACK_SHARE = 0.5
+"""A pair's slack as a share of its median distance over :data:`PROBES` random configurations."""
+MIN_SLACK_M, MAX_SLACK_M = 0.002, 0.02
+"""The least and the most slack of a pair [m]."""
+PROBES = 256
+"""Seeded random configurations on which a pair's median distance is measured."""
+TESTED_ABOVE_M = 0.002
+"""How much larger than asked a cell's first test is [m]: the margins of a plan differ by less."""
+LEVEL_M = 0.0005
+"""A margin is rounded up to a multiple of this [m] before its cells are looked up."""
+MAX_POOLS = 16
+"""coal's pools kept, one per pair and tested margin; more are dropped and built again."""
+
+
+class NearCells:
+    """The near pairs' grids (:class:`~cpr_kin.bounds.pair_cells.CellGrids`) and what their cells clear.
+
+    Args:
+        model: the robot's Pinocchio model (one-degree-of-freedom joints).
+        collision_model: its geometry model (copied, never modified).
+        pairs: the near pairs' geometry indices.
+        geometry_radii: ``(G, nj)`` each geometry's motion radius about each joint
+            (:attr:`cpr_kin.bounds.reach.GeometryReach.radii`); default: within ``model``'s limits.
+
+    Where some pair has no grid (:func:`~cpr_kin.bounds.pair_cells.cell_grids`), it clears
+    nothing. ``tested`` counts the cells coal has tested.
+    """
+
+    def __init__(
+        self,
+        model: Any,
+        collision_model: Any,
+        pairs: Sequence[tuple[int, int]],
+        geometry_radii: FloatArray | None = None,
+    ) -> None:
+        self.model = model
+        self.geometry_model = collision_model.copy()
+        self.geometry_model.removeAllCollisionPairs()  # collision pair k is near pair k
+        for a, b in pairs:
+            self.geometry_model.addCollisionPair(pin.CollisionPair(a, b))
+        self.grids: CellGrids | None = None
+        if pairs:
+            if geometry_radii is None:
+                limits = (model.lowerPositionLimit, model.upperPositionLimit)
+                geometry_radii = np.array([r.radii for r in geometry_reach(model, collision_model, *limits)])
+            radii = relative_radii(model, collision_model, pairs, geometry_radii)
+            self.grids = cell_grids(model, radii, self._slacks())
+        size = self.grids.size if self.grids is not None else 0
+        self._cleared = np.full(size, -np.inf, dtype=np.float32)
+        self._refused = np.full(size, np.inf, dtype=np.float32)
+        self._levels: dict[tuple[float, ...], Float32Array] = {}
+        self._pools: dict[tuple[int, float], Any] = {}
+        self._data = model.createData()
+        self.tested = 0
+
+    def __bool__(self) -> bool:
+        return self.grids is not None
+
+    def clear(self, batch: FloatArray, margins_m: Sequence[float]) -> BoolArray:
+        """``(N,)`` where every near pair is certainly farther than its margin ``margins_m`` [m].
+
+        ``margins_m``: one per near pair; coal's error is added. A cell not yet tested at that
+        margin (rounded up to :data:`LEVEL_M`) is tested now, at its centre.
+        """
+        grids = self.grids
+        if grids is None:
+            return np.zeros(len(batch), dtype=bool)
+        levels = self._level(tuple(margins_m))
+        cells, states = self._states(grids, batch, levels)
+        unknown = np.flatnonzero(states == UNKNOWN)
+        if unknown.size:
+            for k, level in enumerate(levels.tolist()):
+                row_cells = cells[unknown, k]
+                untested = (self._cleared[row_cells] < level) & (self._refused[row_cells] > level)
+                if untested.any():
+                    self._test(grids, k, level, row_cells[untested], batch[unknown[untested]])
+            cells, states = self._states(grids, batch, levels)
+        return np.asarray(states == CLEAR)
+
+    def _slacks(self) -> FloatArray:
+        """Each pair's slack [m]: :data:`SLACK_SHARE` of its median distance over :data:`PROBES`."""
+        probes = sampled_configurations(self.model, PROBES, np.random.default_rng(0))
+        data, geometry_data = self.model.createData(), self.geometry_model.createData()
+        distances = np.empty((len(probes), len(self.geometry_model.collisionPairs)))
+        for n, q in enumerate(probes):
+            pin.computeDistances(self.model, data, self.geometry_model, geometry_data, q)
+            distances[n] = [result.min_distance for result in geometry_data.distanceResults]
+        return np.clip(SLACK_SHARE * np.median(distances, axis=0), MIN_SLACK_M, MAX_SLACK_M)
+
+    def _level(self, margins_m: tuple[float, ...]) -> Float32Array:
+        """The margins, coal's error added, rounded up to :data:`LEVEL_M`: float32 no smaller than them."""
+        if margins_m not in self._levels:
+            wanted = [m + float(coal_error_m(m)) for m in margins_m]
+            rounded = [max(math.ceil(m / LEVEL_M) * LEVEL_M, m) for m in wanted]
+            self._levels[margins_m] = np.array([_float32_at_least(m) for m in rounded])
+        return self._levels[margins_m]
+
+    def _states(
+        self, grids: CellGrids, batch: FloatArray, levels: Float32Array
+    ) -> tuple[IntArray, NDArray[np.int8]]:
+        """:func:`cell_states` at ``levels`` ``(K,)`` [m]: cells ``(N, K)`` and states ``(N,)``."""
+        cells = np.empty((len(batch), len(levels)), dtype=np.int64)
+        states = np.empty(len(batch), dtype=np.int8)
+        arrays = grids.arrays()
+        cell_states(np.ascontiguousarray(batch), *arrays, self._cleared, self._refused, levels, cells, states)
+        return cells, states
+
+    def _test(self, grids: CellGrids, k: int, level_m: float, cells: IntArray, rows: FloatArray) -> None:
+        """Test pair ``k``'s ``cells`` (placed as ``rows``) at their centres, first above ``level_m`` [m]."""
+        distinct, first = np.unique(cells, return_index=True)
+        centres = grids.centres(k, distinct, rows[first])
+        above = level_m + TESTED_ABOVE_M
+        hit = self._hits(k, above + float(grids.slack_m[k]), centres)
+        self._cleared[distinct[~hit]] = _float32_at_most(above)
+        if hit.any():
+            self._refused[distinct[hit]] = np.minimum(self._refused[distinct[hit]], _float32_at_least(above))
+            distinct, hit = distinct[hit], self._hits(k, level_m + float(grids.slack_m[k]), centres[hit])
+            self._cleared[distinct[~hit]] = _float32_at_most(level_m)
+            self._refused[distinct[hit]] = _float32_at_least(level_m)
+
+    def _hits(self, k: int, margin_m: float, centres: FloatArray) -> BoolArray:
+        """``(M,)`` whether pair ``k`` may be within ``margin_m`` [m] (coal's error added) at ``centres``."""
+        margin_m += float(coal_error_m(margin_m))
+        key = (k, margin_m)
+        if key not in self._pools:  # a few per pair: a plan asks a few margins
+            if len(self._pools) >= MAX_POOLS:
+                self._pools.clear()
+            self._pools[key] = pin.GeometryPool(self.model, self.geometry_model, 1)
+            active = np.arange(len(self.geometry_model.collisionPairs)) == k
+            configure_pool(self._pools[key], self.geometry_model, margin_m, active)
+        self.tested += len(centres)
+        return pool_collisions(self._pools[key], self.model, self._data, self.geometry_model, centres, 1)
+
+
+def _float32_at_least(value: float) -> np.float32:
+    """The least float32 >= ``value``."""
+    rounded = np.float32(value)
+    return rounded if rounded >= value else np.nextafter(rounded, np.float32(np.inf))
+
+
+def _float32_at_most(value: float) -> np.float32:
+    """The largest float32 <= ``value``."""
+    rounded = np.float32(value)
+    return rounded if rounded <= value else np.nextafter(rounded, np.float32(-np.inf))
