@@ -24,8 +24,7 @@ def geometry(robot: ck.Robot, link: str) -> int:
 
 
 def near_cells(robot: ck.Robot, pairs: list[tuple[int, int]]) -> NearCells:
-    radii = np.array([r.radii for r in robot_reach(robot)])
-    return NearCells(robot.model, robot.collision_model, pairs, radii)
+    return NearCells(robot.model, robot.collision_model, pairs, robot_reach(robot))
 
 
 def hull_distances(cells: NearCells, q: np.ndarray) -> np.ndarray:

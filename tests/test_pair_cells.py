@@ -57,7 +57,7 @@ def test_a_pairs_distance_anywhere_in_a_cell_is_within_its_slack_of_the_centres(
     panda: ck.Robot, slack_m: float
 ) -> None:
     pairs = hand_pairs(panda)
-    radii = relative_radii(panda.model, panda.collision_model, pairs, [r.radii for r in robot_reach(panda)])
+    radii = relative_radii(panda.model, panda.collision_model, pairs, robot_reach(panda))
     grids = cell_grids(panda.model, radii, np.full(2, slack_m))
     assert grids is not None and grids.joints.tolist() == [[5, 6], [5, 6]]  # joints 6 and 7
     q = np.random.default_rng(0).uniform(panda.limits.lower, panda.limits.upper, (400, panda.nq))
@@ -79,14 +79,10 @@ def test_a_pairs_distance_anywhere_in_a_cell_is_within_its_slack_of_the_centres(
 
 def test_a_pair_with_more_joints_between_or_too_many_cells_has_no_grid(panda: ck.Robot) -> None:
     pairs = [(geometry(panda, "panda_link3"), geometry(panda, "panda_link7"))]  # four joints between
-    radii = relative_radii(panda.model, panda.collision_model, pairs, [r.radii for r in robot_reach(panda)])
+    radii = relative_radii(panda.model, panda.collision_model, pairs, robot_reach(panda))
     assert np.count_nonzero(radii) == 4 and cell_grids(panda.model, radii, np.array([0.01])) is None
-    fine = relative_radii(panda.model, panda.collision_model, hand_pairs(panda)[:1], robot_reach_radii(panda))
+    fine = relative_radii(panda.model, panda.collision_model, hand_pairs(panda)[:1], robot_reach(panda))
     assert cell_grids(panda.model, fine, np.array([1e-5])) is None  # millions of cells
-
-
-def robot_reach_radii(robot: ck.Robot) -> np.ndarray:
-    return np.array([r.radii for r in robot_reach(robot)])
 
 
 def test_a_joint_is_tiled_within_its_limits_and_a_revolute_one_of_a_turn_or_more_wraps(

@@ -7,13 +7,17 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
 import cpr_kin as ck
+from cpr_kin.bounds.reach import relative_radii
 from cpr_kin.certified.self_curve import check_self_curve
+from cpr_kin.collision.robot_reach import robot_reach
 from cpr_kin.collision.self_collision import SelfCollision, read_srdf, self_pairs
 from cpr_kin.model.packages import example_robot_data_share
 from planning import Scene, Target, plan
+from planning.bench.mbm import vamp_resources
 from planning.errors import PlanningError
 from planning.pipeline.problem import build_problem, with_planner
 from planning.pipeline.settings import PlannerSettings
@@ -136,6 +140,40 @@ def test_a_pairs_distance_changes_no_faster_than_its_relative_radii(panda: ck.Ro
     names = collision.pairs
     link5_finger = names.index(("panda_link5", "panda_leftfinger_0"))
     assert np.all(collision.pair_radii[link5_finger][:5] == 0.0)  # joints 1-5 carry both
+
+
+def test_a_joint_turning_one_geometry_counts_the_nearer_of_the_two_to_its_axis() -> None:
+    # vamp's UR5: its shoulder turns the upper arm (0.64 m from the axis at its far end) about
+    # the base, which lies within a few centimetres of that axis: turning the base the other
+    # way moves it no more. Oracle: coal's hull distance of every pair, one joint stepped at a time.
+    ur5 = ck.load_robot(vamp_resources("ur5") / "ur5.urdf", srdf=vamp_resources("ur5") / "ur5.srdf")
+    collision = ck.CollisionWorld(ur5, []).self_collision
+    reach = robot_reach(ur5)
+    unturned = [dataclasses.replace(r, below=np.full_like(r.below, np.inf)) for r in reach]
+    one_sided = relative_radii(ur5.model, ur5.collision_model, collision._pairs, unturned)
+    radii = collision.pair_radii
+    assert np.all(radii <= one_sided) and radii.sum() < 0.7 * one_sided.sum()
+    links = [(ur5.geometries[a].link, ur5.geometries[b].link) for a, b in collision._pairs]
+    base_arm = links.index(("base_link", "upper_arm_link"))
+    assert radii[base_arm, 0] < 0.25 * one_sided[base_arm, 0]
+    model, geometry_model = ur5.model, collision.geometry_model
+    data, geometry_data = model.createData(), geometry_model.createData()
+
+    def hull_distances(q: np.ndarray) -> np.ndarray:
+        pin.computeDistances(model, data, geometry_model, geometry_data, q)
+        return np.array([r.min_distance for r in geometry_data.distanceResults])
+
+    rng = np.random.default_rng(8)
+    tightest = 0.0
+    for q in rng.uniform(ur5.limits.lower, ur5.limits.upper, (40, ur5.nq)):
+        before = hull_distances(q)
+        for j in range(ur5.nq):
+            step = np.zeros(ur5.nq)
+            step[j] = rng.choice([-1.0, 1.0]) * rng.uniform(0.001, 0.05)
+            change = np.abs(hull_distances(q + step) - before)
+            assert np.all(change <= radii[:, j] * abs(step[j]) + 2e-6)  # coal: 1e-6
+            tightest = max(tightest, float(change[base_arm] / (radii[base_arm, j] * abs(step[j]) or 1.0)))
+    assert tightest > 0.2  # the base pair's bound is not loose by orders of magnitude
 
 
 def test_the_certificate_computes_few_samples_and_equals_computing_every_one(panda: ck.Robot) -> None:

@@ -8,8 +8,10 @@ to the ball. Along the way, the largest distance of the set from each revolute a
 how fast the geometry moves when that joint turns (:func:`cpr_kin.motion_radii`). At the
 root the set is a segment on the first joint's axis plus a ball: a capsule that contains the
 geometry in every configuration. A pair's distance changes only by the joints that carry one
-of its geometries and not the other (:func:`relative_radii`). These bounds of a robot, kept
-once per robot, and of its geometries against obstacles: :mod:`cpr_kin.collision.robot_reach`.
+of its geometries and not the other, and a joint down the other's chain turns each about its
+axis relative to the other: the nearer of the two to the axis bounds the change (carried down
+the chain the same way: :func:`relative_radii`). These bounds of a robot, kept once per robot,
+and of its geometries against obstacles: :mod:`cpr_kin.collision.robot_reach`.
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
 FloatArray = NDArray[np.float64]
 
@@ -57,10 +59,16 @@ class GeometryReach:
         hulls: grown hulls each containing the geometry in every configuration, carried up
             from its bounding box's centre and radius, and from its bounding box's corners
             (which is tighter depends on the shape and the joints: use both).
+        below: per joint down the chain from the geometry's link, the largest distance of the
+            geometry from that joint's axis over the joints between them (revolute) or 1
+            (prismatic); ``inf`` for the other joints [m or m/m]. A joint that turns another
+            geometry turns it relative to this one as much as this one relative to it: their
+            distance changes no faster than the smaller of the two radii (:func:`relative_radii`).
     """
 
     radii: FloatArray
     hulls: tuple[Hull, ...]
+    below: FloatArray
 
 
 def joint_axis(joint: Any) -> tuple[bool, FloatArray]:
@@ -98,7 +106,10 @@ def geometry_reach(
         ]
         carried = [_carry(model, axes, obj, points, ball, lower, upper) for points, ball in seeds]
         radii = np.min([speed for speed, _ in carried], axis=0)  # each bounds the speed
-        bounds.append(GeometryReach(radii=radii, hulls=tuple(hull for _, hull in carried)))
+        below = np.min(
+            [_carry_down(model, axes, obj, points, ball, lower, upper) for points, ball in seeds], axis=0
+        )
+        bounds.append(GeometryReach(radii=radii, hulls=tuple(hull for _, hull in carried), below=below))
     return bounds
 
 
@@ -136,8 +147,47 @@ def _carry(
     return radii, Hull(points=points, ball=ball)
 
 
+def _carry_down(
+    model: Any,
+    axes: list[tuple[bool, FloatArray]],
+    obj: Any,
+    points: FloatArray,
+    ball: float,
+    lower: FloatArray,
+    upper: FloatArray,
+) -> FloatArray:
+    """Per joint down the chain from ``obj``'s link, its largest distance from its axis (``below``).
+
+    The bound (``points`` in the geometry's frame, ``ball``) is carried down each joint's
+    child chain: into a joint's frame, where its motion turns the bound about its axis (folded
+    onto the axis, the ball grown by their distance) or slides it along its travel.
+    """
+    below = np.full(len(axes), np.inf)
+    placement = obj.placement
+    start = points @ np.asarray(placement.rotation).T + np.asarray(placement.translation), ball
+    children: dict[int, list[int]] = {}
+    for joint in range(1, model.njoints):
+        children.setdefault(model.parents[joint], []).append(joint)
+    stack = [(child, *start) for child in children.get(obj.parentJoint, [])]
+    while stack:
+        joint, points, ball = stack.pop()
+        placement = model.jointPlacements[joint]  # into the joint's frame, before its motion
+        points = (points - np.asarray(placement.translation)) @ np.asarray(placement.rotation)
+        i = joint - 1
+        prismatic, axis = axes[i]
+        if prismatic:
+            below[i] = 1.0
+            points = np.vstack([points - lower[i] * axis, points - upper[i] * axis])
+        else:
+            distance = float(_distance_from_axis(points, axis).max())
+            below[i] = distance + ball
+            points, ball = np.outer(points @ axis, axis), ball + distance
+        stack.extend((child, points, ball) for child in children.get(joint, []))
+    return below
+
+
 def relative_radii(
-    model: Any, collision_model: Any, pairs: Sequence[tuple[int, int]], geometry_radii: ArrayLike
+    model: Any, collision_model: Any, pairs: Sequence[tuple[int, int]], reach: Sequence[GeometryReach]
 ) -> FloatArray:
     """``(P, nj)`` how fast each pair's distance may change per joint speed [m/rad, m/m].
 
@@ -145,11 +195,12 @@ def relative_radii(
         model: the robot's Pinocchio model (one-degree-of-freedom joints).
         collision_model: its geometry model.
         pairs: ``(geometry index, geometry index)`` per pair.
-        geometry_radii: ``(G, nj)`` each geometry's motion radius about each joint, 0 for the
-            joints that do not carry it (:attr:`cpr_kin.bounds.reach.GeometryReach.radii`).
+        reach: each geometry's bounds (:func:`geometry_reach`).
 
-    A joint carrying both geometries or neither counts 0; one carrying only one of them,
-    that geometry's radius about it.
+    A joint carrying both geometries or neither counts 0. One carrying only one of them counts
+    that geometry's radius about it (:attr:`GeometryReach.radii`), or, where the joint lies down
+    the other's chain, the other's distance from its axis if that is smaller
+    (:attr:`GeometryReach.below`: the motion is relative).
     """
     joints = model.njoints - 1
     carried = np.zeros((len(collision_model.geometryObjects), joints), dtype=bool)
@@ -158,9 +209,10 @@ def relative_radii(
         while joint > 0:
             carried[g, joint - 1] = True
             joint = model.parents[joint]
-    radii = np.asarray(geometry_radii, dtype=float)
     if not len(pairs):
         return np.zeros((0, joints))
+    radii, below = np.array([r.radii for r in reach]), np.array([r.below for r in reach])
     a, b = np.asarray(pairs, dtype=np.intp).T
     only_a, only_b = carried[a] & ~carried[b], carried[b] & ~carried[a]
-    return np.where(only_a, radii[a], 0.0) + np.where(only_b, radii[b], 0.0)
+    turning_a, turning_b = np.minimum(radii[a], below[b]), np.minimum(radii[b], below[a])
+    return np.where(only_a, turning_a, 0.0) + np.where(only_b, turning_b, 0.0)

@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 
 from cpr_kin.bounds.batch_kinematics import sampled_configurations
 from cpr_kin.bounds.pair_cells import CLEAR, UNKNOWN, CellGrids, cell_grids, cell_states
-from cpr_kin.bounds.reach import geometry_reach, relative_radii
+from cpr_kin.bounds.reach import GeometryReach, geometry_reach, relative_radii
 from cpr_kin.collision.decisive import coal_error_m
 from cpr_kin.collision.obstacle_pools import configure_pool, pool_collisions
 
@@ -56,8 +56,8 @@ class NearCells:
         model: the robot's Pinocchio model (one-degree-of-freedom joints).
         collision_model: its geometry model (copied, never modified).
         pairs: the near pairs' geometry indices.
-        geometry_radii: ``(G, nj)`` each geometry's motion radius about each joint
-            (:attr:`cpr_kin.bounds.reach.GeometryReach.radii`); default: within ``model``'s limits.
+        reach: each geometry's bounds (:func:`cpr_kin.bounds.reach.geometry_reach`); default:
+            within ``model``'s limits.
 
     Where some pair has no grid (:func:`~cpr_kin.bounds.pair_cells.cell_grids`), it clears
     nothing. ``tested`` counts the cells coal has tested.
@@ -68,7 +68,7 @@ class NearCells:
         model: Any,
         collision_model: Any,
         pairs: Sequence[tuple[int, int]],
-        geometry_radii: FloatArray | None = None,
+        reach: Sequence[GeometryReach] | None = None,
     ) -> None:
         self.model = model
         self.geometry_model = collision_model.copy()
@@ -77,10 +77,11 @@ class NearCells:
             self.geometry_model.addCollisionPair(pin.CollisionPair(a, b))
         self.grids: CellGrids | None = None
         if pairs:
-            if geometry_radii is None:
-                limits = (model.lowerPositionLimit, model.upperPositionLimit)
-                geometry_radii = np.array([r.radii for r in geometry_reach(model, collision_model, *limits)])
-            radii = relative_radii(model, collision_model, pairs, geometry_radii)
+            if reach is None:
+                reach = geometry_reach(
+                    model, collision_model, model.lowerPositionLimit, model.upperPositionLimit
+                )
+            radii = relative_radii(model, collision_model, pairs, reach)
             self.grids = cell_grids(model, radii, self._slacks())
         size = self.grids.size if self.grids is not None else 0
         self._cleared = np.full(size, -np.inf, dtype=np.float32)

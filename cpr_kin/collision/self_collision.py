@@ -16,7 +16,7 @@ a curve counts (:mod:`cpr_kin.certified.self_curve`).
 from __future__ import annotations
 
 import copy
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -26,7 +26,7 @@ import pinocchio as pin
 from lxml import etree
 from numpy.typing import ArrayLike, NDArray
 
-from cpr_kin.bounds.reach import geometry_reach, relative_radii
+from cpr_kin.bounds.reach import GeometryReach, geometry_reach, relative_radii
 from cpr_kin.collision.self_screen import ScreenedSelfTest
 from cpr_kin.collision.self_split import SelfScreen
 from cpr_kin.common.errors import CprKinError, UrdfError
@@ -170,9 +170,8 @@ class SelfCollision:
         pairs: geometry index pairs to check (:func:`self_pairs`).
         names: the geometries' names, by index.
         num_threads: threads of :meth:`violated`'s batches.
-        geometry_radii: ``(G, nj)`` each geometry's motion radius about each joint
-            (:attr:`cpr_kin.bounds.reach.GeometryReach.radii`, within the robot's joint ranges);
-            by default from the model's position limits.
+        reach: each geometry's bounds (:func:`cpr_kin.bounds.reach.geometry_reach`, within the
+            robot's joint ranges); by default from the model's position limits.
         allowance_m: ``(P,)`` added to each pair's coal distance [m] wherever a distance,
             bound or margin is asked (:attr:`allowance_m`); default none.
         screen: the pairs' near/far split and bounds (:class:`~cpr_kin.collision.self_split.SelfScreen`);
@@ -189,7 +188,7 @@ class SelfCollision:
         pairs: tuple[tuple[int, int], ...],
         names: list[str],
         num_threads: int = 1,
-        geometry_radii: FloatArray | None = None,
+        reach: Sequence[GeometryReach] | None = None,
         allowance_m: FloatArray | None = None,
         screen: SelfScreen | None = None,
         exact_meshes: Mapping[int, ExactMesh] | None = None,
@@ -198,12 +197,11 @@ class SelfCollision:
         self.geometry_model = collision_model.copy()
         for a, b in pairs:
             self.geometry_model.addCollisionPair(pin.CollisionPair(a, b))
-        if geometry_radii is None and pairs:
+        if reach is None and pairs:
             reach = geometry_reach(model, collision_model, model.lowerPositionLimit, model.upperPositionLimit)
-            geometry_radii = np.array([r.radii for r in reach])
         self.pair_radii = (
-            relative_radii(model, collision_model, pairs, geometry_radii)
-            if geometry_radii is not None
+            relative_radii(model, collision_model, pairs, reach)
+            if reach is not None
             else np.zeros((0, model.njoints - 1))
         )
         """``(P, nj)`` per pair, how fast its distance may change per joint speed [m/rad, m/m]

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cpr_kin.bounds.batch_kinematics import sampled_configurations
+from cpr_kin.bounds.reach import GeometryReach
 from cpr_kin.bounds.self_bounds import SelfPairBounds
 from cpr_kin.collision.near_cells import NearCells
 from cpr_kin.collision.robot_reach import robot_reach
@@ -84,13 +85,13 @@ class SelfScreen:
         geometry_model: Any,
         pairs: Sequence[tuple[int, int]],
         threshold_m: float,
-        geometry_radii: FloatArray | None = None,
+        reach: Sequence[GeometryReach] | None = None,
     ) -> SelfScreen:
         """The split of ``pairs`` (geometry indices of ``geometry_model``) on ``model``'s ranges.
 
         ``threshold_m``: the distance [m] the probes ask the bounds about (:func:`screen_threshold`).
-        ``geometry_radii``: ``(G, nj)`` each geometry's motion radius about each joint
-        (:attr:`cpr_kin.bounds.reach.GeometryReach.radii`); default: from ``model``'s limits.
+        ``reach``: each geometry's bounds (:func:`cpr_kin.bounds.reach.geometry_reach`); default:
+        within ``model``'s limits.
         """
         probes = sampled_configurations(model, PROBES, np.random.default_rng(0))
         all_bounds = SelfPairBounds(model, geometry_model, pairs)
@@ -99,7 +100,7 @@ class SelfScreen:
         near.setflags(write=False)
         far = SelfPairBounds(model, geometry_model, [p for p, n in zip(pairs, near, strict=True) if not n])
         near_pairs = [p for p, n in zip(pairs, near, strict=True) if n]
-        return cls(all_bounds, far, near, NearCells(model, geometry_model, near_pairs, geometry_radii))
+        return cls(all_bounds, far, near, NearCells(model, geometry_model, near_pairs, reach))
 
 
 _SCREENS: weakref.WeakKeyDictionary[Robot, dict[tuple[Pairs, float], SelfScreen]] = (
@@ -116,6 +117,5 @@ def robot_self_screen(robot: Robot, pairs: Pairs, margin_m: float) -> SelfScreen
     screens = _SCREENS.setdefault(robot, {})
     key = (pairs, screen_threshold(margin_m))
     if key not in screens:
-        radii = np.array([r.radii for r in robot_reach(robot)])
-        screens[key] = SelfScreen.build(robot.model, robot.collision_model, pairs, key[1], radii)
+        screens[key] = SelfScreen.build(robot.model, robot.collision_model, pairs, key[1], robot_reach(robot))
     return screens[key]

@@ -31,7 +31,7 @@ def world_self_collision(
         kept,
         [g.name for g in robot.geometries],
         num_threads,
-        geometry_radii=np.array([r.radii for r in robot_reach(robot)]),
+        reach=robot_reach(robot),
         allowance_m=np.array([self_margin_m if pair in contact_only else 0.0 for pair in kept]),
         screen=robot_self_screen(robot, kept, self_margin_m) if kept else None,
         exact_meshes=robot.exact_meshes,
