@@ -92,7 +92,7 @@ def geometry_reach(
     model: Any, collision_model: Any, lower: FloatArray, upper: FloatArray
 ) -> list[GeometryReach]:
     """The bounds of every collision geometry of a Pinocchio model (one-DOF joints)."""
-    axes = [joint_axis(model.joints[k]) for k in range(1, model.njoints)]
+    chain = _Chain(model, [joint_axis(model.joints[k]) for k in range(1, model.njoints)], lower, upper)
     bounds = []
     for obj in collision_model.geometryObjects:
         shape = obj.geometry
@@ -104,86 +104,67 @@ def geometry_reach(
             (np.atleast_2d(np.asarray(shape.aabb_center, dtype=float)), float(shape.aabb_radius)),
             (corners, 0.0),
         ]
-        carried = [_carry(model, axes, obj, points, ball, lower, upper) for points, ball in seeds]
+        placed = [
+            (points @ np.asarray(obj.placement.rotation).T + obj.placement.translation, b)
+            for points, b in seeds
+        ]
+        carried = [chain.up(obj.parentJoint, points, ball) for points, ball in placed]
         radii = np.min([speed for speed, _ in carried], axis=0)  # each bounds the speed
-        below = np.min(
-            [_carry_down(model, axes, obj, points, ball, lower, upper) for points, ball in seeds], axis=0
-        )
+        below = np.min([chain.down(obj.parentJoint, points, ball) for points, ball in placed], axis=0)
         bounds.append(GeometryReach(radii=radii, hulls=tuple(hull for _, hull in carried), below=below))
     return bounds
 
 
-def _carry(
-    model: Any,
-    axes: list[tuple[bool, FloatArray]],
-    obj: Any,
-    points: FloatArray,
-    ball: float,
-    lower: FloatArray,
-    upper: FloatArray,
-) -> tuple[FloatArray, Hull]:
-    """Carry a bound (``points`` in the geometry's frame, ``ball``) up to the world.
+@dataclass(frozen=True)
+class _Chain:
+    """A model's joints as the bounds cross them: each one's (is prismatic, axis) and its limits."""
 
-    Returns the per-joint radii (see :class:`GeometryReach`) and the world hull.
-    """
-    placement = obj.placement
-    points = points @ np.asarray(placement.rotation).T + np.asarray(placement.translation)
-    radii = np.zeros(len(axes))
-    joint = obj.parentJoint
-    while joint > 0:
+    model: Any
+    axes: list[tuple[bool, FloatArray]]
+    lower: FloatArray
+    upper: FloatArray
+
+    def through(
+        self, joint: int, points: FloatArray, ball: float, sign: float
+    ) -> tuple[float, FloatArray, float]:
+        """A bound (``points`` in ``joint``'s frame, ``ball``) moved by every value of the joint.
+
+        Returns its radius about the joint (1 for a prismatic one) and the bound of every
+        position: slid along the travel (``sign`` -1: the frame moves, not the bound), or turned
+        about the axis (folded onto it, the ball grown by the points' distance from it).
+        """
         i = joint - 1
-        prismatic, axis = axes[i]
+        prismatic, axis = self.axes[i]
         if prismatic:
-            radii[i] = 1.0
-            points = np.vstack([points + lower[i] * axis, points + upper[i] * axis])
-        else:
-            distance = float(_distance_from_axis(points, axis).max())
-            radii[i] = distance + ball
-            ball += distance
-            points = np.outer(points @ axis, axis)
-        placement = model.jointPlacements[joint]
-        points = points @ np.asarray(placement.rotation).T + np.asarray(placement.translation)
-        joint = model.parents[joint]
-    return radii, Hull(points=points, ball=ball)
+            ends = (points + sign * self.lower[i] * axis, points + sign * self.upper[i] * axis)
+            return 1.0, np.vstack(ends), ball
+        distance = float(_distance_from_axis(points, axis).max())
+        return distance + ball, np.outer(points @ axis, axis), ball + distance
 
+    def up(self, joint: int, points: FloatArray, ball: float) -> tuple[FloatArray, Hull]:
+        """A bound in ``joint``'s frame carried up to the world: radii per joint (``radii``), world hull."""
+        radii = np.zeros(len(self.axes))
+        while joint > 0:
+            radii[joint - 1], points, ball = self.through(joint, points, ball, 1.0)
+            placement = self.model.jointPlacements[joint]
+            points = points @ np.asarray(placement.rotation).T + np.asarray(placement.translation)
+            joint = self.model.parents[joint]
+        return radii, Hull(points=points, ball=ball)
 
-def _carry_down(
-    model: Any,
-    axes: list[tuple[bool, FloatArray]],
-    obj: Any,
-    points: FloatArray,
-    ball: float,
-    lower: FloatArray,
-    upper: FloatArray,
-) -> FloatArray:
-    """Per joint down the chain from ``obj``'s link, its largest distance from its axis (``below``).
-
-    The bound (``points`` in the geometry's frame, ``ball``) is carried down each joint's
-    child chain: into a joint's frame, where its motion turns the bound about its axis (folded
-    onto the axis, the ball grown by their distance) or slides it along its travel.
-    """
-    below = np.full(len(axes), np.inf)
-    placement = obj.placement
-    start = points @ np.asarray(placement.rotation).T + np.asarray(placement.translation), ball
-    children: dict[int, list[int]] = {}
-    for joint in range(1, model.njoints):
-        children.setdefault(model.parents[joint], []).append(joint)
-    stack = [(child, *start) for child in children.get(obj.parentJoint, [])]
-    while stack:
-        joint, points, ball = stack.pop()
-        placement = model.jointPlacements[joint]  # into the joint's frame, before its motion
-        points = (points - np.asarray(placement.translation)) @ np.asarray(placement.rotation)
-        i = joint - 1
-        prismatic, axis = axes[i]
-        if prismatic:
-            below[i] = 1.0
-            points = np.vstack([points - lower[i] * axis, points - upper[i] * axis])
-        else:
-            distance = float(_distance_from_axis(points, axis).max())
-            below[i] = distance + ball
-            points, ball = np.outer(points @ axis, axis), ball + distance
-        stack.extend((child, points, ball) for child in children.get(joint, []))
-    return below
+    def down(self, joint: int, points: FloatArray, ball: float) -> FloatArray:
+        """A bound in ``joint``'s frame carried down every chain below it: its distance from each axis."""
+        below = np.full(len(self.axes), np.inf)
+        children: dict[int, list[int]] = {}
+        for child in range(1, self.model.njoints):
+            children.setdefault(self.model.parents[child], []).append(child)
+        stack = [(child, points, ball) for child in children.get(joint, [])]
+        while stack:
+            joint, points, ball = stack.pop()
+            placement = self.model.jointPlacements[joint]  # into the joint's frame, before its motion
+            points = (points - np.asarray(placement.translation)) @ np.asarray(placement.rotation)
+            below[joint - 1], points, ball = self.through(joint, points, ball, -1.0)
+            stack.extend((child, points, ball) for child in children.get(joint, []))
+        return below
 
 
 def relative_radii(
