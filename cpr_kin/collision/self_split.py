@@ -40,8 +40,8 @@ SCREEN_THRESHOLDS_M = (0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0)
 """The distances [m] the probes may ask the bounds about (:func:`screen_threshold`): a few per
 robot, each screen built once."""
 TYPICAL_MARGIN_M = 0.01
-"""The self margin [m] a :class:`ScreenedSelfTest` given no screen splits its pairs for (the
-planner's default self margin)."""
+"""The self margin [m] a :class:`~cpr_kin.collision.self_screen.ScreenedSelfTest` given no screen
+splits its pairs for (the planner's default self margin)."""
 
 
 def screen_threshold(margin_m: float) -> float:
