@@ -240,6 +240,7 @@ def test_warm_up_prepares_a_robot_that_reaches_the_paper_poses_inside_its_crate(
 WARM_UR5 = """
 import cpr_kin as ck
 from cpr_kin.bounds.bound_kernels import pair_bounds
+from cpr_kin.bounds.pair_cells import cell_states
 from cpr_kin.bounds.self_bounds import self_bounds
 from planning.curves.horner import evaluate
 from planning.bench.mbm import vamp_resources
@@ -247,7 +248,7 @@ from planning.warming import warm_up
 from planning.search.firefly import _move
 ur5 = ck.load_robot(vamp_resources("ur5") / "ur5.urdf", srdf=vamp_resources("ur5") / "ur5.srdf")
 warm_up(ur5)
-print(min(len(kernel.signatures) for kernel in (pair_bounds, self_bounds, evaluate, _move)))
+print(min(len(kernel.signatures) for kernel in (pair_bounds, self_bounds, cell_states, evaluate, _move)))
 """
 
 
