@@ -1,6 +1,6 @@
 """Shared fixtures: the bundled CPR, the paper's scene, geometric paths to time, the example pick
-and place planned once, a stop that says yes after a count of questions, and a script loaded
-as a module or run for its markdown table."""
+and place planned once, a stop that says yes after a count of questions, a script loaded
+as a module or run for its markdown table, and trimesh's shared random draws seeded."""
 
 from __future__ import annotations
 
@@ -16,6 +16,7 @@ import coal
 import numpy as np
 import pinocchio as pin
 import pytest
+import trimesh.util
 
 import cpr_kin as ck
 from planning.curves.spline import SepticSplineSolver, uniform_knots
@@ -30,6 +31,22 @@ PAPER_GOAL_TCP = (-0.5, 0.45, 0.25)
 REST = SplineSettings(p=1e6, a=(0.0, 0.0, 1.0), ends="rest")
 LIFT = np.array([0.4, 0.25, -0.1, 0.0, 0.0])
 """An offset of the middle waypoints: the path lifts over something, a curved path."""
+
+
+@pytest.fixture(autouse=True)
+def seeded_trimesh(monkeypatch: pytest.MonkeyPatch) -> None:
+    """trimesh's unseeded draws seeded, for each test anew.
+
+    trimesh draws from one generator it seeds from the OS wherever it is given no seed: its
+    containment test, for one, casts a ray through an edge again in a random direction. An
+    oracle built on it must give the same answer every run.
+    """
+    shared = np.random.default_rng(0)
+
+    def generator(seed: object = None) -> np.random.Generator:
+        return shared if seed is None else np.random.default_rng(seed)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(trimesh.util, "random_generator", generator)
 
 
 SCRIPTS = Path(__file__).resolve().parents[1] / "scripts"
