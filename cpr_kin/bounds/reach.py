@@ -92,7 +92,11 @@ def geometry_reach(
     model: Any, collision_model: Any, lower: FloatArray, upper: FloatArray
 ) -> list[GeometryReach]:
     """The bounds of every collision geometry of a Pinocchio model (one-DOF joints)."""
-    chain = _Chain(model, [joint_axis(model.joints[k]) for k in range(1, model.njoints)], lower, upper)
+    children: dict[int, list[int]] = {}
+    for joint in range(1, model.njoints):
+        children.setdefault(model.parents[joint], []).append(joint)
+    axes = [joint_axis(model.joints[k]) for k in range(1, model.njoints)]
+    chain = _Chain(model, axes, lower, upper, children)
     bounds = []
     for obj in collision_model.geometryObjects:
         shape = obj.geometry
@@ -117,12 +121,13 @@ def geometry_reach(
 
 @dataclass(frozen=True)
 class _Chain:
-    """A model's joints as the bounds cross them: each one's (is prismatic, axis) and its limits."""
+    """A model's joints as the bounds cross them: each one's (is prismatic, axis), its limits and children."""
 
     model: Any
     axes: list[tuple[bool, FloatArray]]
     lower: FloatArray
     upper: FloatArray
+    children: dict[int, list[int]]
 
     def through(
         self, joint: int, points: FloatArray, ball: float, sign: float
@@ -154,9 +159,7 @@ class _Chain:
     def down(self, joint: int, points: FloatArray, ball: float) -> FloatArray:
         """A bound in ``joint``'s frame carried down every chain below it: its distance from each axis."""
         below = np.full(len(self.axes), np.inf)
-        children: dict[int, list[int]] = {}
-        for child in range(1, self.model.njoints):
-            children.setdefault(self.model.parents[child], []).append(child)
+        children = self.children
         stack = [(child, points, ball) for child in children.get(joint, [])]
         while stack:
             joint, points, ball = stack.pop()
