@@ -9,7 +9,7 @@ same trajectory either way: coal's answers do not depend on the threads), first 
 machine as it is, then again while ``--busy`` processes this script starts spin on a core
 each (what a user's simulator, browser or second planner does to a plan). Prints per robot
 and load the median and summed planning time of each thread count and their ratio: what
-:func:`cpr_kin.collision.obstacle_pools.default_threads` chooses from (docs/tuning.md, Threads).
+:func:`cpr_kin.collision.coal_pools.default_threads` chooses from (docs/tuning.md, Threads).
 """
 
 from __future__ import annotations

@@ -12,7 +12,7 @@ import pytest
 from scipy.optimize import minimize
 
 import cpr_kin as ck
-from cpr_kin.collision.obstacle_pools import default_threads
+from cpr_kin.collision.coal_pools import default_threads
 
 from .conftest import PAPER_GOAL_TCP, PAPER_START_TCP, random_configurations
 

@@ -78,23 +78,24 @@ def test_any_below_is_sound_and_at_most_the_bounds_answer(robot: ck.Robot, rng: 
         assert uncertain.any() and not uncertain.all()
 
 
-def test_obstacles_below_is_any_below_per_obstacle(robot: ck.Robot, rng: np.random.Generator) -> None:
+def test_pairs_below_is_any_below_pair_by_pair(robot: ck.Robot, rng: np.random.Generator) -> None:
     obstacles = [random_obstacle(shape, rng) for shape in SHAPES]
     obstacles = [ck.Obstacle(**{**o.__dict__, "name": f"o{k}"}) for k, o in enumerate(obstacles)]
     pairs = all_pairs(robot, obstacles)
     bounds = PairBounds(robot.model, robot.collision_model, obstacles, pairs)
     configurations = random_configurations(robot, rng, 300)
+    exact = coal_distances(robot, ck.CollisionWorld(robot, obstacles), configurations)
     per_pair = bounds(configurations)
-    obstacle = np.array([k for _, k in pairs])
     for threshold in (0.0, 0.05, 0.1):
-        grouped = bounds.obstacles_below(configurations, threshold)
-        assert grouped.shape == (len(configurations), len(obstacles))
-        np.testing.assert_array_equal(grouped.any(axis=1), bounds.any_below(configurations, threshold))
-        for k in range(len(obstacles)):  # each obstacle's answer is its own pairs' any_below
-            own = PairBounds(robot.model, robot.collision_model, obstacles, [p for p in pairs if p[1] == k])
-            np.testing.assert_array_equal(grouped[:, k], own.any_below(configurations, threshold))
-            assert not np.any(grouped[:, k] & ~(per_pair[:, obstacle == k] <= threshold).any(axis=1))
-    assert grouped.sum(axis=1).max() >= 2  # configurations near two obstacles at once occur
+        flagged = bounds.pairs_below(configurations, threshold)
+        assert flagged.shape == (len(configurations), len(pairs))
+        np.testing.assert_array_equal(flagged.any(axis=1), bounds.any_below(configurations, threshold))
+        assert np.all(flagged[exact <= threshold - 2e-6])  # sound pair by pair (coal's tolerance)
+        assert not np.any(flagged & ~(per_pair <= threshold))  # the spheres only ever clear more
+        for p in range(0, len(pairs), 7):  # each pair's answer is its own any_below
+            own = PairBounds(robot.model, robot.collision_model, obstacles, [pairs[p]])
+            np.testing.assert_array_equal(flagged[:, p], own.any_below(configurations, threshold))
+    assert (flagged.sum(axis=1) >= 2).any() and (flagged.sum(axis=1) < flagged.shape[1]).all()
 
 
 def test_mesh_obstacle_is_bounded_by_its_bounding_box(

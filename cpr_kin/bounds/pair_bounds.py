@@ -7,9 +7,9 @@ a few lines of arithmetic. Compiled code places the capsules with the kinematic 
 yes/no test (``docs/benchmarks.md``). A positive bound is at most coal's
 distance (shapes that overlap get a bound <= 0), so a configuration whose bounds all exceed
 a margin keeps it for certain: :meth:`cpr_kin.CollisionWorld.margin_violated` sends coal only
-the others. That check asks :meth:`PairBounds.any_below`, which first compares the bounding
-spheres of each capsule and obstacle (most pairs are far apart) and stops at a
-configuration's first uncertain pair.
+the pairs of the others whose bound does not (:meth:`PairBounds.pairs_below`). These tests
+first compare the bounding spheres of each capsule and obstacle (most pairs are far apart);
+:meth:`PairBounds.any_below` stops at a configuration's first uncertain pair.
 The bounds themselves are compiled (:mod:`cpr_kin.bounds.bound_kernels`).
 """
 
@@ -141,7 +141,7 @@ class PairBounds:
             np.array([k for _, k in pairs], dtype=np.int64),
         )
         bounds = [_obstacle_bound(obstacle) for obstacle in obstacles]
-        self.n_obstacles = len(bounds)
+        self._pair_columns = np.arange(len(pairs), dtype=np.int64)  # each pair its own group
         self._obstacles = (
             np.array([b[0] for b in bounds], dtype=np.int64),
             np.array([b[1] for b in bounds], dtype=float).reshape(-1, 3, 3),
@@ -189,13 +189,14 @@ class PairBounds:
         """
         return self._below(q, threshold_m, np.zeros(self.n_pairs, dtype=np.int64), 1)[:, 0]
 
-    def obstacles_below(self, q: FloatArray, threshold_m: float) -> BoolArray:
-        """``(N, O)`` whether some pair with obstacle ``o`` may be within ``threshold_m`` [m] at ``q``.
+    def pairs_below(self, q: FloatArray, threshold_m: float) -> BoolArray:
+        """``(N, P)`` whether each pair may be within ``threshold_m`` [m] at configurations ``q``.
 
-        :meth:`any_below` per obstacle (``O`` the obstacles given), each configuration's
-        test stopping once every obstacle has an uncertain pair.
+        :meth:`any_below` pair by pair: false where the pair's bounding spheres or its bound
+        of :meth:`__call__` put it farther, what coal need not test
+        (:mod:`cpr_kin.collision.obstacle_tests`).
         """
-        return self._below(q, threshold_m, self._pairs[1], self.n_obstacles)
+        return self._below(q, threshold_m, self._pair_columns, self.n_pairs)
 
     def _below(self, q: FloatArray, threshold_m: float, pair_group: IntArray, groups: int) -> BoolArray:
         batch = np.ascontiguousarray(q, dtype=float)

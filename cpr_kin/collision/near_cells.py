@@ -27,8 +27,8 @@ from numpy.typing import NDArray
 from cpr_kin.bounds.batch_kinematics import sampled_configurations
 from cpr_kin.bounds.pair_cells import CLEAR, UNKNOWN, CellGrids, cell_grids, cell_states
 from cpr_kin.bounds.reach import GeometryReach, geometry_reach, relative_radii
+from cpr_kin.collision.coal_pools import configure_pool, pool_collisions
 from cpr_kin.collision.decisive import coal_error_m
-from cpr_kin.collision.obstacle_pools import configure_pool, pool_collisions
 
 FloatArray = NDArray[np.float64]
 Float32Array = NDArray[np.float32]

@@ -17,8 +17,8 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from cpr_kin.collision.closest_pairs import closest_pairs
+from cpr_kin.collision.coal_pools import configure_pool, pool_collisions
 from cpr_kin.collision.decisive import coal_error_m
-from cpr_kin.collision.obstacle_pools import configure_pool, pool_collisions
 from cpr_kin.collision.self_split import TYPICAL_MARGIN_M, SelfScreen, screen_threshold
 from cpr_kin.shapes.exact_pairs import ExactPairs
 

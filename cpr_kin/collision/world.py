@@ -21,8 +21,9 @@ from numpy.typing import ArrayLike, NDArray
 from cpr_kin.bounds.pair_bounds import PairBounds
 from cpr_kin.collision.clearance import BatchClearance, Clearance, PairDistance
 from cpr_kin.collision.closest_pairs import closest_pairs
+from cpr_kin.collision.coal_pools import default_threads
 from cpr_kin.collision.decisive import below_coal, coal_error_m
-from cpr_kin.collision.obstacle_pools import ObstaclePools, default_threads
+from cpr_kin.collision.obstacle_tests import ObstacleTests
 from cpr_kin.collision.robot_reach import pair_reach_distances
 from cpr_kin.collision.touch_links import checked_pairs
 from cpr_kin.collision.world_self_pairs import world_self_collision
@@ -43,7 +44,7 @@ class CollisionWorld:
         robot: the robot (its collision geometry model is copied, never modified).
         obstacles: the obstacles; their names must be unique.
         num_threads: threads of the parallel checks (default:
-            :func:`~cpr_kin.collision.obstacle_pools.default_threads`).
+            :func:`~cpr_kin.collision.coal_pools.default_threads`).
         allowed_pairs: link pairs of the robot allowed to touch (a scene's), beyond its SRDF's;
             an obstacle's own ``touch_links`` may touch it (:mod:`cpr_kin.collision.touch_links`).
         self_margin_m: the self margin the world's user holds the robot's own pairs to [m]: a
@@ -89,9 +90,7 @@ class CollisionWorld:
         self._data = robot.model.createData()
         self._all = model.createData()
         self._exact = ExactPairs(model, robot.exact_meshes)
-        self._pools = ObstaclePools(
-            robot.model, model, np.array([k for _, k in pairs], dtype=np.int64), self.num_threads, self._exact
-        )
+        self._tests = ObstacleTests(robot.model, model, self._exact)
         self._reach_distance = pair_reach_distances(robot, self.obstacles, self._pairs)
         self._pair_bounds: dict[tuple[bool, ...], PairBounds] = {}
         self._within: dict[float, tuple[BoolArray, PairBounds | None]] = {}
@@ -102,7 +101,7 @@ class CollisionWorld:
         hulls = copy.copy(self)
         hulls.robot = dataclasses.replace(self.robot, exact_meshes={})
         hulls._exact = ExactPairs(self.geometry_model, {})
-        hulls._pools = self._pools.on_hulls()
+        hulls._tests = self._tests.on_hulls()
         hulls.self_collision = self.self_collision.on_hulls()
         return hulls
 
@@ -238,15 +237,13 @@ class CollisionWorld:
     def margin_violated(self, q: ArrayLike, margin_m: float, ordered: bool = False) -> NDArray[np.bool_]:
         """``(N,)`` whether any robot geometry is closer than ``margin_m`` [m] to an obstacle.
 
-        A yes/no check run by coal's collision test with ``margin_m`` as security margin, in
-        parallel over :attr:`num_threads` threads (Pinocchio's ``GeometryPool``); several
-        times faster than :meth:`clearance_batch` when distances are not needed. Pairs that
-        cannot come within the margin in any configuration (their reach capsule is farther,
-        see :mod:`cpr_kin.bounds.reach`) are not tested, and a configuration goes to coal only for
-        the obstacles of which some pair is not certainly farther than the margin by a cheap
-        bound (:mod:`cpr_kin.bounds.pair_bounds`, computed for the whole batch at once;
-        :mod:`cpr_kin.collision.obstacle_pools`). Distances within coal's error of the margin
-        (:func:`~cpr_kin.collision.decisive.coal_error_m`) always go to coal.
+        A yes/no check run by coal's collision test with ``margin_m`` as security margin.
+        Pairs that cannot come within the margin in any configuration (their reach capsule is
+        farther, see :mod:`cpr_kin.bounds.reach`) are not tested, and coal tests a
+        configuration's pair only where its cheap bound (:mod:`cpr_kin.bounds.pair_bounds`,
+        computed for the whole batch at once) does not put it certainly farther than the
+        margin (:mod:`cpr_kin.collision.obstacle_tests`). Distances within coal's error of the
+        margin (:func:`~cpr_kin.collision.decisive.coal_error_m`) always go to coal.
 
         With ``ordered``, the configurations are decided in order up to the first violated
         one, and those after it are reported violated without a test: what an edge check
@@ -258,8 +255,8 @@ class CollisionWorld:
         near, bounds = self._pairs_within(margin_m)
         if bounds is None or not len(batch):
             return np.zeros(len(batch), dtype=bool)
-        uncertain = bounds.obstacles_below(batch, float(margin_m + coal_error_m(margin_m)))
-        return self._pools.violated(batch, uncertain, margin_m, near, ordered)
+        uncertain = bounds.pairs_below(batch, float(margin_m + coal_error_m(margin_m)))
+        return self._tests.violated(batch, uncertain, np.flatnonzero(near), margin_m, ordered)
 
     def keeps_clearance(
         self, q: ArrayLike, margin_m: float, self_margin_m: float, ordered: bool = False

@@ -1,0 +1,117 @@
+"""coal's yes/no margin test of the robot-obstacle pairs their bounds leave uncertain.
+
+Where a configuration's pair bounds (:meth:`cpr_kin.bounds.pair_bounds.PairBounds.pairs_below`)
+leave some pair uncertain, coal decides: the configuration's geometries are placed once, and
+coal tests those pairs alone, one after another, up to the first within the margin. Every
+other pair is certainly farther. (Before, every pair of an obstacle with an uncertain pair
+went to coal in a Pinocchio ``GeometryPool``: five to eight times the pairs the bounds leave,
+on MotionBenchMaker's Panda and UR5; docs/tuning.md, Kernels.) Where a pair's robot link has
+an exact mesh that decides (:mod:`cpr_kin.shapes.exact_pairs`), a hull test that flags it is
+decided again on the mesh.
+"""
+
+from __future__ import annotations
+
+import copy
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import NDArray
+
+from cpr_kin.collision.coal_pools import set_margins
+from cpr_kin.shapes.exact_pairs import ExactPairs
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+BoolArray = NDArray[np.bool_]
+
+MAX_MARGINS = 8
+"""Margins whose geometry data is kept; more are dropped and set again (a plan asks a few)."""
+
+
+class ObstacleTests:
+    """coal's margin test of chosen robot-obstacle pairs, configuration by configuration.
+
+    Args:
+        model: the robot's Pinocchio model.
+        geometry_model: the world's geometry model (robot and obstacles, every pair added).
+        exact: the pairs on the robot's exact meshes (default: none decides).
+    """
+
+    def __init__(self, model: Any, geometry_model: Any, exact: ExactPairs | None = None) -> None:
+        self.model, self.geometry_model = model, geometry_model
+        self._exact = exact if exact else None
+        self._data = model.createData()
+        self._exact_data: Any = None
+        self._at_margin: dict[float, Any] = {}
+
+    def on_hulls(self) -> ObstacleTests:
+        """The tests with the hulls deciding alone (:meth:`cpr_kin.CollisionWorld.on_hulls`)."""
+        hulls = copy.copy(self)
+        hulls._exact = None
+        return hulls
+
+    def violated(
+        self,
+        batch: FloatArray,
+        uncertain: BoolArray,
+        pairs: IntArray,
+        margin_m: float,
+        ordered: bool = False,
+    ) -> BoolArray:
+        """``(N,)`` whether some pair is closer than ``margin_m`` [m] at configurations ``batch``.
+
+        Args:
+            batch: ``(N, nq)`` configurations.
+            uncertain: ``(N, P)`` the pairs coal must test at each (the others are certainly
+                farther than the margin).
+            pairs: ``(P,)`` those pairs' indices in the geometry model's collision pairs.
+            margin_m: the security margin [m].
+            ordered: decide the configurations in order up to the first violated one; those
+                after it are reported violated without a test.
+        """
+        violated = np.zeros(len(batch), dtype=bool)
+        rows = np.flatnonzero(uncertain.any(axis=1))
+        if not rows.size:
+            return violated
+        geometry_data = self._geometry_data(margin_m)
+        for row in rows.tolist():
+            if self._row_violated(batch[row], pairs[uncertain[row]].tolist(), margin_m, geometry_data):
+                violated[row] = True
+                if ordered:
+                    violated[row:] = True
+                    break
+        return violated
+
+    def _row_violated(self, q: FloatArray, pairs: list[int], margin_m: float, geometry_data: Any) -> bool:
+        """Whether one of ``pairs`` is closer than ``margin_m`` [m] at ``q`` (placed once)."""
+        model, geometry_model = self.model, self.geometry_model
+        pin.updateGeometryPlacements(model, self._data, geometry_model, geometry_data, q)
+        for pair in pairs:
+            if pin.computeCollision(geometry_model, geometry_data, pair) and not self._clear_on_mesh(
+                q, pair, margin_m
+            ):
+                return True
+        return False
+
+    def _clear_on_mesh(self, q: FloatArray, pair: int, margin_m: float) -> bool:
+        """Whether ``pair``, flagged on its hull at ``q``, keeps ``margin_m`` [m] on its exact mesh."""
+        exact = self._exact
+        if exact is None or not exact.refined[pair]:
+            return False
+        if self._exact_data is None:
+            self._exact_data = self.geometry_model.createData()
+        margins = np.full(len(self.geometry_model.collisionPairs), margin_m)
+        data = (self.model, self._data, self.geometry_model, self._exact_data)
+        return not exact.violated(*data, q[None], [pair], margins)[0]
+
+    def _geometry_data(self, margin_m: float) -> Any:
+        """A geometry data whose collision tests have the security margin ``margin_m`` [m]."""
+        if margin_m not in self._at_margin:
+            if len(self._at_margin) >= MAX_MARGINS:
+                self._at_margin.clear()
+            geometry_data = self.geometry_model.createData()
+            set_margins(geometry_data, self.geometry_model, margin_m)
+            self._at_margin[margin_m] = geometry_data
+        return self._at_margin[margin_m]
