@@ -72,28 +72,26 @@ class ObstacleTests:
                 after it are reported violated without a test.
         """
         violated = np.zeros(len(batch), dtype=bool)
-        rows = np.flatnonzero(uncertain.any(axis=1))
+        rows, columns = np.nonzero(uncertain)  # row by row, in order
         if not rows.size:
             return violated
+        model, data, geometry_model = self.model, self._data, self.geometry_model
         geometry_data = self._geometry_data(margin_m)
-        for row in rows.tolist():
-            if self._row_violated(batch[row], pairs[uncertain[row]].tolist(), margin_m, geometry_data):
-                violated[row] = True
+        placed = decided = -1
+        for row, pair in zip(rows.tolist(), pairs[columns].tolist(), strict=True):
+            if row == decided:  # a pair of this row was found within the margin
+                continue
+            if row != placed:
+                pin.updateGeometryPlacements(model, data, geometry_model, geometry_data, batch[row])
+                placed = row
+            if pin.computeCollision(geometry_model, geometry_data, pair) and not self._clear_on_mesh(
+                batch[row], pair, margin_m
+            ):
+                violated[row], decided = True, row
                 if ordered:
                     violated[row:] = True
                     break
         return violated
-
-    def _row_violated(self, q: FloatArray, pairs: list[int], margin_m: float, geometry_data: Any) -> bool:
-        """Whether one of ``pairs`` is closer than ``margin_m`` [m] at ``q`` (placed once)."""
-        model, geometry_model = self.model, self.geometry_model
-        pin.updateGeometryPlacements(model, self._data, geometry_model, geometry_data, q)
-        for pair in pairs:
-            if pin.computeCollision(geometry_model, geometry_data, pair) and not self._clear_on_mesh(
-                q, pair, margin_m
-            ):
-                return True
-        return False
 
     def _clear_on_mesh(self, q: FloatArray, pair: int, margin_m: float) -> bool:
         """Whether ``pair``, flagged on its hull at ``q``, keeps ``margin_m`` [m] on its exact mesh."""
