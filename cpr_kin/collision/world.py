@@ -43,8 +43,9 @@ class CollisionWorld:
     Args:
         robot: the robot (its collision geometry model is copied, never modified).
         obstacles: the obstacles; their names must be unique.
-        num_threads: threads of the parallel checks (default:
-            :func:`~cpr_kin.collision.coal_pools.default_threads`).
+        num_threads: threads of the parallel checks of the robot's own pairs (default:
+            :func:`~cpr_kin.collision.coal_pools.default_threads`); coal tests the obstacles'
+            pairs one configuration at a time (:mod:`cpr_kin.collision.obstacle_tests`).
         allowed_pairs: link pairs of the robot allowed to touch (a scene's), beyond its SRDF's;
             an obstacle's own ``touch_links`` may touch it (:mod:`cpr_kin.collision.touch_links`).
         self_margin_m: the self margin the world's user holds the robot's own pairs to [m]: a
