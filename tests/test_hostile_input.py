@@ -225,8 +225,7 @@ def test_unusable_output_folders_are_refused(
 @pytest.fixture(scope="module")
 def trajectory_file(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     folder = tmp_path_factory.mktemp("check")
-    # three waypoints, four segments a second each: the edits below name their knots
-    scene = write(folder, GOOD + CRATE + "duration: 4.0\nplanner: {waypoints: 3}\nspline: {ends: natural}\n")
+    scene = write(folder, GOOD + CRATE + "duration: 4.0\nspline: {ends: natural}\n")
     assert main(["plan", str(scene), "--out", str(folder / "out")]) == 0
     return scene, folder / "out" / "trajectory.json"
 

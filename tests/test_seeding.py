@@ -102,16 +102,9 @@ THREE = 3
 """The waypoints the scenes below were chosen with (the planner's default until stop 67)."""
 
 
-CHOSEN_SPACING_M = 0.04
-"""The edge spacing [m] of RRT-Connect's trees the scenes below were chosen with (the default
-until stop 94): their draws (how many samples a path takes, which path comes first) depend on it."""
-
-
 def uniform_samples(problem: Problem, **seeding: Any) -> Problem:
-    """``problem`` whose RRT-Connect draws uniform samples only, with :data:`THREE` waypoints and
-    :data:`CHOSEN_SPACING_M` (as chosen)."""
-    chosen = SeedingTuning(local_share=0.0, max_resolution_m=CHOSEN_SPACING_M, **seeding)
-    tuning = SearchTuning(seeding=chosen)
+    """``problem`` whose RRT-Connect draws uniform samples only, with :data:`THREE` waypoints (as chosen)."""
+    tuning = SearchTuning(seeding=SeedingTuning(local_share=0.0, **seeding))
     return with_planner(problem, waypoints=THREE, tuning=tuning)
 
 
@@ -212,7 +205,7 @@ def test_seeding_none_is_a_setting(robot: ck.Robot) -> None:
 def test_a_passage_narrower_than_margin_plus_step_is_found_with_a_finer_step(robot: ck.Robot) -> None:
     """Generated scene 43 of seed 13: RRT-Connect finds no path keeping the margin plus the 5 mm
     certified step clear in 10,000 samples (its way passes 2 mm outside the margin; in more,
-    or checked farther apart than 4 cm, an edge may slip through); its trees go on at a 1 mm step's
+    an edge checked every 4 cm may slip through); its trees go on at a 1 mm step's
     clearance, and the plan is searched and certified at it."""
     from planning.bench.scene_generator import generate_scenes
     from planning.pipeline.planner import plan
@@ -220,11 +213,9 @@ def test_a_passage_narrower_than_margin_plus_step_is_found_with_a_finer_step(rob
     scene = generate_scenes(100, seed=13, robot=robot, narrow=33)[43]
     assert scene.planner.verify_step_m == 0.005
     problem = build_problem(scene, robot)
-    chosen = SeedingTuning(max_samples=10_000, max_resolution_m=CHOSEN_SPACING_M)
-    strict = with_planner(problem, tuning=SearchTuning(seeding=chosen))
+    strict = with_planner(problem, tuning=SearchTuning(seeding=SeedingTuning(max_samples=10_000)))
     assert seed_search(strict).path is None  # nothing keeps margin + 5 mm clear
-    as_chosen = SeedingTuning(max_resolution_m=CHOSEN_SPACING_M)
-    result = plan(scene.with_planner(tuning=SearchTuning(seeding=as_chosen)), robot)
+    result = plan(scene, robot)
     assert result.scene.planner.verify_step_m == pytest.approx(0.001)
     assert result.verification.accepted and result.metrics.min_clearance_m >= scene.safety_margin
 

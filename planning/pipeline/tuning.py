@@ -67,7 +67,7 @@ class SeedingTuning:
 
     share: float = 0.6
     spread: float = 0.01
-    max_resolution_m: float = 0.08
+    max_resolution_m: float = 0.04
     path_attempts: int = 3
     redraw_samples: int = 300
     max_samples: int = 50_000
