@@ -11,7 +11,7 @@ import pinocchio as pin
 import pytest
 
 import cpr_kin as ck
-from cpr_kin.bounds.reach import relative_radii
+from cpr_kin.bounds.reach import geometry_reach, relative_radii
 from cpr_kin.certified.self_curve import check_self_curve
 from cpr_kin.collision.robot_reach import robot_reach
 from cpr_kin.collision.self_collision import SelfCollision, read_srdf, self_pairs
@@ -174,6 +174,17 @@ def test_a_joint_turning_one_geometry_counts_the_nearer_of_the_two_to_its_axis()
             assert np.all(change <= radii[:, j] * abs(step[j]) + 2e-6)  # coal: 1e-6
             tightest = max(tightest, float(change[base_arm] / (radii[base_arm, j] * abs(step[j]) or 1.0)))
     assert tightest > 0.2  # the base pair's bound is not loose by orders of magnitude
+
+
+def test_relative_radii_default_to_the_reach_within_the_models_limits(panda: ck.Robot) -> None:
+    model, collision_model = panda.model, panda.collision_model
+    pairs = ck.CollisionWorld(panda, []).self_collision._pairs
+    within = geometry_reach(model, collision_model, model.lowerPositionLimit, model.upperPositionLimit)
+    by_default = relative_radii(model, collision_model, pairs)
+    np.testing.assert_array_equal(by_default, relative_radii(model, collision_model, pairs, within))
+    assert relative_radii(model, collision_model, []).shape == (0, model.njoints - 1)
+    names = [f"{a}-{b}" for a, b in pairs]
+    np.testing.assert_array_equal(SelfCollision(model, collision_model, pairs, names).pair_radii, by_default)
 
 
 def test_the_certificate_computes_few_samples_and_equals_computing_every_one(panda: ck.Robot) -> None:

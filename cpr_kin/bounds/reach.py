@@ -171,7 +171,10 @@ class _Chain:
 
 
 def relative_radii(
-    model: Any, collision_model: Any, pairs: Sequence[tuple[int, int]], reach: Sequence[GeometryReach]
+    model: Any,
+    collision_model: Any,
+    pairs: Sequence[tuple[int, int]],
+    reach: Sequence[GeometryReach] | None = None,
 ) -> FloatArray:
     """``(P, nj)`` how fast each pair's distance may change per joint speed [m/rad, m/m].
 
@@ -179,7 +182,8 @@ def relative_radii(
         model: the robot's Pinocchio model (one-degree-of-freedom joints).
         collision_model: its geometry model.
         pairs: ``(geometry index, geometry index)`` per pair.
-        reach: each geometry's bounds (:func:`geometry_reach`).
+        reach: each geometry's bounds (:func:`geometry_reach`); default: within ``model``'s
+            position limits.
 
     A joint carrying both geometries or neither counts 0. One carrying only one of them counts
     that geometry's radius about it (:attr:`GeometryReach.radii`), or, where the joint lies down
@@ -195,6 +199,8 @@ def relative_radii(
             joint = model.parents[joint]
     if not len(pairs):
         return np.zeros((0, joints))
+    if reach is None:
+        reach = geometry_reach(model, collision_model, model.lowerPositionLimit, model.upperPositionLimit)
     radii, below = np.array([r.radii for r in reach]), np.array([r.below for r in reach])
     a, b = np.asarray(pairs, dtype=np.intp).T
     only_a, only_b = carried[a] & ~carried[b], carried[b] & ~carried[a]

@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 
 from cpr_kin.bounds.batch_kinematics import sampled_configurations
 from cpr_kin.bounds.pair_cells import CLEAR, UNKNOWN, CellGrids, cell_grids, cell_states
-from cpr_kin.bounds.reach import GeometryReach, geometry_reach, relative_radii
+from cpr_kin.bounds.reach import GeometryReach, relative_radii
 from cpr_kin.collision.coal_pools import configure_pool, pool_collisions
 from cpr_kin.collision.decisive import coal_error_m
 
@@ -77,10 +77,6 @@ class NearCells:
             self.geometry_model.addCollisionPair(pin.CollisionPair(a, b))
         self.grids: CellGrids | None = None
         if pairs:
-            if reach is None:
-                reach = geometry_reach(
-                    model, collision_model, model.lowerPositionLimit, model.upperPositionLimit
-                )
             radii = relative_radii(model, collision_model, pairs, reach)
             self.grids = cell_grids(model, radii, self._slacks())
         size = self.grids.size if self.grids is not None else 0

@@ -26,7 +26,7 @@ import pinocchio as pin
 from lxml import etree
 from numpy.typing import ArrayLike, NDArray
 
-from cpr_kin.bounds.reach import GeometryReach, geometry_reach, relative_radii
+from cpr_kin.bounds.reach import GeometryReach, relative_radii
 from cpr_kin.collision.self_screen import ScreenedSelfTest
 from cpr_kin.collision.self_split import SelfScreen
 from cpr_kin.common.errors import CprKinError, UrdfError
@@ -197,13 +197,7 @@ class SelfCollision:
         self.geometry_model = collision_model.copy()
         for a, b in pairs:
             self.geometry_model.addCollisionPair(pin.CollisionPair(a, b))
-        if reach is None and pairs:
-            reach = geometry_reach(model, collision_model, model.lowerPositionLimit, model.upperPositionLimit)
-        self.pair_radii = (
-            relative_radii(model, collision_model, pairs, reach)
-            if reach is not None
-            else np.zeros((0, model.njoints - 1))
-        )
+        self.pair_radii = relative_radii(model, collision_model, pairs, reach)
         """``(P, nj)`` per pair, how fast its distance may change per joint speed [m/rad, m/m]
         (:func:`cpr_kin.bounds.reach.relative_radii`)."""
         self.allowance_m = (
