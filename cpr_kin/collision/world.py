@@ -34,7 +34,6 @@ from cpr_kin.shapes.obstacles import Obstacle, checked_obstacles
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
-BoolArray = NDArray[np.bool_]
 
 
 class CollisionWorld:
@@ -94,7 +93,7 @@ class CollisionWorld:
         self._tests = ObstacleTests(robot.model, model, self._exact)
         self._reach_distance = pair_reach_distances(robot, self.obstacles, self._pairs)
         self._pair_bounds: dict[tuple[bool, ...], PairBounds] = {}
-        self._within: dict[float, tuple[BoolArray, PairBounds | None]] = {}
+        self._within: dict[float, tuple[IntArray, PairBounds | None]] = {}
         self.self_collision = world_self_collision(robot, allowed_pairs, self_margin_m, self.num_threads)
 
     def on_hulls(self) -> CollisionWorld:
@@ -220,9 +219,9 @@ class CollisionWorld:
             below_m = np.inf
         elif not np.isfinite(below_m):
             raise CprKinError(f"distance bound {below_m} m must be finite")
-        near, bounds = self._pairs_within(below_m)
+        pairs, bounds = self._pairs_within(below_m)
         values = np.empty((len(batch), 0)) if bounds is None else bounds(batch)
-        model, data, pairs = self.robot.model, self._data, np.flatnonzero(near)
+        model, data = self.robot.model, self._data
         return closest_pairs(
             model, data, self.geometry_model, self._all, batch, values, pairs, below_m, exact=self._exact
         )
@@ -253,11 +252,11 @@ class CollisionWorld:
         batch = self._check_batch(q)
         if not (np.isfinite(margin_m) and margin_m >= 0.0):
             raise CprKinError(f"safety margin {margin_m} m must be a finite number >= 0")
-        near, bounds = self._pairs_within(margin_m)
+        pairs, bounds = self._pairs_within(margin_m)
         if bounds is None or not len(batch):
             return np.zeros(len(batch), dtype=bool)
         uncertain = bounds.pairs_below(batch, float(margin_m + coal_error_m(margin_m)))
-        return self._tests.violated(batch, uncertain, np.flatnonzero(near), margin_m, ordered)
+        return self._tests.violated(batch, uncertain, pairs, margin_m, ordered)
 
     def keeps_clearance(
         self, q: ArrayLike, margin_m: float, self_margin_m: float, ordered: bool = False
@@ -275,14 +274,16 @@ class CollisionWorld:
             free[free] = ~self.self_collision.violated(batch[free], self_margin_m)
         return free
 
-    def _pairs_within(self, distance_m: float) -> tuple[BoolArray, PairBounds | None]:
-        """The pairs whose reach comes within ``distance_m`` [m] and their bounds (``None``: no pair).
+    def _pairs_within(self, distance_m: float) -> tuple[IntArray, PairBounds | None]:
+        """The pairs whose reach comes within ``distance_m`` [m] (their indices) and their bounds.
 
-        Looked up once per distance (a plan asks a few margins many times).
+        The bounds' columns are those pairs, in order (``None``: no pair). Looked up once per
+        distance (a plan asks a few margins many times).
         """
         if distance_m not in self._within:
             near = self._reach_distance <= distance_m
-            self._within[distance_m] = (near, self._bounds(tuple(near.tolist())) if near.any() else None)
+            bounds = self._bounds(tuple(near.tolist())) if near.any() else None
+            self._within[distance_m] = (np.flatnonzero(near), bounds)
         return self._within[distance_m]
 
     def _every_pair_bounds(self) -> PairBounds:
