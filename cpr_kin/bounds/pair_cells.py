@@ -5,9 +5,8 @@ and only by the joints between its geometries. A grid over those joints (a revol
 angle taken modulo a turn where its range is a turn or more; any other joint's range tiled
 within its limits) whose cells are ``h_j`` wide with ``sum_j r_j h_j / 2`` at most a *slack*
 holds the pair's distance, anywhere in a cell, within that slack of its distance at the cell's
-centre. What a cell is known to clear
-is kept by :class:`cpr_kin.collision.near_cells.NearCells`; :func:`cell_states` reads it for a
-batch of configurations.
+centre. What a cell is known to clear is kept by :class:`cpr_kin.collision.near_cells.NearCells`;
+:func:`cell_states` reads it for a batch of configurations.
 """
 
 from __future__ import annotations
