@@ -10,6 +10,7 @@ import cpr_kin as ck
 from cpr_kin.bounds.pair_cells import cell_states
 from cpr_kin.collision.near_cells import LEVEL_M, TESTED_ABOVE_M, NearCells
 from cpr_kin.collision.robot_reach import robot_reach
+from cpr_kin.shapes.exact_pairs import ExactPairs
 from planning.bench.mbm import vamp_resources
 
 
@@ -102,3 +103,39 @@ def test_the_robots_screen_keeps_its_cells_across_worlds(panda: ck.Robot) -> Non
     assert again.self_collision._screen is screen
     again.self_collision.violated(q, 0.001)
     assert screen.near_cells.tested == tested
+
+
+def mesh_distances(cells: NearCells, exact: ExactPairs, q: np.ndarray) -> np.ndarray:
+    """``(N, K)`` each near pair's distance on its exact meshes (the hulls' where it has none)."""
+    model, geometry_model = cells.model, cells.geometry_model
+    data, geometry_data = model.createData(), geometry_model.createData()
+    found = np.empty((len(q), len(geometry_model.collisionPairs)))
+    for n, x in enumerate(q):
+        pin.computeDistances(model, data, geometry_model, geometry_data, x)
+        hulls = [r.min_distance for r in geometry_data.distanceResults]
+        found[n] = [exact.distance(geometry_data, k, hull) for k, hull in enumerate(hulls)]
+    return found
+
+
+def test_on_the_meshes_a_concave_links_cells_clear_what_its_hull_does_not() -> None:
+    ur5 = ck.load_robot(vamp_resources("ur5") / "ur5.urdf", srdf=vamp_resources("ur5") / "ur5.srdf")
+    world = ck.CollisionWorld(ur5, [], self_margin_m=0.001)
+    screen = world.self_collision._screen
+    assert screen is not None and screen.near_cells and ur5.exact_meshes
+    pairs = [p for p, near in zip(world.self_collision._pairs, screen.near, strict=True) if near]
+    cells = NearCells(ur5.model, ur5.collision_model, pairs, robot_reach(ur5), ur5.exact_meshes)
+    hulls_only = near_cells(ur5, pairs)
+    exact = ExactPairs(cells.geometry_model, ur5.exact_meshes)
+    assert exact.refined.all()  # both near pairs have a concave link's mesh
+    q = np.random.default_rng(5).uniform(ur5.limits.lower, ur5.limits.upper, (2000, ur5.nq))
+    margins = [0.001] * len(pairs)
+    on_meshes = cells.clear(q, margins, on_meshes=True)
+    on_hulls = cells.clear(q, margins)
+    # never clearer than the meshes (the oracle: coal's distance on them), nor the hulls than the hulls
+    assert np.all(mesh_distances(cells, exact, q)[on_meshes] >= 0.001)
+    assert np.all(hull_distances(cells, q)[on_hulls] >= 0.001)
+    # the meshes clear more, and what they learned is not the hulls'
+    assert on_meshes.sum() > on_hulls.sum() + 100 and np.all(on_meshes[on_hulls])
+    np.testing.assert_array_equal(on_hulls, hulls_only.clear(q, margins))
+    # without meshes, a test on the meshes is the hulls' test
+    np.testing.assert_array_equal(hulls_only.clear(q, margins, on_meshes=True), on_hulls)

@@ -12,12 +12,20 @@ where the centre is clear, every configuration of the cell clears the margin, an
 ones need no coal. A cell remembers the largest margin it cleared and the smallest it did not.
 The grids are the robot's, kept across plans (:func:`~cpr_kin.collision.self_split.robot_self_screen`);
 what they gain: ``docs/tuning.md``, Kernels.
+
+Where a pair has an exact mesh (:mod:`cpr_kin.shapes.exact_pairs`), a test asked *on the meshes*
+has the meshes decide a centre the hulls do not clear, and remembers its answers apart from the
+hulls': a concave link's hull may stay within the margin over whole cells its mesh clears. The
+slack holds for the meshes as for the hulls (each mesh lies within its hull, on the same link),
+and a cell whose centre's meshes are apart by more than the slack cannot hold a configuration
+where they touch, or where one holds the other.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -29,6 +37,8 @@ from cpr_kin.bounds.pair_cells import CLEAR, UNKNOWN, CellGrids, cell_grids, cel
 from cpr_kin.bounds.reach import GeometryReach, relative_radii
 from cpr_kin.collision.coal_pools import configure_pool, pool_collisions
 from cpr_kin.collision.decisive import coal_error_m
+from cpr_kin.shapes.exact_meshes import ExactMesh
+from cpr_kin.shapes.exact_pairs import ExactPairs
 
 FloatArray = NDArray[np.float64]
 Float32Array = NDArray[np.float32]
@@ -58,6 +68,9 @@ class NearCells:
         pairs: the near pairs' geometry indices.
         reach: each geometry's bounds (:func:`cpr_kin.bounds.reach.geometry_reach`); default:
             within ``model``'s limits.
+        exact_meshes: the robot's exact link meshes by geometry index
+            (:attr:`cpr_kin.Robot.exact_meshes`), what a test on the meshes decides with
+            (module docstring); default: none, the hulls decide alone.
 
     Where some pair has no grid (:func:`~cpr_kin.bounds.pair_cells.cell_grids`), it clears
     nothing. ``tested`` counts the cells coal has tested.
@@ -69,6 +82,7 @@ class NearCells:
         collision_model: Any,
         pairs: Sequence[tuple[int, int]],
         reach: Sequence[GeometryReach] | None = None,
+        exact_meshes: Mapping[int, ExactMesh] | None = None,
     ) -> None:
         self.model = model
         self.geometry_model = collision_model.copy()
@@ -80,35 +94,40 @@ class NearCells:
             radii = relative_radii(model, collision_model, pairs, reach)
             self.grids = cell_grids(model, radii, self._slacks())
         size = self.grids.size if self.grids is not None else 0
-        self._cleared = np.full(size, -np.inf, dtype=np.float32)
-        self._refused = np.full(size, np.inf, dtype=np.float32)
+        self._exact = ExactPairs(self.geometry_model, exact_meshes or {})
+        hulls = _Learned(size)
+        self._learned = {False: hulls, True: _Learned(size) if self._exact else hulls}
         self._levels: dict[tuple[float, ...], Float32Array] = {}
         self._pools: dict[tuple[int, float], Any] = {}
         self._data = model.createData()
+        self._geometry_data = self.geometry_model.createData()
         self.tested = 0
 
     def __bool__(self) -> bool:
         return self.grids is not None
 
-    def clear(self, batch: FloatArray, margins_m: Sequence[float]) -> BoolArray:
+    def clear(self, batch: FloatArray, margins_m: Sequence[float], on_meshes: bool = False) -> BoolArray:
         """``(N,)`` where every near pair is certainly farther than its margin ``margins_m`` [m].
 
         ``margins_m``: one per near pair; coal's error is added. A cell not yet tested at that
-        margin (rounded up to :data:`LEVEL_M`) is tested now, at its centre.
+        margin (rounded up to :data:`LEVEL_M`) is tested now, at its centre. ``on_meshes``: the
+        pairs' distance on their exact meshes where they have one (module docstring), else on
+        the hulls.
         """
         grids = self.grids
         if grids is None:
             return np.zeros(len(batch), dtype=bool)
+        learned = self._learned[on_meshes]
         levels = self._level(tuple(margins_m))
-        cells, states = self._states(grids, batch, levels)
+        cells, states = self._states(grids, batch, levels, learned)
         unknown = np.flatnonzero(states == UNKNOWN)
         if unknown.size:
             for k, level in enumerate(levels.tolist()):
                 row_cells = cells[unknown, k]
-                untested = (self._cleared[row_cells] < level) & (self._refused[row_cells] > level)
+                untested = (learned.cleared[row_cells] < level) & (learned.refused[row_cells] > level)
                 if untested.any():
-                    self._test(grids, k, level, row_cells[untested], batch[unknown[untested]])
-            cells, states = self._states(grids, batch, levels)
+                    self._test(grids, k, level, row_cells[untested], batch[unknown[untested]], on_meshes)
+            cells, states = self._states(grids, batch, levels, learned)
         return np.asarray(states == CLEAR)
 
     def _slacks(self) -> FloatArray:
@@ -130,30 +149,41 @@ class NearCells:
         return self._levels[margins_m]
 
     def _states(
-        self, grids: CellGrids, batch: FloatArray, levels: Float32Array
+        self, grids: CellGrids, batch: FloatArray, levels: Float32Array, learned: _Learned
     ) -> tuple[IntArray, NDArray[np.int8]]:
         """:func:`cell_states` at ``levels`` ``(K,)`` [m]: cells ``(N, K)`` and states ``(N,)``."""
         cells = np.empty((len(batch), len(levels)), dtype=np.int64)
         states = np.empty(len(batch), dtype=np.int8)
         arrays = grids.arrays()
-        cell_states(np.ascontiguousarray(batch), *arrays, self._cleared, self._refused, levels, cells, states)
+        cell_states(
+            np.ascontiguousarray(batch), *arrays, learned.cleared, learned.refused, levels, cells, states
+        )
         return cells, states
 
-    def _test(self, grids: CellGrids, k: int, level_m: float, cells: IntArray, rows: FloatArray) -> None:
+    def _test(
+        self, grids: CellGrids, k: int, level_m: float, cells: IntArray, rows: FloatArray, on_meshes: bool
+    ) -> None:
         """Test pair ``k``'s ``cells`` (placed as ``rows``) at their centres, first above ``level_m`` [m]."""
+        learned = self._learned[on_meshes]
         distinct, first = np.unique(cells, return_index=True)
         centres = grids.centres(k, distinct, rows[first])
         above = level_m + TESTED_ABOVE_M
-        hit = self._hits(k, above + float(grids.slack_m[k]), centres)
-        self._cleared[distinct[~hit]] = _float32_at_most(above)
+        hit = self._hits(k, above + float(grids.slack_m[k]), centres, on_meshes)
+        learned.cleared[distinct[~hit]] = _float32_at_most(above)
         if hit.any():
-            self._refused[distinct[hit]] = np.minimum(self._refused[distinct[hit]], _float32_at_least(above))
-            distinct, hit = distinct[hit], self._hits(k, level_m + float(grids.slack_m[k]), centres[hit])
-            self._cleared[distinct[~hit]] = _float32_at_most(level_m)
-            self._refused[distinct[hit]] = _float32_at_least(level_m)
+            refused = np.minimum(learned.refused[distinct[hit]], _float32_at_least(above))
+            learned.refused[distinct[hit]] = refused
+            slack_m = float(grids.slack_m[k])
+            distinct, hit = distinct[hit], self._hits(k, level_m + slack_m, centres[hit], on_meshes)
+            learned.cleared[distinct[~hit]] = _float32_at_most(level_m)
+            learned.refused[distinct[hit]] = _float32_at_least(level_m)
 
-    def _hits(self, k: int, margin_m: float, centres: FloatArray) -> BoolArray:
-        """``(M,)`` whether pair ``k`` may be within ``margin_m`` [m] (coal's error added) at ``centres``."""
+    def _hits(self, k: int, margin_m: float, centres: FloatArray, on_meshes: bool) -> BoolArray:
+        """``(M,)`` whether pair ``k`` may be within ``margin_m`` [m] (coal's error added) at ``centres``.
+
+        On the hulls; ``on_meshes``, a hit on the hulls of a pair with an exact mesh is decided
+        again on the meshes.
+        """
         margin_m += float(coal_error_m(margin_m))
         key = (k, margin_m)
         if key not in self._pools:  # a few per pair: a plan asks a few margins
@@ -163,7 +193,12 @@ class NearCells:
             active = np.arange(len(self.geometry_model.collisionPairs)) == k
             configure_pool(self._pools[key], self.geometry_model, margin_m, active)
         self.tested += len(centres)
-        return pool_collisions(self._pools[key], self.model, self._data, self.geometry_model, centres, 1)
+        hit = pool_collisions(self._pools[key], self.model, self._data, self.geometry_model, centres, 1)
+        if on_meshes and self._exact.refined[k] and hit.any():
+            margins_m = np.full(len(self.geometry_model.collisionPairs), margin_m)
+            data = (self.model, self._data, self.geometry_model, self._geometry_data)
+            hit[hit] = self._exact.violated(*data, centres[hit], [k], margins_m)
+        return hit
 
 
 def _float32_at_least(value: float) -> np.float32:
@@ -176,3 +211,21 @@ def _float32_at_most(value: float) -> np.float32:
     """The largest float32 <= ``value``."""
     rounded = np.float32(value)
     return rounded if rounded <= value else np.nextafter(rounded, np.float32(-np.inf))
+
+
+@dataclass
+class _Learned:
+    """What the cells are known to clear, on one kind of geometry (hulls, or the exact meshes).
+
+    Attributes:
+        cleared: ``(C,)`` per cell, the largest margin [m] it is known to clear.
+        refused: ``(C,)`` per cell, the smallest margin [m] it is known not to clear.
+    """
+
+    size: int
+    cleared: Float32Array = field(init=False)
+    refused: Float32Array = field(init=False)
+
+    def __post_init__(self) -> None:
+        self.cleared = np.full(self.size, -np.inf, dtype=np.float32)
+        self.refused = np.full(self.size, np.inf, dtype=np.float32)

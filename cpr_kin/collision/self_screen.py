@@ -93,7 +93,8 @@ class ScreenedSelfTest:
         if self.near_pairs and not self._near_cells:
             hits[:] = self._coal(0, batch)
         elif self.near_pairs:  # coal where their cells are in doubt
-            doubtful = np.flatnonzero(~self._near_cells.clear(batch, self._coal_state.near_margins))
+            margins = self._coal_state.near_margins
+            doubtful = np.flatnonzero(~self._near_cells.clear(batch, margins, self._exact is not None))
             if doubtful.size:
                 hits[doubtful] = self._coal(0, batch[doubtful])
         if self.far_bounds.n_pairs:

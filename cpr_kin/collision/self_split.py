@@ -12,7 +12,7 @@ grids (:class:`~cpr_kin.collision.near_cells.NearCells`) go with the split, and 
 from __future__ import annotations
 
 import weakref
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -24,6 +24,7 @@ from cpr_kin.bounds.reach import GeometryReach
 from cpr_kin.bounds.self_bounds import SelfPairBounds
 from cpr_kin.collision.near_cells import NearCells
 from cpr_kin.collision.robot_reach import robot_reach
+from cpr_kin.shapes.exact_meshes import ExactMesh
 
 if TYPE_CHECKING:
     from cpr_kin.model.robot import Robot
@@ -86,12 +87,14 @@ class SelfScreen:
         pairs: Sequence[tuple[int, int]],
         threshold_m: float,
         reach: Sequence[GeometryReach] | None = None,
+        exact_meshes: Mapping[int, ExactMesh] | None = None,
     ) -> SelfScreen:
         """The split of ``pairs`` (geometry indices of ``geometry_model``) on ``model``'s ranges.
 
         ``threshold_m``: the distance [m] the probes ask the bounds about (:func:`screen_threshold`).
         ``reach``: each geometry's bounds (:func:`cpr_kin.bounds.reach.geometry_reach`); default:
-        within ``model``'s limits.
+        within ``model``'s limits. ``exact_meshes``: the robot's exact link meshes, for the near
+        cells' tests on the meshes (:class:`~cpr_kin.collision.near_cells.NearCells`); default: none.
         """
         probes = sampled_configurations(model, PROBES, np.random.default_rng(0))
         all_bounds = SelfPairBounds(model, geometry_model, pairs)
@@ -100,7 +103,8 @@ class SelfScreen:
         near.setflags(write=False)
         far = SelfPairBounds(model, geometry_model, [p for p, n in zip(pairs, near, strict=True) if not n])
         near_pairs = [p for p, n in zip(pairs, near, strict=True) if n]
-        return cls(all_bounds, far, near, NearCells(model, geometry_model, near_pairs, reach))
+        cells = NearCells(model, geometry_model, near_pairs, reach, exact_meshes)
+        return cls(all_bounds, far, near, cells)
 
 
 _SCREENS: weakref.WeakKeyDictionary[Robot, dict[tuple[Pairs, float], SelfScreen]] = (
@@ -117,5 +121,7 @@ def robot_self_screen(robot: Robot, pairs: Pairs, margin_m: float) -> SelfScreen
     screens = _SCREENS.setdefault(robot, {})
     key = (pairs, screen_threshold(margin_m))
     if key not in screens:
-        screens[key] = SelfScreen.build(robot.model, robot.collision_model, pairs, key[1], robot_reach(robot))
+        screens[key] = SelfScreen.build(
+            robot.model, robot.collision_model, pairs, key[1], robot_reach(robot), robot.exact_meshes
+        )
     return screens[key]
