@@ -65,10 +65,10 @@ def test_a_check_under_way_is_cut_an_overrun_after_the_limit() -> None:
 def test_past_the_cut_the_check_under_way_stops_and_its_candidate_is_refused(robot: ck.Robot) -> None:
     problem = build_problem(paper_scene(), robot)
     searched = search(Attempt(problem), None, None)
-    hopeless = beyond_margin(problem, searched)
-    late = choose(dataclasses.replace(problem, deadline=Deadline(0.0, 1.0)), searched, hopeless)
+    deepest = beyond_margin(problem, searched)
+    late = choose(dataclasses.replace(problem, deadline=Deadline(0.0, 1.0)), searched, deepest)
     assert isinstance(late, Choice)  # the oracle: past the limit, before the cut, the best passes
-    cut = choose(dataclasses.replace(problem, deadline=Deadline(0.0, 1.0, 0.0)), searched, hopeless)
+    cut = choose(dataclasses.replace(problem, deadline=Deadline(0.0, 1.0, 0.0)), searched, deepest)
     assert isinstance(cut, Refusal) and cut.verified == "1 candidate verified"
     assert cut.cause == f"the best candidate {STOPPED}" and not cut.check.times.size
     message = str(cut.error())

@@ -166,12 +166,12 @@ def test_a_best_candidate_deep_inside_the_margin_is_verified_in_one_timing_only(
         return original(*args)
 
     monkeypatch.setattr(choosing, "verify", counted)
-    hopeless = choosing.beyond_margin(problem, searched)
-    chosen = choosing.choose(problem, searched, hopeless)
+    deepest_words = choosing.beyond_margin(problem, searched)
+    chosen = choosing.choose(problem, searched, deepest_words)
     assert isinstance(chosen, choosing.Refusal) and len(verified) == 1
     assert "wall" in chosen.cause
     # past the deadline, not verified at all: the refusal names the deepest sample (the oracle's)
-    late = choosing.choose(dataclasses.replace(problem, deadline=Deadline(0.0, 1.0)), searched, hopeless)
+    late = choosing.choose(dataclasses.replace(problem, deadline=Deadline(0.0, 1.0)), searched, deepest_words)
     assert isinstance(late, choosing.Refusal) and len(verified) == 1 and late.verified == ""
     assert late.cause.startswith("no candidate was feasible; the best: ")
     assert f"to 'wall' {deepest:.3f} m at a sample of its path" in late.cause

@@ -222,17 +222,21 @@ def foreseen_clear(problem: Problem, candidates: FloatArray) -> BoolArray:
     return np.asarray(keeps.reshape(len(candidates), -1).all(axis=1))
 
 
-def choose(problem: Problem, searched: SearchResult, hopeless: str | None) -> Choice | Refusal:
-    """The first candidate whose timing passes (module docstring); ``hopeless``: :func:`beyond_margin`'s."""
+def choose(problem: Problem, searched: SearchResult, deepest: str | None) -> Choice | Refusal:
+    """The first candidate whose timing passes (module docstring).
+
+    ``deepest``: :func:`beyond_margin`'s sample of the best deeper inside a margin than a step, in
+    words (``None``: none is). Where there is one, the best's check would only say why it fails.
+    """
     objective = problem.objective
     order = np.argsort(searched.population_fitness, kind="stable")
     feasible = objective.feasible(searched.population_fitness)
     candidates = distinct([searched.x] + [searched.population[k] for k in order if feasible[k]])
     timed: dict[int, Offered] = {}
     verified: dict[int, Verification] = {}  # each candidate's first verification
-    if hopeless is not None and problem.deadline.passed():  # its check would only say why it fails
+    if deepest is not None and problem.deadline.passed():  # its check would only say why it fails
         why = infeasibility(objective.breakdown(searched.x[None]), problem)
-        cause = f"no candidate was feasible; the best: {hopeless}, {why}"
+        cause = f"no candidate was feasible; the best: {deepest}, {why}"
         return Refusal(cause, unchecked(problem.scene.safety_margin, problem.scene.planner.verify_step_m))
     # an infeasible best is verified first, whatever its foresight: its check says why
     foresee = bool(objective.feasible(searched.fitness)) and not problem.deadline.passed()
@@ -242,7 +246,7 @@ def choose(problem: Problem, searched: SearchResult, hopeless: str | None) -> Ch
         if verification.accepted:
             x = candidates[k]
             return Choice(x, objective.nodes(x[None])[0], timing, verification, len(timed))
-        if hopeless or problem.deadline.passed():
+        if deepest is not None or problem.deadline.passed():
             break  # its other timings follow the same path; or time is up
     first = verified.get(0) or next(iter(verified.values()))  # candidates is never empty
     found = f"the best candidate {'; '.join(first.problems)}"
