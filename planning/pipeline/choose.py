@@ -223,11 +223,7 @@ def foreseen_clear(problem: Problem, candidates: FloatArray) -> BoolArray:
 
 
 def choose(problem: Problem, searched: SearchResult, deepest: str | None) -> Choice | Refusal:
-    """The first candidate whose timing passes (module docstring).
-
-    ``deepest``: :func:`beyond_margin`'s sample of the best deeper inside a margin than a step, in
-    words (``None``: none is). Where there is one, the best's check would only say why it fails.
-    """
+    """The first candidate whose timing passes (module docstring); ``deepest``: :func:`beyond_margin`'s."""
     objective = problem.objective
     order = np.argsort(searched.population_fitness, kind="stable")
     feasible = objective.feasible(searched.population_fitness)
