@@ -8,6 +8,13 @@ passages), and prints the SHA-256 of each plan's ``cpr-trajectory/1`` file (with
 times; the recorded URDF and SRDF paths replaced by their names) and one digest of them all. Run it on
 two checkouts: a refactoring that means to change no result must print the same digest.
 A scene with no trajectory prints the failure's class instead of a hash.
+
+Those scenes are all the CPR's, whose links are their own collision shapes. ``--arms N`` also
+plans ``N`` scenes of :func:`planning.bench.arm_scenes.blocked_scene` (seeds 0 to ``N - 1``) for
+each of :data:`ARMS`, example-robot-data's arms: the UR5's concave links have exact meshes, so
+its plans go to the hulls first or, where the ends clear only on the meshes, to the meshes,
+paths the CPR never takes. Their hashes get a digest of their own (``arms``), so that ``all``
+stays comparable with a run without them.
 """
 
 from __future__ import annotations
@@ -20,10 +27,13 @@ from pathlib import Path
 from typing import Any
 
 import cpr_kin as ck
+from cpr_kin.model.packages import example_robot
 from planning import NoSolutionError, Optimizer, PlannerSettings, Scene, load_scene, plan, warm_up
+from planning.bench.arm_scenes import blocked_scene
 from planning.bench.scene_generator import generate_scenes
 from planning.cli.arguments import integer_at_least
 from planning.io.bundled import bundled_scene_paths, paper_scene_path
+from planning.io.scene_file import parse_scene
 from planning.io.trajectory_io import trajectory_json
 from planning.search import baselines
 
@@ -41,6 +51,8 @@ MODES: dict[str, dict[str, Any]] = {
     "no seeding": {"seeding": "none"},
 }
 """Planner-setting changes applied to the paper case, one plan each."""
+ARMS = ("ur5", "panda")
+"""The example-robot-data arms of ``--arms``: one with exact meshes (the UR5's), one without."""
 
 
 def scenes(generated: int, robot: ck.Robot) -> Iterator[tuple[str, Scene]]:
@@ -60,6 +72,16 @@ def scenes(generated: int, robot: ck.Robot) -> Iterator[tuple[str, Scene]]:
     yield "paper, goal at start", dataclasses.replace(paper, goal=paper.start)
     for scene in generate_scenes(generated, seed=5, robot=robot, narrow=generated // 4):
         yield scene.name, scene
+
+
+def arm_scenes(count: int) -> Iterator[tuple[str, Scene, ck.Robot]]:
+    """``(label, scene, robot)`` of ``count`` blocked scenes of each of :data:`ARMS` (module docstring)."""
+    for name in ARMS:
+        robot = ck.load_robot(example_robot(name))
+        warm_up(robot)
+        for seed in range(count):
+            document = blocked_scene(f"{name}_{seed}", name, robot, seed)
+            yield document["name"], parse_scene(document, f"{name} seed {seed}"), robot
 
 
 def _changed(scene: Scene, **changes: Any) -> Scene:
@@ -84,6 +106,12 @@ def main() -> None:
     parser.add_argument(
         "--generated", type=integer_at_least(0), default=20, help="generated scenes (default: 20)"
     )
+    parser.add_argument(
+        "--arms",
+        type=integer_at_least(0),
+        default=0,
+        help="blocked scenes of each example-robot-data arm, under their own digest (default: 0)",
+    )
     args = parser.parse_args()
     robot = ck.load_cpr()
     warm_up(robot)
@@ -101,6 +129,13 @@ def main() -> None:
         total.update(f"{label} {digest}\n".encode())
         print(f"{label:<36} {digest}", flush=True)
     print(f"{'all':<36} {total.hexdigest()}")
+    if args.arms:
+        arms = hashlib.sha256()
+        for label, scene, arm in arm_scenes(args.arms):
+            digest = fingerprint(scene, arm)
+            arms.update(f"{label} {digest}\n".encode())
+            print(f"{label:<36} {digest}", flush=True)
+        print(f"{'arms':<36} {arms.hexdigest()}")
 
 
 if __name__ == "__main__":
