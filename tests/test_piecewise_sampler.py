@@ -71,3 +71,18 @@ def test_buffer_is_reused_and_resized() -> None:
 def test_bad_input(knots: list[float], times: list[float], pattern: str) -> None:
     with pytest.raises(PlanningError, match=pattern):
         PiecewiseSampler(knots, times, 8)
+
+
+def test_samplers_of_the_same_times_share_read_only_matrices_but_not_their_buffers() -> None:
+    times = np.linspace(0.0, 2.0, 11)
+    first = PiecewiseSampler([0.0, 1.0, 2.0], times, 8, derivatives=2)
+    second = PiecewiseSampler(np.array([0.0, 1.0, 2.0]), times.copy(), 8, derivatives=2)
+    assert first._blocks is second._blocks  # computed once
+    with pytest.raises(ValueError):
+        first._blocks[0][2][0][0, 0] = 1.0
+    coefficients = np.random.default_rng(0).normal(size=(2, 3, 8))
+    kept = first(coefficients)
+    expected = kept.copy()
+    second(2.0 * coefficients)  # another sampler's call leaves this one's result as it was
+    np.testing.assert_array_equal(kept, expected)
+    np.testing.assert_allclose(second(coefficients), expected, rtol=0, atol=0)

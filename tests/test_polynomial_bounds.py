@@ -54,3 +54,11 @@ def test_bad_input() -> None:
         DerivativeBounds([0.0, 1.0], 8, (8,))
     with pytest.raises(PlanningError, match=r"expected \(1, M, 8\)"):
         DerivativeBounds([0.0, 1.0], 8, (1,))(np.zeros((2, 3, 8)))
+
+
+def test_bounds_of_equal_knots_share_their_read_only_matrices() -> None:
+    first = DerivativeBounds([0.0, 1.0, 2.5], 8, (1, 2, 3))
+    second = DerivativeBounds(np.array([0.0, 1.0, 2.5]), 8, [1, 2, 3])
+    assert first._matrices is second._matrices  # computed once
+    assert not first._matrices.flags.writeable
+    assert DerivativeBounds([0.0, 1.0, 2.0], 8, (1, 2, 3))._matrices is not first._matrices

@@ -4,10 +4,14 @@ The fitness evaluates every joint of every candidate path (a few hundred columns
 same times over and over. Precomputing, per segment, the matrix of (derivative) powers of
 the local times turns each evaluation into one matrix product per segment and order. The
 results go into buffers kept between calls: for arrays of this size (a few hundred kB) a
-fresh allocation costs more in page faults than the products themselves.
+fresh allocation costs more in page faults than the products themselves. The matrices depend
+only on the knots and times, which every problem of a planner's settings shares (the search's
+knots are the waypoints' indices): they are computed once for each (:func:`_blocks`).
 """
 
 from __future__ import annotations
+
+import functools
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -64,17 +68,11 @@ class PiecewiseSampler:
             raise PlanningError(f"derivatives = {derivatives} must lie in [0, {order - 1}]")
         if not 0 <= first <= derivatives:
             raise PlanningError(f"first = {first} must lie in [0, derivatives = {derivatives}]")
-        segment = np.clip(np.searchsorted(knots, times, side="right") - 1, 0, len(knots) - 2)
-        local = times - knots[segment]
         self.order = order
         self.derivatives = derivatives
         self.first = first
         self.count = len(times)
-        self._blocks: list[tuple[int, slice, list[FloatArray]]] = []
-        for i in np.unique(segment):
-            rows = np.flatnonzero(segment == i)  # contiguous: the times are sorted
-            powers = [derivative_powers(local[rows], order, r) for r in range(first, derivatives + 1)]
-            self._blocks.append((int(i), slice(int(rows[0]), int(rows[-1]) + 1), powers))
+        self._blocks = _blocks(tuple(knots.tolist()), tuple(times.tolist()), order, derivatives, first)
         self._buffer = np.empty(0)  # grows to the largest call's size, reused below it
 
     def __call__(self, coefficients: FloatArray) -> FloatArray:
@@ -89,3 +87,25 @@ class PiecewiseSampler:
             for r, matrix in enumerate(powers):
                 np.matmul(matrix, columns, out=out[r, rows])
         return out
+
+
+Block = tuple[int, slice, tuple[FloatArray, ...]]
+"""A segment, the rows of its times, and its matrices of :func:`derivative_powers` (read-only)."""
+
+
+@functools.lru_cache(maxsize=64)
+def _blocks(
+    knots: tuple[float, ...], times: tuple[float, ...], order: int, derivatives: int, first: int
+) -> tuple[Block, ...]:
+    """Per segment holding some of ``times``: its rows and power matrices (:class:`PiecewiseSampler`)."""
+    knots_s, times_s = np.asarray(knots), np.asarray(times)
+    segment = np.clip(np.searchsorted(knots_s, times_s, side="right") - 1, 0, len(knots_s) - 2)
+    local = times_s - knots_s[segment]
+    blocks = []
+    for i in np.unique(segment):
+        rows = np.flatnonzero(segment == i)  # contiguous: the times are sorted
+        powers = tuple(derivative_powers(local[rows], order, r) for r in range(first, derivatives + 1))
+        for matrix in powers:
+            matrix.setflags(write=False)  # shared by every sampler of these times
+        blocks.append((int(i), slice(int(rows[0]), int(rows[-1]) + 1), powers))
+    return tuple(blocks)

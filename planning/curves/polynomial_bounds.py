@@ -18,6 +18,7 @@ are sampled densely.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from math import comb
 
@@ -65,15 +66,7 @@ class DerivativeBounds:
             raise PlanningError(f"derivatives {list(derivatives)} must be orders in [0, {order - 1}]")
         self.order = order
         self.derivatives = tuple(int(r) for r in derivatives)
-        # per segment: all derivatives' Bernstein coefficients in one product, (N, R order, order)
-        self._matrices = np.stack(
-            [
-                np.vstack(
-                    [bernstein_matrix(order, h) @ derivative_matrix(r, order) for r in self.derivatives]
-                )
-                for h in np.diff(knots)
-            ]
-        )
+        self._matrices = _hull_matrices(tuple(np.diff(knots).tolist()), order, self.derivatives)
 
     def __call__(self, coefficients: FloatArray) -> FloatArray:
         """``(len(derivatives), M)`` bounds for ``(N, M, order)`` coefficients."""
@@ -84,3 +77,19 @@ class DerivativeBounds:
         # columns last, so that the largest |coefficient| is taken across contiguous rows
         hull = np.abs(np.matmul(self._matrices, coefficients.transpose(0, 2, 1)))
         return np.asarray(hull.reshape(n, len(self.derivatives), self.order, -1).max(axis=(0, 2)))
+
+
+@functools.lru_cache(maxsize=64)
+def _hull_matrices(steps_s: tuple[float, ...], order: int, derivatives: tuple[int, ...]) -> FloatArray:
+    """``(N, R order, order)`` Bernstein matrices of every derivative, per segment of ``steps_s`` [s].
+
+    :class:`DerivativeBounds`' one product per segment; read-only, shared by equal knots.
+    """
+    matrices = np.stack(
+        [
+            np.vstack([bernstein_matrix(order, h) @ derivative_matrix(r, order) for r in derivatives])
+            for h in steps_s
+        ]
+    )
+    matrices.setflags(write=False)
+    return matrices
