@@ -87,16 +87,11 @@ def test_the_margin_test_follows_the_mesh(tmp_path: Path) -> None:
     model = pin.Model()
     # the hulls 0.1 m deep, the sampled excess 0.247 m: the mesh is asked for margins up to 0.147 m
     for margin_m, expected in ((0.1, False), (0.14, False), (0.151, True), (0.3, True)):
-        violated = found.pairs.violated(
-            model,
-            model.createData(),
-            found.geometry_model,
-            found.geometry_data,
-            np.zeros((1, 0)),
-            [0],
-            np.array([margin_m]),
-        )
+        data = (model, model.createData(), found.geometry_model, found.geometry_data)
+        violated = found.pairs.violated(*data, np.zeros((1, 0)), [0], np.array([margin_m]))
         assert violated[0] == expected
+        # one margin for every pair asks the same
+        assert found.pairs.violated(*data, np.zeros((1, 0)), [0], margin_m)[0] == expected
 
 
 UR5 = ROBOTS / "ur_description" / "urdf" / "ur5_robot.urdf"

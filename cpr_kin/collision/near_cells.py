@@ -195,9 +195,8 @@ class NearCells:
         self.tested += len(centres)
         hit = pool_collisions(self._pools[key], self.model, self._data, self.geometry_model, centres, 1)
         if on_meshes and self._exact.refined[k] and hit.any():
-            margins_m = np.full(len(self.geometry_model.collisionPairs), margin_m)
             data = (self.model, self._data, self.geometry_model, self._geometry_data)
-            hit[hit] = self._exact.violated(*data, centres[hit], [k], margins_m)
+            hit[hit] = self._exact.violated(*data, centres[hit], [k], margin_m)
         return hit
 
 

@@ -100,9 +100,8 @@ class ObstacleTests:
             return False
         if self._exact_data is None:
             self._exact_data = self.geometry_model.createData()
-        margins = np.full(len(self.geometry_model.collisionPairs), margin_m)
         data = (self.model, self._data, self.geometry_model, self._exact_data)
-        return not exact.violated(*data, q[None], [pair], margins)[0]
+        return not exact.violated(*data, q[None], [pair], margin_m)[0]
 
     def _geometry_data(self, margin_m: float) -> Any:
         """A geometry data whose collision tests have the security margin ``margin_m`` [m]."""

@@ -197,15 +197,17 @@ class ExactPairs:
         geometry_data: Any,
         batch: FloatArray,
         pairs: Sequence[int],
-        margins_m: FloatArray,
+        margins_m: float | FloatArray,
     ) -> BoolArray:
         """``(N,)`` whether some of ``pairs`` is closer than its margin at configurations ``batch``.
 
-        ``margins_m`` ``(P,)`` one margin per collision pair [m]. The pairs without a mesh are
-        asked first; a pair with one goes to its meshes only in its margin's band (module docstring).
+        ``margins_m`` [m]: one margin for every pair, or ``(P,)`` one per collision pair. The
+        pairs without a mesh are asked first; a pair with one goes to its meshes only in its
+        margin's band (module docstring).
         """
         order = sorted(pairs, key=lambda p: bool(self.refined[p]))
-        margins, excess, refined = margins_m.tolist(), self.excess_m.tolist(), self.refined.tolist()
+        margins = np.broadcast_to(np.asarray(margins_m, dtype=float), len(self._pairs)).tolist()
+        excess, refined = self.excess_m.tolist(), self.refined.tolist()
         every = 4 * len(order) >= len(self._pairs)  # coal on every pair in one call, for most of them
         found = np.zeros(len(batch), dtype=bool)
         for row, q in enumerate(batch):
