@@ -11,6 +11,8 @@ import pytest
 import yaml
 
 import cpr_kin as ck
+from cpr_kin.certified.motion import motion_radii
+from cpr_kin.collision.robot_reach import robot_reach
 from cpr_kin.model.packages import example_robot
 from planning import build_problem, plan
 from planning.cli import main
@@ -51,6 +53,20 @@ def test_the_hulls_view_answers_as_a_robot_without_meshes(ur10: ck.Robot) -> Non
     # the world itself still asks its meshes: fewer configurations refused
     assert world.self_collision.violated(q, 0.01).sum() < view.self_collision.violated(q, 0.01).sum()
     assert view.robot.exact_meshes == {} and world.robot.exact_meshes
+
+
+def test_a_robot_on_its_hulls_is_one_robot_whose_reach_is_computed_once(
+    ur10: ck.Robot, robot: ck.Robot
+) -> None:
+    hulls = ur10.on_hulls
+    assert hulls is ur10.on_hulls and hulls.exact_meshes == {} and ur10.exact_meshes
+    assert hulls.model is ur10.model and hulls.collision_model is ur10.collision_model
+    assert robot.on_hulls is robot  # the CPR has no exact meshes
+    world = ck.CollisionWorld(ur10, [], self_margin_m=0.01)
+    assert world.on_hulls().robot is hulls and world.on_hulls().robot is hulls  # every plan's view: one robot
+    # what is computed once per robot (the reach, the motion radii of every verification) stays computed
+    assert robot_reach(hulls) is robot_reach(world.on_hulls().robot)
+    np.testing.assert_array_equal(motion_radii(hulls), motion_radii(ur10))  # the same shapes, the same reach
 
 
 def test_ends_clear_on_the_hulls_plan_there_and_pass_on_the_meshes(ur10: ck.Robot) -> None:

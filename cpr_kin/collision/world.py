@@ -11,7 +11,6 @@ obstacle. Distances are accurate to about 1e-6 of their size (coal's GJK toleran
 from __future__ import annotations
 
 import copy
-import dataclasses
 from collections.abc import Sequence
 
 import numpy as np
@@ -99,7 +98,7 @@ class CollisionWorld:
     def on_hulls(self) -> CollisionWorld:
         """The world with its robot's hulls deciding alone, sharing its data (use one at a time)."""
         hulls = copy.copy(self)
-        hulls.robot = dataclasses.replace(self.robot, exact_meshes={})
+        hulls.robot = self.robot.on_hulls
         hulls._exact = ExactPairs(self.geometry_model, {})
         hulls._tests = self._tests.on_hulls()
         hulls.self_collision = self.self_collision.on_hulls()

@@ -11,6 +11,7 @@ and its own IK of a tool position. The collision geometry forms two groups:
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -136,6 +137,15 @@ class Robot:
     def visual_model(self) -> Any:
         """Pinocchio geometry model of the visual shapes (class docstring)."""
         return self.build_visual_model()
+
+    @cached_property
+    def on_hulls(self) -> Robot:
+        """The robot with its shapes deciding alone: no exact meshes (itself when it has none).
+
+        One object per robot, so that what is computed once per robot (its reach, its self
+        screens) is computed once for its hulls too, however many plans go on them.
+        """
+        return dataclasses.replace(self, exact_meshes={}) if self.exact_meshes else self
 
     @property
     def joint_names(self) -> tuple[str, ...]:
