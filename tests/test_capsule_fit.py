@@ -1,6 +1,7 @@
 from __future__ import annotations
 
 import itertools
+from pathlib import Path
 
 import coal
 import numpy as np
@@ -8,7 +9,14 @@ import pytest
 import trimesh
 from scipy.spatial.transform import Rotation
 
-from cpr_kin.bounds.capsule_fit import Capsule, capsule_along, enclosing_circle, fitted_capsule, frame_about
+from cpr_kin.bounds.capsule_fit import (
+    Capsule,
+    _fitted,
+    capsule_along,
+    enclosing_circle,
+    fitted_capsule,
+    frame_about,
+)
 from cpr_kin.bounds.pair_bounds import bounding_capsule
 
 
@@ -127,3 +135,27 @@ def test_the_fit_is_memoised_and_refuses_bad_points() -> None:
     for bad in (np.zeros((0, 3)), np.zeros((4, 2)), np.array([[0.0, np.nan, 1.0]])):
         with pytest.raises(ValueError, match="must be"):
             fitted_capsule(bad)
+
+
+def test_a_meshs_fit_is_kept_on_disk_and_an_edited_one_is_fitted_anew(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("CPR_FIREFLY_CACHE", str(tmp_path))
+    points = Rotation.random(random_state=3).apply(
+        np.random.default_rng(3).normal(size=(400, 3)) * [0.2, 0.05, 0.04]
+    )
+    fitted = fitted_capsule(points)
+    (kept,) = (tmp_path / "capsule-fits").glob("*.npy")
+    np.testing.assert_array_equal(np.load(kept), np.append(fitted.ends.ravel(), fitted.radius))
+    _fitted.cache_clear()  # a new process: read from disk, the same capsule
+    read = fitted_capsule(points)
+    assert read is not fitted
+    np.testing.assert_array_equal(read.ends, fitted.ends)
+    assert read.radius == fitted.radius
+    np.save(kept, np.append(fitted.ends.ravel(), fitted.radius / 2))  # edited: it no longer holds them
+    _fitted.cache_clear()
+    again = fitted_capsule(points)
+    assert again.radius == fitted.radius and np.all(again.distances(points) <= again.radius)
+    small = np.random.default_rng(4).normal(size=(8, 3))  # a primitive's corners: not kept
+    fitted_capsule(small)
+    assert len(list((tmp_path / "capsule-fits").glob("*.npy"))) == 1
