@@ -248,6 +248,9 @@ def test_paper_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> No
     assert code == 0
     assert "FMA processing time" in stdout and "53 s" in stdout
     assert "Beside the paper" in (tmp_path / "paper" / "report.md").read_text()
+    # the paper's jerk ranges, one row per joint it names, in that joint's unit (the robot's)
+    assert "jerk theta1 min / max                      -0.071 / 0.2026 rad/s^3" in stdout
+    assert "-0.518 / 0.673 m/s^3" in stdout and "-0.292 / 0.265 m/s^3" in stdout
 
 
 @pytest.mark.slow

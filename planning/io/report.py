@@ -7,7 +7,9 @@ reports cannot disagree.
 
 from __future__ import annotations
 
+import json
 from collections.abc import Sequence
+from importlib import resources
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -15,14 +17,17 @@ import numpy as np
 if TYPE_CHECKING:  # types only: a batch's parent formats tables without the planner
     from planning.pipeline.result import PlanResult
 
-PAPER_FIGURES = {
-    "fma_time_s": 53.0,
-    "objective_s": 3.98,
-    "node_deviation_um": 0.55,
-    "node_deviation_limit_um": 20.0,
-    "jerk": {"theta1": (-0.071, 0.2026), "d2": (-0.518, 0.673), "d3": (-0.292, 0.265)},
-}
-"""The paper's reported figures (docs/paper_case.md)."""
+
+def paper_figures() -> dict[str, Any]:
+    """The paper's reported figures (docs/paper_case.md), data of its case beside its scene.
+
+    ``planning/scenes/paper_figures.json``: its FMA time [s], objective [s], node deviation
+    and its limit [um], and each joint's jerk range by joint name.
+    """
+    figures: dict[str, Any] = json.loads(
+        (resources.files("planning") / "scenes" / "paper_figures.json").read_text()
+    )
+    return figures
 
 
 def plan_record(result: PlanResult, timings: bool = True) -> dict[str, Any]:
@@ -54,26 +59,26 @@ def summary_line(result: PlanResult) -> str:
 
 def paper_rows(result: PlanResult) -> list[tuple[str, str, str]]:
     """``(figure, paper, ours)`` rows for the paper case."""
-    r = plan_record(result)
+    r, paper = plan_record(result), paper_figures()
     firefly = result.scene.planner.firefly
     rows = [
         (
             f"FMA processing time (n={firefly.fireflies}, {firefly.iterations} iterations)",
-            f"{PAPER_FIGURES['fma_time_s']:.0f} s",
+            f"{paper['fma_time_s']:.0f} s",
             f"{r['optimiser_time_s']:.3f} s",
         ),
         ("planning time, end to end", "-", f"{r['planning_time_s']:.3f} s"),
         ("objective evaluations", "-", f"{r['evaluations']}"),
-        ("objective value: PTP time t_sol", f"{PAPER_FIGURES['objective_s']} s", f"{r['t_sol']:.3f} s"),
+        ("objective value: PTP time t_sol", f"{paper['objective_s']} s", f"{r['t_sol']:.3f} s"),
         ("fitness (eq. 4)", "-", f"{r['fitness']:.4f}"),
         (
             "max node deviation (p=1e6, h=1 s)",
-            f"{PAPER_FIGURES['node_deviation_um']} um (limit 20 um)",
+            f"{paper['node_deviation_um']} um (limit {paper['node_deviation_limit_um']:g} um)",
             f"{r['max_node_deviation'] * 1e6:.2f} um",
         ),
     ]
-    for joint, (low, high) in PAPER_FIGURES["jerk"].items():  # type: ignore[attr-defined]
-        unit = "rad/s^3" if joint.startswith("theta") else "m/s^3"
+    for joint, (low, high) in paper["jerk"].items():
+        unit = f"{result.robot.joint_unit(joint)}/s^3"
         rows.append(
             (
                 f"jerk {joint} min / max",

@@ -84,8 +84,9 @@ class PlannerSettings:
             all the way out (``docs/tuning.md``).
         max_node_deviation: largest spline node deviation a candidate may have [rad or m];
             ``None`` (default): no bound. The paper case requires 20e-6.
-        moving_joints: joints the waypoints move; default: theta1, d2, d3, and a wrist
-            joint when start and goal differ in it.
+        moving_joints: joints the waypoints move; default: every joint but the robot's wrist
+            joints (:attr:`cpr_kin.Robot.wrist_joints`), and a wrist joint when start and goal
+            differ in it.
         seeding: ``"paths"`` (default): the search starts from the straight line and, when
             that is blocked, from a sampling planner's path, with more waypoints if the
             path needs them (:mod:`planning.pipeline.seeding`); ``"none"`` (the paper): from a
