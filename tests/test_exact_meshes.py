@@ -110,6 +110,27 @@ def test_holds_agrees_with_trimeshs_signed_distance_on_a_torus_whichever_way_it_
     assert not mesh.holds(np.zeros((1, 3)))[0]  # the hole is outside
 
 
+def rows_sorted(array: np.ndarray) -> np.ndarray:
+    """``array``'s rows in lexicographic order."""
+    return array[np.lexsort(array.T[::-1])]
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_hull_planes_are_scipys_qhull_facets(seed: int) -> None:
+    """coal's Qhull gives the facets SciPy's does (the same options), each holding every point."""
+    from scipy.spatial import ConvexHull
+
+    rng = np.random.default_rng(seed)
+    torus = trimesh.creation.torus(major_radius=0.2, minor_radius=0.05, major_sections=24, minor_sections=12)
+    for points in (np.asarray(torus.vertices), rng.normal(size=(500, 3)) * (0.3, 0.1, 0.05)):
+        planes = hull_planes(points)
+        expected = ConvexHull(points, qhull_options="Qt").equations
+        assert planes.shape == expected.shape
+        np.testing.assert_array_equal(rows_sorted(planes), rows_sorted(expected))  # the same facets
+        np.testing.assert_allclose(np.linalg.norm(planes[:, :3], axis=1), 1.0)
+        assert np.all(points @ planes[:, :3].T + planes[:, 3] <= 1e-12)  # outward normals
+
+
 def test_holds_any_is_holds_of_the_moved_points_any() -> None:
     torus = trimesh.creation.torus(major_radius=0.2, minor_radius=0.05, major_sections=24, minor_sections=12)
     triangles = np.asarray(torus.triangles)

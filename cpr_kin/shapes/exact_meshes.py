@@ -271,11 +271,15 @@ def _triangles(source: MeshSource) -> tuple[FloatArray, FloatArray | None, Float
 
 
 def hull_planes(points: FloatArray) -> FloatArray:
-    """``(H, 4)`` the facets' planes of the convex hull of ``points`` ``(..., 3)`` (:class:`ExactMesh`)."""
-    from scipy.spatial import ConvexHull
+    """``(H, 4)`` the facets' planes of the convex hull of ``points`` ``(..., 3)`` (:class:`ExactMesh`).
 
-    equations: FloatArray = ConvexHull(points.reshape(-1, 3), qhull_options="Qt").equations
-    return equations
+    By coal's Qhull (options ``Qt``), which the robot's hulls are built with: SciPy's
+    ``spatial`` (a tenth of a second to import) is not needed to load a robot.
+    """
+    corners = coal.StdVec_Vec3s()
+    corners.extend(list(np.asarray(points, dtype=float).reshape(-1, 3)))
+    hull = coal.Convex.convexHull(corners, True, "Qt")
+    return np.column_stack([np.asarray(hull.normals()), np.asarray(hull.offsets()).ravel()])
 
 
 def as_transform(placement: Any) -> Any:
