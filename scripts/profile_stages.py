@@ -24,11 +24,17 @@ functions of the pipeline that do each stage are wrapped in a timer (nothing els
 - ``other``: the rest of the plan (the hulls' problem, the choice's bookkeeping, the result).
 
 A stage's time excludes the stages it calls (a path found inside the seeding is the path's),
-so the stages and ``other`` add up to the plan's wall time. Printed per robot and class: the
+so the stages and ``other`` add up to the plan's wall time. What the time buys across the
+stages is timed too, each computation inclusively (:data:`COMPUTATIONS`: the margin tests of
+obstacles and of the robot's own pairs, the near cells' first tests, the closest pairs' coal
+distances, the search's torque-limited duration estimate, RNEA, the trajectories' extrema); they
+overlap (the self tests hold the cells' tests, the estimate its RNEA), so their shares need not
+add up. Printed per robot and class: the
 problems planned, their median plan [ms] and median duration over Ruckig's jerk-limited bound
 for the straight line (:func:`planning.bench.ruckig_bound.free_space_bound`: what each stage's
 time buys), then each stage's median [ms] and its share of the class's summed time; the table
-as markdown to ``DIR/stages.md``. ``--planner`` changes the scenes' planner settings (the keys
+as markdown to ``DIR/stages.md``; then each computation's summed time [s] and share, to
+``DIR/computations.md``. ``--planner`` changes the scenes' planner settings (the keys
 of a scene file's ``planner:`` block, each value read as YAML): ``iterations=0 refine=none``
 profiles the pipeline without its search. Every scene and robot is loaded
 before anything runs: a missing or malformed file, a task (not one motion), or a robot that does
@@ -40,13 +46,14 @@ from __future__ import annotations
 
 import argparse
 import functools
+import importlib
 import statistics
 import sys
 import tempfile
 import time
 from collections import defaultdict
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -72,6 +79,16 @@ STAGES: dict[str, tuple[str, str]] = {
     "verify": ("planning.pipeline.verification", "verify_trajectory"),
 }
 """Each stage's function, by module and name (the module docstring)."""
+COMPUTATIONS: dict[str, tuple[str, str]] = {
+    "obstacle tests": ("cpr_kin.collision.world", "CollisionWorld.margin_violated"),
+    "self tests": ("cpr_kin.collision.self_screen", "ScreenedSelfTest.violated"),
+    "cells learned": ("cpr_kin.collision.near_cells", "NearCells._test"),
+    "closest pairs": ("cpr_kin.collision.closest_pairs", "closest_pairs"),
+    "torque estimate": ("planning.curves.torque_estimate", "sampled_torque_durations"),
+    "RNEA": ("cpr_kin.kinematics.dynamics", "Dynamics.torques"),
+    "extrema": ("planning.curves.trajectory", "Trajectory.extrema"),
+}
+"""Computations that cut across the stages, by module and name (``Class.method`` for a method)."""
 
 
 class StageClock:
@@ -119,6 +136,55 @@ class StageClock:
         return spent
 
 
+class ComputationClock:
+    """Inclusive wall times of the wrapped computations (a call inside an open one of its own: once).
+
+    ``clock``: the time [s] (default: ``time.perf_counter``).
+    """
+
+    def __init__(self, clock: Callable[[], float] = time.perf_counter) -> None:
+        self.clock = clock
+        self.spent_s: dict[str, float] = defaultdict(float)
+        self._open: dict[str, int] = defaultdict(int)
+
+    def wrapped(self, name: str, function: Callable[..., Any]) -> Callable[..., Any]:
+        """``function`` whose calls are charged to ``name``, with all they call."""
+
+        @functools.wraps(function)
+        def timed(*args: Any, **kwargs: Any) -> Any:
+            if self._open[name]:
+                return function(*args, **kwargs)
+            self._open[name] += 1
+            started = self.clock()
+            try:
+                return function(*args, **kwargs)
+            finally:
+                self.spent_s[name] += self.clock() - started
+                self._open[name] -= 1
+
+        return timed
+
+    def install(self) -> None:
+        """Wrap every computation: a method on its class, a function wherever it was imported by name."""
+        for name, (module_name, attribute) in COMPUTATIONS.items():
+            owner: Any = importlib.import_module(module_name)
+            class_name, _, function_name = attribute.rpartition(".")
+            if class_name:
+                owner = getattr(owner, class_name)
+            original = getattr(owner, function_name)
+            timed = self.wrapped(name, original)
+            setattr(owner, function_name, timed)
+            for module in list(sys.modules.values()) if not class_name else ():
+                if getattr(module, "__dict__", {}).get(function_name) is original:
+                    setattr(module, function_name, timed)
+
+    def lap(self) -> dict[str, float]:
+        """The computations' times since the last lap [s], and reset."""
+        spent = {name: self.spent_s.get(name, 0.0) for name in COMPUTATIONS}
+        self.spent_s.clear()
+        return spent
+
+
 @dataclass(frozen=True)
 class Profiled:
     """One plan's profile.
@@ -129,6 +195,7 @@ class Profiled:
         total_s: the plan's wall time [s].
         stages: each stage's exclusive time [s] (:class:`StageClock`).
         over_bound: its trajectory's duration over Ruckig's bound for the straight line.
+        computations: each computation's inclusive time [s] (:class:`ComputationClock`).
     """
 
     robot: str
@@ -136,6 +203,16 @@ class Profiled:
     total_s: float
     stages: dict[str, float]
     over_bound: float
+    computations: dict[str, float] = field(default_factory=dict)
+
+
+def by_class(rows: list[Profiled]) -> list[tuple[tuple[str, str], list[Profiled]]]:
+    """The rows per robot and class, then per robot (``"all"``), in order."""
+    groups: dict[tuple[str, str], list[Profiled]] = defaultdict(list)
+    for row in rows:
+        for key in ((row.robot, row.group), (row.robot, "all")):
+            groups[key].append(row)
+    return sorted(groups.items(), key=lambda kv: (kv[0][0], kv[0][1] == "all"))
 
 
 def table(rows: list[Profiled]) -> list[str]:
@@ -147,11 +224,7 @@ def table(rows: list[Profiled]) -> list[str]:
         + " |",
         "|---|---|---|---|---|" + "---|" * len(columns),
     ]
-    groups: dict[tuple[str, str], list[Profiled]] = defaultdict(list)
-    for row in rows:
-        for key in ((row.robot, row.group), (row.robot, "all")):
-            groups[key].append(row)
-    for (robot_name, group), planned in sorted(groups.items(), key=lambda kv: (kv[0][0], kv[0][1] == "all")):
+    for (robot_name, group), planned in by_class(rows):
         summed = sum(row.total_s for row in planned)
         spent = [{**row.stages, "other": row.total_s - sum(row.stages.values())} for row in planned]
         cells = [
@@ -164,6 +237,24 @@ def table(rows: list[Profiled]) -> list[str]:
             f"| {robot_name} | {group} | {len(planned)} | {median_ms:.1f} | {over_bound:.3f} | "
             + " | ".join(cells)
             + " |"
+        )
+    return lines
+
+
+def computations_table(rows: list[Profiled]) -> list[str]:
+    """Markdown rows per robot and class, then per robot: each computation's summed time and share."""
+    lines = [
+        "| robot | class | planned | summed plans [s] | "
+        + " | ".join(f"{name} [s] (share)" for name in COMPUTATIONS)
+        + " |",
+        "|---|---|---|---|" + "---|" * len(COMPUTATIONS),
+    ]
+    for (robot_name, group), planned in by_class(rows):
+        summed = sum(row.total_s for row in planned)
+        spent = [sum(row.computations.get(name, 0.0) for row in planned) for name in COMPUTATIONS]
+        cells = [f"{seconds:.3f} ({seconds / summed:.0%})" for seconds in spent]
+        lines.append(
+            f"| {robot_name} | {group} | {len(planned)} | {summed:.3f} | " + " | ".join(cells) + " |"
         )
     return lines
 
@@ -227,11 +318,13 @@ def main() -> int:
         parser.error(outcome.message)
     for robot in robots.values():
         warm_up(robot)
-    clock = StageClock()
+    clock, computations = StageClock(), ComputationClock()
     clock.install()
+    computations.install()
     rows = []
     for case, scene in loaded:
         clock.lap()
+        computations.lap()
         started = time.perf_counter()
         try:
             result = plan(scene, robots[str(scene.robot)])
@@ -240,17 +333,18 @@ def main() -> int:
             continue
         total_s, stages = time.perf_counter() - started, clock.lap()
         over_bound = result.trajectory.duration / free_space_bound(result.problem)
-        rows.append(Profiled(case.robot, case.group, total_s, stages, over_bound))
+        rows.append(Profiled(case.robot, case.group, total_s, stages, over_bound, computations.lap()))
         shown = " ".join(f"{stage} {1000 * spent:.0f}" for stage, spent in stages.items())
         print(
             f"{case.robot} {case.path.stem}: {1000 * total_s:.0f} ms ({shown}), "
             f"{over_bound:.3f} of Ruckig's bound",
             flush=True,
         )
-    lines = table(rows)
+    lines, bought = table(rows), computations_table(rows)
     out.mkdir(parents=True, exist_ok=True)
     (out / "stages.md").write_text("\n".join(lines) + "\n")
-    print("\n".join(lines))
+    (out / "computations.md").write_text("\n".join(bought) + "\n")
+    print("\n".join([*lines, "", *bought]))
     return 0
 
 

@@ -67,6 +67,57 @@ def test_the_table_gives_each_stage_s_median_and_share(script: ModuleType) -> No
     assert any(line.startswith("| arm | all | 2 |") for line in lines)
 
 
+def test_a_computation_is_charged_all_it_calls_and_its_own_nested_calls_once(script: ModuleType) -> None:
+    now = [0.0]
+    clock = script.ComputationClock(clock=lambda: now[0])
+
+    def leaf() -> None:
+        now[0] += 2.0
+
+    timed_leaf = clock.wrapped("RNEA", leaf)
+
+    def recursive(depth: int) -> int:
+        now[0] += 1.0
+        timed_leaf()
+        return depth if depth == 0 else timed_recursive(depth - 1)
+
+    timed_recursive = clock.wrapped("closest pairs", recursive)
+    assert timed_recursive(2) == 0 and timed_recursive.__name__ == "recursive"
+    assert clock.spent_s == {"closest pairs": 9.0, "RNEA": 6.0}  # inclusive; three levels counted once
+    assert clock.lap() == {**dict.fromkeys(script.COMPUTATIONS, 0.0), "closest pairs": 9.0, "RNEA": 6.0}
+    assert clock.lap() == dict.fromkeys(script.COMPUTATIONS, 0.0)
+
+
+def test_every_computation_names_a_function_of_the_code(script: ModuleType) -> None:
+    import importlib
+
+    for module_name, attribute in script.COMPUTATIONS.values():
+        owner = importlib.import_module(module_name)
+        for part in attribute.split("."):
+            owner = getattr(owner, part)
+        assert callable(owner), attribute
+
+
+def test_the_computations_table_gives_each_s_summed_time_and_share(script: ModuleType) -> None:
+    stages = dict.fromkeys(script.STAGES, 0.0)
+    rows = [
+        script.Profiled("arm", "box", 1.0, stages, 1.1, {"closest pairs": 0.25, "RNEA": 0.1}),
+        script.Profiled("arm", "cage", 3.0, stages, 1.3, {"closest pairs": 0.75}),
+    ]
+    lines = script.computations_table(rows)
+    every = next(line for line in lines if line.startswith("| arm | all |"))
+    cells = dict(
+        zip(
+            ["robot", "class", "planned", "summed", *script.COMPUTATIONS],
+            every.strip("|").split("|"),
+            strict=True,
+        )
+    )
+    assert cells["planned"].strip() == "2" and cells["summed"].strip() == "4.000"
+    assert cells["closest pairs"].strip() == "1.000 (25%)" and cells["RNEA"].strip() == "0.100 (2%)"
+    assert cells["extrema"].strip() == "0.000 (0%)"
+
+
 @pytest.mark.slow
 def test_the_script_profiles_a_scene_file_and_its_stages_add_up(script: ModuleType, tmp_path: Path) -> None:
     run = subprocess.run(
@@ -85,6 +136,11 @@ def test_the_script_profiles_a_scene_file_and_its_stages_add_up(script: ModuleTy
     assert spent["build"] > 0 and spent["verify"] > 0 and spent["timing"] > 0  # the wrapped functions ran
     assert sum(spent.values()) <= total + len(spent)  # each rounded to a millisecond
     assert "| scenes | shelf | 1 |" in (tmp_path / "stages.md").read_text()
+    bought = (tmp_path / "computations.md").read_text()
+    row = next(row for row in bought.splitlines() if row.startswith("| scenes | shelf | 1 |"))
+    seconds = dict(zip(script.COMPUTATIONS, re.findall(r"([\d.]+) \(\d+%\)", row), strict=True))
+    assert float(seconds["obstacle tests"]) > 0 and float(seconds["extrema"]) > 0  # the wrapped ones ran
+    assert all(float(value) <= total / 1000 for value in seconds.values())  # each within the plan
     over_bound = float(re.search(r"\), ([\d.]+) of Ruckig's bound", line).group(1))  # type: ignore[union-attr]
     assert over_bound >= 1.0  # no trajectory beats the jerk-limited straight line
 
