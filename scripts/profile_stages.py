@@ -121,19 +121,12 @@ class StageClock:
         return timed
 
     def install(self) -> None:
-        """Wrap every stage's function, in its module and wherever a module imported it by name."""
-        for stage, (module_name, name) in STAGES.items():
-            original = getattr(sys.modules[module_name], name)
-            timed = self.wrapped(stage, original)
-            for module in list(sys.modules.values()):
-                if getattr(module, "__dict__", {}).get(name) is original:
-                    setattr(module, name, timed)
+        """Wrap every stage's function (:func:`install`)."""
+        install(STAGES, self.wrapped)
 
     def lap(self) -> dict[str, float]:
         """The stages' times since the last lap [s], and reset."""
-        spent = {stage: self.spent_s.get(stage, 0.0) for stage in STAGES}
-        self.spent_s.clear()
-        return spent
+        return lap(self.spent_s, STAGES)
 
 
 class ComputationClock:
@@ -165,24 +158,40 @@ class ComputationClock:
         return timed
 
     def install(self) -> None:
-        """Wrap every computation: a method on its class, a function wherever it was imported by name."""
-        for name, (module_name, attribute) in COMPUTATIONS.items():
-            owner: Any = importlib.import_module(module_name)
-            class_name, _, function_name = attribute.rpartition(".")
-            if class_name:
-                owner = getattr(owner, class_name)
-            original = getattr(owner, function_name)
-            timed = self.wrapped(name, original)
-            setattr(owner, function_name, timed)
-            for module in list(sys.modules.values()) if not class_name else ():
-                if getattr(module, "__dict__", {}).get(function_name) is original:
-                    setattr(module, function_name, timed)
+        """Wrap every computation (:func:`install`)."""
+        install(COMPUTATIONS, self.wrapped)
 
     def lap(self) -> dict[str, float]:
         """The computations' times since the last lap [s], and reset."""
-        spent = {name: self.spent_s.get(name, 0.0) for name in COMPUTATIONS}
-        self.spent_s.clear()
-        return spent
+        return lap(self.spent_s, COMPUTATIONS)
+
+
+def install(
+    functions: dict[str, tuple[str, str]], wrapped: Callable[[str, Callable[..., Any]], Callable[..., Any]]
+) -> None:
+    """Replace each of ``functions`` by ``wrapped(name, function)``.
+
+    A method (``Class.method``) on its class; a function in its module and wherever a module
+    imported it by name.
+    """
+    for name, (module_name, attribute) in functions.items():
+        owner: Any = importlib.import_module(module_name)
+        class_name, _, function_name = attribute.rpartition(".")
+        if class_name:
+            owner = getattr(owner, class_name)
+        original = getattr(owner, function_name)
+        timed = wrapped(name, original)
+        setattr(owner, function_name, timed)
+        for module in list(sys.modules.values()) if not class_name else ():
+            if getattr(module, "__dict__", {}).get(function_name) is original:
+                setattr(module, function_name, timed)
+
+
+def lap(spent_s: dict[str, float], names: dict[str, tuple[str, str]]) -> dict[str, float]:
+    """``spent_s`` [s] of each of ``names`` (0 where absent), and ``spent_s`` cleared."""
+    spent = {name: spent_s.get(name, 0.0) for name in names}
+    spent_s.clear()
+    return spent
 
 
 @dataclass(frozen=True)
