@@ -131,6 +131,16 @@ def test_the_hull_planes_are_scipys_qhull_facets(seed: int) -> None:
         assert np.all(points @ planes[:, :3].T + planes[:, 3] <= 1e-12)  # outward normals
 
 
+def test_a_flat_set_has_no_hull_planes_and_a_flat_mesh_holds_nothing() -> None:
+    plate = trimesh.creation.box(extents=(0.2, 0.1, 0.0))  # coal's Qhull crashed on it
+    planes = hull_planes(np.asarray(plate.vertices))
+    assert planes.shape == (0, 4)
+    triangles = np.asarray(plate.triangles)
+    mesh = ExactMesh(0, bvh_of(plate), pin.SE3.Identity(), math.inf, triangles, None, planes)
+    points = np.random.default_rng(5).uniform(-0.15, 0.15, (500, 3)) * (1.0, 1.0, 0.1)
+    assert not mesh.holds(points).any()  # a surface of no volume has no inside
+
+
 def test_holds_any_is_holds_of_the_moved_points_any() -> None:
     torus = trimesh.creation.torus(major_radius=0.2, minor_radius=0.05, major_sections=24, minor_sections=12)
     triangles = np.asarray(torus.triangles)

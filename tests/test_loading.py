@@ -406,3 +406,34 @@ def test_an_srdf_given_as_the_urdf_is_named_as_such() -> None:
         ck.UrdfError, match="holds <group>s and no <link>: it is an SRDF; give the robot's URDF"
     ):
         ck.load_robot(srdf)
+
+
+FLAT_ARM = """<?xml version="1.0"?>
+<robot name="flat_arm">
+  <link name="base"><collision><geometry><cylinder radius="0.05" length="0.1"/></geometry></collision></link>
+  <link name="arm">
+    <collision><origin xyz="0.1 0 0"/><geometry><mesh filename="plate.stl"/></geometry></collision>
+  </link>
+  <link name="tool"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="arm"/><origin xyz="0 0 0.1"/>
+    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="10" velocity="1"/></joint>
+  <joint name="tip" type="fixed"><parent link="arm"/><child link="tool"/><origin xyz="0.2 0 0"/></joint>
+</robot>
+"""
+
+
+def test_a_link_whose_mesh_is_flat_loads_as_its_capsule_and_its_mesh_decides(tmp_path: Path) -> None:
+    # a plate of no thickness: coal's Qhull crashed the process (a segmentation fault) on its hull
+    import trimesh
+
+    trimesh.creation.box(extents=(0.2, 0.1, 0.0)).export(tmp_path / "plate.stl")
+    (tmp_path / "flat_arm.urdf").write_text(FLAT_ARM)
+    robot = ck.load_robot(tmp_path / "flat_arm.urdf", tcp="tool")
+    assert len(robot.capsule_meshes) == 1 and len(robot.exact_meshes) == 1
+    # a ball 2 cm above the plate's middle (at q = 0 the plate lies at z = 0.1 m, x in [0, 0.2] m),
+    # inside the capsule about it: the plate's own mesh says how far it is
+    ball = ck.Obstacle.sphere(0.01, (0.1, 0.0, 0.13))
+    world = ck.CollisionWorld(robot, [ball])
+    q = np.zeros((1, robot.nq))
+    assert not world.margin_violated(q, 0.015)[0] and world.margin_violated(q, 0.025)[0]
+    assert world.min_clearance_batch(q)[0][0] == pytest.approx(0.02, abs=1e-5)

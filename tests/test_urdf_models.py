@@ -89,3 +89,29 @@ def test_centauros_pelvis_is_its_hull_of_polygons() -> None:
         )
         assert abs(distance + hull.nearest.signed_distance(point[None])[0]) < 1e-5
     assert len(outside) > 100
+
+
+def test_a_flat_mesh_becomes_a_capsule_containing_it_not_a_crash() -> None:
+    # coal's Qhull crashed the process (a segmentation fault) on a mesh whose vertices span no volume
+    model = pin.Model()
+    joint = model.addJoint(0, pin.JointModelRZ(), pin.SE3.Identity(), "spin")
+    geometry_model = pin.GeometryModel()
+    plate = np.array([[0.0, 0.0, 0.0], [0.2, 0.0, 0.0], [0.2, 0.1, 0.0], [0.0, 0.1, 0.0]])
+    rod = np.c_[np.linspace(0.0, 0.3, 5), np.zeros(5), np.zeros(5)]
+    shapes = {"plate": (plate, [[0, 1, 2], [0, 2, 3]]), "rod": (rod, [[0, 1, 2], [2, 3, 4]])}
+    for name, (vertices, triangles) in shapes.items():
+        geometry_model.addGeometryObject(
+            pin.GeometryObject(name, joint, pin.SE3.Identity(), mesh(vertices, triangles))
+        )
+    replaced = convex_hulls(geometry_model)
+    assert [s.hull for s in replaced] == [False, False]
+    for shape, (vertices, _) in zip(geometry_model.geometryObjects, shapes.values(), strict=True):
+        assert isinstance(shape.geometry, coal.Capsule | coal.Sphere)
+        half = getattr(shape.geometry, "halfLength", 0.0)
+        ends = np.array([shape.placement.act(np.array([0.0, 0.0, z])) for z in (-half, half)])
+        axis = ends[1] - ends[0]
+        t = np.clip((vertices - ends[0]) @ axis / max(axis @ axis, 1e-300), 0.0, 1.0)
+        assert (
+            np.linalg.norm(vertices - (ends[0] + t[:, None] * axis), axis=1).max()
+            <= shape.geometry.radius + 1e-9
+        )

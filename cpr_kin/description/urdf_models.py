@@ -24,6 +24,7 @@ from cpr_kin.bounds.pair_bounds import bounding_capsule
 from cpr_kin.common.errors import UrdfError
 from cpr_kin.description.urdf_file import captured_stderr
 from cpr_kin.shapes.exact_meshes import MeshSource
+from cpr_kin.shapes.mesh_geometry import spans_volume
 
 
 def build_models(xml: str, path: Path, kind: Any = pin.GeometryType.COLLISION) -> tuple[Any, Any]:
@@ -86,8 +87,9 @@ def convex_hulls(collision: Any) -> tuple[MeshSource, ...]:
     coal's convex shapes give a vertex at most 255 neighbours. A hull whose triangles put
     more around a vertex (a fine fan, as Centauro's pelvis has: 566) is built of polygons
     instead (qhull's merged facets, the same hull); one whose polygons still do (a cone's
-    apex) is replaced by the mesh's bounding capsule
-    (:func:`cpr_kin.bounds.pair_bounds.bounding_capsule`), which contains it too.
+    apex), and a flat mesh, whose hull has no volume (coal's Qhull would crash on it,
+    :func:`~cpr_kin.shapes.mesh_geometry.spans_volume`), is replaced by the mesh's bounding
+    capsule (:func:`cpr_kin.bounds.pair_bounds.bounding_capsule`), which contains it too.
 
     Returns:
         Each replaced mesh (:class:`~cpr_kin.shapes.exact_meshes.MeshSource`), in geometry order;
@@ -99,7 +101,8 @@ def convex_hulls(collision: Any) -> tuple[MeshSource, ...]:
         if not isinstance(geometry, coal.BVHModelBase):
             continue
         scale = tuple(float(s) for s in obj.meshScale)
-        for keep_triangles, qhull_options in ((True, "Qt"), (False, "Qx")):
+        flat = not spans_volume(np.asarray(geometry.vertices(), dtype=float))
+        for keep_triangles, qhull_options in () if flat else ((True, "Qt"), (False, "Qx")):
             try:
                 geometry.buildConvexHull(keep_triangles, qhull_options)
             except RuntimeError:  # "Too many neighbors."

@@ -104,7 +104,8 @@ class Robot:
         massless_links: links a planned joint moves that have a shape but no ``<inertial>``
             (massless, the URDF's rule; :mod:`cpr_kin.kinematics.dynamics`).
         capsule_meshes: collision geometries whose convex hull coal cannot hold (a vertex
-            with more than 255 neighbours), checked as their bounding capsule instead.
+            with more than 255 neighbours) or that have none (a flat mesh), checked as their
+            bounding capsule instead.
         exact_meshes: by geometry index, the link meshes their shapes (hulls, capsules) exceed
             by more than :data:`cpr_kin.shapes.exact_meshes.REFINED_ABOVE_M`: those shapes are bounds,
             and the meshes decide where they come within a margin (:mod:`cpr_kin.shapes.exact_pairs`).

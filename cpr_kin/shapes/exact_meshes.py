@@ -30,6 +30,7 @@ from numpy.typing import NDArray
 
 from cpr_kin.common.compiled import njit
 from cpr_kin.common.disk_cache import cached_array, cached_json
+from cpr_kin.shapes.mesh_geometry import spans_volume
 
 FloatArray = NDArray[np.float64]
 
@@ -274,8 +275,12 @@ def hull_planes(points: FloatArray) -> FloatArray:
     """``(H, 4)`` the facets' planes of the convex hull of ``points`` ``(..., 3)`` (:class:`ExactMesh`).
 
     By coal's Qhull (options ``Qt``), which the robot's hulls are built with: SciPy's
-    ``spatial`` (a tenth of a second to import) is not needed to load a robot.
+    ``spatial`` (a tenth of a second to import) is not needed to load a robot. None for a
+    flat set (:func:`~cpr_kin.shapes.mesh_geometry.spans_volume`): no point is then outside
+    a plane, and the winding number alone decides.
     """
+    if not spans_volume(points):
+        return np.empty((0, 4))
     corners = coal.StdVec_Vec3s()
     corners.extend(list(np.asarray(points, dtype=float).reshape(-1, 3)))
     hull = coal.Convex.convexHull(corners, True, "Qt")

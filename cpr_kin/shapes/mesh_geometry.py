@@ -1,4 +1,4 @@
-"""A mesh obstacle's coal geometry, read from its file: its convex hull, or its triangle surface."""
+"""Meshes as coal shapes: whether points span a volume (Qhull's precondition), a mesh obstacle's geometry."""
 
 from __future__ import annotations
 
@@ -10,6 +10,22 @@ import numpy as np
 from cpr_kin.common.errors import ObstacleError
 from cpr_kin.common.names import shown
 from cpr_kin.shapes.obstacle_ranges import MAX_COORDINATE_M, MAX_MESH_VERTICES
+
+FLAT_SHARE = 1e-9
+"""A point set thinner than this share of its extent, across its thinnest direction, spans no volume."""
+
+
+def spans_volume(points: Any) -> bool:
+    """Whether ``points`` ``(N, 3)`` span a volume: Qhull can build their convex hull.
+
+    A flat (or line-like) set has a hull of no volume, which SciPy's Qhull refuses and coal's
+    crashes on (a segmentation fault, not an exception): ask this first.
+    """
+    vertices = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    if len(vertices) < 4:
+        return False
+    spread = np.linalg.svd(vertices - vertices.mean(axis=0), compute_uv=False)
+    return bool(spread[-1] > FLAT_SHARE * max(float(spread[0]), 1e-300))
 
 
 def mesh_geometry(path: Path, scale: float, convex: bool, name: str) -> Any:
@@ -38,9 +54,7 @@ def mesh_geometry(path: Path, scale: float, convex: bool, name: str) -> Any:
     if not np.all(np.isfinite(vertices)) or np.abs(vertices * scale).max() > MAX_COORDINATE_M:
         raise ObstacleError(f"{what} has vertices that are not finite or beyond {MAX_COORDINATE_M:g} m")
     if convex:
-        # the hull of a flat (or line-like) mesh has no volume: Qhull refuses it
-        spread = np.linalg.svd(vertices - vertices.mean(axis=0), compute_uv=False)
-        if len(vertices) < 4 or spread[-1] <= 1e-9 * max(spread[0], 1e-300):
+        if not spans_volume(vertices):
             raise ObstacleError(
                 f"{what} is flat (its vertices span no volume), so it has no convex hull; "
                 "give a solid mesh, or convex: false to use its surface"

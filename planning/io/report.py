@@ -188,7 +188,8 @@ def limits_section(result: PlanResult) -> list[str]:
         ]
     if robot.capsule_meshes:
         lines += [
-            f"Collision meshes checked as their bounding capsule (coal cannot hold their convex hull): "
+            f"Collision meshes checked as their bounding capsule (coal cannot hold their convex hull, or "
+            "they are flat): "
             f"{', '.join(robot.capsule_meshes)}.",
             "",
         ]
