@@ -31,3 +31,38 @@ def test_a_set_spans_a_volume_exactly_where_scipys_qhull_builds_a_hull_of_volume
 def test_a_thin_solid_spans_a_volume_and_a_flat_one_does_not() -> None:
     assert spans_volume(trimesh.creation.box(extents=(0.2, 0.1, 1e-4)).vertices)
     assert not spans_volume(trimesh.creation.box(extents=(0.2, 0.1, 0.0)).vertices)
+
+
+@pytest.mark.slow
+def test_coals_qhull_builds_every_thin_box_spans_volume_accepts() -> None:
+    """Boxes from 1e-8 to 1e-3 m thin, about the origin and 10 and 100 m from it: where ``spans_volume``
+    accepts one, coal builds its hull (in a child process: coal crashes, it raises nothing)."""
+    import subprocess
+    import sys
+
+    program = """
+import sys
+import coal, numpy as np, trimesh
+from cpr_kin.shapes.mesh_geometry import spans_volume
+for thickness in (1e-8, 3e-8, 1e-7, 3e-7, 1e-6, 1e-5, 1e-4, 1e-3):
+    for offset in (0.0, 10.0, 100.0):
+        box = trimesh.creation.box(extents=(0.2, 0.1, thickness))
+        box.apply_translation([offset, 0.0, 0.0])
+        vertices, faces = np.asarray(box.vertices, float), np.asarray(box.faces, np.int64)
+        if not spans_volume(vertices):
+            continue
+        mesh = coal.BVHModelOBBRSS()
+        mesh.beginModel(len(faces), len(vertices))
+        mesh.addVertices(vertices)
+        mesh.addTriangles(faces)
+        mesh.endModel()
+        mesh.buildConvexHull(True, "Qt")
+        print(thickness, offset, mesh.convex.num_points, flush=True)
+"""
+    run = subprocess.run(
+        [sys.executable, "-c", program], capture_output=True, text=True, timeout=120, check=False
+    )
+    assert run.returncode == 0, run.stderr[-2000:]
+    built = [line.split() for line in run.stdout.splitlines()]
+    assert len(built) >= 8 and all(points == "8" for *_, points in built)  # a box's eight corners
+    assert ["1e-08", "0.0", "8"] not in built  # the thinnest is flat, wherever it lies

@@ -11,21 +11,27 @@ from cpr_kin.common.errors import ObstacleError
 from cpr_kin.common.names import shown
 from cpr_kin.shapes.obstacle_ranges import MAX_COORDINATE_M, MAX_MESH_VERTICES
 
-FLAT_SHARE = 1e-9
-"""A point set thinner than this share of its extent, across its thinnest direction, spans no volume."""
+FLAT_SHARE = 1e-6
+"""A point set thinner than this share of its size (its extent, or its distance from the origin
+where that is larger) across its thinnest direction spans no volume. coal's Qhull crashed on
+boxes 1.5e-8 of their extent thin, and built them from 5e-8 on: this leaves a margin."""
 
 
 def spans_volume(points: Any) -> bool:
     """Whether ``points`` ``(N, 3)`` span a volume: Qhull can build their convex hull.
 
     A flat (or line-like) set has a hull of no volume, which SciPy's Qhull refuses and coal's
-    crashes on (a segmentation fault, not an exception): ask this first.
+    crashes on (a segmentation fault, not an exception): ask this first. Thickness and size are
+    root-mean-square distances (the thinnest and widest principal directions' and from the
+    origin), so Qhull's precision, relative to the coordinates, is covered where the set lies
+    far from its frame's origin.
     """
     vertices = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     if len(vertices) < 4:
         return False
-    spread = np.linalg.svd(vertices - vertices.mean(axis=0), compute_uv=False)
-    return bool(spread[-1] > FLAT_SHARE * max(float(spread[0]), 1e-300))
+    spread = np.linalg.svd(vertices - vertices.mean(axis=0), compute_uv=False) / np.sqrt(len(vertices))
+    size = max(float(spread[0]), float(np.sqrt(np.mean(np.sum(vertices**2, axis=1)))), 1e-300)
+    return bool(spread[-1] > FLAT_SHARE * size)
 
 
 def mesh_geometry(path: Path, scale: float, convex: bool, name: str) -> Any:
