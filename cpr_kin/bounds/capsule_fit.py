@@ -124,16 +124,17 @@ def fitted_capsule(points: FloatArray) -> Capsule:
 
 @functools.lru_cache(maxsize=512)
 def _fitted(data: bytes, count: int) -> Capsule:
+    points = np.frombuffer(data, dtype=float).reshape(count, 3)
     if count <= HULL_ABOVE:  # a primitive's corners: fitted in less time than a file is read
-        return _fit(np.frombuffer(data, dtype=float).reshape(count, 3))
+        return _fit(points)
 
     def compute() -> FloatArray:
-        capsule = _fit(np.frombuffer(data, dtype=float).reshape(count, 3))
+        capsule = _fit(points)
         return np.append(capsule.ends.ravel(), capsule.radius)
 
     digest = hashlib.sha256(FIT_VERSION + data).hexdigest()
     kept = cached_array("capsule-fits", f"{digest}-{count}", compute)
-    if not _holds(kept, np.frombuffer(data, dtype=float).reshape(count, 3)):  # a file edited: fitted anew
+    if not _holds(kept, points):  # a file edited: fitted anew
         kept = compute()
     return Capsule(kept[:6].reshape(2, 3).copy(), float(kept[6]))
 
