@@ -13,6 +13,7 @@ import pytest
 import yaml
 
 import cpr_kin as ck
+from cpr_kin.common.compiled import COMPILING
 from planning.cli import main
 from planning.io.trajectory_reader import read_trajectory
 from planning.pipeline.metrics import WALL_TIMES
@@ -283,16 +284,10 @@ def test_usage_error_exits_2_without_traceback() -> None:
     assert "the following arguments are required" in completed.stderr and "Traceback" not in completed.stderr
 
 
-@pytest.mark.slow
-def test_progress_bar_only_on_a_terminal(tmp_path: Path) -> None:
-    scene = write_scene(tmp_path, SCENE)
-    command = [sys.executable, "-m", "planning.cli", "plan", str(scene), "--out"]
-    piped = subprocess.run([*command, str(tmp_path / "piped")], capture_output=True, text=True, check=False)
-    assert piped.returncode == 0 and "it/s" not in piped.stdout + piped.stderr
+def on_a_terminal(command: list[str], env: dict[str, str] | None = None) -> tuple[int, bytes]:
+    """Run ``command`` with stdout and stderr on a pseudo-terminal: its exit code and what it showed."""
     leader, follower = pty.openpty()
-    process = subprocess.Popen(
-        [*command, str(tmp_path / "tty")], stdout=follower, stderr=follower, close_fds=True
-    )
+    process = subprocess.Popen(command, stdout=follower, stderr=follower, close_fds=True, env=env)
     os.close(follower)
     output = b""
     while True:
@@ -303,10 +298,49 @@ def test_progress_bar_only_on_a_terminal(tmp_path: Path) -> None:
         if not chunk:
             break
         output += chunk
-    assert process.wait(timeout=60) == 0
+    code = process.wait(timeout=120)
     os.close(leader)
+    return code, output
+
+
+@pytest.mark.slow
+def test_progress_bar_only_on_a_terminal(tmp_path: Path) -> None:
+    scene = write_scene(tmp_path, SCENE)
+    command = [sys.executable, "-m", "planning.cli", "plan", str(scene), "--out"]
+    piped = subprocess.run([*command, str(tmp_path / "piped")], capture_output=True, text=True, check=False)
+    assert piped.returncode == 0 and "it/s" not in piped.stdout + piped.stderr
+    code, output = on_a_terminal([*command, str(tmp_path / "tty")])
+    assert code == 0
     assert b"search" in output and b"best=" in output  # the bar, its seeds' best at least
     assert b"it/s" in output or b"s/it" in output
+
+
+@pytest.mark.slow
+def test_a_first_runs_compilation_is_said_on_a_terminal_once(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = write_scene(tmp_path, SCENE)
+    assert run(["plan", str(scene), "--out", str(tmp_path / "out")], capsys)[0] == 0
+    check = [
+        sys.executable,
+        "-m",
+        "planning.cli",
+        "check",
+        str(scene),
+        str(tmp_path / "out" / "trajectory.json"),
+    ]
+    notice = f"cpr-plan check: {COMPILING}".encode()
+
+    def cold(name: str) -> dict[str, str]:  # a disk cache of kernels of its own: empty at first
+        return {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / name)}
+
+    piped = subprocess.run(check, capture_output=True, text=True, env=cold("piped"), check=False)
+    assert piped.returncode == 0 and "verified against" in piped.stdout and piped.stderr == ""
+    assert any((tmp_path / "piped").rglob("*.nbi"))  # it did compile: nothing said in a pipe
+    code, shown = on_a_terminal(check, cold("terminal"))
+    assert code == 0 and b"verified against" in shown and shown.count(notice) == 1, shown
+    code, shown = on_a_terminal(check, cold("terminal"))  # loaded from the cache: nothing to say
+    assert code == 0 and b"verified against" in shown and notice not in shown, shown
 
 
 def test_paper_search_flag_is_the_papers_settings_written_in_the_scene(

@@ -1,10 +1,18 @@
-"""The kernels' disk cache in a source checkout: dropped when a file that compiles a kernel changes."""
+"""The kernels' disk cache in a source checkout: dropped when a file that compiles a kernel changes;
+the first compilation of a process said once."""
 
 from __future__ import annotations
 
+import importlib.util
+import logging
 from pathlib import Path
+from types import ModuleType
 
-from cpr_kin.common.compiled import forget_stale_kernels
+import numba
+import numba.core.event
+import pytest
+
+from cpr_kin.common.compiled import COMPILING, FirstCompile, forget_stale_kernels
 
 
 def checkout(root: Path) -> list[Path]:
@@ -54,3 +62,41 @@ def test_a_stamp_that_cannot_be_kept_is_no_error(tmp_path: Path) -> None:
     checkout(tmp_path / "repo")
     (tmp_path / "blocker").write_text("a file where the stamp's folder would be")
     assert not forget_stale_kernels(tmp_path / "repo", tmp_path / "blocker" / "stamp.txt")
+
+
+def kernel_module(folder: Path, name: str) -> ModuleType:
+    """A module of one cached kernel ``f`` in ``folder/kernel.py``, imported anew as ``name``."""
+    source = folder / "kernel.py"
+    if not source.exists():
+        source.write_text("import numba\n\n\n@numba.njit(cache=True)\ndef f(x):\n    return x + 1\n")
+    spec = importlib.util.spec_from_file_location(name, source)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_first_compilation_is_said_once_and_a_cached_kernel_says_nothing(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    log = logging.getLogger("cpr_kin.test_compiled")
+    listener = FirstCompile(log)
+    with (
+        caplog.at_level(logging.INFO, logger=log.name),
+        numba.core.event.install_listener("numba:compile", listener),
+    ):
+        assert kernel_module(tmp_path, "loaded_from_source").f(1) == 2  # compiled, kept on disk
+        assert [r.getMessage() for r in caplog.records] == [COMPILING]
+        numba.njit(lambda x: x * 2)(3)  # a second compilation: said already
+        assert len(caplog.records) == 1
+
+    caplog.clear()
+    again = FirstCompile(log)
+    with (
+        caplog.at_level(logging.INFO, logger=log.name),
+        numba.core.event.install_listener("numba:compile", again),
+    ):
+        assert kernel_module(tmp_path, "loaded_from_cache").f(1) == 2  # the same file: numba's cache
+        assert caplog.records == [] and not again.said
+        numba.njit(lambda x: x * 3)(3)
+        assert [r.getMessage() for r in caplog.records] == [COMPILING] and again.said

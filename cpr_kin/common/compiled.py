@@ -10,17 +10,22 @@ function of another file (``batch_kinematics.place_capsule`` in the bound kernel
 old code when that file changes, and computes with it, silently. An installed package does not
 change; in a source checkout (a ``.git`` beside the packages) :func:`forget_stale_kernels` drops
 every cached kernel of the checkout when a file that compiles one has changed, before any is loaded.
+
+A compilation keeps a first run waiting with nothing to show for it; the first of a process is
+said on the logger :data:`COMPILE_LOG` (``INFO``), which ``cpr-plan`` prints on stderr.
 """
 
 from __future__ import annotations
 
 import hashlib
+import logging
 import os
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar, cast
 
 import numba
+import numba.core.event
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -45,6 +50,35 @@ KERNEL_MARK = b"common.compiled import"
 """What a file that compiles a kernel holds (its import of this module)."""
 STAMP = Path(__file__).resolve().parent / "__pycache__" / "kernel-sources.txt"
 """Where the checkout's kernel sources were last seen: their files' stat and their bytes' digest."""
+
+
+COMPILE_LOG = logging.getLogger("cpr_kin.compiled")
+"""Where :class:`FirstCompile` says that kernels are being compiled."""
+COMPILING = (
+    "compiling the numba kernels, which the first run on a machine (or after an update) does once: "
+    "tens of seconds; later runs load them from the disk cache"
+)
+"""What :class:`FirstCompile` says."""
+
+
+class FirstCompile(numba.core.event.Listener):
+    """Says :data:`COMPILING` on ``log`` (``INFO``) at the first kernel numba compiles, once.
+
+    Numba announces a compilation (its event ``numba:compile``) only where its disk cache holds
+    no code for the kernel: a kernel loaded from the cache says nothing.
+    """
+
+    def __init__(self, log: logging.Logger = COMPILE_LOG) -> None:
+        self.log, self.said = log, False
+
+    def on_start(self, event: Any) -> None:
+        """Say it, the first time."""
+        if not self.said:
+            self.said = True
+            self.log.info(COMPILING)
+
+    def on_end(self, event: Any) -> None:
+        """Nothing: the start was said."""
 
 
 def forget_stale_kernels(root: Path = CHECKOUT, stamp: Path = STAMP) -> bool:
@@ -105,3 +139,4 @@ def _package_files(root: str) -> list[str]:
 
 
 forget_stale_kernels()
+numba.core.event.register("numba:compile", FirstCompile())  # type: ignore[no-untyped-call]

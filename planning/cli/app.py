@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
+import logging
 import os
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 from cpr_kin.common.names import one_line
@@ -214,6 +216,32 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+@contextlib.contextmanager
+def library_notices(label: str) -> Iterator[None]:
+    """Within: what the robot package says at ``INFO`` or above (that it compiles its kernels) on stderr.
+
+    Each notice is one line, ``label: notice``, for someone who waits at a terminal: where
+    stderr is not one (a pipe, a file), nothing is added to it. The logger's own settings come
+    back on exit.
+    """
+    if not sys.stderr.isatty():
+        yield
+        return
+    log = logging.getLogger("cpr_kin")
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter(f"{label}: %(message)s"))
+    level, propagate = log.level, log.propagate
+    log.addHandler(handler)
+    log.setLevel(logging.INFO)
+    log.propagate = False
+    try:
+        yield
+    finally:
+        log.removeHandler(handler)
+        log.setLevel(level)
+        log.propagate = propagate
+
+
 def main(argv: Sequence[str] | None = None, *, restore_signals: bool = True) -> int:
     """Entry point of ``cpr-plan``; returns the exit code.
 
@@ -221,12 +249,13 @@ def main(argv: Sequence[str] | None = None, *, restore_signals: bool = True) -> 
     input, 3 for no trajectory, 130 when ``SIGINT`` or ``SIGTERM`` stopped the command (also
     inside compiled code, and when a shell started it with ``SIGINT`` ignored), 4 for an
     unexpected exception, a bug (``CPR_PLAN_TRACEBACK=1`` shows it whole). One line on
-    stderr, never a traceback. ``restore_signals=False`` (the installed command) ignores a
+    stderr, never a traceback; on a terminal, a first run's compilation is said there too
+    (:func:`library_notices`). ``restore_signals=False`` (the installed command) ignores a
     signal that comes once the command is over.
     """
     args = build_parser().parse_args(argv)
     label = f"cpr-plan {args.command}"
-    with interrupts(restore=restore_signals) as signalled:
+    with interrupts(restore=restore_signals) as signalled, library_notices(label):
         try:
             code: int = args.run(args)
         except SystemExit:
