@@ -437,3 +437,47 @@ def test_a_link_whose_mesh_is_flat_loads_as_its_capsule_and_its_mesh_decides(tmp
     q = np.zeros((1, robot.nq))
     assert not world.margin_violated(q, 0.015)[0] and world.margin_violated(q, 0.025)[0]
     assert world.min_clearance_batch(q)[0][0] == pytest.approx(0.02, abs=1e-5)
+
+
+def with_a_vertex(path: Path, vertex: tuple[float, float, float]) -> None:
+    """A binary STL of a 20 x 10 x 5 cm box at ``path``, its first triangle's first vertex ``vertex``."""
+    import struct
+
+    import trimesh
+
+    data = bytearray(trimesh.exchange.stl.export_stl(trimesh.creation.box(extents=(0.2, 0.1, 0.05))))
+    data[84 + 12 : 84 + 24] = struct.pack("<3f", *vertex)  # 80 header, 4 count, then 12 normal
+    path.write_bytes(bytes(data))
+
+
+@pytest.mark.parametrize("value", [np.inf, -np.inf, np.nan])
+def test_a_mesh_with_a_vertex_not_finite_is_refused_naming_link_and_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], value: float
+) -> None:
+    # coal crashed the process (a segmentation fault) on the hull of an infinite vertex
+    with_a_vertex(tmp_path / "plate.stl", (0.1, value, 0.02))
+    (tmp_path / "flat_arm.urdf").write_text(FLAT_ARM)
+    with pytest.raises(ck.UrdfError, match=r"link 'arm': mesh '.*plate.stl' has a vertex that is not finite"):
+        ck.load_robot(tmp_path / "flat_arm.urdf", tcp="tool")
+    from planning.cli import main
+
+    assert main(["robot-info", str(tmp_path / "flat_arm.urdf"), "--tcp", "tool"]) == 2
+    stderr = capsys.readouterr().err
+    assert "not finite" in stderr and stderr.count("\n") == 1 and "Traceback" not in stderr
+
+
+def test_a_mesh_in_millimetres_without_its_scale_is_refused_and_loads_with_it(tmp_path: Path) -> None:
+    import trimesh
+
+    trimesh.creation.box(extents=(200.0, 100.0, 50.0)).export(tmp_path / "plate.stl")  # millimetres
+    (tmp_path / "flat_arm.urdf").write_text(FLAT_ARM)
+    reach = float(np.linalg.norm([100.0, 50.0, 25.0]))
+    with pytest.raises(
+        ck.UrdfError, match=rf"mesh '.*plate.stl' reaches {reach:.6g} m .* beyond 100 m.*0\.001"
+    ):
+        ck.load_robot(tmp_path / "flat_arm.urdf", tcp="tool")
+    scaled = FLAT_ARM.replace('filename="plate.stl"', 'filename="plate.stl" scale="0.001 0.001 0.001"')
+    (tmp_path / "scaled_arm.urdf").write_text(scaled)
+    robot = ck.load_robot(tmp_path / "scaled_arm.urdf", tcp="tool")
+    (hull,) = (o.geometry for o in robot.collision_model.geometryObjects if o.name == "arm")
+    assert np.abs(np.asarray(hull.points(), dtype=float)).max(axis=0) == pytest.approx([0.1, 0.05, 0.025])

@@ -26,9 +26,19 @@ from cpr_kin.description.urdf_file import captured_stderr
 from cpr_kin.shapes.exact_meshes import MeshSource
 from cpr_kin.shapes.mesh_geometry import spans_volume
 
+MAX_MESH_REACH_M = 100.0
+"""Largest distance of a link mesh's vertex from its link's frame [m], scale applied. An arm's
+links span metres; a mesh drawn in millimetres and given no ``scale`` reaches hundreds, and far
+out the distance arithmetic loses its meaning."""
+
 
 def build_models(xml: str, path: Path, kind: Any = pin.GeometryType.COLLISION) -> tuple[Any, Any]:
-    """Pinocchio's kinematic model and the ``kind`` geometry model of the prepared URDF text."""
+    """Pinocchio's kinematic model and the ``kind`` geometry model of the prepared URDF text.
+
+    Raises:
+        UrdfError: Pinocchio cannot build them, a mesh file cannot be read, or a mesh has a
+            vertex that is not finite or lies beyond :data:`MAX_MESH_REACH_M` (:func:`check_meshes`).
+    """
     try:
         with captured_stderr() as complaints:  # urdfdom prints to fd 2; a model that builds needs none
             model = pin.buildModelFromXML(xml)
@@ -39,7 +49,40 @@ def build_models(xml: str, path: Path, kind: Any = pin.GeometryType.COLLISION) -
             raise UrdfError(_unreadable_mesh(xml, path, unread.group(1))) from None
         said = " ".join(line.strip() for line in complaints[:2])
         raise UrdfError(f"Pinocchio cannot build a model from '{path}': {exc} {said}".strip()) from None
+    check_meshes(model, geometry, path)
     return model, geometry
+
+
+def check_meshes(model: Any, geometry: Any, path: Path) -> None:
+    """Refuse a mesh of ``geometry`` with a vertex that is not finite or beyond :data:`MAX_MESH_REACH_M`.
+
+    coal would take such a mesh and crash on its hull (a segmentation fault at an infinite
+    vertex) or compute with nonsense; the message names the link, the file and the vertex.
+
+    Raises:
+        UrdfError: the first such mesh.
+    """
+    for obj in geometry.geometryObjects:
+        if not isinstance(obj.geometry, coal.BVHModelBase):
+            continue
+        vertices = np.asarray(obj.geometry.vertices(), dtype=float).reshape(-1, 3)
+        finite = np.isfinite(vertices).all(axis=1)
+        reach = np.where(finite, np.linalg.norm(np.where(finite[:, None], vertices, 0.0), axis=1), np.inf)
+        if not vertices.size or reach.max() <= MAX_MESH_REACH_M:
+            continue
+        worst = int(np.argmax(reach))
+        link = model.frames[obj.parentFrame].name if obj.parentFrame < len(model.frames) else obj.name
+        what = f"URDF '{path}': link '{link}': mesh '{obj.meshPath}'"
+        vertex = ", ".join(f"{v:.6g}" for v in vertices[worst])
+        if not finite[worst]:
+            raise UrdfError(
+                f"{what} has a vertex that is not finite: vertex {worst} = ({vertex}); fix the mesh file"
+            )
+        raise UrdfError(
+            f"{what} reaches {reach[worst]:.6g} m from its link's frame at vertex {worst} = ({vertex}) m, "
+            f'beyond {MAX_MESH_REACH_M:g} m; a mesh drawn in millimetres needs scale="0.001 0.001 0.001" '
+            "in its <mesh>"
+        )
 
 
 def _unreadable_mesh(xml: str, path: Path, mesh: str) -> str:
