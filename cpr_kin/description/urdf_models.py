@@ -30,14 +30,18 @@ MAX_MESH_REACH_M = 100.0
 """Largest distance of a link mesh's vertex from its link's frame [m], scale applied. An arm's
 links span metres; a mesh drawn in millimetres and given no ``scale`` reaches hundreds, and far
 out the distance arithmetic loses its meaning."""
+MIN_MESH_SPAN_M = 1e-6
+"""Smallest largest extent of a link mesh [m], scale applied: a mesh smaller than a micrometre
+(a scale of 0, or 1e-9) is no part of an arm, and its points merge into one at the hull's
+tolerance (trimesh's 1e-8 m)."""
 
 
 def build_models(xml: str, path: Path, kind: Any = pin.GeometryType.COLLISION) -> tuple[Any, Any]:
     """Pinocchio's kinematic model and the ``kind`` geometry model of the prepared URDF text.
 
     Raises:
-        UrdfError: Pinocchio cannot build them, a mesh file cannot be read, or a mesh has a
-            vertex that is not finite or lies beyond :data:`MAX_MESH_REACH_M` (:func:`check_meshes`).
+        UrdfError: Pinocchio cannot build them, a mesh file cannot be read, or a mesh is not
+            finite, reaches too far or spans too little (:func:`check_meshes`).
     """
     try:
         with captured_stderr() as complaints:  # urdfdom prints to fd 2; a model that builds needs none
@@ -54,10 +58,12 @@ def build_models(xml: str, path: Path, kind: Any = pin.GeometryType.COLLISION) -
 
 
 def check_meshes(model: Any, geometry: Any, path: Path) -> None:
-    """Refuse a mesh of ``geometry`` with a vertex that is not finite or beyond :data:`MAX_MESH_REACH_M`.
+    """Refuse a mesh of ``geometry`` that is not finite, reaches too far or spans too little.
 
-    coal would take such a mesh and crash on its hull (a segmentation fault at an infinite
-    vertex) or compute with nonsense; the message names the link, the file and the vertex.
+    A vertex not finite, one beyond :data:`MAX_MESH_REACH_M` of the link's frame, or a mesh whose
+    largest extent is below :data:`MIN_MESH_SPAN_M`: coal would take such a mesh and crash on its
+    hull (a segmentation fault at an infinite vertex), compute with nonsense, or merge its points
+    into one. The message names the link, the file and the vertex or the extent.
 
     Raises:
         UrdfError: the first such mesh.
@@ -66,17 +72,26 @@ def check_meshes(model: Any, geometry: Any, path: Path) -> None:
         if not isinstance(obj.geometry, coal.BVHModelBase):
             continue
         vertices = np.asarray(obj.geometry.vertices(), dtype=float).reshape(-1, 3)
+        if not vertices.size:
+            continue
         finite = np.isfinite(vertices).all(axis=1)
         reach = np.where(finite, np.linalg.norm(np.where(finite[:, None], vertices, 0.0), axis=1), np.inf)
-        if not vertices.size or reach.max() <= MAX_MESH_REACH_M:
+        span = float(np.ptp(vertices, axis=0).max()) if finite.all() else np.inf
+        if reach.max() <= MAX_MESH_REACH_M and span >= MIN_MESH_SPAN_M:
             continue
-        worst = int(np.argmax(reach))
         link = model.frames[obj.parentFrame].name if obj.parentFrame < len(model.frames) else obj.name
         what = f"URDF '{path}': link '{link}': mesh '{obj.meshPath}'"
+        worst = int(np.argmax(reach))
         vertex = ", ".join(f"{v:.6g}" for v in vertices[worst])
         if not finite[worst]:
             raise UrdfError(
                 f"{what} has a vertex that is not finite: vertex {worst} = ({vertex}); fix the mesh file"
+            )
+        if span < MIN_MESH_SPAN_M:
+            raise UrdfError(
+                f"{what} spans {span:.3g} m (its largest extent, scale applied), "
+                f"below {MIN_MESH_SPAN_M:g} m; "
+                "check the scale in its <mesh>"
             )
         raise UrdfError(
             f"{what} reaches {reach[worst]:.6g} m from its link's frame at vertex {worst} = ({vertex}) m, "
