@@ -55,6 +55,22 @@ REFUSED = [
      r"the joint name 'd\\u202e2' holds U\+202E \(RIGHT-TO-LEFT OVERRIDE\)"),
     ("control character", lambda t: t.replace('link name="tcp"', 'link name="t\x85cp"'),
      r"the link name 't\\x85cp' holds U\+0085"),
+    ("NaN lower limit", theta1_limit("nan", "2.9"),
+     r"joint 'theta1' limit lower = 'nan' is not supported; give a finite number$"),
+    ("velocity below zero", theta1_limit("-2.9", "2.9", "-1.5"),
+     r"joint 'theta1' limit velocity = '-1.5' is not supported; give a finite number >= 0"),
+    ("NaN radius", lambda t: t.replace('radius="0.15"', 'radius="nan"', 1),
+     r"link 'base_link': (visual|collision) cylinder radius = 'nan' is not supported; give a number in"),
+    ("box side below zero", lambda t: t.replace('size="0.12 0.12 0.9"', 'size="0.12 -0.12 0.9"'),
+     r"link 'column_link': (visual|collision) box size = '0.12 -0.12 0.9' is not supported; give 3 numbers"),
+    ("box of 1e30 m", lambda t: t.replace('size="0.12 0.12 0.9"', 'size="0.12 0.12 1e30"'),
+     r"box size = '0.12 0.12 1e30' is not supported; give 3 numbers in \(0, 100\] m"),
+    ("NaN mass", lambda t: t.replace('mass value="10.0"', 'mass value="nan"'),
+     r"link 'base_link' inertial mass = 'nan' is not a finite number"),
+    ("mass below zero", lambda t: t.replace('mass value="10.0"', 'mass value="-10.0"'),
+     r"link 'base_link' inertial mass = -10 kg is below zero; a body's is at least zero"),
+    ("moment below zero", lambda t: t.replace('ixx="0.065"', 'ixx="-0.065"', 1),
+     r"link 'base_link' inertial ixx = -0.065 kg m\^2 is below zero"),
 ]  # fmt: skip
 
 
@@ -64,6 +80,15 @@ def test_an_unsupported_urdf_is_refused_at_load_naming_the_joint(
 ) -> None:
     with pytest.raises(ck.UrdfError, match=message):
         ck.load_cpr(variant(tmp_path, edit))
+
+
+def test_a_moment_below_zero_by_rounding_loads(tmp_path: Path) -> None:
+    # iCub's hip has ixx = -5.4e-20 kg m^2; Tiago's antenna an inertia that is not positive
+    # semi-definite (not held): neither is a body the planner should refuse
+    rounded = ck.load_cpr(variant(tmp_path, lambda t: t.replace('ixx="0.065"', 'ixx="-5e-13"', 1)))
+    assert rounded.nq == ck.load_cpr().nq
+    with pytest.raises(ck.UrdfError, match=r"ixx = -1e-09 kg m\^2 is below zero"):
+        ck.load_cpr(variant(tmp_path, lambda t: t.replace('ixx="0.065"', 'ixx="-1e-9"', 1)))
 
 
 def test_a_continuous_joint_is_planned_within_one_turn(tmp_path: Path) -> None:

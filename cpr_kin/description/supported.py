@@ -17,7 +17,12 @@ the joint, the value and what is supported:
   and jerk limits takes at most :data:`MAX_CROSSING_S` (a plan's motion is a few such
   crossings at most);
 - link, joint and collision names without control or bidirectional characters
-  (:mod:`cpr_kin.common.names`).
+  (:mod:`cpr_kin.common.names`);
+- limits, shapes and inertials that are finite numbers: a shape's size above zero and at most
+  :data:`MAX_SHAPE_M` (boxes, cylinders, spheres; a mesh's scale not zero), an effort,
+  velocity, mass and moment of inertia at least zero. A NaN radius or mass made Pinocchio's
+  parser drop the link's elements in silence (the loader then said the link had no collision
+  geometry), and a negative one computed with nonsense.
 """
 
 from __future__ import annotations
@@ -41,6 +46,16 @@ MAX_PRISMATIC_M = 10.0
 """Largest |position limit| of a prismatic joint [m]."""
 LIMIT_TOLERANCE = 1e-3
 """How far a position limit may pass its bound (a URDF that writes 2 pi as 6.2832) [rad or m]."""
+MAX_SHAPE_M = 100.0
+"""Largest size of a link's shape [m]: a box's side, a cylinder's radius or length, a sphere's
+radius, and the distance of a mesh's vertex from its link's frame. An arm's links span metres;
+a mesh drawn in millimetres and given no ``scale`` reaches hundreds, and far out the distance
+arithmetic loses its meaning."""
+SHAPE_SIZES = {"box": ("size", 3), "cylinder": ("radius", 1, "length", 1), "sphere": ("radius", 1)}
+"""The size attributes of each URDF shape, and how many numbers each holds."""
+INERTIA_NAMES = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+ROUNDING_KG_M2 = 1e-12
+"""How far a moment of inertia may pass below zero by rounding [kg m^2] (a milligram at a millimetre)."""
 MAX_CROSSING_S = 600.0
 """Longest time a joint may need to cross its whole range at rest at both ends [s] (the
 longest fixed duration a scene may ask is the same)."""
@@ -61,7 +76,10 @@ def check_names(tree: etree._ElementTree, path: Path) -> None:
 
 
 def check_joints(tree: etree._ElementTree, path: Path) -> None:
-    """Refuse joint types the planner does not plan, and axes that are not directions."""
+    """Refuse joint types the planner does not plan, axes that are not directions, bad limits.
+
+    A limit must be a finite number, an effort or velocity one of at least zero.
+    """
     for joint in tree.getroot().findall("joint"):
         name, kind = joint.get("name", "?"), joint.get("type", "?")
         if kind not in SUPPORTED_TYPES:
@@ -79,6 +97,92 @@ def check_joints(tree: etree._ElementTree, path: Path) -> None:
                 raise UrdfError(
                     f"URDF '{path}': joint '{name}' axis xyz = '{escaped(text[:40])}' is not a direction; "
                     "give three finite numbers, not all zero (e.g. '0 0 1')"
+                )
+        limit = joint.find("limit")
+        for key in ("lower", "upper", "effort", "velocity"):
+            text = None if limit is None else limit.get(key)
+            value = None if text is None else _numbers(text, 1)
+            least = -math.inf if key in ("lower", "upper") else 0.0
+            if text is not None and (value is None or not least <= value[0] < math.inf):
+                wanted = "a finite number" if key in ("lower", "upper") else "a finite number >= 0"
+                raise UrdfError(
+                    f"URDF '{path}': joint '{name}' limit {key} = '{escaped(text[:40])}' is not supported; "
+                    f"give {wanted}"
+                )
+
+
+def _numbers(text: str | None, count: int) -> list[float] | None:
+    """``count`` numbers written in ``text``, or ``None`` where it holds anything else."""
+    try:
+        values = [float(v) for v in (text or "").split()]
+    except ValueError:
+        return None
+    return values if len(values) == count else None
+
+
+def check_shapes(tree: etree._ElementTree, path: Path) -> None:
+    """Refuse a shape size outside ``(0, MAX_SHAPE_M]``, and a mesh scale that is not three numbers.
+
+    A size is a box's sides, a cylinder's radius and length, a sphere's radius; a mesh's scale
+    must be three finite numbers other than zero.
+    """
+    for link in tree.getroot().findall("link"):
+        for element in link.iter("collision", "visual"):
+            where = f"URDF '{path}': link '{link.get('name', '?')}': {element.tag}"
+            for shape in element.iterfind("geometry/*"):
+                sizes = SHAPE_SIZES.get(str(shape.tag), ())
+                for name, count in zip(sizes[::2], sizes[1::2], strict=True):
+                    text = shape.get(name)
+                    values = _numbers(text, int(count))
+                    if values is None or not all(0.0 < v <= MAX_SHAPE_M for v in values):
+                        wanted = "a number" if count == 1 else f"{count} numbers"
+                        raise UrdfError(
+                            f"{where} {shape.tag} {name} = '{escaped(str(text)[:40])}' is not supported; "
+                            f"give {wanted} in (0, {MAX_SHAPE_M:g}] m"
+                        )
+                scale = shape.get("scale") if shape.tag == "mesh" else None
+                if scale is not None:
+                    values = _numbers(scale, 3)
+                    if values is None or not all(math.isfinite(v) and v != 0.0 for v in values):
+                        raise UrdfError(
+                            f"{where} mesh scale = '{escaped(scale[:40])}' is not supported; "
+                            "give three finite numbers other than zero (e.g. '0.001 0.001 0.001')"
+                        )
+
+
+def check_inertials(tree: etree._ElementTree, path: Path) -> None:
+    """Refuse an inertial no body has: a mass or a moment (``ixx``, ``iyy``, ``izz``) below zero.
+
+    Either also where an entry is not finite. A moment may pass zero by rounding
+    (:data:`ROUNDING_KG_M2`, or 1e-9 of the largest entry; iCub's hip has -5.4e-20). The matrix is
+    not held to positive semi-definiteness: real files miss it (example-robot-data's Tiago
+    antenna, Romeo's body) by amounts that change its torques little.
+    """
+    for link in tree.getroot().findall("link"):
+        inertial = link.find("inertial")
+        if inertial is None:
+            continue
+        where = f"URDF '{path}': link '{link.get('name', '?')}' inertial"
+        mass, inertia = inertial.find("mass"), inertial.find("inertia")
+        texts = {"mass": None if mass is None else mass.get("value")}
+        if inertia is not None:
+            texts |= {name: inertia.get(name) for name in INERTIA_NAMES}
+        values = {name: _numbers(text, 1) for name, text in texts.items() if text is not None}
+        for name, value in values.items():
+            if value is None or not math.isfinite(value[0]):
+                raise UrdfError(f"{where} {name} = '{escaped(str(texts[name])[:40])}' is not a finite number")
+        largest = max((abs(v[0]) for n, v in values.items() if v is not None and n != "mass"), default=0.0)
+        rounding = max(ROUNDING_KG_M2, 1e-9 * largest)
+        for name, least, unit in (
+            ("mass", 0.0, "kg"),
+            ("ixx", -rounding, "kg m^2"),
+            ("iyy", -rounding, "kg m^2"),
+            ("izz", -rounding, "kg m^2"),
+        ):
+            value = values.get(name)
+            if value is not None and value[0] < least:
+                raise UrdfError(
+                    f"{where} {name} = {value[0]:g} {unit} is below zero; a body's is at least zero"
                 )
 
 
@@ -123,8 +227,8 @@ def checked_urdf(path: Path, validate: bool = True) -> etree._ElementTree:
     """The URDF at ``path`` parsed and checked as the loader checks it, before anything reads it.
 
     Strict XML (:func:`~cpr_kin.description.urdf_file.parse_urdf`), yourdfpy's validation (unless
-    ``validate`` is ``False``: a file the caller knows, such as a preset's), printable names
-    and supported joints.
+    ``validate`` is ``False``: a file the caller knows, such as a preset's), printable names,
+    supported joints, shapes and inertials.
 
     Raises:
         UrdfError: naming the file and the first problem.
@@ -134,4 +238,6 @@ def checked_urdf(path: Path, validate: bool = True) -> etree._ElementTree:
         validate_urdf(path)
     check_names(tree, path)
     check_joints(tree, path)
+    check_shapes(tree, path)
+    check_inertials(tree, path)
     return tree

@@ -22,14 +22,11 @@ from lxml import etree
 from cpr_kin.bounds.capsule_fit import frame_about
 from cpr_kin.bounds.pair_bounds import bounding_capsule
 from cpr_kin.common.errors import UrdfError
+from cpr_kin.description.supported import MAX_SHAPE_M
 from cpr_kin.description.urdf_file import captured_stderr
 from cpr_kin.shapes.exact_meshes import MeshSource
 from cpr_kin.shapes.mesh_geometry import spans_volume
 
-MAX_MESH_REACH_M = 100.0
-"""Largest distance of a link mesh's vertex from its link's frame [m], scale applied. An arm's
-links span metres; a mesh drawn in millimetres and given no ``scale`` reaches hundreds, and far
-out the distance arithmetic loses its meaning."""
 MIN_MESH_SPAN_M = 1e-6
 """Smallest largest extent of a link mesh [m], scale applied: a mesh smaller than a micrometre
 (a scale of 0, or 1e-9) is no part of an arm, and its points merge into one at the hull's
@@ -60,7 +57,7 @@ def build_models(xml: str, path: Path, kind: Any = pin.GeometryType.COLLISION) -
 def check_meshes(model: Any, geometry: Any, path: Path) -> None:
     """Refuse a mesh of ``geometry`` that is not finite, reaches too far or spans too little.
 
-    A vertex not finite, one beyond :data:`MAX_MESH_REACH_M` of the link's frame, or a mesh whose
+    A vertex not finite, one beyond :data:`MAX_SHAPE_M` of the link's frame, or a mesh whose
     largest extent is below :data:`MIN_MESH_SPAN_M`: coal would take such a mesh and crash on its
     hull (a segmentation fault at an infinite vertex), compute with nonsense, or merge its points
     into one. The message names the link, the file and the vertex or the extent.
@@ -77,7 +74,7 @@ def check_meshes(model: Any, geometry: Any, path: Path) -> None:
         finite = np.isfinite(vertices).all(axis=1)
         reach = np.where(finite, np.linalg.norm(np.where(finite[:, None], vertices, 0.0), axis=1), np.inf)
         span = float(np.ptp(vertices, axis=0).max()) if finite.all() else np.inf
-        if reach.max() <= MAX_MESH_REACH_M and span >= MIN_MESH_SPAN_M:
+        if reach.max() <= MAX_SHAPE_M and span >= MIN_MESH_SPAN_M:
             continue
         link = model.frames[obj.parentFrame].name if obj.parentFrame < len(model.frames) else obj.name
         what = f"URDF '{path}': link '{link}': mesh '{obj.meshPath}'"
@@ -95,7 +92,7 @@ def check_meshes(model: Any, geometry: Any, path: Path) -> None:
             )
         raise UrdfError(
             f"{what} reaches {reach[worst]:.6g} m from its link's frame at vertex {worst} = ({vertex}) m, "
-            f'beyond {MAX_MESH_REACH_M:g} m; a mesh drawn in millimetres needs scale="0.001 0.001 0.001" '
+            f'beyond {MAX_SHAPE_M:g} m; a mesh drawn in millimetres needs scale="0.001 0.001 0.001" '
             "in its <mesh>"
         )
 
