@@ -51,8 +51,8 @@ MAX_SHAPE_M = 100.0
 radius, and the distance of a mesh's vertex from its link's frame. An arm's links span metres;
 a mesh drawn in millimetres and given no ``scale`` reaches hundreds, and far out the distance
 arithmetic loses its meaning."""
-SHAPE_SIZES = {"box": ("size", 3), "cylinder": ("radius", 1, "length", 1), "sphere": ("radius", 1)}
-"""The size attributes of each URDF shape, and how many numbers each holds."""
+SHAPE_SIZES = {"box": (("size", 3),), "cylinder": (("radius", 1), ("length", 1)), "sphere": (("radius", 1),)}
+"""The size attributes of each URDF shape, each with how many numbers it holds."""
 INERTIA_NAMES = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 ROUNDING_KG_M2 = 1e-12
 """How far a moment of inertia may pass below zero by rounding [kg m^2] (a milligram at a millimetre)."""
@@ -130,10 +130,9 @@ def check_shapes(tree: etree._ElementTree, path: Path) -> None:
         for element in link.iter("collision", "visual"):
             where = f"URDF '{path}': link '{link.get('name', '?')}': {element.tag}"
             for shape in element.iterfind("geometry/*"):
-                sizes = SHAPE_SIZES.get(str(shape.tag), ())
-                for name, count in zip(sizes[::2], sizes[1::2], strict=True):
+                for name, count in SHAPE_SIZES.get(str(shape.tag), ()):
                     text = shape.get(name)
-                    values = _numbers(text, int(count))
+                    values = _numbers(text, count)
                     if values is None or not all(0.0 < v <= MAX_SHAPE_M for v in values):
                         wanted = "a number" if count == 1 else f"{count} numbers"
                         raise UrdfError(

@@ -86,9 +86,8 @@ def check_meshes(model: Any, geometry: Any, path: Path) -> None:
             )
         if span < MIN_MESH_SPAN_M:
             raise UrdfError(
-                f"{what} spans {span:.3g} m (its largest extent, scale applied), "
-                f"below {MIN_MESH_SPAN_M:g} m; "
-                "check the scale in its <mesh>"
+                f"{what} spans {span:.3g} m (its largest extent, scale applied), below "
+                f"{MIN_MESH_SPAN_M:g} m; check the scale in its <mesh>"
             )
         raise UrdfError(
             f"{what} reaches {reach[worst]:.6g} m from its link's frame at vertex {worst} = ({vertex}) m, "
