@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import json
 from collections.abc import Callable
 from pathlib import Path
 
@@ -351,3 +352,18 @@ def test_a_stoppable_self_check_decides_as_one_that_is_not_until_stopped(panda: 
         asked, at_once = after_calls(len(asked) - 1)  # stopped at its last question
         with pytest.raises(ck.CheckStoppedError):
             check_self_curve(*args, stop=at_once)
+
+
+def test_robot_info_names_the_links_an_srdf_names_and_the_urdf_lacks(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from planning.cli import main
+
+    srdf = tmp_path / "other.srdf"
+    srdf.write_text('<robot><disable_collisions link1="arm_link" link2="elbow"/></robot>')
+    urdf = str(ck.cpr_urdf_path())
+    assert main(["robot-info", urdf, "--tcp", "tcp", "--srdf", str(srdf)]) == 0
+    said = capsys.readouterr().out
+    assert f"SRDF: {srdf} (it names links the URDF lacks: elbow; their disable_collisions entries" in said
+    assert main(["robot-info", urdf, "--tcp", "tcp", "--srdf", str(srdf), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["srdf_unknown_links"] == ["elbow"]

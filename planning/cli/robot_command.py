@@ -22,6 +22,7 @@ def robot_report(robot: ck.Robot) -> dict[str, Any]:
     return {
         "urdf": str(robot.urdf_path),
         "srdf": None if robot.srdf_path is None else str(robot.srdf_path),
+        "srdf_unknown_links": list(robot.srdf_unknown_links),
         "limits_file": None if robot.limits_path is None else str(robot.limits_path),
         "limits_defaulted": list(robot.limits_defaulted),
         "joints": [
@@ -80,7 +81,13 @@ def cmd_robot_info(args: argparse.Namespace) -> int:
         return EXIT_OK
     lines = [
         f"URDF: {report['urdf']}",
-        f"SRDF: {report['srdf'] or 'none'}",
+        f"SRDF: {report['srdf'] or 'none'}"
+        + (
+            f" (it names links the URDF lacks: {', '.join(report['srdf_unknown_links'])}; their "
+            "disable_collisions entries are skipped, as MoveIt skips them)"
+            if report["srdf_unknown_links"]
+            else ""
+        ),
         f"limits: {report['limits_file'] or 'the documented defaults'}"
         + (f" (defaults for {', '.join(report['limits_defaulted'])})" if report["limits_defaulted"] else ""),
         f"planned joints ({len(report['joints'])}), range, velocity, acceleration, jerk limits:",
