@@ -12,7 +12,8 @@ import pytest
 import trimesh
 
 from cpr_kin.common.disk_cache import cache_folder
-from cpr_kin.shapes.exact_meshes import ExactMesh, MeshSource, exact_meshes, hull_excess, hull_planes
+from cpr_kin.shapes.exact_meshes import ExactMesh, MeshSource, exact_meshes, hull_excess
+from cpr_kin.shapes.mesh_geometry import hull_planes
 
 
 def bvh_of(mesh: trimesh.Trimesh) -> coal.BVHModelOBBRSS:
@@ -23,6 +24,11 @@ def bvh_of(mesh: trimesh.Trimesh) -> coal.BVHModelOBBRSS:
     bvh.addTriangles(np.asarray(mesh.faces, dtype=np.int64))
     bvh.endModel()
     return bvh
+
+
+def corners(triangles: np.ndarray) -> np.ndarray:
+    """The corners of ``triangles`` ``(F, 3, 3)``, each once."""
+    return np.unique(triangles.reshape(-1, 3), axis=0)
 
 
 def l_shape() -> trimesh.Trimesh:
@@ -102,7 +108,16 @@ def test_holds_agrees_with_trimeshs_signed_distance_on_a_torus_whichever_way_it_
     if flipped:
         torus.invert()
     triangles = np.asarray(torus.triangles)
-    mesh = ExactMesh(0, bvh_of(torus), pin.SE3.Identity(), math.inf, triangles, None, hull_planes(triangles))
+    mesh = ExactMesh(
+        0,
+        bvh_of(torus),
+        pin.SE3.Identity(),
+        math.inf,
+        triangles,
+        None,
+        hull_planes(triangles),
+        corners(triangles),
+    )
     found = mesh.holds(points)
     assert 100 < expected.sum() < 2900
     near_surface = np.abs(signed) < 1e-3  # within a hair of the faceted surface either may say either
@@ -136,7 +151,9 @@ def test_a_flat_set_has_no_hull_planes_and_a_flat_mesh_holds_nothing() -> None:
     planes = hull_planes(np.asarray(plate.vertices))
     assert planes.shape == (0, 4)
     triangles = np.asarray(plate.triangles)
-    mesh = ExactMesh(0, bvh_of(plate), pin.SE3.Identity(), math.inf, triangles, None, planes)
+    mesh = ExactMesh(
+        0, bvh_of(plate), pin.SE3.Identity(), math.inf, triangles, None, planes, corners(triangles)
+    )
     points = np.random.default_rng(5).uniform(-0.15, 0.15, (500, 3)) * (1.0, 1.0, 0.1)
     assert not mesh.holds(points).any()  # a surface of no volume has no inside
 
@@ -144,7 +161,16 @@ def test_a_flat_set_has_no_hull_planes_and_a_flat_mesh_holds_nothing() -> None:
 def test_holds_any_is_holds_of_the_moved_points_any() -> None:
     torus = trimesh.creation.torus(major_radius=0.2, minor_radius=0.05, major_sections=24, minor_sections=12)
     triangles = np.asarray(torus.triangles)
-    mesh = ExactMesh(0, bvh_of(torus), pin.SE3.Identity(), math.inf, triangles, None, hull_planes(triangles))
+    mesh = ExactMesh(
+        0,
+        bvh_of(torus),
+        pin.SE3.Identity(),
+        math.inf,
+        triangles,
+        None,
+        hull_planes(triangles),
+        corners(triangles),
+    )
     rng = np.random.default_rng(7)
     answers = []
     for _ in range(200):  # a few points in another frame, placed at random about the torus

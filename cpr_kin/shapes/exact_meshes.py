@@ -21,6 +21,7 @@ import hashlib
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -30,7 +31,8 @@ from numpy.typing import NDArray
 
 from cpr_kin.common.compiled import njit
 from cpr_kin.common.disk_cache import cached_array, cached_json
-from cpr_kin.shapes.mesh_geometry import spans_volume
+from cpr_kin.shapes.mesh_geometry import hull_planes
+from cpr_kin.shapes.vertex_witness import VertexGroups, vertex_groups
 
 FloatArray = NDArray[np.float64]
 
@@ -81,6 +83,7 @@ class ExactMesh:
             for more than :data:`MAX_PIECES` pieces.
         hull_planes: ``(H, 4)`` the facets of the mesh's convex hull, ``n . x + d <= 0`` inside
             (unit ``n``, ``d`` [m]).
+        corners: ``(V, 3)`` the triangles' corners, each once [m].
     """
 
     geometry: int
@@ -90,6 +93,12 @@ class ExactMesh:
     triangles: FloatArray = field(repr=False)
     piece_points: FloatArray | None = field(repr=False)
     hull_planes: FloatArray = field(repr=False)
+    corners: FloatArray = field(repr=False)
+
+    @cached_property
+    def vertex_groups(self) -> VertexGroups:
+        """The mesh's corners, in its frame, grouped (:mod:`cpr_kin.shapes.vertex_witness`)."""
+        return vertex_groups(self.corners)
 
     def holds(self, points_in_mesh: FloatArray) -> NDArray[np.bool_]:
         """``(M,)`` which of ``points_in_mesh`` ``(M, 3)`` [m] lie inside the mesh.
@@ -200,6 +209,7 @@ def exact_meshes(sources: Sequence[MeshSource], samples: int = EXCESS_SAMPLES) -
                 triangles,
                 pieces,
                 hull_planes(corners),
+                corners,
             )
     return found
 
@@ -269,22 +279,6 @@ def _triangles(source: MeshSource) -> tuple[FloatArray, FloatArray | None, Float
     pieces = np.unique(label[used], return_index=True)[1]
     points = vertices[used[pieces]] if len(pieces) <= MAX_PIECES else None
     return vertices[faces], points, vertices[used]
-
-
-def hull_planes(points: FloatArray) -> FloatArray:
-    """``(H, 4)`` the facets' planes of the convex hull of ``points`` ``(..., 3)`` (:class:`ExactMesh`).
-
-    By coal's Qhull (options ``Qt``), which the robot's hulls are built with: SciPy's
-    ``spatial`` (a tenth of a second to import) is not needed to load a robot. None for a
-    flat set (:func:`~cpr_kin.shapes.mesh_geometry.spans_volume`): no point is then outside
-    a plane, and the winding number alone decides.
-    """
-    if not spans_volume(points):
-        return np.empty((0, 4))
-    corners = coal.StdVec_Vec3s()
-    corners.extend(list(np.asarray(points, dtype=float).reshape(-1, 3)))
-    hull = coal.Convex.convexHull(corners, True, "Qt")
-    return np.column_stack([np.asarray(hull.normals()), np.asarray(hull.offsets()).ravel()])
 
 
 def as_transform(placement: Any) -> Any:

@@ -31,6 +31,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from cpr_kin.shapes.exact_meshes import ExactMesh, as_transform
+from cpr_kin.shapes.vertex_witness import VertexWitness
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -85,6 +86,7 @@ class ExactPairs:
         excess = {g: mesh.excess_m for g, mesh in self._meshes.items()}
         self.excess_m = np.array([excess.get(a, 0.0) + excess.get(b, 0.0) for a, b in self._pairs])
         self.refined = np.array([a in excess or b in excess for a, b in self._pairs], dtype=bool)
+        self._witness = VertexWitness(self._shapes, self._meshes)
         self._request = coal.DistanceRequest()
         self._collision = coal.CollisionRequest()
         self._collision.enable_contact = False
@@ -152,10 +154,14 @@ class ExactPairs:
         the first pair of triangles within it; for a margin near a link's size (dense meshes a
         few centimetres apart), seconds. So the test takes a margin up to
         :data:`COLLIDE_MARGIN_UP_TO_M`, and above it coal's distance decides, which prunes by the
-        nearest pair found so far.
+        nearest pair found so far. Where one side is a mesh and the other a primitive, a vertex
+        of the mesh within the margin of it answers first (:mod:`cpr_kin.shapes.vertex_witness`:
+        where the mesh wraps the primitive, coal's descent takes milliseconds).
         """
         a, b = self._pairs[pair]
         (shape_a, at_a), (shape_b, at_b) = self._placed(geometry_data, a), self._placed(geometry_data, b)
+        if self._witness.proves(a, at_a, b, at_b, margin_m):
+            return True
         placed = (shape_a, as_transform(at_a), shape_b, as_transform(at_b))
         self._collision.security_margin = float(collide_margin_m(min(margin_m, COLLIDE_MARGIN_UP_TO_M)))
         hit = coal.collide(*placed, self._collision, coal.CollisionResult())

@@ -1,4 +1,7 @@
-"""Meshes as coal shapes: whether points span a volume (Qhull's precondition), a mesh obstacle's geometry."""
+"""Meshes as coal shapes: whether points span a volume (Qhull's precondition), their hull's planes.
+
+And a mesh obstacle's geometry.
+"""
 
 from __future__ import annotations
 
@@ -6,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from cpr_kin.common.errors import ObstacleError
 from cpr_kin.common.names import shown
@@ -32,6 +36,24 @@ def spans_volume(points: Any) -> bool:
     spread = np.linalg.svd(vertices - vertices.mean(axis=0), compute_uv=False) / np.sqrt(len(vertices))
     size = max(float(spread[0]), float(np.sqrt(np.mean(np.sum(vertices**2, axis=1)))), 1e-300)
     return bool(spread[-1] > FLAT_SHARE * size)
+
+
+def hull_planes(points: Any) -> NDArray[np.float64]:
+    """``(H, 4)`` the facets' planes of the convex hull of ``points`` ``(..., 3)``, ``n . x + d <= 0`` inside.
+
+    By coal's Qhull (options ``Qt``), which the robot's hulls are built with: SciPy's
+    ``spatial`` (a tenth of a second to import) is not needed to load a robot. None for a
+    flat set (:func:`spans_volume`): no point is then outside
+    a plane, and the winding number alone decides.
+    """
+    import coal
+
+    if not spans_volume(points):
+        return np.empty((0, 4))
+    corners = coal.StdVec_Vec3s()
+    corners.extend(list(np.asarray(points, dtype=float).reshape(-1, 3)))
+    hull = coal.Convex.convexHull(corners, True, "Qt")
+    return np.column_stack([np.asarray(hull.normals()), np.asarray(hull.offsets()).ravel()])
 
 
 def mesh_geometry(path: Path, scale: float, convex: bool, name: str) -> Any:
