@@ -26,9 +26,13 @@ def bvh_of(mesh: trimesh.Trimesh) -> coal.BVHModelOBBRSS:
     return bvh
 
 
-def corners(triangles: np.ndarray) -> np.ndarray:
-    """The corners of ``triangles`` ``(F, 3, 3)``, each once."""
-    return np.unique(triangles.reshape(-1, 3), axis=0)
+def exact_mesh_of(mesh: trimesh.Trimesh) -> ExactMesh:
+    """``mesh`` as an exact mesh of geometry 0, in its own frame (excess not measured)."""
+    triangles = np.asarray(mesh.triangles)
+    corners = np.unique(triangles.reshape(-1, 3), axis=0)
+    return ExactMesh(
+        0, bvh_of(mesh), pin.SE3.Identity(), math.inf, triangles, None, hull_planes(triangles), corners
+    )
 
 
 def l_shape() -> trimesh.Trimesh:
@@ -107,17 +111,7 @@ def test_holds_agrees_with_trimeshs_signed_distance_on_a_torus_whichever_way_it_
     expected = signed > 0.0  # trimesh, its faces outward: positive inside, by the closest point's side
     if flipped:
         torus.invert()
-    triangles = np.asarray(torus.triangles)
-    mesh = ExactMesh(
-        0,
-        bvh_of(torus),
-        pin.SE3.Identity(),
-        math.inf,
-        triangles,
-        None,
-        hull_planes(triangles),
-        corners(triangles),
-    )
+    mesh = exact_mesh_of(torus)
     found = mesh.holds(points)
     assert 100 < expected.sum() < 2900
     near_surface = np.abs(signed) < 1e-3  # within a hair of the faceted surface either may say either
@@ -150,27 +144,15 @@ def test_a_flat_set_has_no_hull_planes_and_a_flat_mesh_holds_nothing() -> None:
     plate = trimesh.creation.box(extents=(0.2, 0.1, 0.0))  # coal's Qhull crashed on it
     planes = hull_planes(np.asarray(plate.vertices))
     assert planes.shape == (0, 4)
-    triangles = np.asarray(plate.triangles)
-    mesh = ExactMesh(
-        0, bvh_of(plate), pin.SE3.Identity(), math.inf, triangles, None, planes, corners(triangles)
-    )
+    mesh = exact_mesh_of(plate)  # its hull planes: none, as above
+    assert mesh.hull_planes.shape == (0, 4)
     points = np.random.default_rng(5).uniform(-0.15, 0.15, (500, 3)) * (1.0, 1.0, 0.1)
     assert not mesh.holds(points).any()  # a surface of no volume has no inside
 
 
 def test_holds_any_is_holds_of_the_moved_points_any() -> None:
     torus = trimesh.creation.torus(major_radius=0.2, minor_radius=0.05, major_sections=24, minor_sections=12)
-    triangles = np.asarray(torus.triangles)
-    mesh = ExactMesh(
-        0,
-        bvh_of(torus),
-        pin.SE3.Identity(),
-        math.inf,
-        triangles,
-        None,
-        hull_planes(triangles),
-        corners(triangles),
-    )
+    mesh = exact_mesh_of(torus)
     rng = np.random.default_rng(7)
     answers = []
     for _ in range(200):  # a few points in another frame, placed at random about the torus
