@@ -52,6 +52,7 @@ def warm_up(robot: ck.Robot | None = None) -> float:
         plan(small, robot, threads=1)
     _warm_own_motion(robot if robot is not None else small.robot_spec().load(), small)
     _warm_sampling()
+    _warm_vertex_witness()
     return time.perf_counter() - started
 
 
@@ -66,6 +67,19 @@ def _warm_sampling() -> None:
 
     start, goal, ones = np.array([0.1, 0.1]), np.array([0.9, 0.1]), np.ones(2)
     rrt_connect(beside_the_wall, start, goal, 0.0 * ones, ones, ones, np.random.default_rng(0))
+
+
+def _warm_vertex_witness() -> None:
+    """Ask the exact meshes' vertex test once (:mod:`cpr_kin.shapes.vertex_witness`): its kernel loads.
+
+    A plan asks it only where a link's exact mesh nears a primitive within a margin, which the
+    warm-up's own motions seldom do.
+    """
+    from cpr_kin.shapes.vertex_witness import BOX, any_vertex_within, vertex_groups
+
+    groups = vertex_groups(np.zeros((1, 3)))
+    placed = (np.eye(3), np.zeros(3), BOX, np.ones(3), 0.0)
+    any_vertex_within(groups.vertices, groups.starts, groups.centres, groups.radii, *placed)
 
 
 def _warm_own_motion(robot: ck.Robot, small: Scene) -> None:

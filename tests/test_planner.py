@@ -246,9 +246,11 @@ from planning.curves.horner import evaluate
 from planning.bench.mbm import vamp_resources
 from planning.warming import warm_up
 from planning.search.firefly import _move
+from cpr_kin.shapes.vertex_witness import any_vertex_within
 ur5 = ck.load_robot(vamp_resources("ur5") / "ur5.urdf", srdf=vamp_resources("ur5") / "ur5.srdf")
 warm_up(ur5)
-print(min(len(kernel.signatures) for kernel in (pair_bounds, self_bounds, cell_states, evaluate, _move)))
+kernels = (pair_bounds, self_bounds, cell_states, evaluate, _move, any_vertex_within)
+print(min(len(kernel.signatures) for kernel in kernels))
 """
 
 
