@@ -1,8 +1,6 @@
 from __future__ import annotations
 
-import io
 import json
-import logging
 import os
 import pty
 import subprocess
@@ -17,7 +15,6 @@ import yaml
 import cpr_kin as ck
 from cpr_kin.common.compiled import COMPILING
 from planning.cli import main
-from planning.cli.app import library_notices
 from planning.io.trajectory_reader import read_trajectory
 from planning.pipeline.metrics import WALL_TIMES
 
@@ -447,30 +444,3 @@ def test_a_file_name_a_terminal_would_obey_is_printed_escaped(
     scene = write_scene(tmp_path, "start: [", name="odd\u202eyaml.yaml")
     code, _, stderr = run(["plan", str(scene), "--out", str(tmp_path / "out")], capsys)
     assert code == 2 and "odd\\u202eyaml.yaml" in stderr and "\u202e" not in stderr
-
-
-class Terminal(io.StringIO):
-    """A stderr that says it is a terminal."""
-
-    def isatty(self) -> bool:
-        return True
-
-
-def test_library_notices_show_the_robot_packages_info_on_a_terminal_only(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    log = logging.getLogger("cpr_kin")
-    before = (log.level, log.propagate, list(log.handlers))
-    shown = Terminal()
-    monkeypatch.setattr(sys, "stderr", shown)
-    with library_notices("cpr-plan plan"):
-        logging.getLogger("cpr_kin.compiled").info("compiling")
-        logging.getLogger("cpr_kin.compiled").debug("not shown")
-    logging.getLogger("cpr_kin.compiled").info("after: not shown")
-    assert shown.getvalue() == "cpr-plan plan: compiling\n"
-    assert (log.level, log.propagate, list(log.handlers)) == before
-    piped = io.StringIO()
-    monkeypatch.setattr(sys, "stderr", piped)
-    with library_notices("cpr-plan plan"):
-        logging.getLogger("cpr_kin.compiled").info("compiling")
-    assert piped.getvalue() == ""

@@ -39,6 +39,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 import cpr_kin as ck  # lazy (lazy_loader): its modules load in the workers, where they are used
 from cpr_kin.common.names import escaped, one_line, repeated
 from planning.errors import PlanningError
+from planning.notices import library_notices
 from planning.outcome import STATUS_EXIT, classify
 
 if TYPE_CHECKING:  # the scene reader is imported in the workers, where scenes are planned
@@ -115,7 +116,9 @@ def plan_scene_file(path: Path, out: Path, threads: int | None = 1, gate: Gate =
     ``threads = 1`` by default: the batch runs scenes in parallel, not the checks of one.
     The files are published within ``gate``; a closed gate (an interrupted cluster batch)
     makes the row ``interrupted`` and writes nothing. It imports the planner itself, in the
-    worker: the process that dispatches the scenes never needs it.
+    worker: the process that dispatches the scenes never needs it. A worker whose stderr is a
+    terminal (a local batch run from one) says there that it compiles the kernels
+    (:func:`~planning.notices.library_notices`).
     """
     from planning.io.publish import OutputFolder
     from planning.io.scene_file import load_scene_file
@@ -124,7 +127,7 @@ def plan_scene_file(path: Path, out: Path, threads: int | None = 1, gate: Gate =
     name = path.stem
     try:
         read = load_scene_file(path)
-        with OutputFolder(out) as folder:
+        with OutputFolder(out) as folder, library_notices("cpr-plan batch"):
             robot = _robot(read.scene.robot_spec())
             record, files = (
                 _task_outputs(read, robot, threads) if read.task else _plan_outputs(read, robot, threads)

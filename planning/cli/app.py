@@ -3,11 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import contextlib
-import logging
 import os
 import sys
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 
 from cpr_kin.common.names import one_line
@@ -18,6 +16,7 @@ from planning.cli.moveit_command import cmd_import_moveit
 from planning.cli.plan_commands import cmd_paper, cmd_plan
 from planning.cli.robot_command import cmd_robot_info
 from planning.cli.signals import interrupts
+from planning.notices import library_notices
 from planning.outcome import EXIT_INTERRUPTED, Interrupted, classify
 
 
@@ -214,32 +213,6 @@ def build_parser() -> argparse.ArgumentParser:
     sub.add_argument("--json", action="store_true", help="print the results as JSON")
     sub.set_defaults(run=cmd_batch)
     return parser
-
-
-@contextlib.contextmanager
-def library_notices(label: str) -> Iterator[None]:
-    """Within: what the robot package says at ``INFO`` or above (that it compiles its kernels) on stderr.
-
-    Each notice is one line, ``label: notice``, for someone who waits at a terminal: where
-    stderr is not one (a pipe, a file), nothing is added to it. The logger's own settings come
-    back on exit.
-    """
-    if not sys.stderr.isatty():
-        yield
-        return
-    log = logging.getLogger("cpr_kin")
-    handler = logging.StreamHandler(sys.stderr)
-    handler.setFormatter(logging.Formatter(f"{label}: %(message)s"))
-    level, propagate = log.level, log.propagate
-    log.addHandler(handler)
-    log.setLevel(logging.INFO)
-    log.propagate = False
-    try:
-        yield
-    finally:
-        log.removeHandler(handler)
-        log.setLevel(level)
-        log.propagate = propagate
 
 
 def main(argv: Sequence[str] | None = None, *, restore_signals: bool = True) -> int:
