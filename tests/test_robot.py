@@ -189,7 +189,8 @@ def test_limits_file_unknown_joint(tmp_path: Path) -> None:
     (tmp_path / "cpr_limits.yaml").write_text(
         ck.cpr_limits_path().read_text() + "elbow: {acceleration: 1, jerk: 1}\n"
     )
-    with pytest.raises(ck.UrdfError, match=r"unknown joint\(s\) \['elbow'\]"):
+    planned = r"the planned joints are \['theta1', 'd2', 'd3', 'theta4', 'theta5'\] \(the URDF's other"
+    with pytest.raises(ck.UrdfError, match=rf"unknown joint\(s\) \['elbow'\]; {planned}"):
         ck.load_cpr(tmp_path / "cpr.urdf")
 
 

@@ -195,8 +195,8 @@ def read_dynamic_limits(
     if unknown:
         listed = ", ".join(repr(n)[:40] for n in unknown[:3]) + (", ..." if len(unknown) > 3 else "")
         raise UrdfError(
-            f"joint limits file '{path}' names unknown joint(s) [{listed}]; the robot's are "
-            f"{list(dict.fromkeys((*names, *known)))}"
+            f"joint limits file '{path}' names unknown joint(s) [{listed}]; the planned joints are "
+            f"{list(names)} (the URDF's other joints may be named too)"
         )
     velocity = urdf_velocity.copy()
     for i, name in enumerate(names):  # the file's velocity where the URDF gives none
