@@ -75,11 +75,11 @@ def _warm_vertex_witness() -> None:
     A plan asks it only where a link's exact mesh nears a primitive within a margin, which the
     warm-up's own motions seldom do.
     """
-    from cpr_kin.shapes.vertex_witness import BOX, any_vertex_within, vertex_groups
+    import pinocchio as pin
 
-    groups = vertex_groups(np.zeros((1, 3)))
-    placed = (np.eye(3), np.zeros(3), BOX, np.ones(3), 0.0)
-    any_vertex_within(groups.vertices, groups.starts, groups.centres, groups.radii, *placed)
+    from cpr_kin.shapes.vertex_witness import BOX, vertex_groups
+
+    vertex_groups(np.zeros((1, 3))).within(pin.SE3.Identity(), (BOX, np.ones(3)), 0.0)
 
 
 def _warm_own_motion(robot: ck.Robot, small: Scene) -> None:

@@ -14,7 +14,7 @@ import pytest
 import cpr_kin as ck
 from cpr_kin.model.packages import example_robot_data_share
 from cpr_kin.shapes.exact_pairs import ExactPairs
-from cpr_kin.shapes.vertex_witness import VertexWitness, any_vertex_within, primitive_of, vertex_groups
+from cpr_kin.shapes.vertex_witness import VertexWitness, primitive_of, vertex_groups
 
 SHARE = example_robot_data_share()
 assert SHARE is not None, "example-robot-data is part of the robots extra, which make installs"
@@ -42,25 +42,12 @@ def test_a_vertex_is_within_a_margin_exactly_where_coal_measures_it_so(shape: An
     rng = np.random.default_rng(7)
     primitive = primitive_of(shape)
     assert primitive is not None
-    kind, sizes = primitive
     for _ in range(200):
         at = pin.SE3(pin.exp3(rng.normal(size=3)), rng.uniform(-0.2, 0.2, 3))  # the shape in the world
         point = rng.uniform(-0.5, 0.5, 3)  # a vertex, in the world
         distance = coal_distance(point, shape, at)
-        world_in_shape = at.inverse()
         for margin, expected in ((distance + 1e-6, True), (distance - 1e-6, False)):
-            groups = vertex_groups(point[None])
-            found = any_vertex_within(
-                groups.vertices,
-                groups.starts,
-                groups.centres,
-                groups.radii,
-                world_in_shape.rotation,
-                world_in_shape.translation,
-                kind,
-                sizes,
-                margin,
-            )
+            found = vertex_groups(point[None]).within(at.inverse(), primitive, margin)
             assert found == expected, (distance, margin)
 
 
@@ -84,10 +71,10 @@ def test_the_nearest_vertex_decides_beside_a_far_group() -> None:
     near = np.array([[0.0, 0.0, 0.0], [0.01, 0.0, 0.0], [0.0, 0.01, 0.0]])
     far = near + np.array([1.0, 1.0, 1.0])
     groups = vertex_groups(np.concatenate([near, far]))
-    kind, sizes = primitive_of(coal.Sphere(0.05))  # type: ignore[misc]
-    place = (np.eye(3), np.array([0.0, 0.0, 0.2]))  # the near triangle 0.15 m from the ball
-    arguments = (groups.vertices, groups.starts, groups.centres, groups.radii, *place, kind, sizes)
-    assert not any_vertex_within(*arguments, 0.14) and any_vertex_within(*arguments, 0.16)
+    ball = primitive_of(coal.Sphere(0.05))
+    assert ball is not None
+    place = pin.SE3(np.eye(3), np.array([0.0, 0.0, 0.2]))  # the near triangle 0.15 m from the ball
+    assert not groups.within(place, ball, 0.14) and groups.within(place, ball, 0.16)
 
 
 def test_a_proof_is_a_hit_on_the_mesh_and_the_margin_test_answers_as_without_it() -> None:

@@ -89,11 +89,8 @@ def check_joints(tree: etree._ElementTree, path: Path) -> None:
         axis = joint.find("axis")
         if kind != "fixed" and axis is not None:
             text = axis.get("xyz", "1 0 0")
-            try:
-                vector = [float(v) for v in text.split()]
-            except ValueError:
-                vector = []
-            if len(vector) != 3 or not all(map(math.isfinite, vector)) or math.hypot(*vector) < 1e-9:
+            vector = _numbers(text, 3)
+            if vector is None or not all(map(math.isfinite, vector)) or math.hypot(*vector) < 1e-9:
                 raise UrdfError(
                     f"URDF '{path}': joint '{name}' axis xyz = '{escaped(text[:40])}' is not a direction; "
                     "give three finite numbers, not all zero (e.g. '0 0 1')"

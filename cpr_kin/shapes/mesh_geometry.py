@@ -43,8 +43,8 @@ def hull_planes(points: Any) -> NDArray[np.float64]:
 
     By coal's Qhull (options ``Qt``), which the robot's hulls are built with: SciPy's
     ``spatial`` (a tenth of a second to import) is not needed to load a robot. None for a
-    flat set (:func:`spans_volume`): no point is then outside
-    a plane, and the winding number alone decides.
+    flat set (:func:`spans_volume`): no point is then outside a plane, and the winding number
+    alone decides.
     """
     import coal
 

@@ -68,6 +68,16 @@ class VertexGroups:
     centres: FloatArray
     radii: FloatArray
 
+    def within(self, placement: Any, primitive: tuple[int, FloatArray], margin_m: float) -> bool:
+        """Whether a vertex lies closer than ``margin_m`` [m] to ``primitive`` (:func:`primitive_of`).
+
+        ``placement``: the vertices' frame in the primitive's (a ``pinocchio.SE3``).
+        """
+        kind, sizes = primitive
+        rotation, translation = placement.rotation, placement.translation
+        groups = (self.vertices, self.starts, self.centres, self.radii)
+        return bool(any_vertex_within(*groups, rotation, translation, kind, sizes, margin_m))
+
 
 def vertex_groups(points: FloatArray) -> VertexGroups:
     """``points`` ``(V, 3)`` [m] (a mesh's corners) as :class:`VertexGroups`."""
@@ -101,6 +111,17 @@ def _distance(kind: int, sizes: FloatArray, px: float, py: float, pz: float) -> 
     return float(np.sqrt(px * px + py * py + off_axis * off_axis) - sizes[0])
 
 
+@njit_inline
+def _moved(rotation: FloatArray, translation: FloatArray, point: FloatArray) -> tuple[float, float, float]:
+    """``point`` ``(3,)`` rotated, then translated."""
+    r, (x, y, z) = rotation, (point[0], point[1], point[2])
+    return (
+        r[0, 0] * x + r[0, 1] * y + r[0, 2] * z + translation[0],
+        r[1, 0] * x + r[1, 1] * y + r[1, 2] * z + translation[1],
+        r[2, 0] * x + r[2, 1] * y + r[2, 2] * z + translation[2],
+    )
+
+
 @njit
 def any_vertex_within(
     vertices: FloatArray,
@@ -120,19 +141,12 @@ def any_vertex_within(
     signed distance is below zero). A group whose ball keeps the margin is passed over; the
     search stops at the first vertex close enough.
     """
-    r, t = rotation, translation
     for g in range(starts.shape[0] - 1):
-        x, y, z = centres[g, 0], centres[g, 1], centres[g, 2]
-        px = r[0, 0] * x + r[0, 1] * y + r[0, 2] * z + t[0]
-        py = r[1, 0] * x + r[1, 1] * y + r[1, 2] * z + t[1]
-        pz = r[2, 0] * x + r[2, 1] * y + r[2, 2] * z + t[2]
+        px, py, pz = _moved(rotation, translation, centres[g])
         if _distance(kind, sizes, px, py, pz) - radii[g] >= margin_m:
             continue
         for v in range(starts[g], starts[g + 1]):
-            x, y, z = vertices[v, 0], vertices[v, 1], vertices[v, 2]
-            px = r[0, 0] * x + r[0, 1] * y + r[0, 2] * z + t[0]
-            py = r[1, 0] * x + r[1, 1] * y + r[1, 2] * z + t[1]
-            pz = r[2, 0] * x + r[2, 1] * y + r[2, 2] * z + t[2]
+            px, py, pz = _moved(rotation, translation, vertices[v])
             if _distance(kind, sizes, px, py, pz) < margin_m:
                 return True
     return False
@@ -175,18 +189,5 @@ class VertexWitness:
             primitive = self._primitives[other]
             if primitive is None:
                 continue
-            mesh_in_other = at_other.actInv(at_mesh)
-            groups = mesh.vertex_groups
-            return bool(
-                any_vertex_within(
-                    groups.vertices,
-                    groups.starts,
-                    groups.centres,
-                    groups.radii,
-                    mesh_in_other.rotation,
-                    mesh_in_other.translation,
-                    *primitive,
-                    margin_m,
-                )
-            )
+            return mesh.vertex_groups.within(at_other.actInv(at_mesh), primitive, margin_m)
         return False
