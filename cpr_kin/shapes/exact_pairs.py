@@ -209,21 +209,18 @@ class ExactPairs:
 
         ``margins_m`` [m]: one margin for every pair, or ``(P,)`` one per collision pair. The
         pairs without a mesh are asked first; a pair with one goes to its meshes only in its
-        margin's band (module docstring).
+        margin's band (module docstring). A configuration's pairs are measured one at a time,
+        up to the first closer than its margin: where the hulls flagged it, that is most often
+        one of the first (``docs/tuning.md``, Exact meshes).
         """
         order = sorted(pairs, key=lambda p: bool(self.refined[p]))
         margins = np.broadcast_to(np.asarray(margins_m, dtype=float), len(self._pairs)).tolist()
         excess, refined = self.excess_m.tolist(), self.refined.tolist()
-        every = 4 * len(order) >= len(self._pairs)  # coal on every pair in one call, for most of them
         found = np.zeros(len(batch), dtype=bool)
         for row, q in enumerate(batch):
-            if every:
-                pin.computeDistances(model, data, geometry_model, geometry_data, q)
-                hulls = [geometry_data.distanceResults[p].min_distance for p in order]
-            else:
-                pin.updateGeometryPlacements(model, data, geometry_model, geometry_data, q)
-                hulls = [pin.computeDistance(geometry_model, geometry_data, p).min_distance for p in order]
-            for p, hull in zip(order, hulls, strict=True):
+            pin.updateGeometryPlacements(model, data, geometry_model, geometry_data, q)
+            for p in order:
+                hull = pin.computeDistance(geometry_model, geometry_data, p).min_distance
                 if hull >= margins[p]:
                     continue
                 if (
