@@ -167,3 +167,28 @@ def test_every_query_gives_one_answer_never_below_the_hulls(urdf: Path) -> None:
         np.testing.assert_array_equal(one_by_one, clear_m[:60] < margin_m)
     grouped = world.clearance_batch(q[:50]).clearance_m.min(axis=1)
     np.testing.assert_allclose(grouped, clear_m[:50], atol=1e-9)
+
+
+def test_an_ordered_self_test_on_the_meshes_is_exact_up_to_its_first_violation() -> None:
+    """Edges through the UR5's own links: the meshes decide up to the first violated configuration.
+
+    Ordered, the answer equals the unordered one up to and including the first violation and
+    is violated after it, on the exact meshes as on the hulls (where the meshes are skipped
+    past it, the screen's later tiers too).
+    """
+    robot = ck.load_robot(UR5)
+    world = ck.CollisionWorld(robot, [])
+    rng = np.random.default_rng(8)
+    starts = rng.uniform(robot.limits.lower, robot.limits.upper, (80, robot.nq))
+    ends = rng.uniform(robot.limits.lower, robot.limits.upper, (80, robot.nq))
+    blocked_inside = 0
+    for a, b in zip(starts, ends, strict=True):
+        edge = a + np.linspace(0.0, 1.0, 25)[:, None] * (b - a)
+        for margin_m in (0.0, 0.011):
+            full = world.self_collision.violated(edge, margin_m)
+            ordered = world.self_collision.violated(edge, margin_m, ordered=True)
+            first = int(np.argmax(full)) if full.any() else len(edge)
+            np.testing.assert_array_equal(ordered[: first + 1], full[: first + 1])
+            assert ordered[first:].all()
+            blocked_inside += int(0 < first < len(edge) - 1 and not full[first:].all())
+    assert blocked_inside >= 10  # edges first violated part of the way, and free again later

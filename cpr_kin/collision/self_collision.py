@@ -254,18 +254,20 @@ class SelfCollision:
         """
         return self._screened().pair_bounds(np.atleast_2d(np.asarray(q, dtype=float)), pair)
 
-    def violated(self, q: ArrayLike, margin_m: float) -> NDArray[np.bool_]:
+    def violated(self, q: ArrayLike, margin_m: float, ordered: bool = False) -> NDArray[np.bool_]:
         """``(N,)`` whether any pair is closer than ``margin_m`` [m] at configurations ``q``.
 
         coal's collision test with ``margin_m`` as its security margin, which stops at the first
         pair closer than that, in parallel over :attr:`num_threads` threads, screened by the
         pairs' cheap bounds (:class:`~cpr_kin.collision.self_screen.ScreenedSelfTest`): a fraction of
-        :meth:`distances`' cost, with the same answer.
+        :meth:`distances`' cost, with the same answer. With ``ordered``, the answer is exact up
+        to the first violated configuration, and those after it are reported violated: what an
+        edge check needs, without the exact meshes' tests of the configurations past it.
         """
         batch = np.atleast_2d(np.asarray(q, dtype=float))
         if not self._pairs or not len(batch):
             return np.zeros(len(batch), dtype=bool)
-        return self._screened().violated(batch, margin_m)
+        return self._screened().violated(batch, margin_m, ordered)
 
     def on_hulls(self) -> SelfCollision:
         """The pairs with the hulls deciding alone (:meth:`cpr_kin.CollisionWorld.on_hulls`)."""

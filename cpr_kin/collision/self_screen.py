@@ -86,17 +86,21 @@ class ScreenedSelfTest:
         hulls._exact = None
         return hulls
 
-    def violated(self, batch: FloatArray, margin_m: float) -> NDArray[np.bool_]:
-        """``(N,)`` whether any pair is closer than ``margin_m`` [m] at configurations ``batch``."""
+    def violated(self, batch: FloatArray, margin_m: float, ordered: bool = False) -> NDArray[np.bool_]:
+        """``(N,)`` whether any pair is closer than ``margin_m`` [m] at configurations ``batch``.
+
+        With ``ordered``, exact up to the first violated configuration; those after it are
+        reported violated, the meshes not asked about them (what an edge check needs).
+        """
         self._prepare(margin_m)
         hits = np.zeros(len(batch), dtype=bool)
         if self.near_pairs and not self._near_cells:
-            hits[:] = self._coal(0, batch)
+            _settle(hits, np.arange(len(batch)), self._coal(0, batch, ordered), ordered)
         elif self.near_pairs:  # coal where their cells are in doubt
             margins = self._coal_state.near_margins
             doubtful = np.flatnonzero(~self._near_cells.clear(batch, margins, self._exact is not None))
             if doubtful.size:
-                hits[doubtful] = self._coal(0, batch[doubtful])
+                _settle(hits, doubtful, self._coal(0, batch[doubtful], ordered), ordered)
         if self.far_bounds.n_pairs:
             open_rows = np.flatnonzero(~hits)
             threshold = float(margin_m + coal_error_m(margin_m))
@@ -104,7 +108,7 @@ class ScreenedSelfTest:
             if doubtful.size:
                 within = self.far_bounds(batch[doubtful], threshold) <= threshold
                 self._switch_far(np.any(within, axis=0))
-                hits[doubtful] = self._coal(1, batch[doubtful])
+                _settle(hits, doubtful, self._coal(1, batch[doubtful], ordered), ordered)
         return hits
 
     def _switch_far(self, doubtful: BoolArray) -> None:
@@ -154,8 +158,11 @@ class ScreenedSelfTest:
             *data, batch, bounds, pairs, offsets_m=offsets, exact=self._exact, exact_below_m=exact_below_m
         )
 
-    def _coal(self, tier: int, batch: FloatArray) -> NDArray[np.bool_]:
-        """Coal's test of ``tier``'s pairs (0 near, 1 far) at ``batch``: the hulls flag, the meshes decide."""
+    def _coal(self, tier: int, batch: FloatArray, ordered: bool = False) -> NDArray[np.bool_]:
+        """Coal's test of ``tier``'s pairs (0 near, 1 far) at ``batch``: the hulls flag, the meshes decide.
+
+        ``ordered``: the meshes decide up to the first configuration they find violated.
+        """
         state = self._coal_state
         flagged = pool_collisions(
             state.pools[tier], self.model, state.data, self.geometry_model, batch, self.num_threads
@@ -164,7 +171,7 @@ class ScreenedSelfTest:
             return flagged
         active = np.flatnonzero(self._near if tier == 0 else state.far_on)
         data = (self.model, state.data, self.geometry_model, state.distance_data)
-        return self._exact.recheck(flagged, *data, batch, active, state.pair_margins)
+        return self._exact.recheck(flagged, *data, batch, active, state.pair_margins, ordered)
 
     def _prepare(self, margin_m: float) -> _CoalState:
         """Build the two pools and distance data once; set their margin and pairs when the margin changes.
@@ -189,6 +196,17 @@ class ScreenedSelfTest:
                         request.enable_contact = False
             state.margin_m = margin_m
         return state
+
+
+def _settle(hits: BoolArray, rows: IntArray, found: BoolArray, ordered: bool) -> None:
+    """Write a test's answer ``found`` at ``rows`` of ``hits``, in place.
+
+    ``ordered``: every configuration after the first one found is marked too (an ordered
+    test's answer, which the later tiers then skip).
+    """
+    hits[rows] = found
+    if ordered and found.any():
+        hits[rows[int(np.argmax(found))] :] = True
 
 
 @dataclass

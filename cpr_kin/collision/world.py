@@ -264,13 +264,14 @@ class CollisionWorld:
 
         ``margin_m`` [m] from every obstacle (:meth:`margin_violated`), then, only where that
         holds, ``self_margin_m`` [m] between the robot's own checked pairs. With ``ordered``,
-        exact up to the first configuration that does not keep them; those after the first
-        too close to an obstacle are reported so without a test (:meth:`margin_violated`).
+        exact up to the first configuration that does not keep them; those after it are
+        reported so, without the tests an unordered check would make there
+        (:meth:`margin_violated`, :meth:`~cpr_kin.collision.self_collision.SelfCollision.violated`).
         """
         batch = np.asarray(q, dtype=float)  # margin_violated checks it
         free = ~self.margin_violated(batch, margin_m, ordered)
         if self.self_collision and free.any():
-            free[free] = ~self.self_collision.violated(batch[free], self_margin_m)
+            free[free] = ~self.self_collision.violated(batch[free], self_margin_m, ordered)
         return free
 
     def _pairs_within(self, distance_m: float) -> tuple[IntArray, PairBounds | None]:

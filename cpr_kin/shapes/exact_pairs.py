@@ -181,17 +181,19 @@ class ExactPairs:
         batch: FloatArray,
         active: IntArray,
         margins_m: FloatArray,
+        ordered: bool = False,
     ) -> BoolArray:
         """``flagged`` ``(N,)``, what a margin test on the hulls flagged at ``batch``, decided again.
 
         Where some of the ``active`` pairs has a mesh, each flagged configuration is decided by
         :meth:`violated` (``margins_m`` ``(P,)`` per collision pair [m]); elsewhere the hulls' answer
-        stands. Updated in place and returned.
+        stands. With ``ordered``, up to the first configuration found violated, those after it
+        reported violated without a test. Updated in place and returned.
         """
         if flagged.any() and self.refined[active].any():
             rows = np.flatnonzero(flagged)
             flagged[rows] = self.violated(
-                model, data, geometry_model, geometry_data, batch[rows], active.tolist(), margins_m
+                model, data, geometry_model, geometry_data, batch[rows], active.tolist(), margins_m, ordered
             )
         return flagged
 
@@ -204,8 +206,12 @@ class ExactPairs:
         batch: FloatArray,
         pairs: Sequence[int],
         margins_m: float | FloatArray,
+        ordered: bool = False,
     ) -> BoolArray:
         """``(N,)`` whether some of ``pairs`` is closer than its margin at configurations ``batch``.
+
+        With ``ordered``, the configurations are decided in order up to the first violated one;
+        those after it are reported violated without a test (what an edge check needs).
 
         ``margins_m`` [m]: one margin for every pair, or ``(P,)`` one per collision pair. The
         pairs without a mesh are asked first; a pair with one goes to its meshes only in its
@@ -230,6 +236,9 @@ class ExactPairs:
                 ):
                     found[row] = True
                     break
+            if ordered and found[row]:
+                found[row:] = True
+                break
         return found
 
     def _distance(self, shape_a: Any, at_a: Any, shape_b: Any, at_b: Any) -> Any:
