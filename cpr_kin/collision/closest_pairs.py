@@ -77,17 +77,18 @@ def closest_pairs(
     # overlap, coal's signed distance (a penetration depth) may be any negative value: -inf
     certain = below_coal(np.take_along_axis(bounds, order, axis=1))
     certain[certain <= 0.0] = -np.inf
+    # each row ascends, and a visit stops below ``below_m``: only a row's first pairs below it are visited
+    visited = np.count_nonzero(certain < below_m, axis=1).tolist()
     pairs, extra = pair_index.tolist(), offsets.tolist()
     refined = exact.refined.tolist() if exact else []
     on_meshes = exact.settled if exact else None
     place, compute = pin.updateGeometryPlacements, pin.computeDistance
-    for k in range(len(batch)):
-        row = certain[k]
-        if not row.size or row[0] >= below_m:
+    for k, count in enumerate(visited):
+        if not count:
             continue
         place(model, data, geometry_model, geometry_data, batch[k])
         best, which, limit = np.inf, -1, below_m
-        for bound, column in zip(row.tolist(), order[k].tolist(), strict=True):
+        for bound, column in zip(certain[k, :count].tolist(), order[k, :count].tolist(), strict=True):
             if bound >= limit:
                 break  # no pair left can be closer
             pair = pairs[column]

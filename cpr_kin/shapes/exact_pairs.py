@@ -86,6 +86,9 @@ class ExactPairs:
         excess = {g: mesh.excess_m for g, mesh in self._meshes.items()}
         self.excess_m = np.array([excess.get(a, 0.0) + excess.get(b, 0.0) for a, b in self._pairs])
         self.refined = np.array([a in excess or b in excess for a, b in self._pairs], dtype=bool)
+        self.excess_m.setflags(write=False)
+        self.refined.setflags(write=False)
+        self._excess, self._refined = self.excess_m.tolist(), self.refined.tolist()  # for the loops
         self._witness = VertexWitness(self._shapes, self._meshes)
         self._request = coal.DistanceRequest()
         self._collision = coal.CollisionRequest()
@@ -219,9 +222,10 @@ class ExactPairs:
         up to the first closer than its margin: where the hulls flagged it, that is most often
         one of the first (``docs/tuning.md``, Exact meshes).
         """
-        order = sorted(pairs, key=lambda p: bool(self.refined[p]))
-        margins = np.broadcast_to(np.asarray(margins_m, dtype=float), len(self._pairs)).tolist()
-        excess, refined = self.excess_m.tolist(), self.refined.tolist()
+        excess, refined = self._excess, self._refined
+        order = sorted(pairs, key=refined.__getitem__)
+        given = np.asarray(margins_m, dtype=float)
+        margins = np.broadcast_to(given, len(excess)).tolist() if given.ndim else [float(given)] * len(excess)
         found = np.zeros(len(batch), dtype=bool)
         for row, q in enumerate(batch):
             pin.updateGeometryPlacements(model, data, geometry_model, geometry_data, q)
