@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 MAX_COORDINATE_M = 100.0
-"""Largest |coordinate| of an obstacle's centre [m]. The CPR reaches about 1.3 m; far out
-the distance arithmetic loses its meaning (at 1e200 m it overflows)."""
+"""Largest |coordinate| of an obstacle's centre [m]: a hundred times an arm's reach (about a metre);
+far out the distance arithmetic loses its meaning (at 1e200 m it overflows)."""
 SIZE_RANGE_M = (1e-4, 100.0)
 """Allowed box sides, radii and lengths [m]."""
 MAX_ANGLE_RAD = 100.0

@@ -85,7 +85,7 @@ class TargetSpec(Strict):
     @model_validator(mode="before")
     @classmethod
     def _held_joint_by_name(cls, data: Any) -> Any:
-        """A joint named beside ``tcp`` (``{tcp: [...], theta4: 0.1}``): say where it goes."""
+        """A joint named beside ``tcp`` (``{tcp: [...], <joint>: 0.1}``): say where it goes."""
         if isinstance(data, dict) and "tcp" in data:
             strays = [key for key in data if key not in cls.model_fields]
             if strays:

@@ -39,7 +39,7 @@ DEFAULT_SPLINE = SplineSettings(p=1e6, a=(0.0, 0.0, 1.0), ends="rest")
 ends, which a real robot needs (the paper case itself uses natural ends)."""
 
 MAX_SAFETY_MARGIN_M = 1.0
-"""Largest safety margin [m]: the CPR reaches about 1.3 m."""
+"""Largest safety margin [m]: about an arm's whole reach (a Panda's 0.86 m, a UR10's 1.3 m)."""
 DURATION_RANGE_S = (0.01, 600.0)
 """Allowed fixed durations [s]."""
 MAX_IPO_SAMPLES = 100_000
