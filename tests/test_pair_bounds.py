@@ -209,3 +209,27 @@ def test_margin_check_with_bounds_agrees_with_distances_for_every_shape(
             violated = world.margin_violated(configurations, margin)
             ambiguous = np.abs(distances - margin) < 1e-6
             np.testing.assert_array_equal(violated[~ambiguous], (distances < margin)[~ambiguous])
+
+
+def test_flat_boxes_are_flagged_exactly_where_their_bounds_are_below(
+    robot: ck.Robot, rng: np.random.Generator
+) -> None:
+    # shelves and table tops, turned: their bounding spheres let most capsules in, and the
+    # capsule centre's gap to the box decides first; it may only skip what the bound clears
+    obstacles = [
+        ck.Obstacle.box(
+            [rng.uniform(0.4, 1.2), rng.uniform(0.3, 0.8), rng.uniform(0.01, 0.04)],
+            rng.uniform([-0.6, -0.6, 0.0], [0.6, 0.6, 0.9]),
+            rng.uniform(-np.pi, np.pi, 3),
+            name=f"shelf{k}",
+        )
+        for k in range(6)
+    ]
+    pairs = all_pairs(robot, obstacles)
+    bounds = PairBounds(robot.model, robot.collision_model, obstacles, pairs)
+    configurations = random_configurations(robot, rng, 400)
+    per_pair = bounds(configurations)
+    for threshold in (0.0, 0.02, 0.1):
+        flagged = bounds.pairs_below(configurations, threshold)
+        np.testing.assert_array_equal(flagged, per_pair <= threshold)
+        assert flagged.any() and not flagged.all()

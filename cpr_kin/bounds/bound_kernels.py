@@ -211,6 +211,24 @@ def pair_bounds(
             out[n, p] = bound - capsule_radius[c]
 
 
+@njit_inline
+def _centre_box_gap(
+    x: float, y: float, z: float, o: int, obstacle_rotation: FloatArray, obstacle_half: FloatArray
+) -> float:
+    """Distance [m] from the point ``(x, y, z)`` (in the world's axes, from box ``o``'s centre) to the box.
+
+    A capsule's points lie within its reach of its centre, so this less the reach bounds the
+    capsule's distance from the box from below: a cheaper first test than the segment's
+    (:func:`_segment_box`) where a flat box (a shelf, a table top) lets many capsules into
+    its bounding sphere (``docs/tuning.md``, Kernels).
+    """
+    r = obstacle_rotation
+    ex = max(abs(r[o, 0, 0] * x + r[o, 1, 0] * y + r[o, 2, 0] * z) - obstacle_half[o, 0], 0.0)
+    ey = max(abs(r[o, 0, 1] * x + r[o, 1, 1] * y + r[o, 2, 1] * z) - obstacle_half[o, 1], 0.0)
+    ez = max(abs(r[o, 0, 2] * x + r[o, 1, 2] * y + r[o, 2, 2] * z) - obstacle_half[o, 2], 0.0)
+    return float(np.sqrt(ex * ex + ey * ey + ez * ez))
+
+
 @njit
 def groups_below(
     q: FloatArray,
@@ -236,8 +254,10 @@ def groups_below(
     The arguments are :func:`pair_bounds`', plus each pair's group (``pair_group``, ``(P,)``
     in ``[0, G)`` for ``out`` of shape ``(N, G)``) and the bounding-sphere radii of the
     capsules (``capsule_reach``) and obstacles (``obstacle_reach``): a pair whose spheres
-    are farther apart than ``threshold`` needs no finer bound, a pair whose group is already
-    below none, and a configuration stops once every group is.
+    are farther apart than ``threshold`` needs no finer bound, nor a box whose distance from
+    the capsule's sphere is (:func:`_centre_box_gap`), a pair whose group is already below
+    none, and a configuration stops once every group is. Each test only skips pairs whose
+    bound would be above ``threshold``: ``out`` is what the bounds alone give.
     """
     joints = len(chain[0])
     rotation, translation = np.empty((joints, 3, 3)), np.empty((joints, 3))
@@ -257,6 +277,10 @@ def groups_below(
             z = 0.5 * (world[c, 0, 2] + world[c, 1, 2]) - obstacle_origin[o, 2]
             apart = threshold + capsule_reach[c] + obstacle_reach[o]
             if x * x + y * y + z * z > apart * apart:
+                continue
+            if kind[o] == BOX and _centre_box_gap(x, y, z, o, obstacle_rotation, obstacle_half) > (
+                threshold + capsule_reach[c]
+            ):
                 continue
             bound = _segment_obstacle_bound(
                 world, c, o, kind, obstacle_rotation, obstacle_origin, obstacle_radius, obstacle_half
