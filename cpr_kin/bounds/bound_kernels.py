@@ -123,6 +123,16 @@ def _segment_box(
 
 
 @njit_inline
+def _to_obstacle(x: float, y: float, z: float, o: int, rotation: FloatArray) -> tuple[float, float, float]:
+    """The vector ``(x, y, z)``, in the world's axes, in obstacle ``o``'s axes (``rotation[o]``'s columns)."""
+    return (
+        rotation[o, 0, 0] * x + rotation[o, 1, 0] * y + rotation[o, 2, 0] * z,
+        rotation[o, 0, 1] * x + rotation[o, 1, 1] * y + rotation[o, 2, 1] * z,
+        rotation[o, 0, 2] * x + rotation[o, 1, 2] * y + rotation[o, 2, 2] * z,
+    )
+
+
+@njit_inline
 def _in_obstacle(
     world: FloatArray, c: int, e: int, o: int, obstacle_rotation: FloatArray, obstacle_origin: FloatArray
 ) -> tuple[float, float, float]:
@@ -130,11 +140,7 @@ def _in_obstacle(
     x = world[c, e, 0] - obstacle_origin[o, 0]
     y = world[c, e, 1] - obstacle_origin[o, 1]
     z = world[c, e, 2] - obstacle_origin[o, 2]
-    return (
-        obstacle_rotation[o, 0, 0] * x + obstacle_rotation[o, 1, 0] * y + obstacle_rotation[o, 2, 0] * z,
-        obstacle_rotation[o, 0, 1] * x + obstacle_rotation[o, 1, 1] * y + obstacle_rotation[o, 2, 1] * z,
-        obstacle_rotation[o, 0, 2] * x + obstacle_rotation[o, 1, 2] * y + obstacle_rotation[o, 2, 2] * z,
-    )
+    return _to_obstacle(x, y, z, o, obstacle_rotation)
 
 
 @njit_inline
@@ -222,10 +228,9 @@ def _centre_box_gap(
     (:func:`_segment_box`) where a flat box (a shelf, a table top) lets many capsules into
     its bounding sphere (``docs/tuning.md``, Kernels).
     """
-    r = obstacle_rotation
-    ex = max(abs(r[o, 0, 0] * x + r[o, 1, 0] * y + r[o, 2, 0] * z) - obstacle_half[o, 0], 0.0)
-    ey = max(abs(r[o, 0, 1] * x + r[o, 1, 1] * y + r[o, 2, 1] * z) - obstacle_half[o, 1], 0.0)
-    ez = max(abs(r[o, 0, 2] * x + r[o, 1, 2] * y + r[o, 2, 2] * z) - obstacle_half[o, 2], 0.0)
+    px, py, pz = _to_obstacle(x, y, z, o, obstacle_rotation)
+    half = obstacle_half
+    ex, ey, ez = _excess(px, half[o, 0]), _excess(py, half[o, 1]), _excess(pz, half[o, 2])
     return float(np.sqrt(ex * ex + ey * ey + ez * ez))
 
 
