@@ -19,7 +19,7 @@ EXTRAS := dev,bench,robots
 # trajectory optimisation; its RRT needs none of that: it is installed without its pins
 PYROBOPLAN := pyroboplan>=1.3.1
 
-.PHONY: demo test test-fast lint format wheel-check test-latest lock bench bench-peers import-mbm bench-mbm bench-torque clean
+.PHONY: bytecode demo test test-fast lint format wheel-check test-latest lock bench bench-peers import-mbm bench-mbm bench-torque clean
 
 $(STAMP): pyproject.toml $(CONSTRAINTS)
 	$(PYTHON) -m venv $(VENV)
@@ -28,14 +28,21 @@ $(STAMP): pyproject.toml $(CONSTRAINTS)
 	$(PY) -m pip install --quiet --no-deps -c $(CONSTRAINTS) "$(PYROBOPLAN)"
 	touch $(STAMP)
 
-demo: $(STAMP)
+# The packages' bytecode, as pip writes an installed wheel's: a checkout installed in place has
+# none, and where Python may not write it (PYTHONDONTWRITEBYTECODE) every new process would
+# compile the packages again (0.16 s of each `cpr-plan` call; docs/benchmarks.md). Only files
+# changed since are compiled again.
+bytecode: $(STAMP)
+	$(PY) -m compileall -q cpr_kin planning
+
+demo: bytecode
 	$(PY) scripts/paper_case.py
 
-test: $(STAMP)
+test: bytecode
 	@sh scripts/ensure_chromium.sh
 	$(PY) -m pytest --numprocesses auto --maxprocesses 2
 
-test-fast: $(STAMP)
+test-fast: bytecode
 	$(PY) -m pytest -m "not slow"
 
 lint: $(STAMP)
@@ -69,7 +76,7 @@ test-latest:
 lock: test-latest
 	.venv-latest/bin/python scripts/dependency_drift.py $(CONSTRAINTS) --write
 
-bench: $(STAMP)
+bench: bytecode
 	$(PY) scripts/bench_clearance.py
 	$(PY) scripts/bench_spline.py
 	$(PY) scripts/bench_planner.py
@@ -77,18 +84,18 @@ bench: $(STAMP)
 	$(PY) scripts/bench_timing.py --out out/bench_timing.md
 	$(PY) scripts/bench_search.py
 
-bench-peers: $(STAMP)
+bench-peers: bytecode
 	$(PY) scripts/bench_peers.py --scenes 50 --out out/bench_peers.md
 
-import-mbm: $(STAMP)
+import-mbm: bytecode
 	$(PY) scripts/import_mbm.py
 
 # two problems at once: both robots' 1,400 problems in about 35 min on 2 cores (one worker: 68)
 MBM_ARGS ?= --workers 2
-bench-mbm: $(STAMP)
+bench-mbm: bytecode
 	$(PY) scripts/bench_mbm.py --out out/bench_mbm $(MBM_ARGS)
 
-bench-torque: $(STAMP)
+bench-torque: bytecode
 	$(PY) scripts/bench_torque.py --scenes 20 --limit 3 --out out/bench_torque
 
 clean:
