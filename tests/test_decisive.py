@@ -99,3 +99,11 @@ def test_a_check_in_chunks_is_the_check_in_one_call_and_stops_between_chunks() -
     ask(None)  # no stop: nothing asked
     with pytest.raises(ck.CheckStoppedError):
         ask(lambda: True)
+
+
+def test_coal_error_of_a_float_is_the_arrays_to_the_bit() -> None:
+    rng = np.random.default_rng(3)
+    for distance in [0.0, -0.0, 1.0, -1.0, *rng.uniform(-5.0, 5.0, 200).tolist()]:
+        error = coal_error_m(distance)
+        assert isinstance(error, float)
+        assert error == float(coal_error_m(np.array([distance]))[0])

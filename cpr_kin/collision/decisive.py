@@ -14,7 +14,7 @@ its ``stop`` (:data:`Stop`) between its pieces of work (:func:`ask`, :func:`chun
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
+from typing import Any, overload
 
 import numpy as np
 from numpy.typing import NDArray
@@ -42,12 +42,23 @@ COAL_RELATIVE_ERROR = 1e-6
 accurate to about 1e-6 of their size; below a metre, to 1e-6 m): :func:`coal_error_m`."""
 
 
-def coal_error_m(distance_m: float | FloatArray) -> FloatArray:
+@overload
+def coal_error_m(distance_m: float) -> float: ...
+
+
+@overload
+def coal_error_m(distance_m: FloatArray) -> FloatArray: ...
+
+
+def coal_error_m(distance_m: float | FloatArray) -> float | FloatArray:
     """Coal's error at ``distance_m`` [m]: :data:`COAL_RELATIVE_ERROR` of ``max(1 m, |distance|)``.
 
     A configuration goes to coal unless its bounds clear a margin by this much, and a bound
-    rules a pair out, or stands for coal's value, only less this much.
+    rules a pair out, or stands for coal's value, only less this much. A float gives a float
+    (a test's margin, asked at every call of the margin tests), an array an array.
     """
+    if isinstance(distance_m, float):
+        return COAL_RELATIVE_ERROR * max(1.0, abs(distance_m))
     return np.asarray(COAL_RELATIVE_ERROR * np.maximum(1.0, np.abs(distance_m)))
 
 

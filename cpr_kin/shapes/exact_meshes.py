@@ -282,5 +282,9 @@ def _triangles(source: MeshSource) -> tuple[FloatArray, FloatArray | None, Float
 
 
 def as_transform(placement: Any) -> Any:
-    """The ``coal.Transform3s`` of a Pinocchio placement."""
-    return coal.Transform3s(np.asarray(placement.rotation), np.asarray(placement.translation))
+    """The ``coal.Transform3s`` of a Pinocchio placement (``pinocchio.SE3``).
+
+    By the conversion Pinocchio registers with coal, without NumPy copies of its rotation and
+    translation between them (the same numbers; a mesh's pair test asks two a query).
+    """
+    return coal.Transform3s(placement)
