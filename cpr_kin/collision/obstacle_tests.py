@@ -72,9 +72,11 @@ class ObstacleTests:
                 after it are reported violated without a test.
         """
         violated = np.zeros(len(batch), dtype=bool)
-        rows, columns = np.nonzero(uncertain)  # row by row, in order
-        if not rows.size:
+        # row by row, in order; NumPy's nonzero of a 2-d array costs 5x this on a plan's batches
+        flat = uncertain.ravel().nonzero()[0]
+        if not flat.size:
             return violated
+        rows, columns = np.divmod(flat, uncertain.shape[1])
         model, data, geometry_model = self.model, self._data, self.geometry_model
         geometry_data = self._geometry_data(margin_m)
         placed = decided = -1
