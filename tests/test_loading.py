@@ -19,6 +19,7 @@ import yourdfpy
 
 import cpr_kin as ck
 from cpr_kin.description.resources import makers_limits_path
+from cpr_kin.description.robot_options import SHOWN_LINKS
 from cpr_kin.model.packages import example_robot, example_robot_data_share
 
 SHARE = example_robot_data_share()
@@ -239,6 +240,19 @@ def test_a_tool_the_urdf_lacks_is_named_not_taken_for_no_tool() -> None:
         r"did you mean .*'r_gripper_tool_frame'",
     ):
         ck.load_robot(ROBOTS / "pr2_description/urdf/pr2.urdf", tcp="r_gripper_tool")
+
+
+def test_a_missing_tool_frame_lists_the_first_links_and_counts_the_rest() -> None:
+    urdf = ROBOTS / "romeo_description/urdf/romeo.urdf"
+    model = pin.buildModelFromUrdf(str(urdf))
+    links = sorted({f.name for f in model.frames if f.type == pin.FrameType.BODY})
+    assert len(links) > SHOWN_LINKS  # a humanoid: more links than a message lists
+    with pytest.raises(ck.UrdfError) as refused:
+        ck.load_robot(urdf, tcp="LWristPitchLink")
+    message = str(refused.value)
+    assert "did you mean 'LWristPitch'" in message
+    assert f"its links are {links[:SHOWN_LINKS]} and {len(links) - SHOWN_LINKS} more" in message
+    assert message.endswith(" more")  # the rest counted, not listed
 
 
 def test_a_urdf_without_collision_shapes_is_refused_naming_the_fix() -> None:

@@ -14,6 +14,8 @@ from numbers import Real
 from pathlib import Path
 from typing import Any, Protocol
 
+import pinocchio as pin
+
 from cpr_kin.common.errors import UrdfError
 from cpr_kin.common.names import shown
 
@@ -22,6 +24,9 @@ NAME_OPTIONS = ("joints", "effector_links", "wrist_joints", "limits_names")
 OPTIONAL = ("joints", "effector_links")
 """Those of :data:`NAME_OPTIONS` that may be ``None`` (a default chosen at the load)."""
 SHOWN_CHARS = 60
+
+SHOWN_LINKS = 30
+"""Most of a URDF's links a message about a missing tool frame lists (a humanoid has 150 frames)."""
 """Longest rendering of an option's value in a message (a tuple of names runs long)."""
 
 
@@ -101,14 +106,20 @@ def check_tcp(tcp: str | None, model: Any, path: Path) -> None:
     several arms would be refused for having no single arm, as if no tool had been named.
 
     Raises:
-        UrdfError: naming the frame, up to three close names and the URDF's frames.
+        UrdfError: naming the frame, up to three close names (of every frame) and the URDF's
+            links (the first :data:`SHOWN_LINKS` of them, alphabetically, and how many there are).
     """
     if tcp is None or model.existFrame(tcp):
         return
-    known = sorted({f.name for f in model.frames})
-    close = get_close_matches(tcp, known, n=3, cutoff=0.5)
+    close = get_close_matches(tcp, sorted({f.name for f in model.frames}), n=3, cutoff=0.5)
     hint = f"did you mean {', '.join(repr(name) for name in close)}? " if close else ""
+    links = sorted({f.name for f in model.frames if f.type == pin.FrameType.BODY})
+    listed = (
+        f"{links}"
+        if len(links) <= SHOWN_LINKS
+        else f"{links[:SHOWN_LINKS]} and {len(links) - SHOWN_LINKS} more"
+    )
     raise UrdfError(
         f"URDF '{path}' has no link or frame named '{tcp}' (the tool frame, tcp); "
-        f"{hint}its frames are {known}"
+        f"{hint}its links are {listed}"
     )
