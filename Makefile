@@ -30,7 +30,7 @@ $(STAMP): pyproject.toml $(CONSTRAINTS)
 
 # The packages' bytecode, as pip writes an installed wheel's: a checkout installed in place has
 # none, and where Python may not write it (PYTHONDONTWRITEBYTECODE) every new process would
-# compile the packages again (0.16 s of each `cpr-plan` call; docs/benchmarks.md). Only files
+# compile the packages again (about 0.1 s of each `cpr-plan` call; docs/benchmarks.md). Only files
 # changed since are compiled again.
 bytecode: $(STAMP)
 	$(PY) -m compileall -q cpr_kin planning
