@@ -24,10 +24,9 @@ NAME_OPTIONS = ("joints", "effector_links", "wrist_joints", "limits_names")
 OPTIONAL = ("joints", "effector_links")
 """Those of :data:`NAME_OPTIONS` that may be ``None`` (a default chosen at the load)."""
 SHOWN_CHARS = 60
-
+"""Longest rendering of an option's value in a message (a tuple of names runs long)."""
 SHOWN_LINKS = 30
 """Most of a URDF's links a message about a missing tool frame lists (a humanoid has 150 frames)."""
-"""Longest rendering of an option's value in a message (a tuple of names runs long)."""
 
 
 class Options(Protocol):
