@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import importlib.util
 import logging
+import subprocess
+import sys
 from pathlib import Path
 from types import ModuleType
 
@@ -100,3 +102,32 @@ def test_the_first_compilation_is_said_once_and_a_cached_kernel_says_nothing(
         assert caplog.records == [] and not again.said
         numba.njit(lambda x: x * 3)(3)
         assert [r.getMessage() for r in caplog.records] == [COMPILING] and again.said
+
+
+ONE_SPECIALISATION = """
+import gc
+import numba
+import cpr_kin as ck
+from planning.bench.mbm import vamp_resources
+from planning.warming import warm_up
+
+warm_up()
+resources = vamp_resources("panda")
+warm_up(ck.load_robot(resources / "panda.urdf", srdf=resources / "panda.srdf"))
+for kernel in gc.get_objects():
+    if isinstance(kernel, numba.core.registry.CPUDispatcher) and len(kernel.signatures) > 1:
+        function = kernel.py_func
+        if function.__module__.split(".")[0] in ("cpr_kin", "planning"):
+            print(function.__module__, function.__qualname__, len(kernel.signatures))
+"""
+
+
+@pytest.mark.slow
+def test_a_plan_loads_each_kernel_once() -> None:
+    """Every kernel planning calls is called with one set of argument types (array layout, read-only
+    or not): each further one is another compiled version to load from disk in every new process."""
+    completed = subprocess.run(
+        [sys.executable, "-c", ONE_SPECIALISATION], capture_output=True, text=True, check=False, timeout=600
+    )
+    assert completed.returncode == 0, completed.stderr
+    assert completed.stdout == ""

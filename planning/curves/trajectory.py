@@ -90,7 +90,7 @@ class Trajectory:
 
     def __post_init__(self) -> None:
         knots = np.array(self.knots, dtype=float)
-        coefficients = np.array(self.coefficients, dtype=float)
+        coefficients = np.array(self.coefficients, dtype=float, order="C")  # one compiled `evaluate`
         if knots.ndim != 1 or len(knots) < 2 or not (knots[1:] > knots[:-1]).all():
             raise PlanningError(
                 f"trajectory knots {knots.tolist()} must be at least two increasing times [s]"

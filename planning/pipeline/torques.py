@@ -217,9 +217,12 @@ def search_torque(
         return None
     limits = robot.limits
     points = np.linspace(q_start, q_goal, LINE_SAMPLES)
-    steps, d1, d2 = sampled_derivatives(points, limits.velocity)
-    x = phase_plane_profile(d1, d2, steps, limits.velocity, limits.acceleration, np.zeros_like(d1))
-    terms = dynamics.path_terms(points[kept_samples(points, limits.velocity)], d1, d2)
+    # writable copies of the (read-only) limits, as the search's own are: the kernels below are
+    # then loaded once in a process, not once more for read-only arguments
+    velocity, acceleration = np.array(limits.velocity), np.array(limits.acceleration)
+    steps, d1, d2 = sampled_derivatives(points, velocity)
+    x = phase_plane_profile(d1, d2, steps, velocity, acceleration, np.zeros_like(d1))
+    terms = dynamics.path_terms(points[kept_samples(points, velocity)], d1, d2)
     usage = dynamics.utilisation(profile_torques(terms, x, path_acceleration(x, steps)))
     return dynamics if usage.max() >= UNBOUND_SHARE else None
 
