@@ -9,8 +9,9 @@ import pytest
 import trimesh
 
 import cpr_kin as ck
-from cpr_kin.bounds.bound_kernels import CAPSULE, _segment_box
-from cpr_kin.bounds.pair_bounds import PairBounds, _obstacle_bound, bounding_capsule
+from cpr_kin.bounds.bound_kernels import CAPSULE
+from cpr_kin.bounds.box_distance import segment_box_distance
+from cpr_kin.bounds.pair_bounds import PairBounds, _obstacle_bound, bounding_capsule, world_extents
 
 from .conftest import random_configurations
 from .test_collision import random_obstacle
@@ -151,7 +152,7 @@ def test_the_box_bound_is_the_segment_s_exact_distance() -> None:
         if rng.random() < 0.3:  # parallel to a face (one zero step) or to an axis (two)
             still = rng.choice(3, size=rng.integers(1, 3), replace=False)
             b[still] = a[still]
-        bound = _segment_box(*a, *(b - a), *half)
+        bound = segment_box_distance(*a, *(b - a), *half)
         along = b - a
         length = float(np.linalg.norm(along))
         if length < 1e-6:
@@ -174,7 +175,7 @@ def test_the_box_bound_is_the_segment_s_exact_distance() -> None:
         a, b = rng.uniform(-0.5, 0.5, (2, 3))
         points = a + np.linspace(0.0, 1.0, 20001)[:, None] * (b - a)
         sampled = np.linalg.norm(np.maximum(np.abs(points) - half, 0.0), axis=1).min()
-        bound = _segment_box(*a, *(b - a), *half)
+        bound = segment_box_distance(*a, *(b - a), *half)
         assert sampled - 1e-4 <= bound <= sampled + 1e-12
 
 
@@ -233,3 +234,20 @@ def test_flat_boxes_are_flagged_exactly_where_their_bounds_are_below(
         flagged = bounds.pairs_below(configurations, threshold)
         np.testing.assert_array_equal(flagged, per_pair <= threshold)
         assert flagged.any() and not flagged.all()
+
+
+def test_world_extents_hold_each_obstacle_as_coal_bounds_it(rng: np.random.Generator) -> None:
+    # the margin test's first test: a box in the world's axes about the bound's centre holds
+    # the obstacle (coal's own axis-aligned box of it), and is tight for a box
+    for shape in (*SHAPES, *SHAPES):
+        obstacle = random_obstacle(shape, rng)
+        bound = _obstacle_bound(obstacle)
+        kind, rotation, centre, radius, half = bound[0], bound[1], bound[2], bound[3], bound[4]
+        extent = world_extents(np.array([kind]), rotation[None], np.array([radius]), half[None])[0]
+        placed = coal.CollisionObject(obstacle.geometry(), coal.Transform3s(obstacle.placement))
+        placed.computeAABB()
+        low, high = np.asarray(placed.getAABB().min_), np.asarray(placed.getAABB().max_)
+        assert np.all(centre - extent <= low + 1e-9) and np.all(high <= centre + extent + 1e-9)
+        if shape == "box":
+            np.testing.assert_allclose(centre - extent, low, atol=1e-9)
+            np.testing.assert_allclose(centre + extent, high, atol=1e-9)

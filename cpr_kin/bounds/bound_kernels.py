@@ -14,7 +14,7 @@ robot capsule's radius):
   (for any point of the segment, its distance from the axis is at least ``d`` and from the
   slab at least ``g``);
 - box, and any other shape by its local bounding box (half sides ``h``): the exact distance
-  from the segment to the box (:func:`_segment_box`).
+  from the segment to the box (:func:`~cpr_kin.bounds.box_distance.segment_box_distance`).
 """
 
 from __future__ import annotations
@@ -23,6 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cpr_kin.bounds.batch_kinematics import ChainArrays, place_capsules
+from cpr_kin.bounds.box_distance import excess, segment_box_distance
 from cpr_kin.common.compiled import njit, njit_inline
 
 FloatArray = NDArray[np.float64]
@@ -48,78 +49,6 @@ def _point_segment(ax: float, ay: float, az: float, dx: float, dy: float, dz: fl
 def _gap(low: float, high: float, half: float) -> float:
     """Gap between the intervals ``[low, high]`` and ``[-half, half]`` (0 where they overlap)."""
     return max(low - half, -half - high, 0.0)
-
-
-@njit
-def _excess(p: float, half: float) -> float:
-    """How far the coordinate ``p`` lies beyond the slab ``|p| <= half``, signed (0 within it)."""
-    if p > half:
-        return p - half
-    if p < -half:
-        return p + half
-    return 0.0
-
-
-@njit
-def _box_slope(
-    t: float,
-    ax: float,
-    ay: float,
-    az: float,
-    dx: float,
-    dy: float,
-    dz: float,
-    hx: float,
-    hy: float,
-    hz: float,
-) -> float:
-    """Half the derivative in ``t`` of the squared distance from ``a + t d`` to the box, half sides ``h``."""
-    return dx * _excess(ax + t * dx, hx) + dy * _excess(ay + t * dy, hy) + dz * _excess(az + t * dz, hz)
-
-
-@njit
-def _segment_box(
-    ax: float, ay: float, az: float, dx: float, dy: float, dz: float, hx: float, hy: float, hz: float
-) -> float:
-    """The distance [m] from the segment ``a -> a + d`` to the box ``|x| <= hx, |y| <= hy, |z| <= hz``.
-
-    The squared distance from the point ``a + t d`` is ``f(t) = sum_i e_i(t)^2`` with ``e_i``
-    the coordinate's excess beyond the box's slab: convex in ``t``, its derivative continuous,
-    nondecreasing and linear between the kinks where a coordinate crosses a face's plane
-    (``t = (+-h_i - a_i) / d_i``). The minimum over ``[0, 1]`` lies at an end where the
-    derivative does not change sign there, else between the two kinks (or ends) that bracket
-    the sign change, where the derivative is linear and its zero is interpolated. Exact up to
-    rounding (1e-16 m at the scale of a robot); why a box is worth it: ``docs/tuning.md``, Kernels.
-    """
-    low, high = 0.0, 1.0
-    slope_low = _box_slope(low, ax, ay, az, dx, dy, dz, hx, hy, hz)
-    slope_high = _box_slope(high, ax, ay, az, dx, dy, dz, hx, hy, hz)
-    if slope_low >= 0.0:
-        t = low
-    elif slope_high <= 0.0:
-        t = high
-    else:
-        t = -1.0
-        for axis in range(3):
-            start = ax if axis == 0 else (ay if axis == 1 else az)
-            step = dx if axis == 0 else (dy if axis == 1 else dz)
-            half = hx if axis == 0 else (hy if axis == 1 else hz)
-            if step == 0.0:
-                continue
-            for side in (-1.0, 1.0):
-                kink = (side * half - start) / step
-                if low < kink < high:
-                    slope = _box_slope(kink, ax, ay, az, dx, dy, dz, hx, hy, hz)
-                    if slope < 0.0:
-                        low, slope_low = kink, slope
-                    elif slope > 0.0:
-                        high, slope_high = kink, slope
-                    else:
-                        t = kink
-        if t < 0.0:  # the derivative is linear on [low, high]: its zero
-            t = low - slope_low * (high - low) / (slope_high - slope_low)
-    ex, ey, ez = _excess(ax + t * dx, hx), _excess(ay + t * dy, hy), _excess(az + t * dz, hz)
-    return float(np.sqrt(ex * ex + ey * ey + ez * ez))
 
 
 @njit_inline
@@ -168,7 +97,7 @@ def _segment_obstacle_bound(
         bound = _point_segment(ax, ay, az, dx, dy, dz) - radius
     elif kind[o] == BOX:
         hx, hy, hz = obstacle_half[o, 0], obstacle_half[o, 1], obstacle_half[o, 2]
-        bound = _segment_box(ax, ay, az, dx, dy, dz, hx, hy, hz)
+        bound = segment_box_distance(ax, ay, az, dx, dy, dz, hx, hy, hz)
     else:
         axis_distance = _point_segment(ax, ay, 0.0, dx, dy, 0.0)
         gap = _gap(min(az, bz), max(az, bz), obstacle_half[o, 2])
@@ -224,13 +153,13 @@ def _centre_box_gap(
     """Distance [m] from the point ``(x, y, z)`` (in the world's axes, from box ``o``'s centre) to the box.
 
     A capsule's points lie within its reach of its centre, so this less the reach bounds the
-    capsule's distance from the box from below: a cheaper first test than the segment's
-    (:func:`_segment_box`) where a flat box (a shelf, a table top) lets many capsules into
-    its bounding sphere (``docs/tuning.md``, Kernels).
+    capsule's distance from the box from below: a cheaper test than the segment's
+    (:func:`~cpr_kin.bounds.box_distance.segment_box_distance`) where a turned flat box (a
+    shelf, a table top) lets many capsules into its bounding sphere (``docs/tuning.md``, Kernels).
     """
     px, py, pz = _to_obstacle(x, y, z, o, obstacle_rotation)
     half = obstacle_half
-    ex, ey, ez = _excess(px, half[o, 0]), _excess(py, half[o, 1]), _excess(pz, half[o, 2])
+    ex, ey, ez = excess(px, half[o, 0]), excess(py, half[o, 1]), excess(pz, half[o, 2])
     return float(np.sqrt(ex * ex + ey * ey + ez * ez))
 
 
@@ -253,16 +182,19 @@ def groups_below(
     obstacle_radius: FloatArray,
     obstacle_half: FloatArray,
     obstacle_reach: FloatArray,
+    obstacle_extent: FloatArray,
 ) -> None:
     """Write into ``out[n, g]`` whether a pair of group ``g`` has a bound below ``threshold`` [m] at ``q[n]``.
 
     The arguments are :func:`pair_bounds`', plus each pair's group (``pair_group``, ``(P,)``
-    in ``[0, G)`` for ``out`` of shape ``(N, G)``) and the bounding-sphere radii of the
-    capsules (``capsule_reach``) and obstacles (``obstacle_reach``): a pair whose spheres
-    are farther apart than ``threshold`` needs no finer bound, nor a box whose distance from
-    the capsule's sphere is (:func:`_centre_box_gap`), a pair whose group is already below
-    none, and a configuration stops once every group is. Each test only skips pairs whose
-    bound would be above ``threshold``: ``out`` is what the bounds alone give.
+    in ``[0, G)`` for ``out`` of shape ``(N, G)``), the bounding-sphere radii of the capsules
+    (``capsule_reach``) and obstacles (``obstacle_reach``) and the half sides of a box in the
+    world's axes about each obstacle's centre that holds it (``obstacle_extent``, ``(O, 3)``).
+    A pair needs no finer bound where the capsule's sphere is farther than ``threshold`` from
+    that box along an axis (a shelf's board or a table top is thin along one), or from the
+    obstacle's sphere, or from a box obstacle itself (:func:`_centre_box_gap`); nor where its
+    group is already below, and a configuration stops once every group is. Each test only
+    skips pairs whose bound would be above ``threshold``: ``out`` is what the bounds alone give.
     """
     joints = len(chain[0])
     rotation, translation = np.empty((joints, 3, 3)), np.empty((joints, 3))
@@ -280,12 +212,17 @@ def groups_below(
             x = 0.5 * (world[c, 0, 0] + world[c, 1, 0]) - obstacle_origin[o, 0]
             y = 0.5 * (world[c, 0, 1] + world[c, 1, 1]) - obstacle_origin[o, 1]
             z = 0.5 * (world[c, 0, 2] + world[c, 1, 2]) - obstacle_origin[o, 2]
-            apart = threshold + capsule_reach[c] + obstacle_reach[o]
+            slack = threshold + capsule_reach[c]
+            if (
+                abs(x) > slack + obstacle_extent[o, 0]
+                or abs(y) > slack + obstacle_extent[o, 1]
+                or abs(z) > slack + obstacle_extent[o, 2]
+            ):
+                continue
+            apart = slack + obstacle_reach[o]
             if x * x + y * y + z * z > apart * apart:
                 continue
-            if kind[o] == BOX and _centre_box_gap(x, y, z, o, obstacle_rotation, obstacle_half) > (
-                threshold + capsule_reach[c]
-            ):
+            if kind[o] == BOX and _centre_box_gap(x, y, z, o, obstacle_rotation, obstacle_half) > slack:
                 continue
             bound = _segment_obstacle_bound(
                 world, c, o, kind, obstacle_rotation, obstacle_origin, obstacle_radius, obstacle_half

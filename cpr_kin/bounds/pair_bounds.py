@@ -142,14 +142,19 @@ class PairBounds:
         )
         bounds = [_obstacle_bound(obstacle) for obstacle in obstacles]
         self._pair_columns = np.arange(len(pairs), dtype=np.int64)  # each pair its own group
+        kind = np.array([b[0] for b in bounds], dtype=np.int64)
+        rotation = np.array([b[1] for b in bounds], dtype=float).reshape(-1, 3, 3)
+        radius = np.array([b[3] for b in bounds], dtype=float)
+        half = np.array([b[4] for b in bounds], dtype=float).reshape(-1, 3)
         self._obstacles = (
-            np.array([b[0] for b in bounds], dtype=np.int64),
-            np.array([b[1] for b in bounds], dtype=float).reshape(-1, 3, 3),
+            kind,
+            rotation,
             np.array([b[2] for b in bounds], dtype=float).reshape(-1, 3),
-            np.array([b[3] for b in bounds], dtype=float),
-            np.array([b[4] for b in bounds], dtype=float).reshape(-1, 3),
+            radius,
+            half,
         )
         obstacle_reach = np.array([b[5] for b in bounds], dtype=float)
+        obstacle_extent = world_extents(kind, rotation, radius, half)
         # the compiled kernels' arguments after the configurations (and threshold) and the output
         self._arguments: tuple[Any, ...] = (
             self._chain.arrays,
@@ -164,6 +169,7 @@ class PairBounds:
             *self._pairs,
             *self._obstacles,
             obstacle_reach,
+            obstacle_extent,
         )
 
     @property
@@ -203,6 +209,19 @@ class PairBounds:
         out = np.empty((len(batch), groups), dtype=np.bool_)
         groups_below(batch, float(threshold_m), out, pair_group, *self._any_arguments)
         return out
+
+
+def world_extents(kind: IntArray, rotation: FloatArray, radius: FloatArray, half: FloatArray) -> FloatArray:
+    """``(O, 3)`` half sides [m] of a box in the world's axes, about each obstacle bound's centre, holding it.
+
+    The bound's own box turned into the world's axes (``|rotation| @ half sides``): a box's
+    half sides; a cylinder's ``(R, R, h)``; a capsule's ``(R, R, h + R)``; a sphere's radius on
+    every axis. The margin test's first test (:func:`~cpr_kin.bounds.bound_kernels.groups_below`).
+    """
+    rounded = np.column_stack([radius, radius, half[:, 2] + np.where(kind == CAPSULE, radius, 0.0)])
+    local = np.where((kind == BOX)[:, None], half, rounded)
+    local[kind == SPHERE] = radius[kind == SPHERE, None]
+    return np.einsum("oij,oj->oi", np.abs(rotation), local)
 
 
 def _obstacle_bound(obstacle: Obstacle) -> tuple[int, FloatArray, FloatArray, float, FloatArray, float]:
