@@ -221,7 +221,8 @@ def world_extents(kind: IntArray, rotation: FloatArray, radius: FloatArray, half
     rounded = np.column_stack([radius, radius, half[:, 2] + np.where(kind == CAPSULE, radius, 0.0)])
     local = np.where((kind == BOX)[:, None], half, rounded)
     local[kind == SPHERE] = radius[kind == SPHERE, None]
-    return np.einsum("oij,oj->oi", np.abs(rotation), local)
+    extents: FloatArray = np.einsum("oij,oj->oi", np.abs(rotation), local)
+    return extents
 
 
 def _obstacle_bound(obstacle: Obstacle) -> tuple[int, FloatArray, FloatArray, float, FloatArray, float]:
