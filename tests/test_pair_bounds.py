@@ -11,7 +11,7 @@ import trimesh
 import cpr_kin as ck
 from cpr_kin.bounds.bound_kernels import CAPSULE
 from cpr_kin.bounds.box_distance import segment_box_distance
-from cpr_kin.bounds.pair_bounds import PairBounds, _obstacle_bound, bounding_capsule, world_extents
+from cpr_kin.bounds.pair_bounds import PairBounds, _obstacle_bound, bounding_capsule
 
 from .conftest import random_configurations
 from .test_collision import random_obstacle
@@ -126,7 +126,8 @@ def test_a_round_mesh_obstacle_is_bounded_by_its_fitted_capsule(
     rod.apply_transform(trimesh.transformations.rotation_matrix(0.8, [1.0, 1.0, 0.0]))  # type: ignore[no-untyped-call]
     rod.export(path)
     mesh = ck.Obstacle.from_mesh(path, xyz=(0.3, 0.4, 0.3), rpy=(0.1, 0.2, 0.3), name="rod")
-    kind, _, _, radius, half, _ = _obstacle_bound(mesh)
+    bound = _obstacle_bound(mesh)
+    kind, radius, half = bound.kind, bound.radius, bound.half
     assert (
         kind == CAPSULE
         and radius == pytest.approx(0.03, abs=1e-6)
@@ -242,8 +243,7 @@ def test_world_extents_hold_each_obstacle_as_coal_bounds_it(rng: np.random.Gener
     for shape in (*SHAPES, *SHAPES):
         obstacle = random_obstacle(shape, rng)
         bound = _obstacle_bound(obstacle)
-        kind, rotation, centre, radius, half = bound[0], bound[1], bound[2], bound[3], bound[4]
-        extent = world_extents(np.array([kind]), rotation[None], np.array([radius]), half[None])[0]
+        centre, extent = bound.centre, bound.world_extent
         placed = coal.CollisionObject(obstacle.geometry(), coal.Transform3s(obstacle.placement))
         placed.computeAABB()
         low, high = np.asarray(placed.getAABB().min_), np.asarray(placed.getAABB().max_)

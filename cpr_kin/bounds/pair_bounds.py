@@ -142,19 +142,15 @@ class PairBounds:
         )
         bounds = [_obstacle_bound(obstacle) for obstacle in obstacles]
         self._pair_columns = np.arange(len(pairs), dtype=np.int64)  # each pair its own group
-        kind = np.array([b[0] for b in bounds], dtype=np.int64)
-        rotation = np.array([b[1] for b in bounds], dtype=float).reshape(-1, 3, 3)
-        radius = np.array([b[3] for b in bounds], dtype=float)
-        half = np.array([b[4] for b in bounds], dtype=float).reshape(-1, 3)
         self._obstacles = (
-            kind,
-            rotation,
-            np.array([b[2] for b in bounds], dtype=float).reshape(-1, 3),
-            radius,
-            half,
+            np.array([b.kind for b in bounds], dtype=np.int64),
+            np.array([b.rotation for b in bounds], dtype=float).reshape(-1, 3, 3),
+            np.array([b.centre for b in bounds], dtype=float).reshape(-1, 3),
+            np.array([b.radius for b in bounds], dtype=float),
+            np.array([b.half for b in bounds], dtype=float).reshape(-1, 3),
         )
-        obstacle_reach = np.array([b[5] for b in bounds], dtype=float)
-        obstacle_extent = world_extents(kind, rotation, radius, half)
+        obstacle_reach = np.array([b.reach for b in bounds], dtype=float)
+        obstacle_extent = np.array([b.world_extent for b in bounds], dtype=float).reshape(-1, 3)
         # the compiled kernels' arguments after the configurations (and threshold) and the output
         self._arguments: tuple[Any, ...] = (
             self._chain.arrays,
@@ -211,25 +207,48 @@ class PairBounds:
         return out
 
 
-def world_extents(kind: IntArray, rotation: FloatArray, radius: FloatArray, half: FloatArray) -> FloatArray:
-    """``(O, 3)`` half sides [m] of a box in the world's axes, about each obstacle bound's centre, holding it.
+class ObstacleBound(NamedTuple):
+    """The shape that bounds an obstacle in the compiled kernels, in the world.
 
-    The bound's own box turned into the world's axes (``|rotation| @ half sides``): a box's
-    half sides; a cylinder's ``(R, R, h)``; a capsule's ``(R, R, h + R)``; a sphere's radius on
-    every axis. The margin test's first test (:func:`~cpr_kin.bounds.bound_kernels.groups_below`).
+    Attributes:
+        kind: :data:`~cpr_kin.bounds.bound_kernels.SPHERE`, ``CYLINDER``, ``CAPSULE`` or ``BOX``.
+        rotation: ``(3, 3)`` its axes in the world's (a cylinder's or capsule's along z).
+        centre: ``(3,)`` its centre [m].
+        radius: a sphere's, cylinder's or capsule's radius [m] (0 for a box).
+        half: ``(3,)`` a box's half sides; a cylinder's or capsule's half length as z [m].
+        reach: the radius of its bounding sphere about the centre [m] (a box's half diagonal).
     """
-    rounded = np.column_stack([radius, radius, half[:, 2] + np.where(kind == CAPSULE, radius, 0.0)])
-    local = np.where((kind == BOX)[:, None], half, rounded)
-    local[kind == SPHERE] = radius[kind == SPHERE, None]
-    extents: FloatArray = np.einsum("oij,oj->oi", np.abs(rotation), local)
-    return extents
+
+    kind: int
+    rotation: FloatArray
+    centre: FloatArray
+    radius: float
+    half: FloatArray
+    reach: float
+
+    @property
+    def world_extent(self) -> FloatArray:
+        """``(3,)`` half sides [m] of a box in the world's axes about the centre that holds the shape.
+
+        Its own box (a box's half sides; a cylinder's ``(R, R, h)``, a capsule's ``(R, R, h + R)``,
+        a sphere's radius on every axis) turned into the world's axes: the margin test's first
+        test (:func:`~cpr_kin.bounds.bound_kernels.groups_below`).
+        """
+        if self.kind == SPHERE:
+            return np.full(3, self.radius)
+        own = self.half
+        if self.kind != BOX:
+            own = np.array(
+                [self.radius, self.radius, self.half[2] + (self.radius if self.kind == CAPSULE else 0.0)]
+            )
+        extent: FloatArray = np.abs(self.rotation) @ own
+        return extent
 
 
-def _obstacle_bound(obstacle: Obstacle) -> tuple[int, FloatArray, FloatArray, float, FloatArray, float]:
-    """Kind, rotation, centre [m], radius [m], half sides (z: half length) [m] and reach [m] of a bound.
+def _obstacle_bound(obstacle: Obstacle) -> ObstacleBound:
+    """The shape that bounds ``obstacle`` in the compiled kernels.
 
-    A box has no radius (its bound reads its half sides); the reach is the radius of the
-    obstacle's bounding sphere about the centre (a box's: its half diagonal). A mesh is bounded by its
+    A sphere, cylinder, capsule or box bounds itself. A mesh is bounded by its
     bounding box or by the capsule fitted to its vertices
     (:func:`cpr_kin.bounds.capsule_fit.fitted_capsule`), whichever is smaller.
     """
@@ -238,13 +257,15 @@ def _obstacle_bound(obstacle: Obstacle) -> tuple[int, FloatArray, FloatArray, fl
     origin = np.asarray(placement.translation, dtype=float)
     radius = float(obstacle.radius or 0.0)
     if obstacle.shape == "sphere":
-        return SPHERE, rotation, origin, radius, np.zeros(3), radius
+        return ObstacleBound(SPHERE, rotation, origin, radius, np.zeros(3), radius)
     if obstacle.shape in ("cylinder", "capsule"):
         half_length = float(obstacle.length or 0.0) / 2
         half = np.array([0.0, 0.0, half_length])
         if obstacle.shape == "cylinder":
-            return CYLINDER, rotation, origin, radius, half, float(np.hypot(radius, half_length))
-        return CAPSULE, rotation, origin, radius, half, radius + half_length
+            return ObstacleBound(
+                CYLINDER, rotation, origin, radius, half, float(np.hypot(radius, half_length))
+            )
+        return ObstacleBound(CAPSULE, rotation, origin, radius, half, radius + half_length)
     geometry = obstacle.geometry()
     centre, half = _local_box(geometry)  # a box, or a mesh's bounding box
     diagonal = float(np.linalg.norm(half))
@@ -253,17 +274,15 @@ def _obstacle_bound(obstacle: Obstacle) -> tuple[int, FloatArray, FloatArray, fl
         fitted = fitted_capsule(vertices)
         if fitted.volume < 8.0 * float(np.prod(half)):
             return _capsule_bound(fitted, rotation, origin)
-    return BOX, rotation, origin + rotation @ centre, 0.0, half, diagonal
+    return ObstacleBound(BOX, rotation, origin + rotation @ centre, 0.0, half, diagonal)
 
 
-def _capsule_bound(
-    capsule: Capsule, rotation: FloatArray, origin: FloatArray
-) -> tuple[int, FloatArray, FloatArray, float, FloatArray, float]:
-    """:func:`_obstacle_bound`'s values of a capsule given in the obstacle's frame (its axis as z)."""
+def _capsule_bound(capsule: Capsule, rotation: FloatArray, origin: FloatArray) -> ObstacleBound:
+    """The :class:`ObstacleBound` of a capsule given in the obstacle's frame (its axis as z)."""
     middle = capsule.ends.mean(axis=0)
     along = capsule.ends[1] - capsule.ends[0]
     half_length = float(np.linalg.norm(along)) / 2
     axes = frame_about(along if half_length > 0.0 else np.array([0.0, 0.0, 1.0]))  # in the obstacle's frame
     half = np.array([0.0, 0.0, half_length])
     reach = capsule.radius + half_length
-    return CAPSULE, rotation @ axes, origin + rotation @ middle, capsule.radius, half, reach
+    return ObstacleBound(CAPSULE, rotation @ axes, origin + rotation @ middle, capsule.radius, half, reach)
