@@ -88,9 +88,12 @@ def closest_pairs(
             continue
         place(model, data, geometry_model, geometry_data, batch[k])
         best, which, limit = np.inf, -1, below_m
-        for bound, column in zip(certain[k, :count].tolist(), order[k, :count].tolist(), strict=True):
-            if bound >= limit:
+        # read element by element: a visit mostly ends after a pair or two of a row of hundreds
+        row_bounds, row_order = certain[k], order[k]
+        for j in range(count):
+            if row_bounds[j] >= limit:
                 break  # no pair left can be closer
+            column = int(row_order[j])
             pair = pairs[column]
             found = compute(geometry_model, geometry_data, pair).min_distance
             if on_meshes is not None and refined[pair]:
