@@ -11,7 +11,8 @@ import trimesh
 import cpr_kin as ck
 from cpr_kin.bounds.bound_kernels import CAPSULE
 from cpr_kin.bounds.box_distance import segment_box_distance
-from cpr_kin.bounds.pair_bounds import PairBounds, _obstacle_bound, bounding_capsule
+from cpr_kin.bounds.obstacle_bounds import obstacle_bound
+from cpr_kin.bounds.pair_bounds import PairBounds, bounding_capsule
 
 from .conftest import random_configurations
 from .test_collision import random_obstacle
@@ -126,7 +127,7 @@ def test_a_round_mesh_obstacle_is_bounded_by_its_fitted_capsule(
     rod.apply_transform(trimesh.transformations.rotation_matrix(0.8, [1.0, 1.0, 0.0]))  # type: ignore[no-untyped-call]
     rod.export(path)
     mesh = ck.Obstacle.from_mesh(path, xyz=(0.3, 0.4, 0.3), rpy=(0.1, 0.2, 0.3), name="rod")
-    bound = _obstacle_bound(mesh)
+    bound = obstacle_bound(mesh)
     kind, radius, half = bound.kind, bound.radius, bound.half
     assert (
         kind == CAPSULE
@@ -242,7 +243,7 @@ def test_world_extents_hold_each_obstacle_as_coal_bounds_it(rng: np.random.Gener
     # the obstacle (coal's own axis-aligned box of it), and is tight for a box
     for shape in (*SHAPES, *SHAPES):
         obstacle = random_obstacle(shape, rng)
-        bound = _obstacle_bound(obstacle)
+        bound = obstacle_bound(obstacle)
         centre, extent = bound.centre, bound.world_extent
         placed = coal.CollisionObject(obstacle.geometry(), coal.Transform3s(obstacle.placement))
         placed.computeAABB()

@@ -23,8 +23,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cpr_kin.bounds.batch_kinematics import KinematicChain
-from cpr_kin.bounds.bound_kernels import BOX, CAPSULE, CYLINDER, SPHERE, groups_below, pair_bounds
-from cpr_kin.bounds.capsule_fit import Capsule, fitted_capsule, frame_about
+from cpr_kin.bounds.bound_kernels import groups_below, pair_bounds
+from cpr_kin.bounds.capsule_fit import Capsule, fitted_capsule
+from cpr_kin.bounds.obstacle_bounds import local_box, obstacle_bound, shape_vertices
 from cpr_kin.shapes.obstacles import Obstacle
 
 FloatArray = NDArray[np.float64]
@@ -47,13 +48,13 @@ def bounding_capsule(geometry: Any) -> tuple[FloatArray, float]:
     if isinstance(geometry, coal.Capsule | coal.Cylinder):
         half_length = float(geometry.halfLength)
         return np.array([[0.0, 0.0, -half_length], [0.0, 0.0, half_length]]), float(geometry.radius)
-    centre, half = _local_box(geometry)
+    centre, half = local_box(geometry)
     axis = int(np.argmax(half))
     ends = np.array([centre, centre])
     ends[0, axis] -= half[axis]
     ends[1, axis] += half[axis]
     boxed = Capsule(ends, float(np.linalg.norm(np.delete(half, axis))))
-    vertices = _vertices(geometry)
+    vertices = shape_vertices(geometry)
     if vertices is None:
         return boxed.ends, boxed.radius
     fitted = fitted_capsule(vertices)
@@ -61,17 +62,6 @@ def bounding_capsule(geometry: Any) -> tuple[FloatArray, float]:
     fitted = Capsule(fitted.ends, fitted.radius + swept)
     best = min((boxed, fitted), key=lambda capsule: capsule.volume)
     return best.ends, best.radius
-
-
-def _vertices(geometry: Any) -> FloatArray | None:
-    """``(N, 3)`` a mesh's vertices in its own frame [m]; ``None`` for another shape or an empty mesh."""
-    if isinstance(geometry, coal.ConvexBase):
-        points = np.asarray(geometry.points(), dtype=float)
-    elif isinstance(geometry, coal.BVHModelBase):
-        points = np.asarray(geometry.vertices(), dtype=float)
-    else:
-        return None
-    return points.reshape(-1, 3) if points.size else None
 
 
 class JointCapsules(NamedTuple):
@@ -90,28 +80,35 @@ class JointCapsules(NamedTuple):
     reach: FloatArray
 
 
-def joint_capsules(collision_model: Any, geometries: Sequence[int]) -> JointCapsules:
-    """The capsules (:func:`bounding_capsule`) of ``collision_model``'s ``geometries``, in joint frames."""
+KnownCapsules = dict[int, tuple[int, FloatArray, float]]
+"""Capsules computed before, by geometry index: joint (``-1``: the world), ends ``(2, 3)`` [m], radius [m]."""
+
+
+def joint_capsules(
+    collision_model: Any, geometries: Sequence[int], known: KnownCapsules | None = None
+) -> JointCapsules:
+    """The capsules (:func:`bounding_capsule`) of ``collision_model``'s ``geometries``, in joint frames.
+
+    ``known``: those computed before for ``collision_model``, taken from it and the others
+    added to it (a robot's, kept for every world it plans in: the capsule fits are its dearest part).
+    """
+    known = {} if known is None else known
     ends, radii, joints = [], [], []
     for g in geometries:
-        obj = collision_model.geometryObjects[g]
-        local, radius = bounding_capsule(obj.geometry)
-        placement = obj.placement  # geometry in its joint's frame
-        ends.append(local @ np.asarray(placement.rotation).T + np.asarray(placement.translation))
+        if g not in known:
+            obj = collision_model.geometryObjects[g]
+            local, radius = bounding_capsule(obj.geometry)
+            placement = obj.placement  # geometry in its joint's frame
+            at = local @ np.asarray(placement.rotation).T + np.asarray(placement.translation)
+            known[g] = (int(obj.parentJoint) - 1, at, radius)  # joint -1: fixed to the world
+        joint, at, radius = known[g]
+        ends.append(at)
         radii.append(radius)
-        joints.append(int(obj.parentJoint) - 1)  # -1: fixed to the world
+        joints.append(joint)
     capsule_ends = np.array(ends, dtype=float).reshape(-1, 2, 3)
     capsule_radius = np.array(radii, dtype=float)
     reach = np.linalg.norm(capsule_ends[:, 1] - capsule_ends[:, 0], axis=1) / 2 + capsule_radius
     return JointCapsules(np.array(joints, dtype=np.int64), capsule_ends, capsule_radius, reach)
-
-
-def _local_box(geometry: Any) -> tuple[FloatArray, FloatArray]:
-    """Centre and half sides [m] of a coal geometry's bounding box in its own frame."""
-    geometry.computeLocalAABB()
-    low = np.asarray(geometry.aabb_local.min_, dtype=float)
-    high = np.asarray(geometry.aabb_local.max_, dtype=float)
-    return (low + high) / 2, (high - low) / 2
 
 
 class PairBounds:
@@ -122,6 +119,8 @@ class PairBounds:
         collision_model: the robot's Pinocchio geometry model.
         obstacles: the obstacles.
         pairs: ``(robot geometry index, obstacle index)`` per output column.
+        chain: ``model``'s kinematic chain, where the caller keeps it (default: built).
+        known: the capsules of ``collision_model`` computed before (:func:`joint_capsules`).
     """
 
     def __init__(
@@ -130,17 +129,19 @@ class PairBounds:
         collision_model: Any,
         obstacles: Sequence[Obstacle],
         pairs: Sequence[tuple[int, int]],
+        chain: KinematicChain | None = None,
+        known: KnownCapsules | None = None,
     ) -> None:
-        self._chain = KinematicChain.from_model(model)
+        self._chain = KinematicChain.from_model(model) if chain is None else chain
         geometries = sorted({g for g, _ in pairs})
         slot = {g: k for k, g in enumerate(geometries)}
-        capsules = joint_capsules(collision_model, geometries)
+        capsules = joint_capsules(collision_model, geometries, known)
         self._capsules = (capsules.joint, capsules.ends, capsules.radius)
         self._pairs = (
             np.array([slot[g] for g, _ in pairs], dtype=np.int64),
             np.array([k for _, k in pairs], dtype=np.int64),
         )
-        bounds = [_obstacle_bound(obstacle) for obstacle in obstacles]
+        bounds = [obstacle_bound(obstacle) for obstacle in obstacles]
         self._pair_columns = np.arange(len(pairs), dtype=np.int64)  # each pair its own group
         self._obstacles = (
             np.array([b.kind for b in bounds], dtype=np.int64),
@@ -205,84 +206,3 @@ class PairBounds:
         out = np.empty((len(batch), groups), dtype=np.bool_)
         groups_below(batch, float(threshold_m), out, pair_group, *self._any_arguments)
         return out
-
-
-class ObstacleBound(NamedTuple):
-    """The shape that bounds an obstacle in the compiled kernels, in the world.
-
-    Attributes:
-        kind: :data:`~cpr_kin.bounds.bound_kernels.SPHERE`, ``CYLINDER``, ``CAPSULE`` or ``BOX``.
-        rotation: ``(3, 3)`` its axes in the world's (a cylinder's or capsule's along z).
-        centre: ``(3,)`` its centre [m].
-        radius: a sphere's, cylinder's or capsule's radius [m] (0 for a box).
-        half: ``(3,)`` a box's half sides; a cylinder's or capsule's half length as z [m].
-        reach: the radius of its bounding sphere about the centre [m] (a box's half diagonal).
-    """
-
-    kind: int
-    rotation: FloatArray
-    centre: FloatArray
-    radius: float
-    half: FloatArray
-    reach: float
-
-    @property
-    def world_extent(self) -> FloatArray:
-        """``(3,)`` half sides [m] of a box in the world's axes about the centre that holds the shape.
-
-        Its own box (a box's half sides; a cylinder's ``(R, R, h)``, a capsule's ``(R, R, h + R)``,
-        a sphere's radius on every axis) turned into the world's axes: the margin test's first
-        test (:func:`~cpr_kin.bounds.bound_kernels.groups_below`).
-        """
-        if self.kind == SPHERE:
-            return np.full(3, self.radius)
-        own = self.half
-        if self.kind != BOX:
-            own = np.array(
-                [self.radius, self.radius, self.half[2] + (self.radius if self.kind == CAPSULE else 0.0)]
-            )
-        extent: FloatArray = np.abs(self.rotation) @ own
-        return extent
-
-
-def _obstacle_bound(obstacle: Obstacle) -> ObstacleBound:
-    """The shape that bounds ``obstacle`` in the compiled kernels.
-
-    A sphere, cylinder, capsule or box bounds itself. A mesh is bounded by its
-    bounding box or by the capsule fitted to its vertices
-    (:func:`cpr_kin.bounds.capsule_fit.fitted_capsule`), whichever is smaller.
-    """
-    placement = obstacle.placement
-    rotation = np.asarray(placement.rotation, dtype=float)
-    origin = np.asarray(placement.translation, dtype=float)
-    radius = float(obstacle.radius or 0.0)
-    if obstacle.shape == "sphere":
-        return ObstacleBound(SPHERE, rotation, origin, radius, np.zeros(3), radius)
-    if obstacle.shape in ("cylinder", "capsule"):
-        half_length = float(obstacle.length or 0.0) / 2
-        half = np.array([0.0, 0.0, half_length])
-        if obstacle.shape == "cylinder":
-            return ObstacleBound(
-                CYLINDER, rotation, origin, radius, half, float(np.hypot(radius, half_length))
-            )
-        return ObstacleBound(CAPSULE, rotation, origin, radius, half, radius + half_length)
-    geometry = obstacle.geometry()
-    centre, half = _local_box(geometry)  # a box, or a mesh's bounding box
-    diagonal = float(np.linalg.norm(half))
-    vertices = _vertices(geometry)
-    if vertices is not None:  # a mesh: the capsule fitted to it where that is smaller than its box
-        fitted = fitted_capsule(vertices)
-        if fitted.volume < 8.0 * float(np.prod(half)):
-            return _capsule_bound(fitted, rotation, origin)
-    return ObstacleBound(BOX, rotation, origin + rotation @ centre, 0.0, half, diagonal)
-
-
-def _capsule_bound(capsule: Capsule, rotation: FloatArray, origin: FloatArray) -> ObstacleBound:
-    """The :class:`ObstacleBound` of a capsule given in the obstacle's frame (its axis as z)."""
-    middle = capsule.ends.mean(axis=0)
-    along = capsule.ends[1] - capsule.ends[0]
-    half_length = float(np.linalg.norm(along)) / 2
-    axes = frame_about(along if half_length > 0.0 else np.array([0.0, 0.0, 1.0]))  # in the obstacle's frame
-    half = np.array([0.0, 0.0, half_length])
-    reach = capsule.radius + half_length
-    return ObstacleBound(CAPSULE, rotation @ axes, origin + rotation @ middle, capsule.radius, half, reach)

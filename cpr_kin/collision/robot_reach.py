@@ -1,4 +1,4 @@
-"""A robot's reach bounds (:mod:`cpr_kin.bounds.reach`), once per robot, and its least distances to obstacles.
+"""A robot's reach bounds and capsules (:mod:`cpr_kin.bounds`), once per robot; its least obstacle distances.
 
 The least distance of each robot geometry and obstacle pair over every configuration bounds
 what a world's margin test needs to ask of that pair.
@@ -8,11 +8,13 @@ from __future__ import annotations
 
 import weakref
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
+from cpr_kin.bounds.batch_kinematics import KinematicChain
+from cpr_kin.bounds.pair_bounds import KnownCapsules
 from cpr_kin.bounds.reach import GeometryReach, geometry_reach
 
 if TYPE_CHECKING:
@@ -36,6 +38,28 @@ def robot_reach(robot: Robot) -> tuple[GeometryReach, ...]:
         reach = geometry_reach(robot.model, robot.collision_model, limits.lower, limits.upper)
         _ROBOT_REACH[robot] = tuple(reach)
     return _ROBOT_REACH[robot]
+
+
+class RobotCapsules(NamedTuple):
+    """What a robot's pair bounds (:class:`~cpr_kin.bounds.pair_bounds.PairBounds`) are built on, kept.
+
+    Attributes:
+        chain: its kinematic chain.
+        known: its geometries' capsules fitted so far (:func:`~cpr_kin.bounds.pair_bounds.joint_capsules`).
+    """
+
+    chain: KinematicChain
+    known: KnownCapsules
+
+
+_ROBOT_CAPSULES: weakref.WeakKeyDictionary[Robot, RobotCapsules] = weakref.WeakKeyDictionary()
+
+
+def robot_capsules(robot: Robot) -> RobotCapsules:
+    """``robot``'s :class:`RobotCapsules`, once per robot: each world builds pair bounds for a few margins."""
+    if robot not in _ROBOT_CAPSULES:
+        _ROBOT_CAPSULES[robot] = RobotCapsules(KinematicChain.from_model(robot.model), {})
+    return _ROBOT_CAPSULES[robot]
 
 
 _ROBOT_SWEPT: weakref.WeakKeyDictionary[Robot, tuple[tuple[tuple[Any, Any], ...], ...]] = (

@@ -23,7 +23,7 @@ from cpr_kin.collision.closest_pairs import closest_pairs
 from cpr_kin.collision.coal_pools import default_threads
 from cpr_kin.collision.decisive import below_coal, coal_error_m
 from cpr_kin.collision.obstacle_tests import ObstacleTests
-from cpr_kin.collision.robot_reach import pair_reach_distances
+from cpr_kin.collision.robot_reach import pair_reach_distances, robot_capsules
 from cpr_kin.collision.touch_links import checked_pairs
 from cpr_kin.collision.world_self_pairs import world_self_collision
 from cpr_kin.common.errors import CprKinError
@@ -294,6 +294,7 @@ class CollisionWorld:
         """The pair bounds of the ``active`` pairs, built once per set of pairs."""
         if active not in self._pair_bounds:
             pairs = [pair for pair, on in zip(self._pairs, active, strict=True) if on]  # (geometry, obstacle)
-            robot = self.robot
-            self._pair_bounds[active] = PairBounds(robot.model, robot.collision_model, self.obstacles, pairs)
+            robot, chain, known = self.robot, *robot_capsules(self.robot)
+            model, collision = robot.model, robot.collision_model
+            self._pair_bounds[active] = PairBounds(model, collision, self.obstacles, pairs, chain, known)
         return self._pair_bounds[active]
