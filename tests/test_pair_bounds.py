@@ -11,8 +11,9 @@ import trimesh
 import cpr_kin as ck
 from cpr_kin.bounds.bound_kernels import CAPSULE
 from cpr_kin.bounds.box_distance import segment_box_distance
-from cpr_kin.bounds.obstacle_bounds import obstacle_bound
+from cpr_kin.bounds.obstacle_bounds import obstacle_arrays, obstacle_bound
 from cpr_kin.bounds.pair_bounds import PairBounds, bounding_capsule
+from cpr_kin.collision.robot_reach import robot_capsules
 
 from .conftest import random_configurations
 from .test_collision import random_obstacle
@@ -62,6 +63,29 @@ def test_bounds_never_exceed_coal_distances(robot: ck.Robot, rng: np.random.Gene
     # and they are useful: most pairs that keep 10 cm are certified to keep 5 cm
     far = exact > 0.1
     assert np.mean(bounds[far] > 0.05) > 0.8
+
+
+def test_bounds_on_kept_capsules_and_shared_obstacles_are_those_built_afresh(
+    robot: ck.Robot, rng: np.random.Generator
+) -> None:
+    """A world's pair sets share the robot's capsules and chain and the obstacles' arrays: the same bits."""
+    obstacles = [random_obstacle(shape, rng) for shape in SHAPES for _ in range(2)]
+    obstacles = [ck.Obstacle(**{**o.__dict__, "name": f"o{k}"}) for k, o in enumerate(obstacles)]
+    pairs = all_pairs(robot, obstacles)
+    configurations = random_configurations(robot, rng, 100)
+    chain, known = robot_capsules(robot)
+    shapes = obstacle_arrays(obstacles)
+    model, collision = robot.model, robot.collision_model
+    for subset in (pairs[1::3], pairs[::2], pairs):
+        fresh = PairBounds(model, collision, obstacles, subset)
+        kept = PairBounds(model, collision, obstacles, subset, chain=chain, known=known, shapes=shapes)
+        np.testing.assert_array_equal(kept(configurations), fresh(configurations))
+        for threshold in (0.0, 0.05):
+            np.testing.assert_array_equal(
+                kept.pairs_below(configurations, threshold), fresh.pairs_below(configurations, threshold)
+            )
+    assert set(known) == {g for g, _ in pairs}  # each capsule fitted once, then kept with the robot
+    assert robot_capsules(robot).known is known
 
 
 def test_any_below_is_sound_and_at_most_the_bounds_answer(robot: ck.Robot, rng: np.random.Generator) -> None:

@@ -8,6 +8,7 @@ robot geometry's box and vertices (:func:`~cpr_kin.bounds.pair_bounds.bounding_c
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any, NamedTuple
 
 import coal
@@ -76,6 +77,43 @@ class ObstacleBound(NamedTuple):
             )
         extent: FloatArray = np.abs(self.rotation) @ own
         return extent
+
+
+class ObstacleArrays(NamedTuple):
+    """The obstacles' bounds (:func:`obstacle_bound`) as the compiled kernels take them, one row each.
+
+    Attributes:
+        kind: ``(O,)`` each bound's kind.
+        rotation: ``(O, 3, 3)`` its axes in the world's.
+        centre: ``(O, 3)`` its centre [m].
+        radius: ``(O,)`` its radius [m].
+        half: ``(O, 3)`` its half sides or half length [m].
+        reach: ``(O,)`` its bounding sphere's radius [m].
+        extent: ``(O, 3)`` the half sides of its box in the world's axes [m]
+            (:attr:`ObstacleBound.world_extent`).
+    """
+
+    kind: NDArray[np.int64]
+    rotation: FloatArray
+    centre: FloatArray
+    radius: FloatArray
+    half: FloatArray
+    reach: FloatArray
+    extent: FloatArray
+
+
+def obstacle_arrays(obstacles: Sequence[Obstacle]) -> ObstacleArrays:
+    """:class:`ObstacleArrays` of ``obstacles``: every pair set among them shares them."""
+    bounds = [obstacle_bound(obstacle) for obstacle in obstacles]
+    return ObstacleArrays(
+        np.array([b.kind for b in bounds], dtype=np.int64),
+        np.array([b.rotation for b in bounds], dtype=float).reshape(-1, 3, 3),
+        np.array([b.centre for b in bounds], dtype=float).reshape(-1, 3),
+        np.array([b.radius for b in bounds], dtype=float),
+        np.array([b.half for b in bounds], dtype=float).reshape(-1, 3),
+        np.array([b.reach for b in bounds], dtype=float),
+        np.array([b.world_extent for b in bounds], dtype=float).reshape(-1, 3),
+    )
 
 
 def obstacle_bound(obstacle: Obstacle) -> ObstacleBound:

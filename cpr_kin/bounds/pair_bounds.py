@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 from cpr_kin.bounds.batch_kinematics import KinematicChain
 from cpr_kin.bounds.bound_kernels import groups_below, pair_bounds
 from cpr_kin.bounds.capsule_fit import Capsule, fitted_capsule
-from cpr_kin.bounds.obstacle_bounds import local_box, obstacle_bound, shape_vertices
+from cpr_kin.bounds.obstacle_bounds import ObstacleArrays, local_box, obstacle_arrays, shape_vertices
 from cpr_kin.shapes.obstacles import Obstacle
 
 FloatArray = NDArray[np.float64]
@@ -121,6 +121,8 @@ class PairBounds:
         pairs: ``(robot geometry index, obstacle index)`` per output column.
         chain: ``model``'s kinematic chain, where the caller keeps it (default: built).
         known: the capsules of ``collision_model`` computed before (:func:`joint_capsules`).
+        shapes: the obstacles' bounds (:func:`~cpr_kin.bounds.obstacle_bounds.obstacle_arrays`),
+            where the caller keeps them for every set of pairs among them (default: built).
     """
 
     def __init__(
@@ -129,8 +131,10 @@ class PairBounds:
         collision_model: Any,
         obstacles: Sequence[Obstacle],
         pairs: Sequence[tuple[int, int]],
+        *,
         chain: KinematicChain | None = None,
         known: KnownCapsules | None = None,
+        shapes: ObstacleArrays | None = None,
     ) -> None:
         self._chain = KinematicChain.from_model(model) if chain is None else chain
         geometries = sorted({g for g, _ in pairs})
@@ -141,17 +145,10 @@ class PairBounds:
             np.array([slot[g] for g, _ in pairs], dtype=np.int64),
             np.array([k for _, k in pairs], dtype=np.int64),
         )
-        bounds = [obstacle_bound(obstacle) for obstacle in obstacles]
+        shapes = obstacle_arrays(obstacles) if shapes is None else shapes
         self._pair_columns = np.arange(len(pairs), dtype=np.int64)  # each pair its own group
-        self._obstacles = (
-            np.array([b.kind for b in bounds], dtype=np.int64),
-            np.array([b.rotation for b in bounds], dtype=float).reshape(-1, 3, 3),
-            np.array([b.centre for b in bounds], dtype=float).reshape(-1, 3),
-            np.array([b.radius for b in bounds], dtype=float),
-            np.array([b.half for b in bounds], dtype=float).reshape(-1, 3),
-        )
-        obstacle_reach = np.array([b.reach for b in bounds], dtype=float)
-        obstacle_extent = np.array([b.world_extent for b in bounds], dtype=float).reshape(-1, 3)
+        self._obstacles = (shapes.kind, shapes.rotation, shapes.centre, shapes.radius, shapes.half)
+        obstacle_reach, obstacle_extent = shapes.reach, shapes.extent
         # the compiled kernels' arguments after the configurations (and threshold) and the output
         self._arguments: tuple[Any, ...] = (
             self._chain.arrays,

@@ -14,7 +14,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cpr_kin.bounds.batch_kinematics import KinematicChain
-from cpr_kin.bounds.pair_bounds import KnownCapsules
+from cpr_kin.bounds.obstacle_bounds import ObstacleArrays
+from cpr_kin.bounds.pair_bounds import KnownCapsules, PairBounds
 from cpr_kin.bounds.reach import GeometryReach, geometry_reach
 
 if TYPE_CHECKING:
@@ -60,6 +61,19 @@ def robot_capsules(robot: Robot) -> RobotCapsules:
     if robot not in _ROBOT_CAPSULES:
         _ROBOT_CAPSULES[robot] = RobotCapsules(KinematicChain.from_model(robot.model), {})
     return _ROBOT_CAPSULES[robot]
+
+
+def robot_pair_bounds(
+    robot: Robot, obstacles: Sequence[Obstacle], pairs: Sequence[tuple[int, int]], shapes: ObstacleArrays
+) -> PairBounds:
+    """:class:`~cpr_kin.bounds.pair_bounds.PairBounds` of ``robot``'s ``pairs`` with ``obstacles``.
+
+    Bounded by ``shapes`` (their :func:`~cpr_kin.bounds.obstacle_bounds.obstacle_arrays`), on the
+    robot's capsules and chain (:func:`robot_capsules`).
+    """
+    chain, known = robot_capsules(robot)
+    model, collision = robot.model, robot.collision_model
+    return PairBounds(model, collision, obstacles, pairs, chain=chain, known=known, shapes=shapes)
 
 
 _ROBOT_SWEPT: weakref.WeakKeyDictionary[Robot, tuple[tuple[tuple[Any, Any], ...], ...]] = (

@@ -17,13 +17,14 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
+from cpr_kin.bounds.obstacle_bounds import obstacle_arrays
 from cpr_kin.bounds.pair_bounds import PairBounds
 from cpr_kin.collision.clearance import BatchClearance, Clearance, PairDistance
 from cpr_kin.collision.closest_pairs import closest_pairs
 from cpr_kin.collision.coal_pools import default_threads
 from cpr_kin.collision.decisive import below_coal, coal_error_m
 from cpr_kin.collision.obstacle_tests import ObstacleTests
-from cpr_kin.collision.robot_reach import pair_reach_distances, robot_capsules
+from cpr_kin.collision.robot_reach import pair_reach_distances, robot_pair_bounds
 from cpr_kin.collision.touch_links import checked_pairs
 from cpr_kin.collision.world_self_pairs import world_self_collision
 from cpr_kin.common.errors import CprKinError
@@ -92,6 +93,7 @@ class CollisionWorld:
         self._tests = ObstacleTests(robot.model, model, self._exact)
         self._reach_distance = pair_reach_distances(robot, self.obstacles, self._pairs)
         self._pair_bounds: dict[tuple[bool, ...], PairBounds] = {}
+        self._shapes = obstacle_arrays(self.obstacles)  # every pair set's bounds share them
         self._within: dict[float, tuple[IntArray, PairBounds | None]] = {}
         self.self_collision = world_self_collision(robot, allowed_pairs, self_margin_m, self.num_threads)
 
@@ -294,7 +296,5 @@ class CollisionWorld:
         """The pair bounds of the ``active`` pairs, built once per set of pairs."""
         if active not in self._pair_bounds:
             pairs = [pair for pair, on in zip(self._pairs, active, strict=True) if on]  # (geometry, obstacle)
-            robot, chain, known = self.robot, *robot_capsules(self.robot)
-            model, collision = robot.model, robot.collision_model
-            self._pair_bounds[active] = PairBounds(model, collision, self.obstacles, pairs, chain, known)
+            self._pair_bounds[active] = robot_pair_bounds(self.robot, self.obstacles, pairs, self._shapes)
         return self._pair_bounds[active]
