@@ -19,7 +19,7 @@ EXTRAS := dev,bench,robots
 # trajectory optimisation; its RRT needs none of that: it is installed without its pins
 PYROBOPLAN := pyroboplan>=1.3.1
 
-.PHONY: bytecode demo test test-fast lint format wheel-check test-latest lock bench bench-peers import-mbm bench-mbm bench-torque clean
+.PHONY: bytecode kernels demo test test-fast lint format wheel-check test-latest lock bench bench-peers import-mbm bench-mbm bench-torque clean
 
 $(STAMP): pyproject.toml $(CONSTRAINTS)
 	$(PYTHON) -m venv $(VENV)
@@ -35,7 +35,13 @@ $(STAMP): pyproject.toml $(CONSTRAINTS)
 bytecode: $(STAMP)
 	$(PY) -m compileall -q cpr_kin planning
 
-demo: bytecode
+# The kernels compiled ahead of time (numba's pycc and the C compiler): a new `cpr-plan` process
+# then runs them without importing numba, about half a second sooner (docs/benchmarks.md). Built
+# again only where a kernel's file changed; the tests compile their own (tests/test_ahead.py).
+kernels: bytecode
+	$(PY) -m planning.ahead_of_time
+
+demo: kernels
 	$(PY) scripts/paper_case.py
 
 test: bytecode
@@ -61,6 +67,8 @@ wheel-check: $(STAMP)
 	$(PYTHON) -m venv build/wheel-check/venv
 	build/wheel-check/venv/bin/python -m pip install --quiet -c $(CONSTRAINTS) build/wheel-check/dist/*.whl
 	cd build/wheel-check/run && ../venv/bin/cpr-plan --help > /dev/null
+	cd build/wheel-check/run && ../venv/bin/python -m planning.ahead_of_time --bundled-only
+	cd build/wheel-check/run && ../venv/bin/python -c 'import sys, cpr_kin.bounds.bound_kernels as k; sys.exit("numba" in sys.modules)'
 	cd build/wheel-check/run && ../venv/bin/cpr-plan paper --out paper
 	cd build/wheel-check/run && ../venv/bin/cpr-plan check "$$(../venv/bin/python -c 'import planning.io.bundled as b; print(b.paper_scene_path())')" paper/trajectory.json
 

@@ -4,6 +4,12 @@ as a module or run for its markdown table, and trimesh's shared random draws see
 
 from __future__ import annotations
 
+import os
+
+# numba's dispatchers, whatever kernels compiled ahead of time this checkout holds: tests read their
+# signatures and compile kernels of their own (tests/test_ahead.py runs the kernels compiled ahead)
+os.environ["CPR_KERNELS"] = "jit"
+
 import importlib.util
 import subprocess
 import sys

@@ -14,7 +14,11 @@ import numba
 import numba.core.event
 import pytest
 
-from cpr_kin.common.compiled import COMPILING, FirstCompile, forget_stale_kernels
+from cpr_kin.common.compiled import COMPILING
+from cpr_kin.common.just_in_time import FirstCompile
+from cpr_kin.common.kernel_sources import forget_stale_kernels, sources_digest
+
+PACKAGES = ("pkg",)
 
 
 def checkout(root: Path) -> list[Path]:
@@ -41,29 +45,42 @@ def test_a_kernels_file_changed_drops_the_cached_kernels(tmp_path: Path) -> None
     stamp = tmp_path / "stamp.txt"
     files = checkout(tmp_path / "repo")
     package = tmp_path / "repo" / "pkg"
-    assert forget_stale_kernels(tmp_path / "repo", stamp)  # never seen: what is cached may be stale
+    assert forget_stale_kernels(tmp_path / "repo", stamp, PACKAGES)  # never seen: what is cached may be stale
     assert not any(path.exists() for path in files)
     files = cached(package)
-    assert not forget_stale_kernels(tmp_path / "repo", stamp)  # nothing changed
+    assert not forget_stale_kernels(tmp_path / "repo", stamp, PACKAGES)  # nothing changed
     (package / "other.py").write_text("LIMIT = 2.0\n")  # a file that compiles nothing
-    assert not forget_stale_kernels(tmp_path / "repo", stamp)
+    assert not forget_stale_kernels(tmp_path / "repo", stamp, PACKAGES)
     assert all(path.exists() for path in files)
     (package / "kernels.py").write_text((package / "kernels.py").read_text().replace("return x", "return 2"))
-    assert forget_stale_kernels(tmp_path / "repo", stamp)
+    assert forget_stale_kernels(tmp_path / "repo", stamp, PACKAGES)
     assert not any(path.exists() for path in files)
+
+
+def test_the_sources_digest_follows_the_kernel_files_alone(tmp_path: Path) -> None:
+    checkout(tmp_path / "repo")
+    package, stamp = tmp_path / "repo" / "pkg", tmp_path / "stamp.txt"
+    first = sources_digest(tmp_path / "repo", stamp, PACKAGES)
+    assert first == sources_digest(tmp_path / "repo", tmp_path / "another.txt", PACKAGES)  # from the bytes
+    (package / "other.py").write_text("LIMIT = 2.0\n")
+    assert sources_digest(tmp_path / "repo", stamp, PACKAGES) == first
+    (package / "kernels.py").write_text((package / "kernels.py").read_text() + "\n# changed\n")
+    assert sources_digest(tmp_path / "repo", stamp, PACKAGES) != first
 
 
 def test_outside_a_checkout_nothing_is_touched(tmp_path: Path) -> None:
     files = checkout(tmp_path / "repo")
     (tmp_path / "repo" / ".git").rmdir()
-    assert not forget_stale_kernels(tmp_path / "repo", tmp_path / "stamp.txt")
+    assert not forget_stale_kernels(tmp_path / "repo", tmp_path / "stamp.txt", PACKAGES)
     assert all(path.exists() for path in files)
 
 
 def test_a_stamp_that_cannot_be_kept_is_no_error(tmp_path: Path) -> None:
-    checkout(tmp_path / "repo")
+    files = checkout(tmp_path / "repo")
     (tmp_path / "blocker").write_text("a file where the stamp's folder would be")
-    assert not forget_stale_kernels(tmp_path / "repo", tmp_path / "blocker" / "stamp.txt")
+    # nothing seen, as in a checkout never stamped: what is cached may be stale, and is dropped
+    assert forget_stale_kernels(tmp_path / "repo", tmp_path / "blocker" / "stamp.txt", PACKAGES)
+    assert not any(path.exists() for path in files)
 
 
 def kernel_module(folder: Path, name: str) -> ModuleType:
@@ -82,7 +99,7 @@ def test_the_first_compilation_is_said_once_and_a_cached_kernel_says_nothing(
     tmp_path: Path, caplog: pytest.LogCaptureFixture
 ) -> None:
     log = logging.getLogger("cpr_kin.test_compiled")
-    listener = FirstCompile(log)
+    listener = FirstCompile(log, COMPILING)
     with (
         caplog.at_level(logging.INFO, logger=log.name),
         numba.core.event.install_listener("numba:compile", listener),
@@ -93,7 +110,7 @@ def test_the_first_compilation_is_said_once_and_a_cached_kernel_says_nothing(
         assert len(caplog.records) == 1
 
     caplog.clear()
-    again = FirstCompile(log)
+    again = FirstCompile(log, COMPILING)
     with (
         caplog.at_level(logging.INFO, logger=log.name),
         numba.core.event.install_listener("numba:compile", again),

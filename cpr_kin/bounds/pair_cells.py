@@ -59,7 +59,7 @@ def cell_states(
     UNKNOWN; elsewhere those after the first DOUBTFUL pair are not.
     """
     for n in range(batch.shape[0]):
-        state = CLEAR
+        state = np.int64(CLEAR)  # typed int64, not the constants' literal types (which pycc cannot unify)
         for k in range(joints.shape[0]):
             flat = offsets[k]
             for j in range(joints.shape[1]):
@@ -75,10 +75,10 @@ def cell_states(
                 flat += min(int(x / step[k, j]), counts[k, j] - 1) * strides[k, j]
             cells[n, k] = flat
             if flat < 0 or refused[flat] <= levels[k]:
-                state = DOUBTFUL
+                state = np.int64(DOUBTFUL)
                 break
             if cleared[flat] < levels[k]:
-                state = UNKNOWN
+                state = np.int64(UNKNOWN)
         states[n] = state
 
 

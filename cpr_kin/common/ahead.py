@@ -1,0 +1,232 @@
+"""The kernels compiled ahead of time: one extension module, loaded without numba.
+
+A new process that calls a numba kernel pays for numba before the kernel's own code runs,
+cached or not: its import and its first dispatch (its typing and lowering registries, and
+SciPy's linear algebra, which it probes for BLAS), then each cached kernel's load
+(docs/benchmarks.md: the new-process row). ``python -m planning.ahead_of_time`` compiles every
+kernel a warm-up calls, with the argument types it calls them with, into one extension module
+(numba's ``pycc``) and writes beside it what those types are (:class:`Kernels`).
+
+Here each kernel is a guard: its arguments are checked against each compiled signature, as
+numba's dispatcher would type them (an array's dtype, dimensions, layout and writability; a
+float, an int, a bool; a tuple's items), and where one matches, the compiled code runs; where
+none does, the kernel is compiled just in time by numba, as without the module. The module is
+named after the kernel files' digest (:func:`~cpr_kin.common.kernel_sources.sources_digest`):
+a changed kernel file leaves it unused. ``CPR_KERNELS=jit`` (or numba's ``NUMBA_DISABLE_JIT=1``)
+never loads it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import hashlib
+import importlib.machinery
+import importlib.util
+import inspect
+import json
+import os
+import platform
+from collections.abc import Callable
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+import numpy as np
+
+from cpr_kin.common.kernel_sources import sources_digest
+
+MODE_VARIABLE = "CPR_KERNELS"
+"""The environment variable that chooses: ``jit`` never loads the kernels compiled ahead of time."""
+SUFFIX = importlib.machinery.EXTENSION_SUFFIXES[0]
+
+
+def module_name(digest: str) -> str:
+    """The extension module's name for the kernel files' digest ``digest``, on this machine's CPU.
+
+    The module is compiled for the host CPU (as numba compiles): one built on another machine
+    (a home folder shared between machines) has another name.
+    """
+    return f"cpr_kernels_{digest[:20]}_{host_key()}"
+
+
+@functools.cache
+def host_key() -> str:
+    """A short digest of this machine's CPU: its architecture, model and features where the system says."""
+    described = platform.machine()
+    with contextlib.suppress(OSError):
+        lines = Path("/proc/cpuinfo").read_text().splitlines()
+        described += "".join(sorted({line for line in lines if line.startswith(("model name", "flags"))}))
+    return hashlib.sha256(described.encode()).hexdigest()[:8]
+
+
+FOLDER_VARIABLE = "CPR_KERNELS_DIR"
+"""The environment variable naming the module's one folder, instead of :func:`kernel_folders`' defaults."""
+
+
+def kernel_folders() -> list[Path]:
+    """Where the module is looked for and built, first first.
+
+    :data:`FOLDER_VARIABLE`'s folder alone where set; else the package's ``__pycache__``, then the
+    user's cache.
+    """
+    if os.environ.get(FOLDER_VARIABLE):
+        return [Path(os.environ[FOLDER_VARIABLE])]
+    cache = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
+    return [Path(__file__).resolve().parent / "__pycache__", cache / "cpr-firefly" / "kernels"]
+
+
+def export_name(module: str, name: str, index: int) -> str:
+    """The name in the extension module of signature ``index`` of kernel ``name`` of ``module``."""
+    return f"{module.replace('.', '_')}__{name}__{index}"
+
+
+class Kernels:
+    """The extension module of compiled kernels and, per kernel, the argument types of each export.
+
+    Args:
+        module: the extension module.
+        signatures: ``{"module:name": [argument specs of export 0, of export 1, ...]}``; a spec
+            is ``["array", dtype, ndim, layout, readonly]``, ``["float"]``, ``["int"]``,
+            ``["bool"]`` or ``["tuple", [item specs]]``.
+    """
+
+    def __init__(self, module: ModuleType, signatures: dict[str, list[list[Any]]]) -> None:
+        self.module, self.signatures = module, signatures
+
+    def guarded(
+        self, function: Callable[..., Any], fallback: Callable[[], Callable[..., Any]]
+    ) -> Callable[..., Any]:
+        """``function`` run by its exports where its arguments' types match one's, else by ``fallback()``.
+
+        ``fallback`` is asked once, at the first call that matches no export; a kernel with no
+        export always falls back.
+        """
+        key = f"{function.__module__}:{function.__name__}"
+        parameters = list(inspect.signature(function).parameters.values())
+        if any(p.kind != p.POSITIONAL_OR_KEYWORD for p in parameters):  # not a kernel's
+            return _falling_back(function, fallback)
+        arguments = [p.name for p in parameters]
+        # the guard is a closure: its constants and the arguments kept are cells, faster than globals
+        cells: dict[str, Any] = {"_fallback": fallback, "_ndarray": np.ndarray, "_jit": []}
+        cells |= {f"_default{i}": p.default for i, p in enumerate(parameters) if p.default is not p.empty}
+        heading = ", ".join(
+            a if f"_default{i}" not in cells else f"{a}=_default{i}" for i, a in enumerate(arguments)
+        )
+        body, kept = [], []
+        for index, specs in enumerate(self.signatures.get(key, [])):
+            cells[f"_export{index}"] = getattr(
+                self.module, export_name(function.__module__, function.__name__, index)
+            )
+            checks = []
+            for i, (spec, argument) in enumerate(zip(specs, arguments, strict=True)):
+                check = _check(spec, argument, cells)
+                if spec[0] not in SCALARS:  # the object that passed last is not checked again
+                    kept.append(last := f"_last{index}_{i}")
+                    check = f"({argument} is {last} or ({check} and ({last} := {argument}) is {argument}))"
+                checks.append(check)
+            body += [
+                f"        if {' and '.join(checks) or 'True'}:",
+                f"            return _export{index}({', '.join(arguments)})",
+            ]
+        lines = [
+            f"def _make({', '.join(cells)}):",
+            *(f"    {last} = None" for last in kept),
+            f"    def {function.__name__}({heading}):",
+            *([f"        nonlocal {', '.join(kept)}"] if kept else []),
+            *body,
+            "        if not _jit:",
+            "            _jit.append(_fallback())",
+            f"        return _jit[0]({', '.join(arguments)})",
+            f"    return {function.__name__}",
+        ]
+        names: dict[str, Any] = {}
+        exec(compile("\n".join(lines), f"<compiled ahead: {key}>", "exec"), names)
+        guard = names["_make"](**cells)
+        guard.__doc__, guard.__module__, guard.__qualname__ = (
+            function.__doc__,
+            function.__module__,
+            function.__qualname__,
+        )
+        guard.__wrapped__ = function
+        return guard  # type: ignore[no-any-return]
+
+
+SCALARS = ("float", "int", "bool")
+
+
+def _falling_back(
+    function: Callable[..., Any], fallback: Callable[[], Callable[..., Any]]
+) -> Callable[..., Any]:
+    """``function`` run by ``fallback()``, asked at the first call."""
+    jit: list[Callable[..., Any]] = []
+
+    @functools.wraps(function)
+    def guard(*args: Any, **kwargs: Any) -> Any:
+        if not jit:
+            jit.append(fallback())
+        return jit[0](*args, **kwargs)
+
+    return guard
+
+
+def _check(spec: list[Any], value: str, names: dict[str, Any]) -> str:
+    """A Python expression: whether ``value`` has the type ``spec`` describes (numba's typing of it)."""
+    kind = spec[0]
+    if kind == "array":
+        _, dtype, ndim, layout, readonly = spec
+        dtype_name = f"_dtype_{dtype}"
+        names[dtype_name] = np.dtype(dtype)
+        # a dtype equal to NumPy's is not always the same object (an array numba returned)
+        same_dtype = f"({value}.dtype is {dtype_name} or {value}.dtype == {dtype_name})"
+        check = f"type({value}) is _ndarray and {same_dtype} and {value}.ndim == {ndim}"
+        if layout == "C":  # CARRAY: C-contiguous, aligned, writeable
+            check += f" and {value}.flags.{'c_contiguous' if readonly else 'carray'}"
+        elif layout == "F":
+            check += f" and {value}.flags.{'f_contiguous' if readonly else 'farray'}"
+        elif not readonly:
+            check += f" and {value}.flags.writeable"
+        return f"({check})"
+    if kind == "float":
+        return f"(type({value}) is float or type({value}) is _float64)" + _named(
+            names, "_float64", np.float64
+        )
+    if kind == "int":
+        return f"(type({value}) is int or type({value}) is _int64)" + _named(names, "_int64", np.int64)
+    if kind == "bool":
+        return f"(type({value}) is bool or type({value}) is _bool)" + _named(names, "_bool", np.bool_)
+    items = spec[1]
+    item_checks = [_check(item, f"{value}[{i}]", names) for i, item in enumerate(items)]
+    size = f"isinstance({value}, tuple) and len({value}) == {len(items)}"
+    return f"({' and '.join([size, *item_checks])})"
+
+
+def _named(names: dict[str, Any], name: str, value: Any) -> str:
+    """``""``, with ``value`` put in ``names`` as ``name``."""
+    names[name] = value
+    return ""
+
+
+def load_kernels(folders: list[Path] | None = None) -> Kernels | None:
+    """The kernels compiled ahead of time for today's kernel files, or ``None``.
+
+    ``None`` where :data:`MODE_VARIABLE` is ``jit``, numba's JIT is disabled, no folder holds a
+    module for the kernel files' digest with its signatures, or it cannot be loaded.
+    """
+    if os.environ.get(MODE_VARIABLE) == "jit" or os.environ.get("NUMBA_DISABLE_JIT", "0") not in ("", "0"):
+        return None
+    name = module_name(sources_digest())
+    for folder in kernel_folders() if folders is None else folders:
+        path, signatures = folder / f"{name}{SUFFIX}", folder / f"{name}.json"
+        if not (path.is_file() and signatures.is_file()):
+            continue
+        try:
+            spec = importlib.util.spec_from_file_location(name, path)
+            if spec is None or spec.loader is None:
+                continue
+            module = importlib.util.module_from_spec(spec)
+            spec.loader.exec_module(module)
+            return Kernels(module, json.loads(signatures.read_text()))
+        except (ImportError, OSError, ValueError):
+            continue
+    return None

@@ -1,0 +1,189 @@
+"""Compile the kernels ahead of time: ``python -m planning.ahead_of_time [--robot URDF [--srdf SRDF]]``.
+
+Every later process then runs them without importing numba (:mod:`cpr_kin.common.ahead`):
+``cpr-plan plan`` starts about half a second sooner (docs/benchmarks.md). The kernels are
+compiled with the argument types a warm-up calls them with (:func:`planning.warming.warm_up`,
+on the bundled CPR and on each robot given), by numba's ``pycc`` and the machine's C compiler,
+into the first writable folder of :func:`~cpr_kin.common.ahead.kernel_folders`. A kernel the
+warm-up does not call, or calls with types ``pycc`` cannot take, stays numba's, compiled just in
+time as before. Run it again after an update: a module built for other kernel files is not used.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from cpr_kin.common.ahead import (
+    MODE_VARIABLE,
+    SUFFIX,
+    export_name,
+    host_key,
+    kernel_folders,
+    load_kernels,
+    module_name,
+)
+from cpr_kin.common.kernel_sources import sources_digest
+
+
+def argument_spec(numba_type: Any) -> list[Any] | None:
+    """The :class:`~cpr_kin.common.ahead.Kernels` spec of a numba argument type (``None``: none)."""
+    from numba.core import types
+
+    if isinstance(numba_type, types.Array):
+        if not numba_type.aligned or not isinstance(numba_type.dtype, types.Number | types.Boolean):
+            return None
+        return ["array", str(numba_type.dtype), numba_type.ndim, numba_type.layout, not numba_type.mutable]
+    if numba_type == types.float64:
+        return ["float"]
+    if numba_type == types.int64:
+        return ["int"]
+    if numba_type == types.boolean:
+        return ["bool"]
+    if isinstance(numba_type, types.BaseTuple):
+        items = [argument_spec(item) for item in numba_type.types]  # type: ignore[attr-defined]
+        return None if any(item is None for item in items) else ["tuple", items]
+    return None
+
+
+def compile_kernels(folder: Path, warm: Callable[[], object]) -> tuple[Path, list[str], list[str]]:
+    """Run ``warm``, then compile every kernel it called into ``folder``: the module, kernels compiled, left.
+
+    The process must compile just in time (:data:`~cpr_kin.common.ahead.MODE_VARIABLE` ``jit``).
+    The module and its signatures are written under a temporary name and renamed into place.
+    """
+    from numba.pycc import CC  # type: ignore[attr-defined]
+
+    from cpr_kin.common import compiled
+
+    warm()
+    name = module_name(sources_digest())
+    build = CC(name)  # type: ignore[no-untyped-call]
+    build.target_cpu = "host"
+    signatures: dict[str, list[list[Any]]] = {}
+    compiled_names, left = [], []
+    for function in list(compiled._KERNELS):
+        dispatcher: Any = compiled._dispatcher(function)
+        key = f"{function.__module__}:{function.__name__}"
+        exported: list[list[Any]] = []
+        for arguments in dispatcher.signatures:
+            specs = [argument_spec(t) for t in arguments]
+            if any(spec is None for spec in specs):
+                continue
+            signature = dispatcher.overloads[arguments].signature
+            export = export_name(function.__module__, function.__name__, len(exported))
+            build.export(export, signature)(function)  # type: ignore[no-untyped-call]
+            exported.append(specs)
+        if exported:
+            signatures[key] = exported
+            compiled_names.append(key)
+        elif not compiled._KERNELS[function]:
+            left.append(key)
+    folder.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(dir=folder) as scratch:
+        build.output_dir = scratch
+        build.compile()
+        module = folder / f"{name}{SUFFIX}"
+        os.replace(Path(scratch) / f"{name}{SUFFIX}", module)
+        (Path(scratch) / "signatures.json").write_text(json.dumps(signatures, indent=1))
+        os.replace(Path(scratch) / "signatures.json", folder / f"{name}.json")
+    for older in folder.glob(f"cpr_kernels_*_{host_key()}.*"):  # other kernel files: never loaded again
+        if not older.name.startswith(name):
+            older.unlink(missing_ok=True)
+    return module, compiled_names, left
+
+
+def default_robots() -> list[tuple[Path, Path | None]]:
+    """The arms a build warms up on beside the CPR, where on this machine: ``(URDF, SRDF)`` each.
+
+    They have pairs of their own to bound and exact meshes, which the CPR lacks:
+    example-robot-data's Panda (the ``robots`` extra), and MotionBenchMaker's Panda and UR5 where
+    ``planning.bench.mbm`` has unpacked their resources in the disk cache: the Panda's links come
+    near enough for the near pairs' cells, the UR5's meshes decide points inside them.
+    """
+    from cpr_kin.common.disk_cache import cache_folder
+    from cpr_kin.model.packages import example_robot_data_share
+
+    robots: list[tuple[Path, Path | None]] = []
+    share = example_robot_data_share()
+    if share is not None:
+        panda = share / "example-robot-data" / "robots" / "panda_description"
+        robots.append((panda / "urdf" / "panda.urdf", panda / "srdf" / "panda.srdf"))
+    for name in ("panda", "ur5"):
+        for mbm in sorted(cache_folder().glob(f"vamp_planner-*/resources/{name}"))[-1:]:
+            robots.append((mbm / f"{name}.urdf", mbm / f"{name}.srdf"))
+    return [(urdf, srdf) for urdf, srdf in robots if urdf.is_file()]
+
+
+def writable_folder() -> Path:
+    """The first folder of :func:`~cpr_kin.common.ahead.kernel_folders` this process may write in."""
+    for folder in kernel_folders():
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+            with tempfile.TemporaryFile(dir=folder):
+                return folder
+        except OSError:
+            continue
+    raise SystemExit(f"error: no folder to write the kernels in: {', '.join(map(str, kernel_folders()))}")
+
+
+def main(argv: list[str] | None = None) -> int:
+    """The command line: compile the kernels, say where and which."""
+    parser = argparse.ArgumentParser(
+        prog="python -m planning.ahead_of_time", description=__doc__.splitlines()[0]
+    )
+    parser.add_argument(
+        "--robot", type=Path, action="append", default=[], help="a URDF to warm up on as well"
+    )
+    parser.add_argument(
+        "--srdf", type=Path, action="append", default=[], help="its SRDF (in the robots' order)"
+    )
+    parser.add_argument(
+        "--force", action="store_true", help="compile even where a module for today's sources exists"
+    )
+    parser.add_argument(
+        "--bundled-only", action="store_true", help="warm up on the bundled CPR alone, not the default arms"
+    )
+    args = parser.parse_args(argv)
+    if shutil.which(os.environ.get("CC", "cc")) is None and shutil.which("gcc") is None:
+        print(
+            "error: no C compiler (cc or gcc) on the PATH: the kernels stay compiled just in time",
+            file=sys.stderr,
+        )
+        return 2
+    built = load_kernels()
+    if built is not None and not args.force:
+        print(f"the kernels compiled ahead of time are up to date: {built.module.__file__}")
+        return 0
+    os.environ[MODE_VARIABLE] = "jit"  # the warm-up must run numba's dispatchers, whose types are compiled
+
+    def warm() -> None:
+        import cpr_kin as ck
+        from planning.warming import warm_up
+
+        warm_up()
+        robots = [(urdf, args.srdf[i] if i < len(args.srdf) else None) for i, urdf in enumerate(args.robot)]
+        if not robots and not args.bundled_only:
+            robots = default_robots()
+        for urdf, srdf in robots:
+            warm_up(ck.load_robot(urdf, srdf=srdf))
+
+    started = time.perf_counter()
+    module, compiled_names, left = compile_kernels(writable_folder(), warm)
+    seconds = time.perf_counter() - started
+    print(f"{len(compiled_names)} kernels compiled ahead of time into {module} in {seconds:.0f} s")
+    if left:
+        print(f"not called from Python by the warm-up, left to numba if ever so called: {', '.join(left)}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,202 @@
+"""The kernels compiled ahead of time: the guards' choice of export or numba, the specs of numba's
+types, the module found by its sources' digest, and a real build whose plans are numba's to the byte."""
+
+from __future__ import annotations
+
+import collections
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+import pytest
+from numba.core import types
+
+from cpr_kin.common.ahead import FOLDER_VARIABLE, MODE_VARIABLE, Kernels, export_name, load_kernels
+from planning.ahead_of_time import argument_spec
+
+ROOT = Path(__file__).resolve().parents[1]
+F8_C = ["array", "float64", 2, "C", False]
+"""A writable C-contiguous 2-d float64 array's spec."""
+
+
+def kernel(values: Any, scale: Any, flags: Any = True) -> str:
+    """The kernel's Python code: here, what ran."""
+    return "python"
+
+
+def guarded(specs: list[list[Any]]) -> tuple[Any, list[str]]:
+    """``kernel`` behind a guard whose one export (a Python stand-in) takes ``specs``; the fallbacks asked."""
+    asked: list[str] = []
+
+    def fallback() -> Any:
+        asked.append("numba")
+        return kernel
+
+    module = SimpleNamespace(**{export_name(__name__, "kernel", 0): lambda *args: "export"})
+    kernels = Kernels(module, {f"{__name__}:kernel": [specs]})  # type: ignore[arg-type]
+    return kernels.guarded(kernel, fallback), asked
+
+
+def test_a_guard_runs_the_export_where_numba_would_type_the_arguments_alike() -> None:
+    guard, asked = guarded([F8_C, ["float"], ["tuple", [["int"], ["bool"]]]])
+    good = np.ones((3, 2))
+    assert guard(good, 0.5, (1, True)) == "export"
+    assert guard(good, np.float64(0.5), (np.int64(1), np.bool_(False))) == "export"
+    numba_returned = np.frombuffer(good.tobytes()).reshape(3, 2).copy()  # equal dtype, maybe another object
+    assert guard(numba_returned, 0.5, (1, True)) == "export"
+    assert guard.__name__ == "kernel" and guard.__wrapped__ is kernel and asked == []
+
+
+@pytest.mark.parametrize(
+    ("values", "scale", "flags"),
+    [
+        (np.ones((3, 2), dtype=np.float32), 0.5, (1, True)),  # another dtype
+        (np.ones(3), 0.5, (1, True)),  # another number of dimensions
+        (np.ones((2, 3)).T, 0.5, (1, True)),  # not C-contiguous
+        (np.ones((3, 2)).astype(">f8"), 0.5, (1, True)),  # another byte order
+        ([[1.0, 2.0]], 0.5, (1, True)),  # not an array
+        (np.ones((3, 2)), 1, (1, True)),  # an int for a float
+        (np.ones((3, 2)), 0.5, (1.0, True)),  # a float for an int
+        (np.ones((3, 2)), 0.5, (1,)),  # a shorter tuple
+        (np.ones((3, 2)), 0.5, (1, 1)),  # an int for a bool
+    ],
+)
+def test_a_guard_falls_back_to_numba_where_the_types_differ(values: Any, scale: Any, flags: Any) -> None:
+    guard, asked = guarded([F8_C, ["float"], ["tuple", [["int"], ["bool"]]]])
+    assert guard(values, scale, flags) == "python"
+    assert guard(values, scale, flags) == "python" and asked == ["numba"]  # asked once
+
+
+def test_a_read_only_array_takes_only_a_read_only_export_and_keywords_are_the_kernels() -> None:
+    guard, _ = guarded([F8_C, ["float"], ["bool"]])
+    frozen = np.ones((3, 2))
+    frozen.setflags(write=False)
+    assert guard(frozen, 0.5, True) == "python"  # numba would compile a read-only version
+    reading, _ = guarded([["array", "float64", 2, "C", True], ["float"], ["bool"]])
+    assert reading(frozen, 0.5, True) == "export" and reading(np.ones((3, 2)), 0.5, True) == "export"
+    assert reading(frozen, scale=0.5, flags=True) == "export"
+    assert reading(frozen, flags=True, scale=1) == "python"  # an int for the float, by its name
+
+
+def test_an_array_that_passed_is_not_checked_again_but_another_is() -> None:
+    guard, _ = guarded([F8_C, ["float"], ["bool"]])
+    fixed = np.ones((3, 2))
+    assert guard(fixed, 0.5, True) == "export"
+    assert guard(fixed, 0.5, True) == "export"
+    assert guard(np.ones((3, 2), dtype=np.int64), 0.5, True) == "python"
+    assert guard(fixed, 0.5, True) == "export"
+
+
+def test_a_default_argument_is_the_kernels() -> None:
+    guard, _ = guarded([F8_C, ["float"], ["bool"]])
+    assert guard(np.ones((3, 2)), 0.5) == "export"
+    guard, _ = guarded([F8_C, ["float"], ["int"]])
+    assert guard(np.ones((3, 2)), 0.5) == "python"  # the default, True, is no int
+
+
+def test_a_kernel_without_an_export_always_falls_back() -> None:
+    kernels = Kernels(SimpleNamespace(), {})  # type: ignore[arg-type]
+    assert kernels.guarded(kernel, lambda: kernel)(np.ones((3, 2)), 0.5, True) == "python"
+
+
+Chain = collections.namedtuple("Chain", "parent axis")
+
+
+def test_numba_types_become_specs_and_the_others_none() -> None:
+    array = types.Array(types.float64, 2, "C")
+    frozen = types.Array(types.int64, 1, "A", readonly=True)
+    assert argument_spec(array) == ["array", "float64", 2, "C", False]
+    assert argument_spec(frozen) == ["array", "int64", 1, "A", True]
+    assert argument_spec(types.float64) == ["float"]
+    assert argument_spec(types.int64) == ["int"]
+    assert argument_spec(types.boolean) == ["bool"]
+    tuple_of: Any = types.UniTuple  # numba's types are untyped for mypy
+    named = types.NamedTuple([array, frozen], Chain)  # type: ignore[no-untyped-call]
+    assert argument_spec(named) == ["tuple", [argument_spec(array), argument_spec(frozen)]]
+    assert argument_spec(tuple_of(types.float64, 2)) == ["tuple", [["float"], ["float"]]]
+    for unsupported in (types.float32, types.unicode_type, tuple_of(types.float32, 2)):
+        assert argument_spec(unsupported) is None
+
+
+def test_no_module_where_none_was_built_or_the_mode_is_jit(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv(MODE_VARIABLE, "ahead")
+    assert load_kernels([tmp_path]) is None  # an empty folder
+    (tmp_path / "cpr_kernels_0000.json").write_text("{}")  # another digest's
+    assert load_kernels([tmp_path]) is None
+    monkeypatch.setenv(MODE_VARIABLE, "jit")
+    assert load_kernels() is None
+
+
+PLAN = """
+import hashlib, sys
+import numpy as np
+import planning
+result = planning.plan(planning.paper_scene(seed=3))
+from cpr_kin.bounds.bound_kernels import groups_below
+print(type(groups_below).__name__, "numba" in sys.modules)
+samples = result.trajectory(np.linspace(0.0, result.trajectory.duration, 101))
+print(hashlib.sha256(result.waypoints.tobytes() + samples.tobytes()).hexdigest(),
+      result.verification.certified_min_m.hex())
+"""
+
+
+def run(code: str, environment: dict[str, str]) -> list[str]:
+    completed = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        check=False,
+        timeout=600,
+        cwd=ROOT,
+        env={**os.environ, **environment},
+    )
+    assert completed.returncode == 0, completed.stderr
+    return completed.stdout.split("\n")
+
+
+@pytest.mark.slow
+def test_kernels_compiled_ahead_plan_the_bits_numba_plans_without_numba(tmp_path: Path) -> None:
+    ahead = {FOLDER_VARIABLE: str(tmp_path), MODE_VARIABLE: "ahead"}
+    built = subprocess.run(
+        [sys.executable, "-m", "planning.ahead_of_time", "--bundled-only"],
+        capture_output=True,
+        text=True,
+        check=False,
+        timeout=900,
+        cwd=ROOT,
+        env={**os.environ, **ahead},
+    )
+    assert built.returncode == 0, built.stderr
+    assert "kernels compiled ahead of time into" in built.stdout
+    (module,) = tmp_path.glob("cpr_kernels_*.so")
+    signatures = json.loads(module.with_name(module.name.split(".")[0] + ".json").read_text())
+    assert "cpr_kin.bounds.bound_kernels:groups_below" in signatures
+
+    just_in_time = run(PLAN, {FOLDER_VARIABLE: str(tmp_path), MODE_VARIABLE: "jit"})
+    compiled_ahead = run(PLAN, ahead)
+    assert just_in_time[0] == "CPUDispatcher True"
+    assert compiled_ahead[0] == "function False"  # the guard; numba never imported
+    assert compiled_ahead[1] == just_in_time[1]  # the same trajectory, to the bit
+
+    # argument types no export takes: numba compiles the kernel then, and computes what it would
+    mixed = """
+import sys
+import numpy as np
+from planning.curves.horner import evaluate
+coefficients = np.arange(24.0).reshape(2, 3, 4) / 7
+values = evaluate(coefficients, np.array([0.0, 1.0, 2.0]), np.linspace(0.0, 2.0, 5))
+print("numba" in sys.modules, values.tobytes().hex())
+values = evaluate(coefficients.astype(np.float32), np.array([0.0, 1.0, 2.0]), np.linspace(0.0, 2.0, 5))
+print("numba" in sys.modules, values.tobytes().hex())
+"""
+    exported, fallen_back = run(mixed, ahead)[:2]
+    reference = run(mixed, {MODE_VARIABLE: "jit"})
+    assert exported.startswith("False ") and fallen_back.startswith("True ")
+    assert [exported.split()[1], fallen_back.split()[1]] == [line.split()[1] for line in reference[:2]]
