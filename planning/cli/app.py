@@ -7,6 +7,7 @@ import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import NoReturn
 
 from cpr_kin.common.names import one_line
 from planning.cli.arguments import integer_at_least
@@ -14,6 +15,7 @@ from planning.cli.batch_command import cmd_batch
 from planning.cli.file_commands import EXPORTERS, cmd_check, cmd_export, cmd_show
 from planning.cli.moveit_command import cmd_import_moveit
 from planning.cli.plan_commands import cmd_paper, cmd_plan
+from planning.cli.process import end_process, start_process
 from planning.cli.robot_command import cmd_robot_info
 from planning.cli.signals import interrupts
 from planning.notices import library_notices
@@ -250,6 +252,10 @@ def main(argv: Sequence[str] | None = None, *, restore_signals: bool = True) -> 
     return code
 
 
-def console_main() -> int:
-    """The installed ``cpr-plan`` (and ``python -m planning.cli``): :func:`main`, late signals ignored."""
-    return main(restore_signals=False)
+def console_main() -> NoReturn:
+    """The installed ``cpr-plan`` (and ``python -m planning.cli``): :func:`main`, late signals ignored.
+
+    The process runs this one command and ends (:mod:`planning.cli.process`).
+    """
+    start_process()
+    end_process(main(restore_signals=False))

@@ -1,0 +1,42 @@
+"""The process of the installed ``cpr-plan``: it runs one command, then it ends.
+
+A long-lived Python process needs two things that a process running one command does not;
+each costs a new ``cpr-plan plan`` tens of milliseconds of its half second (docs/benchmarks.md,
+the new-process row):
+
+- **the cyclic garbage collector while the command runs.** Its collections walk every object
+  the imports made (NumPy, Pinocchio, pydantic's schemas: some fifty thousand it tracks), again
+  and again while they are made, to find the few cycles a command leaves: about two thousand
+  objects in a plan, most of them the imports' own, no more in a task of two seconds than in a
+  plan of a tenth (peak memory of the example scenes within 1 MB either way). :func:`start_process`
+  switches it off; a library caller keeps it.
+- **Python's teardown.** On exit Python takes apart every module and the robot's models one by
+  one. :func:`end_process` flushes the output and ends the process at once (as mypy does), unless a
+  thread of the command still runs (then Python's own exit waits for it, as it would).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import gc
+import logging
+import os
+import sys
+import threading
+from typing import NoReturn
+
+
+def start_process() -> None:
+    """Set up the process for one command: no cyclic collector (module docstring)."""
+    gc.disable()
+
+
+def end_process(code: int) -> NoReturn:
+    """Exit with ``code``, the output flushed, without Python's teardown where no other thread runs."""
+    logging.shutdown()
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(OSError, ValueError):  # a reader gone, a stream closed: nothing to keep
+            stream.flush()
+    if threading.active_count() > 1:
+        sys.exit(code)
+    os._exit(code)

@@ -1,0 +1,91 @@
+"""The installed command's process: the collector off while it runs, and an exit that keeps every byte."""
+
+from __future__ import annotations
+
+import gc
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from planning.cli import process
+
+ROOT = Path(__file__).resolve().parents[1]
+BUFFERED = {k: v for k, v in os.environ.items() if k != "PYTHONUNBUFFERED"}
+"""The environment, Python's output buffered (as a user's is), whatever this one says."""
+
+
+def python(code: str) -> subprocess.CompletedProcess[str]:
+    """``python -c code`` in a new process, what it printed and its exit code."""
+    return subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        check=False,
+        timeout=60,
+        cwd=ROOT,
+        env=BUFFERED,
+    )
+
+
+def test_start_switches_the_collector_off(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(gc, "disable", lambda: calls.append("disable"))
+    calls: list[str] = []
+    process.start_process()
+    assert calls == ["disable"]
+
+
+def test_end_process_exits_with_the_code_and_every_byte_written() -> None:
+    written = "x" * 100_000  # more than a pipe's buffer, part of it still in Python's at the end
+    completed = python(
+        "import sys, logging\n"
+        "from planning.cli.process import end_process\n"
+        "logging.basicConfig(stream=sys.stderr)\n"
+        f"sys.stdout.write({written!r}); logging.getLogger('t').warning('said')\n"
+        "sys.stderr.write('last')\n"
+        "end_process(3)\n"
+    )
+    assert completed.returncode == 3
+    assert completed.stdout == written
+    assert completed.stderr == "WARNING:t:said\nlast"
+
+
+def test_end_process_waits_for_a_thread_that_still_runs() -> None:
+    completed = python(
+        "import threading, time\n"
+        "from planning.cli.process import end_process\n"
+        "threading.Thread(target=lambda: (time.sleep(0.3), print('thread done'))).start()\n"
+        "end_process(5)\n"
+    )
+    assert completed.returncode == 5 and completed.stdout == "thread done\n"
+
+
+def test_end_process_says_nothing_when_the_reader_went_away() -> None:
+    code = (
+        "import time\nfrom planning.cli.process import end_process\ntime.sleep(0.5)\nprint(1)\nend_process(0)"
+    )
+    child = subprocess.Popen(
+        [sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT, env=BUFFERED
+    )
+    assert child.stdout is not None and child.stderr is not None
+    child.stdout.close()  # as `cpr-plan ... | head -0` would
+    assert child.wait(timeout=60) == 0
+    assert child.stderr.read() == b""
+    child.stderr.close()
+
+
+def test_the_installed_command_runs_with_the_collector_off(tmp_path: Path) -> None:
+    script = tmp_path / "probe.py"
+    script.write_text(
+        "import gc\n"
+        "from planning.cli import app\n"
+        "app.main = lambda restore_signals: print('collector', gc.isenabled()) or 7\n"
+        "app.console_main()\n"
+    )
+    completed = subprocess.run(
+        [sys.executable, str(script)], capture_output=True, text=True, check=False, timeout=60, cwd=ROOT
+    )
+    assert completed.returncode == 7 and completed.stdout == "collector False\n"
+    assert completed.stderr == ""
