@@ -4,7 +4,7 @@ Every later process then runs them without importing numba (:mod:`cpr_kin.common
 ``cpr-plan plan`` starts about half a second sooner (docs/benchmarks.md). The kernels are
 compiled with the argument types a warm-up calls them with (:func:`planning.warming.warm_up`,
 on the bundled CPR and on each robot given), by numba's ``pycc`` and the machine's C compiler,
-into the first writable folder of :func:`~cpr_kin.common.ahead.kernel_folders`. A kernel the
+into the first writable folder of :func:`~cpr_kin.common.kernel_files.kernel_folders`. A kernel the
 warm-up does not call, or calls with types ``pycc`` cannot take, stays numba's, compiled just in
 time as before. Run it again after an update: a module built for other kernel files is not used.
 """
@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import marshal
 import os
 import shutil
 import sys
@@ -22,13 +23,13 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from cpr_kin.common.ahead import (
-    MODE_VARIABLE,
+from cpr_kin.common.ahead import MODE_VARIABLE, Kernels, load_kernels
+from cpr_kin.common.kernel_files import (
     SUFFIX,
     export_name,
+    guards_file,
     host_key,
     kernel_folders,
-    load_kernels,
     module_name,
 )
 from cpr_kin.common.kernel_sources import sources_digest
@@ -58,7 +59,8 @@ def compile_kernels(folder: Path, warm: Callable[[], object]) -> tuple[Path, lis
     """Run ``warm``, then compile every kernel it called into ``folder``: the module, kernels compiled, left.
 
     The process must compile just in time (:data:`~cpr_kin.common.ahead.MODE_VARIABLE` ``jit``).
-    The module and its signatures are written under a temporary name and renamed into place.
+    The module, its signatures and its guards' code (:meth:`~cpr_kin.common.ahead.Kernels.guard_codes`)
+    are written under a temporary name and renamed into place.
     """
     from numba.pycc import CC  # type: ignore[attr-defined]
 
@@ -95,6 +97,9 @@ def compile_kernels(folder: Path, warm: Callable[[], object]) -> tuple[Path, lis
         os.replace(Path(scratch) / f"{name}{SUFFIX}", module)
         (Path(scratch) / "signatures.json").write_text(json.dumps(signatures, indent=1))
         os.replace(Path(scratch) / "signatures.json", folder / f"{name}.json")
+        codes = Kernels(None, signatures).guard_codes(compiled._KERNELS)  # compiled here, not in each process
+        (Path(scratch) / "guards").write_bytes(marshal.dumps(codes))
+        os.replace(Path(scratch) / "guards", folder / guards_file(name))
     for older in folder.glob(f"cpr_kernels_*_{host_key()}.*"):  # other kernel files: never loaded again
         if not older.name.startswith(name):
             older.unlink(missing_ok=True)
@@ -124,7 +129,7 @@ def default_robots() -> list[tuple[Path, Path | None]]:
 
 
 def writable_folder() -> Path:
-    """The first folder of :func:`~cpr_kin.common.ahead.kernel_folders` this process may write in."""
+    """The first folder of :func:`~cpr_kin.common.kernel_files.kernel_folders` this process may write in."""
     for folder in kernel_folders():
         try:
             folder.mkdir(parents=True, exist_ok=True)
@@ -160,7 +165,7 @@ def main(argv: list[str] | None = None) -> int:
         )
         return 2
     built = load_kernels()
-    if built is not None and not args.force:
+    if built is not None and built.module is not None and not args.force:
         print(f"the kernels compiled ahead of time are up to date: {built.module.__file__}")
         return 0
     os.environ[MODE_VARIABLE] = "jit"  # the warm-up must run numba's dispatchers, whose types are compiled
@@ -177,7 +182,11 @@ def main(argv: list[str] | None = None) -> int:
             warm_up(ck.load_robot(urdf, srdf=srdf))
 
     started = time.perf_counter()
-    module, compiled_names, left = compile_kernels(writable_folder(), warm)
+    with tempfile.TemporaryDirectory() as cold:
+        # numba compiles afresh, not from its disk cache: a kernel loaded from there does not
+        # compile the kernels it calls, whose types then go unseen and unexported
+        os.environ["NUMBA_CACHE_DIR"] = cold
+        module, compiled_names, left = compile_kernels(writable_folder(), warm)
     seconds = time.perf_counter() - started
     print(f"{len(compiled_names)} kernels compiled ahead of time into {module} in {seconds:.0f} s")
     if left:

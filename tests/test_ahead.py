@@ -5,18 +5,20 @@ from __future__ import annotations
 
 import collections
 import json
+import marshal
 import os
 import subprocess
 import sys
 from pathlib import Path
-from types import SimpleNamespace
+from types import CodeType, SimpleNamespace
 from typing import Any
 
 import numpy as np
 import pytest
 from numba.core import types
 
-from cpr_kin.common.ahead import FOLDER_VARIABLE, MODE_VARIABLE, Kernels, export_name, load_kernels
+from cpr_kin.common.ahead import MODE_VARIABLE, Kernels, _kept_codes, load_kernels
+from cpr_kin.common.kernel_files import FOLDER_VARIABLE, export_name
 from planning.ahead_of_time import argument_spec
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -104,6 +106,46 @@ def test_a_kernel_without_an_export_always_falls_back() -> None:
     assert kernels.guarded(kernel, lambda: kernel)(np.ones((3, 2)), 0.5, True) == "python"
 
 
+def variadic(*values: Any) -> str:
+    """No kernel: its parameters are not a kernel's."""
+    return "python"
+
+
+def nested_codes(code: CodeType) -> list[CodeType]:
+    """``code`` and every code object compiled inside it (compare them by identity: equal code is ``==``)."""
+    inner = [c for c in code.co_consts if isinstance(c, CodeType)]
+    return [code, *(n for c in inner for n in nested_codes(c))]
+
+
+def test_a_guard_runs_the_code_the_build_kept_where_its_source_is_the_same(tmp_path: Path) -> None:
+    specs = {f"{__name__}:kernel": [[F8_C, ["float"], ["bool"]]]}
+    module = SimpleNamespace(**{export_name(__name__, "kernel", 0): lambda *args: "export"})
+    codes = Kernels(None, specs).guard_codes([kernel, variadic])  # variadic: no kernel's parameters
+    key = f"{__name__}:kernel"
+    assert list(codes) == [key]
+    source = codes[key][0]
+    (tmp_path / "guards").write_bytes(marshal.dumps(codes))
+    kept = _kept_codes(tmp_path / "guards")
+    assert kept.keys() == codes.keys() and kept[key][0] == source
+
+    guard = Kernels(module, specs, kept).guarded(kernel, lambda: kernel)  # type: ignore[arg-type]
+    assert any(c is guard.__code__ for c in nested_codes(kept[key][1]))  # the kept code, not compiled again
+    assert guard(np.ones((3, 2)), 0.5, True) == "export" and guard(np.ones(3), 0.5, True) == "python"
+    stale = {key: ("def _make(): pass", kept[key][1])}  # kept for another source: compiled afresh
+    guard = Kernels(module, specs, stale).guarded(kernel, lambda: kernel)  # type: ignore[arg-type]
+    assert not any(c is guard.__code__ for c in nested_codes(kept[key][1]))
+    assert guard(np.ones((3, 2)), 0.5, True) == "export"
+
+
+@pytest.mark.parametrize(
+    "content", [b"", b"not marshal", marshal.dumps([1, 2]), marshal.dumps({"k": (1, 2)})]
+)
+def test_guards_code_that_cannot_be_read_is_none_kept(tmp_path: Path, content: bytes) -> None:
+    (tmp_path / "guards").write_bytes(content)
+    assert _kept_codes(tmp_path / "guards") == {}
+    assert _kept_codes(tmp_path / "missing") == {}
+
+
 Chain = collections.namedtuple("Chain", "parent axis")
 
 
@@ -173,6 +215,8 @@ def test_kernels_compiled_ahead_plan_the_bits_numba_plans_without_numba(tmp_path
     (module,) = tmp_path.glob("cpr_kernels_*.so")
     signatures = json.loads(module.with_name(module.name.split(".")[0] + ".json").read_text())
     assert "cpr_kin.bounds.bound_kernels:groups_below" in signatures
+    (guards,) = tmp_path.glob("cpr_kernels_*.guards")  # their code, compiled by the build
+    assert signatures.keys() <= _kept_codes(guards).keys()
 
     just_in_time = run(["-c", PLAN], {FOLDER_VARIABLE: str(tmp_path), MODE_VARIABLE: "jit"})
     compiled_ahead = run(["-c", PLAN], ahead)

@@ -11,88 +11,52 @@ Here each kernel is a guard: its arguments are checked against each compiled sig
 numba's dispatcher would type them (an array's dtype, dimensions, layout and writability; a
 float, an int, a bool; a tuple's items), and where one matches, the compiled code runs; where
 none does, the kernel is compiled just in time by numba, as without the module. The module is
-named after the kernel files' digest (:func:`~cpr_kin.common.kernel_sources.sources_digest`):
-a changed kernel file leaves it unused. ``CPR_KERNELS=jit`` (or numba's ``NUMBA_DISABLE_JIT=1``)
-never loads it.
+named after the kernel files' digest (:func:`~cpr_kin.common.kernel_sources.sources_digest`;
+:mod:`cpr_kin.common.kernel_files`): a changed kernel file leaves it unused.
+``CPR_KERNELS=jit`` (or numba's ``NUMBA_DISABLE_JIT=1``) never loads it.
 """
 
 from __future__ import annotations
 
-import contextlib
 import functools
-import hashlib
-import importlib.machinery
 import importlib.util
 import inspect
 import json
+import marshal
 import os
-import platform
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from pathlib import Path
-from types import ModuleType
+from types import CodeType, ModuleType
 from typing import Any
 
 import numpy as np
 
+from cpr_kin.common.kernel_files import SUFFIX, export_name, guards_file, kernel_folders, module_name
 from cpr_kin.common.kernel_sources import sources_digest
 
 MODE_VARIABLE = "CPR_KERNELS"
 """The environment variable that chooses: ``jit`` never loads the kernels compiled ahead of time."""
-SUFFIX = importlib.machinery.EXTENSION_SUFFIXES[0]
-
-
-def module_name(digest: str) -> str:
-    """The extension module's name for the kernel files' digest ``digest``, on this machine's CPU.
-
-    The module is compiled for the host CPU (as numba compiles): one built on another machine
-    (a home folder shared between machines) has another name.
-    """
-    return f"cpr_kernels_{digest[:20]}_{host_key()}"
-
-
-@functools.cache
-def host_key() -> str:
-    """A short digest of this machine's CPU: its architecture, model and features where the system says."""
-    described = platform.machine()
-    with contextlib.suppress(OSError):
-        lines = Path("/proc/cpuinfo").read_text().splitlines()
-        described += "".join(sorted({line for line in lines if line.startswith(("model name", "flags"))}))
-    return hashlib.sha256(described.encode()).hexdigest()[:8]
-
-
-FOLDER_VARIABLE = "CPR_KERNELS_DIR"
-"""The environment variable naming the module's one folder, instead of :func:`kernel_folders`' defaults."""
-
-
-def kernel_folders() -> list[Path]:
-    """Where the module is looked for and built, first first.
-
-    :data:`FOLDER_VARIABLE`'s folder alone where set; else the package's ``__pycache__``, then the
-    user's cache.
-    """
-    if os.environ.get(FOLDER_VARIABLE):
-        return [Path(os.environ[FOLDER_VARIABLE])]
-    cache = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
-    return [Path(__file__).resolve().parent / "__pycache__", cache / "cpr-firefly" / "kernels"]
-
-
-def export_name(module: str, name: str, index: int) -> str:
-    """The name in the extension module of signature ``index`` of kernel ``name`` of ``module``."""
-    return f"{module.replace('.', '_')}__{name}__{index}"
 
 
 class Kernels:
     """The extension module of compiled kernels and, per kernel, the argument types of each export.
 
     Args:
-        module: the extension module.
+        module: the extension module (``None`` where only the guards' code is made, by the build).
         signatures: ``{"module:name": [argument specs of export 0, of export 1, ...]}``; a spec
             is ``["array", dtype, ndim, layout, readonly]``, ``["float"]``, ``["int"]``,
             ``["bool"]`` or ``["tuple", [item specs]]``.
+        codes: ``{"module:name": (source, code)}``, guards compiled before
+            (:meth:`guard_codes`), used where their source is the one to compile.
     """
 
-    def __init__(self, module: ModuleType, signatures: dict[str, list[list[Any]]]) -> None:
-        self.module, self.signatures = module, signatures
+    def __init__(
+        self,
+        module: ModuleType | None,
+        signatures: dict[str, list[list[Any]]],
+        codes: dict[str, tuple[str, CodeType]] | None = None,
+    ) -> None:
+        self.module, self.signatures, self.codes = module, signatures, codes or {}
 
     def guarded(
         self, function: Callable[..., Any], fallback: Callable[[], Callable[..., Any]]
@@ -102,22 +66,64 @@ class Kernels:
         ``fallback`` is asked once, at the first call that matches no export; a kernel with no
         export always falls back.
         """
-        key = f"{function.__module__}:{function.__name__}"
-        parameters = list(inspect.signature(function).parameters.values())
-        if any(p.kind != p.POSITIONAL_OR_KEYWORD for p in parameters):  # not a kernel's
+        made = self._guard_source(function)
+        if made is None:  # not a kernel's parameters
             return _falling_back(function, fallback)
+        source, cells = made
+        exports = {
+            f"_export{i}": getattr(self.module, export_name(function.__module__, function.__name__, i))
+            for i in range(len(self.signatures.get(_key(function), [])))
+        }
+        names: dict[str, Any] = {}
+        exec(self._code(function, source), names)
+        guard = names["_make"](_fallback=fallback, **cells, **exports)
+        guard.__doc__, guard.__module__, guard.__qualname__ = (
+            function.__doc__,
+            function.__module__,
+            function.__qualname__,
+        )
+        guard.__wrapped__ = function
+        return guard  # type: ignore[no-any-return]
+
+    def guard_codes(self, functions: Iterable[Callable[..., Any]]) -> dict[str, tuple[str, CodeType]]:
+        """The guards of ``functions``, their source and its compiled code, for :func:`guards_file`.
+
+        Compiling the guards is most of the time they take to make: the build keeps the code,
+        and a later process uses it where the source it would compile is the same.
+        """
+        codes = {}
+        for function in functions:
+            made = self._guard_source(function)
+            if made is not None:
+                codes[_key(function)] = (made[0], self._code(function, made[0]))
+        return codes
+
+    def _code(self, function: Callable[..., Any], source: str) -> CodeType:
+        """``source`` compiled, or the code kept for it."""
+        kept = self.codes.get(key := _key(function))
+        if kept is not None and kept[0] == source:
+            return kept[1]
+        return compile(source, f"<compiled ahead: {key}>", "exec")
+
+    def _guard_source(self, function: Callable[..., Any]) -> tuple[str, dict[str, Any]] | None:
+        """The source of ``_make``, which returns ``function``'s guard, and its constant arguments.
+
+        ``None`` for a function whose parameters are not a kernel's.
+        """
+        key = _key(function)
+        parameters = list(inspect.signature(function).parameters.values())
+        if any(p.kind != p.POSITIONAL_OR_KEYWORD for p in parameters):
+            return None
         arguments = [p.name for p in parameters]
         # the guard is a closure: its constants and the arguments kept are cells, faster than globals
-        cells: dict[str, Any] = {"_fallback": fallback, "_ndarray": np.ndarray, "_jit": []}
+        cells: dict[str, Any] = {"_ndarray": np.ndarray, "_jit": []}
         cells |= {f"_default{i}": p.default for i, p in enumerate(parameters) if p.default is not p.empty}
         heading = ", ".join(
             a if f"_default{i}" not in cells else f"{a}=_default{i}" for i, a in enumerate(arguments)
         )
         body, kept = [], []
-        for index, specs in enumerate(self.signatures.get(key, [])):
-            cells[f"_export{index}"] = getattr(
-                self.module, export_name(function.__module__, function.__name__, index)
-            )
+        signatures = self.signatures.get(key, [])
+        for index, specs in enumerate(signatures):
             checks = []
             for i, (spec, argument) in enumerate(zip(specs, arguments, strict=True)):
                 check = _check(spec, argument, cells)
@@ -129,8 +135,9 @@ class Kernels:
                 f"        if {' and '.join(checks) or 'True'}:",
                 f"            return _export{index}({', '.join(arguments)})",
             ]
+        parameters_of_make = ["_fallback", *sorted(cells), *(f"_export{i}" for i in range(len(signatures)))]
         lines = [
-            f"def _make({', '.join(cells)}):",
+            f"def _make({', '.join(parameters_of_make)}):",
             *(f"    {last} = None" for last in kept),
             f"    def {function.__name__}({heading}):",
             *([f"        nonlocal {', '.join(kept)}"] if kept else []),
@@ -140,16 +147,12 @@ class Kernels:
             f"        return _jit[0]({', '.join(arguments)})",
             f"    return {function.__name__}",
         ]
-        names: dict[str, Any] = {}
-        exec(compile("\n".join(lines), f"<compiled ahead: {key}>", "exec"), names)
-        guard = names["_make"](**cells)
-        guard.__doc__, guard.__module__, guard.__qualname__ = (
-            function.__doc__,
-            function.__module__,
-            function.__qualname__,
-        )
-        guard.__wrapped__ = function
-        return guard  # type: ignore[no-any-return]
+        return "\n".join(lines), cells
+
+
+def _key(function: Callable[..., Any]) -> str:
+    """A kernel's name in the signatures: ``module:name``."""
+    return f"{function.__module__}:{function.__name__}"
 
 
 SCALARS = ("float", "int", "bool")
@@ -217,16 +220,34 @@ def load_kernels(folders: list[Path] | None = None) -> Kernels | None:
         return None
     name = module_name(sources_digest())
     for folder in kernel_folders() if folders is None else folders:
-        path, signatures = folder / f"{name}{SUFFIX}", folder / f"{name}.json"
-        if not (path.is_file() and signatures.is_file()):
-            continue
-        try:
-            spec = importlib.util.spec_from_file_location(name, path)
-            if spec is None or spec.loader is None:
-                continue
-            module = importlib.util.module_from_spec(spec)
-            spec.loader.exec_module(module)
-            return Kernels(module, json.loads(signatures.read_text()))
-        except (ImportError, OSError, ValueError):
-            continue
+        kernels = kernels_in(folder, name)
+        if kernels is not None:
+            return kernels
     return None
+
+
+def kernels_in(folder: Path, name: str) -> Kernels | None:
+    """The module ``name`` in ``folder``, its signatures and its guards' code; ``None``: not loadable."""
+    path, signatures = folder / f"{name}{SUFFIX}", folder / f"{name}.json"
+    if not (path.is_file() and signatures.is_file()):
+        return None
+    try:
+        spec = importlib.util.spec_from_file_location(name, path)
+        if spec is None or spec.loader is None:
+            return None
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        return Kernels(module, json.loads(signatures.read_text()), _kept_codes(folder / guards_file(name)))
+    except (ImportError, OSError, ValueError):
+        return None
+
+
+def _kept_codes(path: Path) -> dict[str, tuple[str, CodeType]]:
+    """The guards' code kept in ``path`` (:meth:`Kernels.guard_codes`); empty where it cannot be read."""
+    try:
+        codes = marshal.loads(path.read_bytes())
+    except (OSError, EOFError, ValueError, TypeError):
+        return {}
+    if not isinstance(codes, dict):
+        return {}
+    return {k: v for k, v in codes.items() if isinstance(v, tuple) and [*map(type, v)] == [str, CodeType]}
