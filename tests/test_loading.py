@@ -102,6 +102,17 @@ def test_meshes_are_convex_hulls_that_contain_them() -> None:
     assert checked >= 8
 
 
+def test_example_robot_data_is_found_where_its_distribution_lists_its_package() -> None:
+    from importlib import metadata
+
+    distribution = metadata.distribution("example-robot-data")
+    listed = [f for f in distribution.files or () if str(f).endswith("example-robot-data/package.xml")]
+    assert len(listed) == 1
+    share = example_robot_data_share()
+    assert share == Path(str(listed[0].locate())).resolve().parent.parent
+    assert (share / "example-robot-data" / "robots").is_dir()
+
+
 def test_a_mesh_that_is_nowhere_is_named(tmp_path: Path) -> None:
     text = ARMS["xarm7"][0].read_text().replace("xarm7/visual/link1.stl", "xarm7/visual/no_such.stl")
     urdf = tmp_path / "xarm7.urdf"

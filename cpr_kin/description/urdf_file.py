@@ -17,7 +17,6 @@ import sys
 import tempfile
 import warnings
 from collections.abc import Iterator, Sequence
-from importlib import metadata
 from pathlib import Path
 from typing import Any
 
@@ -93,6 +92,8 @@ def validate_urdf(path: Path) -> None:
 
 def _yourdfpy_version() -> str:
     """The installed version of yourdfpy, read without importing it ("" if it cannot be read)."""
+    from importlib import metadata  # here: a file found valid before is the one call that needs it
+
     try:
         return metadata.version("yourdfpy")
     except metadata.PackageNotFoundError:

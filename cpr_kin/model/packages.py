@@ -20,11 +20,11 @@ folder looked in.
 
 from __future__ import annotations
 
+import csv
 import functools
 import os
 import sysconfig
-from collections.abc import Sequence
-from importlib import metadata
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 
 from cpr_kin.common.errors import UrdfError
@@ -35,14 +35,25 @@ PACKAGE = "package://"
 
 @functools.cache
 def example_robot_data_share() -> Path | None:
-    """The folder that holds the installed ``example-robot-data`` package, or ``None``."""
+    """The folder that holds the installed ``example-robot-data`` package, or ``None``.
+
+    Read from the distribution's list of files: its wheel's ``RECORD`` where it has one (a
+    thousand lines, scanned as text, where ``Distribution.files`` would make each a path).
+    """
+    from importlib import metadata  # its import is most of the call: here, where a URDF is loaded
+
     try:
         distribution = metadata.distribution("example-robot-data")
     except metadata.PackageNotFoundError:
         return None
-    for file in distribution.files or ():
-        if str(file).endswith("example-robot-data/package.xml"):
-            return Path(str(file.locate())).resolve().parent.parent
+    record = distribution.read_text("RECORD")
+    if record:
+        names: Iterable[str] = (row[0] for row in csv.reader(record.splitlines()) if row)
+    else:
+        names = (str(file) for file in distribution.files or ())
+    for name in names:
+        if name.endswith("example-robot-data/package.xml"):
+            return Path(str(distribution.locate_file(name))).resolve().parent.parent
     return None
 
 
