@@ -95,12 +95,14 @@ def test_curves_are_pure_mathematics_and_search_knows_no_robot() -> None:
             "planning.errors",
             "planning.validation",
             "cpr_kin.common.compiled",
+            "cpr_kin.common.arrays",
         ),
         "planning.search": (
             "planning.search",
             "planning.errors",
             "planning.validation",
             "cpr_kin.common.compiled",
+            "cpr_kin.common.arrays",
         ),
     }
     offenders = []

@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 
 from cpr_kin.certified.interval_motion import IntervalSpeed, interval_motion
 from cpr_kin.collision.decisive import certified
+from cpr_kin.common.arrays import distinct_sorted
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -107,7 +108,7 @@ def coarse_first(sampler: GridSampler, ceilings: tuple[float, float] = (np.inf, 
         every = np.arange(count)
         slack = sampler.slack(every)
         return FineGrid(*sampler.decide(every, slack), slack)
-    coarse = np.unique(np.r_[np.arange(0, count, STRIDE), count - 1])
+    coarse = distinct_sorted(np.arange(0, count, STRIDE), count - 1)
     slack = sampler.slack(coarse)
     fine_bound = np.minimum(slack, sampler.largest_slack_m)  # on a fine interval's slack in each
     values, closest = sampler.decide(coarse, slack)
@@ -122,7 +123,7 @@ def coarse_first(sampler: GridSampler, ceilings: tuple[float, float] = (np.inf, 
         wanted = ~done & np.any(
             (floor - 0.5 * fine_bound[:, None] < certified_min) | (floor <= sampled_min), axis=1
         )
-        ends = np.union1d(np.flatnonzero(wanted), np.flatnonzero(wanted) + 1)
+        ends = distinct_sorted(np.flatnonzero(wanted), np.flatnonzero(wanted) + 1)
         doubtful = ends[~known[ends].all(axis=1)]
         if doubtful.size:  # exact ends may lift an interval's floor above the minima
             values[doubtful], closest[doubtful] = sampler.exact(coarse[doubtful])

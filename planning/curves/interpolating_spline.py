@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.interpolate import BSpline, make_interp_spline
 
+from cpr_kin.common.arrays import distinct_sorted
 from planning.curves.trajectory import Trajectory
 
 FloatArray = NDArray[np.float64]
@@ -29,7 +30,7 @@ def spline_through(parameter: FloatArray, samples: FloatArray, degree: int = 5) 
     is at most 7, the trajectory layout's; ``n`` must exceed it.
     """
     spline = make_interp_spline(parameter, samples, k=degree, axis=0)
-    breaks = np.unique(spline.t)
+    breaks = distinct_sorted(spline.t)
     middles = 0.5 * (breaks[1:] + breaks[:-1])
     coefficients = np.zeros((len(middles), samples.shape[1], ORDER))
     for power in range(degree + 1):

@@ -16,6 +16,7 @@ import functools
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from cpr_kin.common.arrays import distinct_sorted
 from planning.errors import PlanningError
 
 FloatArray = NDArray[np.float64]
@@ -102,7 +103,7 @@ def _blocks(
     segment = np.clip(np.searchsorted(knots_s, times_s, side="right") - 1, 0, len(knots_s) - 2)
     local = times_s - knots_s[segment]
     blocks = []
-    for i in np.unique(segment):
+    for i in distinct_sorted(segment):
         rows = np.flatnonzero(segment == i)  # contiguous: the times are sorted
         powers = tuple(derivative_powers(local[rows], order, r) for r in range(first, derivatives + 1))
         for matrix in powers:

@@ -20,6 +20,7 @@ from typing import NamedTuple, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from cpr_kin.common.arrays import distinct_sorted
 from planning.curves.phase_plane import path_acceleration
 from planning.curves.trajectory import Trajectory
 
@@ -158,7 +159,7 @@ def torque_time_scale(trajectory: Trajectory, model: TorqueModel, at_least: floa
         return 0.0
     start, end = float(trajectory.knots[0]), float(trajectory.knots[-1])
     count = max(2, int(np.ceil((end - start) / COARSE_STEP_S)) + 1)
-    coarse = np.union1d(np.linspace(start, end, count), trajectory.knots)
+    coarse = distinct_sorted(np.linspace(start, end, count), trajectory.knots)
     needed = _needed_scales(trajectory, model, limited, coarse)
     top = max(float(needed.max()), at_least)
     if not np.isfinite(top) or needed.max() < UNBOUND_SHARE * top:
@@ -185,7 +186,7 @@ def local_peaks(values: FloatArray, floor: float) -> NDArray[np.bool_]:
 def _around(centres: FloatArray, reach: float, step: float, start: float, end: float) -> FloatArray:
     """Times every ``step`` within ``reach`` of each of ``centres`` [s] in ``[start, end]``, sorted."""
     offsets = np.arange(-reach, reach + step / 2, step)
-    return np.unique(np.clip((centres[:, None] + offsets).ravel(), start, end))
+    return distinct_sorted(np.clip((centres[:, None] + offsets).ravel(), start, end))
 
 
 def _needed_scales(

@@ -34,6 +34,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
+from cpr_kin.common.arrays import distinct_sorted
 from planning.curves.averaged_path import averaged_samples
 from planning.curves.jerk_window import sampled_path_durations
 from planning.curves.path_timing import NODE_STEP_S, smoothing_limits
@@ -133,7 +134,7 @@ class SplinePaths:
         q_start, q_goal = motion.q_start, motion.q_goal
         self.q_start = q_start
         # joints the spline moves; the others stay at their start (= goal) value throughout
-        self.fitted = np.union1d(motion.moving, np.flatnonzero(q_start != q_goal))
+        self.fitted = distinct_sorted(motion.moving, np.flatnonzero(q_start != q_goal))
         self.settings, self.solver, self.timed, self.torque = settings, solver, timed, torque
         self.lower_q, self.upper_q, self.range_q = limits.lower, limits.upper, limits.range
         self._derivative_limits = (limits.velocity, limits.acceleration, limits.jerk)

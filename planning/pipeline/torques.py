@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
+from cpr_kin.common.arrays import distinct_sorted
 from cpr_kin.model.robot import joint_units
 from planning.curves.phase_plane import (
     kept_samples,
@@ -81,7 +82,7 @@ class GravityLimit:
         and the last: gravity's torques vary smoothly along a path.
         """
         count, k, nq = samples.shape
-        checked = np.unique(np.append(np.arange(0, k, 4), k - 1))
+        checked = distinct_sorted(np.arange(0, k, 4), k - 1)
         usage = self.usage(samples[:, checked].reshape(-1, nq)).reshape(count, len(checked))
         return np.asarray(np.maximum(usage.max(axis=1) - 1.0, 0.0))
 
@@ -143,7 +144,7 @@ def torque_profile(
     """The torques of ``trajectory`` every ``step_s`` [s] and at its knots, by RNEA."""
     start, end = float(trajectory.knots[0]), float(trajectory.knots[-1])
     count = max(2, int(np.floor((end - start) / step_s + 1e-9)) + 1)
-    times = np.union1d(start + step_s * np.arange(count), trajectory.knots)
+    times = distinct_sorted(start + step_s * np.arange(count), trajectory.knots)
     torques = dynamics.torques(trajectory(times), trajectory(times, 1), trajectory(times, 2))
     return TorqueProfile(times, torques, dynamics.effort, dynamics.joint_names)
 
