@@ -1,27 +1,37 @@
-"""The start-up floor of a ``cpr-plan`` process: what the planner stands on, before a line of ours runs.
+"""The start-up floor of a ``cpr-plan plan`` process: what the planner stands on, before a line of ours runs.
 
     python scripts/startup_floor.py
 
-Imports Pinocchio, coal, SciPy's linear algebra and numba, as the planner does, and calls one
-trivial compiled kernel, cached on disk like the planner's (its first run compiles it): numba's
-first call of any cached kernel loads its typing and lowering registries, a cost of its own that
-every process using a compiled kernel pays once. ``cpr-plan plan``'s wall time less this one's is
-what the planner itself adds (docs/benchmarks.md: the new-process row).
+Imports the libraries ``cpr-plan plan`` imports, and nothing of ours: NumPy (and its random
+generators), Pinocchio, coal, pydantic with its models' machinery (and ``importlib.metadata``,
+which pydantic imports to look for plugins before its first validator), PyYAML, lxml,
+threadpoolctl and lazy_loader; no numba, which a plan with the kernels compiled ahead of time
+does not import (``make kernels``). The process runs as the installed command's does, the cyclic collector off
+and no teardown at its end (``planning/cli/process.py``). ``cpr-plan plan``'s wall time less
+this one's is what the planner itself adds (docs/benchmarks.md: the new-process row).
 """
 
 from __future__ import annotations
 
-import coal  # noqa: F401 - imported for its start-up cost
-import numpy as np
-import pinocchio  # noqa: F401
-import scipy.linalg  # noqa: F401
-from numba import njit
+import gc
+import os
+import sys
 
+gc.disable()
 
-@njit(cache=True)
-def _total(values: np.ndarray) -> float:
-    return float(values.sum())
+import importlib.metadata  # noqa: E402, F401 - each imported for its start-up cost
 
+import coal  # noqa: E402, F401
+import lazy_loader  # noqa: E402, F401
+import lxml.etree  # noqa: E402, F401
+import numpy.random  # noqa: E402, F401
+import pinocchio  # noqa: E402, F401
+import pydantic  # noqa: E402, F401
+import threadpoolctl  # noqa: E402, F401
+import yaml  # noqa: E402, F401
+from pydantic import BaseModel  # noqa: E402, F401 - the models' machinery, which `import pydantic` defers
 
 if __name__ == "__main__":
-    _total(np.ones(3))
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(0)
