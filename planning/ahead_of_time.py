@@ -12,6 +12,7 @@ time as before. Run it again after an update: a module built for other kernel fi
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import marshal
 import os
@@ -161,6 +162,13 @@ def main(argv: list[str] | None = None) -> int:
     if shutil.which(os.environ.get("CC", "cc")) is None and shutil.which("gcc") is None:
         print(
             "error: no C compiler (cc or gcc) on the PATH: the kernels stay compiled just in time",
+            file=sys.stderr,
+        )
+        return 2
+    if importlib.util.find_spec("setuptools") is None:
+        print(
+            "error: numba's pycc needs setuptools, which this environment lacks (Python 3.12's venvs come "
+            "without it): pip install setuptools; until then the kernels stay compiled just in time",
             file=sys.stderr,
         )
         return 2

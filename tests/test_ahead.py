@@ -239,3 +239,22 @@ print("numba" in sys.modules, values.tobytes().hex())
     reference = run(["-c", mixed], {MODE_VARIABLE: "jit"})
     assert exported.startswith("False ") and fallen_back.startswith("True ")
     assert [exported.split()[1], fallen_back.split()[1]] == [line.split()[1] for line in reference[:2]]
+
+
+def test_the_build_says_what_it_lacks_and_leaves_the_kernels_to_numba(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import importlib.util
+    import shutil
+
+    from planning import ahead_of_time
+
+    finds = importlib.util.find_spec
+    monkeypatch.setattr(
+        importlib.util, "find_spec", lambda name: None if name == "setuptools" else finds(name)
+    )
+    assert ahead_of_time.main([]) == 2
+    assert "numba's pycc needs setuptools" in capsys.readouterr().err
+    monkeypatch.setattr(shutil, "which", lambda name: None)
+    assert ahead_of_time.main([]) == 2
+    assert "no C compiler (cc or gcc) on the PATH" in capsys.readouterr().err
