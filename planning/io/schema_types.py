@@ -55,6 +55,10 @@ one reports the branch the user meant."""
 
 
 class Strict(BaseModel):
-    """A schema block: unknown keys refused, a number must be a number (not true, not "0.1")."""
+    """A schema block: unknown keys refused, a number must be a number (not true, not "0.1").
 
-    model_config = ConfigDict(extra="forbid", frozen=True, strict=True)
+    Its validator is built where it is first used (``defer_build``): a scene file's model then
+    builds the blocks it holds once, inside its own, rather than each block's at its import too.
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True, defer_build=True)
