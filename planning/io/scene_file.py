@@ -26,7 +26,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from pydantic import ValidationError
 
@@ -41,11 +41,12 @@ from planning.io.robot_entry import default_robot, robot_entry, robot_spec_of
 from planning.io.scene_schema import SceneSpec, describe_errors
 from planning.io.shape_entry import obstacle_of, obstacle_to_dict, payload_to_dict
 from planning.io.target_entry import target_entry
-from planning.io.task_entry import task_entries, task_segments
 from planning.pipeline.scene import DEFAULT_SELF_MARGIN_M, MAX_OBSTACLES, Scene
 from planning.pipeline.settings import PlannerSettings
 from planning.pipeline.target import Target
-from planning.task.segments import Segment
+
+if TYPE_CHECKING:
+    from planning.task.segments import Segment
 
 MAX_SCENE_BYTES = 1_000_000
 """Largest scene file [bytes]: the largest valid scene (500 obstacles) takes about 60 kB."""
@@ -141,7 +142,11 @@ def parse_scene_file(data: Any, source: str = "scene", base: Path | None = None)
     planner = spec.planner.model_dump()
     if planner["moving_joints"] is not None:
         planner["moving_joints"] = tuple(planner["moving_joints"])
-    task = () if spec.task is None else task_segments(spec.task, payload, base, source)
+    task: tuple[Segment, ...] = ()
+    if spec.task is not None:
+        from planning.io.task_segments import task_segments  # planning.task, where a scene has a task
+
+        task = task_segments(spec.task, payload, base, source)
     try:
         scene = Scene(
             name=spec.name or source,
@@ -228,7 +233,7 @@ def scene_to_dict(scene: Scene, task: Sequence[Segment] = ()) -> dict[str, Any]:
             else {}
         ),
         "start": target_entry(scene.start),
-        **({"task": task_entries(task)} if task else {"goal": target_entry(scene.goal)}),
+        **({"task": _task_entries(task)} if task else {"goal": target_entry(scene.goal)}),
         "duration": scene.duration,
         "obstacles": [obstacle_to_dict(o) for o in scene.obstacles],
         **({} if scene.payload is None else {"payload": payload_to_dict(scene.payload)}),
@@ -252,3 +257,10 @@ def scene_document(scene: Scene, task: Sequence[Segment] = ()) -> dict[str, Any]
 def dump_scene(scene: Scene, path: str | Path) -> None:
     """Write ``scene`` as a scene file, atomically."""
     write_file(Path(path), dump_yaml(scene_document(scene)))
+
+
+def _task_entries(task: Sequence[Segment]) -> list[dict[str, Any]]:
+    """``task:`` in the scene file's form (:func:`planning.io.task_segments.task_entries`)."""
+    from planning.io.task_segments import task_entries
+
+    return task_entries(task)

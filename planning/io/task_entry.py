@@ -1,4 +1,4 @@
-"""A scene file's ``task:``, to and from the segments of :mod:`planning.task` (docs/formats.md).
+"""A scene file's ``task:``: its schema, checked against :mod:`planning.task.limits` (docs/formats.md).
 
 ```yaml
 task:                       # in order; each entry has exactly one key
@@ -22,46 +22,42 @@ another object are the file's errors.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import TYPE_CHECKING, Annotated, Literal
 
 import numpy as np
 import pinocchio as pin
 from pydantic import AfterValidator, BaseModel, Field, model_validator
 
-import cpr_kin as ck
-from planning.errors import SceneError
 from planning.io.schema_types import Name, Point, Strict, Turn, between
-from planning.io.shape_entry import PayloadSpec, obstacle_of, payload_to_dict
-from planning.io.target_entry import PoseSpec, TargetSpec, target_entry
-from planning.task.orientation import UPRIGHT_RAD, OrientationConstraint
-from planning.task.segments import LONGEST_WAIT_S, Attach, Detach, Move, Segment, Wait, segment_name
-from planning.task.tool_line import (
+from planning.io.shape_entry import PayloadSpec
+from planning.io.target_entry import PoseSpec, TargetSpec
+from planning.task.limits import (
     COARSEST_ANGLE_RAD,
     COARSEST_POSITION_M,
     FASTEST_TOOL_M_S,
     FINEST_ANGLE_RAD,
     FINEST_POSITION_M,
+    LINE_ANGLE_RAD,
+    LINE_POSITION_M,
+    LONGEST_WAIT_S,
     SHORTEST_LINE_M,
-    LineTolerance,
-    ToolLine,
-    ToolPose,
+    UPRIGHT_RAD,
 )
 from planning.validation import unit_quaternion
 
+if TYPE_CHECKING:  # the classes, imported where a spec becomes one (reading a scene needs only the bounds)
+    from planning.task.orientation import OrientationConstraint
+    from planning.task.tool_line import ToolLine
+
 MAX_TASK_SEGMENTS = 200
 """Most segments of a task."""
-_DEFAULT_TOLERANCE = LineTolerance()
 
 
 class LineToleranceSpec(Strict):
     """``{position_m, angle_rad}``: the deviation a line allows at every instant [m, rad]."""
 
-    position_m: Annotated[float, between(FINEST_POSITION_M, COARSEST_POSITION_M)] = (
-        _DEFAULT_TOLERANCE.position_m
-    )
-    angle_rad: Annotated[float, between(FINEST_ANGLE_RAD, COARSEST_ANGLE_RAD)] = _DEFAULT_TOLERANCE.angle_rad
+    position_m: Annotated[float, between(FINEST_POSITION_M, COARSEST_POSITION_M)] = LINE_POSITION_M
+    angle_rad: Annotated[float, between(FINEST_ANGLE_RAD, COARSEST_ANGLE_RAD)] = LINE_ANGLE_RAD
 
 
 class LineSpec(Strict):
@@ -93,6 +89,8 @@ class LineSpec(Strict):
 
     def line(self) -> ToolLine:
         """The :class:`~planning.task.tool_line.ToolLine`."""
+        from planning.task.tool_line import LineTolerance, ToolLine, ToolPose
+
         to = None
         if self.to is not None:
             to = ToolPose.of(pin.SE3(self.to.rotation(), np.array(self.to.xyz)))
@@ -139,6 +137,9 @@ class ConstraintSpec(Strict):
 
     def constraint(self) -> OrientationConstraint:
         """The :class:`~planning.task.orientation.OrientationConstraint`."""
+        from planning.task.orientation import OrientationConstraint
+        from planning.task.tool_line import ToolPose
+
         quat = None
         if self.quat_xyzw is not None:
             quat = (self.quat_xyzw[0], self.quat_xyzw[1], self.quat_xyzw[2], self.quat_xyzw[3])
@@ -197,87 +198,3 @@ def task_model_at(location: tuple[int | str, ...]) -> type[BaseModel] | None:
     if location[1:3] == ("move", "constraint"):
         return ConstraintSpec
     return _STEP_MODELS.get(str(location[1]))
-
-
-def task_segments(
-    steps: Sequence[TaskStepSpec], held: ck.Payload | None, base: Path, source: str
-) -> tuple[Segment, ...]:
-    """The segments of a validated ``task:``; what the robot carries checked in order from ``held``.
-
-    Raises:
-        SceneError: an attach while carrying, a detach of nothing or of another object, a
-            payload that is not physical, naming ``task[i].key``.
-    """
-    segments: list[Segment] = []
-    for index, step in enumerate(steps):
-        segment = _segment(step, base, f"{source}: task[{index}]")
-        where = f"{source}: task[{index}].{segment_name(segment)}"
-        if isinstance(segment, Attach):
-            if held is not None:
-                raise SceneError(f"{where}: the robot already carries '{held.name}' here; detach it first")
-            held = segment.payload
-        elif isinstance(segment, Detach):
-            if held is None:
-                raise SceneError(f"{where}: the robot carries nothing here; attach a payload first")
-            if segment.name is not None and segment.name != held.name:
-                raise SceneError(f"{where}.name = {segment.name!r}, but the robot carries {held.name!r} here")
-            held = None
-        segments.append(segment)
-    return tuple(segments)
-
-
-def _segment(step: TaskStepSpec, base: Path, where: str) -> Segment:
-    if step.move is not None:
-        constraint = None if step.move.constraint is None else step.move.constraint.constraint()
-        return Move(step.move.target(), constraint)
-    if step.line is not None:
-        return step.line.line()
-    if step.wait is not None:
-        return Wait(step.wait)
-    if step.attach is not None:
-        shape = step.attach.shape
-        try:
-            payload = step.attach.payload(None if shape is None else obstacle_of(shape, "payload", base))
-        except ck.CprKinError as exc:
-            raise SceneError(f"{where}.attach: {exc}") from None
-        return Attach(payload)
-    assert step.detach is not None  # exactly one key (validator)
-    return Detach(step.detach.name)
-
-
-def task_entries(segments: Sequence[Segment]) -> list[dict[str, Any]]:
-    """``task:`` in the scene file's form (the inverse of :func:`task_segments`)."""
-    return [{segment_name(s): _entry(s)} for s in segments]
-
-
-def _entry(segment: Segment) -> Any:
-    if isinstance(segment, Move):
-        if segment.constraint is None:
-            return target_entry(segment.goal)
-        held = segment.constraint
-        constraint: dict[str, Any] = {"axes": list(held.axes), "angle_rad": held.angle_rad}
-        if held.quat_xyzw is not None:
-            constraint["quat_xyzw"] = list(held.quat_xyzw)
-        if held.frame is not None:
-            constraint["frame"] = held.frame
-        return {**target_entry(segment.goal), "constraint": constraint}
-    if isinstance(segment, Wait):
-        return segment.seconds
-    if isinstance(segment, Attach):
-        return payload_to_dict(segment.payload)
-    if isinstance(segment, Detach):
-        return {} if segment.name is None else {"name": segment.name}
-    entry: dict[str, Any] = {}
-    if segment.to is not None:
-        entry["to"] = {"xyz": list(segment.to.xyz), "quat_xyzw": list(segment.to.quat_xyzw)}
-    else:
-        entry |= {"by": list(segment.by or ()), "frame": segment.offset_frame}
-    if segment.frame is not None:
-        entry["tool_frame"] = segment.frame
-    entry["tolerance"] = {
-        "position_m": segment.tolerance.position_m,
-        "angle_rad": segment.tolerance.angle_rad,
-    }
-    if segment.tool_speed_m_s is not None:
-        entry["tool_speed_m_s"] = segment.tool_speed_m_s
-    return entry

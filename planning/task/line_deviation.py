@@ -26,7 +26,8 @@ from numpy.typing import NDArray
 import cpr_kin as ck
 from cpr_kin.kinematics.forward import frame_levers
 from planning.curves.trajectory import Trajectory
-from planning.task.tool_line import SHORTEST_LINE_M, LineGeometry, LineTolerance
+from planning.task.limits import SHORTEST_LINE_M
+from planning.task.tool_line import LineGeometry, LineTolerance
 
 FloatArray = NDArray[np.float64]
 

@@ -30,16 +30,15 @@ import cpr_kin as ck
 from cpr_kin.kinematics.forward import frame_levers
 from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
+from planning.task.limits import COARSEST_ANGLE_RAD, FINEST_ANGLE_RAD, UPRIGHT_RAD
 from planning.task.line_deviation import LONGEST_STEP_S, MOST_SAMPLES, SLACK_SHARE, rotation_angles
-from planning.task.tool_line import COARSEST_ANGLE_RAD, FINEST_ANGLE_RAD, ToolPose
+from planning.task.tool_line import ToolPose
 from planning.validation import number_in
 
 FloatArray = NDArray[np.float64]
 
 AXES = ("x", "y", "z")
 """The tool frame's axes, by name."""
-UPRIGHT_RAD = math.radians(5.0)
-"""The default angle of a constraint [rad]: 5 degrees."""
 
 
 @dataclass(frozen=True)

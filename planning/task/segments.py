@@ -11,12 +11,10 @@ from dataclasses import dataclass
 
 import cpr_kin as ck
 from planning.pipeline.target import Target
+from planning.task.limits import LONGEST_WAIT_S
 from planning.task.orientation import OrientationConstraint
 from planning.task.tool_line import ToolLine
 from planning.validation import number_in
-
-LONGEST_WAIT_S = 3600.0
-"""The longest wait of a task [s]."""
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,6 @@ z axis", the approach of a gripper).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from functools import cached_property
 
@@ -19,25 +18,21 @@ import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
 from planning.errors import PlanningError
+from planning.task.limits import (
+    COARSEST_ANGLE_RAD,
+    COARSEST_POSITION_M,
+    FASTEST_TOOL_M_S,
+    FINEST_ANGLE_RAD,
+    FINEST_POSITION_M,
+    LINE_ANGLE_RAD,
+    LINE_POSITION_M,
+    SHORTEST_LINE_M,
+    SHORTEST_TURN_RAD,
+)
 from planning.validation import number_in, unit_quaternion
 
 FloatArray = NDArray[np.float64]
 
-SHORTEST_LINE_M = 1e-4
-"""Shortest translation of a line [m]; a pure rotation must turn at least :data:`SHORTEST_TURN_RAD`."""
-SHORTEST_TURN_RAD = 1e-3
-"""Smallest rotation of a line without translation [rad]."""
-FINEST_POSITION_M = 1e-6
-"""The finest position tolerance of a line [m]: its samples are put on the line to a thousandth
-of the tolerance, and the certified check's samples come closer the finer it is."""
-FINEST_ANGLE_RAD = 1e-5
-"""The finest angle tolerance of a line [rad]."""
-COARSEST_POSITION_M = 0.1
-"""The coarsest position tolerance of a line [m]."""
-COARSEST_ANGLE_RAD = math.pi / 4
-"""The coarsest angle tolerance of a line [rad]."""
-FASTEST_TOOL_M_S = 100.0
-"""The largest tool speed limit of a line [m/s]."""
 TOOL_FRAME = "tool"
 """``ToolLine.offset_frame``: the offset is in the tool frame at the start."""
 BASE_FRAME = "base"
@@ -98,8 +93,8 @@ class LineTolerance:
             same progress [rad].
     """
 
-    position_m: float = 1e-3
-    angle_rad: float = 0.01
+    position_m: float = LINE_POSITION_M
+    angle_rad: float = LINE_ANGLE_RAD
 
     def __post_init__(self) -> None:
         number_in("line tolerance position_m", self.position_m, FINEST_POSITION_M, COARSEST_POSITION_M, "m")
