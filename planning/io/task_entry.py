@@ -31,18 +31,7 @@ from pydantic import AfterValidator, BaseModel, Field, model_validator
 from planning.io.schema_types import Name, Point, Strict, Turn, between
 from planning.io.shape_entry import PayloadSpec
 from planning.io.target_entry import PoseSpec, TargetSpec
-from planning.task.limits import (
-    COARSEST_ANGLE_RAD,
-    COARSEST_POSITION_M,
-    FASTEST_TOOL_M_S,
-    FINEST_ANGLE_RAD,
-    FINEST_POSITION_M,
-    LINE_ANGLE_RAD,
-    LINE_POSITION_M,
-    LONGEST_WAIT_S,
-    SHORTEST_LINE_M,
-    UPRIGHT_RAD,
-)
+from planning.task import limits
 from planning.validation import unit_quaternion
 
 if TYPE_CHECKING:  # the classes, imported where a spec becomes one (reading a scene needs only the bounds)
@@ -53,11 +42,17 @@ MAX_TASK_SEGMENTS = 200
 """Most segments of a task."""
 
 
+PositionTolerance = Annotated[float, between(limits.FINEST_POSITION_M, limits.COARSEST_POSITION_M)]
+"""How far a line's tool may leave it [m]."""
+AngleTolerance = Annotated[float, between(limits.FINEST_ANGLE_RAD, limits.COARSEST_ANGLE_RAD)]
+"""How far a line's or a constraint's tool may turn from its orientation [rad]."""
+
+
 class LineToleranceSpec(Strict):
     """``{position_m, angle_rad}``: the deviation a line allows at every instant [m, rad]."""
 
-    position_m: Annotated[float, between(FINEST_POSITION_M, COARSEST_POSITION_M)] = LINE_POSITION_M
-    angle_rad: Annotated[float, between(FINEST_ANGLE_RAD, COARSEST_ANGLE_RAD)] = LINE_ANGLE_RAD
+    position_m: PositionTolerance = limits.LINE_POSITION_M
+    angle_rad: AngleTolerance = limits.LINE_ANGLE_RAD
 
 
 class LineSpec(Strict):
@@ -68,7 +63,7 @@ class LineSpec(Strict):
     frame: Literal["tool", "base"] = "tool"
     tool_frame: Name | None = None
     tolerance: LineToleranceSpec = Field(default_factory=LineToleranceSpec)
-    tool_speed_m_s: Annotated[float, Field(gt=0, le=FASTEST_TOOL_M_S)] | None = None
+    tool_speed_m_s: Annotated[float, Field(gt=0, le=limits.FASTEST_TOOL_M_S)] | None = None
 
     @model_validator(mode="after")
     def _one_end(self) -> LineSpec:
@@ -76,10 +71,10 @@ class LineSpec(Strict):
             raise ValueError(
                 "give exactly one of 'to' (a pose {xyz, quat_xyzw}) or 'by' (an offset [x, y, z] [m])"
             )
-        if self.by is not None and float(np.linalg.norm(self.by)) < SHORTEST_LINE_M:
+        if self.by is not None and float(np.linalg.norm(self.by)) < limits.SHORTEST_LINE_M:
             raise ValueError(
                 f"by = {self.by} m is a line of zero length (it keeps the orientation); it must move at "
-                f"least {SHORTEST_LINE_M:g} m"
+                f"least {limits.SHORTEST_LINE_M:g} m"
             )
         if self.to is not None and "frame" in self.model_fields_set:
             raise ValueError(
@@ -122,7 +117,7 @@ class ConstraintSpec(Strict):
     """``constraint:`` of a ``move``: the tool's orientation held about ``axes`` within ``angle_rad``."""
 
     axes: Annotated[list[Axis], Field(min_length=2, max_length=3)] = Field(default_factory=_upright)
-    angle_rad: Annotated[float, between(FINEST_ANGLE_RAD, COARSEST_ANGLE_RAD)] = UPRIGHT_RAD
+    angle_rad: AngleTolerance = limits.UPRIGHT_RAD
     quat_xyzw: Quaternion | None = None
     rpy: Turn | None = None
     frame: Name | None = None
@@ -165,7 +160,7 @@ class TaskStepSpec(Strict):
 
     move: MoveSpec | None = None
     line: LineSpec | None = None
-    wait: Annotated[float, Field(gt=0, le=LONGEST_WAIT_S)] | None = None
+    wait: Annotated[float, Field(gt=0, le=limits.LONGEST_WAIT_S)] | None = None
     attach: PayloadSpec | None = None
     detach: DetachSpec | None = None
 
