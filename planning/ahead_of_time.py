@@ -14,7 +14,6 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import json
-import marshal
 import os
 import shutil
 import sys
@@ -24,7 +23,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from cpr_kin.common.ahead import MODE_VARIABLE, Kernels, load_kernels
+from cpr_kin.common.ahead import MODE_VARIABLE, Kernels, load_kernels, write_codes
 from cpr_kin.common.kernel_files import (
     SUFFIX,
     export_name,
@@ -99,7 +98,7 @@ def compile_kernels(folder: Path, warm: Callable[[], object]) -> tuple[Path, lis
         (Path(scratch) / "signatures.json").write_text(json.dumps(signatures, indent=1))
         os.replace(Path(scratch) / "signatures.json", folder / f"{name}.json")
         codes = Kernels(None, signatures).guard_codes(compiled._KERNELS)  # compiled here, not in each process
-        (Path(scratch) / "guards").write_bytes(marshal.dumps(codes))
+        write_codes(Path(scratch) / "guards", codes)
         os.replace(Path(scratch) / "guards", folder / guards_file(name))
     for older in folder.glob(f"cpr_kernels_*_{host_key()}.*"):  # other kernel files: never loaded again
         if not older.name.startswith(name):

@@ -4,6 +4,7 @@ types, the module found by its sources' digest, and a real build whose plans are
 from __future__ import annotations
 
 import collections
+import importlib.util
 import json
 import marshal
 import os
@@ -17,7 +18,7 @@ import numpy as np
 import pytest
 from numba.core import types
 
-from cpr_kin.common.ahead import MODE_VARIABLE, Kernels, _kept_codes, load_kernels
+from cpr_kin.common.ahead import MODE_VARIABLE, Kernels, kept_codes, load_kernels, write_codes
 from cpr_kin.common.kernel_files import FOLDER_VARIABLE, export_name
 from planning.ahead_of_time import argument_spec
 
@@ -124,8 +125,8 @@ def test_a_guard_runs_the_code_the_build_kept_where_its_source_is_the_same(tmp_p
     key = f"{__name__}:kernel"
     assert list(codes) == [key]
     source = codes[key][0]
-    (tmp_path / "guards").write_bytes(marshal.dumps(codes))
-    kept = _kept_codes(tmp_path / "guards")
+    write_codes(tmp_path / "guards", codes)
+    kept = kept_codes(tmp_path / "guards")
     assert kept.keys() == codes.keys() and kept[key][0] == source
 
     guard = Kernels(module, specs, kept).guarded(kernel, lambda: kernel)  # type: ignore[arg-type]
@@ -138,12 +139,21 @@ def test_a_guard_runs_the_code_the_build_kept_where_its_source_is_the_same(tmp_p
 
 
 @pytest.mark.parametrize(
-    "content", [b"", b"not marshal", marshal.dumps([1, 2]), marshal.dumps({"k": (1, 2)})]
+    "content",
+    [
+        b"",
+        b"not marshal",
+        marshal.dumps([1, 2]),
+        marshal.dumps((importlib.util.MAGIC_NUMBER, {"k": (1, 2)})),
+        marshal.dumps(
+            (b"other", {"k": ("def _make(): pass", compile("pass", "k", "exec"))})
+        ),  # another Python's
+    ],
 )
 def test_guards_code_that_cannot_be_read_is_none_kept(tmp_path: Path, content: bytes) -> None:
     (tmp_path / "guards").write_bytes(content)
-    assert _kept_codes(tmp_path / "guards") == {}
-    assert _kept_codes(tmp_path / "missing") == {}
+    assert kept_codes(tmp_path / "guards") == {}
+    assert kept_codes(tmp_path / "missing") == {}
 
 
 Chain = collections.namedtuple("Chain", "parent axis")
@@ -216,7 +226,7 @@ def test_kernels_compiled_ahead_plan_the_bits_numba_plans_without_numba(tmp_path
     signatures = json.loads(module.with_name(module.name.split(".")[0] + ".json").read_text())
     assert "cpr_kin.bounds.bound_kernels:groups_below" in signatures
     (guards,) = tmp_path.glob("cpr_kernels_*.guards")  # their code, compiled by the build
-    assert signatures.keys() <= _kept_codes(guards).keys()
+    assert signatures.keys() <= kept_codes(guards).keys()
 
     just_in_time = run(["-c", PLAN], {FOLDER_VARIABLE: str(tmp_path), MODE_VARIABLE: "jit"})
     compiled_ahead = run(["-c", PLAN], ahead)

@@ -237,17 +237,28 @@ def kernels_in(folder: Path, name: str) -> Kernels | None:
             return None
         module = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(module)
-        return Kernels(module, json.loads(signatures.read_text()), _kept_codes(folder / guards_file(name)))
+        return Kernels(module, json.loads(signatures.read_text()), kept_codes(folder / guards_file(name)))
     except (ImportError, OSError, ValueError):
         return None
 
 
-def _kept_codes(path: Path) -> dict[str, tuple[str, CodeType]]:
-    """The guards' code kept in ``path`` (:meth:`Kernels.guard_codes`); empty where it cannot be read."""
+def write_codes(path: Path, codes: dict[str, tuple[str, CodeType]]) -> None:
+    """Write the guards' code ``codes`` (:meth:`Kernels.guard_codes`) to ``path``.
+
+    Marked, as a ``.pyc`` is, with this Python's bytecode version (:func:`kept_codes` reads it).
+    """
+    path.write_bytes(marshal.dumps((importlib.util.MAGIC_NUMBER, codes)))
+
+
+def kept_codes(path: Path) -> dict[str, tuple[str, CodeType]]:
+    """The guards' code :func:`write_codes` wrote in ``path``.
+
+    Empty where it cannot be read, or is of another bytecode version.
+    """
     try:
-        codes = marshal.loads(path.read_bytes())
+        magic, codes = marshal.loads(path.read_bytes())
     except (OSError, EOFError, ValueError, TypeError):
         return {}
-    if not isinstance(codes, dict):
+    if magic != importlib.util.MAGIC_NUMBER or not isinstance(codes, dict):
         return {}
     return {k: v for k, v in codes.items() if isinstance(v, tuple) and [*map(type, v)] == [str, CodeType]}
