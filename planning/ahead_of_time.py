@@ -4,9 +4,10 @@ Every later process then runs them without importing numba (:mod:`cpr_kin.common
 ``cpr-plan plan`` starts about half a second sooner (docs/benchmarks.md). The kernels are
 compiled with the argument types a warm-up calls them with (:func:`planning.warming.warm_up`,
 on the bundled CPR and on each robot given), by numba's ``pycc`` and the machine's C compiler,
-into the first writable folder of :func:`~cpr_kin.common.kernel_files.kernel_folders`. A kernel the
-warm-up does not call, or calls with types ``pycc`` cannot take, stays numba's, compiled just in
-time as before. Run it again after an update: a module built for other kernel files is not used.
+into the first writable folder of :func:`~cpr_kin.common.kernel_files.kernel_folders`. A
+kernel the warm-up does not call, calls with types ``pycc`` cannot take, or ``pycc`` cannot
+compile, stays numba's, compiled just in time as before. Run it again after an update: a
+module built for other kernel files is not used.
 """
 
 from __future__ import annotations
@@ -19,7 +20,8 @@ import shutil
 import sys
 import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -55,8 +57,77 @@ def argument_spec(numba_type: Any) -> list[Any] | None:
     return None
 
 
-def compile_kernels(folder: Path, warm: Callable[[], object]) -> tuple[Path, list[str], list[str]]:
-    """Run ``warm``, then compile every kernel it called into ``folder``: the module, kernels compiled, left.
+@dataclass(frozen=True)
+class Export:
+    """One compiled signature of a kernel.
+
+    Attributes:
+        key: the kernel, ``module:name``.
+        name: its name in the extension module (:func:`~cpr_kin.common.kernel_files.export_name`).
+        signature: numba's signature of it.
+        function: the kernel's Python function.
+    """
+
+    key: str
+    name: str
+    signature: Any
+    function: Callable[..., Any]
+
+
+@dataclass(frozen=True)
+class Build:
+    """What a build compiled.
+
+    Attributes:
+        module: the extension module's path.
+        compiled: the kernels compiled into it, ``module:name`` each.
+        uncalled: kernels the warm-up never called from Python: left to numba, if ever so called.
+        uncompilable: kernels ``pycc`` could not compile: left to numba.
+    """
+
+    module: Path
+    compiled: tuple[str, ...]
+    uncalled: tuple[str, ...]
+    uncompilable: tuple[str, ...]
+
+
+def build_module(
+    name: str, exports: Sequence[Export], folder: Path, compiler: Callable[[str], Any]
+) -> list[str]:
+    """Compile ``exports`` into the extension module ``name`` in ``folder``; the kernels it left out.
+
+    ``compiler`` is numba's ``pycc.CC``. It compiles a module's exports together, and one it
+    cannot compile fails them all: then each kernel is compiled alone, into a module that is
+    thrown away, and the module is built without those that fail (numba compiles them just in
+    time, as without a build).
+    """
+
+    def compile_into(chosen: Sequence[Export], module: str, output: Path) -> None:
+        build = compiler(module)
+        build.target_cpu = "host"
+        build.output_dir = str(output)
+        for export in chosen:
+            build.export(export.name, export.signature)(export.function)
+        build.compile()
+
+    try:
+        compile_into(exports, name, folder)
+        return []
+    except Exception:  # numba's typing or lowering, or the C compiler: its errors share no base class
+        pass
+    failed = []
+    for key in dict.fromkeys(export.key for export in exports):
+        with tempfile.TemporaryDirectory(dir=folder) as alone:
+            try:
+                compile_into([e for e in exports if e.key == key], f"{name}_alone", Path(alone))
+            except Exception:
+                failed.append(key)
+    compile_into([e for e in exports if e.key not in failed], name, folder)
+    return failed
+
+
+def compile_kernels(folder: Path, warm: Callable[[], object]) -> Build:
+    """Run ``warm``, then compile every kernel it called into ``folder``.
 
     The process must compile just in time (:data:`~cpr_kin.common.ahead.MODE_VARIABLE` ``jit``).
     The module, its signatures and its guards' code (:meth:`~cpr_kin.common.ahead.Kernels.guard_codes`)
@@ -68,10 +139,9 @@ def compile_kernels(folder: Path, warm: Callable[[], object]) -> tuple[Path, lis
 
     warm()
     name = module_name(sources_digest())
-    build = CC(name)  # type: ignore[no-untyped-call]
-    build.target_cpu = "host"
     signatures: dict[str, list[list[Any]]] = {}
-    compiled_names, left = [], []
+    exports: list[Export] = []
+    uncalled = []
     for function in list(compiled._KERNELS):
         dispatcher: Any = compiled._dispatcher(function)
         key = f"{function.__module__}:{function.__name__}"
@@ -80,19 +150,17 @@ def compile_kernels(folder: Path, warm: Callable[[], object]) -> tuple[Path, lis
             specs = [argument_spec(t) for t in arguments]
             if any(spec is None for spec in specs):
                 continue
-            signature = dispatcher.overloads[arguments].signature
             export = export_name(function.__module__, function.__name__, len(exported))
-            build.export(export, signature)(function)  # type: ignore[no-untyped-call]
+            exports.append(Export(key, export, dispatcher.overloads[arguments].signature, function))
             exported.append(specs)
         if exported:
             signatures[key] = exported
-            compiled_names.append(key)
         elif not compiled._KERNELS[function]:
-            left.append(key)
+            uncalled.append(key)
     folder.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=folder) as scratch:
-        build.output_dir = scratch
-        build.compile()
+        failed = build_module(name, exports, Path(scratch), CC)
+        signatures = {key: specs for key, specs in signatures.items() if key not in failed}
         module = folder / f"{name}{SUFFIX}"
         os.replace(Path(scratch) / f"{name}{SUFFIX}", module)
         (Path(scratch) / "signatures.json").write_text(json.dumps(signatures, indent=1))
@@ -103,7 +171,7 @@ def compile_kernels(folder: Path, warm: Callable[[], object]) -> tuple[Path, lis
     for older in folder.glob(f"cpr_kernels_*_{host_key()}.*"):  # other kernel files: never loaded again
         if not older.name.startswith(name):
             older.unlink(missing_ok=True)
-    return module, compiled_names, left
+    return Build(module, tuple(signatures), tuple(uncalled), tuple(failed))
 
 
 def default_robots() -> list[tuple[Path, Path | None]]:
@@ -193,11 +261,14 @@ def main(argv: list[str] | None = None) -> int:
         # numba compiles afresh, not from its disk cache: a kernel loaded from there does not
         # compile the kernels it calls, whose types then go unseen and unexported
         os.environ["NUMBA_CACHE_DIR"] = cold
-        module, compiled_names, left = compile_kernels(writable_folder(), warm)
+        build = compile_kernels(writable_folder(), warm)
     seconds = time.perf_counter() - started
-    print(f"{len(compiled_names)} kernels compiled ahead of time into {module} in {seconds:.0f} s")
-    if left:
-        print(f"not called from Python by the warm-up, left to numba if ever so called: {', '.join(left)}")
+    print(f"{len(build.compiled)} kernels compiled ahead of time into {build.module} in {seconds:.0f} s")
+    if build.uncompilable:
+        print(f"pycc could not compile these, left to numba: {', '.join(build.uncompilable)}")
+    if build.uncalled:
+        uncalled = ", ".join(build.uncalled)
+        print(f"not called from Python by the warm-up, left to numba if ever so called: {uncalled}")
     return 0
 
 

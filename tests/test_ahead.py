@@ -12,7 +12,7 @@ import subprocess
 import sys
 from pathlib import Path
 from types import CodeType, SimpleNamespace
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 import pytest
@@ -20,7 +20,7 @@ from numba.core import types
 
 from cpr_kin.common.ahead import MODE_VARIABLE, Kernels, kept_codes, load_kernels, write_codes
 from cpr_kin.common.kernel_files import FOLDER_VARIABLE, export_name
-from planning.ahead_of_time import argument_spec
+from planning.ahead_of_time import Export, argument_spec, build_module
 
 ROOT = Path(__file__).resolve().parents[1]
 F8_C = ["array", "float64", 2, "C", False]
@@ -268,3 +268,44 @@ def test_the_build_says_what_it_lacks_and_leaves_the_kernels_to_numba(
     monkeypatch.setattr(shutil, "which", lambda name: None)
     assert ahead_of_time.main([]) == 2
     assert "no C compiler (cc or gcc) on the PATH" in capsys.readouterr().err
+
+
+class FakeCompiler:
+    """numba's ``pycc.CC`` as the build uses it: it fails a module holding an export named ``*bad*``."""
+
+    modules: ClassVar[list[list[str]]] = []
+
+    def __init__(self, name: str) -> None:
+        self.name, self.output_dir, self.target_cpu = name, "", ""
+        self.exports: list[str] = []
+
+    def export(self, name: str, signature: Any) -> Any:
+        return lambda function: self.exports.append(name)
+
+    def compile(self) -> None:
+        FakeCompiler.modules.append(list(self.exports))
+        if any("bad" in name for name in self.exports):
+            raise TypeError("No conversion from Literal[int](1) to Literal[int](0)")
+        (Path(self.output_dir) / f"{self.name}.so").write_text(" ".join(self.exports))
+
+
+def test_a_build_leaves_out_the_kernels_pycc_cannot_compile_and_compiles_the_rest(tmp_path: Path) -> None:
+    exports = [
+        Export(f"m:{k}", f"m__{k}__{i}", None, kernel)
+        for k, i in [("good", 0), ("bad", 0), ("good", 1), ("also", 0)]
+    ]
+    FakeCompiler.modules = []
+    assert build_module("cpr_kernels_x", exports, tmp_path, FakeCompiler) == ["m:bad"]
+    assert (tmp_path / "cpr_kernels_x.so").read_text() == "m__good__0 m__good__1 m__also__0"
+    # all together, then each kernel alone, then the module without the one that failed
+    assert FakeCompiler.modules == [
+        [e.name for e in exports],
+        ["m__good__0", "m__good__1"],
+        ["m__bad__0"],
+        ["m__also__0"],
+        ["m__good__0", "m__good__1", "m__also__0"],
+    ]
+    FakeCompiler.modules = []
+    good = [e for e in exports if e.key != "m:bad"]
+    assert build_module("cpr_kernels_y", good, tmp_path, FakeCompiler) == []
+    assert len(FakeCompiler.modules) == 1  # compiled once where all compile
