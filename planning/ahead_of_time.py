@@ -32,6 +32,7 @@ from cpr_kin.common.kernel_files import (
     guards_file,
     host_key,
     kernel_folders,
+    kernel_key,
     module_name,
 )
 from cpr_kin.common.kernel_sources import sources_digest
@@ -144,7 +145,7 @@ def compile_kernels(folder: Path, warm: Callable[[], object]) -> Build:
     uncalled = []
     for function in list(compiled._KERNELS):
         dispatcher: Any = compiled._dispatcher(function)
-        key = f"{function.__module__}:{function.__name__}"
+        key = kernel_key(function)
         exported: list[list[Any]] = []
         for arguments in dispatcher.signatures:
             specs = [argument_spec(t) for t in arguments]

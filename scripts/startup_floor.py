@@ -6,9 +6,10 @@ Imports the libraries ``cpr-plan plan`` imports, and nothing of ours: NumPy (and
 generators), Pinocchio, coal, pydantic with its models' machinery (and ``importlib.metadata``,
 which pydantic imports to look for plugins before its first validator), PyYAML, lxml,
 threadpoolctl and lazy_loader; no numba, which a plan with the kernels compiled ahead of time
-does not import (``make kernels``). The process runs as the installed command's does, the cyclic collector off
-and no teardown at its end (``planning/cli/process.py``). ``cpr-plan plan``'s wall time less
-this one's is what the planner itself adds (docs/benchmarks.md: the new-process row).
+does not import (``make kernels``). The process runs as the installed command's does, the
+cyclic collector off and no teardown at its end (``planning/cli/process.py``). ``cpr-plan
+plan``'s wall time less this one's is what the planner itself adds (docs/benchmarks.md: the
+new-process row).
 """
 
 from __future__ import annotations

@@ -31,7 +31,14 @@ from typing import Any
 
 import numpy as np
 
-from cpr_kin.common.kernel_files import SUFFIX, export_name, guards_file, kernel_folders, module_name
+from cpr_kin.common.kernel_files import (
+    SUFFIX,
+    export_name,
+    guards_file,
+    kernel_folders,
+    kernel_key,
+    module_name,
+)
 from cpr_kin.common.kernel_sources import sources_digest
 
 MODE_VARIABLE = "CPR_KERNELS"
@@ -72,7 +79,7 @@ class Kernels:
         source, cells = made
         exports = {
             f"_export{i}": getattr(self.module, export_name(function.__module__, function.__name__, i))
-            for i in range(len(self.signatures.get(_key(function), [])))
+            for i in range(len(self.signatures.get(kernel_key(function), [])))
         }
         names: dict[str, Any] = {}
         exec(self._code(function, source), names)
@@ -95,12 +102,12 @@ class Kernels:
         for function in functions:
             made = self._guard_source(function)
             if made is not None:
-                codes[_key(function)] = (made[0], self._code(function, made[0]))
+                codes[kernel_key(function)] = (made[0], self._code(function, made[0]))
         return codes
 
     def _code(self, function: Callable[..., Any], source: str) -> CodeType:
         """``source`` compiled, or the code kept for it."""
-        kept = self.codes.get(key := _key(function))
+        kept = self.codes.get(key := kernel_key(function))
         if kept is not None and kept[0] == source:
             return kept[1]
         return compile(source, f"<compiled ahead: {key}>", "exec")
@@ -110,7 +117,7 @@ class Kernels:
 
         ``None`` for a function whose parameters are not a kernel's.
         """
-        key = _key(function)
+        key = kernel_key(function)
         parameters = list(inspect.signature(function).parameters.values())
         if any(p.kind != p.POSITIONAL_OR_KEYWORD for p in parameters):
             return None
@@ -148,11 +155,6 @@ class Kernels:
             f"    return {function.__name__}",
         ]
         return "\n".join(lines), cells
-
-
-def _key(function: Callable[..., Any]) -> str:
-    """A kernel's name in the signatures: ``module:name``."""
-    return f"{function.__module__}:{function.__name__}"
 
 
 SCALARS = ("float", "int", "bool")

@@ -15,7 +15,9 @@ import importlib.machinery
 import os
 import platform
 import sys
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 SUFFIX = importlib.machinery.EXTENSION_SUFFIXES[0]
 
@@ -61,6 +63,11 @@ def kernel_folders() -> list[Path]:
         return [Path(os.environ[FOLDER_VARIABLE])]
     cache = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
     return [Path(__file__).resolve().parent / "__pycache__", cache / "cpr-firefly" / "kernels"]
+
+
+def kernel_key(function: Callable[..., Any]) -> str:
+    """A kernel's name in the signatures file: ``module:name``."""
+    return f"{function.__module__}:{function.__name__}"
 
 
 def export_name(module: str, name: str, index: int) -> str:

@@ -16,8 +16,8 @@ task:                       # in order; each entry has exactly one key
 A line's ``frame`` is the frame ``by`` is given in (``tool``: the tool's axes at the line's
 start, the default; ``base``); ``tool_frame`` the frame held on the line (default: the
 robot's tool frame); ``tool_speed_m_s`` a limit on its speed. What the robot carries is
-checked here, in order: a detach of nothing, an attach while carrying, a detach naming
-another object are the file's errors.
+checked in order where the segments are built (:mod:`planning.io.task_segments`): a detach of
+nothing, an attach while carrying, a detach naming another object are the file's errors.
 """
 
 from __future__ import annotations
