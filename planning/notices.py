@@ -8,7 +8,6 @@ command line shows it to someone at a terminal, a line on stderr, and adds nothi
 from __future__ import annotations
 
 import contextlib
-import logging
 import sys
 from collections.abc import Iterator
 
@@ -24,6 +23,8 @@ def library_notices(label: str) -> Iterator[None]:
     if not sys.stderr.isatty():
         yield
         return
+    import logging  # only for a terminal's notices: a new process's start-up otherwise
+
     log = logging.getLogger("cpr_kin")
     handler = logging.StreamHandler(sys.stderr)
     handler.setFormatter(logging.Formatter(f"{label}: %(message)s"))

@@ -30,11 +30,15 @@ def python(code: str) -> subprocess.CompletedProcess[str]:
     )
 
 
-def test_start_switches_the_collector_off(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_start_switches_the_collector_off_and_keeps_a_users_plugin_setting(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
     monkeypatch.setattr(gc, "disable", lambda: calls.append("disable"))
+    monkeypatch.setenv(process.PYDANTIC_PLUGINS, "")  # the user's: every plugin loads
     calls: list[str] = []
     process.start_process()
     assert calls == ["disable"]
+    assert os.environ[process.PYDANTIC_PLUGINS] == ""
 
 
 def test_end_process_exits_with_the_code_and_every_byte_written() -> None:
@@ -89,3 +93,46 @@ def test_the_installed_command_runs_with_the_collector_off(tmp_path: Path) -> No
     )
     assert completed.returncode == 7 and completed.stdout == "collector False\n"
     assert completed.stderr == ""
+
+
+def test_the_installed_command_holds_blas_to_one_thread_and_searches_no_plugins(tmp_path: Path) -> None:
+    script = tmp_path / "probe.py"
+    script.write_text(
+        "import sys\n"
+        "from planning.cli import app\n"
+        "print('numpy before', 'numpy' in sys.modules)\n"
+        "def main(restore_signals):\n"
+        "    import numpy, threadpoolctl\n"
+        "    from planning.pipeline import blas_threads\n"
+        "    pools = threadpoolctl.ThreadpoolController().select(user_api='blas').info()\n"
+        "    blas_threads._controller = None  # not searched for: the process is on one thread\n"
+        "    blas_threads.one_blas_thread(lambda: None)()\n"
+        "    print('threads', sorted({pool['num_threads'] for pool in pools}))\n"
+        "    import pydantic.plugin._loader as plugins\n"
+        "    print('plugins', list(plugins.get_plugins()), plugins._plugins)\n"
+        "    return 0\n"
+        "app.main = main\n"
+        "app.console_main()\n"
+    )
+    env = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", process.PYDANTIC_PLUGINS)}
+    completed = subprocess.run(
+        [sys.executable, str(script)],
+        capture_output=True,
+        text=True,
+        check=False,
+        timeout=60,
+        cwd=ROOT,
+        env=env,
+    )
+    assert completed.stderr == ""
+    assert completed.stdout == "numpy before False\nthreads [1]\nplugins [] None\n"  # none searched for
+
+
+def test_a_library_caller_keeps_its_blas_threads() -> None:
+    completed = python(
+        "import numpy, os\n"
+        "from planning.cli.process import start_process\n"
+        "start_process()\n"
+        "print(os.environ.get('OPENBLAS_NUM_THREADS'))\n"
+    )
+    assert completed.returncode == 0 and completed.stdout == "None\n"

@@ -11,12 +11,11 @@ Python, for debugging; ``CPR_KERNELS=jit`` compiles just in time even where a mo
 ahead of time exists.
 
 A compilation keeps a first run waiting with nothing to show for it; the first of a process is
-said on the logger :data:`COMPILE_LOG` (``INFO``), which ``cpr-plan`` prints on stderr.
+said on the logger named :data:`COMPILE_LOG` (``INFO``), which ``cpr-plan`` prints on stderr.
 """
 
 from __future__ import annotations
 
-import logging
 import sys
 from collections.abc import Callable
 from typing import Any, TypeVar, cast
@@ -25,8 +24,8 @@ from cpr_kin.common.ahead import Kernels, load_kernels
 
 F = TypeVar("F", bound=Callable[..., Any])
 
-COMPILE_LOG = logging.getLogger("cpr_kin.compiled")
-"""Where the first compilation of a process is said."""
+COMPILE_LOG = "cpr_kin.compiled"
+"""The logger where the first compilation of a process is said (``logging`` is imported only then)."""
 COMPILING = (
     "compiling the numba kernels, which the first run on a machine (or after an update) does once: "
     "tens of seconds; later runs load them from the disk cache"
@@ -67,9 +66,11 @@ def _kernel(function: Callable[..., Any], inline: bool) -> Callable[..., Any]:
 def _dispatcher(function: Callable[..., Any]) -> Callable[..., Any]:
     """Numba's dispatcher of ``function``, made once."""
     if function not in _JIT:
+        import logging
+
         from cpr_kin.common.just_in_time import jit
 
-        _JIT[function] = jit(function, _KERNELS[function], COMPILE_LOG, COMPILING)
+        _JIT[function] = jit(function, _KERNELS[function], logging.getLogger(COMPILE_LOG), COMPILING)
     return _JIT[function]
 
 

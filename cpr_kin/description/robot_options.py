@@ -9,7 +9,6 @@ tool frame on a tree of several arms read as no tool frame at all).
 
 from __future__ import annotations
 
-from difflib import get_close_matches
 from numbers import Real
 from pathlib import Path
 from typing import Any, Protocol
@@ -110,6 +109,8 @@ def check_tcp(tcp: str | None, model: Any, path: Path) -> None:
     """
     if tcp is None or model.existFrame(tcp):
         return
+    from difflib import get_close_matches  # a message's, not every load's (a new process's start-up)
+
     close = get_close_matches(tcp, sorted({f.name for f in model.frames}), n=3, cutoff=0.5)
     hint = f"did you mean {', '.join(repr(name) for name in close)}? " if close else ""
     links = sorted({f.name for f in model.frames if f.type == pin.FrameType.BODY})

@@ -1,6 +1,6 @@
 """The process of the installed ``cpr-plan``: it runs one command, then it ends.
 
-A long-lived Python process needs two things that a process running one command does not;
+A long-lived Python process needs four things that a process running one command does not;
 each costs a new ``cpr-plan plan`` tens of milliseconds of its half second (docs/benchmarks.md,
 the new-process row):
 
@@ -10,6 +10,14 @@ the new-process row):
   objects in a plan, most of them the imports' own, no more in a task of two seconds than in a
   plan of a tenth (peak memory of the example scenes within 1 MB either way). :func:`start_process`
   switches it off; a library caller keeps it.
+- **BLAS threads given back after each plan.** A plan holds BLAS to one thread
+  (:mod:`planning.pipeline.blas_threads`); a process that runs one command holds it so from its
+  start (:func:`start_process`), before NumPy loads OpenBLAS, and needs no search of its
+  libraries for their thread pools.
+- **pydantic's plugins.** Before its first validator, pydantic reads the entry points of every
+  installed distribution for plugins (tools that watch a program's own models); the command's
+  only models are its file schemas. :func:`start_process` sets ``PYDANTIC_DISABLE_PLUGINS`` to
+  ``__all__`` unless the environment sets it (an empty value lets every plugin load).
 - **Python's teardown.** On exit Python takes apart every module and the robot's models one by
   one. :func:`end_process` flushes the output and ends the process at once (as mypy does), unless a
   thread of the command still runs (then Python's own exit waits for it, as it would).
@@ -19,21 +27,33 @@ from __future__ import annotations
 
 import contextlib
 import gc
-import logging
 import os
 import sys
 import threading
 from typing import NoReturn
 
+from planning.pipeline.blas_threads import one_thread_for_process
+
+PYDANTIC_PLUGINS = "PYDANTIC_DISABLE_PLUGINS"
+"""pydantic's variable naming the plugins it leaves out (``__all__``: every one, no search)."""
+
 
 def start_process() -> None:
-    """Set up the process for one command: no cyclic collector (module docstring)."""
+    """Set up the process for one command (module docstring).
+
+    No cyclic collector, one BLAS thread, no search for pydantic's plugins unless the
+    environment names some.
+    """
     gc.disable()
+    one_thread_for_process()
+    os.environ.setdefault(PYDANTIC_PLUGINS, "__all__")
 
 
 def end_process(code: int) -> NoReturn:
     """Exit with ``code``, the output flushed, without Python's teardown where no other thread runs."""
-    logging.shutdown()
+    logging = sys.modules.get("logging")  # its handlers flushed and closed, where anything logged
+    if logging is not None:
+        logging.shutdown()
     for stream in (sys.stdout, sys.stderr):
         with contextlib.suppress(OSError, ValueError):  # a reader gone, a stream closed: nothing to keep
             stream.flush()
