@@ -19,7 +19,8 @@ from .description.loading import RobotSpec, load_robot
 from .kinematics.carried import carrying, holding_links, left_at, taken_from
 from .kinematics.dynamics import Dynamics, Payload, robot_dynamics
 from .kinematics.forward import frame_poses, frame_positions
-from .kinematics.numerical_ik import IkSettings, IkTarget, solve_ik
+from .kinematics.ik_target import IkTarget
+from .kinematics.numerical_ik import IkSettings, solve_ik
 from .model.limits import JointLimits
 from .model.robot import GROUPS, PositionIk, Robot, RobotGeometry
 from .presets import (

@@ -32,7 +32,8 @@ import numpy as np
 import pinocchio as pin
 
 import cpr_kin as ck
-from cpr_kin.kinematics.numerical_ik import IkTarget, solve_ik
+from cpr_kin.kinematics.ik_target import IkTarget
+from cpr_kin.kinematics.numerical_ik import solve_ik
 from planning.bench.roboplan_carry import RoboplanCarry
 from planning.cli.arguments import COUNT, SEED
 from planning.errors import NoSolutionError, PlanningError

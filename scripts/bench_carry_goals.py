@@ -29,7 +29,8 @@ from typing import Any
 import numpy as np
 
 import cpr_kin as ck
-from cpr_kin.kinematics.numerical_ik import IkTarget, solve_ik
+from cpr_kin.kinematics.ik_target import IkTarget
+from cpr_kin.kinematics.numerical_ik import solve_ik
 from cpr_kin.model.packages import example_robot
 from planning.cli.arguments import COUNT, SEED
 from planning.errors import NoSolutionError, PlanningError

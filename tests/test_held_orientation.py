@@ -17,7 +17,8 @@ import pinocchio as pin
 import pytest
 
 import cpr_kin as ck
-from cpr_kin.kinematics.numerical_ik import IkTarget, solve_ik
+from cpr_kin.kinematics.ik_target import IkTarget
+from cpr_kin.kinematics.numerical_ik import solve_ik
 from cpr_kin.model.packages import example_robot
 from planning.errors import NoSolutionError, PlanningError
 from planning.io.scene_file import SceneFile, parse_scene_file

@@ -20,6 +20,7 @@ import yourdfpy
 import cpr_kin as ck
 from cpr_kin.description.resources import makers_limits_path
 from cpr_kin.description.robot_options import SHOWN_LINKS
+from cpr_kin.model import packages
 from cpr_kin.model.packages import example_robot, example_robot_data_share
 
 SHARE = example_robot_data_share()
@@ -139,6 +140,20 @@ def test_package_dirs_are_looked_in_first(tmp_path: Path) -> None:
         ck.load_robot(urdf, package_dirs=[tmp_path / "shared", tmp_path / "share"])
     with pytest.raises(ck.UrdfError, match=r"package folder '.*xarm7.urdf' .* is not a folder"):
         ck.load_robot(urdf, package_dirs=[urdf])
+
+
+def test_a_urdf_that_names_no_package_looks_for_none(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # example-robot-data is found by a search of every installed distribution: only where asked
+    def not_asked() -> Path:
+        raise AssertionError("example-robot-data looked up for a URDF that names no package")
+
+    urdf = panda_copy(tmp_path, lambda text: text)  # every mesh a file:// path
+    monkeypatch.setattr(packages, "example_robot_data_share", not_asked)
+    assert ck.load_robot(urdf).nq == 7
+    with pytest.raises(ck.UrdfError, match=r"package folder '.*nowhere' \(packages, .*\) does not exist"):
+        ck.load_robot(urdf, package_dirs=[tmp_path / "nowhere"])  # a folder given is checked all the same
+    with pytest.raises(AssertionError, match="looked up"):  # a package:// mesh looks there
+        ck.load_robot(ARMS["so101"][0])
 
 
 def test_planned_and_held_joints_are_checked() -> None:

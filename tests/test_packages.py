@@ -125,6 +125,28 @@ def test_cpr_plan_plan_imports_no_benchmark_module(tmp_path: Path) -> None:
 
 
 @pytest.mark.slow
+def test_a_plan_of_the_cpr_imports_no_machinery_for_what_its_scene_lacks(tmp_path: Path) -> None:
+    # no pairs of its own, no cloud, a tool position its own IK reaches, meshes named by path:
+    # a new process of `cpr-plan plan` does not pay for the modules of those (docs/benchmarks.md)
+    unused = [
+        "cpr_kin.collision.self_screen",  # the self-collision screen of a robot with pairs
+        "cpr_kin.bounds.self_bounds",
+        "cpr_kin.certified.self_curve",
+        "cpr_kin.collision.self_filter",  # a point cloud's voxels
+        "cpr_kin.shapes.octree_files",
+        "cpr_kin.kinematics.numerical_ik",  # the CPR's analytic IK, verified by an IkTarget
+    ]
+    code = (
+        "import sys; from planning.cli import main; from planning.io.bundled import bundled_scene_paths; "
+        "from cpr_kin.model.packages import example_robot_data_share as share; "
+        f"code = main(['plan', str(bundled_scene_paths()[1]), '--out', {str(tmp_path / 'out')!r}]); "
+        f"print(code, share.cache_info().currsize, *[m in sys.modules for m in {unused!r}])"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.split("\n")[-2].split() == ["0", "0", *["False"] * len(unused)]
+
+
+@pytest.mark.slow
 def test_an_installed_wheel_carries_its_data_and_stubs(tmp_path: Path) -> None:
     # the wheel, not the checkout: the URDF, limits and scenes as package data, and the
     # __init__.pyi stubs that the lazy exports are read from

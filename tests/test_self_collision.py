@@ -15,7 +15,8 @@ import cpr_kin as ck
 from cpr_kin.bounds.reach import geometry_reach, relative_radii
 from cpr_kin.certified.self_curve import check_self_curve
 from cpr_kin.collision.robot_reach import robot_reach
-from cpr_kin.collision.self_collision import SelfCollision, read_srdf, self_pairs
+from cpr_kin.collision.self_collision import SelfCollision
+from cpr_kin.collision.srdf_pairs import read_srdf, self_pairs
 from cpr_kin.model.packages import example_robot_data_share
 from planning import Scene, Target, plan
 from planning.bench.mbm import vamp_resources

@@ -27,7 +27,6 @@ import numpy as np
 import pinocchio as pin
 
 from cpr_kin.bounds.batch_kinematics import sampled_configurations
-from cpr_kin.bounds.self_bounds import bounded_pairs
 
 SAMPLES = 1000
 """Seeded configurations in which a pair must stay close, and apart, to be close by design."""
@@ -74,6 +73,8 @@ def close_pairs(
     """
     if not pairs:
         return ()
+    from cpr_kin.bounds.self_bounds import bounded_pairs  # a robot with pairs of its own only
+
     q = sampled_configurations(model, samples, np.random.default_rng(0))
     candidates, geometry_model = bounded_pairs(model, collision_model, pairs, q, CLOSE_LIMIT_M)
     if not candidates:

@@ -19,8 +19,6 @@ import numpy as np
 import pinocchio as pin
 
 from cpr_kin.bounds.batch_kinematics import sampled_configurations
-from cpr_kin.bounds.self_bounds import bounded_pairs
-from cpr_kin.shapes.exact_pairs import collide_margin_m
 
 SAMPLES = 1000
 """Seeded configurations in which a pair must collide to be taken as touching by design."""
@@ -39,6 +37,9 @@ def overlapping_pairs(
     """
     if not pairs:
         return ()
+    from cpr_kin.bounds.self_bounds import bounded_pairs  # a robot with pairs of its own only
+    from cpr_kin.shapes.exact_pairs import collide_margin_m
+
     q = sampled_configurations(model, samples, np.random.default_rng(0))
     candidates, geometry_model = bounded_pairs(model, collision_model, pairs, q, 0.0)
     if not candidates:

@@ -8,7 +8,6 @@ import numpy as np
 
 from cpr_kin.collision.robot_reach import robot_reach
 from cpr_kin.collision.self_collision import SelfCollision
-from cpr_kin.collision.self_split import robot_self_screen
 from cpr_kin.model.robot import Robot
 
 
@@ -25,6 +24,11 @@ def world_self_collision(
     links = [g.link for g in robot.geometries]
     kept = tuple((a, b) for a, b in robot.self_pairs if frozenset((links[a], links[b])) not in allowed)
     contact_only = {c.geometries for c in robot.close_pairs if c.held_to_contact(self_margin_m)}
+    screen = None
+    if kept:  # the split's machinery, for a robot with pairs of its own only
+        from cpr_kin.collision.self_split import robot_self_screen
+
+        screen = robot_self_screen(robot, kept, self_margin_m)
     return SelfCollision(
         robot.model,
         robot.collision_model,
@@ -33,6 +37,6 @@ def world_self_collision(
         num_threads,
         reach=robot_reach(robot),
         allowance_m=np.array([self_margin_m if pair in contact_only else 0.0 for pair in kept]),
-        screen=robot_self_screen(robot, kept, self_margin_m) if kept else None,
+        screen=screen,
         exact_meshes=robot.exact_meshes,
     )

@@ -38,21 +38,17 @@ from lxml import etree
 
 from cpr_kin.bounds.close_pairs import close_pairs
 from cpr_kin.bounds.overlapping_pairs import overlapping_pairs
-from cpr_kin.collision.self_collision import SrdfPairs, find_srdf, read_srdf, self_pairs
+from cpr_kin.collision.srdf_pairs import SrdfPairs, find_srdf, read_srdf, self_pairs
 from cpr_kin.common.errors import UrdfError
 from cpr_kin.description.resources import makers_limits_path
 from cpr_kin.description.robot_options import check_not_one_name, check_options, check_tcp
 from cpr_kin.description.supported import check_limits, checked_urdf
-from cpr_kin.description.urdf_file import (
-    collision_names,
-    massless_links,
-    prepared_xml,
-)
+from cpr_kin.description.urdf_file import collision_names, massless_links, mesh_filenames, prepared_xml
 from cpr_kin.description.urdf_models import VisualModel, build_models, convex_hulls
 from cpr_kin.model.arm import ArmChain, arm_chain, default_joints
 from cpr_kin.model.geometry_groups import carried_alone, grouped_geometries
 from cpr_kin.model.limits import LIMITS_NAMES, JointLimits, find_limits_file, read_dynamic_limits
-from cpr_kin.model.packages import package_roots
+from cpr_kin.model.packages import mesh_package_roots
 from cpr_kin.model.robot import PositionIk, Robot, joint_units
 from cpr_kin.shapes.exact_meshes import exact_meshes
 
@@ -64,7 +60,7 @@ class RobotSpec:
     Attributes:
         urdf: the URDF file.
         srdf: its SRDF, whose ``disable_collisions`` the self-collision checks leave out;
-            default: found by :func:`~cpr_kin.collision.self_collision.find_srdf` (``<urdf name>.srdf``
+            default: found by :func:`~cpr_kin.collision.srdf_pairs.find_srdf` (``<urdf name>.srdf``
             or ``<robot name>.srdf`` beside the URDF or in ``robot_description/srdf/``).
         package_dirs: folders that hold the packages its ``package://`` meshes name.
         limits: its acceleration and jerk limits file; default: found beside the URDF by
@@ -110,7 +106,7 @@ class RobotSpec:
         """The robot (module docstring)."""
         path = Path(self.urdf)
         tree = checked_urdf(path, self.validate)
-        xml = prepared_xml(tree, path, package_roots(path, self.package_dirs))
+        xml = prepared_xml(tree, path, mesh_package_roots(path, mesh_filenames(tree), self.package_dirs))
         arm = arm_chain(tree)
         model, collision = build_models(xml, path)
         check_tcp(self.tcp, model, path)

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from lxml import etree
 
-from cpr_kin.collision.self_collision import parse_srdf
+from cpr_kin.collision.srdf_pairs import parse_srdf
 from cpr_kin.common.errors import UrdfError
 
 

@@ -200,6 +200,11 @@ def prepared_xml(tree: etree._ElementTree, path: Path, roots: Sequence[Path]) ->
     return str(etree.tostring(root, encoding="unicode"))
 
 
+def mesh_filenames(tree: etree._ElementTree) -> list[str]:
+    """The file names of the URDF's meshes, as it gives them (``package://...``, relative or absolute)."""
+    return [mesh.get("filename") or "" for mesh in tree.iter("mesh")]
+
+
 def massless_links(tree: etree._ElementTree, model: Any) -> tuple[str, ...]:
     """Links that a planned joint of ``model`` moves which have a shape but no ``<inertial>``."""
     import pinocchio as pin  # the model is Pinocchio's; reading a URDF alone needs none

@@ -22,7 +22,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from cpr_kin.collision.self_collision import adjacent
+from cpr_kin.collision.srdf_pairs import adjacent
 from cpr_kin.common.errors import CprKinError
 from cpr_kin.kinematics.dynamics import PAYLOAD_NAME, Payload
 from cpr_kin.kinematics.forward import frame_poses

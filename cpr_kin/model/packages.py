@@ -98,6 +98,23 @@ def package_roots(urdf_path: Path, package_dirs: Sequence[Path] = ()) -> list[Pa
     return list(dict.fromkeys(roots))
 
 
+def mesh_package_roots(
+    urdf_path: Path, mesh_filenames: Iterable[str], package_dirs: Sequence[Path] = ()
+) -> list[Path]:
+    """:func:`package_roots` for a URDF whose meshes are ``mesh_filenames``: none where none names a package.
+
+    The folders given are checked either way; the installed example-robot-data, found by a
+    search of every installed distribution, is looked up only for a URDF that names a package.
+
+    Raises:
+        UrdfError: a folder of ``package_dirs`` is not a folder (:func:`check_package_dirs`).
+    """
+    check_package_dirs(urdf_path, package_dirs)
+    if not any(name.startswith(PACKAGE) for name in mesh_filenames):
+        return []
+    return package_roots(urdf_path, package_dirs)
+
+
 def resolve_mesh(filename: str, urdf_path: Path, roots: Sequence[Path]) -> Path:
     """The absolute path of the mesh a URDF names ``filename``.
 

@@ -16,16 +16,18 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from cpr_kin.bounds.close_pairs import ClosePair
 from cpr_kin.common.errors import CprKinError, JointLimitError
 from cpr_kin.model.frames import frame_index, link_names
 from cpr_kin.model.limits import JointLimits
-from cpr_kin.shapes.exact_meshes import ExactMesh
+
+if TYPE_CHECKING:  # a robot of pairs of its own or exact meshes imports what they are
+    from cpr_kin.bounds.close_pairs import ClosePair
+    from cpr_kin.shapes.exact_meshes import ExactMesh
 
 FloatArray = NDArray[np.float64]
 

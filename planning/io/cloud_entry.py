@@ -17,19 +17,9 @@ import numpy as np
 from pydantic import Field, model_validator
 
 import cpr_kin as ck
-from cpr_kin.collision.self_filter import clear_of_robot
 from cpr_kin.common.errors import ObstacleError
-from cpr_kin.shapes.cloud_obstacles import voxel_obstacles
 from cpr_kin.shapes.obstacles import placement
-from cpr_kin.shapes.octree_files import SUFFIXES as OCTREE_SUFFIXES
-from cpr_kin.shapes.octree_files import read_octree
-from cpr_kin.shapes.point_clouds import (
-    MAX_POINTS,
-    RESOLUTION_RANGE_M,
-    checked_voxels,
-    read_points,
-    voxel_centres,
-)
+from cpr_kin.shapes.point_clouds import MAX_POINTS, RESOLUTION_RANGE_M
 from planning.io.schema_types import FilePath, Name, Point, Strict, Turn, between
 from planning.pipeline.scene import MAX_SAFETY_MARGIN_M
 
@@ -69,7 +59,9 @@ class PointCloudSpec(Strict):
     @property
     def is_octree(self) -> bool:
         """Whether ``file`` is an OctoMap file."""
-        return self.file is not None and Path(self.file).suffix.lower() in OCTREE_SUFFIXES
+        from cpr_kin.shapes.octree_files import SUFFIXES  # a cloud's reader, only for a cloud
+
+        return self.file is not None and Path(self.file).suffix.lower() in SUFFIXES
 
 
 @dataclass(frozen=True)
@@ -104,6 +96,12 @@ def cloud_obstacles(
     Raises:
         cpr_kin.CprKinError: an unreadable file, bad points, a resolution other than the octree's.
     """
+    # A scene with a cloud imports what makes its voxels; one without, only the schema's bounds.
+    from cpr_kin.collision.self_filter import clear_of_robot
+    from cpr_kin.shapes.cloud_obstacles import voxel_obstacles
+    from cpr_kin.shapes.octree_files import read_octree
+    from cpr_kin.shapes.point_clouds import checked_voxels, read_points, voxel_centres
+
     if item.file is None:
         points, resolution_m = np.asarray(item.points, dtype=float), float(item.resolution or 0.0)
     elif item.is_octree:

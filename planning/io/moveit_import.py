@@ -42,7 +42,7 @@ from typing import Any
 import trimesh
 
 import cpr_kin as ck
-from cpr_kin.collision.self_collision import parse_srdf
+from cpr_kin.collision.srdf_pairs import parse_srdf
 from cpr_kin.description.srdf_groups import group_joints
 from cpr_kin.description.supported import checked_urdf
 from cpr_kin.model.limits import read_limits_file

@@ -14,7 +14,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from cpr_kin.certified.self_curve import check_self_curve
 from cpr_kin.collision.decisive import Stop
 from planning.curves.continuity import discontinuity
 from planning.curves.trajectory import Trajectory
@@ -97,6 +96,8 @@ def _self_problems(
     """
     if not world.self_collision:
         return []
+    from cpr_kin.certified.self_curve import check_self_curve  # a robot with pairs of its own only
+
     interval = (float(trajectory.knots[0]), float(trajectory.knots[-1]))
     try:
         check = check_self_curve(
