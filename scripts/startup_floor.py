@@ -3,10 +3,11 @@
     python scripts/startup_floor.py
 
 Imports the libraries ``cpr-plan plan`` imports, and nothing of ours: NumPy (and its random
-generators), Pinocchio, coal, pydantic with its models' machinery (and ``importlib.metadata``,
-which pydantic imports to look for plugins before its first validator), PyYAML, lxml,
-threadpoolctl and lazy_loader; no numba, which a plan with the kernels compiled ahead of time
-does not import (``make kernels``). The process runs as the installed command's does, the
+generators), Pinocchio, coal, pydantic with its models' machinery and its fields' constraints
+(and ``importlib.metadata``, which pydantic's plugin loader imports), PyYAML, lxml and
+lazy_loader; no numba, which a plan with the kernels compiled ahead of time does not import
+(``make kernels``), and no threadpoolctl, which the installed command does not need
+(``planning.pipeline.blas_threads``). The process runs as the installed command's does, the
 cyclic collector off and no teardown at its end (``planning/cli/process.py``). ``cpr-plan
 plan``'s wall time less this one's is what the planner itself adds (docs/benchmarks.md: the
 new-process row).
@@ -28,9 +29,8 @@ import lxml.etree  # noqa: E402, F401
 import numpy.random  # noqa: E402, F401
 import pinocchio  # noqa: E402, F401
 import pydantic  # noqa: E402, F401
-import threadpoolctl  # noqa: E402, F401
 import yaml  # noqa: E402, F401
-from pydantic import BaseModel  # noqa: E402, F401 - the models' machinery, which `import pydantic` defers
+from pydantic import BaseModel, Field  # noqa: E402, F401 - the models' machinery, which `import pydantic` defers
 
 if __name__ == "__main__":
     sys.stdout.flush()
