@@ -7,10 +7,10 @@ generators), Pinocchio, coal, pydantic with its models' machinery and its fields
 (and ``importlib.metadata``, which pydantic's plugin loader imports), PyYAML, lxml and
 lazy_loader; no numba, which a plan with the kernels compiled ahead of time does not import
 (``make kernels``), and no threadpoolctl, which the installed command does not need
-(``planning.pipeline.blas_threads``). The process runs as the installed command's does, the
-cyclic collector off and no teardown at its end (``planning/cli/process.py``). ``cpr-plan
-plan``'s wall time less this one's is what the planner itself adds (docs/benchmarks.md: the
-new-process row).
+(``planning.pipeline.blas_threads``). The process runs as the installed command's does: BLAS on
+one thread from its start, the cyclic collector off and no teardown at its end
+(``planning/cli/process.py``). ``cpr-plan plan``'s wall time less this one's is what the
+planner itself adds (docs/benchmarks.md: the new-process row).
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ import os
 import sys
 
 gc.disable()
+os.environ["OPENBLAS_NUM_THREADS"] = "1"  # as the installed command sets it, before NumPy loads OpenBLAS
 
 import importlib.metadata  # noqa: E402, F401 - each imported for its start-up cost
 
