@@ -17,17 +17,10 @@ BUFFERED = {k: v for k, v in os.environ.items() if k != "PYTHONUNBUFFERED"}
 """The environment, Python's output buffered (as a user's is), whatever this one says."""
 
 
-def python(code: str) -> subprocess.CompletedProcess[str]:
-    """``python -c code`` in a new process, what it printed and its exit code."""
-    return subprocess.run(
-        [sys.executable, "-c", code],
-        capture_output=True,
-        text=True,
-        check=False,
-        timeout=60,
-        cwd=ROOT,
-        env=BUFFERED,
-    )
+def python(*arguments: str, env: dict[str, str] = BUFFERED) -> subprocess.CompletedProcess[str]:
+    """``python ARGUMENTS`` in a new process, what it printed and its exit code."""
+    command = [sys.executable, *arguments]
+    return subprocess.run(command, capture_output=True, text=True, check=False, timeout=60, cwd=ROOT, env=env)
 
 
 def test_start_switches_the_collector_off_and_keeps_a_users_plugin_setting(
@@ -44,12 +37,13 @@ def test_start_switches_the_collector_off_and_keeps_a_users_plugin_setting(
 def test_end_process_exits_with_the_code_and_every_byte_written() -> None:
     written = "x" * 100_000  # more than a pipe's buffer, part of it still in Python's at the end
     completed = python(
+        "-c",
         "import sys, logging\n"
         "from planning.cli.process import end_process\n"
         "logging.basicConfig(stream=sys.stderr)\n"
         f"sys.stdout.write({written!r}); logging.getLogger('t').warning('said')\n"
         "sys.stderr.write('last')\n"
-        "end_process(3)\n"
+        "end_process(3)\n",
     )
     assert completed.returncode == 3
     assert completed.stdout == written
@@ -58,10 +52,11 @@ def test_end_process_exits_with_the_code_and_every_byte_written() -> None:
 
 def test_end_process_waits_for_a_thread_that_still_runs() -> None:
     completed = python(
+        "-c",
         "import threading, time\n"
         "from planning.cli.process import end_process\n"
         "threading.Thread(target=lambda: (time.sleep(0.3), print('thread done'))).start()\n"
-        "end_process(5)\n"
+        "end_process(5)\n",
     )
     assert completed.returncode == 5 and completed.stdout == "thread done\n"
 
@@ -88,9 +83,7 @@ def test_the_installed_command_runs_with_the_collector_off(tmp_path: Path) -> No
         "app.main = lambda restore_signals: print('collector', gc.isenabled()) or 7\n"
         "app.console_main()\n"
     )
-    completed = subprocess.run(
-        [sys.executable, str(script)], capture_output=True, text=True, check=False, timeout=60, cwd=ROOT
-    )
+    completed = python(str(script))
     assert completed.returncode == 7 and completed.stdout == "collector False\n"
     assert completed.stderr == ""
 
@@ -115,24 +108,17 @@ def test_the_installed_command_holds_blas_to_one_thread_and_searches_no_plugins(
         "app.console_main()\n"
     )
     env = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", process.PYDANTIC_PLUGINS)}
-    completed = subprocess.run(
-        [sys.executable, str(script)],
-        capture_output=True,
-        text=True,
-        check=False,
-        timeout=60,
-        cwd=ROOT,
-        env=env,
-    )
+    completed = python(str(script), env=env)
     assert completed.stderr == ""
     assert completed.stdout == "numpy before False\nthreads [1]\nplugins [] None\n"  # none searched for
 
 
 def test_a_library_caller_keeps_its_blas_threads() -> None:
     completed = python(
+        "-c",
         "import numpy, os\n"
         "from planning.cli.process import start_process\n"
         "start_process()\n"
-        "print(os.environ.get('OPENBLAS_NUM_THREADS'))\n"
+        "print(os.environ.get('OPENBLAS_NUM_THREADS'))\n",
     )
     assert completed.returncode == 0 and completed.stdout == "None\n"
