@@ -367,3 +367,38 @@ def test_what_the_writers_dump_the_reader_takes_however_often_a_value_is_shared(
     (tmp_path / "aliased.yaml").write_text(yaml.safe_dump(document))
     with pytest.raises(UserFileError, match="anchors"):  # what the reader refuses: the writer must not
         load_yaml(tmp_path / "aliased.yaml", 10_000)
+
+
+def test_the_schema_models_are_given_their_annotations_as_objects() -> None:
+    # pydantic evaluates an annotation given as text (`from __future__ import annotations`)
+    # for each field of each model in every process: half the time of making the models
+    # (docs/tuning.md, One BLAS thread from the start); the schema's modules give it objects
+    import inspect
+
+    from pydantic import BaseModel
+
+    from planning.io import (
+        cloud_entry,
+        robot_entry,
+        scene_schema,
+        schema_types,
+        shape_entry,
+        target_entry,
+        task_entry,
+    )
+
+    modules = (cloud_entry, robot_entry, scene_schema, schema_types, shape_entry, target_entry, task_entry)
+    models = {
+        model
+        for module in modules
+        for _, model in inspect.getmembers(module, inspect.isclass)
+        if issubclass(model, BaseModel) and model.__module__ == module.__name__
+    }
+    assert len(models) >= 20
+    given_as_text = {
+        f"{model.__name__}.{name}"
+        for model in models
+        for name, annotation in vars(model).get("__annotations__", {}).items()
+        if isinstance(annotation, str)
+    }
+    assert given_as_text == set()

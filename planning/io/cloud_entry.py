@@ -7,11 +7,9 @@ cloud's frame, placed by ``xyz`` and ``rpy``, become the voxels of
 start are left out (:mod:`cpr_kin.collision.self_filter`).
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, Literal, Self
 
 import numpy as np
 from pydantic import Field, model_validator
@@ -43,7 +41,7 @@ class PointCloudSpec(Strict):
     filter_padding: Annotated[float, between(0.0, MAX_SAFETY_MARGIN_M)] | None = None
 
     @model_validator(mode="after")
-    def _one_source(self) -> PointCloudSpec:
+    def _one_source(self) -> Self:
         if (self.file is None) == (self.points is None):
             raise ValueError(
                 "give exactly one of 'file' (a point-cloud or octree file) or 'points' ([[x, y, z], ...] [m])"
@@ -74,14 +72,14 @@ class RobotAtStart:
         padding_m: the default padding: the scene's safety margin [m].
     """
 
-    robot: ck.Robot
+    robot: "ck.Robot"
     q: np.ndarray
     padding_m: float
 
 
 def cloud_obstacles(
     item: PointCloudSpec, name: str, base: Path, robot_at_start: RobotAtStart | None = None
-) -> list[ck.Obstacle]:
+) -> "list[ck.Obstacle]":
     """A cloud's voxel blocks (:func:`~cpr_kin.shapes.cloud_obstacles.voxel_obstacles`); files from ``base``.
 
     Args:

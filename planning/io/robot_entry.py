@@ -14,8 +14,6 @@ file is read, and a scene of that robot is written without the entry. The scene 
 absolute paths; :func:`robot_entry` writes a spec back in the mapping form.
 """
 
-from __future__ import annotations
-
 import dataclasses
 from pathlib import Path
 from typing import Annotated, Any
@@ -58,12 +56,12 @@ def _urdf(value: str, base: Path) -> Path:
     return path
 
 
-def default_robot() -> ck.RobotSpec:
+def default_robot() -> "ck.RobotSpec":
     """The robot of a scene file without ``robot:``: the CPR preset (:func:`cpr_kin.cpr_spec`)."""
     return ck.cpr_spec()
 
 
-def robot_spec_of(entry: str | RobotMapping | None, base: Path) -> ck.RobotSpec:
+def robot_spec_of(entry: str | RobotMapping | None, base: Path) -> "ck.RobotSpec":
     """The :class:`cpr_kin.RobotSpec` of a ``robot:`` entry (module docstring); none: the default."""
     if entry is None:
         return default_robot()
@@ -83,7 +81,7 @@ def robot_spec_of(entry: str | RobotMapping | None, base: Path) -> ck.RobotSpec:
     return dataclasses.replace(spec, **{k: v for k, v in changes.items() if v not in (None, ())})
 
 
-def robot_entry(spec: ck.RobotSpec) -> dict[str, Any]:
+def robot_entry(spec: "ck.RobotSpec") -> dict[str, Any]:
     """The mapping form of ``spec``, with the keys that differ from what its URDF alone gives."""
     entry: dict[str, Any] = {"urdf": str(spec.urdf)}
     plain = ck.robot_spec(spec.urdf)

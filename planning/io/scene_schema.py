@@ -6,10 +6,8 @@ becomes one line per problem naming the field path (``obstacles[1].size[2]``), t
 and what is allowed (:func:`describe_errors`).
 """
 
-from __future__ import annotations
-
 import math
-from typing import Annotated, Literal
+from typing import Annotated, Literal, Self
 
 from pydantic import AfterValidator, BaseModel, Field, ValidationError, model_validator
 
@@ -102,7 +100,7 @@ class SplineSpec(Strict):
     ends: Literal["natural", "rest"] = DEFAULT_SPLINE.ends
 
     @model_validator(mode="after")
-    def _some_weight(self) -> SplineSpec:
+    def _some_weight(self) -> Self:
         if not any(self.a):
             raise ValueError(
                 "a = [0, 0, 0] leaves the spline undetermined; give a weight > 0, e.g. a: [0, 0, 1]"
@@ -136,7 +134,7 @@ class SceneSpec(Strict):
     torque_scale: Annotated[float, between(*TORQUE_SCALE_RANGE)] = 1.0
 
     @model_validator(mode="after")
-    def _goal_or_task(self) -> SceneSpec:
+    def _goal_or_task(self) -> Self:
         if (self.goal is None) == (self.task is None):
             raise ValueError(
                 "give exactly one of 'goal' (where one motion goes) or 'task' (a list of segments: move, "

@@ -1,7 +1,5 @@
 """The value types the file schemas share: bounded numbers, points, printable names, file paths."""
 
-from __future__ import annotations
-
 from typing import Annotated, Any
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Discriminator, Field
@@ -59,6 +57,9 @@ class Strict(BaseModel):
 
     Its validator is built where it is first used (``defer_build``): a scene file's model then
     builds the blocks it holds once, inside its own, rather than each block's at its import too.
+    The modules of the models give pydantic their annotations as objects, not as text (no
+    ``from __future__ import annotations``), which it would evaluate field by field in every
+    process (``tests/test_scene_file.py``).
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True, strict=True, defer_build=True)

@@ -9,11 +9,9 @@ payload: {mass_kg: 1.5, com_in_tcp: [0, 0, 0.05], shape: {shape: sphere, radius:
 ```
 """
 
-from __future__ import annotations
-
 import dataclasses
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Literal, Self
 
 import numpy as np
 from pydantic import Field, model_validator
@@ -108,12 +106,12 @@ class PayloadSpec(Strict):
     touch_obstacles: Annotated[list[Name], Field(max_length=64)] = Field(default_factory=list)
 
     @model_validator(mode="after")
-    def _links_once(self) -> PayloadSpec:
+    def _links_once(self) -> Self:
         if self.shape is not None and self.shape.touch_links:
             raise ValueError("the links a payload may touch are its own 'touch_links', not its shape's")
         return self
 
-    def payload(self, shape: ck.Obstacle | None) -> ck.Payload:
+    def payload(self, shape: "ck.Obstacle | None") -> "ck.Payload":
         """The :class:`cpr_kin.Payload` with ``shape`` built from :attr:`shape`.
 
         Raises:
@@ -136,7 +134,7 @@ class PayloadSpec(Strict):
 
 def obstacle_of(
     item: BoxSpec | SphereSpec | CylinderSpec | CapsuleSpec | MeshSpec, name: str, base: Path
-) -> ck.Obstacle:
+) -> "ck.Obstacle":
     """The obstacle (or payload shape) of a validated entry; a mesh relative to ``base``.
 
     Raises:
@@ -158,7 +156,7 @@ def obstacle_of(
     return dataclasses.replace(obstacle, touch_links=links) if links else obstacle
 
 
-def obstacle_to_dict(obstacle: ck.Obstacle) -> dict[str, Any]:
+def obstacle_to_dict(obstacle: "ck.Obstacle") -> dict[str, Any]:
     """An obstacle in the scene file's form (docs/formats.md)."""
     entry: dict[str, Any] = {"name": obstacle.name, "shape": obstacle.shape}
     if obstacle.shape == "box":
@@ -179,7 +177,7 @@ def obstacle_to_dict(obstacle: ck.Obstacle) -> dict[str, Any]:
     return entry
 
 
-def payload_to_dict(payload: ck.Payload) -> dict[str, Any]:
+def payload_to_dict(payload: "ck.Payload") -> dict[str, Any]:
     """A payload in the scene file's form (docs/formats.md)."""
     entry: dict[str, Any] = {} if payload.name == PAYLOAD_NAME else {"name": payload.name}
     entry |= {"mass_kg": payload.mass_kg, "com_in_tcp": list(payload.com_in_frame_m)}

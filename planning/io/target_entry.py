@@ -10,9 +10,7 @@ goal:  {pose: {xyz: [0.5, 0.2, 0.4], rpy: [3.1416, 0, 0]}, tolerance_rad: 0.01}
 ```
 """
 
-from __future__ import annotations
-
-from typing import Annotated, Any
+from typing import Annotated, Any, Self
 
 import numpy as np
 import pinocchio as pin
@@ -58,7 +56,7 @@ class PoseSpec(Strict):
     rpy: Turn | None = None
 
     @model_validator(mode="after")
-    def _one_orientation(self) -> PoseSpec:
+    def _one_orientation(self) -> Self:
         if (self.quat_xyzw is None) == (self.rpy is None):
             raise ValueError("give exactly one of 'quat_xyzw' [x, y, z, w] or 'rpy' [roll, pitch, yaw] [rad]")
         return self
@@ -96,7 +94,7 @@ class TargetSpec(Strict):
         return data
 
     @model_validator(mode="after")
-    def _one_of(self) -> TargetSpec:
+    def _one_of(self) -> Self:
         given = [name for name in ("q", "tcp", "pose") if getattr(self, name) is not None]
         if len(given) != 1:
             raise ValueError(

@@ -20,9 +20,7 @@ checked in order where the segments are built (:mod:`planning.io.task_segments`)
 nothing, an attach while carrying, a detach naming another object are the file's errors.
 """
 
-from __future__ import annotations
-
-from typing import TYPE_CHECKING, Annotated, Literal
+from typing import TYPE_CHECKING, Annotated, Literal, Self
 
 import numpy as np
 import pinocchio as pin
@@ -66,7 +64,7 @@ class LineSpec(Strict):
     tool_speed_m_s: Annotated[float, Field(gt=0, le=limits.FASTEST_TOOL_M_S)] | None = None
 
     @model_validator(mode="after")
-    def _one_end(self) -> LineSpec:
+    def _one_end(self) -> Self:
         if (self.to is None) == (self.by is None):
             raise ValueError(
                 "give exactly one of 'to' (a pose {xyz, quat_xyzw}) or 'by' (an offset [x, y, z] [m])"
@@ -82,7 +80,7 @@ class LineSpec(Strict):
             )
         return self
 
-    def line(self) -> ToolLine:
+    def line(self) -> "ToolLine":
         """The :class:`~planning.task.tool_line.ToolLine`."""
         from planning.task.tool_line import LineTolerance, ToolLine, ToolPose
 
@@ -123,14 +121,14 @@ class ConstraintSpec(Strict):
     frame: Name | None = None
 
     @model_validator(mode="after")
-    def _one_reference(self) -> ConstraintSpec:
+    def _one_reference(self) -> Self:
         if self.quat_xyzw is not None and self.rpy is not None:
             raise ValueError("give at most one of 'quat_xyzw' and 'rpy' (neither: the tool's at the start)")
         if len(set(self.axes)) != len(self.axes):
             raise ValueError(f"axes = {self.axes} names an axis twice; give two or three different axes")
         return self
 
-    def constraint(self) -> OrientationConstraint:
+    def constraint(self) -> "OrientationConstraint":
         """The :class:`~planning.task.orientation.OrientationConstraint`."""
         from planning.task.orientation import OrientationConstraint
         from planning.task.tool_line import ToolPose
@@ -165,7 +163,7 @@ class TaskStepSpec(Strict):
     detach: DetachSpec | None = None
 
     @model_validator(mode="after")
-    def _one_key(self) -> TaskStepSpec:
+    def _one_key(self) -> Self:
         given = [key for key in type(self).model_fields if getattr(self, key) is not None]
         if len(given) != 1:
             raise ValueError(f"an entry of task has exactly one key of {list(type(self).model_fields)}")
