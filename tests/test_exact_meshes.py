@@ -12,7 +12,7 @@ import pytest
 import trimesh
 
 from cpr_kin.common.disk_cache import cache_folder
-from cpr_kin.shapes.exact_meshes import ExactMesh, MeshSource, as_transform, exact_meshes, hull_excess
+from cpr_kin.shapes.exact_meshes import ExactMesh, MeshSource, exact_meshes, hull_excess
 from cpr_kin.shapes.mesh_geometry import hull_planes
 
 
@@ -164,15 +164,3 @@ def test_holds_any_is_holds_of_the_moved_points_any() -> None:
         answers.append(answer)
     assert 20 < sum(answers) < 180  # both answers met
     assert not mesh.holds_any(np.zeros((0, 3)), np.eye(3), np.zeros(3))
-
-
-@pytest.mark.parametrize("seed", [0, 1])
-def test_as_transform_places_points_as_the_pinocchio_placement_does(seed: int) -> None:
-    rng = np.random.default_rng(seed)
-    for _ in range(50):
-        placement = pin.SE3(pin.exp3(rng.normal(size=3)), rng.uniform(-2.0, 2.0, 3))
-        transform = as_transform(placement)
-        point = rng.uniform(-1.0, 1.0, 3)
-        assert np.array_equal(transform.getRotation(), placement.rotation)
-        assert np.array_equal(transform.getTranslation(), placement.translation)
-        np.testing.assert_allclose(transform.transform(point), placement.act(point), rtol=0, atol=1e-15)

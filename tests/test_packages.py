@@ -126,7 +126,7 @@ def test_cpr_plan_plan_imports_no_benchmark_module(tmp_path: Path) -> None:
 
 @pytest.mark.slow
 def test_a_plan_of_the_cpr_imports_no_machinery_for_what_its_scene_lacks(tmp_path: Path) -> None:
-    # no pairs of its own, no cloud, a tool position its own IK reaches, meshes named by path:
+    # no pairs of its own, no cloud, a tool position its own IK reaches, no mesh:
     # a new process of `cpr-plan plan` does not pay for the modules of those (docs/benchmarks.md)
     unused = [
         "cpr_kin.collision.self_screen",  # the self-collision screen of a robot with pairs
@@ -135,6 +135,8 @@ def test_a_plan_of_the_cpr_imports_no_machinery_for_what_its_scene_lacks(tmp_pat
         "cpr_kin.collision.self_filter",  # a point cloud's voxels
         "cpr_kin.shapes.octree_files",
         "cpr_kin.kinematics.numerical_ik",  # the CPR's analytic IK, verified by an IkTarget
+        "cpr_kin.shapes.exact_meshes",  # links given as meshes, and their vertices' witness
+        "cpr_kin.shapes.vertex_witness",
     ]
     code = (
         "import sys; from planning.cli import main; from planning.io.bundled import bundled_scene_paths; "

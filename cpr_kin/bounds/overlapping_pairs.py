@@ -33,12 +33,12 @@ def overlapping_pairs(
     capsule bound above zero at any of them rules it out
     (:class:`~cpr_kin.bounds.self_bounds.SelfPairBounds`);
     coal decides the rest, configuration by configuration, until the pair is found apart (by
-    more than :data:`~cpr_kin.shapes.exact_pairs.COLLIDE_MARGIN_AT_LEAST_M`).
+    more than :data:`~cpr_kin.shapes.coal_queries.COLLIDE_MARGIN_AT_LEAST_M`).
     """
     if not pairs:
         return ()
     from cpr_kin.bounds.self_bounds import bounded_pairs  # a robot with pairs of its own only
-    from cpr_kin.shapes.exact_pairs import collide_margin_m
+    from cpr_kin.shapes.coal_queries import collide_margin_m
 
     q = sampled_configurations(model, samples, np.random.default_rng(0))
     candidates, geometry_model = bounded_pairs(model, collision_model, pairs, q, 0.0)

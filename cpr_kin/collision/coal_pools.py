@@ -15,7 +15,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
-from cpr_kin.shapes.exact_pairs import collide_margin_m
+from cpr_kin.shapes.coal_queries import collide_margin_m
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
@@ -65,7 +65,7 @@ def set_margins(geometry_data: Any, geometry_model: Any, margin_m: float | Float
     """Give ``geometry_data``'s collision tests the security margin ``margin_m`` [m].
 
     ``margin_m`` is one margin for every pair, or one per collision pair of ``geometry_model``;
-    coal is asked at least :data:`~cpr_kin.shapes.exact_pairs.COLLIDE_MARGIN_AT_LEAST_M`.
+    coal is asked at least :data:`~cpr_kin.shapes.coal_queries.COLLIDE_MARGIN_AT_LEAST_M`.
     """
     if np.ndim(margin_m) == 0:
         margins = np.full((geometry_model.ngeoms,) * 2, float(margin_m))

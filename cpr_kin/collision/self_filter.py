@@ -21,7 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.common.errors import CprKinError
 from cpr_kin.model.robot import Robot
-from cpr_kin.shapes.exact_meshes import as_transform
+from cpr_kin.shapes.coal_queries import as_transform
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]

@@ -50,7 +50,6 @@ from cpr_kin.model.geometry_groups import carried_alone, grouped_geometries
 from cpr_kin.model.limits import LIMITS_NAMES, JointLimits, find_limits_file, read_dynamic_limits
 from cpr_kin.model.packages import mesh_package_roots
 from cpr_kin.model.robot import PositionIk, Robot, joint_units
-from cpr_kin.shapes.exact_meshes import exact_meshes
 
 
 @dataclass(frozen=True)
@@ -156,6 +155,11 @@ class RobotSpec:
         checked = self_pairs(model, collision, srdf_pairs.disabled)
         overlapping = overlapping_pairs(model, collision, checked)
         kept = tuple(pair for pair in checked if pair not in overlapping)
+        exact = {}
+        if meshes:  # links given as meshes: where their hulls exceed them, the meshes decide
+            from cpr_kin.shapes.exact_meshes import exact_meshes
+
+            exact = exact_meshes(meshes)
         return Robot(
             urdf_path=path,
             model=model,
@@ -179,7 +183,7 @@ class RobotSpec:
             srdf_unknown_links=srdf_pairs.unknown_links,
             massless_links=massless_links(tree, model),
             capsule_meshes=tuple(collision.geometryObjects[m.geometry].name for m in meshes if not m.hull),
-            exact_meshes=exact_meshes(meshes),
+            exact_meshes=exact,
         )
 
     def _planned(self, model: Any, tree: etree._ElementTree, path: Path, arm: ArmChain) -> tuple[str, ...]:

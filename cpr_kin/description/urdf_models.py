@@ -12,7 +12,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import coal
 import numpy as np
@@ -24,8 +24,10 @@ from cpr_kin.bounds.pair_bounds import bounding_capsule
 from cpr_kin.common.errors import UrdfError
 from cpr_kin.description.supported import MAX_SHAPE_M
 from cpr_kin.description.urdf_file import captured_stderr
-from cpr_kin.shapes.exact_meshes import MeshSource
 from cpr_kin.shapes.mesh_geometry import spans_volume
+
+if TYPE_CHECKING:  # what a robot whose links are meshes imports, where it has one
+    from cpr_kin.shapes.exact_meshes import MeshSource
 
 MIN_MESH_SPAN_M = 1e-6
 """Smallest largest extent of a link mesh [m], scale applied: a mesh smaller than a micrometre
@@ -154,6 +156,8 @@ def convex_hulls(collision: Any) -> tuple[MeshSource, ...]:
         geometry = obj.geometry
         if not isinstance(geometry, coal.BVHModelBase):
             continue
+        from cpr_kin.shapes.exact_meshes import MeshSource
+
         scale = tuple(float(s) for s in obj.meshScale)
         flat = not spans_volume(np.asarray(geometry.vertices(), dtype=float))
         for keep_triangles, qhull_options in () if flat else ((True, "Qt"), (False, "Qx")):

@@ -279,12 +279,3 @@ def _triangles(source: MeshSource) -> tuple[FloatArray, FloatArray | None, Float
     pieces = np.unique(label[used], return_index=True)[1]
     points = vertices[used[pieces]] if len(pieces) <= MAX_PIECES else None
     return vertices[faces], points, vertices[used]
-
-
-def as_transform(placement: Any) -> Any:
-    """The ``coal.Transform3s`` of a Pinocchio placement (``pinocchio.SE3``).
-
-    By the conversion Pinocchio registers with coal, without NumPy copies of its rotation and
-    translation between them (the same numbers; a mesh's pair test asks two a query).
-    """
-    return coal.Transform3s(placement)

@@ -23,15 +23,18 @@ hulls' (negative) distance stands: the meshes' depth is not measured.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import coal
 import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
-from cpr_kin.shapes.exact_meshes import ExactMesh, as_transform
-from cpr_kin.shapes.vertex_witness import VertexWitness
+from cpr_kin.shapes.coal_queries import as_transform, collide_margin_m
+
+if TYPE_CHECKING:  # a robot with exact meshes imports them, and their vertices' witness
+    from cpr_kin.shapes.exact_meshes import ExactMesh
+    from cpr_kin.shapes.vertex_witness import VertexWitness
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -41,23 +44,6 @@ COLLIDE_MARGIN_UP_TO_M = 0.015
 """The largest margin [m] coal's collision test is asked with; a larger one goes to its distance
 (:meth:`ExactPairs.closer_than`). Above the self margin a scene keeps by default (10 mm) plus the
 search's step (1 mm): at 10 mm, each of those tests paid the collision test and the distance."""
-
-
-COLLIDE_MARGIN_AT_LEAST_M = 1e-6
-"""The least margin [m] coal's collision test is asked with (:func:`collide_margin_m`). At a margin of
-0 its GJK, warm-started from the pair's last query, can prove two shapes apart by a lower bound
-of 1e-12 m while they are 5 cm deep (coal 3.0.3: two cylinders of the Z1, docs/tuning.md); its
-distances are good to 1e-6 m (:data:`cpr_kin.collision.decisive.COAL_RELATIVE_ERROR`), so at
-this margin a test answers within that."""
-
-
-def collide_margin_m(margin_m: float | FloatArray) -> FloatArray:
-    """The margin [m] coal's collision test is asked with for ``margin_m`` [m]: at least the floor.
-
-    :data:`COLLIDE_MARGIN_AT_LEAST_M`: a margin below it (0, or a pair's margin less its
-    allowance) is asked at it.
-    """
-    return np.maximum(margin_m, COLLIDE_MARGIN_AT_LEAST_M)
 
 
 class ExactPairs:
@@ -89,7 +75,11 @@ class ExactPairs:
         self.excess_m.setflags(write=False)
         self.refined.setflags(write=False)
         self._excess, self._refined = self.excess_m.tolist(), self.refined.tolist()  # for the loops
-        self._witness = VertexWitness(self._shapes, self._meshes)
+        self._witness: VertexWitness | None = None
+        if meshes:
+            from cpr_kin.shapes.vertex_witness import VertexWitness
+
+            self._witness = VertexWitness(self._shapes, self._meshes)
         self._request = coal.DistanceRequest()
         self._collision = coal.CollisionRequest()
         self._collision.enable_contact = False
@@ -163,7 +153,7 @@ class ExactPairs:
         """
         a, b = self._pairs[pair]
         (shape_a, at_a), (shape_b, at_b) = self._placed(geometry_data, a), self._placed(geometry_data, b)
-        if self._witness.proves(a, at_a, b, at_b, margin_m):
+        if self._witness is not None and self._witness.proves(a, at_a, b, at_b, margin_m):
             return True
         placed = (shape_a, as_transform(at_a), shape_b, as_transform(at_b))
         self._collision.security_margin = float(collide_margin_m(min(margin_m, COLLIDE_MARGIN_UP_TO_M)))
