@@ -90,6 +90,7 @@ bench: bytecode
 	$(PY) scripts/bench_spline.py
 	$(PY) scripts/bench_planner.py
 	$(PY) scripts/bench_batch.py
+	$(PY) scripts/bench_startup.py
 	$(PY) scripts/bench_timing.py --out out/bench_timing.md
 	$(PY) scripts/bench_search.py
 

@@ -1,0 +1,44 @@
+"""``scripts/bench_startup.py``: ``cpr-plan plan`` in new processes, beside the start-up floor."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from .conftest import SCRIPTS, script_table
+
+SHELF = Path(__file__).resolve().parents[1] / "examples" / "scenes" / "shelf.yaml"
+
+
+@pytest.mark.slow
+def test_the_command_and_the_floor_are_timed_in_new_processes_each_against_the_floor() -> None:
+    rows = script_table("bench_startup", "--scene", str(SHELF), "--runs", "2")
+    assert rows[0] == ["command", "kernels", "wall s", "CPU s", "peak MiB", "wall / floor", "CPU / floor"]
+    named = {row[0]: row[1:] for row in rows[1:]}
+    assert set(named) == {"this checkout", "start-up floor"}
+    assert named["this checkout"][0] in ("ahead of time", "numba") and named["start-up floor"][0] == "-"
+    assert named["start-up floor"][4:] == ["1.00", "1.00"]  # the floor over itself
+    mine, floor = (named[name] for name in ("this checkout", "start-up floor"))
+    assert all(float(cell) > 0 for cell in mine[1:] + floor[1:])
+    assert float(mine[1]) > float(floor[1]) and float(mine[3]) > float(floor[3])  # it imports the floor
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        (["--scene", "no_such.yaml"], "--scene no_such.yaml: no such file; give a scene file (YAML)"),
+        (["--compare", "/"], "--compare /: not a checkout of this project (no planning/ package)"),
+    ],
+)
+def test_a_bad_argument_is_one_line_and_exit_1(arguments: list[str], message: str) -> None:
+    done = subprocess.run(
+        [sys.executable, str(SCRIPTS / "bench_startup.py"), *arguments],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
+    assert done.returncode == 1 and done.stderr.strip() == message
