@@ -24,7 +24,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from planning.cli.arguments import COUNT, SEED, integer_at_least
+from planning.cli.arguments import COUNT, SEED, checkout, integer_at_least
 
 TARGET_S = 10.0
 
@@ -83,16 +83,12 @@ def main() -> None:
     )
     parser.add_argument("--workers", type=COUNT, default=2, help="worker processes (default: 2)")
     parser.add_argument("--runs", type=COUNT, default=3, help="timed runs (default: 3)")
-    parser.add_argument("--compare", type=Path, help="another checkout to time beside this one")
+    parser.add_argument("--compare", type=checkout, help="another checkout to time beside this one")
     args = parser.parse_args()
     here = Path(__file__).resolve().parents[1]
     codes = {"this checkout": here}
     if args.compare is not None:
-        if not (args.compare / "planning").is_dir():
-            raise SystemExit(
-                f"--compare {args.compare}: not a checkout of this project (no planning/ package)"
-            )
-        codes[f"compare ({args.compare})"] = args.compare.resolve()
+        codes[f"compare ({args.compare})"] = args.compare
     with tempfile.TemporaryDirectory() as tmp:
         scene_folders = {
             name: write_scenes(code, Path(tmp) / f"scenes-{k}", args.scenes, args.seed, args.narrow)

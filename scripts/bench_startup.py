@@ -28,7 +28,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from planning.cli.arguments import COUNT
+from planning.cli.arguments import COUNT, checkout
 
 HERE = Path(__file__).resolve().parents[1]
 TARGET_S = 0.5
@@ -89,18 +89,14 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scene", type=Path, default=HERE / "examples" / "scenes" / "shelf.yaml")
     parser.add_argument("--runs", type=COUNT, default=15, help="timed runs of each command (default: 15)")
-    parser.add_argument("--compare", type=Path, help="another checkout to time beside this one")
+    parser.add_argument("--compare", type=checkout, help="another checkout to time beside this one")
     args = parser.parse_args()
     scene = args.scene.resolve()
     if not scene.is_file():
         raise SystemExit(f"--scene {args.scene}: no such file; give a scene file (YAML)")
     codes = {"this checkout": HERE}
     if args.compare is not None:
-        if not (args.compare / "planning").is_dir():
-            raise SystemExit(
-                f"--compare {args.compare}: not a checkout of this project (no planning/ package)"
-            )
-        codes[f"compare ({args.compare})"] = args.compare.resolve()
+        codes[f"compare ({args.compare})"] = args.compare
     floor = [sys.executable, str(HERE / "scripts" / "startup_floor.py")]
     runs: dict[str, list[Run]] = {name: [] for name in [*codes, "start-up floor"]}
     with tempfile.TemporaryDirectory() as tmp:

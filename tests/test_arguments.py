@@ -46,6 +46,16 @@ def test_a_number_at_least_its_bound_takes_the_bound_itself() -> None:
         ("bench_peers", ["--scenes", "-1"], "argument --scenes: -1 must be an integer >= 0"),
         ("bench_planner", ["--runs", "0"], "argument --runs: 0 must be an integer >= 1"),
         ("bench_startup", ["--runs", "0"], "argument --runs: 0 must be an integer >= 1"),
+        (
+            "bench_startup",
+            ["--compare", "/"],
+            "argument --compare: / is not a checkout of this project (no planning/ package)",
+        ),
+        (
+            "bench_batch",
+            ["--compare", "/"],
+            "argument --compare: / is not a checkout of this project (no planning/ package)",
+        ),
         ("bench_timing", ["--rrt-time", "0"], "argument --rrt-time: 0 must be a number > 0 s"),
         ("bench_torque", ["--limit", "-1"], "argument --limit: -1 must be an integer >= 1"),
         ("bench_torque", ["--limit", "101"], "--limit 101 must be in [1, 100] problems per class"),

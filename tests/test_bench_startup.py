@@ -26,19 +26,13 @@ def test_the_command_and_the_floor_are_timed_in_new_processes_each_against_the_f
     assert float(mine[1]) > float(floor[1]) and float(mine[3]) > float(floor[3])  # it imports the floor
 
 
-@pytest.mark.parametrize(
-    ("arguments", "message"),
-    [
-        (["--scene", "no_such.yaml"], "--scene no_such.yaml: no such file; give a scene file (YAML)"),
-        (["--compare", "/"], "--compare /: not a checkout of this project (no planning/ package)"),
-    ],
-)
-def test_a_bad_argument_is_one_line_and_exit_1(arguments: list[str], message: str) -> None:
+def test_a_scene_that_is_not_there_is_one_line_and_exit_1() -> None:
     done = subprocess.run(
-        [sys.executable, str(SCRIPTS / "bench_startup.py"), *arguments],
+        [sys.executable, str(SCRIPTS / "bench_startup.py"), "--scene", "no_such.yaml"],
         capture_output=True,
         text=True,
         timeout=60,
         check=False,
     )
-    assert done.returncode == 1 and done.stderr.strip() == message
+    assert done.returncode == 1
+    assert done.stderr.strip() == "--scene no_such.yaml: no such file; give a scene file (YAML)"

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import math
 from collections.abc import Callable
+from pathlib import Path
 
 
 def integer_at_least(low: int) -> Callable[[str], int]:
@@ -53,6 +54,14 @@ def _number(low: float, unit: str, strict: bool) -> Callable[[str], float]:
         return value
 
     return parse
+
+
+def checkout(text: str) -> Path:
+    """An argparse type: another checkout of this project to time beside this one, made absolute."""
+    path = Path(text)
+    if not (path / "planning").is_dir():
+        raise argparse.ArgumentTypeError(f"{text} is not a checkout of this project (no planning/ package)")
+    return path.resolve()
 
 
 SEED = integer_at_least(0)
