@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 
 from planning.cli import process
+from planning.pipeline.blas_threads import OPENBLAS_THREADS
 
 ROOT = Path(__file__).resolve().parents[1]
 BUFFERED = {k: v for k, v in os.environ.items() if k != "PYTHONUNBUFFERED"}
@@ -107,7 +108,7 @@ def test_the_installed_command_holds_blas_to_one_thread_and_searches_no_plugins(
         "app.main = main\n"
         "app.console_main()\n"
     )
-    env = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", process.PYDANTIC_PLUGINS)}
+    env = {k: v for k, v in os.environ.items() if k not in (OPENBLAS_THREADS, process.PYDANTIC_PLUGINS)}
     completed = python(str(script), env=env)
     assert completed.stderr == ""
     assert completed.stdout == "numpy before False\nthreads [1]\nplugins [] None\n"  # none searched for
@@ -119,6 +120,6 @@ def test_a_library_caller_keeps_its_blas_threads() -> None:
         "import numpy, os\n"
         "from planning.cli.process import start_process\n"
         "start_process()\n"
-        "print(os.environ.get('OPENBLAS_NUM_THREADS'))\n",
+        f"print(os.environ.get({OPENBLAS_THREADS!r}))\n",
     )
     assert completed.returncode == 0 and completed.stdout == "None\n"

@@ -109,10 +109,10 @@ def mesh_package_roots(
     Raises:
         UrdfError: a folder of ``package_dirs`` is not a folder (:func:`check_package_dirs`).
     """
+    if any(name.startswith(PACKAGE) for name in mesh_filenames):
+        return package_roots(urdf_path, package_dirs)  # which checks the folders given
     check_package_dirs(urdf_path, package_dirs)
-    if not any(name.startswith(PACKAGE) for name in mesh_filenames):
-        return []
-    return package_roots(urdf_path, package_dirs)
+    return []
 
 
 def resolve_mesh(filename: str, urdf_path: Path, roots: Sequence[Path]) -> Path:

@@ -37,17 +37,17 @@ _set_at_start = False
 """Whether :func:`one_thread_for_process` set :data:`OPENBLAS_THREADS` before NumPy loaded."""
 
 
-def one_thread_for_process() -> bool:
+def one_thread_for_process() -> None:
     """Hold OpenBLAS to one thread for the whole process, if NumPy has not loaded it yet.
 
     For a process that runs one command and ends (its child processes inherit the setting);
-    a library caller keeps its own threads. Returns whether it was in time.
+    a library caller keeps its own threads. Too late, it does nothing: each plan is then
+    limited on its own.
     """
     global _set_at_start
     if "numpy" not in sys.modules:
         os.environ[OPENBLAS_THREADS] = "1"
         _set_at_start = True
-    return _set_at_start
 
 
 @functools.cache
