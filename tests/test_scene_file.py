@@ -12,6 +12,7 @@ import trimesh
 import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from pydantic import BaseModel
 
 import cpr_kin as ck
 from cpr_kin.common.user_files import StrictLoader, UserFileError, dump_yaml, load_yaml
@@ -369,13 +370,9 @@ def test_what_the_writers_dump_the_reader_takes_however_often_a_value_is_shared(
         load_yaml(tmp_path / "aliased.yaml", 10_000)
 
 
-def test_the_schema_models_are_given_their_annotations_as_objects() -> None:
-    # pydantic evaluates an annotation given as text (`from __future__ import annotations`)
-    # for each field of each model in every process: half the time of making the models
-    # (docs/tuning.md, One BLAS thread from the start); the schema's modules give it objects
+def schema_models() -> set[type[BaseModel]]:
+    """The pydantic models of the scene file's schema modules."""
     import inspect
-
-    from pydantic import BaseModel
 
     from planning.io import (
         cloud_entry,
@@ -395,10 +392,33 @@ def test_the_schema_models_are_given_their_annotations_as_objects() -> None:
         if issubclass(model, BaseModel) and model.__module__ == module.__name__
     }
     assert len(models) >= 20
+    return models
+
+
+def test_the_schema_models_are_given_their_annotations_as_objects() -> None:
+    # pydantic evaluates an annotation given as text (`from __future__ import annotations`)
+    # for each field of each model in every process: half the time of making the models
+    # (docs/tuning.md, One BLAS thread from the start); the schema's modules give it objects
     given_as_text = {
         f"{model.__name__}.{name}"
-        for model in models
+        for model in schema_models()
         for name, annotation in vars(model).get("__annotations__", {}).items()
         if isinstance(annotation, str)
     }
     assert given_as_text == set()
+
+
+def test_no_schema_default_is_made_by_a_builtin_whose_signature_python_parses() -> None:
+    # pydantic reads each default factory's signature; the builtin list's is text that
+    # Python parses with tokenize, whose pattern a new process then compiles (4 ms)
+    from planning.io.schema_types import empty_list
+
+    factories = {
+        f"{model.__name__}.{name}": field.default_factory
+        for model in schema_models()
+        for name, field in model.model_fields.items()
+        if field.default_factory is not None
+    }
+    assert empty_list in factories.values()
+    assert {name for name, made_by in factories.items() if made_by in (list, set, tuple, frozenset)} == set()
+    assert empty_list() == [] and empty_list() is not empty_list()

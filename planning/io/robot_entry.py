@@ -22,7 +22,16 @@ from pydantic import Field, Tag
 
 import cpr_kin as ck
 from cpr_kin.model.packages import EXAMPLE_ROBOTS, example_robot
-from planning.io.schema_types import BY_KIND, MAPPING_TAG, OTHER_TAG, Angle, FilePath, Name, Strict
+from planning.io.schema_types import (
+    BY_KIND,
+    MAPPING_TAG,
+    OTHER_TAG,
+    Angle,
+    FilePath,
+    Name,
+    Strict,
+    empty_list,
+)
 
 
 class RobotMapping(Strict):
@@ -30,7 +39,7 @@ class RobotMapping(Strict):
 
     urdf: FilePath
     srdf: FilePath | None = None
-    packages: Annotated[list[FilePath], Field(max_length=64)] = Field(default_factory=list)
+    packages: Annotated[list[FilePath], Field(max_length=64)] = Field(default_factory=empty_list)
     limits: FilePath | None = None
     joints: Annotated[list[Name], Field(min_length=1, max_length=64)] | None = None
     tcp: Name | None = None

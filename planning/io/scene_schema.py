@@ -19,6 +19,7 @@ from planning.io.schema_types import (
     Name,
     Strict,
     between,
+    empty_list,
     printable,
 )
 from planning.io.shape_entry import (
@@ -122,12 +123,14 @@ class SceneSpec(Strict):
     self_margin: Annotated[float, between(0.0, MAX_SAFETY_MARGIN_M)] = DEFAULT_SELF_MARGIN_M
     allowed_collisions: Annotated[
         list[Annotated[list[Name], Field(min_length=2, max_length=2)]], Field(max_length=10_000)
-    ] = Field(default_factory=list)
+    ] = Field(default_factory=empty_list)
     start: TargetSpec
     goal: TargetSpec | None = None
     task: TaskSpec | None = None
     duration: Annotated[float, between(*DURATION_RANGE_S)] | None = None
-    obstacles: Annotated[list[ObstacleSpec], Field(max_length=MAX_OBSTACLES)] = Field(default_factory=list)
+    obstacles: Annotated[list[ObstacleSpec], Field(max_length=MAX_OBSTACLES)] = Field(
+        default_factory=empty_list
+    )
     planner: PlannerSpec = Field(default_factory=PlannerSpec)
     spline: SplineSpec = Field(default_factory=SplineSpec)
     payload: PayloadSpec | None = None

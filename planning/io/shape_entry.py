@@ -20,14 +20,14 @@ import cpr_kin as ck
 from cpr_kin.kinematics.dynamics import MAX_COM_OFFSET_M, MAX_PAYLOAD_KG, PAYLOAD_NAME
 from cpr_kin.shapes.obstacle_ranges import SCALE_RANGE
 from planning.io.cloud_entry import PointCloudSpec
-from planning.io.schema_types import FilePath, Name, Point, Size, Strict, Turn, between
+from planning.io.schema_types import FilePath, Name, Point, Size, Strict, Turn, between, empty_list
 
 
 class _Placed(Strict):
     name: Name | None = None
     xyz: Point
     rpy: Turn = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-    touch_links: Annotated[list[Name], Field(max_length=64)] = Field(default_factory=list)
+    touch_links: Annotated[list[Name], Field(max_length=64)] = Field(default_factory=empty_list)
 
 
 class BoxSpec(_Placed):
@@ -102,8 +102,8 @@ class PayloadSpec(Strict):
     ) = None
     frame: Name | None = None
     shape: PayloadShapeSpec | None = None
-    touch_links: Annotated[list[Name], Field(max_length=64)] = Field(default_factory=list)
-    touch_obstacles: Annotated[list[Name], Field(max_length=64)] = Field(default_factory=list)
+    touch_links: Annotated[list[Name], Field(max_length=64)] = Field(default_factory=empty_list)
+    touch_obstacles: Annotated[list[Name], Field(max_length=64)] = Field(default_factory=empty_list)
 
     @model_validator(mode="after")
     def _links_once(self) -> Self:
