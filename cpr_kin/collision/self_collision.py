@@ -85,7 +85,12 @@ class SelfCollision:
         self._names = names
         self.num_threads = num_threads
         self._screen = screen
-        self._exact = ExactPairs(self.geometry_model, exact_meshes or {})
+        measured = None
+        if exact_meshes:  # what the meshes' tests measure answers the later ones near it
+            from cpr_kin.collision.clear_balls import ClearBalls
+
+            measured = ClearBalls(self.pair_radii)
+        self._exact = ExactPairs(self.geometry_model, exact_meshes or {}, measured)
         self._test: ScreenedSelfTest | None = None  # built on the first query
 
     @property

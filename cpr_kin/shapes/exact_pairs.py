@@ -23,7 +23,7 @@ hulls' (negative) distance stands: the meshes' depth is not measured.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import coal
 import numpy as np
@@ -31,6 +31,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from cpr_kin.shapes.coal_queries import as_transform, collide_margin_m
+from cpr_kin.shapes.held_whole import inner_points, may_hold
 
 if TYPE_CHECKING:  # a robot with exact meshes imports them, and their vertices' witness
     from cpr_kin.shapes.exact_meshes import ExactMesh
@@ -46,12 +47,26 @@ COLLIDE_MARGIN_UP_TO_M = 0.015
 search's step (1 mm): at 10 mm, each of those tests paid the collision test and the distance."""
 
 
+class MeasuredApart(Protocol):
+    """What a margin test remembers of the meshes' distances (as :mod:`cpr_kin.collision.clear_balls`)."""
+
+    def clear(self, pair: int, q: FloatArray, margin_m: float) -> bool:
+        """Whether pair ``pair`` surely keeps ``margin_m`` [m] at ``q``, by what was measured."""
+        ...
+
+    def add(self, pair: int, q: FloatArray, distance_m: float) -> None:
+        """Keep that pair ``pair``'s meshes are ``distance_m`` [m] apart at ``q``."""
+        ...
+
+
 class ExactPairs:
     """The collision pairs of a geometry model, with the exact meshes of some of its geometries.
 
     Args:
         geometry_model: a geometry model whose first geometries are the robot's, pairs added.
         meshes: the robot's exact meshes by geometry index (:attr:`cpr_kin.Robot.exact_meshes`).
+        measured: where :meth:`violated` keeps the meshes' distances it measures and asks them
+            first (by default it keeps none, and asks coal's collision test).
 
     Attributes:
         excess_m: ``(P,)`` per collision pair, how far its distance on the shapes may be below
@@ -59,13 +74,15 @@ class ExactPairs:
         refined: ``(P,)`` the pairs with an exact mesh.
     """
 
-    def __init__(self, geometry_model: Any, meshes: Mapping[int, ExactMesh]) -> None:
+    def __init__(
+        self, geometry_model: Any, meshes: Mapping[int, ExactMesh], measured: MeasuredApart | None = None
+    ) -> None:
         objects = geometry_model.geometryObjects
         self._pairs = [(int(p.first), int(p.second)) for p in geometry_model.collisionPairs]
         self._meshes = dict(meshes)
         self._shapes = [obj.geometry for obj in objects]
         self._inner = (
-            [_inner_points(obj.geometry, self._meshes.get(g)) for g, obj in enumerate(objects)]
+            [inner_points(obj.geometry, self._meshes.get(g)) for g, obj in enumerate(objects)]
             if meshes
             else []
         )
@@ -83,6 +100,7 @@ class ExactPairs:
         self._request = coal.DistanceRequest()
         self._collision = coal.CollisionRequest()
         self._collision.enable_contact = False
+        self._measured = measured
 
     def __bool__(self) -> bool:
         return bool(self.refined.any())
@@ -226,7 +244,7 @@ class ExactPairs:
                 if (
                     not refined[p]
                     or hull + excess[p] < margins[p]
-                    or self.closer_than(geometry_data, p, hull, margins[p])
+                    or self._closer_at(geometry_data, p, hull, margins[p], q)
                 ):
                     found[row] = True
                     break
@@ -234,6 +252,33 @@ class ExactPairs:
                 found[row:] = True
                 break
         return found
+
+    def _closer_at(
+        self, geometry_data: Any, pair: int, hull_m: float, margin_m: float, q: FloatArray
+    ) -> bool:
+        """:meth:`closer_than` at configuration ``q``, the memory asked first where there is one.
+
+        With one, where it proves the pair clear, no coal; else a vertex within the margin, or
+        coal's distance (dearer than the collision test), which it then keeps.
+        """
+        measured = self._measured
+        if measured is None:
+            return self.closer_than(geometry_data, pair, hull_m, margin_m)
+        asked_m = float(collide_margin_m(margin_m))
+        if measured.clear(pair, q, asked_m):
+            return False
+        a, b = self._pairs[pair]
+        (_, at_a), (_, at_b) = self._placed(geometry_data, a), self._placed(geometry_data, b)
+        if self._witness is not None and self._witness.proves(a, at_a, b, at_b, margin_m):
+            return True
+        found = self.measured(geometry_data, pair, hull_m)
+        if found is None:  # the hulls penetrate and the meshes meet, or one holds the other
+            return True
+        distance_m = float(found.min_distance)
+        if distance_m < asked_m:
+            return True
+        measured.add(pair, q, distance_m)
+        return False
 
     def _distance(self, shape_a: Any, at_a: Any, shape_b: Any, at_b: Any) -> Any:
         """The ``coal.DistanceResult`` of two shapes at their ``coal.Transform3s`` placements."""
@@ -250,40 +295,6 @@ class ExactPairs:
         return mesh.bvh, placement * mesh.mesh_in_shape
 
     def _one_holds_other(self, a: int, at_a: Any, b: int, at_b: Any) -> bool:
-        """Whether ``a``'s mesh may hold ``b`` whole or ``b``'s ``a`` (:meth:`_held` both ways)."""
-        return self._held(a, at_a, b, at_b) or self._held(b, at_b, a, at_a)
-
-    def _held(self, outer: int, at_outer: Any, inner: int, at_inner: Any) -> bool:
-        """Whether ``outer``'s mesh may hold ``inner`` whole (module docstring); ``False`` if it has none.
-
-        ``at_outer`` and ``at_inner`` place their decisive shapes (:meth:`_placed`) in the world.
-        """
-        mesh = self._meshes.get(outer)
-        if mesh is None:
-            return False
-        points = self._inner[inner]
-        if points is None:
-            return True  # voxels, loose triangles, a mesh of many pieces: cannot be told
-        if not len(points):
-            return False
-        inner_in_outer = at_outer.actInv(at_inner)
-        return mesh.holds_any(points, inner_in_outer.rotation, inner_in_outer.translation)
-
-
-def _inner_points(shape: Any, mesh: ExactMesh | None) -> FloatArray | None:
-    """Points of a shape in its frame, one in each piece: inside an outer mesh if the shape is held whole.
-
-    An exact mesh's piece points; one point of a bounded primitive or convex shape; none of a
-    half-space or a plane (no bounded mesh holds one); ``None`` where the pieces are not known.
-    """
-    if mesh is not None:
-        return mesh.piece_points
-    if isinstance(shape, coal.ConvexBase):
-        return np.asarray([shape.point(0)], dtype=float)
-    if isinstance(shape, (coal.Halfspace, coal.Plane)):
-        return np.zeros((0, 3))
-    if isinstance(shape, coal.TriangleP):
-        return np.asarray([shape.a], dtype=float)
-    if isinstance(shape, coal.ShapeBase):
-        return np.zeros((1, 3))  # a box, sphere, cylinder, capsule, cone or ellipsoid: centred on its origin
-    return None
+        """Whether ``a``'s mesh may hold ``b`` whole or ``b``'s ``a`` (:mod:`cpr_kin.shapes.held_whole`)."""
+        meshes, inner = self._meshes, self._inner
+        return may_hold(meshes.get(a), inner[b], at_a, at_b) or may_hold(meshes.get(b), inner[a], at_b, at_a)
