@@ -42,9 +42,9 @@ class ClearBalls:
     """
 
     def __init__(self, pair_radii: FloatArray, kept: int = KEPT) -> None:
-        self._radii = np.asarray(pair_radii, dtype=float)
-        self._joints = [np.flatnonzero(radii > 0.0) for radii in self._radii]
-        self._moving = [radii[joints] for radii, joints in zip(self._radii, self._joints, strict=True)]
+        radii_of = np.asarray(pair_radii, dtype=float)
+        self._joints = [np.flatnonzero(radii > 0.0) for radii in radii_of]
+        self._moving = [radii[joints] for radii, joints in zip(radii_of, self._joints, strict=True)]
         self._kept = kept
         self._last: dict[int, int] = {}  # the slot that answered last: asked first
         self._centres: dict[int, FloatArray] = {}
@@ -77,11 +77,11 @@ class ClearBalls:
 
         Kept less coal's error at that distance, the oldest of :data:`KEPT` dropped.
         """
-        joints = self._joints[pair]
-        if pair not in self._centres:
+        joints, added = self._joints[pair], self._added.get(pair, 0)
+        if not added:
             self._centres[pair] = np.empty((self._kept, len(joints)))
             self._apart_m[pair] = np.empty(self._kept)
-        slot = self._added.get(pair, 0) % self._kept
+        slot = added % self._kept
         self._centres[pair][slot] = q[joints]
         self._apart_m[pair][slot] = distance_m - coal_error_m(float(distance_m))
-        self._added[pair] = self._added.get(pair, 0) + 1
+        self._added[pair] = added + 1

@@ -157,7 +157,9 @@ class ExactPairs:
             return None
         return result
 
-    def closer_than(self, geometry_data: Any, pair: int, hull_m: float, margin_m: float) -> bool:
+    def closer_than(
+        self, geometry_data: Any, pair: int, hull_m: float, margin_m: float, q: FloatArray | None = None
+    ) -> bool:
         """Whether pair ``pair`` is within ``margin_m`` >= 0 [m] on its meshes, hulls ``hull_m`` apart.
 
         coal's collision test with the margin as security margin descends into every pair of
@@ -167,20 +169,32 @@ class ExactPairs:
         :data:`COLLIDE_MARGIN_UP_TO_M`, and above it coal's distance decides, which prunes by the
         nearest pair found so far. Where one side is a mesh and the other a primitive, a vertex
         of the mesh within the margin of it answers first (:mod:`cpr_kin.shapes.vertex_witness`:
-        where the mesh wraps the primitive, coal's descent takes milliseconds).
+        where the mesh wraps the primitive, coal's descent takes milliseconds). Given the
+        configuration ``q`` and a memory (``measured``), the memory is asked first, and coal's
+        distance decides instead of its collision test (dearer, but a distance the memory keeps).
         """
+        memory = self._measured if q is not None else None
+        asked_m = float(collide_margin_m(margin_m)) if memory is not None else margin_m
+        if memory is not None and q is not None and memory.clear(pair, q, asked_m):
+            return False
         a, b = self._pairs[pair]
         (shape_a, at_a), (shape_b, at_b) = self._placed(geometry_data, a), self._placed(geometry_data, b)
         if self._witness is not None and self._witness.proves(a, at_a, b, at_b, margin_m):
             return True
         placed = (shape_a, as_transform(at_a), shape_b, as_transform(at_b))
-        self._collision.security_margin = float(collide_margin_m(min(margin_m, COLLIDE_MARGIN_UP_TO_M)))
-        hit = coal.collide(*placed, self._collision, coal.CollisionResult())
-        if not hit and margin_m > COLLIDE_MARGIN_UP_TO_M:
-            hit = self._distance(*placed).min_distance < margin_m
-        if hit:
+        if memory is not None:
+            distance_m = float(self._distance(*placed).min_distance)
+            hit = distance_m < asked_m
+        else:
+            self._collision.security_margin = float(collide_margin_m(min(margin_m, COLLIDE_MARGIN_UP_TO_M)))
+            hit = coal.collide(*placed, self._collision, coal.CollisionResult())
+            if not hit and margin_m > COLLIDE_MARGIN_UP_TO_M:
+                hit = self._distance(*placed).min_distance < margin_m
+        if hit or (hull_m < 0.0 and self._one_holds_other(a, at_a, b, at_b)):
             return True
-        return hull_m < 0.0 and self._one_holds_other(a, at_a, b, at_b)
+        if memory is not None and q is not None:
+            memory.add(pair, q, distance_m)
+        return False
 
     def recheck(
         self,
@@ -244,7 +258,7 @@ class ExactPairs:
                 if (
                     not refined[p]
                     or hull + excess[p] < margins[p]
-                    or self._closer_at(geometry_data, p, hull, margins[p], q)
+                    or self.closer_than(geometry_data, p, hull, margins[p], q)
                 ):
                     found[row] = True
                     break
@@ -252,33 +266,6 @@ class ExactPairs:
                 found[row:] = True
                 break
         return found
-
-    def _closer_at(
-        self, geometry_data: Any, pair: int, hull_m: float, margin_m: float, q: FloatArray
-    ) -> bool:
-        """:meth:`closer_than` at configuration ``q``, the memory asked first where there is one.
-
-        With one, where it proves the pair clear, no coal; else a vertex within the margin, or
-        coal's distance (dearer than the collision test), which it then keeps.
-        """
-        measured = self._measured
-        if measured is None:
-            return self.closer_than(geometry_data, pair, hull_m, margin_m)
-        asked_m = float(collide_margin_m(margin_m))
-        if measured.clear(pair, q, asked_m):
-            return False
-        a, b = self._pairs[pair]
-        (_, at_a), (_, at_b) = self._placed(geometry_data, a), self._placed(geometry_data, b)
-        if self._witness is not None and self._witness.proves(a, at_a, b, at_b, margin_m):
-            return True
-        found = self.measured(geometry_data, pair, hull_m)
-        if found is None:  # the hulls penetrate and the meshes meet, or one holds the other
-            return True
-        distance_m = float(found.min_distance)
-        if distance_m < asked_m:
-            return True
-        measured.add(pair, q, distance_m)
-        return False
 
     def _distance(self, shape_a: Any, at_a: Any, shape_b: Any, at_b: Any) -> Any:
         """The ``coal.DistanceResult`` of two shapes at their ``coal.Transform3s`` placements."""
