@@ -410,7 +410,7 @@ def test_the_schema_models_are_given_their_annotations_as_objects() -> None:
 
 def test_no_schema_default_is_made_by_a_builtin_whose_signature_python_parses() -> None:
     # pydantic reads each default factory's signature; the builtin list's is text that
-    # Python parses with tokenize, whose pattern a new process then compiles (4 ms)
+    # Python parses with tokenize, whose pattern a new process then compiles
     from planning.io.schema_types import empty_list
 
     factories = {

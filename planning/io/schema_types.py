@@ -18,9 +18,9 @@ def empty_list() -> list[Any]:
     """A new empty list: the default factory of the schemas' list fields.
 
     pydantic reads a default factory's signature (whether it takes the data validated so far).
-    The builtin ``list``'s is text that Python parses with ``tokenize``, whose pattern a new
-    process compiles first: about 4 ms of ``cpr-plan plan`` (docs/tuning.md, A process that runs
-    one command). A function's signature is read from its code.
+    The builtin ``list``'s is text that Python parses with ``tokenize``, whose pattern every new
+    ``cpr-plan`` process would compile for it (docs/tuning.md, A process that runs one command).
+    A function's signature is read from its code.
     """
     return []
 
