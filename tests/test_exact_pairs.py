@@ -11,9 +11,11 @@ import pytest
 import trimesh
 
 import cpr_kin as ck
+import cpr_kin.shapes.exact_pairs as exact_pairs
 from cpr_kin.model.packages import example_robot_data_share
 from cpr_kin.shapes.exact_meshes import MeshSource, exact_meshes
 from cpr_kin.shapes.exact_pairs import ExactPairs
+from cpr_kin.shapes.mesh_pieces import pieces_apart
 from tests.test_exact_meshes import bvh_of, l_shape
 
 SHARE = example_robot_data_share()
@@ -192,3 +194,33 @@ def test_an_ordered_self_test_on_the_meshes_is_exact_up_to_its_first_violation()
             assert ordered[first:].all()
             blocked_inside += int(0 < first < len(edge) - 1 and not full[first:].all())
     assert blocked_inside >= 10  # edges first violated part of the way, and free again later
+
+
+def test_the_convex_pieces_change_no_answer_of_the_margin_test(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    rng = np.random.default_rng(3)
+    cases = [
+        (tuple(rng.uniform((-0.2, -0.2, -0.1), (1.2, 1.2, 0.2)).tolist()), float(rng.uniform(0.01, 0.1)))
+        for _ in range(40)
+    ]
+    placed = [l_and_ball(tmp_path, centre, radius) for centre, radius in cases]
+    decided = []
+
+    def counted(*args: object) -> float | None:
+        found = pieces_apart(*args)  # type: ignore[arg-type]
+        decided.append(found is not None)
+        return found
+
+    def answers() -> list[bool]:
+        return [
+            found.pairs.closer_than(found.geometry_data, 0, found.hull_m, margin_m)
+            for found in placed
+            for margin_m in (0.0, 0.01, 0.05, 0.12)
+        ]
+
+    monkeypatch.setattr(exact_pairs, "pieces_apart", counted)
+    with_pieces = answers()
+    monkeypatch.setattr(exact_pairs, "pieces_apart", lambda *_: None)  # the meshes decide every test
+    assert answers() == with_pieces
+    assert sum(decided) > 10  # where the hull comes within the margin, the pieces often answer

@@ -113,3 +113,33 @@ def test_margins_beyond_those_kept_are_set_again(cluttered: ck.CollisionWorld) -
     for a, b, m in zip(first, again, margins, strict=True):
         np.testing.assert_array_equal(a, b)
         np.testing.assert_array_equal(a, world.min_clearance_batch(q)[0] < m)
+
+
+def test_the_meshes_are_not_asked_where_a_pair_without_one_is_within_the_margin(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    ur5 = ck.load_robot(UR5)
+    forearm = {g: mesh for g, mesh in ur5.exact_meshes.items() if ur5.geometries[g].name == "forearm_link"}
+    robot = dataclasses.replace(ur5, exact_meshes=forearm)  # the other links' hulls decide alone
+    obstacles = [ck.Obstacle.box((0.2, 0.2, 0.2), (0.5, 0.0, 0.3)), ck.Obstacle.sphere(0.1, (0.2, 0.4, 0.5))]
+    world = ck.CollisionWorld(robot, obstacles)
+    exact = ExactPairs(world.geometry_model, robot.exact_meshes)
+    q = np.random.default_rng(8).uniform(robot.limits.lower, robot.limits.upper, (400, robot.nq))
+    margin_m = 0.02
+    on_hulls = pair_distances(world.on_hulls(), q)
+    hull_decides = np.any(on_hulls[:, ~exact.refined] < margin_m, axis=1)
+    asked: list[np.ndarray] = []
+    violated = ExactPairs.violated
+
+    def recorded(self: ExactPairs, *args: object, **kwargs: object) -> np.ndarray:
+        asked.extend(np.asarray(args[4]))
+        return violated(self, *args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(ExactPairs, "violated", recorded)
+    tests = ObstacleTests(robot.model, world.geometry_model, exact)
+    uncertain, pairs = np.ones((len(q), len(world.pairs)), dtype=bool), np.arange(len(world.pairs))
+    found = tests.violated(q, uncertain, pairs, margin_m)
+    np.testing.assert_array_equal(found, world.min_clearance_batch(q)[0] < margin_m)
+    rows = {tuple(x) for x in q[hull_decides].tolist()}
+    assert asked and hull_decides.sum() > 20  # the meshes were asked, elsewhere
+    assert not any(tuple(x) in rows for x in np.asarray(asked).tolist())

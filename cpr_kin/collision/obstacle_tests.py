@@ -7,7 +7,8 @@ other pair is certainly farther. (Before, every pair of an obstacle with an unce
 went to coal in a Pinocchio ``GeometryPool``: five to eight times the pairs the bounds leave,
 on MotionBenchMaker's Panda and UR5; docs/tuning.md, Kernels.) Where a pair's robot link has
 an exact mesh that decides (:mod:`cpr_kin.shapes.exact_pairs`), a hull test that flags it is
-decided again on the mesh.
+decided again on the mesh; a configuration's pairs without a mesh are tested first, since
+their hulls decide alone and one found within the margin spares the meshes' tests.
 """
 
 from __future__ import annotations
@@ -77,6 +78,11 @@ class ObstacleTests:
         if not flat.size:
             return violated
         rows, columns = np.divmod(flat, uncertain.shape[1])
+        if self._exact is not None:  # a row's pairs without a mesh first: their hulls decide alone
+            meshed = self._exact.refined[pairs[columns]]
+            if meshed.any():
+                order = np.lexsort((meshed, rows))
+                rows, columns = rows[order], columns[order]
         model, data, geometry_model = self.model, self._data, self.geometry_model
         geometry_data = self._geometry_data(margin_m)
         placed = decided = -1

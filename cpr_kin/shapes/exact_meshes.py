@@ -32,6 +32,7 @@ from numpy.typing import NDArray
 from cpr_kin.common.compiled import njit
 from cpr_kin.common.disk_cache import cached_array, cached_json
 from cpr_kin.shapes.mesh_geometry import hull_planes
+from cpr_kin.shapes.mesh_pieces import convex_pieces
 from cpr_kin.shapes.vertex_witness import VertexGroups, vertex_groups
 
 FloatArray = NDArray[np.float64]
@@ -94,6 +95,14 @@ class ExactMesh:
     piece_points: FloatArray | None = field(repr=False)
     hull_planes: FloatArray = field(repr=False)
     corners: FloatArray = field(repr=False)
+
+    @cached_property
+    def pieces(self) -> tuple[Any, ...]:
+        """The convex pieces (coal's) whose union holds the triangles, in the mesh's frame.
+
+        :mod:`~cpr_kin.shapes.mesh_pieces`, made or read from disk on first use.
+        """
+        return convex_pieces(self.triangles)
 
     @cached_property
     def vertex_groups(self) -> VertexGroups:
