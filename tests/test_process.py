@@ -123,3 +123,44 @@ def test_a_library_caller_keeps_its_blas_threads() -> None:
         f"print(os.environ.get({OPENBLAS_THREADS!r}))\n",
     )
     assert completed.returncode == 0 and completed.stdout == "None\n"
+
+
+@pytest.mark.parametrize("unbuffered", [False, True], ids=["buffered", "PYTHONUNBUFFERED"])
+def test_a_command_whose_reader_left_runs_to_its_end_and_says_nothing(
+    tmp_path: Path, unbuffered: bool
+) -> None:
+    done = tmp_path / "done"
+    code = (
+        "import sys, time\n"
+        "from planning.cli.process import end_process, start_process\n"
+        "start_process()\n"
+        "time.sleep(0.5)\n"
+        "print('x' * 100_000)\n"  # more than the pipe holds: the write that finds the reader gone
+        "print('after', file=sys.stdout, flush=True)\n"
+        f"open({str(done)!r}, 'w').write('files written')\n"
+        "end_process(4)\n"
+    )
+    env = {**BUFFERED, "PYTHONUNBUFFERED": "1"} if unbuffered else BUFFERED
+    child = subprocess.Popen(
+        [sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT, env=env
+    )
+    assert child.stdout is not None and child.stderr is not None
+    child.stdout.close()  # as `cpr-plan ... | head -0` would
+    assert child.wait(timeout=60) == 4
+    assert child.stderr.read() == b""
+    child.stderr.close()
+    assert done.read_text() == "files written"
+
+
+@pytest.mark.slow
+def test_a_plan_piped_to_a_reader_that_leaves_writes_its_files_and_exits_zero(tmp_path: Path) -> None:
+    scene = "examples/scenes/shelf.yaml"
+    command = [sys.executable, "-m", "planning.cli", "plan", scene, "--out", str(tmp_path)]
+    env = {**BUFFERED, "PYTHONUNBUFFERED": "1"}
+    child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT, env=env)
+    assert child.stdout is not None and child.stderr is not None
+    child.stdout.close()
+    assert child.wait(timeout=300) == 0
+    assert child.stderr.read() == b""
+    child.stderr.close()
+    assert (tmp_path / "trajectory.json").is_file() and (tmp_path / "manifest.json").is_file()

@@ -21,6 +21,13 @@ the new-process row):
 - **Python's teardown.** On exit Python takes apart every module and the robot's models one by
   one. :func:`end_process` flushes the output and ends the process at once (as mypy does), unless a
   thread of the command still runs (then Python's own exit waits for it, as it would).
+
+And one it needs that a library caller does not: its output's reader may leave
+(``cpr-plan plan ... | head -1``). A write to that pipe then fails, mid-command, whenever
+Python hands it on (at once with ``PYTHONUNBUFFERED`` set, else when its buffer fills or is
+flushed); :func:`start_process` makes the command's standard output and error go quiet
+instead (:class:`QuietWhenReaderLeaves`), so the command runs to its end, writes its files
+and exits with its own code, whatever the buffering.
 """
 
 from __future__ import annotations
@@ -30,7 +37,7 @@ import gc
 import os
 import sys
 import threading
-from typing import NoReturn
+from typing import Any, NoReturn, TextIO, cast
 
 from planning.pipeline.blas_threads import one_thread_for_process
 
@@ -47,6 +54,45 @@ def start_process() -> None:
     gc.disable()
     one_thread_for_process()
     os.environ.setdefault(PYDANTIC_PLUGINS, "__all__")
+    sys.stdout = cast(TextIO, QuietWhenReaderLeaves(sys.stdout))
+    sys.stderr = cast(TextIO, QuietWhenReaderLeaves(sys.stderr))
+
+
+class QuietWhenReaderLeaves:
+    """A text stream that goes quiet once its reader has left (a pipe closed at its other end).
+
+    Writes and flushes go to ``stream``; the first that finds the pipe broken points the
+    stream's file at the null device, and everything after it, what was still buffered too,
+    goes there. Every other attribute is ``stream``'s.
+    """
+
+    def __init__(self, stream: TextIO) -> None:
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        """Write ``text``; nothing is said where the reader has left."""
+        try:
+            return self._stream.write(text)
+        except BrokenPipeError:
+            self._leave()
+            return len(text)
+
+    def flush(self) -> None:
+        """Flush the stream; nothing is said where the reader has left."""
+        try:
+            self._stream.flush()
+        except BrokenPipeError:
+            self._leave()
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._stream, name)
+
+    def _leave(self) -> None:
+        """Point the stream's file at the null device: what it still holds, and all after, is dropped."""
+        with contextlib.suppress(OSError, ValueError):  # a stream without a file of its own: nothing to point
+            quiet = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(quiet, self._stream.fileno())
+            os.close(quiet)
 
 
 def end_process(code: int) -> NoReturn:
