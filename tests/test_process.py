@@ -24,6 +24,22 @@ def python(*arguments: str, env: dict[str, str] = BUFFERED) -> subprocess.Comple
     return subprocess.run(command, capture_output=True, text=True, check=False, timeout=60, cwd=ROOT, env=env)
 
 
+def reader_leaves(*arguments: str, env: dict[str, str] = BUFFERED) -> tuple[int, bytes]:
+    """``python ARGUMENTS`` in a new process whose output's reader leaves at once: its exit code and stderr.
+
+    As ``cpr-plan ... | head -0`` would: standard output is a pipe closed at its other end.
+    """
+    child = subprocess.Popen(
+        [sys.executable, *arguments], stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT, env=env
+    )
+    assert child.stdout is not None and child.stderr is not None
+    child.stdout.close()
+    code = child.wait(timeout=300)
+    said = child.stderr.read()
+    child.stderr.close()
+    return code, said
+
+
 def test_start_switches_the_collector_off_and_keeps_a_users_plugin_setting(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
@@ -66,14 +82,7 @@ def test_end_process_says_nothing_when_the_reader_went_away() -> None:
     code = (
         "import time\nfrom planning.cli.process import end_process\ntime.sleep(0.5)\nprint(1)\nend_process(0)"
     )
-    child = subprocess.Popen(
-        [sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT, env=BUFFERED
-    )
-    assert child.stdout is not None and child.stderr is not None
-    child.stdout.close()  # as `cpr-plan ... | head -0` would
-    assert child.wait(timeout=60) == 0
-    assert child.stderr.read() == b""
-    child.stderr.close()
+    assert reader_leaves("-c", code) == (0, b"")
 
 
 def test_the_installed_command_runs_with_the_collector_off(tmp_path: Path) -> None:
@@ -141,26 +150,12 @@ def test_a_command_whose_reader_left_runs_to_its_end_and_says_nothing(
         "end_process(4)\n"
     )
     env = {**BUFFERED, "PYTHONUNBUFFERED": "1"} if unbuffered else BUFFERED
-    child = subprocess.Popen(
-        [sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT, env=env
-    )
-    assert child.stdout is not None and child.stderr is not None
-    child.stdout.close()  # as `cpr-plan ... | head -0` would
-    assert child.wait(timeout=60) == 4
-    assert child.stderr.read() == b""
-    child.stderr.close()
+    assert reader_leaves("-c", code, env=env) == (4, b"")
     assert done.read_text() == "files written"
 
 
 @pytest.mark.slow
 def test_a_plan_piped_to_a_reader_that_leaves_writes_its_files_and_exits_zero(tmp_path: Path) -> None:
-    scene = "examples/scenes/shelf.yaml"
-    command = [sys.executable, "-m", "planning.cli", "plan", scene, "--out", str(tmp_path)]
-    env = {**BUFFERED, "PYTHONUNBUFFERED": "1"}
-    child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT, env=env)
-    assert child.stdout is not None and child.stderr is not None
-    child.stdout.close()
-    assert child.wait(timeout=300) == 0
-    assert child.stderr.read() == b""
-    child.stderr.close()
+    plan = ("-m", "planning.cli", "plan", "examples/scenes/shelf.yaml", "--out", str(tmp_path))
+    assert reader_leaves(*plan, env={**BUFFERED, "PYTHONUNBUFFERED": "1"}) == (0, b"")
     assert (tmp_path / "trajectory.json").is_file() and (tmp_path / "manifest.json").is_file()
