@@ -178,7 +178,8 @@ class ExactPairs:
         a lower bound of the meshes').
         """
         memory = self._measured if q is not None else None
-        asked_m = float(collide_margin_m(margin_m)) if memory is not None else margin_m
+        least_m = float(collide_margin_m(margin_m))  # the least margin coal's test is asked
+        asked_m = least_m if memory is not None else margin_m
         if memory is not None and q is not None and memory.clear(pair, q, asked_m):
             return False
         a, b = self._pairs[pair]
@@ -186,7 +187,6 @@ class ExactPairs:
         if self._witness is not None and self._witness.proves(a, at_a, b, at_b, margin_m):
             return True
         placed = (shape_a, as_transform(at_a), shape_b, as_transform(at_b))
-        least_m = float(collide_margin_m(margin_m))
         apart_m = pieces_apart(self._pieces(a), placed[1], self._pieces(b), placed[3], least_m)
         if apart_m is not None:  # every triangle lies in a piece that keeps the margin
             distance_m, hit = apart_m, False
