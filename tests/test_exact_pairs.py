@@ -15,7 +15,7 @@ import cpr_kin.shapes.exact_pairs as exact_pairs
 from cpr_kin.model.packages import example_robot_data_share
 from cpr_kin.shapes.exact_meshes import MeshSource, exact_meshes
 from cpr_kin.shapes.exact_pairs import ExactPairs
-from cpr_kin.shapes.mesh_pieces import pieces_apart
+from cpr_kin.shapes.mesh_pieces import Side, sides_apart
 from tests.test_exact_meshes import bvh_of, l_shape
 
 SHARE = example_robot_data_share()
@@ -207,8 +207,8 @@ def test_the_convex_pieces_change_no_answer_of_the_margin_test(
     placed = [l_and_ball(tmp_path, centre, radius) for centre, radius in cases]
     decided = []
 
-    def counted(*args: object) -> float | None:
-        found = pieces_apart(*args)  # type: ignore[arg-type]
+    def counted(first: Side, second: Side, margin_m: float) -> float | None:
+        found = sides_apart(first, second, margin_m)
         decided.append(found is not None)
         return found
 
@@ -219,8 +219,8 @@ def test_the_convex_pieces_change_no_answer_of_the_margin_test(
             for margin_m in (0.0, 0.01, 0.05, 0.12)
         ]
 
-    monkeypatch.setattr(exact_pairs, "pieces_apart", counted)
+    monkeypatch.setattr(exact_pairs, "sides_apart", counted)
     with_pieces = answers()
-    monkeypatch.setattr(exact_pairs, "pieces_apart", lambda *_: None)  # the meshes decide every test
+    monkeypatch.setattr(exact_pairs, "sides_apart", lambda *_: None)  # the meshes decide every test
     assert answers() == with_pieces
     assert sum(decided) > 10  # where the hull comes within the margin, the pieces often answer

@@ -6,13 +6,14 @@ from pathlib import Path
 
 import coal
 import numpy as np
+import pinocchio as pin
 import pytest
 import trimesh
 
 import cpr_kin.shapes.mesh_pieces as mesh_pieces_module
 from cpr_kin.model.packages import example_robot_data_share
 from cpr_kin.shapes.coal_queries import COLLIDE_MARGIN_AT_LEAST_M
-from cpr_kin.shapes.mesh_pieces import CUTS, convex_pieces, mesh_pieces, pieces_apart
+from cpr_kin.shapes.mesh_pieces import CUTS, Side, convex_pieces, mesh_pieces, pieces_apart, sides_apart
 from tests.test_exact_meshes import bvh_of, l_shape
 
 SHARE = example_robot_data_share()
@@ -74,6 +75,33 @@ def test_the_pieces_distance_is_at_most_the_meshs_and_keeps_the_margin() -> None
             assert margin_m + COLLIDE_MARGIN_AT_LEAST_M <= apart_m <= exact_m + 1e-9
     # the hull comes within the margin where the pieces often keep it
     assert within_hull > 50 and decided > 150
+
+
+def test_two_meshes_pieces_distance_is_at_most_theirs_and_keeps_the_margin() -> None:
+    mesh = forearm()
+    pieces, bvh = convex_pieces(np.asarray(mesh.triangles)), bvh_of(mesh)
+    hull = coal.Convex.convexHull(_points(mesh.vertices), True, "Qt")
+    rng = np.random.default_rng(11)
+    decided = 0
+    for _ in range(150):
+        rotation = pin.exp3(rng.normal(size=3))
+        other = pin.SE3(rotation, rng.uniform(-0.25, 0.25, 3))
+        margin_m = float(rng.choice([0.0, 0.005, 0.02]))
+        first = Side(pieces, coal.Transform3s(), hull, pin.SE3.Identity())
+        second = Side(pieces, coal.Transform3s(other), hull, other)
+        apart_m = sides_apart(first, second, margin_m)
+        if apart_m is not None:
+            decided += 1
+            exact_m = coal.distance(
+                bvh,
+                coal.Transform3s(),
+                bvh,
+                coal.Transform3s(other),
+                coal.DistanceRequest(),
+                coal.DistanceResult(),
+            )
+            assert margin_m + COLLIDE_MARGIN_AT_LEAST_M <= apart_m <= exact_m + 1e-9
+    assert decided > 30
 
 
 def test_a_side_without_shapes_proves_nothing() -> None:

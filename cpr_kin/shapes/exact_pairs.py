@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 
 from cpr_kin.shapes.coal_queries import as_transform, collide_margin_m
 from cpr_kin.shapes.held_whole import inner_points, may_hold
-from cpr_kin.shapes.mesh_pieces import pieces_apart
+from cpr_kin.shapes.mesh_pieces import Side, sides_apart
 
 if TYPE_CHECKING:  # a robot with exact meshes imports them, and their vertices' witness
     from cpr_kin.shapes.exact_meshes import ExactMesh
@@ -170,12 +170,10 @@ class ExactPairs:
         :data:`COLLIDE_MARGIN_UP_TO_M`, and above it coal's distance decides, which prunes by the
         nearest pair found so far. Where one side is a mesh and the other a primitive, a vertex
         of the mesh within the margin of it answers first (:mod:`cpr_kin.shapes.vertex_witness`:
-        where the mesh wraps the primitive, coal's descent takes milliseconds). Then the meshes'
-        convex pieces (:mod:`cpr_kin.shapes.mesh_pieces`): where every pair of them keeps the margin,
-        so do the meshes, without their test. Given the configuration ``q`` and a memory
-        (``measured``), the memory is asked first, and coal's distance decides instead of its
-        collision test (dearer, but a distance the memory keeps: the pieces' where they decided,
-        a lower bound of the meshes').
+        where the mesh wraps the primitive, coal's descent takes milliseconds), then the meshes'
+        convex pieces (:mod:`cpr_kin.shapes.mesh_pieces`: where they keep the margin, so do the
+        meshes). Given the configuration ``q`` and a memory (``measured``), it is asked first,
+        and coal's distance decides instead of its collision test (a distance the memory keeps).
         """
         memory = self._measured if q is not None else None
         least_m = float(collide_margin_m(margin_m))  # the least margin coal's test is asked
@@ -187,7 +185,8 @@ class ExactPairs:
         if self._witness is not None and self._witness.proves(a, at_a, b, at_b, margin_m):
             return True
         placed = (shape_a, as_transform(at_a), shape_b, as_transform(at_b))
-        apart_m = pieces_apart(self._pieces(a), placed[1], self._pieces(b), placed[3], least_m)
+        sides = self._side(geometry_data, a, placed[1]), self._side(geometry_data, b, placed[3])
+        apart_m = sides_apart(*sides, least_m)
         if apart_m is not None:  # every triangle lies in a piece that keeps the margin
             distance_m, hit = apart_m, False
         elif memory is not None:
@@ -289,10 +288,10 @@ class ExactPairs:
             return self._shapes[geometry], placement
         return mesh.bvh, placement * mesh.mesh_in_shape
 
-    def _pieces(self, geometry: int) -> tuple[Any, ...]:
-        """The geometry's convex pieces: its mesh's (:mod:`~cpr_kin.shapes.mesh_pieces`), else its shape."""
-        mesh = self._meshes.get(geometry)
-        return (self._shapes[geometry],) if mesh is None else mesh.pieces
+    def _side(self, geometry_data: Any, geometry: int, at: Any) -> Side:
+        """The geometry's convex pieces at ``at`` (its mesh's, else its shape) and its own shape, placed."""
+        mesh, shape = self._meshes.get(geometry), self._shapes[geometry]
+        return Side((shape,) if mesh is None else mesh.pieces, at, shape, geometry_data.oMg[geometry])
 
     def _one_holds_other(self, a: int, at_a: Any, b: int, at_b: Any) -> bool:
         """Whether ``a``'s mesh may hold ``b`` whole or ``b``'s ``a`` (:mod:`cpr_kin.shapes.held_whole`)."""
