@@ -13,6 +13,7 @@ import trimesh
 import cpr_kin.shapes.mesh_pieces as mesh_pieces_module
 from cpr_kin.model.packages import example_robot_data_share
 from cpr_kin.shapes.coal_queries import COLLIDE_MARGIN_AT_LEAST_M
+from cpr_kin.shapes.mesh_geometry import convex_hull
 from cpr_kin.shapes.mesh_pieces import CUTS, Side, convex_pieces, mesh_pieces, pieces_apart, sides_apart
 from tests.test_exact_meshes import bvh_of, l_shape
 
@@ -49,7 +50,7 @@ def test_the_ls_pieces_leave_its_notch_empty() -> None:
     # the notch (x, y in [0.5, 1]) lies in the L's hull; (0.7, 0.7) is 0.2 m from the L, and
     # about as far from every piece
     notch = coal.Sphere(1e-3), coal.Transform3s(np.eye(3), np.array([0.7, 0.7, 0.05]))
-    hull = coal.Convex.convexHull(_points(l_shape().vertices), True, "Qt")
+    hull = convex_hull(l_shape().vertices)
     assert _distance(hull, *notch) < 0.0  # the hull holds it
     pieces = convex_pieces(np.asarray(l_shape().triangles))
     assert min(_distance(piece, *notch) for piece in pieces) > 0.19
@@ -58,7 +59,7 @@ def test_the_ls_pieces_leave_its_notch_empty() -> None:
 def test_the_pieces_distance_is_at_most_the_meshs_and_keeps_the_margin() -> None:
     mesh = forearm()
     pieces, bvh, at = convex_pieces(np.asarray(mesh.triangles)), bvh_of(mesh), coal.Transform3s()
-    hull = coal.Convex.convexHull(_points(mesh.vertices), True, "Qt")
+    hull = convex_hull(mesh.vertices)
     rng = np.random.default_rng(7)
     low, high = mesh.bounds[0] - 0.1, mesh.bounds[1] + 0.1
     decided = within_hull = 0
@@ -80,7 +81,7 @@ def test_the_pieces_distance_is_at_most_the_meshs_and_keeps_the_margin() -> None
 def test_two_meshes_pieces_distance_is_at_most_theirs_and_keeps_the_margin() -> None:
     mesh = forearm()
     pieces, bvh = convex_pieces(np.asarray(mesh.triangles)), bvh_of(mesh)
-    hull = coal.Convex.convexHull(_points(mesh.vertices), True, "Qt")
+    hull = convex_hull(mesh.vertices)
     rng = np.random.default_rng(11)
     decided = 0
     for _ in range(150):
@@ -135,9 +136,3 @@ def _distance(
     """The distance [m] (coal's) of ``shape`` at the origin and ``other`` at ``placed``."""
     result = coal.DistanceResult()
     return float(coal.distance(shape, coal.Transform3s(), other, placed, coal.DistanceRequest(), result))
-
-
-def _points(vertices: np.ndarray) -> coal.StdVec_Vec3s:
-    points = coal.StdVec_Vec3s()
-    points.extend(list(np.asarray(vertices, dtype=float)))
-    return points

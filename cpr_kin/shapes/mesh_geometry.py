@@ -1,4 +1,4 @@
-"""Meshes as coal shapes: whether points span a volume (Qhull's precondition), their hull's planes.
+"""Meshes as coal shapes: whether points span a volume (Qhull's precondition), their hull and its planes.
 
 And a mesh obstacle's geometry.
 """
@@ -46,14 +46,23 @@ def hull_planes(points: Any) -> NDArray[np.float64]:
     flat set (:func:`spans_volume`): no point is then outside a plane, and the winding number
     alone decides.
     """
-    import coal
-
     if not spans_volume(points):
         return np.empty((0, 4))
+    hull = convex_hull(points)
+    return np.column_stack([np.asarray(hull.normals()), np.asarray(hull.offsets()).ravel()])
+
+
+def convex_hull(points: Any) -> Any:
+    """The convex hull (a ``coal.Convex``) of ``points`` ``(..., 3)`` [m]: coal's Qhull, options ``Qt``.
+
+    As the robot's hulls are built. The points must span a volume (:func:`spans_volume`): coal
+    crashes on a flat set.
+    """
+    import coal
+
     corners = coal.StdVec_Vec3s()
     corners.extend(list(np.asarray(points, dtype=float).reshape(-1, 3)))
-    hull = coal.Convex.convexHull(corners, True, "Qt")
-    return np.column_stack([np.asarray(hull.normals()), np.asarray(hull.offsets()).ravel()])
+    return coal.Convex.convexHull(corners, True, "Qt")
 
 
 def mesh_geometry(path: Path, scale: float, convex: bool, name: str) -> Any:

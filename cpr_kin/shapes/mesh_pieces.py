@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 
 from cpr_kin.common.disk_cache import cached_array
 from cpr_kin.shapes.coal_queries import COLLIDE_MARGIN_AT_LEAST_M, as_transform
-from cpr_kin.shapes.mesh_geometry import spans_volume
+from cpr_kin.shapes.mesh_geometry import convex_hull, spans_volume
 
 FloatArray = NDArray[np.float64]
 
@@ -70,7 +70,7 @@ def mesh_pieces(triangles: FloatArray) -> tuple[FloatArray, ...]:
 
 def convex_pieces(triangles: FloatArray) -> tuple[coal.ConvexBase, ...]:
     """The convex hulls (coal's) of :func:`mesh_pieces`, in the triangles' frame."""
-    return tuple(_hull(corners) for corners in mesh_pieces(triangles))
+    return tuple(convex_hull(corners) for corners in mesh_pieces(triangles))
 
 
 def pieces_apart(
@@ -149,7 +149,7 @@ def _best_cut(triangles: FloatArray, rng: np.random.Generator) -> tuple[FloatArr
             below = along <= np.quantile(along, share)
             estimated = (triangles[sample[below[sample]]], triangles[sample[~below[sample]]])
             if all(spans_volume(side) for side in estimated):
-                volume = sum(_hull(_corners(side)).computeVolume() for side in estimated)
+                volume = sum(convex_hull(_corners(side)).computeVolume() for side in estimated)
                 ranked.append((volume, below))
     for _, below in sorted(ranked, key=lambda cut: cut[0]):
         sides = (triangles[below], triangles[~below])
@@ -161,10 +161,3 @@ def _best_cut(triangles: FloatArray, rng: np.random.Generator) -> tuple[FloatArr
 def _corners(triangles: FloatArray) -> FloatArray:
     """The triangles' corners ``(V, 3)``, each once."""
     return np.unique(triangles.reshape(-1, 3), axis=0)
-
-
-def _hull(corners: FloatArray) -> coal.ConvexBase:
-    """The convex hull of ``corners`` ``(V, 3)``: coal's Qhull, options ``Qt``, as the robot's hulls."""
-    points = coal.StdVec_Vec3s()
-    points.extend(list(np.asarray(corners, dtype=float)))
-    return coal.Convex.convexHull(points, True, "Qt")
