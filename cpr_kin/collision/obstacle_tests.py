@@ -8,7 +8,10 @@ went to coal in a Pinocchio ``GeometryPool``: five to eight times the pairs the 
 on MotionBenchMaker's Panda and UR5; docs/tuning.md, Kernels.) Where a pair's robot link has
 an exact mesh that decides (:mod:`cpr_kin.shapes.exact_pairs`), a hull test that flags it is
 decided again on the mesh; a configuration's pairs without a mesh are tested first, since
-their hulls decide alone and one found within the margin spares the meshes' tests.
+their hulls decide alone and one found within the margin spares the meshes' tests. Where the
+robot's joints and the pairs' shapes allow, :mod:`cpr_kin.collision.hull_tests` decides the
+batch first, in one compiled call, giving coal's answers: coal is then asked only for the
+tests it leaves (a distance at the margin, a shape it does not take).
 """
 
 from __future__ import annotations
@@ -21,6 +24,8 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from cpr_kin.collision.coal_pools import set_margins
+from cpr_kin.collision.hull_tests import HullTests, Verdicts
+from cpr_kin.shapes.convex_gjk import UNSURE
 from cpr_kin.shapes.exact_pairs import ExactPairs
 
 FloatArray = NDArray[np.float64]
@@ -46,11 +51,17 @@ class ObstacleTests:
         self._data = model.createData()
         self._exact_data: Any = None
         self._at_margin: dict[float, Any] = {}
+        self._hulls = HullTests.of(model, geometry_model)
+        # which hulls' hits a mesh decides, writable (the compiled tests take one array type)
+        self._meshed = np.zeros(len(geometry_model.collisionPairs), dtype=bool)
+        if self._exact is not None:
+            self._meshed[:] = self._exact.refined
 
     def on_hulls(self) -> ObstacleTests:
         """The tests with the hulls deciding alone (:meth:`cpr_kin.CollisionWorld.on_hulls`)."""
         hulls = copy.copy(self)
         hulls._exact = None
+        hulls._meshed = np.zeros_like(self._meshed)
         return hulls
 
     def violated(
@@ -72,6 +83,11 @@ class ObstacleTests:
             ordered: decide the configurations in order up to the first violated one; those
                 after it are reported violated without a test.
         """
+        if self._hulls is not None:
+            verdicts = self._hulls.violated(batch, uncertain, pairs, margin_m, self._meshed, ordered)
+            if len(verdicts.rows):
+                self._ask_coal(batch, verdicts, margin_m, ordered)
+            return verdicts.violated
         violated = np.zeros(len(batch), dtype=bool)
         # row by row, in order; NumPy's nonzero of a 2-d array costs 5x this on a plan's batches
         flat = uncertain.ravel().nonzero()[0]
@@ -83,23 +99,36 @@ class ObstacleTests:
             if meshed.any():
                 order = np.lexsort((meshed, rows))
                 rows, columns = rows[order], columns[order]
+        unsure = np.full(len(rows), UNSURE, dtype=np.int64)
+        self._ask_coal(batch, Verdicts(violated, rows, pairs[columns], unsure), margin_m, ordered)
+        return violated
+
+    def _ask_coal(self, batch: FloatArray, left: Verdicts, margin_m: float, ordered: bool) -> None:
+        """Decide the tests ``left`` holds (their rows ascending) by coal, into ``left.violated``.
+
+        A test's ``HULL_HIT`` needs its mesh only; with ``ordered``, a configuration found
+        violated marks every later one so.
+        """
+        violated = left.violated
         model, data, geometry_model = self.model, self._data, self.geometry_model
         geometry_data = self._geometry_data(margin_m)
-        placed = decided = -1
-        for row, pair in zip(rows.tolist(), pairs[columns].tolist(), strict=True):
-            if row == decided:  # a pair of this row was found within the margin
+        placed = -1
+        for row, pair, state in zip(
+            left.rows.tolist(), left.pairs.tolist(), left.states.tolist(), strict=True
+        ):
+            if violated[row]:  # this row was found within the margin (or lies past an ordered hit)
                 continue
-            if row != placed:
-                pin.updateGeometryPlacements(model, data, geometry_model, geometry_data, batch[row])
-                placed = row
-            if pin.computeCollision(geometry_model, geometry_data, pair) and not self._clear_on_mesh(
-                batch[row], pair, margin_m
-            ):
-                violated[row], decided = True, row
+            if state == UNSURE:
+                if row != placed:
+                    pin.updateGeometryPlacements(model, data, geometry_model, geometry_data, batch[row])
+                    placed = row
+                if not pin.computeCollision(geometry_model, geometry_data, pair):
+                    continue
+            if not self._clear_on_mesh(batch[row], pair, margin_m):
+                violated[row] = True
                 if ordered:
                     violated[row:] = True
-                    break
-        return violated
+                    return
 
     def _clear_on_mesh(self, q: FloatArray, pair: int, margin_m: float) -> bool:
         """Whether ``pair``, flagged on its hull at ``q``, keeps ``margin_m`` [m] on its exact mesh."""
