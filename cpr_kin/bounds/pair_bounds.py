@@ -26,6 +26,7 @@ from cpr_kin.bounds.batch_kinematics import KinematicChain
 from cpr_kin.bounds.bound_kernels import groups_below, pair_bounds
 from cpr_kin.bounds.capsule_fit import Capsule, fitted_capsule
 from cpr_kin.bounds.obstacle_bounds import ObstacleArrays, local_box, obstacle_arrays, shape_vertices
+from cpr_kin.shapes.coal_queries import swept_radius_m
 from cpr_kin.shapes.obstacles import Obstacle
 
 FloatArray = NDArray[np.float64]
@@ -58,8 +59,7 @@ def bounding_capsule(geometry: Any) -> tuple[FloatArray, float]:
     if vertices is None:
         return boxed.ends, boxed.radius
     fitted = fitted_capsule(vertices)
-    swept = float(geometry.getSweptSphereRadius()) if hasattr(geometry, "getSweptSphereRadius") else 0.0
-    fitted = Capsule(fitted.ends, fitted.radius + swept)
+    fitted = Capsule(fitted.ends, fitted.radius + swept_radius_m(geometry))
     best = min((boxed, fitted), key=lambda capsule: capsule.volume)
     return best.ends, best.radius
 

@@ -27,6 +27,11 @@ def collide_margin_m(margin_m: float | FloatArray) -> FloatArray:
     return np.maximum(margin_m, COLLIDE_MARGIN_AT_LEAST_M)
 
 
+def swept_radius_m(shape: Any) -> float:
+    """The radius [m] coal sweeps ``shape`` by (its swept sphere radius; 0 where it has none)."""
+    return float(shape.getSweptSphereRadius()) if hasattr(shape, "getSweptSphereRadius") else 0.0
+
+
 def as_transform(placement: Any) -> Any:
     """The ``coal.Transform3s`` of a Pinocchio placement (``pinocchio.SE3``).
 

@@ -9,6 +9,7 @@ import coal
 import numpy as np
 from numpy.typing import NDArray
 
+from cpr_kin.shapes.coal_queries import swept_radius_m
 from cpr_kin.shapes.convex_gjk import BOX, CAPSULE, CONVEX, CYLINDER, SPHERE, UNSUPPORTED
 
 FloatArray = NDArray[np.float64]
@@ -56,8 +57,7 @@ class GeometryShapes:
         counts, vertices = np.zeros(len(objects), dtype=np.int64), []
         for g, obj in enumerate(objects):
             shape = obj.geometry
-            swept = float(shape.getSweptSphereRadius()) if hasattr(shape, "getSweptSphereRadius") else 0.0
-            radii[g] = swept
+            radii[g] = swept = swept_radius_m(shape)
             if isinstance(shape, coal.ConvexBase) and shape.num_points <= MAX_VERTICES:
                 points = np.asarray(shape.points(), dtype=float).reshape(-1, 3)
                 kinds[g], counts[g] = CONVEX, len(points)
