@@ -83,6 +83,8 @@ class ObstacleTests:
             ordered: decide the configurations in order up to the first violated one; those
                 after it are reported violated without a test.
         """
+        if not uncertain.any():  # every pair certainly farther: most of a sampling planner's queries
+            return np.zeros(len(batch), dtype=bool)
         if self._hulls is not None:
             verdicts = self._hulls.violated(batch, uncertain, pairs, margin_m, self._meshed, ordered)
             if len(verdicts.rows):
@@ -91,8 +93,6 @@ class ObstacleTests:
         violated = np.zeros(len(batch), dtype=bool)
         # row by row, in order; NumPy's nonzero of a 2-d array costs 5x this on a plan's batches
         flat = uncertain.ravel().nonzero()[0]
-        if not flat.size:
-            return violated
         rows, columns = np.divmod(flat, uncertain.shape[1])
         if self._exact is not None:  # a row's pairs without a mesh first: their hulls decide alone
             meshed = self._exact.refined[pairs[columns]]
