@@ -112,6 +112,33 @@ def test_time_scale_for_limits_reaches_a_limit_exactly(trajectory: Trajectory) -
     assert s_v == pytest.approx(float(np.max(trajectory.extrema(1).peak / velocity)))
 
 
+@pytest.mark.parametrize("scale", [0.37, 1.0, 2.9])
+def test_time_scaled_carries_the_extrema_found(
+    trajectory: Trajectory, scale: float, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    late = Trajectory(trajectory.knots + 1.25, trajectory.coefficients)  # a start other than 0
+    found = [late.extrema(r) for r in range(4)]
+    scaled = late.time_scaled(scale)
+    searched = Trajectory(scaled.knots, scaled.coefficients)  # the same trajectory, nothing known
+    anew = [searched.extrema(r) for r in range(4)]
+
+    def no_search(*args: object) -> None:
+        raise AssertionError("the scaled trajectory searched its extrema again")
+
+    monkeypatch.setattr("planning.curves.trajectory.extremum_candidates", no_search)
+    for r, before in enumerate(found):
+        carried = scaled.extrema(r)
+        assert carried.derivative == r
+        for name in ("minimum", "maximum"):
+            np.testing.assert_allclose(getattr(carried, name), getattr(anew[r], name), rtol=1e-12, atol=1e-12)
+        for name in ("time_of_minimum", "time_of_maximum"):  # a root where the value is flat: less sharp
+            np.testing.assert_allclose(getattr(carried, name), getattr(anew[r], name), atol=1e-6)
+        np.testing.assert_allclose(carried.peak, before.peak * scale**-r, rtol=1e-15)
+        # read-only, as the searched ones are
+        with pytest.raises(ValueError, match="read-only"):
+            carried.maximum[0] = 0.0
+
+
 def test_errors(trajectory: Trajectory) -> None:
     with pytest.raises(PlanningError, match=re.escape("time scale -1.0 must be a finite number > 0")):
         trajectory.time_scaled(-1.0)

@@ -67,10 +67,23 @@ class Extrema:
     time_of_minimum: FloatArray
     time_of_maximum: FloatArray
 
+    def __post_init__(self) -> None:
+        for array in (self.minimum, self.maximum, self.time_of_minimum, self.time_of_maximum):
+            array.setflags(write=False)  # a trajectory's own, shared with every reader
+
     @property
     def peak(self) -> FloatArray:
         """``(nj,)`` largest absolute value per joint."""
         return np.asarray(np.maximum(np.abs(self.minimum), np.abs(self.maximum)))
+
+    def time_scaled(self, start_s: float, scale: float) -> Extrema:
+        """These extrema once the trajectory runs ``scale`` times slower from ``start_s`` [s].
+
+        Its r-th derivative at ``start_s + scale (t - start_s)`` is ``scale^-r`` times this one's at ``t``.
+        """
+        factor = float(scale) ** -self.derivative
+        stretched = (start_s + (t - start_s) * scale for t in (self.time_of_minimum, self.time_of_maximum))
+        return Extrema(self.derivative, self.minimum * factor, self.maximum * factor, *stretched)
 
 
 @dataclass(frozen=True)
@@ -200,8 +213,6 @@ class Trajectory:
         joints = np.arange(nj)
         minimum, maximum = values[joints, low], values[joints, high]
         t_min, t_max = times[joints, low], times[joints, high]
-        for array in (minimum, maximum, t_min, t_max):
-            array.setflags(write=False)
         self._extrema[derivative] = Extrema(derivative, minimum, maximum, t_min, t_max)
         return self._extrema[derivative]
 
@@ -256,13 +267,16 @@ class Trajectory:
     def time_scaled(self, scale: float) -> Trajectory:
         """The same path run ``scale`` times slower: ``q'(t) = q(t0 + (t - t0) / scale)``.
 
-        Knots stretch by ``scale`` and the r-th derivative shrinks by ``scale^-r``.
+        Knots stretch by ``scale`` and the r-th derivative (its extrema found too) shrinks by ``scale^-r``.
         """
         if not (np.isfinite(scale) and scale > 0):
             raise PlanningError(f"time scale {scale} must be a finite number > 0")
         powers = float(scale) ** -np.arange(self.coefficients.shape[2])
         knots = self.knots[0] + (self.knots - self.knots[0]) * scale
-        return Trajectory(knots=knots, coefficients=self.coefficients * powers)
+        scaled = Trajectory(knots=knots, coefficients=self.coefficients * powers)
+        for derivative, found in self._extrema.items():  # known here: scaled, not searched again
+            scaled._extrema[derivative] = found.time_scaled(float(self.knots[0]), scale)
+        return scaled
 
     def time_scale_for_limits(
         self, velocity: ArrayLike, acceleration: ArrayLike | None = None, jerk: ArrayLike | None = None
