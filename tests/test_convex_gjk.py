@@ -51,10 +51,7 @@ def state_of(table: GeometryShapes, margin_m: float, guess: np.ndarray | None = 
         margin_state(
             0,
             1,
-            table.kinds,
-            table.half,
-            table.first,
-            table.vertices,
+            table.cores,
             table.rotations,
             table.translations,
             reach - BAND_M,

@@ -160,6 +160,7 @@ def _decide(
     """
     batch, uncertain, pairs = tests
     kinds, half, first, vertices, radii = shapes
+    cores = (kinds, half, first, vertices)
     joints, in_joint_rotation, in_joint_translation = fixed
     margin_m, band_m = margins
     count, joint_count = len(kinds), len(chain[0])
@@ -199,10 +200,7 @@ def _decide(
                     state = margin_state(
                         g1,
                         g2,
-                        kinds,
-                        half,
-                        first,
-                        vertices,
+                        cores,
                         rotation,
                         translation,
                         reach - band_m,

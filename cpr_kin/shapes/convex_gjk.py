@@ -44,27 +44,23 @@ FACES = np.array([[0, 1, 2, 3], [0, 2, 3, 1], [0, 3, 1, 2], [1, 3, 2, 0]], dtype
 """A tetrahedron's faces (three vertices) and the vertex opposite each."""
 CONVERGED = 1e-12
 """Relative progress ``(|v|^2 - v.w) / |v|^2`` below which GJK has converged without a verdict."""
+Cores = tuple[IntArray, FloatArray, IntArray, FloatArray]
+"""The shapes' cores as :func:`support` reads them: ``(kinds, half, first, vertices)``, each
+geometry's kind ``(G,)``, a box's half sides or a capsule's or cylinder's ``(r, h, 0)`` ``(G, 3)``
+[m], where each convex shape's vertices begin ``(G + 1,)``, and those vertices ``(V, 3)``
+[m] (:class:`~cpr_kin.shapes.gjk_shapes.GeometryShapes`)."""
 
 
 @njit
 def support(
-    g: int,
-    kinds: IntArray,
-    half: FloatArray,
-    first: IntArray,
-    vertices: FloatArray,
-    rotation: FloatArray,
-    translation: FloatArray,
-    dx: float,
-    dy: float,
-    dz: float,
+    g: int, cores: Cores, rotation: FloatArray, translation: FloatArray, dx: float, dy: float, dz: float
 ) -> tuple[float, float, float]:
     """The point of shape ``g``'s core farthest along the world direction ``(dx, dy, dz)``, in the world.
 
-    ``rotation[g]`` ``(3, 3)`` and ``translation[g]`` ``(3,)`` [m] place the shape; ``half[g]``
-    holds a box's half sides, or a capsule's or cylinder's radius and half length (``(r, h,
-    0)``); a convex shape's vertices are ``vertices[first[g]:first[g + 1]]``.
+    ``rotation[g]`` ``(3, 3)`` and ``translation[g]`` ``(3,)`` [m] place the shape; ``cores``
+    (:data:`Cores`) holds its kind and its box's, segment's or vertices' dimensions.
     """
+    kinds, half, first, vertices = cores
     lx = rotation[g, 0, 0] * dx + rotation[g, 1, 0] * dy + rotation[g, 2, 0] * dz
     ly = rotation[g, 0, 1] * dx + rotation[g, 1, 1] * dy + rotation[g, 2, 1] * dz
     lz = rotation[g, 0, 2] * dx + rotation[g, 1, 2] * dy + rotation[g, 2, 2] * dz
@@ -206,10 +202,7 @@ def reduce_simplex(simplex: FloatArray, size: int, weights: FloatArray) -> int:
 def margin_state(
     g1: int,
     g2: int,
-    kinds: IntArray,
-    half: FloatArray,
-    first: IntArray,
-    vertices: FloatArray,
+    cores: Cores,
     rotation: FloatArray,
     translation: FloatArray,
     below_m: float,
@@ -234,8 +227,8 @@ def margin_state(
         vz = translation[g1, 2] - translation[g2, 2]
     size, lower = 0, 0.0
     for _ in range(MAX_ITERATIONS):
-        ax, ay, az = support(g1, kinds, half, first, vertices, rotation, translation, -vx, -vy, -vz)
-        bx, by, bz = support(g2, kinds, half, first, vertices, rotation, translation, vx, vy, vz)
+        ax, ay, az = support(g1, cores, rotation, translation, -vx, -vy, -vz)
+        bx, by, bz = support(g2, cores, rotation, translation, vx, vy, vz)
         wx, wy, wz = ax - bx, ay - by, az - bz
         squared = vx * vx + vy * vy + vz * vz
         along = vx * wx + vy * wy + vz * wz

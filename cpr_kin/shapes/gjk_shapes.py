@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cpr_kin.shapes.coal_queries import swept_radius_m
-from cpr_kin.shapes.convex_gjk import BOX, CAPSULE, CONVEX, CYLINDER, SPHERE, UNSUPPORTED
+from cpr_kin.shapes.convex_gjk import BOX, CAPSULE, CONVEX, CYLINDER, SPHERE, UNSUPPORTED, Cores
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -47,6 +47,11 @@ class GeometryShapes:
     joints: IntArray
     rotations: FloatArray
     translations: FloatArray
+
+    @property
+    def cores(self) -> Cores:
+        """The cores as :func:`~cpr_kin.shapes.convex_gjk.support` reads them."""
+        return self.kinds, self.half, self.first, self.vertices
 
     @classmethod
     def of(cls, geometry_model: Any) -> GeometryShapes:
