@@ -58,7 +58,6 @@ class Extrema:
         maximum: ``(nj,)`` largest value per joint.
         time_of_minimum: ``(nj,)`` [s].
         time_of_maximum: ``(nj,)`` [s].
-
     """
 
     derivative: int
@@ -68,8 +67,10 @@ class Extrema:
     time_of_maximum: FloatArray
 
     def __post_init__(self) -> None:
-        for array in (self.minimum, self.maximum, self.time_of_minimum, self.time_of_maximum):
-            array.setflags(write=False)  # a trajectory's own, shared with every reader
+        for name in ("minimum", "maximum", "time_of_minimum", "time_of_maximum"):  # own, read-only copies
+            array = np.array(getattr(self, name), dtype=float)
+            array.setflags(write=False)
+            object.__setattr__(self, name, array)
 
     @property
     def peak(self) -> FloatArray:
@@ -193,8 +194,7 @@ class Trajectory:
 
         Candidates are the segment ends and the real roots of the next derivative inside
         the segments that may hold an extremum (:mod:`planning.curves.segment_extrema`); no
-        sampling is involved. Computed once per order (the trajectory is
-        immutable).
+        sampling is involved. Computed once per order (the trajectory is immutable).
         """
         if derivative in self._extrema:
             return self._extrema[derivative]
