@@ -45,7 +45,7 @@ REFUSED = [
     ("slow joint", theta1_limit("-2.9", "2.9", "1e-6"),
      r"joint 'theta1' needs 5.8e\+06 s to cross its range .* at most 600 s: raise the limits"),
     ("planar", lambda t: t.replace('name="d2" type="prismatic"', 'name="d2" type="planar"'),
-     r"joint 'd2' is of type 'planar'; supported: \['revolute', 'prismatic', 'continuous', 'fixed'\]"),
+     r"joints names \['d2'\], a base's planar or floating joint\(s\): they are held at their identity pose"),
     ("mimic", lambda t: t.replace('<joint name="theta5" type="revolute">',
                                   '<joint name="theta5" type="revolute"><mimic joint="theta4"/>'),
      r"joint\(s\) \['theta5'\] mimic another; they cannot be planned"),

@@ -10,8 +10,9 @@ Loading, in order:
 3. Pinocchio builds the kinematic, collision and visual models (what its URDF parser prints
    stays off the terminal);
 4. the joints that are not planned are held: at the value given in ``held``, a ``mimic``
-   joint at ``multiplier x leader + offset`` of its (held) leader, any other at 0 clipped into
-   its range; Pinocchio's reduced model keeps the planned joints only;
+   joint at ``multiplier x leader + offset`` of its (held) leader, a ``planar`` or ``floating``
+   joint (a mobile base's) at its identity pose, any other at 0 clipped into its range
+   (:mod:`cpr_kin.description.joint_roles`); Pinocchio's reduced model keeps the planned joints only;
 5. velocity limits come from the URDF, acceleration and jerk limits from the limits file
    (given, or found beside the URDF, :func:`~cpr_kin.model.limits.find_limits_file`), the
    documented defaults where it gives none (:func:`~cpr_kin.model.limits.default_limits`, listed in
@@ -34,18 +35,17 @@ from typing import Any
 
 import numpy as np
 import pinocchio as pin
-from lxml import etree
 
 from cpr_kin.bounds.close_pairs import close_pairs
 from cpr_kin.bounds.overlapping_pairs import overlapping_pairs
 from cpr_kin.collision.srdf_pairs import SrdfPairs, find_srdf, read_srdf, self_pairs
-from cpr_kin.common.errors import UrdfError
+from cpr_kin.description.joint_roles import base_joints, held_values, planned_joints
 from cpr_kin.description.resources import makers_limits_path
 from cpr_kin.description.robot_options import check_not_one_name, check_options, check_tcp
 from cpr_kin.description.supported import check_limits, checked_urdf
 from cpr_kin.description.urdf_file import collision_names, massless_links, mesh_filenames, prepared_xml
 from cpr_kin.description.urdf_models import VisualModel, build_models, convex_hulls
-from cpr_kin.model.arm import ArmChain, arm_chain, default_joints
+from cpr_kin.model.arm import ArmChain, arm_chain
 from cpr_kin.model.geometry_groups import carried_alone, grouped_geometries
 from cpr_kin.model.limits import LIMITS_NAMES, JointLimits, find_limits_file, read_dynamic_limits
 from cpr_kin.model.packages import mesh_package_roots
@@ -109,11 +109,12 @@ class RobotSpec:
         arm = arm_chain(tree)
         model, collision = build_models(xml, path)
         check_tcp(self.tcp, model, path)
-        planned = self._planned(model, tree, path, arm)
-        held = self._held_values(model, tree, planned, path)
+        bases = base_joints(tree)
+        planned = planned_joints(self.joints, self.tcp, model, tree, path, arm, bases)
+        held = held_values(dict(self.held), model, tree, planned + bases, path)
         visual = VisualModel(xml, path)
-        if held:
-            lock = [model.getJointId(name) for name in held]
+        if held or bases:
+            lock = [model.getJointId(name) for name in (*held, *bases)]
             q_ref = pin.neutral(model)
             for name, value in held.items():
                 q_ref[model.joints[model.getJointId(name)].idx_q] = value
@@ -186,79 +187,6 @@ class RobotSpec:
             exact_meshes=exact,
         )
 
-    def _planned(self, model: Any, tree: etree._ElementTree, path: Path, arm: ArmChain) -> tuple[str, ...]:
-        """The planned joints, checked against the URDF's."""
-        names = tuple(model.names[1:])
-        mimics = {j.get("name") for j in tree.getroot().findall("joint") if j.find("mimic") is not None}
-        if self.joints is None:
-            return default_joints(model, arm, self.tcp, mimics, path)
-        unknown = [j for j in self.joints if j not in names]
-        _refuse_fixed(tree, unknown, "joints", names, path)
-        if unknown:
-            raise UrdfError(f"URDF '{path}' has no joint(s) {unknown}; its joints are {list(names)}")
-        order = [j for j in names if j in self.joints]
-        if tuple(order) != tuple(self.joints) or len(set(self.joints)) != len(self.joints):
-            raise UrdfError(
-                f"URDF '{path}': joints = {list(self.joints)}; give each once, in the URDF's "
-                f"chain order {order}"
-            )
-        planned_mimics = sorted(mimics & set(self.joints))
-        if planned_mimics:
-            raise UrdfError(f"URDF '{path}': joint(s) {planned_mimics} mimic another; they cannot be planned")
-        return tuple(self.joints)
-
-    def _held_values(
-        self, model: Any, tree: etree._ElementTree, planned: tuple[str, ...], path: Path
-    ) -> dict[str, float]:
-        """The value of each held joint [rad or m], checked against its range."""
-        given = dict(self.held)
-        names = tuple(model.names[1:])
-        unknown = sorted(set(given) - set(names))
-        _refuse_fixed(tree, unknown, "held", names, path)
-        if unknown or set(given) & set(planned):
-            problem = (
-                f"no joint(s) {unknown}"
-                if unknown
-                else f"planned joint(s) {sorted(set(given) & set(planned))}"
-            )
-            raise UrdfError(f"URDF '{path}': held names {problem}; hold joints of {list(names)} not planned")
-        mimic = {
-            j.get("name"): j.find("mimic")
-            for j in tree.getroot().findall("joint")
-            if j.find("mimic") is not None
-        }
-        values: dict[str, float] = {}
-        for name in (n for n in names if n not in planned):
-            i = model.joints[model.getJointId(name)].idx_q
-            low, high = float(model.lowerPositionLimit[i]), float(model.upperPositionLimit[i])
-            value = float(given.get(name, np.clip(0.0, low, high)))
-            leader = mimic[name].get("joint", "") if name in mimic else ""
-            if name in mimic and (name not in given or leader in names):
-                if leader not in names:
-                    raise UrdfError(
-                        f"URDF '{path}': joint '{name}' mimics joint '{leader}', which the URDF does not "
-                        f"have; name one of its joints in the <mimic>, or hold '{name}' (held={{...}})"
-                    )
-                if leader in planned:
-                    raise UrdfError(f"URDF '{path}': joint '{name}' mimics planned joint '{leader}'")
-                multiplier = float(mimic[name].get("multiplier", "1"))
-                offset = float(mimic[name].get("offset", "0"))
-                lead = given.get(leader, float(np.clip(0.0, *_range(model, leader))))
-                follows = multiplier * lead + offset
-                if name in given and abs(value - follows) > 1e-9:
-                    raise UrdfError(
-                        f"URDF '{path}': held joint '{name}' = {value:g} mimics '{leader}' = {lead:g} "
-                        f"({multiplier:g} x '{leader}' + {offset:g} = {follows:g}); hold '{leader}' "
-                        f"and leave '{name}' to follow it"
-                    )
-                value = follows
-            if not low - 1e-9 <= value <= high + 1e-9:
-                raise UrdfError(
-                    f"URDF '{path}': held joint '{name}' = {value:g} is outside [{low:g}, {high:g}]"
-                )
-            values[name] = value
-        return values
-
     def _tcp_frame(self, model: Any, arm: ArmChain) -> str:
         """The tool-centre-point frame (attribute ``tcp``, checked by :func:`check_tcp`)."""
         if self.tcp is not None:
@@ -266,20 +194,6 @@ class RobotSpec:
         if model.existFrame("tcp"):
             return "tcp"
         return arm.tool
-
-
-def _refuse_fixed(tree: etree._ElementTree, given: list[str], key: str, names: Any, path: Path) -> None:
-    """Refuse names in ``given`` (of option ``key``) of the URDF's fixed joints, which never move."""
-    fixed = sorted(set(given) & {j.get("name") for j in tree.getroot().findall("joint")})
-    if fixed:
-        raise UrdfError(
-            f"URDF '{path}': {key} names fixed joint(s) {fixed}; its movable joints: {list(names)}"
-        )
-
-
-def _range(model: Any, joint: str) -> tuple[float, float]:  # a joint's position range [rad or m]
-    i = model.joints[model.getJointId(joint)].idx_q
-    return float(model.lowerPositionLimit[i]), float(model.upperPositionLimit[i])
 
 
 def load_robot(urdf_path: str | Path, **options: Any) -> Robot:

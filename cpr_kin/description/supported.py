@@ -8,9 +8,10 @@ refuses it at once (:class:`~cpr_kin.common.errors.UrdfError`, exit 2 on the com
 the joint, the value and what is supported:
 
 - joint types: ``revolute``, ``prismatic``, ``continuous`` (planned within
-  :data:`~cpr_kin.description.urdf_file.CONTINUOUS_RANGE_RAD`) and ``fixed``; ``floating`` and
-  ``planar`` joints are not planned, and a ``mimic`` joint is held (with the joint it
-  mimics); each moving joint with an axis that is a direction;
+  :data:`~cpr_kin.description.urdf_file.CONTINUOUS_RANGE_RAD`) and ``fixed``; a ``planar`` or
+  ``floating`` joint (a mobile base's) is never planned but held at its identity pose, and a
+  ``mimic`` joint is held (with the joint it mimics); each moving joint with an axis that is a
+  direction;
 - position limits within :data:`MAX_REVOLUTE_RAD` (one turn either way) for a revolute
   joint and :data:`MAX_PRISMATIC_M` for a prismatic one, with ``lower < upper``;
 - crossing a joint's whole range, at rest at both ends, within its velocity, acceleration
@@ -38,8 +39,12 @@ from cpr_kin.common.names import escaped, unprintable
 from cpr_kin.description.urdf_file import parse_urdf, validate_urdf
 from cpr_kin.model.limits import JointLimits
 
-SUPPORTED_TYPES = ("revolute", "prismatic", "continuous", "fixed")
+PLANNED_TYPES = ("revolute", "prismatic", "continuous", "fixed")
 """Joint types the planner plans (``fixed`` joints join links rigidly)."""
+BASE_TYPES = ("planar", "floating")
+"""Joint types of a mobile base, held at their identity pose: the scene's frame is their child's."""
+SUPPORTED_TYPES = PLANNED_TYPES + BASE_TYPES
+"""Joint types a URDF may hold."""
 MAX_REVOLUTE_RAD = 2 * math.pi
 """Largest |position limit| of a revolute joint [rad]: one turn either way, as UR and xArm arms have."""
 MAX_PRISMATIC_M = 10.0
@@ -84,10 +89,11 @@ def check_joints(tree: etree._ElementTree, path: Path) -> None:
         name, kind = joint.get("name", "?"), joint.get("type", "?")
         if kind not in SUPPORTED_TYPES:
             raise UrdfError(
-                f"URDF '{path}': joint '{name}' is of type '{kind}'; supported: {list(SUPPORTED_TYPES)}"
+                f"URDF '{path}': joint '{name}' is of type '{kind}'; supported: {list(PLANNED_TYPES)} "
+                f"(planned) and {list(BASE_TYPES)} (a base's, held at its identity pose)"
             )
         axis = joint.find("axis")
-        if kind != "fixed" and axis is not None:
+        if kind not in ("fixed", "floating") and axis is not None:
             text = axis.get("xyz", "1 0 0")
             vector = _numbers(text, 3)
             if vector is None or not all(map(math.isfinite, vector)) or math.hypot(*vector) < 1e-9:

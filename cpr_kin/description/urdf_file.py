@@ -57,6 +57,14 @@ def parse_urdf(path: Path) -> etree._ElementTree:
         raise UrdfError(
             f"URDF file '{path}' holds <group>s and no <link>: it is an SRDF; give the robot's URDF"
         )
+    macros = sorted(
+        {e.tag.split("}")[-1] for e in root.iter() if isinstance(e.tag, str) and "xacro" in e.tag}
+    )
+    if macros:
+        raise UrdfError(
+            f"URDF file '{path}' is a xacro file (it holds <xacro:{macros[0]}>); expand it into a URDF "
+            f"first: xacro {path.name} > {path.stem}_expanded.urdf (pip install xacro)"
+        )
     if root.find("link") is None:
         raise UrdfError(
             f"URDF file '{path}' has no <link>: an empty robot; a URDF "

@@ -100,7 +100,7 @@ def arm_chain(tree: etree._ElementTree) -> ArmChain:
 
 
 def default_joints(
-    model: Any, arm: ArmChain, tcp: str | None, mimics: set[str], path: Path
+    model: Any, arm: ArmChain, tcp: str | None, unplanned: set[str], path: Path
 ) -> tuple[str, ...]:
     """The planned joints when none are named: the arm's, or those from the root to ``tcp``.
 
@@ -108,7 +108,8 @@ def default_joints(
         model: the URDF's Pinocchio model (every joint).
         arm: its :func:`arm_chain`.
         tcp: the tool frame the user named (a link or joint name), or ``None``.
-        mimics: the joints that mimic another (never planned).
+        unplanned: the joints never planned: those that mimic another, a base's planar or
+            floating ones.
         path: the URDF file, for messages.
 
     Raises:
@@ -120,9 +121,9 @@ def default_joints(
     if tcp is not None and model.existFrame(tcp):
         supports = model.supports[model.frames[frame_index(model, tcp)].parentJoint]
         along = {model.names[j] for j in supports}
-        return tuple(n for n in names if n in along and n not in mimics)
-    planned = tuple(n for n in names if n in arm.joints and n not in mimics)
-    others = [n for n in names if n not in arm.joints and n not in mimics]
+        return tuple(n for n in names if n in along and n not in unplanned)
+    planned = tuple(n for n in names if n in arm.joints and n not in unplanned)
+    others = [n for n in names if n not in arm.joints and n not in unplanned]
     if len(planned) < 2 and others:
         raise UrdfError(
             f"URDF '{path}' has no single arm: its tree branches after {len(planned)} joint(s) "
