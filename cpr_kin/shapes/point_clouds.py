@@ -9,9 +9,9 @@ bounds then see each block's own box, not the whole cloud's, and spare coal the 
 from the robot.
 
 Files (:func:`read_points`): ``.npy`` (an ``(N, 3)`` array), ``.xyz`` / ``.txt`` (three numbers
-a line, more columns ignored), ``.ply`` (through trimesh) and ``.pcd`` (PCL's format, ASCII or
-binary, ``x y z`` fields). At most :data:`MAX_POINTS` points: a larger file is refused before
-it is read whole.
+a line, more columns ignored), ``.ply`` (its vertices, :mod:`cpr_kin.shapes.ply_points`) and
+``.pcd`` (PCL's format, ASCII or binary, ``x y z`` fields). At most :data:`MAX_POINTS` points:
+a larger file is refused before it is read whole.
 """
 
 from __future__ import annotations
@@ -27,6 +27,7 @@ from cpr_kin.common.errors import ObstacleError
 from cpr_kin.common.names import shown
 from cpr_kin.common.user_files import UserFileError, read_bytes
 from cpr_kin.shapes.obstacle_ranges import MAX_COORDINATE_M
+from cpr_kin.shapes.ply_points import read_ply_points
 
 FloatArray = NDArray[np.float64]
 
@@ -148,11 +149,7 @@ def _read(data: bytes, path: Path, suffix: str) -> FloatArray:
         lines = data.decode("utf-8").splitlines()
         return np.loadtxt(lines, usecols=(0, 1, 2), ndmin=2, comments="#", max_rows=MAX_POINTS + 1)
     if suffix == ".ply":
-        import trimesh
-
-        # a PointCloud, or a Trimesh whose vertices are the points
-        loaded: Any = trimesh.load(io.BytesIO(data), file_type="ply")
-        return np.array(loaded.vertices, dtype=np.float64)
+        return read_ply_points(data, MAX_POINTS, path)
     return _read_pcd(data, path)
 
 
