@@ -23,6 +23,13 @@ SCENE = {
         {"name": "post", "shape": "box", "size": [0.1, 0.1, 0.8], "xyz": [0.45, 0.35, 0.4]},
         {"name": "ball", "shape": "sphere", "radius": 0.08, "xyz": [0.3, -0.4, 0.6]},
         {"name": "pipe", "shape": "cylinder", "radius": 0.03, "length": 0.6, "xyz": [-0.4, 0.3, 0.5]},
+        {  # a scanned board: voxels, an octree in roboplan
+            "name": "board",
+            "shape": "point_cloud",
+            "points": np.random.default_rng(3).uniform([-0.2, -0.2, 0], [0.2, 0.2, 0.02], (300, 3)).tolist(),
+            "resolution": 0.04,
+            "xyz": [-0.2, -0.45, 0.45],
+        },
     ],
 }
 

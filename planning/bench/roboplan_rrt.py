@@ -74,7 +74,7 @@ class RoboplanPeer:
     """A scene in roboplan, with our collision model (module docstring); plan it with :meth:`plan`.
 
     Raises:
-        PlanningError: an obstacle roboplan has no shape for (a capsule, voxels), a robot
+        PlanningError: an obstacle roboplan has no shape for (a capsule), a robot
             without its URDF's file.
     """
 
@@ -198,9 +198,9 @@ def _add_obstacle(peer: Any, obstacle: ck.Obstacle, folder: Path) -> None:
     """Add ``obstacle`` to the roboplan scene ``peer``, a convex mesh as its hull (an STL in ``folder``).
 
     Raises:
-        PlanningError: a shape roboplan has none for (a capsule, voxels, a triangle surface).
+        PlanningError: a shape roboplan has none for (a capsule, a triangle surface).
     """
-    from roboplan.core import Box, Cylinder, Mesh, Sphere
+    from roboplan.core import Box, Cylinder, Mesh, OcTree, Sphere
 
     pose, name = np.asarray(obstacle.placement.homogeneous), f"obstacle:{obstacle.name}"
     radius, length = float(obstacle.radius or 0.0), float(obstacle.length or 0.0)
@@ -217,6 +217,10 @@ def _add_obstacle(peer: Any, obstacle: ck.Obstacle, folder: Path) -> None:
         peer.addMeshGeometry(
             name, "universe", Mesh(str(hull), np.full(3, float(obstacle.scale))), pose, white
         )
+    elif obstacle.shape == "voxels":  # an octree: coal's boxes (centre, side, occupancy, threshold)
+        side = float(obstacle.resolution or 0.0)
+        boxes = [np.array([*centre, side, 1.0, 0.5]) for centre in np.asarray(obstacle.points, dtype=float)]
+        peer.addOcTreeGeometry(name, "universe", OcTree(boxes, side), pose, white)
     else:
         raise PlanningError(f"the roboplan peer has no {obstacle.shape} shape ('{obstacle.name}')")
 
