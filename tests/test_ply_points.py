@@ -46,7 +46,9 @@ def test_the_ascii_and_binary_files_trimesh_writes_read_as_trimesh_reads_them(tm
     for encoding in ("ascii", "binary"):
         path = tmp_path / f"{encoding}.ply"
         path.write_bytes(trimesh.exchange.ply.export_ply(mesh, encoding=encoding))
-        expected = np.asarray(trimesh.load(path, process=False).vertices)
+        loaded = trimesh.load(path, process=False)
+        assert isinstance(loaded, trimesh.Trimesh)
+        expected = np.asarray(loaded.vertices)
         np.testing.assert_allclose(read_ply_points(path.read_bytes(), 10_000, path), expected, atol=1e-6)
 
 
