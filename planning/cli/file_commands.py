@@ -138,8 +138,8 @@ def cmd_show(args: argparse.Namespace) -> int:
         viewer.show_carried(document.trajectory, carried)
         viewer.show_plan(document.trajectory, document.waypoints, measured=measured)
         viewer.animate(document.trajectory)
-        print(f"meshcat viewer at {viewer.url}  (127.0.0.1 only; Ctrl-C to stop)", flush=True)
-        try:
+        try:  # from the line on, Ctrl-C is the way to stop: even one that strikes as it is written
+            print(f"meshcat viewer at {viewer.url}  (127.0.0.1 only; Ctrl-C to stop)", flush=True)
             while True:
                 time.sleep(3600)
         except KeyboardInterrupt:
