@@ -39,7 +39,7 @@ def warm_up(robot: ck.Robot | None = None) -> float:
     that is timed. It plans the paper case with two fireflies for one iteration and a small
     motion of the robot (the paper's, the CPR, if none is given) in its joint space, runs the search's
     duration estimates with and without the torques, and asks its collision world every
-    kind of query once (:func:`_warm_own_motion`).
+    kind of query once and solves its numerical IK once (:func:`_warm_own_motion`).
     """
     started = time.perf_counter()
     small = paper_scene(fireflies=2, iterations=1)
@@ -105,6 +105,10 @@ def _warm_own_motion(robot: ck.Robot, small: Scene) -> None:
         problem = build_problem(own, robot, threads=1)
         _estimate_durations(problem, dynamics)  # before the plan, which may find nothing
         solve(problem)
+    # the numerical IK's descent, to the goal's tool pose from the start (a pose goal's)
+    goal_tool = ck.frame_poses(robot, ends[1, first][None])[0]
+    with contextlib.suppress(ck.IkMissError):
+        ck.solve_ik(robot, ck.IkTarget(goal_tool[:3, 3], goal_tool[:3, :3]), ends[0, first])
     # an obstacle at the tool, so that the pairs' bounds leave it in doubt and coal decides
     tool = ck.frame_poses(robot, ends[0, first][None])[0][:3, 3]
     _query_collisions(ck.CollisionWorld(robot, [ck.Obstacle.sphere(0.05, tuple(tool))]), ends[:, first])

@@ -10,7 +10,7 @@ import pytest
 import yourdfpy
 
 import cpr_kin as ck
-from cpr_kin.kinematics.numerical_ik import tool_reach_m
+from cpr_kin.kinematics.numerical_ik import descent, tool_reach_m
 from cpr_kin.model.packages import example_robot
 
 ARMS = ("so101", "ur5", "panda", "xarm7")
@@ -137,28 +137,29 @@ def test_the_reach_bound_counts_prismatic_travel(robot: ck.Robot) -> None:
     assert without_travel < distances.max() <= tool_reach_m(robot)
 
 
+def test_a_start_that_makes_no_progress_ends_after_its_patience() -> None:
+    robot = ck.load_robot(example_robot("ur5"))
+    target = ck.IkTarget(np.array([1.25, 0.0, 0.3]))  # out of reach: the arm stretches, then stalls
+    free = np.ones(robot.nq, dtype=bool)
+    steps = {}
+    for patience in (20, 1000):
+        settings = ck.IkSettings(restarts=0, more_restarts=0, iterations=1000, patience=patience)
+        with pytest.raises(ck.IkMissError, match=r"the closest of 1 IK starts came 0\.3"):
+            ck.solve_ik(robot, target, settings=settings)
+        mid_range = (robot.limits.lower + robot.limits.upper) / 2  # the start solve_ik takes first
+        steps[patience] = descent(robot, target, free, settings)(mid_range)[1]
+    assert 20 < steps[20] <= 100  # its patience ran out soon after the stretch
+    assert steps[1000] == 1000  # without it, every step is taken
+
+
 class CountedTarget(ck.IkTarget):
-    """An IK target that counts how often a descent measures its error."""
+    """An IK target that counts how often its error is measured (once a start, at its end)."""
 
     steps = 0
 
     def excess(self, placement: pin.SE3) -> float:
         CountedTarget.steps += 1
         return super().excess(placement)
-
-
-def test_a_start_that_makes_no_progress_ends_after_its_patience() -> None:
-    robot = ck.load_robot(example_robot("ur5"))
-    target = CountedTarget(np.array([1.25, 0.0, 0.3]))  # out of reach: the arm stretches, then stalls
-    steps = {}
-    for patience in (20, 1000):
-        CountedTarget.steps = 0
-        settings = ck.IkSettings(restarts=0, more_restarts=0, iterations=1000, patience=patience)
-        with pytest.raises(ck.IkMissError, match=r"the closest of 1 IK starts came 0\.3"):
-            ck.solve_ik(robot, target, settings=settings)
-        steps[patience] = CountedTarget.steps
-    assert 20 < steps[20] <= 100  # its patience ran out soon after the stretch
-    assert steps[1000] == 1000  # without it, every step is taken
 
 
 def test_a_target_beyond_the_reach_bound_is_refused_before_any_start() -> None:

@@ -29,10 +29,13 @@ from numpy.typing import ArrayLike, NDArray
 from cpr_kin.certified.motion import path_weights
 from cpr_kin.common.errors import CprKinError, IkMissError
 from cpr_kin.kinematics.forward import frame_levers
+from cpr_kin.kinematics.ik_descent import ToolChain, descend
 from cpr_kin.kinematics.ik_target import IkTarget
 from cpr_kin.model.robot import Robot
 
 FloatArray = NDArray[np.float64]
+Descent = Callable[[FloatArray], tuple[FloatArray, int]]
+"""A start's descent: from the start, the configuration it ends at and its steps (:func:`descent`)."""
 
 
 PROGRESS = 0.05
@@ -80,41 +83,27 @@ class IkSettings:
                 raise CprKinError(f"IkSettings.{name} = {value!r} must be a number in (0, 10]")
 
 
-def _descend(
-    robot: Robot, target: IkTarget, q: FloatArray, free: NDArray[np.bool_], settings: IkSettings
-) -> FloatArray:
-    """One start's damped least squares descent, moving the ``free`` joints; the configuration it ends at.
+def descent(robot: Robot, target: IkTarget, free: NDArray[np.bool_], settings: IkSettings) -> Descent:
+    """One start's damped least-squares descent of ``target``, moving the ``free`` ``(nq,)`` joints.
 
-    It ends where the target is reached, after ``settings.iterations`` steps, or once
-    ``settings.patience`` steps in a row have not made progress.
+    The returned function takes the start ``(nq,)`` [rad, m] and returns the configuration it
+    ends at and the steps it took: it ends where the target is reached, after
+    ``settings.iterations`` steps, or once ``settings.patience`` steps in a row have not made
+    progress. It runs compiled (:mod:`cpr_kin.kinematics.ik_descent`).
     """
-    model, data, frame = robot.model, robot.data, robot.frame_id(robot.tcp_frame)
-    lower, upper = robot.limits.lower, robot.limits.upper
-    frame_type = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
-    least, stuck = math.inf, 0
-    for _ in range(settings.iterations):
-        pin.framesForwardKinematics(model, data, q)
-        placement = data.oMf[frame]
-        excess = target.excess(placement)
-        if excess <= 1.0:  # reached
-            break
-        if excess < (1.0 - PROGRESS) * least:
-            least, stuck = excess, 0
-        else:
-            stuck += 1
-            if stuck >= settings.patience:
-                break
-        jacobian = pin.computeFrameJacobian(model, data, q, frame, frame_type)
-        error = target.position - placement.translation
-        if target.rotation is not None:
-            error = np.concatenate([error, rotation_error(placement.rotation, target.rotation)])
-        else:
-            jacobian = jacobian[:3]
-        jacobian = jacobian * free  # a held joint's column is zero: it does not move
-        step = damped_step(jacobian, error, settings.damping)
-        step = np.clip(step, -settings.max_step, settings.max_step)
-        q = np.clip(q + step, lower, upper)
-    return q
+    chain, tool = ToolChain.of(robot).arrays
+    pose = target.rotation is not None
+    goal = (
+        np.array(target.position, dtype=float),
+        np.array(target.rotation if pose else np.eye(3), dtype=float),
+        np.array([target.tolerance_m, target.tolerance_rad]),
+        pose,
+    )
+    lower, upper = np.array(robot.limits.lower, dtype=float), np.array(robot.limits.upper, dtype=float)
+    rates = np.array([settings.damping, settings.max_step, PROGRESS])
+    step = (np.array(free, dtype=np.bool_), lower, upper, rates)
+    counts = (int(settings.iterations), int(settings.patience))
+    return lambda q: descend(np.array(q, dtype=float), chain, tool, goal, step, counts)
 
 
 def rotation_error(rotation: FloatArray, target: FloatArray) -> FloatArray:
@@ -189,11 +178,12 @@ def solve_ik(
     closest: pin.SE3 | None = None
     frame = robot.frame_id(robot.tcp_frame)
     draws = [seed, *rng.uniform(lower, upper, (settings.restarts, robot.nq))]
+    descend_from = descent(robot, target, free, settings)
     tried = 0
     while tried < len(draws):
         start = np.where(free, draws[tried], seed)
         tried += 1
-        q = turned_towards(_descend(robot, target, start, free, settings), seed, revolute, lower, upper)
+        q = turned_towards(descend_from(start)[0], seed, revolute, lower, upper)
         pin.framesForwardKinematics(robot.model, robot.data, q)
         placement = pin.SE3(robot.data.oMf[frame])
         if closest is None or target.excess(placement) < target.excess(closest):
