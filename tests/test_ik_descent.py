@@ -10,8 +10,8 @@ import pinocchio as pin
 import pytest
 
 import cpr_kin as ck
-from cpr_kin.kinematics.ik_descent import ToolChain, damped_solve, rotation_log
 from cpr_kin.kinematics.numerical_ik import PROGRESS, descent
+from cpr_kin.kinematics.tool_chain import ToolChain, damped_solve, rotation_log
 from cpr_kin.model.packages import example_robot
 
 FloatArray = np.ndarray

@@ -29,8 +29,9 @@ from numpy.typing import ArrayLike, NDArray
 from cpr_kin.certified.motion import path_weights
 from cpr_kin.common.errors import CprKinError, IkMissError
 from cpr_kin.kinematics.forward import frame_levers
-from cpr_kin.kinematics.ik_descent import ToolChain, descend
+from cpr_kin.kinematics.ik_descent import descend
 from cpr_kin.kinematics.ik_target import IkTarget
+from cpr_kin.kinematics.tool_chain import ToolChain
 from cpr_kin.model.robot import Robot
 
 FloatArray = NDArray[np.float64]

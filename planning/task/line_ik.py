@@ -3,7 +3,8 @@
 From the start configuration the line is walked in small steps (:data:`STEP_M`,
 :data:`STEP_RAD`): each step predicts the joints by the Jacobian's damped pseudo-inverse of
 the line's constant twist, then Newton's method with damped least squares puts the frame on
-the line's pose there, to :data:`IK_SHARE` of the tolerance, within the joint ranges. The
+the line's pose there, to :data:`IK_SHARE` of the tolerance, within the joint ranges (compiled:
+:func:`~planning.task.line_newton.newton_to_pose`). The
 samples are joined by a quintic spline in the progress ``sigma`` (C4: the jerk of the timed
 motion is continuous) and the spline's midpoints are checked against the line by forward
 kinematics; where the spline strays, the steps are halved.
@@ -25,7 +26,8 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from cpr_kin.kinematics.numerical_ik import damped_step, rotation_error
+from cpr_kin.kinematics.numerical_ik import damped_step
+from cpr_kin.kinematics.tool_chain import ToolChain
 from planning.curves.interpolating_spline import spline_through
 from planning.curves.trajectory import Trajectory
 from planning.errors import ToolLineBrokenError
@@ -37,6 +39,7 @@ from planning.task.joint_ranges import (
     joint_range,
 )
 from planning.task.line_deviation import rotation_angles
+from planning.task.line_newton import newton_to_pose
 from planning.task.tool_line import LineGeometry, LineTolerance
 
 FloatArray = NDArray[np.float64]
@@ -154,17 +157,6 @@ def _weights(tolerance: LineTolerance) -> FloatArray:
     return np.array([1.0 / tolerance.position_m] * 3 + [1.0 / tolerance.angle_rad] * 3)
 
 
-def _error(placement: pin.SE3, target: pin.SE3) -> FloatArray:
-    """``(6,)`` position and rotation error to ``target``, world-aligned [m, rad]."""
-    rotation = rotation_error(placement.rotation, target.rotation)
-    return np.concatenate([target.translation - placement.translation, rotation])
-
-
-def _size(weighted: FloatArray) -> float:
-    """The larger of the position and the rotation error, each over its tolerance."""
-    return max(float(np.linalg.norm(weighted[:3])), float(np.linalg.norm(weighted[3:])))
-
-
 def _walk(
     robot: ck.Robot,
     q: FloatArray,
@@ -182,6 +174,8 @@ def _walk(
     model, data, fid = robot.model, robot.data, robot.frame_id(frame)
     bounds = joint_range(robot, inset)
     weights = _weights(tolerance)
+    chain, tool = ToolChain.of(robot, frame).arrays
+    rules = (weights, *bounds, np.array([DAMPING, PROGRESS, IK_SHARE, NEWTON_STEPS], dtype=float))
     twist = np.concatenate([geometry.shift_m, geometry.start.rotation @ geometry.turn]) * weights
     samples, residual = [q], 0.0
     for k in range(1, len(sigma)):
@@ -191,7 +185,8 @@ def _walk(
             null_space = np.eye(len(q)) - _solve(jacobian, jacobian)
             step += away_from_limits(robot, q, null_space, limit_gain)
         guess = np.clip(q + step, *bounds)
-        found, excess = _newton(robot, fid, guess, geometry.pose(float(sigma[k])), weights, bounds)
+        target = geometry.pose(float(sigma[k]))
+        found, excess = newton_to_pose(guess, chain, tool, (target.translation, target.rotation), rules)
         jump = np.abs(found - q)
         if excess > REACH_SHARE or jump.max() > LARGEST_JOINT_STEP:
             raise ToolLineBrokenError(_why(robot, found, jump, excess, jacobian), float(sigma[k - 1]))
@@ -212,30 +207,6 @@ def _solve(jacobian: FloatArray, error: FloatArray) -> FloatArray:
     """
     size = max(float(np.sum(jacobian * jacobian)), 1.0)  # the trace of J J^T
     return damped_step(jacobian, error, DAMPING * math.sqrt(size))
-
-
-def _newton(
-    robot: ck.Robot,
-    fid: int,
-    q: FloatArray,
-    target: pin.SE3,
-    weights: FloatArray,
-    bounds: tuple[FloatArray, FloatArray],
-) -> tuple[FloatArray, float]:
-    """The configuration near ``q`` within ``bounds`` that puts the frame at ``target``, and its error."""
-    model, data = robot.model, robot.data
-    excess = math.inf
-    for _ in range(NEWTON_STEPS):
-        pin.framesForwardKinematics(model, data, q)
-        error = _error(data.oMf[fid], target) * weights
-        if _size(error) > (1.0 - PROGRESS) * excess:  # settled: the least-squares pose, not the line's
-            break
-        excess = _size(error)
-        if excess <= IK_SHARE:
-            break
-        jacobian = _jacobian(model, data, fid, q) * weights[:, None]
-        q = np.clip(q + _solve(jacobian, error), *bounds)
-    return q, excess
 
 
 def _why(robot: ck.Robot, q: FloatArray, jump: FloatArray, excess: float, jacobian: FloatArray) -> str:
@@ -273,8 +244,8 @@ def _excess(
 ) -> float:
     """The largest error of ``configurations`` from the line's poses at ``sigma``, over the tolerance.
 
-    As :func:`_size` of :func:`_error` weighted, for all at once: the rotation error's norm is
-    the relative rotation's angle.
+    As :func:`~planning.task.line_newton.newton_to_pose` measures it, for all at once: the
+    rotation error's norm is the relative rotation's angle.
     """
     poses = ck.frame_poses(robot, configurations, frame)
     on_line = geometry.start.translation + sigma[:, None] * geometry.shift_m
