@@ -107,15 +107,6 @@ def descent(robot: Robot, target: IkTarget, free: NDArray[np.bool_], settings: I
     return lambda q: descend(np.array(q, dtype=float), chain, tool, goal, step, counts)
 
 
-def rotation_error(rotation: FloatArray, target: FloatArray) -> FloatArray:
-    """``(3,)`` the rotation from ``rotation`` to ``target`` (``(3, 3)`` each), world-aligned [rad].
-
-    The logarithm of the relative rotation, in the axes of the world: what a
-    ``LOCAL_WORLD_ALIGNED`` Jacobian's angular rows move.
-    """
-    return np.asarray(rotation @ pin.log3(rotation.T @ target))
-
-
 def damped_step(jacobian: FloatArray, error: FloatArray, damping: float) -> FloatArray:
     """The damped least-squares step ``J^T (J J^T + lambda^2 I)^-1 e`` with ``lambda = damping``."""
     system = jacobian @ jacobian.T + damping**2 * np.eye(len(error))

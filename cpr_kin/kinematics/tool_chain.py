@@ -196,9 +196,8 @@ def rotation_error(
 ) -> float:
     """Write the rotation from ``tool_rot`` to ``target_rot`` in the world's axes into ``out`` ``(3,)`` [rad].
 
-    ``tool_rot @ log3(tool_rot^T target_rot)``, as
-    :func:`~cpr_kin.kinematics.numerical_ik.rotation_error`; ``relative`` ``(3, 3)`` is scratch.
-    Returns the rotation's angle [rad].
+    ``tool_rot @ log3(tool_rot^T target_rot)``: what a ``LOCAL_WORLD_ALIGNED`` Jacobian's angular
+    rows move. ``relative`` ``(3, 3)`` is scratch. Returns the rotation's angle [rad].
     """
     for r in range(3):
         for c in range(3):
