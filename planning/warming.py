@@ -2,8 +2,9 @@
 
 Planning compiles its numba kernels (or loads them from their on-disk cache) on its first
 call in a process; :func:`warm_up` moves that one-time cost out of a plan that is timed, by
-planning the bundled paper case small and a motion of the robot's own. It reads the bundled
-scene, so it sits above the pipeline and the files (docs/architecture.md).
+planning the bundled paper case small, a motion of the robot's own and a small task of a tool
+line and an upright carry. It reads the bundled scene, so it sits above the pipeline, the tasks
+and the files (docs/architecture.md).
 """
 
 from __future__ import annotations
@@ -26,9 +27,17 @@ from planning.pipeline.scene import Scene
 from planning.pipeline.target import Target
 from planning.pipeline.torques import held
 from planning.search.rrt_connect import rrt_connect
+from planning.task import Move, OrientationConstraint, ToolLine, plan_task
+from planning.task.tool_line import BASE_FRAME
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
+
+TASK_LINE_M = (0.0, 0.0, 0.02)
+"""The warm-up task's tool line: 2 cm straight up in the base frame [m] (a line a five-joint arm
+follows too, as the CPR's column lifts its tool)."""
+TASK_ANGLE_RAD = 0.1
+"""The warm-up task's upright carry: the tool's z axis within this of the start's [rad]."""
 
 
 def warm_up(robot: ck.Robot | None = None) -> float:
@@ -105,6 +114,7 @@ def _warm_own_motion(robot: ck.Robot, small: Scene) -> None:
         problem = build_problem(own, robot, threads=1)
         _estimate_durations(problem, dynamics)  # before the plan, which may find nothing
         solve(problem)
+    _warm_task(own, robot)
     # the numerical IK's descent, to the goal's tool pose from the start (a pose goal's)
     goal_tool = ck.frame_poses(robot, ends[1, first][None])[0]
     with contextlib.suppress(ck.IkMissError):
@@ -112,6 +122,19 @@ def _warm_own_motion(robot: ck.Robot, small: Scene) -> None:
     # an obstacle at the tool, so that the pairs' bounds leave it in doubt and coal decides
     tool = ck.frame_poses(robot, ends[0, first][None])[0][:3, 3]
     _query_collisions(ck.CollisionWorld(robot, [ck.Obstacle.sphere(0.05, tuple(tool))]), ends[:, first])
+
+
+def _warm_task(own: Scene, robot: ck.Robot) -> None:
+    """Plan a small task from ``own``'s start: a tool line, then an upright carry back to the start.
+
+    A task's kernels are its own (the line's Newton steps, the projection onto an orientation
+    constraint, the B-spline through a path's samples): they load, or a process that plans a
+    task would compile them (:mod:`planning.ahead_of_time` exports what the warm-up calls).
+    """
+    scene = Scene(start=own.start, goal=own.start, obstacles=own.obstacles, self_margin=0.0, name="warm-up")
+    carry = Move(goal=own.start, constraint=OrientationConstraint(("x", "y"), TASK_ANGLE_RAD))
+    with contextlib.suppress(PlanningError, NoSolutionError):
+        plan_task(scene, [ToolLine(by=TASK_LINE_M, offset_frame=BASE_FRAME), carry], robot, threads=1)
 
 
 def _estimate_durations(problem: Problem, dynamics: ck.Dynamics) -> None:

@@ -24,9 +24,9 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.interpolate import BSpline, make_interp_spline
 
 from planning.curves.arc_length import FINE, ArcLengthPath, arc_length_path
+from planning.curves.interpolating_spline import spline_through
 from planning.curves.moving_average import arc_at_times, averaged_motion, scaled_duration
 from planning.curves.path_pieces import split_at
 from planning.curves.path_timing import (
@@ -146,7 +146,7 @@ def _timed(
 def _capped(
     path: Trajectory,
     arc: ArcLengthPath,
-    parameter: BSpline,
+    parameter: Trajectory,
     smoothing: Smoothing,
     share: float,
     step_s: float,
@@ -156,11 +156,11 @@ def _capped(
     window_s = jerk_window_s(arc, profile, smoothing.limits[2])
     s = arc_at_times(profile, arc.ds, step_s)
     averaged = averaged_motion(s[:, None], window_s, step_s, smoothing.second_share)[0, :, 0]
-    u = parameter(np.clip(averaged, 0.0, arc.length[-1]))
+    u = parameter(np.clip(averaged, 0.0, arc.length[-1]))[:, 0]
     return _derivatives(path(u), step_s), np.asarray(u)
 
 
-def path_parameter(path: Trajectory, length: FloatArray) -> BSpline:
+def path_parameter(path: Trajectory, length: FloatArray) -> Trajectory:
     """``u(s)``: the path's own parameter at an arc length, a smooth (C4) interpolant.
 
     ``length`` ``(FINE,)``: the arc length at :data:`~planning.curves.arc_length.FINE` samples
@@ -170,7 +170,7 @@ def path_parameter(path: Trajectory, length: FloatArray) -> BSpline:
     """
     u = np.linspace(path.knots[0], path.knots[-1], FINE)
     rising = np.concatenate([[True], np.diff(length) > 0.0])
-    return make_interp_spline(length[rising], u[rising], k=5)
+    return spline_through(length[rising], u[rising, None])
 
 
 def _derivatives(positions: FloatArray, step_s: float) -> FloatArray:

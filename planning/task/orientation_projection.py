@@ -11,15 +11,13 @@ angle must stay within the whole allowed one.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
-import pinocchio as pin
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from cpr_kin.kinematics.numerical_ik import damped_step
+from cpr_kin.kinematics.tool_chain import ToolChain
 from planning.task.orientation import OrientationConstraint
+from planning.task.orientation_newton import project_on_constraint
 
 FloatArray = NDArray[np.float64]
 
@@ -49,8 +47,15 @@ class Projector:
     ) -> None:
         self.robot, self.frame, self.constraint, self.reference = robot, frame, constraint, reference
         self.aim_rad = AIM_SHARE * constraint.angle_rad
-        self._fid = robot.frame_id(frame)
-        self._weights = np.array([1.0 / HOLD_POSITION_M] * 3 + [1.0 / constraint.angle_rad] * 3)
+        self._chain = ToolChain.of(robot, frame).arrays
+        self._reference = np.ascontiguousarray(reference, dtype=float)
+        weights = np.array([1.0 / HOLD_POSITION_M] * 3 + [1.0 / constraint.angle_rad] * 3)
+        bounds = (np.asarray(robot.limits.lower, dtype=float), np.asarray(robot.limits.upper, dtype=float))
+        free = -1 if constraint.free_axis is None else constraint.free_axis
+        self._rules, self._rules_keeping = (
+            (weights, *bounds, np.array([self.aim_rad, free, keep, DAMPING, NEWTON_STEPS], dtype=float))
+            for keep in (0.0, 1.0)
+        )
 
     def angles(self, configurations: FloatArray) -> FloatArray:
         """``(N,)`` the constraint's angle of each of ``configurations`` ``(N, nq)`` [rad]."""
@@ -60,39 +65,8 @@ class Projector:
     def project(self, q: FloatArray, keep_position: bool = False) -> tuple[FloatArray, float]:
         """``q`` moved the least onto the manifold (see above), and its angle there [rad].
 
-        An angle above :attr:`aim_rad` means the projection did not get there.
+        An angle above :attr:`aim_rad` means the projection did not get there. Compiled:
+        :func:`~planning.task.orientation_newton.project_on_constraint`.
         """
-        robot, fid = self.robot, self._fid
-        lower, upper = robot.limits.lower, robot.limits.upper
-        rows = slice(0, 6) if keep_position else slice(3, 6)
-        where = None
-        angle = math.inf
-        q = np.asarray(q, dtype=float)
-        for step in range(NEWTON_STEPS + 1):
-            full = self._full_jacobian(q)  # and the frame's placement in data.oMf
-            placement = robot.data.oMf[fid]
-            if where is None:
-                where = placement.translation.copy()
-            error = self.constraint.error(placement.rotation, self.reference)
-            angle = float(np.linalg.norm(error))
-            if angle <= self.aim_rad or step == NEWTON_STEPS:
-                break
-            turn = error * (1.0 - 0.9 * self.aim_rad / angle)
-            target = (np.concatenate([where - placement.translation, turn]) * self._weights)[rows]
-            jacobian = (self._less_free_turn(full, placement.rotation) * self._weights[:, None])[rows]
-            size = max(float(np.sum(jacobian * jacobian)), 1.0)
-            q = np.clip(q + damped_step(jacobian, target, DAMPING * math.sqrt(size)), lower, upper)
-        return q, angle
-
-    def _full_jacobian(self, q: FloatArray) -> FloatArray:
-        """``(6, nq)`` the frame's world-aligned Jacobian at ``q`` (its placement updated on the way)."""
-        aligned = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
-        return np.array(pin.computeFrameJacobian(self.robot.model, self.robot.data, q, self._fid, aligned))
-
-    def _less_free_turn(self, jacobian: FloatArray, rotation: FloatArray) -> FloatArray:
-        """``jacobian`` with its angular rows less the turn about the free axis, if there is one."""
-        free = self.constraint.free_axis
-        if free is not None:
-            axis = rotation[:, free]
-            jacobian[3:] = (np.eye(3) - np.outer(axis, axis)) @ jacobian[3:]
-        return jacobian
+        rules = self._rules_keeping if keep_position else self._rules
+        return project_on_constraint(np.asarray(q, dtype=float), *self._chain, self._reference, rules)
