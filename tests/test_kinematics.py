@@ -1,10 +1,13 @@
 from __future__ import annotations
 
 import numpy as np
+import pinocchio as pin
 import pytest
 import yourdfpy
 
 import cpr_kin as ck
+from cpr_kin.kinematics.tool_chain import ToolChain
+from cpr_kin.model.packages import example_robot
 
 from .conftest import random_configurations
 
@@ -57,3 +60,25 @@ def test_single_equals_batch(robot: ck.Robot, rng: np.random.Generator) -> None:
 def test_batch_shape_error(robot: ck.Robot) -> None:
     with pytest.raises(ValueError, match=r"expected \(nq,\) or \(N, nq\)"):
         ck.frame_positions(robot, np.zeros((3, 4)))
+
+
+@pytest.mark.parametrize("name", ["panda", "ur5"])
+def test_every_frame_is_placed_as_pinocchio_places_it(name: str) -> None:
+    """The compiled chain against Pinocchio's own forward kinematics, every frame of the model."""
+    robot = ck.load_robot(example_robot(name))
+    configurations = ck.sampled_configurations(robot.model, 20, np.random.default_rng(3))
+    for frame in robot.model.frames:
+        fid = robot.model.getFrameId(frame.name, frame.type)
+        if robot.frame_id(frame.name) != fid:  # a name two frames share: the link's is the one named
+            continue
+        poses = ck.frame_poses(robot, configurations, frame.name)
+        for q, pose in zip(configurations, poses, strict=True):
+            pin.forwardKinematics(robot.model, robot.data, q)
+            expected = pin.updateFramePlacement(robot.model, robot.data, fid).homogeneous
+            np.testing.assert_allclose(pose, expected, atol=1e-12, rtol=0)
+
+
+def test_a_robots_chain_to_a_frame_is_made_once(robot: ck.Robot) -> None:
+    assert ToolChain.of(robot, "arm_link") is ToolChain.of(robot, "arm_link")
+    assert ToolChain.of(robot) is ToolChain.of(robot, robot.tcp_frame)
+    assert ToolChain.of(robot, "arm_link") is not ToolChain.of(robot)

@@ -5,9 +5,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
+from cpr_kin.kinematics.tool_chain import ToolChain, tool_poses
 from cpr_kin.model.robot import Robot, joint_units
 
 FloatArray = NDArray[np.float64]
@@ -26,6 +26,9 @@ def _as_batch(robot: Robot, q: ArrayLike) -> tuple[FloatArray, bool]:
 def frame_poses(robot: Robot, q: ArrayLike, frame: str | None = None) -> FloatArray:
     """Homogeneous transforms ``frame_in_world`` of ``frame`` at configuration(s) ``q``.
 
+    Compiled on the robot's chain to the frame (:func:`~cpr_kin.kinematics.tool_chain.tool_poses`):
+    Pinocchio's placements, to the rounding of their sums.
+
     Args:
         robot: the robot.
         q: one configuration ``(nq,)`` or a batch ``(N, nq)`` [rad, m].
@@ -36,13 +39,9 @@ def frame_poses(robot: Robot, q: ArrayLike, frame: str | None = None) -> FloatAr
         ``(4, 4)`` for one configuration, ``(N, 4, 4)`` for a batch.
 
     """
-    fid = robot.frame_id(robot.tcp_frame if frame is None else frame)
     batch, single = _as_batch(robot, q)
-    model, data = robot.model, robot.data
-    out = np.empty((len(batch), 4, 4))
-    for k, qk in enumerate(batch):
-        pin.forwardKinematics(model, data, qk)
-        out[k] = pin.updateFramePlacement(model, data, fid).homogeneous
+    chain, tool = ToolChain.of(robot, frame).arrays
+    out = tool_poses(np.ascontiguousarray(batch), chain, tool)
     return out[0] if single else out
 
 

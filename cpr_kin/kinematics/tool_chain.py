@@ -11,13 +11,14 @@ axes (:func:`tool_jacobian`, Pinocchio's ``LOCAL_WORLD_ALIGNED``), the logarithm
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
 from cpr_kin.bounds.batch_kinematics import ChainArrays, KinematicChain, place_joints
-from cpr_kin.common.compiled import njit_inline
+from cpr_kin.common.compiled import njit, njit_inline
 from cpr_kin.model.robot import Robot
 
 FloatArray = NDArray[np.float64]
@@ -50,9 +51,21 @@ class ToolChain:
 
     @classmethod
     def of(cls, robot: Robot, frame_name: str | None = None) -> ToolChain:
-        """The chain of ``robot``'s model to ``frame_name`` (by default :attr:`Robot.tcp_frame`)."""
+        """The chain of ``robot``'s model to ``frame_name`` (by default :attr:`Robot.tcp_frame`).
+
+        Made once per robot and frame (the robot's model does not change); its arrays are
+        shared, not to be written.
+        """
+        name = frame_name or robot.tcp_frame
+        known = _CHAINS.setdefault(robot, {})
+        if name not in known:
+            known[name] = cls._made(robot, name)
+        return known[name]
+
+    @classmethod
+    def _made(cls, robot: Robot, frame_name: str) -> ToolChain:
         model = robot.model
-        frame = model.frames[robot.frame_id(frame_name or robot.tcp_frame)]
+        frame = model.frames[robot.frame_id(frame_name)]
         parent = int(frame.parentJoint)
         moves = np.zeros(model.njoints - 1, dtype=np.bool_)
         for j in model.supports[parent]:
@@ -66,6 +79,27 @@ class ToolChain:
     def arrays(self) -> tuple[ChainArrays, ToolArrays]:
         """The chain's arrays and the tool's, as the compiled functions take them."""
         return self.chain.arrays, (self.tool_in_joint, self.moves_tool, self.joint)
+
+
+_CHAINS: weakref.WeakKeyDictionary[Robot, dict[str, ToolChain]] = weakref.WeakKeyDictionary()
+"""Each robot's chains, by frame name, for as long as the robot lives."""
+
+
+@njit
+def tool_poses(configurations: FloatArray, chain: ChainArrays, tool: ToolArrays) -> FloatArray:
+    """``(N, 4, 4)`` the tool frame's placements in the world at ``configurations`` ``(N, nq)``."""
+    joints = len(chain[0])
+    work = (np.empty((joints, 3, 3)), np.empty((joints, 3)), np.empty((4, 3)))
+    tool_rot, tool_pos = np.empty((3, 3)), np.empty(3)
+    out = np.zeros((len(configurations), 4, 4))
+    for k in range(len(configurations)):
+        place_tool(configurations[k], chain, tool, work, tool_rot, tool_pos)
+        for r in range(3):
+            for c in range(3):
+                out[k, r, c] = tool_rot[r, c]
+            out[k, r, 3] = tool_pos[r]
+        out[k, 3, 3] = 1.0
+    return out
 
 
 @njit_inline

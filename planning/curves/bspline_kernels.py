@@ -18,6 +18,8 @@ from numpy.typing import NDArray
 from cpr_kin.common.compiled import njit, njit_inline
 
 FloatArray = NDArray[np.float64]
+BasisWork = tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]
+"""Scratch of :func:`basis_derivatives`: ``ndu``, ``left``, ``right``, ``a``, ``ders``."""
 
 
 @njit_inline
@@ -39,14 +41,16 @@ def knot_span(knots: FloatArray, degree: int, n_basis: int, x: float) -> int:
 
 
 @njit_inline
-def basis_derivatives(knots: FloatArray, degree: int, span: int, x: float, count: int) -> FloatArray:
+def basis_derivatives(
+    knots: FloatArray, degree: int, span: int, x: float, count: int, work: BasisWork
+) -> FloatArray:
     """``(count + 1, degree + 1)`` the derivatives 0..``count`` at ``x`` of the span's basis functions.
 
-    Column ``j`` is the function ``span - degree + j`` (Piegl and Tiller's A2.3).
+    Column ``j`` is the function ``span - degree + j`` (Piegl and Tiller's A2.3). ``work`` is
+    :func:`basis_work`'s, written over (the view returned is its ``ders``).
     """
+    ndu, left, right, a, ders = work
     p = degree
-    ndu = np.zeros((p + 1, p + 1))
-    left, right = np.zeros(p + 1), np.zeros(p + 1)
     ndu[0, 0] = 1.0
     for j in range(1, p + 1):
         left[j] = x - knots[span + 1 - j]
@@ -58,10 +62,8 @@ def basis_derivatives(knots: FloatArray, degree: int, span: int, x: float, count
             ndu[r, j] = saved + right[r + 1] * temp
             saved = left[j - r] * temp
         ndu[j, j] = saved
-    ders = np.zeros((count + 1, p + 1))
     for j in range(p + 1):
         ders[0, j] = ndu[j, p]
-    a = np.zeros((2, p + 1))
     for r in range(p + 1):
         s1, s2 = 0, 1
         a[0, 0] = 1.0
@@ -89,6 +91,14 @@ def basis_derivatives(knots: FloatArray, degree: int, span: int, x: float, count
     return ders
 
 
+@njit_inline
+def basis_work(degree: int) -> BasisWork:
+    """Scratch arrays of :func:`basis_derivatives` for ``degree``, made once per spline."""
+    size = degree + 1
+    table, ders = np.zeros((size, size)), np.zeros((size, size))
+    return table, np.zeros(size), np.zeros(size), np.zeros((2, size)), ders
+
+
 @njit
 def interpolating_coefficients(
     knots: FloatArray, degree: int, sites: FloatArray, values: FloatArray
@@ -101,9 +111,10 @@ def interpolating_coefficients(
     n, width = len(sites), 2 * degree + 1
     band = np.zeros((n, width))
     rhs = values.copy()
+    work = basis_work(degree)
     for i in range(n):
         span = knot_span(knots, degree, n, sites[i])
-        row = basis_derivatives(knots, degree, span, sites[i], 0)
+        row = basis_derivatives(knots, degree, span, sites[i], 0, work)
         for j in range(degree + 1):
             band[i, span - degree + j - i + degree] = row[0, j]
     for col in range(n):  # forward elimination
@@ -140,11 +151,12 @@ def power_pieces(knots: FloatArray, degree: int, coefficients: FloatArray, order
         if knots[span + 1] > knots[span]:
             count += 1
     out = np.zeros((count, m, order))
+    work = basis_work(degree)
     piece = 0
     for span in range(degree, n):
         if not knots[span + 1] > knots[span]:
             continue
-        ders = basis_derivatives(knots, degree, span, knots[span], degree)
+        ders = basis_derivatives(knots, degree, span, knots[span], degree, work)
         factorial = 1.0
         for r in range(degree + 1):
             if r > 0:
