@@ -3,8 +3,9 @@
 A walk clips each sample to the joint ranges; a spline through samples that sit at a limit
 can pass it by a little, so the walk is redone within ranges brought in by twice that
 overshoot (:func:`beyond_range`, :data:`RANGE_INSETS`). On an arm with more joints than the
-tool's six directions, the Jacobian's null space pulls joints near a limit back toward the
-middle (:func:`away_from_limits`).
+tool's six directions, the Jacobian's null space pulls joints in the outer :data:`LIMIT_ZONE`
+of their range back toward the middle, by :data:`LIMIT_GAIN` of their distance from it, more
+the closer they are to the limit (the walk's pull, :mod:`planning.task.line_walk`).
 """
 
 from __future__ import annotations
@@ -38,19 +39,3 @@ def beyond_range(robot: ck.Robot, path: Trajectory) -> FloatArray:
     """``(nq,)`` how far the path passes each joint's range [rad or m] (0 within it)."""
     lower, upper = joint_range(robot)
     return np.maximum(np.maximum(lower - path.extrema(0).minimum, path.extrema(0).maximum - upper), 0.0)
-
-
-def away_from_limits(robot: ck.Robot, q: FloatArray, null_space: FloatArray, gain: float) -> FloatArray:
-    """A step in the Jacobian's null space (its projector given) moving joints near a limit to the middle.
-
-    Only a redundant arm (a Panda's seven joints for six task directions) has such a null
-    space; the tool does not move by it (to first order, the Newton steps correct the rest).
-    A joint in the outer :data:`LIMIT_ZONE` of its range is pulled toward the middle by
-    ``gain`` of its distance from it, more the closer it is to the limit.
-    """
-    lower, upper = joint_range(robot)
-    middle, half = 0.5 * (lower + upper), 0.5 * (upper - lower)
-    depth = np.clip((np.abs(q - middle) / half - (1.0 - LIMIT_ZONE)) / LIMIT_ZONE, 0.0, 1.0)
-    if not depth.any():
-        return np.zeros_like(q)
-    return np.asarray(gain * null_space @ (depth * (middle - q)))

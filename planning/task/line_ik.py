@@ -4,7 +4,7 @@ From the start configuration the line is walked in small steps (:data:`STEP_M`,
 :data:`STEP_RAD`): each step predicts the joints by the Jacobian's damped pseudo-inverse of
 the line's constant twist, then Newton's method with damped least squares puts the frame on
 the line's pose there, to :data:`IK_SHARE` of the tolerance, within the joint ranges (compiled:
-:func:`~planning.task.line_newton.newton_to_pose`). The
+:func:`~planning.task.line_walk.walk_line`). The
 samples are joined by a quintic spline in the progress ``sigma`` (C4: the jerk of the timed
 motion is continuous) and the spline's midpoints are checked against the line by forward
 kinematics; where the spline strays, the steps are halved.
@@ -26,20 +26,13 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from cpr_kin.kinematics.numerical_ik import damped_step
 from cpr_kin.kinematics.tool_chain import ToolChain
 from planning.curves.interpolating_spline import spline_through
 from planning.curves.trajectory import Trajectory
 from planning.errors import ToolLineBrokenError
-from planning.task.joint_ranges import (
-    LIMIT_GAIN,
-    RANGE_INSETS,
-    away_from_limits,
-    beyond_range,
-    joint_range,
-)
+from planning.task.joint_ranges import LIMIT_GAIN, LIMIT_ZONE, RANGE_INSETS, beyond_range, joint_range
 from planning.task.line_deviation import rotation_angles
-from planning.task.line_newton import newton_to_pose
+from planning.task.line_walk import walk_line
 from planning.task.tool_line import LineGeometry, LineTolerance
 
 FloatArray = NDArray[np.float64]
@@ -131,7 +124,7 @@ def _pulled_if_broken(
     """``walk(0)``, and where it breaks on a redundant arm, ``walk(LIMIT_GAIN)``.
 
     An arm of more joints than the tool's six directions walks again with its null space
-    pulling joints from their limits (:func:`~planning.task.joint_ranges.away_from_limits`).
+    pulling joints from their limits (:mod:`planning.task.joint_ranges`).
     Only on a break: the pull lengthens the joints' motion on lines that need none. Of two
     breaks, the one further along is raised.
     """
@@ -169,44 +162,31 @@ def _walk(
 ) -> tuple[FloatArray, float]:
     """The samples of the walk at ``sigma`` and their largest error, over the tolerance.
 
-    ``limit_gain``: of :func:`~planning.task.joint_ranges.away_from_limits`'s pull, none by default.
+    Compiled (:func:`~planning.task.line_walk.walk_line`). ``limit_gain``: the pull of joints
+    from their limits (:data:`~planning.task.joint_ranges.LIMIT_GAIN`), none by default.
     """
-    model, data, fid = robot.model, robot.data, robot.frame_id(frame)
     bounds = joint_range(robot, inset)
     weights = _weights(tolerance)
     chain, tool = ToolChain.of(robot, frame).arrays
-    rules = (weights, *bounds, np.array([DAMPING, PROGRESS, IK_SHARE, NEWTON_STEPS], dtype=float))
+    newton = (weights, *bounds, np.array([DAMPING, PROGRESS, IK_SHARE, NEWTON_STEPS], dtype=float))
     twist = np.concatenate([geometry.shift_m, geometry.start.rotation @ geometry.turn]) * weights
-    samples, residual = [q], 0.0
-    for k in range(1, len(sigma)):
-        jacobian = _jacobian(model, data, fid, q) * weights[:, None]
-        step = _solve(jacobian, twist * (sigma[k] - sigma[k - 1]))
-        if limit_gain:
-            null_space = np.eye(len(q)) - _solve(jacobian, jacobian)
-            step += away_from_limits(robot, q, null_space, limit_gain)
-        guess = np.clip(q + step, *bounds)
-        target = geometry.pose(float(sigma[k]))
-        found, excess = newton_to_pose(guess, chain, tool, (target.translation, target.rotation), rules)
-        jump = np.abs(found - q)
-        if excess > REACH_SHARE or jump.max() > LARGEST_JOINT_STEP:
-            raise ToolLineBrokenError(_why(robot, found, jump, excess, jacobian), float(sigma[k - 1]))
-        q, residual = found, max(residual, excess)
-        samples.append(q)
-    return np.array(samples), residual
+    line = (sigma, geometry.start.translation + sigma[:, None] * geometry.shift_m, geometry.rotations(sigma))
+    checks = np.array([limit_gain, LIMIT_ZONE, REACH_SHARE, LARGEST_JOINT_STEP], dtype=float)
+    walk = (twist, np.stack(joint_range(robot)), checks)
+    samples, residual, broken, found, excess = walk_line(
+        np.asarray(q, dtype=float), chain, tool, line, newton, walk
+    )
+    if broken >= 0:
+        last = samples[broken - 1]
+        jacobian = _jacobian(robot.model, robot.data, robot.frame_id(frame), last) * weights[:, None]
+        raise ToolLineBrokenError(
+            _why(robot, found, np.abs(found - last), excess, jacobian), float(sigma[broken - 1])
+        )
+    return samples, residual
 
 
 def _jacobian(model: object, data: object, fid: int, q: FloatArray) -> FloatArray:
     return np.asarray(pin.computeFrameJacobian(model, data, q, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED))
-
-
-def _solve(jacobian: FloatArray, error: FloatArray) -> FloatArray:
-    """The damped least-squares step, its damping :data:`DAMPING` of the Jacobian's size.
-
-    :func:`~cpr_kin.kinematics.numerical_ik.damped_step`, with ``lambda^2`` that share squared
-    of the trace of ``J J^T`` (at least 1).
-    """
-    size = max(float(np.sum(jacobian * jacobian)), 1.0)  # the trace of J J^T
-    return damped_step(jacobian, error, DAMPING * math.sqrt(size))
 
 
 def _why(robot: ck.Robot, q: FloatArray, jump: FloatArray, excess: float, jacobian: FloatArray) -> str:

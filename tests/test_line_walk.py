@@ -1,0 +1,132 @@
+"""The compiled walk along a tool line against the same rules written with Pinocchio and NumPy."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import cpr_kin as ck
+from cpr_kin.kinematics.numerical_ik import damped_step
+from cpr_kin.model.packages import example_robot
+from planning.errors import ToolLineBrokenError
+from planning.task import LineTolerance, ToolLine
+from planning.task.joint_ranges import LIMIT_GAIN, LIMIT_ZONE, joint_range
+from planning.task.line_ik import (
+    DAMPING,
+    IK_SHARE,
+    LARGEST_JOINT_STEP,
+    NEWTON_STEPS,
+    PROGRESS,
+    REACH_SHARE,
+    _walk,
+)
+from planning.task.tool_line import BASE_FRAME, LineGeometry
+
+FloatArray = np.ndarray
+TOLERANCE = LineTolerance()
+WEIGHTS = np.array([1.0 / TOLERANCE.position_m] * 3 + [1.0 / TOLERANCE.angle_rad] * 3)
+
+
+def solve(jacobian: FloatArray, error: FloatArray) -> FloatArray:
+    size = max(float(np.sum(jacobian * jacobian)), 1.0)
+    return damped_step(jacobian, error, DAMPING * math.sqrt(size))
+
+
+def newton(
+    robot: ck.Robot, fid: int, q: FloatArray, target: pin.SE3, bounds: tuple[FloatArray, FloatArray]
+) -> tuple[FloatArray, float]:
+    """The corrector, in Pinocchio's calls (tests/test_line_newton.py holds it to the compiled one)."""
+    model, data = robot.model, robot.data
+    excess = math.inf
+    for _ in range(NEWTON_STEPS):
+        pin.framesForwardKinematics(model, data, q)
+        placement = data.oMf[fid]
+        turn = placement.rotation @ pin.log3(placement.rotation.T @ target.rotation)
+        error = np.concatenate([target.translation - placement.translation, turn]) * WEIGHTS
+        size = max(float(np.linalg.norm(error[:3])), float(np.linalg.norm(error[3:])))
+        if size > (1.0 - PROGRESS) * excess:
+            break
+        excess = size
+        if excess <= IK_SHARE:
+            break
+        jacobian = pin.computeFrameJacobian(model, data, q, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+        q = np.clip(q + solve(jacobian * WEIGHTS[:, None], error), *bounds)
+    return q, excess
+
+
+def reference_walk(
+    robot: ck.Robot, q: FloatArray, geometry: LineGeometry, sigma: FloatArray, gain: float
+) -> tuple[FloatArray, float, int]:
+    """The walk step by step: the predictor, the pull in the null space, the corrector, the stops."""
+    model, data, fid = robot.model, robot.data, robot.frame_id(robot.tcp_frame)
+    bounds = joint_range(robot)
+    lower, upper = bounds
+    middle, half = 0.5 * (lower + upper), 0.5 * (upper - lower)
+    twist = np.concatenate([geometry.shift_m, geometry.start.rotation @ geometry.turn]) * WEIGHTS
+    rotations = geometry.rotations(sigma)
+    samples, residual = [q], 0.0
+    for k in range(1, len(sigma)):
+        jacobian = pin.computeFrameJacobian(model, data, q, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+        jacobian = jacobian * WEIGHTS[:, None]
+        step = solve(jacobian, twist * (sigma[k] - sigma[k - 1]))
+        if gain:
+            depth = np.clip((np.abs(q - middle) / half - (1.0 - LIMIT_ZONE)) / LIMIT_ZONE, 0.0, 1.0)
+            null_space = np.eye(len(q)) - solve(jacobian, jacobian)
+            step += gain * null_space @ (depth * (middle - q))
+        guess = np.clip(q + step, *bounds)
+        target = pin.SE3(rotations[k], geometry.start.translation + sigma[k] * geometry.shift_m)
+        found, excess = newton(robot, fid, guess, target, bounds)
+        if excess > REACH_SHARE or np.abs(found - q).max() > LARGEST_JOINT_STEP:
+            return np.array(samples), residual, k
+        q, residual = found, max(residual, excess)
+        samples.append(q)
+    return np.array(samples), residual, -1
+
+
+ARMS = [
+    pytest.param(lambda: ck.load_cpr(), id="cpr"),
+    pytest.param(lambda: ck.load_robot(example_robot("panda")), id="panda"),
+    pytest.param(lambda: ck.load_robot(example_robot("ur5")), id="ur5"),
+]
+
+
+@pytest.mark.parametrize("gain", [0.0, LIMIT_GAIN])
+@pytest.mark.parametrize("load", ARMS)
+def test_the_compiled_walk_takes_the_reference_steps(load: object, gain: float) -> None:
+    robot = load()  # type: ignore[operator]
+    lower, upper = joint_range(robot)
+    rng = np.random.default_rng(5)
+    ends = {"whole": 0, "broken": 0}
+    for _ in range(8):
+        inside = 0.02 * (upper - lower)  # some starts in the outer zone, where the pull acts
+        q = rng.uniform(lower + inside, upper - inside)
+        start = pin.SE3(ck.frame_poses(robot, q))
+        offset = (0.0, 0.0, float(rng.choice([-1.0, 1.0]) * rng.uniform(0.05, 0.3)))
+        geometry = LineGeometry(start, ToolLine(by=offset, offset_frame=BASE_FRAME).goal(start))
+        sigma = np.linspace(0.0, 1.0, 61)
+        expected, residual_ref, broken_ref = reference_walk(robot, q, geometry, sigma, gain)
+        try:
+            samples, residual = _walk(robot, q, robot.tcp_frame, geometry, TOLERANCE, sigma, gain)
+        except ToolLineBrokenError as broken:
+            assert broken_ref > 0, "the compiled walk broke where the reference did not"
+            assert broken.fraction == sigma[broken_ref - 1]
+            ends["broken"] += 1
+            continue
+        assert broken_ref == -1, f"the reference broke at sample {broken_ref}, the compiled walk did not"
+        np.testing.assert_allclose(samples, expected, atol=1e-9)
+        assert residual == pytest.approx(residual_ref, rel=1e-6, abs=1e-12)
+        ends["whole"] += 1
+    assert ends["whole"] >= 2  # lines of 5 to 30 cm from configurations inside the ranges
+
+
+def test_the_lines_rotations_are_its_poses_rotations() -> None:
+    """The walk's targets by Rodrigues' formula, in a batch, against ``pose``'s exponential map."""
+    start = pin.SE3(pin.rpy.rpyToMatrix(0.3, -0.2, 1.1), np.array([0.4, 0.1, 0.3]))
+    goal = pin.SE3(pin.rpy.rpyToMatrix(-0.5, 0.4, 0.2), np.array([0.2, -0.1, 0.5]))
+    geometry = LineGeometry(start, goal)
+    sigma = np.linspace(0.0, 1.0, 17)
+    for s, rotation in zip(sigma, geometry.rotations(sigma), strict=True):
+        np.testing.assert_allclose(rotation, geometry.pose(float(s)).rotation, atol=1e-14)
