@@ -85,3 +85,52 @@ def test_the_compiled_projection_takes_the_reference_steps(
     held = len(axes) + (3 if keep_position else 0)
     if held <= robot.nq:  # joints enough to hold what is asked
         assert onto >= 6  # most nearby configurations reach the manifold
+
+
+def reference_steps(
+    projector: Projector, q: FloatArray, aim: FloatArray, step_m: float, range_m: float, count: int
+) -> tuple[list[FloatArray], bool, float]:
+    """The walk's steps one projection at a time, in Python (the rules of ``Projector.steps``)."""
+    radii = ck.motion_radii(projector.robot)
+
+    def distance(a: FloatArray, b: FloatArray) -> float:
+        return float(radii @ np.abs(a - b))
+
+    steps: list[FloatArray] = []
+    left, travelled = distance(q, aim), 0.0
+    while len(steps) < count and left > 1e-9 and travelled < range_m:
+        guess = aim if left <= step_m else q + (aim - q) * (step_m / left)
+        stepped, angle = projector.project(guess)
+        moved, remaining = distance(q, stepped), distance(stepped, aim)
+        if angle > projector.aim_rad or moved > 2 * step_m or remaining >= left:
+            return steps, True, travelled
+        steps.append(stepped)
+        q, left, travelled = stepped, remaining, travelled + moved
+    return steps, False, travelled
+
+
+@pytest.mark.parametrize("load", ARMS)
+def test_the_compiled_steps_are_the_projections_one_at_a_time(load: object) -> None:
+    robot = load()  # type: ignore[operator]
+    lower, upper = np.asarray(robot.limits.lower), np.asarray(robot.limits.upper)
+    rng = np.random.default_rng(13)
+    middle = rng.uniform(lower, upper)
+    rotation = ck.frame_poses(robot, middle[None])[0][:3, :3]
+    projector = Projector(
+        robot, robot.tcp_frame, OrientationConstraint(("x", "y"), math.radians(5.0)), rotation
+    )
+    radii = ck.motion_radii(robot)
+    outcomes = set()
+    for _ in range(10):
+        start, _ = projector.project(np.clip(middle + rng.normal(scale=0.1, size=robot.nq), lower, upper))
+        aim, _ = projector.project(np.clip(start + rng.normal(scale=0.3, size=robot.nq), lower, upper))
+        for count, range_m in ((16, math.inf), (64, 0.05), (2000, math.inf)):
+            expected, stuck_ref, travelled_ref = reference_steps(projector, start, aim, 0.01, range_m, count)
+            steps, stuck, travelled = projector.steps(start, aim, 0.01, range_m, count, radii)
+            assert stuck == stuck_ref and len(steps) == len(expected)
+            if expected:
+                np.testing.assert_allclose(steps, np.array(expected), atol=1e-9)
+            assert travelled == pytest.approx(travelled_ref, rel=1e-9, abs=1e-12)
+            reached = bool(expected) and float(radii @ np.abs(expected[-1] - aim)) <= 1e-9
+            outcomes.add("stuck" if stuck else "reached" if reached else "counted or ranged")
+    assert {"reached", "counted or ranged"} <= outcomes  # the walk's ends, both seen

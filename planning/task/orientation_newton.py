@@ -105,3 +105,50 @@ def project_on_constraint(
         for v in range(nq):
             q[v] = min(upper[v], max(lower[v], q[v] + change[v]))
     return q, angle
+
+
+@njit
+def project_steps(
+    q: FloatArray,
+    aim: FloatArray,
+    chain: ChainArrays,
+    tool: ToolArrays,
+    reference: FloatArray,
+    rules: ProjectionRules,
+    walk: FloatArray,
+) -> tuple[FloatArray, int, bool, float]:
+    """Up to ``count`` projected steps from ``q`` toward ``aim`` (both ``(nq,)``), and whether it got stuck.
+
+    ``walk`` is ``[step, range left, count, radii (nq)]`` (:mod:`planning.task.orientation_rrt`):
+    each step aims ``step`` [m] of robot motion (``sum_j radii_j |dq_j|``) along the straight
+    line to ``aim`` (at ``aim`` itself once it is that close) and is projected onto the
+    manifold; the walk is stuck where a projection does not get there, jumps more than twice a
+    step, or comes no closer to ``aim``. It stops after ``count`` steps, at ``aim``, or once it
+    has travelled the range left. Returns the steps ``(count, nq)`` (the first ``n`` are
+    walked), ``n``, whether it got stuck and the robot motion travelled [m].
+    """
+    step_m, range_m, count = walk[0], walk[1], int(walk[2])
+    radii = walk[3:]
+    nq = len(q)
+    steps = np.zeros((count, nq))
+    guess = np.empty(nq)
+    left, travelled, n = _distance(q, aim, radii), 0.0, 0
+    while n < count and left > 1e-9 and travelled < range_m:
+        for v in range(nq):
+            guess[v] = aim[v] if left <= step_m else q[v] + (aim[v] - q[v]) * (step_m / left)
+        stepped, angle = project_on_constraint(guess, chain, tool, reference, rules)
+        moved, remaining = _distance(q, stepped, radii), _distance(stepped, aim, radii)
+        if angle > rules[3][0] or moved > 2.0 * step_m or remaining >= left:
+            return steps, n, True, travelled
+        steps[n] = stepped
+        q, left, travelled, n = stepped, remaining, travelled + moved, n + 1
+    return steps, n, False, travelled
+
+
+@njit_inline
+def _distance(a: FloatArray, b: FloatArray, radii: FloatArray) -> float:
+    """The robot motion between ``a`` and ``b``, ``sum_j radii_j |a_j - b_j|`` [m]."""
+    total = 0.0
+    for v in range(len(a)):
+        total += radii[v] * abs(a[v] - b[v])
+    return total

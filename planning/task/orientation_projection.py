@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 import cpr_kin as ck
 from cpr_kin.kinematics.tool_chain import ToolChain
 from planning.task.orientation import OrientationConstraint
-from planning.task.orientation_newton import project_on_constraint
+from planning.task.orientation_newton import project_on_constraint, project_steps
 
 FloatArray = NDArray[np.float64]
 
@@ -70,3 +70,25 @@ class Projector:
         """
         rules = self._rules_keeping if keep_position else self._rules
         return project_on_constraint(np.asarray(q, dtype=float), *self._chain, self._reference, rules)
+
+    def steps(
+        self, q: FloatArray, aim: FloatArray, step_m: float, range_m: float, count: int, radii: FloatArray
+    ) -> tuple[FloatArray, bool, float]:
+        """Up to ``count`` steps from ``q`` toward ``aim``, each projected; whether the walk got stuck.
+
+        Each step aims ``step_m`` of robot motion (``sum_j radii_j |dq_j|`` [m]) along the
+        straight line to ``aim`` and is projected; the walk is stuck where a projection does not
+        get there, jumps more than twice a step, or comes no closer to ``aim``, and ends at
+        ``aim`` or after ``range_m`` of motion. Returns the steps ``(n, nq)``, stuck, and the
+        motion travelled [m] (:func:`~planning.task.orientation_newton.project_steps`).
+        """
+        walk = np.concatenate([[step_m, range_m, float(count)], radii])
+        steps, n, stuck, travelled = project_steps(
+            np.asarray(q, dtype=float),
+            np.asarray(aim, dtype=float),
+            *self._chain,
+            self._reference,
+            self._rules,
+            walk,
+        )
+        return steps[:n], stuck, travelled

@@ -59,27 +59,19 @@ class _Walker:
         walk ends where the deadline has passed.
         """
         steps: list[FloatArray] = []
-        q, left, travelled = start, self.distance(start, aim), 0.0
-        while left > 1e-9 and travelled < range_m and not self.deadline.passed():
-            batch: list[FloatArray] = []
-            while len(batch) < BATCH and left > 1e-9 and travelled < range_m:
-                guess = aim if left <= STEP_M else q + (aim - q) * (STEP_M / left)
-                stepped, angle = self.projector.project(guess)
-                moved, remaining = self.distance(q, stepped), self.distance(stepped, aim)
-                if angle > self.projector.aim_rad or moved > 2 * STEP_M or remaining >= left:
-                    left = 0.0  # stuck: the batch so far is the walk's end
-                    break
-                batch.append(stepped)
-                q, left, travelled = stepped, remaining, travelled + moved
-            if not batch:
-                break
-            kept = self.world.keeps_clearance(
-                np.array(batch), self.margin_m, self.self_margin_m, ordered=True
+        q, travelled = start, 0.0
+        while self.distance(q, aim) > 1e-9 and travelled < range_m and not self.deadline.passed():
+            batch, stuck, moved = self.projector.steps(
+                q, aim, STEP_M, range_m - travelled, BATCH, self.weights
             )
-            valid = int(np.argmin(kept)) if not kept.all() else len(batch)
-            steps += batch[:valid]
-            if valid < len(batch):
+            if not len(batch):
                 break
+            kept = self.world.keeps_clearance(batch, self.margin_m, self.self_margin_m, ordered=True)
+            valid = int(np.argmin(kept)) if not kept.all() else len(batch)
+            steps += list(batch[:valid])
+            if valid < len(batch) or stuck:
+                break
+            q, travelled = batch[-1], travelled + moved
         return steps
 
     def reaches(self, steps: list[FloatArray], aim: FloatArray) -> bool:
