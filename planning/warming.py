@@ -28,6 +28,8 @@ from planning.pipeline.target import Target
 from planning.pipeline.torques import held
 from planning.search.rrt_connect import rrt_connect
 from planning.task import Move, OrientationConstraint, ToolLine, plan_task
+from planning.task.orientation_projection import Projector
+from planning.task.orientation_rrt import BATCH, STEP_M
 from planning.task.tool_line import BASE_FRAME
 
 FloatArray = NDArray[np.float64]
@@ -127,14 +129,20 @@ def _warm_own_motion(robot: ck.Robot, small: Scene) -> None:
 def _warm_task(own: Scene, robot: ck.Robot) -> None:
     """Plan a small task from ``own``'s start: a tool line, then an upright carry back to the start.
 
-    A task's kernels are its own (the line's Newton steps, the projection onto an orientation
-    constraint, the B-spline through a path's samples): they load, or a process that plans a
-    task would compile them (:mod:`planning.ahead_of_time` exports what the warm-up calls).
+    A task's kernels are its own (the line's walk, the projection onto an orientation
+    constraint and the walk on its manifold, the B-spline through a path's samples): they load,
+    or a process that plans a task would compile them (:mod:`planning.ahead_of_time` exports
+    what the warm-up calls).
     """
     scene = Scene(start=own.start, goal=own.start, obstacles=own.obstacles, self_margin=0.0, name="warm-up")
-    carry = Move(goal=own.start, constraint=OrientationConstraint(("x", "y"), TASK_ANGLE_RAD))
+    constraint = OrientationConstraint(("x", "y"), TASK_ANGLE_RAD)
     with contextlib.suppress(PlanningError, NoSolutionError):
-        plan_task(scene, [ToolLine(by=TASK_LINE_M, offset_frame=BASE_FRAME), carry], robot, threads=1)
+        line = ToolLine(by=TASK_LINE_M, offset_frame=BASE_FRAME)
+        plan_task(scene, [line, Move(goal=own.start, constraint=constraint)], robot, threads=1)
+    # the carry above bends the planner's path; a carry that plans on the manifold walks it
+    q = np.asarray(own.start.configuration(robot), dtype=float)
+    projector = Projector(robot, robot.tcp_frame, constraint, ck.frame_poses(robot, q)[:3, :3])
+    projector.steps(q, q + 0.01, STEP_M, np.inf, BATCH, ck.motion_radii(robot))
 
 
 def _estimate_durations(problem: Problem, dynamics: ck.Dynamics) -> None:

@@ -68,6 +68,22 @@ def test_the_sources_digest_follows_the_kernel_files_alone(tmp_path: Path) -> No
     assert sources_digest(tmp_path / "repo", stamp, PACKAGES) != first
 
 
+def test_the_sources_digest_follows_the_warm_up_that_chooses_the_kernels(tmp_path: Path) -> None:
+    """A warm-up that calls a kernel anew must name a module yet to be built, not an older one."""
+    checkout(tmp_path / "repo")
+    planning = tmp_path / "repo" / "planning"
+    planning.mkdir()
+    (planning / "__init__.py").write_text("")
+    (planning / "warming.py").write_text("def warm_up():\n    pass\n")
+    (planning / "other.py").write_text("LIMIT = 1.0\n")
+    packages, stamp = ("pkg", "planning"), tmp_path / "stamp.txt"
+    first = sources_digest(tmp_path / "repo", stamp, packages)
+    (planning / "other.py").write_text("LIMIT = 2.0\n")
+    assert sources_digest(tmp_path / "repo", stamp, packages) == first
+    (planning / "warming.py").write_text("def warm_up():\n    f(1)\n")
+    assert sources_digest(tmp_path / "repo", stamp, packages) != first
+
+
 def test_outside_a_checkout_nothing_is_touched(tmp_path: Path) -> None:
     files = checkout(tmp_path / "repo")
     (tmp_path / "repo" / ".git").rmdir()
@@ -142,9 +158,15 @@ for kernel in gc.get_objects():
 @pytest.mark.slow
 def test_a_plan_loads_each_kernel_once() -> None:
     """Every kernel planning calls is called with one set of argument types (array layout, read-only
-    or not): each further one is another compiled version to load from disk in every new process."""
-    completed = subprocess.run(
-        [sys.executable, "-c", ONE_SPECIALISATION], capture_output=True, text=True, check=False, timeout=600
-    )
-    assert completed.returncode == 0, completed.stderr
+    or not): each further one is another compiled version to load from disk in every new process.
+
+    Counted in a process that loads the kernels from numba's disk cache, as every process after
+    the first does: one that compiles them also counts the versions of the kernels they call,
+    which live inside their callers' cached code, not in a file of their own (a first run
+    fills the cache).
+    """
+    for _ in range(2):
+        command = [sys.executable, "-c", ONE_SPECIALISATION]
+        completed = subprocess.run(command, capture_output=True, text=True, check=False, timeout=600)
+        assert completed.returncode == 0, completed.stderr
     assert completed.stdout == ""

@@ -7,8 +7,9 @@ old code when that file changes, and computes with it, silently. An installed pa
 change; in a source checkout (a ``.git`` beside the packages) :func:`forget_stale_kernels` drops
 every cached kernel of the checkout when a file that compiles one has changed, before any is
 loaded. :func:`sources_digest` names the kernels compiled ahead of time
-(:mod:`cpr_kin.common.ahead`) after the same files, so that a changed kernel is never run from
-an older build.
+(:mod:`cpr_kin.common.ahead`) after the same files and the warm-up that chooses their argument
+types, so that a changed kernel is never run from an older build, nor a kernel newly warmed
+left out of one.
 """
 
 from __future__ import annotations
@@ -23,6 +24,10 @@ PACKAGES = ("cpr_kin", "planning")
 """The packages whose files may compile a kernel."""
 KERNEL_MARK = b"common.compiled import"
 """What a file that compiles a kernel holds (its import of :mod:`cpr_kin.common.compiled`)."""
+SIGNATURE_SOURCES = ("planning/warming.py",)
+"""Files, from the checkout's root, that choose which kernels are compiled ahead of time and with
+which argument types (the warm-up the build runs): part of the digest too, so that a warm-up
+that calls a kernel anew names a module yet to be built."""
 STAMP = Path(__file__).resolve().parent / "__pycache__" / "kernel-sources.txt"
 """Where the checkout's kernel sources were last seen: their files' stat and their bytes' digest."""
 
@@ -83,12 +88,16 @@ def _digests(root: Path, stamp: Path, packages: tuple[str, ...]) -> tuple[str, s
 
 
 def _kernels_digest(files: list[str], root: Path) -> str:
-    """The SHA-256 of the paths (from ``root``) and bytes of those of ``files`` that compile a kernel."""
+    """The SHA-256 of the paths (from ``root``) and bytes of ``files`` that compile a kernel or choose them.
+
+    :data:`KERNEL_MARK` marks the first, :data:`SIGNATURE_SOURCES` names the others.
+    """
     digest = hashlib.sha256()
     for file in files:
         data = Path(file).read_bytes()
-        if KERNEL_MARK in data:
-            digest.update(os.path.relpath(file, root).encode() + b"\0" + data)
+        relative = os.path.relpath(file, root)
+        if KERNEL_MARK in data or relative.replace(os.sep, "/") in SIGNATURE_SOURCES:
+            digest.update(relative.encode() + b"\0" + data)
     return digest.hexdigest()
 
 
