@@ -22,10 +22,10 @@ from cpr_kin.kinematics.numerical_ik import solve_ik
 from cpr_kin.model.packages import example_robot
 from planning.errors import NoSolutionError, PlanningError
 from planning.io.scene_file import SceneFile, parse_scene_file
-from planning.pipeline.verification import Requirements
+from planning.pipeline.verification import Requirements, verify_trajectory
 from planning.task import Move, TaskMotion, check_task, plan_task, record_problems, task_record
 from planning.task.free_motion import free_problem
-from planning.task.held_orientation import goal_on_constraint
+from planning.task.held_orientation import _held, _held_planned, goal_on_constraint
 from planning.task.orientation import OrientationConstraint
 from planning.task.orientation_projection import Projector
 from planning.task.orientation_rrt import STEP_M, orientation_path
@@ -116,7 +116,8 @@ def test_a_constraint_the_start_breaks_is_refused_naming_the_segment() -> None:
         plan_task(read.scene, read.task)
 
 
-def test_rrt_on_the_constraint_finds_an_upright_way_around_a_post_where_the_straight_one_is_blocked() -> None:
+def around_the_post() -> tuple[ck.CollisionWorld, Projector, Requirements, np.ndarray]:
+    """A Panda's upright carry round a post, the straight way blocked: the path RRT-Connect plans on it."""
     robot = ck.load_robot(example_robot("panda"))
     post = ck.Obstacle.box((0.08, 0.08, 0.5), (0.55, 0.03, 0.25), name="post")
     world = ck.CollisionWorld(robot, [post])
@@ -133,10 +134,26 @@ def test_rrt_on_the_constraint_finds_an_upright_way_around_a_post_where_the_stra
     assert not world.keeps_clearance(straight, 0.02, 0.01).all()  # the straight way hits the post
     path = orientation_path(world, projector, ends[0], ends[1], required, np.random.default_rng(0))
     np.testing.assert_allclose(path[[0, -1]], ends, atol=1e-12)
+    return world, projector, required, path
+
+
+def test_rrt_on_the_constraint_finds_an_upright_way_around_a_post_where_the_straight_one_is_blocked() -> None:
+    world, projector, _, path = around_the_post()
     assert projector.angles(path).max() <= projector.aim_rad + 1e-9
     assert world.keeps_clearance(path, 0.02 + STEP_M, 0.01).all()
-    radii = ck.motion_radii(robot)
+    radii = ck.motion_radii(world.robot)
     assert (np.abs(np.diff(path, axis=0)) @ radii).max() <= 2 * STEP_M + 1e-9
+
+
+def test_a_path_planned_on_the_constraint_is_timed_through_its_steps_sparsely() -> None:
+    """Each step is projected on its own: a spline through all of them zigzags and must crawl."""
+    world, projector, required, path = around_the_post()
+    motion = _held_planned(world, projector, path, required)
+    every = _held(world, projector, path, required, bent=False)
+    assert len(motion.samples) < len(path) // 2
+    assert verify_trajectory(world, motion.trajectory, required).accepted
+    assert motion.deviation.angle_rad <= projector.constraint.angle_rad
+    assert motion.trajectory.duration < 0.8 * every.trajectory.duration
 
 
 def test_a_bent_path_that_cannot_be_timed_gives_way_to_one_planned_on_the_constraint(

@@ -16,6 +16,7 @@ certified angle (:func:`~planning.task.orientation.orientation_deviation`) keeps
 
 from __future__ import annotations
 
+import contextlib
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -29,7 +30,7 @@ from planning.curves.on_path_timing import time_on_path
 from planning.curves.trajectory import Trajectory
 from planning.errors import NoSolutionError, PlanningError
 from planning.pipeline.deadline import Deadline
-from planning.pipeline.verification import Requirements
+from planning.pipeline.verification import Requirements, verify_trajectory
 from planning.task.line_motion import first_blocked, why_blocked
 from planning.task.orientation import OrientationConstraint, OrientationDeviation, orientation_deviation
 from planning.task.orientation_projection import Projector
@@ -51,6 +52,12 @@ NODE_STEP_S, KNOT_HALVINGS = 0.1, 4
 """The timing's knot spacing [s], and how often it may be halved to keep the constraint."""
 PROBE_STEP = 0.05
 """Largest move of a joint between two samples of a goal's probe [rad or m] (:func:`goal_on_constraint`)."""
+SPARSER = (16, 4)
+"""Every how many steps of a path planned on the constraint a spline is tried through before one
+through them all, sparsest first. Each step is projected on its own, and a spline through every
+one follows the zigzags of their projections, which the timing crawls through (docs/tuning.md,
+Tool lines). A sparser spline that leaves the constraint gets projected midpoints; one whose
+timed motion is not clear of the obstacles (certified) gives way to the next."""
 
 
 @dataclass(frozen=True)
@@ -116,6 +123,19 @@ def hold_orientation(
             planned = orientation_path(world, projector, ends[0], ends[1], required, rng, deadline)
         except NoSolutionError as failed:
             raise NoSolutionError(f"the free path bent onto the constraint: {why}; {failed}") from None
+    return _held_planned(world, projector, planned, required)
+
+
+def _held_planned(
+    world: ck.CollisionWorld, projector: Projector, planned: FloatArray, required: Requirements
+) -> HeldMotion:
+    """The path planned on the constraint, through every :data:`SPARSER`-th step where that keeps it clear."""
+    for every in SPARSER:
+        kept = planned[np.unique(np.r_[np.arange(0, len(planned), every), len(planned) - 1])]
+        with contextlib.suppress(NoSolutionError):
+            motion = _held(world, projector, kept, required, bent=False)
+            if verify_trajectory(world, motion.trajectory, required).accepted:
+                return motion
     return _held(world, projector, planned, required, bent=False)
 
 
