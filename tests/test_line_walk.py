@@ -16,14 +16,13 @@ from planning.task import LineTolerance, ToolLine
 from planning.task.joint_ranges import LIMIT_GAIN, LIMIT_ZONE, joint_range
 from planning.task.line_ik import (
     DAMPING,
-    IK_SHARE,
     LARGEST_JOINT_STEP,
-    NEWTON_STEPS,
-    PROGRESS,
     REACH_SHARE,
     _walk,
 )
 from planning.task.tool_line import BASE_FRAME, LineGeometry
+
+from .test_line_newton import reference as corrector
 
 FloatArray = np.ndarray
 TOLERANCE = LineTolerance()
@@ -33,28 +32,6 @@ WEIGHTS = np.array([1.0 / TOLERANCE.position_m] * 3 + [1.0 / TOLERANCE.angle_rad
 def solve(jacobian: FloatArray, error: FloatArray) -> FloatArray:
     size = max(float(np.sum(jacobian * jacobian)), 1.0)
     return damped_step(jacobian, error, DAMPING * math.sqrt(size))
-
-
-def newton(
-    robot: ck.Robot, fid: int, q: FloatArray, target: pin.SE3, bounds: tuple[FloatArray, FloatArray]
-) -> tuple[FloatArray, float]:
-    """The corrector, in Pinocchio's calls (tests/test_line_newton.py holds it to the compiled one)."""
-    model, data = robot.model, robot.data
-    excess = math.inf
-    for _ in range(NEWTON_STEPS):
-        pin.framesForwardKinematics(model, data, q)
-        placement = data.oMf[fid]
-        turn = placement.rotation @ pin.log3(placement.rotation.T @ target.rotation)
-        error = np.concatenate([target.translation - placement.translation, turn]) * WEIGHTS
-        size = max(float(np.linalg.norm(error[:3])), float(np.linalg.norm(error[3:])))
-        if size > (1.0 - PROGRESS) * excess:
-            break
-        excess = size
-        if excess <= IK_SHARE:
-            break
-        jacobian = pin.computeFrameJacobian(model, data, q, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
-        q = np.clip(q + solve(jacobian * WEIGHTS[:, None], error), *bounds)
-    return q, excess
 
 
 def reference_walk(
@@ -78,7 +55,7 @@ def reference_walk(
             step += gain * null_space @ (depth * (middle - q))
         guess = np.clip(q + step, *bounds)
         target = pin.SE3(rotations[k], geometry.start.translation + sigma[k] * geometry.shift_m)
-        found, excess = newton(robot, fid, guess, target, bounds)
+        found, excess = corrector(robot, robot.tcp_frame, guess, target, bounds)
         if excess > REACH_SHARE or np.abs(found - q).max() > LARGEST_JOINT_STEP:
             return np.array(samples), residual, k
         q, residual = found, max(residual, excess)

@@ -248,6 +248,21 @@ def rotation_error(
 
 
 @njit_inline
+def weighted_damping(jacobian: FloatArray, weights: FloatArray, share: float) -> float:
+    """Scale the rows of ``jacobian`` ``(6, nq)`` by ``weights`` ``(6,)`` in place; its damping.
+
+    The damping of a least-squares step on it: ``share * sqrt(max(trace(J J^T), 1))``, the
+    share of the weighted Jacobian's size.
+    """
+    trace = 0.0
+    for r in range(6):
+        for v in range(jacobian.shape[1]):
+            jacobian[r, v] *= weights[r]
+            trace += jacobian[r, v] * jacobian[r, v]
+    return share * math.sqrt(max(trace, 1.0))
+
+
+@njit_inline
 def damped_step(
     jacobian: FloatArray,
     error: FloatArray,

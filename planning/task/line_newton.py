@@ -17,7 +17,14 @@ from numpy.typing import NDArray
 
 from cpr_kin.bounds.batch_kinematics import ChainArrays
 from cpr_kin.common.compiled import njit
-from cpr_kin.kinematics.tool_chain import ToolArrays, damped_step, place_tool, rotation_error, tool_jacobian
+from cpr_kin.kinematics.tool_chain import (
+    ToolArrays,
+    damped_step,
+    place_tool,
+    rotation_error,
+    tool_jacobian,
+    weighted_damping,
+)
 
 FloatArray = NDArray[np.float64]
 PoseArrays = tuple[FloatArray, FloatArray]
@@ -66,12 +73,7 @@ def newton_to_pose(
         if excess <= settled:
             break
         tool_jacobian(chain, tool, free, work, tool_pos, jacobian)
-        trace = 0.0
-        for r in range(6):
-            for v in range(nq):
-                jacobian[r, v] *= weights[r]
-                trace += jacobian[r, v] * jacobian[r, v]
-        damped_step(jacobian, error, 6, damping * math.sqrt(max(trace, 1.0)), solve_work, change)
+        damped_step(jacobian, error, 6, weighted_damping(jacobian, weights, damping), solve_work, change)
         for v in range(nq):
             q[v] = min(upper[v], max(lower[v], q[v] + change[v]))
     return q, excess

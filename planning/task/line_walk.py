@@ -11,14 +11,12 @@ or makes a joint jump ends the walk; the caller says why. The rules are those of
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numpy.typing import NDArray
 
 from cpr_kin.bounds.batch_kinematics import ChainArrays
 from cpr_kin.common.compiled import njit, njit_inline
-from cpr_kin.kinematics.tool_chain import ToolArrays, damped_step, place_tool, tool_jacobian
+from cpr_kin.kinematics.tool_chain import ToolArrays, damped_step, place_tool, tool_jacobian, weighted_damping
 from planning.task.line_newton import NewtonRules, newton_to_pose
 
 FloatArray = NDArray[np.float64]
@@ -62,12 +60,7 @@ def walk_line(
     for k in range(1, len(sigma)):
         place_tool(q, chain, tool, work, tool_rot, tool_pos)
         tool_jacobian(chain, tool, free, work, tool_pos, jacobian)
-        trace = 0.0
-        for r in range(6):
-            for v in range(nq):
-                jacobian[r, v] *= weights[r]
-                trace += jacobian[r, v] * jacobian[r, v]
-        lam = damping * math.sqrt(max(trace, 1.0))
+        lam = weighted_damping(jacobian, weights, damping)
         progress = sigma[k] - sigma[k - 1]
         for r in range(6):
             change[r] = twist[r] * progress
