@@ -52,12 +52,15 @@ NODE_STEP_S, KNOT_HALVINGS = 0.1, 4
 """The timing's knot spacing [s], and how often it may be halved to keep the constraint."""
 PROBE_STEP = 0.05
 """Largest move of a joint between two samples of a goal's probe [rad or m] (:func:`goal_on_constraint`)."""
+FEWEST_SPARSE = 8
+"""Fewest samples a sparser spline goes through (:data:`SPARSER`; a quintic needs six)."""
 SPARSER = (16, 4)
-"""Every how many steps of a path planned on the constraint a spline is tried through before one
-through them all, sparsest first. Each step is projected on its own, and a spline through every
-one follows the zigzags of their projections, which the timing crawls through (docs/tuning.md,
-Tool lines). A sparser spline that leaves the constraint gets projected midpoints; one whose
-timed motion is not clear of the obstacles (certified) gives way to the next."""
+"""Every how many samples of a path on the constraint (the free path's, bent, or the steps of one
+planned on it) a spline is tried through before one through them all, sparsest first. Each
+sample is projected on its own, and a spline through every one follows the zigzags of their
+projections, which the timing crawls through (docs/tuning.md, Tool lines). A sparser spline that
+leaves the constraint gets projected midpoints; one whose timed motion is not clear of the
+obstacles (certified) gives way to the next."""
 
 
 @dataclass(frozen=True)
@@ -116,27 +119,32 @@ def hold_orientation(
     try:
         bent = _bent(projector, _raw_samples(free))
         _refuse_blocked(world, bent, required)
-        return _held(world, projector, bent, required, bent=True)
+        return _held_sparsest(world, projector, bent, required, bent=True)
     except NoSolutionError as why:  # blocked, or it cannot be joined or timed (a corner it made)
         try:
             rng = np.random.default_rng(seed)
             planned = orientation_path(world, projector, ends[0], ends[1], required, rng, deadline)
         except NoSolutionError as failed:
             raise NoSolutionError(f"the free path bent onto the constraint: {why}; {failed}") from None
-    return _held_planned(world, projector, planned, required)
+    return _held_sparsest(world, projector, planned, required, bent=False)
 
 
-def _held_planned(
-    world: ck.CollisionWorld, projector: Projector, planned: FloatArray, required: Requirements
+def _held_sparsest(
+    world: ck.CollisionWorld, projector: Projector, samples: FloatArray, required: Requirements, bent: bool
 ) -> HeldMotion:
-    """The path planned on the constraint, through every :data:`SPARSER`-th step where that keeps it clear."""
+    """:func:`_held` through every :data:`SPARSER`-th of ``samples`` where that keeps the motion clear.
+
+    Never through fewer than :data:`FEWEST_SPARSE`.
+    """
     for every in SPARSER:
-        kept = planned[np.unique(np.r_[np.arange(0, len(planned), every), len(planned) - 1])]
+        kept = samples[np.unique(np.r_[np.arange(0, len(samples), every), len(samples) - 1])]
+        if len(kept) < FEWEST_SPARSE:
+            continue
         with contextlib.suppress(NoSolutionError):
-            motion = _held(world, projector, kept, required, bent=False)
+            motion = _held(world, projector, kept, required, bent)
             if verify_trajectory(world, motion.trajectory, required).accepted:
                 return motion
-    return _held(world, projector, planned, required, bent=False)
+    return _held(world, projector, samples, required, bent)
 
 
 def goal_on_constraint(
