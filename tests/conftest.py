@@ -150,6 +150,15 @@ def random_configurations(robot: ck.Robot, rng: np.random.Generator, n: int) -> 
     return rng.uniform(robot.limits.lower, robot.limits.upper, (n, robot.nq))
 
 
+def damped_step(jacobian: np.ndarray, error: np.ndarray, damping: float) -> np.ndarray:
+    """The damped least-squares step ``J^T (J J^T + lambda^2 I)^-1 e``, ``lambda = damping``, by NumPy.
+
+    The reference the compiled descents (``cpr_kin.kinematics.tool_chain``) are held to.
+    """
+    system = jacobian @ jacobian.T + damping**2 * np.eye(len(error))
+    return np.asarray(jacobian.T @ np.linalg.solve(system, error))
+
+
 @pytest.fixture(scope="session")
 def lines(robot: ck.Robot) -> list[tuple[np.ndarray, np.ndarray]]:
     """Start and goal pairs: the paper's, then 8 random ones in the moving joints."""

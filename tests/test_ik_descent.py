@@ -14,6 +14,8 @@ from cpr_kin.kinematics.numerical_ik import PROGRESS, descent
 from cpr_kin.kinematics.tool_chain import ToolChain, damped_solve, rotation_log
 from cpr_kin.model.packages import example_robot
 
+from .conftest import damped_step
+
 FloatArray = np.ndarray
 
 
@@ -77,8 +79,7 @@ def reference_step(
     else:
         jacobian = jacobian[:3]
     jacobian = jacobian * free
-    system = jacobian @ jacobian.T + settings.damping**2 * np.eye(len(error))
-    step = np.clip(jacobian.T @ np.linalg.solve(system, error), -settings.max_step, settings.max_step)
+    step = np.clip(damped_step(jacobian, error, settings.damping), -settings.max_step, settings.max_step)
     return np.asarray(np.clip(q + step, robot.limits.lower, robot.limits.upper))
 
 

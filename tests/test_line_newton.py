@@ -9,12 +9,13 @@ import pinocchio as pin
 import pytest
 
 import cpr_kin as ck
-from cpr_kin.kinematics.numerical_ik import damped_step
 from cpr_kin.kinematics.tool_chain import ToolChain
 from cpr_kin.model.packages import example_robot
 from planning.task import LineTolerance
 from planning.task.line_ik import DAMPING, IK_SHARE, NEWTON_STEPS, PROGRESS
 from planning.task.line_newton import newton_to_pose
+
+from .conftest import damped_step
 
 FloatArray = np.ndarray
 TOLERANCE = LineTolerance()

@@ -9,7 +9,6 @@ import pinocchio as pin
 import pytest
 
 import cpr_kin as ck
-from cpr_kin.kinematics.numerical_ik import damped_step
 from cpr_kin.model.packages import example_robot
 from planning.errors import ToolLineBrokenError
 from planning.task import LineTolerance, ToolLine
@@ -22,6 +21,7 @@ from planning.task.line_ik import (
 )
 from planning.task.tool_line import BASE_FRAME, LineGeometry
 
+from .conftest import damped_step
 from .test_line_newton import reference as corrector
 
 FloatArray = np.ndarray

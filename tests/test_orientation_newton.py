@@ -9,10 +9,11 @@ import pinocchio as pin
 import pytest
 
 import cpr_kin as ck
-from cpr_kin.kinematics.numerical_ik import damped_step
 from cpr_kin.model.packages import example_robot
 from planning.task import OrientationConstraint
 from planning.task.orientation_projection import DAMPING, HOLD_POSITION_M, NEWTON_STEPS, Projector
+
+from .conftest import damped_step
 
 FloatArray = np.ndarray
 

@@ -107,12 +107,6 @@ def descent(robot: Robot, target: IkTarget, free: NDArray[np.bool_], settings: I
     return lambda q: descend(np.array(q, dtype=float), chain, tool, goal, step, counts)
 
 
-def damped_step(jacobian: FloatArray, error: FloatArray, damping: float) -> FloatArray:
-    """The damped least-squares step ``J^T (J J^T + lambda^2 I)^-1 e`` with ``lambda = damping``."""
-    system = jacobian @ jacobian.T + damping**2 * np.eye(len(error))
-    return np.asarray(jacobian.T @ np.linalg.solve(system, error))
-
-
 def tool_reach_m(robot: Robot) -> float:
     """An upper bound of the tool frame's distance from the model's origin, in any configuration [m].
 

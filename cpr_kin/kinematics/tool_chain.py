@@ -273,9 +273,8 @@ def damped_step(
 ) -> None:
     """Write the damped least-squares step ``J^T (J J^T + damping^2 I)^-1 e`` into ``out`` ``(nq,)``.
 
-    Of the first ``rows`` rows of ``jacobian`` ``(6, nq)`` and ``error`` ``(6,)``, as
-    :func:`~cpr_kin.kinematics.numerical_ik.damped_step`; ``work`` is ``(system (6, 6),
-    solved (6,))``, scratch.
+    Of the first ``rows`` rows of ``jacobian`` ``(6, nq)`` and ``error`` ``(6,)``; ``work`` is
+    ``(system (6, 6), solved (6,))``, scratch.
     """
     system, solved = work
     nq = jacobian.shape[1]

@@ -20,7 +20,6 @@ from cpr_kin.kinematics.tool_chain import ToolArrays, damped_step, place_tool, t
 from planning.task.line_newton import NewtonRules, newton_to_pose
 
 FloatArray = NDArray[np.float64]
-IntArray = NDArray[np.int64]
 LinePoses = tuple[FloatArray, FloatArray, FloatArray]
 """The line at the walk's samples: ``sigma`` ``(K,)``, positions ``(K, 3)`` [m] and rotations
 ``(K, 3, 3)`` in the world."""
