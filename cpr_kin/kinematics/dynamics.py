@@ -2,10 +2,10 @@
 
 :func:`robot_dynamics` copies a robot's Pinocchio model, adds the payload's inertia to the
 body that carries its frame (the tool frame unless the payload names another), and keeps
-the URDF's effort limits times a safety factor. Torques are Pinocchio's recursive
-Newton-Euler algorithm (``pinocchio.rnea``): gravity, Coriolis and inertia, the payload
-included, for the planned joints (the held ones are rigid, their links part of the bodies
-that carry them).
+the URDF's effort limits times a safety factor. Torques are the recursive Newton-Euler
+algorithm (Pinocchio's ``rnea``, compiled for many states at once: :mod:`cpr_kin.kinematics.rnea`):
+gravity, Coriolis and inertia, the payload included, for the planned joints (the held ones are
+rigid, their links part of the bodies that carry them).
 
 A link the URDF gives no ``<inertial>`` is massless, as the URDF specification and
 Pinocchio take it; :attr:`Dynamics.massless_links` names those that have a collision or
@@ -22,8 +22,10 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike, NDArray
 
+from cpr_kin.bounds.batch_kinematics import ChainArrays, KinematicChain
 from cpr_kin.common.errors import CprKinError
 from cpr_kin.common.names import unprintable
+from cpr_kin.kinematics.rnea import BodiesArrays, BodyArrays, channel_torques
 from cpr_kin.shapes.obstacles import Obstacle
 
 if TYPE_CHECKING:
@@ -147,7 +149,6 @@ class Dynamics:
         payload: the payload, if any.
         torque_scale: share of the URDF's effort limits the torques may use.
         massless_links: links with a shape but no ``<inertial>`` (module docstring).
-        threads: threads of the batched torque computations.
     """
 
     joint_names: tuple[str, ...]
@@ -156,20 +157,13 @@ class Dynamics:
     payload: Payload | None = None
     torque_scale: float = 1.0
     massless_links: tuple[str, ...] = ()
-    threads: int = 1
-    _pool: Any = field(default=None, repr=False)
+    _arrays: tuple[ChainArrays, BodiesArrays, FloatArray] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "_pool", pin.ModelPool(self.model, self.threads))
         self.effort.setflags(write=False)
-
-    def __getstate__(self) -> dict[str, Any]:
-        """The fields but the model pool, which does not pickle (rebuilt on unpickling)."""
-        return {**self.__dict__, "_pool": None}
-
-    def __setstate__(self, state: dict[str, Any]) -> None:
-        self.__dict__.update(state)
-        object.__setattr__(self, "_pool", pin.ModelPool(self.model, self.threads))
+        gravity = np.array(self.model.gravity.linear, dtype=float)
+        chain = KinematicChain.from_model(self.model).arrays
+        object.__setattr__(self, "_arrays", (chain, BodyArrays.from_model(self.model).arrays, gravity))
 
     @property
     def limited(self) -> bool:
@@ -180,24 +174,13 @@ class Dynamics:
         """``(T, nq)`` joint torques [N m or N] at ``(T, nq)`` positions, velocities and accelerations.
 
         ``qd`` and ``qdd`` default to zero: the torques that hold the robot still (gravity).
-        One call of Pinocchio's batched RNEA (``rneaInParallel``, :attr:`threads`) for all ``T``.
+        Pinocchio's ``rnea`` at each state, in one compiled call for all ``T``.
         """
-        q = np.ascontiguousarray(np.atleast_2d(np.asarray(q, dtype=float)))
-        qd = (
-            np.zeros_like(q)
-            if qd is None
-            else np.ascontiguousarray(np.atleast_2d(np.asarray(qd, dtype=float)))
-        )
-        qdd = (
-            np.zeros_like(q)
-            if qdd is None
-            else np.ascontiguousarray(np.atleast_2d(np.asarray(qdd, dtype=float)))
-        )
-        out = np.empty_like(q)
-        pin.rneaInParallel(
-            self.threads, self._pool, q.T, qd.T, qdd.T, out.T
-        )  # (nq, T) views, written in place
-        return out
+        q = np.atleast_2d(np.asarray(q, dtype=float))
+        motion = [
+            np.zeros_like(q) if d is None else np.atleast_2d(np.asarray(d, dtype=float)) for d in (qd, qdd)
+        ]
+        return self._channels(q, motion[0][None], motion[1][None], with_gravity=(True,))[0]
 
     def path_terms(
         self, q: FloatArray, dq: FloatArray, ddq: FloatArray
@@ -206,24 +189,41 @@ class Dynamics:
 
         With ``qd = dq s'`` and ``qdd = dq s'' + ddq s'^2``, RNEA is affine in ``s''`` and
         ``s'^2``: ``slope = M(q) dq``, ``curve = M(q) ddq + C(q, dq) dq`` and ``offset = g(q)``
-        (Pham and Pham 2018, TOPP-RA's torque constraint).
+        (Pham and Pham 2018, TOPP-RA's torque constraint): three channels of one pass, the two
+        first without gravity.
         """
-        offset = self.torques(q)
-        slope = self.torques(q, None, dq) - offset
-        curve = self.torques(q, dq, ddq) - offset
+        q, dq, ddq = (np.atleast_2d(np.asarray(a, dtype=float)) for a in (q, dq, ddq))
+        still = np.zeros_like(q)
+        offset, slope, curve = self._channels(
+            q, np.stack([still, still, dq]), np.stack([still, dq, ddq]), with_gravity=(True, False, False)
+        )
         return slope, curve, offset
+
+    def _channels(
+        self, q: FloatArray, velocities: FloatArray, accelerations: FloatArray, with_gravity: tuple[bool, ...]
+    ) -> FloatArray:
+        """``(C, T, nq)`` :func:`~cpr_kin.kinematics.rnea.channel_torques` at ``q`` ``(T, nq)``."""
+        chain, bodies, gravity = self._arrays
+        gravities = np.array([gravity if on else np.zeros(3) for on in with_gravity])
+        out = np.empty(velocities.shape)
+        channel_torques(
+            np.ascontiguousarray(q),
+            np.ascontiguousarray(velocities),
+            np.ascontiguousarray(accelerations),
+            gravities,
+            chain,
+            bodies,
+            out,
+        )
+        return out
 
     def utilisation(self, torques: FloatArray) -> FloatArray:
         """``|torque| / effort`` per sample and joint (0 where the effort is unknown)."""
         return np.abs(torques) / self.effort
 
 
-def robot_dynamics(
-    robot: Robot, payload: Payload | None = None, torque_scale: float = 1.0, threads: int = 1
-) -> Dynamics:
+def robot_dynamics(robot: Robot, payload: Payload | None = None, torque_scale: float = 1.0) -> Dynamics:
     """The robot's :class:`Dynamics` carrying ``payload``, its efforts times ``torque_scale``.
-
-    ``threads``: threads of its batched torque computations (a process per core: 1).
 
     Raises:
         CprKinError: an unknown payload frame, or ``torque_scale`` outside :data:`TORQUE_SCALE_RANGE`.
@@ -247,5 +247,4 @@ def robot_dynamics(
         payload=payload,
         torque_scale=float(torque_scale),
         massless_links=robot.massless_links,
-        threads=max(1, int(threads)),
     )

@@ -204,7 +204,7 @@ def build_problem(
         instance_of("robot", robot, ck.Robot, "cpr_kin.Robot (load_robot, load_cpr), or None: the scene's")
     robot = scene_robot(scene, robot or scene.robot_spec().load())
     world = scene_world(scene, robot, threads)
-    dynamics = scene_dynamics(robot, scene, world.num_threads)
+    dynamics = scene_dynamics(robot, scene)
     q_start = endpoint(world, scene, "start", dynamics=dynamics)
     preferred = None if goal_test is None else goal_test(q_start)
     q_goal = endpoint(world, scene, "goal", seed_q=q_start, dynamics=dynamics, preferred=preferred)

@@ -163,16 +163,14 @@ def torque_problems(dynamics: ck.Dynamics, profile: TorqueProfile) -> list[str]:
     ]
 
 
-def scene_dynamics(robot: ck.Robot, scene: Scene, threads: int = 1) -> ck.Dynamics:
+def scene_dynamics(robot: ck.Robot, scene: Scene) -> ck.Dynamics:
     """The robot's dynamics with the scene's payload and ``torque_scale``.
-
-    ``threads``: those of its batched torque computations (the collision world's).
 
     Raises:
         PlanningError: the payload's frame is not the robot's.
     """
     try:
-        return ck.robot_dynamics(robot, scene.payload, scene.torque_scale, threads)
+        return ck.robot_dynamics(robot, scene.payload, scene.torque_scale)
     except ck.CprKinError as exc:
         raise PlanningError(f"payload: {exc}") from None
 
