@@ -180,7 +180,7 @@ class Dynamics:
         motion = [
             np.zeros_like(q) if d is None else np.atleast_2d(np.asarray(d, dtype=float)) for d in (qd, qdd)
         ]
-        return self._channels(q, motion[0][None], motion[1][None], with_gravity=(True,))[0]
+        return np.asarray(self._channels(q, motion[0][None], motion[1][None], with_gravity=(True,))[0])
 
     def path_terms(
         self, q: FloatArray, dq: FloatArray, ddq: FloatArray
