@@ -115,3 +115,17 @@ def test_unknown_efforts_do_not_limit_and_massless_links_are_named(tmp_path: Pat
     dynamics = ck.robot_dynamics(ck.load_cpr(urdf, ck.cpr_limits_path()))
     assert dynamics.limited and np.isfinite(dynamics.effort).tolist() == [True, True, True, False, False]
     assert dynamics.massless_links == ("wrist_link",)
+
+
+@pytest.mark.parametrize(
+    ("q", "qd"),
+    [(np.zeros((2, 3)), None), (np.zeros((2, 5)), np.zeros((1, 5))), (np.zeros((2, 5)), np.zeros((2, 4)))],
+)
+def test_states_of_the_wrong_shape_are_refused_naming_it(
+    robot: ck.Robot, q: np.ndarray, qd: np.ndarray | None
+) -> None:
+    dynamics = ck.robot_dynamics(robot)
+    with pytest.raises(ck.CprKinError, match=r"one shape \(T, 5\)"):
+        dynamics.torques(q, qd)
+    with pytest.raises(ck.CprKinError, match=r"one shape \(T, 5\)"):
+        dynamics.path_terms(q, np.zeros_like(q) if qd is None else qd, np.zeros_like(q))

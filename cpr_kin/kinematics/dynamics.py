@@ -175,12 +175,14 @@ class Dynamics:
 
         ``qd`` and ``qdd`` default to zero: the torques that hold the robot still (gravity).
         Pinocchio's ``rnea`` at each state, in one compiled call for all ``T``.
+
+        Raises:
+            CprKinError: states not ``(T, nq)`` alike.
         """
         q = np.atleast_2d(np.asarray(q, dtype=float))
-        motion = [
-            np.zeros_like(q) if d is None else np.atleast_2d(np.asarray(d, dtype=float)) for d in (qd, qdd)
-        ]
-        return np.asarray(self._channels(q, motion[0][None], motion[1][None], with_gravity=(True,))[0])
+        qd, qdd = (np.zeros_like(q) if d is None else d for d in (qd, qdd))
+        q, qd, qdd = self._states(q, qd, qdd)
+        return np.asarray(self._channels(q, qd[None], qdd[None], with_gravity=(True,))[0])
 
     def path_terms(
         self, q: FloatArray, dq: FloatArray, ddq: FloatArray
@@ -191,30 +193,40 @@ class Dynamics:
         ``s'^2``: ``slope = M(q) dq``, ``curve = M(q) ddq + C(q, dq) dq`` and ``offset = g(q)``
         (Pham and Pham 2018, TOPP-RA's torque constraint): three channels of one pass, the two
         first without gravity.
+
+        Raises:
+            CprKinError: states not ``(T, nq)`` alike.
         """
-        q, dq, ddq = (np.atleast_2d(np.asarray(a, dtype=float)) for a in (q, dq, ddq))
+        q, dq, ddq = self._states(q, dq, ddq)
         still = np.zeros_like(q)
         offset, slope, curve = self._channels(
             q, np.stack([still, still, dq]), np.stack([still, dq, ddq]), with_gravity=(True, False, False)
         )
         return slope, curve, offset
 
+    def _states(self, *arrays: ArrayLike) -> tuple[FloatArray, ...]:
+        """``arrays`` as ``(T, nq)`` C-ordered floats of one shape: the compiled loop reads them unchecked.
+
+        Raises:
+            CprKinError: one is not ``(T, nq)``, or not the first one's shape.
+        """
+        states = tuple(np.ascontiguousarray(np.atleast_2d(np.asarray(a, dtype=float))) for a in arrays)
+        shape = states[0].shape
+        if len(shape) != 2 or shape[1] != self.model.nq or any(a.shape != shape for a in states):
+            raise CprKinError(
+                f"torques need positions, velocities and accelerations of one shape (T, {self.model.nq}), "
+                f"a row per state; got {', '.join(str(a.shape) for a in states)}"
+            )
+        return states
+
     def _channels(
         self, q: FloatArray, velocities: FloatArray, accelerations: FloatArray, with_gravity: tuple[bool, ...]
     ) -> FloatArray:
-        """``(C, T, nq)`` :func:`~cpr_kin.kinematics.rnea.channel_torques` at ``q`` ``(T, nq)``."""
+        """``(C, T, nq)`` :func:`~cpr_kin.kinematics.rnea.channel_torques` at ``q`` (:meth:`_states`)."""
         chain, bodies, gravity = self._arrays
         gravities = np.array([gravity if on else np.zeros(3) for on in with_gravity])
         out = np.empty(velocities.shape)
-        channel_torques(
-            np.ascontiguousarray(q),
-            np.ascontiguousarray(velocities),
-            np.ascontiguousarray(accelerations),
-            gravities,
-            chain,
-            bodies,
-            out,
-        )
+        channel_torques(q, velocities, accelerations, gravities, chain, bodies, out)
         return out
 
     def utilisation(self, torques: FloatArray) -> FloatArray:
