@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cpr_kin.bounds.batch_kinematics import ChainArrays
-from cpr_kin.common.compiled import njit
+from cpr_kin.common.compiled import njit, njit_inline
 
 FloatArray = NDArray[np.float64]
 BodiesArrays = tuple[FloatArray, FloatArray, FloatArray, FloatArray]
@@ -153,26 +153,17 @@ def channel_torques(
                     acceleration[j, 5] += z * push + w0 * s1 - w1 * s0
                     w0, w1, w2 = w0 + s0, w1 + s1, w2 + s2
                     velocity[j, 3], velocity[j, 4], velocity[j, 5] = w0, w1, w2
-                # the force I a + v x* I v; the momentum I v: (m (l - c x w), I_c w + c x its linear part)
-                m, c0, c1, c2 = mass[j], centre[j, 0], centre[j, 1], centre[j, 2]
-                h0, h1, h2 = (
-                    m * (l0 - (c1 * w2 - c2 * w1)),
-                    m * (l1 - (c2 * w0 - c0 * w2)),
-                    m * (l2 - (c0 * w1 - c1 * w0)),
+                # the force I a + v x* I v, I the body's spatial inertia (its mass, centre and inertia)
+                body = (mass[j], centre[j, 0], centre[j, 1], centre[j, 2])
+                rotational = (
+                    (inertia[j, 0, 0], inertia[j, 0, 1], inertia[j, 0, 2]),
+                    (inertia[j, 1, 0], inertia[j, 1, 1], inertia[j, 1, 2]),
+                    (inertia[j, 2, 0], inertia[j, 2, 1], inertia[j, 2, 2]),
                 )
-                k0 = inertia[j, 0, 0] * w0 + inertia[j, 0, 1] * w1 + inertia[j, 0, 2] * w2 + c1 * h2 - c2 * h1
-                k1 = inertia[j, 1, 0] * w0 + inertia[j, 1, 1] * w1 + inertia[j, 1, 2] * w2 + c2 * h0 - c0 * h2
-                k2 = inertia[j, 2, 0] * w0 + inertia[j, 2, 1] * w1 + inertia[j, 2, 2] * w2 + c0 * h1 - c1 * h0
+                h0, h1, h2, k0, k1, k2 = _inertia_times(body, rotational, l0, l1, l2, w0, w1, w2)
                 b0, b1, b2 = acceleration[j, 0], acceleration[j, 1], acceleration[j, 2]
                 u0, u1, u2 = acceleration[j, 3], acceleration[j, 4], acceleration[j, 5]
-                f0, f1, f2 = (
-                    m * (b0 - (c1 * u2 - c2 * u1)),
-                    m * (b1 - (c2 * u0 - c0 * u2)),
-                    m * (b2 - (c0 * u1 - c1 * u0)),
-                )
-                e0 = inertia[j, 0, 0] * u0 + inertia[j, 0, 1] * u1 + inertia[j, 0, 2] * u2 + c1 * f2 - c2 * f1
-                e1 = inertia[j, 1, 0] * u0 + inertia[j, 1, 1] * u1 + inertia[j, 1, 2] * u2 + c2 * f0 - c0 * f2
-                e2 = inertia[j, 2, 0] * u0 + inertia[j, 2, 1] * u1 + inertia[j, 2, 2] * u2 + c0 * f1 - c1 * f0
+                f0, f1, f2, e0, e1, e2 = _inertia_times(body, rotational, b0, b1, b2, u0, u1, u2)
                 # v x* (h, k) = (w x h, w x k + l x h)
                 force[j, 0] = f0 + w1 * h2 - w2 * h1
                 force[j, 1] = f1 + w2 * h0 - w0 * h2
@@ -200,24 +191,38 @@ def channel_torques(
                 force[parent, 0] += n0
                 force[parent, 1] += n1
                 force[parent, 2] += n2
-                force[parent, 3] += (
-                    rotation[j, 0, 0] * e0
-                    + rotation[j, 0, 1] * e1
-                    + rotation[j, 0, 2] * e2
-                    + t1 * n2
-                    - t2 * n1
-                )
-                force[parent, 4] += (
-                    rotation[j, 1, 0] * e0
-                    + rotation[j, 1, 1] * e1
-                    + rotation[j, 1, 2] * e2
-                    + t2 * n0
-                    - t0 * n2
-                )
-                force[parent, 5] += (
-                    rotation[j, 2, 0] * e0
-                    + rotation[j, 2, 1] * e1
-                    + rotation[j, 2, 2] * e2
-                    + t0 * n1
-                    - t1 * n0
-                )
+                u0 = rotation[j, 0, 0] * e0 + rotation[j, 0, 1] * e1 + rotation[j, 0, 2] * e2
+                u1 = rotation[j, 1, 0] * e0 + rotation[j, 1, 1] * e1 + rotation[j, 1, 2] * e2
+                u2 = rotation[j, 2, 0] * e0 + rotation[j, 2, 1] * e1 + rotation[j, 2, 2] * e2
+                force[parent, 3] += u0 + t1 * n2 - t2 * n1
+                force[parent, 4] += u1 + t2 * n0 - t0 * n2
+                force[parent, 5] += u2 + t0 * n1 - t1 * n0
+
+
+@njit_inline
+def _inertia_times(
+    body: tuple[float, float, float, float],
+    rotational: tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float]],
+    l0: float,
+    l1: float,
+    l2: float,
+    w0: float,
+    w1: float,
+    w2: float,
+) -> tuple[float, float, float, float, float, float]:
+    """A body's spatial inertia times a motion ``(l, w)``: the force ``(m (l - c x w), I_c w + c x that)``.
+
+    ``body``: its mass [kg] and centre of mass ``c`` [m]; ``rotational``: ``I_c``, its rows
+    [kg m^2] (Pinocchio's ``Inertia * Motion``). Scalars only, so that inlined it costs nothing.
+    """
+    m, c0, c1, c2 = body
+    (i00, i01, i02), (i10, i11, i12), (i20, i21, i22) = rotational
+    f0, f1, f2 = (
+        m * (l0 - (c1 * w2 - c2 * w1)),
+        m * (l1 - (c2 * w0 - c0 * w2)),
+        m * (l2 - (c0 * w1 - c1 * w0)),
+    )
+    e0 = i00 * w0 + i01 * w1 + i02 * w2 + c1 * f2 - c2 * f1
+    e1 = i10 * w0 + i11 * w1 + i12 * w2 + c2 * f0 - c0 * f2
+    e2 = i20 * w0 + i21 * w1 + i22 * w2 + c0 * f1 - c1 * f0
+    return f0, f1, f2, e0, e1, e2
