@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cpr_kin.common.disk_cache import cache_folder, cached_array, cached_json
+from cpr_kin.common.disk_cache import cache_folder, cached_array, cached_json, read_array, write_array
 
 
 @pytest.fixture
@@ -68,3 +68,15 @@ def test_a_folder_that_cannot_be_written_is_no_error(tmp_path: Path, monkeypatch
     blocker.write_text("not a folder")
     monkeypatch.setenv("CPR_FIREFLY_CACHE", str(blocker / "cache"))
     assert cached_json("kind", "abc", lambda: {"v": 2}) == {"v": 2}
+    write_array("kind", "abc", np.ones(3))
+    assert read_array("kind", "abc") is None
+
+
+def test_an_array_written_is_read_back_whole_and_replaced(folder: Path) -> None:
+    assert read_array("kept", "abc") is None
+    write_array("kept", "abc", np.arange(4.0))
+    write_array("kept", "abc", np.arange(3, dtype=np.float32))
+    found = read_array("kept", "abc")
+    assert found is not None and found.dtype == np.float32
+    np.testing.assert_array_equal(found, [0.0, 1.0, 2.0])
+    assert sorted(p.name for p in (folder / "kept").iterdir()) == ["abc.npy"]  # no part left behind

@@ -10,8 +10,9 @@ The first configuration that falls in a cell has coal test the centre with a mar
 larger (and :data:`TESTED_ABOVE_M` more, so that the few margins of a plan share the answer):
 where the centre is clear, every configuration of the cell clears the margin, and the next
 ones need no coal. A cell remembers the largest margin it cleared and the smallest it did not.
-The grids are the robot's, kept across plans (:func:`~cpr_kin.collision.self_split.robot_self_screen`);
-what they gain: ``docs/tuning.md``, Kernels.
+The grids are the robot's, kept across plans (:func:`~cpr_kin.collision.self_split.robot_self_screen`)
+and, what they learned, across processes (:mod:`cpr_kin.collision.learned_cells`); what they
+gain: ``docs/tuning.md``, Kernels.
 
 Where a pair has an exact mesh (:mod:`cpr_kin.shapes.exact_pairs`), a test asked *on the meshes*
 has the meshes decide a centre the hulls do not clear, and remembers its answers apart from the
@@ -24,8 +25,8 @@ where they touch, or where one holds the other.
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -37,6 +38,7 @@ from cpr_kin.bounds.pair_cells import CLEAR, UNKNOWN, CellGrids, cell_grids, cel
 from cpr_kin.bounds.reach import GeometryReach, relative_radii
 from cpr_kin.collision.coal_pools import configure_pool, pool_collisions
 from cpr_kin.collision.decisive import coal_error_m
+from cpr_kin.collision.learned_cells import CellMemory, LearnedCells, cells_digest
 from cpr_kin.shapes.exact_meshes import ExactMesh
 from cpr_kin.shapes.exact_pairs import ExactPairs
 
@@ -71,6 +73,8 @@ class NearCells:
         exact_meshes: the robot's exact link meshes by geometry index
             (:attr:`cpr_kin.Robot.exact_meshes`), what a test on the meshes decides with
             (module docstring); default: none, the hulls decide alone.
+        kept: whether what the cells learn is kept on disk for the robot's next process
+            (:mod:`cpr_kin.collision.learned_cells`), and read from there now (default: not).
 
     Where some pair has no grid (:func:`~cpr_kin.bounds.pair_cells.cell_grids`), it clears
     nothing. ``tested`` counts the cells coal has tested.
@@ -83,6 +87,7 @@ class NearCells:
         pairs: Sequence[tuple[int, int]],
         reach: Sequence[GeometryReach] | None = None,
         exact_meshes: Mapping[int, ExactMesh] | None = None,
+        kept: bool = False,
     ) -> None:
         self.model = model
         self.geometry_model = collision_model.copy()
@@ -95,8 +100,12 @@ class NearCells:
             self.grids = cell_grids(model, radii, self._slacks())
         size = self.grids.size if self.grids is not None else 0
         self._exact = ExactPairs(self.geometry_model, exact_meshes or {})
-        hulls = _Learned(size)
-        self._learned = {False: hulls, True: _Learned(size) if self._exact else hulls}
+        digest = None
+        if kept and self.grids is not None:
+            constants = (TESTED_ABOVE_M, LEVEL_M)
+            digest = cells_digest(model, collision_model, pairs, self.grids, exact_meshes or {}, constants)
+        self.memory = CellMemory(size, bool(self._exact), digest)
+        self._learned = self.memory.kinds
         self._levels: dict[tuple[float, ...], Float32Array] = {}
         self._pools: dict[tuple[int, float], Any] = {}
         self._data = model.createData()
@@ -149,7 +158,7 @@ class NearCells:
         return self._levels[margins_m]
 
     def _states(
-        self, grids: CellGrids, batch: FloatArray, levels: Float32Array, learned: _Learned
+        self, grids: CellGrids, batch: FloatArray, levels: Float32Array, learned: LearnedCells
     ) -> tuple[IntArray, NDArray[np.int8]]:
         """:func:`cell_states` at ``levels`` ``(K,)`` [m]: cells ``(N, K)`` and states ``(N,)``."""
         cells = np.empty((len(batch), len(levels)), dtype=np.int64)
@@ -164,6 +173,7 @@ class NearCells:
         self, grids: CellGrids, k: int, level_m: float, cells: IntArray, rows: FloatArray, on_meshes: bool
     ) -> None:
         """Test pair ``k``'s ``cells`` (placed as ``rows``) at their centres, first above ``level_m`` [m]."""
+        start = time.perf_counter()
         learned = self._learned[on_meshes]
         distinct, first = np.unique(cells, return_index=True)
         centres = grids.centres(k, distinct, rows[first])
@@ -177,6 +187,7 @@ class NearCells:
             distinct, hit = distinct[hit], self._hits(k, level_m + slack_m, centres[hit], on_meshes)
             learned.cleared[distinct[~hit]] = _float32_at_most(level_m)
             learned.refused[distinct[hit]] = _float32_at_least(level_m)
+        self.memory.learned(time.perf_counter() - start)
 
     def _hits(self, k: int, margin_m: float, centres: FloatArray, on_meshes: bool) -> BoolArray:
         """``(M,)`` whether pair ``k`` may be within ``margin_m`` [m] (coal's error added) at ``centres``.
@@ -210,21 +221,3 @@ def _float32_at_most(value: float) -> np.float32:
     """The largest float32 <= ``value``."""
     rounded = np.float32(value)
     return rounded if rounded <= value else np.nextafter(rounded, np.float32(-np.inf))
-
-
-@dataclass
-class _Learned:
-    """What the cells are known to clear, on one kind of geometry (hulls, or the exact meshes).
-
-    Attributes:
-        cleared: ``(C,)`` per cell, the largest margin [m] it is known to clear.
-        refused: ``(C,)`` per cell, the smallest margin [m] it is known not to clear.
-    """
-
-    size: int
-    cleared: Float32Array = field(init=False)
-    refused: Float32Array = field(init=False)
-
-    def __post_init__(self) -> None:
-        self.cleared = np.full(self.size, -np.inf, dtype=np.float32)
-        self.refused = np.full(self.size, np.inf, dtype=np.float32)

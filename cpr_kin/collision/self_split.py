@@ -88,6 +88,7 @@ class SelfScreen:
         threshold_m: float,
         reach: Sequence[GeometryReach] | None = None,
         exact_meshes: Mapping[int, ExactMesh] | None = None,
+        kept: bool = False,
     ) -> SelfScreen:
         """The split of ``pairs`` (geometry indices of ``geometry_model``) on ``model``'s ranges.
 
@@ -95,6 +96,8 @@ class SelfScreen:
         ``reach``: each geometry's bounds (:func:`cpr_kin.bounds.reach.geometry_reach`); default:
         within ``model``'s limits. ``exact_meshes``: the robot's exact link meshes, for the near
         cells' tests on the meshes (:class:`~cpr_kin.collision.near_cells.NearCells`); default: none.
+        ``kept``: the near cells' memory is kept on disk between processes
+        (:mod:`cpr_kin.collision.learned_cells`).
         """
         probes = sampled_configurations(model, PROBES, np.random.default_rng(0))
         all_bounds = SelfPairBounds(model, geometry_model, pairs)
@@ -103,7 +106,7 @@ class SelfScreen:
         near.setflags(write=False)
         far = SelfPairBounds(model, geometry_model, [p for p, n in zip(pairs, near, strict=True) if not n])
         near_pairs = [p for p, n in zip(pairs, near, strict=True) if n]
-        cells = NearCells(model, geometry_model, near_pairs, reach, exact_meshes)
+        cells = NearCells(model, geometry_model, near_pairs, reach, exact_meshes, kept)
         return cls(all_bounds, far, near, cells)
 
 
@@ -116,12 +119,12 @@ def robot_self_screen(robot: Robot, pairs: Pairs, margin_m: float) -> SelfScreen
     """:meth:`SelfScreen.build` of ``robot``'s ``pairs`` for the self margin ``margin_m`` [m], built once.
 
     One per robot, pairs and :func:`screen_threshold`. A :class:`~cpr_kin.Robot` does not
-    change; its screens go with it.
+    change; its screens go with it, and what their near cells learn is kept on disk for the
+    robot's next process (:mod:`cpr_kin.collision.learned_cells`).
     """
     screens = _SCREENS.setdefault(robot, {})
     key = (pairs, screen_threshold(margin_m))
     if key not in screens:
-        screens[key] = SelfScreen.build(
-            robot.model, robot.collision_model, pairs, key[1], robot_reach(robot), robot.exact_meshes
-        )
+        model, reach, meshes = robot.model, robot_reach(robot), robot.exact_meshes
+        screens[key] = SelfScreen.build(model, robot.collision_model, pairs, key[1], reach, meshes, kept=True)
     return screens[key]

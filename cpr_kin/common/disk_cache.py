@@ -51,14 +51,32 @@ def cached_array(kind: str, digest: str, compute: Callable[[], NDArray[Any]]) ->
     As :func:`cached_json`: an unreadable file is computed again and replaced; an array is read
     without pickles.
     """
+    return _cached(cache_folder() / kind / f"{digest}.npy", _read_npy, _write_npy, compute)
 
-    def read(path: Path) -> NDArray[Any]:
-        found: NDArray[Any] = np.load(path, allow_pickle=False)
-        return found
 
-    return _cached(
-        cache_folder() / kind / f"{digest}.npy", read, lambda v, s: np.save(s, v, allow_pickle=False), compute
-    )
+def read_array(kind: str, digest: str) -> NDArray[Any] | None:
+    """The array kept as ``kind/digest.npy``; ``None`` where there is none or it cannot be read."""
+    with contextlib.suppress(OSError, ValueError, EOFError):
+        return _read_npy(cache_folder() / kind / f"{digest}.npy")
+    return None
+
+
+def write_array(kind: str, digest: str, value: NDArray[Any]) -> None:
+    """Keep ``value`` as ``kind/digest.npy``, whole, in place of what was there.
+
+    As :func:`cached_json` writes: a reader never sees half of it; a folder that cannot be written
+    is no error.
+    """
+    _write(cache_folder() / kind / f"{digest}.npy", value, _write_npy)
+
+
+def _read_npy(path: Path) -> NDArray[Any]:
+    found: NDArray[Any] = np.load(path, allow_pickle=False)
+    return found
+
+
+def _write_npy(value: NDArray[Any], stream: BinaryIO) -> None:
+    np.save(stream, value, allow_pickle=False)
 
 
 def _cached(
@@ -72,15 +90,20 @@ def _cached(
     Written to a temporary file of the writer's own (process and thread), then renamed: a reader
     never sees half of one. A folder that cannot be written is no error.
     """
-    with contextlib.suppress(OSError, ValueError):
+    with contextlib.suppress(OSError, ValueError, EOFError):
         found = read(path)
         if found is not None:
             return found
     value = compute()
+    _write(path, value, write)
+    return value
+
+
+def _write(path: Path, value: T, write: Callable[[T, BinaryIO], object]) -> None:
+    """``value`` written to ``path`` through a temporary file of the writer's own, then renamed."""
     with contextlib.suppress(OSError):
         path.parent.mkdir(parents=True, exist_ok=True)
         partial = path.with_suffix(f".{os.getpid()}.{threading.get_ident()}.part")  # a writer's own
         with partial.open("wb") as stream:
             write(value, stream)
         partial.replace(path)
-    return value

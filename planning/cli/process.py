@@ -19,8 +19,10 @@ the new-process row):
   only models are its file schemas. :func:`start_process` sets ``PYDANTIC_DISABLE_PLUGINS`` to
   ``__all__`` unless the environment sets it (an empty value lets every plugin load).
 - **Python's teardown.** On exit Python takes apart every module and the robot's models one by
-  one. :func:`end_process` flushes the output and ends the process at once (as mypy does), unless a
-  thread of the command still runs (then Python's own exit waits for it, as it would).
+  one. :func:`end_process` flushes the output, keeps what the robot's near cells learned
+  (:func:`cpr_kin.collision.learned_cells.keep_learned`, which Python's exit functions would
+  run) and ends the process at once (as mypy does), unless a thread of the command still runs
+  (then Python's own exit waits for it, as it would).
 
 And one it needs that a library caller does not: its output's reader may leave
 (``cpr-plan plan ... | head -1``). A write to that pipe then fails, mid-command, whenever
@@ -100,6 +102,9 @@ def end_process(code: int) -> NoReturn:
     logging = sys.modules.get("logging")  # its handlers flushed and closed, where anything logged
     if logging is not None:
         logging.shutdown()
+    learned = sys.modules.get("cpr_kin.collision.learned_cells")  # what a robot's near cells learned
+    if learned is not None:
+        learned.keep_learned()
     for stream in (sys.stdout, sys.stderr):
         with contextlib.suppress(OSError, ValueError):  # a reader gone, a stream closed: nothing to keep
             stream.flush()
