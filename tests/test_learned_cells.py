@@ -78,7 +78,7 @@ def test_another_robots_or_a_damaged_memory_is_not_read(ur5: ck.Robot, folder: P
     assert alone.tested > 0
     digest = kept.memory.digest
     assert digest is not None
-    for damaged in (np.zeros((4, 3), dtype=np.float32), np.zeros((4, kept.grids.size))):  # type: ignore[union-attr]
+    for damaged in (np.zeros((6, 3), dtype=np.float32), np.zeros((6, kept.grids.size))):  # type: ignore[union-attr]
         write_array("near-cells", digest, damaged)
         again = cells_of(ur5, pairs)
         again.clear(q, margins, on_meshes=True)
@@ -117,8 +117,9 @@ def test_learning_is_kept_once_it_adds_up(
     monkeypatch.setattr(learned_cells, "SAVE_AFTER_S", 0.0)
     cells.clear(configurations(ur5, 6), margins, on_meshes=True)
     kept = read_array("near-cells", cells.memory.digest)
-    assert kept is not None and kept.shape == (4, cells.grids.size)  # type: ignore[union-attr]
-    np.testing.assert_array_equal(kept[2], cells.memory.kinds[True].cleared)
+    assert kept is not None and kept.shape == (6, cells.grids.size)  # type: ignore[union-attr]
+    for found, known in zip(kept[3:], cells.memory.kinds[True].arrays(), strict=True):
+        np.testing.assert_array_equal(found, known)
 
 
 @pytest.mark.slow

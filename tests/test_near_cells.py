@@ -7,7 +7,8 @@ import pinocchio as pin
 import pytest
 
 import cpr_kin as ck
-from cpr_kin.bounds.pair_cells import cell_states
+from cpr_kin.bounds.pair_cells import CLEAR, cell_states
+from cpr_kin.collision.learned_cells import LearnedCells
 from cpr_kin.collision.near_cells import LEVEL_M, TESTED_ABOVE_M, NearCells
 from cpr_kin.collision.robot_reach import robot_reach
 from cpr_kin.shapes.exact_pairs import ExactPairs
@@ -60,7 +61,7 @@ def test_a_cleared_configuration_is_farther_than_its_margin_and_the_far_ones_are
     grids = cells.grids
     assert grids is not None
     found = np.empty((len(q), 2), dtype=np.int64)  # every cell, none known
-    unknown = np.full(grids.size, -np.inf, np.float32), np.full(grids.size, np.inf, np.float32)
+    unknown = LearnedCells(grids.size).arrays()  # nothing cleared, nothing refused, no centre measured
     cell_states(q, *grids.arrays(), *unknown, np.zeros(2, np.float32), found, np.empty(len(q), np.int8))
     # a configuration whose cells' centres clear the first test is cleared
     at_centres = [hull_distances(cells, grids.centres(k, found[:, k], q))[:, k] for k in range(2)]
@@ -81,6 +82,26 @@ def test_a_cell_is_tested_once_and_a_larger_margin_tests_it_again(panda: ck.Robo
     assert cells.tested == tested  # answered from memory
     cells.clear(q, [0.001 + 2 * TESTED_ABOVE_M, 0.001])
     assert cells.tested > tested
+
+
+def test_near_a_refused_cells_centre_a_configuration_clears_by_the_distance_measured_there(
+    panda: ck.Robot,
+) -> None:
+    cells = near_cells(panda, hand_pairs(panda))
+    grids = cells.grids
+    assert grids is not None
+    q = np.random.default_rng(6).uniform(panda.limits.lower, panda.limits.upper, (3000, panda.nq))
+    margins = [0.02, 0.02]  # most of the hand's cells do not clear 2 cm as a whole
+    clear = cells.clear(q, margins)
+    learned = cells.memory.kinds[False]
+    assert np.isfinite(learned.centre_m).sum() > 100  # measured where a cell was refused
+    cells_alone = LearnedCells(grids.size)
+    cells_alone.cleared[:], cells_alone.refused[:] = learned.cleared, learned.refused
+    _, states = cells._states(grids, q, cells._level(tuple(margins)), cells_alone)
+    by_centre = clear & (states != CLEAR)
+    assert by_centre.sum() > 20
+    # never clearer than coal (the oracle): each pair is at least its margin apart
+    assert np.all(hull_distances(cells, q)[clear] >= 0.02)
 
 
 def test_a_pair_without_a_grid_leaves_every_configuration_to_coal(panda: ck.Robot) -> None:

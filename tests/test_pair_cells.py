@@ -9,6 +9,7 @@ import pytest
 import cpr_kin as ck
 from cpr_kin.bounds.pair_cells import DOUBTFUL, UNKNOWN, CellGrids, cell_grids, cell_states
 from cpr_kin.bounds.reach import relative_radii
+from cpr_kin.collision.learned_cells import LearnedCells
 from cpr_kin.collision.robot_reach import robot_reach
 from planning.bench.mbm import vamp_resources
 
@@ -34,7 +35,7 @@ def grid_cells(grids: CellGrids | None, q: np.ndarray) -> tuple[np.ndarray, np.n
     assert grids is not None
     k = len(grids.offsets)
     found, states = np.empty((len(q), k), dtype=np.int64), np.empty(len(q), dtype=np.int8)
-    unknown = np.full(grids.size, -np.inf, np.float32), np.full(grids.size, np.inf, np.float32)
+    unknown = LearnedCells(grids.size).arrays()  # nothing cleared, nothing refused, no centre measured
     cell_states(q, *grids.arrays(), *unknown, np.zeros(k, np.float32), found, states)
     return found, states
 

@@ -5,8 +5,9 @@ and only by the joints between its geometries. A grid over those joints (a revol
 angle taken modulo a turn where its range is a turn or more; any other joint's range tiled
 within its limits) whose cells are ``h_j`` wide with ``sum_j r_j h_j / 2`` at most a *slack*
 holds the pair's distance, anywhere in a cell, within that slack of its distance at the cell's
-centre. What a cell is known to clear is kept by :class:`cpr_kin.collision.near_cells.NearCells`;
-:func:`cell_states` reads it for a batch of configurations.
+centre. What a cell is known to clear, and where it is not, the distance at its centre, are
+kept by :class:`cpr_kin.collision.near_cells.NearCells`; :func:`cell_states` reads them for a
+batch of configurations.
 """
 
 from __future__ import annotations
@@ -45,8 +46,10 @@ def cell_states(
     counts: IntArray,
     strides: IntArray,
     offsets: IntArray,
+    radius: FloatArray,
     cleared: Float32Array,
     refused: Float32Array,
+    centre_m: Float32Array,
     levels: Float32Array,
     cells: IntArray,
     states: NDArray[np.int8],
@@ -54,14 +57,18 @@ def cell_states(
     """Write each configuration's state into ``states`` ``(N,)`` and its cells into ``cells`` ``(N, K)``.
 
     The arguments after ``batch`` are :class:`CellGrids`' arrays, then what each cell is known
-    to clear (``cleared``, the largest margin [m]) and not (``refused``, the smallest), and the
-    margin [m] each pair must clear (``levels``). A row's cells are all written where it is
-    UNKNOWN; elsewhere those after the first DOUBTFUL pair are not.
+    to clear (``cleared``, the largest margin [m]) and not (``refused``, the smallest), a lower
+    bound of the pair's distance at the cell's centre (``centre_m`` [m], ``-inf`` where not
+    measured), and the margin [m] each pair must clear (``levels``). Where a cell does not clear
+    the margin, a configuration in it still does where the centre's bound less
+    ``sum_j r_j |q_j - c_j|`` (its offset from the centre) exceeds it. A row's cells are all
+    written where it is UNKNOWN; elsewhere those after the first DOUBTFUL pair are not.
     """
     for n in range(batch.shape[0]):
         state = np.int64(CLEAR)  # typed int64, not the constants' literal types (which pycc cannot unify)
         for k in range(joints.shape[0]):
             flat = offsets[k]
+            moved = 0.0  # how far the pair's distance may be from the centre's [m]
             for j in range(joints.shape[1]):
                 joint = joints[k, j]
                 if joint < 0:
@@ -72,9 +79,16 @@ def cell_states(
                 elif x < 0.0 or x > step[k, j] * counts[k, j]:
                     flat = -1
                     break
-                flat += min(int(x / step[k, j]), counts[k, j] - 1) * strides[k, j]
+                index = min(int(x / step[k, j]), counts[k, j] - 1)
+                flat += index * strides[k, j]
+                moved += radius[k, j] * abs(x - (index + 0.5) * step[k, j])
             cells[n, k] = flat
-            if flat < 0 or refused[flat] <= levels[k]:
+            if flat < 0:
+                state = np.int64(DOUBTFUL)
+                break
+            if refused[flat] <= levels[k]:
+                if centre_m[flat] - moved > levels[k]:
+                    continue  # this configuration, near the centre, clears it
                 state = np.int64(DOUBTFUL)
                 break
             if cleared[flat] < levels[k]:
@@ -95,6 +109,8 @@ class CellGrids:
         counts: the cells along the joint.
         strides: how far apart in the flat index two cells neighbouring along the joint are.
         offsets: ``(K,)`` where the pair's cells begin in the flat index.
+        radius: how fast the pair's distance may change with the joint [m/rad, m/m]
+            (:func:`cpr_kin.bounds.reach.relative_radii`), 0 past the last.
         size: the cells of every grid.
     """
 
@@ -106,11 +122,15 @@ class CellGrids:
     counts: IntArray
     strides: IntArray
     offsets: IntArray
+    radius: FloatArray
     size: int
 
-    def arrays(self) -> tuple[IntArray, FloatArray, FloatArray, FloatArray, IntArray, IntArray, IntArray]:
+    def arrays(
+        self,
+    ) -> tuple[IntArray, FloatArray, FloatArray, FloatArray, IntArray, IntArray, IntArray, FloatArray]:
         """The arrays :func:`cell_states` takes after the configurations."""
-        return self.joints, self.origin, self.step, self.turn, self.counts, self.strides, self.offsets
+        grid = (self.joints, self.origin, self.step, self.turn, self.counts, self.strides, self.offsets)
+        return (*grid, self.radius)
 
     def centres(self, k: int, cells: IntArray, rows: FloatArray) -> FloatArray:
         """``rows`` ``(M, nq)`` with pair ``k``'s joints moved to the centres of its ``cells`` ``(M,)``."""
@@ -133,7 +153,7 @@ def cell_grids(model: Any, pair_radii: FloatArray, slack_m: FloatArray) -> CellG
     """
     shape = (len(pair_radii), MAX_JOINTS)
     joints, counts = np.full(shape, -1, dtype=np.int64), np.ones(shape, dtype=np.int64)
-    origin, step, turn = np.zeros(shape), np.ones(shape), np.zeros(shape)
+    origin, step, turn, radius = np.zeros(shape), np.ones(shape), np.zeros(shape), np.zeros(shape)
     offsets, size = np.zeros(shape[0], dtype=np.int64), 0
     for k, (radii, slack) in enumerate(zip(pair_radii, slack_m.tolist(), strict=True)):
         moved = np.flatnonzero(radii > 0.0).tolist()
@@ -149,9 +169,10 @@ def cell_grids(model: Any, pair_radii: FloatArray, slack_m: FloatArray) -> CellG
             counts[k, j] = math.ceil(span * len(moved) * radii[joint] / (2.0 * slack))
             joints[k, j], origin[k, j] = joint, 0.0 if wraps else lower
             step[k, j], turn[k, j] = span / counts[k, j], 2.0 * math.pi if wraps else 0.0
+            radius[k, j] = radii[joint]
         if math.prod(counts[k].tolist()) > MAX_CELLS:
             return None
         offsets[k], size = size, size + math.prod(counts[k].tolist())
     strides = np.cumprod(counts[:, ::-1], axis=1)[:, ::-1]  # row-major: the last joint's stride is 1
     strides = np.concatenate([strides[:, 1:], np.ones((shape[0], 1), dtype=np.int64)], axis=1)
-    return CellGrids(slack_m, joints, origin, step, turn, counts, strides, offsets, size)
+    return CellGrids(slack_m, joints, origin, step, turn, counts, strides, offsets, radius, size)

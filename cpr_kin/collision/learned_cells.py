@@ -42,7 +42,7 @@ if TYPE_CHECKING:
 
 Float32Array = NDArray[np.float32]
 
-FORMAT = b"near-cells-1"
+FORMAT = b"near-cells-2"
 """Named in the digest: a change to what a file holds makes the memories anew."""
 DECIDING_MODULES = (
     "collision/near_cells.py",
@@ -69,20 +69,29 @@ class LearnedCells:
         size: the cells.
         cleared: ``(C,)`` per cell, the largest margin [m] it is known to clear.
         refused: ``(C,)`` per cell, the smallest margin [m] it is known not to clear.
+        centre_m: ``(C,)`` per cell, a lower bound of the pair's distance at its centre [m]
+            (``-inf``: not measured; measured where the cell does not clear a margin asked).
     """
 
     size: int
     cleared: Float32Array = field(init=False)
     refused: Float32Array = field(init=False)
+    centre_m: Float32Array = field(init=False)
 
     def __post_init__(self) -> None:
         self.cleared = np.full(self.size, -np.inf, dtype=np.float32)
         self.refused = np.full(self.size, np.inf, dtype=np.float32)
+        self.centre_m = np.full(self.size, -np.inf, dtype=np.float32)
 
-    def merge(self, cleared: Float32Array, refused: Float32Array) -> None:
-        """Take in what another memory of the same cells knows (the larger cleared, the smaller refused)."""
+    def arrays(self) -> tuple[Float32Array, Float32Array, Float32Array]:
+        """``cleared``, ``refused`` and ``centre_m``: what is kept."""
+        return self.cleared, self.refused, self.centre_m
+
+    def merge(self, cleared: Float32Array, refused: Float32Array, centre_m: Float32Array) -> None:
+        """Take in what another memory of the same cells knows: the larger bounds, the smaller refused."""
         np.maximum(self.cleared, cleared, out=self.cleared)
         np.minimum(self.refused, refused, out=self.refused)
+        np.maximum(self.centre_m, centre_m, out=self.centre_m)
 
 
 class CellMemory:
@@ -120,7 +129,7 @@ class CellMemory:
         if self.digest is None or not self._changed:
             return
         self._read(self.digest)
-        stacked = np.stack([array for kind in self._distinct() for array in (kind.cleared, kind.refused)])
+        stacked = np.stack([array for kind in self._distinct() for array in kind.arrays()])
         write_array("near-cells", self.digest, stacked)
         self._unsaved_s, self._changed = 0.0, False
 
@@ -132,10 +141,11 @@ class CellMemory:
         """Merge in the memory kept on disk under ``digest``, if there is one of these cells."""
         kinds = self._distinct()
         found = read_array("near-cells", digest)
-        if found is None or found.dtype != np.float32 or found.shape != (2 * len(kinds), kinds[0].size):
+        kept = len(kinds[0].arrays())
+        if found is None or found.dtype != np.float32 or found.shape != (kept * len(kinds), kinds[0].size):
             return
         for k, kind in enumerate(kinds):
-            kind.merge(found[2 * k], found[2 * k + 1])
+            kind.merge(*found[kept * k : kept * (k + 1)])
 
 
 _LIVE: weakref.WeakSet[CellMemory] = weakref.WeakSet()

@@ -9,7 +9,9 @@ it, anywhere in a cell, within the pair's slack of its distance at the cell's ce
 The first configuration that falls in a cell has coal test the centre with a margin that much
 larger (and :data:`TESTED_ABOVE_M` more, so that the few margins of a plan share the answer):
 where the centre is clear, every configuration of the cell clears the margin, and the next
-ones need no coal. A cell remembers the largest margin it cleared and the smallest it did not.
+ones need no coal. A cell remembers the largest margin it cleared and the smallest it did not;
+where it does not clear one, the distance measured at its centre, from which a configuration
+near the centre may still clear it (:func:`~cpr_kin.bounds.pair_cells.cell_states`).
 The grids are the robot's, kept across plans (:func:`~cpr_kin.collision.self_split.robot_self_screen`)
 and, what they learned, across processes (:mod:`cpr_kin.collision.learned_cells`); what they
 gain: ``docs/tuning.md``, Kernels.
@@ -163,10 +165,8 @@ class NearCells:
         """:func:`cell_states` at ``levels`` ``(K,)`` [m]: cells ``(N, K)`` and states ``(N,)``."""
         cells = np.empty((len(batch), len(levels)), dtype=np.int64)
         states = np.empty(len(batch), dtype=np.int8)
-        arrays = grids.arrays()
-        cell_states(
-            np.ascontiguousarray(batch), *arrays, learned.cleared, learned.refused, levels, cells, states
-        )
+        known = (learned.cleared, learned.refused, learned.centre_m)
+        cell_states(np.ascontiguousarray(batch), *grids.arrays(), *known, levels, cells, states)
         return cells, states
 
     def _test(
@@ -184,10 +184,29 @@ class NearCells:
             refused = np.minimum(learned.refused[distinct[hit]], _float32_at_least(above))
             learned.refused[distinct[hit]] = refused
             slack_m = float(grids.slack_m[k])
-            distinct, hit = distinct[hit], self._hits(k, level_m + slack_m, centres[hit], on_meshes)
+            distinct, centres = distinct[hit], centres[hit]
+            hit = self._hits(k, level_m + slack_m, centres, on_meshes)
             learned.cleared[distinct[~hit]] = _float32_at_most(level_m)
             learned.refused[distinct[hit]] = _float32_at_least(level_m)
+            unmeasured = hit & np.isneginf(learned.centre_m[distinct])
+            if unmeasured.any():  # a configuration near the centre may still clear the margin
+                measured = self._centre_distances(k, centres[unmeasured], on_meshes)
+                learned.centre_m[distinct[unmeasured]] = [_float32_at_most(d) for d in measured.tolist()]
         self.memory.learned(time.perf_counter() - start)
+
+    def _centre_distances(self, k: int, centres: FloatArray, on_meshes: bool) -> FloatArray:
+        """``(M,)`` lower bounds [m] of pair ``k``'s distance at ``centres``: coal's, less its error.
+
+        On the hulls; ``on_meshes``, on the pair's meshes where it has one.
+        """
+        data, geometry_data = self._data, self._geometry_data
+        found = np.empty(len(centres))
+        for n, q in enumerate(centres):
+            pin.updateGeometryPlacements(self.model, data, self.geometry_model, geometry_data, q)
+            hull_m = pin.computeDistance(self.geometry_model, geometry_data, k).min_distance
+            exact = on_meshes and self._exact.refined[k]
+            found[n] = self._exact.distance(geometry_data, k, hull_m) if exact else hull_m
+        return found - coal_error_m(found)
 
     def _hits(self, k: int, margin_m: float, centres: FloatArray, on_meshes: bool) -> BoolArray:
         """``(M,)`` whether pair ``k`` may be within ``margin_m`` [m] (coal's error added) at ``centres``.
