@@ -78,7 +78,9 @@ def test_another_robots_or_a_damaged_memory_is_not_read(ur5: ck.Robot, folder: P
     assert alone.tested > 0
     digest = kept.memory.digest
     assert digest is not None
-    for damaged in (np.zeros((6, 3), dtype=np.float32), np.zeros((6, kept.grids.size))):  # type: ignore[union-attr]
+    size = kept.grids.size  # type: ignore[union-attr]
+    nan = np.full((6, size), np.nan, dtype=np.float32)
+    for damaged in (np.zeros((6, 3), dtype=np.float32), np.zeros((6, size)), nan):
         write_array("near-cells", digest, damaged)
         again = cells_of(ur5, pairs)
         again.clear(q, margins, on_meshes=True)

@@ -13,9 +13,10 @@ kinematic model, the pairs' shapes, placements and exact meshes, the grids and s
 code that tests (this package's deciding modules) and coal's and Pinocchio's versions. A file
 of another shape, or one that cannot be read, is an empty memory.
 
-A memory only ever skips coal where a test at a cell's centre cleared a larger margin, and a
-margin test is coal's whether its cells know it or not: what is kept changes how fast a plan
-is, never what it finds.
+A memory only ever skips coal where a test at a cell's centre cleared a larger margin, or where
+the distance measured there, less how far a configuration lies from the centre, does; a margin
+test is coal's whether its cells know it or not: what is kept changes how fast a plan is, never
+what it finds. A file holding a NaN is not read (a NaN would clear every margin).
 """
 
 from __future__ import annotations
@@ -142,7 +143,8 @@ class CellMemory:
         kinds = self._distinct()
         found = read_array("near-cells", digest)
         kept = len(kinds[0].arrays())
-        if found is None or found.dtype != np.float32 or found.shape != (kept * len(kinds), kinds[0].size):
+        shape = (kept * len(kinds), kinds[0].size)
+        if found is None or found.dtype != np.float32 or found.shape != shape or np.isnan(found).any():
             return
         for k, kind in enumerate(kinds):
             kind.merge(*found[kept * k : kept * (k + 1)])
