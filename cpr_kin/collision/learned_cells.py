@@ -173,14 +173,13 @@ def cells_digest(
     pairs: Sequence[tuple[int, int]],
     grids: CellGrids,
     exact_meshes: Mapping[int, ExactMesh],
-    constants: Sequence[float],
 ) -> str:
     """The SHA-256 naming the near cells of ``pairs`` (geometry indices of ``geometry_model``).
 
     Of: :data:`FORMAT`, coal's and Pinocchio's versions, the deciding modules' code, the model
     (its joints, placements and limits, serialised), each pair's two geometries (shape, parent
-    joint, placement) and exact meshes (triangles and placement), the grids' arrays and the
-    ``constants`` the tests add to a margin.
+    joint, placement) and exact meshes (triangles and placement) and the grids' arrays. The
+    constants a test adds to a margin are in the deciding modules' code.
     """
     digest = hashlib.sha256(FORMAT)
     digest.update(f"coal {coal.__version__} pinocchio {pin.__version__}".encode())
@@ -202,7 +201,6 @@ def cells_digest(
             digest.update(mesh.mesh_in_shape.homogeneous.tobytes())
     for array in (grids.slack_m, *grids.arrays()):
         digest.update(np.ascontiguousarray(array).tobytes())
-    digest.update(np.asarray(constants, dtype=float).tobytes())
     return digest.hexdigest()
 
 

@@ -38,6 +38,7 @@ from numpy.typing import NDArray
 from cpr_kin.bounds.batch_kinematics import sampled_configurations
 from cpr_kin.bounds.pair_cells import CLEAR, UNKNOWN, CellGrids, cell_grids, cell_states
 from cpr_kin.bounds.reach import GeometryReach, relative_radii
+from cpr_kin.collision.closest_pairs import closest_pairs
 from cpr_kin.collision.coal_pools import configure_pool, pool_collisions
 from cpr_kin.collision.decisive import coal_error_m
 from cpr_kin.collision.learned_cells import CellMemory, LearnedCells, cells_digest
@@ -104,8 +105,7 @@ class NearCells:
         self._exact = ExactPairs(self.geometry_model, exact_meshes or {})
         digest = None
         if kept and self.grids is not None:
-            constants = (TESTED_ABOVE_M, LEVEL_M)
-            digest = cells_digest(model, collision_model, pairs, self.grids, exact_meshes or {}, constants)
+            digest = cells_digest(model, collision_model, pairs, self.grids, exact_meshes or {})
         self.memory = CellMemory(size, bool(self._exact), digest)
         self._learned = self.memory.kinds
         self._levels: dict[tuple[float, ...], Float32Array] = {}
@@ -199,13 +199,9 @@ class NearCells:
 
         On the hulls; ``on_meshes``, on the pair's meshes where it has one.
         """
-        data, geometry_data = self._data, self._geometry_data
-        found = np.empty(len(centres))
-        for n, q in enumerate(centres):
-            pin.updateGeometryPlacements(self.model, data, self.geometry_model, geometry_data, q)
-            hull_m = pin.computeDistance(self.geometry_model, geometry_data, k).min_distance
-            exact = on_meshes and self._exact.refined[k]
-            found[n] = self._exact.distance(geometry_data, k, hull_m) if exact else hull_m
+        data = (self.model, self._data, self.geometry_model, self._geometry_data)
+        unbounded, pair = np.full((len(centres), 1), -np.inf), np.array([k], dtype=np.int64)
+        found, _ = closest_pairs(*data, centres, unbounded, pair, exact=self._exact if on_meshes else None)
         return found - coal_error_m(found)
 
     def _hits(self, k: int, margin_m: float, centres: FloatArray, on_meshes: bool) -> BoolArray:
