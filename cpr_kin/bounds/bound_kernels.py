@@ -183,19 +183,23 @@ def groups_below(
     obstacle_half: FloatArray,
     obstacle_reach: FloatArray,
     obstacle_extent: FloatArray,
+    blocks: tuple[IntArray, FloatArray, IntArray, IntArray],
 ) -> None:
     """Write into ``out[n, g]`` whether a pair of group ``g`` has a bound below ``threshold`` [m] at ``q[n]``.
 
     The arguments are :func:`pair_bounds`', plus each pair's group (``pair_group``, ``(P,)``
     in ``[0, G)`` for ``out`` of shape ``(N, G)``), the bounding-sphere radii of the capsules
-    (``capsule_reach``) and obstacles (``obstacle_reach``) and the half sides of a box in the
-    world's axes about each obstacle's centre that holds it (``obstacle_extent``, ``(O, 3)``).
-    A pair needs no finer bound where the capsule's sphere is farther than ``threshold`` from
-    that box along an axis (a shelf's board or a table top is thin along one), or from the
+    (``capsule_reach``) and obstacles (``obstacle_reach``), the half sides of a box in the
+    world's axes about each obstacle's centre that holds it (``obstacle_extent``, ``(O, 3)``)
+    and the pairs in blocks (:attr:`~cpr_kin.bounds.obstacle_blocks.ObstacleBlocks.arrays`).
+    A block needs no pair tested where the capsule's sphere is farther than ``threshold`` from
+    its cluster's box along an axis; a pair none where the sphere is that far from the
+    obstacle's box (a shelf's board or a table top is thin along one), or from the
     obstacle's sphere, or from a box obstacle itself (:func:`_centre_box_gap`); nor where its
     group is already below, and a configuration stops once every group is. Each test only
     skips pairs whose bound would be above ``threshold``: ``out`` is what the bounds alone give.
     """
+    block_capsule, block_box, block_start, order = blocks
     joints = len(chain[0])
     rotation, translation = np.empty((joints, 3, 3)), np.empty((joints, 3))
     world = np.empty((len(capsule_joint), 2, 3))
@@ -204,31 +208,46 @@ def groups_below(
         place_capsules(q[n], chain, capsule_joint, capsule_ends, rotation, translation, scratch, world)
         out[n, :] = False
         open_groups = out.shape[1]
-        for p in range(len(pair_capsule)):
-            group = pair_group[p]
-            if out[n, group]:
-                continue
-            c, o = pair_capsule[p], pair_obstacle[p]
-            x = 0.5 * (world[c, 0, 0] + world[c, 1, 0]) - obstacle_origin[o, 0]
-            y = 0.5 * (world[c, 0, 1] + world[c, 1, 1]) - obstacle_origin[o, 1]
-            z = 0.5 * (world[c, 0, 2] + world[c, 1, 2]) - obstacle_origin[o, 2]
+        for b in range(len(block_capsule)):
+            c = block_capsule[b]
+            mx = 0.5 * (world[c, 0, 0] + world[c, 1, 0])
+            my = 0.5 * (world[c, 0, 1] + world[c, 1, 1])
+            mz = 0.5 * (world[c, 0, 2] + world[c, 1, 2])
             slack = threshold + capsule_reach[c]
             if (
-                abs(x) > slack + obstacle_extent[o, 0]
-                or abs(y) > slack + obstacle_extent[o, 1]
-                or abs(z) > slack + obstacle_extent[o, 2]
+                mx < block_box[b, 0, 0] - slack
+                or mx > block_box[b, 1, 0] + slack
+                or my < block_box[b, 0, 1] - slack
+                or my > block_box[b, 1, 1] + slack
+                or mz < block_box[b, 0, 2] - slack
+                or mz > block_box[b, 1, 2] + slack
             ):
                 continue
-            apart = slack + obstacle_reach[o]
-            if x * x + y * y + z * z > apart * apart:
-                continue
-            if kind[o] == BOX and _centre_box_gap(x, y, z, o, obstacle_rotation, obstacle_half) > slack:
-                continue
-            bound = _segment_obstacle_bound(
-                world, c, o, kind, obstacle_rotation, obstacle_origin, obstacle_radius, obstacle_half
-            )
-            if bound - capsule_radius[c] <= threshold:
-                out[n, group] = True
-                open_groups -= 1
-                if open_groups == 0:
-                    break
+            for i in range(block_start[b], block_start[b + 1]):
+                p = order[i]
+                group = pair_group[p]
+                if out[n, group]:
+                    continue
+                o = pair_obstacle[p]
+                x, y, z = mx - obstacle_origin[o, 0], my - obstacle_origin[o, 1], mz - obstacle_origin[o, 2]
+                if (
+                    abs(x) > slack + obstacle_extent[o, 0]
+                    or abs(y) > slack + obstacle_extent[o, 1]
+                    or abs(z) > slack + obstacle_extent[o, 2]
+                ):
+                    continue
+                apart = slack + obstacle_reach[o]
+                if x * x + y * y + z * z > apart * apart:
+                    continue
+                if kind[o] == BOX and _centre_box_gap(x, y, z, o, obstacle_rotation, obstacle_half) > slack:
+                    continue
+                bound = _segment_obstacle_bound(
+                    world, c, o, kind, obstacle_rotation, obstacle_origin, obstacle_radius, obstacle_half
+                )
+                if bound - capsule_radius[c] <= threshold:
+                    out[n, group] = True
+                    open_groups -= 1
+                    if open_groups == 0:
+                        break
+            if open_groups == 0:
+                break

@@ -8,7 +8,8 @@ yes/no test (``docs/benchmarks.md``). A positive bound is at most coal's
 distance (shapes that overlap get a bound <= 0), so a configuration whose bounds all exceed
 a margin keeps it for certain: :meth:`cpr_kin.CollisionWorld.margin_violated` sends coal only
 the pairs of the others whose bound does not (:meth:`PairBounds.pairs_below`). These tests
-first compare the bounding spheres of each capsule and obstacle (most pairs are far apart);
+first compare each capsule with clusters of nearby obstacles (:mod:`cpr_kin.bounds.obstacle_blocks`),
+then the bounding spheres of each capsule and obstacle (most pairs are far apart);
 :meth:`PairBounds.any_below` stops at a configuration's first uncertain pair.
 The bounds themselves are compiled (:mod:`cpr_kin.bounds.bound_kernels`).
 """
@@ -25,6 +26,7 @@ from numpy.typing import NDArray
 from cpr_kin.bounds.batch_kinematics import KinematicChain
 from cpr_kin.bounds.bound_kernels import groups_below, pair_bounds
 from cpr_kin.bounds.capsule_fit import Capsule, fitted_capsule
+from cpr_kin.bounds.obstacle_blocks import obstacle_blocks
 from cpr_kin.bounds.obstacle_bounds import ObstacleArrays, local_box, obstacle_arrays, shape_vertices
 from cpr_kin.shapes.coal_queries import swept_radius_m
 from cpr_kin.shapes.obstacles import Obstacle
@@ -164,6 +166,7 @@ class PairBounds:
             *self._obstacles,
             obstacle_reach,
             obstacle_extent,
+            obstacle_blocks(*self._pairs, shapes.centre, obstacle_extent).arrays,
         )
 
     @property

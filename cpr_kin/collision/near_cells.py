@@ -36,7 +36,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from cpr_kin.bounds.batch_kinematics import sampled_configurations
-from cpr_kin.bounds.pair_cells import CLEAR, UNKNOWN, CellGrids, cell_grids, cell_states
+from cpr_kin.bounds.pair_cells import CLEAR, DOUBTFUL, UNKNOWN, CellGrids, cell_grids, cell_states
 from cpr_kin.bounds.reach import GeometryReach, relative_radii
 from cpr_kin.collision.closest_pairs import closest_pairs
 from cpr_kin.collision.coal_pools import configure_pool, pool_collisions
@@ -125,21 +125,30 @@ class NearCells:
         pairs' distance on their exact meshes where they have one (module docstring), else on
         the hulls.
         """
+        return np.asarray(self.states(batch, margins_m, on_meshes) == CLEAR)
+
+    def states(
+        self, batch: FloatArray, margins_m: Sequence[float], on_meshes: bool = False
+    ) -> NDArray[np.int8]:
+        """``(N,)`` :meth:`clear` as states: ``CLEAR`` (0) where it holds, nonzero elsewhere.
+
+        What a caller that wants the other rows takes (``np.flatnonzero``), in one step.
+        """
         grids = self.grids
         if grids is None:
-            return np.zeros(len(batch), dtype=bool)
+            return np.full(len(batch), DOUBTFUL, dtype=np.int8)
         learned = self._learned[on_meshes]
         levels = self._level(tuple(margins_m))
         cells, states = self._states(grids, batch, levels, learned)
-        unknown = np.flatnonzero(states == UNKNOWN)
-        if unknown.size:
+        if states.max(initial=CLEAR) == UNKNOWN:
+            unknown = np.flatnonzero(states == UNKNOWN)
             for k, level in enumerate(levels.tolist()):
                 row_cells = cells[unknown, k]
                 untested = (learned.cleared[row_cells] < level) & (learned.refused[row_cells] > level)
                 if untested.any():
                     self._test(grids, k, level, row_cells[untested], batch[unknown[untested]], on_meshes)
             cells, states = self._states(grids, batch, levels, learned)
-        return np.asarray(states == CLEAR)
+        return states
 
     def _slacks(self) -> FloatArray:
         """Each pair's slack [m]: :data:`SLACK_SHARE` of its median distance over :data:`PROBES`."""

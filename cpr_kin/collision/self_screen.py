@@ -98,13 +98,16 @@ class ScreenedSelfTest:
             _settle(hits, np.arange(len(batch)), self._coal(0, batch, ordered), ordered)
         elif self.near_pairs:  # coal where their cells are in doubt
             margins = self._coal_state.near_margins
-            doubtful = np.flatnonzero(~self._near_cells.clear(batch, margins, self._exact is not None))
+            doubtful = np.flatnonzero(self._near_cells.states(batch, margins, self._exact is not None))
             if doubtful.size:
                 _settle(hits, doubtful, self._coal(0, batch[doubtful], ordered), ordered)
         if self.far_bounds.n_pairs:
-            open_rows = np.flatnonzero(~hits)
             threshold = float(margin_m + coal_error_m(margin_m))
-            doubtful = open_rows[self.far_bounds.any_below(batch[open_rows], threshold)]
+            if hits.any():
+                open_rows = np.flatnonzero(~hits)
+                doubtful = open_rows[self.far_bounds.any_below(batch[open_rows], threshold)]
+            else:  # every row open: no copy of the batch
+                doubtful = np.flatnonzero(self.far_bounds.any_below(batch, threshold))
             if doubtful.size:
                 within = self.far_bounds(batch[doubtful], threshold) <= threshold
                 self._switch_far(np.any(within, axis=0))
