@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import threading
 import time
 from pathlib import Path
@@ -10,7 +11,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cpr_kin.common.disk_cache import cache_folder, cached_array, cached_json, read_array, write_array
+from cpr_kin.common.disk_cache import (
+    cache_folder,
+    cached_array,
+    cached_json,
+    keep_file,
+    kept_file,
+    read_array,
+    write_array,
+)
 
 
 @pytest.fixture
@@ -80,3 +89,43 @@ def test_an_array_written_is_read_back_whole_and_replaced(folder: Path) -> None:
     assert found is not None and found.dtype == np.float32
     np.testing.assert_array_equal(found, [0.0, 1.0, 2.0])
     assert sorted(p.name for p in (folder / "kept").iterdir()) == ["abc.npy"]  # no part left behind
+
+
+def test_an_array_that_is_not_valid_is_computed_again_and_replaced(folder: Path) -> None:
+    def indices(found: np.ndarray) -> bool:
+        return found.dtype == np.int64 and found.ndim == 1
+
+    write_array("kind", "abc", np.arange(3.0))  # floats where indices are kept: edited
+    np.testing.assert_array_equal(cached_array("kind", "abc", lambda: np.arange(2), indices), [0, 1])
+    found = read_array("kind", "abc")
+    assert found is not None and indices(found)
+
+
+def test_a_file_kept_is_found_and_marked_used(folder: Path) -> None:
+    assert kept_file("models", "a.bin") is None
+    keep_file("models", "a.bin", lambda path: path.write_bytes(b"model"), most_bytes=100)
+    found = kept_file("models", "a.bin")
+    assert found == folder / "models" / "a.bin" and found.read_bytes() == b"model"
+    os.utime(found, (1.0, 1.0))
+    assert kept_file("models", "a.bin") is not None and found.stat().st_mtime > 1.0
+
+
+def test_files_kept_beyond_the_bytes_go_least_recently_used_first(folder: Path) -> None:
+    for k, name in enumerate(("a.bin", "b.bin", "c.bin")):
+        keep_file("models", name, lambda path: path.write_bytes(b"x" * 10), most_bytes=30)
+        os.utime(folder / "models" / name, (1000.0 + k, 1000.0 + k))
+    kept_file("models", "a.bin")  # the oldest, read: now the newest
+    keep_file("models", "d.bin", lambda path: path.write_bytes(b"x" * 15), most_bytes=30)
+    assert sorted(p.name for p in (folder / "models").iterdir()) == ["a.bin", "d.bin"]  # 25 bytes
+    keep_file("models", "e.bin", lambda path: path.write_bytes(b"x" * 40), most_bytes=30)
+    assert sorted(p.name for p in (folder / "models").iterdir()) == ["e.bin"]  # alone above: it stays
+
+
+def test_a_save_that_fails_keeps_nothing_and_leaves_no_part(folder: Path) -> None:
+    def failing(path: Path) -> None:
+        path.write_bytes(b"half")
+        raise RuntimeError("disk full")
+
+    keep_file("models", "a.bin", failing, most_bytes=100)
+    assert kept_file("models", "a.bin") is None
+    assert list((folder / "models").iterdir()) == []

@@ -1,9 +1,10 @@
 """Where the toolkit keeps what it computed or downloaded once, between processes.
 
 ``$CPR_FIREFLY_CACHE``, else ``$XDG_CACHE_HOME/cpr-firefly``, else ``~/.cache/cpr-firefly``.
-Entries are small JSON documents or NumPy arrays named by a digest of what they were computed
-from, written whole (to a temporary file, then renamed) so that a reader never sees half of
-one. A folder that cannot be written is no error: the value is computed again next time.
+Entries are small JSON documents, NumPy arrays or other libraries' files (:func:`keep_file`)
+named by a digest of what they were computed from, written whole (to a temporary file, then
+renamed) so that a reader never sees half of one. A folder that cannot be written is no error:
+the value is computed again next time.
 """
 
 from __future__ import annotations
@@ -45,13 +46,24 @@ def cached_json(kind: str, digest: str, compute: Callable[[], dict[str, Any]]) -
     )
 
 
-def cached_array(kind: str, digest: str, compute: Callable[[], NDArray[Any]]) -> NDArray[Any]:
+def cached_array(
+    kind: str,
+    digest: str,
+    compute: Callable[[], NDArray[Any]],
+    valid: Callable[[NDArray[Any]], bool] | None = None,
+) -> NDArray[Any]:
     """The array cached as ``kind/digest.npy``, computed by ``compute`` and kept when absent.
 
     As :func:`cached_json`: an unreadable file is computed again and replaced; an array is read
-    without pickles.
+    without pickles. ``valid``: what a kept array must satisfy to be read (its shape, dtype and
+    range, which a file cut short or edited need not keep); one that fails is computed again.
     """
-    return _cached(cache_folder() / kind / f"{digest}.npy", _read_npy, _write_npy, compute)
+
+    def read(path: Path) -> NDArray[Any] | None:
+        found = _read_npy(path)
+        return found if valid is None or valid(found) else None
+
+    return _cached(cache_folder() / kind / f"{digest}.npy", read, _write_npy, compute)
 
 
 def read_array(kind: str, digest: str) -> NDArray[Any] | None:
@@ -68,6 +80,56 @@ def write_array(kind: str, digest: str, value: NDArray[Any]) -> None:
     is no error.
     """
     _write(cache_folder() / kind / f"{digest}.npy", value, _write_npy)
+
+
+def kept_file(kind: str, name: str) -> Path | None:
+    """The file kept as ``kind/name``, marked as just used (:func:`keep_file`); ``None`` where none is."""
+    path = cache_folder() / kind / name
+    if not path.is_file():
+        return None
+    with contextlib.suppress(OSError):  # a folder that cannot be written still reads
+        os.utime(path)
+    return path
+
+
+def keep_file(kind: str, name: str, save: Callable[[Path], object], most_bytes: int) -> None:
+    """Keep the file ``save`` writes to the path it is given as ``kind/name``; ``most_bytes`` of them at most.
+
+    ``save`` writes to a temporary path of the writer's own, which is then renamed: a reader
+    never sees half of it. Where the files of ``kind`` then add up to more than ``most_bytes``,
+    those least recently kept or read (:func:`kept_file`) are removed until they do not (the
+    one just kept stays): for entries of megabytes (a robot's meshes), which a new version of
+    a robot or of the libraries leaves behind. A folder that cannot be written, or a ``save``
+    that fails (``OSError``, ``RuntimeError``), is no error.
+    """
+    path = cache_folder() / kind / name
+    partial = path.with_suffix(f".{os.getpid()}.{threading.get_ident()}.part")  # a writer's own
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        save(partial)
+        partial.replace(path)
+    except (OSError, RuntimeError):
+        with contextlib.suppress(OSError):
+            partial.unlink(missing_ok=True)
+        return
+    try:
+        entries = [(_used_at(e), e) for e in path.parent.iterdir() if e.suffix == path.suffix and e != path]
+        total = path.stat().st_size
+    except OSError:
+        return
+    for _, entry in sorted(entries, reverse=True):  # the most recently used first
+        with contextlib.suppress(OSError):  # one removed meanwhile by another process
+            total += entry.stat().st_size
+            if total > most_bytes:
+                entry.unlink()
+
+
+def _used_at(path: Path) -> float:
+    """When ``path`` was last kept or read [s since the epoch]; ``-inf`` where it is gone."""
+    try:
+        return path.stat().st_mtime
+    except OSError:
+        return -float("inf")
 
 
 def _read_npy(path: Path) -> NDArray[Any]:

@@ -22,6 +22,7 @@ from lxml import etree
 from cpr_kin.bounds.capsule_fit import frame_about
 from cpr_kin.bounds.pair_bounds import bounding_capsule
 from cpr_kin.common.errors import UrdfError
+from cpr_kin.description.geometry_cache import geometry_model
 from cpr_kin.description.supported import MAX_SHAPE_M
 from cpr_kin.description.urdf_file import captured_stderr
 from cpr_kin.shapes.mesh_geometry import spans_volume
@@ -45,7 +46,7 @@ def build_models(xml: str, path: Path, kind: Any = pin.GeometryType.COLLISION) -
     try:
         with captured_stderr() as complaints:  # urdfdom prints to fd 2; a model that builds needs none
             model = pin.buildModelFromXML(xml)
-            geometry = pin.buildGeomFromUrdfString(model, xml, kind)
+            geometry = geometry_model(model, xml, kind)
     except Exception as exc:  # Pinocchio reports C++ exceptions as RuntimeError/ValueError
         unread = re.search(r"Could not load resource (.+?)\s*(?:\n|$)", str(exc))
         if unread is not None:  # coal's loader names its own source file; the link is what helps

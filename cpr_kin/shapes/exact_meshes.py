@@ -30,9 +30,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cpr_kin.common.compiled import njit
-from cpr_kin.common.disk_cache import cached_array, cached_json
-from cpr_kin.shapes.mesh_geometry import hull_planes
+from cpr_kin.common.disk_cache import cached_json
 from cpr_kin.shapes.mesh_pieces import convex_pieces
+from cpr_kin.shapes.mesh_topology import mesh_topology
 from cpr_kin.shapes.vertex_witness import VertexGroups, vertex_groups
 
 FloatArray = NDArray[np.float64]
@@ -41,9 +41,6 @@ REFINED_ABOVE_M = 1e-3
 """A hull reaching beyond its mesh by more than this [m] is a bound, and the mesh decides."""
 EXCESS_SAMPLES = 2_000
 """Points drawn on a hull's surface to measure its excess when a robot is loaded."""
-MAX_PIECES = 64
-"""A mesh of more connected pieces than this is not tested for holding another shape (module
-:mod:`cpr_kin.shapes.exact_pairs`): where its hull is penetrated, the hull decides."""
 
 
 @dataclass(frozen=True)
@@ -81,7 +78,7 @@ class ExactMesh:
             not measured).
         triangles: ``(F, 3, 3)`` the mesh's triangles' corners, in the mesh's frame [m].
         piece_points: ``(K, 3)`` a vertex of each connected piece of the mesh [m], ``None``
-            for more than :data:`MAX_PIECES` pieces.
+            for more than :data:`~cpr_kin.shapes.mesh_topology.MAX_PIECES` pieces.
         hull_planes: ``(H, 4)`` the facets of the mesh's convex hull, ``n . x + d <= 0`` inside
             (unit ``n``, ``d`` [m]).
         corners: ``(V, 3)`` the triangles' corners, each once [m].
@@ -209,16 +206,16 @@ def exact_meshes(sources: Sequence[MeshSource], samples: int = EXCESS_SAMPLES) -
     for source in sources:
         excess = hull_excess(source, samples)["excess_m"] if source.hull else math.inf
         if excess > REFINED_ABOVE_M:
-            triangles, pieces, corners = _triangles(source)
+            made = mesh_topology(source.bvh, _content(source, b"faces-1"))
             found[source.geometry] = ExactMesh(
                 source.geometry,
                 source.bvh,
                 source.mesh_in_shape,
                 excess,
-                triangles,
-                pieces,
-                hull_planes(corners),
-                corners,
+                made.triangles,
+                made.piece_points,
+                made.hull_planes,
+                made.corners,
             )
     return found
 
@@ -260,31 +257,3 @@ def _content(source: MeshSource, what: bytes) -> bytes:
     except OSError:
         body = np.asarray(source.bvh.vertices(), dtype=float).tobytes()
     return body + np.asarray(source.scale, dtype=float).tobytes() + what
-
-
-def _triangles(source: MeshSource) -> tuple[FloatArray, FloatArray | None, FloatArray]:
-    """The mesh's triangles' corners ``(F, 3, 3)``, a vertex of each connected piece (``None``: too many).
-
-    And the vertices of its triangles ``(V, 3)``, each once. The triangles' vertex indices are
-    kept on disk by the mesh's file and vertices (coal hands them out one by one).
-    """
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    bvh = source.bvh
-    vertices = np.asarray(bvh.vertices(), dtype=float)
-
-    def indices() -> NDArray[np.int64]:
-        return np.array(
-            [[t[0], t[1], t[2]] for t in (bvh.tri_indices(i) for i in range(bvh.num_tris))], dtype=np.int64
-        ).reshape(-1, 3)
-
-    digest = hashlib.sha256(_content(source, b"faces-1") + vertices.tobytes()).hexdigest()
-    faces = cached_array("mesh-faces", f"{digest}-{bvh.num_tris}", indices)
-    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]]])
-    graph = coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(len(vertices),) * 2)
-    _, label = connected_components(graph, directed=False)
-    used = np.unique(faces)
-    pieces = np.unique(label[used], return_index=True)[1]
-    points = vertices[used[pieces]] if len(pieces) <= MAX_PIECES else None
-    return vertices[faces], points, vertices[used]

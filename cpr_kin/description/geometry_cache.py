@@ -1,0 +1,107 @@
+"""Pinocchio's geometry model of a URDF whose links are meshes, built once and kept on disk.
+
+Building a geometry model reads every mesh file (coal's assimp loader) and builds coal's tree
+of bounding volumes over its triangles: most of a robot's load where its meshes are fine
+(MotionBenchMaker's UR5 with its Robotiq gripper and force sensor, two meshes of 40,000
+triangles each: 0.4 s of every load, in every new process). Pinocchio's binary archive of the
+built model reads back several times faster, its trees included. So the model is kept under
+``$CPR_FIREFLY_CACHE/geometry-models/`` (:mod:`cpr_kin.common.disk_cache`), named by a digest of
+everything it is built from: the prepared URDF's text, the model's kind (collision or visual),
+every mesh file's path and bytes, and Pinocchio's and coal's versions. The files are large (the
+trees: about 60 MB for that UR5, 220 MB for example-robot-data's SO-101), so they are kept up to
+:data:`KEPT_BYTES` in all, the least recently used removed.
+
+A kept model is read only where it fits: the archive reads whole (one cut short or damaged
+raises in Pinocchio's reader) and holds, in the URDF's order, one object per link geometry of
+the kind, each on its link's frame. Otherwise, and for a URDF without meshes (nothing slow to
+build), the model is built as before.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+from typing import Any
+
+import coal
+import pinocchio as pin
+from lxml import etree
+
+from cpr_kin.common.disk_cache import keep_file, kept_file
+
+KEPT_BYTES = 1 << 30
+"""The geometry models kept on disk add up to this at most [bytes] (several robots, or one robot's
+collision and visual models; a new version of the libraries or of a robot's files makes new ones)."""
+FORMAT = b"geometry-model-1"
+"""Named in the digest: a change to what is kept makes the models anew."""
+_TAGS = {pin.GeometryType.COLLISION: "collision", pin.GeometryType.VISUAL: "visual"}
+
+
+def geometry_model(model: Any, xml: str, kind: Any) -> Any:
+    """The ``kind`` geometry model of the prepared URDF text ``xml`` for ``model``: kept, or built and kept.
+
+    ``pinocchio.buildGeomFromUrdfString(model, xml, kind)``'s model either way (module
+    docstring). Its exceptions (a mesh it cannot read) are the caller's.
+    """
+    links = _link_geometries(xml, _TAGS[kind])
+    names = [link for link, _ in links]
+    meshes = [mesh for _, shape in links for mesh in shape.iter("mesh")]
+    digest = _digest(xml, kind, [mesh.get("filename") or "" for mesh in meshes]) if meshes else None
+    if digest is None:
+        return pin.buildGeomFromUrdfString(model, xml, kind)
+    name = f"{digest}.bin"
+    path = kept_file("geometry-models", name)
+    if path is not None:
+        kept = _read(path)
+        if kept is not None and _fits(kept, model, names):
+            return kept
+    built = pin.buildGeomFromUrdfString(model, xml, kind)
+    if _fits(built, model, names):  # else it would never be read: not kept
+        keep_file("geometry-models", name, lambda partial: built.saveToBinary(str(partial)), KEPT_BYTES)
+    return built
+
+
+def _link_geometries(xml: str, tag: str) -> list[tuple[str, Any]]:
+    """``(link, <geometry>)`` of every ``tag`` (collision or visual) element, in the URDF's order."""
+    root = etree.fromstring(xml.encode(), etree.XMLParser(resolve_entities=False, no_network=True))
+    found = []
+    for link in root.findall("link"):
+        for element in link.findall(tag):
+            shape = element.find("geometry")
+            if shape is not None and len(shape):
+                found.append((link.get("name", ""), shape))
+    return found
+
+
+def _digest(xml: str, kind: Any, files: list[str]) -> str | None:
+    """What the model is built from, hashed; ``None`` where a mesh file cannot be read (the builder says)."""
+    digest = hashlib.sha256(FORMAT + xml.encode() + str(kind).encode())
+    digest.update(f"pinocchio {pin.__version__} coal {coal.__version__}".encode())
+    for file in dict.fromkeys(files):
+        try:
+            with Path(file).open("rb") as stream:  # in pieces: a mesh file may be large
+                body = hashlib.file_digest(stream, "sha256").digest()
+        except OSError:
+            return None
+        digest.update(file.encode() + b"\0" + body)
+    return digest.hexdigest()
+
+
+def _read(path: Path) -> Any | None:
+    """The geometry model kept at ``path``; ``None`` where Pinocchio cannot read it whole."""
+    kept = pin.GeometryModel()
+    try:
+        kept.loadFromBinary(str(path))
+    except (RuntimeError, MemoryError, OSError):  # cut short, damaged, removed meanwhile
+        return None
+    return kept
+
+
+def _fits(kept: Any, model: Any, links: list[str]) -> bool:
+    """Whether ``kept`` holds one object per geometry of ``links``, each on its link's frame."""
+    objects = kept.geometryObjects
+    if len(objects) != len(links):
+        return False
+    frames = model.frames
+    on_frames = [frames[o.parentFrame].name if 0 <= o.parentFrame < len(frames) else "" for o in objects]
+    return sorted(on_frames) == sorted(links)
