@@ -6,7 +6,6 @@ import subprocess
 import sys
 from pathlib import Path
 
-import coal
 import numpy as np
 import pytest
 import trimesh
@@ -15,21 +14,13 @@ from cpr_kin.model.packages import example_robot_data_share
 from cpr_kin.shapes import mesh_topology as topology
 from cpr_kin.shapes.mesh_geometry import hull_planes
 from cpr_kin.shapes.mesh_topology import MAX_PIECES, mesh_topology
+from tests.test_exact_meshes import bvh_of
 
 
 @pytest.fixture(autouse=True)
 def own_cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     monkeypatch.setenv("CPR_FIREFLY_CACHE", str(tmp_path / "cache"))
     return tmp_path / "cache"
-
-
-def bvh_of(mesh: trimesh.Trimesh) -> coal.BVHModelOBBRSS:
-    bvh = coal.BVHModelOBBRSS()
-    bvh.beginModel(len(mesh.faces), len(mesh.vertices))
-    bvh.addVertices(np.asarray(mesh.vertices, dtype=float))
-    bvh.addTriangles(np.asarray(mesh.faces, dtype=np.int64))
-    bvh.endModel()
-    return bvh
 
 
 def boxes(count: int) -> trimesh.Trimesh:
