@@ -129,3 +129,12 @@ def test_a_save_that_fails_keeps_nothing_and_leaves_no_part(folder: Path) -> Non
     keep_file("models", "a.bin", failing, most_bytes=100)
     assert kept_file("models", "a.bin") is None
     assert list((folder / "models").iterdir()) == []
+
+
+def test_arrays_beyond_the_bytes_go_least_recently_read_or_written_first(folder: Path) -> None:
+    for k, name in enumerate(("a", "b", "c")):
+        write_array("kept", name, np.zeros(100))  # 928 bytes each, header included
+        os.utime(folder / "kept" / f"{name}.npy", (1000.0 + k, 1000.0 + k))
+    assert read_array("kept", "a") is not None  # the oldest, read: now the newest
+    write_array("kept", "d", np.zeros(100), most_bytes=2000)
+    assert sorted(p.name for p in (folder / "kept").iterdir()) == ["a.npy", "d.npy"]

@@ -124,6 +124,20 @@ def test_learning_is_kept_once_it_adds_up(
         np.testing.assert_array_equal(found, known)
 
 
+def test_old_memories_go_beyond_the_kept_bytes(
+    ur5: ck.Robot, folder: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    old = folder / "near-cells" / "an-older-version.npy"
+    old.parent.mkdir(parents=True)
+    np.save(old, np.zeros(1000, dtype=np.float32))  # another version's memory, never read again
+    pairs = near_pairs(ur5)
+    cells = cells_of(ur5, pairs)
+    cells.clear(configurations(ur5, 7), [0.001] * len(pairs), on_meshes=True)
+    monkeypatch.setattr(learned_cells, "KEPT_BYTES", 1)  # below any one memory: the one kept stays alone
+    cells.memory.save()
+    assert [p.name for p in (folder / "near-cells").iterdir()] == [f"{cells.memory.digest}.npy"]
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("ending", ["", "from planning.cli.process import end_process; end_process(0)\n"])
 def test_a_new_process_reads_what_an_ended_one_learned(folder: Path, ending: str) -> None:

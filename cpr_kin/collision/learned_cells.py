@@ -57,6 +57,10 @@ DECIDING_MODULES = (
     "shapes/coal_queries.py",
 )
 """The files, under the package, whose code decides a cell's test: part of the digest."""
+KEPT_BYTES = 64 << 20
+"""The memories kept on disk add up to this at most [bytes] (a robot's is a few MB at most: the
+UR5's 0.6 MB); beyond it, those least recently read or kept are removed (another version of the
+code or of a robot's files names new ones, and the old ones are never read again)."""
 SAVE_AFTER_S = 0.05
 """Time [s] spent learning since the memory was last kept that has it kept again at once
 (the rest is kept when the process ends)."""
@@ -131,7 +135,7 @@ class CellMemory:
             return
         self._read(self.digest)
         stacked = np.stack([array for kind in self._distinct() for array in kind.arrays()])
-        write_array("near-cells", self.digest, stacked)
+        write_array("near-cells", self.digest, stacked, KEPT_BYTES)
         self._unsaved_s, self._changed = 0.0, False
 
     def _distinct(self) -> list[LearnedCells]:

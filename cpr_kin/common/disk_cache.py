@@ -67,19 +67,24 @@ def cached_array(
 
 
 def read_array(kind: str, digest: str) -> NDArray[Any] | None:
-    """The array kept as ``kind/digest.npy``; ``None`` where there is none or it cannot be read."""
+    """The array kept as ``kind/digest.npy``, marked as just used; ``None``: none, or unreadable."""
+    path = kept_file(kind, f"{digest}.npy")
     with contextlib.suppress(OSError, ValueError, EOFError):
-        return _read_npy(cache_folder() / kind / f"{digest}.npy")
+        return None if path is None else _read_npy(path)
     return None
 
 
-def write_array(kind: str, digest: str, value: NDArray[Any]) -> None:
+def write_array(kind: str, digest: str, value: NDArray[Any], most_bytes: int | None = None) -> None:
     """Keep ``value`` as ``kind/digest.npy``, whole, in place of what was there.
 
     As :func:`cached_json` writes: a reader never sees half of it; a folder that cannot be written
-    is no error.
+    is no error. ``most_bytes``: as :func:`keep_file`'s, the arrays of ``kind`` least recently
+    kept or read (:func:`read_array`) removed beyond it; ``None``: none removed.
     """
-    _write(cache_folder() / kind / f"{digest}.npy", value, _write_npy)
+    path = cache_folder() / kind / f"{digest}.npy"
+    _write(path, value, _write_npy)
+    if most_bytes is not None:
+        _prune(path, most_bytes)
 
 
 def kept_file(kind: str, name: str) -> Path | None:
@@ -112,6 +117,11 @@ def keep_file(kind: str, name: str, save: Callable[[Path], object], most_bytes: 
         with contextlib.suppress(OSError):
             partial.unlink(missing_ok=True)
         return
+    _prune(path, most_bytes)
+
+
+def _prune(path: Path, most_bytes: int) -> None:
+    """Remove the files beside ``path`` (its suffix) least recently used beyond ``most_bytes``, not it."""
     try:
         entries = [(_used_at(e), e) for e in path.parent.iterdir() if e.suffix == path.suffix and e != path]
         total = path.stat().st_size
