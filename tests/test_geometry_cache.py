@@ -14,8 +14,9 @@ import trimesh
 
 import cpr_kin as ck
 from cpr_kin.description import geometry_cache
-from cpr_kin.description.geometry_cache import geometry_model
+from cpr_kin.description.geometry_cache import geometry_model, mesh_hull
 from cpr_kin.model.packages import example_robot_data_share
+from tests.test_exact_meshes import bvh_of
 
 URDF = """<robot name="two">
   <link name="base"><collision><geometry><mesh filename="{base}"/></geometry></collision></link>
@@ -167,3 +168,26 @@ def test_a_robot_loaded_from_its_kept_model_is_the_robot_built() -> None:
     world = [ck.CollisionWorld(r, []) for r in (built_robot, kept_robot)]
     built_distances, kept_distances = (w.self_collision.distances(configurations)[0] for w in world)
     np.testing.assert_array_equal(kept_distances, built_distances)
+
+
+def test_a_meshs_hull_is_kept_and_reads_back_as_qhull_builds_it(own_cache: Path) -> None:
+    mesh = trimesh.creation.capsule(height=0.3, radius=0.05)
+    built_bvh, kept_bvh = bvh_of(mesh), bvh_of(mesh)
+    built_bvh.buildConvexHull(True, "Qt")
+    first = mesh_hull(bvh_of(mesh), True, "Qt")
+    (kept,) = (own_cache.parent / "mesh-hulls").glob("*.bin")
+    again = mesh_hull(kept_bvh, True, "Qt")
+    assert kept_bvh.convex is None  # read from the disk, not built
+    ball, request = coal.Sphere(0.01), coal.DistanceRequest()
+    for hull in (first, again):
+        assert isinstance(hull, coal.Convex) and hull.num_points == built_bvh.convex.num_points
+        for point in np.random.default_rng(5).uniform(-0.3, 0.3, (20, 3)):
+            at = coal.Transform3s(np.eye(3), point)
+            distances = [
+                coal.distance(h, coal.Transform3s(), ball, at, request, coal.DistanceResult())
+                for h in (hull, built_bvh.convex)
+            ]
+            assert distances[0] == distances[1]
+    kept.write_bytes(kept.read_bytes()[:100])  # cut short: built again
+    assert mesh_hull(bvh_of(mesh), True, "Qt").num_points == built_bvh.convex.num_points
+    assert kept.stat().st_size > 100

@@ -11,6 +11,11 @@ every mesh file's path and bytes, and Pinocchio's and coal's versions. The files
 trees: about 60 MB for that UR5, 220 MB for example-robot-data's SO-101), so they are kept up to
 :data:`KEPT_BYTES` in all, the least recently used removed.
 
+Each mesh's convex hull (coal's Qhull, which the collision model holds in the mesh's place:
+:func:`~cpr_kin.description.urdf_models.convex_hulls`) is kept too, under ``mesh-hulls/``, named
+by the mesh's vertices and Qhull's options (:func:`mesh_hull`): the SO-101's fine meshes took
+0.25 s of Qhull in every load.
+
 A kept model is read only where it fits: the archive reads whole (one cut short or damaged
 raises in Pinocchio's reader) and holds, in the URDF's order, one object per link geometry of
 the kind, each on its link's frame. Otherwise, and for a URDF without meshes (nothing slow to
@@ -24,11 +29,14 @@ from pathlib import Path
 from typing import Any
 
 import coal
+import numpy as np
 import pinocchio as pin
 from lxml import etree
 
 from cpr_kin.common.disk_cache import keep_file, kept_file
 
+HULL_BYTES = 256 << 20
+"""The hulls kept on disk add up to this at most [bytes] (a robot's are a few MB)."""
 KEPT_BYTES = 1 << 30
 """The geometry models kept on disk add up to this at most [bytes] (several robots, or one robot's
 collision and visual models; a new version of the libraries or of a robot's files makes new ones)."""
@@ -105,3 +113,28 @@ def _fits(kept: Any, model: Any, links: list[str]) -> bool:
     frames = model.frames
     on_frames = [frames[o.parentFrame].name if 0 <= o.parentFrame < len(frames) else "" for o in objects]
     return sorted(on_frames) == sorted(links)
+
+
+def mesh_hull(bvh: Any, keep_triangles: bool, qhull_options: str) -> Any:
+    """The convex hull of coal's triangle model ``bvh`` that ``bvh.buildConvexHull`` builds, kept on disk.
+
+    A hull of triangles (a ``coal.Convex``) is kept; one of polygons (where a vertex has too
+    many neighbours for triangles) is built each time. Qhull's ``RuntimeError`` is the caller's.
+    """
+    vertices = np.ascontiguousarray(bvh.vertices(), dtype=float)
+    key = f"{FORMAT.decode()} coal {coal.__version__} {keep_triangles} {qhull_options}".encode()
+    name = hashlib.sha256(key + vertices.tobytes()).hexdigest() + ".bin"
+    path = kept_file("mesh-hulls", name) if keep_triangles else None
+    if path is not None:
+        kept = coal.Convex()
+        try:
+            kept.loadFromBinary(str(path))
+        except (RuntimeError, MemoryError, OSError):
+            kept = None
+        if kept is not None and kept.num_points > 0:
+            return kept
+    bvh.buildConvexHull(keep_triangles, qhull_options)
+    hull = bvh.convex
+    if isinstance(hull, coal.Convex):
+        keep_file("mesh-hulls", name, lambda partial: hull.saveToBinary(str(partial)), HULL_BYTES)
+    return hull

@@ -22,7 +22,7 @@ from lxml import etree
 from cpr_kin.bounds.capsule_fit import frame_about
 from cpr_kin.bounds.pair_bounds import bounding_capsule
 from cpr_kin.common.errors import UrdfError
-from cpr_kin.description.geometry_cache import geometry_model
+from cpr_kin.description.geometry_cache import geometry_model, mesh_hull
 from cpr_kin.description.supported import MAX_SHAPE_M
 from cpr_kin.description.urdf_file import captured_stderr
 from cpr_kin.shapes.mesh_geometry import spans_volume
@@ -163,10 +163,9 @@ def convex_hulls(collision: Any) -> tuple[MeshSource, ...]:
         flat = not spans_volume(np.asarray(geometry.vertices(), dtype=float))
         for keep_triangles, qhull_options in () if flat else ((True, "Qt"), (False, "Qx")):
             try:
-                geometry.buildConvexHull(keep_triangles, qhull_options)
+                obj.geometry = mesh_hull(geometry, keep_triangles, qhull_options)  # kept on disk
             except RuntimeError:  # "Too many neighbors."
                 continue
-            obj.geometry = geometry.convex
             sources.append(MeshSource(index, geometry, pin.SE3.Identity(), obj.meshPath, scale))
             break
         else:
