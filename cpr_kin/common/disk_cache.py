@@ -108,16 +108,8 @@ def keep_file(kind: str, name: str, save: Callable[[Path], object], most_bytes: 
     that fails (``OSError``, ``RuntimeError``), is no error.
     """
     path = cache_folder() / kind / name
-    partial = path.with_suffix(f".{os.getpid()}.{threading.get_ident()}.part")  # a writer's own
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        save(partial)
-        partial.replace(path)
-    except (OSError, RuntimeError):
-        with contextlib.suppress(OSError):
-            partial.unlink(missing_ok=True)
-        return
-    _prune(path, most_bytes)
+    if _saved(path, save):
+        _prune(path, most_bytes)
 
 
 def _prune(path: Path, most_bytes: int) -> None:
@@ -172,10 +164,29 @@ def _cached(
 
 
 def _write(path: Path, value: T, write: Callable[[T, BinaryIO], object]) -> None:
-    """``value`` written to ``path`` through a temporary file of the writer's own, then renamed."""
-    with contextlib.suppress(OSError):
-        path.parent.mkdir(parents=True, exist_ok=True)
-        partial = path.with_suffix(f".{os.getpid()}.{threading.get_ident()}.part")  # a writer's own
+    """``value`` written to ``path`` by ``write`` on a stream, whole (:func:`_saved`)."""
+
+    def save(partial: Path) -> None:
         with partial.open("wb") as stream:
             write(value, stream)
+
+    _saved(path, save)
+
+
+def _saved(path: Path, save: Callable[[Path], object]) -> bool:
+    """Whether ``save`` wrote ``path`` whole, through a temporary file of the writer's own.
+
+    The temporary file (the process's and thread's) is renamed: a reader never sees half. A
+    folder that cannot be written, or a ``save`` that fails (``OSError``, or a library's
+    ``RuntimeError``), is no error: nothing is kept, no temporary file is left.
+    """
+    partial = path.with_suffix(f".{os.getpid()}.{threading.get_ident()}.part")  # a writer's own
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        save(partial)
         partial.replace(path)
+    except (OSError, RuntimeError):
+        with contextlib.suppress(OSError):
+            partial.unlink(missing_ok=True)
+        return False
+    return True

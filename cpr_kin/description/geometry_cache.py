@@ -58,11 +58,9 @@ def geometry_model(model: Any, xml: str, kind: Any) -> Any:
     if digest is None:
         return pin.buildGeomFromUrdfString(model, xml, kind)
     name = f"{digest}.bin"
-    path = kept_file("geometry-models", name)
-    if path is not None:
-        kept = _read(path)
-        if kept is not None and _fits(kept, model, names):
-            return kept
+    kept = _read(kept_file("geometry-models", name), pin.GeometryModel())
+    if kept is not None and _fits(kept, model, names):
+        return kept
     built = pin.buildGeomFromUrdfString(model, xml, kind)
     if _fits(built, model, names):  # else it would never be read: not kept
         keep_file("geometry-models", name, lambda partial: built.saveToBinary(str(partial)), KEPT_BYTES)
@@ -95,22 +93,21 @@ def _digest(xml: str, kind: Any, files: list[str]) -> str | None:
     return digest.hexdigest()
 
 
-def _read(path: Path) -> Any | None:
-    """The geometry model kept at ``path``; ``None`` where Pinocchio cannot read it whole."""
-    kept = pin.GeometryModel()
+def _read(path: Path | None, empty: Any) -> Any | None:
+    """``empty`` (a Pinocchio or coal object) read from its binary archive at ``path``, if it reads whole."""
+    if path is None:
+        return None
     try:
-        kept.loadFromBinary(str(path))
+        empty.loadFromBinary(str(path))
     except (RuntimeError, MemoryError, OSError):  # cut short, damaged, removed meanwhile
         return None
-    return kept
+    return empty
 
 
 def _fits(kept: Any, model: Any, links: list[str]) -> bool:
     """Whether ``kept`` holds one object per geometry of ``links``, each on its link's frame."""
-    objects = kept.geometryObjects
-    if len(objects) != len(links):
-        return False
     frames = model.frames
+    objects = kept.geometryObjects
     on_frames = [frames[o.parentFrame].name if 0 <= o.parentFrame < len(frames) else "" for o in objects]
     return sorted(on_frames) == sorted(links)
 
@@ -124,15 +121,9 @@ def mesh_hull(bvh: Any, keep_triangles: bool, qhull_options: str) -> Any:
     vertices = np.ascontiguousarray(bvh.vertices(), dtype=float)
     key = f"{FORMAT.decode()} coal {coal.__version__} {keep_triangles} {qhull_options}".encode()
     name = hashlib.sha256(key + vertices.tobytes()).hexdigest() + ".bin"
-    path = kept_file("mesh-hulls", name) if keep_triangles else None
-    if path is not None:
-        kept = coal.Convex()
-        try:
-            kept.loadFromBinary(str(path))
-        except (RuntimeError, MemoryError, OSError):
-            kept = None
-        if kept is not None and kept.num_points > 0:
-            return kept
+    kept = _read(kept_file("mesh-hulls", name), coal.Convex()) if keep_triangles else None
+    if kept is not None and kept.num_points > 0:
+        return kept
     bvh.buildConvexHull(keep_triangles, qhull_options)
     hull = bvh.convex
     if isinstance(hull, coal.Convex):
