@@ -130,10 +130,11 @@ def test_old_memories_go_beyond_the_kept_bytes(
     old = folder / "near-cells" / "an-older-version.npy"
     old.parent.mkdir(parents=True)
     np.save(old, np.zeros(1000, dtype=np.float32))  # another version's memory, never read again
+    monkeypatch.setattr(learned_cells, "KEPT_BYTES", 1)  # below any one memory: the one kept stays alone
+    monkeypatch.setattr(learned_cells, "SAVE_AFTER_S", 1e9)  # kept by the save below, however slow the cells
     pairs = near_pairs(ur5)
     cells = cells_of(ur5, pairs)
     cells.clear(configurations(ur5, 7), [0.001] * len(pairs), on_meshes=True)
-    monkeypatch.setattr(learned_cells, "KEPT_BYTES", 1)  # below any one memory: the one kept stays alone
     cells.memory.save()
     assert [p.name for p in (folder / "near-cells").iterdir()] == [f"{cells.memory.digest}.npy"]
 
