@@ -16,6 +16,7 @@ from .common.errors import (
     UrdfError,
 )
 from .description.loading import RobotSpec, load_robot
+from .description.shared_robots import forget_shared_robots, shared_robot
 from .kinematics.carried import carrying, holding_links, left_at, taken_from
 from .kinematics.dynamics import Dynamics, Payload, robot_dynamics
 from .kinematics.forward import frame_poses, frame_positions
@@ -70,6 +71,7 @@ __all__ = [
     "cpr_limits_path",
     "cpr_spec",
     "cpr_urdf_path",
+    "forget_shared_robots",
     "frame_poses",
     "frame_positions",
     "holding_links",
@@ -81,6 +83,7 @@ __all__ = [
     "robot_dynamics",
     "robot_spec",
     "sampled_configurations",
+    "shared_robot",
     "solve_ik",
     "taken_from",
     "tcp_ik",

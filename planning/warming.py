@@ -61,7 +61,7 @@ def warm_up(robot: ck.Robot | None = None) -> float:
         expected = (NoSolutionError, PlanningError)
     with contextlib.suppress(*expected):
         plan(small, robot, threads=1)
-    _warm_own_motion(robot if robot is not None else small.robot_spec().load(), small)
+    _warm_own_motion(robot if robot is not None else ck.shared_robot(small.robot_spec()), small)
     _warm_sampling()
     _warm_vertex_witness()
     return time.perf_counter() - started

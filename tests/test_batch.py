@@ -202,20 +202,3 @@ def test_a_task_scene_is_planned_as_plan_plans_it(tmp_path: Path) -> None:
     assert main(["check", str(task), str(tmp_path / "out" / "task" / "trajectory.json")]) == 0  # the oracle
     (row,) = csv.DictReader(summary_csv([item]).splitlines())
     assert row["status"] == "ok" and row["duration"] and row["t_sol"] == "" and row["evaluations"] == ""
-
-
-def test_two_scenes_at_once_in_one_process_plan_on_robots_of_their_own() -> None:
-    # a Dask worker's threads plan scenes at once: a robot's Pinocchio data is not theirs to share
-    import threading
-
-    import cpr_kin as ck
-    from planning.batch.items import _robot
-
-    spec = ck.cpr_spec()
-    here = _robot(spec)
-    assert _robot(spec) is here  # loaded once per thread
-    other: list[ck.Robot] = []
-    thread = threading.Thread(target=lambda: other.append(_robot(spec)))
-    thread.start()
-    thread.join()
-    assert other[0] is not here and other[0].data is not here.data

@@ -27,12 +27,10 @@ from __future__ import annotations
 import contextlib
 import csv
 import io
-import threading
 import time
 from collections.abc import Iterator
 from contextlib import AbstractContextManager
 from dataclasses import asdict, dataclass
-from functools import lru_cache
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
@@ -80,22 +78,6 @@ class BatchItem:
         return cls(escaped(scene), status, STATUS_EXIT[status], one_line(message), None, elapsed)
 
 
-def _robot(spec: ck.RobotSpec) -> ck.Robot:
-    """The robot, loaded once per worker thread and spec.
-
-    A robot's computations share its Pinocchio data (:attr:`cpr_kin.Robot.data`): two scenes
-    planned at once in one process (a Dask worker's threads) must not share a robot, or one
-    may read the other's forward kinematics between two calls.
-    """
-    return _loaded(spec, threading.get_ident())
-
-
-@lru_cache(maxsize=8)
-def _loaded(spec: ck.RobotSpec, thread: int) -> ck.Robot:
-    """``spec``'s robot for the thread ``thread`` (:func:`_robot`)."""
-    return spec.load()
-
-
 class Gate(Protocol):
     """What lets a task publish its files (a cluster's :class:`~planning.batch.cluster.PublishGate`)."""
 
@@ -128,7 +110,7 @@ def plan_scene_file(path: Path, out: Path, threads: int | None = 1, gate: Gate =
     try:
         read = load_scene_file(path)
         with OutputFolder(out) as folder, library_notices("cpr-plan batch"):
-            robot = _robot(read.scene.robot_spec())
+            robot = ck.shared_robot(read.scene.robot_spec())  # one per worker thread
             record, files = (
                 _task_outputs(read, robot, threads) if read.task else _plan_outputs(read, robot, threads)
             )

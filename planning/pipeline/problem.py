@@ -202,7 +202,7 @@ def build_problem(
     instance_of("scene", scene, Scene, "planning.Scene (load_scene, paper_scene, Scene(start=..., goal=...))")
     if robot is not None:
         instance_of("robot", robot, ck.Robot, "cpr_kin.Robot (load_robot, load_cpr), or None: the scene's")
-    robot = scene_robot(scene, robot or scene.robot_spec().load())
+    robot = scene_robot(scene, robot or ck.shared_robot(scene.robot_spec()))
     world = scene_world(scene, robot, threads)
     dynamics = scene_dynamics(robot, scene)
     q_start = endpoint(world, scene, "start", dynamics=dynamics)

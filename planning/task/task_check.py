@@ -85,7 +85,7 @@ def check_task(
     Raises:
         PlanningError: an entry that is not one (a missing or wrong field, named).
     """
-    base = robot or scene.robot_spec().load()
+    base = robot or ck.shared_robot(scene.robot_spec())
     kinds = [KINDS[type(s)] for s in segments]
     recorded = [str(e.get("kind")) if isinstance(e, Mapping) else "?" for e in entries]
     if recorded != kinds:

@@ -180,7 +180,7 @@ def plan_task(
     if scene.duration is not None:
         raise PlanningError(FIXED_DURATION.format(seconds=scene.duration))
     checked_touches(scene, segments)
-    base = robot or scene.robot_spec().load()
+    base = robot or ck.shared_robot(scene.robot_spec())
     carrying = _carrying(scene, base, None, threads)
     q, start_world = carrying.problem.q_start, carrying.problem.world
     kinds, payloads, planned = [], [], list[PlannedMotion | None]()
