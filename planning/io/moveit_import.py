@@ -173,7 +173,7 @@ def import_moveit(
         planned = group_joints(robot.srdf, request.group_name, tree).joints
     else:  # the URDF was checked above: not validated twice
         spec = replace(ck.robot_spec(robot.urdf), package_dirs=robot.package_dirs, validate=False)
-        planned = spec.load().joint_names
+        planned = ck.shared_robot(spec).joint_names  # a folder of imports loads it once
     if request.group_name and robot.srdf is None:
         ignored.append(
             f"request.group_name '{request.group_name}' (no SRDF to look it up in): planned {planned}"
