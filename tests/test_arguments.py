@@ -45,6 +45,7 @@ def test_a_number_at_least_its_bound_takes_the_bound_itself() -> None:
         ("bench_ik", ["--seed", "-1"], "argument --seed: -1 must be an integer >= 0"),
         ("bench_peers", ["--scenes", "-1"], "argument --scenes: -1 must be an integer >= 0"),
         ("bench_planner", ["--runs", "0"], "argument --runs: 0 must be an integer >= 1"),
+        ("bench_library_loop", ["--rounds", "0"], "argument --rounds: 0 must be an integer >= 1"),
         ("bench_startup", ["--runs", "0"], "argument --runs: 0 must be an integer >= 1"),
         (
             "bench_startup",

@@ -1,0 +1,39 @@
+"""``scripts/bench_library_loop.py``: a script's ``plan(load_scene(path))`` with the robot kept and loaded."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+from .conftest import SCRIPTS, script_table
+
+
+@pytest.mark.slow
+def test_each_robot_gets_a_row_both_ways_and_the_same_trajectories() -> None:
+    rows = script_table("bench_library_loop", "--robots", "cpr", "--scenes", "1", "--rounds", "2")
+    assert rows[0] == [
+        "robot",
+        "scenes",
+        "kept: median call [s]",
+        "loaded each call: median [s]",
+        "kept / loaded",
+    ]
+    (cpr,) = rows[1:]
+    assert cpr[:2] == ["cpr", "1"]
+    kept, loaded, ratio = (float(cell) for cell in cpr[2:])
+    assert kept > 0 and loaded > 0
+    assert ratio == pytest.approx(kept / loaded, abs=0.01)
+
+
+def test_a_robot_it_does_not_know_is_refused_with_the_choices() -> None:
+    done = subprocess.run(
+        [sys.executable, str(SCRIPTS / "bench_library_loop.py"), "--robots", "r2d2"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
+    assert done.returncode == 2
+    assert "argument --robots: invalid choice: 'r2d2'" in done.stderr
