@@ -1,9 +1,10 @@
 """A robot loaded once per thread and reused while its files stay as they were read.
 
 Loading a robot reads its URDF, SRDF, limits and meshes and builds its models: for an arm of
-meshes, longer than a warm plan of it takes (``docs/benchmarks.md``). A program that plans scene after scene with ``plan(scene)`` asks for
-the same robot each time; :func:`shared_robot` loads it on the first call and hands the same
-:class:`~cpr_kin.model.robot.Robot` back while nothing it was built from has changed.
+meshes, longer than a warm plan of it takes (``docs/benchmarks.md``). A program that plans
+scene after scene with ``plan(scene)`` asks for the same robot each time; :func:`shared_robot`
+loads it on the first call and hands the same :class:`~cpr_kin.model.robot.Robot` back while
+nothing it was built from has changed.
 
 - **Per thread.** A robot's computations share its Pinocchio data
   (:attr:`~cpr_kin.model.robot.Robot.data`): two plans at once in one process (a Dask worker's
