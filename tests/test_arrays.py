@@ -8,7 +8,7 @@ import sys
 import numpy as np
 import pytest
 
-from cpr_kin.common.arrays import distinct_sorted
+from cpr_kin.common.arrays import distinct_sorted, finite_median
 
 
 @pytest.mark.parametrize("dtype", [np.int64, np.float64])
@@ -38,3 +38,23 @@ def test_distinct_sorted_imports_no_numpy_ma_where_np_unique_does(call: str, imp
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.split() == [str(imported)]
+
+
+def test_finite_median_is_numpys_median_to_the_bit() -> None:
+    rng = np.random.default_rng(11)
+    for shape in [(256, 3), (255, 4), (1, 2), (2, 5), (7,)]:
+        values = rng.normal(size=shape) * 1e-2
+        np.testing.assert_array_equal(finite_median(values), np.median(values, axis=0))
+        if values.ndim == 2:
+            np.testing.assert_array_equal(finite_median(values, axis=1), np.median(values, axis=1))
+    with pytest.raises(ValueError, match="no values"):
+        finite_median(np.zeros((0, 3)))
+
+
+def test_finite_median_imports_no_numpy_ma() -> None:
+    code = (
+        "import sys; from cpr_kin.common.arrays import finite_median; "
+        "finite_median([[3.0, 1.0], [2.0, 5.0]]); print('numpy.ma' in sys.modules)"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.split() == ["False"]

@@ -159,3 +159,25 @@ def test_a_plan_piped_to_a_reader_that_leaves_writes_its_files_and_exits_zero(tm
     plan = ("-m", "planning.cli", "plan", "examples/scenes/shelf.yaml", "--out", str(tmp_path))
     assert reader_leaves(*plan, env={**BUFFERED, "PYTHONUNBUFFERED": "1"}) == (0, b"")
     assert (tmp_path / "trajectory.json").is_file() and (tmp_path / "manifest.json").is_file()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("scene", ["shelf.yaml", "panda_pick_and_place.yaml"])
+def test_a_plan_and_a_task_written_call_neither_numpys_unique_nor_median(scene: str, tmp_path: Path) -> None:
+    # both import numpy.ma at their first call (9 ms of a new process), which nothing here needs
+    # (cpr_kin.common.arrays); numba's just-in-time dispatch imports it too, so the calls are counted
+    completed = python(
+        "-c",
+        "import numpy as np\n"
+        "called = []\n"
+        "for name in ('unique', 'median'):\n"
+        "    def spy(*args, _real=getattr(np, name), _name=name, **kwargs):\n"
+        "        called.append(_name)\n"
+        "        return _real(*args, **kwargs)\n"
+        "    setattr(np, name, spy)\n"
+        "from planning.cli.app import main\n"
+        f"code = main(['plan', 'examples/scenes/{scene}', '--out', {str(tmp_path)!r}])\n"
+        "print(code, sorted(set(called)))\n",
+    )
+    assert completed.returncode == 0, completed.stderr[-2000:]
+    assert completed.stdout.splitlines()[-1] == "0 []"

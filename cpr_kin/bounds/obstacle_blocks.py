@@ -21,6 +21,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from cpr_kin.common.arrays import distinct_sorted
+
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
@@ -76,7 +78,7 @@ def obstacle_blocks(
         return ObstacleBlocks(
             np.zeros(0, np.int64), np.zeros((0, 2, 3)), np.zeros(1, np.int64), np.zeros(0, np.int64)
         )
-    used = np.unique(pair_obstacle)
+    used = distinct_sorted(pair_obstacle)  # np.unique would import numpy.ma into a new process
     cluster = np.empty(len(centre), dtype=np.int64)
     boxes = []
     for k, members in enumerate(_clusters(centre, used, cluster_size)):

@@ -42,6 +42,7 @@ from cpr_kin.collision.closest_pairs import closest_pairs
 from cpr_kin.collision.coal_pools import configure_pool, pool_collisions
 from cpr_kin.collision.decisive import coal_error_m
 from cpr_kin.collision.learned_cells import CellMemory, LearnedCells, cells_digest
+from cpr_kin.common.arrays import finite_median
 from cpr_kin.shapes.exact_meshes import ExactMesh
 from cpr_kin.shapes.exact_pairs import ExactPairs
 
@@ -158,7 +159,7 @@ class NearCells:
         for n, q in enumerate(probes):
             pin.computeDistances(self.model, data, self.geometry_model, geometry_data, q)
             distances[n] = [result.min_distance for result in geometry_data.distanceResults]
-        return np.clip(SLACK_SHARE * np.median(distances, axis=0), MIN_SLACK_M, MAX_SLACK_M)
+        return np.clip(SLACK_SHARE * finite_median(distances, axis=0), MIN_SLACK_M, MAX_SLACK_M)
 
     def _level(self, margins_m: tuple[float, ...]) -> Float32Array:
         """The margins, coal's error added, rounded up to :data:`LEVEL_M`: float32 no smaller than them."""

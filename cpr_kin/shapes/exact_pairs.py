@@ -30,6 +30,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
+from cpr_kin.common.arrays import distinct_sorted
 from cpr_kin.shapes.coal_queries import as_transform, collide_margin_m
 from cpr_kin.shapes.held_whole import inner_points, may_hold
 from cpr_kin.shapes.mesh_pieces import Side, sides_apart
@@ -114,7 +115,7 @@ class ExactPairs:
         pair of its group cannot be the group's closest.
         """
         ceiling = np.full(len(hull_m), np.inf)
-        for g in np.unique(group):
+        for g in distinct_sorted(group).tolist():  # np.unique would import numpy.ma into a new process
             members = group == g
             ceiling[members] = np.min(hull_m[members] + self.excess_m[members])
         return np.asarray(self.refined & (hull_m < ceiling))

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from cpr_kin.common.arrays import distinct_sorted
 from cpr_kin.common.disk_cache import cached_array
 from cpr_kin.shapes.mesh_geometry import hull_planes
 
@@ -66,7 +67,7 @@ def mesh_topology(bvh: Any, content: bytes) -> MeshTopology:
         return _indices_of(found, len(vertices)) and found.shape == (count, 3)
 
     faces = cached_array("mesh-faces", f"{digest}-{count}", indices, faces_fit)
-    used = np.unique(faces)
+    used = distinct_sorted(faces)  # np.unique would import numpy.ma into a new process
     corners = vertices[used]
     pieces = cached_array(
         "mesh-components",

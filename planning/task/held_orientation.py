@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
+from cpr_kin.common.arrays import distinct_sorted
 from planning.curves.interpolating_spline import chord_parameter, spline_through
 from planning.curves.on_path_timing import time_on_path
 from planning.curves.trajectory import Trajectory
@@ -137,7 +138,7 @@ def _held_sparsest(
     Never through fewer than :data:`FEWEST_SPARSE`.
     """
     for every in SPARSER:
-        kept = samples[np.unique(np.r_[np.arange(0, len(samples), every), len(samples) - 1])]
+        kept = samples[distinct_sorted(np.arange(0, len(samples), every), len(samples) - 1)]
         if len(kept) < FEWEST_SPARSE:
             continue
         with contextlib.suppress(NoSolutionError):
