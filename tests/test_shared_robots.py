@@ -86,6 +86,24 @@ def test_a_failed_load_keeps_nothing(arm: ck.RobotSpec) -> None:
     assert ck.shared_robot(arm) is robot
 
 
+def test_a_robot_whose_urdf_changed_while_it_loaded_is_not_kept(
+    arm: ck.RobotSpec, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    load = ck.RobotSpec.load
+
+    def edited_meanwhile(spec: ck.RobotSpec) -> ck.Robot:
+        robot = load(spec)
+        touch_later(Path(spec.urdf))  # an editor saved it after it was read
+        return robot
+
+    monkeypatch.setattr(ck.RobotSpec, "load", edited_meanwhile)
+    first = ck.shared_robot(arm)
+    monkeypatch.undo()
+    second = ck.shared_robot(arm)
+    assert second is not first  # read again
+    assert ck.shared_robot(arm) is second
+
+
 def test_at_most_the_kept_robots_stay(arm: ck.RobotSpec, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(shared_robots, "KEPT_ROBOTS", 1)
     first = ck.shared_robot(arm)

@@ -58,18 +58,22 @@ def shared_robot(spec: RobotSpec) -> Robot:
     """``spec``'s robot, loaded on this thread's first call and kept while its files are unchanged.
 
     Raises what :meth:`RobotSpec.load <cpr_kin.description.loading.RobotSpec.load>` raises; a
-    failed load keeps nothing.
+    failed load keeps nothing, nor does a load during which the URDF changed.
     """
-    key = (spec, os.path.abspath(spec.urdf), threading.get_ident())  # a relative URDF is the cwd's
+    urdf = os.path.abspath(spec.urdf)  # a relative URDF is the working folder's
+    key = (spec, urdf, threading.get_ident())
     with _lock:
         kept = _kept.get(key)
         if kept is not None:
             _kept.move_to_end(key)
     if kept is not None and _stamps(kept.sources) == kept.stamps:
         return kept.robot
+    before = _stamps((urdf,))
     robot = spec.load()
     sources = _sources(robot)
     fresh = _Kept(robot, sources, _stamps(sources))
+    if _stamps((urdf,)) != before:  # the URDF changed while it was read: the robot may be of neither
+        return robot
     with _lock:
         _kept[key] = fresh
         _kept.move_to_end(key)
