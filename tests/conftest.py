@@ -68,19 +68,24 @@ def load_script(name: str) -> ModuleType:
     return module
 
 
+def run_script(name: str, *arguments: str, timeout_s: float = 600) -> subprocess.CompletedProcess[str]:
+    """``scripts/<name>.py`` run in a new process with ``arguments``: what it printed and its exit code."""
+    return subprocess.run(
+        [sys.executable, str(SCRIPTS / f"{name}.py"), *arguments],
+        capture_output=True,
+        text=True,
+        timeout=timeout_s,
+        check=False,
+    )
+
+
 def script_table(name: str, *arguments: str) -> list[list[str]]:
     """``scripts/<name>.py`` run in a new process with ``arguments``: its markdown table's rows.
 
     The header row first, each row's cells stripped; the script must exit 0 (else the end of
     its standard error is the failure's message).
     """
-    completed = subprocess.run(
-        [sys.executable, str(SCRIPTS / f"{name}.py"), *arguments],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        check=False,
-    )
+    completed = run_script(name, *arguments)
     assert completed.returncode == 0, completed.stderr[-2000:]
     lines = [line for line in completed.stdout.splitlines() if line.startswith("| ")]
     return [[cell.strip() for cell in line.split("|")[1:-1]] for line in lines]

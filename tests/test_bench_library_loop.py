@@ -2,12 +2,9 @@
 
 from __future__ import annotations
 
-import subprocess
-import sys
-
 import pytest
 
-from .conftest import SCRIPTS, script_table
+from .conftest import run_script, script_table
 
 
 @pytest.mark.slow
@@ -28,12 +25,6 @@ def test_each_robot_gets_a_row_both_ways_and_the_same_trajectories() -> None:
 
 
 def test_a_robot_it_does_not_know_is_refused_with_the_choices() -> None:
-    done = subprocess.run(
-        [sys.executable, str(SCRIPTS / "bench_library_loop.py"), "--robots", "r2d2"],
-        capture_output=True,
-        text=True,
-        timeout=60,
-        check=False,
-    )
+    done = run_script("bench_library_loop", "--robots", "r2d2", timeout_s=60)
     assert done.returncode == 2
     assert "argument --robots: invalid choice: 'r2d2'" in done.stderr

@@ -2,13 +2,11 @@
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
-from .conftest import SCRIPTS, script_table
+from .conftest import run_script, script_table
 
 SHELF = Path(__file__).resolve().parents[1] / "examples" / "scenes" / "shelf.yaml"
 
@@ -27,12 +25,6 @@ def test_the_command_and_the_floor_are_timed_in_new_processes_each_against_the_f
 
 
 def test_a_scene_that_is_not_there_is_one_line_and_exit_1() -> None:
-    done = subprocess.run(
-        [sys.executable, str(SCRIPTS / "bench_startup.py"), "--scene", "no_such.yaml"],
-        capture_output=True,
-        text=True,
-        timeout=60,
-        check=False,
-    )
+    done = run_script("bench_startup", "--scene", "no_such.yaml", timeout_s=60)
     assert done.returncode == 1
     assert done.stderr.strip() == "--scene no_such.yaml: no such file; give a scene file (YAML)"
