@@ -72,7 +72,7 @@ def shared_robot(spec: RobotSpec) -> Robot:
     robot = spec.load()
     sources = _sources(robot)
     fresh = _Kept(robot, sources, _stamps(sources))
-    if _stamps((urdf,)) != before:  # the URDF changed while it was read: the robot may be of neither
+    if fresh.stamps[0] != before[0]:  # the URDF changed while it was read: the robot may be of neither
         return robot
     with _lock:
         _kept[key] = fresh
@@ -89,7 +89,7 @@ def forget_shared_robots() -> None:
 
 
 def _sources(robot: Robot) -> tuple[str, ...]:
-    """What ``robot`` was built from: its files, its collision meshes and the folders searched."""
+    """What ``robot`` was built from, its URDF first: its files, collision meshes and the folders searched."""
     urdf = Path(robot.urdf_path).absolute()
     files = (urdf, robot.srdf_path, robot.limits_path)
     # a mesh's path is absolute once resolved; a primitive's names its shape (``BOX``)
