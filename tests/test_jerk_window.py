@@ -46,6 +46,37 @@ def test_the_averaged_jerk_is_the_timings_own_on_random_profiles(second: float) 
         )
 
 
+def formula_usage(
+    times: np.ndarray, velocity: np.ndarray, jerk: np.ndarray, window_s: float, second: float
+) -> float:
+    """The module docstring's jerk at every instant where one of its four velocities meets a grid
+    point, each velocity interpolated by NumPy (0 before the start and after the end)."""
+    delays = np.array([0.0, second, 1.0, 1.0 + second]) * window_s
+    signs = np.array([1.0, -1.0, -1.0, 1.0])
+    instants = (times[:, None] + delays[None, :]).ravel()
+    usage = 0.0
+    for j in range(velocity.shape[1]):
+        speed = [np.interp(instants - delay, times, velocity[:, j], left=0.0, right=0.0) for delay in delays]
+        averaged = np.tensordot(signs, np.array(speed), axes=1) / (second * window_s**2)
+        usage = max(usage, float(np.max(np.abs(averaged))) / jerk[j])
+    return usage
+
+
+@pytest.mark.parametrize("second", [0.25, 0.3, 1.0])
+def test_the_averaged_jerk_is_the_formulas_at_every_breakpoint(second: float) -> None:
+    """Shifts that coincide (a quarter: 9 distinct of 16) or do not (0.3: 13) give the formula's value."""
+    rng = np.random.default_rng(11)
+    for _ in range(20):
+        times = np.concatenate([[0.0], np.cumsum(rng.uniform(0.005, 0.2, int(rng.integers(2, 40))))])
+        velocity = rng.uniform(-2.0, 2.0, (times.size, 3))
+        velocity[[0, -1]] = 0.0  # from rest to rest
+        jerk = rng.uniform(5.0, 50.0, 3)
+        window_s = float(rng.uniform(0.01, 0.5))
+        assert averaged_jerk_usage(times, velocity, jerk, window_s, second) == pytest.approx(
+            formula_usage(times, velocity, jerk, window_s, second), rel=1e-12
+        )
+
+
 def test_a_move_too_short_to_cruise_doubles_the_window() -> None:
     """Bang-bang (``+a`` then ``-a``): the first average's jerk is ``2 a / w`` for a window of
     ``w``, so the usage is 2 at ``w = a / j`` and 1 at twice it; the motion lasts ``T + 2.5 a / j``."""

@@ -55,30 +55,61 @@ def averaged_jerk_usage(
         jerk: ``(nj,)`` jerk limits.
         window_s: the first average's width [s], > 0.
         second_share: the second average's width as a share of ``window_s``, in (0, 1].
+
+    The jerk is checked where one of its four velocities meets a grid point: at each of the
+    four breakpoints, each term reads the velocity at the grid's instants shifted by the
+    breakpoint's delay less its own. Of those 16 shifts, the four of a term at its own
+    breakpoint are 0 and others coincide (with a second share of a quarter, 9 are distinct),
+    so each distinct shift's velocities are interpolated once.
     """
     count, joints = velocity.shape
     scale = 1.0 / (second_share * window_s**2)
     delays = (0.0, second_share, 1.0, 1.0 + second_share)  # of the four velocities, shares of the window
-    averaged = np.zeros((count, joints))
-    usage = 0.0
-    for breakpoint in delays:  # the instants where one of the four velocities meets a grid point
-        averaged[:] = 0.0
+    offsets = np.empty(16)
+    slot = np.empty(16, dtype=np.int64)  # the distinct shift that term t reads at breakpoint b: 4 b + t
+    distinct = 0
+    for b in range(4):
         for term in range(4):
-            delay, sign = delays[term], SIGNS[term]
-            offset = (breakpoint - delay) * window_s
-            k = 0  # the grid interval of times[g] + offset, increasing with g
-            for g in range(count):
-                t = times[g] + offset
-                if t <= times[0] or t >= times[-1]:
-                    continue  # at rest before the start and after the end
-                while times[k + 1] < t:
-                    k += 1
-                share = (t - times[k]) / max(times[k + 1] - times[k], 1e-300)
-                for j in range(joints):
-                    averaged[g, j] += sign * (velocity[k, j] + share * (velocity[k + 1, j] - velocity[k, j]))
+            offset = (delays[b] - delays[term]) * window_s
+            slot[4 * b + term] = distinct
+            for i in range(distinct):
+                if offsets[i] == offset:
+                    slot[4 * b + term] = i
+                    break
+            if slot[4 * b + term] == distinct:
+                offsets[distinct] = offset
+                distinct += 1
+    shifted = np.zeros((distinct, count, joints))  # the velocity at times[g] + offsets[i]
+    for i in range(distinct):
+        k = 0  # the grid interval of times[g] + offset, increasing with g
+        for g in range(count):
+            t = times[g] + offsets[i]
+            if t <= times[0] or t >= times[-1]:
+                continue  # at rest before the start and after the end
+            while times[k + 1] < t:
+                k += 1
+            share = (t - times[k]) / max(times[k + 1] - times[k], 1e-300)
+            for j in range(joints):
+                shifted[i, g, j] = velocity[k, j] + share * (velocity[k + 1, j] - velocity[k, j])
+    peak = np.zeros(joints)  # the largest |averaged jerk| * r w^2 of each joint
+    for b in range(4):
+        first, second, third, fourth = (
+            shifted[slot[4 * b]],
+            shifted[slot[4 * b + 1]],
+            shifted[slot[4 * b + 2]],
+            shifted[slot[4 * b + 3]],
+        )
         for g in range(count):
             for j in range(joints):
-                usage = max(usage, abs(averaged[g, j]) * scale / jerk[j])
+                averaged = 0.0  # the terms in order, as a sum from zero
+                averaged += SIGNS[0] * first[g, j]
+                averaged += SIGNS[1] * second[g, j]
+                averaged += SIGNS[2] * third[g, j]
+                averaged += SIGNS[3] * fourth[g, j]
+                peak[j] = max(peak[j], abs(averaged))
+    usage = 0.0
+    for j in range(joints):
+        usage = max(usage, peak[j] * scale / jerk[j])
     return usage
 
 
