@@ -10,7 +10,12 @@ from planning.curves.jerk_window import jerk_limited_duration, profile_window, s
 from planning.curves.path_timing import SECOND_SHARE, time_path
 from planning.curves.phase_plane import phase_plane_profile, sampled_derivatives
 from planning.curves.spline import SepticSplineSolver, uniform_knots
-from planning.curves.torque_estimate import sampled_torque_durations, torque_limited_duration
+from planning.curves.torque_estimate import (
+    TERM_STRIDE,
+    path_picks,
+    sampled_torque_durations,
+    torque_limited_duration,
+)
 from planning.curves.torque_limits import (
     HEADROOM,
     TorqueRows,
@@ -159,6 +164,35 @@ def test_the_search_estimate_of_many_paths_is_each_paths_own(robot: ck.Robot, pa
         for one in samples
     ]
     assert together.tolist() == alone and together[1] == 0.0 and len(set(together.tolist())) >= 3
+
+
+def test_the_estimate_of_a_few_fitted_joints_is_theirs(robot: ck.Robot, path: Trajectory) -> None:
+    """Fitted joints a subset: without binding torques, their own estimate; where gravity alone
+    exceeds a limit (a payload no joint holds), the estimate without torques too."""
+    limits = robot.limits
+    fitted = np.array([0, 2, 3])
+    kinematic = np.stack([limits.velocity, limits.acceleration, limits.jerk])[:, fitted]
+    window = float(np.max(limits.acceleration / limits.jerk))
+    samples = path(np.linspace(path.knots[0], path.knots[-1], 64))[None]
+    points = np.ascontiguousarray(samples[:, :, fitted])
+    plain = sampled_path_durations(points, *limits_of(kinematic), window, ROUNDS, TOLERANCE, SECOND_SHARE)
+    light = ck.robot_dynamics(robot, ck.Payload(2.0, (0.0, 0.0, 0.05)))
+    assert sampled_torque_durations(samples, fitted, kinematic, light, window, SECOND_SHARE).tolist() == [
+        pytest.approx(plain[0], rel=1e-12)
+    ]
+    crushing = ck.robot_dynamics(robot, ck.Payload(1000.0, (0.0, 0.0, 0.05)))
+    assert np.any(
+        np.abs(crushing.path_terms(samples[0], 0 * samples[0], 0 * samples[0])[2]) > crushing.effort
+    )
+    assert sampled_torque_durations(samples, fitted, kinematic, crushing, window, SECOND_SHARE).tolist() == (
+        plain.tolist()
+    )
+
+
+@pytest.mark.parametrize("kept", range(2, 14))
+def test_the_torques_are_computed_at_every_strideth_sample_and_the_last(kept: int) -> None:
+    expected = sorted({*range(0, kept, TERM_STRIDE), kept - 1})
+    assert path_picks(kept, TERM_STRIDE).tolist() == expected
 
 
 def test_the_compiled_estimate_of_a_path_is_the_rows_profile_and_window_composed(

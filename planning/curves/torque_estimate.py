@@ -10,11 +10,13 @@ each path.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numpy.typing import NDArray
 
 from cpr_kin.common.compiled import njit
-from planning.curves.jerk_window import jerk_limited_duration, profile_window, sampled_path_durations
+from planning.curves.jerk_window import jerk_limited_duration, profile_window
 from planning.curves.phase_plane import kept_samples, phase_plane_profile, sampled_derivatives
 from planning.curves.torque_limits import HEADROOM, TorqueModel
 from planning.curves.velocity_caps import ROUNDS, TOLERANCE
@@ -41,44 +43,146 @@ def sampled_torque_durations(
     (:func:`~planning.curves.torque_limits.phase_plane_rows`). Their terms are computed on
     every :data:`TERM_STRIDE`-th sample and the last, and interpolated between (they vary
     smoothly along a path); a path where gravity alone exceeds a limit keeps the estimate
-    without torques (the verification will refuse it, naming the torque).
+    without torques (the verification will refuse it, naming the torque). Two compiled
+    passes round one batched RNEA of every path's picked samples: :func:`path_rows`, then
+    :func:`torque_durations`.
     """
     limited = np.isfinite(model.effort)
     bound = model.effort[limited] * (1.0 - HEADROOM)
-    points = np.ascontiguousarray(samples[:, :, fitted])
-    velocity, acceleration, jerk = limits
-    durations = np.zeros(len(samples))
-    paths, rows_q, rows_dq, rows_ddq = [], [], [], []
-    for s in range(len(samples)):  # each path's samples kept, derivatives and picked rows
-        index = kept_samples(points[s], velocity)
+    fitted_index = np.asarray(fitted, dtype=np.int64)
+    rows = PathRows(*path_rows(np.ascontiguousarray(samples), fitted_index, limits[0], TERM_STRIDE))
+    if not len(rows.q):
+        return np.zeros(len(samples))
+    every = np.stack(model.path_terms(rows.q, rows.dq, rows.ddq))
+    terms = np.ascontiguousarray(every[:, :, limited])
+    paths = (rows.kept, rows.steps, rows.d1, rows.d2)
+    return torque_durations(paths, terms, bound, limits, window_s, ROUNDS, TOLERANCE, second_share)
+
+
+class PathRows(NamedTuple):
+    """:func:`path_rows`' answer: each sampled path's kept samples, derivatives and picked RNEA rows.
+
+    The paths' arrays are padded to the longest; path ``s`` holds ``kept[s]`` samples
+    (fewer than 2: no motion, no rows), and its rows follow the previous paths' in ``q``,
+    ``dq``, ``ddq``.
+    """
+
+    kept: NDArray[np.int64]
+    """``(S,)`` samples kept of each path (:func:`~planning.curves.phase_plane.kept_samples`)."""
+    steps: FloatArray
+    """``(S, K)`` their arc-length steps (the first ``kept - 1``)."""
+    d1: FloatArray
+    """``(S, K, nj)`` the fitted joints' ``dq/ds`` at the kept samples."""
+    d2: FloatArray
+    """``(S, K, nj)`` their ``d2q/ds2``."""
+    q: FloatArray
+    """``(T, nq)`` the picked samples' configurations, path after path."""
+    dq: FloatArray
+    """``(T, nq)`` their ``dq/ds`` (0 for the joints not fitted)."""
+    ddq: FloatArray
+    """``(T, nq)`` their ``d2q/ds2``."""
+
+
+@njit
+def path_picks(kept: int, stride: int) -> NDArray[np.int64]:
+    """The kept samples whose torque terms are computed: every ``stride``-th and the last."""
+    last_taken = (kept - 1) % stride == 0
+    pick = np.empty((kept - 1) // stride + 1 + (0 if last_taken else 1), dtype=np.int64)
+    for i in range((kept - 1) // stride + 1):
+        pick[i] = i * stride
+    if not last_taken:
+        pick[-1] = kept - 1
+    return pick
+
+
+@njit
+def path_rows(
+    samples: FloatArray, fitted: NDArray[np.int64], velocity: FloatArray, stride: int
+) -> tuple[NDArray[np.int64], FloatArray, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Each path's kept samples and derivatives, and the rows RNEA needs (:class:`PathRows`' fields).
+
+    ``samples`` ``(S, K, nq)``; the derivatives of the ``fitted`` joints, in seconds at their
+    ``velocity`` limits (:func:`~planning.curves.phase_plane.sampled_derivatives`); the rows
+    at :func:`path_picks`.
+    """
+    paths, count, nq = samples.shape
+    joints = len(fitted)
+    kept = np.zeros(paths, dtype=np.int64)
+    indices = np.zeros((paths, count), dtype=np.int64)  # the kept samples' indices
+    steps = np.zeros((paths, count))
+    d1_all, d2_all = np.zeros((paths, count, joints)), np.zeros((paths, count, joints))
+    total = 0
+    for s in range(paths):
+        points = np.ascontiguousarray(samples[s][:, fitted])
+        index = kept_samples(points, velocity)
         if len(index) < 2:
             continue
-        steps, d1, d2 = sampled_derivatives(points[s], velocity)
-        pick = np.arange(0, len(index), TERM_STRIDE)  # and the last sample
-        pick = pick if pick[-1] == len(index) - 1 else np.append(pick, len(index) - 1)
-        dq, ddq = np.zeros((2, len(pick), samples.shape[2]))
-        dq[:, fitted], ddq[:, fitted] = d1[pick], d2[pick]
-        paths.append((s, steps, d1, d2, pick))
-        rows_q.append(samples[s, index[pick]])
-        rows_dq.append(dq)
-        rows_ddq.append(ddq)
-    if not paths:
-        return durations
-    # one batched RNEA for every path's picked rows
-    every = np.stack(
-        model.path_terms(np.concatenate(rows_q), np.concatenate(rows_dq), np.concatenate(rows_ddq))
-    )
-    ends = np.cumsum([len(pick) for *_, pick in paths])
-    for (s, steps, d1, d2, pick), end in zip(paths, ends, strict=True):
-        terms = np.ascontiguousarray(every[:, end - len(pick) : end][:, :, limited])
-        if np.any(np.abs(terms[2]) > bound):  # gravity beyond a limit: the estimate without torques
-            plain = sampled_path_durations(
-                points[s : s + 1], velocity, acceleration, jerk, window_s, ROUNDS, TOLERANCE, second_share
+        step, d1, d2 = sampled_derivatives(points, velocity)
+        kept[s], indices[s, : len(index)] = len(index), index
+        steps[s, : len(step)], d1_all[s, : len(index)], d2_all[s, : len(index)] = step, d1, d2
+        total += len(path_picks(len(index), stride))
+    q, dq, ddq = np.empty((total, nq)), np.zeros((total, nq)), np.zeros((total, nq))
+    row = 0
+    for s in range(paths):
+        if kept[s] < 2:
+            continue
+        for k in path_picks(kept[s], stride):
+            q[row] = samples[s, indices[s, k]]
+            for j in range(joints):
+                dq[row, fitted[j]], ddq[row, fitted[j]] = d1_all[s, k, j], d2_all[s, k, j]
+            row += 1
+    return kept, steps, d1_all, d2_all, q, dq, ddq
+
+
+@njit
+def torque_durations(
+    paths: tuple[NDArray[np.int64], FloatArray, FloatArray, FloatArray],
+    terms: FloatArray,
+    bound: FloatArray,
+    limits: FloatArray,
+    window_s: float,
+    rounds: int,
+    tolerance: float,
+    second_share: float,
+) -> FloatArray:
+    """``(S,)`` each path's duration estimate [s], its torques' ``terms`` ``(3, T, L)`` at its rows.
+
+    ``paths``: :class:`PathRows`' ``kept``, ``steps``, ``d1``, ``d2``; :func:`torque_limited_duration`
+    of each path that moves; where gravity alone exceeds a ``bound`` ``(L,)``, the estimate
+    without torques, as :func:`~planning.curves.jerk_window.sampled_path_durations` gives it.
+    """
+    kept_of, steps_of, d1_of, d2_of = paths
+    durations = np.zeros(len(kept_of))
+    velocity, acceleration, jerk = limits[0], limits[1], limits[2]
+    start = 0
+    for s in range(len(kept_of)):
+        kept = kept_of[s]
+        if kept < 2:
+            continue
+        pick = path_picks(kept, TERM_STRIDE)
+        steps = steps_of[s, : max(kept - 1, 1)].copy()
+        d1, d2 = d1_of[s, :kept].copy(), d2_of[s, :kept].copy()
+        own = terms[:, start : start + len(pick)]
+        start += len(pick)
+        if np.any(np.abs(own[2]) > bound):  # gravity beyond a limit: the estimate without torques
+            x = phase_plane_profile(d1, d2, steps, velocity, acceleration, np.zeros_like(d1))
+            times, window, usage = profile_window(
+                x, steps, d1, jerk, window_s, rounds, tolerance, second_share
             )
-            durations[s] = plain[0]
+            durations[s] = jerk_limited_duration(times, window, usage, second_share)
             continue
         durations[s] = torque_limited_duration(
-            steps, d1, d2, pick, terms, bound, limits, window_s, ROUNDS, TOLERANCE, second_share
+            steps,
+            d1,
+            d2,
+            pick,
+            np.ascontiguousarray(own),
+            bound,
+            limits,
+            window_s,
+            rounds,
+            tolerance,
+            second_share,
         )
     return durations
 
