@@ -56,7 +56,8 @@ def sampled_torque_durations(
     every = np.stack(model.path_terms(rows.q, rows.dq, rows.ddq))
     terms = np.ascontiguousarray(every[:, :, limited])
     paths = (rows.kept, rows.steps, rows.d1, rows.d2)
-    return torque_durations(paths, terms, bound, limits, window_s, ROUNDS, TOLERANCE, second_share)
+    averaging = (window_s, ROUNDS, TOLERANCE, second_share)
+    return torque_durations(paths, terms, bound, limits, averaging)
 
 
 class PathRows(NamedTuple):
@@ -140,18 +141,18 @@ def torque_durations(
     terms: FloatArray,
     bound: FloatArray,
     limits: FloatArray,
-    window_s: float,
-    rounds: int,
-    tolerance: float,
-    second_share: float,
+    averaging: tuple[float, int, float, float],
 ) -> FloatArray:
     """``(S,)`` each path's duration estimate [s], its torques' ``terms`` ``(3, T, L)`` at its rows.
 
-    ``paths``: :class:`PathRows`' ``kept``, ``steps``, ``d1``, ``d2``; :func:`torque_limited_duration`
-    of each path that moves; where gravity alone exceeds a ``bound`` ``(L,)``, the estimate
-    without torques, as :func:`~planning.curves.jerk_window.sampled_path_durations` gives it.
+    ``paths``: :class:`PathRows`' ``kept``, ``steps``, ``d1``, ``d2``; ``averaging``: the averages'
+    first width [s], the widenings' rounds and tolerance, and the second share. Each path that
+    moves gets :func:`torque_limited_duration`; where gravity alone exceeds a ``bound`` ``(L,)``,
+    the estimate without torques, as :func:`~planning.curves.jerk_window.sampled_path_durations`
+    gives it.
     """
     kept_of, steps_of, d1_of, d2_of = paths
+    window_s, rounds, tolerance, second_share = averaging
     durations = np.zeros(len(kept_of))
     velocity, acceleration, jerk = limits[0], limits[1], limits[2]
     start = 0
@@ -171,18 +172,9 @@ def torque_durations(
             )
             durations[s] = jerk_limited_duration(times, window, usage, second_share)
             continue
+        contiguous = np.ascontiguousarray(own)
         durations[s] = torque_limited_duration(
-            steps,
-            d1,
-            d2,
-            pick,
-            np.ascontiguousarray(own),
-            bound,
-            limits,
-            window_s,
-            rounds,
-            tolerance,
-            second_share,
+            steps, d1, d2, pick, contiguous, bound, limits, window_s, rounds, tolerance, second_share
         )
     return durations
 
