@@ -50,7 +50,7 @@ def sampled_torque_durations(
     limited = np.isfinite(model.effort)
     bound = model.effort[limited] * (1.0 - HEADROOM)
     fitted_index = np.asarray(fitted, dtype=np.int64)
-    rows = PathRows(*path_rows(np.ascontiguousarray(samples), fitted_index, limits[0], TERM_STRIDE))
+    rows = PathRows(*path_rows(np.ascontiguousarray(samples), fitted_index, limits[0]))
     if not len(rows.q):
         return np.zeros(len(samples))
     every = np.stack(model.path_terms(rows.q, rows.dq, rows.ddq))
@@ -63,7 +63,7 @@ def sampled_torque_durations(
 class PathRows(NamedTuple):
     """:func:`path_rows`' answer: each sampled path's kept samples, derivatives and picked RNEA rows.
 
-    The paths' arrays are padded to the longest; path ``s`` holds ``kept[s]`` samples
+    The paths' arrays have room for every sample; path ``s`` holds ``kept[s]`` of them
     (fewer than 2: no motion, no rows), and its rows follow the previous paths' in ``q``,
     ``dq``, ``ddq``.
     """
@@ -85,7 +85,7 @@ class PathRows(NamedTuple):
 
 
 @njit
-def path_picks(kept: int, stride: int) -> NDArray[np.int64]:
+def path_picks(kept: int, stride: int = TERM_STRIDE) -> NDArray[np.int64]:
     """The kept samples whose torque terms are computed: every ``stride``-th and the last."""
     last_taken = (kept - 1) % stride == 0
     pick = np.empty((kept - 1) // stride + 1 + (0 if last_taken else 1), dtype=np.int64)
@@ -98,13 +98,13 @@ def path_picks(kept: int, stride: int) -> NDArray[np.int64]:
 
 @njit
 def path_rows(
-    samples: FloatArray, fitted: NDArray[np.int64], velocity: FloatArray, stride: int
+    samples: FloatArray, fitted: NDArray[np.int64], velocity: FloatArray
 ) -> tuple[NDArray[np.int64], FloatArray, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
     """Each path's kept samples and derivatives, and the rows RNEA needs (:class:`PathRows`' fields).
 
     ``samples`` ``(S, K, nq)``; the derivatives of the ``fitted`` joints, in seconds at their
     ``velocity`` limits (:func:`~planning.curves.phase_plane.sampled_derivatives`); the rows
-    at :func:`path_picks`.
+    at :func:`path_picks` (every :data:`TERM_STRIDE`-th kept sample and the last).
     """
     paths, count, nq = samples.shape
     joints = len(fitted)
@@ -121,13 +121,13 @@ def path_rows(
         step, d1, d2 = sampled_derivatives(points, velocity)
         kept[s], indices[s, : len(index)] = len(index), index
         steps[s, : len(step)], d1_all[s, : len(index)], d2_all[s, : len(index)] = step, d1, d2
-        total += len(path_picks(len(index), stride))
+        total += len(path_picks(len(index)))
     q, dq, ddq = np.empty((total, nq)), np.zeros((total, nq)), np.zeros((total, nq))
     row = 0
     for s in range(paths):
         if kept[s] < 2:
             continue
-        for k in path_picks(kept[s], stride):
+        for k in path_picks(kept[s]):
             q[row] = samples[s, indices[s, k]]
             for j in range(joints):
                 dq[row, fitted[j]], ddq[row, fitted[j]] = d1_all[s, k, j], d2_all[s, k, j]
@@ -160,7 +160,7 @@ def torque_durations(
         kept = kept_of[s]
         if kept < 2:
             continue
-        pick = path_picks(kept, TERM_STRIDE)
+        pick = path_picks(kept)
         steps = steps_of[s, : max(kept - 1, 1)].copy()
         d1, d2 = d1_of[s, :kept].copy(), d2_of[s, :kept].copy()
         own = terms[:, start : start + len(pick)]
