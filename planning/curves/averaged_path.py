@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 
 from cpr_kin.common.compiled import njit
 from planning.curves.jerk_window import profile_window
-from planning.curves.phase_plane import kept_samples, phase_plane_profile, sampled_derivatives
+from planning.curves.phase_plane import kept_derivatives, kept_samples, phase_plane_profile
 
 FloatArray = NDArray[np.float64]
 
@@ -74,7 +74,7 @@ def averaged_samples(
     averaged = points.copy()
     for s in range(points.shape[0]):
         index = kept_samples(points[s], limits[0])
-        steps, d1, d2 = sampled_derivatives(points[s], limits[0])
+        steps, d1, d2 = kept_derivatives(points[s], index, limits[0])
         if index.size < 2 or len(d1) < 2:
             continue
         kept = points[s][index]

@@ -213,8 +213,19 @@ def sampled_derivatives(points: FloatArray, v: FloatArray) -> tuple[FloatArray, 
     to the one before are dropped (:func:`kept_samples`); derivatives are the three-point
     formulas of a non-uniform grid, taken from the neighbour at the ends.
     """
+    return kept_derivatives(points, kept_samples(points, v), v)
+
+
+@njit
+def kept_derivatives(
+    points: FloatArray, index: NDArray[np.int64], v: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """:func:`sampled_derivatives` at the samples ``index`` that :func:`kept_samples` keeps.
+
+    For a caller that needs those samples too: they are found once.
+    """
     joints = points.shape[1]
-    kept = points[kept_samples(points, v)]
+    kept = points[index]
     m = kept.shape[0]
     steps = np.empty(max(m - 1, 1))
     steps[0] = 1.0

@@ -23,10 +23,10 @@ import cpr_kin as ck
 from cpr_kin.common.arrays import distinct_sorted
 from cpr_kin.model.robot import joint_units
 from planning.curves.phase_plane import (
+    kept_derivatives,
     kept_samples,
     path_acceleration,
     phase_plane_profile,
-    sampled_derivatives,
 )
 from planning.curves.torque_limits import UNBOUND_SHARE, profile_torques
 from planning.curves.trajectory import Trajectory
@@ -219,9 +219,10 @@ def search_torque(
     # writable copies of the (read-only) limits, as the search's own are: the kernels below are
     # then loaded once in a process, not once more for read-only arguments
     velocity, acceleration = np.array(limits.velocity), np.array(limits.acceleration)
-    steps, d1, d2 = sampled_derivatives(points, velocity)
+    index = kept_samples(points, velocity)
+    steps, d1, d2 = kept_derivatives(points, index, velocity)
     x = phase_plane_profile(d1, d2, steps, velocity, acceleration, np.zeros_like(d1))
-    terms = dynamics.path_terms(points[kept_samples(points, velocity)], d1, d2)
+    terms = dynamics.path_terms(points[index], d1, d2)
     usage = dynamics.utilisation(profile_torques(terms, x, path_acceleration(x, steps)))
     return dynamics if usage.max() >= UNBOUND_SHARE else None
 
