@@ -10,14 +10,12 @@ each path.
 
 from __future__ import annotations
 
-from typing import NamedTuple
-
 import numpy as np
 from numpy.typing import NDArray
 
 from cpr_kin.common.compiled import njit
 from planning.curves.jerk_window import jerk_limited_duration, profile_window
-from planning.curves.phase_plane import kept_samples, phase_plane_profile, sampled_derivatives
+from planning.curves.phase_plane import kept_derivatives, kept_samples, phase_plane_profile
 from planning.curves.torque_limits import HEADROOM, TorqueModel
 from planning.curves.velocity_caps import ROUNDS, TOLERANCE
 
@@ -50,38 +48,13 @@ def sampled_torque_durations(
     limited = np.isfinite(model.effort)
     bound = model.effort[limited] * (1.0 - HEADROOM)
     fitted_index = np.asarray(fitted, dtype=np.int64)
-    rows = PathRows(*path_rows(np.ascontiguousarray(samples), fitted_index, limits[0]))
-    if not len(rows.q):
+    kept, steps, d1, d2, q, dq, ddq = path_rows(np.ascontiguousarray(samples), fitted_index, limits[0])
+    if not len(q):
         return np.zeros(len(samples))
-    every = np.stack(model.path_terms(rows.q, rows.dq, rows.ddq))
+    every = np.stack(model.path_terms(q, dq, ddq))
     terms = np.ascontiguousarray(every[:, :, limited])
-    paths = (rows.kept, rows.steps, rows.d1, rows.d2)
     averaging = (window_s, ROUNDS, TOLERANCE, second_share)
-    return torque_durations(paths, terms, bound, limits, averaging)
-
-
-class PathRows(NamedTuple):
-    """:func:`path_rows`' answer: each sampled path's kept samples, derivatives and picked RNEA rows.
-
-    The paths' arrays have room for every sample; path ``s`` holds ``kept[s]`` of them
-    (fewer than 2: no motion, no rows), and its rows follow the previous paths' in ``q``,
-    ``dq``, ``ddq``.
-    """
-
-    kept: NDArray[np.int64]
-    """``(S,)`` samples kept of each path (:func:`~planning.curves.phase_plane.kept_samples`)."""
-    steps: FloatArray
-    """``(S, K)`` their arc-length steps (the first ``kept - 1``)."""
-    d1: FloatArray
-    """``(S, K, nj)`` the fitted joints' ``dq/ds`` at the kept samples."""
-    d2: FloatArray
-    """``(S, K, nj)`` their ``d2q/ds2``."""
-    q: FloatArray
-    """``(T, nq)`` the picked samples' configurations, path after path."""
-    dq: FloatArray
-    """``(T, nq)`` their ``dq/ds`` (0 for the joints not fitted)."""
-    ddq: FloatArray
-    """``(T, nq)`` their ``d2q/ds2``."""
+    return torque_durations((kept, steps, d1, d2), terms, bound, limits, averaging)
 
 
 @njit
@@ -100,11 +73,16 @@ def path_picks(kept: int, stride: int = TERM_STRIDE) -> NDArray[np.int64]:
 def path_rows(
     samples: FloatArray, fitted: NDArray[np.int64], velocity: FloatArray
 ) -> tuple[NDArray[np.int64], FloatArray, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
-    """Each path's kept samples and derivatives, and the rows RNEA needs (:class:`PathRows`' fields).
+    """Each path of ``samples`` ``(S, K, nq)``: its kept samples and derivatives, and the rows RNEA needs.
 
-    ``samples`` ``(S, K, nq)``; the derivatives of the ``fitted`` joints, in seconds at their
-    ``velocity`` limits (:func:`~planning.curves.phase_plane.sampled_derivatives`); the rows
-    at :func:`path_picks` (every :data:`TERM_STRIDE`-th kept sample and the last).
+    Returns ``kept`` ``(S,)``, how many samples each path keeps
+    (:func:`~planning.curves.phase_plane.kept_samples`; fewer than 2: no motion, no rows);
+    ``steps`` ``(S, K)``, their arc-length steps (the first ``kept - 1``); ``d1``, ``d2``
+    ``(S, K, nj)``, the ``fitted`` joints' ``dq/ds`` and ``d2q/ds2`` there, in seconds at their
+    ``velocity`` limits (:func:`~planning.curves.phase_plane.kept_derivatives`); and ``q``,
+    ``dq``, ``ddq`` ``(T, nq)``, the configurations and derivatives (0 for the joints not
+    fitted) at :func:`path_picks` (every :data:`TERM_STRIDE`-th kept sample and the last),
+    path after path.
     """
     paths, count, nq = samples.shape
     joints = len(fitted)
@@ -118,7 +96,7 @@ def path_rows(
         index = kept_samples(points, velocity)
         if len(index) < 2:
             continue
-        step, d1, d2 = sampled_derivatives(points, velocity)
+        step, d1, d2 = kept_derivatives(points, index, velocity)
         kept[s], indices[s, : len(index)] = len(index), index
         steps[s, : len(step)], d1_all[s, : len(index)], d2_all[s, : len(index)] = step, d1, d2
         total += len(path_picks(len(index)))
@@ -145,7 +123,7 @@ def torque_durations(
 ) -> FloatArray:
     """``(S,)`` each path's duration estimate [s], its torques' ``terms`` ``(3, T, L)`` at its rows.
 
-    ``paths``: :class:`PathRows`' ``kept``, ``steps``, ``d1``, ``d2``; ``averaging``: the averages'
+    ``paths``: :func:`path_rows`' ``kept``, ``steps``, ``d1``, ``d2``; ``averaging``: the averages'
     first width [s], the widenings' rounds and tolerance, and the second share. Each path that
     moves gets :func:`torque_limited_duration`; where gravity alone exceeds a ``bound`` ``(L,)``,
     the estimate without torques, as :func:`~planning.curves.jerk_window.sampled_path_durations`
