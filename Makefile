@@ -31,9 +31,11 @@ $(STAMP): pyproject.toml $(CONSTRAINTS)
 # The packages' bytecode, as pip writes an installed wheel's: a checkout installed in place has
 # none, and where Python may not write it (PYTHONDONTWRITEBYTECODE) every new process would
 # compile the packages again (about 0.1 s of each `cpr-plan` call; docs/benchmarks.md). Only files
-# changed since are compiled again.
+# changed since are compiled again. Then the methods Python writes for their dataclasses, which it
+# would compile in every process too (planning/cli/dataclass_code.py).
 bytecode: $(STAMP)
 	$(PY) -m compileall -q cpr_kin planning
+	$(PY) -m planning.cli.dataclass_code
 
 # The kernels compiled ahead of time (numba's pycc and the C compiler): a new `cpr-plan` process
 # then runs them without importing numba, about half a second sooner (docs/benchmarks.md). Built
@@ -69,6 +71,7 @@ wheel-check: $(STAMP)
 	build/wheel-check/venv/bin/python -m pip install --quiet -c $(CONSTRAINTS) build/wheel-check/dist/*.whl
 	cd build/wheel-check/run && ../venv/bin/cpr-plan --help > /dev/null
 	cd build/wheel-check/run && ../venv/bin/python -m planning.ahead_of_time --bundled-only
+	cd build/wheel-check/run && ../venv/bin/python -m planning.cli.dataclass_code
 	cd build/wheel-check/run && ../venv/bin/python -c 'import sys, cpr_kin.bounds.bound_kernels as k; sys.exit("numba" in sys.modules)'
 	cd build/wheel-check/run && ../venv/bin/cpr-plan paper --out paper
 	cd build/wheel-check/run && ../venv/bin/cpr-plan check "$$(../venv/bin/python -c 'import planning.io.bundled as b; print(b.paper_scene_path())')" paper/trajectory.json

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import builtins
+import dataclasses
 import gc
 import os
 import subprocess
@@ -11,6 +13,7 @@ from pathlib import Path
 import pytest
 
 from planning.cli import process
+from planning.cli.dataclass_code import KeptCode
 from planning.pipeline.blas_threads import OPENBLAS_THREADS
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -45,10 +48,12 @@ def test_start_switches_the_collector_off_and_keeps_a_users_plugin_setting(
 ) -> None:
     monkeypatch.setattr(gc, "disable", lambda: calls.append("disable"))
     monkeypatch.setenv(process.PYDANTIC_PLUGINS, "")  # the user's: every plugin loads
+    monkeypatch.setattr(dataclasses, "exec", builtins.exec, raising=False)  # Python's own again after
     calls: list[str] = []
     process.start_process()
     assert calls == ["disable"]
     assert os.environ[process.PYDANTIC_PLUGINS] == ""
+    assert isinstance(dataclasses.exec, KeptCode)  # type: ignore[attr-defined]
 
 
 def test_end_process_exits_with_the_code_and_every_byte_written() -> None:

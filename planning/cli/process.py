@@ -1,6 +1,6 @@
 """The process of the installed ``cpr-plan``: it runs one command, then it ends.
 
-A long-lived Python process needs four things that a process running one command does not;
+A long-lived Python process does five things that a process running one command need not;
 each costs a new ``cpr-plan plan`` tens of milliseconds of its half second (docs/benchmarks.md,
 the new-process row):
 
@@ -18,6 +18,10 @@ the new-process row):
   installed distribution for plugins (tools that watch a program's own models); the command's
   only models are its file schemas. :func:`start_process` sets ``PYDANTIC_DISABLE_PLUGINS`` to
   ``__all__`` unless the environment sets it (an empty value lets every plugin load).
+- **compiling its dataclasses' methods.** Python compiles each dataclass's methods from text
+  when the class is made, some fifty milliseconds of a plan's classes; the process reads the
+  code compiled by an earlier one instead, and keeps what it compiled for the next
+  (:mod:`planning.cli.dataclass_code`).
 - **Python's teardown.** On exit Python takes apart every module and the robot's models one by
   one. :func:`end_process` flushes the output, keeps what the robot's near cells learned
   (:func:`cpr_kin.collision.learned_cells.keep_learned`, which Python's exit functions would
@@ -51,10 +55,13 @@ def start_process() -> None:
     """Set up the process for one command (module docstring).
 
     No cyclic collector, one BLAS thread, no search for pydantic's plugins unless the
-    environment names some.
+    environment names some, the dataclasses' methods compiled before reused.
     """
     gc.disable()
     one_thread_for_process()
+    from planning.cli.dataclass_code import reuse_dataclass_code  # `python -m` builds its file
+
+    reuse_dataclass_code()
     os.environ.setdefault(PYDANTIC_PLUGINS, "__all__")
     sys.stdout = cast(TextIO, QuietWhenReaderLeaves(sys.stdout))
     sys.stderr = cast(TextIO, QuietWhenReaderLeaves(sys.stderr))
@@ -105,6 +112,9 @@ def end_process(code: int) -> NoReturn:
     learned = sys.modules.get("cpr_kin.collision.learned_cells")  # what a robot's near cells learned
     if learned is not None:
         learned.keep_learned()
+    methods = sys.modules.get("planning.cli.dataclass_code")  # the dataclasses' methods compiled
+    if methods is not None:
+        methods.keep_dataclass_code()
     for stream in (sys.stdout, sys.stderr):
         with contextlib.suppress(OSError, ValueError):  # a reader gone, a stream closed: nothing to keep
             stream.flush()
