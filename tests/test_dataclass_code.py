@@ -5,11 +5,13 @@ from __future__ import annotations
 import builtins
 import dataclasses
 import importlib.util
+import inspect
 import marshal
 import os
 import stat
 import subprocess
 import sys
+import typing
 from pathlib import Path
 from typing import Any
 
@@ -53,6 +55,7 @@ def behaviour(cls: Any) -> list[Any]:
     seen += [a == cls("home"), a == b, a != b, hash(cls("home", (1.0,))) == hash(cls("home", (1.0,)))]
     seen += [a.notes is not cls("home").notes, a == cls("home", notes=["other"])]
     seen.append([f.name for f in dataclasses.fields(cls)])
+    seen += [str(inspect.signature(cls)), cls.__init__.__annotations__, typing.get_type_hints(cls.__init__)]
     with pytest.raises(dataclasses.FrozenInstanceError) as assigned:
         a.name = "away"
     with pytest.raises(dataclasses.FrozenInstanceError) as deleted:
@@ -87,8 +90,9 @@ def test_the_table_goes_through_its_file_and_a_bad_file_is_ignored(
     assert read_stored(path) == kept.stored
     assert stat.S_IMODE(path.stat().st_mode) == 0o666 & ~current_umask()  # as Python's bytecode
     good = path.read_bytes()
-    magic = importlib.util.MAGIC_NUMBER
-    for bad in (b"", good[: len(good) // 2], b"\0\0\0\0" + good[len(magic) :], magic + marshal.dumps([1, 2])):
+    magic = importlib.util.MAGIC_NUMBER + dataclass_code.FORMAT
+    older = importlib.util.MAGIC_NUMBER + b"dataclass code 1\n" + good[len(magic) :]  # another format
+    for bad in (b"", good[: len(good) // 2], b"\0\0\0\0" + good[4:], older, magic + marshal.dumps([1, 2])):
         path.write_bytes(bad)
         assert read_stored(path) == {}
     path.write_bytes(magic + marshal.dumps({"def f(): pass": b"not code", "x": 3}))
@@ -149,7 +153,7 @@ def test_a_new_command_process_compiles_none_of_the_planners_dataclasses(tmp_pat
     assert "dataclass methods kept" in built.stdout and not built.stderr
     (path,) = tmp_path.rglob("dataclass_code.*.marshal")
     stale = {**read_stored(path), "x = 1": marshal.dumps(compile("x = 1", "<string>", "exec"))}
-    path.write_bytes(importlib.util.MAGIC_NUMBER + marshal.dumps(stale))
+    path.write_bytes(importlib.util.MAGIC_NUMBER + dataclass_code.FORMAT + marshal.dumps(stale))
     again = subprocess.run(run, capture_output=True, text=True, check=True, cwd=ROOT, env=env, timeout=300)
     assert "(0 compiled now)" in again.stdout and set(read_stored(path)) == set(stale) - {"x = 1"}
     probe = (

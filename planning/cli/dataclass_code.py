@@ -10,7 +10,8 @@ code. So, in a process that runs one command:
 
 - :func:`reuse_dataclass_code` points :mod:`dataclasses`'s ``exec`` at :class:`KeptCode`, which
   compiles each text once and reads the code compiled before from this package's
-  ``__pycache__`` (the file named by Python's cache tag, headed by its bytecode's magic number);
+  ``__pycache__`` (the file named by Python's cache tag, headed by its bytecode's magic number and
+  :data:`FORMAT`);
 - :func:`keep_dataclass_code`, at the process's end, writes the table back where it learned a
   text: whole, to a temporary file renamed in place, and not where Python writes no bytecode
   (``PYTHONDONTWRITEBYTECODE``) or cannot write the folder, as Python treats its own.
@@ -39,6 +40,8 @@ from typing import Any
 
 MOST_TEXTS = 4096
 """The most texts the file keeps; beyond, it keeps only those of the process writing it."""
+FORMAT = b"dataclass code 2\n"
+"""What follows Python's magic number in the file: a file of another format is not read."""
 
 
 def code_file() -> Path:
@@ -75,7 +78,9 @@ class KeptCode:
                 code = marshal.loads(stored)
                 if isinstance(code, CodeType):
                     return code
-        code = compile(text, "<string>", "exec")
+        # as `exec` compiles the text for dataclasses, whose module has no `from __future__`
+        # import: this module's `annotations` would make the methods' annotations strings
+        code = compile(text, "<string>", "exec", dont_inherit=True)
         self.stored[text] = marshal.dumps(code)
         self.compiled += 1
         return code
@@ -94,7 +99,7 @@ def read_stored(path: Path) -> dict[str, bytes]:
         data = path.read_bytes()
     except OSError:
         return {}
-    magic = importlib.util.MAGIC_NUMBER
+    magic = _header()
     if not data.startswith(magic):
         return {}
     try:
@@ -131,12 +136,17 @@ def write_stored(path: Path, table: dict[str, bytes]) -> None:
         handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
         try:
             with os.fdopen(handle, "wb") as out:
-                out.write(importlib.util.MAGIC_NUMBER + marshal.dumps(table))
+                out.write(_header() + marshal.dumps(table))
             os.chmod(temporary, 0o666 & ~_umask())  # as Python's own bytecode
             os.replace(temporary, path)
         finally:
             with contextlib.suppress(OSError):
                 os.unlink(temporary)
+
+
+def _header() -> bytes:
+    """The file's first bytes: Python's bytecode magic number and :data:`FORMAT`."""
+    return importlib.util.MAGIC_NUMBER + FORMAT
 
 
 def _umask() -> int:
