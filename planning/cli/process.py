@@ -59,7 +59,8 @@ def start_process() -> None:
     """
     gc.disable()
     one_thread_for_process()
-    from planning.cli.dataclass_code import reuse_dataclass_code  # `python -m` builds its file
+    # imported here, not with this module: `python -m planning.cli.dataclass_code` runs it unimported
+    from planning.cli.dataclass_code import reuse_dataclass_code
 
     reuse_dataclass_code()
     os.environ.setdefault(PYDANTIC_PLUGINS, "__all__")
