@@ -108,7 +108,7 @@ def keep_file(kind: str, name: str, save: Callable[[Path], object], most_bytes: 
     that fails (``OSError``, ``RuntimeError``), is no error.
     """
     path = cache_folder() / kind / name
-    if _saved(path, save):
+    if saved_whole(path, save):
         _prune(path, most_bytes)
 
 
@@ -164,16 +164,16 @@ def _cached(
 
 
 def _write(path: Path, value: T, write: Callable[[T, BinaryIO], object]) -> None:
-    """``value`` written to ``path`` by ``write`` on a stream, whole (:func:`_saved`)."""
+    """``value`` written to ``path`` by ``write`` on a stream, whole (:func:`saved_whole`)."""
 
     def save(partial: Path) -> None:
         with partial.open("wb") as stream:
             write(value, stream)
 
-    _saved(path, save)
+    saved_whole(path, save)
 
 
-def _saved(path: Path, save: Callable[[Path], object]) -> bool:
+def saved_whole(path: Path, save: Callable[[Path], object]) -> bool:
     """Whether ``save`` wrote ``path`` whole, through a temporary file of the writer's own.
 
     The temporary file (the process's and thread's) is renamed: a reader never sees half. A

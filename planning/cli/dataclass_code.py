@@ -30,10 +30,8 @@ import dataclasses
 import importlib
 import importlib.util
 import marshal
-import os
 import pkgutil
 import sys
-import tempfile
 from pathlib import Path
 from types import CodeType
 from typing import Any
@@ -130,30 +128,19 @@ def keep_dataclass_code() -> None:
 
 
 def write_stored(path: Path, table: dict[str, bytes]) -> None:
-    """Write ``table`` to ``path`` whole (a temporary file, renamed); an unwritable folder is no error."""
-    with contextlib.suppress(OSError, ValueError):  # then compiled again next time
-        path.parent.mkdir(parents=True, exist_ok=True)
-        handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
-        try:
-            with os.fdopen(handle, "wb") as out:
-                out.write(_header() + marshal.dumps(table))
-            os.chmod(temporary, 0o666 & ~_umask())  # as Python's own bytecode
-            os.replace(temporary, path)
-        finally:
-            with contextlib.suppress(OSError):
-                os.unlink(temporary)
+    """Write ``table`` to ``path`` whole; a folder that cannot be written is no error.
+
+    :func:`~cpr_kin.common.disk_cache.saved_whole`: a temporary file of the writer's own,
+    renamed, with the mode Python's own bytecode gets.
+    """
+    from cpr_kin.common.disk_cache import saved_whole  # it brings NumPy: imported only to write
+
+    saved_whole(path, lambda partial: partial.write_bytes(_header() + marshal.dumps(table)))
 
 
 def _header() -> bytes:
     """The file's first bytes: Python's bytecode magic number and :data:`FORMAT`."""
     return importlib.util.MAGIC_NUMBER + FORMAT
-
-
-def _umask() -> int:
-    """The process's file mode mask (read by setting it, then set back)."""
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
 
 
 def build(packages: tuple[str, ...] = ("cpr_kin", "planning")) -> KeptCode:
