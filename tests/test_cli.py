@@ -188,6 +188,27 @@ def test_an_unreachable_tcp_exits_3_with_the_distance(
     assert not out.exists()
 
 
+def test_a_scene_without_obstacles_writes_json_any_parser_reads(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """No obstacle: the certified clearance is unbounded, ``null`` in JSON (which has no infinity)."""
+
+    def refuse(constant: str) -> None:
+        raise ValueError(f"{constant} is not JSON")
+
+    scene = write_scene(tmp_path, {**SCENE, "obstacles": []})
+    out = tmp_path / "out"
+    code, stdout, _ = run(["plan", str(scene), "--out", str(out), "--json"], capsys)
+    assert code == 0
+    summary = json.loads(stdout, parse_constant=refuse)
+    metrics = json.loads((out / "trajectory.json").read_text(), parse_constant=refuse)["metrics"]
+    assert summary["min_clearance"] is None and metrics["min_clearance"] is None
+    code, stdout, _ = run(["check", str(scene), str(out / "trajectory.json"), "--json"], capsys)
+    assert code == 0
+    checked = json.loads(stdout, parse_constant=refuse)
+    assert checked["status"] == "ok" and checked["certified_min_clearance_m"] is None
+
+
 def test_plan_check_and_reproducibility(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     scene = write_scene(tmp_path, SCENE)
     first, second = tmp_path / "a", tmp_path / "b"

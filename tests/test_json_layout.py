@@ -62,7 +62,28 @@ def test_values_json_cannot_hold_are_refused_as_json_refuses_them() -> None:
         dumps({"a": [object()]})
     with pytest.raises(TypeError, match="keys must be strings, not int 3"):
         dumps({"a": {3: 1.0}})
-    assert math.isnan(json.loads(dumps([float("nan")]))[0])  # as json.dumps: NaN, not an error
+
+
+def strict_loads(text: str) -> object:
+    """``text`` parsed as RFC 8259 JSON, which has no ``NaN``, ``Infinity`` or ``-Infinity``."""
+
+    def refuse(constant: str) -> None:
+        raise ValueError(f"{constant} is not JSON")
+
+    return json.loads(text, parse_constant=refuse)
+
+
+def test_numbers_that_are_not_finite_are_written_null() -> None:
+    document = {
+        "a": math.inf,
+        "b": [1.0, math.nan, -math.inf],
+        "c": {"d": [[2, np.float64(np.inf)]]},
+        "e": 2.5,
+    }
+    text = dumps(document)
+    assert strict_loads(text) == {"a": None, "b": [1.0, None, None], "c": {"d": [[2, None]]}, "e": 2.5}
+    with pytest.raises(ValueError, match="Infinity is not JSON"):
+        strict_loads(json.dumps(document))  # what json writes: a strict parser refuses it
 
 
 def test_a_trajectory_file_has_a_line_per_coefficient_row(robot: ck.Robot) -> None:

@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import sys
 from pathlib import Path
 from typing import Any
 
 from cpr_kin.common.names import escaped
 from planning.cli.terminal import terminal_bar
+from planning.io import json_layout
 from planning.outcome import EXIT_INTERRUPTED
 
 
@@ -45,7 +45,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
     if args.json:
         summary = {"scenes": len(paths), "done": len(items), "ok": len(items) - len(failed)}
         items_json = [dataclasses.asdict(i) for i in items]
-        print(json.dumps({**summary, "items": items_json, "interrupted": run.interrupted}, indent=1))
+        print(json_layout.dumps({**summary, "items": items_json, "interrupted": run.interrupted}))
     else:
         rows = []
         for item in items:

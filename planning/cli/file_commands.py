@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import time
 from pathlib import Path
@@ -13,6 +12,7 @@ import cpr_kin as ck  # lazy (lazy_loader): only the modules a command uses are 
 from cpr_kin.common.names import escaped
 from planning.cli.plan_commands import load
 from planning.errors import PlanningError
+from planning.io import json_layout
 from planning.outcome import EXIT_NO_TRAJECTORY, EXIT_OK
 
 if TYPE_CHECKING:
@@ -37,7 +37,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     verification = verify_for_scene(problem, document.trajectory, document.joint_names)
     check, problems = verification.check, verification.problems
     if args.json:
-        print(json.dumps(verification.to_record(), indent=1))
+        print(json_layout.dumps(verification.to_record()))
     elif problems:
         print(escaped(f"{args.trajectory}: FAILS {args.scene}:\n  " + "\n  ".join(problems)))
     else:

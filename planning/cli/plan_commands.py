@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import time
 from pathlib import Path
@@ -12,6 +11,7 @@ from typing import TYPE_CHECKING
 from cpr_kin.common.names import escaped
 from planning.cli.signals import checkpoint
 from planning.cli.terminal import firefly_progress
+from planning.io import json_layout
 from planning.outcome import EXIT_OK, Interrupted, interruption
 
 if TYPE_CHECKING:
@@ -76,7 +76,7 @@ def _plan_and_write(read: SceneFile, out: str, args: argparse.Namespace, paper: 
             checkpoint()  # a signal something swallowed still stops the command before it writes
             outputs = folder.publish(files)
             if args.json:
-                print(json.dumps({**summary(result), "outputs": [str(p) for p in outputs]}, indent=1))
+                print(json_layout.dumps({**summary(result), "outputs": [str(p) for p in outputs]}))
             else:
                 print(summary_line(result))
                 if paper:
@@ -116,7 +116,7 @@ def _task_planned_and_written(
     checkpoint()
     outputs = folder.publish(files)
     if args.json:
-        print(json.dumps({**task_summary(task, elapsed), "outputs": [str(p) for p in outputs]}, indent=1))
+        print(json_layout.dumps({**task_summary(task, elapsed), "outputs": [str(p) for p in outputs]}))
     else:
         print(task_summary_line(task, elapsed))
         print(escaped("wrote " + ", ".join(str(p) for p in outputs)))

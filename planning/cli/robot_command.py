@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import math
 from pathlib import Path
 from typing import Any
 
 import cpr_kin as ck
 from cpr_kin.common.names import escaped
+from planning.io import json_layout
 from planning.outcome import EXIT_OK
 
 
@@ -77,7 +77,7 @@ def cmd_robot_info(args: argparse.Namespace) -> int:
         spec = dataclasses.replace(spec, **{key: value for key, value in named.items() if value is not None})
     report = robot_report(ck.load_cpr() if spec is None else spec.load())
     if args.json:
-        print(json.dumps(report, indent=2))
+        print(json_layout.dumps(report, indent=2))
         return EXIT_OK
     lines = [
         f"URDF: {report['urdf']}",

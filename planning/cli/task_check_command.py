@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import argparse
-import json
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 from cpr_kin.common.names import escaped
 from planning.errors import PlanningError
+from planning.io import json_layout
 from planning.outcome import EXIT_NO_TRAJECTORY, EXIT_OK
 
 if TYPE_CHECKING:
@@ -50,7 +50,7 @@ def check_task_file(read: SceneFile, document: TrajectoryFile, args: argparse.Na
             "problems": list(checked.problems),
             "segments": len(read.task),
         }
-        print(json.dumps(record, indent=1))
+        print(json_layout.dumps(record))
     elif checked.problems:
         print(escaped(f"{args.trajectory}: FAILS {args.scene}:\n  " + "\n  ".join(checked.problems)))
     else:
