@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import struct
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -61,6 +62,17 @@ def test_an_ascii_ply_skips_the_rows_of_the_elements_before_its_vertices() -> No
     )
     points = read_ply_points(text.encode(), 10, Path("a.ply"))
     np.testing.assert_array_equal(points, [[1.5, 2.5, 3.5], [-1, -2, -3]])
+
+
+@pytest.mark.parametrize("fmt", ["ascii", "binary_little_endian"])
+def test_a_ply_of_no_vertices_reads_as_no_points_without_a_warning(fmt: str) -> None:
+    header = (
+        f"ply\nformat {fmt} 1.0\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\n"
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a user's one-line error is not preceded by numpy's warning
+        points = read_ply_points(f"{header}end_header\n".encode(), 10, Path("empty.ply"))
+    assert points.shape == (0, 3)
 
 
 BAD = [

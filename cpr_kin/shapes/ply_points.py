@@ -91,6 +91,8 @@ def read_ply_points(data: bytes, max_points: int, path: Path) -> FloatArray:
         lines = data[body:].decode("ascii").splitlines()[skipped : skipped + vertex.count]
         if len(lines) < vertex.count:
             raise ObstacleError(f"{what}: {len(lines)} vertex lines of the {vertex.count} its header gives")
+        if not lines:  # no rows: numpy's reader would warn of an empty input
+            return np.empty((0, 3))
         return np.loadtxt(lines, usecols=columns, ndmin=2, dtype=float)
     order = BYTE_ORDERS[fmt]
     if vertex.has_lists or any(e.has_lists for e in before):
