@@ -462,6 +462,46 @@ FLAT_ARM = """<?xml version="1.0"?>
 """
 
 
+BOX_ARM = """<?xml version="1.0"?>
+<robot name="box_arm">
+  <link name="base"><collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>
+  <link name="arm">
+    <collision><origin xyz="0.1 0 0"/><geometry><box size="0.2 0.05 0.05"/></geometry></collision>
+  </link>
+  <link name="tool"/>
+  <joint name="j1" type="JOINT_TYPE"><parent link="base"/><child link="arm"/><origin xyz="0 0 0.1"/>
+    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="10" velocity="1"/></joint>
+  <joint name="tip" type="fixed"><parent link="arm"/><child link="tool"/><origin xyz="0.2 0 0"/></joint>
+</robot>
+"""
+
+
+@pytest.mark.parametrize(
+    ("joint_type", "tcp", "message"),
+    [
+        (
+            "fixed",
+            None,
+            r"has no joint to plan: .*\(its moving joints: \[\]\); give the robot a joint",
+        ),
+        (
+            "revolute",
+            "base",
+            r"between its root and the tool frame 'base': .*name a tool frame the joints move",
+        ),
+    ],
+)
+def test_a_robot_with_no_joint_to_plan_is_named_as_such(
+    tmp_path: Path, joint_type: str, tcp: str | None, message: str
+) -> None:
+    # before, the first error named a collision group ("no collision geometry in group 'links'")
+    (tmp_path / "arm.urdf").write_text(BOX_ARM.replace("JOINT_TYPE", joint_type))
+    with pytest.raises(ck.UrdfError, match=message):
+        ck.load_robot(tmp_path / "arm.urdf", tcp=tcp)
+    if tcp is not None:  # the same arm to its own tool plans its joint
+        assert ck.load_robot(tmp_path / "arm.urdf", tcp="tool").joint_names == ("j1",)
+
+
 def test_a_link_whose_mesh_is_flat_loads_as_its_capsule_and_its_mesh_decides(tmp_path: Path) -> None:
     # a plate of no thickness: coal's Qhull crashed the process (a segmentation fault) on its hull
     import trimesh

@@ -60,13 +60,23 @@ def planned_joints(
         bases: its :func:`base_joints`, never planned.
 
     Raises:
-        UrdfError: a joint the URDF lacks, a fixed, mimic or base joint, or the joints out of
-            the URDF's chain order.
+        UrdfError: a joint the URDF lacks, a fixed, mimic or base joint, the joints out of
+            the URDF's chain order, or none named and none to plan (no moving joint, or
+            none between the root and ``tcp``).
     """
     names = tuple(model.names[1:])
     mimics = {j.get("name") for j in tree.getroot().findall("joint") if j.find("mimic") is not None}
     if joints is None:
-        return default_joints(model, arm, tcp, mimics | set(bases), path)
+        planned = default_joints(model, arm, tcp, mimics | set(bases), path)
+        if not planned:
+            where = "" if tcp is None else f" between its root and the tool frame '{tcp}'"
+            raise UrdfError(
+                f"URDF '{path}' has no joint to plan{where}: a planned joint is revolute, "
+                "prismatic or continuous, mimics none and is no base's planar or floating joint "
+                f"(its moving joints: {list(names)}); "
+                + ("give the robot a joint" if tcp is None else "name a tool frame the joints move")
+            )
+        return planned
     named_bases = [j for j in joints if j in bases]
     if named_bases:
         raise UrdfError(
