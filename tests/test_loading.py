@@ -462,20 +462,6 @@ FLAT_ARM = """<?xml version="1.0"?>
 """
 
 
-BOX_ARM = """<?xml version="1.0"?>
-<robot name="box_arm">
-  <link name="base"><collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>
-  <link name="arm">
-    <collision><origin xyz="0.1 0 0"/><geometry><box size="0.2 0.05 0.05"/></geometry></collision>
-  </link>
-  <link name="tool"/>
-  <joint name="j1" type="JOINT_TYPE"><parent link="base"/><child link="arm"/><origin xyz="0 0 0.1"/>
-    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="10" velocity="1"/></joint>
-  <joint name="tip" type="fixed"><parent link="arm"/><child link="tool"/><origin xyz="0.2 0 0"/></joint>
-</robot>
-"""
-
-
 @pytest.mark.parametrize(
     ("joint_type", "tcp", "message"),
     [
@@ -495,7 +481,8 @@ def test_a_robot_with_no_joint_to_plan_is_named_as_such(
     tmp_path: Path, joint_type: str, tcp: str | None, message: str
 ) -> None:
     # before, the first error named a collision group ("no collision geometry in group 'links'")
-    (tmp_path / "arm.urdf").write_text(BOX_ARM.replace("JOINT_TYPE", joint_type))
+    box_arm = FLAT_ARM.replace('<mesh filename="plate.stl"/>', '<box size="0.2 0.05 0.05"/>')
+    (tmp_path / "arm.urdf").write_text(box_arm.replace('type="revolute"', f'type="{joint_type}"'))
     with pytest.raises(ck.UrdfError, match=message):
         ck.load_robot(tmp_path / "arm.urdf", tcp=tcp)
     if tcp is not None:  # the same arm to its own tool plans its joint
