@@ -97,6 +97,12 @@ def test_what_cannot_change_hands_is_refused_naming_it(base: ck.Robot) -> None:
         scene_after(_scene(), base, Q, Detach())
     with pytest.raises(PlanningError, match="attach: the robot already carries 'part'"):
         scene_after(_scene(payload=shaped), base, Q, Attach(ck.Payload(1.0, name="other")))
+    # a name no obstacle has, no shape, no mass: a misspelt obstacle, which used to carry nothing
+    with pytest.raises(
+        PlanningError, match=r"attach: 'prat' is no obstacle .* it would carry nothing; .*\['part'\]"
+    ):
+        scene_after(_scene((BOX,)), base, Q, Attach(ck.Payload(0.0, name="prat")))
+    assert scene_after(_scene((BOX,)), base, Q, Attach(ck.Payload(0.2, name="load"))).payload is not None
 
 
 def test_the_example_checks_the_part_where_it_waits_and_where_it_is_left(pick_and_place: PlannedTask) -> None:

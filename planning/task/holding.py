@@ -39,8 +39,9 @@ def scene_after(scene: Scene, robot: ck.Robot, q: FloatArray, change: Attach | D
 
     Raises:
         PlanningError: a detach of nothing or of another object; an attach while carrying; an
-            attach that gives a shape to an obstacle's name, or names a point cloud; an object
-            left where an obstacle of its name already is.
+            attach that gives a shape to an obstacle's name, or names a point cloud; an attach
+            of nothing (no obstacle of its name, no shape, no mass); an object left where an
+            obstacle of its name already is.
     """
     held = scene.payload
     if isinstance(change, Detach):
@@ -64,6 +65,13 @@ def scene_after(scene: Scene, robot: ck.Robot, q: FloatArray, change: Attach | D
         raise PlanningError(f"attach: the robot already carries '{held.name}' (detach it first)")
     payload = change.payload
     found = next((o for o in scene.obstacles if o.name == payload.name), None)
+    if found is None and payload.shape is None and payload.mass_kg == 0.0:
+        named = sorted(o.name for o in scene.obstacles)
+        raise PlanningError(
+            f"attach: '{payload.name}' is no obstacle of the scene here, and the payload has neither a "
+            f"shape nor a mass: it would carry nothing; name an obstacle (here: {named}) or give "
+            "'shape' or 'mass_kg'"
+        )
     if found is None:
         return dataclasses.replace(scene, payload=payload)
     taken = _checked(lambda: ck.taken_from(robot, payload, found, q), "attach")
