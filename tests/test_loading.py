@@ -281,6 +281,13 @@ def test_a_missing_tool_frame_lists_the_first_links_and_counts_the_rest() -> Non
     assert message.endswith(" more")  # the rest counted, not listed
 
 
+def test_a_missing_tool_frame_is_never_offered_pinocchios_root() -> None:
+    # 'nowhere' is closest to 'universe', the root frame Pinocchio adds and no URDF names
+    with pytest.raises(ck.UrdfError) as refused:
+        ck.load_robot(example_robot("ur5"), tcp="nowhere")
+    assert "universe" not in str(refused.value) and "no link or frame named 'nowhere'" in str(refused.value)
+
+
 def test_a_urdf_without_collision_shapes_is_refused_naming_the_fix() -> None:
     with pytest.raises(
         ck.UrdfError, match=r"has no <collision> geometry: .*give the links <collision> elements"

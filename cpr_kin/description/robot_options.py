@@ -104,14 +104,16 @@ def check_tcp(tcp: str | None, model: Any, path: Path) -> None:
     several arms would be refused for having no single arm, as if no tool had been named.
 
     Raises:
-        UrdfError: naming the frame, up to three close names (of every frame) and the URDF's
+        UrdfError: naming the frame, up to three close names (of the URDF's frames) and its
             links (the first :data:`SHOWN_LINKS` of them, alphabetically, and how many there are).
     """
     if tcp is None or model.existFrame(tcp):
         return
     from difflib import get_close_matches  # a message's, not every load's (a new process's start-up)
 
-    close = get_close_matches(tcp, sorted({f.name for f in model.frames}), n=3, cutoff=0.5)
+    # every frame but Pinocchio's own root, 'universe', which no URDF names
+    named = sorted({f.name for f in list(model.frames)[1:]})
+    close = get_close_matches(tcp, named, n=3, cutoff=0.5)
     hint = f"did you mean {', '.join(repr(name) for name in close)}? " if close else ""
     links = sorted({f.name for f in model.frames if f.type == pin.FrameType.BODY})
     listed = (
