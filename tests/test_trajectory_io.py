@@ -1,12 +1,14 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import cpr_kin as ck
+from planning.errors import PlanningError
 from planning.io.bundled import paper_scene
 from planning.io.trajectory_io import write_samples, write_trajectory
 from planning.io.trajectory_reader import read_trajectory
@@ -94,3 +96,14 @@ def test_samples_csv(result: PlanResult, tmp_path: Path) -> None:
         np.testing.assert_allclose(data[:, 20 + r], np.max(np.abs(columns) / limit, axis=1), rtol=1e-9)
     # the usage never exceeds what the exact extrema allow
     assert np.all(data[:, 21:] <= np.array(list(result.metrics.limit_utilisation.values())) + 1e-9)
+
+
+@pytest.mark.parametrize("write", [write_trajectory, write_samples])
+def test_what_is_no_plan_is_refused_naming_it_and_nothing_is_written(
+    write: Callable[[object, Path], None], tmp_path: Path
+) -> None:
+    with pytest.raises(
+        PlanningError, match=r"result is a NoneType; give a planning.PlanResult \(plan\(scene\)\)"
+    ):
+        write(None, tmp_path / "plan.json")
+    assert list(tmp_path.iterdir()) == []

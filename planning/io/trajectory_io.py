@@ -20,6 +20,7 @@ from numpy.typing import NDArray
 from planning.curves.trajectory import DERIVATIVE_NAMES, Trajectory
 from planning.io.json_layout import dumps
 from planning.io.publish import write_file
+from planning.validation import instance_of
 
 if TYPE_CHECKING:  # types only: writing files needs neither the planner nor the robot
     import cpr_kin as ck
@@ -66,7 +67,12 @@ def trajectory_json(result: PlanResult, timings: bool = False) -> str:
 
 
 def write_trajectory(result: PlanResult, path: str | Path, timings: bool = False) -> None:
-    """Write the plan as a ``cpr-trajectory/1`` JSON file, atomically (see :func:`trajectory_json`)."""
+    """Write the plan as a ``cpr-trajectory/1`` JSON file, atomically (see :func:`trajectory_json`).
+
+    Raises:
+        PlanningError: ``result`` is no :class:`~planning.pipeline.result.PlanResult`.
+    """
+    _a_plan(result)
     write_file(Path(path), trajectory_json(result, timings))
 
 
@@ -99,8 +105,20 @@ def samples_csv(
 
 
 def write_samples(result: PlanResult, path: str | Path) -> None:
-    """Write the trajectory sampled at the planner's IPO period as CSV, atomically."""
+    """Write the trajectory sampled at the planner's IPO period as CSV, atomically.
+
+    Raises:
+        PlanningError: ``result`` is no :class:`~planning.pipeline.result.PlanResult`.
+    """
+    _a_plan(result)
     write_file(Path(path), plan_samples_csv(result))
+
+
+def _a_plan(result: Any) -> None:
+    """Refuse what is not a plan's result (``None``, a task's motion), naming where one comes from."""
+    from planning.pipeline.result import PlanResult  # the pipeline's, loaded by whoever planned
+
+    instance_of("result", result, PlanResult, "planning.PlanResult (plan(scene))")
 
 
 def plan_samples_csv(result: PlanResult) -> str:
