@@ -11,12 +11,14 @@ import os
 os.environ["CPR_KERNELS"] = "jit"
 
 import importlib.util
+import json
 import subprocess
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
+from typing import Any
 
 import coal
 import numpy as np
@@ -149,6 +151,15 @@ def after_calls(count: int) -> tuple[list[int], Callable[[], bool]]:
 @pytest.fixture()
 def rng() -> np.random.Generator:
     return np.random.default_rng(12345)
+
+
+def strict_loads(text: str) -> Any:
+    """``text`` parsed as RFC 8259 JSON, which has no ``NaN``, ``Infinity`` or ``-Infinity``."""
+
+    def refuse(constant: str) -> None:
+        raise ValueError(f"{constant} is not JSON")
+
+    return json.loads(text, parse_constant=refuse)
 
 
 def random_configurations(robot: ck.Robot, rng: np.random.Generator, n: int) -> np.ndarray:

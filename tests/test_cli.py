@@ -18,6 +18,8 @@ from planning.cli import main
 from planning.io.trajectory_reader import read_trajectory
 from planning.pipeline.metrics import WALL_TIMES
 
+from .conftest import strict_loads
+
 SCENE: dict[str, Any] = {
     "name": "swing",
     "safety_margin": 0.1,
@@ -192,20 +194,16 @@ def test_a_scene_without_obstacles_writes_json_any_parser_reads(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """No obstacle: the certified clearance is unbounded, ``null`` in JSON (which has no infinity)."""
-
-    def refuse(constant: str) -> None:
-        raise ValueError(f"{constant} is not JSON")
-
     scene = write_scene(tmp_path, {**SCENE, "obstacles": []})
     out = tmp_path / "out"
     code, stdout, _ = run(["plan", str(scene), "--out", str(out), "--json"], capsys)
     assert code == 0
-    summary = json.loads(stdout, parse_constant=refuse)
-    metrics = json.loads((out / "trajectory.json").read_text(), parse_constant=refuse)["metrics"]
+    summary = strict_loads(stdout)
+    metrics = strict_loads((out / "trajectory.json").read_text())["metrics"]
     assert summary["min_clearance"] is None and metrics["min_clearance"] is None
     code, stdout, _ = run(["check", str(scene), str(out / "trajectory.json"), "--json"], capsys)
     assert code == 0
-    checked = json.loads(stdout, parse_constant=refuse)
+    checked = strict_loads(stdout)
     assert checked["status"] == "ok" and checked["certified_min_clearance_m"] is None
 
 

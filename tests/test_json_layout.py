@@ -12,6 +12,8 @@ from planning.io.json_layout import dumps
 from planning.io.trajectory_io import trajectory_document, trajectory_json
 from planning.pipeline.planner import plan
 
+from .conftest import strict_loads
+
 
 def random_document(rng: np.random.Generator, depth: int = 0) -> object:
     """A seeded random JSON document: nested objects and lists of every JSON type."""
@@ -62,15 +64,6 @@ def test_values_json_cannot_hold_are_refused_as_json_refuses_them() -> None:
         dumps({"a": [object()]})
     with pytest.raises(TypeError, match="keys must be strings, not int 3"):
         dumps({"a": {3: 1.0}})
-
-
-def strict_loads(text: str) -> object:
-    """``text`` parsed as RFC 8259 JSON, which has no ``NaN``, ``Infinity`` or ``-Infinity``."""
-
-    def refuse(constant: str) -> None:
-        raise ValueError(f"{constant} is not JSON")
-
-    return json.loads(text, parse_constant=refuse)
 
 
 def test_numbers_that_are_not_finite_are_written_null() -> None:
