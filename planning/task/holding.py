@@ -65,14 +65,14 @@ def scene_after(scene: Scene, robot: ck.Robot, q: FloatArray, change: Attach | D
         raise PlanningError(f"attach: the robot already carries '{held.name}' (detach it first)")
     payload = change.payload
     found = next((o for o in scene.obstacles if o.name == payload.name), None)
-    if found is None and payload.shape is None and payload.mass_kg == 0.0:
-        named = sorted(o.name for o in scene.obstacles)
-        raise PlanningError(
-            f"attach: '{payload.name}' is no obstacle of the scene here, and the payload has neither a "
-            f"shape nor a mass: it would carry nothing; name an obstacle (here: {named}) or give "
-            "'shape' or 'mass_kg'"
-        )
     if found is None:
+        if payload.shape is None and payload.mass_kg == 0.0:
+            named = sorted(o.name for o in scene.obstacles)
+            raise PlanningError(
+                f"attach: '{payload.name}' is no obstacle of the scene here, and the payload has neither "
+                f"a shape nor a mass: it would carry nothing; name an obstacle (here: {named}) or give "
+                "'shape' or 'mass_kg'"
+            )
         return dataclasses.replace(scene, payload=payload)
     taken = _checked(lambda: ck.taken_from(robot, payload, found, q), "attach")
     rest = tuple(o for o in scene.obstacles if o is not found)
