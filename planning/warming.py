@@ -12,6 +12,7 @@ from __future__ import annotations
 import contextlib
 import copy
 import dataclasses
+import itertools
 import time
 
 import numpy as np
@@ -50,7 +51,9 @@ def warm_up(robot: ck.Robot | None = None) -> float:
     that is timed. It plans the paper case with two fireflies for one iteration and a small
     motion of the robot (the paper's, the CPR, if none is given) in its joint space, runs the search's
     duration estimates with and without the torques, and asks its collision world every
-    kind of query once and solves its numerical IK once (:func:`_warm_own_motion`).
+    kind of query once and solves its numerical IK once (:func:`_warm_own_motion`); then it
+    asks about pairs of the robot's own links as a plan of an arm whose links come near each
+    other does, whatever the robot (:func:`_warm_robot_pairs`).
     """
     started = time.perf_counter()
     small = paper_scene(fireflies=2, iterations=1)
@@ -61,9 +64,11 @@ def warm_up(robot: ck.Robot | None = None) -> float:
         expected = (NoSolutionError, PlanningError)
     with contextlib.suppress(*expected):
         plan(small, robot, threads=1)
-    _warm_own_motion(robot if robot is not None else ck.shared_robot(small.robot_spec()), small)
+    own = robot if robot is not None else ck.shared_robot(small.robot_spec())
+    _warm_own_motion(own, small)
     _warm_sampling()
     _warm_vertex_witness()
+    _warm_robot_pairs(own)
     return time.perf_counter() - started
 
 
@@ -91,6 +96,61 @@ def _warm_vertex_witness() -> None:
     from cpr_kin.shapes.vertex_witness import BOX, vertex_groups
 
     vertex_groups(np.zeros((1, 3))).within(pin.SE3.Identity(), (BOX, np.ones(3)), 0.0)
+
+
+def _warm_robot_pairs(robot: ck.Robot) -> None:
+    """Ask about pairs of ``robot``'s own links as a plan of an arm with near links does: their kernels load.
+
+    A plan bounds a robot's own pairs (:mod:`cpr_kin.bounds.self_bounds`), looks the near ones
+    up in grids over their joints (:mod:`cpr_kin.collision.near_cells`) and asks whether an
+    exact mesh holds a shape whole (:mod:`cpr_kin.shapes.held_whole`) only for an arm whose
+    links come near each other, which the CPR's never do. Without this, a build of the kernels
+    on the CPR alone leaves those kernels to numba, and every process that plans such an arm
+    (a Panda) loads all the kernels just in time. Any pairs of geometries on two links serve,
+    and a tetrahedron's mesh.
+    """
+    from cpr_kin.collision.near_cells import NearCells
+    from cpr_kin.collision.self_collision import SelfCollision
+
+    geometries = robot.collision_model.geometryObjects
+    pairs = tuple(
+        (a, b)
+        for a, b in itertools.combinations(range(len(geometries)), 2)
+        if geometries[a].parentJoint != geometries[b].parentJoint
+    )
+    q = ck.sampled_configurations(robot.model, 8, np.random.default_rng(0))
+    own = SelfCollision(robot.model, robot.collision_model, pairs, [g.name for g in geometries])
+    own.violated(q, 0.01)
+    own.distances(q)
+    for pair in pairs:
+        cells = NearCells(robot.model, robot.collision_model, [pair])
+        if cells.grids is not None:
+            cells.states(q, [0.01])
+            break
+    _warm_held_whole()
+
+
+def _warm_held_whole() -> None:
+    """Ask whether a tetrahedron's exact mesh holds a sphere whole (``held_whole.may_hold``)."""
+    import coal
+    import pinocchio as pin
+
+    from cpr_kin.shapes.exact_meshes import ExactMesh
+    from cpr_kin.shapes.held_whole import inner_points, may_hold
+    from cpr_kin.shapes.mesh_topology import mesh_topology
+
+    corners = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.0, 0.1, 0.0], [0.0, 0.0, 0.1]])  # [m]
+    bvh = coal.BVHModelOBBRSS()
+    bvh.beginModel(4, 4)
+    bvh.addVertices(corners)
+    bvh.addTriangles(np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]))
+    bvh.endModel()
+    made = mesh_topology(bvh, b"the warm-up's tetrahedron")
+    tetrahedron = ExactMesh(
+        0, bvh, pin.SE3.Identity(), 0.0, made.triangles, made.piece_points, made.hull_planes, made.corners
+    )
+    at = pin.SE3.Identity()
+    may_hold(tetrahedron, inner_points(coal.Sphere(0.01), None), at, at)
 
 
 def _warm_own_motion(robot: ck.Robot, small: Scene) -> None:

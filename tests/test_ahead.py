@@ -198,6 +198,20 @@ print(hashlib.sha256(result.waypoints.tobytes() + samples.tobytes()).hexdigest()
       result.verification.certified_min_m.hex())
 """
 
+NEAR_LINKS = """
+import sys
+import numpy as np
+import cpr_kin as ck
+from planning.bench.mbm import vamp_resources
+resources = vamp_resources("panda")
+robot = ck.load_robot(resources / "panda.urdf", srdf=resources / "panda.srdf")
+q = ck.sampled_configurations(robot.model, 64, np.random.default_rng(0))
+ck.CollisionWorld(robot, []).self_collision.violated(q, 0.0)
+from cpr_kin.collision.self_split import _SCREENS
+near = any(screen.near_cells.grids is not None for screen in _SCREENS[robot].values())
+print(f"near pairs: {near}, numba: {'numba' in sys.modules}")
+"""
+
 
 def run(arguments: list[str], environment: dict[str, str]) -> list[str]:
     """The lines ``python ARGUMENTS`` prints in a new process with ``environment`` set."""
@@ -233,6 +247,11 @@ def test_kernels_compiled_ahead_plan_the_bits_numba_plans_without_numba(tmp_path
     assert just_in_time[0] == "CPUDispatcher True"
     assert compiled_ahead[0] == "function False"  # the guard; numba never imported
     assert compiled_ahead[1] == just_in_time[1]  # the same trajectory, to the bit
+
+    # an arm whose links come near each other at most configurations (the MotionBenchMaker Panda's):
+    # its self check looks them up in the near pairs' grids, a kernel the CPR's plans never call;
+    # a build on the CPR alone exports it too, or that arm's every process would run numba
+    assert run(["-c", NEAR_LINKS], ahead)[0] == "near pairs: True, numba: False"
 
     # argument types no export takes: numba compiles the kernel then, and computes what it would
     mixed = """
