@@ -205,6 +205,14 @@ def test_a_scene_without_obstacles_writes_json_any_parser_reads(
     assert code == 0
     checked = strict_loads(stdout)
     assert checked["status"] == "ok" and checked["certified_min_clearance_m"] is None
+    # and what a person reads says why, not "inf m"
+    code, stdout, _ = run(["plan", str(scene), "--out", str(tmp_path / "words")], capsys)
+    assert code == 0 and "certified clearance unbounded, no obstacle (margin" in stdout
+    report = (tmp_path / "words" / "report.md").read_text()
+    assert "| certified min clearance | unbounded, no obstacle (margin" in report
+    code, stdout, _ = run(["check", str(scene), str(out / "trajectory.json")], capsys)
+    assert code == 0 and "certified clearance unbounded, no obstacle >= " in stdout
+    assert "inf" not in stdout + report
 
 
 def test_plan_check_and_reproducibility(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

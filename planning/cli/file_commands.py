@@ -13,6 +13,7 @@ from cpr_kin.common.names import escaped
 from planning.cli.plan_commands import load
 from planning.errors import PlanningError
 from planning.io import json_layout
+from planning.io.report import clearance_text
 from planning.outcome import EXIT_NO_TRAJECTORY, EXIT_OK
 
 if TYPE_CHECKING:
@@ -48,7 +49,7 @@ def cmd_check(args: argparse.Namespace) -> int:
         print(
             escaped(
                 f"{args.trajectory}: verified against {args.scene}: "
-                f"certified clearance {check.certified_min_m:.4f} m "
+                f"certified clearance {clearance_text(check.certified_min_m)} "
                 f">= {scene.safety_margin} m over {len(check.times)} checks, joints within range and limits"
                 f"{', torques within effort limits' if problem.dynamics.limited else ''}"
                 f"{model} (coal's tolerance: 1e-6 of a distance)"

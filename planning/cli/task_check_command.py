@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 from cpr_kin.common.names import escaped
 from planning.errors import PlanningError
 from planning.io import json_layout
+from planning.io.report import clearance_text
 from planning.outcome import EXIT_NO_TRAJECTORY, EXIT_OK
 
 if TYPE_CHECKING:
@@ -57,7 +58,7 @@ def check_task_file(read: SceneFile, document: TrajectoryFile, args: argparse.Na
         print(
             escaped(
                 f"{args.trajectory}: verified against {args.scene}: a task of {len(read.task)} segments, "
-                f"certified clearance {checked.certified_min_clearance_m:.4f} m >= "
+                f"certified clearance {clearance_text(checked.certified_min_clearance_m)} >= "
                 f"{read.scene.safety_margin} m over {checked.checks} checks with what the robot carries "
                 "in each, every line within its tolerance at every instant, joints within range and limits, "
                 "torques within effort limits, jerk continuous (coal's tolerance: 1e-6 of a distance)"

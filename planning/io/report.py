@@ -46,12 +46,21 @@ def summary(result: PlanResult) -> dict[str, Any]:
     }
 
 
+def clearance_text(clearance_m: float) -> str:
+    """A certified clearance [m] as the summaries and reports word it: ``unbounded`` with no obstacle.
+
+    A scene without obstacles (or a segment away from all) has an infinite clearance, which
+    the files write as ``null`` (:mod:`planning.io.json_layout`); a person reads why.
+    """
+    return f"{clearance_m:.4f} m" if np.isfinite(clearance_m) else "unbounded, no obstacle"
+
+
 def summary_line(result: PlanResult) -> str:
     """The CLI's one-line summary of a plan."""
     r = plan_record(result)
     return (
         f"{result.scene.name}: verified trajectory of {r['duration']:.3f} s, certified clearance "
-        f"{r['min_clearance']:.4f} m (margin {result.scene.safety_margin} m), "
+        f"{clearance_text(r['min_clearance'])} (margin {result.scene.safety_margin} m), "
         f"node deviation {r['max_node_deviation']:.3g}, "
         f"planned in {r['planning_time_s']:.3f} s ({r['evaluations']} evaluations)"
     )
@@ -108,7 +117,7 @@ def report_markdown(result: PlanResult, paper: bool = False) -> str:
     scene = result.scene
     rows = [
         ("duration", f"{r['duration']:.3f} s"),
-        ("certified min clearance", f"{r['min_clearance']:.4f} m (margin {scene.safety_margin} m)"),
+        ("certified min clearance", f"{clearance_text(r['min_clearance'])} (margin {scene.safety_margin} m)"),
         ("PTP time t_sol (objective)", f"{r['t_sol']:.3f} s"),
         ("fitness", f"{r['fitness']:.4f}"),
         ("max node deviation", f"{r['max_node_deviation']:.3g}"),

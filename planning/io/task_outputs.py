@@ -12,7 +12,7 @@ from __future__ import annotations
 from typing import Any
 
 from planning.io.json_layout import dumps
-from planning.io.report import markdown_table
+from planning.io.report import clearance_text, markdown_table
 from planning.io.scene_file import scene_to_dict
 from planning.io.trajectory_io import FORMAT, samples_csv
 from planning.task.task_plan import TaskMotion
@@ -69,7 +69,8 @@ def task_summary_line(task: TaskMotion, planning_time_s: float) -> str:
     kinds = ", ".join(s.kind for s in task.segments)
     return (
         f"{task.scene.name}: verified task of {len(task.segments)} segments ({kinds}), "
-        f"{task.trajectory.duration:.3f} s, certified clearance {task.certified_min_clearance_m:.4f} m "
+        f"{task.trajectory.duration:.3f} s, "
+        f"certified clearance {clearance_text(task.certified_min_clearance_m)} "
         f"(margin {task.scene.safety_margin} m), planned in {planning_time_s:.3f} s"
     )
 
@@ -90,7 +91,9 @@ def task_report_markdown(task: TaskMotion) -> str:
     rows = []
     for index, segment in enumerate(task.segments):
         verified = segment.verification
-        clearance = "-" if verified is None else f"{verified.check.certified_min_m:.4f}"
+        clearance = "-"
+        if verified is not None:  # the column's unit is in its header
+            clearance = clearance_text(verified.check.certified_min_m).removesuffix(" m")
         line = segment.line
         deviation = (
             "-"
@@ -120,7 +123,8 @@ def task_report_markdown(task: TaskMotion) -> str:
         f"# Task: {task.scene.name}",
         "",
         f"{len(task.segments)} segments in one trajectory of {task.trajectory.duration:.3f} s, {verdict}; "
-        f"certified clearance {task.certified_min_clearance_m:.4f} m (margin {task.scene.safety_margin} m); "
+        f"certified clearance {clearance_text(task.certified_min_clearance_m)} "
+        f"(margin {task.scene.safety_margin} m); "
         "jerk continuous at every knot, at rest only at its ends, waits, attaches and detaches.",
         "",
         markdown_table(rows, headers),
