@@ -125,7 +125,8 @@ def task_report_markdown(task: TaskMotion) -> str:
         f"{len(task.segments)} segments in one trajectory of {task.trajectory.duration:.3f} s, {verdict}; "
         f"certified clearance {clearance_text(task.certified_min_clearance_m)} "
         f"(margin {task.scene.safety_margin} m); "
-        "jerk continuous at every knot, at rest only at its ends, waits, attaches and detaches.",
+        "jerk continuous at every knot, at rest at its ends, waits, attaches and detaches, and at a "
+        "junction where a stop is sooner than passing it.",
         "",
         markdown_table(rows, headers),
         "",

@@ -1,9 +1,10 @@
 """Junctions that do not stop: a task's consecutive motions joined into one path and timed as one.
 
-The robot stops only where the task says so: at a wait, an attach or a detach (a grasp), and
-at the task's ends. Between two motions their paths are joined into one, C3, and timed as one
-(:func:`~planning.curves.on_path_timing.time_on_path_marked`), so that the robot passes the
-junction without stopping. A line and a path under an orientation constraint are *rigid*:
+The robot must stop where the task says so: at a wait, an attach or a detach (a grasp), and
+at the task's ends. Between two motions their paths may be joined into one, C3, and timed as
+one (:func:`~planning.curves.on_path_timing.time_on_path_marked`), so that the robot passes the
+junction without stopping; the caller joins them where that is sooner than a stop
+(:mod:`planning.task.task_timing`). A line and a path under an orientation constraint are *rigid*:
 followed as planned. A free motion's path may be bent near a junction: its last (or first)
 :data:`BLEND_SHARE` is replaced by a septic bridge whose ends take the position and first three
 derivatives of the paths it joins (:func:`~planning.curves.path_pieces.bridge`), so that the

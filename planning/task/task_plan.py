@@ -5,7 +5,8 @@ before ends: a :class:`Move` by the planner's search (to a joint, ``tcp`` or pos
 scene's obstacles, margins and payload), a :class:`~planning.task.tool_line.ToolLine` by
 :func:`~planning.task.line_motion.plan_line`, a :class:`Wait` standing still. Each is planned
 from rest to rest; then motions that follow each other without a wait, an attach or a detach
-are joined into one path and timed as one, so that the robot stops only where the task says
+are joined into one path and timed as one where that is sooner than stopping between them, so
+that the robot stops where the task says and where a stop is sooner
 (:mod:`planning.task.task_timing`). The whole is C3 and each segment verified as every
 trajectory of the planner is. The scene's own goal is neither planned to nor needed: the
 segments say where the robot goes.

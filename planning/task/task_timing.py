@@ -2,19 +2,21 @@
 
 Each segment is planned on its own, from rest to rest (:class:`PlannedMotion`). Where two or
 more motions follow each other without a wait, an attach or a detach between them (a run,
-:func:`~planning.task.junctions.runs`), they are joined into one path and timed as one
+:func:`~planning.task.junctions.runs`), they may be joined into one path and timed as one
 (:func:`~planning.task.junctions.joined_motion`): the robot passes their junctions without
-stopping. The joined motion is cut at the junctions and each part verified as its segment:
+stopping, where that is sooner than stopping (:func:`_fastest_joins`). A joined motion is cut
+at the junctions and each part verified as its segment:
 the planner's verification with what the robot carries, a line's deviation certified within
 its tolerance (and its tool speed within its limit: the whole run is slowed for it), a
-constrained motion's angle within its constraint. Where any part fails, the run keeps its
-stops: each segment's own rest-to-rest motion, verified as planned.
+constrained motion's angle within its constraint. Where any part fails, those motions keep
+their stops: each segment's own rest-to-rest motion, verified as planned.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import itertools
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -80,10 +82,9 @@ def timed_motions(motions: Sequence[PlannedMotion | None], robot: ck.Robot) -> l
     rigid = [None if m is None or m.still else m.rigid for m in motions]
     timed: list[TimedMotion | None] = [None] * len(motions)
     for run in runs(rigid):
-        joined = _joined(robot, [m for m in (motions[i] for i in run) if m is not None])
-        if joined is not None:
-            for index, part in zip(run, joined, strict=True):
-                timed[index] = part
+        for first, parts in _fastest_joins(robot, [m for m in (motions[i] for i in run) if m is not None]):
+            for offset, part in enumerate(parts):
+                timed[run[first + offset]] = part
     for index, motion in enumerate(motions):
         if motion is not None and timed[index] is None:
             verification = verify_finer_where_needed(motion.problem, motion.trajectory, motion.required)
@@ -91,8 +92,69 @@ def timed_motions(motions: Sequence[PlannedMotion | None], robot: ck.Robot) -> l
     return timed
 
 
-def _joined(robot: ck.Robot, run: list[PlannedMotion]) -> list[TimedMotion] | None:
-    """The run joined and each part verified as its segment; ``None`` where any part fails."""
+def _fastest_joins(robot: ck.Robot, run: list[PlannedMotion]) -> list[tuple[int, list[TimedMotion]]]:
+    """The parts of ``run`` joined where passing their junctions is faster than stopping at them, verified.
+
+    The robot passes a junction without stopping only where it arrives sooner so: a motion
+    that turns back at a junction (a move out and back the same way) stops, turns and goes
+    faster than it bends through a hairpin at speed. Of every way to cut the run into
+    consecutive parts, each either two or more motions joined and timed as one or one motion
+    from rest to rest, the one of the least duration is taken (dynamic programming over the
+    cuts, each part timed once; a tie joins). A joined part whose motions fail their
+    verification is then ruled out and the choice made again.
+
+    Returns:
+        ``(index of its first motion in run, its motions as the task runs them)`` for each
+        joined part; the motions of no part stop at both ends, as planned.
+    """
+    count = len(run)
+    own_s = [motion.trajectory.duration for motion in run]
+    timings: dict[tuple[int, int], tuple[Trajectory, list[float]] | None] = {}
+    verified: dict[tuple[int, int], list[TimedMotion] | None] = {}
+
+    def duration_s(first: int, end: int) -> float:
+        if end == first + 1:
+            return own_s[first]
+        if (first, end) not in timings:
+            timings[first, end] = _timed_join(robot, run[first:end])
+        timing = timings[first, end]
+        if timing is None or verified.get((first, end), True) is None:
+            return math.inf
+        return timing[1][-1]
+
+    while True:
+        least_s, cut = [0.0] + [math.inf] * count, [0] * (count + 1)
+        for end in range(1, count + 1):
+            for first in range(end):  # the longest part first: a tie joins
+                total_s = least_s[first] + duration_s(first, end)
+                if total_s < least_s[end]:
+                    least_s[end], cut[end] = total_s, first
+        parts, end = [], count
+        while end:
+            parts.append((cut[end], end))
+            end = cut[end]
+        chosen = []
+        for first, end in reversed(parts):
+            if end - first < 2:
+                continue
+            if (first, end) not in verified:
+                timing = timings[first, end]  # chosen, so timed
+                verified[first, end] = (
+                    None if timing is None else _verified_parts(robot, run[first:end], *timing)
+                )
+            joined = verified[first, end]
+            if joined is None:
+                break  # ruled out: choose again
+            chosen.append((first, joined))
+        else:
+            return chosen
+
+
+def _timed_join(robot: ck.Robot, run: list[PlannedMotion]) -> tuple[Trajectory, list[float]] | None:
+    """The motions of ``run`` joined and timed as one, and the times of its ends and junctions [s].
+
+    Slowed where a line's tool would exceed its speed limit; ``None`` where they cannot be joined.
+    """
     limits = robot.limits
     try:
         marked = joined_motion(
@@ -110,6 +172,13 @@ def _joined(robot: ck.Robot, run: list[PlannedMotion]) -> list[TimedMotion] | No
     )
     if slower > 1.0:
         trajectory, times = trajectory.time_scaled(slower), [t * slower for t in times]
+    return trajectory, times
+
+
+def _verified_parts(
+    robot: ck.Robot, run: list[PlannedMotion], trajectory: Trajectory, times: list[float]
+) -> list[TimedMotion] | None:
+    """``trajectory`` cut at ``times``, each part verified as its motion's segment (``None``: one fails)."""
     parts = []
     for k, motion in enumerate(run):
         part = trajectory.between(times[k], times[k + 1])
