@@ -13,7 +13,6 @@ from cpr_kin.common.names import escaped
 from planning.cli.plan_commands import load
 from planning.errors import PlanningError
 from planning.io import json_layout
-from planning.io.report import clearance_text
 from planning.outcome import EXIT_NO_TRAJECTORY, EXIT_OK
 
 if TYPE_CHECKING:
@@ -23,6 +22,7 @@ if TYPE_CHECKING:
 
 def cmd_check(args: argparse.Namespace) -> int:
     """Re-verify a trajectory file against a scene; exit 3 when it fails."""
+    from planning.io.report import clearance_text
     from planning.io.trajectory_reader import read_trajectory
     from planning.pipeline.problem import build_problem
     from planning.pipeline.verification import verify_for_scene

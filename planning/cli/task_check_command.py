@@ -9,7 +9,6 @@ from typing import TYPE_CHECKING, Any
 from cpr_kin.common.names import escaped
 from planning.errors import PlanningError
 from planning.io import json_layout
-from planning.io.report import clearance_text
 from planning.outcome import EXIT_NO_TRAJECTORY, EXIT_OK
 
 if TYPE_CHECKING:
@@ -55,6 +54,8 @@ def check_task_file(read: SceneFile, document: TrajectoryFile, args: argparse.Na
     elif checked.problems:
         print(escaped(f"{args.trajectory}: FAILS {args.scene}:\n  " + "\n  ".join(checked.problems)))
     else:
+        from planning.io.report import clearance_text  # numpy's: not at the command's start
+
         print(
             escaped(
                 f"{args.trajectory}: verified against {args.scene}: a task of {len(read.task)} segments, "
