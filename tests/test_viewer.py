@@ -255,13 +255,16 @@ def test_a_tasks_path_is_coloured_by_what_its_checks_measured(pick_and_place: Pl
         drawn = viewer.show_plan(task.trajectory, task.junctions, measured=measured)
         own = viewer.show_plan(task.trajectory, task.junctions)  # the drawn world's, without the part
     np.testing.assert_array_equal(drawn["clearance"], measured.at(drawn["times"]))
-    # the part, waiting and left behind, comes closest: the drawn world alone would colour it clearer
-    assert drawn["clearance"].min() < own["clearance"].min() - 0.01
+    # the part, waiting and left behind, comes closer than anything the drawn world alone holds,
+    # somewhere on the path: that world would colour it clearer there
+    np.testing.assert_array_equal(drawn["times"], own["times"])
+    assert (own["clearance"] - drawn["clearance"]).max() > 0.01
     assert drawn["clearance"].min() >= task.margin_m
-    # and the closest pair drawn is the one the checks met, found in that segment's world: the
-    # part's, at the least measured clearance (exact there: coal decides a check's minimum)
+    # and the closest pair drawn is the one the checks met, found in that segment's world, at
+    # the least measured clearance (exact there: coal decides a check's minimum)
     closest = drawn["closest"]
-    assert closest.obstacle == "part" and drawn["worst_time"] == measured.worst_time_s
+    assert measured.closest is not None and closest.obstacle == measured.closest.obstacle
+    assert drawn["worst_time"] == measured.worst_time_s
     assert closest.distance_m == pytest.approx(float(measured.clearance_m.min()), abs=1e-6)
     assert np.linalg.norm(closest.point_on_robot - closest.point_on_obstacle) == pytest.approx(
         closest.distance_m, abs=1e-6
