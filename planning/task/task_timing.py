@@ -82,9 +82,10 @@ def timed_motions(motions: Sequence[PlannedMotion | None], robot: ck.Robot) -> l
     rigid = [None if m is None or m.still else m.rigid for m in motions]
     timed: list[TimedMotion | None] = [None] * len(motions)
     for run in runs(rigid):
-        for first, parts in _fastest_joins(robot, [m for m in (motions[i] for i in run) if m is not None]):
-            for offset, part in enumerate(parts):
-                timed[run[first + offset]] = part
+        members = [(index, motion) for index in run if (motion := motions[index]) is not None]
+        for first, parts in _fastest_joins(robot, [motion for _, motion in members]):
+            for (index, _), part in zip(members[first:], parts, strict=False):
+                timed[index] = part
     for index, motion in enumerate(motions):
         if motion is not None and timed[index] is None:
             verification = verify_finer_where_needed(motion.problem, motion.trajectory, motion.required)
