@@ -1,6 +1,7 @@
 """Shared fixtures: the bundled CPR, the paper's scene, geometric paths to time, the example pick
 and place planned once, a stop that says yes after a count of questions, a script loaded
-as a module or run for its markdown table, and trimesh's shared random draws seeded."""
+as a module or run for its markdown table, a UR5 on a slow lift, and trimesh's shared random
+draws seeded."""
 
 from __future__ import annotations
 
@@ -102,6 +103,33 @@ def spline_path(nodes: np.ndarray) -> Trajectory:
 
 def limits_of(robot: ck.Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return robot.limits.velocity, robot.limits.acceleration, robot.limits.jerk
+
+
+LIFT_SPEED_M_S = 0.02
+"""The lift's velocity limit under :func:`ur5_on_a_lift` [m/s] (a PR2's torso: 0.013)."""
+
+
+@pytest.fixture(scope="session")
+def ur5_on_a_lift(tmp_path_factory: pytest.TempPathFactory) -> ck.Robot:
+    """example-robot-data's UR5 on a prismatic lift of 0.4 m at :data:`LIFT_SPEED_M_S`, its first joint.
+
+    The arm's joints move at 3.15-3.2 rad/s: a mobile manipulator's torso and arm (a PR2, a Fetch).
+    """
+    from cpr_kin.model.packages import example_robot
+
+    lift = (
+        '<link name="lift_link"/><joint name="lift_joint" type="prismatic"><parent link="world"/>'
+        '<child link="lift_link"/><axis xyz="0 0 1"/>'
+        f'<limit lower="0" upper="0.4" velocity="{LIFT_SPEED_M_S}" effort="1000"/></joint>'
+    )
+    text = example_robot("ur5").read_text()
+    mount = '<joint name="world_joint" type="fixed">\n    <parent link="world"/>'
+    if mount not in text:
+        raise AssertionError("example-robot-data's UR5 no longer joins base_link to world as expected")
+    text = text.replace(mount, lift + mount.replace('"world"', '"lift_link"'))
+    path = tmp_path_factory.mktemp("lift") / "ur5_on_a_lift.urdf"
+    path.write_text(text)
+    return ck.load_robot(path, srdf=example_robot("ur5").parents[1] / "srdf" / "ur5.srdf")
 
 
 @pytest.fixture(scope="session")

@@ -96,6 +96,7 @@ def test_curves_are_pure_mathematics_and_search_knows_no_robot() -> None:
             "planning.validation",
             "cpr_kin.common.compiled",
             "cpr_kin.common.arrays",
+            "cpr_kin.common.rest_to_rest",
         ),
         "planning.search": (
             "planning.search",

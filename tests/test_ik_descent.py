@@ -10,8 +10,9 @@ import pinocchio as pin
 import pytest
 
 import cpr_kin as ck
+from cpr_kin.kinematics.least_squares import damped_solve
 from cpr_kin.kinematics.numerical_ik import PROGRESS, descent
-from cpr_kin.kinematics.tool_chain import ToolChain, damped_solve, rotation_log
+from cpr_kin.kinematics.tool_chain import ToolChain, rotation_log
 from cpr_kin.model.packages import example_robot
 
 from .conftest import damped_step
@@ -65,9 +66,12 @@ def test_the_damped_solve_is_numpys(size: int) -> None:
 
 
 def reference_step(
-    robot: ck.Robot, target: ck.IkTarget, q: FloatArray, free: FloatArray, settings: ck.IkSettings
+    robot: ck.Robot, target: ck.IkTarget, q: FloatArray, scales: FloatArray, settings: ck.IkSettings
 ) -> FloatArray:
-    """One damped least-squares step by Pinocchio's frame Jacobian (LOCAL_WORLD_ALIGNED) and NumPy."""
+    """One damped least-squares step by Pinocchio's frame Jacobian (LOCAL_WORLD_ALIGNED) and NumPy.
+
+    In the coordinates ``q / scales`` (a held joint's scale 0): ``S step(J S, e)``.
+    """
     model, data, frame = robot.model, robot.data, robot.frame_id(robot.tcp_frame)
     pin.framesForwardKinematics(model, data, q)
     placement = data.oMf[frame]
@@ -78,8 +82,8 @@ def reference_step(
         error = np.concatenate([error, rotation])
     else:
         jacobian = jacobian[:3]
-    jacobian = jacobian * free
-    step = np.clip(damped_step(jacobian, error, settings.damping), -settings.max_step, settings.max_step)
+    step = scales * damped_step(jacobian * scales, error, settings.damping)
+    step = np.clip(step, -settings.max_step, settings.max_step)
     return np.asarray(np.clip(q + step, robot.limits.lower, robot.limits.upper))
 
 
@@ -94,10 +98,14 @@ ROBOTS = {
 }
 
 
+@pytest.mark.parametrize("speed_scaled", [False, True], ids=["plain", "speed-scaled"])
 @pytest.mark.parametrize("name", sorted(ROBOTS))
 @pytest.mark.parametrize("pose", [True, False], ids=["pose", "position"])
-def test_one_step_is_the_damped_least_squares_step_on_pinocchios_jacobian(name: str, pose: bool) -> None:
+def test_one_step_is_the_damped_least_squares_step_on_pinocchios_jacobian(
+    name: str, pose: bool, speed_scaled: bool
+) -> None:
     robot = ROBOTS[name]()
+    speeds = np.array(robot.limits.speed_scales) if speed_scaled else None
     rng = np.random.default_rng(11)
     settings = ck.IkSettings(iterations=1, damping=0.05, max_step=0.2)
     for k in range(8):
@@ -106,9 +114,10 @@ def test_one_step_is_the_damped_least_squares_step_on_pinocchios_jacobian(name: 
         target = ck.IkTarget(tool[:3, 3], tool[:3, :3] if pose else None)
         free = np.ones(robot.nq, dtype=bool)
         free[k % robot.nq] = k % 2 == 0  # every other draw holds a joint
-        stepped, steps = descent(robot, target, free, settings)(q)
+        stepped, steps = descent(robot, target, free, settings, speeds)(q)
         assert steps == 1
-        np.testing.assert_allclose(stepped, reference_step(robot, target, q, free, settings), atol=1e-10)
+        scales = free * (1.0 if speeds is None else speeds)
+        np.testing.assert_allclose(stepped, reference_step(robot, target, q, scales, settings), atol=1e-10)
         assert free[k % robot.nq] or stepped[k % robot.nq] == q[k % robot.nq]
 
 

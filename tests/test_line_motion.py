@@ -9,6 +9,8 @@ positions, and the joint torques by Pinocchio's RNEA with the payload.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -19,6 +21,9 @@ from planning.errors import PlanningError, ToolLineBrokenError
 from planning.outcome import classify
 from planning.pipeline.verification import Requirements
 from planning.task import LineMotion, LineTolerance, ToolLine, ToolPose, line_ik, plan_line
+from planning.task.joint_ranges import LIMIT_GAIN
+
+from .conftest import LIFT_SPEED_M_S
 
 NO_MARGIN = Requirements(margin_m=0.0, step_m=0.01)
 
@@ -107,13 +112,51 @@ def test_a_ur5_carrying_two_kilograms_turns_while_it_moves_within_its_torques() 
 def test_a_redundant_arm_walks_its_null_space_away_from_a_joint_limit() -> None:
     robot = ck.load_robot(example_robot("panda"))
     world = ck.CollisionWorld(robot, [])
-    q = robot.configuration([0.8074, 1.0755, 2.6868, -2.6199, -0.1031, 3.3556, -0.4478])
-    line = ToolLine(by=(0.1181, 0.0398, 0.1406), offset_frame="base")
-    motion = plan_line(world, q, line, NO_MARGIN)  # joint 3 starts 0.21 rad from its limit
+    q = robot.configuration([-2.6973, 0.9042, -2.2187, -2.3293, 1.7752, 1.6829, 2.1835])
+    line = ToolLine(by=(-0.0317, 0.0603, -0.1409), offset_frame="base")
+    motion = plan_line(world, q, line, NO_MARGIN)  # joint 1 starts 0.2 rad from its limit
     found = sampled(motion, robot)
     assert found["distance_m"] <= 1e-3 and found["angle_rad"] <= 0.01 and found["inside"]
-    with pytest.raises(ToolLineBrokenError, match="'panda_joint3' reaches its limit"):  # the plain walk
+    with pytest.raises(ToolLineBrokenError, match="'panda_joint1' reaches its limit"):  # the plain walk
         line_ik._walk(robot, q, motion.frame, motion.geometry, line.tolerance, motion.path.sigma)
+
+
+def test_where_the_walks_least_in_time_break_the_plain_steps_carry_the_line() -> None:
+    """A Panda's joint 5 at 5 cm from its limit: the walks that favour its faster wrist joints break."""
+    robot = ck.load_robot(example_robot("panda"))
+    world = ck.CollisionWorld(robot, [])
+    q = robot.configuration([-2.1216, -1.7128, -0.9084, -1.0179, 2.8378, 3.193, 1.1029])
+    line = ToolLine(by=(-0.0759, -0.092, 0.0918), offset_frame="base")
+    motion = plan_line(world, q, line, NO_MARGIN)
+    found = sampled(motion, robot)
+    assert found["distance_m"] <= 1e-3 and found["angle_rad"] <= 0.01 and found["inside"]
+    for gain in (0.0, LIMIT_GAIN):  # the speed-scaled walks, with and without the pull from the limits
+        with pytest.raises(ToolLineBrokenError, match="reaches its limit"):
+            line_ik._walk(robot, q, motion.frame, motion.geometry, line.tolerance, motion.path.sigma, gain)
+
+
+@pytest.mark.parametrize("by", [(0.0, 0.0, -0.05), (0.1, 0.0, 0.0), (0.0, 0.08, 0.05)])
+def test_a_line_moves_the_fast_joints_and_leaves_a_slow_lift_where_it_is(
+    ur5_on_a_lift: ck.Robot, by: tuple[float, float, float]
+) -> None:
+    """Each step of the walk is the least in time: the arm's joints (3.2 rad/s) carry the line.
+
+    The oracle: the same robot with every joint as fast, whose steps are the plain least-squares
+    steps; those move the lift (a metre of it weighs as a radian of a joint) by centimetres, which
+    at its 0.02 m/s takes longer than the whole line does.
+    """
+    robot = ur5_on_a_lift
+    fast = np.full(robot.nq, float(robot.limits.velocity.max()))
+    equally_fast = dataclasses.replace(robot, limits=dataclasses.replace(robot.limits, velocity=fast))
+    q = robot.configuration([0.2, 0.3, -1.2, 1.5, -1.9, 1.2, 0.0])
+    line = ToolLine(by=by, offset_frame="base")
+    motion = plan_line(ck.CollisionWorld(robot, []), q, line, NO_MARGIN)
+    found = sampled(motion, robot)
+    assert found["distance_m"] <= 1e-3 and found["angle_rad"] <= 0.01 and found["inside"]
+    plain = plan_line(ck.CollisionWorld(equally_fast, []), q, line, NO_MARGIN)
+    lift_m, plain_lift_m = np.ptp(motion.path.samples[:, 0]), np.ptp(plain.path.samples[:, 0])
+    assert lift_m < 1e-3 and plain_lift_m > 0.04
+    assert motion.trajectory.duration < plain_lift_m / LIFT_SPEED_M_S
 
 
 def test_a_line_out_of_the_joint_range_breaks_at_the_share_it_reaches() -> None:

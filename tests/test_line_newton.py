@@ -23,9 +23,14 @@ WEIGHTS = np.array([1.0 / TOLERANCE.position_m] * 3 + [1.0 / TOLERANCE.angle_rad
 
 
 def reference(
-    robot: ck.Robot, frame: str, q: FloatArray, target: pin.SE3, bounds: tuple[FloatArray, FloatArray]
+    robot: ck.Robot,
+    frame: str,
+    q: FloatArray,
+    target: pin.SE3,
+    bounds: tuple[FloatArray, FloatArray],
+    scales: FloatArray,
 ) -> tuple[FloatArray, float]:
-    """The corrector as Pinocchio's calls and numpy's solve, step by step."""
+    """The corrector as Pinocchio's calls and numpy's solve, step by step, in coordinates ``q / scales``."""
     model, data, fid = robot.model, robot.data, robot.frame_id(frame)
     excess = math.inf
     for _ in range(NEWTON_STEPS):
@@ -42,16 +47,22 @@ def reference(
         frame_jacobian = pin.computeFrameJacobian(model, data, q, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
         jacobian = frame_jacobian * WEIGHTS[:, None]
         damping = DAMPING * math.sqrt(max(float(np.sum(jacobian**2)), 1.0))
-        q = np.clip(q + damped_step(jacobian, error, damping), *bounds)
+        q = np.clip(q + scales * damped_step(jacobian * scales, error, damping), *bounds)
     return q, excess
 
 
 def compiled(
-    robot: ck.Robot, frame: str, q: FloatArray, target: pin.SE3, bounds: tuple[FloatArray, FloatArray]
+    robot: ck.Robot,
+    frame: str,
+    q: FloatArray,
+    target: pin.SE3,
+    bounds: tuple[FloatArray, FloatArray],
+    scales: FloatArray,
 ) -> tuple[FloatArray, float]:
     chain, tool = ToolChain.of(robot, frame).arrays
     rates = np.array([DAMPING, PROGRESS, IK_SHARE, NEWTON_STEPS], dtype=float)
-    return newton_to_pose(q, chain, tool, (target.translation, target.rotation), (WEIGHTS, *bounds, rates))
+    rules = (WEIGHTS, scales, *bounds, rates)
+    return newton_to_pose(q, chain, tool, (target.translation, target.rotation), rules)
 
 
 ARMS = [
@@ -62,19 +73,23 @@ ARMS = [
 ]
 
 
+@pytest.mark.parametrize("speed_scaled", [False, True], ids=["plain", "speed-scaled"])
 @pytest.mark.parametrize(("load", "frame"), ARMS)
-def test_the_compiled_corrector_takes_the_reference_steps(load: object, frame: str | None) -> None:
+def test_the_compiled_corrector_takes_the_reference_steps(
+    load: object, frame: str | None, speed_scaled: bool
+) -> None:
     robot = load()  # type: ignore[operator]
     frame = frame or robot.tcp_frame
     lower, upper = np.asarray(robot.limits.lower), np.asarray(robot.limits.upper)
+    scales = np.array(robot.limits.speed_scales) if speed_scaled else np.ones(robot.nq)
     rng = np.random.default_rng(7)
     reached = 0
     for _ in range(20):
         wanted = rng.uniform(lower, upper)
         guess = np.clip(wanted + rng.normal(scale=0.05, size=robot.nq), lower, upper)
         target = pin.SE3(ck.frame_poses(robot, wanted[None], frame)[0])
-        q_ref, excess_ref = reference(robot, frame, guess, target, (lower, upper))
-        q_new, excess_new = compiled(robot, frame, guess, target, (lower, upper))
+        q_ref, excess_ref = reference(robot, frame, guess, target, (lower, upper), scales)
+        q_new, excess_new = compiled(robot, frame, guess, target, (lower, upper), scales)
         np.testing.assert_allclose(q_new, q_ref, atol=1e-9)
         assert excess_new == pytest.approx(excess_ref, rel=1e-6, abs=1e-9)
         assert np.all(q_new >= lower) and np.all(q_new <= upper)
@@ -89,8 +104,9 @@ def test_a_pose_out_of_reach_settles_short_of_it_within_the_bounds() -> None:
     lower, upper = np.asarray(robot.limits.lower), np.asarray(robot.limits.upper)
     q = 0.5 * (lower + upper)
     target = pin.SE3(np.eye(3), np.array([3.0, 0.0, 0.5]))  # 3 m away: beyond a UR5's reach
-    q_ref, excess_ref = reference(robot, robot.tcp_frame, q, target, (lower, upper))
-    q_new, excess_new = compiled(robot, robot.tcp_frame, q, target, (lower, upper))
+    scales = np.array(robot.limits.speed_scales)
+    q_ref, excess_ref = reference(robot, robot.tcp_frame, q, target, (lower, upper), scales)
+    q_new, excess_new = compiled(robot, robot.tcp_frame, q, target, (lower, upper), scales)
     assert excess_new > 1e3  # metres over a millimetre's tolerance
     assert excess_new == pytest.approx(excess_ref, rel=1e-6)
     np.testing.assert_allclose(q_new, q_ref, atol=1e-6)

@@ -29,33 +29,34 @@ TOLERANCE = LineTolerance()
 WEIGHTS = np.array([1.0 / TOLERANCE.position_m] * 3 + [1.0 / TOLERANCE.angle_rad] * 3)
 
 
-def solve(jacobian: FloatArray, error: FloatArray) -> FloatArray:
-    size = max(float(np.sum(jacobian * jacobian)), 1.0)
-    return damped_step(jacobian, error, DAMPING * math.sqrt(size))
-
-
 def reference_walk(
     robot: ck.Robot, q: FloatArray, geometry: LineGeometry, sigma: FloatArray, gain: float
 ) -> tuple[FloatArray, float, int]:
-    """The walk step by step: the predictor, the pull in the null space, the corrector, the stops."""
+    """The walk step by step: the predictor, the pull in the null space, the corrector, the stops.
+
+    Each least-squares step in the coordinates ``q / scales`` (the joints' speed scales), and
+    the pull's null space that of those steps: ``pull - S step(J S, J pull)``.
+    """
     model, data, fid = robot.model, robot.data, robot.frame_id(robot.tcp_frame)
     bounds = joint_range(robot)
     lower, upper = bounds
     middle, half = 0.5 * (lower + upper), 0.5 * (upper - lower)
     twist = np.concatenate([geometry.shift_m, geometry.start.rotation @ geometry.turn]) * WEIGHTS
     rotations = geometry.rotations(sigma)
+    scales = np.array(robot.limits.speed_scales)
     samples, residual = [q], 0.0
     for k in range(1, len(sigma)):
         jacobian = pin.computeFrameJacobian(model, data, q, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
         jacobian = jacobian * WEIGHTS[:, None]
-        step = solve(jacobian, twist * (sigma[k] - sigma[k - 1]))
+        damping = DAMPING * math.sqrt(max(float(np.sum(jacobian * jacobian)), 1.0))  # the unscaled columns'
+        step = scales * damped_step(jacobian * scales, twist * (sigma[k] - sigma[k - 1]), damping)
         if gain:
             depth = np.clip((np.abs(q - middle) / half - (1.0 - LIMIT_ZONE)) / LIMIT_ZONE, 0.0, 1.0)
-            null_space = np.eye(len(q)) - solve(jacobian, jacobian)
-            step += gain * null_space @ (depth * (middle - q))
+            pull = depth * (middle - q)
+            step += gain * (pull - scales * damped_step(jacobian * scales, jacobian @ pull, damping))
         guess = np.clip(q + step, *bounds)
         target = pin.SE3(rotations[k], geometry.start.translation + sigma[k] * geometry.shift_m)
-        found, excess = corrector(robot, robot.tcp_frame, guess, target, bounds)
+        found, excess = corrector(robot, robot.tcp_frame, guess, target, bounds, scales)
         if excess > REACH_SHARE or np.abs(found - q).max() > LARGEST_JOINT_STEP:
             return np.array(samples), residual, k
         q, residual = found, max(residual, excess)

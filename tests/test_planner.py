@@ -224,14 +224,13 @@ def test_warm_up_compiles_the_kernels_and_returns_its_time(robot: ck.Robot) -> N
 
 
 def test_warm_up_prepares_a_robot_that_reaches_the_paper_poses_inside_its_crate() -> None:
-    # Baxter's left arm reaches the paper's goal with its forearm in the paper's crate: the
-    # paper case is bad input for it, which must not stop its warm-up
+    # Baxter's right arm reaches the paper's start (on its left) only with a link in the left
+    # arm's margin: the paper case is bad input for it, which must not stop its warm-up
     share = example_robot_data_share()
     assert share is not None, "example-robot-data is part of the robots extra, which make installs"
     baxter = share / "example-robot-data" / "robots" / "baxter_description"
-    robot = ck.load_robot(
-        baxter / "urdf" / "baxter.urdf", tcp="left_gripper", srdf=baxter / "srdf" / "baxter_manipulation.srdf"
-    )
+    srdf = baxter / "srdf" / "baxter_manipulation.srdf"
+    robot = ck.load_robot(baxter / "urdf" / "baxter.urdf", tcp="right_gripper", srdf=srdf)
     with pytest.raises(PlanningError, match="is inside the safety margin"):
         build_problem(paper_scene(), robot)
     assert warm_up(robot) > 0.0

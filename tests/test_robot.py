@@ -25,6 +25,16 @@ def test_joints_and_limits_match_design(robot: ck.Robot) -> None:
     assert robot.joint_units == ("rad", "m", "m", "rad", "rad") == joint_units(robot.model)
 
 
+def test_speed_scales_and_move_times_follow_the_limits(robot: ck.Robot) -> None:
+    lim = robot.limits  # the CPR's velocities [1.5, 0.5, 0.5, 2.0, 2.0]: the wrist's the fastest
+    np.testing.assert_allclose(lim.speed_scales, [0.75, 0.25, 0.25, 1.0, 1.0], rtol=1e-15)
+    change = np.array([[0.0, 0.3, 0.0, 0.0, 0.0], [1.2, 0.0, 0.0, 0.0, -0.1], [0.0] * 5])
+    # d2: 0.3 m >= v^2 / a = 0.125 m, cruises: 0.3 / 0.5 + 0.5 / 2; theta1: 1.2 rad >= 0.75 rad,
+    # cruises: 1.2 / 1.5 + 1.5 / 3, slower than theta5's triangle 2 sqrt(0.1 / 4)
+    np.testing.assert_allclose(lim.move_time_s(change), [0.85, 1.3, 0.0], rtol=1e-12)
+    assert lim.move_time_s(change[1]) == pytest.approx(1.3)  # one change: one time
+
+
 def test_collision_groups(robot: ck.Robot) -> None:
     groups = {g.name: g.group for g in robot.geometries}
     assert groups == {

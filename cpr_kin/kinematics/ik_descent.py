@@ -5,8 +5,10 @@ each start takes up to a hundred steps: in Python, with Pinocchio's forward kine
 Jacobian a call each, a step costs tens of microseconds of calls for microseconds of
 arithmetic. Here a whole start runs compiled on the robot's chain to its tool frame
 (:mod:`cpr_kin.kinematics.tool_chain`: the frame's placement, its Jacobian in the world's
-axes, the rotation error as a logarithm, the step ``J^T (J J^T + lambda^2 I)^-1 e`` by a
-Cholesky factorisation); the rules are those of ``numerical_ik``'s docstring.
+axes, the rotation error as a logarithm, the step ``S J_S^T (J_S J_S^T + lambda^2 I)^-1 e``
+with ``J_S = J S`` by a Cholesky factorisation, ``S`` the joints' scales: 1 for the plain
+step, the speed scales for the step least in time, 0 for a held joint); the rules are those of
+``numerical_ik``'s docstring.
 """
 
 from __future__ import annotations
@@ -18,15 +20,15 @@ from numpy.typing import NDArray
 
 from cpr_kin.bounds.batch_kinematics import ChainArrays
 from cpr_kin.common.compiled import njit
-from cpr_kin.kinematics.tool_chain import ToolArrays, damped_step, place_tool, rotation_error, tool_jacobian
+from cpr_kin.kinematics.least_squares import damped_step, scale_columns, scale_step
+from cpr_kin.kinematics.tool_chain import ToolArrays, place_tool, rotation_error, tool_jacobian
 
 FloatArray = NDArray[np.float64]
-BoolArray = NDArray[np.bool_]
 TargetArrays = tuple[FloatArray, FloatArray, FloatArray, bool]
 """A target as compiled code takes it: position [m], rotation, tolerances [m, rad], whether a pose."""
-StepArrays = tuple[BoolArray, FloatArray, FloatArray, FloatArray]
-"""How a step moves: ``free`` joints, ``lower`` and ``upper`` limits, and ``[damping, max_step,
-progress]``."""
+StepArrays = tuple[FloatArray, FloatArray, FloatArray, FloatArray]
+"""How a step moves: each joint's ``scales`` (0: held), ``lower`` and ``upper`` limits, and
+``[damping, max_step, progress]``."""
 
 
 @njit
@@ -45,7 +47,8 @@ def descend(
     a row have not made the least error ``progress`` smaller (``numerical_ik``).
     """
     position, rotation, tolerances, pose = target
-    free, lower, upper, rates = step
+    scales, lower, upper, rates = step
+    free = scales > 0.0
     damping, max_step, progress = rates[0], rates[1], rates[2]
     iterations, patience = counts
     joints, nq, rows = len(chain[0]), len(q), 6 if pose else 3
@@ -72,7 +75,9 @@ def descend(
             if stuck >= patience:
                 break
         tool_jacobian(chain, tool, free, work, tool_pos, jacobian)
+        scale_columns(jacobian, scales)
         damped_step(jacobian, error, rows, damping, solve_work, change)
+        scale_step(change, scales)
         steps += 1
         for v in range(nq):
             q[v] = min(upper[v], max(lower[v], q[v] + min(max_step, max(-max_step, change[v]))))

@@ -5,10 +5,18 @@ within a tolerance. From the seed configuration first, then from seeded random o
 (``restarts``), it iterates ``dq = J^T (J J^T + lambda^2 I)^-1 e`` on the frame's error ``e``
 (the position difference; for a pose, also the rotation's logarithm, in the world-aligned
 frame), each step at most ``max_step`` [rad or m] per joint and clipped into the joint
-ranges. Every solution is checked by forward kinematics against the target and its
+ranges. From the seed, and from every other random start, the step is the least in time, not
+in the joints' units (the Jacobian's columns scaled by the joints' speed limits,
+:attr:`~cpr_kin.model.limits.JointLimits.speed_scales`), and those random starts are drawn
+near the seed in time (each joint's draw pulled towards the seed's value by its speed scale):
+where the arm can reach the target by its fast joints, a slow one (a torso lift) keeps about
+its seed's value. The other random starts explore the whole ranges with the plain step. On an
+arm whose joints are equally fast both kinds are the same. Every solution is checked by
+forward kinematics against the target and its
 tolerance; of those that pass, the ones the ``accept`` test allows (collision-free, say) come
 first, and of those the ones the ``prefer`` test also passes (on a constraint, say) before
-the rest, then the one nearest the seed (in robot motion, ``sum_j R_j |dq_j|``). A revolute joint
+the rest, then the one the robot reaches soonest from the seed, nearest in robot motion
+(``sum_j R_j |dq_j|``) of those about as soon (:func:`soonest`). A revolute joint
 whose range spans more than a turn (a UR's ``[-2 pi, 2 pi]``) reaches the same pose a turn
 apart: each solution is first turned by whole turns towards the seed, within the range, or a
 restart's shoulder a turn away made the robot swing round for nothing. A target that
@@ -41,6 +49,9 @@ Descent = Callable[[FloatArray], tuple[FloatArray, int]]
 
 PROGRESS = 0.05
 """The relative decrease of a start's least error that counts as progress (:attr:`IkSettings.patience`)."""
+SAME_TIME_SHARE = 0.05
+"""Solutions reached this share later than the soonest count as soon (:func:`soonest`): of them the
+nearest in robot motion is chosen."""
 
 
 @dataclass(frozen=True)
@@ -84,13 +95,22 @@ class IkSettings:
                 raise CprKinError(f"IkSettings.{name} = {value!r} must be a number in (0, 10]")
 
 
-def descent(robot: Robot, target: IkTarget, free: NDArray[np.bool_], settings: IkSettings) -> Descent:
+def descent(
+    robot: Robot,
+    target: IkTarget,
+    free: NDArray[np.bool_],
+    settings: IkSettings,
+    scales: FloatArray | None = None,
+) -> Descent:
     """One start's damped least-squares descent of ``target``, moving the ``free`` ``(nq,)`` joints.
 
     The returned function takes the start ``(nq,)`` [rad, m] and returns the configuration it
     ends at and the steps it took: it ends where the target is reached, after
     ``settings.iterations`` steps, or once ``settings.patience`` steps in a row have not made
-    progress. It runs compiled (:mod:`cpr_kin.kinematics.ik_descent`).
+    progress. It runs compiled (:mod:`cpr_kin.kinematics.ik_descent`). ``scales`` ``(nq,)``
+    weigh the joints' share of each step (the robot's
+    :attr:`~cpr_kin.model.limits.JointLimits.speed_scales`: the step least in time); ``None``:
+    the plain least-squares step, in the joints' own units.
     """
     chain, tool = ToolChain.of(robot).arrays
     pose = target.rotation is not None
@@ -102,7 +122,8 @@ def descent(robot: Robot, target: IkTarget, free: NDArray[np.bool_], settings: I
     )
     lower, upper = np.array(robot.limits.lower, dtype=float), np.array(robot.limits.upper, dtype=float)
     rates = np.array([settings.damping, settings.max_step, PROGRESS])
-    step = (np.array(free, dtype=np.bool_), lower, upper, rates)
+    weights = np.ones(robot.nq) if scales is None else np.asarray(scales, dtype=float)
+    step = (np.where(np.asarray(free, dtype=bool), weights, 0.0), lower, upper, rates)
     counts = (int(settings.iterations), int(settings.patience))
     return lambda q: descend(np.array(q, dtype=float), chain, tool, goal, step, counts)
 
@@ -164,12 +185,18 @@ def solve_ik(
     closest: pin.SE3 | None = None
     frame = robot.frame_id(robot.tcp_frame)
     draws = [seed, *rng.uniform(lower, upper, (settings.restarts, robot.nq))]
-    descend_from = descent(robot, target, free, settings)
+    speeds = robot.limits.speed_scales
+    soon_from, anywhere_from = (
+        descent(robot, target, free, settings, speeds),
+        descent(robot, target, free, settings),
+    )
     tried = 0
     while tried < len(draws):
-        start = np.where(free, draws[tried], seed)
+        soon = tried % 2 == 0  # the seed and every other draw: near the seed in time
+        start = seed + speeds * (draws[tried] - seed) if soon else draws[tried]
+        start = np.where(free, start, seed)
+        q = turned_towards((soon_from if soon else anywhere_from)(start)[0], seed, revolute, lower, upper)
         tried += 1
-        q = turned_towards(descend_from(start)[0], seed, revolute, lower, upper)
         pin.framesForwardKinematics(robot.model, robot.data, q)
         placement = pin.SE3(robot.data.oMf[frame])
         if closest is None or target.excess(placement) < target.excess(closest):
@@ -187,8 +214,22 @@ def solve_ik(
     if not found:
         assert closest is not None  # the seed is always tried
         raise IkMissError(f"{missed}: the closest of {tried} IK starts came {target.miss(closest)}")
+    return soonest(robot, preferred or accepted or found, seed)
+
+
+def soonest(robot: Robot, solutions: Sequence[FloatArray], seed: FloatArray) -> FloatArray:
+    """Of ``solutions`` (joint vectors [rad, m]), the one the robot reaches soonest from ``seed``.
+
+    Reached soonest: the robot's :meth:`~cpr_kin.model.limits.JointLimits.move_time_s` from
+    ``seed`` at most :data:`SAME_TIME_SHARE` above the least; of those, the nearest in robot
+    motion (``sum_j R_j |dq_j|``, :func:`~cpr_kin.certified.motion.path_weights`), which sweeps
+    the least space.
+    """
+    times_s = robot.limits.move_time_s(np.array(solutions) - seed)
+    latest_s = (1.0 + SAME_TIME_SHARE) * times_s.min()
+    soon = [q for q, time_s in zip(solutions, times_s, strict=True) if time_s <= latest_s]
     weights = path_weights(robot)
-    return min(preferred or accepted or found, key=lambda q: float(weights @ np.abs(q - seed)))
+    return min(soon, key=lambda q: float(weights @ np.abs(q - seed)))
 
 
 def turned_towards(

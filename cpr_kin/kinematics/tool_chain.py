@@ -3,8 +3,8 @@
 The tool frame's placement at a configuration (:func:`place_tool`, on
 :func:`~cpr_kin.bounds.batch_kinematics.place_joints`), its geometric Jacobian in the world's
 axes (:func:`tool_jacobian`, Pinocchio's ``LOCAL_WORLD_ALIGNED``), the logarithm of a rotation
-(:func:`rotation_log`, Pinocchio's ``log3``) and a damped least-squares solve by Cholesky
-(:func:`damped_solve`): what the numerical IK's descent
+(:func:`rotation_log`, Pinocchio's ``log3``): with the damped least-squares steps of
+:mod:`cpr_kin.kinematics.least_squares`, what the numerical IK's descent
 (:mod:`cpr_kin.kinematics.ik_descent`) and a tool line's Newton steps are made of, compiled.
 """
 
@@ -134,30 +134,6 @@ def rotation_log(m: FloatArray, out: FloatArray) -> float:
 
 
 @njit_inline
-def damped_solve(system: FloatArray, rhs: FloatArray, size: int, out: FloatArray) -> None:
-    """Write ``system^-1 rhs`` into ``out[:size]``: ``system`` ``(size, size)`` symmetric positive definite.
-
-    Cholesky, in place in ``system``'s lower triangle, then two triangular solves.
-    """
-    for i in range(size):
-        for j in range(i + 1):
-            total = system[i, j]
-            for k in range(j):
-                total -= system[i, k] * system[j, k]
-            system[i, j] = math.sqrt(total) if i == j else total / system[j, j]
-    for i in range(size):
-        total = rhs[i]
-        for k in range(i):
-            total -= system[i, k] * out[k]
-        out[i] = total / system[i, i]
-    for i in range(size - 1, -1, -1):
-        total = out[i]
-        for k in range(i + 1, size):
-            total -= system[k, i] * out[k]
-        out[i] = total / system[i, i]
-
-
-@njit_inline
 def place_tool(
     q: FloatArray,
     chain: ChainArrays,
@@ -245,49 +221,3 @@ def rotation_error(
     for r in range(3):
         out[r] = tool_rot[r, 0] * l0 + tool_rot[r, 1] * l1 + tool_rot[r, 2] * l2
     return angle
-
-
-@njit_inline
-def weighted_damping(jacobian: FloatArray, weights: FloatArray, share: float) -> float:
-    """Scale the rows of ``jacobian`` ``(6, nq)`` by ``weights`` ``(6,)`` in place; its damping.
-
-    The damping of a least-squares step on it: ``share * sqrt(max(trace(J J^T), 1))``, the
-    share of the weighted Jacobian's size.
-    """
-    trace = 0.0
-    for r in range(6):
-        for v in range(jacobian.shape[1]):
-            jacobian[r, v] *= weights[r]
-            trace += jacobian[r, v] * jacobian[r, v]
-    return share * math.sqrt(max(trace, 1.0))
-
-
-@njit_inline
-def damped_step(
-    jacobian: FloatArray,
-    error: FloatArray,
-    rows: int,
-    damping: float,
-    work: tuple[FloatArray, FloatArray],
-    out: FloatArray,
-) -> None:
-    """Write the damped least-squares step ``J^T (J J^T + damping^2 I)^-1 e`` into ``out`` ``(nq,)``.
-
-    Of the first ``rows`` rows of ``jacobian`` ``(6, nq)`` and ``error`` ``(6,)``; ``work`` is
-    ``(system (6, 6), solved (6,))``, scratch.
-    """
-    system, solved = work
-    nq = jacobian.shape[1]
-    for r in range(rows):
-        for c in range(r + 1):
-            total = damping * damping if r == c else 0.0
-            for v in range(nq):
-                total += jacobian[r, v] * jacobian[c, v]
-            system[r, c] = total
-            system[c, r] = total
-    damped_solve(system, error, rows, solved)
-    for v in range(nq):
-        total = 0.0
-        for r in range(rows):
-            total += jacobian[r, v] * solved[r]
-        out[v] = total

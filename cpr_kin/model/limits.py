@@ -12,6 +12,7 @@ from numpy.typing import NDArray
 
 from cpr_kin.common.errors import CprKinError, UrdfError
 from cpr_kin.common.names import shown
+from cpr_kin.common.rest_to_rest import trapezoid_time
 from cpr_kin.common.user_files import UserFileError, load_yaml
 from cpr_kin.model.packages import installed
 
@@ -72,6 +73,25 @@ class JointLimits:
     def range(self) -> FloatArray:
         """Width of each joint's position range [rad or m]."""
         return self.upper - self.lower
+
+    @property
+    def speed_scales(self) -> FloatArray:
+        """Each joint's velocity limit over the fastest joint's, in (0, 1].
+
+        The joint-space metric in which a step's size is about the time it takes: a damped
+        least-squares step on the Jacobian's columns scaled by these (and the step scaled back)
+        moves the fast joints rather than a slow one (a torso lift of 0.013 m/s beside an arm
+        of 2 rad/s), whatever their units. Joints of equal limits all get 1: the plain step.
+        """
+        return np.asarray(self.velocity / self.velocity.max())
+
+    def move_time_s(self, change: FloatArray) -> FloatArray:
+        """``(...)`` the shortest rest-to-rest time [s] of a joint move by ``change`` ``(..., nq)`` [rad, m].
+
+        The slowest joint's :func:`trapezoid_time` under the velocity and acceleration limits:
+        the others can be slowed to arrive with it.
+        """
+        return np.asarray(trapezoid_time(change, self.velocity, self.acceleration).max(axis=-1))
 
     def index(self, name: str) -> int:
         """Index of joint ``name``; raises :class:`CprKinError` naming the known joints."""

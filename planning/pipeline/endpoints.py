@@ -2,8 +2,9 @@
 
 :func:`endpoint` gives :func:`~planning.pipeline.problem.build_problem` (and the benchmarks'
 validity test, :func:`planning.bench.mbm.endpoint_violations`) the configuration of a start or
-goal: a joint vector as it is, a ``tcp`` or ``pose`` by the IK solution nearest the seed of
-those clear of the margins that the motors can hold still. :func:`margin_violation` says
+goal: a joint vector as it is, a ``tcp`` or ``pose`` by the IK solution the robot reaches
+soonest from the seed (:func:`cpr_kin.kinematics.numerical_ik.soonest`) of those clear of the
+margins that the motors can hold still. :func:`margin_violation` says
 what at a configuration comes inside the safety or self margin.
 """
 

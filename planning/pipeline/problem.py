@@ -188,7 +188,7 @@ def build_problem(
         threads: threads of the parallel collision checks (default: one on 2 cores, two on
             more); a batch that plans scenes in parallel processes gives each 1.
         goal_test: from the start's configuration, a test of a ``tcp`` or ``pose`` goal's IK
-            solutions: the nearest the start that passes it is chosen where one does
+            solutions: the one reached soonest from the start of those that pass it is chosen where one does
             (:func:`~planning.pipeline.endpoints.endpoint`).
 
     Raises:

@@ -101,11 +101,11 @@ def joint_line(
         sigma = np.linspace(0.0, 1.0, steps + 1)
 
         def walk(
-            gain: float, sigma: FloatArray = sigma, inset: FloatArray = inset
+            gain: float, scales: FloatArray, sigma: FloatArray = sigma, inset: FloatArray = inset
         ) -> tuple[FloatArray, float]:
-            return _walk(robot, q, frame, geometry, tolerance, sigma, gain, inset)
+            return _walk(robot, q, frame, geometry, tolerance, sigma, gain, inset, scales)
 
-        samples, residual = _pulled_if_broken(robot, walk)
+        samples, residual = _walked(robot, walk)
         path = spline_through(sigma, samples, SPLINE_DEGREE)
         beyond = beyond_range(robot, path)
         if beyond.any() and insets < RANGE_INSETS:  # samples at a limit, the spline past it
@@ -118,25 +118,30 @@ def joint_line(
         steps *= 2
 
 
-def _pulled_if_broken(
-    robot: ck.Robot, walk: Callable[[float], tuple[FloatArray, float]]
+def _walked(
+    robot: ck.Robot, walk: Callable[[float, FloatArray], tuple[FloatArray, float]]
 ) -> tuple[FloatArray, float]:
-    """``walk(0)``, and where it breaks on a redundant arm, ``walk(LIMIT_GAIN)``.
+    """The first of the walks ``walk(gain, scales)`` that reaches the line's end.
 
-    An arm of more joints than the tool's six directions walks again with its null space
-    pulling joints from their limits (:mod:`planning.task.joint_ranges`).
-    Only on a break: the pull lengthens the joints' motion on lines that need none. Of two
-    breaks, the one further along is raised.
+    First with the steps least in time (the robot's speed scales), then, on a redundant arm, with
+    its null space pulling joints from their limits (``LIMIT_GAIN``,
+    :mod:`planning.task.joint_ranges`): the pull lengthens the joints' motion on lines that need
+    none, so only on a break. Where the joints' speeds differ, both again with the plain steps
+    (scales of 1): a walk that prefers the fast joints may drive one into its limit where the
+    plain steps share the motion otherwise (Romeo's elbow, at its limit at a line's start). Of
+    the breaks, the one furthest along is raised.
     """
-    try:
-        return walk(0.0)
-    except ToolLineBrokenError as plain:
-        if robot.nq <= 6:
-            raise
-        try:
-            return walk(LIMIT_GAIN)
-        except ToolLineBrokenError as pulled:
-            raise (pulled if pulled.fraction > plain.fraction else plain) from None
+    speeds = np.array(robot.limits.speed_scales)
+    gains = (0.0, LIMIT_GAIN) if robot.nq > 6 else (0.0,)
+    metrics = (speeds,) if np.all(speeds == 1.0) else (speeds, np.ones(robot.nq))
+    breaks = []
+    for scales in metrics:
+        for gain in gains:
+            try:
+                return walk(gain, scales)
+            except ToolLineBrokenError as broken:
+                breaks.append(broken)
+    raise max(breaks, key=lambda broken: broken.fraction) from None
 
 
 def _step_count(geometry: LineGeometry) -> int:
@@ -159,16 +164,21 @@ def _walk(
     sigma: FloatArray,
     limit_gain: float = 0.0,
     inset: FloatArray | float = 0.0,
+    scales: FloatArray | None = None,
 ) -> tuple[FloatArray, float]:
     """The samples of the walk at ``sigma`` and their largest error, over the tolerance.
 
     Compiled (:func:`~planning.task.line_walk.walk_line`). ``limit_gain``: the pull of joints
     from their limits (:data:`~planning.task.joint_ranges.LIMIT_GAIN`), none by default.
+    ``scales`` ``(nq,)``: the joints' weights in each step (default: the robot's speed
+    scales, the steps least in time; ones: the plain least-squares steps).
     """
     bounds = joint_range(robot, inset)
     weights = _weights(tolerance)
     chain, tool = ToolChain.of(robot, frame).arrays
-    newton = (weights, *bounds, np.array([DAMPING, PROGRESS, IK_SHARE, NEWTON_STEPS], dtype=float))
+    rates = np.array([DAMPING, PROGRESS, IK_SHARE, NEWTON_STEPS], dtype=float)
+    joint_scales = np.array(robot.limits.speed_scales if scales is None else scales, dtype=float)
+    newton = (weights, joint_scales, *bounds, rates)
     twist = np.concatenate([geometry.shift_m, geometry.start.rotation @ geometry.turn]) * weights
     line = (sigma, geometry.start.translation + sigma[:, None] * geometry.shift_m, geometry.rotations(sigma))
     checks = np.array([limit_gain, LIMIT_ZONE, REACH_SHARE, LARGEST_JOINT_STEP], dtype=float)

@@ -17,21 +17,16 @@ from numpy.typing import NDArray
 
 from cpr_kin.bounds.batch_kinematics import ChainArrays
 from cpr_kin.common.compiled import njit
-from cpr_kin.kinematics.tool_chain import (
-    ToolArrays,
-    damped_step,
-    place_tool,
-    rotation_error,
-    tool_jacobian,
-    weighted_damping,
-)
+from cpr_kin.kinematics.least_squares import damped_step, scale_columns, scale_step, weighted_damping
+from cpr_kin.kinematics.tool_chain import ToolArrays, place_tool, rotation_error, tool_jacobian
 
 FloatArray = NDArray[np.float64]
 PoseArrays = tuple[FloatArray, FloatArray]
 """A pose as compiled code takes it: position ``(3,)`` [m] and rotation ``(3, 3)``, in the world."""
-NewtonRules = tuple[FloatArray, FloatArray, FloatArray, FloatArray]
-"""How the corrector steps and stops: ``weights`` ``(6,)`` (one over each tolerance), ``lower`` and
-``upper`` ``(nq,)`` [rad, m], and ``[damping, progress, settled, steps]``."""
+NewtonRules = tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]
+"""How the corrector steps and stops: ``weights`` ``(6,)`` (one over each tolerance), the joints'
+``scales`` ``(nq,)`` (their speed scales: each step the least in time), ``lower`` and ``upper``
+``(nq,)`` [rad, m], and ``[damping, progress, settled, steps]``."""
 
 
 @njit
@@ -44,11 +39,12 @@ def newton_to_pose(
     world's axes, times ``weights``; its size the larger of the two norms) and stops once it
     is at most ``settled`` or no longer ``progress`` smaller than the step before (the error
     returned is then the last that was); otherwise it moves by the damped least-squares step
-    of the weighted Jacobian, ``lambda = damping * sqrt(max(trace(J J^T), 1))``, into
-    ``[lower, upper]``; ``steps`` at most.
+    of the weighted Jacobian, ``lambda = damping * sqrt(max(trace(J J^T), 1))``, its columns
+    then times ``scales`` (and the step scaled back), into ``[lower, upper]``; ``steps`` at
+    most.
     """
     position, rotation = target
-    weights, lower, upper, rates = rules
+    weights, scales, lower, upper, rates = rules
     damping, progress, settled, steps = rates[0], rates[1], rates[2], int(rates[3])
     joints, nq = len(chain[0]), len(q)
     q = q.copy()
@@ -73,7 +69,10 @@ def newton_to_pose(
         if excess <= settled:
             break
         tool_jacobian(chain, tool, free, work, tool_pos, jacobian)
-        damped_step(jacobian, error, 6, weighted_damping(jacobian, weights, damping), solve_work, change)
+        lam = weighted_damping(jacobian, weights, damping)
+        scale_columns(jacobian, scales)
+        damped_step(jacobian, error, 6, lam, solve_work, change)
+        scale_step(change, scales)
         for v in range(nq):
             q[v] = min(upper[v], max(lower[v], q[v] + change[v]))
     return q, excess

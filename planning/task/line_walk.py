@@ -2,8 +2,10 @@
 
 :mod:`planning.task.line_ik` walks a line in hundreds of small steps. Each step predicts the
 joints by the damped pseudo-inverse of the tolerance-weighted Jacobian applied to the line's
-twist over the step (on a redundant arm, plus a pull of joints near a limit toward the middle
-of their range, in the Jacobian's null space), then corrects them onto the line's pose there
+twist over the step, the step least in time (the Jacobian's columns scaled by the joints'
+speed scales: on a redundant arm the fast joints move, a slow torso lift hardly; on
+others the same step), on a redundant arm plus a pull of joints near a limit toward the
+middle of their range, in the Jacobian's null space; then corrects them onto the line's pose there
 (:func:`~planning.task.line_newton.newton_to_pose`). A sample that stays too far from the line
 or makes a joint jump ends the walk; the caller says why. The rules are those of
 :mod:`planning.task.line_ik` and :mod:`planning.task.joint_ranges`.
@@ -16,7 +18,8 @@ from numpy.typing import NDArray
 
 from cpr_kin.bounds.batch_kinematics import ChainArrays
 from cpr_kin.common.compiled import njit, njit_inline
-from cpr_kin.kinematics.tool_chain import ToolArrays, damped_step, place_tool, tool_jacobian, weighted_damping
+from cpr_kin.kinematics.least_squares import damped_step, scale_columns, scale_step, weighted_damping
+from cpr_kin.kinematics.tool_chain import ToolArrays, place_tool, tool_jacobian
 from planning.task.line_newton import NewtonRules, newton_to_pose
 
 FloatArray = NDArray[np.float64]
@@ -42,7 +45,7 @@ def walk_line(
     (``samples`` is then whole; otherwise only its first ``broken`` rows are the walk's).
     """
     sigma, positions, rotations = line
-    weights, lower, upper, rates = newton
+    weights, scales, lower, upper, rates = newton
     twist, ranges, checks = walk
     gain, zone, reach_share, largest_step = checks[0], checks[1], checks[2], checks[3]
     damping = rates[0]
@@ -63,14 +66,19 @@ def walk_line(
         progress = sigma[k] - sigma[k - 1]
         for r in range(6):
             change[r] = twist[r] * progress
-        damped_step(jacobian, change, 6, lam, solve_work, step)
-        if gain > 0.0 and _limit_pull(q, ranges, zone, pull):
-            for r in range(6):  # the pull less what the Jacobian sees of it: its null-space part
+        pulled = gain > 0.0 and _limit_pull(q, ranges, zone, pull)
+        if pulled:
+            for r in range(6):  # what the Jacobian sees of the pull (in the joints' own units)
                 total = 0.0
                 for v in range(nq):
                     total += jacobian[r, v] * pull[v]
                 rhs[r] = total
+        scale_columns(jacobian, scales)
+        damped_step(jacobian, change, 6, lam, solve_work, step)
+        scale_step(step, scales)
+        if pulled:  # the pull less what the Jacobian sees of it: its null-space part
             damped_step(jacobian, rhs, 6, lam, solve_work, back)
+            scale_step(back, scales)
             for v in range(nq):
                 step[v] += gain * (pull[v] - back[v])
         for v in range(nq):

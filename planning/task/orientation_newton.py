@@ -17,7 +17,8 @@ from numpy.typing import NDArray
 
 from cpr_kin.bounds.batch_kinematics import ChainArrays
 from cpr_kin.common.compiled import njit, njit_inline
-from cpr_kin.kinematics.tool_chain import ToolArrays, damped_step, place_tool, rotation_error, tool_jacobian
+from cpr_kin.kinematics.least_squares import damped_step
+from cpr_kin.kinematics.tool_chain import ToolArrays, place_tool, rotation_error, tool_jacobian
 
 FloatArray = NDArray[np.float64]
 ProjectionRules = tuple[FloatArray, FloatArray, FloatArray, FloatArray]
