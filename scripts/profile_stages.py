@@ -30,13 +30,13 @@ obstacles and of the robot's own pairs, the near cells' first tests, the closest
 distances, the search's torque-limited duration estimate, RNEA, the trajectories' extrema); they
 overlap (the self tests hold the cells' tests, the estimate its RNEA), so their shares need not
 add up. Printed per robot and class: the
-problems planned, their median plan [ms] and median duration over Ruckig's jerk-limited bound
+problems planned, their median plan [ms], median duration over Ruckig's jerk-limited bound
 for the straight line (:func:`planning.bench.ruckig_bound.free_space_bound`: what each stage's
-time buys), then each stage's median [ms] and its share of the class's summed time; the table
-as markdown to ``DIR/stages.md``; then each computation's summed time [s] and share, to
-``DIR/computations.md``. ``--planner`` changes the scenes' planner settings (the keys
-of a scene file's ``planner:`` block, each value read as YAML): ``iterations=0 refine=none``
-profiles the pipeline without its search. Every scene and robot is loaded
+time buys) and median duration [s], then each stage's median [ms] and its share of the
+class's summed time; the table as markdown to ``DIR/stages.md``; then each computation's
+summed time [s] and share, to ``DIR/computations.md``. ``--planner`` changes the scenes'
+planner settings (the keys of a scene file's ``planner:`` block, each value read as YAML):
+``iterations=0 refine=none`` profiles the pipeline without its search. Every scene and robot is loaded
 before anything runs: a missing or malformed file, a task (not one motion), or a robot that does
 not load is named in one line. Needs the ``bench`` extra for MotionBenchMaker's problems
 (downloaded once, :mod:`planning.bench.mbm`).
@@ -204,6 +204,8 @@ class Profiled:
         total_s: the plan's wall time [s].
         stages: each stage's exclusive time [s] (:class:`StageClock`).
         over_bound: its trajectory's duration over Ruckig's bound for the straight line.
+        duration_s: its trajectory's duration [s] (beside another checkout's where the goal
+            may differ: a pose's IK solution, whose bound differs too).
         computations: each computation's inclusive time [s] (:class:`ComputationClock`).
     """
 
@@ -212,6 +214,7 @@ class Profiled:
     total_s: float
     stages: dict[str, float]
     over_bound: float
+    duration_s: float
     computations: dict[str, float] = field(default_factory=dict)
 
 
@@ -228,10 +231,11 @@ def table(rows: list[Profiled]) -> list[str]:
     """Markdown rows per robot and class, then per robot (module docstring)."""
     columns = [*STAGES, "other"]
     lines = [
-        "| robot | class | planned | median plan [ms] | duration / Ruckig bound (median) | "
+        "| robot | class | planned | median plan [ms] | duration / Ruckig bound (median) "
+        + "| duration [s] (median) | "
         + " | ".join(f"{c} [ms] (share)" for c in columns)
         + " |",
-        "|---|---|---|---|---|" + "---|" * len(columns),
+        "|---|---|---|---|---|---|" + "---|" * len(columns),
     ]
     for (robot_name, group), planned in by_class(rows):
         summed = sum(row.total_s for row in planned)
@@ -242,10 +246,10 @@ def table(rows: list[Profiled]) -> list[str]:
         ]
         median_ms = 1000 * statistics.median(row.total_s for row in planned)
         over_bound = statistics.median(row.over_bound for row in planned)
+        duration_s = statistics.median(row.duration_s for row in planned)
         lines.append(
-            f"| {robot_name} | {group} | {len(planned)} | {median_ms:.1f} | {over_bound:.3f} | "
-            + " | ".join(cells)
-            + " |"
+            f"| {robot_name} | {group} | {len(planned)} | {median_ms:.1f} | {over_bound:.3f} "
+            f"| {duration_s:.3f} | " + " | ".join(cells) + " |"
         )
     return lines
 
@@ -342,11 +346,14 @@ def main() -> int:
             continue
         total_s, stages = time.perf_counter() - started, clock.lap()
         over_bound = result.trajectory.duration / free_space_bound(result.problem)
-        rows.append(Profiled(case.robot, case.group, total_s, stages, over_bound, computations.lap()))
+        duration_s = result.trajectory.duration
+        rows.append(
+            Profiled(case.robot, case.group, total_s, stages, over_bound, duration_s, computations.lap())
+        )
         shown = " ".join(f"{stage} {1000 * spent:.0f}" for stage, spent in stages.items())
         print(
             f"{case.robot} {case.path.stem}: {1000 * total_s:.0f} ms ({shown}), "
-            f"{over_bound:.3f} of Ruckig's bound",
+            f"{over_bound:.3f} of Ruckig's bound ({duration_s:.3f} s)",
             flush=True,
         )
     lines, bought = table(rows), computations_table(rows)

@@ -1,4 +1,4 @@
-"""``scripts/bench_ik.py``: the IK with and without its patience on the example arms, as a user runs it."""
+"""``scripts/bench_ik.py``: the IK on the example arms and the PR2, as a user runs it."""
 
 from __future__ import annotations
 
@@ -7,8 +7,6 @@ import sys
 from pathlib import Path
 
 import pytest
-
-from cpr_kin.model.packages import EXAMPLE_ROBOTS
 
 SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "bench_ik.py"
 
@@ -22,12 +20,14 @@ def run(*arguments: str) -> subprocess.CompletedProcess[str]:
 
 @pytest.mark.slow
 def test_the_benchmark_prints_a_row_per_arm() -> None:
-    completed = run("--targets", "2", "--seed", "4")
+    completed = run("--targets", "2", "--seed", "4", "--robots", "ur5", "pr2")
     assert completed.returncode == 0, completed.stderr[-2000:]
     rows = {line.split()[0]: line.split() for line in completed.stdout.splitlines()[1:]}
-    assert set(rows) == set(EXAMPLE_ROBOTS)
-    for row in rows.values():  # solved new / old of 2 targets each
-        assert 0 <= int(row[1]) <= 2 and row[2] == "/" and 0 <= int(row[3]) <= 2
+    assert set(rows) == {"ur5", "pr2"}
+    for row in rows.values():  # solved of 2 targets, then the times and ratios
+        assert 0 < int(row[1]) <= 2 and row[2] == "/" and row[3] == "2"
+        move_s, over_drawn, worst = (float(value) for value in row[5:8])
+        assert move_s > 0.0 and 0.0 < over_drawn <= worst
 
 
 def test_a_bad_target_count_is_one_line_naming_it() -> None:

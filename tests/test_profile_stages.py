@@ -53,15 +53,20 @@ def test_a_stage_is_charged_its_own_time_not_that_of_the_stages_it_calls(script:
 def test_the_table_gives_each_stage_s_median_and_share(script: ModuleType) -> None:
     stages = dict.fromkeys(script.STAGES, 0.0)
     rows = [
-        script.Profiled("arm", "box", 1.0, {**stages, "refine": 0.5, "verify": 0.25}, 1.1),
-        script.Profiled("arm", "box", 3.0, {**stages, "refine": 1.5, "verify": 0.75}, 1.3),
+        script.Profiled("arm", "box", 1.0, {**stages, "refine": 0.5, "verify": 0.25}, 1.1, 2.0),
+        script.Profiled("arm", "box", 3.0, {**stages, "refine": 1.5, "verify": 0.75}, 1.3, 3.0),
     ]
     lines = script.table(rows)
     box = next(line for line in lines if line.startswith("| arm | box |"))
     cells = [cell.strip() for cell in box.strip("|").split("|")]
     columns = [*script.STAGES, "other"]
-    assert cells[2:5] == ["2", "2000.0", "1.200"]  # planned, median plan [ms], median duration / bound
-    by_stage = dict(zip(columns, cells[5:], strict=True))
+    assert cells[2:6] == [
+        "2",
+        "2000.0",
+        "1.200",
+        "2.500",
+    ]  # planned, plan [ms], duration / bound, duration [s]
+    by_stage = dict(zip(columns, cells[6:], strict=True))
     assert by_stage["refine"] == "1000.0 (50%)" and by_stage["verify"] == "500.0 (25%)"
     assert by_stage["other"] == "500.0 (25%)"  # what no stage took
     assert any(line.startswith("| arm | all | 2 |") for line in lines)
@@ -101,8 +106,8 @@ def test_every_computation_names_a_function_of_the_code(script: ModuleType) -> N
 def test_the_computations_table_gives_each_s_summed_time_and_share(script: ModuleType) -> None:
     stages = dict.fromkeys(script.STAGES, 0.0)
     rows = [
-        script.Profiled("arm", "box", 1.0, stages, 1.1, {"closest pairs": 0.25, "RNEA": 0.1}),
-        script.Profiled("arm", "cage", 3.0, stages, 1.3, {"closest pairs": 0.75}),
+        script.Profiled("arm", "box", 1.0, stages, 1.1, 2.0, {"closest pairs": 0.25, "RNEA": 0.1}),
+        script.Profiled("arm", "cage", 3.0, stages, 1.3, 3.0, {"closest pairs": 0.75}),
     ]
     lines = script.computations_table(rows)
     every = next(line for line in lines if line.startswith("| arm | all |"))
