@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
@@ -22,47 +23,42 @@ TOLERANCE = LineTolerance()
 WEIGHTS = np.array([1.0 / TOLERANCE.position_m] * 3 + [1.0 / TOLERANCE.angle_rad] * 3)
 
 
-def reference(
-    robot: ck.Robot,
-    frame: str,
-    q: FloatArray,
-    target: pin.SE3,
-    bounds: tuple[FloatArray, FloatArray],
-    scales: FloatArray,
-) -> tuple[FloatArray, float]:
-    """The corrector as Pinocchio's calls and numpy's solve, step by step, in coordinates ``q / scales``."""
-    model, data, fid = robot.model, robot.data, robot.frame_id(frame)
-    excess = math.inf
-    for _ in range(NEWTON_STEPS):
-        pin.framesForwardKinematics(model, data, q)
-        placement = data.oMf[fid]
-        turn = placement.rotation @ pin.log3(placement.rotation.T @ target.rotation)
-        error = np.concatenate([target.translation - placement.translation, turn]) * WEIGHTS
-        size = max(float(np.linalg.norm(error[:3])), float(np.linalg.norm(error[3:])))
-        if size > (1.0 - PROGRESS) * excess:
-            break
-        excess = size
-        if excess <= IK_SHARE:
-            break
-        frame_jacobian = pin.computeFrameJacobian(model, data, q, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
-        jacobian = frame_jacobian * WEIGHTS[:, None]
-        damping = DAMPING * math.sqrt(max(float(np.sum(jacobian**2)), 1.0))
-        q = np.clip(q + scales * damped_step(jacobian * scales, error, damping), *bounds)
-    return q, excess
+@dataclass(frozen=True)
+class Corrector:
+    """The corrector on ``robot``'s ``frame`` within ``bounds``, its steps in coordinates ``q / scales``."""
 
+    robot: ck.Robot
+    frame: str
+    bounds: tuple[FloatArray, FloatArray]
+    scales: FloatArray
 
-def compiled(
-    robot: ck.Robot,
-    frame: str,
-    q: FloatArray,
-    target: pin.SE3,
-    bounds: tuple[FloatArray, FloatArray],
-    scales: FloatArray,
-) -> tuple[FloatArray, float]:
-    chain, tool = ToolChain.of(robot, frame).arrays
-    rates = np.array([DAMPING, PROGRESS, IK_SHARE, NEWTON_STEPS], dtype=float)
-    rules = (WEIGHTS, scales, *bounds, rates)
-    return newton_to_pose(q, chain, tool, (target.translation, target.rotation), rules)
+    def reference(self, q: FloatArray, target: pin.SE3) -> tuple[FloatArray, float]:
+        """The corrector as Pinocchio's calls and numpy's solve, step by step."""
+        model, data, fid = self.robot.model, self.robot.data, self.robot.frame_id(self.frame)
+        excess = math.inf
+        for _ in range(NEWTON_STEPS):
+            pin.framesForwardKinematics(model, data, q)
+            placement = data.oMf[fid]
+            turn = placement.rotation @ pin.log3(placement.rotation.T @ target.rotation)
+            error = np.concatenate([target.translation - placement.translation, turn]) * WEIGHTS
+            size = max(float(np.linalg.norm(error[:3])), float(np.linalg.norm(error[3:])))
+            if size > (1.0 - PROGRESS) * excess:
+                break
+            excess = size
+            if excess <= IK_SHARE:
+                break
+            world_aligned = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+            jacobian = pin.computeFrameJacobian(model, data, q, fid, world_aligned) * WEIGHTS[:, None]
+            damping = DAMPING * math.sqrt(max(float(np.sum(jacobian**2)), 1.0))
+            q = np.clip(q + self.scales * damped_step(jacobian * self.scales, error, damping), *self.bounds)
+        return q, excess
+
+    def compiled(self, q: FloatArray, target: pin.SE3) -> tuple[FloatArray, float]:
+        """:func:`newton_to_pose`'s answer."""
+        chain, tool = ToolChain.of(self.robot, self.frame).arrays
+        rates = np.array([DAMPING, PROGRESS, IK_SHARE, NEWTON_STEPS], dtype=float)
+        rules = (WEIGHTS, self.scales, *self.bounds, rates)
+        return newton_to_pose(q, chain, tool, (target.translation, target.rotation), rules)
 
 
 ARMS = [
@@ -82,14 +78,15 @@ def test_the_compiled_corrector_takes_the_reference_steps(
     frame = frame or robot.tcp_frame
     lower, upper = np.asarray(robot.limits.lower), np.asarray(robot.limits.upper)
     scales = np.array(robot.limits.speed_scales) if speed_scaled else np.ones(robot.nq)
+    corrector = Corrector(robot, frame, (lower, upper), scales)
     rng = np.random.default_rng(7)
     reached = 0
     for _ in range(20):
         wanted = rng.uniform(lower, upper)
         guess = np.clip(wanted + rng.normal(scale=0.05, size=robot.nq), lower, upper)
         target = pin.SE3(ck.frame_poses(robot, wanted[None], frame)[0])
-        q_ref, excess_ref = reference(robot, frame, guess, target, (lower, upper), scales)
-        q_new, excess_new = compiled(robot, frame, guess, target, (lower, upper), scales)
+        q_ref, excess_ref = corrector.reference(guess, target)
+        q_new, excess_new = corrector.compiled(guess, target)
         np.testing.assert_allclose(q_new, q_ref, atol=1e-9)
         assert excess_new == pytest.approx(excess_ref, rel=1e-6, abs=1e-9)
         assert np.all(q_new >= lower) and np.all(q_new <= upper)
@@ -104,9 +101,9 @@ def test_a_pose_out_of_reach_settles_short_of_it_within_the_bounds() -> None:
     lower, upper = np.asarray(robot.limits.lower), np.asarray(robot.limits.upper)
     q = 0.5 * (lower + upper)
     target = pin.SE3(np.eye(3), np.array([3.0, 0.0, 0.5]))  # 3 m away: beyond a UR5's reach
-    scales = np.array(robot.limits.speed_scales)
-    q_ref, excess_ref = reference(robot, robot.tcp_frame, q, target, (lower, upper), scales)
-    q_new, excess_new = compiled(robot, robot.tcp_frame, q, target, (lower, upper), scales)
+    corrector = Corrector(robot, robot.tcp_frame, (lower, upper), np.array(robot.limits.speed_scales))
+    q_ref, excess_ref = corrector.reference(q, target)
+    q_new, excess_new = corrector.compiled(q, target)
     assert excess_new > 1e3  # metres over a millimetre's tolerance
     assert excess_new == pytest.approx(excess_ref, rel=1e-6)
     np.testing.assert_allclose(q_new, q_ref, atol=1e-6)

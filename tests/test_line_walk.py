@@ -22,7 +22,7 @@ from planning.task.line_ik import (
 from planning.task.tool_line import BASE_FRAME, LineGeometry
 
 from .conftest import damped_step
-from .test_line_newton import reference as corrector
+from .test_line_newton import Corrector
 
 FloatArray = np.ndarray
 TOLERANCE = LineTolerance()
@@ -56,7 +56,7 @@ def reference_walk(
             step += gain * (pull - scales * damped_step(jacobian * scales, jacobian @ pull, damping))
         guess = np.clip(q + step, *bounds)
         target = pin.SE3(rotations[k], geometry.start.translation + sigma[k] * geometry.shift_m)
-        found, excess = corrector(robot, robot.tcp_frame, guess, target, bounds, scales)
+        found, excess = Corrector(robot, robot.tcp_frame, bounds, scales).reference(guess, target)
         if excess > REACH_SHARE or np.abs(found - q).max() > LARGEST_JOINT_STEP:
             return np.array(samples), residual, k
         q, residual = found, max(residual, excess)
