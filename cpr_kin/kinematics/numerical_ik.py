@@ -122,8 +122,8 @@ def descent(
     )
     lower, upper = np.array(robot.limits.lower, dtype=float), np.array(robot.limits.upper, dtype=float)
     rates = np.array([settings.damping, settings.max_step, PROGRESS])
-    weights = np.ones(robot.nq) if scales is None else np.asarray(scales, dtype=float)
-    step = (np.where(np.asarray(free, dtype=bool), weights, 0.0), lower, upper, rates)
+    joint_scales = np.ones(robot.nq) if scales is None else np.asarray(scales, dtype=float)
+    step = (np.where(np.asarray(free, dtype=bool), joint_scales, 0.0), lower, upper, rates)
     counts = (int(settings.iterations), int(settings.patience))
     return lambda q: descend(np.array(q, dtype=float), chain, tool, goal, step, counts)
 

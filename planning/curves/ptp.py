@@ -7,7 +7,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from cpr_kin.common.rest_to_rest import trapezoid_time
 
-__all__ = ["ptp_time", "trapezoid_time"]
+__all__ = ["ptp_time", "trapezoid_time"]  # trapezoid_time: planning's API since the paper case
 
 FloatArray = NDArray[np.float64]
 

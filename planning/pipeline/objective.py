@@ -36,7 +36,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from planning.curves.ptp import ptp_time, trapezoid_time
+from cpr_kin.common.rest_to_rest import trapezoid_time
+from planning.curves.ptp import ptp_time
 from planning.curves.spline import SepticSplineSolver
 from planning.pipeline.fitness import FITNESS_RULES, Terms
 from planning.pipeline.motion import Motion

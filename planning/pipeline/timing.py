@@ -32,8 +32,8 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from cpr_kin.common.rest_to_rest import trapezoid_time
 from planning.curves.path_timing import limits_time_scale, time_path
-from planning.curves.ptp import trapezoid_time
 from planning.curves.spline import SepticSplineSolver, SplineFit
 from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
