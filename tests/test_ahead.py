@@ -228,6 +228,35 @@ def run(arguments: list[str], environment: dict[str, str]) -> list[str]:
     return completed.stdout.split("\n")
 
 
+DESCENT = """
+import sys
+import numpy as np
+import cpr_kin as ck
+from cpr_kin.kinematics import ik_descent
+from cpr_kin.kinematics.tool_chain import ToolChain
+from planning.curves import horner
+robot = ck.load_cpr()
+chain, tool = ToolChain.of(robot).arrays
+goal = (np.array([0.4, 0.3, 0.3]), np.eye(3), np.array([1e-4, 1e-3]), False)
+step = (np.ones(robot.nq), robot.limits.lower.copy(), robot.limits.upper.copy(), np.array([1e-3, 0.3, 0.05]))
+q = (robot.limits.lower + robot.limits.upper) / 2
+exported = ik_descent.descend(q, chain, tool, goal, step, (150, 20))
+print("numba:", "numba" in sys.modules)
+fallen = ik_descent.descend(q.astype(np.float32), chain, tool, goal, step, (150, 20))
+print("numba:", "numba" in sys.modules)
+print(f"descend: {type(ik_descent.descend).__name__}, evaluate: {type(horner.evaluate).__name__}")
+if hasattr(horner.evaluate, "__wrapped__"):
+    import cpr_kin.common.compiled as compiled
+    before = set(compiled._ALONE)
+    horner.evaluate(np.ones((1, 2, 8)), np.array([0.0, 1.0]), np.array([0.5]))
+    print("horner after the fallback:", "its export" if set(compiled._ALONE) == before else "numba")
+else:
+    print("horner after the fallback: numba")
+print(exported[1], exported[0].tobytes().hex())
+print(fallen[1], np.asarray(fallen[0], dtype=float).tobytes().hex())
+"""
+
+
 @pytest.mark.slow
 def test_kernels_compiled_ahead_plan_the_bits_numba_plans_without_numba(tmp_path: Path) -> None:
     ahead = {FOLDER_VARIABLE: str(tmp_path), MODE_VARIABLE: "ahead"}
@@ -268,6 +297,14 @@ print("numba" in sys.modules, values.tobytes().hex())
     reference = run(["-c", mixed], {MODE_VARIABLE: "jit"})
     assert exported.startswith("False ") and fallen_back.startswith("True ")
     assert [exported.split()[1], fallen_back.split()[1]] == [line.split()[1] for line in reference[:2]]
+
+    # a kernel that calls kernels (the IK's descent: the tool's placement, Jacobian, least squares)
+    # falls back alone: numba compiles it and those it calls, and every other kernel keeps its export
+    alone = run(["-c", DESCENT], ahead)
+    assert alone[:2] == ["numba: False", "numba: True"]
+    assert alone[2] == "descend: function, evaluate: function"  # guards, not numba's dispatchers
+    assert alone[3] == "horner after the fallback: its export"
+    assert alone[4:6] == run(["-c", DESCENT], {MODE_VARIABLE: "jit"})[4:6]  # the same answers
 
 
 def test_the_build_says_what_it_lacks_and_leaves_the_kernels_to_numba(

@@ -4,7 +4,9 @@ Hot loops that NumPy can only express as many small array operations (a per-conf
 kinematic chain, the firefly sweep) are compiled with numba instead. Where the kernels were
 compiled ahead of time for today's sources (``python -m planning.ahead_of_time``;
 :mod:`cpr_kin.common.ahead`), a kernel runs that code and numba is not imported, unless a call
-brings argument types none was compiled for. Otherwise numba compiles each kernel on its first
+brings argument types none was compiled for: numba then compiles that kernel, and the kernels
+it calls, for those (:func:`_just_in_time`); the others keep the code compiled ahead of time.
+Otherwise numba compiles each kernel on its first
 call and caches the code on disk (:mod:`cpr_kin.common.just_in_time`), so only the first run on
 a machine pays for compilation. Setting ``NUMBA_DISABLE_JIT=1`` runs the same functions as plain
 Python, for debugging; ``CPR_KERNELS=jit`` compiles just in time even where a module compiled
@@ -16,7 +18,7 @@ said on the logger named :data:`COMPILE_LOG` (``INFO``), which ``cpr-plan`` prin
 
 from __future__ import annotations
 
-import sys
+import types
 from collections.abc import Callable
 from typing import Any, TypeVar, cast
 
@@ -36,6 +38,9 @@ _AHEAD: list[Kernels | None] = []
 _KERNELS: dict[Callable[..., Any], bool] = {}
 """Every kernel's function, and whether it is inlined: what :func:`_just_in_time` compiles."""
 _JIT: dict[Callable[..., Any], Callable[..., Any]] = {}
+"""Every kernel's numba dispatcher, where no kernels compiled ahead of time were loaded."""
+_ALONE: dict[Callable[..., Any], Callable[..., Any]] = {}
+"""The dispatchers of the kernels called with types no export takes, and of the kernels they call."""
 
 
 def njit(function: F) -> F:
@@ -77,17 +82,33 @@ def _dispatcher(function: Callable[..., Any]) -> Callable[..., Any]:
 def _just_in_time(function: Callable[..., Any]) -> Callable[..., Any]:
     """Numba's dispatcher of ``function``, where a call's argument types match none compiled ahead of time.
 
-    A kernel compiled just in time calls other kernels by their modules' names, which must then
-    be numba's dispatchers too: every kernel known gets one, and every name of a kernel's module
-    bound to a guard of :meth:`~cpr_kin.common.ahead.Kernels.guarded` is bound to its dispatcher
-    instead.
+    Numba compiles a kernel's calls of other kernels through the names its module binds them
+    to, which are the guards of the code compiled ahead of time
+    (:meth:`~cpr_kin.common.ahead.Kernels.guarded`): numba cannot call those. The dispatcher is
+    made of a copy of ``function`` whose globals bind each kernel it calls to that kernel's own
+    dispatcher, made the same way, so that numba compiles (or loads from its disk cache)
+    ``function`` and the kernels it calls, no others: every other kernel, and every call of
+    this one whose types an export takes, keeps running the code compiled ahead of time.
     """
-    for kernel in _KERNELS:
-        _dispatcher(kernel)
-    for module_name in {kernel.__module__ for kernel in _KERNELS}:
-        module = sys.modules.get(module_name)
-        for name, value in list(vars(module).items()) if module is not None else []:
-            wrapped = getattr(value, "__wrapped__", None)
-            if wrapped in _JIT and callable(value) and value is not _JIT[wrapped]:
-                setattr(module, name, _JIT[wrapped])
-    return _JIT[function]
+    if function not in _ALONE:
+        import logging
+
+        from cpr_kin.common.just_in_time import jit
+
+        callees = {
+            name: _just_in_time(kernel)
+            for name in function.__code__.co_names
+            if (kernel := getattr(function.__globals__.get(name), "__wrapped__", None)) in _KERNELS
+        }
+        alone = function
+        if callees:
+            alone = types.FunctionType(
+                function.__code__,
+                {**function.__globals__, **callees},
+                function.__name__,
+                function.__defaults__,
+                function.__closure__,
+            )
+            alone.__qualname__, alone.__module__ = function.__qualname__, function.__module__
+        _ALONE[function] = jit(alone, _KERNELS[function], logging.getLogger(COMPILE_LOG), COMPILING)
+    return _ALONE[function]
