@@ -1,6 +1,6 @@
 """The numerical IK on the example arms: success, time, and how soon the robot reaches what it chose.
 
-    python scripts/bench_ik.py [--targets 40] [--seed 1] [--robots panda pr2 ...]
+    python scripts/bench_ik.py [--targets 40] [--seed 1] [--robots panda pr2 tiago ...]
 
 For each arm, ``--targets`` seeded random poses and positions of its tool frame (the forward
 kinematics of random configurations, so each is reachable), each solved from another random
@@ -15,9 +15,9 @@ worst, and the time to refuse a target out of reach: 5 m away, beyond
 beyond the farthest of 20,000 random configurations' tool positions but within that bound
 (every start runs).
 
-The arms are example-robot-data's (:data:`~cpr_kin.model.packages.EXAMPLE_ROBOTS`) and its
-PR2's left arm, whose torso lift (0.013 m/s) is two hundred times slower than its arm's joints:
-the arm of a mobile manipulator. The move times are computed by NumPy here, the same on any
+The arms are example-robot-data's (:data:`~cpr_kin.model.packages.EXAMPLE_ROBOTS`) and the arms
+of its PR2 (the left one) and TIAGo, on their torso lifts (0.013 and 0.07 m/s, far slower than
+their arms' joints): mobile manipulators'. The move times are computed by NumPy here, the same on any
 checkout, so that two checkouts' figures compare.
 """
 
@@ -35,10 +35,13 @@ import cpr_kin as ck
 from cpr_kin.model.packages import EXAMPLE_ROBOTS, example_robot, example_robot_data_share
 from planning.cli.arguments import COUNT, SEED
 
-PR2 = ("pr2_description/urdf/pr2.urdf", "pr2_description/srdf/pr2.srdf", "l_gripper_tool_frame")
-"""example-robot-data's PR2: its URDF, SRDF and the left arm's tool frame (the planned joints: the
-torso lift and the left arm's seven)."""
-ARMS = (*sorted(EXAMPLE_ROBOTS), "pr2")
+ON_A_LIFT = {
+    "pr2": ("pr2_description/urdf/pr2.urdf", "l_gripper_tool_frame"),
+    "tiago": ("tiago_description/robots/tiago.urdf", "arm_tool_link"),
+}
+"""example-robot-data's mobile manipulators: each URDF and its arm's tool frame (the planned joints:
+the torso lift, 0.013 and 0.07 m/s, and the arm's seven)."""
+ARMS = (*sorted(EXAMPLE_ROBOTS), *ON_A_LIFT)
 
 
 @dataclasses.dataclass
@@ -53,14 +56,13 @@ class Tally:
 
 def load(name: str) -> ck.Robot:
     """An arm of :data:`ARMS`."""
-    if name != "pr2":
+    if name not in ON_A_LIFT:
         return ck.load_robot(example_robot(name))
     share = example_robot_data_share()
     if share is None:
-        raise SystemExit("bench_ik: the PR2 needs example-robot-data (the 'robots' extra)")
-    robots = Path(share) / "example-robot-data" / "robots"
-    urdf, srdf, tcp = PR2
-    return ck.load_robot(robots / urdf, srdf=robots / srdf, tcp=tcp)
+        raise SystemExit(f"bench_ik: the {name} needs example-robot-data (the 'robots' extra)")
+    urdf, tcp = ON_A_LIFT[name]
+    return ck.load_robot(Path(share) / "example-robot-data" / "robots" / urdf, tcp=tcp)
 
 
 def move_time_s(robot: ck.Robot, change: np.ndarray) -> float:
