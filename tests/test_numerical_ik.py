@@ -80,6 +80,22 @@ def test_a_slow_joint_keeps_about_its_seed_value_where_the_fast_joints_reach_the
     assert soon >= 8
 
 
+def test_where_the_seeds_descent_least_in_time_misses_its_plain_descent_is_tried(
+    ur5_on_a_lift: ck.Robot,
+) -> None:
+    robot = ur5_on_a_lift
+    seed = np.array([0.356, 4.0511, -0.2515, -1.6816, 3.7935, 5.3222, -2.9389])
+    wanted = np.array([0.2156, -0.7194, 5.4163, -2.8871, 2.9155, 1.4373, -5.9267])
+    tool = ck.frame_poses(robot, wanted[None])[0]
+    target = ck.IkTarget(tool[:3, 3], tool[:3, :3])
+    only_the_seed = ck.IkSettings(restarts=0, more_restarts=0)
+    free = np.ones(robot.nq, dtype=bool)
+    scaled, _ = descent(robot, target, free, only_the_seed, robot.limits.speed_scales)(seed)
+    assert not target.reached(pin.SE3(ck.frame_poses(robot, scaled[None])[0]))  # stalls
+    q = ck.solve_ik(robot, target, seed, settings=only_the_seed)
+    assert target.reached(pin.SE3(ck.frame_poses(robot, q[None])[0]))
+
+
 def test_of_solutions_about_as_soon_the_nearest_in_robot_motion_is_chosen(ur5_on_a_lift: ck.Robot) -> None:
     robot = ur5_on_a_lift
     seed = (robot.limits.lower + robot.limits.upper) / 2

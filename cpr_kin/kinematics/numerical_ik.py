@@ -10,8 +10,10 @@ in the joints' units (the Jacobian's columns scaled by the joints' speed limits,
 :attr:`~cpr_kin.model.limits.JointLimits.speed_scales`), and those random starts are drawn
 near the seed in time (each joint's draw pulled towards the seed's value by its speed scale):
 where the arm can reach the target by its fast joints, a slow one (a torso lift) keeps about
-its seed's value. The other random starts explore the whole ranges with the plain step. On an
-arm whose joints are equally fast both kinds are the same. Every solution is checked by
+its seed's value; where the seed's least-in-time descent misses the target, the seed's plain
+descent is tried too (what came first before). The other random starts explore the whole
+ranges with the plain step. On an arm whose joints are equally fast both kinds are the same.
+Every solution is checked by
 forward kinematics against the target and its
 tolerance; of those that pass, the ones the ``accept`` test allows (collision-free, say) come
 first, and of those the ones the ``prefer`` test also passes (on a constraint, say) before
@@ -190,18 +192,28 @@ def solve_ik(
         descent(robot, target, free, settings, speeds),
         descent(robot, target, free, settings),
     )
+
+    def reached(q: FloatArray) -> bool:
+        """Whether ``q`` puts the tool frame at the target, by forward kinematics; the closest kept."""
+        nonlocal closest
+        pin.framesForwardKinematics(robot.model, robot.data, q)
+        placement = pin.SE3(robot.data.oMf[frame])
+        if closest is None or target.excess(placement) < target.excess(closest):
+            closest = placement
+        return bool(target.reached(placement))
+
     tried = 0
     while tried < len(draws):
         soon = tried % 2 == 0  # the seed and every other draw: near the seed in time
         start = seed + speeds * (draws[tried] - seed) if soon else draws[tried]
         start = np.where(free, start, seed)
         q = turned_towards((soon_from if soon else anywhere_from)(start)[0], seed, revolute, lower, upper)
+        solved = reached(q)
+        if not solved and tried == 0 and np.any(speeds < 1.0):  # the seed's plain descent too
+            q = turned_towards(anywhere_from(start)[0], seed, revolute, lower, upper)
+            solved = reached(q)
         tried += 1
-        pin.framesForwardKinematics(robot.model, robot.data, q)
-        placement = pin.SE3(robot.data.oMf[frame])
-        if closest is None or target.excess(placement) < target.excess(closest):
-            closest = placement
-        if target.reached(placement):  # verified by forward kinematics
+        if solved:
             found.append(q)
             if accept is None or accept(q):
                 accepted.append(q)
