@@ -108,3 +108,25 @@ def test_the_lines_rotations_are_its_poses_rotations() -> None:
     sigma = np.linspace(0.0, 1.0, 17)
     for s, rotation in zip(sigma, geometry.rotations(sigma), strict=True):
         np.testing.assert_allclose(rotation, geometry.pose(float(s)).rotation, atol=1e-14)
+
+
+def test_on_an_arm_of_five_joints_the_steps_least_in_time_are_the_plain_steps() -> None:
+    """The CPR's five joints hold a line's six directions in the least-squares sense: a unique
+    solution, whatever the joints' weights, so its walks agree up to the damping (1e-5 of the
+    Jacobian's size)."""
+    robot = ck.load_cpr()
+    rng = np.random.default_rng(5)
+    walked = 0
+    for _ in range(8):
+        q = rng.uniform(robot.limits.lower + 0.05, robot.limits.upper - 0.05)
+        start = pin.SE3(ck.frame_poses(robot, q))
+        geometry = LineGeometry(start, ToolLine(by=(0.0, 0.0, -0.05), offset_frame=BASE_FRAME).goal(start))
+        sigma = np.linspace(0.0, 1.0, 41)
+        try:
+            least_in_time, _ = _walk(robot, q, robot.tcp_frame, geometry, TOLERANCE, sigma)
+        except ToolLineBrokenError:
+            continue
+        plain, _ = _walk(robot, q, robot.tcp_frame, geometry, TOLERANCE, sigma, scales=np.ones(robot.nq))
+        np.testing.assert_allclose(least_in_time, plain, atol=1e-7)
+        walked += 1
+    assert walked >= 4
