@@ -17,8 +17,9 @@ beyond the farthest of 20,000 random configurations' tool positions but within t
 
 The arms are example-robot-data's (:data:`~cpr_kin.model.packages.EXAMPLE_ROBOTS`) and the arms
 of its PR2 (the left one) and TIAGo, on their torso lifts (0.013 and 0.07 m/s, far slower than
-their arms' joints): mobile manipulators'. The move times are computed by NumPy here, the same on any
-checkout, so that two checkouts' figures compare.
+their arms' joints): mobile manipulators'. The move times come from
+:func:`planning.curves.ptp.trapezoid_time`, which checkouts before and after stop 125 both have,
+so that two checkouts' figures compare.
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ import numpy as np
 import cpr_kin as ck
 from cpr_kin.model.packages import EXAMPLE_ROBOTS, example_robot, example_robot_data_share
 from planning.cli.arguments import COUNT, SEED
+from planning.curves.ptp import trapezoid_time
 
 ON_A_LIFT = {
     "pr2": ("pr2_description/urdf/pr2.urdf", "l_gripper_tool_frame"),
@@ -67,8 +69,7 @@ def load(name: str) -> ck.Robot:
 
 def move_time_s(robot: ck.Robot, change: np.ndarray) -> float:
     """The slowest joint's shortest rest-to-rest time over ``change`` [s]: trapezoids of ``v`` and ``a``."""
-    d, v, a = np.abs(change), robot.limits.velocity, robot.limits.acceleration
-    return float(np.max(np.where(d >= v * v / a, d / v + v / a, 2.0 * np.sqrt(d / a))))
+    return float(trapezoid_time(change, robot.limits.velocity, robot.limits.acceleration).max())
 
 
 def refusal_s(robot: ck.Robot, position: np.ndarray) -> float:

@@ -1,5 +1,6 @@
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 from pathlib import Path
@@ -33,6 +34,8 @@ def test_speed_scales_and_move_times_follow_the_limits(robot: ck.Robot) -> None:
     # cruises: 1.2 / 1.5 + 1.5 / 3, slower than theta5's triangle 2 sqrt(0.1 / 4)
     np.testing.assert_allclose(lim.move_time_s(change), [0.85, 1.3, 0.0], rtol=1e-12)
     assert lim.move_time_s(change[1]) == pytest.approx(1.3)  # one change: one time
+    assert lim.speeds_differ
+    assert not dataclasses.replace(lim, velocity=np.full(robot.nq, 0.5)).speeds_differ
 
 
 def test_collision_groups(robot: ck.Robot) -> None:

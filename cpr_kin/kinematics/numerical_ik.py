@@ -209,7 +209,7 @@ def solve_ik(
         start = np.where(free, start, seed)
         q = turned_towards((soon_from if soon else anywhere_from)(start)[0], seed, revolute, lower, upper)
         solved = reached(q)
-        if not solved and tried == 0 and np.any(speeds < 1.0):  # the seed's plain descent too
+        if not solved and tried == 0 and robot.limits.speeds_differ:  # the seed's plain descent too
             q = turned_towards(anywhere_from(start)[0], seed, revolute, lower, upper)
             solved = reached(q)
         tried += 1

@@ -85,6 +85,11 @@ class JointLimits:
         """
         return np.asarray(self.velocity / self.velocity.max())
 
+    @property
+    def speeds_differ(self) -> bool:
+        """Whether some joint is slower than the fastest (its steps least in time are not its plain ones)."""
+        return bool(np.any(self.velocity < self.velocity.max()))
+
     def move_time_s(self, change: FloatArray) -> FloatArray:
         """``(...)`` the shortest rest-to-rest time [s] of a joint move by ``change`` ``(..., nq)`` [rad, m].
 

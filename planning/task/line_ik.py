@@ -133,7 +133,7 @@ def _walked(
     """
     speeds = np.array(robot.limits.speed_scales)
     gains = (0.0, LIMIT_GAIN) if robot.nq > 6 else (0.0,)
-    metrics = (speeds,) if np.all(speeds == 1.0) else (speeds, np.ones(robot.nq))
+    metrics = (speeds, np.ones(robot.nq)) if robot.limits.speeds_differ else (speeds,)
     breaks = []
     for scales in metrics:
         for gain in gains:
