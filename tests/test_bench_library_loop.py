@@ -21,7 +21,9 @@ def test_each_robot_gets_a_row_both_ways_and_the_same_trajectories() -> None:
     assert cpr[:2] == ["cpr", "1"]
     kept, loaded, ratio = (float(cell) for cell in cpr[2:])
     assert kept > 0 and loaded > 0
-    assert ratio == pytest.approx(kept / loaded, abs=0.01)
+    # the times are printed to 1 ms and the ratio to 0.01: the ratio of the printed times is that close
+    rounding = kept / loaded * (0.0005 / kept + 0.0005 / loaded) + 0.005
+    assert ratio == pytest.approx(kept / loaded, abs=rounding + 1e-9)
 
 
 def test_a_robot_it_does_not_know_is_refused_with_the_choices() -> None:

@@ -104,11 +104,17 @@ def test_near_a_refused_cells_centre_a_configuration_clears_by_the_distance_meas
     assert np.all(hull_distances(cells, q)[clear] >= 0.02)
 
 
-def test_a_pair_without_a_grid_leaves_every_configuration_to_coal(panda: ck.Robot) -> None:
-    cells = near_cells(panda, [(geometry(panda, "panda_link3"), geometry(panda, "panda_link7"))])
-    assert not cells and cells.grids is None
-    q = np.random.default_rng(3).uniform(panda.limits.lower, panda.limits.upper, (20, panda.nq))
-    assert not cells.clear(q, [0.0]).any() and cells.tested == 0
+def test_a_pair_without_a_grid_is_left_out_and_the_others_keep_theirs(panda: ck.Robot) -> None:
+    hand = hand_pairs(panda)
+    apart = (geometry(panda, "panda_link3"), geometry(panda, "panda_link7"))  # four joints between
+    cells = near_cells(panda, [hand[0], apart, hand[1]])
+    assert cells.pairs == tuple(hand) and len(cells.geometry_model.collisionPairs) == 2
+    q = np.random.default_rng(3).uniform(panda.limits.lower, panda.limits.upper, (500, panda.nq))
+    margins = [0.001, 0.001]
+    np.testing.assert_array_equal(cells.clear(q, margins), near_cells(panda, hand).clear(q, margins))
+    alone = near_cells(panda, [apart])
+    assert not alone and alone.pairs == () and alone.grids is None
+    assert not alone.clear(q[:20], []).any() and alone.tested == 0
 
 
 def test_the_robots_screen_keeps_its_cells_across_worlds(panda: ck.Robot) -> None:

@@ -10,11 +10,19 @@ import pinocchio as pin
 import pytest
 
 import cpr_kin as ck
+from cpr_kin.bounds.batch_kinematics import sampled_configurations
 from cpr_kin.bounds.segments import segment_distance
 from cpr_kin.bounds.self_bounds import SelfPairBounds
 from cpr_kin.collision.self_collision import SelfCollision
 from cpr_kin.collision.self_screen import ScreenedSelfTest
-from cpr_kin.collision.self_split import SCREEN_THRESHOLDS_M, SelfScreen, robot_self_screen, screen_threshold
+from cpr_kin.collision.self_split import (
+    NEAR_SHARE,
+    PROBES,
+    SCREEN_THRESHOLDS_M,
+    SelfScreen,
+    robot_self_screen,
+    screen_threshold,
+)
 from cpr_kin.model.packages import example_robot_data_share
 
 SHARE = example_robot_data_share()
@@ -156,3 +164,24 @@ def test_a_smaller_threshold_leaves_no_more_pairs_near(arm: ck.Robot) -> None:
     near = [SelfScreen.build(arm.model, arm.collision_model, pairs, t).near for t in SCREEN_THRESHOLDS_M]
     for smaller, larger in itertools.pairwise(near):  # a bound within t is within any larger t
         assert not np.any(smaller & ~larger)
+
+
+def test_a_pair_mostly_near_without_a_grid_is_screened_as_a_far_one(arm: ck.Robot) -> None:
+    collision = ck.CollisionWorld(arm, []).self_collision
+    pairs = collision._pairs
+    threshold_m = SCREEN_THRESHOLDS_M[-1]  # 1 m: most pairs' bounds are in doubt, far along the chain too
+    screen = SelfScreen.build(arm.model, arm.collision_model, pairs, threshold_m)
+    probes = sampled_configurations(arm.model, PROBES, np.random.default_rng(0))
+    mostly = (screen.all_bounds(probes, threshold_m) <= threshold_m).mean(axis=0) > NEAR_SHARE
+    near = [p for p, n in zip(pairs, screen.near, strict=True) if n]
+    assert near and not np.any(screen.near & ~mostly)
+    assert list(screen.near_cells.pairs) == near and screen.near_cells.grids is not None  # each with a grid
+    gridless = mostly & ~screen.near  # those more than two joints apart
+    assert gridless.any() and screen.far_bounds.n_pairs == len(pairs) - len(near)
+    # coal's answer still
+    model, geometry_model, exact = arm.model, collision.geometry_model, collision._exact
+    test = ScreenedSelfTest(model, geometry_model, pairs, 2, screen=screen, exact=exact)
+    q = np.random.default_rng(6).uniform(arm.limits.lower, arm.limits.upper, (300, arm.nq))
+    distance, _ = collision.distances(q)
+    for margin_m in (0.0, 0.01, 0.3):
+        np.testing.assert_array_equal(test.violated(q, margin_m), distance < margin_m)

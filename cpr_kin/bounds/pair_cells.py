@@ -142,36 +142,72 @@ class CellGrids:
         return centred
 
 
+@dataclass(frozen=True)
+class _Axis:
+    """One joint of a pair's grid: its ``q`` index, cells, where they begin, their width and its period."""
+
+    joint: int
+    count: int
+    origin: float
+    step: float
+    turn: float
+    radius: float
+
+
+def _axes(model: Any, radii: FloatArray, slack_m: float) -> list[_Axis] | None:
+    """The joints of a grid of one pair whose distance changes by ``radii`` ``(nj,)``, ``None`` without one.
+
+    The rule of :func:`cell_grids`, for one pair.
+    """
+    moved = np.flatnonzero(radii > 0.0).tolist()
+    if not 0 < len(moved) <= MAX_JOINTS:
+        return None
+    axes = []
+    for joint in moved:
+        prismatic, _ = joint_axis(model.joints[joint + 1])
+        lower, upper = float(model.lowerPositionLimit[joint]), float(model.upperPositionLimit[joint])
+        wraps = not prismatic and not upper - lower < 2.0 * math.pi  # NaN limits wrap too
+        span = 2.0 * math.pi if wraps else upper - lower
+        if not (math.isfinite(span) and span > 0.0):
+            return None
+        count = math.ceil(span * len(moved) * radii[joint] / (2.0 * slack_m))
+        origin, turn = (0.0, 2.0 * math.pi) if wraps else (lower, 0.0)
+        axes.append(_Axis(joint, count, origin, span / count, turn, float(radii[joint])))
+    if math.prod(axis.count for axis in axes) > MAX_CELLS:
+        return None
+    return axes
+
+
+def has_grid(model: Any, radii: FloatArray, slack_m: float) -> bool:
+    """Whether a pair whose distance changes by ``radii`` ``(nj,)`` per joint speed can have a grid.
+
+    At most :data:`MAX_JOINTS` joints between its geometries, each within finite limits (or a
+    revolute joint's turn), and at most :data:`MAX_CELLS` cells of ``slack_m`` [m].
+    """
+    return _axes(model, radii, slack_m) is not None
+
+
 def cell_grids(model: Any, pair_radii: FloatArray, slack_m: FloatArray) -> CellGrids | None:
     """The grids of pairs whose distances change by ``pair_radii`` ``(K, nj)`` per joint speed.
 
-    ``None`` where some pair has no joint or more than :data:`MAX_JOINTS` between its
-    geometries, a prismatic joint without finite limits, or more than :data:`MAX_CELLS` cells.
-    A revolute joint whose range is a turn or more wraps (its angle modulo a turn: the geometry
-    is the same); another is tiled within its limits, and a configuration beyond them has no cell.
-    A joint ``j`` of ``J`` gets cells of width ``h_j`` with ``r_j h_j / 2 <= slack / J``.
+    ``None`` where some pair has no grid (:func:`has_grid`): no joint or more than
+    :data:`MAX_JOINTS` between its geometries, a prismatic joint without finite limits, or more
+    than :data:`MAX_CELLS` cells. A revolute joint whose range is a turn or more wraps (its angle
+    modulo a turn: the geometry is the same); another is tiled within its limits, and a
+    configuration beyond them has no cell. A joint ``j`` of ``J`` gets cells of width ``h_j``
+    with ``r_j h_j / 2 <= slack / J``.
     """
     shape = (len(pair_radii), MAX_JOINTS)
     joints, counts = np.full(shape, -1, dtype=np.int64), np.ones(shape, dtype=np.int64)
     origin, step, turn, radius = np.zeros(shape), np.ones(shape), np.zeros(shape), np.zeros(shape)
     offsets, size = np.zeros(shape[0], dtype=np.int64), 0
     for k, (radii, slack) in enumerate(zip(pair_radii, slack_m.tolist(), strict=True)):
-        moved = np.flatnonzero(radii > 0.0).tolist()
-        if not 0 < len(moved) <= MAX_JOINTS:
+        axes = _axes(model, radii, slack)
+        if axes is None:
             return None
-        for j, joint in enumerate(moved):
-            prismatic, _ = joint_axis(model.joints[joint + 1])
-            lower, upper = float(model.lowerPositionLimit[joint]), float(model.upperPositionLimit[joint])
-            wraps = not prismatic and not upper - lower < 2.0 * math.pi  # NaN limits wrap too
-            span = 2.0 * math.pi if wraps else upper - lower
-            if not (math.isfinite(span) and span > 0.0):
-                return None
-            counts[k, j] = math.ceil(span * len(moved) * radii[joint] / (2.0 * slack))
-            joints[k, j], origin[k, j] = joint, 0.0 if wraps else lower
-            step[k, j], turn[k, j] = span / counts[k, j], 2.0 * math.pi if wraps else 0.0
-            radius[k, j] = radii[joint]
-        if math.prod(counts[k].tolist()) > MAX_CELLS:
-            return None
+        for j, axis in enumerate(axes):
+            joints[k, j], counts[k, j], origin[k, j] = axis.joint, axis.count, axis.origin
+            step[k, j], turn[k, j], radius[k, j] = axis.step, axis.turn, axis.radius
         offsets[k], size = size, size + math.prod(counts[k].tolist())
     strides = np.cumprod(counts[:, ::-1], axis=1)[:, ::-1]  # row-major: the last joint's stride is 1
     strides = np.concatenate([strides[:, 1:], np.ones((shape[0], 1), dtype=np.int64)], axis=1)

@@ -36,7 +36,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from cpr_kin.bounds.batch_kinematics import sampled_configurations
-from cpr_kin.bounds.pair_cells import CLEAR, DOUBTFUL, UNKNOWN, CellGrids, cell_grids, cell_states
+from cpr_kin.bounds.pair_cells import CLEAR, DOUBTFUL, UNKNOWN, CellGrids, cell_grids, cell_states, has_grid
 from cpr_kin.bounds.reach import GeometryReach, relative_radii
 from cpr_kin.collision.closest_pairs import closest_pairs
 from cpr_kin.collision.coal_pools import configure_pool, pool_collisions
@@ -80,8 +80,10 @@ class NearCells:
         kept: whether what the cells learn is kept on disk for the robot's next process
             (:mod:`cpr_kin.collision.learned_cells`), and read from there now (default: not).
 
-    Where some pair has no grid (:func:`~cpr_kin.bounds.pair_cells.cell_grids`), it clears
-    nothing. ``tested`` counts the cells coal has tested.
+    A pair that cannot have a grid (:func:`~cpr_kin.bounds.pair_cells.has_grid`: more than two
+    joints between its geometries) is left out: ``pairs`` holds the others, in order, and its
+    pair ``k`` is collision pair ``k`` of ``geometry_model``. ``tested`` counts the cells coal has
+    tested.
     """
 
     def __init__(
@@ -94,19 +96,23 @@ class NearCells:
         kept: bool = False,
     ) -> None:
         self.model = model
-        self.geometry_model = collision_model.copy()
-        self.geometry_model.removeAllCollisionPairs()  # collision pair k is near pair k
-        for a, b in pairs:
-            self.geometry_model.addCollisionPair(pin.CollisionPair(a, b))
+        self.geometry_model = _with_pairs(collision_model, pairs)
         self.grids: CellGrids | None = None
+        self.pairs: tuple[tuple[int, int], ...] = ()
         if pairs:
-            radii = relative_radii(model, collision_model, pairs, reach)
-            self.grids = cell_grids(model, radii, self._slacks())
+            radii, slacks = relative_radii(model, collision_model, pairs, reach), self._slacks()
+            gridded = [has_grid(model, r, s) for r, s in zip(radii, slacks.tolist(), strict=True)]
+            self.pairs = tuple(p for p, g in zip(pairs, gridded, strict=True) if g)
+            if not all(gridded):
+                self.geometry_model = _with_pairs(collision_model, self.pairs)
+                radii, slacks = radii[gridded], slacks[gridded]
+            if self.pairs:
+                self.grids = cell_grids(model, radii, slacks)
         size = self.grids.size if self.grids is not None else 0
         self._exact = ExactPairs(self.geometry_model, exact_meshes or {})
         digest = None
         if kept and self.grids is not None:
-            digest = cells_digest(model, collision_model, pairs, self.grids, exact_meshes or {})
+            digest = cells_digest(model, collision_model, self.pairs, self.grids, exact_meshes or {})
         self.memory = CellMemory(size, bool(self._exact), digest)
         self._learned = self.memory.kinds
         self._levels: dict[tuple[float, ...], Float32Array] = {}
@@ -234,6 +240,15 @@ class NearCells:
             data = (self.model, self._data, self.geometry_model, self._geometry_data)
             hit[hit] = self._exact.violated(*data, centres[hit], [k], margin_m)
         return hit
+
+
+def _with_pairs(collision_model: Any, pairs: Sequence[tuple[int, int]]) -> Any:
+    """A copy of ``collision_model`` whose collision pairs are ``pairs``, in order (the model unchanged)."""
+    geometry_model = collision_model.copy()
+    geometry_model.removeAllCollisionPairs()
+    for a, b in pairs:
+        geometry_model.addCollisionPair(pin.CollisionPair(a, b))
+    return geometry_model
 
 
 def _float32_at_least(value: float) -> np.float32:

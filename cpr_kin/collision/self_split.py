@@ -64,7 +64,11 @@ class SelfScreen:
     chain, a few centimetres apart by design): bounding them first would only delay coal.
     The pairs are split on :data:`PROBES` seeded random configurations within the joint
     ranges: those whose bound is within the screen's distance in more than
-    :data:`NEAR_SHARE` of them are *near*, the others *far* (``docs/tuning.md``, Kernels).
+    :data:`NEAR_SHARE` of them and that have a grid over the joints between their geometries
+    (:func:`~cpr_kin.bounds.pair_cells.has_grid`) are *near*, the others *far*
+    (``docs/tuning.md``, Kernels). A pair mostly within the distance but without a grid (a
+    humanoid's torso and elbow, four joints apart) is far: were it near, every configuration
+    would go to coal for every near pair, the gridded ones too.
 
     Attributes:
         all_bounds: the bounds of every pair, in order.
@@ -102,11 +106,13 @@ class SelfScreen:
         probes = sampled_configurations(model, PROBES, np.random.default_rng(0))
         all_bounds = SelfPairBounds(model, geometry_model, pairs)
         uncertain = all_bounds(probes, threshold_m) <= threshold_m
-        near = uncertain.mean(axis=0) > NEAR_SHARE
+        mostly = uncertain.mean(axis=0) > NEAR_SHARE
+        candidates = [p for p, m in zip(pairs, mostly, strict=True) if m]
+        cells = NearCells(model, geometry_model, candidates, reach, exact_meshes, kept)
+        gridded = {tuple(p) for p in cells.pairs}  # a pair without a grid is bounded first, as a far one
+        near = np.array([tuple(p) in gridded for p in pairs], dtype=bool)
         near.setflags(write=False)
         far = SelfPairBounds(model, geometry_model, [p for p, n in zip(pairs, near, strict=True) if not n])
-        near_pairs = [p for p, n in zip(pairs, near, strict=True) if n]
-        cells = NearCells(model, geometry_model, near_pairs, reach, exact_meshes, kept)
         return cls(all_bounds, far, near, cells)
 
 
