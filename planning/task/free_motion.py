@@ -63,10 +63,14 @@ def plan_free(
     required: Requirements,
     progress: Callable[[FireflyProgress], None] | None = None,
     threads: int | None = None,
+    goal_test: Callable[[FloatArray], bool] | None = None,
 ) -> FreeMotion:
     """The free motion from ``scene``'s start to its goal, keeping ``constraint`` if given.
 
     ``threads``: those of the parallel collision checks (default: one on 2 cores, two on more).
+    ``goal_test``: a test of a ``tcp`` or ``pose`` goal's IK solutions (the line the task draws
+    next walks from there, :mod:`planning.task.line_goal`): the soonest of those it passes is
+    the goal where one does.
 
     Raises:
         PlanningError: bad input: a start or goal inside a margin, or that does not keep the
@@ -76,13 +80,30 @@ def plan_free(
             constraint together).
     """
     if constraint is None:
-        problem = free_problem(scene, robot, threads)
+        problem = free_problem(scene, robot, threads, None if goal_test is None else lambda _: goal_test)
         return FreeMotion(solve(problem, progress).trajectory, problem)
-    problem = free_problem(scene, robot, threads, functools.partial(goal_on_constraint, robot, constraint))
+    on_constraint = functools.partial(_on_constraint, robot, constraint, goal_test)
+    problem = free_problem(scene, robot, threads, on_constraint)
     deadline = Deadline.after(scene.planner.time_limit_s, time.perf_counter())  # the search's own clock
     free = solve(problem, progress).trajectory
     held = hold_orientation(problem.world, free, constraint, required, scene.planner.seed, deadline)
     return FreeMotion(held.trajectory, problem, held)
+
+
+def _on_constraint(
+    robot: ck.Robot,
+    constraint: OrientationConstraint,
+    goal_test: Callable[[FloatArray], bool] | None,
+    q_start: FloatArray,
+) -> Callable[[FloatArray], bool]:
+    """From ``q_start``, a constrained move's goal test: on the constraint's way, then ``goal_test``.
+
+    :func:`~planning.task.held_orientation.goal_on_constraint`'s test first.
+    """
+    on_constraint = goal_on_constraint(robot, constraint, q_start)
+    if goal_test is None:
+        return on_constraint
+    return lambda q: on_constraint(q) and goal_test(q)
 
 
 def free_problem(

@@ -78,12 +78,9 @@ def plan_line(
     """
     robot = world.robot
     q = robot.configuration(q_start)
-    frame = robot.tcp_frame if line.frame is None else line.frame
-    pose = ck.frame_poses(robot, q, frame)
-    start = pin.SE3(pose[:3, :3], pose[:3, 3])
-    geometry = LineGeometry(start, line.goal(start))
     _refuse_blocked(world, q[None], np.zeros(1), required)  # the start first: bad input
-    path = joint_line(robot, q, frame, geometry, line.tolerance)
+    path = line_path(robot, q, line)
+    frame, geometry = path.frame, path.geometry
     _refuse_blocked(world, path.samples, path.sigma, required)
     trajectory, deviation = _timed(robot, frame, path, line, required)
     verification = verify_trajectory(world, trajectory, required)
@@ -95,6 +92,19 @@ def plan_line(
             "; ".join(verification.problems), _progress_at(robot, frame, path, trajectory, when)
         )
     return LineMotion(line, frame, geometry, path, trajectory, deviation, verification)
+
+
+def line_path(robot: ck.Robot, q: FloatArray, line: ToolLine) -> JointLine:
+    """The joint path from ``q`` that holds ``line``'s frame on it, obstacles aside.
+
+    Raises:
+        ToolLineBrokenError: the line cannot be followed to its end (a joint limit, a
+            singularity, a pose out of reach).
+    """
+    frame = robot.tcp_frame if line.frame is None else line.frame
+    pose = ck.frame_poses(robot, q, frame)
+    start = pin.SE3(pose[:3, :3], pose[:3, 3])
+    return joint_line(robot, q, frame, LineGeometry(start, line.goal(start)), line.tolerance)
 
 
 def _refuse_blocked(

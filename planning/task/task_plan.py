@@ -39,6 +39,7 @@ from planning.pipeline.verification import Requirements, Verification
 from planning.task.free_motion import FIXED_DURATION, plan_free
 from planning.task.held_orientation import HeldMotion
 from planning.task.holding import changed_object, checked_touches, scene_after, untaken
+from planning.task.line_goal import line_after, line_walks
 from planning.task.line_motion import LineMotion, plan_line
 from planning.task.segments import KINDS, Attach, Detach, Move, Segment, Wait, segment_name
 from planning.task.task_timing import PlannedMotion, timed_motions
@@ -194,7 +195,9 @@ def plan_task(
                 payloads.append(changed_object(segment, before, carrying.scene))
                 planned.append(None)
                 continue
-            motion = _planned(carrying, base, q, segment, progress)
+            line = line_after(segments, index) if isinstance(segment, Move) else None
+            walks = None if line is None else line_walks(carrying.problem.world, line, carrying.required)
+            motion = _planned(carrying, base, q, segment, progress, walks)
         except (PlanningError, ck.CprKinError) as exc:
             raise PlanningError(f"task[{index}] ({segment_name(segment)}): {exc}") from exc
         except NoSolutionError as exc:
@@ -248,8 +251,13 @@ def _planned(
     q: FloatArray,
     segment: Segment,
     progress: Callable[[FireflyProgress], None] | None,
+    goal_test: Callable[[FloatArray], bool] | None = None,
 ) -> PlannedMotion:
-    """One segment from ``q``: a line, a wait, a free motion (bent onto its constraint if it has one)."""
+    """One segment from ``q``: a line, a wait, a free motion (bent onto its constraint if it has one).
+
+    ``goal_test``: a free motion's goal test (:func:`~planning.task.free_motion.plan_free`; the
+    line after it walks from there).
+    """
     required = carrying.required
     if isinstance(segment, ToolLine):
         line = plan_line(carrying.problem.world, q, segment, required)
@@ -261,7 +269,7 @@ def _planned(
         return PlannedMotion(still, carrying.problem, required, still=True)
     if isinstance(segment, Move):
         scene = dataclasses.replace(carrying.scene, start=Target(q=tuple(q.tolist())), goal=segment.goal)
-        free = plan_free(scene, base, segment.constraint, required, progress, carrying.threads)
+        free = plan_free(scene, base, segment.constraint, required, progress, carrying.threads, goal_test)
         return PlannedMotion(free.trajectory, free.problem, required, held=free.held)
     raise PlanningError(
         f"a task segment is a Move, a ToolLine, a Wait, an Attach or a Detach, not a {type(segment).__name__}"
