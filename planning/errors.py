@@ -15,14 +15,29 @@ also a ``ValueError``, which the planner lets through.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     import cpr_kin as ck
 
 
 class CprPlanError(Exception):
-    """Base class of every exception :mod:`planning` raises."""
+    """Base class of every exception :mod:`planning` raises.
+
+    Pickled with its message and attributes as they are, whatever its constructor takes: an
+    error raised in a worker process reaches the caller whole (``concurrent.futures``, Dask).
+    """
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return _restored, (type(self), self.args, self.__dict__)
+
+
+def _restored(cls: type[CprPlanError], args: tuple[Any, ...], state: dict[str, Any]) -> CprPlanError:
+    """An error of class ``cls`` with ``args`` and attributes ``state``, its constructor not called."""
+    error = cls.__new__(cls)
+    error.args = args
+    error.__dict__.update(state)
+    return error
 
 
 class PlanningError(CprPlanError, ValueError):
@@ -71,13 +86,14 @@ class ToolLineBrokenError(NoSolutionError):
     """A tool line cannot be followed to its end: the share achieved and why.
 
     Attributes:
+        reason: why it breaks there.
         fraction: the share of the line (its progress, 0 to 1) the tool follows before it
             breaks, as MoveIt's Cartesian path reports it.
     """
 
     def __init__(self, reason: str, fraction: float) -> None:
         super().__init__(f"the tool line breaks after {fraction:.1%} of its length: {reason}")
-        self.fraction = fraction
+        self.reason, self.fraction = reason, fraction
 
 
 class TaskSegmentError(NoSolutionError):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import re
 
 import numpy as np
 import pytest
@@ -14,7 +15,7 @@ from planning.errors import TaskSegmentError, ToolLineBrokenError
 from planning.io.scene_file import parse_scene_file
 from planning.pipeline.verification import Requirements
 from planning.task import plan_task
-from planning.task.line_goal import line_after, line_walks
+from planning.task.line_goal import LineWalks, line_after
 from planning.task.line_motion import line_path
 from planning.task.segments import Detach, Move, Wait
 from planning.task.tool_line import ToolLine
@@ -57,8 +58,8 @@ def scene(read: tuple[Scene, Move, ToolLine]) -> Scene:
 def test_the_line_after_a_move_is_the_next_segment_but_waits(read: tuple[Scene, Move, ToolLine]) -> None:
     _, move, line = read
     wait = Wait(0.2)
-    assert line_after([move, line], 0) is line
-    assert line_after([move, wait, wait, line], 0) is line
+    assert line_after([move, line], 0) == 1
+    assert line_after([move, wait, wait, line], 0) == 3
     assert line_after([move, Detach(), line], 0) is None  # what it carries changes
     assert line_after([move, move, line], 0) is None
     assert line_after([move], 0) is None and line_after([line, line], 1) is None
@@ -72,7 +73,7 @@ def test_a_move_before_a_line_takes_a_goal_from_which_the_line_walks(
     alone = build_problem(scene, panda)
     with pytest.raises(ToolLineBrokenError, match=r"singularity|limit|cannot take"):
         line_path(panda, alone.motion.q_goal, line)
-    walks = line_walks(alone.world, line, Requirements.of(alone))
+    walks = LineWalks(alone.world, line, Requirements.of(alone))
     assert not walks(alone.motion.q_goal)
     # in the task, the move takes another solution of the same pose, and the line walks from it
     task = plan_task(start_scene, [move, line], panda)
@@ -89,7 +90,7 @@ def test_where_the_soonest_goals_line_walks_the_goal_is_the_moves_own(
     start_scene, move, _ = read
     down = ToolLine(by=(0.0, 0.0, -0.03), offset_frame="base")  # a short line: it walks from the soonest
     alone = build_problem(scene, panda)
-    assert line_walks(alone.world, down, Requirements.of(alone))(alone.motion.q_goal)
+    assert LineWalks(alone.world, down, Requirements.of(alone))(alone.motion.q_goal)
     task = plan_task(start_scene, [move, down], panda)
     np.testing.assert_allclose(task.trajectory(task.segments[1].t0), alone.motion.q_goal, rtol=0.0, atol=1e-9)
 
@@ -99,5 +100,12 @@ def test_a_line_that_breaks_from_every_goal_still_names_where_it_breaks(
 ) -> None:
     start_scene, move, line = read
     far = dataclasses.replace(line, by=(0.0, 0.0, -2.0))  # two metres down: out of reach
-    with pytest.raises(TaskSegmentError, match=r"task\[1\] \(line\): the tool line breaks after"):
+    with pytest.raises(TaskSegmentError, match=r"task\[1\] \(line\): the tool line breaks after") as raised:
         plan_task(start_scene, [move, far], panda)
+    assert re.search(
+        r"it breaks from each of the \d+ IK solutions of the move's goal tried$", str(raised.value)
+    )
+    # a line after a joint goal: no goal to choose, nothing said of one
+    with pytest.raises(TaskSegmentError) as raised:
+        plan_task(start_scene, [Move(start_scene.start), far], panda)
+    assert "IK solutions" not in str(raised.value)

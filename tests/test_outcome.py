@@ -1,12 +1,20 @@
 from __future__ import annotations
 
+import pickle
 import signal
 
 import numpy as np
 import pytest
 
 import cpr_kin as ck
-from planning.errors import NoTrajectoryFoundError, PlanningError, SceneError
+from planning.errors import (
+    CprPlanError,
+    NoTrajectoryFoundError,
+    PlanningError,
+    SceneError,
+    TaskSegmentError,
+    ToolLineBrokenError,
+)
 from planning.outcome import STATUS_EXIT, Interrupted, classify, interruption
 
 
@@ -62,3 +70,22 @@ def test_an_interrupt_is_found_through_the_chain_of_causes() -> None:
     looped = ValueError("a")
     looped.__context__ = looped  # a cycle ends the walk
     assert interruption(looped) is None
+
+
+@pytest.mark.parametrize(
+    "error",
+    [
+        no_trajectory(),
+        ToolLineBrokenError("joint 'd2' reaches its limit", 0.25),
+        TaskSegmentError(3, "line", ToolLineBrokenError("a singularity", 0.5)),
+        PlanningError("start q = [9] is outside its range"),
+    ],
+)
+def test_an_error_from_a_worker_process_is_unpickled_whole(error: CprPlanError) -> None:
+    # a process pool or Dask returns a worker's exception pickled; a constructor of other
+    # arguments than the message once made unpickling raise TypeError in the caller
+    again = pickle.loads(pickle.dumps(error))
+    assert type(again) is type(error) and str(again) == str(error)
+    assert classify(again) == classify(error)
+    for name, value in vars(error).items():
+        assert repr(getattr(again, name)) == repr(value)

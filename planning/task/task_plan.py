@@ -31,7 +31,7 @@ import cpr_kin as ck
 from planning.curves.continuity import discontinuity
 from planning.curves.stop_and_go import joined
 from planning.curves.trajectory import Trajectory
-from planning.errors import NoSolutionError, PlanningError, TaskSegmentError
+from planning.errors import NoSolutionError, PlanningError, TaskSegmentError, ToolLineBrokenError
 from planning.pipeline.problem import Problem, build_problem
 from planning.pipeline.scene import Scene
 from planning.pipeline.target import Target
@@ -39,7 +39,7 @@ from planning.pipeline.verification import Requirements, Verification
 from planning.task.free_motion import FIXED_DURATION, plan_free
 from planning.task.held_orientation import HeldMotion
 from planning.task.holding import changed_object, checked_touches, scene_after, untaken
-from planning.task.line_goal import line_after, line_walks
+from planning.task.line_goal import LineWalks, line_after
 from planning.task.line_motion import LineMotion, plan_line
 from planning.task.segments import KINDS, Attach, Detach, Move, Segment, Wait, segment_name
 from planning.task.task_timing import PlannedMotion, timed_motions
@@ -186,6 +186,8 @@ def plan_task(
     carrying = _carrying(scene, base, None, threads)
     q, start_world = carrying.problem.q_start, carrying.problem.world
     kinds, payloads, planned = [], [], list[PlannedMotion | None]()
+    walks: LineWalks | None = None  # the line after the last move: its goal's test
+    walks_at = -1  # that line's index
     for index, segment in enumerate(segments):
         kinds.append(KINDS.get(type(segment), type(segment).__name__))
         try:
@@ -195,12 +197,18 @@ def plan_task(
                 payloads.append(changed_object(segment, before, carrying.scene))
                 planned.append(None)
                 continue
-            line = line_after(segments, index) if isinstance(segment, Move) else None
-            walks = None if line is None else line_walks(carrying.problem.world, line, carrying.required)
-            motion = _planned(carrying, base, q, segment, progress, walks)
+            goal_test = None
+            if isinstance(segment, Move) and (line := line_after(segments, index)) is not None:
+                next_line = segments[line]
+                assert isinstance(next_line, ToolLine)  # what line_after finds
+                walks, walks_at = LineWalks(carrying.problem.world, next_line, carrying.required), line
+                goal_test = walks
+            motion = _planned(carrying, base, q, segment, progress, goal_test)
         except (PlanningError, ck.CprKinError) as exc:
             raise PlanningError(f"task[{index}] ({segment_name(segment)}): {exc}") from exc
         except NoSolutionError as exc:
+            if isinstance(exc, ToolLineBrokenError) and walks is not None and index == walks_at:
+                exc = walks.from_no_goal(exc)
             raise TaskSegmentError(index, segment_name(segment), exc) from exc
         payloads.append(None)
         planned.append(motion)
