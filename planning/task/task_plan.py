@@ -186,8 +186,7 @@ def plan_task(
     carrying = _carrying(scene, base, None, threads)
     q, start_world = carrying.problem.q_start, carrying.problem.world
     kinds, payloads, planned = [], [], list[PlannedMotion | None]()
-    walks: LineWalks | None = None  # the line after the last move: its goal's test
-    walks_at = -1  # that line's index
+    goal_tests: dict[int, LineWalks] = {}  # a move's goal test, by the index of the line after it
     for index, segment in enumerate(segments):
         kinds.append(KINDS.get(type(segment), type(segment).__name__))
         try:
@@ -201,14 +200,13 @@ def plan_task(
             if isinstance(segment, Move) and (line := line_after(segments, index)) is not None:
                 next_line = segments[line]
                 assert isinstance(next_line, ToolLine)  # what line_after finds
-                walks, walks_at = LineWalks(carrying.problem.world, next_line, carrying.required), line
-                goal_test = walks
+                goal_test = goal_tests[line] = LineWalks(carrying.problem.world, next_line, carrying.required)
             motion = _planned(carrying, base, q, segment, progress, goal_test)
         except (PlanningError, ck.CprKinError) as exc:
             raise PlanningError(f"task[{index}] ({segment_name(segment)}): {exc}") from exc
         except NoSolutionError as exc:
-            if isinstance(exc, ToolLineBrokenError) and walks is not None and index == walks_at:
-                exc = walks.from_no_goal(exc)
+            if isinstance(exc, ToolLineBrokenError) and index in goal_tests:
+                exc = goal_tests[index].from_no_goal(exc)
             raise TaskSegmentError(index, segment_name(segment), exc) from exc
         payloads.append(None)
         planned.append(motion)
