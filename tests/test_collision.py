@@ -13,6 +13,8 @@ from scipy.optimize import minimize
 
 import cpr_kin as ck
 from cpr_kin.collision.coal_pools import default_threads
+from cpr_kin.collision.robot_reach import pair_reach_distances
+from cpr_kin.collision.touch_links import checked_pairs
 
 from .conftest import PAPER_GOAL_TCP, PAPER_START_TCP, random_configurations
 
@@ -253,7 +255,7 @@ def test_reach_distance_bounds_every_pair_from_below(robot: ck.Robot, rng: np.ra
     obstacles = [random_obstacle(shape, rng) for shape in ("box", "sphere", "cylinder", "capsule", "box")]
     obstacles = [ck.Obstacle(**{**o.__dict__, "name": f"o{k}"}) for k, o in enumerate(obstacles)]
     world = ck.CollisionWorld(robot, obstacles)
-    bound = world._reach_distance
+    bound = pair_reach_distances(robot, world.obstacles, checked_pairs(robot, world.obstacles))
     assert np.sum(bound > 0.05) >= 3  # some pairs can be left out of the yes/no test
     configurations = random_configurations(robot, rng, 300)
     for q in configurations:
@@ -274,7 +276,8 @@ def test_reach_distance_of_the_turning_column_is_exact(robot: ck.Robot) -> None:
     crate = ck.Obstacle(shape="box", xyz=np.array([0.0, 0.6, 0.15]), size=np.array([0.3, 0.3, 0.3]), name="c")
     world = ck.CollisionWorld(robot, [crate])
     column = [p for p, (geometry, _, _) in enumerate(world.pairs) if geometry == "column"]
-    assert world._reach_distance[column[0]] == pytest.approx(0.45 - 0.06 * np.sqrt(2), abs=1e-6)
+    reach = pair_reach_distances(robot, world.obstacles, checked_pairs(robot, world.obstacles))
+    assert reach[column[0]] == pytest.approx(0.45 - 0.06 * np.sqrt(2), abs=1e-6)
 
 
 def test_an_ordered_check_is_exact_up_to_the_first_failure(rng: np.random.Generator) -> None:

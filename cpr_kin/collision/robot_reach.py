@@ -1,7 +1,8 @@
 """A robot's reach bounds and capsules (:mod:`cpr_kin.bounds`), once per robot; its least obstacle distances.
 
 The least distance of each robot geometry and obstacle pair over every configuration bounds
-what a world's margin test needs to ask of that pair.
+what a world's margin test needs to ask of that pair (:class:`PairReach`: coal's, asked only of
+the pairs a cheaper bound cannot rule out).
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ if TYPE_CHECKING:
     from cpr_kin.shapes.obstacles import Obstacle
 
 FloatArray = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
 
 
 _ROBOT_REACH: weakref.WeakKeyDictionary[Robot, tuple[GeometryReach, ...]] = weakref.WeakKeyDictionary()
@@ -74,6 +76,37 @@ def robot_pair_bounds(
     chain, known = robot_capsules(robot)
     model, collision = robot.model, robot.collision_model
     return PairBounds(model, collision, obstacles, pairs, chain=chain, known=known, shapes=shapes)
+
+
+class PairBoundsSets:
+    """:func:`robot_pair_bounds` of subsets of a world's pairs, each built once.
+
+    Args:
+        robot: the robot.
+        obstacles: the obstacles.
+        pairs: ``(geometry index, obstacle index)`` of every pair.
+        shapes: the obstacles' bounds (:func:`~cpr_kin.bounds.obstacle_bounds.obstacle_arrays`).
+
+    Holds no reference to the world that owns it: a world's parts sharing it make no reference
+    cycle, so a world's arrays are freed when it is dropped, not at the next garbage collection.
+    """
+
+    def __init__(
+        self,
+        robot: Robot,
+        obstacles: Sequence[Obstacle],
+        pairs: Sequence[tuple[int, int]],
+        shapes: ObstacleArrays,
+    ) -> None:
+        self._robot, self._obstacles, self._pairs, self._shapes = robot, obstacles, list(pairs), shapes
+        self._built: dict[tuple[bool, ...], PairBounds] = {}
+
+    def __call__(self, active: tuple[bool, ...]) -> PairBounds:
+        """The pair bounds of the pairs flagged true (one flag per pair, in ``pairs``' order)."""
+        if active not in self._built:
+            pairs = [pair for pair, on in zip(self._pairs, active, strict=True) if on]
+            self._built[active] = robot_pair_bounds(self._robot, self._obstacles, pairs, self._shapes)
+        return self._built[active]
 
 
 _ROBOT_SWEPT: weakref.WeakKeyDictionary[Robot, tuple[tuple[tuple[Any, Any], ...], ...]] = (
@@ -131,3 +164,89 @@ def pair_reach_distances(
             bound = max(bound, result.min_distance)
         distances.append(bound)
     return np.array(distances)
+
+
+_ROBOT_SEGMENTS: weakref.WeakKeyDictionary[Robot, tuple[tuple[FloatArray, FloatArray], ...]] = (
+    weakref.WeakKeyDictionary()
+)
+
+
+def _robot_segments(robot: Robot) -> tuple[tuple[FloatArray, FloatArray], ...]:
+    """Per robot geometry, its swept capsules: segments ``(H, 2, 3)`` and radii ``(H,)`` [m]; once a robot."""
+    if robot not in _ROBOT_SEGMENTS:
+        reach, segments = robot_reach(robot), []
+        for geometry in robot.geometries:
+            capsules = [hull.capsule() for hull in reach[geometry.index].hulls]
+            ends = np.array([[c - h * a, c + h * a] for c, a, h, _ in capsules]).reshape(-1, 2, 3)
+            segments.append((ends, np.array([r for _, _, _, r in capsules], dtype=float)))
+        _ROBOT_SEGMENTS[robot] = tuple(segments)
+    return _ROBOT_SEGMENTS[robot]
+
+
+def sphere_reach_distances(
+    robot: Robot, shapes: ObstacleArrays, pairs: Sequence[tuple[int, int]]
+) -> FloatArray:
+    """Per ``(geometry index, obstacle index)`` pair, a cheaper lower bound of its least distance [m].
+
+    Of each of the geometry's swept capsules (:func:`pair_reach_distances`' shapes), the
+    distance from its segment to the centre of the obstacle's bounding sphere (``shapes``,
+    :func:`~cpr_kin.bounds.obstacle_bounds.obstacle_arrays`), less both radii; the largest. Where
+    positive, at most :func:`pair_reach_distances`'s; every pair in a few array operations per
+    geometry, where coal takes a query per pair and capsule.
+    """
+    segments = _robot_segments(robot)
+    distances = np.full(len(pairs), -np.inf)
+    geometry = np.array([g for g, _ in pairs], dtype=np.int64)
+    obstacle = np.array([k for _, k in pairs], dtype=np.int64)
+    for g in set(geometry.tolist()):
+        rows = np.flatnonzero(geometry == g)
+        centres, reach = shapes.centre[obstacle[rows]], shapes.reach[obstacle[rows]]
+        ends, radii = segments[g]
+        for (a, b), radius in zip(ends, radii, strict=True):
+            along = b - a
+            length2 = float(along @ along)
+            t = np.clip((centres - a) @ along / length2, 0.0, 1.0) if length2 > 0.0 else np.zeros(len(rows))
+            apart = np.linalg.norm(centres - (a + t[:, None] * along), axis=1) - radius - reach
+            distances[rows] = np.maximum(distances[rows], apart)
+    return distances
+
+
+class PairReach:
+    """Lower bounds of a world's pairs' distances in any configuration, coal's computed where asked.
+
+    Args:
+        robot: the robot.
+        obstacles: the obstacles.
+        pairs: ``(geometry index, obstacle index)`` of every pair.
+        shapes: the obstacles' bounds (:func:`~cpr_kin.bounds.obstacle_bounds.obstacle_arrays`).
+
+    Attributes:
+        sphere_m: ``(P,)`` every pair's :func:`sphere_reach_distances`.
+    """
+
+    def __init__(
+        self,
+        robot: Robot,
+        obstacles: Sequence[Obstacle],
+        pairs: Sequence[tuple[int, int]],
+        shapes: ObstacleArrays,
+    ) -> None:
+        self._robot, self._obstacles, self._pairs = robot, obstacles, list(pairs)
+        self.sphere_m = sphere_reach_distances(robot, shapes, pairs)
+        self._coal = np.full(len(self._pairs), np.nan)  # pair_reach_distances', where computed
+
+    def within(self, distance_m: float) -> BoolArray:
+        """``(P,)`` whether each pair's :func:`pair_reach_distances` is at most ``distance_m`` [m].
+
+        coal computes it (once) only for the pairs whose :attr:`sphere_m` is at most
+        ``max(distance_m, 0)``: a pair the sphere puts farther is farther (a sphere that reaches
+        the capsule, at most 0, holds every pair that may overlap). Every pair is within ``inf``.
+        """
+        if distance_m == np.inf:
+            return np.ones(len(self._pairs), dtype=bool)
+        maybe = self.sphere_m <= max(distance_m, 0.0)
+        asked = np.flatnonzero(maybe & np.isnan(self._coal))
+        if asked.size:
+            chosen = [self._pairs[p] for p in asked.tolist()]
+            self._coal[asked] = pair_reach_distances(self._robot, self._obstacles, chosen)
+        return np.asarray(maybe & (self._coal <= distance_m))

@@ -5,7 +5,8 @@ model and registers robot-obstacle pairs only (the robot never tests itself). Di
 signed: negative values are penetration depths (into a point cloud's voxels, at most a voxel's).
 A concave link is measured on its exact mesh where its hull comes near (:mod:`cpr_kin.shapes.exact_pairs`).
 The clearance of a group is the smallest distance between any of its geometries and any
-obstacle. Distances are accurate to about 1e-6 of their size (coal's GJK tolerance).
+obstacle. Distances are accurate to about 1e-6 of their size (coal's GJK tolerance). Among many
+obstacles, a query's cost follows those within reach (:mod:`cpr_kin.collision.reach_tiers`).
 """
 
 from __future__ import annotations
@@ -24,7 +25,8 @@ from cpr_kin.collision.closest_pairs import closest_pairs
 from cpr_kin.collision.coal_pools import default_threads
 from cpr_kin.collision.decisive import below_coal, coal_error_m
 from cpr_kin.collision.obstacle_tests import ObstacleTests
-from cpr_kin.collision.robot_reach import pair_reach_distances, robot_pair_bounds
+from cpr_kin.collision.reach_tiers import ReachTiers
+from cpr_kin.collision.robot_reach import PairBoundsSets, PairReach
 from cpr_kin.collision.touch_links import checked_pairs
 from cpr_kin.collision.world_self_pairs import world_self_collision
 from cpr_kin.common.errors import CprKinError
@@ -91,10 +93,11 @@ class CollisionWorld:
         self._all = model.createData()
         self._exact = ExactPairs(model, robot.exact_meshes)
         self._tests = ObstacleTests(robot.model, model, self._exact)
-        self._reach_distance = pair_reach_distances(robot, self.obstacles, self._pairs)
-        self._pair_bounds: dict[tuple[bool, ...], PairBounds] = {}
         self._shapes = obstacle_arrays(self.obstacles)  # every pair set's bounds share them
+        self._bounds = PairBoundsSets(robot, self.obstacles, self._pairs, self._shapes)
+        self._reach = PairReach(robot, self.obstacles, self._pairs, self._shapes)
         self._within: dict[float, tuple[IntArray, PairBounds | None]] = {}
+        self._tiers = ReachTiers(self._reach.sphere_m, self._pair_group, self._bounds)
         self.self_collision = world_self_collision(robot, allowed_pairs, self_margin_m, self.num_threads)
 
     def on_hulls(self) -> CollisionWorld:
@@ -159,15 +162,15 @@ class CollisionWorld:
         with no pair. coal's distance of the closest pair; the pairs are visited in the
         order of their bounds and only those that may be closest are computed
         (:func:`cpr_kin.collision.closest_pairs.closest_pairs`). The bounds are the group's columns of
-        every pair's (:meth:`pair_bounds`, ``per_pair_m`` where the caller has them at ``q``). A
-        distance at or above ``exact_below_m`` [m] may be reported as that (a lower bound).
+        every pair's (:meth:`pair_bounds`, ``per_pair_m`` where the caller has them). A distance
+        at or above ``exact_below_m`` [m] may be reported as that (a lower bound).
         """
         batch = self._check_batch(q)
-        columns = self._pair_group == group_index
-        if not columns.any():
+        pairs = self._tiers.columns(group_index)
+        if not pairs.size:
             return np.full(len(batch), np.inf), np.full(len(batch), -1, dtype=np.int64)
-        bounds = (self.pair_bounds(batch) if per_pair_m is None else per_pair_m)[:, columns]
-        model, data, pairs = self.robot.model, self._data, np.flatnonzero(columns)
+        bounds = self._tiers.group_bounds(batch, group_index) if per_pair_m is None else per_pair_m[:, pairs]
+        model, data = self.robot.model, self._data
         return closest_pairs(
             model,
             data,
@@ -181,28 +184,26 @@ class CollisionWorld:
         )
 
     def pair_bounds(self, q: ArrayLike) -> FloatArray:
-        """``(N, P)`` every pair's lower bound [m] at ``q`` ``(N, nq)``: :mod:`cpr_kin.bounds.pair_bounds`."""
+        """``(N, P)`` every pair's lower bound [m] at ``q``: its capsule bound or its reach, the larger.
+
+        Capsule bounds: :mod:`cpr_kin.bounds.pair_bounds`; reach: :mod:`cpr_kin.collision.reach_tiers`.
+        """
         batch = self._check_batch(q)
-        return self._every_pair_bounds()(batch) if self._pairs else np.empty((len(batch), 0))
+        if not self._pairs:
+            return np.empty((len(batch), 0))
+        return np.maximum(self._bounds((True,) * len(self._pairs))(batch), self._reach.sphere_m)
 
     def clearance_lower_bounds(self, q: ArrayLike, per_pair_m: FloatArray | None = None) -> FloatArray:
         """``(N, len(GROUPS))`` lower bounds [m] of each group's clearance at ``q`` ``(N, nq)``.
 
-        From the pair bounds (:meth:`pair_bounds`, ``per_pair_m`` where the caller has them),
-        a fraction of coal's cost, less coal's own error
-        (:func:`cpr_kin.collision.decisive.below_coal`): a positive bound is at most
-        :meth:`clearance_batch`'s value; where the geometries' bounding shapes overlap nothing
-        is known and the bound is ``-inf``. ``inf`` for a group with no pair.
+        The least of its pairs' bounds (:meth:`pair_bounds`, ``per_pair_m`` where the caller has
+        them), less coal's error (:func:`~cpr_kin.collision.decisive.below_coal`): at most
+        :meth:`clearance_batch`'s where positive; ``-inf`` where the bounding shapes overlap (nothing
+        is known), ``inf`` for a group with no pair.
         """
-        batch = self._check_batch(q)
-        bounds = np.full((len(batch), len(GROUPS)), np.inf)
-        if not self._pairs:
-            return bounds
-        per_pair = self.pair_bounds(batch) if per_pair_m is None else per_pair_m
-        for group_index in range(len(GROUPS)):
-            columns = self._pair_group == group_index
-            if columns.any():
-                bounds[:, group_index] = below_coal(per_pair[:, columns].min(axis=1))
+        least = self._tiers.least(self._check_batch(q), len(GROUPS), per_pair_m)
+        bounds, finite = least.copy(), np.isfinite(least)
+        bounds[finite] = below_coal(least[finite])
         bounds[bounds <= 0.0] = -np.inf
         return bounds
 
@@ -240,7 +241,7 @@ class CollisionWorld:
 
         A yes/no check run by coal's collision test with ``margin_m`` as security margin.
         Pairs that cannot come within the margin in any configuration (their reach capsule is
-        farther, see :mod:`cpr_kin.bounds.reach`) are not tested, and coal tests a
+        farther, :class:`~cpr_kin.collision.robot_reach.PairReach`) are not tested, and coal tests a
         configuration's pair only where its cheap bound (:mod:`cpr_kin.bounds.pair_bounds`,
         computed for the whole batch at once) does not put it certainly farther than the
         margin (:mod:`cpr_kin.collision.obstacle_tests`). Distances within coal's error of the
@@ -283,18 +284,7 @@ class CollisionWorld:
         distance (a plan asks a few margins many times).
         """
         if distance_m not in self._within:
-            near = self._reach_distance <= distance_m
+            near = self._reach.within(distance_m)
             bounds = self._bounds(tuple(near.tolist())) if near.any() else None
             self._within[distance_m] = (np.flatnonzero(near), bounds)
         return self._within[distance_m]
-
-    def _every_pair_bounds(self) -> PairBounds:
-        """The bounds of every pair (built once; each pair's column is its own)."""
-        return self._bounds((True,) * len(self._pairs))
-
-    def _bounds(self, active: tuple[bool, ...]) -> PairBounds:
-        """The pair bounds of the ``active`` pairs, built once per set of pairs."""
-        if active not in self._pair_bounds:
-            pairs = [pair for pair, on in zip(self._pairs, active, strict=True) if on]  # (geometry, obstacle)
-            self._pair_bounds[active] = robot_pair_bounds(self.robot, self.obstacles, pairs, self._shapes)
-        return self._pair_bounds[active]
