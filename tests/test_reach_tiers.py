@@ -17,6 +17,7 @@ from cpr_kin.collision.decisive import below_coal
 from cpr_kin.collision.reach_tiers import ReachTiers
 from cpr_kin.collision.robot_reach import (
     PairReach,
+    WorldPairs,
     pair_reach_distances,
     robot_pair_bounds,
     sphere_reach_distances,
@@ -181,7 +182,7 @@ def test_the_spheres_bound_coals_reach_and_within_asks_coal_only_of_the_pairs_th
         return pair_reach_distances(robot, obstacles, chosen)
 
     monkeypatch.setattr(robot_reach, "pair_reach_distances", counted)
-    reach = PairReach(robot, obstacles, pairs, obstacle_arrays(obstacles))
+    reach = PairReach(WorldPairs(robot, obstacles, pairs, obstacle_arrays(obstacles)))
     for distance_m in (-0.01, 0.0, 0.02, 0.1, 0.3, 1.0, np.inf):
         np.testing.assert_array_equal(reach.within(distance_m), coal_m <= distance_m)
     assert sum(measured) < 0.3 * len(pairs)  # each pair at most once, the far ones never

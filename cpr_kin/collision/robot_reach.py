@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import weakref
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
@@ -78,34 +79,40 @@ def robot_pair_bounds(
     return PairBounds(model, collision, obstacles, pairs, chain=chain, known=known, shapes=shapes)
 
 
-class PairBoundsSets:
-    """:func:`robot_pair_bounds` of subsets of a world's pairs, each built once.
+@dataclass(frozen=True, eq=False)
+class WorldPairs:
+    """What a world's pair bounds are built of.
 
-    Args:
+    Attributes:
         robot: the robot.
         obstacles: the obstacles.
-        pairs: ``(geometry index, obstacle index)`` of every pair.
+        pairs: ``(geometry index, obstacle index)`` of every checked pair.
         shapes: the obstacles' bounds (:func:`~cpr_kin.bounds.obstacle_bounds.obstacle_arrays`).
+    """
+
+    robot: Robot
+    obstacles: Sequence[Obstacle]
+    pairs: Sequence[tuple[int, int]]
+    shapes: ObstacleArrays
+
+
+class PairBoundsSets:
+    """:func:`robot_pair_bounds` of subsets of a world's pairs (``of``), each built once.
 
     Holds no reference to the world that owns it: a world's parts sharing it make no reference
     cycle, so a world's arrays are freed when it is dropped, not at the next garbage collection.
     """
 
-    def __init__(
-        self,
-        robot: Robot,
-        obstacles: Sequence[Obstacle],
-        pairs: Sequence[tuple[int, int]],
-        shapes: ObstacleArrays,
-    ) -> None:
-        self._robot, self._obstacles, self._pairs, self._shapes = robot, obstacles, list(pairs), shapes
+    def __init__(self, of: WorldPairs) -> None:
+        self._of = of
         self._built: dict[tuple[bool, ...], PairBounds] = {}
 
     def __call__(self, active: tuple[bool, ...]) -> PairBounds:
         """The pair bounds of the pairs flagged true (one flag per pair, in ``pairs``' order)."""
         if active not in self._built:
-            pairs = [pair for pair, on in zip(self._pairs, active, strict=True) if on]
-            self._built[active] = robot_pair_bounds(self._robot, self._obstacles, pairs, self._shapes)
+            of = self._of
+            pairs = [pair for pair, on in zip(of.pairs, active, strict=True) if on]
+            self._built[active] = robot_pair_bounds(of.robot, of.obstacles, pairs, of.shapes)
         return self._built[active]
 
 
@@ -212,27 +219,15 @@ def sphere_reach_distances(
 
 
 class PairReach:
-    """Lower bounds of a world's pairs' distances in any configuration, coal's computed where asked.
-
-    Args:
-        robot: the robot.
-        obstacles: the obstacles.
-        pairs: ``(geometry index, obstacle index)`` of every pair.
-        shapes: the obstacles' bounds (:func:`~cpr_kin.bounds.obstacle_bounds.obstacle_arrays`).
+    """Lower bounds of a world's pairs' (``of``) distances in any configuration, coal's where asked.
 
     Attributes:
         sphere_m: ``(P,)`` every pair's :func:`sphere_reach_distances`.
     """
 
-    def __init__(
-        self,
-        robot: Robot,
-        obstacles: Sequence[Obstacle],
-        pairs: Sequence[tuple[int, int]],
-        shapes: ObstacleArrays,
-    ) -> None:
-        self._robot, self._obstacles, self._pairs = robot, obstacles, list(pairs)
-        self.sphere_m = sphere_reach_distances(robot, shapes, pairs)
+    def __init__(self, of: WorldPairs) -> None:
+        self._robot, self._obstacles, self._pairs = of.robot, of.obstacles, list(of.pairs)
+        self.sphere_m = sphere_reach_distances(of.robot, of.shapes, of.pairs)
         self._coal = np.full(len(self._pairs), np.nan)  # pair_reach_distances', where computed
 
     def within(self, distance_m: float) -> BoolArray:

@@ -26,7 +26,7 @@ from cpr_kin.collision.coal_pools import default_threads
 from cpr_kin.collision.decisive import below_coal, coal_error_m
 from cpr_kin.collision.obstacle_tests import ObstacleTests
 from cpr_kin.collision.reach_tiers import ReachTiers
-from cpr_kin.collision.robot_reach import PairBoundsSets, PairReach
+from cpr_kin.collision.robot_reach import PairBoundsSets, PairReach, WorldPairs
 from cpr_kin.collision.touch_links import checked_pairs
 from cpr_kin.collision.world_self_pairs import world_self_collision
 from cpr_kin.common.errors import CprKinError
@@ -94,8 +94,8 @@ class CollisionWorld:
         self._exact = ExactPairs(model, robot.exact_meshes)
         self._tests = ObstacleTests(robot.model, model, self._exact)
         self._shapes = obstacle_arrays(self.obstacles)  # every pair set's bounds share them
-        self._bounds = PairBoundsSets(robot, self.obstacles, self._pairs, self._shapes)
-        self._reach = PairReach(robot, self.obstacles, self._pairs, self._shapes)
+        of = WorldPairs(robot, self.obstacles, self._pairs, self._shapes)
+        self._bounds, self._reach = PairBoundsSets(of), PairReach(of)
         self._within: dict[float, tuple[IntArray, PairBounds | None]] = {}
         self._tiers = ReachTiers(self._reach.sphere_m, self._pair_group, self._bounds)
         self.self_collision = world_self_collision(robot, allowed_pairs, self_margin_m, self.num_threads)
