@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import dataclasses
 
+import coal
 import numpy as np
 import pinocchio as pin
 import pytest
+import trimesh
 
 import cpr_kin as ck
 from cpr_kin.bounds.close_pairs import CLOSE_LIMIT_M, close_pairs
@@ -50,6 +52,16 @@ def test_only_a_pair_apart_and_close_at_every_angle_is_found_with_its_largest_ga
     assert found.links == ("link_of_hub", "link_of_close")
     assert close_pairs(model, geometry_model, [], links) == ()
     assert CLOSE_LIMIT_M > 0.006
+
+
+def test_a_pair_that_meets_in_places_and_stays_close_elsewhere_is_found_with_its_largest_gap() -> None:
+    # a ball turning 0.302 m from the axis hugs a hub 10 mm off it: 8 mm into the hub at angle 0,
+    # 12 mm from it at pi (analytic: |0.302 u(angle) - 0.01 x| - 0.3)
+    model, geometry_model, ids = turning_balls({"hub": (False, 0.2, 0.01), "hugging": (True, 0.1, 0.302)})
+    links = [f"link_of_{obj.name}" for obj in geometry_model.geometryObjects]
+    (found,) = close_pairs(model, geometry_model, [(ids["hub"], ids["hugging"])], links)
+    assert found.largest_m == pytest.approx(0.012, abs=1e-5)  # the sampled angles' largest gap
+    assert found.held_to_contact(0.015) and not found.held_to_contact(0.01)
 
 
 def _held_pair(allowance_m: float) -> tuple[SelfCollision, np.ndarray, np.ndarray]:
@@ -149,3 +161,61 @@ def test_arms_without_such_pairs_keep_every_margin() -> None:
         robot = ck.load_robot(ROBOTS / urdf)
         world = ck.CollisionWorld(robot, [], self_margin_m=0.01)
         assert not world.self_collision.allowance_m.any()
+
+
+FINGER = {
+    "urdf": str(ROBOTS / "finger_edu_description" / "robots" / "finger_edu.urdf"),
+    "tcp": "finger_tip_link",
+}
+
+
+def _meshes_apart_m(robot: ck.Robot, pair: tuple[int, int], q: np.ndarray) -> np.ndarray:
+    """Coal's distance [m] of ``pair``'s link meshes as trimesh reads them, at each configuration."""
+    objects = [robot.collision_model.geometryObjects[g] for g in pair]
+    models = []
+    for obj in objects:
+        mesh: trimesh.Trimesh = trimesh.load(obj.meshPath, force="mesh")  # type: ignore[assignment]
+        bvh = coal.BVHModelOBBRSS()
+        bvh.beginModel(len(mesh.faces), len(mesh.vertices))
+        bvh.addVertices(np.asarray(mesh.vertices * obj.meshScale, dtype=np.float64))
+        bvh.addTriangles(np.asarray(mesh.faces, dtype=np.int64))
+        bvh.endModel()
+        models.append(bvh)
+    data, request = robot.model.createData(), coal.DistanceRequest()
+    apart = []
+    for x in q:
+        pin.forwardKinematics(robot.model, data, x)
+        placed = [data.oMi[obj.parentJoint] * obj.placement for obj in objects]
+        transforms = [coal.Transform3s(at.rotation, at.translation) for at in placed]
+        result = coal.DistanceResult()
+        coal.distance(models[0], transforms[0], models[1], transforms[1], request, result)
+        apart.append(result.min_distance)
+    return np.array(apart)
+
+
+def test_a_finger_whose_middle_link_meets_its_base_in_places_is_held_to_contact_and_plans() -> None:
+    # finger_edu's middle link stays 3-4 mm from the base's front housing wherever it does not
+    # swing into it: held to a 10 mm self margin, every configuration was refused
+    robot = ck.load_robot(FINGER["urdf"], tcp=FINGER["tcp"])
+    (close,) = [c for c in robot.close_pairs if c.held_to_contact(0.01)]
+    assert close.links == ("finger_base_link", "finger_middle_link")
+    assert 0.003 < close.largest_m < 0.005
+    q = np.random.default_rng(5).uniform(robot.limits.lower, robot.limits.upper, (200, robot.nq))
+    held = ck.CollisionWorld(robot, [], self_margin_m=0.01).self_collision
+    refused = held.violated(q, 0.01)
+    meshes_m = _meshes_apart_m(robot, close.geometries, q)
+    assert 0.05 < np.mean(meshes_m <= 0.0) < 0.5  # the meshes meet in places (oracle: trimesh + coal)
+    assert refused[meshes_m <= 0.0].all()  # held to contact: meeting is refused still
+    assert np.mean(~refused) > 0.3 and np.all(meshes_m[~refused] > 0.0)
+    scene = parse_scene(
+        {
+            "name": "finger",
+            "robot": FINGER,
+            "start": {"q": [0.0, -0.5, 1.0]},
+            "goal": {"q": [0.6, 0.5, -1.2]},
+            "obstacles": [],
+        }
+    )
+    result = plan(scene, robot)
+    assert not verify_for_scene(build_problem(scene, robot), result.trajectory).problems  # `check`'s verdict
+    assert "finger_base_link / finger_middle_link" in report_markdown(result)

@@ -180,7 +180,7 @@ class RobotSpec:
             overlapping_links=tuple(
                 dict.fromkeys((geometries[a].link, geometries[b].link) for a, b in overlapping)
             ),
-            close_pairs=close_pairs(model, collision, kept, [g.link for g in geometries]),
+            close_pairs=close_pairs(model, collision, kept, [g.link for g in geometries], meshes=exact),
             srdf_unknown_links=srdf_pairs.unknown_links,
             massless_links=massless_links(tree, model),
             capsule_meshes=tuple(collision.geometryObjects[m.geometry].name for m in meshes if not m.hull),

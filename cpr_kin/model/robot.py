@@ -100,8 +100,8 @@ class Robot:
         srdf_unknown_links: links the SRDF names that the URDF lacks (their entries skipped).
         overlapping_links: link pairs whose shapes collide in every sampled configuration,
             touching by design and not checked (:mod:`cpr_kin.bounds.overlapping_pairs`).
-        close_pairs: checked pairs a few millimetres apart in every sampled configuration and
-            touching in none, held to contact only by a self margin above their largest
+        close_pairs: checked pairs a few millimetres apart in every sampled configuration where
+            they do not meet, held to contact only by a self margin above their largest
             distance (:mod:`cpr_kin.bounds.close_pairs`).
         massless_links: links a planned joint moves that have a shape but no ``<inertial>``
             (massless, the URDF's rule; :mod:`cpr_kin.kinematics.dynamics`).

@@ -191,8 +191,8 @@ def limits_section(result: PlanResult) -> list[str]:
             f"{c.links[0]} / {c.links[1]} ({1000 * c.largest_m:.1f} mm)" for c in held_to_contact
         )
         lines += [
-            "Link pairs within the self margin in every sampled configuration and touching in none, "
-            f"held to contact only (their largest sampled distance): {pairs}.",
+            "Link pairs within the self margin in every sampled configuration where they do not "
+            f"touch, held to contact only (their largest sampled distance): {pairs}.",
             "",
         ]
     if robot.capsule_meshes:
