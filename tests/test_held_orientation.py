@@ -280,3 +280,51 @@ def test_a_carry_the_constraint_cannot_reach_stops_at_the_time_limit() -> None:
         NoSolutionError, match=r"by the time limit \(2 s; RRT-Connect on the constraint stopped"
     ):
         plan_task(read.scene, read.task, ur10)
+
+
+def test_a_carry_to_a_tool_position_ends_with_the_tool_upright_at_it() -> None:
+    # a tool position leaves the orientation to the IK, whose nearest solution turned the UR5's
+    # tool 0.4 rad off the upright (refused as bad input); the constraint's orientation is meant
+    goal_m = [0.45, 0.3, 0.3]
+    document = {
+        "robot": "ur5",
+        "safety_margin": 0.02,
+        "start": {"q": ARMS["ur5"]["start"]},
+        "task": [
+            {"move": {"pose": {"xyz": [0.5, -0.25, 0.3], "rpy": DOWN}}},
+            {"move": {"tcp": goal_m, "constraint": UPRIGHT}},
+        ],
+    }
+    read = parse_scene_file(document, "ur5 upright carry to a tool position")
+    task = plan_task(read.scene, read.task)
+    assert task.accepted, task.problems
+    robot = task.world.robot
+    model, data = robot.model, robot.model.createData()
+    fid = model.getFrameId(robot.tcp_frame)
+    carry = task.segments[1]
+    axes = []
+    for t in (carry.t0, carry.t1):  # pinocchio's forward kinematics, the oracle
+        pin.framesForwardKinematics(model, data, task.trajectory(t))
+        axes.append(data.oMf[fid].rotation[:, 2].copy())
+    np.testing.assert_allclose(data.oMf[fid].translation, goal_m, atol=1e-4)  # the goal's tolerance
+    assert np.arccos(np.clip(axes[0] @ axes[1], -1.0, 1.0)) <= UPRIGHT["angle_rad"]
+
+
+def test_a_tool_position_the_arm_cannot_hold_upright_is_refused_naming_it() -> None:
+    # the SO-101 (five joints) points its tool along its arm's vertical plane: held along the
+    # world's x axis, its tool cannot reach a point off that plane
+    so101 = ck.load_robot(example_robot("so101"))
+    middle = ((so101.limits.lower + so101.limits.upper) / 2).tolist()
+    document = {
+        "robot": "so101",
+        "safety_margin": 0.01,
+        "start": {"q": middle},
+        "task": [{"move": {"tcp": [0.2, 0.1, 0.15], "constraint": UPRIGHT}}],
+    }
+    read = parse_scene_file(document, "so101 held off its plane")
+    with pytest.raises(
+        PlanningError,
+        match=r"task\[0\] \(move\): the motion's goal: the arm cannot turn 'gripper_frame_link' onto the "
+        r"constraint's orientation about \['x', 'y'\] with the tool at \[0\.2, 0\.1, 0\.15\] m",
+    ):
+        plan_task(read.scene, read.task, so101)

@@ -20,15 +20,17 @@ from numpy.typing import NDArray
 
 import cpr_kin as ck
 from planning.curves.trajectory import Trajectory
-from planning.errors import PlanningError
+from planning.errors import CprPlanError, PlanningError
 from planning.pipeline.deadline import Deadline
 from planning.pipeline.planner import solve
 from planning.pipeline.problem import Problem, build_problem
 from planning.pipeline.scene import Scene
+from planning.pipeline.target import Target
 from planning.pipeline.timing import FreeDuration
 from planning.pipeline.verification import Requirements
 from planning.task.held_orientation import HeldMotion, goal_on_constraint, hold_orientation
 from planning.task.orientation import OrientationConstraint
+from planning.task.orientation_projection import Projector
 
 if TYPE_CHECKING:
     from planning.search.firefly import FireflyProgress
@@ -84,6 +86,17 @@ def plan_free(
         return FreeMotion(solve(problem, progress).trajectory, problem)
     on_constraint = functools.partial(_on_constraint, robot, constraint, goal_test)
     problem = free_problem(scene, robot, threads, on_constraint)
+    turned = _goal_turned_onto(problem, constraint)
+    if turned is not None:  # a tool position whose IK solution turns the tool off the constraint
+        try:
+            problem = free_problem(dataclasses.replace(scene, goal=turned), robot, threads, on_constraint)
+        except (CprPlanError, ck.CprKinError) as exc:
+            at_m = list(scene.goal.tcp or ())
+            raise PlanningError(
+                f"the motion's goal: the arm cannot hold '{robot.tcp_frame}' at {at_m} m in the constraint's "
+                f"orientation about {list(constraint.axes)} ({exc}): move the goal, or allow a larger "
+                "angle_rad"
+            ) from None
     deadline = Deadline.after(scene.planner.time_limit_s, time.perf_counter())  # the search's own clock
     free = solve(problem, progress).trajectory
     held = hold_orientation(problem.world, free, constraint, required, scene.planner.seed, deadline)
@@ -104,6 +117,47 @@ def _on_constraint(
     if goal_test is None:
         return on_constraint
     return lambda q: on_constraint(q) and goal_test(q)
+
+
+def _goal_turned_onto(problem: Problem, constraint: OrientationConstraint) -> Target | None:
+    """A ``tcp`` goal turned onto ``constraint``: the pose its IK solution takes there, or ``None``.
+
+    A tool position leaves the tool's orientation to the IK, which may turn it off the
+    constraint (a 6- or 7-joint arm's solutions turn it any way); the constraint's own
+    orientation is the one meant. Where ``problem``'s goal is a ``tcp`` goal of the tool frame
+    whose solution does not keep the constraint, it is moved the least onto it, the tool held
+    where it is (:meth:`~planning.task.orientation_projection.Projector.project`), and its
+    orientation there, with the goal's position, is the pose goal returned (solved and verified
+    as every pose is). ``None`` where the goal keeps the constraint, is no tool position of the
+    tool frame, or the start breaks the constraint (:func:`hold_orientation` names it).
+
+    Raises:
+        PlanningError: the arm cannot turn the tool onto the constraint there.
+    """
+    robot, goal = problem.robot, problem.scene.goal
+    if goal.tcp is None or constraint.frame not in (None, robot.tcp_frame):
+        return None
+    frame = robot.tcp_frame
+    start = ck.frame_poses(robot, problem.q_start[None], frame)[0]
+    held = constraint.about(start[:3, :3])
+    projector = Projector(robot, frame, held, held.reference())
+    start_rad, goal_rad = projector.angles(np.array([problem.q_start, problem.q_goal]))
+    if start_rad > held.angle_rad or goal_rad <= held.angle_rad:  # a start that breaks it is the error
+        return None
+    q, angle = projector.project(problem.q_goal, keep_position=True)
+    if angle > projector.aim_rad:
+        raise PlanningError(
+            f"the motion's goal: the arm cannot turn '{frame}' onto the constraint's orientation about "
+            f"{list(held.axes)} with the tool at {list(goal.tcp)} m (turned the least, it comes "
+            f"{angle:.4g} rad from it; allowed {held.angle_rad:.4g} rad): move the goal, or allow a larger "
+            "angle_rad"
+        )
+    rotation = ck.frame_poses(robot, q[None], frame)[0][:3, :3]
+    return Target(
+        pose=(tuple(goal.tcp), tuple(map(tuple, rotation.tolist()))),
+        tolerance_m=goal.tolerance_m,
+        tolerance_rad=goal.tolerance_rad,
+    )
 
 
 def free_problem(
