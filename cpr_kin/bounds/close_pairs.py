@@ -38,7 +38,7 @@ SAMPLES = 1000
 """Seeded configurations in which a pair must stay close to be close by design."""
 MESH_SAMPLES = 16
 """Of those, the configurations where a pair refined by exact meshes is measured on them: those
-where its shapes are farthest apart (``docs/tuning.md``, Exact meshes)."""
+where its shapes are farthest apart (``docs/tuning.md``, Pairs close by design)."""
 CLOSE_LIMIT_M = 0.05
 """Largest distance [m] a pair close by design may keep: a self margin above it excuses no
 pair farther than this."""

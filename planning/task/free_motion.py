@@ -137,10 +137,8 @@ def _goal_turned_onto(problem: Problem, constraint: OrientationConstraint) -> Ta
     robot, goal = problem.robot, problem.scene.goal
     if goal.tcp is None or constraint.frame not in (None, robot.tcp_frame):
         return None
-    frame = robot.tcp_frame
-    start = ck.frame_poses(robot, problem.q_start[None], frame)[0]
-    held = constraint.about(start[:3, :3])
-    projector = Projector(robot, frame, held, held.reference())
+    projector = Projector.from_start(robot, constraint, problem.q_start)
+    frame, held = projector.frame, projector.constraint
     start_rad, goal_rad = projector.angles(np.array([problem.q_start, problem.q_goal]))
     if start_rad > held.angle_rad or goal_rad <= held.angle_rad:  # a start that breaks it is the error
         return None

@@ -104,12 +104,9 @@ def hold_orientation(
         NoSolutionError: neither the bent path nor one planned on the constraint keeps it and
             the margins (why, for both), or the timed motion leaves it.
     """
-    robot = world.robot
-    frame = constraint.frame or robot.tcp_frame
     ends = free(free.knots[[0, -1]])
-    poses = ck.frame_poses(robot, ends, frame)
-    constraint = constraint.about(poses[0][:3, :3])
-    projector = Projector(robot, frame, constraint, constraint.reference())
+    projector = Projector.from_start(world.robot, constraint, ends[0])
+    frame, constraint = projector.frame, projector.constraint
     for label, angle in zip(("start", "goal"), projector.angles(ends), strict=True):
         if angle > constraint.angle_rad:
             raise PlanningError(
@@ -161,9 +158,7 @@ def goal_on_constraint(
     constraint (as a free path is bent), keeps it without a jump: a way along the
     constraint, obstacles aside.
     """
-    frame = constraint.frame or robot.tcp_frame
-    held = constraint.about(ck.frame_poses(robot, q_start[None], frame)[0][:3, :3])
-    projector = Projector(robot, frame, held, held.reference())
+    projector = Projector.from_start(robot, constraint, q_start)
 
     def reached(q_goal: FloatArray) -> bool:
         count = int(np.clip(math.ceil(np.abs(q_goal - q_start).max() / PROBE_STEP) + 1, 3, MOST_SAMPLES))

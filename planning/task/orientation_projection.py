@@ -57,6 +57,17 @@ class Projector:
             for keep in (0.0, 1.0)
         )
 
+    @classmethod
+    def from_start(cls, robot: ck.Robot, constraint: OrientationConstraint, q_start: FloatArray) -> Projector:
+        """The projector of a motion that starts at ``q_start``.
+
+        ``constraint``'s frame (the robot's tool frame where it names none); its reference that
+        frame's orientation at ``q_start`` where it names none.
+        """
+        frame = constraint.frame or robot.tcp_frame
+        held = constraint.about(ck.frame_poses(robot, np.asarray(q_start)[None], frame)[0][:3, :3])
+        return cls(robot, frame, held, held.reference())
+
     def angles(self, configurations: FloatArray) -> FloatArray:
         """``(N,)`` the constraint's angle of each of ``configurations`` ``(N, nq)`` [rad]."""
         rotations = ck.frame_poses(self.robot, configurations, self.frame)[:, :3, :3]
