@@ -9,11 +9,14 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 import pytest
+from lxml import etree
 
 import cpr_kin as ck
-from cpr_kin.description.supported import MAX_CROSSING_S, crossing_time
+from cpr_kin.description.supported import MAX_CROSSING_S, check_tree, crossing_time
 from cpr_kin.model.limits import DEFAULT_ACCELERATION_PER_S, DEFAULT_JERK_PER_S
+from cpr_kin.model.packages import example_robot_data_share
 from planning import PlannerSettings, paper_scene, plan
 from planning.cli import main
 
@@ -36,6 +39,7 @@ def theta1_limit(lower: str, upper: str, velocity: str = "1.5") -> Callable[[str
     )
 
 
+BRACE = '<joint name="brace" type="fixed"><parent link="base_link"/><child link="arm_link"/></joint>'
 SUPPORTED = r"the planner supports lower < upper within \[-6.2832, 6.2832\] rad"
 REFUSED = [
     ("range 1e3", theta1_limit("-1000", "1000"),
@@ -55,6 +59,20 @@ REFUSED = [
      r"the joint name 'd\\u202e2' holds U\+202E \(RIGHT-TO-LEFT OVERRIDE\)"),
     ("control character", lambda t: t.replace('link name="tcp"', 'link name="t\x85cp"'),
      r"the link name 't\\x85cp' holds U\+0085"),
+    ("closed loop", lambda t: t.replace('<parent link="base_link"/><child link="column_link"/>',
+                                        '<parent link="tool_link"/><child link="column_link"/>'),
+     r"joints 'd2' \(column_link -> carriage_link\), 'd3' \(carriage_link -> arm_link\), "
+     r"'theta4' \(arm_link -> wrist_link\), 'theta5' \(wrist_link -> tool_link\), "
+     r"'theta1' \(tool_link -> column_link\) close a loop, which hangs from no root link"),
+    ("two parents", lambda t: t.replace("</robot>", BRACE + "</robot>"),
+     r"link 'arm_link' is the child of joints 'd3' and 'brace'; a link hangs from one joint at most"),
+    ("second root", lambda t: t.replace("</robot>", '<link name="stray"/></robot>'),
+     r"links 'base_link', 'stray' are each the child of no joint; .* join the others to 'base_link's tree"),
+    ("undefined link", lambda t: t.replace('<child link="tcp"/>', '<child link="tpc"/>'),
+     r"joint 'tcp_joint' names child link 'tpc', which the file does not define; a joint joins two of its "
+     r"links \('base_link', 'column_link', .* 'tcp'\)"),
+    ("link defined twice", lambda t: t.replace('<link name="tcp"/>', '<link name="tcp"/><link name="tcp"/>'),
+     r"link name\(s\) 'tcp' are defined more than once"),
     ("NaN lower limit", theta1_limit("nan", "2.9"),
      r"joint 'theta1' limit lower = 'nan' is not supported; give a finite number$"),
     ("velocity below zero", theta1_limit("-2.9", "2.9", "-1.5"),
@@ -80,6 +98,31 @@ def test_an_unsupported_urdf_is_refused_at_load_naming_the_joint(
 ) -> None:
     with pytest.raises(ck.UrdfError, match=message):
         ck.load_cpr(variant(tmp_path, edit))
+
+
+def test_every_link_of_a_tree_the_check_passes_is_a_frame_of_pinocchios_model(tmp_path: Path) -> None:
+    # the oracle: Pinocchio's parser builds every link of a tree; of a closed loop only the
+    # root, which is what the loader said before ("no link or frame named 'tcp'")
+    share = example_robot_data_share()
+    assert share is not None, "example-robot-data is part of the robots extra, which make installs"
+    files = sorted((share / "example-robot-data" / "robots").glob("*/*/*.urdf"))
+    passed = 0
+    for path in [*files, ck.cpr_urdf_path()]:
+        try:  # a xacro file, or a robot without a name: not a URDF Pinocchio reads
+            model = pin.buildModelFromUrdf(str(path))
+        except ValueError:
+            continue
+        tree = etree.parse(str(path))
+        check_tree(tree, path)
+        links = {link.get("name") for link in tree.getroot().findall("link")}
+        assert links <= {frame.name for frame in model.frames}, path
+        passed += 1
+    assert passed >= 40
+    loop = variant(tmp_path, lambda t: t.replace('<parent link="base_link"/>', '<parent link="tool_link"/>'))
+    built = {frame.name for frame in pin.buildModelFromUrdf(str(loop)).frames}
+    assert "tcp" not in built
+    with pytest.raises(ck.UrdfError, match="close a loop"):
+        check_tree(etree.parse(str(loop)), loop)
 
 
 def test_a_moment_below_zero_by_rounding_loads(tmp_path: Path) -> None:
