@@ -1,4 +1,4 @@
-"""Scenes drawn for any arm: start and goal keep their clearances, far apart, the ball above the base."""
+"""Scenes drawn for any arm: start and goal keep their clearances, far apart, the ball on the arm's side."""
 
 from __future__ import annotations
 
@@ -14,12 +14,14 @@ import yaml
 
 import cpr_kin as ck
 from cpr_kin.model.packages import example_robot, example_robot_data_share
-from planning.bench.arm_scenes import blocked_scene
+from planning.bench.arm_scenes import blocked_scene, reaching_side
 from planning.bench.mbm import endpoint_violations
 from planning.errors import PlanningError
 from planning.io.scene_file import parse_scene
 from planning.pipeline.endpoints import margin_violation
+from planning.pipeline.planner import plan
 from planning.pipeline.problem import build_problem
+from planning.pipeline.verification import verify_for_scene
 
 
 @pytest.fixture(scope="module")
@@ -116,19 +118,55 @@ def test_the_script_writes_no_file_when_a_scene_cannot_be_drawn(tmp_path: Path) 
     assert "Traceback" not in done.stderr and not out.exists()
 
 
-def test_an_arm_that_hangs_below_its_base_is_told_why_it_gets_no_scene() -> None:
+def test_an_arm_that_hangs_below_its_base_gets_its_ball_below_it_and_plans() -> None:
     # example-robot-data's hextilt flying arm hangs below the drone: every draw's midway tool
-    # point is below the base, and the message once said only "lower self_clearance_m"
+    # point lay below the base, and the generator refused it ("write its scenes by hand")
     share = example_robot_data_share()
     assert share is not None
     urdf = share / "example-robot-data/robots/hextilt_description/urdf/hextilt_flying_arm_5.urdf"
     arm = ck.load_robot(urdf)
+    reach = float(
+        np.linalg.norm(ck.frame_poses(arm, ((arm.limits.lower + arm.limits.upper) / 2)[None])[0][:3, 3])
+    )
+    assert reaching_side(arm, reach) == -1
+    document = blocked_scene("hextilt_0", str(urdf), arm, 0)
+    ball = document["obstacles"][0]
+    assert ball["xyz"][2] <= -0.1 * ball["radius"] / 0.12  # a tenth of the reach below the base
+    scene = parse_scene(document)
+    result = plan(scene, arm)
+    assert not verify_for_scene(build_problem(scene, arm), result.trajectory).problems  # `check`'s verdict
+    for name in ("ur5", "panda"):  # arms that reach up (the UR about as far below its base as above)
+        robot = ck.load_robot(example_robot(name))
+        assert reaching_side(robot, 1.0) == 1
+
+
+PLANAR_ARM = """<robot name="planar">
+  <link name="base"/>
+  <link name="upper"><collision><origin xyz="0.15 0 0"/><geometry><box size="0.3 0.04 0.04"/></geometry>
+    </collision></link>
+  <link name="fore"><collision><origin xyz="0.15 0 0"/><geometry><box size="0.3 0.04 0.04"/></geometry>
+    </collision></link>
+  <link name="tool"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="upper"/><axis xyz="0 0 1"/>
+    <limit lower="-2.5" upper="2.5" velocity="1" effort="100"/></joint>
+  <joint name="j2" type="revolute"><parent link="upper"/><child link="fore"/><origin xyz="0.3 0 0"/>
+    <axis xyz="0 0 1"/><limit lower="-2.5" upper="2.5" velocity="1" effort="100"/></joint>
+  <joint name="t" type="fixed"><parent link="fore"/><child link="tool"/><origin xyz="0.3 0 0"/></joint>
+</robot>
+"""
+
+
+def test_an_arm_that_moves_in_its_bases_horizontal_plane_is_told_why_it_gets_no_scene(tmp_path: Path) -> None:
+    urdf = tmp_path / "planar.urdf"
+    urdf.write_text(PLANAR_ARM)
+    arm = ck.load_robot(urdf)
     with pytest.raises(
         PlanningError,
-        match=r"\(refused: .*\d+ with the tool's midway point less than a tenth of the reach above the "
-        r"base.*\); the generator draws arms that reach up from their base",
+        match=r"\(refused: .*\d+ with the tool's midway point less than a tenth of the reach from the "
+        r"base's height.*\); the generator puts the ball a tenth of the reach above the base .* an arm "
+        r"that moves about its base's height \(in its horizontal plane\) has no such scene",
     ):
-        blocked_scene("hextilt_0", str(urdf), arm, 0, draws=50)
+        blocked_scene("planar_0", str(urdf), arm, 0, draws=50)
 
 
 def test_a_goal_pose_is_valid_when_a_clear_ik_solution_reaches_it() -> None:

@@ -5,7 +5,10 @@ brings (a URDF, an example-robot-data name) has none we know. So :func:`blocked_
 in the robot's own joint space: a start configuration and a goal configuration in the middle
 60 % of every joint's range whose tool positions lie at least half the arm's reach apart,
 and a ball of 12 % of that reach at the tool's position halfway along the straight joint-space
-way between them, at least 10 % of the reach above the base. The goal is given as the tool's
+way between them, at least 10 % of the reach from the base's height on the side the arm
+reaches: above the base, or below it for an arm that hangs (a flying arm under its drone,
+an arm mounted upside down), one whose median tool height over the middle of its ranges
+lies more than 10 % of its reach below the base (:func:`reaching_side`). The goal is given as the tool's
 pose (solved by the planner's IK), the start as the configuration. Start and goal must keep
 ``margin_m + 0.02`` m from the ball and ``self_clearance_m`` between the robot's own checked
 pairs, and gravity's torques there must be within the URDF's effort limits (the planner
@@ -31,6 +34,26 @@ from planning.validation import integer_in, number_in
 
 DRAWS = 4000
 """Most draws of a start and goal before :func:`blocked_scene` gives up."""
+SIDE_DRAWS = 256
+"""Configurations whose tool heights tell on which side of its base an arm reaches (:func:`reaching_side`)."""
+BASE_LEVEL_SHARE = 0.1
+"""How far from the base's height the ball's centre lies at least, and how far below it an arm's
+median tool height must lie for it to hang, as a share of the arm's reach."""
+
+
+def reaching_side(robot: ck.Robot, reach_m: float) -> int:
+    """``1`` where ``robot`` reaches up from its base, ``-1`` where it hangs below it.
+
+    It hangs where the median tool height [m] of :data:`SIDE_DRAWS` configurations drawn in the
+    middle 60 % of its ranges (a fixed seed: the scenes' own draws are untouched) lies more
+    than :data:`BASE_LEVEL_SHARE` of its reach ``reach_m`` [m] below the base; a UR arm,
+    which reaches about as far below its base as above it, reaches up.
+    """
+    lower, upper = robot.limits.lower, robot.limits.upper
+    middle, half = (lower + upper) / 2, (upper - lower) / 2
+    draws = np.random.default_rng(0).uniform(middle - 0.6 * half, middle + 0.6 * half, (SIDE_DRAWS, robot.nq))
+    height_m = float(np.median(ck.frame_poses(robot, draws)[:, 2, 3]))
+    return -1 if height_m < -BASE_LEVEL_SHARE * reach_m else 1
 
 
 def blocked_scene(
@@ -67,6 +90,7 @@ def blocked_scene(
     lower, upper = robot.limits.lower, robot.limits.upper
     middle, half = (lower + upper) / 2, (upper - lower) / 2
     reach = float(np.linalg.norm(ck.frame_poses(robot, middle[None])[0][:3, 3]))
+    side = reaching_side(robot, reach)
     dynamics = ck.robot_dynamics(robot)
     too_close: Counter[tuple[str, str]] = Counter()  # the closest pair of each end refused for it
     refused: Counter[str] = Counter()  # why each draw was refused (REFUSALS' keys)
@@ -76,7 +100,7 @@ def blocked_scene(
         if np.linalg.norm(tools[0, :3, 3] - tools[2, :3, 3]) < 0.5 * reach:
             refused["near"] += 1
             continue
-        if tools[1, 2, 3] < 0.1 * reach:
+        if side * tools[1, 2, 3] < BASE_LEVEL_SHARE * reach:
             refused["low"] += 1
             continue
         ball = ck.Obstacle.sphere(0.12 * reach, tuple(tools[1, :3, 3]), name="ball")
@@ -118,7 +142,7 @@ def blocked_scene(
 
 REFUSALS = {
     "near": "with the tool's ends less than half the reach apart",
-    "low": "with the tool's midway point less than a tenth of the reach above the base",
+    "low": "with the tool's midway point less than a tenth of the reach from the base's height",
     "ball": "with an end near the ball",
     "self": "with the robot's own pairs too close",
     "gravity": "where the motors cannot hold an end against gravity",
@@ -138,8 +162,9 @@ def _fix(blocker: str, robot: ck.Robot, too_close: Counter[tuple[str, str]]) -> 
         )
     if blocker == "low":
         return (
-            "the generator draws arms that reach up from their base, with the ball above it; an arm "
-            "that hangs below its base (a flying arm) has no such scene: write its scenes by hand"
+            "the generator puts the ball a tenth of the reach above the base of an arm that reaches up, "
+            "below the base of one that hangs; an arm that moves about its base's height (in its "
+            "horizontal plane) has no such scene: write its scenes by hand"
         )
     if blocker == "ball":
         return "its links stay near the ball whatever its ends: lower margin_m, or write its scenes by hand"
