@@ -178,6 +178,24 @@ def test_a_five_joint_arm_cannot_hold_its_orientation_across_its_arm() -> None:
     assert 0.0 <= broken.value.fraction < 0.5
 
 
+def test_a_frame_too_few_joints_move_is_told_so_not_a_singularity() -> None:
+    # the Panda's link3 is moved by its first three joints: its Jacobian has rank 3 everywhere,
+    # and the message said only "it passes through a singularity of the arm"
+    robot = ck.load_robot(example_robot("panda"))
+    world = ck.CollisionWorld(robot, [])
+    home = robot.configuration([0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785])
+    model, data = robot.model, robot.model.createData()
+    jacobian = pin.computeFrameJacobian(model, data, home, model.getFrameId("panda_link3"))
+    assert np.linalg.matrix_rank(jacobian) == 3  # the oracle: Pinocchio's own Jacobian
+    line = ToolLine(by=(0.05, 0.0, 0.0), offset_frame="base", frame="panda_link3")
+    with pytest.raises(
+        ToolLineBrokenError,
+        match=r"frame 'panda_link3' is moved by 3 joint\(s\) \(panda_joint1, panda_joint2, panda_joint3\), "
+        r"fewer than the 6 values of its pose the line holds: hold a frame the whole arm moves",
+    ):
+        plan_line(world, home, line, NO_MARGIN)
+
+
 def test_an_obstacle_on_the_line_breaks_it_where_the_margin_is_first_crossed() -> None:
     robot = ck.load_cpr()
     q = robot.configuration([0.3, 0.3, 0.25, 0.2, 0.5])

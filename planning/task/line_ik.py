@@ -190,7 +190,7 @@ def _walk(
         last = samples[broken - 1]
         jacobian = _jacobian(robot.model, robot.data, robot.frame_id(frame), last) * weights[:, None]
         raise ToolLineBrokenError(
-            _why(robot, found, np.abs(found - last), excess, jacobian), float(sigma[broken - 1])
+            _why(robot, frame, found, np.abs(found - last), excess, jacobian), float(sigma[broken - 1])
         )
     return samples, residual
 
@@ -199,8 +199,10 @@ def _jacobian(model: object, data: object, fid: int, q: FloatArray) -> FloatArra
     return np.asarray(pin.computeFrameJacobian(model, data, q, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED))
 
 
-def _why(robot: ck.Robot, q: FloatArray, jump: FloatArray, excess: float, jacobian: FloatArray) -> str:
-    """Why the walk stops at ``q``, in words."""
+def _why(
+    robot: ck.Robot, frame: str, q: FloatArray, jump: FloatArray, excess: float, jacobian: FloatArray
+) -> str:
+    """Why the walk stops at ``q``, in words (``jacobian``: ``frame``'s, weighted, at the last sample)."""
     names, lower, upper = robot.joint_names, *joint_range(robot)
     if jump.max() > LARGEST_JOINT_STEP:
         j = int(np.argmax(jump))
@@ -217,6 +219,14 @@ def _why(robot: ck.Robot, q: FloatArray, jump: FloatArray, excess: float, jacobi
         )
     values = np.linalg.svd(jacobian, compute_uv=False)
     if values[-1] < SINGULAR * values[0]:
+        moving = [names[j] for j in np.flatnonzero(np.linalg.norm(jacobian, axis=0) > 0.0)]
+        rank = int(np.count_nonzero(values >= SINGULAR * values[0]))
+        if rank == len(moving) < len(jacobian):  # too few joints, not a singularity of them
+            return (
+                f"frame '{frame}' is moved by {len(moving)} joint(s) ({', '.join(moving)}), fewer than the "
+                f"{len(jacobian)} values of its pose the line holds: hold a frame the whole arm moves, such "
+                "as the tool's"
+            )
         return "it passes through a singularity of the arm"
     return (
         f"the arm cannot take the line's pose there (it stays {excess:.3g} x the tolerance away: "
