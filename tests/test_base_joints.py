@@ -17,6 +17,7 @@ import yourdfpy
 
 import cpr_kin as ck
 from planning import PlannerSettings, paper_scene, plan
+from planning.cli import main
 
 URDF = ck.cpr_urdf_path().read_text()
 ROOT_LINK = '<link name="base_link">'
@@ -41,6 +42,7 @@ def test_the_base_joint_is_held_at_its_identity_and_the_kinematics_are_the_arms(
     based = ck.load_robot(on_a_base(tmp_path, kind))
     plain = ck.load_robot(ck.cpr_urdf_path())
     assert based.limits.names == plain.limits.names and "base_joint" not in based.held
+    assert based.base_joints == ("base_joint",) and plain.base_joints == ()
     rng = np.random.default_rng(7)
     q = rng.uniform(plain.limits.lower, plain.limits.upper, size=(20, plain.nq))
     for frame in ("tcp", "column_link", "wrist_link"):
@@ -55,6 +57,15 @@ def test_a_robot_on_a_planar_base_plans_what_the_fixed_one_plans(tmp_path: Path)
     plain = plan(scene, ck.load_robot(ck.cpr_urdf_path()))
     assert based.verification.accepted
     assert based.trajectory.duration == pytest.approx(plain.trajectory.duration, rel=1e-9)
+
+
+def test_robot_info_names_the_held_base_joint(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # it listed the planned and held joints only: the base's joint was nowhere
+    assert main(["robot-info", str(on_a_base(tmp_path, "floating"))]) == 0
+    assert (
+        "base joints held at their identity pose (the scene's frame is their child link's): base_joint"
+        in (capsys.readouterr().out)
+    )
 
 
 def test_a_base_joint_is_refused_as_planned_or_held_naming_why(tmp_path: Path) -> None:

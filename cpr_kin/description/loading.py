@@ -175,6 +175,7 @@ class RobotSpec:
             limits_path=dynamic.source,
             limits_defaulted=dynamic.defaulted,
             held=held,
+            base_joints=bases,
             srdf_path=srdf,
             self_pairs=kept,
             overlapping_links=tuple(

@@ -94,6 +94,8 @@ class Robot:
             the documented defaults, :func:`cpr_kin.model.limits.default_limits`).
         limits_defaulted: the joints whose acceleration or jerk limit is a default.
         held: the URDF's joints that are not planned, at the values they are held at.
+        base_joints: the URDF's ``planar`` and ``floating`` joints (a mobile base's), never
+            planned and held at their identity pose: the scene's frame is their child link's.
         srdf_path: the SRDF whose ``disable_collisions`` were applied, if any.
         self_pairs: indices of the collision geometry pairs checked against each other
             (:mod:`cpr_kin.collision.self_collision`); empty: the robot cannot meet itself.
@@ -127,6 +129,7 @@ class Robot:
     limits_path: Path | None = None
     limits_defaulted: tuple[str, ...] = ()
     held: Mapping[str, float] = field(default_factory=dict)
+    base_joints: tuple[str, ...] = ()
     srdf_path: Path | None = None
     self_pairs: tuple[tuple[int, int], ...] = ()
     srdf_unknown_links: tuple[str, ...] = ()

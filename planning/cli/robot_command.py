@@ -38,6 +38,7 @@ def robot_report(robot: ck.Robot) -> dict[str, Any]:
             for k, name in enumerate(limits.names)
         ],
         "held": dict(robot.held),
+        "base_joints": list(robot.base_joints),
         "tcp_frame": robot.tcp_frame,
         "excess_samples": SAMPLES,
         "shapes": [
@@ -97,6 +98,14 @@ def cmd_robot_info(args: argparse.Namespace) -> int:
             for j in report["joints"]
         ),
         f"held joints: {report['held'] or 'none'}",
+        *(
+            [
+                f"base joints held at their identity pose (the scene's frame is their child link's): "
+                f"{', '.join(report['base_joints'])}"
+            ]
+            if report["base_joints"]
+            else []
+        ),
         f"tool frame: {report['tcp_frame']}",
         f"collision shapes ({len(report['shapes'])}), each shape's largest distance beyond its link mesh "
         f"(sampled on {report['excess_samples']:,} points; about the spacing below the true largest):",
