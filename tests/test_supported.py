@@ -9,14 +9,11 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
-import pinocchio as pin
 import pytest
-from lxml import etree
 
 import cpr_kin as ck
-from cpr_kin.description.supported import MAX_CROSSING_S, check_tree, crossing_time
+from cpr_kin.description.supported import MAX_CROSSING_S, crossing_time
 from cpr_kin.model.limits import DEFAULT_ACCELERATION_PER_S, DEFAULT_JERK_PER_S
-from cpr_kin.model.packages import example_robot_data_share
 from planning import PlannerSettings, paper_scene, plan
 from planning.cli import main
 
@@ -98,31 +95,6 @@ def test_an_unsupported_urdf_is_refused_at_load_naming_the_joint(
 ) -> None:
     with pytest.raises(ck.UrdfError, match=message):
         ck.load_cpr(variant(tmp_path, edit))
-
-
-def test_every_link_of_a_tree_the_check_passes_is_a_frame_of_pinocchios_model(tmp_path: Path) -> None:
-    # the oracle: Pinocchio's parser builds every link of a tree; of a closed loop only the
-    # root, which is what the loader said before ("no link or frame named 'tcp'")
-    share = example_robot_data_share()
-    assert share is not None, "example-robot-data is part of the robots extra, which make installs"
-    files = sorted((share / "example-robot-data" / "robots").glob("*/*/*.urdf"))
-    passed = 0
-    for path in [*files, ck.cpr_urdf_path()]:
-        try:  # a xacro file, or a robot without a name: not a URDF Pinocchio reads
-            model = pin.buildModelFromUrdf(str(path))
-        except ValueError:
-            continue
-        tree = etree.parse(str(path))
-        check_tree(tree, path)
-        links = {link.get("name") for link in tree.getroot().findall("link")}
-        assert links <= {frame.name for frame in model.frames}, path
-        passed += 1
-    assert passed >= 40
-    loop = variant(tmp_path, lambda t: t.replace('<parent link="base_link"/>', '<parent link="tool_link"/>'))
-    built = {frame.name for frame in pin.buildModelFromUrdf(str(loop)).frames}
-    assert "tcp" not in built
-    with pytest.raises(ck.UrdfError, match="close a loop"):
-        check_tree(etree.parse(str(loop)), loop)
 
 
 def test_a_moment_below_zero_by_rounding_loads(tmp_path: Path) -> None:
