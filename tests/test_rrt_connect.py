@@ -11,8 +11,9 @@ import pytest
 from numpy.typing import NDArray
 
 from planning.errors import PlanningError
-from planning.search.rrt_connect import Relaxation, rrt_connect
+from planning.search.rrt_connect import Relaxation, _Sampler, rrt_connect
 from planning.search.rrt_settings import RrtSettings
+from planning.search.rrt_trees import Tree
 from planning.search.waypoints import waypoints_along
 
 WEIGHTS = np.ones(2)
@@ -302,3 +303,23 @@ def test_a_relaxation_changes_nothing_before_its_samples_and_holds_at_once_for_e
     assert found is not None and found.relaxed
     # held at the check's resolution: the looser wall eroded by it, as `eroded` for the strict one
     assert densely_valid(found.path, lambda q: wall_with_slot(q, 0.02 + RrtSettings().resolution_m))
+
+
+def test_the_samplers_uniform_draws_are_numpys_uniform_to_the_bit() -> None:
+    # the identity the sampler's shortcut rests on: low + (high - low) * u from the same u
+    lower, upper = np.array([-2.9, 0.0, 0.05, -3.1, -1e-3]), np.array([2.9, 0.6, 0.5, 3.1, 2.5])
+    sampler = _Sampler(lower, upper, dataclasses.replace(RrtSettings(), local_share=0.0))
+    ours, numpys = np.random.default_rng(12), np.random.default_rng(12)
+    root = Tree(np.zeros(5))
+    for _ in range(500):
+        np.testing.assert_array_equal(sampler(root, ours), numpys.uniform(lower, upper))
+    local = _Sampler(lower, upper, dataclasses.replace(RrtSettings(), local_share=0.5))
+    ours, numpys = np.random.default_rng(13), np.random.default_rng(13)
+    for _ in range(500):  # the share's coin is rng.uniform()'s number too
+        drawn = local(root, ours)
+        if numpys.uniform() < 0.5:
+            numpys.integers(root.size)
+            expected = np.clip(numpys.standard_normal(5) * local.spread, lower, upper)
+        else:
+            expected = numpys.uniform(lower, upper)
+        np.testing.assert_array_equal(drawn, expected)

@@ -196,15 +196,21 @@ class _Sampler:
 
     def __init__(self, lower: FloatArray, upper: FloatArray, settings: RrtSettings) -> None:
         self.lower, self.upper, self.share = lower, upper, settings.local_share
-        self.spread = settings.local_spread * (upper - lower)
+        self.span = upper - lower
+        self.spread = settings.local_spread * self.span
 
     def __call__(self, tree: Tree, rng: np.random.Generator) -> FloatArray:
-        """A sample for ``tree``, drawn from ``rng``."""
-        if self.share and rng.uniform() < self.share:
+        """A sample for ``tree``, drawn from ``rng``.
+
+        Uniform draws are ``lower + span * rng.random(d)``: the numbers ``rng.uniform(lower,
+        upper)`` draws, to the bit (NumPy computes ``low + (high - low) * u`` from the same
+        ``u``), without its broadcasting and checks, a few microseconds a sample.
+        """
+        if self.share and rng.random() < self.share:
             node: FloatArray = tree.nodes[rng.integers(tree.size)]
             drawn = node + self.spread * rng.standard_normal(node.size)
             return np.minimum(np.maximum(drawn, self.lower), self.upper)  # np.clip, without its overhead
-        return rng.uniform(self.lower, self.upper)
+        return self.lower + self.span * rng.random(self.lower.size)
 
 
 def _lazy(
