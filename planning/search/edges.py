@@ -65,9 +65,8 @@ class Edges:
             self.checks += count
         else:
             ok = self._coarse_to_fine(points)
-        if ok.all():
-            return 1.0
-        return int(np.argmin(ok)) / count
+        blocked = int(ok.argmin())  # the first invalid one, or 0 where all are valid
+        return blocked / count if not ok[blocked] else 1.0
 
     def _coarse_to_fine(self, points: FloatArray) -> BoolArray:
         """The validity of ``points``, checked up to the first invalid one (:meth:`free_fraction`)."""
