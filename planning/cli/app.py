@@ -181,7 +181,8 @@ def build_parser() -> argparse.ArgumentParser:
     sub.add_argument(
         "robot",
         metavar="ROBOT",
-        help="a URDF file, an example-robot-data arm's name (panda, ur5, ...), or 'cpr' (the bundled CPR)",
+        help="a URDF file, an example-robot-data arm's name (panda, ur5, ...), 'cpr' (the bundled CPR), "
+        "or a scene file (.yaml: the robot it names)",
     )
     sub.add_argument(
         "--tcp",

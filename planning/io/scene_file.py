@@ -95,20 +95,9 @@ def parse_scene_file(data: Any, source: str = "scene", base: Path | None = None)
     Raises:
         SceneError: anything wrong, with the field path, the value and what is allowed.
     """
-    if not isinstance(data, dict):
-        raise SceneError(
-            f"{source}: a scene must be a mapping of keys (start, goal, obstacles, ...), "
-            f"not {type(data).__name__}"
-        )
-    try:
-        spec = SceneSpec.model_validate(data)
-    except ValidationError as exc:
-        raise SceneError(f"{source}: {describe_errors(exc)}") from None
+    spec = _validated(data, source)
     base = base or Path.cwd()
-    try:
-        robot = robot_spec_of(spec.robot, base)
-    except ck.CprKinError as exc:
-        raise SceneError(f"{source}: robot: {exc}") from None
+    robot = _robot_of(spec, base, source)
     try:
         payload = None
         if spec.payload is not None:
@@ -211,6 +200,36 @@ def load_scene_file(path: str | Path) -> SceneFile:
     """Read and validate a scene file, a task's too (see :func:`load_scene`)."""
     path = Path(path)
     return parse_scene_file(_read(path), source=str(path), base=path.parent)
+
+
+def scene_robot(path: str | Path) -> ck.RobotSpec:
+    """The robot a scene file names (its ``robot:``; none: the CPR preset), the file checked as a scene's.
+
+    What ``cpr-plan robot-info SCENE`` loads: the robot alone, not the obstacles or the ends.
+    """
+    path = Path(path)
+    return _robot_of(_validated(_read(path), str(path)), path.parent, str(path))
+
+
+def _validated(data: Any, source: str) -> SceneSpec:
+    """The parsed document ``data`` checked by the scene schema (:class:`SceneError` naming what is wrong)."""
+    if not isinstance(data, dict):
+        raise SceneError(
+            f"{source}: a scene must be a mapping of keys (start, goal, obstacles, ...), "
+            f"not {type(data).__name__}"
+        )
+    try:
+        return SceneSpec.model_validate(data)
+    except ValidationError as exc:
+        raise SceneError(f"{source}: {describe_errors(exc)}") from None
+
+
+def _robot_of(spec: SceneSpec, base: Path, source: str) -> ck.RobotSpec:
+    """The robot ``spec`` names, its paths relative to ``base``."""
+    try:
+        return robot_spec_of(spec.robot, base)
+    except ck.CprKinError as exc:
+        raise SceneError(f"{source}: robot: {exc}") from None
 
 
 def _read(path: Path) -> Any:
