@@ -8,8 +8,8 @@ and a ball of 12 % of that reach at the tool's position halfway along the straig
 way between them, at least 10 % of the reach from the base's height on the side the arm
 reaches: above the base, or below it for an arm that hangs (a flying arm under its drone,
 an arm mounted upside down), one whose median tool height over the middle of its ranges
-lies more than 10 % of its reach below the base (:func:`reaching_side`). The goal is given as the tool's
-pose (solved by the planner's IK), the start as the configuration. Start and goal must keep
+lies more than 10 % of its reach below the base (:func:`reaching_side`). The goal is given
+as the tool's pose (solved by the planner's IK), the start as the configuration. Start and goal must keep
 ``margin_m + 0.02`` m from the ball and ``self_clearance_m`` between the robot's own checked
 pairs, and gravity's torques there must be within the URDF's effort limits (the planner
 refuses an end its motors cannot hold still); a draw that does not is drawn again. The
