@@ -150,6 +150,14 @@ def test_schema_errors_name_path_and_value(change: dict[str, Any], pattern: str)
     assert str(info.value).startswith("s.yaml: ")
 
 
+def test_a_robot_urdf_that_is_no_file_is_named_with_the_scene(tmp_path: Path) -> None:
+    # the scene read, the plan then said only "URDF file '.../nope.urdf' does not exist"
+    with pytest.raises(SceneError, match=r"^s\.yaml: robot: URDF file '.*nope\.urdf' does not exist"):
+        parse_scene({**MINIMAL, "robot": "nope.urdf"}, source="s.yaml", base=tmp_path)
+    with pytest.raises(SceneError, match=r"^s\.yaml: robot: URDF file '.*' is not a regular file"):
+        parse_scene({**MINIMAL, "robot": {"urdf": "."}}, source="s.yaml", base=tmp_path)
+
+
 def test_file_errors(tmp_path: Path) -> None:
     with pytest.raises(SceneError, match=r"missing\.yaml' does not exist"):
         load_scene(tmp_path / "missing.yaml")

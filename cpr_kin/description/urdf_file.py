@@ -30,16 +30,21 @@ MAX_URDF_BYTES = 10_000_000
 """Largest URDF file [bytes] (the CPR's takes 6 kB)."""
 
 
+def check_urdf_file(path: Path) -> None:
+    """Raise :class:`UrdfError` unless ``path`` is a regular file (what a scene's ``robot:`` checks first)."""
+    if not path.exists():
+        raise UrdfError(f"URDF file '{path}' does not exist; pass the path of a .urdf file")
+    if not path.is_file():
+        raise UrdfError(f"URDF file '{path}' is not a regular file (a folder or a device)")
+
+
 def parse_urdf(path: Path) -> etree._ElementTree:
     """Parse ``path`` as strict XML; raise :class:`UrdfError` if it is missing or malformed.
 
     Entities are not expanded and nothing is fetched from the network: a URDF that defines
     entities (an "XML bomb", or a reference to a local file) is parsed as written.
     """
-    if not path.exists():
-        raise UrdfError(f"URDF file '{path}' does not exist; pass the path of a .urdf file")
-    if not path.is_file():
-        raise UrdfError(f"URDF file '{path}' is not a regular file (a folder or a device)")
+    check_urdf_file(path)
     if path.stat().st_size > MAX_URDF_BYTES:
         raise UrdfError(f"URDF file '{path}' has {path.stat().st_size} bytes; at most {MAX_URDF_BYTES}")
     parser = etree.XMLParser(recover=False, resolve_entities=False, no_network=True, huge_tree=False)
