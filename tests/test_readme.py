@@ -70,11 +70,14 @@ def test_bring_your_own_robot_runs_as_written(tmp_path: Path, monkeypatch: pytes
 
     import yaml
 
+    import cpr_kin as ck
     from planning.cli import main
     from planning.io.scene_file import parse_scene
 
     _, fragment, _ = blocks(README, "yaml")
-    own = parse_scene(yaml.safe_load(fragment))
+    # a scene's robot must name a URDF file: the CPR's stands in for the reader's arm
+    (tmp_path / "my_arm.urdf").write_text(ck.cpr_urdf_path().read_text())
+    own = parse_scene(yaml.safe_load(fragment), base=tmp_path)
     assert own.robot is not None and own.robot.urdf.name == "my_arm.urdf" and own.goal.pose is not None
     panda = next(block for block in blocks(README, "sh") if "panda_post.yaml" in block)
     commands = [line.split("#")[0] for line in panda.splitlines() if line.strip()]
