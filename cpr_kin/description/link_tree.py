@@ -9,14 +9,13 @@ missing; :func:`check_tree` names the joints of the loop, the two parents or the
 
 from __future__ import annotations
 
-from collections import Counter
 from collections.abc import Sequence
 from pathlib import Path
 
 from lxml import etree
 
 from cpr_kin.common.errors import UrdfError
-from cpr_kin.common.names import escaped
+from cpr_kin.common.names import escaped, repeated
 
 MAX_NAMED = 8
 """Most names a message lists (a robot's links run to hundreds)."""
@@ -38,18 +37,16 @@ def check_tree(tree: etree._ElementTree, path: Path) -> None:
     """
     root = tree.getroot()
     links = [link.get("name", "") for link in root.findall("link")]
-    for kind, names in (
-        ("link", links),
-        ("joint", [joint.get("name", "") for joint in root.findall("joint")]),
-    ):
-        twice = sorted(n for n, count in Counter(names).items() if count > 1)
+    joints = root.findall("joint")
+    for kind, names in (("link", links), ("joint", [joint.get("name", "") for joint in joints])):
+        twice = repeated(names)
         if twice:
             raise UrdfError(
                 f"URDF '{path}': {kind} name(s) {_listed(twice)} are defined more than once; names are unique"
             )
     defined = set(links)
     parent_of: dict[str, tuple[str, str]] = {}  # child link -> (joint, parent link)
-    for joint in root.findall("joint"):
+    for joint in joints:
         name = joint.get("name", "?")
         ends = {}
         for end in ("parent", "child"):
@@ -86,11 +83,11 @@ def check_tree(tree: etree._ElementTree, path: Path) -> None:
             link = parent_of[link][1]
         if link not in reached:  # the walk came back to ``link``: a loop, walked upwards
             loop = [parent_of[child] + (child,) for child in walked[walked.index(link) :]][::-1]
-            joints = ", ".join(
+            closing = ", ".join(
                 f"'{escaped(j)}' ({escaped(p)} -> {escaped(c)})" for j, p, c in loop[:MAX_NAMED]
             )
             raise UrdfError(
-                f"URDF '{path}': joints {joints} close a loop, which hangs from no root link; a URDF's "
+                f"URDF '{path}': joints {closing} close a loop, which hangs from no root link; a URDF's "
                 "links form a tree: closed chains are not supported"
             )
         reached.update(walked)
