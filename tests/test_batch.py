@@ -202,3 +202,10 @@ def test_a_task_scene_is_planned_as_plan_plans_it(tmp_path: Path) -> None:
     assert main(["check", str(task), str(tmp_path / "out" / "task" / "trajectory.json")]) == 0  # the oracle
     (row,) = csv.DictReader(summary_csv([item]).splitlines())
     assert row["status"] == "ok" and row["duration"] and row["t_sol"] == "" and row["evaluations"] == ""
+
+
+def test_scene_files_take_either_suffix_in_any_case(tmp_path: Path) -> None:
+    for name in ("b.YAML", "a.yml", "c.Yaml", "notes.txt", "d.yaml.bak"):
+        (tmp_path / name).write_text("{}")
+    (tmp_path / "folder.yaml").mkdir()
+    assert [p.name for p in scene_files(tmp_path)] == ["a.yml", "b.YAML", "c.Yaml"]

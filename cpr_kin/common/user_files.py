@@ -31,6 +31,8 @@ import yaml
 from cpr_kin.common.errors import CprKinError
 from cpr_kin.common.names import cut, shown
 
+YAML_SUFFIXES = (".yaml", ".yml")
+"""What a YAML file's name ends with (in any case: ``SCENE.YAML`` is one)."""
 MAX_DEPTH = 16
 """Deepest nesting of sequences and mappings (a scene file nests 4 levels)."""
 MAX_NODES = 100_000
@@ -73,6 +75,11 @@ StrictLoader.add_implicit_resolver(
     re.compile(r"^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
     list("-+0123456789"),
 )
+
+
+def is_yaml_name(path: Path | str) -> bool:
+    """Whether ``path``'s name ends with one of :data:`YAML_SUFFIXES`, in any case."""
+    return Path(path).suffix.lower() in YAML_SUFFIXES
 
 
 def _line(event: Any) -> str:

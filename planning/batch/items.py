@@ -36,6 +36,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import cpr_kin as ck  # lazy (lazy_loader): its modules load in the workers, where they are used
 from cpr_kin.common.names import escaped, one_line, repeated
+from cpr_kin.common.user_files import is_yaml_name
 from planning.errors import PlanningError
 from planning.notices import library_notices
 from planning.outcome import STATUS_EXIT, classify
@@ -161,11 +162,11 @@ def finished_items(futures: dict[Any, int]) -> Iterator[tuple[int, BatchItem]]:
 
 
 def scene_files(folder: Path) -> list[Path]:
-    """The scene files (``*.yaml``, ``*.yml``) of ``folder``, sorted by name, as absolute paths."""
+    """The scene files (``*.yaml``, ``*.yml``, any case) of ``folder``, sorted by name, absolute."""
     folder = folder.absolute()
     if not folder.is_dir():
         raise PlanningError(f"scene folder '{folder}' does not exist or is not a folder")
-    files = sorted(p for p in folder.iterdir() if p.suffix in (".yaml", ".yml") and p.is_file())
+    files = sorted(p for p in folder.iterdir() if is_yaml_name(p) and p.is_file())
     if not files:
         raise PlanningError(f"scene folder '{folder}' holds no .yaml scene files")
     stems = [p.stem for p in files]

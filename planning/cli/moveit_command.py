@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from cpr_kin.common.names import escaped
+from cpr_kin.common.user_files import is_yaml_name
 from planning.errors import PlanningError
 from planning.outcome import EXIT_OK
 
@@ -17,7 +18,7 @@ def cmd_import_moveit(args: argparse.Namespace) -> int:
     from planning.pipeline.scene import MAX_SAFETY_MARGIN_M
     from planning.validation import number_in
 
-    if args.out.suffix.lower() not in (".yaml", ".yml"):
+    if not is_yaml_name(args.out):
         raise PlanningError(f"--out '{args.out}' must end in .yaml or .yml: a scene file is YAML")
     for flag, value in (("--safety-margin", args.safety_margin), ("--self-margin", args.self_margin)):
         number_in(flag, value, 0.0, MAX_SAFETY_MARGIN_M, unit="m")

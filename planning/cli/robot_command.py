@@ -10,11 +10,9 @@ from typing import Any
 
 import cpr_kin as ck
 from cpr_kin.common.names import escaped
+from cpr_kin.common.user_files import is_yaml_name
 from planning.io import json_layout
 from planning.outcome import EXIT_OK
-
-SCENE_SUFFIXES = (".yaml", ".yml")
-"""What a scene file's name ends with: ``robot-info`` then reports the robot it names."""
 
 
 def robot_report(robot: ck.Robot) -> dict[str, Any]:
@@ -78,7 +76,7 @@ def cmd_robot_info(args: argparse.Namespace) -> int:
             "robot 'cpr' is the bundled preset, its tool frame and SRDF its own: drop --tcp and --srdf"
         )
     spec: ck.RobotSpec | None = None  # None: the bundled preset
-    if Path(args.robot).suffix.lower() in SCENE_SUFFIXES:
+    if is_yaml_name(args.robot):  # a scene file: the robot it names
         spec = scene_robot(args.robot)  # the scene file's robot: entry, as a plan of it loads it
     elif args.robot != "cpr":
         spec = robot_spec_of(args.robot, Path.cwd())

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from cpr_kin.common.user_files import YAML_SUFFIXES
 from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
 from planning.io.publish import write_file
@@ -34,7 +35,7 @@ MAX_POINTS = 1_000_000
 """Most points one document holds (a duration times a rate beyond it is refused)."""
 CHUNK_POINTS = 10_000
 """Points evaluated and written at a time."""
-SUFFIXES = (".yaml", ".yml", ".json")
+SUFFIXES = (*YAML_SUFFIXES, ".json")
 POINT_KEYS = ("positions", "velocities", "accelerations")
 
 
