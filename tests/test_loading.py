@@ -277,7 +277,8 @@ def test_a_missing_tool_frame_lists_the_first_links_and_counts_the_rest() -> Non
         ck.load_robot(urdf, tcp="LWristPitchLink")
     message = str(refused.value)
     assert "did you mean 'LWristPitch'" in message
-    assert f"its links are {links[:SHOWN_LINKS]} and {len(links) - SHOWN_LINKS} more" in message
+    shown = ", ".join(f"'{link}'" for link in links[:SHOWN_LINKS])
+    assert f"its links are {shown} and {len(links) - SHOWN_LINKS} more" in message
     assert message.endswith(" more")  # the rest counted, not listed
 
 

@@ -2,7 +2,7 @@ from __future__ import annotations
 
 import pytest
 
-from cpr_kin.common.names import MAX_LINE_CHARS, escaped, one_line, unprintable
+from cpr_kin.common.names import MAX_LINE_CHARS, escaped, listed, one_line, unprintable
 
 
 @pytest.mark.parametrize(
@@ -40,3 +40,16 @@ def test_one_line_joins_escapes_and_cuts() -> None:
     long = one_line("x " * 2000)
     assert len(long) == MAX_LINE_CHARS and long.endswith("...") and long.startswith("x x")
     assert one_line("short", limit=4) == "s..."
+
+
+@pytest.mark.parametrize("count", [0, 1, 3, 4, 9])
+def test_listed_quotes_the_first_names_and_counts_the_rest(count: int) -> None:
+    names = [f"link_{i}" for i in range(count)]
+    text = listed(names, 3)
+    assert text.count("'") == 2 * min(count, 3)
+    assert text.endswith(f" and {count - 3} more") == (count > 3)
+    assert "more" not in text or count > 3
+
+
+def test_listed_escapes_what_a_terminal_would_obey() -> None:
+    assert listed(["a\u202eb"], 2) == "'a\\u202eb'"

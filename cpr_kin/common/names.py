@@ -77,3 +77,12 @@ def repeated(names: Sequence[str]) -> list[str]:
     """The names that ``names`` gives more than once, sorted (a duplicate joint, obstacle, file)."""
     counts = Counter(names)
     return sorted(name for name, count in counts.items() if count > 1)
+
+
+def listed(names: Sequence[str], most: int) -> str:
+    """``names`` quoted for a message, the first ``most`` of them, the rest counted.
+
+    ``listed(["a", "b", "c"], 2)`` is ``'a', 'b' and 1 more``.
+    """
+    quoted = ", ".join(f"'{escaped(name)}'" for name in names[:most])
+    return quoted + (f" and {len(names) - most} more" if len(names) > most else "")

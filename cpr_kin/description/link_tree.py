@@ -9,22 +9,15 @@ missing; :func:`check_tree` names the joints of the loop, the two parents or the
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from pathlib import Path
 
 from lxml import etree
 
 from cpr_kin.common.errors import UrdfError
-from cpr_kin.common.names import escaped, repeated
+from cpr_kin.common.names import escaped, listed, repeated
 
 MAX_NAMED = 8
 """Most names a message lists (a robot's links run to hundreds)."""
-
-
-def _listed(names: Sequence[str]) -> str:
-    """``names`` quoted for a message, the first :data:`MAX_NAMED` of them."""
-    shown = ", ".join(f"'{escaped(n)}'" for n in names[:MAX_NAMED])
-    return shown + (f" and {len(names) - MAX_NAMED} more" if len(names) > MAX_NAMED else "")
 
 
 def check_tree(tree: etree._ElementTree, path: Path) -> None:
@@ -42,7 +35,8 @@ def check_tree(tree: etree._ElementTree, path: Path) -> None:
         twice = repeated(names)
         if twice:
             raise UrdfError(
-                f"URDF '{path}': {kind} name(s) {_listed(twice)} are defined more than once; names are unique"
+                f"URDF '{path}': {kind} name(s) {listed(twice, MAX_NAMED)} are defined more than once; "
+                "names are unique"
             )
     defined = set(links)
     parent_of: dict[str, tuple[str, str]] = {}  # child link -> (joint, parent link)
@@ -56,7 +50,7 @@ def check_tree(tree: etree._ElementTree, path: Path) -> None:
                 what = f"has no <{end} link=...>" if link is None else f"names {end} link '{escaped(link)}'"
                 raise UrdfError(
                     f"URDF '{path}': joint '{escaped(name)}' {what}, which the file does not define; "
-                    f"a joint joins two of its links ({_listed(links)})"
+                    f"a joint joins two of its links ({listed(links, MAX_NAMED)})"
                 )
             ends[end] = link
         child = ends["child"]
@@ -71,9 +65,9 @@ def check_tree(tree: etree._ElementTree, path: Path) -> None:
     roots = [link for link in links if link not in parent_of]
     if len(roots) > 1:
         raise UrdfError(
-            f"URDF '{path}': links {_listed(roots)} are each the child of no joint; a URDF's links hang "
-            f"from one root: join the others to '{escaped(roots[0])}'s tree by a joint ('fixed' where "
-            "they do not move) or remove them"
+            f"URDF '{path}': links {listed(roots, MAX_NAMED)} are each the child of no joint; "
+            f"a URDF's links hang from one root: join the others to '{escaped(roots[0])}'s tree by a "
+            "joint ('fixed' where they do not move) or remove them"
         )
     reached = set(roots)
     for link in links:

@@ -16,7 +16,7 @@ from typing import Any, Protocol
 import pinocchio as pin
 
 from cpr_kin.common.errors import UrdfError
-from cpr_kin.common.names import shown
+from cpr_kin.common.names import listed, shown
 
 NAME_OPTIONS = ("joints", "effector_links", "wrist_joints", "limits_names")
 """The options that hold a sequence of names."""
@@ -116,12 +116,7 @@ def check_tcp(tcp: str | None, model: Any, path: Path) -> None:
     close = get_close_matches(tcp, named, n=3, cutoff=0.5)
     hint = f"did you mean {', '.join(repr(name) for name in close)}? " if close else ""
     links = sorted({f.name for f in model.frames if f.type == pin.FrameType.BODY})
-    listed = (
-        f"{links}"
-        if len(links) <= SHOWN_LINKS
-        else f"{links[:SHOWN_LINKS]} and {len(links) - SHOWN_LINKS} more"
-    )
     raise UrdfError(
         f"URDF '{path}' has no link or frame named '{tcp}' (the tool frame, tcp); "
-        f"{hint}its links are {listed}"
+        f"{hint}its links are {listed(links, SHOWN_LINKS)}"
     )
