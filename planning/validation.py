@@ -87,15 +87,22 @@ def field_path(location: Location, hidden: Sequence[str] = ()) -> str:
     """``obstacles[1].size[2]`` for pydantic's location ``("obstacles", 1, "size", 2)``.
 
     Parts in ``hidden`` (a tagged union's branch names) are not keys of the file and are left
-    out; a hostile key is shortened like a value.
+    out, but never the part right after one: a branch is a model, so what follows its name is
+    one of its keys, though it be spelt like a branch (``("obstacles", 0, "mesh", "mesh")`` is
+    ``obstacles[0].mesh``). A hostile key is shortened like a value.
     """
     text = ""
+    after_branch = False
     for part in location:
         if isinstance(part, int):
             text += f"[{part}]"
-        elif part not in hidden:
+            after_branch = False
+        elif part in hidden and not after_branch:
+            after_branch = True
+        else:
             key = cut(str(part))
             text += f".{key}" if text else key
+            after_branch = False
     return text or "(top level)"
 
 

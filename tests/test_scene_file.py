@@ -116,6 +116,14 @@ def test_an_obstacles_touch_links_are_read_written_and_read_back_the_same(tmp_pa
             {"obstacles": [{"shape": "box", "size": [0.1, 0.1, 0.1]}]},
             "obstacles[0].xyz: required key is missing",
         ),
+        (  # the key spelt like its shape's tag is named, not dropped with the tag
+            {"obstacles": [{"shape": "mesh", "xyz": [0, 0, 0]}]},
+            "obstacles[0].mesh: required key is missing",
+        ),
+        (
+            {"payload": {"shape": {"shape": "mesh", "xyz": [0, 0, 0]}}},
+            "payload.shape.mesh: required key is missing",
+        ),
         (
             {"start": {"tcp": [0.5, 0.45, 0.25], "q": [0, 0, 0, 0, 0]}},
             "start: give exactly one of 'q' (joint values), 'tcp'",
