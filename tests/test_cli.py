@@ -111,6 +111,11 @@ BAD_INPUTS = [
         {**PANDA, "robot": "no_such_robot"},
         "robot: 'no_such_robot' is neither a URDF file",
     ),
+    (
+        "a robot's name in capitals",
+        {**PANDA, "robot": "UR5"},
+        "]; did you mean 'ur5'?",
+    ),
     ("zero fireflies", with_changes(planner__fireflies=0), "planner.fireflies = 0"),
     ("negative time limit", with_changes(planner__time_limit_s=-1), "planner.time_limit_s = -1"),
     (

@@ -21,6 +21,7 @@ from typing import Annotated, Any
 from pydantic import Field, Tag
 
 import cpr_kin as ck
+from cpr_kin.common.names import escaped
 from cpr_kin.model.packages import EXAMPLE_ROBOTS, example_robot
 from planning.io.schema_types import (
     BY_KIND,
@@ -58,9 +59,13 @@ def _urdf(value: str, base: Path) -> Path:
         return example_robot(value)
     path = (base / value).resolve()
     if not path.exists() and not path.suffix:
+        from difflib import get_close_matches  # a message's, not every scene's (start-up)
+
+        close = get_close_matches(value.lower(), sorted(EXAMPLE_ROBOTS), n=1, cutoff=0.6)
+        hint = f"; did you mean '{close[0]}'?" if close else ""
         raise ck.UrdfError(
-            f"'{value}' is neither a URDF file ('{path}' does not exist) "
-            f"nor one of example-robot-data's arms {sorted(EXAMPLE_ROBOTS)}"
+            f"'{escaped(value)}' is neither a URDF file ('{path}' does not exist) "
+            f"nor one of example-robot-data's arms {sorted(EXAMPLE_ROBOTS)}{hint}"
         )
     return path
 
