@@ -7,6 +7,7 @@ import importlib.util
 import logging
 import subprocess
 import sys
+import time
 from pathlib import Path
 from types import ModuleType
 
@@ -15,7 +16,7 @@ import numba.core.event
 import pytest
 
 from cpr_kin.common.compiled import COMPILING
-from cpr_kin.common.just_in_time import FirstCompile
+from cpr_kin.common.just_in_time import CompileWatch
 from cpr_kin.common.kernel_sources import forget_stale_kernels, sources_digest
 
 PACKAGES = ("pkg",)
@@ -115,7 +116,7 @@ def test_the_first_compilation_is_said_once_and_a_cached_kernel_says_nothing(
     tmp_path: Path, caplog: pytest.LogCaptureFixture
 ) -> None:
     log = logging.getLogger("cpr_kin.test_compiled")
-    listener = FirstCompile(log, COMPILING)
+    listener = CompileWatch(log, COMPILING)
     with (
         caplog.at_level(logging.INFO, logger=log.name),
         numba.core.event.install_listener("numba:compile", listener),
@@ -126,7 +127,7 @@ def test_the_first_compilation_is_said_once_and_a_cached_kernel_says_nothing(
         assert len(caplog.records) == 1
 
     caplog.clear()
-    again = FirstCompile(log, COMPILING)
+    again = CompileWatch(log, COMPILING)
     with (
         caplog.at_level(logging.INFO, logger=log.name),
         numba.core.event.install_listener("numba:compile", again),
@@ -170,3 +171,23 @@ def test_a_plan_loads_each_kernel_once() -> None:
         completed = subprocess.run(command, capture_output=True, text=True, check=False, timeout=600)
         assert completed.returncode == 0, completed.stderr
     assert completed.stdout == ""
+
+
+def test_the_watch_times_compilations_the_outermost_once_and_not_a_cached_kernel(tmp_path: Path) -> None:
+    watch = CompileWatch(logging.getLogger("cpr_kin.test_compiled"), COMPILING)
+    with numba.core.event.install_listener("numba:compile", watch):
+        began = time.perf_counter()
+        assert kernel_module(tmp_path, "timed_from_source").f(1) == 2  # compiled
+        wall_s = time.perf_counter() - began
+        assert 0.5 * wall_s < watch.seconds <= wall_s  # the call is mostly its compilation
+        first_s = watch.seconds
+        inner = numba.njit(lambda x: x + 1)
+        outer = numba.njit(lambda x: inner(x) * 2)  # compiles inner within it
+        began = time.perf_counter()
+        assert outer(1) == 4
+        wall_s = time.perf_counter() - began
+        assert 0.5 * wall_s < watch.seconds - first_s <= wall_s  # nested, so counted once
+    cached = CompileWatch(logging.getLogger("cpr_kin.test_compiled"), COMPILING)
+    with numba.core.event.install_listener("numba:compile", cached):
+        assert kernel_module(tmp_path, "timed_from_cache").f(1) == 2
+    assert cached.seconds == 0.0

@@ -43,6 +43,19 @@ _ALONE: dict[Callable[..., Any], Callable[..., Any]] = {}
 """The dispatchers of the kernels called with types no export takes, and of the kernels they call."""
 
 
+def compile_seconds() -> float:
+    """The wall time numba has spent compiling the kernels in this process [s]: 0 where it compiled none.
+
+    The first run on a machine (or after an update) compiles them; kernels compiled ahead of
+    time are not. A plan's time limit leaves this time out (:mod:`planning.pipeline.deadline`).
+    """
+    if not _JIT and not _ALONE:
+        return 0.0  # every kernel compiled ahead of time, or none made yet: numba not imported
+    from cpr_kin.common.just_in_time import compile_seconds as seconds
+
+    return seconds()
+
+
 def njit(function: F) -> F:
     """Compile ``function`` in nopython mode, cached, releasing the GIL."""
     return cast(F, _kernel(function, inline=False))

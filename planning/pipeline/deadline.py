@@ -17,6 +17,11 @@ arm among shelves, on its exact meshes): one still under way at :attr:`Deadline.
 the limit plus :func:`overrun_s` of it, is stopped there (:meth:`Deadline.cut`), its curve
 not certified. A plan therefore ends by its limit plus that overrun, give or take a piece of
 a check's work (:data:`cpr_kin.collision.decisive.CHUNK_ROWS` configurations).
+
+The limit's clock (:func:`clock_s`) stops while numba compiles kernels
+(:func:`cpr_kin.common.compiled.compile_seconds`): the first run on a machine compiles them, for
+seconds a plan has no use of, and a limit that counted them would stop that plan where the
+next one, its kernels on disk, succeeds.
 """
 
 from __future__ import annotations
@@ -26,11 +31,18 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from cpr_kin.common.compiled import compile_seconds
+
 OVERRUN_SHARE = 0.25
 """The share of a time limit that the work under way when it passes may still take (:func:`overrun_s`)."""
 MIN_OVERRUN_S = 1.0
 """The least time [s] the work under way when a limit passes may still take: the check of one
 timing on a generated scene takes milliseconds, of a long trajectory on exact meshes a second."""
+
+
+def clock_s() -> float:
+    """The clock a time limit runs on [s]: ``time.perf_counter``, less the time numba spent compiling."""
+    return time.perf_counter() - compile_seconds()
 
 
 def overrun_s(limit_s: float) -> float:
@@ -43,7 +55,7 @@ def overrun_s(limit_s: float) -> float:
 
 @dataclass(frozen=True)
 class Deadline:
-    """A point on the ``time.perf_counter`` clock [s]; ``inf``: never.
+    """A point on the :func:`clock_s` clock [s]; ``inf``: never.
 
     Attributes:
         at_s: the clock's reading at which time is up [s].
@@ -57,17 +69,19 @@ class Deadline:
 
     @classmethod
     def after(cls, limit_s: float | None, started_s: float) -> Deadline:
-        """The deadline ``limit_s`` [s] after the clock read ``started_s`` [s] (never when ``None``).
+        """The deadline ``limit_s`` [s] after ``time.perf_counter`` read ``started_s`` [s] (``None``: never).
 
-        Its checks are cut :func:`overrun_s` later.
+        Its checks are cut :func:`overrun_s` later. The time numba spends compiling from now on
+        is not counted (:func:`clock_s`).
         """
         if limit_s is None:
             return cls()
-        return cls(started_s + limit_s, limit_s, started_s + limit_s + overrun_s(limit_s))
+        start_s = started_s - compile_seconds()
+        return cls(start_s + limit_s, limit_s, start_s + limit_s + overrun_s(limit_s))
 
     def passed(self) -> bool:
         """Whether time is up."""
-        return self.at_s != math.inf and time.perf_counter() >= self.at_s
+        return self.at_s != math.inf and clock_s() >= self.at_s
 
     @property
     def stop(self) -> Callable[[], bool] | None:
@@ -76,10 +90,11 @@ class Deadline:
 
     def cut(self) -> bool:
         """Whether a certified check still under way must stop (a :data:`cpr_kin.collision.decisive.Stop`)."""
-        return self.cut_at_s != math.inf and time.perf_counter() >= self.cut_at_s
+        return self.cut_at_s != math.inf and clock_s() >= self.cut_at_s
 
-    def reason(self, elapsed_s: float) -> str:
-        """Why a plan stopped at ``elapsed_s`` [s] of its ``limit_s``: for a "no solution" message."""
+    def reason(self) -> str:
+        """Why a plan stopped, the time it took on the limit's clock: for a "no solution" message."""
+        elapsed_s = clock_s() - (self.at_s - (self.limit_s or 0.0))
         return (
             f"stopped after {elapsed_s:.3g} s by the time limit time_limit_s = {self.limit_s:g} s "
             "(raise it, or leave it unset for no limit)"

@@ -116,13 +116,12 @@ def _solved(
             if following is None:
                 break
         attempt = following
-    stopped = deadline.reason(time.perf_counter() - started) if deadline.passed() else ""
+    stopped = deadline.reason() if deadline.passed() else ""
     if attempt.path is None:
         raise chosen.error(attempt.tried, stopped)
     if last_resort_by.passed():
-        elapsed_s = time.perf_counter() - started
         found = "RRT-Connect found a path, but the time limit passed before it was followed"
-        raise chosen.error(attempt.tried, last_resort_by.reason(elapsed_s), found)
+        raise chosen.error(attempt.tried, last_resort_by.reason(), found)
     problem, followed = follow_path(attempt.problem, attempt.path)  # the last resort
     if isinstance(followed, Refusal):
         raise chosen.error(attempt.tried, stopped, f"RRT-Connect found a path, but {followed.cause}")
