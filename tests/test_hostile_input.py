@@ -141,6 +141,11 @@ CASES: list[tuple[str, Callable[[Path], str], str | re.Pattern[str]]] = [
         "is not a regular file (a folder or a device)",
     ),
     (
+        "device as robot",
+        lambda _: "robot: /dev/zero\n" + GOOD,
+        "robot: URDF file '/dev/zero' is not a regular file",
+    ),
+    (
         "hostile key",
         lambda _: GOOD + "k" * 1_000 + ": 1\n",
         "kkkkkkk...: unknown key; allowed here: name, robot",

@@ -22,6 +22,7 @@ from pydantic import Field, Tag
 
 import cpr_kin as ck
 from cpr_kin.common.names import escaped
+from cpr_kin.description.urdf_file import check_urdf_file
 from cpr_kin.model.packages import EXAMPLE_ROBOTS, example_robot
 from planning.io.schema_types import (
     BY_KIND,
@@ -54,7 +55,11 @@ RobotEntry = Annotated[
 
 
 def _urdf(value: str, base: Path) -> Path:
-    """A URDF named by ``value``: an example-robot-data arm, else a path relative to ``base``."""
+    """A URDF named by ``value``: an example-robot-data arm, else a path relative to ``base``.
+
+    Raises:
+        UrdfError: no such arm, and no such file (or not a regular file); read when it loads.
+    """
     if value in EXAMPLE_ROBOTS:
         return example_robot(value)
     path = (base / value).resolve()
@@ -67,6 +72,7 @@ def _urdf(value: str, base: Path) -> Path:
             f"'{escaped(value)}' is neither a URDF file ('{path}' does not exist) "
             f"nor one of example-robot-data's arms {sorted(EXAMPLE_ROBOTS)}{hint}"
         )
+    check_urdf_file(path)
     return path
 
 

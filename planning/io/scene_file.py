@@ -33,7 +33,6 @@ from pydantic import ValidationError
 import cpr_kin as ck
 from cpr_kin.common.names import repeated
 from cpr_kin.common.user_files import UserFileError, dump_yaml, load_yaml
-from cpr_kin.description.urdf_file import check_urdf_file
 from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError, SceneError
 from planning.io.cloud_entry import PointCloudSpec, RobotAtStart, cloud_obstacles
@@ -228,11 +227,9 @@ def _validated(data: Any, source: str) -> SceneSpec:
 def _robot_of(spec: SceneSpec, base: Path, source: str) -> ck.RobotSpec:
     """The robot ``spec`` names, its paths relative to ``base``; its URDF a file (read when it loads)."""
     try:
-        robot = robot_spec_of(spec.robot, base)
-        check_urdf_file(Path(robot.urdf))
+        return robot_spec_of(spec.robot, base)
     except ck.CprKinError as exc:
         raise SceneError(f"{source}: robot: {exc}") from None
-    return robot
 
 
 def _read(path: Path) -> Any:
