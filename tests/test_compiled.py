@@ -174,6 +174,7 @@ def test_a_plan_loads_each_kernel_once() -> None:
 
 
 def test_the_watch_times_compilations_the_outermost_once_and_not_a_cached_kernel(tmp_path: Path) -> None:
+    numba.njit(lambda x: x - 1)(1)  # numba's own start (LLVM's), outside any compilation, done
     watch = CompileWatch(logging.getLogger("cpr_kin.test_compiled"), COMPILING)
     with numba.core.event.install_listener("numba:compile", watch):
         began = time.perf_counter()
@@ -191,3 +192,9 @@ def test_the_watch_times_compilations_the_outermost_once_and_not_a_cached_kernel
     with numba.core.event.install_listener("numba:compile", cached):
         assert kernel_module(tmp_path, "timed_from_cache").f(1) == 2
     assert cached.seconds == 0.0
+
+
+def test_the_end_of_a_compilation_begun_before_the_watch_adds_nothing() -> None:
+    watch = CompileWatch(logging.getLogger("cpr_kin.test_compiled"), COMPILING)
+    watch.on_end(None)  # registered while numba was compiling: its end alone arrives
+    assert watch.seconds == 0.0

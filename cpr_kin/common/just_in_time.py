@@ -48,8 +48,10 @@ class CompileWatch(numba.core.event.Listener):
         self._depth += 1
 
     def on_end(self, event: Any) -> None:
-        """Add an outermost compilation's time."""
-        self._depth = max(self._depth - 1, 0)
+        """Add an outermost compilation's time (not one begun before the watch was registered)."""
+        if self._depth == 0:
+            return
+        self._depth -= 1
         if self._depth == 0:
             self.seconds += time.perf_counter() - self._began_s
 
