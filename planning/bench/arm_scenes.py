@@ -24,6 +24,7 @@ from collections import Counter
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 import cpr_kin as ck
 from planning.errors import PlanningError
@@ -34,6 +35,8 @@ from planning.validation import integer_in, number_in
 
 DRAWS = 4000
 """Most draws of a start and goal before :func:`blocked_scene` gives up."""
+MIDDLE_SHARE = 0.6
+"""The share of each joint's range, about its middle, that configurations are drawn from."""
 SIDE_DRAWS = 256
 """Configurations whose tool heights tell on which side of its base an arm reaches (:func:`reaching_side`)."""
 BASE_LEVEL_SHARE = 0.1
@@ -45,15 +48,20 @@ def reaching_side(robot: ck.Robot, reach_m: float) -> int:
     """``1`` where ``robot`` reaches up from its base, ``-1`` where it hangs below it.
 
     It hangs where the median tool height [m] of :data:`SIDE_DRAWS` configurations drawn in the
-    middle 60 % of its ranges (a fixed seed: the scenes' own draws are untouched) lies more
+    middle :data:`MIDDLE_SHARE` of its ranges (a fixed seed: the scenes' own draws are untouched) lies more
     than :data:`BASE_LEVEL_SHARE` of its reach ``reach_m`` [m] below the base; a UR arm,
     which reaches about as far below its base as above it, reaches up.
     """
-    lower, upper = robot.limits.lower, robot.limits.upper
-    middle, half = (lower + upper) / 2, (upper - lower) / 2
-    draws = np.random.default_rng(0).uniform(middle - 0.6 * half, middle + 0.6 * half, (SIDE_DRAWS, robot.nq))
+    draws = _middle_draws(robot, np.random.default_rng(0), SIDE_DRAWS)
     height_m = float(np.median(ck.frame_poses(robot, draws)[:, 2, 3]))
     return -1 if height_m < -BASE_LEVEL_SHARE * reach_m else 1
+
+
+def _middle_draws(robot: ck.Robot, rng: np.random.Generator, count: int) -> NDArray[np.float64]:
+    """``(count, nq)`` configurations drawn uniformly in the middle :data:`MIDDLE_SHARE` of every range."""
+    lower, upper = robot.limits.lower, robot.limits.upper
+    middle, half = (lower + upper) / 2, (upper - lower) / 2
+    return rng.uniform(middle - MIDDLE_SHARE * half, middle + MIDDLE_SHARE * half, (count, robot.nq))
 
 
 def blocked_scene(
@@ -87,15 +95,14 @@ def blocked_scene(
     number_in("margin_m", margin_m, 0.0, MAX_SAFETY_MARGIN_M, unit="m")
     number_in("self_clearance_m", self_clearance_m, 0.0, MAX_SAFETY_MARGIN_M, unit="m", low_open=True)
     rng = np.random.default_rng(seed)
-    lower, upper = robot.limits.lower, robot.limits.upper
-    middle, half = (lower + upper) / 2, (upper - lower) / 2
+    middle = (robot.limits.lower + robot.limits.upper) / 2
     reach = float(np.linalg.norm(ck.frame_poses(robot, middle[None])[0][:3, 3]))
     side = reaching_side(robot, reach)
     dynamics = ck.robot_dynamics(robot)
     too_close: Counter[tuple[str, str]] = Counter()  # the closest pair of each end refused for it
     refused: Counter[str] = Counter()  # why each draw was refused (REFUSALS' keys)
     for _ in range(draws):
-        start, goal = rng.uniform(middle - 0.6 * half, middle + 0.6 * half, (2, robot.nq))
+        start, goal = _middle_draws(robot, rng, 2)
         tools = ck.frame_poses(robot, np.array([start, (start + goal) / 2, goal]))
         if np.linalg.norm(tools[0, :3, 3] - tools[2, :3, 3]) < 0.5 * reach:
             refused["near"] += 1
