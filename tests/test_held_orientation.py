@@ -310,6 +310,58 @@ def test_a_carry_to_a_tool_position_ends_with_the_tool_upright_at_it() -> None:
     assert np.arccos(np.clip(axes[0] @ axes[1], -1.0, 1.0)) <= UPRIGHT["angle_rad"]
 
 
+def test_a_carry_constrained_on_a_frame_fixed_to_the_tool_turns_the_tool_goal_too() -> None:
+    # the constraint names the wrist's last link, which carries the tool frame: turning the tool
+    # turns it, so the tool position becomes a pose goal as for the tool frame itself (it was
+    # refused: the IK's solution held the link 1.03 rad off)
+    goal_m = [0.45, 0.3, 0.3]
+    document = {
+        "robot": "ur5",
+        "safety_margin": 0.02,
+        "start": {"q": ARMS["ur5"]["start"]},
+        "task": [
+            {"move": {"pose": {"xyz": [0.5, -0.25, 0.3], "rpy": DOWN}}},
+            {"move": {"tcp": goal_m, "constraint": dict(UPRIGHT, frame="wrist_3_link")}},
+        ],
+    }
+    read = parse_scene_file(document, "ur5 carry held by its wrist")
+    task = plan_task(read.scene, read.task)
+    assert task.accepted, task.problems
+    robot = task.world.robot
+    model, data = robot.model, robot.model.createData()
+    wrist, tool = model.getFrameId("wrist_3_link"), model.getFrameId(robot.tcp_frame)
+    carry = task.segments[1]
+    rotations = []
+    for t in np.linspace(carry.t0, carry.t1, 50):  # pinocchio's forward kinematics, the oracle
+        pin.framesForwardKinematics(model, data, task.trajectory(t))
+        rotations.append(data.oMf[wrist].rotation.copy())
+    np.testing.assert_allclose(data.oMf[tool].translation, goal_m, atol=1e-4)  # the goal's tolerance
+    for rotation in rotations:  # the link's z axis within the angle of where it started
+        cosine = rotations[0][:, 2] @ rotation[:, 2]
+        assert np.arccos(np.clip(cosine, -1.0, 1.0)) <= UPRIGHT["angle_rad"]
+
+
+def test_a_tool_position_with_a_constraint_on_a_frame_the_tool_does_not_carry_is_refused() -> None:
+    # the forearm does not turn with the tool: no tool orientation can turn it onto the constraint
+    document = {
+        "robot": "ur5",
+        "safety_margin": 0.02,
+        "start": {"q": ARMS["ur5"]["start"]},
+        "task": [
+            {"move": {"pose": {"xyz": [0.5, -0.25, 0.3], "rpy": DOWN}}},
+            {"move": {"tcp": [0.45, 0.3, 0.3], "constraint": dict(UPRIGHT, frame="forearm_link")}},
+        ],
+    }
+    read = parse_scene_file(document, "ur5 carry held by its forearm")
+    with pytest.raises(
+        PlanningError,
+        match=r"task\[1\] \(move\): the motion's goal: the IK solution of its tool position \[0\.45, 0\.3, "
+        r"0\.3\] m holds 'forearm_link' [0-9.]+ rad from .* 'forearm_link' does not move with the tool frame "
+        r"'tool0', so no tool orientation turns it: give the goal as joint values \(q\)",
+    ):
+        plan_task(read.scene, read.task)
+
+
 def test_a_tool_position_the_arm_cannot_hold_upright_is_refused_naming_it() -> None:
     # the SO-101 (five joints) points its tool along its arm's vertical plane: held along the
     # world's x axis, its tool cannot reach a point off that plane

@@ -234,6 +234,23 @@ def test_unknown_frame(robot: ck.Robot) -> None:
         robot.frame_id("gripper")
 
 
+def test_frames_fixed_together_keep_their_relative_pose(robot: ck.Robot) -> None:
+    # the oracle: two frames move as one exactly where their relative placement is the same at
+    # every configuration (Pinocchio's forward kinematics at seeded random ones)
+    names = sorted({f.name for f in robot.model.frames if f.name != "universe"})
+    rng = np.random.default_rng(7)
+    draws = rng.uniform(robot.limits.lower, robot.limits.upper, size=(5, robot.nq))
+    poses = {name: ck.frame_poses(robot, draws, name) for name in names}
+    for first in names:
+        for second in names:
+            relative = np.linalg.inv(poses[first]) @ poses[second]
+            constant = np.allclose(relative, relative[0], atol=1e-9)
+            assert robot.fixed_together(first, second) == constant, (first, second)
+    assert robot.fixed_together("tool_link", "tcp") and not robot.fixed_together("tcp", "base_link")
+    with pytest.raises(ck.CprKinError, match="unknown frame 'gripper'"):
+        robot.fixed_together("tcp", "gripper")
+
+
 def test_bad_limits_dataclass() -> None:
     with pytest.raises(ck.CprKinError, match=re.escape("jerk limit 0.0 must be > 0")):
         ck.JointLimits(

@@ -192,6 +192,11 @@ class Robot:
             raise CprKinError(f"unknown frame '{frame}'; the robot's frames are {known}")
         return index
 
+    def fixed_together(self, frame: str, other: str) -> bool:
+        """Whether ``frame`` and ``other`` move as one: one joint carries both (fixed joints between them)."""
+        frames = self.model.frames
+        return bool(frames[self.frame_id(frame)].parentJoint == frames[self.frame_id(other)].parentJoint)
+
     def configuration(self, values: ArrayLike | dict[str, float], *, check_limits: bool = True) -> FloatArray:
         """Validate a joint vector and return it as a float array of shape ``(nq,)``.
 

@@ -124,24 +124,36 @@ def _goal_turned_onto(problem: Problem, constraint: OrientationConstraint) -> Ta
 
     A tool position leaves the tool's orientation to the IK, which may turn it off the
     constraint (a 6- or 7-joint arm's solutions turn it any way); the constraint's own
-    orientation is the one meant. Where ``problem``'s goal is a ``tcp`` goal of the tool frame
-    whose solution does not keep the constraint, it is moved the least onto it, the tool held
-    where it is (:meth:`~planning.task.orientation_projection.Projector.project`), and its
+    orientation is the one meant. Where ``problem``'s goal is a ``tcp`` goal whose solution
+    does not keep the constraint, on the tool frame or on a frame fixed to it (a gripper's
+    link), it is moved the least onto it, the constrained frame held where it is
+    (:meth:`~planning.task.orientation_projection.Projector.project`), and the tool's
     orientation there, with the goal's position, is the pose goal returned (solved and verified
-    as every pose is). ``None`` where the goal keeps the constraint, is no tool position of the
-    tool frame, or the start breaks the constraint (:func:`hold_orientation` names it).
+    as every pose is: the frame fixed to the tool turns with it). ``None`` where the goal keeps
+    the constraint, is no tool position, or the start breaks the constraint
+    (:func:`hold_orientation` names it).
 
     Raises:
-        PlanningError: the arm cannot turn the tool onto the constraint there.
+        PlanningError: the arm cannot turn the tool onto the constraint there, or the
+            constrained frame does not move with the tool (a tool position leaves its
+            orientation to the IK).
     """
     robot, goal = problem.robot, problem.scene.goal
-    if goal.tcp is None or constraint.frame not in (None, robot.tcp_frame):
+    if goal.tcp is None:
         return None
     projector = Projector.from_start(robot, constraint, problem.q_start)
     frame, held = projector.frame, projector.constraint
     start_rad, goal_rad = projector.angles(np.array([problem.q_start, problem.q_goal]))
     if start_rad > held.angle_rad or goal_rad <= held.angle_rad:  # a start that breaks it is the error
         return None
+    if not robot.fixed_together(frame, robot.tcp_frame):
+        raise PlanningError(
+            f"the motion's goal: the IK solution of its tool position {list(goal.tcp)} m holds '{frame}' "
+            f"{goal_rad:.4g} rad from the constraint's orientation about {list(held.axes)} (allowed "
+            f"{held.angle_rad:.4g} rad), and '{frame}' does not move with the tool frame "
+            f"'{robot.tcp_frame}', so no tool orientation turns it: give the goal as joint values (q) that "
+            "keep the constraint, or constrain the tool frame"
+        )
     q, angle = projector.project(problem.q_goal, keep_position=True)
     if angle > projector.aim_rad:
         raise PlanningError(
@@ -150,7 +162,7 @@ def _goal_turned_onto(problem: Problem, constraint: OrientationConstraint) -> Ta
             f"{angle:.4g} rad from it; allowed {held.angle_rad:.4g} rad): move the goal, or allow a larger "
             "angle_rad"
         )
-    rotation = ck.frame_poses(robot, q[None], frame)[0][:3, :3]
+    rotation = ck.frame_poses(robot, q[None], robot.tcp_frame)[0][:3, :3]
     return Target(
         pose=(tuple(goal.tcp), tuple(map(tuple, rotation.tolist()))),
         tolerance_m=goal.tolerance_m,
