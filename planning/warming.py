@@ -27,7 +27,9 @@ from planning.pipeline.problem import Problem, build_problem
 from planning.pipeline.scene import Scene
 from planning.pipeline.target import Target
 from planning.pipeline.torques import held
+from planning.search.nearest_nodes import INDEXED_FROM
 from planning.search.rrt_connect import rrt_connect
+from planning.search.rrt_trees import Tree
 from planning.task import Move, OrientationConstraint, ToolLine, plan_task
 from planning.task.orientation_projection import Projector
 from planning.task.orientation_rrt import BATCH, STEP_M
@@ -73,9 +75,10 @@ def warm_up(robot: ck.Robot | None = None) -> float:
 
 
 def _warm_sampling() -> None:
-    """Run RRT-Connect once through a slot in a wall of the unit square: its kernels load.
+    """Run RRT-Connect once through a slot in a wall of the unit square, ask a large tree: its kernels load.
 
-    The warm-up's own motions are clear on their straight line and draw no sample.
+    The warm-up's own motions are clear on their straight line and draw no sample; only a hard
+    problem's trees grow large enough for their k-d tree (:mod:`planning.search.nearest_nodes`).
     """
 
     def beside_the_wall(q: FloatArray) -> BoolArray:
@@ -83,6 +86,10 @@ def _warm_sampling() -> None:
 
     start, goal, ones = np.array([0.1, 0.1]), np.array([0.9, 0.1]), np.ones(2)
     rrt_connect(beside_the_wall, start, goal, 0.0 * ones, ones, ones, np.random.default_rng(0))
+    tree = Tree(start)  # a tree large enough to keep its nodes in a k-d tree (a hard problem's)
+    for node in np.random.default_rng(0).random((INDEXED_FROM, 2)):
+        tree.add(node, 0)
+    tree.nearest(goal, ones)
 
 
 def _warm_vertex_witness() -> None:

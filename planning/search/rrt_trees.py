@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cpr_kin.common.compiled import njit
+from planning.search.nearest_nodes import INDEXED_FROM, NodeIndex
 
 FloatArray = NDArray[np.float64]
 
@@ -28,6 +29,7 @@ class Tree:
         self.nodes = np.empty((64, root.size))
         self.parents = np.empty(64, dtype=np.intp)
         self.nodes[0], self.parents[0], self.size = root, -1, 1
+        self._index: NodeIndex | None = None
 
     def add(self, q: FloatArray, parent: int) -> int:
         """Add node ``q`` under node ``parent``; its index."""
@@ -39,8 +41,16 @@ class Tree:
         return self.size - 1
 
     def nearest(self, q: FloatArray, weights: FloatArray) -> int:
-        """Index of the node nearest to ``q`` by the motion bound with ``weights``."""
-        return nearest_node(self.nodes, self.size, q, weights)
+        """Index of the first node nearest to ``q`` by the motion bound with ``weights``.
+
+        A scan of every node, or from :data:`~planning.search.nearest_nodes.INDEXED_FROM` nodes
+        on, a k-d tree of them (:mod:`planning.search.nearest_nodes`): the same node.
+        """
+        if self.size < INDEXED_FROM:
+            return nearest_node(self.nodes, self.size, q, weights)
+        if self._index is None or self._index.stale(self.size):
+            self._index = NodeIndex(self.nodes, self.size, weights)
+        return self._index.nearest(self.nodes, self.size, q, weights)
 
     def branch(self, index: int) -> FloatArray:
         """The nodes from ``index`` back to the root."""
