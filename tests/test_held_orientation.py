@@ -282,77 +282,48 @@ def test_a_carry_the_constraint_cannot_reach_stops_at_the_time_limit() -> None:
         plan_task(read.scene, read.task, ur10)
 
 
-def test_a_carry_to_a_tool_position_ends_with_the_tool_upright_at_it() -> None:
-    # a tool position leaves the orientation to the IK, whose nearest solution turned the UR5's
-    # tool 0.4 rad off the upright (refused as bad input); the constraint's orientation is meant
-    goal_m = [0.45, 0.3, 0.3]
+def ur5_carry_to(goal_m: list[float], constraint: dict[str, Any]) -> SceneFile:
+    """The UR5 moved to a pose, then carried under ``constraint`` to the tool position ``goal_m``."""
     document = {
         "robot": "ur5",
         "safety_margin": 0.02,
         "start": {"q": ARMS["ur5"]["start"]},
         "task": [
             {"move": {"pose": {"xyz": [0.5, -0.25, 0.3], "rpy": DOWN}}},
-            {"move": {"tcp": goal_m, "constraint": UPRIGHT}},
+            {"move": {"tcp": goal_m, "constraint": constraint}},
         ],
     }
-    read = parse_scene_file(document, "ur5 upright carry to a tool position")
+    return parse_scene_file(
+        document, f"ur5 carry to a tool position held by {constraint.get('frame', 'tool')}"
+    )
+
+
+@pytest.mark.parametrize("frame", [None, "wrist_3_link"])
+def test_a_carry_to_a_tool_position_ends_there_with_the_constrained_frame_upright(frame: str | None) -> None:
+    # a tool position leaves the orientation to the IK, whose nearest solution turned the UR5's
+    # tool 0.4 rad off the upright (refused as bad input); the constraint's orientation is meant.
+    # The wrist's last link carries the tool frame: turning the tool turns it, so a constraint
+    # on it turns the goal the same way (refused until stop 132: the IK's solution held it 1.03 rad off)
+    goal_m = [0.45, 0.3, 0.3]
+    read = ur5_carry_to(goal_m, UPRIGHT if frame is None else dict(UPRIGHT, frame=frame))
     task = plan_task(read.scene, read.task)
     assert task.accepted, task.problems
     robot = task.world.robot
     model, data = robot.model, robot.model.createData()
-    fid = model.getFrameId(robot.tcp_frame)
+    held, tool = model.getFrameId(frame or robot.tcp_frame), model.getFrameId(robot.tcp_frame)
     carry = task.segments[1]
     axes = []
-    for t in (carry.t0, carry.t1):  # pinocchio's forward kinematics, the oracle
-        pin.framesForwardKinematics(model, data, task.trajectory(t))
-        axes.append(data.oMf[fid].rotation[:, 2].copy())
-    np.testing.assert_allclose(data.oMf[fid].translation, goal_m, atol=1e-4)  # the goal's tolerance
-    assert np.arccos(np.clip(axes[0] @ axes[1], -1.0, 1.0)) <= UPRIGHT["angle_rad"]
-
-
-def test_a_carry_constrained_on_a_frame_fixed_to_the_tool_turns_the_tool_goal_too() -> None:
-    # the constraint names the wrist's last link, which carries the tool frame: turning the tool
-    # turns it, so the tool position becomes a pose goal as for the tool frame itself (it was
-    # refused: the IK's solution held the link 1.03 rad off)
-    goal_m = [0.45, 0.3, 0.3]
-    document = {
-        "robot": "ur5",
-        "safety_margin": 0.02,
-        "start": {"q": ARMS["ur5"]["start"]},
-        "task": [
-            {"move": {"pose": {"xyz": [0.5, -0.25, 0.3], "rpy": DOWN}}},
-            {"move": {"tcp": goal_m, "constraint": dict(UPRIGHT, frame="wrist_3_link")}},
-        ],
-    }
-    read = parse_scene_file(document, "ur5 carry held by its wrist")
-    task = plan_task(read.scene, read.task)
-    assert task.accepted, task.problems
-    robot = task.world.robot
-    model, data = robot.model, robot.model.createData()
-    wrist, tool = model.getFrameId("wrist_3_link"), model.getFrameId(robot.tcp_frame)
-    carry = task.segments[1]
-    rotations = []
     for t in np.linspace(carry.t0, carry.t1, 50):  # pinocchio's forward kinematics, the oracle
         pin.framesForwardKinematics(model, data, task.trajectory(t))
-        rotations.append(data.oMf[wrist].rotation.copy())
+        axes.append(data.oMf[held].rotation[:, 2].copy())
     np.testing.assert_allclose(data.oMf[tool].translation, goal_m, atol=1e-4)  # the goal's tolerance
-    for rotation in rotations:  # the link's z axis within the angle of where it started
-        cosine = rotations[0][:, 2] @ rotation[:, 2]
-        assert np.arccos(np.clip(cosine, -1.0, 1.0)) <= UPRIGHT["angle_rad"]
+    for axis in axes:  # the held z axis within the angle of where the carry started
+        assert np.arccos(np.clip(axes[0] @ axis, -1.0, 1.0)) <= UPRIGHT["angle_rad"]
 
 
 def test_a_tool_position_with_a_constraint_on_a_frame_the_tool_does_not_carry_is_refused() -> None:
     # the forearm does not turn with the tool: no tool orientation can turn it onto the constraint
-    document = {
-        "robot": "ur5",
-        "safety_margin": 0.02,
-        "start": {"q": ARMS["ur5"]["start"]},
-        "task": [
-            {"move": {"pose": {"xyz": [0.5, -0.25, 0.3], "rpy": DOWN}}},
-            {"move": {"tcp": [0.45, 0.3, 0.3], "constraint": dict(UPRIGHT, frame="forearm_link")}},
-        ],
-    }
-    read = parse_scene_file(document, "ur5 carry held by its forearm")
+    read = ur5_carry_to([0.45, 0.3, 0.3], dict(UPRIGHT, frame="forearm_link"))
     with pytest.raises(
         PlanningError,
         match=r"task\[1\] \(move\): the motion's goal: the IK solution of its tool position \[0\.45, 0\.3, "
