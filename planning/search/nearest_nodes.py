@@ -3,7 +3,7 @@
 RRT-Connect (:mod:`planning.search.rrt_connect`) asks twice a sample for the node of a tree
 nearest a configuration, by the motion bound ``sum_j w_j |dq_j|``. A scan of every node costs
 what the tree holds: on a hard problem (MotionBenchMaker's Fetch among shelves) the trees
-reach tens of thousands of nodes, and the scans took a sixth to a quarter of the plan.
+reach tens of thousands of nodes, and the scans a large share of the plan (``docs/tuning.md``).
 
 So a tree of :data:`INDEXED_FROM` nodes or more keeps them in a k-d tree
 (:class:`NodeIndex`): cells of at most :data:`LEAF_NODES` nodes, each split at the median
@@ -30,7 +30,7 @@ FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
 INDEXED_FROM = 2048
-"""Nodes from which a tree keeps its k-d tree: below, a scan costs a few microseconds."""
+"""Nodes from which a tree keeps its k-d tree: below, a scan is the cheaper (``docs/tuning.md``)."""
 LEAF_NODES = 16
 """Most nodes of a cell of the k-d tree."""
 REBUILD_SHARE = 0.125
