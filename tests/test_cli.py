@@ -218,6 +218,10 @@ def test_a_scene_without_obstacles_writes_json_any_parser_reads(
     code, stdout, _ = run(["check", str(scene), str(out / "trajectory.json")], capsys)
     assert code == 0 and "certified clearance unbounded, no obstacle >= " in stdout
     assert "inf" not in stdout + report
+    # the two files in the wrong order: one line saying which is which, not the scene's missing keys
+    code, _, err = run(["check", str(out / "trajectory.json"), str(scene)], capsys)
+    assert code == 2 and err.count("\n") == 1 and "Traceback" not in err
+    assert "trajectory.json is a trajectory file (cpr-trajectory/1), not a scene; give the scene file" in err
 
 
 def test_plan_check_and_reproducibility(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -87,6 +87,3 @@ def test_robot_info_of_a_branched_robot_names_its_tool_frame(capsys: pytest.Capt
     assert [j["name"] for j in report["joints"]] == [
         f"left_{j}" for j in ("s0", "s1", "e0", "e1", "w0", "w1", "w2")
     ]
-    assert main(["robot-info", "cpr", "--tcp", "tcp"]) == 2
-    error = capsys.readouterr().err
-    assert "drop --tcp and --srdf" in error and len(error.strip().splitlines()) == 1

@@ -24,6 +24,20 @@ def test_a_scene_files_robot_is_the_one_its_plan_loads(name: str, capsys: pytest
     assert [j["name"] for j in report["joints"]] == list(robot.joint_names)
 
 
+def test_the_bundled_robot_with_another_tool_frame_is_the_one_a_scene_of_it_loads(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # `robot-info cpr --tcp ...` was refused while a scene could name that robot
+    scene = tmp_path / "scene.yaml"
+    ends = "start: {q: [0, 0.3, 0.3, 0, 0]}\ngoal: {q: [1, 0.3, 0.3, 0, 0]}\n"
+    scene.write_text("robot: {urdf: cpr, tcp: tool_link}\n" + ends)
+    assert main(["robot-info", "cpr", "--tcp", "tool_link", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    robot = load_scene(scene).robot_spec().load()  # the oracle: what `cpr-plan plan` loads
+    assert report["tcp_frame"] == robot.tcp_frame == "tool_link" and Path(report["urdf"]) == robot.urdf_path
+    assert [j["name"] for j in report["joints"]] == list(robot.joint_names)
+
+
 def test_a_bad_scene_file_is_one_line_naming_the_field(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

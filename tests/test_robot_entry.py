@@ -34,6 +34,17 @@ def test_a_robot_by_name_is_example_robot_datas() -> None:
     assert robot.nq == 7 and robot.tcp_frame == "panda_hand_tcp"
 
 
+def test_the_bundled_robot_by_name_is_the_default_and_takes_a_mapping_s_keys() -> None:
+    # 'cpr' named the bundled robot on the command line (robot-info, --urdf) but not in a scene
+    ends = {"start": {"q": [0.0, 0.3, 0.3, 0.0, 0.0]}, "goal": {"q": [0.5, 0.3, 0.3, 0.0, 0.0]}}
+    assert parse_scene({"robot": "cpr", **ends}).robot == parse_scene(ends).robot == ck.cpr_spec()
+    scene = parse_scene({"robot": {"urdf": "cpr", "tcp": "tool_link"}, **ends})
+    assert scene.robot is not None and scene.robot.urdf == ck.cpr_urdf_path()
+    assert scene.robot.load().tcp_frame == "tool_link" and scene.robot.joints == ck.CPR_JOINTS
+    with pytest.raises(SceneError, match=r"the bundled 'cpr'.*did you mean 'cpr'"):
+        parse_scene({"robot": "cpt", **ends})
+
+
 def test_a_urdf_path_is_relative_to_the_scene_file(tmp_path: Path) -> None:
     (tmp_path / "robots").mkdir()
     shutil.copy(ck.load_cpr().urdf_path, tmp_path / "robots" / "my_cpr.urdf")

@@ -2,6 +2,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import json
 import math
 import re
 from pathlib import Path
@@ -20,6 +21,7 @@ from planning.bench.scene_generator import generate_scenes
 from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError, SceneError
 from planning.io.bundled import bundled_scene_paths, duration_free_scenes, paper_scene, paper_scene_path
+from planning.io.file_formats import OUTPUTS, TRAJECTORY
 from planning.io.scene_file import (
     dump_scene,
     load_scene,
@@ -175,6 +177,10 @@ def test_file_errors(tmp_path: Path) -> None:
     (tmp_path / "list.yaml").write_text("- 1\n- 2\n")
     with pytest.raises(SceneError, match=r"must be a mapping of keys .* not list"):
         load_scene(tmp_path / "list.yaml")
+    for name, written in (("trajectory", TRAJECTORY), ("manifest", OUTPUTS)):  # a plan's files, not scenes
+        (tmp_path / f"{name}.json").write_text(json.dumps({"format": written, "sha256": {}}))
+        with pytest.raises(SceneError, match=rf"{name}\.json is (a|an) .* \({written}\), not a scene"):
+            load_scene(tmp_path / f"{name}.json")
 
 
 # --- property tests: any input loads or raises SceneError, never anything else ---------------

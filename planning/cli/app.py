@@ -112,7 +112,8 @@ def build_parser() -> argparse.ArgumentParser:
     sub.add_argument(
         "--urdf",
         type=Path,
-        help="the robot's URDF when the one the file records is not here ('cpr': the bundled CPR)",
+        help="the robot's URDF when the one the file records is not here, or a name: 'cpr' (the bundled "
+        "CPR), an example-robot-data arm's (panda, ur5, ...)",
     )
     sub.set_defaults(run=cmd_show)
 

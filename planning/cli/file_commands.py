@@ -69,17 +69,17 @@ def shown_robot(document: TrajectoryFile, scene: Scene, urdf: Path | None) -> ck
     Raises:
         PlanningError: the recorded robot's files are not on this machine (and no ``urdf`` given).
     """
-    from planning.io.robot_entry import default_robot
+    from planning.io.robot_entry import BUNDLED, default_robot, robot_spec_of
 
-    if urdf is not None:
-        return ck.load_cpr() if str(urdf) == "cpr" else ck.robot_spec(urdf).load()
+    if urdf is not None:  # a path, or a name (the bundled robot's, an example arm's)
+        return robot_spec_of(str(urdf), Path.cwd()).load()
     spec = scene.robot_spec()
-    if spec == default_robot() and document.robot not in ("cpr", str(spec.urdf)):
+    if spec == default_robot() and document.robot not in (BUNDLED, str(spec.urdf)):
         spec = ck.robot_spec(Path(document.robot))
     if not Path(spec.urdf).is_file():
         raise PlanningError(
             f"the trajectory's robot URDF '{spec.urdf}' is not on this machine; "
-            "pass the robot with --urdf PATH (the bundled CPR: --urdf cpr)"
+            f"pass the robot with --urdf PATH (the bundled CPR: --urdf {BUNDLED})"
         )
     return spec.load()
 

@@ -61,28 +61,19 @@ def robot_report(robot: ck.Robot) -> dict[str, Any]:
 
 
 def cmd_robot_info(args: argparse.Namespace) -> int:
-    """Print what the planner makes of ``args.robot``: a scene's ``robot:`` value, ``cpr``, a scene file.
+    """Print what the planner makes of ``args.robot``: a scene's ``robot:`` value, or a scene file.
 
     ``--tcp`` and ``--srdf`` are those keys of a scene's ``robot:`` mapping: a robot whose tree
     branches (a humanoid, a mobile manipulator) loads only with its tool frame named.
     """
-    from planning.errors import PlanningError
     from planning.io.robot_entry import robot_spec_of
     from planning.io.scene_file import scene_robot
 
+    # a scene file: the robot it names, as a plan of it loads it
+    spec = scene_robot(args.robot) if is_yaml_name(args.robot) else robot_spec_of(args.robot, Path.cwd())
     named = {"tcp": args.tcp, "srdf": None if args.srdf is None else args.srdf.resolve()}
-    if args.robot == "cpr" and any(value is not None for value in named.values()):
-        raise PlanningError(
-            "robot 'cpr' is the bundled preset, its tool frame and SRDF its own: drop --tcp and --srdf"
-        )
-    spec: ck.RobotSpec | None = None  # None: the bundled preset
-    if is_yaml_name(args.robot):  # a scene file: the robot it names
-        spec = scene_robot(args.robot)  # the scene file's robot: entry, as a plan of it loads it
-    elif args.robot != "cpr":
-        spec = robot_spec_of(args.robot, Path.cwd())
-    if spec is not None:
-        spec = dataclasses.replace(spec, **{key: value for key, value in named.items() if value is not None})
-    report = robot_report(ck.load_cpr() if spec is None else spec.load())
+    spec = dataclasses.replace(spec, **{key: value for key, value in named.items() if value is not None})
+    report = robot_report(spec.load())
     if args.json:
         print(json_layout.dumps(report, indent=2))
         return EXIT_OK

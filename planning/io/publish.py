@@ -38,6 +38,7 @@ from types import TracebackType
 from typing import Any
 
 from planning.errors import PlanningError
+from planning.io.file_formats import OUTPUTS
 from planning.io.uninterrupted import uninterrupted
 
 MANIFEST = "manifest.json"
@@ -120,7 +121,7 @@ def _manifest(files: dict[str, str | bytes]) -> str:
         name: hashlib.sha256(content.encode("utf-8") if isinstance(content, str) else content).hexdigest()
         for name, content in sorted(files.items())
     }
-    return json.dumps({"format": "cpr-plan-outputs/1", "sha256": digests}, indent=1) + "\n"
+    return json.dumps({"format": OUTPUTS, "sha256": digests}, indent=1) + "\n"
 
 
 def complete_set(folder: Path) -> bool:

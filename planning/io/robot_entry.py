@@ -1,6 +1,7 @@
 """A scene file's ``robot:`` entry: a name, a URDF path, or a mapping, to and from :class:`cpr_kin.RobotSpec`.
 
-- a name of example-robot-data's arms (``robot: panda``, :data:`cpr_kin.model.packages.EXAMPLE_ROBOTS`);
+- a name: ``cpr``, the bundled CPR preset (:data:`BUNDLED`), or one of example-robot-data's arms
+  (``robot: panda``, :data:`cpr_kin.model.packages.EXAMPLE_ROBOTS`);
 - a URDF path, relative to the scene file (``robot: ../urdf/my_arm.urdf``): the CPR preset
   for a URDF with the CPR's joints, else the generic rules (:func:`cpr_kin.robot_spec`);
 - a mapping ``{urdf, srdf, packages, limits, joints, tcp, fixed}``: ``urdf`` as above (a
@@ -35,6 +36,10 @@ from planning.io.schema_types import (
     empty_list,
 )
 
+BUNDLED = "cpr"
+"""The name of the bundled robot, the CPR preset: wherever a robot is named (a scene's
+``robot:``, its ``urdf:``, ``cpr-plan robot-info cpr``, ``--urdf cpr``)."""
+
 
 class RobotMapping(Strict):
     """``robot: {urdf, srdf, packages, limits, joints, tcp, fixed}`` (module docstring)."""
@@ -55,22 +60,24 @@ RobotEntry = Annotated[
 
 
 def _urdf(value: str, base: Path) -> Path:
-    """A URDF named by ``value``: an example-robot-data arm, else a path relative to ``base``.
+    """A URDF named by ``value``: the bundled one, an example-robot-data arm, or a path relative to ``base``.
 
     Raises:
         UrdfError: no such arm, and no such file (or not a regular file); read when it loads.
     """
+    if value == BUNDLED:
+        return ck.cpr_spec().urdf
     if value in EXAMPLE_ROBOTS:
         return example_robot(value)
     path = (base / value).resolve()
     if not path.exists() and not path.suffix:
         from difflib import get_close_matches  # a message's, not every scene's (start-up)
 
-        close = get_close_matches(value.lower(), sorted(EXAMPLE_ROBOTS), n=1, cutoff=0.6)
+        close = get_close_matches(value.lower(), [BUNDLED, *sorted(EXAMPLE_ROBOTS)], n=1, cutoff=0.6)
         hint = f"; did you mean '{close[0]}'?" if close else ""
         raise ck.UrdfError(
-            f"'{escaped(value)}' is neither a URDF file ('{path}' does not exist) "
-            f"nor one of example-robot-data's arms {sorted(EXAMPLE_ROBOTS)}{hint}"
+            f"'{escaped(value)}' is neither a URDF file ('{path}' does not exist), the bundled "
+            f"'{BUNDLED}', nor one of example-robot-data's arms {sorted(EXAMPLE_ROBOTS)}{hint}"
         )
     check_urdf_file(path)
     return path

@@ -36,6 +36,7 @@ from cpr_kin.common.user_files import UserFileError, dump_yaml, load_yaml
 from planning.curves.spline_settings import SplineSettings
 from planning.errors import PlanningError, SceneError
 from planning.io.cloud_entry import PointCloudSpec, RobotAtStart, cloud_obstacles
+from planning.io.file_formats import WRITTEN
 from planning.io.publish import write_file
 from planning.io.robot_entry import default_robot, robot_entry, robot_spec_of
 from planning.io.scene_schema import SceneSpec, describe_errors
@@ -217,6 +218,12 @@ def _validated(data: Any, source: str) -> SceneSpec:
         raise SceneError(
             f"{source}: a scene must be a mapping of keys (start, goal, obstacles, ...), "
             f"not {type(data).__name__}"
+        )
+    written = data.get("format")
+    if isinstance(written, str) and written in WRITTEN:  # the files of a command taken in the wrong order
+        raise SceneError(
+            f"{source} is {WRITTEN[written]} ({written}), not a scene; give the scene file "
+            "(start, goal, obstacles) here, and that file where it is asked for"
         )
     try:
         return SceneSpec.model_validate(data)

@@ -11,10 +11,11 @@ from __future__ import annotations
 
 from typing import Any
 
+from planning.io.file_formats import TRAJECTORY
 from planning.io.json_layout import dumps
 from planning.io.report import clearance_text, markdown_table
 from planning.io.scene_file import scene_to_dict
-from planning.io.trajectory_io import FORMAT, samples_csv
+from planning.io.trajectory_io import samples_csv
 from planning.task.task_plan import TaskMotion
 from planning.task.task_record import task_record
 
@@ -38,7 +39,7 @@ def task_document(task: TaskMotion, planning_time_s: float | None = None) -> dic
     """
     trajectory, robot = task.trajectory, task.world.robot
     return {
-        "format": FORMAT,
+        "format": TRAJECTORY,
         "joint_names": list(robot.joint_names),
         "robot": str(robot.urdf_path),
         "srdf": None if robot.srdf_path is None else str(robot.srdf_path),

@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from planning.curves.trajectory import DERIVATIVE_NAMES, Trajectory
+from planning.io.file_formats import TRAJECTORY
 from planning.io.json_layout import dumps
 from planning.io.publish import write_file
 from planning.validation import instance_of
@@ -27,7 +28,6 @@ if TYPE_CHECKING:  # types only: writing files needs neither the planner nor the
     from planning.pipeline.result import PlanResult
 
 FloatArray = NDArray[np.float64]
-FORMAT = "cpr-trajectory/1"
 
 
 def trajectory_document(result: PlanResult, timings: bool = False) -> dict[str, Any]:
@@ -45,7 +45,7 @@ def trajectory_document(result: PlanResult, timings: bool = False) -> dict[str, 
         for i, (t0, t1) in enumerate(zip(trajectory.knots[:-1], trajectory.knots[1:], strict=True))
     ]
     return {
-        "format": FORMAT,
+        "format": TRAJECTORY,
         "joint_names": list(result.joint_names),
         "robot": str(result.robot.urdf_path),
         "srdf": None if result.robot.srdf_path is None else str(result.robot.srdf_path),

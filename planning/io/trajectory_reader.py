@@ -29,7 +29,6 @@ from planning.errors import PlanningError
 from planning.pipeline.scene import DURATION_RANGE_S
 
 FloatArray = NDArray[np.float64]
-FORMAT = "cpr-trajectory/1"
 
 MAX_TRAJECTORY_BYTES = 50_000_000
 """Largest trajectory file [bytes] (a plan writes about 20 kB)."""
