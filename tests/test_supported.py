@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 import re
 from collections.abc import Callable
@@ -16,6 +17,7 @@ from cpr_kin.description.supported import MAX_CROSSING_S, crossing_time
 from cpr_kin.model.limits import DEFAULT_ACCELERATION_PER_S, DEFAULT_JERK_PER_S
 from planning import PlannerSettings, paper_scene, plan
 from planning.cli import main
+from planning.io.report import limits_section
 
 URDF = ck.cpr_urdf_path().read_text()
 THETA1 = '<limit lower="-2.9" upper="2.9" velocity="1.5" effort="100"/>'
@@ -37,11 +39,14 @@ def theta1_limit(lower: str, upper: str, velocity: str = "1.5") -> Callable[[str
 
 
 BRACE = '<joint name="brace" type="fixed"><parent link="base_link"/><child link="arm_link"/></joint>'
-SUPPORTED = r"the planner supports lower < upper within \[-6.2832, 6.2832\] rad"
+SUPPORTED = (
+    r"the planner supports lower < upper with a part within \[-6.2832, 6.2832\] rad, one turn either way "
+    r"\(a wider range is planned within it\)$"
+)
 REFUSED = [
-    ("range 1e3", theta1_limit("-1000", "1000"),
-     r"joint 'theta1' range \[-1000, 1000\] rad is not supported; " + SUPPORTED),
-    ("range 1e12", theta1_limit("-1e12", "1e12"), r"'theta1' range \[-1e\+12, 1e\+12\] rad is not supported"),
+    ("range beyond a turn", theta1_limit("7", "1000"),
+     r"joint 'theta1' range \[7, 1000\] rad is not supported; " + SUPPORTED),
+    ("range 1e12 below", theta1_limit("-1e12", "-6.3"), r"'theta1' range \[-1e\+12, -6.3\] rad is not"),
     ("empty range", theta1_limit("0.5", "0.5"), r"joint 'theta1' range \[0.5, 0.5\] rad is not supported"),
     ("slow joint", theta1_limit("-2.9", "2.9", "1e-6"),
      r"joint 'theta1' needs 5.8e\+06 s to cross its range .* at most 600 s: raise the limits"),
@@ -119,12 +124,12 @@ def test_a_continuous_joint_is_planned_within_one_turn(tmp_path: Path) -> None:
 def test_the_command_line_refuses_it_at_once_with_exit_2(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    variant(tmp_path, theta1_limit("-1e12", "1e12"))
+    variant(tmp_path, theta1_limit("7", "1e12"))
     scene = tmp_path / "scene.yaml"
     scene.write_text("robot: robot.urdf\nstart: {tcp: [0.5, 0.45, 0.25]}\ngoal: {tcp: [-0.5, 0.45, 0.25]}\n")
     assert main(["plan", str(scene), "--out", str(tmp_path / "out")]) == 2
     error = capsys.readouterr().err
-    assert "joint 'theta1' range [-1e+12, 1e+12] rad is not supported" in error and error.count("\n") == 1
+    assert "joint 'theta1' range [7, 1e+12] rad is not supported" in error and error.count("\n") == 1
     assert not (tmp_path / "out").exists()
 
 
@@ -135,6 +140,44 @@ def test_the_widest_supported_range_plans(tmp_path: Path) -> None:
     scene = dataclasses.replace(paper_scene(), duration=None, planner=PlannerSettings())
     result = plan(scene, robot)
     assert result.verification.accepted
+
+
+@pytest.mark.parametrize(("lower", "upper"), [("-6.98132", "6.98132"), ("-1e12", "1e12"), ("-1", "1e9")])
+def test_a_range_beyond_one_turn_is_planned_within_it(tmp_path: Path, lower: str, upper: str) -> None:
+    # an industrial wrist's +-400 degrees, a URDF's "no limit": refused before ("range [-6.98132,
+    # 6.98132] rad is not supported"); planned within its part of [-2 pi, 2 pi], and said so
+    robot = ck.load_cpr(variant(tmp_path, theta1_limit(lower, upper)))
+    expected = (max(float(lower), -2 * math.pi), min(float(upper), 2 * math.pi))
+    assert (robot.limits.lower[0], robot.limits.upper[0]) == expected
+    assert robot.ranges_narrowed == {"theta1": (float(lower), float(upper))}
+    bundled = ck.load_cpr().limits
+    assert np.array_equal(robot.limits.lower[1:], bundled.lower[1:])
+    assert np.array_equal(robot.limits.upper[1:], bundled.upper[1:])
+    scene = dataclasses.replace(paper_scene(), duration=None, planner=PlannerSettings())
+    result = plan(scene, robot)
+    assert result.verification.accepted
+    q = result.trajectory(np.linspace(0.0, result.trajectory.duration, 200))
+    assert np.all((q >= robot.limits.lower) & (q <= robot.limits.upper))
+    assert f"The URDF's ranges of theta1 [{float(lower):.4g}, {float(upper):.4g}] rad pass one turn" in (
+        "\n".join(limits_section(result))
+    )
+
+
+def test_robot_info_says_which_range_is_narrowed(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    urdf = variant(tmp_path, theta1_limit("-6.98132", "6.98132"))
+    assert main(["robot-info", str(urdf), "--json"]) == 0
+    joints = json.loads(capsys.readouterr().out)["joints"]
+    assert joints[0]["urdf_range"] == [-6.98132, 6.98132] and joints[0]["upper"] == 2 * math.pi
+    assert [j["urdf_range"] for j in joints[1:]] == [None] * 4
+    assert main(["robot-info", str(urdf)]) == 0
+    line = "theta1: [-6.283, 6.283] rad, 1.5, 3, 15 (the URDF's range [-6.981, 6.981] rad, planned within one"
+    assert line in capsys.readouterr().out
+
+
+def test_a_range_within_one_turn_as_written_is_not_narrowed(tmp_path: Path) -> None:
+    # 6.2832 is 2 pi as a URDF writes it: within the tolerance, kept as the URDF gives it
+    robot = ck.load_cpr(variant(tmp_path, theta1_limit("-6.2832", "6.2832")))
+    assert robot.ranges_narrowed == {} and robot.limits.upper[0] == 6.2832
 
 
 @pytest.mark.parametrize(

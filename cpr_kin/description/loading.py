@@ -5,8 +5,9 @@ Loading, in order:
 1. the URDF is read as strict XML, validated by yourdfpy (but a preset's bundled file, which
    the tests validate), and checked for what the planner supports (:mod:`cpr_kin.description.supported`);
 2. its mesh paths (``package://NAME/...``, relative, absolute) are resolved
-   (:mod:`cpr_kin.model.packages`) and its ``continuous`` joints bounded
-   (:func:`~cpr_kin.description.urdf_file.prepared_xml`);
+   (:mod:`cpr_kin.model.packages`), its ``continuous`` joints bounded and its revolute ranges
+   beyond one turn either way narrowed to it (:func:`~cpr_kin.description.urdf_file.prepared_xml`,
+   listed in :attr:`Robot.ranges_narrowed`);
 3. Pinocchio builds the kinematic, collision and visual models (what its URDF parser prints
    stays off the terminal);
 4. the joints that are not planned are held: at the value given in ``held``, a ``mimic``
@@ -43,7 +44,13 @@ from cpr_kin.description.joint_roles import base_joints, held_values, planned_jo
 from cpr_kin.description.resources import makers_limits_path
 from cpr_kin.description.robot_options import check_not_one_name, check_options, check_tcp
 from cpr_kin.description.supported import check_limits, checked_urdf
-from cpr_kin.description.urdf_file import collision_names, massless_links, mesh_filenames, prepared_xml
+from cpr_kin.description.urdf_file import (
+    collision_names,
+    massless_links,
+    mesh_filenames,
+    narrowed_ranges,
+    prepared_xml,
+)
 from cpr_kin.description.urdf_models import VisualModel, build_models, convex_hulls
 from cpr_kin.model.arm import ArmChain, arm_chain
 from cpr_kin.model.geometry_groups import carried_alone, grouped_geometries
@@ -174,6 +181,7 @@ class RobotSpec:
             position_ik=self.position_ik,
             limits_path=dynamic.source,
             limits_defaulted=dynamic.defaulted,
+            ranges_narrowed={n: r for n, r in narrowed_ranges(tree).items() if n in names},
             held=held,
             base_joints=bases,
             srdf_path=srdf,

@@ -3,17 +3,21 @@
 A URDF can describe what no plan should be asked of: a joint that turns without end, a
 range of a thousand turns, a velocity limit of a micrometre per second. Left in, such a
 joint makes the search's box, the trajectories and their checks as large as the range or
-as long as the crossing time, and a plan runs for minutes and gigabytes. So the loader
-refuses it at once (:class:`~cpr_kin.common.errors.UrdfError`, exit 2 on the command line), naming
-the joint, the value and what is supported:
+as long as the crossing time, and a plan runs for minutes and gigabytes. So an endless
+joint is planned within one turn, a range beyond one turn either way within that
+(:func:`~cpr_kin.description.urdf_file.narrowed_ranges`), and the loader refuses the rest at
+once (:class:`~cpr_kin.common.errors.UrdfError`, exit 2 on the command line), naming the
+joint, the value and what is supported:
 
 - joint types: ``revolute``, ``prismatic``, ``continuous`` (planned within
   :data:`~cpr_kin.description.urdf_file.CONTINUOUS_RANGE_RAD`) and ``fixed``; a ``planar`` or
   ``floating`` joint (a mobile base's) is never planned but held at its identity pose, and a
   ``mimic`` joint is held (with the joint it mimics); each moving joint with an axis that is a
   direction;
-- position limits within :data:`MAX_REVOLUTE_RAD` (one turn either way) for a revolute
-  joint and :data:`MAX_PRISMATIC_M` for a prismatic one, with ``lower < upper``;
+- position limits ``lower < upper``: a revolute joint's range with a part within
+  :data:`MAX_REVOLUTE_RAD` (one turn either way; a wider range is planned within it,
+  :func:`~cpr_kin.description.urdf_file.narrowed_ranges`), a prismatic one's within
+  :data:`MAX_PRISMATIC_M`;
 - crossing a joint's whole range, at rest at both ends, within its velocity, acceleration
   and jerk limits takes at most :data:`MAX_CROSSING_S` (a plan's motion is a few such
   crossings at most);
@@ -38,7 +42,7 @@ from lxml import etree
 from cpr_kin.common.errors import UrdfError
 from cpr_kin.common.names import escaped, unprintable
 from cpr_kin.description.link_tree import check_tree
-from cpr_kin.description.urdf_file import parse_urdf, validate_urdf
+from cpr_kin.description.urdf_file import RANGE_TOLERANCE_RAD, TURN_EITHER_WAY_RAD, parse_urdf, validate_urdf
 from cpr_kin.model.limits import JointLimits
 
 PLANNED_TYPES = ("revolute", "prismatic", "continuous", "fixed")
@@ -47,11 +51,11 @@ BASE_TYPES = ("planar", "floating")
 """Joint types of a mobile base, held at their identity pose: the scene's frame is their child's."""
 SUPPORTED_TYPES = PLANNED_TYPES + BASE_TYPES
 """Joint types a URDF may hold."""
-MAX_REVOLUTE_RAD = 2 * math.pi
-"""Largest |position limit| of a revolute joint [rad]: one turn either way, as UR and xArm arms have."""
+MAX_REVOLUTE_RAD = TURN_EITHER_WAY_RAD
+"""Largest |position limit| of a revolute joint as planned [rad]: one turn either way."""
 MAX_PRISMATIC_M = 10.0
 """Largest |position limit| of a prismatic joint [m]."""
-LIMIT_TOLERANCE = 1e-3
+LIMIT_TOLERANCE = RANGE_TOLERANCE_RAD
 """How far a position limit may pass its bound (a URDF that writes 2 pi as 6.2832) [rad or m]."""
 MAX_SHAPE_M = 100.0
 """Largest size of a link's shape [m]: a box's side, a cylinder's radius or length, a sphere's
@@ -210,9 +214,15 @@ def check_limits(limits: JointLimits, units: Sequence[str], path: Path) -> None:
         bound = MAX_REVOLUTE_RAD if unit == "rad" else MAX_PRISMATIC_M
         lower, upper = float(limits.lower[i]), float(limits.upper[i])
         if not -bound - LIMIT_TOLERANCE <= lower < upper <= bound + LIMIT_TOLERANCE:
+            supported = (
+                f"a part within [{-bound:.5g}, {bound:.5g}] rad, one turn either way (a wider range is "
+                "planned within it)"
+                if unit == "rad"
+                else f"within [{-bound:.5g}, {bound:.5g}] m"
+            )
             raise UrdfError(
                 f"URDF '{path}': joint '{name}' range [{lower:g}, {upper:g}] {unit} is not supported; "
-                f"the planner supports lower < upper within [{-bound:.5g}, {bound:.5g}] {unit}"
+                f"the planner supports lower < upper with {supported}"
             )
         velocity, acceleration, jerk = (
             float(v[i]) for v in (limits.velocity, limits.acceleration, limits.jerk)

@@ -177,6 +177,35 @@ CONTINUOUS_RANGE_RAD = math.pi
 """The range a ``continuous`` joint is planned within: ``[-pi, pi]`` rad, one turn. A
 continuous joint turns without end; a plan between two poses never needs more than a turn
 of it, and a bounded range keeps the search's box and the trajectories bounded."""
+TURN_EITHER_WAY_RAD = 2 * math.pi
+"""How far either way a ``revolute`` joint is planned [rad]: a wider range (an industrial
+wrist's +-400 degrees, a leg's +-10 rad, a URDF's +-1e9 for "no limit") is planned within
+``[-2 pi, 2 pi]``, one turn either way as UR and xArm arms have, for the reason a continuous
+joint's is bounded (:func:`narrowed_ranges`)."""
+RANGE_TOLERANCE_RAD = 1e-3
+"""How far a revolute range may pass one turn and count as within it (a URDF that writes
+2 pi as 6.2832) [rad]."""
+
+
+def narrowed_ranges(tree: etree._ElementTree) -> dict[str, tuple[float, float]]:
+    """The revolute joints whose range passes :data:`TURN_EITHER_WAY_RAD`, with their URDF ranges [rad].
+
+    Each is planned within its range's part within one turn either way. A range with no such
+    part (``[7, 10]`` rad) is not narrowed: the loader refuses it, naming it
+    (:func:`cpr_kin.description.supported.check_limits`).
+    """
+    bound, narrowed = TURN_EITHER_WAY_RAD + RANGE_TOLERANCE_RAD, {}
+    for joint in tree.getroot().findall("joint"):
+        limit = joint.find("limit")
+        if joint.get("type") != "revolute" or limit is None:
+            continue
+        try:
+            lower, upper = float(limit.get("lower", "0")), float(limit.get("upper", "0"))
+        except ValueError:  # refused by name where the URDF is checked
+            continue
+        if (lower < -bound or upper > bound) and max(lower, -bound) < min(upper, bound):
+            narrowed[joint.get("name", "")] = (lower, upper)
+    return narrowed
 
 
 def prepared_xml(tree: etree._ElementTree, path: Path, roots: Sequence[Path]) -> str:
@@ -187,6 +216,7 @@ def prepared_xml(tree: etree._ElementTree, path: Path, roots: Sequence[Path]) ->
     its specification allows for a continuous joint, they are 0: unknown, so that a planned
     joint without a velocity limit is refused by name at load, naming the two places to give
     one, while a joint the planner only holds, such as a mobile base's caster wheel, loads),
+    a revolute range beyond one turn either way is narrowed to it (:func:`narrowed_ranges`),
     and every mesh file name is made absolute (:func:`cpr_kin.model.packages.resolve_mesh`), so
     that a missing mesh is named before Pinocchio reads anything.
 
@@ -194,7 +224,13 @@ def prepared_xml(tree: etree._ElementTree, path: Path, roots: Sequence[Path]) ->
         UrdfError: a mesh not found.
     """
     root = copy.deepcopy(tree.getroot())
+    narrowed = narrowed_ranges(tree)
     for joint in root.findall("joint"):
+        name, limit = joint.get("name", ""), joint.find("limit")
+        if name in narrowed and limit is not None and joint.get("type") == "revolute":
+            lower, upper = narrowed[name]
+            limit.set("lower", repr(max(lower, -TURN_EITHER_WAY_RAD)))
+            limit.set("upper", repr(min(upper, TURN_EITHER_WAY_RAD)))
         if joint.get("type") != "continuous":
             continue
         joint.set("type", "revolute")

@@ -93,6 +93,8 @@ class Robot:
         limits_path: the file the acceleration and jerk limits were read from (``None``:
             the documented defaults, :func:`cpr_kin.model.limits.default_limits`).
         limits_defaulted: the joints whose acceleration or jerk limit is a default.
+        ranges_narrowed: the planned joints whose URDF range passes one turn either way, with
+            that range [rad]: each is planned within its part of ``[-2 pi, 2 pi]`` (``limits``).
         held: the URDF's joints that are not planned, at the values they are held at.
         base_joints: the URDF's ``planar`` and ``floating`` joints (a mobile base's), never
             planned and held at their identity pose: the scene's frame is their child link's.
@@ -128,6 +130,7 @@ class Robot:
     position_ik: PositionIk | None = field(default=None, repr=False)
     limits_path: Path | None = None
     limits_defaulted: tuple[str, ...] = ()
+    ranges_narrowed: Mapping[str, tuple[float, float]] = field(default_factory=dict)
     held: Mapping[str, float] = field(default_factory=dict)
     base_joints: tuple[str, ...] = ()
     srdf_path: Path | None = None

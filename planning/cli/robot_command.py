@@ -35,6 +35,8 @@ def robot_report(robot: ck.Robot) -> dict[str, Any]:
                 "velocity": float(limits.velocity[k]),
                 "acceleration": float(limits.acceleration[k]),
                 "jerk": float(limits.jerk[k]),
+                # the URDF's range where it passes one turn either way (planned within it), else None
+                "urdf_range": list(robot.ranges_narrowed[name]) if name in robot.ranges_narrowed else None,
             }
             for k, name in enumerate(limits.names)
         ],
@@ -92,6 +94,12 @@ def cmd_robot_info(args: argparse.Namespace) -> int:
         *(
             f"  {j['name']}: [{j['lower']:.4g}, {j['upper']:.4g}] {j['unit']}, {j['velocity']:.4g}, "
             f"{j['acceleration']:.4g}, {j['jerk']:.4g}"
+            + (
+                f" (the URDF's range [{j['urdf_range'][0]:.4g}, {j['urdf_range'][1]:.4g}] {j['unit']}, "
+                "planned within one turn either way)"
+                if j["urdf_range"]
+                else ""
+            )
             for j in report["joints"]
         ),
         f"held joints: {report['held'] or 'none'}",

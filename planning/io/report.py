@@ -168,6 +168,14 @@ def limits_section(result: PlanResult) -> list[str]:
             "give the maker's in a limits file for a faster motion.",
             "",
         ]
+    if robot.ranges_narrowed:
+        narrowed = ", ".join(
+            f"{name} [{lower:.4g}, {upper:.4g}] rad" for name, (lower, upper) in robot.ranges_narrowed.items()
+        )
+        lines += [
+            f"The URDF's ranges of {narrowed} pass one turn either way: planned within [-2 pi, 2 pi] rad.",
+            "",
+        ]
     if robot.held:
         held = ", ".join(f"{name} = {value:g}" for name, value in robot.held.items())
         lines += [f"Held (not planned): {held}.", ""]
