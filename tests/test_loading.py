@@ -323,6 +323,34 @@ def test_a_tool_named_as_a_joint_and_a_link_is_the_link() -> None:
 
 
 @pytest.mark.parametrize(
+    ("urdf", "tcp"),
+    [
+        ("anymal_c_simple_description/urdf/anymal.urdf", "LF_FOOT"),
+        ("b1_description/urdf/b1-z1.urdf", "gripperMover"),
+    ],
+)
+def test_joints_named_as_links_are_held_and_planned_as_the_urdf_says(urdf: str, tcp: str) -> None:
+    # ANYmal's joint and link 'LF_HAA', the B1-Z1's fixed joint and link 'gripperStator': Pinocchio's
+    # reduction to the planned joints refused two frames of one name (a ValueError, an internal error)
+    robot = ck.load_robot(ROBOTS / urdf, tcp=tcp)
+    reference = yourdfpy.URDF.load(str(ROBOTS / urdf), build_scene_graph=True, load_meshes=False)
+    links = [f.name for f in robot.model.frames if f.type == pin.FrameType.BODY]
+    assert set(robot.model.names[1:]) == set(robot.joint_names)  # the names given back
+    rng = np.random.default_rng(11)
+    for q in rng.uniform(robot.limits.lower, robot.limits.upper, (10, robot.nq)):
+        configuration = dict(zip(robot.joint_names, q, strict=True)) | dict(robot.held)
+        reference.update_cfg({k: v for k, v in configuration.items() if k in reference.actuated_joint_names})
+        for link in links:
+            np.testing.assert_allclose(
+                ck.frame_poses(robot, q, link),
+                reference.get_transform(frame_to=link),
+                atol=1e-9,
+                err_msg=link,
+            )
+    assert robot.visual_model.ngeoms > 0  # reduced the same way
+
+
+@pytest.mark.parametrize(
     ("options", "message"),
     [
         ({"joints": "panda_joint1"}, r"joints = 'panda_joint1' must be a sequence, not one name"),

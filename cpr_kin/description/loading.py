@@ -51,7 +51,7 @@ from cpr_kin.description.urdf_file import (
     narrowed_ranges,
     prepared_xml,
 )
-from cpr_kin.description.urdf_models import VisualModel, build_models, convex_hulls
+from cpr_kin.description.urdf_models import VisualModel, build_models, convex_hulls, reduced_models
 from cpr_kin.model.arm import ArmChain, arm_chain
 from cpr_kin.model.geometry_groups import carried_alone, grouped_geometries
 from cpr_kin.model.limits import LIMITS_NAMES, JointLimits, find_limits_file, read_dynamic_limits
@@ -125,7 +125,7 @@ class RobotSpec:
             q_ref = pin.neutral(model)
             for name, value in held.items():
                 q_ref[model.joints[model.getJointId(name)].idx_q] = value
-            model, (collision,) = pin.buildReducedModel(model, [collision], lock, q_ref)
+            model, (collision,) = reduced_models(model, [collision], lock, q_ref)
             visual = VisualModel(xml, path, tuple(lock), tuple(q_ref))
         names = tuple(model.names[1:])
         tcp = self._tcp_frame(model, arm)

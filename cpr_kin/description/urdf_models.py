@@ -10,6 +10,7 @@ beyond its mesh, the mesh decides (:mod:`cpr_kin.shapes.exact_meshes`).
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -99,6 +100,45 @@ def check_meshes(model: Any, geometry: Any, path: Path) -> None:
         )
 
 
+JOINT_SUFFIX = "\x00joint"
+"""Appended to a joint's name while Pinocchio reduces a model (:func:`reduced_models`): no URDF
+name holds a NUL."""
+
+
+JOINT_FRAMES = (pin.FrameType.JOINT, pin.FrameType.FIXED_JOINT)
+"""The frame types of a URDF's joints (a locked joint's frame is a fixed one in the reduced model)."""
+
+
+def reduced_models(model: Any, geometries: list[Any], locked: list[int], q_ref: Any) -> tuple[Any, list[Any]]:
+    """Pinocchio's ``buildReducedModel``: ``model`` with its ``locked`` joints fixed at ``q_ref``.
+
+    Also where a joint and a link share a name (ANYmal's ``LF_HAA``, the B1-Z1's fixed
+    ``gripperStator``, as URDF allows: joints and links are named apart). Pinocchio's reduction
+    looks frames up by name alone and refuses two ("Several frames match the filter"); the
+    joints' names are made distinct while it reduces and given back after.
+    """
+    links = {frame.name for frame in model.frames if frame.type == pin.FrameType.BODY}
+    shared = {frame.name for frame in model.frames if frame.type in JOINT_FRAMES and frame.name in links}
+    if shared:
+        model = model.copy()
+        _rename(model, lambda name: name + JOINT_SUFFIX if name in shared else name)
+    reduced, reduced_geometries = pin.buildReducedModel(model, geometries, locked, q_ref)
+    if shared:
+        _rename(reduced, lambda name: name.removesuffix(JOINT_SUFFIX))
+    return reduced, list(reduced_geometries)
+
+
+def _rename(model: Any, renamed: Callable[[str], str]) -> None:
+    """Rename ``model``'s joints, in ``model.names`` and their joints' frames, by ``renamed``, in place."""
+    for index, name in enumerate(model.names):
+        model.names[index] = renamed(name)
+    for index, frame in enumerate(model.frames):
+        if frame.type in JOINT_FRAMES and renamed(frame.name) != frame.name:
+            changed = model.frames[index]
+            changed.name = renamed(frame.name)
+            model.frames[index] = changed
+
+
 def _unreadable_mesh(xml: str, path: Path, mesh: str) -> str:
     """The message for a mesh file coal (assimp) cannot read: the link, the file, the formats."""
     root = etree.fromstring(xml.encode(), etree.XMLParser(resolve_entities=False, no_network=True))
@@ -134,7 +174,7 @@ class VisualModel:
         """The visual geometry model, reduced to the planned joints."""
         model, visual = build_models(self.xml, self.path, pin.GeometryType.VISUAL)
         if self.locked:
-            _, (visual,) = pin.buildReducedModel(model, [visual], list(self.locked), np.array(self.q_ref))
+            _, (visual,) = reduced_models(model, [visual], list(self.locked), np.array(self.q_ref))
         return visual
 
 
