@@ -274,3 +274,20 @@ def test_the_script_writes_the_srdf_it_is_given_into_the_scenes(tmp_path: Path) 
     scene = parse_scene(yaml.safe_load((tmp_path / "b" / "baxter_0.yaml").read_text()))
     assert scene.robot is not None and scene.robot.srdf == srdf
     build_problem(scene, scene.robot.load())  # start and goal keep their margins with its pairs
+
+
+def test_the_ends_pass_the_planners_check_where_a_pair_close_by_design_is_held_to_its_margin() -> None:
+    # Bolt's leg: base_link and FL_UPPER_LEG sit at most 19 mm apart. A world of the 0.02 m self
+    # clearance let them touch; the scene's 0.01 m self margin holds them to it, and the planner
+    # refused the drawn ends ("goal q = [...] is inside the self margin: base_link is 0.002 m
+    # from FL_UPPER_LEG")
+    share = example_robot_data_share()
+    assert share is not None
+    urdf = share / "example-robot-data/robots/bolt_description/robots/bolt.urdf"
+    leg = ck.load_robot(urdf, tcp="FL_FOOT")
+    assert leg.close_pairs and leg.close_pairs[0].largest_m > 0.01  # the case: above the scene's margin
+    for seed in (1207, 1208):
+        scene = parse_scene(blocked_scene(f"bolt_{seed}", {"urdf": str(urdf), "tcp": "FL_FOOT"}, leg, seed))
+        problem = build_problem(scene, leg)  # the planner's own check of the ends: it raised
+        for q in (problem.motion.q_start, problem.motion.q_goal):
+            assert margin_violation(problem.world, scene, q) is None

@@ -14,8 +14,10 @@ as the tool's pose (solved by the planner's IK), the start as the configuration.
 pairs, and gravity's torques there must be within the URDF's effort limits (the planner
 refuses an end its motors cannot hold still); a draw that does not is drawn again. The
 straight way is blocked; whether a way around exists is for the planners to find out.
-The scene keeps the default self margin, or half ``self_clearance_m`` where that is lower
-(the ends must lie outside the margin the planner asks of them).
+The scene keeps the default self margin, or half ``self_clearance_m`` where that is below the
+default; its ends lie outside the margin the planner asks of them, checked as the plan checks
+them (a pair of links close by design that ``self_clearance_m`` lets touch may be held to that
+margin).
 """
 
 from __future__ import annotations
@@ -99,6 +101,12 @@ def blocked_scene(
     reach = float(np.linalg.norm(ck.frame_poses(robot, middle[None])[0][:3, 3]))
     side = reaching_side(robot, reach)
     dynamics = ck.robot_dynamics(robot)
+    self_margin_m = (
+        self_clearance_m / 2 if self_clearance_m < DEFAULT_SELF_MARGIN_M else DEFAULT_SELF_MARGIN_M
+    )
+    # the ends checked as the plan checks them too: a pair close by design that a world of
+    # ``self_clearance_m`` lets touch may be held to the scene's lower margin
+    planned = ck.CollisionWorld(robot, [], self_margin_m=self_margin_m).self_collision
     too_close: Counter[tuple[str, str]] = Counter()  # the closest pair of each end refused for it
     refused: Counter[str] = Counter()  # why each draw was refused (REFUSALS' keys)
     for _ in range(draws):
@@ -118,7 +126,9 @@ def blocked_scene(
             continue
         if world.self_collision:
             distance, pair = world.self_collision.distances(ends)
-            if distance.min() <= self_clearance_m:
+            if distance.min() <= self_clearance_m or (
+                planned and planned.violated(ends, self_margin_m).any()
+            ):
                 too_close[world.self_collision.pairs[int(pair[np.argmin(distance)])]] += 1
                 refused["self"] += 1
                 continue
@@ -129,7 +139,7 @@ def blocked_scene(
             "name": name,
             "robot": robot_entry,
             "safety_margin": margin_m,
-            **({"self_margin": self_clearance_m / 2} if self_clearance_m < DEFAULT_SELF_MARGIN_M else {}),
+            **({"self_margin": self_margin_m} if self_margin_m != DEFAULT_SELF_MARGIN_M else {}),
             "start": {"q": start.tolist()},
             "goal": {"pose": {"xyz": tools[2, :3, 3].tolist(), "rpy": _rpy(tools[2, :3, :3])}},
             "obstacles": [
