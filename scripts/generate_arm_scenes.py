@@ -40,6 +40,14 @@ def main() -> int:
         type=Path,
         help="its velocity, acceleration and jerk limits file (default: found beside the URDF)",
     )
+    parser.add_argument(
+        "--package-dir",
+        type=Path,
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="a folder holding the packages its package:// meshes name (repeatable)",
+    )
     parser.add_argument("--count", type=COUNT, default=10, help="number of scenes (default: 10)")
     parser.add_argument("--seed", type=SEED, default=0, help="seed of the first scene (default: 0)")
     parser.add_argument(
@@ -58,12 +66,15 @@ def main() -> int:
     entry: str | dict[str, Any] = args.robot if named else str(urdf)
     srdf = None if args.srdf is None else args.srdf.resolve()
     limits = None if args.limits is None else args.limits.resolve()
+    packages = [str(d.resolve()) for d in args.package_dir]
     given = {"tcp": args.tcp, "srdf": srdf, "limits": limits}
-    options = {key: str(value) for key, value in given.items() if value}
+    options: dict[str, Any] = {key: str(value) for key, value in given.items() if value}
+    if packages:
+        options["packages"] = packages
     if options:
         entry = {"urdf": entry, **options}
     try:
-        robot = ck.load_robot(urdf, tcp=args.tcp, srdf=srdf, limits=limits)
+        robot = ck.load_robot(urdf, tcp=args.tcp, srdf=srdf, limits=limits, package_dirs=packages)
         stem = args.robot if named else urdf.stem
         documents = [  # all drawn before any is written: a scene that cannot be drawn leaves no files
             blocked_scene(f"{stem}_{seed}", entry, robot, seed, args.margin, args.self_clearance)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import json
 import subprocess
 import sys
 from pathlib import Path
@@ -291,3 +292,34 @@ def test_the_ends_pass_the_planners_check_where_a_pair_close_by_design_is_held_t
         problem = build_problem(scene, leg)  # the planner's own check of the ends: it raised
         for q in (problem.motion.q_start, problem.motion.q_goal):
             assert margin_violation(problem.world, scene, q) is None
+
+
+def test_a_robot_whose_meshes_name_a_package_elsewhere_is_given_its_folder(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a maker's URDF names its meshes 'package://NAME/...' of a package no search path holds:
+    # robot-info and the scene generator take the folder as a scene's robot: {packages} does
+    from planning.cli import main
+
+    share = example_robot_data_share()
+    assert share is not None
+    text = example_robot("ur5").read_text().replace("package://example-robot-data/", "package://my_arm_pkg/")
+    urdf = tmp_path / "my_ur5.urdf"
+    urdf.write_text(text)
+    (tmp_path / "packages").mkdir()
+    (tmp_path / "packages" / "my_arm_pkg").symlink_to(share / "example-robot-data", target_is_directory=True)
+    assert main(["robot-info", str(urdf), "--json"]) == 2
+    assert "my_arm_pkg" in capsys.readouterr().err
+    assert main(["robot-info", str(urdf), "--package-dir", str(tmp_path / "packages"), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    robot = ck.load_robot(example_robot("ur5"))  # the oracle: the same arm, its meshes found by name
+    assert [j["name"] for j in report["joints"]] == list(robot.joint_names)
+    assert [s["geometry"] for s in report["shapes"]] == [g.name for g in robot.geometries]
+    script = Path(__file__).resolve().parent.parent / "scripts" / "generate_arm_scenes.py"
+    command = [sys.executable, str(script), "--robot", str(urdf), "--count", "1", "--seed", "3"]
+    packages = ["--package-dir", str(tmp_path / "packages"), "--out", str(tmp_path / "scenes")]
+    done = subprocess.run([*command, *packages], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr[-2000:]
+    scene = parse_scene(yaml.safe_load((tmp_path / "scenes" / "my_ur5_3.yaml").read_text()))
+    assert scene.robot is not None and scene.robot.package_dirs == ((tmp_path / "packages").resolve(),)
+    build_problem(scene, scene.robot.load())

@@ -193,6 +193,14 @@ def build_parser() -> argparse.ArgumentParser:
     sub.add_argument(
         "--srdf", type=Path, metavar="FILE", help="its SRDF (default: found by name beside the URDF)"
     )
+    sub.add_argument(
+        "--package-dir",
+        type=Path,
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="a folder holding the packages its package:// meshes name (repeatable; a scene's packages)",
+    )
     sub.add_argument("--json", action="store_true", help="print the report as JSON")
     sub.set_defaults(run=cmd_robot_info)
 

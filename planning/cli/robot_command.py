@@ -65,15 +65,20 @@ def robot_report(robot: ck.Robot) -> dict[str, Any]:
 def cmd_robot_info(args: argparse.Namespace) -> int:
     """Print what the planner makes of ``args.robot``: a scene's ``robot:`` value, or a scene file.
 
-    ``--tcp`` and ``--srdf`` are those keys of a scene's ``robot:`` mapping: a robot whose tree
-    branches (a humanoid, a mobile manipulator) loads only with its tool frame named.
+    ``--tcp``, ``--srdf`` and ``--package-dir`` are the keys ``tcp``, ``srdf`` and ``packages`` of a
+    scene's ``robot:`` mapping: a robot whose tree branches (a humanoid, a mobile manipulator)
+    loads only with its tool frame named.
     """
     from planning.io.robot_entry import robot_spec_of
     from planning.io.scene_file import scene_robot
 
     # a scene file: the robot it names, as a plan of it loads it
     spec = scene_robot(args.robot) if is_yaml_name(args.robot) else robot_spec_of(args.robot, Path.cwd())
-    named = {"tcp": args.tcp, "srdf": None if args.srdf is None else args.srdf.resolve()}
+    named = {
+        "tcp": args.tcp,
+        "srdf": None if args.srdf is None else args.srdf.resolve(),
+        "package_dirs": tuple(d.resolve() for d in args.package_dir) or None,
+    }
     spec = dataclasses.replace(spec, **{key: value for key, value in named.items() if value is not None})
     report = robot_report(spec.load())
     if args.json:
