@@ -210,8 +210,8 @@ def test_a_continuous_joint_without_limits_is_held_but_not_planned(tmp_path: Pat
     arm = [f"panda_joint{k}" for k in range(1, 7)]
     robot = ck.load_robot(urdf, joints=arm, held={"panda_joint7": 0.3})
     assert robot.joint_names == tuple(arm) and dict(robot.held)["panda_joint7"] == 0.3
-    with pytest.raises(ck.UrdfError, match=r"held joint 'panda_joint7' = 4 is outside \[-3.14159, 3.14159\]"):
-        ck.load_robot(urdf, joints=arm, held={"panda_joint7": 4.0})  # one turn, as a planned one
+    with pytest.raises(ck.UrdfError, match=r"held joint 'panda_joint7' = 7 is outside \[-6.28319, 6.28319\]"):
+        ck.load_robot(urdf, joints=arm, held={"panda_joint7": 7.0})  # one turn either way, as a planned one
 
 
 def test_a_tool_without_collision_geometry_leaves_the_effector_group_to_the_link_above() -> None:

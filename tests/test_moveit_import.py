@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import copy
 import json
+import math
 from pathlib import Path
 from typing import Any
 
@@ -20,6 +21,7 @@ import cpr_kin as ck
 from cpr_kin.model.packages import example_robot
 from planning.cli import main
 from planning.io.moveit_objects import CONE_SIDES
+from planning.io.moveit_state import wrapped
 from planning.io.scene_file import load_scene
 
 PANDA = example_robot("panda")
@@ -903,3 +905,18 @@ def test_a_default_entry_yields_to_the_pairs_own_entry_as_in_moveit() -> None:
     defaults = {"default_entry_names": ["a", "c"], "default_entry_values": [True, False]}
     never = matrix.model_copy(update=defaults)
     assert AllowedContacts(never).link_pairs(links) == []  # of two defaults, false wins
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_continuous_joints_goal_is_turned_to_within_half_a_turn_of_its_start(seed: int) -> None:
+    # MoveIt plans a continuous joint the short way round: a goal at -3.0 rad from a start at
+    # 3.0 rad was wrapped into [-pi, pi] alone and planned 6 rad round
+    rng = np.random.default_rng(seed)
+    start = {"c": float(rng.uniform(-math.pi, math.pi)), "r": 0.5}
+    goal = {"c": float(rng.uniform(-20.0, 20.0)), "r": float(rng.uniform(-3.0, 3.0))}
+    turned = wrapped(goal, {"c"}, start)
+    assert turned["r"] == goal["r"]  # a revolute joint's value is as given
+    assert abs(turned["c"] - start["c"]) <= math.pi + 1e-12  # the short way
+    assert math.remainder(turned["c"] - goal["c"], math.tau) == pytest.approx(0.0, abs=1e-9)  # whole turns
+    assert abs(turned["c"]) <= 2 * math.pi  # within the range it is planned in
+    assert wrapped({"c": 3.0}, {"c"}, {"c": -3.0}) == {"c": pytest.approx(3.0 - math.tau)}

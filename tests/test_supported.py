@@ -15,7 +15,8 @@ import pytest
 import cpr_kin as ck
 from cpr_kin.description.supported import MAX_CROSSING_S, crossing_time
 from cpr_kin.model.limits import DEFAULT_ACCELERATION_PER_S, DEFAULT_JERK_PER_S
-from planning import PlannerSettings, paper_scene, plan
+from cpr_kin.model.packages import example_robot_data_share
+from planning import PlannerSettings, Scene, Target, paper_scene, plan
 from planning.cli import main
 from planning.io.report import limits_section
 
@@ -111,13 +112,13 @@ def test_a_moment_below_zero_by_rounding_loads(tmp_path: Path) -> None:
         ck.load_cpr(variant(tmp_path, lambda t: t.replace('ixx="0.065"', 'ixx="-1e-9"', 1)))
 
 
-def test_a_continuous_joint_is_planned_within_one_turn(tmp_path: Path) -> None:
+def test_a_continuous_joint_is_planned_within_one_turn_either_way(tmp_path: Path) -> None:
     robot = ck.load_cpr(
         variant(
             tmp_path, lambda t: t.replace('name="theta1" type="revolute"', 'name="theta1" type="continuous"')
         )
     )
-    assert (robot.limits.lower[0], robot.limits.upper[0]) == (-math.pi, math.pi)
+    assert (robot.limits.lower[0], robot.limits.upper[0]) == (-2 * math.pi, 2 * math.pi)
     assert robot.limits.velocity[0] == 1.5 and robot.nq == 5  # one coordinate, not cos/sin
 
 
@@ -273,3 +274,23 @@ def test_a_limit_without_lower_and_upper_is_the_specifications_zero_range(tmp_pa
         ck.UrdfError, match=rf"joint 'theta1' range \[0, 0\] rad is not supported; {SUPPORTED}"
     ):
         ck.load_cpr(no_range, validate=True)
+
+
+def test_a_pose_goal_across_a_continuous_joints_half_turn_is_reached_the_short_way() -> None:
+    # Kinova's first joint is continuous: from 3.0 rad to a pose 0.3 rad further, across pi.
+    # Planned within [-pi, pi], its IK solution's -2.98 rad could not be turned to 3.30 rad:
+    # 5.3 s of motion, another elbow; now the joint turns 0.3 rad
+    share = example_robot_data_share()
+    assert share is not None
+    robot = ck.load_robot(share / "example-robot-data/robots/kinova_description/robots/kinova.urdf")
+    q_start = np.array([3.0, 2.9, 1.3, -2.0, 1.5, 0.5])
+    q_across = q_start + np.array([0.3 - 2 * math.pi, 0, 0, 0, 0, 0])  # the same pose as 3.3 rad
+    pose = ck.frame_poses(robot, q_across)
+    goal = Target(pose=(tuple(pose[:3, 3]), tuple(map(tuple, pose[:3, :3]))))
+    scene = Scene(robot=ck.robot_spec(robot.urdf_path), start=Target(q=tuple(q_start)), goal=goal)
+    result = plan(scene, robot)
+    assert result.verification.accepted
+    q = result.trajectory(np.linspace(0.0, result.trajectory.duration, 400))
+    assert np.ptp(q[:, 0]) == pytest.approx(0.3, abs=0.02)  # the short way: 0.3 rad, not 6
+    reached = ck.frame_poses(robot, q[-1])
+    np.testing.assert_allclose(reached, pose, atol=1e-3)  # the goal pose, by forward kinematics

@@ -173,15 +173,18 @@ def collision_names(tree: etree._ElementTree) -> dict[str, list[str]]:
     return names
 
 
-CONTINUOUS_RANGE_RAD = math.pi
-"""The range a ``continuous`` joint is planned within: ``[-pi, pi]`` rad, one turn. A
-continuous joint turns without end; a plan between two poses never needs more than a turn
-of it, and a bounded range keeps the search's box and the trajectories bounded."""
 TURN_EITHER_WAY_RAD = 2 * math.pi
 """How far either way a ``revolute`` joint is planned [rad]: a wider range (an industrial
 wrist's +-400 degrees, a leg's +-10 rad, a URDF's +-1e9 for "no limit") is planned within
 ``[-2 pi, 2 pi]``, one turn either way as UR and xArm arms have, for the reason a continuous
 joint's is bounded (:func:`narrowed_ranges`)."""
+CONTINUOUS_RANGE_RAD = TURN_EITHER_WAY_RAD
+"""The range a ``continuous`` joint is planned within: ``[-2 pi, 2 pi]`` rad, one turn either
+way. A continuous joint turns without end; a plan between two poses never needs more than half
+a turn of it, and a bounded range keeps the search's box and the trajectories bounded. Within
+one turn either way, a goal's IK solution is turned by whole turns towards the start
+(:func:`~cpr_kin.kinematics.numerical_ik.turned_towards`), so a motion across +-pi goes the
+short way: within ``[-pi, pi]`` a turn of 0.3 rad across it took 6 rad."""
 RANGE_TOLERANCE_RAD = 1e-3
 """How far a revolute range may pass one turn and count as within it (a URDF that writes
 2 pi as 6.2832) [rad]."""

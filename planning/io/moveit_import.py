@@ -203,7 +203,7 @@ def import_moveit(
         wrapped(joint_values(scene.robot_state, request.start_state), continuous), ranges, ignored
     )
     if "q" in goal:
-        goal = {**goal, "q": within_ranges(wrapped(goal["q"], continuous), ranges, ignored)}
+        goal = {**goal, "q": within_ranges(wrapped(goal["q"], continuous, values), ranges, ignored)}
     missing = [j for j in planned if j not in values]
     if missing:
         raise MoveItImportError(f"the start state gives no value for the planned joint(s) {missing}")

@@ -1,6 +1,8 @@
 """A MoveIt robot state's joint values as a scene file's: merged, wrapped, and onto their ranges.
 
-A continuous joint's value is turned into [-pi, pi] rad, the range it is planned in. A value
+A continuous joint's start value is turned into [-pi, pi] rad, its goal value by whole turns to
+the nearest of the start's, within the [-2 pi, 2 pi] rad it is planned in: MoveIt plans a
+continuous joint the short way round, and so does the scene. A value
 at most :data:`BOUNDS_TOLERANCE` beyond a joint's URDF range is moved onto it and noted, as
 MoveIt's start-state bounds fixing does (which allows 0.05 rad); farther, it is left for the
 scene's own check to refuse, naming the joint.
@@ -36,9 +38,24 @@ def joint_values(*states: RobotState) -> dict[str, float]:
     return values
 
 
-def wrapped(values: dict[str, float], continuous: set[str]) -> dict[str, float]:
-    """``values`` with those of ``continuous`` joints turned into [-pi, pi] rad, where they are planned."""
-    return {j: math.remainder(v, math.tau) if j in continuous else v for j, v in values.items()}
+def wrapped(
+    values: dict[str, float], continuous: set[str], towards: dict[str, float] | None = None
+) -> dict[str, float]:
+    """``values`` with those of ``continuous`` joints turned by whole turns [rad].
+
+    Into [-pi, pi], or, where ``towards`` (values within it) gives the joint, to the nearest of
+    its value: within pi of it, so a motion from it turns the short way round.
+    """
+    towards = towards or {}
+
+    def turned(joint: str, value: float) -> float:
+        if joint not in continuous:
+            return value
+        if joint not in towards:
+            return math.remainder(value, math.tau)
+        return towards[joint] + math.remainder(value - towards[joint], math.tau)
+
+    return {j: turned(j, v) for j, v in values.items()}
 
 
 BOUNDS_TOLERANCE = 1e-4
