@@ -11,7 +11,7 @@ import yourdfpy
 
 import cpr_kin as ck
 from cpr_kin.certified.motion import path_weights
-from cpr_kin.kinematics.numerical_ik import SAME_TIME_SHARE, descent, soonest, tool_reach_m
+from cpr_kin.kinematics.numerical_ik import SAME_TIME_SHARE, about_seed, descent, soonest, tool_reach_m
 from cpr_kin.model.packages import example_robot
 
 ARMS = ("so101", "ur5", "panda", "xarm7")
@@ -145,9 +145,11 @@ def test_preferred_solutions_come_first_among_the_accepted() -> None:
 
     fallback = ck.solve_ik(robot, target, seed, accept=wrist_up, prefer=never)
     assert wrist_up(fallback) and asked and all(wrist_up(q) for q in asked)
-    weights = ck.path_weights(robot)
-    assert any(np.array_equal(fallback, q) for q in asked)  # one of the accepted, the nearest of them
-    assert float(weights @ np.abs(fallback - seed)) == min(float(weights @ np.abs(q - seed)) for q in asked)
+    assert any(np.array_equal(fallback, q) for q in asked)  # one of the accepted: the one reached soonest
+    times = robot.limits.move_time_s(np.array(asked) - seed)
+    soon = [q for q, t in zip(asked, times, strict=True) if t <= (1 + SAME_TIME_SHARE) * times.min()]
+    weights = ck.path_weights(robot)  # of those about as soon, the nearest in robot motion
+    assert float(weights @ np.abs(fallback - seed)) == min(float(weights @ np.abs(q - seed)) for q in soon)
     assert np.linalg.norm(ck.frame_poses(robot, fallback[None])[0][:3, 3] - target.position) <= 1e-4
 
 
@@ -273,3 +275,15 @@ def test_a_joint_a_turn_away_is_turned_towards_the_seed() -> None:
     assert np.all(np.abs(turned - seed) <= np.abs(q - seed))  # no joint farther from the seed
     assert turned[0] == q[0]  # 0.3 + 2 pi would leave [-2 pi, 2 pi]
     np.testing.assert_array_equal(turned_towards(q, seed, ~revolute, lower, upper), q)  # prismatic: as is
+
+
+def test_starts_of_a_joint_of_more_than_a_turn_are_drawn_within_the_turn_about_the_seed() -> None:
+    # a UR's [-2 pi, 2 pi] joints, a continuous joint's: every pose lies within a turn of the seed
+    lower = np.array([-2 * np.pi, -2 * np.pi, -2.9, 0.0])
+    upper = np.array([2 * np.pi, 2 * np.pi, 2.9, 0.6])
+    revolute = np.array([True, True, True, False])
+    seed = np.array([5.5, -0.3, 2.0, 0.3])
+    low, high = about_seed(seed, lower, upper, revolute)
+    np.testing.assert_allclose(low, [5.5 - np.pi, -0.3 - np.pi, -2.9, 0.0])
+    np.testing.assert_allclose(high, [2 * np.pi, -0.3 + np.pi, 2.9, 0.6])  # within the range too
+    assert np.all(high - low <= 2 * np.pi + 1e-12)  # at most one turn, as a one-turn joint's

@@ -12,7 +12,8 @@ near the seed in time (each joint's draw pulled towards the seed's value by its 
 where the arm can reach the target by its fast joints, a slow one (a torso lift) keeps about
 its seed's value; where the seed's least-in-time descent misses the target, the seed's plain
 descent is tried too (what came first before). The other random starts explore the whole
-ranges with the plain step. On an arm whose joints are equally fast both kinds are the same.
+ranges with the plain step (a revolute range of more than a turn: the turn about the seed,
+:func:`about_seed`). On an arm whose joints are equally fast both kinds are the same.
 Every solution is checked by
 forward kinematics against the target and its
 tolerance; of those that pass, the ones the ``accept`` test allows (collision-free, say) come
@@ -186,7 +187,8 @@ def solve_ik(
     preferred: list[FloatArray] = []  # ``prefer`` asked once per accepted solution
     closest: pin.SE3 | None = None
     frame = robot.frame_id(robot.tcp_frame)
-    draws = [seed, *rng.uniform(lower, upper, (settings.restarts, robot.nq))]
+    low, high = about_seed(seed, lower, upper, revolute)
+    draws = [seed, *rng.uniform(low, high, (settings.restarts, robot.nq))]
     speeds = robot.limits.speed_scales
     soon_from, anywhere_from = (
         descent(robot, target, free, settings, speeds),
@@ -222,7 +224,7 @@ def solve_ik(
                     if len(preferred) >= settings.choices:
                         break
         if tried == settings.restarts + 1 and not preferred:  # then more, drawn only now
-            draws += list(rng.uniform(lower, upper, (settings.more_restarts, robot.nq)))
+            draws += list(rng.uniform(low, high, (settings.more_restarts, robot.nq)))
     if not found:
         assert closest is not None  # the seed is always tried
         raise IkMissError(f"{missed}: the closest of {tried} IK starts came {target.miss(closest)}")
@@ -242,6 +244,23 @@ def soonest(robot: Robot, solutions: Sequence[FloatArray], seed: FloatArray) -> 
     soon = [q for q, time_s in zip(solutions, times_s, strict=True) if time_s <= latest_s]
     weights = path_weights(robot)
     return min(soon, key=lambda q: float(weights @ np.abs(q - seed)))
+
+
+def about_seed(
+    seed: FloatArray, lower: FloatArray, upper: FloatArray, revolute: NDArray[np.bool_]
+) -> tuple[FloatArray, FloatArray]:
+    """The box random starts are drawn from [rad, m]: the ranges, a wide revolute one's within pi of ``seed``.
+
+    A revolute joint whose range spans more than a turn reaches every pose within one turn
+    about the seed, and a solution is turned towards the seed anyway (:func:`turned_towards`):
+    its draws there keep the starts as near the seed, and as spread over the turn, as a
+    joint of one turn's.
+    """
+    wide = revolute & (upper - lower > 2.0 * math.pi)
+    return (
+        np.where(wide, np.maximum(lower, seed - math.pi), lower),
+        np.where(wide, np.minimum(upper, seed + math.pi), upper),
+    )
 
 
 def turned_towards(
