@@ -19,16 +19,21 @@ from typing import Any
 import yaml
 
 import cpr_kin as ck
-from cpr_kin.model.packages import EXAMPLE_ROBOTS, example_robot
+from cpr_kin.model.packages import EXAMPLE_ROBOTS
 from planning.bench.arm_scenes import blocked_scene
 from planning.cli.arguments import COUNT, SEED, number_above, number_at_least
 from planning.errors import PlanningError
+from planning.io.robot_entry import BUNDLED, robot_spec_of
 
 
 def main() -> int:
     """Write the scenes (module docstring)."""
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--robot", required=True, help=f"a URDF path or one of {sorted(EXAMPLE_ROBOTS)}")
+    parser.add_argument(
+        "--robot",
+        required=True,
+        help=f"a URDF path, '{BUNDLED}' (the bundled CPR) or one of {sorted(EXAMPLE_ROBOTS)}",
+    )
     parser.add_argument("--tcp", help="its tool frame (the planned joints: those from the root to it)")
     parser.add_argument(
         "--srdf",
@@ -61,9 +66,8 @@ def main() -> int:
     )
     parser.add_argument("--out", type=Path, required=True, help="folder for the scene files")
     args = parser.parse_args()
-    named = args.robot in EXAMPLE_ROBOTS
-    urdf = example_robot(args.robot) if named else Path(args.robot).resolve()
-    entry: str | dict[str, Any] = args.robot if named else str(urdf)
+    named = args.robot == BUNDLED or args.robot in EXAMPLE_ROBOTS  # a scene's robot: names them too
+    entry: str | dict[str, Any] = args.robot if named else str(Path(args.robot).resolve())
     srdf = None if args.srdf is None else args.srdf.resolve()
     limits = None if args.limits is None else args.limits.resolve()
     packages = [str(d.resolve()) for d in args.package_dir]
@@ -74,8 +78,9 @@ def main() -> int:
     if options:
         entry = {"urdf": entry, **options}
     try:
+        urdf = robot_spec_of(args.robot, Path.cwd()).urdf  # a name as a scene's robot: reads it
         robot = ck.load_robot(urdf, tcp=args.tcp, srdf=srdf, limits=limits, package_dirs=packages)
-        stem = args.robot if named else urdf.stem
+        stem = args.robot if named else Path(urdf).stem
         documents = [  # all drawn before any is written: a scene that cannot be drawn leaves no files
             blocked_scene(f"{stem}_{seed}", entry, robot, seed, args.margin, args.self_clearance)
             for seed in range(args.seed, args.seed + args.count)

@@ -323,3 +323,16 @@ def test_a_robot_whose_meshes_name_a_package_elsewhere_is_given_its_folder(
     scene = parse_scene(yaml.safe_load((tmp_path / "scenes" / "my_ur5_3.yaml").read_text()))
     assert scene.robot is not None and scene.robot.package_dirs == ((tmp_path / "packages").resolve(),)
     build_problem(scene, scene.robot.load())
+
+
+def test_the_script_names_the_bundled_robot_as_a_scene_does(tmp_path: Path) -> None:
+    # '--robot cpr' was read as a file's path: "URDF file '.../cpr' does not exist"
+    script = Path(__file__).resolve().parent.parent / "scripts" / "generate_arm_scenes.py"
+    command = [sys.executable, str(script), "--robot", "cpr", "--count", "1", "--out", str(tmp_path)]
+    done = subprocess.run(command, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr[-2000:]
+    document = yaml.safe_load((tmp_path / "cpr_0.yaml").read_text())
+    assert document["robot"] == "cpr"
+    scene = parse_scene(document)
+    assert scene.robot == ck.cpr_spec()
+    build_problem(scene, scene.robot.load())  # its ends keep their margins
