@@ -9,6 +9,7 @@ from __future__ import annotations
 import copy
 import json
 import math
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -18,11 +19,12 @@ import yaml
 from scipy.spatial.transform import Rotation
 
 import cpr_kin as ck
-from cpr_kin.model.packages import example_robot
+from cpr_kin.model.packages import example_robot, example_robot_data_share
 from planning.cli import main
 from planning.io.moveit_objects import CONE_SIDES
 from planning.io.moveit_state import wrapped
 from planning.io.scene_file import load_scene
+from planning.pipeline.planner import plan
 
 PANDA = example_robot("panda")
 PANDA_SRDF = PANDA.parent.parent / "srdf" / "panda.srdf"
@@ -920,3 +922,40 @@ def test_a_continuous_joints_goal_is_turned_to_within_half_a_turn_of_its_start(s
     assert math.remainder(turned["c"] - goal["c"], math.tau) == pytest.approx(0.0, abs=1e-9)  # whole turns
     assert abs(turned["c"]) <= 2 * math.pi  # within the range it is planned in
     assert wrapped({"c": 3.0}, {"c"}, {"c": -3.0}) == {"c": pytest.approx(3.0 - math.tau)}
+
+
+def test_a_continuous_joints_goal_across_pi_is_imported_and_planned_the_short_way(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Kinova's first joint is continuous: a goal constraint at -3.0 rad from a start at 3.0 rad
+    # was wrapped alone into [-pi, pi] and planned 6 rad round; MoveIt turns it 0.28 rad
+    share = example_robot_data_share()
+    assert share is not None
+    folder = share / "example-robot-data/robots/kinova_description"
+    joints = [f"j2s6s200_joint_{k}" for k in range(1, 7)]
+    start = [3.0, 2.9, 1.3, -2.0, 1.5, 0.5]
+    request = {
+        "group_name": "end_effector",
+        "start_state": {"joint_state": {"name": joints, "position": start}},
+        "goal_constraints": [
+            {
+                "joint_constraints": [
+                    {"joint_name": n, "position": v} for n, v in zip(joints, [-3.0, *start[1:]], strict=True)
+                ]
+            }
+        ],
+    }
+    (tmp_path / "scene.yaml").write_text(yaml.safe_dump({"world": {"collision_objects": []}}))
+    (tmp_path / "request.yaml").write_text(yaml.safe_dump(request))
+    urdf, srdf = folder / "robots/kinova.urdf", folder / "srdf/kinova.srdf"
+    out = tmp_path / "kinova.yaml"
+    arguments = [str(tmp_path / "scene.yaml"), str(tmp_path / "request.yaml"), "--urdf", str(urdf)]
+    assert main(["import-moveit", *arguments, "--srdf", str(srdf), "--out", str(out)]) == 0
+    capsys.readouterr()
+    scene = load_scene(out)
+    goal = scene.goal.q
+    assert isinstance(goal, Mapping)
+    assert goal["j2s6s200_joint_1"] == pytest.approx(-3.0 + 2 * math.pi)  # a whole turn on
+    result = plan(scene)
+    q = result.trajectory(np.linspace(0.0, result.trajectory.duration, 200))
+    assert np.ptp(q[:, 0]) == pytest.approx(2 * math.pi - 6.0, abs=1e-6)  # the short way: 0.28 rad
