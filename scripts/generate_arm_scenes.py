@@ -21,7 +21,7 @@ import yaml
 import cpr_kin as ck
 from cpr_kin.model.packages import EXAMPLE_ROBOTS
 from planning.bench.arm_scenes import blocked_scene
-from planning.cli.arguments import COUNT, SEED, number_above, number_at_least
+from planning.cli.arguments import COUNT, SEED, add_package_dirs, number_above, number_at_least
 from planning.errors import PlanningError
 from planning.io.robot_entry import BUNDLED, robot_spec_of
 
@@ -45,14 +45,7 @@ def main() -> int:
         type=Path,
         help="its velocity, acceleration and jerk limits file (default: found beside the URDF)",
     )
-    parser.add_argument(
-        "--package-dir",
-        type=Path,
-        action="append",
-        default=[],
-        metavar="DIR",
-        help="a folder holding the packages its package:// meshes name (repeatable)",
-    )
+    add_package_dirs(parser)
     parser.add_argument("--count", type=COUNT, default=10, help="number of scenes (default: 10)")
     parser.add_argument("--seed", type=SEED, default=0, help="seed of the first scene (default: 0)")
     parser.add_argument(

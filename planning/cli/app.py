@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import NoReturn
 
 from cpr_kin.common.names import one_line
-from planning.cli.arguments import integer_at_least
+from planning.cli.arguments import add_package_dirs, integer_at_least
 from planning.cli.batch_command import cmd_batch
 from planning.cli.file_commands import EXPORTERS, cmd_check, cmd_export, cmd_show
 from planning.cli.moveit_command import cmd_import_moveit
@@ -127,14 +127,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub.add_argument("request", type=Path, metavar="REQUEST.yaml", help="moveit_msgs/MotionPlanRequest")
     sub.add_argument("--urdf", type=Path, required=True, help="the robot's URDF")
     sub.add_argument("--srdf", type=Path, help="its SRDF (planning groups, disabled collision pairs)")
-    sub.add_argument(
-        "--package-dir",
-        type=Path,
-        action="append",
-        default=[],
-        metavar="DIR",
-        help="folder of packages (repeatable)",
-    )
+    add_package_dirs(sub)
     sub.add_argument(
         "--limits", type=Path, help="acceleration and jerk limits file (default: found, or defaults)"
     )
@@ -193,14 +186,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub.add_argument(
         "--srdf", type=Path, metavar="FILE", help="its SRDF (default: found by name beside the URDF)"
     )
-    sub.add_argument(
-        "--package-dir",
-        type=Path,
-        action="append",
-        default=[],
-        metavar="DIR",
-        help="a folder holding the packages its package:// meshes name (repeatable; a scene's packages)",
-    )
+    add_package_dirs(sub)
     sub.add_argument("--json", action="store_true", help="print the report as JSON")
     sub.set_defaults(run=cmd_robot_info)
 

@@ -70,3 +70,15 @@ COUNT = integer_at_least(1)
 """A count of scenes, runs, problems: a positive integer."""
 SECONDS = number_above(0.0, "s")
 """A time [s], > 0."""
+
+
+def add_package_dirs(parser: argparse.ArgumentParser) -> None:
+    """Give ``parser`` ``--package-dir DIR``, repeatable (``args.package_dir``): a scene's ``packages``."""
+    parser.add_argument(
+        "--package-dir",
+        type=Path,
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="a folder holding the packages the URDF's package:// meshes name (repeatable)",
+    )
