@@ -921,7 +921,13 @@ def test_a_continuous_joints_goal_is_turned_to_within_half_a_turn_of_its_start(s
     assert abs(turned["c"] - start["c"]) <= math.pi + 1e-12  # the short way
     assert math.remainder(turned["c"] - goal["c"], math.tau) == pytest.approx(0.0, abs=1e-9)  # whole turns
     assert abs(turned["c"]) <= 2 * math.pi  # within the range it is planned in
-    assert wrapped({"c": 3.0}, {"c"}, {"c": -3.0}) == {"c": pytest.approx(3.0 - math.tau)}
+    notes: list[str] = []
+    assert wrapped({"c": 3.0}, {"c"}, {"c": -3.0}, notes) == {"c": pytest.approx(3.0 - math.tau)}
+    assert notes == [
+        "c = 3.0 turned by whole turns to -3.28319 rad, within pi of the start's -3 (a continuous "
+        "joint: the same pose, the short way round)"
+    ]
+    assert wrapped({"c": 1.0}, {"c"}, {"c": 0.5}, notes) == {"c": 1.0} and len(notes) == 1  # unturned: unsaid
 
 
 def test_a_continuous_joints_goal_across_pi_is_imported_and_planned_the_short_way(
@@ -951,7 +957,10 @@ def test_a_continuous_joints_goal_across_pi_is_imported_and_planned_the_short_wa
     out = tmp_path / "kinova.yaml"
     arguments = [str(tmp_path / "scene.yaml"), str(tmp_path / "request.yaml"), "--urdf", str(urdf)]
     assert main(["import-moveit", *arguments, "--srdf", str(srdf), "--out", str(out)]) == 0
-    capsys.readouterr()
+    printed = capsys.readouterr().out  # said among what was adjusted
+    assert (
+        "j2s6s200_joint_1 = -3.0 turned by whole turns to 3.28319 rad, within pi of the start's 3" in printed
+    )
     scene = load_scene(out)
     goal = scene.goal.q
     assert isinstance(goal, Mapping)

@@ -200,10 +200,12 @@ def import_moveit(
     mimics = {j.get("name", "") for j in joints if j.find("mimic") is not None}
     ranges = position_ranges(tree)
     values = within_ranges(
-        wrapped(joint_values(scene.robot_state, request.start_state), continuous), ranges, ignored
+        wrapped(joint_values(scene.robot_state, request.start_state), continuous, notes=ignored),
+        ranges,
+        ignored,
     )
     if "q" in goal:
-        goal = {**goal, "q": within_ranges(wrapped(goal["q"], continuous, values), ranges, ignored)}
+        goal = {**goal, "q": within_ranges(wrapped(goal["q"], continuous, values, ignored), ranges, ignored)}
     missing = [j for j in planned if j not in values]
     if missing:
         raise MoveItImportError(f"the start state gives no value for the planned joint(s) {missing}")

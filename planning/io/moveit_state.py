@@ -39,12 +39,16 @@ def joint_values(*states: RobotState) -> dict[str, float]:
 
 
 def wrapped(
-    values: dict[str, float], continuous: set[str], towards: dict[str, float] | None = None
+    values: dict[str, float],
+    continuous: set[str],
+    towards: dict[str, float] | None = None,
+    notes: list[str] | None = None,
 ) -> dict[str, float]:
     """``values`` with those of ``continuous`` joints turned by whole turns [rad].
 
     Into [-pi, pi], or, where ``towards`` (values within it) gives the joint, to the nearest of
-    its value: within pi of it, so a motion from it turns the short way round.
+    its value: within pi of it, so a motion from it turns the short way round. Each value turned
+    is said in ``notes``.
     """
     towards = towards or {}
 
@@ -55,7 +59,15 @@ def wrapped(
             return math.remainder(value, math.tau)
         return towards[joint] + math.remainder(value - towards[joint], math.tau)
 
-    return {j: turned(j, v) for j, v in values.items()}
+    result = {j: turned(j, v) for j, v in values.items()}
+    said = notes if notes is not None else []
+    for joint in sorted(j for j in continuous & set(values) if abs(result[j] - values[j]) > 1e-12):
+        near = f"the start's {towards[joint]:.6g}" if joint in towards else "0"
+        said.append(
+            f"{joint} = {values[joint]!r} turned by whole turns to {result[joint]:.6g} rad, within pi of "
+            f"{near} (a continuous joint: the same pose, the short way round)"
+        )
+    return result
 
 
 BOUNDS_TOLERANCE = 1e-4
