@@ -284,6 +284,7 @@ def test_starts_of_a_joint_of_more_than_a_turn_are_drawn_within_the_turn_about_t
     revolute = np.array([True, True, True, False])
     seed = np.array([5.5, -0.3, 2.0, 0.3])
     low, high = about_seed(seed, lower, upper, revolute)
-    np.testing.assert_allclose(low, [5.5 - np.pi, -0.3 - np.pi, -2.9, 0.0])
-    np.testing.assert_allclose(high, [2 * np.pi, -0.3 + np.pi, 2.9, 0.6])  # within the range too
-    assert np.all(high - low <= 2 * np.pi + 1e-12)  # at most one turn, as a one-turn joint's
+    np.testing.assert_allclose(low, [0.0, -0.3 - np.pi, -2.9, 0.0])  # near the limit: shifted, not cut
+    np.testing.assert_allclose(high, [2 * np.pi, -0.3 + np.pi, 2.9, 0.6])
+    np.testing.assert_allclose((high - low)[:2], 2 * np.pi)  # a whole turn, within the range
+    assert np.all((low >= lower) & (high <= upper) & (low <= seed) & (seed <= high))

@@ -249,18 +249,17 @@ def soonest(robot: Robot, solutions: Sequence[FloatArray], seed: FloatArray) -> 
 def about_seed(
     seed: FloatArray, lower: FloatArray, upper: FloatArray, revolute: NDArray[np.bool_]
 ) -> tuple[FloatArray, FloatArray]:
-    """The box random starts are drawn from [rad, m]: the ranges, a wide revolute one's within pi of ``seed``.
+    """The box random starts are drawn from [rad, m]: the ranges, a wide revolute one's a turn about ``seed``.
 
-    A revolute joint whose range spans more than a turn reaches every pose within one turn
-    about the seed, and a solution is turned towards the seed anyway (:func:`turned_towards`):
-    its draws there keep the starts as near the seed, and as spread over the turn, as a
-    joint of one turn's.
+    A revolute joint whose range spans more than a turn reaches every pose within any one turn
+    of it, and a solution is turned towards the seed anyway (:func:`turned_towards`): its draws
+    within the turn of its range nearest centred on the seed keep the starts as near the seed,
+    and as spread over the turn, as a joint of one turn's. Near a limit the turn is shifted
+    into the range, never cut: a seed at the limit still has the whole turn drawn.
     """
     wide = revolute & (upper - lower > 2.0 * math.pi)
-    return (
-        np.where(wide, np.maximum(lower, seed - math.pi), lower),
-        np.where(wide, np.minimum(upper, seed + math.pi), upper),
-    )
+    low = np.where(wide, np.clip(seed - math.pi, lower, upper - 2.0 * math.pi), lower)
+    return low, np.where(wide, low + 2.0 * math.pi, upper)
 
 
 def turned_towards(
