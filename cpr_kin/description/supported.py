@@ -4,7 +4,7 @@ A URDF can describe what no plan should be asked of: a joint that turns without 
 range of a thousand turns, a velocity limit of a micrometre per second. Left in, such a
 joint makes the search's box, the trajectories and their checks as large as the range or
 as long as the crossing time, and a plan runs for minutes and gigabytes. So an endless
-joint is planned within one turn, a range beyond one turn either way within that
+joint, and a range beyond one turn either way, are planned within one turn either way
 (:func:`~cpr_kin.description.urdf_file.narrowed_ranges`), and the loader refuses the rest at
 once (:class:`~cpr_kin.common.errors.UrdfError`, exit 2 on the command line), naming the
 joint, the value and what is supported:
