@@ -9,8 +9,15 @@ import pytest
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
-from planning.search.nearest_nodes import INDEXED_FROM, LEAF_NODES, REBUILD_SHARE, NodeIndex, build_cells
-from planning.search.rrt_trees import Tree, nearest_node
+from planning.search.nearest_nodes import (
+    INDEXED_FROM,
+    LEAF_NODES,
+    REBUILD_SHARE,
+    NodeIndex,
+    build_cells,
+    nearest_node,
+)
+from planning.search.rrt_trees import Tree
 
 FloatArray = NDArray[np.float64]
 

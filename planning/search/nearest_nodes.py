@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from cpr_kin.common.compiled import njit
+from cpr_kin.common.compiled import njit, njit_inline
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -104,13 +104,24 @@ def build_cells(
     return order, low[:count], high[:count], first_child[:count], start[:count], end[:count]
 
 
-@njit
+@njit_inline
 def _distance(nodes: FloatArray, i: int, q: FloatArray, weights: FloatArray) -> float:
-    """``sum_j w_j |nodes[i, j] - q_j|``, summed in the joints' order."""
+    """``sum_j w_j |nodes[i, j] - q_j|``, summed in the joints' order: the scan's and the index's."""
     distance = 0.0
     for j in range(len(q)):
         distance += abs(nodes[i, j] - q[j]) * weights[j]
     return distance
+
+
+@njit
+def nearest_node(nodes: FloatArray, size: int, q: FloatArray, weights: FloatArray) -> int:
+    """The first of ``nodes[:size]`` nearest ``q`` by the motion bound ``sum_j w_j |dq_j|``, by a scan."""
+    best, index = np.inf, 0
+    for i in range(size):
+        distance = _distance(nodes, i, q, weights)
+        if distance < best:
+            best, index = distance, i
+    return index
 
 
 @njit

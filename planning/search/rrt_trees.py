@@ -16,8 +16,7 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from cpr_kin.common.compiled import njit
-from planning.search.nearest_nodes import INDEXED_FROM, NodeIndex
+from planning.search.nearest_nodes import INDEXED_FROM, NodeIndex, nearest_node
 
 FloatArray = NDArray[np.float64]
 
@@ -59,19 +58,6 @@ class Tree:
             chain.append(self.nodes[index])
             index = int(self.parents[index])
         return np.array(chain)
-
-
-@njit
-def nearest_node(nodes: FloatArray, size: int, q: FloatArray, weights: FloatArray) -> int:
-    """Index of the first of ``nodes[:size]`` nearest to ``q`` by the motion bound ``sum_j w_j |dq_j|``."""
-    best, index = np.inf, 0
-    for i in range(size):
-        distance = 0.0
-        for j in range(len(q)):
-            distance += abs(nodes[i, j] - q[j]) * weights[j]
-        if distance < best:
-            best, index = distance, i
-    return index
 
 
 class GrownTrees:
