@@ -85,7 +85,7 @@ REFUSED = [
     ("box side below zero", lambda t: t.replace('size="0.12 0.12 0.9"', 'size="0.12 -0.12 0.9"'),
      r"link 'column_link': (visual|collision) box size = '0.12 -0.12 0.9' is not supported; give 3 numbers"),
     ("box of 1e30 m", lambda t: t.replace('size="0.12 0.12 0.9"', 'size="0.12 0.12 1e30"'),
-     r"box size = '0.12 0.12 1e30' is not supported; give 3 numbers in \(0, 100\] m"),
+     r"box size = '0.12 0.12 1e30' is not supported; give 3 numbers in [\(\[]0, 100\] m"),
     ("NaN mass", lambda t: t.replace('mass value="10.0"', 'mass value="nan"'),
      r"link 'base_link' inertial mass = 'nan' is not a finite number"),
     ("mass below zero", lambda t: t.replace('mass value="10.0"', 'mass value="-10.0"'),
@@ -101,6 +101,30 @@ def test_an_unsupported_urdf_is_refused_at_load_naming_the_joint(
 ) -> None:
     with pytest.raises(ck.UrdfError, match=message):
         ck.load_cpr(variant(tmp_path, edit))
+
+
+BASE_VISUAL = '<cylinder radius="0.15" length="0.1"/></geometry>\n      <material name="base_grey"/>'
+BASE_COLLISION = '<collision name="base">\n      <origin xyz="0 0 0.05" rpy="0 0 0"/>\n      <geometry>'
+
+
+def extra_visual(radius: str) -> Callable[[str], str]:
+    visual = f'{BASE_VISUAL}\n    </visual>\n    <visual><geometry><sphere radius="{radius}"/></geometry>'
+    return lambda text: text.replace(BASE_VISUAL, visual, 1)
+
+
+def test_a_visual_of_zero_size_draws_nothing_and_loads(tmp_path: Path) -> None:
+    # pybullet's Laikago gives its toes visual spheres of radius 0 (their collision spheres 3 cm)
+    robot = ck.load_cpr(variant(tmp_path, extra_visual("0.0")))
+    bundled = ck.load_cpr()
+    assert robot.visual_model.ngeoms == bundled.visual_model.ngeoms  # the zero sphere left out
+    assert robot.collision_model.ngeoms == bundled.collision_model.ngeoms
+    visual_message = r"visual sphere radius = '-0.1' .* in \[0, 100\] m \(0: drawn as nothing\)$"
+    with pytest.raises(ck.UrdfError, match=visual_message):
+        ck.load_cpr(variant(tmp_path, extra_visual("-0.1")))
+    collision = BASE_COLLISION + '<cylinder radius="0.15"'
+    zero_collision = BASE_COLLISION + '<cylinder radius="0"'
+    with pytest.raises(ck.UrdfError, match=r"collision cylinder radius = '0' .* in \(0, 100\] m$"):
+        ck.load_cpr(variant(tmp_path, lambda t: t.replace(collision, zero_collision)))
 
 
 def test_a_moment_below_zero_by_rounding_loads(tmp_path: Path) -> None:

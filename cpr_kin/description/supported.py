@@ -25,7 +25,8 @@ joint, the value and what is supported:
 - link, joint and collision names without control or bidirectional characters
   (:mod:`cpr_kin.common.names`);
 - limits, shapes and inertials that are finite numbers: a shape's size above zero and at most
-  :data:`MAX_SHAPE_M` (boxes, cylinders, spheres; a mesh's scale not zero), an effort,
+  :data:`MAX_SHAPE_M` (boxes, cylinders, spheres; a mesh's scale not zero; a visual's may be
+  zero, drawn as nothing), an effort,
   velocity, mass and moment of inertia at least zero. A NaN radius or mass made Pinocchio's
   parser drop the link's elements in silence (the loader then said the link had no collision
   geometry), and a negative one computed with nonsense.
@@ -42,7 +43,14 @@ from lxml import etree
 from cpr_kin.common.errors import UrdfError
 from cpr_kin.common.names import escaped, unprintable
 from cpr_kin.description.link_tree import check_tree
-from cpr_kin.description.urdf_file import RANGE_TOLERANCE_RAD, TURN_EITHER_WAY_RAD, parse_urdf, validate_urdf
+from cpr_kin.description.urdf_file import (
+    RANGE_TOLERANCE_RAD,
+    SHAPE_SIZES,
+    TURN_EITHER_WAY_RAD,
+    numbers_in,
+    parse_urdf,
+    validate_urdf,
+)
 from cpr_kin.model.limits import JointLimits
 
 PLANNED_TYPES = ("revolute", "prismatic", "continuous", "fixed")
@@ -62,8 +70,6 @@ MAX_SHAPE_M = 100.0
 radius, and the distance of a mesh's vertex from its link's frame. An arm's links span metres;
 a mesh drawn in millimetres and given no ``scale`` reaches hundreds, and far out the distance
 arithmetic loses its meaning."""
-SHAPE_SIZES = {"box": (("size", 3),), "cylinder": (("radius", 1), ("length", 1)), "sphere": (("radius", 1),)}
-"""The size attributes of each URDF shape, each with how many numbers it holds."""
 INERTIA_NAMES = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 ROUNDING_KG_M2 = 1e-12
 """How far a moment of inertia may pass below zero by rounding [kg m^2] (a milligram at a millimetre)."""
@@ -101,7 +107,7 @@ def check_joints(tree: etree._ElementTree, path: Path) -> None:
         axis = joint.find("axis")
         if kind not in ("fixed", "floating") and axis is not None:
             text = axis.get("xyz", "1 0 0")
-            vector = _numbers(text, 3)
+            vector = numbers_in(text, 3)
             if vector is None or not all(map(math.isfinite, vector)) or math.hypot(*vector) < 1e-9:
                 raise UrdfError(
                     f"URDF '{path}': joint '{name}' axis xyz = '{escaped(text[:40])}' is not a direction; "
@@ -110,7 +116,7 @@ def check_joints(tree: etree._ElementTree, path: Path) -> None:
         limit = joint.find("limit")
         for key in ("lower", "upper", "effort", "velocity"):
             text = None if limit is None else limit.get(key)
-            value = None if text is None else _numbers(text, 1)
+            value = None if text is None else numbers_in(text, 1)
             least = -math.inf if key in ("lower", "upper") else 0.0
             if text is not None and (value is None or not least <= value[0] < math.inf):
                 wanted = "a finite number" if key in ("lower", "upper") else "a finite number >= 0"
@@ -120,37 +126,32 @@ def check_joints(tree: etree._ElementTree, path: Path) -> None:
                 )
 
 
-def _numbers(text: str | None, count: int) -> list[float] | None:
-    """``count`` numbers written in ``text``, or ``None`` where it holds anything else."""
-    try:
-        values = [float(v) for v in (text or "").split()]
-    except ValueError:
-        return None
-    return values if len(values) == count else None
-
-
 def check_shapes(tree: etree._ElementTree, path: Path) -> None:
     """Refuse a shape size outside ``(0, MAX_SHAPE_M]``, and a mesh scale that is not three numbers.
 
     A size is a box's sides, a cylinder's radius and length, a sphere's radius; a mesh's scale
-    must be three finite numbers other than zero.
+    must be three finite numbers other than zero. A visual's size may be zero: it draws
+    nothing, and the models leave it out (:func:`~cpr_kin.description.urdf_file.draws_nothing`).
     """
     for link in tree.getroot().findall("link"):
         for element in link.iter("collision", "visual"):
             where = f"URDF '{path}': link '{link.get('name', '?')}': {element.tag}"
+            draws = element.tag == "visual"  # a visual may draw nothing
+            least = 0.0 if draws else math.nextafter(0.0, 1.0)
+            allowed = f"[0, {MAX_SHAPE_M:g}] m (0: drawn as nothing)" if draws else f"(0, {MAX_SHAPE_M:g}] m"
             for shape in element.iterfind("geometry/*"):
                 for name, count in SHAPE_SIZES.get(str(shape.tag), ()):
                     text = shape.get(name)
-                    values = _numbers(text, count)
-                    if values is None or not all(0.0 < v <= MAX_SHAPE_M for v in values):
+                    values = numbers_in(text, count)
+                    if values is None or not all(least <= v <= MAX_SHAPE_M for v in values):
                         wanted = "a number" if count == 1 else f"{count} numbers"
                         raise UrdfError(
                             f"{where} {shape.tag} {name} = '{escaped(str(text)[:40])}' is not supported; "
-                            f"give {wanted} in (0, {MAX_SHAPE_M:g}] m"
+                            f"give {wanted} in {allowed}"
                         )
                 scale = shape.get("scale") if shape.tag == "mesh" else None
                 if scale is not None:
-                    values = _numbers(scale, 3)
+                    values = numbers_in(scale, 3)
                     if values is None or not all(math.isfinite(v) and v != 0.0 for v in values):
                         raise UrdfError(
                             f"{where} mesh scale = '{escaped(scale[:40])}' is not supported; "
@@ -175,7 +176,7 @@ def check_inertials(tree: etree._ElementTree, path: Path) -> None:
         texts = {"mass": None if mass is None else mass.get("value")}
         if inertia is not None:
             texts |= {name: inertia.get(name) for name in INERTIA_NAMES}
-        values = {name: _numbers(text, 1) for name, text in texts.items() if text is not None}
+        values = {name: numbers_in(text, 1) for name, text in texts.items() if text is not None}
         for name, value in values.items():
             if value is None or not math.isfinite(value[0]):
                 raise UrdfError(f"{where} {name} = '{escaped(str(texts[name])[:40])}' is not a finite number")

@@ -28,6 +28,8 @@ from cpr_kin.model.packages import resolve_mesh
 
 MAX_URDF_BYTES = 10_000_000
 """Largest URDF file [bytes] (the CPR's takes 6 kB)."""
+SHAPE_SIZES = {"box": (("size", 3),), "cylinder": (("radius", 1), ("length", 1)), "sphere": (("radius", 1),)}
+"""The size attributes of each URDF shape, each with how many numbers it holds."""
 
 
 def check_urdf_file(path: Path) -> None:
@@ -211,6 +213,24 @@ def narrowed_ranges(tree: etree._ElementTree) -> dict[str, tuple[float, float]]:
     return narrowed
 
 
+def numbers_in(text: str | None, count: int) -> list[float] | None:
+    """``count`` numbers written in ``text``, or ``None`` where it holds anything else."""
+    try:
+        values = [float(v) for v in (text or "").split()]
+    except ValueError:
+        return None
+    return values if len(values) == count else None
+
+
+def draws_nothing(visual: etree._Element) -> bool:
+    """Whether a ``<visual>`` has a shape of size zero (pybullet's Laikago has toe spheres of radius 0)."""
+    for shape in visual.iterfind("geometry/*"):
+        for name, count in SHAPE_SIZES.get(str(shape.tag), ()):
+            if 0.0 in (numbers_in(shape.get(name), count) or ()):
+                return True
+    return False
+
+
 def prepared_xml(tree: etree._ElementTree, path: Path, roots: Sequence[Path]) -> str:
     """The URDF's text as the models are built from it.
 
@@ -220,7 +240,8 @@ def prepared_xml(tree: etree._ElementTree, path: Path, roots: Sequence[Path]) ->
     joint without a velocity limit is refused by name at load, naming the two places to give
     one, while a joint the planner only holds, such as a mobile base's caster wheel, loads),
     a revolute range beyond one turn either way is narrowed to it (:func:`narrowed_ranges`),
-    and every mesh file name is made absolute (:func:`cpr_kin.model.packages.resolve_mesh`), so
+    a visual that draws nothing (:func:`draws_nothing`) is left out, and every mesh file name
+    is made absolute (:func:`cpr_kin.model.packages.resolve_mesh`), so
     that a missing mesh is named before Pinocchio reads anything.
 
     Raises:
@@ -245,6 +266,10 @@ def prepared_xml(tree: etree._ElementTree, path: Path, roots: Sequence[Path]) ->
                 limit.set(unknown, "0")
         limit.set("lower", repr(-CONTINUOUS_RANGE_RAD))
         limit.set("upper", repr(CONTINUOUS_RANGE_RAD))
+    for link in root.findall("link"):
+        for visual in link.findall("visual"):
+            if draws_nothing(visual):
+                link.remove(visual)
     for mesh in root.iter("mesh"):
         filename = mesh.get("filename")
         if filename:
