@@ -52,3 +52,25 @@ def test_an_invalid_urdf_is_refused_every_time_and_nothing_is_kept(
             urdf_file.validate_urdf(path)
     assert validations == [path, path]
     assert not list((tmp_path / "cache").glob("urdf-valid/*"))
+
+
+@pytest.mark.parametrize(
+    "declared", ['<?xml version="0.0" ?>', "\ufeff<?xml version='2.0' encoding='utf-8'?>"]
+)
+def test_a_declared_xml_version_other_than_1_is_read_as_1_0(
+    tmp_path: Path, validations: list[Path], caplog: pytest.LogCaptureFixture, declared: str
+) -> None:
+    # pybullet's Minitaur, quadruped and WSG-50 gripper declare version 0.0: libxml2 refused them,
+    # while urdfdom (Pinocchio's parser) reads them as XML 1.0
+    path = tmp_path / "old.urdf"
+    path.write_text(URDF_TEXT.replace('<?xml version="1.0"?>', declared, 1), encoding="utf-8")
+    robot = ck.load_cpr(path)
+    assert robot.joint_names == ck.load_cpr().joint_names
+    assert validations == [path]  # yourdfpy's verdict asked, on the same text, and found valid
+    assert "version" not in caplog.text  # nor did yourdfpy log that it parsed another way
+
+
+def test_a_declaration_of_xml_1_x_and_a_file_without_one_are_read_as_written() -> None:
+    for data in (b'<?xml version="1.0"?><robot/>', b"<?xml version='1.1'?><robot/>", b"<robot/>"):
+        assert urdf_file.as_xml_1_0(data) is data
+    assert urdf_file.as_xml_1_0(b"<?xml version='0.0'?>\n<robot/>") == b"<?xml version='1.0'?>\n<robot/>"

@@ -8,15 +8,13 @@ accepts, so that a broken file gets a message naming the problem.
 
 from __future__ import annotations
 
-import contextlib
 import copy
 import hashlib
+import io
 import math
-import os
-import sys
-import tempfile
+import re
 import warnings
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -40,18 +38,36 @@ def check_urdf_file(path: Path) -> None:
         raise UrdfError(f"URDF file '{path}' is not a regular file (a folder or a device)")
 
 
+DECLARED_VERSION = re.compile(rb"""\A(\xef\xbb\xbf)?(\s*<\?xml\s+version\s*=\s*)(["'])([^"']*)\3""")
+"""The version an XML declaration opens with (after a byte-order mark, if any)."""
+
+
+def as_xml_1_0(data: bytes) -> bytes:
+    """``data`` with an XML declaration's version other than ``1.x`` read as ``1.0``.
+
+    Many URDFs (pybullet's Minitaur and WSG-50 gripper among them) declare ``version="0.0"``,
+    which libxml2 refuses while urdfdom, Pinocchio's parser, and yourdfpy read them as XML 1.0.
+    """
+    declared = DECLARED_VERSION.match(data)
+    if declared is None or re.fullmatch(rb"1\.[0-9]+", declared.group(4)):
+        return data
+    quote = declared.group(3)
+    return data[: declared.start(4)] + b"1.0" + quote + data[declared.end() :]
+
+
 def parse_urdf(path: Path) -> etree._ElementTree:
     """Parse ``path`` as strict XML; raise :class:`UrdfError` if it is missing or malformed.
 
     Entities are not expanded and nothing is fetched from the network: a URDF that defines
-    entities (an "XML bomb", or a reference to a local file) is parsed as written.
+    entities (an "XML bomb", or a reference to a local file) is parsed as written. A
+    declaration of another XML version than 1.x is read as 1.0 (:func:`as_xml_1_0`).
     """
     check_urdf_file(path)
     if path.stat().st_size > MAX_URDF_BYTES:
         raise UrdfError(f"URDF file '{path}' has {path.stat().st_size} bytes; at most {MAX_URDF_BYTES}")
     parser = etree.XMLParser(recover=False, resolve_entities=False, no_network=True, huge_tree=False)
     try:
-        tree = etree.parse(str(path), parser)
+        tree = etree.parse(io.BytesIO(as_xml_1_0(path.read_bytes())), parser, base_url=str(path))
     except etree.XMLSyntaxError as exc:
         message = str(exc) if len(str(exc)) <= 120 else str(exc)[:117] + "..."
         raise UrdfError(f"URDF file '{path}' is not well-formed XML: {message}") from None
@@ -122,8 +138,11 @@ def _validated(path: Path) -> dict[str, bool]:
     try:
         with warnings.catch_warnings():  # trimesh's arithmetic on a value that is then refused, by name
             warnings.simplefilter("ignore", RuntimeWarning)
+            content = path.read_bytes()
+            readable = as_xml_1_0(content)  # yourdfpy too says "Unsupported version '0.0'", then reads on
+            source = str(path) if readable is content else io.BytesIO(readable)
             urdf = yourdfpy.URDF.load(
-                str(path), build_scene_graph=False, load_meshes=False, load_collision_meshes=False
+                source, build_scene_graph=False, load_meshes=False, load_collision_meshes=False
             )
     except Exception as exc:  # yourdfpy raises bare exceptions on structural problems
         raise UrdfError(f"URDF file '{path}' cannot be read ({type(exc).__name__}: {exc})") from None
@@ -137,29 +156,6 @@ def _validated(path: Path) -> dict[str, bool]:
         problems = "; ".join(str(e) for e in found)
         raise UrdfError(f"URDF file '{path}' is invalid: {problems}")
     return {"valid": True}
-
-
-@contextlib.contextmanager
-def captured_stderr() -> Iterator[list[str]]:
-    """Capture what native code writes to the process's standard error (file descriptor 2).
-
-    Pinocchio's URDF parser (urdfdom) prints its complaints there, e.g. "Error: Material
-    [grey] color has no rgba", about details the planner does not use. Within the context
-    they go to a temporary file instead of the user's terminal; the yielded list holds its
-    lines once the context ends, for a caller that wants to report them in its own words.
-    """
-    lines: list[str] = []
-    sys.stderr.flush()
-    saved = os.dup(2)
-    with tempfile.TemporaryFile() as sink:
-        os.dup2(sink.fileno(), 2)
-        try:
-            yield lines
-        finally:
-            os.dup2(saved, 2)
-            os.close(saved)
-            sink.seek(0)
-            lines.extend(sink.read(10_000).decode("utf-8", errors="replace").splitlines())
 
 
 def collision_names(tree: etree._ElementTree) -> dict[str, list[str]]:

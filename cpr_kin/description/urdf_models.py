@@ -9,8 +9,12 @@ beyond its mesh, the mesh decides (:mod:`cpr_kin.shapes.exact_meshes`).
 
 from __future__ import annotations
 
+import contextlib
+import os
 import re
-from collections.abc import Callable
+import sys
+import tempfile
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -25,7 +29,6 @@ from cpr_kin.bounds.pair_bounds import bounding_capsule
 from cpr_kin.common.errors import UrdfError
 from cpr_kin.description.geometry_cache import geometry_model, mesh_hull
 from cpr_kin.description.supported import MAX_SHAPE_M
-from cpr_kin.description.urdf_file import captured_stderr
 from cpr_kin.shapes.mesh_geometry import spans_volume
 
 if TYPE_CHECKING:  # what a robot whose links are meshes imports, where it has one
@@ -35,6 +38,29 @@ MIN_MESH_SPAN_M = 1e-6
 """Smallest largest extent of a link mesh [m], scale applied: a mesh smaller than a micrometre
 (a scale of 0, or 1e-9) is no part of an arm, and its points merge into one at the hull's
 tolerance (trimesh's 1e-8 m)."""
+
+
+@contextlib.contextmanager
+def captured_stderr() -> Iterator[list[str]]:
+    """Capture what native code writes to the process's standard error (file descriptor 2).
+
+    Pinocchio's URDF parser (urdfdom) prints its complaints there, e.g. "Error: Material
+    [grey] color has no rgba", about details the planner does not use. Within the context
+    they go to a temporary file instead of the user's terminal; the yielded list holds its
+    lines once the context ends, for a caller that wants to report them in its own words.
+    """
+    lines: list[str] = []
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile() as sink:
+        os.dup2(sink.fileno(), 2)
+        try:
+            yield lines
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            sink.seek(0)
+            lines.extend(sink.read(10_000).decode("utf-8", errors="replace").splitlines())
 
 
 def build_models(xml: str, path: Path, kind: Any = pin.GeometryType.COLLISION) -> tuple[Any, Any]:
