@@ -107,20 +107,28 @@ BASE_VISUAL = '<cylinder radius="0.15" length="0.1"/></geometry>\n      <materia
 BASE_COLLISION = '<collision name="base">\n      <origin xyz="0 0 0.05" rpy="0 0 0"/>\n      <geometry>'
 
 
-def extra_visual(radius: str) -> Callable[[str], str]:
-    visual = f'{BASE_VISUAL}\n    </visual>\n    <visual><geometry><sphere radius="{radius}"/></geometry>'
-    return lambda text: text.replace(BASE_VISUAL, visual, 1)
+def extra_visuals(*shapes: str) -> Callable[[str], str]:
+    visuals = "".join(f"\n    </visual>\n    <visual><geometry>{shape}</geometry>" for shape in shapes)
+    return lambda text: text.replace(BASE_VISUAL, BASE_VISUAL + visuals, 1)
 
 
-def test_a_visual_of_zero_size_draws_nothing_and_loads(tmp_path: Path) -> None:
+def test_a_visual_without_area_draws_nothing_and_loads(tmp_path: Path) -> None:
     # pybullet's Laikago gives its toes visual spheres of radius 0 (their collision spheres 3 cm)
-    robot = ck.load_cpr(variant(tmp_path, extra_visual("0.0")))
+    nothing = ('<sphere radius="0.0"/>', '<box size="0 0 0.1"/>', '<cylinder radius="0" length="0.1"/>')
+    flat = ('<box size="0.2 0.2 0"/>', '<cylinder radius="0.1" length="0"/>')  # a plate and a disc
+    robot = ck.load_cpr(variant(tmp_path, extra_visuals(*nothing, *flat)))
     bundled = ck.load_cpr()
-    assert robot.visual_model.ngeoms == bundled.visual_model.ngeoms  # the zero sphere left out
+    assert robot.visual_model.ngeoms == bundled.visual_model.ngeoms + len(flat)  # those without area left out
+    sides = [
+        np.asarray(o.geometry.halfSide)
+        for o in robot.visual_model.geometryObjects
+        if hasattr(o.geometry, "halfSide")
+    ]
+    assert any(np.array_equal(side, [0.1, 0.1, 0.0]) for side in sides)
     assert robot.collision_model.ngeoms == bundled.collision_model.ngeoms
-    visual_message = r"visual sphere radius = '-0.1' .* in \[0, 100\] m \(0: drawn as nothing\)$"
+    visual_message = r"visual sphere radius = '-0.1' .* in \[0, 100\] m \(a visual may be flat\)$"
     with pytest.raises(ck.UrdfError, match=visual_message):
-        ck.load_cpr(variant(tmp_path, extra_visual("-0.1")))
+        ck.load_cpr(variant(tmp_path, extra_visuals('<sphere radius="-0.1"/>')))
     collision = BASE_COLLISION + '<cylinder radius="0.15"'
     zero_collision = BASE_COLLISION + '<cylinder radius="0"'
     with pytest.raises(ck.UrdfError, match=r"collision cylinder radius = '0' .* in \(0, 100\] m$"):

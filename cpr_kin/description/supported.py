@@ -26,7 +26,7 @@ joint, the value and what is supported:
   (:mod:`cpr_kin.common.names`);
 - limits, shapes and inertials that are finite numbers: a shape's size above zero and at most
   :data:`MAX_SHAPE_M` (boxes, cylinders, spheres; a mesh's scale not zero; a visual's may be
-  zero, drawn as nothing), an effort,
+  zero: a plate, a disc, or nothing drawn), an effort,
   velocity, mass and moment of inertia at least zero. A NaN radius or mass made Pinocchio's
   parser drop the link's elements in silence (the loader then said the link had no collision
   geometry), and a negative one computed with nonsense.
@@ -130,15 +130,15 @@ def check_shapes(tree: etree._ElementTree, path: Path) -> None:
     """Refuse a shape size outside ``(0, MAX_SHAPE_M]``, and a mesh scale that is not three numbers.
 
     A size is a box's sides, a cylinder's radius and length, a sphere's radius; a mesh's scale
-    must be three finite numbers other than zero. A visual's size may be zero: it draws
-    nothing, and the models leave it out (:func:`~cpr_kin.description.urdf_file.draws_nothing`).
+    must be three finite numbers other than zero. A visual's size may be zero: a plate or a disc
+    is drawn, a shape without area left out (:func:`~cpr_kin.description.urdf_file.draws_nothing`).
     """
     for link in tree.getroot().findall("link"):
         for element in link.iter("collision", "visual"):
             where = f"URDF '{path}': link '{link.get('name', '?')}': {element.tag}"
             draws = element.tag == "visual"  # a visual may draw nothing
             least = 0.0 if draws else math.nextafter(0.0, 1.0)
-            allowed = f"[0, {MAX_SHAPE_M:g}] m (0: drawn as nothing)" if draws else f"(0, {MAX_SHAPE_M:g}] m"
+            allowed = f"[0, {MAX_SHAPE_M:g}] m (a visual may be flat)" if draws else f"(0, {MAX_SHAPE_M:g}] m"
             for shape in element.iterfind("geometry/*"):
                 for name, count in SHAPE_SIZES.get(str(shape.tag), ()):
                     text = shape.get(name)

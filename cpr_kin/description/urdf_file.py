@@ -215,11 +215,18 @@ def numbers_in(text: str | None, count: int) -> list[float] | None:
 
 
 def draws_nothing(visual: etree._Element) -> bool:
-    """Whether a ``<visual>`` has a shape of size zero (pybullet's Laikago has toe spheres of radius 0)."""
+    """Whether a ``<visual>``'s shape has no area: a sphere or cylinder of radius 0, a box of two sides 0.
+
+    pybullet's Laikago gives its toes visual spheres of radius 0. A box of one side 0 (a plate)
+    and a cylinder of length 0 (a disc) are drawn.
+    """
     for shape in visual.iterfind("geometry/*"):
-        for name, count in SHAPE_SIZES.get(str(shape.tag), ()):
-            if 0.0 in (numbers_in(shape.get(name), count) or ()):
+        if shape.tag in ("sphere", "cylinder"):
+            radius = numbers_in(shape.get("radius"), 1)
+            if radius == [0.0]:
                 return True
+        elif shape.tag == "box" and (numbers_in(shape.get("size"), 3) or []).count(0.0) >= 2:
+            return True
     return False
 
 
