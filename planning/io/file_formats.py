@@ -6,8 +6,13 @@ user gave where a scene belongs (the files of a command taken in the wrong order
 
 from __future__ import annotations
 
-TRAJECTORY = "cpr-trajectory/1"
-"""A trajectory file (:mod:`planning.io.trajectory_io`, :mod:`planning.io.trajectory_reader`)."""
+from typing import Literal, get_args
+
+TrajectoryFormat = Literal["cpr-trajectory/1"]
+"""A trajectory file's tag as a type: the one value the reader's schema accepts
+(:mod:`planning.io.trajectory_reader`)."""
+TRAJECTORY: str = get_args(TrajectoryFormat)[0]
+"""A trajectory file's tag, as written (:mod:`planning.io.trajectory_io`, :mod:`planning.io.task_outputs`)."""
 OUTPUTS = "cpr-plan-outputs/1"
 """The manifest of a plan's output folder (:mod:`planning.io.publish`)."""
 WRITTEN = {TRAJECTORY: "a trajectory file", OUTPUTS: "an output folder's manifest"}

@@ -14,7 +14,7 @@ import itertools
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -26,6 +26,7 @@ from planning.curves.continuity import discontinuity
 from planning.curves.hermite import ORDER
 from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
+from planning.io.file_formats import TrajectoryFormat
 from planning.pipeline.scene import DURATION_RANGE_S
 
 FloatArray = NDArray[np.float64]
@@ -59,7 +60,7 @@ class _Segment(BaseModel):
 class _Document(BaseModel):
     # other keys are allowed: a tool may add its own beside the documented ones
     model_config = ConfigDict(strict=True, extra="allow")
-    format: Literal["cpr-trajectory/1"]
+    format: TrajectoryFormat
     joint_names: Annotated[list[Annotated[str, Field(max_length=100)]], Field(min_length=1, max_length=32)]
     robot: Annotated[str, Field(max_length=4096)]
     scene: dict[str, Any]
