@@ -1,12 +1,13 @@
-"""Edge checks: the coarse-to-fine free fraction is the exhaustive one, for fewer checks."""
+"""Edge checks (the coarse-to-fine free fraction is the exhaustive one), straightened joints."""
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
 
-from planning.search.edges import COARSE_STRIDE, HEAD, WHOLE_BELOW, Edges
+from planning.search.edges import COARSE_STRIDE, HEAD, WHOLE_BELOW, Edges, path_time, straighten_joints
 
 
 def discs(q: np.ndarray) -> np.ndarray:
@@ -65,3 +66,54 @@ def test_a_check_that_stops_at_the_first_invalid_configuration_gives_the_same_fr
         found = [early.free_fraction(a, b) for a, b in pairs]
         assert found == [exact.free_fraction(a, b) for a, b in pairs]
         assert 0 < sum(f < 1 for f in found) < len(found)
+
+
+def everywhere(q: np.ndarray) -> np.ndarray:
+    return np.ones(len(q), dtype=bool)
+
+
+def test_a_wandering_slow_joint_is_straightened_until_the_path_is_the_straight_line() -> None:
+    """Joints 0 and 1 go straight; the slow joint 2 wanders: straightened, the path is the line."""
+    speeds = np.array([1.0, 1.0, 0.1])
+    path = np.array([[0.0, 0.0, 0.0], [0.25, 0.5, 0.8], [0.5, 1.0, -0.5], [0.75, 1.5, 0.6], [1.0, 2.0, 0.1]])
+    edges = Edges(everywhere, np.ones(3), 0.01)
+    straightened = straighten_joints(path, edges, speeds, np.random.default_rng(0), 100)
+    np.testing.assert_array_equal(straightened[:, :2], path[:, :2])  # the other joints keep their values
+    np.testing.assert_array_equal(straightened[[0, -1]], path[[0, -1]])
+    direct_s = float(np.max(np.abs(path[-1] - path[0]) / speeds))
+    assert path_time(path, speeds) > 3 * direct_s
+    assert math.isclose(path_time(straightened, speeds), direct_s, rel_tol=1e-9)
+    assert np.all(np.diff(straightened[:, 2]) >= 0.0)  # monotone, at the pace of the others
+
+
+def test_a_straightened_joint_that_would_cross_an_obstacle_is_not_taken() -> None:
+    """Joint 1 lifts over a block that its straight move would cross: the detour stays."""
+
+    def beside_block(q: np.ndarray) -> np.ndarray:
+        return np.asarray(~((np.abs(q[:, 0] - 0.5) < 0.1) & (q[:, 1] < 0.5)))
+
+    path = np.array([[0.0, 0.0], [0.5, 0.8], [1.0, 0.0]])
+    edges = Edges(beside_block, np.ones(2), 0.005)
+    straightened = straighten_joints(path, edges, np.ones(2), np.random.default_rng(1), 20)
+    np.testing.assert_array_equal(straightened, path)
+    assert edges.checks > 0  # it was tried, and refused by the validity check
+
+
+def test_a_straightened_joint_that_saves_no_time_costs_no_check() -> None:
+    """The wandering joint is fast; the slow one sets every edge's time: nothing to gain, nothing checked."""
+    path = np.array([[0.0, 0.0], [0.5, 0.3], [1.0, -0.2], [1.5, 0.0]])
+    edges = Edges(everywhere, np.ones(2), 0.01)
+    straightened = straighten_joints(path, edges, np.array([0.1, 10.0]), np.random.default_rng(2), 50)
+    np.testing.assert_array_equal(straightened, path)
+    assert edges.checks == 0
+
+
+def test_a_chain_is_free_exactly_when_every_edge_is() -> None:
+    rng = np.random.default_rng(6)
+    weights = np.array([1.0, 2.0])
+    for _ in range(100):
+        chain = rng.uniform(0, 1, (4, 2))
+        if not discs(chain[:1])[0]:
+            continue
+        every = all(exhaustive(a, b, weights, 0.002) == 1.0 for a, b in itertools.pairwise(chain))
+        assert Edges(discs, weights, 0.002).chain_free(chain) == every

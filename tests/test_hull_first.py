@@ -136,10 +136,10 @@ def test_the_meshes_draw_goes_on_with_the_trees_the_hulls_grew(
     scene = dataclasses.replace(scene, planner=dataclasses.replace(scene.planner, tuning=tuning))
     draws: list[tuple[int, int, int | None]] = []  # trees' nodes taken, nodes left, samples of a path
 
-    def recorded(*args: Any) -> Any:
+    def recorded(*args: Any, **kwargs: Any) -> Any:
         grown: GrownTrees | None = args[10]
         taken = 0 if grown is None else grown.nodes
-        found = rrt_connect(*args)
+        found = rrt_connect(*args, **kwargs)
         draws.append((taken, 0 if grown is None else grown.nodes, None if found is None else found.samples))
         return found
 

@@ -11,6 +11,7 @@ import pytest
 from numpy.typing import NDArray
 
 from planning.errors import PlanningError
+from planning.search.edges import path_time
 from planning.search.rrt_connect import Relaxation, _Sampler, rrt_connect
 from planning.search.rrt_settings import RrtSettings
 from planning.search.rrt_trees import Tree
@@ -213,6 +214,30 @@ def test_settings_and_weights_are_validated() -> None:
         RrtSettings(local_spread=0.0)
     with pytest.raises(PlanningError, match="weights"):
         rrt_connect(wall_with_slot, LOWER, UPPER, LOWER, UPPER, -WEIGHTS, np.random.default_rng(0))
+    with pytest.raises(PlanningError, match="joint_shortcuts"):
+        RrtSettings(joint_shortcuts=-1)
+    for speeds in (np.array([1.0, 0.0]), np.array([1.0, np.inf]), np.ones(3)):
+        with pytest.raises(PlanningError, match=r"speeds \[.*\] must be positive and finite, one per joint"):
+            rrt_connect(
+                wall_with_slot, LOWER, UPPER, LOWER, UPPER, WEIGHTS, np.random.default_rng(0), speeds=speeds
+            )
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_given_the_speeds_the_path_is_as_fast_or_faster_and_as_valid(seed: int) -> None:
+    """The same draw, its path then straightened joint by joint: never slower, every edge valid."""
+    start, goal = np.array([0.1, 0.9]), np.array([0.9, 0.1])
+    speeds = np.array([1.0, 0.05])  # y is slow: its wandering costs most
+    paths = [
+        rrt_connect(
+            wall_with_slot, start, goal, LOWER, UPPER, WEIGHTS, np.random.default_rng(seed), speeds=given
+        )
+        for given in (None, speeds)
+    ]
+    assert paths[0] is not None and paths[1] is not None
+    assert path_time(paths[1].path, speeds) <= path_time(paths[0].path, speeds)
+    assert densely_valid(paths[1].path, eroded)
+    np.testing.assert_array_equal(paths[1].path[[0, -1]], [start, goal])
 
 
 @pytest.mark.parametrize("seed", range(3))

@@ -103,8 +103,9 @@ THREE = 3
 
 
 def uniform_samples(problem: Problem, **seeding: Any) -> Problem:
-    """``problem`` whose RRT-Connect draws uniform samples only, with :data:`THREE` waypoints (as chosen)."""
-    tuning = SearchTuning(seeding=SeedingTuning(local_share=0.0, **seeding))
+    """``problem`` whose RRT-Connect draws uniform samples only and straightens no joint of its
+    paths, with :data:`THREE` waypoints (as when these scenes were chosen)."""
+    tuning = SearchTuning(seeding=SeedingTuning(local_share=0.0, joint_shortcuts=0, **seeding))
     return with_planner(problem, waypoints=THREE, tuning=tuning)
 
 
@@ -195,6 +196,8 @@ def test_placements_are_validated() -> None:
     with pytest.raises(PlanningError, match=r"placements = \[\] must hold at least one share"):
         SeedingTuning(placements=())
     assert SeedingTuning(placements=[0.5]).placements == (0.5,)  # type: ignore[arg-type]
+    with pytest.raises(PlanningError, match=r"joint_shortcuts = -1 .*\[0, 10000\]"):
+        SeedingTuning(joint_shortcuts=-1)
 
 
 def test_seeding_none_is_a_setting(robot: ck.Robot) -> None:

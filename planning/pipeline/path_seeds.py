@@ -100,6 +100,7 @@ def sampled_path(
             explore_resolution_m=tuning.max_resolution_m,
             local_share=tuning.local_share,
             local_spread=tuning.local_spread,
+            joint_shortcuts=tuning.joint_shortcuts,
         )
     if max_samples is not None:
         settings = dataclasses.replace(settings, max_samples=max_samples)
@@ -117,6 +118,7 @@ def sampled_path(
         problem.deadline.passed,
         relaxation,
         problem.grown,
+        speeds=limits.velocity[moving],
     )
 
 

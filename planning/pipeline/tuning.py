@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 from planning.errors import PlanningError
 from planning.search.refinement_settings import RefinementSettings
-from planning.search.rrt_settings import LOCAL_SHARE, LOCAL_SPREAD
+from planning.search.rrt_settings import JOINT_SHORTCUTS, LOCAL_SHARE, LOCAL_SPREAD
 from planning.validation import boolean, integer_in, number_in
 
 
@@ -59,6 +59,9 @@ class SeedingTuning:
             pocket about a goal in a shelf grows out of it; 0: uniform samples only.
         local_spread: standard deviation of those samples about their node [share of each
             joint's range], in (0, 1].
+        joint_shortcuts: attempts to straighten one joint of RRT-Connect's path where that
+            makes it faster at the joints' velocity limits, in [0, 10000]
+            (:func:`planning.search.edges.straighten_joints`); 0: none.
         placements: the waypoint placements along a path offered as its seed, each a share
             of the way from the corners' placement (0) to the evenly spaced one (1), in
             [0, 1] (:func:`~planning.search.waypoints.placements_along`); the best of them
@@ -77,6 +80,7 @@ class SeedingTuning:
     finer_step: float = 0.2
     local_share: float = LOCAL_SHARE
     local_spread: float = LOCAL_SPREAD
+    joint_shortcuts: int = JOINT_SHORTCUTS
     placements: tuple[float, ...] = (0.0, 0.5, 1.0)
 
     def __post_init__(self) -> None:
@@ -92,6 +96,7 @@ class SeedingTuning:
         number_in("finer_step", self.finer_step, 0.0, 1.0, low_open=True)
         number_in("local_share", self.local_share, 0.0, 1.0)
         number_in("local_spread", self.local_spread, 0.0, 1.0, low_open=True)
+        integer_in("joint_shortcuts", self.joint_shortcuts, 0, 10_000)
         shares = tuple(self.placements)
         if not shares:
             raise PlanningError("placements = [] must hold at least one share in [0, 1]")

@@ -8,12 +8,14 @@ coarse pass (the edge's first configurations and every few), then the rest of th
 to where the coarse pass found it blocked (OMPL stops at a motion's first invalid state in
 the same spirit). The same checks shorten a found path: random shortcuts (a straight edge
 between two points on it replaces what lies between when it is valid), then skipping
-vertices (from each vertex straight to the farthest one it sees), then dropping collinear
-vertices.
+vertices (from each vertex straight to the farthest one it sees), then, given the joints'
+speeds, straightening one joint at a time where that makes the path faster
+(:func:`straighten_joints`), then dropping collinear vertices.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable
 
@@ -37,6 +39,8 @@ at a node that stopped against an obstacle and are blocked at once (of the edges
 :data:`WHOLE_BELOW` configurations and more: UR5 68 %, Panda 51 %, the CPR 90 %, on
 MotionBenchMaker's and generated narrow scenes), and are then known from the first call,
 not the second (``docs/tuning.md``)."""
+STRAIGHTENED_GAIN = 1e-3
+"""Least share of a piece's time a straightened joint must save to be checked (:func:`straighten_joints`)."""
 WHOLE_BELOW = 48
 """Edges of fewer configurations are checked whole in the first pass: a second call of the
 validity check would cost more than it saves (a 5-joint arm's edges have 16-100; a 6- or
@@ -67,6 +71,20 @@ class Edges:
             ok = self._coarse_to_fine(points)
         blocked = int(ok.argmin())  # the first invalid one, or 0 where all are valid
         return blocked / count if not ok[blocked] else 1.0
+
+    def chain_free(self, path: FloatArray) -> bool:
+        """Whether every edge of the polyline ``path`` is valid (``path[0]`` assumed valid).
+
+        All its edges' configurations in at most two calls of the validity check, coarse to
+        fine as :meth:`free_fraction` checks one edge.
+        """
+        points = np.concatenate(
+            [edge_points(a, b, self.weights, self.resolution_m) for a, b in itertools.pairwise(path)]
+        )
+        if len(points) < WHOLE_BELOW:
+            self.checks += len(points)
+            return bool(self.valid(points).all())
+        return bool(self._coarse_to_fine(points).all())
 
     def _coarse_to_fine(self, points: FloatArray) -> BoolArray:
         """The validity of ``points``, checked up to the first invalid one (:meth:`free_fraction`)."""
@@ -107,8 +125,20 @@ def edge_points(a: FloatArray, b: FloatArray, weights: FloatArray, resolution_m:
     return points
 
 
-def shortcut(path: FloatArray, edges: Edges, rng: np.random.Generator, attempts: int) -> FloatArray:
-    """Shorten ``path`` by ``attempts`` random shortcuts between points on its edges."""
+def shortcut(
+    path: FloatArray,
+    edges: Edges,
+    rng: np.random.Generator,
+    attempts: int,
+    *,
+    joint_attempts: int = 0,
+    speeds: FloatArray | None = None,
+) -> FloatArray:
+    """Shorten ``path`` by ``attempts`` random shortcuts between points on its edges.
+
+    Then its vertices skipped where a later one is in sight and, with the joints' ``speeds``
+    [joint units/s], ``joint_attempts`` single joints straightened (:func:`straighten_joints`).
+    """
     for _ in range(attempts):
         if len(path) < 3:
             break
@@ -122,7 +152,55 @@ def shortcut(path: FloatArray, edges: Edges, rng: np.random.Generator, attempts:
         b = path[j] + (s1 - arc[j]) / max(lengths[j], 1e-300) * (path[j + 1] - path[j])
         if edges.free_fraction(a, b) == 1.0:
             path = np.concatenate([path[: i + 1], [a, b], path[j + 1 :]])
-    return _drop_collinear(_skip_vertices(path, edges))
+    path = _skip_vertices(path, edges)
+    if speeds is not None:
+        path = straighten_joints(path, edges, speeds, rng, joint_attempts)
+    return _drop_collinear(path)
+
+
+def path_time(path: FloatArray, speeds: FloatArray) -> float:
+    """``path``'s time at the joints' ``speeds`` [s]: each edge as long as its slowest joint takes."""
+    return float((np.abs(np.diff(path, axis=0)) / speeds).max(axis=1, initial=0.0).sum())
+
+
+def straighten_joints(
+    path: FloatArray, edges: Edges, speeds: FloatArray, rng: np.random.Generator, attempts: int
+) -> FloatArray:
+    """``path`` with single joints straightened between two of its vertices where that makes it faster.
+
+    A partial shortcut (Geraerts and Overmars 2007; OMPL's ``partialShortcutPath``), for the
+    joint that wanders where the others go straight (a sampling planner's path moves every
+    joint at random, a slow one as far as a fast one). Each attempt draws two vertices at
+    least two apart and one joint, by the time its wandering between them costs (its travel
+    beyond the straight move, over its speed [joint units/s]); between the two, that joint
+    moves straight, in step with the other joints' motion, and the others keep their values.
+    The change is kept where it shortens :func:`path_time` by more than
+    :data:`STRAIGHTENED_GAIN` and every changed edge is valid; only such a change costs
+    checks. The ends and the vertex count stay.
+    """
+    for _ in range(attempts):
+        if len(path) < 3:
+            break
+        i, j = sorted(int(v) for v in rng.choice(len(path), 2, replace=False))
+        if j - i < 2:
+            continue
+        piece = path[i : j + 1]
+        steps = np.abs(np.diff(piece, axis=0))
+        wander_s = np.maximum(steps.sum(axis=0) - np.abs(piece[-1] - piece[0]), 0.0) / speeds
+        if wander_s.max() <= 0.0:
+            continue
+        k = int(rng.choice(len(speeds), p=wander_s / wander_s.sum()))
+        others = np.delete(steps, k, axis=1) @ np.delete(edges.weights, k)
+        arc = np.concatenate([[0.0], np.cumsum(others)])
+        share = arc / arc[-1] if arc[-1] > 0.0 else np.linspace(0.0, 1.0, len(piece))
+        straightened = piece.copy()
+        straightened[1:-1, k] = piece[0, k] + share[1:-1] * (piece[-1, k] - piece[0, k])  # ends to the bit
+        if path_time(straightened, speeds) >= (1.0 - STRAIGHTENED_GAIN) * path_time(piece, speeds):
+            continue
+        if edges.chain_free(straightened):
+            path = path.copy()
+            path[i : j + 1] = straightened
+    return path
 
 
 def _skip_vertices(path: FloatArray, edges: Edges) -> FloatArray:

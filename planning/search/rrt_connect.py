@@ -15,8 +15,9 @@ arm (``docs/tuning.md``). Edges are checked in batches as :mod:`planning.search.
 describes (not certified: the executed spline gets the certified check). Distances are
 robot motion bounds ``sum_j R_j |dq_j|`` [m] with the joints' motion radii
 (:func:`cpr_kin.motion_radii`), so a step means the same in every joint whatever its unit.
-The path found is then shortened (:func:`planning.search.edges.shortcut`). All randomness
-comes from the generator passed.
+The path found is then shortened (:func:`planning.search.edges.shortcut`); given the joints'
+speeds, also one joint at a time where that makes it faster (a joint the trees moved at
+random, the slow one as far as the fast ones). All randomness comes from the generator passed.
 
 The trees may grow on coarser checks than the path must hold (``explore_resolution_m``, as
 OMPL's motion checks are, a share of the space's extent): most edges a tree tries are
@@ -105,6 +106,8 @@ def rrt_connect(
     stop: Callable[[], bool] | None = None,
     relaxation: Relaxation | None = None,
     grown: GrownTrees | None = None,
+    *,
+    speeds: FloatArray | None = None,
 ) -> RrtPath | None:
     """A valid path from ``start`` to ``goal`` in the box ``[lower, upper]``, or ``None``.
 
@@ -128,6 +131,9 @@ def rrt_connect(
         grown: the trees an earlier draw between the same ends left, under a validity
             ``valid`` accepts too, to go on growing; and where this draw leaves its own when it
             finds no path (:class:`~planning.search.rrt_trees.GrownTrees`). ``None``: new trees.
+        speeds: ``(d,)`` the joints' velocity limits [joint units/s], > 0: the found path's
+            joints are then straightened one at a time where that makes it faster
+            (``settings.joint_shortcuts`` attempts). ``None``: not.
     """
     settings = settings or RrtSettings()
     start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
@@ -135,6 +141,10 @@ def rrt_connect(
     lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
     if not (weights.shape == start.shape == goal.shape and np.all(weights > 0)):
         raise PlanningError(f"weights {weights.tolist()} must be positive, one per joint of start and goal")
+    if speeds is not None:
+        speeds = np.asarray(speeds, dtype=float)
+        if not (speeds.shape == start.shape and np.all(speeds > 0) and np.all(np.isfinite(speeds))):
+            raise PlanningError(f"speeds {speeds.tolist()} must be positive and finite, one per joint")
     relaxed = False
     if not np.all(valid(np.stack([start, goal]))):
         if relaxation is None or not np.all(relaxation.valid(np.stack([start, goal]))):
@@ -148,7 +158,9 @@ def rrt_connect(
     if explore_m > settings.resolution_m:
         keeping = None if relaxed else grown  # the ends' relaxation is not the coarse draw's to tell
         box = (lower, upper)
-        found = _lazy(valid, start, goal, box, weights, rng, settings, step_m, stop, relaxation, keeping)
+        found = _lazy(
+            valid, start, goal, box, weights, rng, settings, step_m, stop, relaxation, keeping, speeds=speeds
+        )
         return found if found is None or not relaxed else dataclasses.replace(found, relaxed=True)
     kept = None if grown is None else grown.take(start, goal, settings.resolution_m, relaxation is not None)
     if kept is not None and grown is not None and grown.relaxed and relaxation is not None:
@@ -184,7 +196,9 @@ def rrt_connect(
             path = np.concatenate([grow.branch(new)[::-1], other.branch(joined)[1:]])
             if grow is not trees[0]:
                 path = path[::-1]
-            path = shortcut(path, edges, rng, settings.shortcuts)
+            path = shortcut(
+                path, edges, rng, settings.shortcuts, joint_attempts=settings.joint_shortcuts, speeds=speeds
+            )
             return RrtPath(path, sample, strict_checks + edges.checks, relaxed)
     if grown is not None:  # no path: the trees, for the next draw
         grown.keep(trees, start, goal, settings.resolution_m, relaxed)
@@ -225,6 +239,8 @@ def _lazy(
     stop: Callable[[], bool] | None,
     relaxation: Relaxation | None,
     grown: GrownTrees | None,
+    *,
+    speeds: FloatArray | None,
 ) -> RrtPath | None:
     """RRT-Connect on coarse edge checks, its path then held at ``resolution_m`` (module docstring).
 
@@ -232,7 +248,9 @@ def _lazy(
     """
     fine = dataclasses.replace(settings, explore_resolution_m=None, step_m=step_m)
     coarse = dataclasses.replace(fine, resolution_m=settings.explore_resolution_m or settings.resolution_m)
-    found = rrt_connect(valid, start, goal, *box, weights, rng, coarse, stop, relaxation, grown)
+    found = rrt_connect(
+        valid, start, goal, *box, weights, rng, coarse, stop, relaxation, grown, speeds=speeds
+    )
     if found is None:
         return None
     if found.relaxed and relaxation is not None:  # the path holds at the looser validity only
@@ -244,9 +262,10 @@ def _lazy(
         if edges.free_fraction(a, b) == 1.0:
             pieces.append(b[None])
             continue
-        detour = rrt_connect(valid, a, b, *box, weights, rng, dataclasses.replace(fine, shortcuts=0), stop)
+        unshortened = dataclasses.replace(fine, shortcuts=0, joint_shortcuts=0)
+        detour = rrt_connect(valid, a, b, *box, weights, rng, unshortened, stop)
         if detour is None:  # the coarse path is no guide here: search again at the fine spacing
-            again = rrt_connect(valid, start, goal, *box, weights, rng, fine, stop, relaxation)
+            again = rrt_connect(valid, start, goal, *box, weights, rng, fine, stop, relaxation, speeds=speeds)
             if again is None:
                 return None
             total = checks + edges.checks + again.checks
@@ -255,7 +274,9 @@ def _lazy(
         pieces.append(detour.path[1:])
     path = np.concatenate(pieces)
     if len(path) > len(found.path):  # detours: shortened again, on the fine checks
-        path = shortcut(path, edges, rng, settings.shortcuts)
+        path = shortcut(
+            path, edges, rng, settings.shortcuts, joint_attempts=settings.joint_shortcuts, speeds=speeds
+        )
     return RrtPath(path, samples, checks + edges.checks, found.relaxed)
 
 

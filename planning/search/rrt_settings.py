@@ -15,6 +15,8 @@ LOCAL_SHARE = 0.2
 """Default share of the samples drawn near a node of the tree they extend (see its setting)."""
 LOCAL_SPREAD = 0.05
 """Default standard deviation of those samples about their node [share of each joint's range]."""
+JOINT_SHORTCUTS = 20
+"""Default attempts to straighten one joint of a found path (see its setting)."""
 
 
 @dataclass(frozen=True)
@@ -33,6 +35,9 @@ class RrtSettings:
             checked at ``resolution_m`` and its blocked edges planned again at that spacing
             (:mod:`planning.search.rrt_connect`).
         shortcuts: random shortcut attempts on the found path, in [0, 10000].
+        joint_shortcuts: attempts to straighten one joint of the shortened path where that
+            makes it faster at the joints' speeds, in [0, 10000] (given the speeds:
+            :func:`planning.search.edges.straighten_joints`).
         local_share: share of the samples drawn near a node of the tree they extend, in
             [0, 1] (:mod:`planning.search.rrt_connect`); 0: every sample uniform in the box, as RRT-Connect's.
         local_spread: standard deviation of those samples about their node [share of each
@@ -44,6 +49,7 @@ class RrtSettings:
     resolution_m: float = 0.02
     explore_resolution_m: float | None = None
     shortcuts: int = 20
+    joint_shortcuts: int = JOINT_SHORTCUTS
     local_share: float = LOCAL_SHARE
     local_spread: float = LOCAL_SPREAD
 
@@ -56,5 +62,6 @@ class RrtSettings:
         if self.explore_resolution_m is not None:
             number_in("explore_resolution_m", self.explore_resolution_m, self.resolution_m, high, unit="m")
         integer_in("shortcuts", self.shortcuts, 0, 10_000)
+        integer_in("joint_shortcuts", self.joint_shortcuts, 0, 10_000)
         number_in("local_share", self.local_share, 0.0, 1.0)
         number_in("local_spread", self.local_spread, 0.0, 1.0, low_open=True)
