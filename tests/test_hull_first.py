@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 from pathlib import Path
 from typing import Any
 
@@ -18,7 +19,9 @@ from planning import build_problem, plan
 from planning.cli import main
 from planning.io.scene_file import parse_scene
 from planning.pipeline import path_seeds, planner
-from planning.pipeline.hulls_first import HULLS_SHARE, on_hulls
+from planning.pipeline import verification as verification_module
+from planning.pipeline.hulls_first import HULLS_SHARE, finer_steps_m, on_hulls
+from planning.pipeline.problem import finer_step_m
 from planning.pipeline.verification import verify_for_scene
 from planning.search.rrt_connect import rrt_connect
 from planning.search.rrt_trees import GrownTrees
@@ -154,3 +157,42 @@ def test_the_meshes_draw_goes_on_with_the_trees_the_hulls_grew(
     plan(scene, ur10)
     (_, _, none), (taken, _, fresh) = draws
     assert none is None and taken == 0 and fresh is not None and samples < fresh
+
+
+def test_the_check_tries_the_finer_step_of_the_hulls_where_the_ends_come_nearer_there(
+    ur10: ck.Robot, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A ball 0.4 mm beyond the margin of the start's hulls, 20 mm beyond its meshes: a plan on the
+    hulls may be certified at half that 0.4 mm, finer than the meshes' finer step (1 mm), and
+    ``check``, on the meshes, tries it after the scene's step and the meshes' (found on
+    MotionBenchMaker's UR5 table_under_pick_0084: certified by the planner, refused by ``check``)."""
+    centre, margin = (0.26, 0.55, 0.1), 0.02
+    probe = ck.CollisionWorld(ur10, [ck.Obstacle.sphere(0.01, centre)])
+    start = np.array(CLEAR_ON_HULLS)[None]
+    on_meshes_m = float(probe.min_clearance_batch(start)[0][0])
+    on_hulls_m = float(probe.on_hulls().min_clearance_batch(start)[0][0])
+    assert on_meshes_m - on_hulls_m > 0.01  # the hulls reach 1 cm and more beyond the meshes there
+    ball = {**BALL, "radius": 0.01 + on_hulls_m - margin - 0.0004, "xyz": list(centre)}
+    scene = parse_scene({**ur10_scene(CLEAR_ON_HULLS), "safety_margin": margin, "obstacles": [ball]})
+    problem = build_problem(scene, ur10)
+    hulls = on_hulls(problem)
+    assert hulls is not None
+    steps = finer_steps_m(problem)
+    assert steps == (finer_step_m(problem), finer_step_m(hulls))
+    assert finer_step_m(problem) == scene.planner.finer_verify_step_m  # the meshes' ends are far enough
+    assert math.isclose(steps[1], 0.0002, rel_tol=1e-6)  # half the hulls' 0.4 mm beyond the margin
+    tried: list[float] = []
+
+    def refused(world: ck.CollisionWorld, trajectory: Any, required: Any) -> Any:
+        tried.append(required.step_m)
+        return dataclasses.replace(verification, problems=("refused",))
+
+    trajectory = plan(scene, ur10).trajectory
+    verification = verify_for_scene(problem, trajectory)
+    assert verification.accepted
+    monkeypatch.setattr(verification_module, "verify_trajectory", refused)
+    assert verify_for_scene(problem, trajectory).problems == ("refused",)
+    assert tried == [scene.planner.verify_step_m, *steps]  # coarsest first, each once
+    assert finer_steps_m(build_problem(parse_scene(ur10_scene(CLEAR_ON_MESHES)), ur10)) == (
+        scene.planner.finer_verify_step_m,
+    )  # ends that only the meshes clear: no plan on the hulls, one finer step

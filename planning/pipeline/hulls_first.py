@@ -56,6 +56,23 @@ def on_hulls(problem: Problem) -> Problem | None:
     return dataclasses.replace(problem, scene=scene, robot=world.robot, world=world, objective=objective)
 
 
+def finer_steps_m(problem: Problem) -> tuple[float, ...]:
+    """The finer certified steps [m] a plan of ``problem`` may be certified at, coarsest first.
+
+    :func:`~planning.pipeline.problem.finer_step_m` of ``problem`` and, where it is planned on
+    its hulls first (:func:`on_hulls`), of the hulls' problem: the ends come nearer the margins
+    on the hulls, so its finer step may be finer still (half their clearance beyond the
+    margins). ``cpr-plan check`` tries them in turn where the scene's steps cannot certify a
+    trajectory (:func:`~planning.pipeline.verification.verify_finer_where_needed`), so that
+    what the planner certified on the hulls, the check certifies on the meshes they contain.
+    """
+    steps = {finer_step_m(problem)}
+    hulls = on_hulls(problem)
+    if hulls is not None:
+        steps.add(finer_step_m(hulls))
+    return tuple(sorted(steps, reverse=True))
+
+
 def shared_trees(hulls: Problem, meshes: Problem) -> GrownTrees:
     """Where the meshes' RRT-Connect draw goes on with the trees of the hulls' draw, where they agree.
 

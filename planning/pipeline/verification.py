@@ -280,20 +280,20 @@ def verify_for_scene(
 def verify_finer_where_needed(
     problem: Problem, trajectory: Trajectory, required: Requirements
 ) -> Verification:
-    """:func:`verify_trajectory` at ``required``'s steps, then where they cannot certify it at the finer step.
+    """:func:`verify_trajectory` at ``required``'s steps, then where they cannot certify it at finer ones.
 
-    The finer step is the one the planner falls back to where margin plus step leaves no way
-    (:func:`~planning.pipeline.problem.finer_step_m`); it only tightens the certified bound
-    (more checks, less slack between them), the margins are ``required``'s.
+    The finer steps are those the planner falls back to where margin plus step leaves no way,
+    coarsest first (:func:`~planning.pipeline.hulls_first.finer_steps_m`); they only tighten the
+    certified bound (more checks, less slack between them), the margins are ``required``'s.
     """
-    from planning.pipeline.problem import finer_step_m
+    from planning.pipeline.hulls_first import finer_steps_m
 
     verification = verify_trajectory(problem.world, trajectory, required)
-    if verification.accepted:
-        return verification
-    finer_m = finer_step_m(problem)
-    if finer_m >= required.step_m:
-        return verification
-    self_step_m = min(required.self_check_step_m, finer_m)
-    finer = dataclasses.replace(required, step_m=finer_m, self_step_m=self_step_m)
-    return verify_trajectory(problem.world, trajectory, finer)
+    for finer_m in finer_steps_m(problem):
+        if verification.accepted:
+            break
+        if finer_m < required.step_m:
+            self_step_m = min(required.self_check_step_m, finer_m)
+            finer = dataclasses.replace(required, step_m=finer_m, self_step_m=self_step_m)
+            verification = verify_trajectory(problem.world, trajectory, finer)
+    return verification
