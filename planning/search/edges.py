@@ -62,15 +62,9 @@ class Edges:
         the others up to the first invalid one of those: an edge that hits an obstacle is
         not checked beyond it. The answer is that of checking every configuration.
         """
-        points = edge_points(a, b, self.weights, self.resolution_m)
-        count = len(points)
-        if count < WHOLE_BELOW:
-            ok = self.valid(points)
-            self.checks += count
-        else:
-            ok = self._coarse_to_fine(points)
+        ok = self._checked(edge_points(a, b, self.weights, self.resolution_m))
         blocked = int(ok.argmin())  # the first invalid one, or 0 where all are valid
-        return blocked / count if not ok[blocked] else 1.0
+        return blocked / len(ok) if not ok[blocked] else 1.0
 
     def chain_free(self, path: FloatArray) -> bool:
         """Whether every edge of the polyline ``path`` is valid (``path[0]`` assumed valid).
@@ -81,10 +75,17 @@ class Edges:
         points = np.concatenate(
             [edge_points(a, b, self.weights, self.resolution_m) for a, b in itertools.pairwise(path)]
         )
+        return bool(self._checked(points).all())
+
+    def _checked(self, points: FloatArray) -> BoolArray:
+        """The validity of a motion's ``points``, exact up to the first invalid one.
+
+        Fewer than :data:`WHOLE_BELOW` in one call, more coarse to fine (:meth:`free_fraction`).
+        """
         if len(points) < WHOLE_BELOW:
             self.checks += len(points)
-            return bool(self.valid(points).all())
-        return bool(self._coarse_to_fine(points).all())
+            return self.valid(points)
+        return self._coarse_to_fine(points)
 
     def _coarse_to_fine(self, points: FloatArray) -> BoolArray:
         """The validity of ``points``, checked up to the first invalid one (:meth:`free_fraction`)."""

@@ -262,8 +262,7 @@ def _lazy(
         if edges.free_fraction(a, b) == 1.0:
             pieces.append(b[None])
             continue
-        unshortened = dataclasses.replace(fine, shortcuts=0, joint_shortcuts=0)
-        detour = rrt_connect(valid, a, b, *box, weights, rng, unshortened, stop)
+        detour = rrt_connect(valid, a, b, *box, weights, rng, dataclasses.replace(fine, shortcuts=0), stop)
         if detour is None:  # the coarse path is no guide here: search again at the fine spacing
             again = rrt_connect(valid, start, goal, *box, weights, rng, fine, stop, relaxation, speeds=speeds)
             if again is None:
