@@ -22,7 +22,7 @@ from planning.pipeline import path_seeds, planner
 from planning.pipeline import verification as verification_module
 from planning.pipeline.hulls_first import HULLS_SHARE, finer_steps_m, on_hulls
 from planning.pipeline.problem import finer_step_m
-from planning.pipeline.verification import verify_for_scene
+from planning.pipeline.verification import Requirements, verify_finer_where_needed, verify_for_scene
 from planning.search.rrt_connect import rrt_connect
 from planning.search.rrt_trees import GrownTrees
 
@@ -193,6 +193,9 @@ def test_the_check_tries_the_finer_step_of_the_hulls_where_the_ends_come_nearer_
     monkeypatch.setattr(verification_module, "verify_trajectory", refused)
     assert verify_for_scene(problem, trajectory).problems == ("refused",)
     assert tried == [scene.planner.verify_step_m, *steps]  # coarsest first, each once
+    tried.clear()  # the planner's own verification of a motion it planned on these meshes: their step alone
+    verify_finer_where_needed(problem, trajectory, Requirements.of(problem))
+    assert tried == [scene.planner.verify_step_m, steps[0]]
     assert finer_steps_m(build_problem(parse_scene(ur10_scene(CLEAR_ON_MESHES)), ur10)) == (
         scene.planner.finer_verify_step_m,
     )  # ends that only the meshes clear: no plan on the hulls, one finer step

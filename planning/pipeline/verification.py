@@ -256,11 +256,9 @@ def verify_for_scene(
 ) -> Verification:
     """What ``cpr-plan check`` says of ``trajectory`` against ``problem``'s scene, its ends included.
 
-    :func:`verify_trajectory` at the scene's certified steps; where they cannot certify it,
-    once more with the obstacle and the self check both at the finer step the planner falls
-    back to where margin plus step leaves no way (:func:`~planning.pipeline.problem.finer_step_m`),
-    as a plan through a narrow passage or to a grasp is certified. A finer step only tightens
-    the certified bound (more checks, less slack between them); the margins are the scene's.
+    :func:`verify_finer_where_needed` at the scene's steps, then at each finer step a plan may
+    have been certified at, on the meshes or their hulls
+    (:func:`~planning.pipeline.hulls_first.finer_steps_m`): through a narrow passage, to a grasp.
 
     Args:
         problem: the scene's problem, built anew.
@@ -274,26 +272,29 @@ def verify_for_scene(
     if joint_names is not None and list(joint_names) != robot_names:
         raise PlanningError(f"trajectory joints {list(joint_names)} are not the robot's {robot_names}")
 
-    return verify_finer_where_needed(problem, trajectory, Requirements.of(problem, endpoints=True))
+    from planning.pipeline.hulls_first import finer_steps_m  # a plan's steps, on the hulls too
+
+    required = Requirements.of(problem, endpoints=True)
+    return verify_finer_where_needed(problem, trajectory, required, finer_steps_m(problem))
 
 
 def verify_finer_where_needed(
-    problem: Problem, trajectory: Trajectory, required: Requirements
+    problem: Problem, trajectory: Trajectory, required: Requirements, finer_m: Sequence[float] | None = None
 ) -> Verification:
     """:func:`verify_trajectory` at ``required``'s steps, then where they cannot certify it at finer ones.
 
-    The finer steps are those the planner falls back to where margin plus step leaves no way,
-    coarsest first (:func:`~planning.pipeline.hulls_first.finer_steps_m`); they only tighten the
-    certified bound (more checks, less slack between them), the margins are ``required``'s.
+    ``finer_m``: the finer steps [m], coarsest first (``None``: the planner's fallback,
+    :func:`~planning.pipeline.problem.finer_step_m`). A finer step only tightens the certified
+    bound (more checks, less slack between them); the margins are ``required``'s.
     """
-    from planning.pipeline.hulls_first import finer_steps_m
+    from planning.pipeline.problem import finer_step_m
 
     verification = verify_trajectory(problem.world, trajectory, required)
-    for finer_m in finer_steps_m(problem):
+    for step_m in (finer_step_m(problem),) if finer_m is None else finer_m:
         if verification.accepted:
             break
-        if finer_m < required.step_m:
-            self_step_m = min(required.self_check_step_m, finer_m)
-            finer = dataclasses.replace(required, step_m=finer_m, self_step_m=self_step_m)
+        if step_m < required.step_m:
+            self_step_m = min(required.self_check_step_m, step_m)
+            finer = dataclasses.replace(required, step_m=step_m, self_step_m=self_step_m)
             verification = verify_trajectory(problem.world, trajectory, finer)
     return verification

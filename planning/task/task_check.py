@@ -30,6 +30,7 @@ import cpr_kin as ck
 from planning.curves.continuity import discontinuity
 from planning.curves.trajectory import Trajectory
 from planning.errors import NoSolutionError, PlanningError
+from planning.pipeline.hulls_first import finer_steps_m
 from planning.pipeline.problem import build_problem
 from planning.pipeline.scene import Scene
 from planning.pipeline.target import Target
@@ -194,5 +195,5 @@ def _verified(
     required = Requirements.of(problem)
     if isinstance(segment, Move):
         required = dataclasses.replace(required, endpoints=(Target(q=q0), segment.goal))
-    verification = verify_finer_where_needed(problem, piece, required)
+    verification = verify_finer_where_needed(problem, piece, required, finer_steps_m(problem))
     return verification, list(verification.problems)
