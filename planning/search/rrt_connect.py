@@ -16,8 +16,9 @@ describes (not certified: the executed spline gets the certified check). Distanc
 robot motion bounds ``sum_j R_j |dq_j|`` [m] with the joints' motion radii
 (:func:`cpr_kin.motion_radii`), so a step means the same in every joint whatever its unit.
 The path found is then shortened (:func:`planning.search.edges.shortcut`); given the joints'
-speeds, also one joint at a time where that makes it faster (a joint the trees moved at
-random, the slow one as far as the fast ones). All randomness comes from the generator passed.
+speeds and ``joint_shortcuts`` (none by default), also one joint at a time where that makes it
+faster (a joint the trees moved at random, the slow one as far as the fast ones). All
+randomness comes from the generator passed.
 
 The trees may grow on coarser checks than the path must hold (``explore_resolution_m``, as
 OMPL's motion checks are, a share of the space's extent): most edges a tree tries are

@@ -15,8 +15,8 @@ LOCAL_SHARE = 0.2
 """Default share of the samples drawn near a node of the tree they extend (see its setting)."""
 LOCAL_SPREAD = 0.05
 """Default standard deviation of those samples about their node [share of each joint's range]."""
-JOINT_SHORTCUTS = 20
-"""Default attempts to straighten one joint of a found path (see its setting)."""
+JOINT_SHORTCUTS = 0
+"""Default attempts to straighten one joint of a found path (see its setting): none (``docs/tuning.md``)."""
 
 
 @dataclass(frozen=True)
