@@ -148,7 +148,9 @@ def passes_check(scene_path: str, trajectory_text: str) -> bool:
         document = read_trajectory(path)
     problem = build_problem(scene, robot)
     try:
-        verification = verify_for_scene(problem, document.trajectory, document.joint_names)
+        verification = verify_for_scene(
+            problem, document.trajectory, document.joint_names, document.certified_step_m
+        )
     except PlanningError:  # the file's joints are not the robot's
         return False
     return not verification.problems

@@ -210,6 +210,7 @@ def test_a_scene_without_obstacles_writes_json_any_parser_reads(
     assert code == 0
     checked = strict_loads(stdout)
     assert checked["status"] == "ok" and checked["certified_min_clearance_m"] is None
+    assert checked["certified_step_m"] == metrics["certified_step"]  # the step that certified it
     # and what a person reads says why, not "inf m"
     code, stdout, _ = run(["plan", str(scene), "--out", str(tmp_path / "words")], capsys)
     assert code == 0 and "certified clearance unbounded, no obstacle (margin" in stdout
@@ -253,6 +254,7 @@ def test_plan_check_and_reproducibility(tmp_path: Path, capsys: pytest.CaptureFi
     # the trajectory passes its own scene, and fails one with an obstacle in its way
     code, stdout, _ = run(["check", str(scene), str(first / "trajectory.json")], capsys)
     assert code == 0 and "verified against" in stdout
+    assert recorded["certified_step"] == 0.005 and "(at most 5 mm of robot motion apart)" in stdout
     trajectory = read_trajectory(first / "trajectory.json").trajectory
     # a ball around the tool tip where it is farthest from the robot at start and goal: the
     # scene stays valid, but the trajectory runs into the ball

@@ -199,3 +199,44 @@ def test_the_check_tries_the_finer_step_of_the_hulls_where_the_ends_come_nearer_
     assert finer_steps_m(build_problem(parse_scene(ur10_scene(CLEAR_ON_MESHES)), ur10)) == (
         scene.planner.finer_verify_step_m,
     )  # ends that only the meshes clear: no plan on the hulls, one finer step
+
+
+def test_check_tries_the_step_its_file_records_first_and_builds_no_other_where_it_certifies(
+    ur10: ck.Robot, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The recorded step (``metrics.certified_step``) after the scene's: where it certifies, the hulls'
+    problem is not built for their finer step; where it does not, the planner's steps follow; a
+    recorded step coarser than the scene's is not taken (a coarser step would loosen the bound)."""
+    from planning.pipeline import hulls_first
+
+    scene = parse_scene({**ur10_scene(CLEAR_ON_HULLS), "obstacles": [BALL]})
+    problem = build_problem(scene, ur10)
+    trajectory = plan(scene, ur10).trajectory
+    accepted = verify_for_scene(problem, trajectory)
+    assert accepted.accepted
+    step_m, recorded_m = scene.planner.verify_step_m, 0.0003
+    tried: list[float] = []
+
+    def certifies_at(step: float) -> Any:
+        def verify(world: ck.CollisionWorld, trajectory: Any, required: Any) -> Any:
+            tried.append(required.step_m)
+            return accepted if required.step_m <= step else dataclasses.replace(accepted, problems=("no",))
+
+        return verify
+
+    def not_built(problem: Any) -> Any:
+        raise AssertionError("the hulls' finer step was built")
+
+    monkeypatch.setattr(verification_module, "verify_trajectory", certifies_at(recorded_m))
+    monkeypatch.setattr(hulls_first, "finer_steps_m", not_built)
+    assert verify_for_scene(problem, trajectory, certified_step_m=recorded_m).accepted
+    assert tried == [step_m, recorded_m]
+    monkeypatch.undo()
+    steps = finer_steps_m(problem)
+    tried.clear()
+    monkeypatch.setattr(verification_module, "verify_trajectory", certifies_at(0.0))  # refuses every step
+    assert not verify_for_scene(problem, trajectory, certified_step_m=recorded_m).accepted
+    assert tried == [step_m, recorded_m, *steps]
+    tried.clear()
+    assert not verify_for_scene(problem, trajectory, certified_step_m=2 * step_m).accepted
+    assert tried == [step_m, *steps]  # the coarser recorded step skipped

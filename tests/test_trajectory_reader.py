@@ -43,6 +43,23 @@ def test_a_written_file_reads_back_exactly(document: dict[str, Any]) -> None:
     np.testing.assert_array_equal(read.trajectory.knots, document["knots"])
     np.testing.assert_array_equal(read.trajectory.coefficients[2], document["segments"][2]["coeffs"])
     assert read.joint_names == tuple(document["joint_names"]) and read.metrics == document["metrics"]
+    assert read.certified_step_m == document["metrics"]["certified_step"] == 0.005  # the scene's step
+
+
+@pytest.mark.parametrize("step", [0.0, -0.001, 0.5, 1e-9, "5 mm", True, [0.001]])
+def test_a_recorded_step_check_could_not_take_is_refused(document: dict[str, Any], step: Any) -> None:
+    """A step outside the settings' range (0.1 mm to 10 cm): ``check`` would run for hours on 1e-9 m."""
+    with pytest.raises(TrajectoryFileError) as info:
+        parse_trajectory(changed(document, "metrics.certified_step", step))
+    assert f"metrics.certified_step = {step!r} is not a step in [0.0001, 0.1] m" in str(info.value)
+
+
+def test_a_file_without_a_recorded_step_reads_with_none(document: dict[str, Any]) -> None:
+    """Files written before the key (or by another tool) are read: ``check`` then tries the planner's steps."""
+    older = copy.deepcopy(document)
+    del older["metrics"]["certified_step"]
+    assert parse_trajectory(json.dumps(older).encode()).certified_step_m is None
+    assert parse_trajectory(changed(document, "metrics.certified_step", 0.0002)).certified_step_m == 0.0002
 
 
 @pytest.mark.parametrize(

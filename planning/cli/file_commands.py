@@ -35,7 +35,9 @@ def cmd_check(args: argparse.Namespace) -> int:
         return check_task_file(read, document, args)
     scene = read.scene
     problem = build_problem(scene)
-    verification = verify_for_scene(problem, document.trajectory, document.joint_names)
+    verification = verify_for_scene(
+        problem, document.trajectory, document.joint_names, document.certified_step_m
+    )
     check, problems = verification.check, verification.problems
     if args.json:
         print(json_layout.dumps(verification.to_record()))
@@ -50,7 +52,8 @@ def cmd_check(args: argparse.Namespace) -> int:
             escaped(
                 f"{args.trajectory}: verified against {args.scene}: "
                 f"certified clearance {clearance_text(check.certified_min_m)} "
-                f">= {scene.safety_margin} m over {len(check.times)} checks, joints within range and limits"
+                f">= {scene.safety_margin} m over {len(check.times)} checks "
+                f"(at most {check.step_m * 1000:g} mm of robot motion apart), joints within range and limits"
                 f"{', torques within effort limits' if problem.dynamics.limited else ''}"
                 f"{model} (coal's tolerance: 1e-6 of a distance)"
             )

@@ -28,6 +28,7 @@ from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
 from planning.io.file_formats import TrajectoryFormat
 from planning.pipeline.scene import DURATION_RANGE_S
+from planning.pipeline.settings import VERIFY_STEP_RANGE_M
 
 FloatArray = NDArray[np.float64]
 
@@ -93,6 +94,26 @@ class TrajectoryFile:
     scene: dict[str, Any]
     metrics: dict[str, Any]
     task: list[dict[str, Any]] | None = None
+    certified_step_m: float | None = None
+
+
+def _certified_step(metrics: dict[str, Any], source: str) -> float | None:
+    """``metrics``' ``certified_step`` [m], ``None`` where absent.
+
+    Raises:
+        TrajectoryFileError: not a number within ``VERIFY_STEP_RANGE_M`` (a step ``check``
+            may take: a smaller one would make it run on for hours).
+    """
+    step = metrics.get("certified_step")
+    if step is None:
+        return None
+    low, high = VERIFY_STEP_RANGE_M
+    if type(step) not in (int, float) or not low <= step <= high:
+        raise TrajectoryFileError(
+            f"{source}: metrics.certified_step = {step!r} is not a step in [{low:g}, {high:g}] m; "
+            "give the step the trajectory was certified at, or leave the key out"
+        )
+    return float(step)
 
 
 def _consistent(document: _Document) -> str | None:
@@ -155,6 +176,7 @@ def parse_trajectory(data: bytes, source: str = "trajectory file") -> Trajectory
         scene=document.scene,
         metrics=document.metrics,
         task=document.task,
+        certified_step_m=_certified_step(document.metrics, source),
     )
 
 

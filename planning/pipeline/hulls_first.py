@@ -13,6 +13,7 @@ meshes plan it in the time left, RRT-Connect going on with the trees the hulls' 
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Iterator
 
 import numpy as np
 
@@ -71,6 +72,18 @@ def finer_steps_m(problem: Problem) -> tuple[float, ...]:
     if hulls is not None:
         steps.add(finer_step_m(hulls))
     return tuple(sorted(steps, reverse=True))
+
+
+def check_steps_m(problem: Problem, recorded_m: float | None = None) -> Iterator[float]:
+    """The finer steps [m] ``cpr-plan check`` tries in turn where the scene's cannot certify a trajectory.
+
+    ``recorded_m`` first: the step its file says it was certified at (``metrics.certified_step``),
+    the one most likely to certify it; then :func:`finer_steps_m`, built only if asked for
+    (on a robot of meshes it builds the hulls' problem).
+    """
+    if recorded_m is not None:
+        yield recorded_m
+    yield from (step_m for step_m in finer_steps_m(problem) if step_m != recorded_m)
 
 
 def shared_trees(hulls: Problem, meshes: Problem) -> GrownTrees:

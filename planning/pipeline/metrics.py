@@ -46,6 +46,9 @@ class Metrics:
         evaluations: objective evaluations.
         candidates_verified: candidates that went through the final verification.
         duration_stretched: the requested duration broke a limit and was stretched.
+        certified_step_m: the certified check's step: the most robot motion between two of its
+            checks [m] (the scene's ``verify_step_m``, or the finer step the plan needed, on
+            the meshes or their hulls); ``cpr-plan check`` tries it where the scene's cannot certify.
         timing: how the trajectory was timed: ``fixed`` (the scene's duration), ``fastest``,
             ``narrowed`` or ``uniform`` (see :mod:`planning.pipeline.timing`).
         timing_time_s: wall time of that timing [s].
@@ -70,6 +73,7 @@ class Metrics:
     evaluations: int
     candidates_verified: int
     duration_stretched: bool
+    certified_step_m: float
     timing: str = "fixed"
     timing_time_s: float = 0.0
     torque_utilisation: dict[str, float] = field(default_factory=dict)
@@ -98,6 +102,7 @@ class Metrics:
             "evaluations": self.evaluations,
             "candidates_verified": self.candidates_verified,
             "duration_stretched": self.duration_stretched,
+            "certified_step": self.certified_step_m,
             "timing": self.timing,
             "timing_time_s": self.timing_time_s,
             "torque_utilisation": self.torque_utilisation,
@@ -173,6 +178,7 @@ def measure(
         evaluations=searched.evaluations,
         candidates_verified=choice.candidates_timed,
         duration_stretched=timing.stretched,
+        certified_step_m=check.step_m,
         timing=timing.method,
         timing_time_s=timing.time_s,
         torque_utilisation=torque_peaks(choice.verification.torques),

@@ -6,7 +6,7 @@ What the planner accepts is what ``cpr-plan check`` re-checks: one function serv
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -54,6 +54,7 @@ class Verification:
             "certified_min_clearance_m": self.check.certified_min_m,
             "safety_margin_m": self.check.margin_m,
             "checks": len(self.check.times),
+            "certified_step_m": self.check.step_m,
             "problems": list(self.problems),
         }
 
@@ -252,18 +253,17 @@ def _verified(
 
 
 def verify_for_scene(
-    problem: Problem, trajectory: Trajectory, joint_names: Sequence[str] | None = None
+    problem: Problem,
+    trajectory: Trajectory,
+    joint_names: Sequence[str] | None = None,
+    certified_step_m: float | None = None,
 ) -> Verification:
-    """What ``cpr-plan check`` says of ``trajectory`` against ``problem``'s scene, its ends included.
+    """What ``cpr-plan check`` says of ``trajectory`` against ``problem``'s scene (built anew), its ends too.
 
     :func:`verify_finer_where_needed` at the scene's steps, then at each finer step a plan may
-    have been certified at, on the meshes or their hulls
-    (:func:`~planning.pipeline.hulls_first.finer_steps_m`): through a narrow passage, to a grasp.
-
-    Args:
-        problem: the scene's problem, built anew.
-        trajectory: the trajectory, in the robot's joint order.
-        joint_names: the joint order the trajectory's file records, if read from one.
+    have been certified at (:func:`~planning.pipeline.hulls_first.check_steps_m`): the step
+    ``certified_step_m`` [m] its file records first, then those of the meshes or their hulls.
+    ``joint_names``: the joint order the file records (``trajectory`` is in the robot's).
 
     Raises:
         PlanningError: ``joint_names`` are not the robot's.
@@ -272,27 +272,26 @@ def verify_for_scene(
     if joint_names is not None and list(joint_names) != robot_names:
         raise PlanningError(f"trajectory joints {list(joint_names)} are not the robot's {robot_names}")
 
-    from planning.pipeline.hulls_first import finer_steps_m  # a plan's steps, on the hulls too
+    from planning.pipeline.hulls_first import check_steps_m  # a plan's steps, on the hulls too
 
     required = Requirements.of(problem, endpoints=True)
-    return verify_finer_where_needed(problem, trajectory, required, finer_steps_m(problem))
+    return verify_finer_where_needed(problem, trajectory, required, check_steps_m(problem, certified_step_m))
 
 
 def verify_finer_where_needed(
-    problem: Problem, trajectory: Trajectory, required: Requirements, finer_m: Sequence[float] | None = None
+    problem: Problem, trajectory: Trajectory, required: Requirements, finer_m: Iterable[float] | None = None
 ) -> Verification:
     """:func:`verify_trajectory` at ``required``'s steps, then where they cannot certify it at finer ones.
 
-    ``finer_m``: the finer steps [m], coarsest first (``None``: the planner's fallback,
+    ``finer_m``: the finer steps [m] in the order to try (``None``: the planner's fallback,
     :func:`~planning.pipeline.problem.finer_step_m`). A finer step only tightens the certified
     bound (more checks, less slack between them); the margins are ``required``'s.
     """
     from planning.pipeline.problem import finer_step_m
 
     verification = verify_trajectory(problem.world, trajectory, required)
-    for step_m in (finer_step_m(problem),) if finer_m is None else finer_m:
-        if verification.accepted:
-            break
+    steps = iter((finer_step_m(problem),) if finer_m is None else finer_m)  # asked for only while refused
+    while not verification.accepted and (step_m := next(steps, None)) is not None:
         if step_m < required.step_m:
             self_step_m = min(required.self_check_step_m, step_m)
             finer = dataclasses.replace(required, step_m=step_m, self_step_m=self_step_m)
