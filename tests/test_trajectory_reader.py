@@ -55,7 +55,7 @@ def test_a_recorded_step_check_could_not_take_is_refused(document: dict[str, Any
 
 
 def test_a_file_without_a_recorded_step_reads_with_none(document: dict[str, Any]) -> None:
-    """Files written before the key (or by another tool) are read: ``check`` then tries the planner's steps."""
+    """A file written before the key (or by another tool) reads; ``check`` then tries the planner's steps."""
     older = copy.deepcopy(document)
     del older["metrics"]["certified_step"]
     assert parse_trajectory(json.dumps(older).encode()).certified_step_m is None
