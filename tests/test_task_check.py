@@ -8,8 +8,12 @@ import dataclasses
 import pytest
 
 import cpr_kin as ck
+from planning.errors import PlanningError
 from planning.io.scene_file import SceneFile
+from planning.pipeline import hulls_first
+from planning.pipeline import verification as verification_module
 from planning.pipeline.target import Target
+from planning.pipeline.verification import Requirements, Verification
 from planning.task import Attach, Move, TaskMotion, ToolLine, Wait, check_task, task_record
 
 from .conftest import PlannedTask
@@ -82,3 +86,47 @@ def test_an_obstacle_on_the_line_fails_that_segment(read: SceneFile, task: TaskM
     scene = dataclasses.replace(read.scene, obstacles=(*read.scene.obstacles, ball))
     found = check_task(scene, read.task, task.trajectory, task_record(task)).problems
     assert any(p.startswith("task[1] (line)") and "ball" in p for p in found)
+
+
+def test_check_tries_the_step_each_entry_records_first(
+    read: SceneFile, task: TaskMotion, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Where the scene's step cannot certify a segment, its entry's ``certified_step`` is tried next,
+    and the planner's finer steps (the hulls' problem on a robot of meshes) are not built."""
+    accepted = next(
+        v for v in check_task(read.scene, read.task, task.trajectory, task_record(task)).verifications if v
+    )
+    record, recorded_m = task_record(task), 0.0003
+    for entry in record:
+        if entry["kind"] in ("free", "line", "wait"):
+            entry["certified_step"] = recorded_m
+    tried: list[float] = []
+
+    def certifies_at_the_recorded_step(
+        world: ck.CollisionWorld, trajectory: object, required: Requirements
+    ) -> Verification:
+        step_m = required.step_m
+        tried.append(step_m)
+        return accepted if step_m <= recorded_m else dataclasses.replace(accepted, problems=("too coarse",))
+
+    def not_built(problem: object) -> object:
+        raise AssertionError("the planner's finer steps were built")
+
+    monkeypatch.setattr(verification_module, "verify_trajectory", certifies_at_the_recorded_step)
+    monkeypatch.setattr(hulls_first, "finer_steps_m", not_built)
+    checked = check_task(read.scene, read.task, task.trajectory, record)
+    assert checked.accepted, checked.problems
+    assert tried == [read.scene.planner.verify_step_m, recorded_m] * 6  # six segments move or wait
+
+
+@pytest.mark.parametrize("step", ["5 mm", 0.0, 2.0, False])
+def test_a_recorded_step_check_could_not_take_names_its_entry(
+    read: SceneFile, task: TaskMotion, step: object
+) -> None:
+    record = task_record(task)
+    record[1]["certified_step"] = step
+    with pytest.raises(PlanningError) as info:
+        check_task(read.scene, read.task, task.trajectory, record)
+    assert str(info.value).startswith(
+        f"task entry 1: certified_step = {step!r} is not a step in [0.0001, 0.1] m"
+    )

@@ -42,7 +42,7 @@ def test_a_task_plans_into_one_file_that_says_what_it_promised(planned: Path) ->
     for before, after in itertools.pairwise(task):
         assert before["t1"] == after["t0"]
     down = task[1]
-    assert set(down) == {"kind", "t0", "t1", "frame", "from", "to", "tolerance"}
+    assert set(down) == {"kind", "t0", "t1", "frame", "from", "to", "tolerance", "certified_step"}
     assert down["tolerance"] == {"position_m": 0.001, "angle_rad": 0.01}
     np.testing.assert_allclose(np.subtract(down["to"]["xyz"], down["from"]["xyz"]), [0, 0, -0.08], atol=1e-12)
     for released in (task[3], task[6]):

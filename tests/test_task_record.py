@@ -42,6 +42,9 @@ def test_the_record_is_plain_json_one_entry_per_segment(task: TaskMotion) -> Non
     assert line["frame"] == "tcp" and set(line["tolerance"]) == {"position_m", "angle_rad"}
     assert line["to"]["xyz"][2] == pytest.approx(line["from"]["xyz"][2] - 0.08, abs=1e-12)
     assert record[3]["object"] == "part" and record[3]["frame"] == "tcp"
+    steps = [s.verification.check.step_m if s.verification else None for s in task.segments]
+    assert [e.get("certified_step") for e in record] == steps  # the attach has none: it does not move
+    assert steps[0] == task.scene.planner.verify_step_m
 
 
 def test_the_promises_hold_and_a_tampered_one_is_caught(task: TaskMotion) -> None:

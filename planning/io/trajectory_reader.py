@@ -28,7 +28,7 @@ from planning.curves.trajectory import Trajectory
 from planning.errors import PlanningError
 from planning.io.file_formats import TrajectoryFormat
 from planning.pipeline.scene import DURATION_RANGE_S
-from planning.pipeline.settings import VERIFY_STEP_RANGE_M
+from planning.pipeline.settings import recorded_step_m
 
 FloatArray = NDArray[np.float64]
 
@@ -98,22 +98,11 @@ class TrajectoryFile:
 
 
 def _certified_step(metrics: dict[str, Any], source: str) -> float | None:
-    """``metrics``' ``certified_step`` [m], ``None`` where absent.
-
-    Raises:
-        TrajectoryFileError: not a number within ``VERIFY_STEP_RANGE_M`` (a step ``check``
-            may take: a smaller one would make it run on for hours).
-    """
-    step = metrics.get("certified_step")
-    if step is None:
-        return None
-    low, high = VERIFY_STEP_RANGE_M
-    if type(step) not in (int, float) or not low <= step <= high:
-        raise TrajectoryFileError(
-            f"{source}: metrics.certified_step = {step!r} is not a step in [{low:g}, {high:g}] m; "
-            "give the step the trajectory was certified at, or leave the key out"
-        )
-    return float(step)
+    """``metrics``' ``certified_step`` [m] (:func:`~planning.pipeline.settings.recorded_step_m`)."""
+    try:
+        return recorded_step_m(metrics.get("certified_step"), "metrics.certified_step")
+    except PlanningError as exc:
+        raise TrajectoryFileError(f"{source}: {exc}") from None
 
 
 def _consistent(document: _Document) -> str | None:

@@ -55,6 +55,24 @@ MAX_TIME_LIMIT_S = 86_400.0
 _FIREFLY_FIELDS = frozenset(f.name for f in dataclasses.fields(FireflySettings))
 
 
+def recorded_step_m(value: Any, where: str) -> float | None:
+    """A file's recorded certified step [m] (``certified_step``), checked; ``None`` where absent.
+
+    Raises:
+        PlanningError: not a number within :data:`VERIFY_STEP_RANGE_M` (a step ``cpr-plan
+            check`` may take: a smaller one would make it run on for hours); ``where`` names the key.
+    """
+    if value is None:
+        return None
+    low, high = VERIFY_STEP_RANGE_M
+    if type(value) not in (int, float) or not low <= value <= high:
+        raise PlanningError(
+            f"{where} = {value!r} is not a step in [{low:g}, {high:g}] m; "
+            "give the step the trajectory was certified at, or leave the key out"
+        )
+    return float(value)
+
+
 @dataclass(frozen=True)
 class PlannerSettings:
     """Settings of the waypoint planner; validated on construction.

@@ -30,9 +30,10 @@ import cpr_kin as ck
 from planning.curves.continuity import discontinuity
 from planning.curves.trajectory import Trajectory
 from planning.errors import NoSolutionError, PlanningError
-from planning.pipeline.hulls_first import finer_steps_m
+from planning.pipeline.hulls_first import check_steps_m
 from planning.pipeline.problem import build_problem
 from planning.pipeline.scene import Scene
+from planning.pipeline.settings import recorded_step_m
 from planning.pipeline.target import Target
 from planning.pipeline.verification import Requirements, Verification, verify_finer_where_needed
 from planning.task.holding import changed_object, scene_after
@@ -117,12 +118,13 @@ def check_task(
                 problems += [f"{where} {p}" for p in _line_ends(base, segment, q_start, entry)]
             if isinstance(segment, Move):
                 problems += [f"{where} {p}" for p in _constraint_kept(base, segment, q_start, entry)]
+            step_m = recorded_step_m(entry.get("certified_step"), "certified_step")
         except PlanningError as exc:
             raise PlanningError(f"task entry {index}: {exc}") from None
         if isinstance(segment, Wait) and abs(span[1] - span[0] - segment.seconds) > TIME_TOLERANCE_S:
             waited = span[1] - span[0]
             problems.append(f"{where} waits {waited:g} s; the task's wait is {segment.seconds:g} s")
-        verification, wrong = _verified(current, base, segment, piece)
+        verification, wrong = _verified(current, base, segment, piece, step_m)
         problems += [f"{where} {w}" for w in wrong]
         verifications.append(verification)
     return TaskCheck(tuple(verifications), tuple(problems))
@@ -184,9 +186,13 @@ def _constraint_kept(robot: ck.Robot, move: Move, q_start: np.ndarray, entry: Ma
 
 
 def _verified(
-    scene: Scene, robot: ck.Robot, segment: Segment, piece: Trajectory
+    scene: Scene, robot: ck.Robot, segment: Segment, piece: Trajectory, step_m: float | None
 ) -> tuple[Verification | None, list[str]]:
-    """``piece`` verified in ``scene`` (with its payload), a free motion's end against its goal."""
+    """``piece`` verified in ``scene`` (with its payload), a free motion's end against its goal.
+
+    Where the scene's steps cannot certify it, the ``step_m`` [m] its entry records is tried
+    first, then those the planner may have taken (:func:`~planning.pipeline.hulls_first.check_steps_m`).
+    """
     q0, q1 = (tuple(piece(t).tolist()) for t in (piece.knots[0], piece.knots[-1]))
     try:
         problem = build_problem(dataclasses.replace(scene, start=Target(q=q0), goal=Target(q=q1)), robot)
@@ -195,5 +201,5 @@ def _verified(
     required = Requirements.of(problem)
     if isinstance(segment, Move):
         required = dataclasses.replace(required, endpoints=(Target(q=q0), segment.goal))
-    verification = verify_finer_where_needed(problem, piece, required, finer_steps_m(problem))
+    verification = verify_finer_where_needed(problem, piece, required, check_steps_m(problem, step_m))
     return verification, list(verification.problems)

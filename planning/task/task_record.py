@@ -6,7 +6,8 @@ the trajectory file's ``task`` list: ``kind`` (``free``, ``line``, ``wait``, ``a
 ``to`` (each ``{xyz, quat_xyzw}`` in the robot's base frame) and ``tolerance:
 {position_m, angle_rad}``; a free motion under an orientation constraint ``constraint:
 {frame, quat_xyzw, axes, angle_rad}``; an ``attach`` or ``detach`` the object's ``object``
-name and ``frame``.
+name and ``frame``; a segment that moves or waits also ``certified_step`` [m], the step its
+verification was certified at (``cpr-plan check`` tries it first).
 
 :func:`record_problems` checks a trajectory against such a list without the planner: the
 entries tile the trajectory in time, a ``wait`` stands still, and over each ``line`` the
@@ -62,6 +63,8 @@ def task_record(task: TaskMotion) -> list[dict[str, Any]]:
         if segment.payload is not None:
             frame = segment.payload.frame_on(task.world.robot)
             entry |= {"object": segment.payload.name, "frame": frame}
+        if segment.verification is not None:
+            entry["certified_step"] = segment.verification.check.step_m
         entries.append(entry)
     return entries
 
