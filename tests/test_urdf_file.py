@@ -20,9 +20,9 @@ def validations(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> list[Path]:
     validated: list[Path] = []
     original = urdf_file._validated
 
-    def counted(path: Path) -> Any:
+    def counted(path: Path, content: bytes) -> Any:
         validated.append(path)
-        return original(path)
+        return original(path, content)
 
     monkeypatch.setattr(urdf_file, "_validated", counted)
     return validated
@@ -40,6 +40,17 @@ def test_a_valid_urdf_is_validated_once_per_content(tmp_path: Path, validations:
     path.write_text(URDF_TEXT.replace('name="cpr"', 'name="cpr_edited"', 1))  # new bytes: asked again
     urdf_file.validate_urdf(path)
     assert validations == [path, path]
+
+
+def test_the_bytes_read_are_the_bytes_validated(tmp_path: Path) -> None:
+    """The verdict is kept under the digest of the bytes read first: those are validated, not the
+    file read again (an edit in between would otherwise have its verdict kept for the old bytes)."""
+    path = tmp_path / "arm.urdf"
+    path.write_text(URDF_TEXT.replace('type="revolute"', 'type="hinge"', 1))  # the file as it is now
+    assert urdf_file._validated(path, URDF_TEXT.encode()) == {"valid": True}  # the bytes read before
+    path.write_text(URDF_TEXT)
+    with pytest.raises(ck.UrdfError, match=r"arm\.urdf' is invalid: .*'type' attribute"):
+        urdf_file._validated(path, URDF_TEXT.replace('type="revolute"', 'type="hinge"', 1).encode())
 
 
 def test_an_invalid_urdf_is_refused_every_time_and_nothing_is_kept(

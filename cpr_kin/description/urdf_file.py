@@ -127,7 +127,7 @@ def validate_urdf(path: Path) -> None:
     """
     content = path.read_bytes()
     digest = hashlib.sha256(b"urdf-valid-1 " + _yourdfpy_version().encode() + b" " + content).hexdigest()
-    cached_json("urdf-valid", digest, lambda: _validated(path))
+    cached_json("urdf-valid", digest, lambda: _validated(path, content))
 
 
 def _yourdfpy_version() -> str:
@@ -140,19 +140,19 @@ def _yourdfpy_version() -> str:
         return ""
 
 
-def _validated(path: Path) -> dict[str, bool]:
-    """Validate the URDF at ``path`` with yourdfpy (:func:`validate_urdf`): ``{"valid": True}``, or raise."""
+def _validated(path: Path, content: bytes) -> dict[str, bool]:
+    """Validate the URDF ``content`` of ``path`` with yourdfpy (:func:`validate_urdf`): ``{"valid": True}``.
+
+    The bytes whose digest keys the verdict, not the file read again (it may have changed since).
+    """
     import yourdfpy
 
     try:
         with warnings.catch_warnings():  # trimesh's arithmetic on a value that is then refused, by name
             warnings.simplefilter("ignore", RuntimeWarning)
-            content = path.read_bytes()
-            readable = as_xml_1_0(content)  # yourdfpy too says "Unsupported version '0.0'", then reads on
-            source = str(path) if readable is content else io.BytesIO(readable)
-            urdf = yourdfpy.URDF.load(
-                source, build_scene_graph=False, load_meshes=False, load_collision_meshes=False
-            )
+            source = io.BytesIO(as_xml_1_0(content))  # yourdfpy refuses XML version '0.0' too
+            unbuilt = dict.fromkeys(("build_scene_graph", "load_meshes", "load_collision_meshes"), False)
+            urdf = yourdfpy.URDF.load(source, mesh_dir=str(path.parent), **unbuilt)
     except Exception as exc:  # yourdfpy raises bare exceptions on structural problems
         raise UrdfError(f"URDF file '{path}' cannot be read ({type(exc).__name__}: {exc})") from None
     found: list[Any] = []
