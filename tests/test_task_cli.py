@@ -74,6 +74,8 @@ def test_check_verifies_a_task_and_names_a_broken_promise(
     assert code == 3 and verdict["status"] == "failed"
     assert any(p.startswith("task[4] (line) records its 'to' pose 0.004 m") for p in verdict["problems"])
     assert any(p.startswith("task entry 4 (line) leaves its line by") for p in verdict["problems"])
+    steps = [entry.get("certified_step") for entry in document["task"]]  # attach and detach: none
+    assert verdict["certified_steps_m"] == steps and steps.count(None) == 2
     shelf = PICK.parent / "shelf.yaml"
     code, _, err = run(["check", str(shelf), str(trajectory)], capsys)
     assert code == 2 and "holds no task: check it against the scene file that holds the task" in err

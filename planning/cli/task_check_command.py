@@ -47,6 +47,7 @@ def check_task_file(read: SceneFile, document: TrajectoryFile, args: argparse.Na
             "certified_min_clearance_m": checked.certified_min_clearance_m,
             "safety_margin_m": read.scene.safety_margin,
             "checks": checked.checks,
+            "certified_steps_m": [None if v is None else v.check.step_m for v in checked.verifications],
             "problems": list(checked.problems),
             "segments": len(read.task),
         }
