@@ -64,13 +64,14 @@ def recorded_step_m(value: Any, where: str) -> float | None:
     """
     if value is None:
         return None
-    low, high = VERIFY_STEP_RANGE_M
-    if type(value) not in (int, float) or not low <= value <= high:
+    try:  # the settings' rule for a number in a range; the message says what a file should hold
+        return number_in(where, value, *VERIFY_STEP_RANGE_M, unit="m")
+    except PlanningError:
+        low, high = VERIFY_STEP_RANGE_M
         raise PlanningError(
             f"{where} = {value!r} is not a step in [{low:g}, {high:g}] m; "
             "give the step the trajectory was certified at, or leave the key out"
-        )
-    return float(value)
+        ) from None
 
 
 @dataclass(frozen=True)
