@@ -546,6 +546,93 @@ def test_a_goal_in_a_moving_or_unknown_frame_is_refused(
     assert not out.exists()
 
 
+def test_a_position_goal_in_a_box_becomes_a_tool_point_within_the_boxs_inscribed_sphere(
+    tmp_path: Path,
+) -> None:
+    # no orientation constraint: a tcp goal; the box's half shortest side is the tolerance, and
+    # the region's centre is moved from the post's frame into the base (checked with scipy's rotations)
+    request = request_with_goal_in("post")
+    goal = request["goal_constraints"][0]
+    del goal["orientation_constraints"]
+    region = goal["position_constraints"][0]["constraint_region"]
+    region["primitives"] = [{"type": "box", "dimensions": [0.010, 0.004, 0.006]}]
+    out = tmp_path / "point.yaml"
+    assert main(["import-moveit", *write(tmp_path, SCENE, request), "--out", str(out)]) == 0
+    scene = load_scene(out)
+    assert scene.robot is not None and scene.robot.tcp == "panda_hand_tcp"
+    assert scene.goal.pose is None and scene.goal.tolerance_m == pytest.approx(0.002, abs=1e-15)
+    centre = transform([0.5, 0.3, 0.0], [0, 0, 0.3826834, 0.9238795]) @ [0.1, 0.2, 0.3, 1.0]
+    assert scene.goal.tcp is not None
+    np.testing.assert_allclose(scene.goal.tcp, centre[:3], atol=1e-7)
+
+
+GOAL = "goal_constraints.0"
+POSITION = f"{GOAL}.position_constraints.0"
+GOAL_REFUSALS = [
+    (
+        f"{GOAL}.joint_constraints",
+        [{"joint_name": "panda_joint1", "position": 0.0}],
+        "a goal of joint and pose constraints together is not supported",
+    ),
+    (f"{GOAL}.visibility_constraints", [{"target_radius": 0.1}], "visibility_constraints are not supported"),
+    (
+        f"{GOAL}.position_constraints",
+        [],
+        "has 0 position and 1 orientation constraints; supported: one position constraint",
+    ),
+    (f"{POSITION}.target_point_offset", [0.0, 0.0, 0.1], "needs a zero target_point_offset"),
+    (
+        f"{POSITION}.constraint_region.primitives",
+        [{"type": 3, "dimensions": [0.1, 0.01]}],
+        "type 3 with dimensions [0.1, 0.01]; a goal region must be a sphere (2, [radius]) or a box",
+    ),
+    (
+        f"{POSITION}.constraint_region.primitives",
+        [{"type": "box", "dimensions": [0.01, 0.0, 0.01]}],
+        "a box's sides must be > 0 m",
+    ),
+    (
+        f"{GOAL}.orientation_constraints.0.link_name",
+        "panda_hand",
+        "link_name = 'panda_hand' differs from the position constraint's 'panda_hand_tcp'",
+    ),
+]
+
+
+@pytest.mark.parametrize(("key", "value", "message"), GOAL_REFUSALS, ids=[r[0] for r in GOAL_REFUSALS])
+def test_a_goal_without_a_scene_counterpart_is_refused_by_name(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], key: str, value: Any, message: str
+) -> None:
+    request = changed(request_with_goal_in("panda_link0"), key, value)
+    out = tmp_path / "goal.yaml"
+    assert main(["import-moveit", *write(tmp_path, SCENE, request), "--out", str(out)]) == 2
+    error = capsys.readouterr().err
+    assert "request.goal_constraints[0]" in error and message in error
+    assert "Traceback" not in error and len(error.strip().splitlines()) == 1
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("joints", "message"),
+    [
+        (JOINTS[:6], "missing ['panda_joint7'], not planned []"),
+        ([*JOINTS, "panda_finger_joint1"], "missing [], not planned ['panda_finger_joint1']"),
+        ([*JOINTS, "panda_joint3"], "constrain ['panda_joint3'] more than once; each joint once"),
+    ],
+)
+def test_a_joint_goal_names_each_planned_joint_once(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], joints: list[str], message: str
+) -> None:
+    request = changed(
+        REQUEST,
+        "goal_constraints.0.joint_constraints",
+        [{"joint_name": name, "position": 0.0} for name in joints],
+    )
+    assert main(["import-moveit", *write(tmp_path, SCENE, request), "--out", str(tmp_path / "g.yaml")]) == 2
+    error = capsys.readouterr().err
+    assert "request.goal_constraints[0].joint_constraints" in error and message in error
+
+
 def test_a_goal_region_with_a_negative_radius_names_the_field(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -197,6 +197,43 @@ def test_bad_planner_settings() -> None:
         RefinementSettings(active="yes")  # type: ignore[arg-type]
 
 
+BAD_SETTINGS: list[tuple[dict[str, Any], str]] = [
+    ({"firefly": {"fireflies": 10}}, r"firefly = \{'fireflies': 10\} must be a FireflySettings"),
+    ({"tuning": None}, r"tuning = None must be a SearchTuning"),
+    ({"seeding": "random"}, r"seeding = 'random'; allowed: 'paths', 'none'"),
+    ({"refine": "bfgs"}, r"refine = 'bfgs'; allowed: 'cma', 'none'"),
+    ({"path": "line"}, r"path = 'line'; allowed: 'spline', 'ptp'"),
+    (
+        {"moving_joints": ("d2", "theta1", "d2")},
+        r"moving_joints = \['d2', 'theta1', 'd2'\] names a joint twice",
+    ),
+]
+
+
+@pytest.mark.parametrize(("changes", "message"), BAD_SETTINGS, ids=[next(iter(c)) for c, _ in BAD_SETTINGS])
+def test_a_bad_setting_from_python_is_named_with_what_is_allowed(
+    changes: dict[str, Any], message: str
+) -> None:
+    with pytest.raises(PlanningError, match=message):
+        PlannerSettings(**changes)
+
+
+def test_a_bad_scene_from_python_is_named_with_what_is_allowed() -> None:
+    start, goal = Target(tcp=PAPER_START_TCP), Target(tcp=PAPER_GOAL_TCP)
+    with pytest.raises(PlanningError, match="scene name '' must be a non-empty text"):
+        Scene(start=start, goal=goal, name="")
+    with pytest.raises(
+        PlanningError, match=r"scene name 'shelf\\x1b' holds .*; names must be printable text"
+    ):
+        Scene(start=start, goal=goal, name="shelf\x1b")
+    far = ck.Obstacle.sphere(0.01, (5.0, 5.0, 5.0))
+    with pytest.raises(PlanningError, match="501 obstacles; at most 500"):
+        Scene(start=start, goal=goal, obstacles=(far,) * 501)
+    with pytest.raises(PlanningError, match=r"duration / planner.ipo = 150000 IPO samples; at most 100000"):
+        Scene(start=start, goal=goal, duration=300.0, planner=PlannerSettings(ipo=0.002))
+    assert Scene(start=start, goal=goal, obstacles=(far,) * 500).obstacles == (far,) * 500  # the limit itself
+
+
 def test_objects_of_the_wrong_kind_are_named_at_the_entry_points(robot: ck.Robot) -> None:
     # a name where an obstacle belongs, a path where a robot does, failed deep inside with an
     # AttributeError

@@ -63,6 +63,27 @@ def test_a_line_to_a_pose_reads_its_quaternion_or_rpy() -> None:
     assert line.tolerance.position_m == 2e-4 and line.tolerance.angle_rad == 0.01
 
 
+def test_every_option_of_a_line_and_a_constraint_is_written_back_as_read() -> None:
+    # the entries a task's file holds must read as the task planned: check re-reads them
+    to = {"xyz": [0.4, 0.2, 0.3], "quat_xyzw": [1.0, 0.0, 0.0, 0.0]}
+    held = {"axes": ["x", "y", "z"], "angle_rad": 0.02, "quat_xyzw": [0, 0, 0, 1], "frame": "tool_link"}
+    entries = [
+        {"line": {"to": to, "tool_frame": "wrist_link", "tool_speed_m_s": 0.05}},
+        {"line": {"by": [0.0, 0.01, 0.0], "tolerance": {"position_m": 3e-4, "angle_rad": 0.02}}},
+        {"move": {"tcp": [0.4, 0.2, 0.35], "constraint": held}},
+    ]
+    read = parse_scene_file(with_task(*entries))
+    first, second, third = read.task
+    assert isinstance(first, ToolLine) and first.frame == "wrist_link" and first.tool_speed_m_s == 0.05
+    assert first.to is not None and first.to.xyz == (0.4, 0.2, 0.3)
+    assert isinstance(second, ToolLine) and second.offset_frame == "tool" and second.to is None
+    assert second.tolerance.position_m == 3e-4 and second.tolerance.angle_rad == 0.02
+    assert isinstance(third, Move) and third.constraint is not None and third.constraint.frame == "tool_link"
+    document = yaml.safe_load(yaml.safe_dump(scene_document(read.scene, read.task)))
+    assert document["task"][0]["line"]["tool_frame"] == "wrist_link"
+    assert parse_scene_file(document).task == read.task
+
+
 def test_load_scene_refuses_a_task_and_says_how_to_plan_it() -> None:
     with pytest.raises(SceneError, match=r"holds a task of 8 segments.*cpr-plan plan"):
         load_scene(PICK)
