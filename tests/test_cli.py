@@ -427,6 +427,13 @@ def test_show_refuses_a_trajectory_whose_robot_is_not_here(
     assert (
         "robot URDF '/elsewhere/robots/cpr.urdf' is not on this machine; pass the robot with --urdf" in stderr
     )
+    # given another robot, it says whose joints differ and draws nothing
+    code, _, stderr = run(["show", str(moved), "--html", str(tmp_path / "v.html"), "--urdf", "panda"], capsys)
+    assert code == 2 and not (tmp_path / "v.html").exists() and len(stderr.strip().splitlines()) == 1
+    assert (
+        "trajectory joints ['theta1', 'd2', 'd3', 'theta4', 'theta5'] are not the robot's ['panda_joint1'"
+        in stderr
+    )
     # given the robot, it draws
     code, stdout, _ = run(["show", str(moved), "--html", str(tmp_path / "v.html"), "--urdf", "cpr"], capsys)
     assert code == 0 and "wrote" in stdout and (tmp_path / "v.html").stat().st_size > 0

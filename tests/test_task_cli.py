@@ -58,6 +58,26 @@ def test_a_task_plans_into_one_file_that_says_what_it_promised(planned: Path) ->
     assert "| 3 | attach 'part' |" in (planned / "report.md").read_text()
 
 
+def test_a_task_planned_with_json_and_plots_says_what_it_wrote(
+    planned: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "drawn"
+    code, stdout, _ = run(["plan", str(PICK), "--out", str(out), "--json", "--plots"], capsys)
+    assert code == 0
+    summary = json.loads(stdout)
+    assert summary["status"] == "ok" and summary["accepted"] and summary["segments"] == 8
+    assert [entry["kind"] for entry in summary["task"]] == [
+        entry["kind"] for entry in json.loads((planned / "trajectory.json").read_text())["task"]
+    ]
+    written = {Path(p).name for p in summary["outputs"]}
+    assert {"trajectory.json", "joints.png", "tcp_path.png"} <= written
+    assert all((out / name).stat().st_size > 0 for name in written)
+    # the summary's numbers are the file's: same seed, same task
+    document = json.loads((out / "trajectory.json").read_text())
+    assert summary["duration"] == document["knots"][-1] == document["metrics"]["duration"]
+    assert (out / "trajectory.json").read_bytes() == (planned / "trajectory.json").read_bytes()
+
+
 def test_check_verifies_a_task_and_names_a_broken_promise(
     planned: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
