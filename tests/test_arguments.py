@@ -62,6 +62,12 @@ def test_a_number_at_least_its_bound_takes_the_bound_itself() -> None:
         ("bench_torque", ["--limit", "101"], "--limit 101 must be in [1, 100] problems per class"),
         ("generate_scenes", ["--seed", "-1", "--out", "x"], "argument --seed: -1 must be an integer >= 0"),
         ("study_parameters", ["--narrow", "-1"], "argument --narrow: -1 must be an integer >= 0"),
+        (
+            "study_parameters",
+            ["--variants", "stall 9"],
+            "--variants ['stall 9']: not variants of this study; its variants: ['1 path attempt'",
+        ),
+        ("study_parameters", ["--files", "x.yaml", "--mbm"], "give --files or --mbm, not both"),
         ("paper_case", ["--seeds", "0"], "argument --seeds: 0 must be an integer >= 1"),
         (
             "generate_arm_scenes",

@@ -49,6 +49,8 @@ from planning.pipeline.torques import GravityLimit
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 LINKS = ck.GROUPS.index("links")
+FIRST_PASS_STRIDE = 4
+"""The fitness's first pass checks every this many of a path's samples (``docs/tuning.md``)."""
 
 
 @dataclass(frozen=True)
@@ -211,16 +213,16 @@ class WaypointObjective:
         """``(S, K, 2)`` per-group clearance where it falls short of the required clearance.
 
         ``inf`` where a sample keeps the required clearance, ``nan`` where it was not checked.
-        Staged: every 4th sample first, for every candidate; the others only for candidates
-        clear there that ``may_be_feasible`` (no other violation), the only ones whose
-        feasibility the remaining samples decide. An infeasible candidate so costs a
-        quarter, its depth the mean over the coarse samples. Where coal's parallel yes/no
+        Staged: every :data:`FIRST_PASS_STRIDE`-th sample first, for every candidate; the
+        others only for candidates clear there that ``may_be_feasible`` (no other violation),
+        the only ones whose feasibility the remaining samples decide. An infeasible candidate
+        so costs a fraction, its depth the mean over the coarse samples. Where coal's parallel yes/no
         test flags a sample, its distance is computed.
         """
         s, k, _ = samples.shape
         clearance = np.full((s, k, 2), np.nan)
         coarse = np.zeros(k, dtype=bool)
-        coarse[::4] = True
+        coarse[::FIRST_PASS_STRIDE] = True
         coarse[-1] = True
         self._fill(clearance, samples, np.arange(s), coarse)
         still_clear = ~(clearance[:, coarse] < self.required_m).any(axis=(1, 2))
