@@ -216,8 +216,8 @@ class WaypointObjective:
         Staged: every :data:`FIRST_PASS_STRIDE`-th sample first, for every candidate; the
         others only for candidates clear there that ``may_be_feasible`` (no other violation),
         the only ones whose feasibility the remaining samples decide. An infeasible candidate
-        so costs a fraction, its depth the mean over the coarse samples. Where coal's parallel yes/no
-        test flags a sample, its distance is computed.
+        so costs a fraction, its depth the mean over the coarse samples. Where coal's parallel
+        yes/no test flags a sample, its distance is computed.
         """
         s, k, _ = samples.shape
         clearance = np.full((s, k, 2), np.nan)
