@@ -200,14 +200,11 @@ def generated(args: argparse.Namespace) -> list[Problem]:
 def from_files(args: argparse.Namespace, out: Path) -> list[Problem]:
     """The scene files of ``--files``, or the MotionBenchMaker selection of ``--mbm``, with the time limit."""
     selection = argparse.Namespace(**{**vars(args), "scenes": args.files})
-    robots: dict[str, ck.Robot] = {}
     problems = []
     for case in selected_cases(selection, out):
         scene = load_scene(case.path).with_planner(time_limit_s=args.time_limit)
-        key = str(scene.robot)
-        if key not in robots:
-            robots[key] = scene.robot.load() if scene.robot is not None else ck.load_cpr()
-        problems.append(Problem(case.path.stem, f"{case.robot} {case.group}", scene, robots[key]))
+        robot = ck.shared_robot(scene.robot_spec())  # the robot plan(scene) itself would load
+        problems.append(Problem(case.path.stem, f"{case.robot} {case.group}", scene, robot))
     return problems
 
 
