@@ -25,8 +25,8 @@ changes one thing from the defaults: the scene-file keys
 ``refine_stall``), the internal knobs of :class:`planning.pipeline.tuning.SearchTuning` (the
 seeding's ``path_attempts``, the refinement's ``sigma``, ``active`` and ``near_bound``), or a
 module's constant set for the variant's plans only (the timing's ``STEPS_PER_RAMP``, the
-fitness's ``FIRST_PASS_STRIDE``). The paper's search (50 fireflies, every iteration, a random
-population, no refinement) is one of them.
+fitness's ``FIRST_PASS_STRIDE``, the last resort's ``POINTS_PER_PIECE``). The paper's search
+(50 fireflies, every iteration, a random population, no refinement) is one of them.
 """
 
 from __future__ import annotations
@@ -112,6 +112,11 @@ def timing_grid(steps: int) -> Variant:
     return constant("planning.curves.velocity_caps", "STEPS_PER_RAMP", steps)
 
 
+def last_resort(*points: int) -> Variant:
+    """The last resort's splines at ``points`` a piece, then stopping (``POINTS_PER_PIECE``)."""
+    return constant("planning.pipeline.path_following", "POINTS_PER_PIECE", points)
+
+
 def first_pass(stride: int) -> Variant:
     """The fitness's first pass on every ``stride``-th sample (``FIRST_PASS_STRIDE``)."""
     return constant("planning.pipeline.objective", "FIRST_PASS_STRIDE", stride)
@@ -148,6 +153,10 @@ VARIANTS: dict[str, Variant] = {
     "timing grid 25 steps a ramp": timing_grid(25),
     "timing grid 50 steps a ramp": timing_grid(50),
     "timing grid 200 steps a ramp": timing_grid(200),
+    "last resort: stop at every vertex": last_resort(),
+    "last resort: 2, 3, 4, 6, 8 points a piece": last_resort(2, 3, 4, 6, 8),
+    "last resort: 3, 6 points a piece": last_resort(3, 6),
+    "last resort: 3, 8 points a piece": last_resort(3, 8),
 }
 """Each variant by its name (the module docstring)."""
 

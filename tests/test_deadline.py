@@ -180,10 +180,10 @@ def test_a_plan_cut_short_returns_what_it_verified(robot: ck.Robot) -> None:
 
 
 def test_past_the_limit_the_last_resort_is_not_run(robot: ck.Robot, monkeypatch: pytest.MonkeyPatch) -> None:
-    """A scene only the last resort plans (its path followed vertex to vertex): once time is up
+    """A scene only the last resort plans (its path followed through its vertices): once time is up
     after the search's choice, the plan stops there, saying that a path was found."""
     scene = spline_touching_scene(robot).with_planner(refine="none", time_limit_s=3600.0)
-    assert plan(scene, robot).metrics.timing == "stop_and_go"  # within the limit: the last resort
+    assert plan(scene, robot).metrics.timing == "through_path"  # within the limit: the last resort
     chosen: list[int] = []
     followed: list[int] = []
 

@@ -1,4 +1,4 @@
-"""The last resort: the sampling planner's path followed vertex to vertex, verified like any plan."""
+"""The last resort: the sampling planner's path followed through its vertices, verified like any plan."""
 
 from __future__ import annotations
 
@@ -11,8 +11,10 @@ import cpr_kin as ck
 from planning.bench.narrow_passages import narrow_scene
 from planning.bench.scene_generator import generate_scenes
 from planning.curves.trajectory import Trajectory
+from planning.pipeline import path_following
 from planning.pipeline.choose import Choice, Refusal
-from planning.pipeline.path_following import follow_path
+from planning.pipeline.deadline import Deadline
+from planning.pipeline.path_following import follow_path, stop_and_go_timing, through_vertices
 from planning.pipeline.path_seeds import sampled_path
 from planning.pipeline.planner import plan
 from planning.pipeline.problem import Problem, build_problem
@@ -26,20 +28,81 @@ def window(robot: ck.Robot) -> Problem:
     return build_problem(narrow_scene(np.random.default_rng(5), robot, "window"), robot)
 
 
-def test_a_sampled_path_is_followed_through_its_vertices_and_verified(window: Problem) -> None:
+def test_a_sampled_path_is_followed_by_a_spline_through_its_vertices_faster_than_stopping(
+    window: Problem,
+) -> None:
     found = sampled_path(window, np.random.default_rng(3))
     assert found is not None
     problem, followed = follow_path(window, found.path)
     assert isinstance(followed, Choice) and followed.verification.accepted
-    assert followed.timing.method == "stop_and_go" and not followed.timing.stretched
+    assert followed.timing.method == "through_path" and not followed.timing.stretched
+    fit = followed.timing.fit.trajectory  # the spline before its timing passes through every vertex
+    passed = fit(fit.knots)[:, window.moving]
+    for vertex in found.path:
+        assert np.abs(passed - vertex).max(axis=1).min() < 1e-9
+    stopping = stop_and_go_timing(window, window.configurations(found.path))
+    assert followed.timing.trajectory.duration < stopping.trajectory.duration
+    assert problem.scene.planner.waypoints == max(1, len(found.path) - 2)
+    assert followed.x.size == problem.objective.lower.size
+
+
+def test_the_spline_through_a_path_meets_its_points_on_centripetal_knots(window: Problem) -> None:
+    """Each piece split into ``points`` equal parts, met exactly; each part's time the square
+    root of its weighted length (the nominal duration spread over them)."""
+    found = sampled_path(window, np.random.default_rng(3))
+    assert found is not None
+    vertices = window.configurations(found.path)
+    weights = ck.path_weights(window.robot)[window.moving]
+    timing = through_vertices(window, vertices, weights, 3)
+    fit = timing.fit.trajectory
+    assert fit.n_segments == 3 * (len(vertices) - 1)
+    met = fit(fit.knots)
+    np.testing.assert_allclose(met[::3], vertices, atol=1e-9)
+    np.testing.assert_allclose(
+        met[1::3][: len(vertices) - 1], vertices[:-1] + np.diff(vertices, axis=0) / 3, atol=1e-9
+    )
+    parts = np.abs(np.diff(met[:, window.moving], axis=0)) @ weights
+    steps = np.diff(fit.knots)
+    np.testing.assert_allclose(steps / steps.sum(), np.sqrt(parts) / np.sqrt(parts).sum(), rtol=1e-9)
+    np.testing.assert_allclose(fit.knots[-1], window.duration.nominal_duration(len(steps)))
+
+
+def test_the_path_as_it_is_when_no_spline_is_tried_stops_at_every_vertex(
+    window: Problem, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    found = sampled_path(window, np.random.default_rng(3))
+    assert found is not None
+    monkeypatch.setattr(path_following, "POINTS_PER_PIECE", ())
+    _, followed = follow_path(window, found.path)
+    assert isinstance(followed, Choice) and followed.verification.accepted
+    assert followed.timing.method == "stop_and_go" and followed.candidates_timed == 1
     trajectory = followed.timing.trajectory
     reached = trajectory(trajectory.knots)[:, window.moving]
     for vertex in found.path:  # every vertex is a knot of the motion, where it stands still
         k = int(np.argmin(np.abs(reached - vertex).max(axis=1)))
         assert np.abs(reached[k] - vertex).max() < 1e-9
         assert np.abs(trajectory(trajectory.knots[k], 1)).max() < 1e-9
-    assert problem.scene.planner.waypoints == max(1, len(found.path) - 2)
-    assert followed.x.size == problem.objective.lower.size
+
+
+def test_a_fixed_duration_is_kept_by_the_spline_through_the_path(window: Problem) -> None:
+    """A scene's fixed duration that the path can be followed within: the spline through it
+    takes exactly that long, within the limits, as fast as stopping at every vertex would."""
+    found = sampled_path(window, np.random.default_rng(3))
+    assert found is not None
+    stopping = stop_and_go_timing(window, window.configurations(found.path)).trajectory.duration
+    fixed = dataclasses.replace(window, duration=FixedDuration(2.0 * stopping))
+    _, followed = follow_path(fixed, found.path)
+    assert isinstance(followed, Choice) and followed.verification.accepted
+    assert followed.timing.method == "through_path" and not followed.timing.stretched
+    assert followed.timing.trajectory.duration == pytest.approx(2.0 * stopping)
+
+
+def test_past_the_deadline_no_spline_is_tried(window: Problem) -> None:
+    found = sampled_path(window, np.random.default_rng(3))
+    assert found is not None
+    spent = dataclasses.replace(window, deadline=Deadline(at_s=0.0, limit_s=1.0))
+    _, followed = follow_path(spent, found.path)
+    assert isinstance(followed, Choice) and followed.timing.method == "stop_and_go"
 
 
 def test_a_path_through_an_obstacle_is_refused_with_the_reason(window: Problem) -> None:
@@ -87,6 +150,6 @@ def test_a_scene_whose_splines_all_touch_the_passage_is_planned_not_refused(robo
         result = plan(dataclasses.replace(scene, planner=planner), robot)
         assert result.verification.accepted
         assert result.metrics.min_clearance_m >= scene.safety_margin
-    assert result.metrics.timing == "stop_and_go"
+    assert result.metrics.timing == "through_path"
     same = plan(dataclasses.replace(scene, planner=planner), robot)
     np.testing.assert_array_equal(same.trajectory.coefficients, result.trajectory.coefficients)

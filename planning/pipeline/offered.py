@@ -15,7 +15,7 @@ from typing import Literal
 from planning.curves.spline import SplineFit
 from planning.curves.trajectory import Trajectory
 
-Method = Literal["fixed", "fastest", "narrowed", "uniform", "stop_and_go"]
+Method = Literal["fixed", "fastest", "narrowed", "uniform", "through_path", "stop_and_go"]
 
 
 @dataclass(frozen=True)
@@ -25,8 +25,9 @@ class Timing:
     Attributes:
         trajectory: the timed trajectory.
         method: ``fixed`` (the scene's duration), ``fastest``, ``narrowed`` or ``uniform``
-            (module docstring), or ``stop_and_go`` (the sampling planner's path followed as it
-            is, :mod:`planning.pipeline.path_following`).
+            (module docstring); or the sampling planner's path followed
+            (:mod:`planning.pipeline.path_following`): ``through_path`` (a spline through its
+            vertices, timed by the scene's duration rule) or ``stop_and_go`` (the path as it is).
         fit: the spline through the nodes that was timed (before timing).
         stretched: a fixed duration broke a limit and was stretched.
         time_s: wall time of computing it [s].

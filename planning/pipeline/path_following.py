@@ -1,25 +1,38 @@
-"""The last resort of a plan: follow the sampling planner's path itself, stopping at its corners.
+"""The last resort of a plan: follow the sampling planner's path itself, through its corners.
 
 The search's trajectories are splines through a few waypoints: smooth and fast, but they cut
 the corners of the path they follow. In a passage barely wider than the clearance every
 one of them may touch it, and the plan would end in "no solution" although RRT-Connect
 found a clear path (a false negative). So when the seeding has no attempt left
-(:meth:`~planning.pipeline.seeding.PathSeeding.after`), :func:`follow_path` times that path
-as it is: straight joint-space segments between its vertices, at rest at each
-(:func:`~planning.curves.stop_and_go.stop_and_go`), which sweep exactly the segments the
-sampling planner checked. Slower than a spline, as the robot stops at every corner; still
-jerk-limited, C3 and given the same certified verification as every trajectory.
+(:meth:`~planning.pipeline.seeding.PathSeeding.after`), :func:`follow_path` follows that path
+closely:
+
+1. a spline that passes exactly through each vertex and through points evenly placed on each
+   piece between them (:data:`POINTS_PER_PIECE` of them per piece, denser at each try), on
+   centripetal knots (each piece's share of time the square root of its length: the spline
+   keeps to the polyline at its corners, where chord-length knots overshoot), timed by the
+   scene's duration rule like any candidate's path. The denser the points, the nearer the
+   spline keeps to the path, and the slower it must run round the corners;
+2. the path as it is, if none passes: straight joint-space segments between its vertices, at
+   rest at each (:func:`~planning.curves.stop_and_go.stop_and_go`), which sweep exactly the
+   segments the sampling planner checked. Slower, as the robot stops at every corner; still
+   jerk-limited and C3.
+
+Each gets the same certified verification as every trajectory; the splines are tried only
+while the plan's time limit has not passed.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import time
+from collections.abc import Iterator
 
 import numpy as np
 from numpy.typing import NDArray
 
 import cpr_kin as ck
-from planning.curves.spline import SplineFit
+from planning.curves.spline import SepticSplineSolver, SplineFit
 from planning.curves.stop_and_go import stop_and_go
 from planning.pipeline.choose import Choice, Refusal, verify
 from planning.pipeline.offered import Timing
@@ -28,20 +41,51 @@ from planning.pipeline.settings import MAX_WAYPOINTS
 from planning.search.waypoints import waypoints_along
 
 FloatArray = NDArray[np.float64]
+POINTS_PER_PIECE = (2, 4, 8)
+"""The splines through the path: points per piece between two vertices, in the order tried
+(``docs/tuning.md``)."""
 
 
 def follow_path(problem: Problem, path: FloatArray) -> tuple[Problem, Choice | Refusal]:
-    """The stop-and-go trajectory along ``path`` ``(k, moving)``, verified, and its problem.
+    """The first verified motion that follows ``path`` ``(k, moving)`` (module docstring), and its problem.
 
     The problem returned has as many waypoints as the path has corners (at most
     :data:`~planning.pipeline.settings.MAX_WAYPOINTS`): the candidate's fitness terms in the
     result are those of the corners. A scene's fixed duration is kept when the path can be
     followed within it, else the trajectory is as fast as the limits allow and reported as
-    stretched.
+    stretched. The refusal, when none passes, is the stop-and-go motion's.
     """
-    started = time.perf_counter()
     vertices = problem.configurations(path)
     vertices[0], vertices[-1] = problem.q_start, problem.q_goal
+    weights = ck.path_weights(problem.robot)[problem.moving]
+    for tried, timing in enumerate(_motions(problem, vertices, weights), start=1):
+        verification = verify(problem, timing.trajectory, timing.fit)
+        if verification.accepted:
+            count = int(np.clip(len(path) - 2, 1, MAX_WAYPOINTS))
+            x = waypoints_along(path, count, weights).ravel()
+            return with_planner(problem, waypoints=count), Choice(x, vertices, timing, verification, tried)
+    cause = "; ".join(verification.problems) or "its certified check fails"
+    return problem, Refusal(f"following it vertex to vertex {cause}", verification.check)
+
+
+def _motions(problem: Problem, vertices: FloatArray, weights: FloatArray) -> Iterator[Timing]:
+    """The splines through ``vertices`` ``(k, nq)`` no slower than stopping at them, then stop-and-go.
+
+    The splines only while the problem's deadline has not passed.
+    """
+    stopping = stop_and_go_timing(problem, vertices)
+    for points in POINTS_PER_PIECE:
+        if problem.deadline.passed():
+            break
+        timing = through_vertices(problem, vertices, weights, points)
+        if timing.trajectory.duration <= stopping.trajectory.duration:
+            yield timing
+    yield stopping
+
+
+def stop_and_go_timing(problem: Problem, vertices: FloatArray) -> Timing:
+    """The motion at rest at each of ``vertices`` ``(k, nq)``, straight between them, held to the rule."""
+    started = time.perf_counter()
     limits = problem.robot.limits
     trajectory = stop_and_go(
         vertices, limits.velocity, limits.acceleration, limits.jerk, torque=problem.dynamics
@@ -53,12 +97,30 @@ def follow_path(problem: Problem, path: FloatArray) -> tuple[Problem, Choice | R
         nodes=np.stack([vertices, *([np.zeros_like(vertices)] * 3)], axis=-1),
         settings=problem.solver.settings,
     )
-    timing = Timing(trajectory, "stop_and_go", fit, stretched, time.perf_counter() - started)
-    verification = verify(problem, trajectory, fit)
-    if not verification.accepted:
-        cause = "; ".join(verification.problems) or "its certified check fails"
-        return problem, Refusal(f"following it vertex to vertex {cause}", verification.check)
-    count = int(np.clip(len(path) - 2, 1, MAX_WAYPOINTS))
-    counted = with_planner(problem, waypoints=count)
-    x = waypoints_along(path, count, ck.path_weights(problem.robot)[problem.moving]).ravel()
-    return counted, Choice(x, vertices, timing, verification, 1)
+    return Timing(trajectory, "stop_and_go", fit, stretched, time.perf_counter() - started)
+
+
+def through_vertices(problem: Problem, vertices: FloatArray, weights: FloatArray, points: int) -> Timing:
+    """The first timing of the spline through ``vertices`` and ``points - 1`` more on each piece.
+
+    The spline interpolates (``p = inf``, the scene's other spline settings kept) on
+    centripetal knots spanning the duration rule's nominal duration, and is timed by the
+    problem's duration rule (its first timing, :meth:`~planning.pipeline.timing.FreeDuration.timings`),
+    reported as ``through_path``.
+
+    Args:
+        problem: the plan's problem.
+        vertices: ``(k, nq)`` the path's vertices, start and goal included [rad, m].
+        weights: ``(moving,)`` the moving joints' weights of a path's length [m/rad, m/m].
+        points: points per piece, the vertex ending it included (1: the vertices alone).
+    """
+    shares = np.arange(1, points + 1) / points
+    pieces = vertices[:-1, None] + shares[None, :, None] * np.diff(vertices, axis=0)[:, None]
+    nodes = np.concatenate([vertices[:1], pieces.reshape(-1, vertices.shape[1])])
+    lengths = np.abs(np.diff(nodes[:, problem.moving], axis=0)) @ weights
+    steps = np.sqrt(np.maximum(lengths, 1e-12 * lengths.max(initial=1.0)))
+    nominal_s = problem.duration.nominal_duration(len(steps))
+    knots = np.concatenate([[0.0], np.cumsum(steps)]) * (nominal_s / steps.sum())
+    settings = dataclasses.replace(problem.solver.settings, p=float("inf"))
+    dense = dataclasses.replace(problem, solver=SepticSplineSolver(knots, settings))
+    return dataclasses.replace(problem.duration.timings(dense, nodes).first, method="through_path")

@@ -9,8 +9,8 @@ each attempt (the seeding rule decides the first and the next,
 :mod:`planning.pipeline.seeding`) is searched (:mod:`planning.pipeline.search`), its
 candidates are timed and verified best first (:mod:`planning.pipeline.choose`), and the
 first that passes becomes the :class:`~planning.pipeline.result.PlanResult`. When no
-attempt is left and the seeding found a sampling planner's path, that path is followed as it
-is (:mod:`planning.pipeline.path_following`) before the plan says "no solution". With a
+attempt is left and the seeding found a sampling planner's path, that path is followed
+closely (:mod:`planning.pipeline.path_following`) before the plan says "no solution". With a
 ``time_limit_s`` the stages stop where it passes (:mod:`planning.pipeline.deadline`): the
 plan times and verifies what its last search found and, failing that, follows the path
 found, with no attempt after it, while the time limit has not passed.
@@ -122,7 +122,8 @@ def _solved(
     if last_resort_by.passed():
         found = "RRT-Connect found a path, but the time limit passed before it was followed"
         raise chosen.error(attempt.tried, last_resort_by.reason(), found)
-    problem, followed = follow_path(attempt.problem, attempt.path)  # the last resort
+    by_the_plans = dataclasses.replace(attempt.problem, deadline=last_resort_by)  # not the hulls' share
+    problem, followed = follow_path(by_the_plans, attempt.path)  # the last resort
     if isinstance(followed, Refusal):
         raise chosen.error(attempt.tried, stopped, f"RRT-Connect found a path, but {followed.cause}")
     elapsed = Elapsed(problem.build_time_s + time.perf_counter() - started, search_s)
