@@ -25,7 +25,7 @@ changes one thing from the defaults: the scene-file keys
 ``refine_stall``), the internal knobs of :class:`planning.pipeline.tuning.SearchTuning` (the
 seeding's ``path_attempts``, the refinement's ``sigma``, ``active`` and ``near_bound``), or a
 module's constant set for the variant's plans only (the timing's ``STEPS_PER_RAMP``, the
-fitness's ``FIRST_PASS_STRIDE``, the last resort's ``POINTS_PER_PIECE``). The paper's search
+fitness's ``FIRST_PASS_STRIDE``, the last resort's ``POINTS_PER_PIECE`` and ``SHORTCUTS``). The paper's search
 (50 fireflies, every iteration, a random population, no refinement) is one of them.
 """
 
@@ -117,6 +117,11 @@ def last_resort(*points: int) -> Variant:
     return constant("planning.pipeline.path_following", "POINTS_PER_PIECE", points)
 
 
+def last_resort_shortcuts(count: int) -> Variant:
+    """The last resort's path given ``count`` more random shortcuts (``SHORTCUTS``)."""
+    return constant("planning.pipeline.path_following", "SHORTCUTS", count)
+
+
 def first_pass(stride: int) -> Variant:
     """The fitness's first pass on every ``stride``-th sample (``FIRST_PASS_STRIDE``)."""
     return constant("planning.pipeline.objective", "FIRST_PASS_STRIDE", stride)
@@ -154,6 +159,10 @@ VARIANTS: dict[str, Variant] = {
     "timing grid 50 steps a ramp": timing_grid(50),
     "timing grid 200 steps a ramp": timing_grid(200),
     "last resort: stop at every vertex": last_resort(),
+    "last resort as at stop 137": Variant(  # the path as found, stopping at every vertex
+        constants=(*last_resort().constants, *last_resort_shortcuts(0).constants)
+    ),
+    **{f"last resort: {n} more shortcuts": last_resort_shortcuts(n) for n in (0, 100, 200, 800, 1600)},
     "last resort: 2, 3, 4, 6, 8 points a piece": last_resort(2, 3, 4, 6, 8),
     "last resort: 3, 6 points a piece": last_resort(3, 6),
     "last resort: 3, 8 points a piece": last_resort(3, 8),

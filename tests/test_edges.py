@@ -7,7 +7,14 @@ import math
 
 import numpy as np
 
-from planning.search.edges import COARSE_STRIDE, HEAD, WHOLE_BELOW, Edges, path_time, straighten_joints
+from planning.search.edges import (
+    COARSE_STRIDE,
+    HEAD,
+    WHOLE_BELOW,
+    Edges,
+    path_time,
+    straighten_joints,
+)
 
 
 def discs(q: np.ndarray) -> np.ndarray:
@@ -117,3 +124,18 @@ def test_a_chain_is_free_exactly_when_every_edge_is() -> None:
             continue
         every = all(exhaustive(a, b, weights, 0.002) == 1.0 for a, b in itertools.pairwise(chain))
         assert Edges(discs, weights, 0.002).chain_free(chain) == every
+
+
+def test_an_edge_from_an_unchecked_point_is_free_only_when_that_point_is_too() -> None:
+    """``free_between`` checks the edge's start as well: a shortcut starts at a point of another
+    edge that no check has seen. Outside the first disc every such answer is ``free_fraction``'s."""
+    rng = np.random.default_rng(7)
+    weights = np.array([1.0, 2.0])
+    edges = Edges(discs, weights, 0.002)
+    inside, beyond = np.array([0.3, 0.1805]), np.array([0.3, 0.05])  # just in the first disc; below it
+    assert not discs(inside[None])[0] and edges.free_fraction(inside, beyond) == 1.0
+    assert not edges.free_between(inside, beyond)
+    pairs = [(a, b) for a, b in rng.uniform(0, 1, (200, 2, 2)) if discs(a[None])[0]]
+    assert [edges.free_between(a, b) for a, b in pairs] == [
+        edges.free_fraction(a, b) == 1.0 for a, b in pairs
+    ]

@@ -14,8 +14,8 @@ from planning.curves.trajectory import Trajectory
 from planning.pipeline import path_following
 from planning.pipeline.choose import Choice, Refusal
 from planning.pipeline.deadline import Deadline
-from planning.pipeline.path_following import follow_path, stop_and_go_timing, through_vertices
-from planning.pipeline.path_seeds import sampled_path
+from planning.pipeline.path_following import follow_path, shortened, stop_and_go_timing, through_vertices
+from planning.pipeline.path_seeds import clearance_validity, sampled_path
 from planning.pipeline.planner import plan
 from planning.pipeline.problem import Problem, build_problem
 from planning.pipeline.scene import Scene
@@ -28,7 +28,7 @@ def window(robot: ck.Robot) -> Problem:
     return build_problem(narrow_scene(np.random.default_rng(5), robot, "window"), robot)
 
 
-def test_a_sampled_path_is_followed_by_a_spline_through_its_vertices_faster_than_stopping(
+def test_a_sampled_path_is_followed_by_a_spline_through_its_vertices_sooner_than_stopping(
     window: Problem,
 ) -> None:
     found = sampled_path(window, np.random.default_rng(3))
@@ -36,14 +36,44 @@ def test_a_sampled_path_is_followed_by_a_spline_through_its_vertices_faster_than
     problem, followed = follow_path(window, found.path)
     assert isinstance(followed, Choice) and followed.verification.accepted
     assert followed.timing.method == "through_path" and not followed.timing.stretched
+    path = shortened(window, found.path)  # the path followed
+    np.testing.assert_array_equal(followed.nodes, window.configurations(path))
     fit = followed.timing.fit.trajectory  # the spline before its timing passes through every vertex
-    passed = fit(fit.knots)[:, window.moving]
-    for vertex in found.path:
+    passed = fit(fit.knots)
+    for vertex in followed.nodes:
         assert np.abs(passed - vertex).max(axis=1).min() < 1e-9
-    stopping = stop_and_go_timing(window, window.configurations(found.path))
-    assert followed.timing.trajectory.duration < stopping.trajectory.duration
-    assert problem.scene.planner.waypoints == max(1, len(found.path) - 2)
+    for stopping in (path, found.path):
+        assert (
+            followed.timing.trajectory.duration
+            < stop_and_go_timing(window, window.configurations(stopping)).trajectory.duration
+        )
+    assert problem.scene.planner.waypoints == max(1, len(path) - 2)
     assert followed.x.size == problem.objective.lower.size
+
+
+def test_the_path_followed_is_shorter_its_vertices_clear_and_drawn_from_the_plans_seed(
+    window: Problem,
+) -> None:
+    """The shortcuts end where the path ends, shorten it (the joints' weighted length), keep the
+    fitness's clearance at every vertex (a shortcut's start too, a point between two checked
+    configurations of an edge), and draw from the plan's seed."""
+    found = sampled_path(window, np.random.default_rng(3))
+    assert found is not None
+    path = shortened(window, found.path)
+    np.testing.assert_array_equal(path[[0, -1]], found.path[[0, -1]])
+    weights = ck.path_weights(window.robot)[window.moving]
+
+    def length(polyline: np.ndarray) -> float:
+        return float(np.abs(np.diff(polyline, axis=0)).sum(axis=0) @ weights)
+
+    assert length(path) < length(found.path)
+    valid = clearance_validity(window)
+    assert all(valid(vertex[None])[0] for vertex in path)
+    np.testing.assert_array_equal(shortened(window, found.path), path)
+    reseeded = dataclasses.replace(
+        window, scene=window.scene.with_planner(seed=window.scene.planner.seed + 1)
+    )
+    assert not np.array_equal(shortened(reseeded, found.path), path)
 
 
 def test_the_spline_through_a_path_meets_its_points_on_centripetal_knots(window: Problem) -> None:

@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 import cpr_kin as ck
 from planning.pipeline.problem import Problem, with_planner
 from planning.pipeline.settings import MAX_WAYPOINTS, PlannerSettings
+from planning.search.edges import Validity
 from planning.search.rrt_connect import Relaxation, RrtPath, rrt_connect
 from planning.search.rrt_settings import RrtSettings
 from planning.search.waypoints import placements_along
@@ -78,25 +79,11 @@ def sampled_path(
     ends left them, and are left there when no path is found.
     """
     robot, moving = problem.robot, problem.moving
-
-    def keeping(kept: FinerProblem) -> Callable[[FloatArray], BoolArray]:
-        def valid(q: FloatArray) -> BoolArray:
-            objective = kept().objective  # the finer problem built at its first check
-            required_m, required_self_m = objective.required_m, objective.required_self_m
-            configurations = problem.configurations(q)
-            free = problem.world.keeps_clearance(configurations, required_m, required_self_m, ordered=True)
-            if problem.gravity is not None and free.any():  # and can be held still
-                free[free] = problem.gravity.holds(configurations[free])
-            return free
-
-        return valid
-
     tuning = problem.scene.planner.tuning.seeding
-    if settings is None:  # the path's edges checked at most as far apart as the clearance required
-        resolution = min(tuning.max_resolution_m, max(0.01, problem.objective.required_m))
+    if settings is None:
         settings = RrtSettings(
             max_samples=draw_samples(problem),
-            resolution_m=resolution,
+            resolution_m=edge_resolution_m(problem),
             explore_resolution_m=tuning.max_resolution_m,
             local_share=tuning.local_share,
             local_spread=tuning.local_spread,
@@ -105,9 +92,9 @@ def sampled_path(
     if max_samples is not None:
         settings = dataclasses.replace(settings, max_samples=max_samples)
     limits = robot.limits
-    relaxation = None if finer is None else Relaxation(keeping(finer), tuning.finer_after)
+    relaxation = None if finer is None else Relaxation(clearance_validity(problem, finer), tuning.finer_after)
     return rrt_connect(
-        keeping(lambda: problem),
+        clearance_validity(problem),
         problem.q_start[moving],
         problem.q_goal[moving],
         limits.lower[moving],
@@ -120,6 +107,32 @@ def sampled_path(
         problem.grown,
         speeds=limits.velocity[moving],
     )
+
+
+def clearance_validity(problem: Problem, kept: FinerProblem | None = None) -> Validity:
+    """Whether configurations of ``problem``'s moving joints keep the fitness's clearance.
+
+    From obstacles and between the robot's own pairs, and, with a gravity limit, can be held
+    still. ``kept``: the problem whose clearance is kept (a finer one, built at the first
+    check; default: ``problem``'s own).
+    """
+
+    def valid(q: FloatArray) -> BoolArray:
+        objective = (problem if kept is None else kept()).objective
+        required_m, required_self_m = objective.required_m, objective.required_self_m
+        configurations = problem.configurations(q)
+        free = problem.world.keeps_clearance(configurations, required_m, required_self_m, ordered=True)
+        if problem.gravity is not None and free.any():  # and can be held still
+            free[free] = problem.gravity.holds(configurations[free])
+        return free
+
+    return valid
+
+
+def edge_resolution_m(problem: Problem) -> float:
+    """How far apart a path's edges are checked [m]: at most as far as the clearance required."""
+    tuning = problem.scene.planner.tuning.seeding
+    return min(tuning.max_resolution_m, max(0.01, problem.objective.required_m))
 
 
 def path_seed(problem: Problem, path: FloatArray, count: int, weights: FloatArray) -> PathSeed:

@@ -7,10 +7,11 @@ at most two batched calls of the validity check, which is what makes it fast in 
 coarse pass (the edge's first configurations and every few), then the rest of the edge up
 to where the coarse pass found it blocked (OMPL stops at a motion's first invalid state in
 the same spirit). The same checks shorten a found path: random shortcuts (a straight edge
-between two points on it replaces what lies between when it is valid), then skipping
-vertices (from each vertex straight to the farthest one it sees), then, given the joints'
-speeds, straightening one joint at a time where that makes the path faster
-(:func:`straighten_joints`), then dropping collinear vertices.
+between two points on it replaces what lies between when it is valid, both its ends
+included: a point of an edge between two of its checked configurations was never checked
+itself), then skipping vertices (from each vertex straight to the farthest one it sees),
+then, given the joints' speeds, straightening one joint at a time where that makes the path
+faster (:func:`straighten_joints`), then dropping collinear vertices.
 """
 
 from __future__ import annotations
@@ -65,6 +66,15 @@ class Edges:
         ok = self._checked(edge_points(a, b, self.weights, self.resolution_m))
         blocked = int(ok.argmin())  # the first invalid one, or 0 where all are valid
         return blocked / len(ok) if not ok[blocked] else 1.0
+
+    def free_between(self, a: FloatArray, b: FloatArray) -> bool:
+        """Whether the edge ``a -> b`` is valid, ``a`` included (a point of another edge, unchecked).
+
+        Checked as :meth:`free_fraction` checks an edge, with ``a`` among the first.
+        """
+        return bool(
+            self._checked(np.concatenate([a[None], edge_points(a, b, self.weights, self.resolution_m)])).all()
+        )
 
     def chain_free(self, path: FloatArray) -> bool:
         """Whether every edge of the polyline ``path`` is valid (``path[0]`` assumed valid).
@@ -151,7 +161,7 @@ def shortcut(
             continue
         a = path[i] + (s0 - arc[i]) / max(lengths[i], 1e-300) * (path[i + 1] - path[i])
         b = path[j] + (s1 - arc[j]) / max(lengths[j], 1e-300) * (path[j + 1] - path[j])
-        if edges.free_fraction(a, b) == 1.0:
+        if edges.free_between(a, b):  # a lies between two checked configurations of its edge
             path = np.concatenate([path[: i + 1], [a, b], path[j + 1 :]])
     path = _skip_vertices(path, edges)
     if speeds is not None:
