@@ -110,18 +110,18 @@ def _motions(
     while the problem's deadline has not passed; then stopping at the vertices of whichever
     of ``paths`` stops sooner (the shortcuts may add corners).
     """
-    stops = [(path, stop_and_go_timing(problem, _vertices(problem, path))) for path in paths]
-    stopping = min(stops, key=lambda pair: pair[1].trajectory.duration)
     distinct = paths[:1] if np.array_equal(*paths) else paths
-    for path in distinct:
-        vertices = _vertices(problem, path)
+    vertices = [_vertices(problem, path) for path in distinct]
+    stops = [stop_and_go_timing(problem, corners) for corners in vertices]
+    sooner = min(range(len(stops)), key=lambda k: stops[k].trajectory.duration)
+    for path, corners in zip(distinct, vertices, strict=True):
         for points in POINTS_PER_PIECE:
             if problem.deadline.passed():
                 break
-            timing = through_vertices(problem, vertices, weights, points)
-            if timing.trajectory.duration <= stopping[1].trajectory.duration:
+            timing = through_vertices(problem, corners, weights, points)
+            if timing.trajectory.duration <= stops[sooner].trajectory.duration:
                 yield path, timing
-    yield stopping
+    yield distinct[sooner], stops[sooner]
 
 
 def stop_and_go_timing(problem: Problem, vertices: FloatArray) -> Timing:
