@@ -68,11 +68,14 @@ def test_the_bounds_are_below_coals_distances(arm: ck.Robot) -> None:
     q = np.random.default_rng(1).uniform(arm.limits.lower, arm.limits.upper, (200, arm.nq))
     below = bounds(q)
     np.testing.assert_array_less(below.min(axis=1), collision.distances(q)[0] + 1e-9)
+    # within a threshold, the boxes' bound where larger (tighter); beyond it, the spheres' (looser)
+    far = bounds(q, threshold_m=0.0)
+    apart = below > 0.0
+    assert np.all(far[apart] <= below[apart] + 1e-12) and np.all(far[~apart] >= below[~apart] - 1e-12)
     for k in range(0, len(pairs), 7):  # every 7th pair on its own against coal's distance
         exact = SelfCollision(arm.model, arm.collision_model, (pairs[k],), names).distances(q)[0]
         np.testing.assert_array_less(below[:, k], exact + 1e-9)
-    far = bounds(q, threshold_m=0.0)  # the spheres' bound where they are apart: looser, still below
-    assert np.all(far <= below + 1e-12)
+        np.testing.assert_array_less(far[:, k], exact + 1e-9)
     for k in range(len(pairs)):  # one pair's column, its two capsules alone placed: the same bits
         np.testing.assert_array_equal(bounds.column(q, k), below[:, k])
 

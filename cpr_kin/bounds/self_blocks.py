@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cpr_kin.bounds.batch_kinematics import ChainArrays, place_capsule, place_joints
+from cpr_kin.bounds.joint_boxes import box_capsule_bound
 from cpr_kin.bounds.pair_bounds import JointCapsules
 from cpr_kin.bounds.segments import segment_distance
 from cpr_kin.common.compiled import njit
@@ -132,11 +133,14 @@ def blocks_below(
     out: BoolArray,
     chain: ChainArrays,
     capsules: tuple[IntArray, FloatArray, FloatArray, FloatArray],
+    boxes: tuple[IntArray, FloatArray, FloatArray, FloatArray],
     blocks: tuple[IntArray, FloatArray, FloatArray, IntArray, IntArray, IntArray, IntArray, IntArray],
 ) -> None:
     """Write into ``out[n]`` whether some pair's bound is at most ``threshold`` [m] at ``q[n]``.
 
-    ``capsules`` holds :class:`~cpr_kin.bounds.pair_bounds.JointCapsules`' arrays, ``blocks``
+    ``capsules`` holds :class:`~cpr_kin.bounds.pair_bounds.JointCapsules`' arrays, ``boxes``
+    :class:`~cpr_kin.bounds.joint_boxes.JointBoxes`' (a pair the capsules leave within the
+    threshold is then bounded by each geometry's box as well), ``blocks``
     :class:`PairBlocks`' (module docstring). Each configuration places the capsules'
     middles and the clusters' centres; a capsule's ends only once a pair needs its segment.
     Points fixed to the world are placed once. Scalar code with explicit indices: compiled
@@ -188,7 +192,12 @@ def blocks_below(
                     if not placed[c]:
                         placed[c] = True
                         place_capsule(c, rotation, translation, capsule_joint, capsule_ends, world)
-                if segment_distance(world[a], world[b]) - capsule_radius[a] - capsule_radius[b] <= threshold:
+                radius_a, radius_b = capsule_radius[a], capsule_radius[b]
+                if segment_distance(world[a], world[b]) - radius_a - radius_b > threshold:
+                    continue
+                if box_capsule_bound(a, rotation, translation, boxes, world[b], radius_b) > threshold:
+                    continue
+                if box_capsule_bound(b, rotation, translation, boxes, world[a], radius_a) <= threshold:
                     out[n] = True
                     break
             if out[n]:

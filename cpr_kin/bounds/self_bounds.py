@@ -5,7 +5,9 @@ about every checked pair at every configuration; most pairs of a serial arm are 
 most of the time. As for obstacles (:mod:`cpr_kin.bounds.pair_bounds`), each geometry is enclosed
 in a capsule fixed to its joint (:func:`~cpr_kin.bounds.pair_bounds.bounding_capsule`), placed by
 the compiled kinematic chain; a pair's capsules are first compared by their bounding
-spheres, then by the exact distance between their segments less both radii. Both are at
+spheres, then by the exact distance between their segments less both radii, and where that
+leaves the pair in doubt, by each geometry's box against the other's capsule
+(:mod:`cpr_kin.bounds.joint_boxes`: a squat link's). Each is at
 most coal's distance between the geometries, so a configuration whose every pair is bounded
 above a margin keeps it for certain, and only the others go to coal
 (:class:`cpr_kin.collision.self_screen.ScreenedSelfTest`).
@@ -22,6 +24,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from cpr_kin.bounds.batch_kinematics import ChainArrays, KinematicChain, place_capsules
+from cpr_kin.bounds.joint_boxes import JointBoxes, box_capsule_bound, joint_boxes
 from cpr_kin.bounds.pair_bounds import joint_capsules
 from cpr_kin.bounds.segments import segment_distance
 from cpr_kin.bounds.self_blocks import PairBlocks, blocks_below
@@ -42,13 +45,18 @@ def self_bounds(
     capsule_ends: FloatArray,
     capsule_radius: FloatArray,
     capsule_reach: FloatArray,
+    boxes: tuple[IntArray, FloatArray, FloatArray, FloatArray],
     pair_a: IntArray,
     pair_b: IntArray,
 ) -> None:
     """Write into ``out[n, p]`` a lower bound [m] of pair ``p``'s distance at ``q[n]``.
 
     A pair whose bounding spheres are more than ``threshold`` apart gets that sphere bound
-    (cheaper, looser); the others the capsules' distance.
+    (cheaper, looser); the others the capsules' distance, and where that is at most a finite
+    ``threshold``, the larger of it and each geometry's box to the other's capsule
+    (:mod:`cpr_kin.bounds.joint_boxes`; ``boxes`` its :class:`JointBoxes`' arrays, by capsule
+    slot): what a yes/no test asks. An infinite ``threshold`` gives every pair its capsules'
+    distance, the cheapest value at every pair.
     """
     joints = len(chain[0])
     rotation, translation = np.empty((joints, 3, 3)), np.empty((joints, 3))
@@ -64,8 +72,14 @@ def self_bounds(
             spheres = np.sqrt(x * x + y * y + z * z) - capsule_reach[a] - capsule_reach[b]
             if spheres > threshold:
                 out[n, k] = spheres
-            else:
-                out[n, k] = segment_distance(world[a], world[b]) - capsule_radius[a] - capsule_radius[b]
+                continue
+            radius_a, radius_b = capsule_radius[a], capsule_radius[b]
+            bound = segment_distance(world[a], world[b]) - radius_a - radius_b
+            if bound <= threshold < np.inf:
+                bound = max(bound, box_capsule_bound(a, rotation, translation, boxes, world[b], radius_b))
+            if bound <= threshold < np.inf:
+                bound = max(bound, box_capsule_bound(b, rotation, translation, boxes, world[a], radius_a))
+            out[n, k] = bound
 
 
 class SelfPairBounds:
@@ -82,26 +96,33 @@ class SelfPairBounds:
         geometries = sorted({g for pair in pairs for g in pair})
         slot = {g: k for k, g in enumerate(geometries)}
         self._capsules = joint_capsules(collision_model, geometries)
+        self._boxes = joint_boxes(collision_model, geometries)
         self._slot_pairs = [(slot[a], slot[b]) for a, b in pairs]  # capsule slots
         self._arguments: tuple[Any, ...] = (
             self._chain.arrays,
             *self._capsules,
+            tuple(self._boxes),
             np.array([a for a, _ in self._slot_pairs], dtype=np.int64),
             np.array([b for _, b in self._slot_pairs], dtype=np.int64),
         )
         self.n_pairs = len(pairs)
-        self._pair_arguments: dict[int, tuple[NDArray[Any], ...]] = {}
+        self._pair_arguments: dict[int, tuple[Any, ...]] = {}
 
     @functools.cached_property
     def _blocks(self) -> tuple[Any, ...]:
         """:func:`~cpr_kin.bounds.self_blocks.blocks_below`'s capsules and blocks, built on the first call."""
-        return (tuple(self._capsules), PairBlocks.build(self._capsules, self._slot_pairs).arrays)
+        return (
+            tuple(self._capsules),
+            tuple(self._boxes),
+            PairBlocks.build(self._capsules, self._slot_pairs).arrays,
+        )
 
     def __call__(self, q: FloatArray, threshold_m: float = np.inf) -> FloatArray:
         """``(N, P)`` lower bounds [m] of each pair's distance at configurations ``q`` ``(N, nq)``.
 
         Pairs whose bounding spheres are more than ``threshold_m`` apart get the spheres'
-        bound; the others (all, by default) the capsules'.
+        bound; the others (all, by default) the capsules', and those within a finite
+        ``threshold_m`` the boxes' too where larger (:func:`self_bounds`).
         """
         batch = np.ascontiguousarray(np.atleast_2d(q), dtype=float)
         out = np.empty((len(batch), self.n_pairs))
@@ -119,13 +140,15 @@ class SelfPairBounds:
         self_bounds(batch, np.inf, out, self._arguments[0], *self._one_pair(pair))
         return out[:, 0]
 
-    def _one_pair(self, pair: int) -> tuple[NDArray[Any], ...]:
+    def _one_pair(self, pair: int) -> tuple[Any, ...]:
         """:func:`self_bounds`' capsule arguments of pair ``pair``'s two capsules alone, as pair 0-1."""
         if pair not in self._pair_arguments:
-            _, joint, ends, radius, reach, pair_a, pair_b = self._arguments
+            _, joint, ends, radius, reach, _, pair_a, pair_b = self._arguments
             both = np.array([pair_a[pair], pair_b[pair]])
             first, second = np.zeros(1, dtype=np.int64), np.ones(1, dtype=np.int64)
-            self._pair_arguments[pair] = (joint[both], ends[both], radius[both], reach[both], first, second)
+            boxes = tuple(JointBoxes(*(array[both] for array in self._boxes)))
+            capsules = (joint[both], ends[both], radius[both], reach[both])
+            self._pair_arguments[pair] = (*capsules, boxes, first, second)
         return self._pair_arguments[pair]
 
     def any_below(self, q: FloatArray, threshold_m: float) -> BoolArray:

@@ -105,7 +105,9 @@ class SelfScreen:
         """
         probes = sampled_configurations(model, PROBES, np.random.default_rng(0))
         all_bounds = SelfPairBounds(model, geometry_model, pairs)
-        uncertain = all_bounds(probes, threshold_m) <= threshold_m
+        uncertain = all_bounds(probes) <= threshold_m  # the capsules': a squat link's box, which
+        # may clear a pair the capsules leave in doubt, is asked after the near pairs' cells
+        # (a near pair that the boxes made far went to coal more often, ``docs/tuning.md``)
         mostly = uncertain.mean(axis=0) > NEAR_SHARE
         candidates = [p for p, m in zip(pairs, mostly, strict=True) if m]
         cells = NearCells(model, geometry_model, candidates, reach, exact_meshes, kept)
