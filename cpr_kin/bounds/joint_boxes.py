@@ -4,11 +4,11 @@ A capsule bounds a long link well and a squat one poorly: about a mobile base's 
 torso's broad column, it reaches half the disc's width above and below it, and an arm passing
 over the base stays in doubt there, so coal is asked (``docs/tuning.md``, Kernels). The
 geometry's own bounding box (in its frame, swept radius included: coal's local AABB) hugs
-such a shape. The distance from the other geometry's capsule to this box, less that capsule's
-radius, is at most coal's distance between the two geometries, as the capsules' distance
-is, where positive: a pair's bound is the larger of the two (:func:`box_capsule_bound`), taken by the self
-bounds (:mod:`cpr_kin.bounds.self_bounds`, :mod:`cpr_kin.bounds.self_blocks`) only where
-the capsules' leave the pair in doubt.
+such a shape. Where positive, the distance from the other geometry's capsule to this box,
+less that capsule's radius, is at most coal's distance between the two geometries, as the
+capsules' distance is (:func:`box_capsule_bound`). A pair's bound is the largest of them
+(:func:`boxed_pair_bound`), asked by the self bounds (:mod:`cpr_kin.bounds.self_bounds`,
+:mod:`cpr_kin.bounds.self_blocks`) only where the capsules leave the pair in doubt.
 """
 
 from __future__ import annotations
@@ -115,3 +115,29 @@ def box_capsule_bound(
     half = boxes[3][g]
     distance = segment_box_distance(ax, ay, az, bx - ax, by - ay, bz - az, half[0], half[1], half[2])
     return distance - radius if distance > radius else -np.inf
+
+
+@njit_inline
+def boxed_pair_bound(
+    a: int,
+    b: int,
+    rotation: FloatArray,
+    translation: FloatArray,
+    boxes: tuple[IntArray, FloatArray, FloatArray, FloatArray],
+    world: FloatArray,
+    radius: FloatArray,
+    bound: float,
+    threshold: float,
+) -> float:
+    """Pair ``a``-``b``'s capsule ``bound`` [m] raised by each geometry's box while at most ``threshold``.
+
+    ``world`` holds the capsules' segments in the world (``world[a]``, ``world[b]``, placed),
+    ``radius`` their radii [m]; the other arguments are :func:`box_capsule_bound`'s. Box ``a``
+    against capsule ``b`` first, then box ``b`` against capsule ``a``, each only while the
+    bound is still within ``threshold``: the rule of every self bound that asks the boxes.
+    """
+    if bound <= threshold:
+        bound = max(bound, box_capsule_bound(a, rotation, translation, boxes, world[b], radius[b]))
+    if bound <= threshold:
+        bound = max(bound, box_capsule_bound(b, rotation, translation, boxes, world[a], radius[a]))
+    return bound

@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cpr_kin.bounds.batch_kinematics import ChainArrays, place_capsule, place_joints
-from cpr_kin.bounds.joint_boxes import box_capsule_bound
+from cpr_kin.bounds.joint_boxes import boxed_pair_bound
 from cpr_kin.bounds.pair_bounds import JointCapsules
 from cpr_kin.bounds.segments import segment_distance
 from cpr_kin.common.compiled import njit
@@ -192,12 +192,11 @@ def blocks_below(
                     if not placed[c]:
                         placed[c] = True
                         place_capsule(c, rotation, translation, capsule_joint, capsule_ends, world)
-                radius_a, radius_b = capsule_radius[a], capsule_radius[b]
-                if segment_distance(world[a], world[b]) - radius_a - radius_b > threshold:
-                    continue
-                if box_capsule_bound(a, rotation, translation, boxes, world[b], radius_b) > threshold:
-                    continue
-                if box_capsule_bound(b, rotation, translation, boxes, world[a], radius_a) <= threshold:
+                bound = segment_distance(world[a], world[b]) - capsule_radius[a] - capsule_radius[b]
+                bound = boxed_pair_bound(
+                    a, b, rotation, translation, boxes, world, capsule_radius, bound, threshold
+                )
+                if bound <= threshold:
                     out[n] = True
                     break
             if out[n]:

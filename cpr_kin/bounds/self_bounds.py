@@ -24,7 +24,7 @@ import pinocchio as pin
 from numpy.typing import NDArray
 
 from cpr_kin.bounds.batch_kinematics import ChainArrays, KinematicChain, place_capsules
-from cpr_kin.bounds.joint_boxes import JointBoxes, box_capsule_bound, joint_boxes
+from cpr_kin.bounds.joint_boxes import boxed_pair_bound, joint_boxes
 from cpr_kin.bounds.pair_bounds import joint_capsules
 from cpr_kin.bounds.segments import segment_distance
 from cpr_kin.bounds.self_blocks import PairBlocks, blocks_below
@@ -73,12 +73,11 @@ def self_bounds(
             if spheres > threshold:
                 out[n, k] = spheres
                 continue
-            radius_a, radius_b = capsule_radius[a], capsule_radius[b]
-            bound = segment_distance(world[a], world[b]) - radius_a - radius_b
-            if bound <= threshold < np.inf:
-                bound = max(bound, box_capsule_bound(a, rotation, translation, boxes, world[b], radius_b))
-            if bound <= threshold < np.inf:
-                bound = max(bound, box_capsule_bound(b, rotation, translation, boxes, world[a], radius_a))
+            bound = segment_distance(world[a], world[b]) - capsule_radius[a] - capsule_radius[b]
+            if threshold < np.inf:
+                bound = boxed_pair_bound(
+                    a, b, rotation, translation, boxes, world, capsule_radius, bound, threshold
+                )
             out[n, k] = bound
 
 
@@ -146,7 +145,7 @@ class SelfPairBounds:
             _, joint, ends, radius, reach, _, pair_a, pair_b = self._arguments
             both = np.array([pair_a[pair], pair_b[pair]])
             first, second = np.zeros(1, dtype=np.int64), np.ones(1, dtype=np.int64)
-            boxes = tuple(JointBoxes(*(array[both] for array in self._boxes)))
+            boxes = tuple(array[both] for array in self._boxes)
             capsules = (joint[both], ends[both], radius[both], reach[both])
             self._pair_arguments[pair] = (*capsules, boxes, first, second)
         return self._pair_arguments[pair]
