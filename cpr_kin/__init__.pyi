@@ -2,7 +2,7 @@
 
 from .bounds.batch_kinematics import sampled_configurations
 from .bounds.close_pairs import ClosePair
-from .certified.interval_motion import IntervalSpeed
+from .certified.coarse_first import IntervalSpeed
 from .certified.motion import CurveCheck, check_curve, check_segment, motion_radii, path_weights
 from .collision.clearance import BatchClearance, Clearance, PairDistance
 from .collision.world import CollisionWorld

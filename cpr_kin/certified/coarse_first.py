@@ -12,6 +12,12 @@ and a fine interval's certified value at least that bound less half its own slac
 could still be below the minima, the interval's ends are computed exactly, and where it still
 could, the interval is sampled finely; until no interval is left that could. The minima are
 the whole fine grid's; elsewhere the grid holds the coarse bound.
+
+The slack between samples is how far a robot point may move between them
+(:func:`interval_motion`). One speed bound for the whole curve is its peak, reached
+mid-motion; near the ends, where a trajectory starts and stops at rest and often passes
+closest to an obstacle (a grasp, a placement), the robot moves far slower, and an interval's
+own speed bound (:data:`IntervalSpeed`) certifies what the peak cannot.
 """
 
 from __future__ import annotations
@@ -22,7 +28,6 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from cpr_kin.certified.interval_motion import IntervalSpeed, interval_motion
 from cpr_kin.collision.decisive import certified
 from cpr_kin.common.arrays import distinct_sorted
 
@@ -43,6 +48,10 @@ Exact = Callable[[IntArray], tuple[FloatArray, IntArray]]
 """Sample indices ``(n,)`` -> values and closest pairs ``(n, G)``, exact in every column with pairs."""
 Slack = Callable[[IntArray], FloatArray]
 """Sample indices ``(n,)``, increasing -> ``(n - 1,)`` bounds on the motion between neighbours [m]."""
+IntervalSpeed = Callable[[FloatArray], FloatArray]
+"""Sample times ``(K,)`` [s] -> ``(K - 1,)`` bounds on the robot's point speed over each
+interval between them [m/s] (e.g. ``motion_radii @`` a trajectory's
+:meth:`~planning.curves.trajectory.Trajectory.speed_bounds`)."""
 
 
 @dataclass(frozen=True)
@@ -76,6 +85,20 @@ class FineGrid:
     values: FloatArray
     closest: IntArray
     slack: FloatArray
+
+
+def interval_motion(
+    times: FloatArray, point_speed: float, interval_speed: IntervalSpeed | None
+) -> FloatArray:
+    """``(K - 1,)`` how far any robot point may move between neighbouring ``times`` [m].
+
+    ``point_speed`` bounds the speed on the whole curve [m/s]; ``interval_speed``, when
+    given, per interval; the lower of the two counts.
+    """
+    speed = np.full(len(times) - 1, float(point_speed))
+    if interval_speed is not None and len(times) > 1:
+        speed = np.minimum(speed, interval_speed(times))
+    return np.asarray(speed * np.diff(times))
 
 
 def fine_slack(times: FloatArray, speed: float, interval_speed: IntervalSpeed | None) -> tuple[Slack, float]:

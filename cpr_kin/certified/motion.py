@@ -24,8 +24,7 @@ from functools import partial
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from cpr_kin.certified.coarse_first import GridSampler, coarse_first, fine_slack
-from cpr_kin.certified.interval_motion import IntervalSpeed
+from cpr_kin.certified.coarse_first import GridSampler, IntervalSpeed, coarse_first, fine_slack
 from cpr_kin.collision.clearance import BatchClearance
 from cpr_kin.collision.decisive import (
     Stop,
@@ -134,7 +133,7 @@ def check_curve(
         margin_m: required clearance [m].
         step_m: largest robot motion between two checks [m].
         interval_speed: bounds on the robot's point speed over each interval between the
-            sample times (:data:`cpr_kin.certified.interval_motion.IntervalSpeed`); each interval's
+            sample times (:data:`cpr_kin.certified.coarse_first.IntervalSpeed`); each interval's
             certified bound uses the lower of it and ``speed_bound``'s. The samples are
             those of ``speed_bound``.
         stop: asked between the check's pieces of work (:data:`cpr_kin.collision.decisive.Stop`).

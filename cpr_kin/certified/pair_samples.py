@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from cpr_kin.certified.interval_motion import IntervalSpeed
+from cpr_kin.certified.coarse_first import IntervalSpeed
 from cpr_kin.collision.decisive import (
     Stop,
     below_coal,
