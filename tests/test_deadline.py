@@ -27,7 +27,7 @@ from planning.pipeline.planner import plan
 from planning.pipeline.problem import build_problem
 from planning.pipeline.scene import Scene
 from planning.pipeline.search import search
-from planning.pipeline.seeding import Attempt
+from planning.pipeline.seeding import SEEDINGS, Attempt
 from planning.pipeline.settings import PlannerSettings
 from planning.pipeline.verification import STOPPED
 from planning.search.firefly import firefly_minimize
@@ -125,6 +125,31 @@ def test_the_hulls_share_of_a_limit_is_cut_where_the_plan_is(monkeypatch: pytest
     hulls, whole = deadlines[0]
     assert hulls.limit_s == 600.0 * HULLS_SHARE and whole.limit_s == 600.0
     assert hulls.at_s < whole.at_s and hulls.cut_at_s == whole.cut_at_s == whole.at_s + 150.0
+    assert hulls.feasible_at_s == whole.at_s and whole.feasible_at_s is None  # a feasible search's end
+
+
+def test_a_deadline_for_a_search_holding_a_feasible_candidate() -> None:
+    share = Deadline(0.0, 1.0, feasible_at_s=np.inf)  # a share passed; the plan's own deadline never
+    assert share.passed() and not share.passed(feasible=True)
+    assert Deadline(0.0, 1.0).passed(feasible=True)  # no share: the same deadline either way
+    assert Deadline(np.inf, 1.0, feasible_at_s=0.0).passed(feasible=True)
+
+
+def test_a_share_past_its_end_stops_only_a_search_that_found_nothing_feasible(robot: ck.Robot) -> None:
+    """Past the hulls' share of a limit, a search whose objective has seen a feasible candidate
+    refines it on to the plan's own deadline; one that has not stops after its first batch."""
+    scene = dataclasses.replace(paper_scene(), planner=PlannerSettings(seed=3))
+    problem = build_problem(scene, robot)
+    attempt = SEEDINGS[scene.planner.seeding].first(problem)
+    assert attempt.feasible_seed  # the oracle: the search holds a feasible candidate from its seeds
+
+    def searched(deadline: Deadline) -> int:
+        late = dataclasses.replace(attempt, problem=dataclasses.replace(problem, deadline=deadline))
+        return search(late, None, None).evaluations
+
+    seeds = len(attempt.seeds) if attempt.seeds is not None else 0
+    assert searched(Deadline(0.0, 1.0)) == seeds  # time up: the seeds evaluated, nothing refined
+    assert searched(Deadline(0.0, 1.0, feasible_at_s=np.inf)) > seeds  # the share passed: refined on
 
 
 def test_rrt_connect_stops_without_a_path() -> None:
@@ -188,7 +213,7 @@ def test_past_the_limit_the_last_resort_is_not_run(robot: ck.Robot, monkeypatch:
     followed: list[int] = []
 
     class SpentAfterTheChoice(Deadline):
-        def passed(self) -> bool:
+        def passed(self, feasible: bool = False) -> bool:
             return bool(chosen)
 
     def counted(calls: list[int], function: Callable[..., Any]) -> Callable[..., Any]:

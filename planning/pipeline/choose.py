@@ -31,7 +31,8 @@ the deepest sample instead).
 Once the problem's deadline has passed, no further timing is tried after one that failed:
 past its time limit a plan verifies only the timing in hand (the best's first, at least),
 and a certified check still under way where the deadline cuts it stops there, refused
-(:mod:`planning.pipeline.deadline`).
+(:mod:`planning.pipeline.deadline`). With a feasible best, the deadline is a search's that
+found one (:attr:`~planning.pipeline.deadline.Deadline.feasible_at_s`: on the hulls, the plan's own).
 """
 
 from __future__ import annotations
@@ -235,14 +236,15 @@ def choose(problem: Problem, searched: SearchResult, deepest: str | None) -> Cho
         cause = f"no candidate was feasible; the best: {deepest}, {why}"
         return Refusal(cause, unchecked(problem.scene.safety_margin, problem.scene.planner.verify_step_m))
     # an infeasible best is verified first, whatever its foresight: its check says why
-    foresee = bool(objective.feasible(searched.fitness)) and not problem.deadline.passed()
+    has_feasible = bool(objective.feasible(searched.fitness))
+    foresee = has_feasible and not problem.deadline.passed(feasible=has_feasible)
     for k, timing in _attempts(problem, candidates, timed, foresee):
         verification = verify(problem, timing.trajectory, timing.fit)
         verified.setdefault(k, verification)
         if verification.accepted:
             x = candidates[k]
             return Choice(x, objective.nodes(x[None])[0], timing, verification, len(timed))
-        if deepest is not None or problem.deadline.passed():
+        if deepest is not None or problem.deadline.passed(feasible=has_feasible):
             break  # its other timings follow the same path; or time is up
     first = verified.get(0) or next(iter(verified.values()))  # candidates is never empty
     found = f"the best candidate {'; '.join(first.problems)}"

@@ -61,11 +61,16 @@ class Deadline:
         at_s: the clock's reading at which time is up [s].
         limit_s: the limit it was set from [s] (``None``: none), for messages.
         cut_at_s: the clock's reading at which a certified check still under way is stopped [s].
+        feasible_at_s: the clock's reading at which time is up for a search that holds a
+            feasible candidate [s] (``None``: :attr:`at_s`). A share of a plan's limit (the
+            hulls', :mod:`planning.pipeline.hulls_first`) bounds how long a search looks for
+            one; a search that found one refines it on to the plan's own deadline.
     """
 
     at_s: float = math.inf
     limit_s: float | None = None
     cut_at_s: float = math.inf
+    feasible_at_s: float | None = None
 
     @classmethod
     def after(cls, limit_s: float | None, started_s: float) -> Deadline:
@@ -79,9 +84,13 @@ class Deadline:
         start_s = started_s - compile_seconds()
         return cls(start_s + limit_s, limit_s, start_s + limit_s + overrun_s(limit_s))
 
-    def passed(self) -> bool:
-        """Whether time is up."""
-        return self.at_s != math.inf and clock_s() >= self.at_s
+    def passed(self, feasible: bool = False) -> bool:
+        """Whether time is up; ``feasible``: for a search that holds a feasible candidate.
+
+        Such a search runs to :attr:`feasible_at_s` where it is set.
+        """
+        at_s = self.feasible_at_s if feasible and self.feasible_at_s is not None else self.at_s
+        return at_s != math.inf and clock_s() >= at_s
 
     @property
     def stop(self) -> Callable[[], bool] | None:

@@ -5,7 +5,9 @@ collision model decides on the mesh, which costs triangle queries; the hulls con
 meshes, so a trajectory certified on them is certified on the meshes too, and they ask coal
 no triangle query. :func:`~planning.pipeline.planner.solve` therefore plans a problem whose
 start and goal keep the margins on the hulls there first (:func:`on_hulls`), with
-:data:`HULLS_SHARE` of the samples and of a time limit; where that finds no trajectory, the
+:data:`HULLS_SHARE` of the samples and of a time limit to find a feasible candidate (one
+found is refined and chosen on to the plan's own limit,
+:attr:`~planning.pipeline.deadline.Deadline.feasible_at_s`); where that finds no trajectory, the
 meshes plan it in the time left, RRT-Connect going on with the trees the hulls' draw grew
 (:class:`~planning.search.rrt_trees.GrownTrees`). Why a quarter: ``docs/tuning.md``.
 """

@@ -75,7 +75,8 @@ def solve(
         hulls, problem = (dataclasses.replace(p, grown=grown) for p in (hulls, problem))
         limit_s = problem.scene.planner.time_limit_s
         share = Deadline.after(None if limit_s is None else limit_s * HULLS_SHARE, started)
-        share = dataclasses.replace(share, cut_at_s=deadline.cut_at_s)  # a check cut where the plan's are
+        # a check cut where the plan's are; a search that found a feasible candidate goes on to its end
+        share = dataclasses.replace(share, cut_at_s=deadline.cut_at_s, feasible_at_s=deadline.at_s)
         try:
             return _solved(hulls, share, started, progress, optimizer, deadline)
         except NoTrajectoryFoundError:

@@ -7,7 +7,10 @@ the CMA-ES refinement from its best within the rest of the evaluation budget,
 runs instead on the same objective and budget. Every draw comes from
 ``numpy.random.default_rng(seed)``.
 
-The planner's search asks the plan's deadline itself (:mod:`planning.pipeline.deadline`). A
+The planner's search asks the plan's deadline itself (:mod:`planning.pipeline.deadline`), as a
+search holding a feasible candidate once its objective has seen one
+(:attr:`~planning.pipeline.deadline.Deadline.feasible_at_s`: the hulls' share of a limit ends
+only a search that found none). A
 caller's optimiser knows nothing of it, so it gets the objective watched: once the deadline
 has passed, the watched objective's next call raises :class:`TimeUp` through the optimiser
 (after its first batch, so that something was evaluated), and the search returns the best
@@ -72,8 +75,12 @@ def planner_search(
     problem: Problem,
     attempt: Attempt | None = None,
     progress: Callable[[FireflyProgress], None] | None = None,
+    stop: Callable[[], bool] | None = None,
 ) -> RefinedFirefly:
-    """The planner's search for ``problem``, from ``attempt``'s seeds (module docstring)."""
+    """The planner's search for ``problem``, from ``attempt``'s seeds (module docstring).
+
+    ``stop``: asked between its iterations and generations (default: the problem's deadline).
+    """
     settings, objective = problem.scene.planner, problem.objective
     return RefinedFirefly(
         firefly=settings.firefly,
@@ -84,7 +91,7 @@ def planner_search(
         lower_bound=objective.lower_bound if settings.refine == "cma" else None,
         progress=progress,
         explore=explores(attempt, settings.tuning),
-        stop=problem.deadline.passed,
+        stop=stop or problem.deadline.passed,
     )
 
 
@@ -121,9 +128,14 @@ def search(
     objective, settings = problem.objective, problem.scene.planner
     rng = np.random.default_rng(settings.seed)
     budget = settings.firefly.evaluations
-    if optimizer is None:
-        return planner_search(problem, attempt, progress)(
-            objective, objective.lower, objective.upper, budget, rng
+    if optimizer is None:  # stopped by the deadline of a search with or without a feasible best
+        seen = WatchedObjective(objective, lambda: False)
+
+        def stop() -> bool:
+            return problem.deadline.passed(feasible=seen.best_value <= objective.feasible_below)
+
+        return planner_search(problem, attempt, progress, stop)(
+            seen, objective.lower, objective.upper, budget, rng
         )
     watched = WatchedObjective(objective, problem.deadline.passed)
     try:
