@@ -20,7 +20,7 @@ import shutil
 import sys
 import tempfile
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -34,8 +34,10 @@ from cpr_kin.common.kernel_files import (
     kernel_folders,
     kernel_key,
     module_name,
+    part_name,
 )
 from cpr_kin.common.kernel_sources import sources_digest
+from planning.kernel_build import Export, build_parts
 
 
 def argument_spec(numba_type: Any) -> list[Any] | None:
@@ -59,72 +61,22 @@ def argument_spec(numba_type: Any) -> list[Any] | None:
 
 
 @dataclass(frozen=True)
-class Export:
-    """One compiled signature of a kernel.
-
-    Attributes:
-        key: the kernel, ``module:name``.
-        name: its name in the extension module (:func:`~cpr_kin.common.kernel_files.export_name`).
-        signature: numba's signature of it.
-        function: the kernel's Python function.
-    """
-
-    key: str
-    name: str
-    signature: Any
-    function: Callable[..., Any]
-
-
-@dataclass(frozen=True)
 class Build:
     """What a build compiled.
 
     Attributes:
-        module: the extension module's path.
-        compiled: the kernels compiled into it, ``module:name`` each.
+        module: the path of its first extension module.
+        parts: its extension modules, the first and the others beside it.
+        compiled: the kernels compiled into them, ``module:name`` each.
         uncalled: kernels the warm-up never called from Python: left to numba, if ever so called.
         uncompilable: kernels ``pycc`` could not compile: left to numba.
     """
 
     module: Path
+    parts: int
     compiled: tuple[str, ...]
     uncalled: tuple[str, ...]
     uncompilable: tuple[str, ...]
-
-
-def build_module(
-    name: str, exports: Sequence[Export], folder: Path, compiler: Callable[[str], Any]
-) -> list[str]:
-    """Compile ``exports`` into the extension module ``name`` in ``folder``; the kernels it left out.
-
-    ``compiler`` is numba's ``pycc.CC``. It compiles a module's exports together, and one it
-    cannot compile fails them all: then each kernel is compiled alone, into a module that is
-    thrown away, and the module is built without those that fail (numba compiles them just in
-    time, as without a build).
-    """
-
-    def compile_into(chosen: Sequence[Export], module: str, output: Path) -> None:
-        build = compiler(module)
-        build.target_cpu = "host"
-        build.output_dir = str(output)
-        for export in chosen:
-            build.export(export.name, export.signature)(export.function)
-        build.compile()
-
-    try:
-        compile_into(exports, name, folder)
-        return []
-    except Exception:  # numba's typing or lowering, or the C compiler: its errors share no base class
-        pass
-    failed = []
-    for key in dict.fromkeys(export.key for export in exports):
-        with tempfile.TemporaryDirectory(dir=folder) as alone:
-            try:
-                compile_into([e for e in exports if e.key == key], f"{name}_alone", Path(alone))
-            except Exception:
-                failed.append(key)
-    compile_into([e for e in exports if e.key not in failed], name, folder)
-    return failed
 
 
 def compile_kernels(folder: Path, warm: Callable[[], object]) -> Build:
@@ -160,19 +112,31 @@ def compile_kernels(folder: Path, warm: Callable[[], object]) -> Build:
             uncalled.append(key)
     folder.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=folder) as scratch:
-        failed = build_module(name, exports, Path(scratch), CC)
+        failed, parts = build_parts(name, exports, Path(scratch), CC, parts=cores())
         signatures = {key: specs for key, specs in signatures.items() if key not in failed}
+        for stale in folder.glob(f"{name}_part*"):  # an earlier build's parts: all of them replaced
+            stale.unlink(missing_ok=True)
+        for part in reversed(range(parts)):  # the first part last: the build is whole once it is there
+            os.replace(
+                Path(scratch) / f"{part_name(name, part)}{SUFFIX}",
+                folder / f"{part_name(name, part)}{SUFFIX}",
+            )
         module = folder / f"{name}{SUFFIX}"
-        os.replace(Path(scratch) / f"{name}{SUFFIX}", module)
         (Path(scratch) / "signatures.json").write_text(json.dumps(signatures, indent=1))
         os.replace(Path(scratch) / "signatures.json", folder / f"{name}.json")
         codes = Kernels(None, signatures).guard_codes(compiled._KERNELS)  # compiled here, not in each process
         write_codes(Path(scratch) / "guards", codes)
         os.replace(Path(scratch) / "guards", folder / guards_file(name))
-    for older in folder.glob(f"cpr_kernels_*_{host_key()}.*"):  # other kernel files: never loaded again
+    for older in folder.glob(f"cpr_kernels_*_{host_key()}*"):  # other kernel files: never loaded again
         if not older.name.startswith(name):
             older.unlink(missing_ok=True)
-    return Build(module, tuple(signatures), tuple(uncalled), tuple(failed))
+    return Build(module, parts, tuple(signatures), tuple(uncalled), tuple(failed))
+
+
+def cores() -> int:
+    """The cores this process may run on, at most four: the build's parts, compiled at once."""
+    usable = os.sched_getaffinity(0) if hasattr(os, "sched_getaffinity") else range(os.cpu_count() or 1)
+    return max(1, min(4, len(usable)))
 
 
 def default_robots() -> list[tuple[Path, Path | None]]:
@@ -241,8 +205,8 @@ def main(argv: list[str] | None = None) -> int:
         )
         return 2
     built = load_kernels()
-    if built is not None and built.module is not None and not args.force:
-        print(f"the kernels compiled ahead of time are up to date: {built.module.__file__}")
+    if built is not None and built.path is not None and not args.force:
+        print(f"the kernels compiled ahead of time are up to date: {built.path}")
         return 0
     os.environ[MODE_VARIABLE] = "jit"  # the warm-up must run numba's dispatchers, whose types are compiled
 
@@ -264,7 +228,10 @@ def main(argv: list[str] | None = None) -> int:
         os.environ["NUMBA_CACHE_DIR"] = cold
         build = compile_kernels(writable_folder(), warm)
     seconds = time.perf_counter() - started
-    print(f"{len(build.compiled)} kernels compiled ahead of time into {build.module} in {seconds:.0f} s")
+    beside = {1: "", 2: " and 1 part beside it"}.get(build.parts, f" and {build.parts - 1} parts beside it")
+    print(
+        f"{len(build.compiled)} kernels compiled ahead of time into {build.module}{beside} in {seconds:.0f} s"
+    )
     if build.uncompilable:
         print(f"pycc could not compile these, left to numba: {', '.join(build.uncompilable)}")
     if build.uncalled:

@@ -19,10 +19,12 @@ import numpy as np
 import pytest
 from numba.core import types
 
-from cpr_kin.common.ahead import MODE_VARIABLE, Kernels, kept_codes, load_kernels, write_codes
+from cpr_kin.common import ahead
+from cpr_kin.common.ahead import MODE_VARIABLE, Kernels, kept_codes, kernels_in, load_kernels, write_codes
 from cpr_kin.common.kernel_files import FOLDER_VARIABLE, SUFFIX, export_name, module_name
 from cpr_kin.common.kernel_sources import sources_digest
-from planning.ahead_of_time import Export, argument_spec, build_module
+from planning.ahead_of_time import argument_spec, cores
+from planning.kernel_build import Export, build_module, build_parts, split_by_kernel
 
 ROOT = Path(__file__).resolve().parents[1]
 BUILT_VARIABLE = "CPR_TEST_BUNDLED_KERNELS"
@@ -47,7 +49,7 @@ def guarded(specs: list[list[Any]]) -> tuple[Any, list[str]]:
         return kernel
 
     module = SimpleNamespace(**{export_name(__name__, "kernel", 0): lambda *args: "export"})
-    kernels = Kernels(module, {f"{__name__}:kernel": [specs]})  # type: ignore[arg-type]
+    kernels = Kernels(module, {f"{__name__}:kernel": [specs]})
     return kernels.guarded(kernel, fallback), asked
 
 
@@ -109,7 +111,7 @@ def test_a_default_argument_is_the_kernels() -> None:
 
 
 def test_a_kernel_without_an_export_always_falls_back() -> None:
-    kernels = Kernels(SimpleNamespace(), {})  # type: ignore[arg-type]
+    kernels = Kernels(SimpleNamespace(), {})
     assert kernels.guarded(kernel, lambda: kernel)(np.ones((3, 2)), 0.5, True) == "python"
 
 
@@ -135,11 +137,11 @@ def test_a_guard_runs_the_code_the_build_kept_where_its_source_is_the_same(tmp_p
     kept = kept_codes(tmp_path / "guards")
     assert kept.keys() == codes.keys() and kept[key][0] == source
 
-    guard = Kernels(module, specs, kept).guarded(kernel, lambda: kernel)  # type: ignore[arg-type]
+    guard = Kernels(module, specs, kept).guarded(kernel, lambda: kernel)
     assert any(c is guard.__code__ for c in nested_codes(kept[key][1]))  # the kept code, not compiled again
     assert guard(np.ones((3, 2)), 0.5, True) == "export" and guard(np.ones(3), 0.5, True) == "python"
     stale = {key: ("def _make(): pass", kept[key][1])}  # kept for another source: compiled afresh
-    guard = Kernels(module, specs, stale).guarded(kernel, lambda: kernel)  # type: ignore[arg-type]
+    guard = Kernels(module, specs, stale).guarded(kernel, lambda: kernel)
     assert not any(c is guard.__code__ for c in nested_codes(kept[key][1]))
     assert guard(np.ones((3, 2)), 0.5, True) == "export"
 
@@ -269,7 +271,7 @@ def test_kernels_compiled_ahead_plan_the_bits_numba_plans_without_numba(tmp_path
     if os.environ.get(BUILT_VARIABLE):
         built_in, name = Path(os.environ[BUILT_VARIABLE]), module_name(sources_digest())
         assert (built_in / f"{name}{SUFFIX}").is_file(), f"{built_in} holds no build of today's sources"
-        for file in built_in.glob(f"{name}.*"):
+        for file in built_in.glob(f"{name}*"):  # its parts too
             shutil.copy2(file, tmp_path)
     else:
         built = run(["-m", "planning.ahead_of_time", "--bundled-only"], ahead)
@@ -277,8 +279,9 @@ def test_kernels_compiled_ahead_plan_the_bits_numba_plans_without_numba(tmp_path
     assert run(["-m", "planning.ahead_of_time", "--bundled-only"], ahead)[0].startswith(
         "the kernels compiled ahead of time are up to date"
     )
-    (module,) = tmp_path.glob("cpr_kernels_*.so")
-    signatures = json.loads(module.with_name(module.name.split(".")[0] + ".json").read_text())
+    assert len(list(tmp_path.glob("cpr_kernels_*.so"))) == cores()  # one part per core, at most four
+    (signatures_file,) = tmp_path.glob("cpr_kernels_*.json")
+    signatures = json.loads(signatures_file.read_text())
     assert "cpr_kin.bounds.bound_kernels:groups_below" in signatures
     (guards,) = tmp_path.glob("cpr_kernels_*.guards")  # their code, compiled by the build
     assert signatures.keys() <= kept_codes(guards).keys()
@@ -377,3 +380,55 @@ def test_a_build_leaves_out_the_kernels_pycc_cannot_compile_and_compiles_the_res
     good = [e for e in exports if e.key != "m:bad"]
     assert build_module("cpr_kernels_y", good, tmp_path, FakeCompiler) == []
     assert len(FakeCompiler.modules) == 1  # compiled once where all compile
+
+
+def test_the_exports_are_dealt_into_parts_each_kernel_whole() -> None:
+    exports = [Export(f"m:k{k}", f"m__k{k}__{i}", None, kernel) for k in range(5) for i in range(k % 3 + 1)]
+    for parts in (1, 2, 3, 4, 7):
+        split = split_by_kernel(exports, parts)
+        assert len(split) == min(parts, 5) and all(split)  # no empty part
+        assert sorted(e.name for part in split for e in part) == sorted(e.name for e in exports)
+        kernels = [{e.key for e in part} for part in split]
+        assert sum(map(len, kernels)) == 5  # a kernel's signatures in one part
+        assert max(map(len, kernels)) - min(map(len, kernels)) <= 1
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the parts are compiled at once on Linux")
+def test_a_build_in_parts_compiles_each_in_its_own_process_and_says_what_they_left_out(
+    tmp_path: Path,
+) -> None:
+    exports = [
+        Export(f"m:{k}", f"m__{k}__{i}", None, kernel)
+        for k, i in [("good", 0), ("bad", 0), ("good", 1), ("also", 0)]
+    ]
+    FakeCompiler.modules = []
+    assert build_parts("cpr_kernels_x", exports, tmp_path, FakeCompiler, parts=2) == (["m:bad"], 2)
+    assert (tmp_path / "cpr_kernels_x.so").read_text() == "m__good__0 m__good__1 m__also__0"
+    assert (tmp_path / "cpr_kernels_x_part1.so").read_text() == ""  # its one kernel left out
+    assert FakeCompiler.modules == []  # compiled in other processes
+
+    class Broken(FakeCompiler):
+        def compile(self) -> None:
+            raise OSError("cc: not found")
+
+    with pytest.raises(RuntimeError, match=r"(?s)could not be compiled.*cc: not found"):
+        build_parts("cpr_kernels_y", exports, tmp_path, Broken, parts=2)
+
+
+def test_a_build_in_parts_loads_as_one_and_a_missing_part_is_no_build(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(ahead, "SUFFIX", ".py")  # Python files standing in for the extension modules
+    name = "cpr_kernels_x"
+    (tmp_path / f"{name}.json").write_text(
+        json.dumps({"m:a": [[["float"]]], "m:b": [[["float"]], [["int"]]]})
+    )
+    (tmp_path / f"{name}.py").write_text(f"{export_name('m', 'a', 0)} = 'a0'\n")
+    part = tmp_path / f"{name}_part1.py"
+    part.write_text(f"{export_name('m', 'b', 0)} = 'b0'\n{export_name('m', 'b', 1)} = 'b1'\n")
+    kernels = kernels_in(tmp_path, name)
+    assert kernels is not None and kernels.path == tmp_path / f"{name}.py"
+    loaded = [getattr(kernels.module, export_name("m", k, i)) for k, i in [("a", 0), ("b", 0), ("b", 1)]]
+    assert loaded == ["a0", "b0", "b1"]
+    part.unlink()
+    assert kernels_in(tmp_path, name) is None  # its signatures name exports no module holds

@@ -1,11 +1,11 @@
-"""The kernels compiled ahead of time: one extension module, loaded without numba.
+"""The kernels compiled ahead of time: extension modules, loaded without numba.
 
 A new process that calls a numba kernel pays for numba before the kernel's own code runs,
 cached or not: its import and its first dispatch (its typing and lowering registries, and
 SciPy's linear algebra, which it probes for BLAS), then each cached kernel's load
 (docs/benchmarks.md: the new-process row). ``python -m planning.ahead_of_time`` compiles every
-kernel a warm-up calls, with the argument types it calls them with, into one extension module
-(numba's ``pycc``) and writes beside it what those types are (:class:`Kernels`).
+kernel a warm-up calls, with the argument types it calls them with, into extension modules
+(numba's ``pycc``, one part per core) and writes beside them what those types are (:class:`Kernels`).
 
 Here each kernel is a guard: its arguments are checked against each compiled signature, as
 numba's dispatcher would type them (an array's dtype, dimensions, layout and writability; a
@@ -21,12 +21,13 @@ from __future__ import annotations
 import functools
 import importlib.util
 import inspect
+import itertools
 import json
 import marshal
 import os
 from collections.abc import Callable, Iterable
 from pathlib import Path
-from types import CodeType, ModuleType
+from types import CodeType, SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -38,6 +39,7 @@ from cpr_kin.common.kernel_files import (
     kernel_folders,
     kernel_key,
     module_name,
+    part_name,
 )
 from cpr_kin.common.kernel_sources import sources_digest
 
@@ -46,24 +48,27 @@ MODE_VARIABLE = "CPR_KERNELS"
 
 
 class Kernels:
-    """The extension module of compiled kernels and, per kernel, the argument types of each export.
+    """The compiled kernels' exports and, per kernel, the argument types of each export.
 
     Args:
-        module: the extension module (``None`` where only the guards' code is made, by the build).
+        module: the exports as attributes, those of the build's extension modules (``None`` where
+            only the guards' code is made, by the build).
         signatures: ``{"module:name": [argument specs of export 0, of export 1, ...]}``; a spec
             is ``["array", dtype, ndim, layout, readonly]``, ``["float"]``, ``["int"]``,
             ``["bool"]`` or ``["tuple", [item specs]]``.
         codes: ``{"module:name": (source, code)}``, guards compiled before
             (:meth:`guard_codes`), used where their source is the one to compile.
+        path: the build's first extension module, where loaded from one.
     """
 
     def __init__(
         self,
-        module: ModuleType | None,
+        module: object | None,
         signatures: dict[str, list[list[Any]]],
         codes: dict[str, tuple[str, CodeType]] | None = None,
+        path: Path | None = None,
     ) -> None:
-        self.module, self.signatures, self.codes = module, signatures, codes or {}
+        self.module, self.signatures, self.codes, self.path = module, signatures, codes or {}, path
 
     def guarded(
         self, function: Callable[..., Any], fallback: Callable[[], Callable[..., Any]]
@@ -229,18 +234,33 @@ def load_kernels(folders: list[Path] | None = None) -> Kernels | None:
 
 
 def kernels_in(folder: Path, name: str) -> Kernels | None:
-    """The module ``name`` in ``folder``, its signatures and its guards' code; ``None``: not loadable."""
+    """The build ``name`` in ``folder``, its signatures and its guards' code; ``None``: not loadable.
+
+    Its extension modules (``name`` and its other parts, :func:`~cpr_kin.common.kernel_files.part_name`)
+    are loaded into one namespace, which must hold every export its signatures name.
+    """
     path, signatures = folder / f"{name}{SUFFIX}", folder / f"{name}.json"
     if not (path.is_file() and signatures.is_file()):
         return None
     try:
-        spec = importlib.util.spec_from_file_location(name, path)
-        if spec is None or spec.loader is None:
+        exports = SimpleNamespace()
+        for part in itertools.count():
+            file = folder / f"{part_name(name, part)}{SUFFIX}"
+            if not file.is_file():
+                break
+            spec = importlib.util.spec_from_file_location(part_name(name, part), file)
+            if spec is None or spec.loader is None:
+                return None
+            module = importlib.util.module_from_spec(spec)
+            spec.loader.exec_module(module)
+            vars(exports).update(vars(module))
+        specs = json.loads(signatures.read_text())
+        kernels = [key.partition(":") for key in specs]
+        named = (export_name(m, k, i) for m, _, k in kernels for i in range(len(specs[f"{m}:{k}"])))
+        if not all(hasattr(exports, export) for export in named):  # a part missing: no build
             return None
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-        return Kernels(module, json.loads(signatures.read_text()), kept_codes(folder / guards_file(name)))
-    except (ImportError, OSError, ValueError):
+        return Kernels(exports, specs, kept_codes(folder / guards_file(name)), path)
+    except (ImportError, OSError, ValueError, TypeError):
         return None
 
 

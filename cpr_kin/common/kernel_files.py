@@ -1,9 +1,10 @@
 """Where the kernels compiled ahead of time are, and what their files are called.
 
-One build (:mod:`planning.ahead_of_time`) writes three files into the first writable of
+One build (:mod:`planning.ahead_of_time`) writes its files into the first writable of
 :func:`kernel_folders`, each named after the kernel files' digest and the machine's CPU
-(:func:`module_name`): the extension module, its signatures (``.json``) and its guards' code
-(:func:`guards_file`); :mod:`cpr_kin.common.ahead` loads them.
+(:func:`module_name`): the extension module (and its other parts, :func:`part_name`), its
+signatures (``.json``) and its guards' code (:func:`guards_file`); :mod:`cpr_kin.common.ahead`
+loads them.
 """
 
 from __future__ import annotations
@@ -39,6 +40,14 @@ def host_key() -> str:
         lines = Path("/proc/cpuinfo").read_text().splitlines()
         described += "".join(sorted({line for line in lines if line.startswith(("model name", "flags"))}))
     return hashlib.sha256(described.encode()).hexdigest()[:8]
+
+
+def part_name(module: str, part: int) -> str:
+    """The name of part ``part`` of the build ``module`` (:func:`module_name`); part 0 is ``module``.
+
+    A build may compile its kernels into several extension modules at once, one per core.
+    """
+    return module if part == 0 else f"{module}_part{part}"
 
 
 def guards_file(module: str) -> str:
