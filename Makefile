@@ -19,7 +19,7 @@ EXTRAS := dev,bench,robots
 # trajectory optimisation; its RRT needs none of that: it is installed without its pins
 PYROBOPLAN := pyroboplan>=1.3.1
 
-.PHONY: bytecode kernels demo test test-fast lint format wheel-check test-latest lock bench bench-peers import-mbm bench-mbm bench-torque clean
+.PHONY: bytecode kernels chromium demo test test-fast lint format wheel-check test-latest lock bench bench-peers import-mbm bench-mbm bench-torque clean
 
 $(STAMP): pyproject.toml $(CONSTRAINTS)
 	$(PYTHON) -m venv $(VENV)
@@ -47,8 +47,11 @@ kernels: bytecode
 demo: kernels
 	$(PY) scripts/paper_case.py
 
-test: bytecode
+# the viewer test renders the exported page in a real Chromium: installed where missing
+chromium:
 	@sh scripts/ensure_chromium.sh
+
+test: bytecode chromium
 	$(PY) -m pytest --numprocesses auto --maxprocesses 2
 
 test-fast: bytecode
