@@ -4,6 +4,7 @@
 # Both install the exact versions of requirements/constraints.txt (tested together); the
 # minimum versions a library user needs stay in pyproject.toml.
 #   make lint          ruff and mypy
+#   make jit-cache     numba's disk cache filled (the tests then load the kernels, not compile them)
 #   make wheel-check   build the wheel, install it into a fresh venv, run the CLI and the paper case there
 #   make test-latest   the tests against the newest releases (.venv-latest), and which versions moved
 #   make lock          rewrite requirements/constraints.txt from the newest releases
@@ -19,7 +20,7 @@ EXTRAS := dev,bench,robots
 # trajectory optimisation; its RRT needs none of that: it is installed without its pins
 PYROBOPLAN := pyroboplan>=1.3.1
 
-.PHONY: bytecode kernels chromium demo test test-fast lint format wheel-check test-latest lock bench bench-peers import-mbm bench-mbm bench-torque clean
+.PHONY: bytecode kernels jit-cache chromium demo test test-fast lint format wheel-check test-latest lock bench bench-peers import-mbm bench-mbm bench-torque clean
 
 $(STAMP): pyproject.toml $(CONSTRAINTS)
 	$(PYTHON) -m venv $(VENV)
@@ -46,6 +47,12 @@ kernels: bytecode
 
 demo: kernels
 	$(PY) scripts/paper_case.py
+
+# numba's disk cache filled by the build's warm-up, just in time (no C compiler needed): the tests
+# run numba's dispatchers, which then load these kernels rather than compile them (CI runs it
+# beside the wheel's check, on the core that check leaves idle)
+jit-cache: bytecode
+	CPR_KERNELS=jit $(PY) -m planning.ahead_of_time --just-in-time
 
 # the viewer test renders the exported page in a real Chromium: installed where missing
 chromium:

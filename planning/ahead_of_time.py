@@ -161,6 +161,23 @@ def default_robots() -> list[tuple[Path, Path | None]]:
     return [(urdf, srdf) for urdf, srdf in robots if urdf.is_file()]
 
 
+def _warm_robots(urdfs: list[Path], srdfs: list[Path], bundled_only: bool) -> None:
+    """The warm-up on the bundled CPR, then on each robot given, or on :func:`default_robots`.
+
+    ``urdfs`` and ``srdfs`` are given in the robots' order; where none is given, the default
+    robots are warmed on unless ``bundled_only``.
+    """
+    import cpr_kin as ck
+    from planning.warming import warm_up
+
+    warm_up()
+    robots = [(urdf, srdfs[i] if i < len(srdfs) else None) for i, urdf in enumerate(urdfs)]
+    if not robots and not bundled_only:
+        robots = default_robots()
+    for urdf, srdf in robots:
+        warm_up(ck.load_robot(urdf, srdf=srdf))
+
+
 def writable_folder() -> Path:
     """The first folder of :func:`~cpr_kin.common.kernel_files.kernel_folders` this process may write in."""
     for folder in kernel_folders():
@@ -190,7 +207,18 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--bundled-only", action="store_true", help="warm up on the bundled CPR alone, not the default arms"
     )
+    parser.add_argument(
+        "--just-in-time",
+        action="store_true",
+        help="only run the warm-up, numba compiling into its disk cache (no C compiler needed)",
+    )
     args = parser.parse_args(argv)
+    if args.just_in_time:  # the kernels numba will load, not compile, in the processes that run it
+        os.environ[MODE_VARIABLE] = "jit"
+        started = time.perf_counter()
+        _warm_robots(args.robot, args.srdf, args.bundled_only)
+        print(f"the kernels are in numba's disk cache ({time.perf_counter() - started:.0f} s)")
+        return 0
     if shutil.which(os.environ.get("CC", "cc")) is None and shutil.which("gcc") is None:
         print(
             "error: no C compiler (cc or gcc) on the PATH: the kernels stay compiled just in time",
@@ -210,23 +238,14 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     os.environ[MODE_VARIABLE] = "jit"  # the warm-up must run numba's dispatchers, whose types are compiled
 
-    def warm() -> None:
-        import cpr_kin as ck
-        from planning.warming import warm_up
-
-        warm_up()
-        robots = [(urdf, args.srdf[i] if i < len(args.srdf) else None) for i, urdf in enumerate(args.robot)]
-        if not robots and not args.bundled_only:
-            robots = default_robots()
-        for urdf, srdf in robots:
-            warm_up(ck.load_robot(urdf, srdf=srdf))
-
     started = time.perf_counter()
     with tempfile.TemporaryDirectory() as cold:
         # numba compiles afresh, not from its disk cache: a kernel loaded from there does not
         # compile the kernels it calls, whose types then go unseen and unexported
         os.environ["NUMBA_CACHE_DIR"] = cold
-        build = compile_kernels(writable_folder(), warm)
+        build = compile_kernels(
+            writable_folder(), lambda: _warm_robots(args.robot, args.srdf, args.bundled_only)
+        )
     seconds = time.perf_counter() - started
     beside = {1: "", 2: " and 1 part beside it"}.get(build.parts, f" and {build.parts - 1} parts beside it")
     print(

@@ -432,3 +432,21 @@ def test_a_build_in_parts_loads_as_one_and_a_missing_part_is_no_build(
     assert loaded == ["a0", "b0", "b1"]
     part.unlink()
     assert kernels_in(tmp_path, name) is None  # its signatures name exports no module holds
+
+
+def test_just_in_time_only_fills_numbas_cache_and_needs_no_c_compiler(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from planning import ahead_of_time
+
+    warmed: list[tuple[list[Path], list[Path], bool, str]] = []
+
+    def warm(urdfs: list[Path], srdfs: list[Path], bundled_only: bool) -> None:
+        warmed.append((urdfs, srdfs, bundled_only, os.environ[MODE_VARIABLE]))
+
+    monkeypatch.setattr(ahead_of_time, "_warm_robots", warm)
+    monkeypatch.setattr(shutil, "which", lambda name: None)  # no C compiler: none needed
+    monkeypatch.setenv(MODE_VARIABLE, "ahead")
+    assert ahead_of_time.main(["--just-in-time", "--robot", "arm.urdf", "--srdf", "arm.srdf"]) == 0
+    assert warmed == [([Path("arm.urdf")], [Path("arm.srdf")], False, "jit")]  # numba's dispatchers run
+    assert "the kernels are in numba's disk cache" in capsys.readouterr().out
