@@ -81,8 +81,8 @@ def split_by_kernel(exports: Sequence[Export], parts: int) -> list[list[Export]]
 
     The kernels are dealt out in turn, in their order: the parts differ by one kernel at most.
     """
-    keys = list(dict.fromkeys(export.key for export in exports))
-    dealt = [[e for e in exports if keys.index(e.key) % parts == i] for i in range(max(1, parts))]
+    turn = {key: i % max(1, parts) for i, key in enumerate(dict.fromkeys(e.key for e in exports))}
+    dealt = [[e for e in exports if turn[e.key] == i] for i in range(max(1, parts))]
     return [part for part in dealt if part]
 
 

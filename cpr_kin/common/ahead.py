@@ -255,10 +255,10 @@ def kernels_in(folder: Path, name: str) -> Kernels | None:
             spec.loader.exec_module(module)
             vars(exports).update(vars(module))
         specs = json.loads(signatures.read_text())
-        kernels = [key.partition(":") for key in specs]
-        named = (export_name(m, k, i) for m, _, k in kernels for i in range(len(specs[f"{m}:{k}"])))
-        if not all(hasattr(exports, export) for export in named):  # a part missing: no build
-            return None
+        for key, exported in specs.items():  # a part missing: no build
+            owner, _, kernel = key.partition(":")
+            if not all(hasattr(exports, export_name(owner, kernel, i)) for i in range(len(exported))):
+                return None
         return Kernels(exports, specs, kept_codes(folder / guards_file(name)), path)
     except (ImportError, OSError, ValueError, TypeError):
         return None
