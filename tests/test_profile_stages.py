@@ -72,6 +72,28 @@ def test_the_table_gives_each_stage_s_median_and_share(script: ModuleType) -> No
     assert any(line.startswith("| arm | all | 2 |") for line in lines)
 
 
+def test_the_tail_holds_each_robot_s_plans_at_or_above_its_95th_percentile(script: ModuleType) -> None:
+    stages = dict.fromkeys(script.STAGES, 0.0)
+    # 40 plans of 1..40 s over two classes: the linear 95th percentile is 1 + 0.95 * 39 = 38.05 s
+    rows = [script.Profiled("arm", ("box", "cage")[k % 2], float(k), stages, 1.0, 1.0) for k in range(1, 41)]
+    rows.append(script.Profiled("other", "box", 5.0, stages, 1.0, 1.0))  # one plan: its own tail
+    groups = script.by_class(rows)
+    assert [key for key, _ in groups] == [
+        ("arm", "cage"),  # the classes as first met (plan 1 is a cage's), then all, then the tail
+        ("arm", "box"),
+        ("arm", "all"),
+        ("arm", script.TAIL),
+        ("other", "box"),
+        ("other", "all"),
+        ("other", script.TAIL),
+    ]
+    tails = {key[0]: planned for key, planned in groups if key[1] == script.TAIL}
+    assert [row.total_s for row in tails["arm"]] == [39.0, 40.0]
+    assert [row.total_s for row in tails["other"]] == [5.0]
+    tail_row = next(line for line in script.table(rows) if line.startswith(f"| arm | {script.TAIL} |"))
+    assert tail_row.split("|")[3:5] == [" 2 ", " 39500.0 "]  # planned, median plan [ms]
+
+
 def test_a_computation_is_charged_all_it_calls_and_its_own_nested_calls_once(script: ModuleType) -> None:
     now = [0.0]
     clock = script.ComputationClock(clock=lambda: now[0])
