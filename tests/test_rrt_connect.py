@@ -11,10 +11,10 @@ import pytest
 from numpy.typing import NDArray
 
 from planning.errors import PlanningError
-from planning.search.edges import path_time
-from planning.search.rrt_connect import Relaxation, _Sampler, rrt_connect
+from planning.search.edges import ScreenedValidity, path_time, screen_of
+from planning.search.rrt_connect import Relaxation, RrtPath, rrt_connect
 from planning.search.rrt_settings import RrtSettings
-from planning.search.rrt_trees import Tree
+from planning.search.rrt_trees import Sampler, Tree
 from planning.search.waypoints import waypoints_along
 
 WEIGHTS = np.ones(2)
@@ -351,12 +351,12 @@ def test_a_relaxation_changes_nothing_before_its_samples_and_holds_at_once_for_e
 def test_the_samplers_uniform_draws_are_numpys_uniform_to_the_bit() -> None:
     # the identity the sampler's shortcut rests on: low + (high - low) * u from the same u
     lower, upper = np.array([-2.9, 0.0, 0.05, -3.1, -1e-3]), np.array([2.9, 0.6, 0.5, 3.1, 2.5])
-    sampler = _Sampler(lower, upper, dataclasses.replace(RrtSettings(), local_share=0.0))
+    sampler = Sampler(lower, upper, dataclasses.replace(RrtSettings(), local_share=0.0))
     ours, numpys = np.random.default_rng(12), np.random.default_rng(12)
     root = Tree(np.zeros(5))
     for _ in range(500):
         np.testing.assert_array_equal(sampler(root, ours), numpys.uniform(lower, upper))
-    local = _Sampler(lower, upper, dataclasses.replace(RrtSettings(), local_share=0.5))
+    local = Sampler(lower, upper, dataclasses.replace(RrtSettings(), local_share=0.5))
     ours, numpys = np.random.default_rng(13), np.random.default_rng(13)
     for _ in range(500):  # the share's coin is rng.uniform()'s number too
         drawn = local(root, ours)
@@ -366,3 +366,140 @@ def test_the_samplers_uniform_draws_are_numpys_uniform_to_the_bit() -> None:
         else:
             expected = numpys.uniform(lower, upper)
         np.testing.assert_array_equal(drawn, expected)
+
+
+class Counted:
+    """A validity that counts the configurations it checks (the expensive check of a screened one)."""
+
+    def __init__(self, valid: object) -> None:
+        self.valid, self.checked = valid, 0
+
+    def __call__(self, q: NDArray[np.float64]) -> NDArray[np.bool_]:
+        self.checked += len(q)
+        return self.valid(q)  # type: ignore[operator, no-any-return]
+
+
+def beside_the_wall(q: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """The wall with its slot, and a post off the way the screen leaves out (an arm's own pairs)."""
+    post = np.hypot(q[:, 0] - 0.8, q[:, 1] - 0.8) < 0.1
+    return np.asarray(wall_with_slot(q) & ~post)
+
+
+LAZY = RrtSettings(resolution_m=0.002, explore_resolution_m=0.05)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_trees_grown_on_a_screen_give_a_path_that_holds_under_the_validity(seed: int) -> None:
+    """The trees grow on the wall alone; the path returned also keeps off the post the screen
+    left out, held at the fine spacing, with fewer configurations checked by the validity (only
+    the path's, not every edge the trees tried)."""
+    start, goal = np.array([0.1, 0.9]), np.array([0.9, 0.1])
+    counts = []
+    for screened in (False, True):
+        full = Counted(beside_the_wall)
+        valid = ScreenedValidity(full, wall_with_slot) if screened else full
+        found = rrt_connect(valid, start, goal, LOWER, UPPER, WEIGHTS, np.random.default_rng(seed), LAZY)
+        assert found is not None
+        np.testing.assert_array_equal(found.path[[0, -1]], [start, goal])
+        assert densely_valid(found.path, eroded_beside_the_wall)
+        counts.append(full.checked)
+    assert counts[1] < counts[0]
+
+
+def eroded_beside_the_wall(q: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """The wall and the post shrunk by the fine check's spacing: an edge may clip them by less."""
+    post = np.hypot(q[:, 0] - 0.8, q[:, 1] - 0.8) < 0.1 - 0.002
+    return np.asarray(wall_with_slot(q, 0.002) & ~post)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_screened_path_through_a_way_only_the_screen_opens_is_held_under_the_validity(seed: int) -> None:
+    """The screen opens the wall's top, where the straight line runs; the validity closes it:
+    the path returned crosses in the slot."""
+    start, goal = np.array([0.1, 0.95]), np.array([0.9, 0.95])
+
+    def open_at_the_top(q: NDArray[np.float64]) -> NDArray[np.bool_]:
+        return np.asarray(wall_with_slot(q) | (q[:, 1] > 0.9))
+
+    valid = ScreenedValidity(wall_with_slot, open_at_the_top)
+    found = rrt_connect(valid, start, goal, LOWER, UPPER, WEIGHTS, np.random.default_rng(seed), LAZY)
+    assert found is not None and not found.relaxed
+    np.testing.assert_array_equal(found.path[[0, -1]], [start, goal])
+    assert densely_valid(found.path, lambda q: wall_with_slot(q, 0.002))
+
+
+def test_a_screened_relaxation_holds_its_path_under_its_validity() -> None:
+    """An end only the looser validity accepts: the trees grow on the looser one's screen, and the
+    path holds under the looser validity, not under its screen alone."""
+    in_the_wall, goal = np.array([0.46, 0.9]), np.array([0.9, 0.1])
+
+    def thinner(q: NDArray[np.float64]) -> NDArray[np.bool_]:
+        return wall_with_slot(q, shrink=0.02)
+
+    def thinner_beside_the_post(q: NDArray[np.float64]) -> NDArray[np.bool_]:
+        return np.asarray(thinner(q) & ~(np.hypot(q[:, 0] - 0.7, q[:, 1] - 0.35) < 0.1))
+
+    strict = ScreenedValidity(beside_the_wall, wall_with_slot)
+    relaxation = Relaxation(ScreenedValidity(thinner_beside_the_post, thinner), after_samples=10_000)
+    found = rrt_connect(
+        strict,
+        in_the_wall,
+        goal,
+        LOWER,
+        UPPER,
+        WEIGHTS,
+        np.random.default_rng(0),
+        LAZY,
+        relaxation=relaxation,
+    )
+    assert found is not None and found.relaxed
+
+    def eroded(q: NDArray[np.float64]) -> NDArray[np.bool_]:  # by the fine check's spacing
+        post = np.hypot(q[:, 0] - 0.7, q[:, 1] - 0.35) < 0.1 - 0.002
+        return np.asarray(wall_with_slot(q, 0.022) & ~post)
+
+    assert densely_valid(found.path, eroded)
+
+
+def test_a_validity_s_screen() -> None:
+    screened = ScreenedValidity(beside_the_wall, wall_with_slot)
+    assert screen_of(screened) is wall_with_slot and screen_of(wall_with_slot) is None
+    q = np.array([[0.8, 0.8], [0.5, 0.9]])  # on the post; in the wall
+    np.testing.assert_array_equal(screened(q), [False, False])
+    np.testing.assert_array_equal(screen_of(screened)(q), [True, False])  # type: ignore[misc]
+
+
+def test_where_a_screened_path_does_not_hold_the_coarse_draw_is_made_again_on_the_validity(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A band the screen leaves out crosses every way to the slot but at its far left: the trees
+    grown on the screen cross it anywhere; where their path's vertex lies in it, or an edge
+    through it finds no detour, the trees grow again on the validity. Every path holds."""
+    import planning.search.rrt_connect as module
+
+    def banded(q: NDArray[np.float64]) -> NDArray[np.bool_]:
+        band = (q[:, 1] > 0.5) & (q[:, 1] < 0.85) & (q[:, 0] > 0.08) & (q[:, 0] < 0.45)
+        return np.asarray(wall_with_slot(q) & ~band)
+
+    def eroded_banded(q: NDArray[np.float64]) -> NDArray[np.bool_]:
+        band = (q[:, 1] > 0.502) & (q[:, 1] < 0.848) & (q[:, 0] > 0.082) & (q[:, 0] < 0.448)
+        return np.asarray(wall_with_slot(q, 0.002) & ~band)
+
+    valid = ScreenedValidity(banded, wall_with_slot)
+    draws = []
+    original = module.rrt_connect
+
+    def counted(check: object, *args: object, **kwargs: object) -> object:
+        settings = args[6] if len(args) > 6 else None
+        if check is valid and isinstance(settings, RrtSettings) and settings.resolution_m == 0.05:
+            draws.append(check)  # a coarse draw on the validity itself
+        return original(check, *args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(module, "rrt_connect", counted)
+    start, goal = np.array([0.1, 0.9]), np.array([0.9, 0.1])
+    for seed in range(8):
+        found = counted(valid, start, goal, LOWER, UPPER, WEIGHTS, np.random.default_rng(seed), LAZY)
+        assert isinstance(found, RrtPath)
+        np.testing.assert_array_equal(found.path[[0, -1]], [start, goal])
+        assert densely_valid(found.path, eroded_banded)
+    assert draws  # some screened path did not hold

@@ -11,7 +11,8 @@ import pytest
 import cpr_kin as ck
 from planning.bench.narrow_passages import narrow_scene
 from planning.errors import PlanningError
-from planning.pipeline.path_seeds import sampled_path
+from planning.io.scene_file import parse_scene
+from planning.pipeline.path_seeds import clearance_validity, sampled_path
 from planning.pipeline.problem import Problem, build_problem, finer_step_m, with_planner
 from planning.pipeline.scene import Scene
 from planning.pipeline.seeding import PathSeeding, seed_search
@@ -19,6 +20,7 @@ from planning.pipeline.settings import PlannerSettings
 from planning.pipeline.target import Target
 from planning.pipeline.tuning import SearchTuning, SeedingTuning
 from planning.pipeline.verification import Requirements, verify_for_scene, verify_trajectory
+from planning.search.edges import ScreenedValidity, screen_of
 from planning.search.waypoints import evenly_along, placements_along, waypoints_along
 
 
@@ -481,3 +483,36 @@ def test_an_infeasible_path_seed_is_refined_without_the_firefly(robot: ck.Robot)
     assert at_once.verification.accepted and exploring.verification.accepted
     assert at_once.optimiser.evaluation_history[0] == len(attempt.seeds)  # the seeds, evaluated once
     assert exploring.optimiser.evaluation_history[0] == problem.scene.planner.firefly.fireflies
+
+
+PANDA_AT_A_POST = {
+    "robot": "panda",
+    "start": {"q": [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785]},
+    "goal": {"q": [1.2, 0.2, 0.0, -1.8, 0.0, 2.0, 0.785]},
+    "obstacles": [{"name": "post", "shape": "box", "size": [0.1, 0.1, 0.8], "xyz": [0.45, 0.35, 0.4]}],
+}
+
+
+def test_a_robot_with_pairs_of_its_own_grows_rrt_connect_s_trees_on_the_obstacles_alone() -> None:
+    """The draw's validity is the whole clearance check; its screen the obstacles' alone, which
+    accepts every configuration the check accepts and some the robot's own links refuse."""
+    problem = build_problem(parse_scene(PANDA_AT_A_POST))
+    valid = clearance_validity(problem)
+    assert isinstance(valid, ScreenedValidity)
+    objective, world = problem.objective, problem.world
+    limits = problem.robot.limits
+    moving = problem.moving
+    q = np.random.default_rng(42).uniform(limits.lower[moving], limits.upper[moving], (80, moving.size))
+    configurations = problem.configurations(q)
+    whole = world.keeps_clearance(configurations, objective.required_m, objective.required_self_m)
+    obstacles = ~world.margin_violated(configurations, objective.required_m)
+    one_by_one = np.array([[valid(row[None])[0], valid.screen(row[None])[0]] for row in q])
+    np.testing.assert_array_equal(one_by_one[:, 0], whole)
+    np.testing.assert_array_equal(one_by_one[:, 1], obstacles)
+    assert (obstacles >= whole).all() and (obstacles > whole).any()  # some the links refuse
+    found = sampled_path(problem, np.random.default_rng(0))
+    assert found is not None and valid(found.path).all()
+
+
+def test_a_robot_without_pairs_of_its_own_has_no_screen(window: Problem) -> None:
+    assert screen_of(clearance_validity(window)) is None

@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 import cpr_kin as ck
 from planning.pipeline.problem import Problem, with_planner
 from planning.pipeline.settings import MAX_WAYPOINTS, PlannerSettings
-from planning.search.edges import Validity
+from planning.search.edges import ScreenedValidity, Validity
 from planning.search.rrt_connect import Relaxation, RrtPath, rrt_connect
 from planning.search.rrt_settings import RrtSettings
 from planning.search.waypoints import placements_along
@@ -114,7 +114,10 @@ def clearance_validity(problem: Problem, kept: FinerProblem | None = None) -> Va
 
     From obstacles and between the robot's own pairs, and, with a gravity limit, can be held
     still. ``kept``: the problem whose clearance is kept (a finer one, built at the first
-    check; default: ``problem``'s own).
+    check; default: ``problem``'s own). For a robot with pairs of its own, a
+    :class:`~planning.search.edges.ScreenedValidity` whose screen is the obstacles' clearance
+    alone: RRT-Connect's trees grow on that, most of their edges thrown away, and the path
+    they find is held under the whole check (``docs/tuning.md``).
     """
 
     def valid(q: FloatArray) -> BoolArray:
@@ -126,7 +129,13 @@ def clearance_validity(problem: Problem, kept: FinerProblem | None = None) -> Va
             free[free] = problem.gravity.holds(configurations[free])
         return free
 
-    return valid
+    def obstacles_kept(q: FloatArray) -> BoolArray:
+        required_m = (problem if kept is None else kept()).objective.required_m
+        return ~problem.world.margin_violated(problem.configurations(q), required_m, ordered=True)
+
+    if not problem.world.self_collision:
+        return valid
+    return ScreenedValidity(valid, obstacles_kept)
 
 
 def edge_resolution_m(problem: Problem) -> float:

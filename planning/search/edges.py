@@ -11,7 +11,8 @@ between two points on it replaces what lies between when it is valid, both its e
 included: a point of an edge between two of its checked configurations was never checked
 itself), then skipping vertices (from each vertex straight to the farthest one it sees),
 then, given the joints' speeds, straightening one joint at a time where that makes the path
-faster (:func:`straighten_joints`), then dropping collinear vertices.
+faster (:func:`straighten_joints`), then dropping collinear vertices. A validity may carry a
+cheaper, looser screen (:class:`ScreenedValidity`) that a planner's trees grow on.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -32,6 +34,35 @@ Validity = Callable[[FloatArray], BoolArray]
 
 Exact up to the first invalid configuration; after it, a check may report any value (an
 edge is known by where it is first blocked, so a check may stop there)."""
+
+
+@dataclass(frozen=True)
+class ScreenedValidity:
+    """A validity check with a cheaper screen that a sampling planner's trees may grow on.
+
+    Called, it is ``valid``. ``screen`` accepts every configuration ``valid`` accepts and costs
+    less (the obstacles without the robot's own pairs): trees grown on it are thrown away
+    mostly, so RRT-Connect grows them on the screen and holds the path they find under
+    ``valid`` (:mod:`planning.search.rrt_connect`).
+
+    Attributes:
+        valid: the check a path must pass.
+        screen: the cheaper, looser check.
+    """
+
+    valid: Validity
+    screen: Validity
+
+    def __call__(self, q: FloatArray) -> BoolArray:
+        """``(N,)`` whether each of ``q`` ``(N, d)`` is valid (``valid``'s answer)."""
+        return self.valid(q)
+
+
+def screen_of(valid: Validity) -> Validity | None:
+    """``valid``'s screen where it has one (:class:`ScreenedValidity`), else ``None``."""
+    return valid.screen if isinstance(valid, ScreenedValidity) else None
+
+
 COARSE_STRIDE = 8
 """Configurations an edge's coarse pass steps over (:meth:`Edges.free_fraction`)."""
 HEAD = 2

@@ -26,7 +26,10 @@ thrown away, and a dense check of each would dominate the planner's time on a 6-
 arm. The shortened path's few edges are then checked at ``resolution_m``; an edge that
 passes between two coarse checks through an obstacle is replaced by RRT-Connect's path
 between its ends at that spacing, and when none is found the whole search runs again at it.
-The path returned always holds at ``resolution_m``.
+The path returned always holds at ``resolution_m``. Where the validity has a cheaper screen
+(:class:`~planning.search.edges.ScreenedValidity`: the obstacles without the robot's own pairs),
+the coarse draw grows the trees on it, and its path is held as above under the validity itself;
+where a vertex of it fails that, the coarse draw is made again on the validity.
 
 A share of the samples (``local_share``) is drawn about a random node of the tree they
 extend (a normal spread of ``local_spread`` of each joint's range), the others uniformly in
@@ -50,7 +53,6 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
-import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -58,9 +60,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from planning.errors import PlanningError
-from planning.search.edges import Edges, Validity, shortcut
+from planning.search.edges import Edges, Validity, screen_of, shortcut
 from planning.search.rrt_settings import RANGE_FRACTION, RrtSettings
-from planning.search.rrt_trees import GrownTrees, Tree
+from planning.search.rrt_trees import GrownTrees, Sampler, Tree, connect
 
 FloatArray = NDArray[np.float64]
 
@@ -170,7 +172,7 @@ def rrt_connect(
     if edges.free_fraction(start, goal) == 1.0:
         return RrtPath(np.array([start, goal]), 0, edges.checks, relaxed)
     trees, strict_checks = kept or (Tree(start), Tree(goal)), 0
-    draw = _Sampler(lower, upper, settings)
+    draw = Sampler(lower, upper, settings)
     for sample in range(1, settings.max_samples + 1):
         if stop is not None and stop():
             break
@@ -191,7 +193,7 @@ def rrt_connect(
         new = grow.add(origin + extended * (end - origin), near)
         other_near = other.nearest(grow.nodes[new], weights)
         connected = edges.free_fraction(other.nodes[other_near], grow.nodes[new])
-        joined = _connect(other, other_near, grow.nodes[new], connected, step_m, weights)
+        joined = connect(other, other_near, grow.nodes[new], connected, step_m, weights)
         if joined is not None:
             # root of grow ... new == joined ... root of other (the meeting point once)
             path = np.concatenate([grow.branch(new)[::-1], other.branch(joined)[1:]])
@@ -204,28 +206,6 @@ def rrt_connect(
     if grown is not None:  # no path: the trees, for the next draw
         grown.keep(trees, start, goal, settings.resolution_m, relaxed)
     return None
-
-
-class _Sampler:
-    """The samples of a search: with ``local_share``, near a node of the tree; else uniform in the box."""
-
-    def __init__(self, lower: FloatArray, upper: FloatArray, settings: RrtSettings) -> None:
-        self.lower, self.upper, self.share = lower, upper, settings.local_share
-        self.span = upper - lower
-        self.spread = settings.local_spread * self.span
-
-    def __call__(self, tree: Tree, rng: np.random.Generator) -> FloatArray:
-        """A sample for ``tree``, drawn from ``rng``.
-
-        Uniform draws are ``lower + span * rng.random(d)``: the numbers ``rng.uniform(lower,
-        upper)`` draws, to the bit (NumPy computes ``low + (high - low) * u`` from the same
-        ``u``), without its broadcasting and checks, a few microseconds a sample.
-        """
-        if self.share and rng.random() < self.share:
-            node: FloatArray = tree.nodes[rng.integers(tree.size)]
-            drawn = node + self.spread * rng.standard_normal(node.size)
-            return np.minimum(np.maximum(drawn, self.lower), self.upper)  # np.clip, without its overhead
-        return self.lower + self.span * rng.random(self.lower.size)
 
 
 def _lazy(
@@ -245,54 +225,74 @@ def _lazy(
 ) -> RrtPath | None:
     """RRT-Connect on coarse edge checks, its path then held at ``resolution_m`` (module docstring).
 
-    ``grown`` serves the coarse draw: its trees are the ones a later draw can go on with.
+    Where ``valid`` and the relaxation's validity have screens, the coarse draw grows the trees
+    on them; where its path does not hold under the validities (a vertex fails, or an edge finds
+    no detour), the coarse draw is made again on them, without the screens' trees. ``grown``
+    serves the coarse draw: its trees are the ones a later draw can go on with.
     """
     fine = dataclasses.replace(settings, explore_resolution_m=None, step_m=step_m)
     coarse = dataclasses.replace(fine, resolution_m=settings.explore_resolution_m or settings.resolution_m)
+    unshortened = dataclasses.replace(fine, shortcuts=0)
+    spent = RrtPath(np.empty((0, len(start))), 0, 0)  # what a draw whose path did not hold took
+
+    def held(found: RrtPath, search_again: bool) -> RrtPath | None:
+        """``found`` held at ``resolution_m``: detours; where one fails, the fine draw or ``None``."""
+        strict, loose = valid, relaxation
+        if found.relaxed and relaxation is not None:  # the path holds at the looser validity only
+            strict, loose = relaxation.valid, None
+        edges = Edges(strict, weights, settings.resolution_m)
+        if not search_again and not strict(found.path[1:]).all():
+            return None  # a vertex the screen let through: no detour reaches it
+        samples, checks = spent.samples + found.samples, spent.checks + found.checks
+        pieces = [found.path[:1]]
+        for a, b in itertools.pairwise(found.path):
+            if edges.free_fraction(a, b) == 1.0:
+                pieces.append(b[None])
+                continue
+            detour = rrt_connect(strict, a, b, *box, weights, rng, unshortened, stop)
+            if detour is None:  # the coarse path is no guide here
+                if not search_again:
+                    return None
+                again = rrt_connect(strict, start, goal, *box, weights, rng, fine, stop, loose, speeds=speeds)
+                if again is None:
+                    return None
+                total = checks + edges.checks + again.checks
+                return RrtPath(again.path, samples + again.samples, total, found.relaxed or again.relaxed)
+            samples, checks = samples + detour.samples, checks + detour.checks
+            pieces.append(detour.path[1:])
+        path = np.concatenate(pieces)
+        if len(path) > len(found.path):  # detours: shortened again, on the fine checks
+            path = shortcut(
+                path, edges, rng, settings.shortcuts, joint_attempts=settings.joint_shortcuts, speeds=speeds
+            )
+        return RrtPath(path, samples, checks + edges.checks, found.relaxed)
+
+    screens = _screens(valid, relaxation)
+    if screens is not None:
+        screen, screen_relaxation = screens
+        found = rrt_connect(
+            screen, start, goal, *box, weights, rng, coarse, stop, screen_relaxation, grown, speeds=speeds
+        )
+        if found is None:
+            return None
+        kept = held(found, search_again=False)
+        if kept is not None:
+            return kept
+        spent, grown = found, None  # the trees grew on the screens
     found = rrt_connect(
         valid, start, goal, *box, weights, rng, coarse, stop, relaxation, grown, speeds=speeds
     )
-    if found is None:
+    return None if found is None else held(found, search_again=True)
+
+
+def _screens(valid: Validity, relaxation: Relaxation | None) -> tuple[Validity, Relaxation | None] | None:
+    """The screens of ``valid`` and of the relaxation's validity, where each has one, else ``None``."""
+    screen = screen_of(valid)
+    if screen is None:
         return None
-    if found.relaxed and relaxation is not None:  # the path holds at the looser validity only
-        valid, relaxation = relaxation.valid, None
-    edges = Edges(valid, weights, settings.resolution_m)
-    samples, checks = found.samples, found.checks
-    pieces = [found.path[:1]]
-    for a, b in itertools.pairwise(found.path):
-        if edges.free_fraction(a, b) == 1.0:
-            pieces.append(b[None])
-            continue
-        detour = rrt_connect(valid, a, b, *box, weights, rng, dataclasses.replace(fine, shortcuts=0), stop)
-        if detour is None:  # the coarse path is no guide here: search again at the fine spacing
-            again = rrt_connect(valid, start, goal, *box, weights, rng, fine, stop, relaxation, speeds=speeds)
-            if again is None:
-                return None
-            total = checks + edges.checks + again.checks
-            return RrtPath(again.path, samples + again.samples, total, found.relaxed or again.relaxed)
-        samples, checks = samples + detour.samples, checks + detour.checks
-        pieces.append(detour.path[1:])
-    path = np.concatenate(pieces)
-    if len(path) > len(found.path):  # detours: shortened again, on the fine checks
-        path = shortcut(
-            path, edges, rng, settings.shortcuts, joint_attempts=settings.joint_shortcuts, speeds=speeds
-        )
-    return RrtPath(path, samples, checks + edges.checks, found.relaxed)
-
-
-def _connect(
-    tree: Tree, near: int, target: FloatArray, fraction: float, step_m: float, weights: FloatArray
-) -> int | None:
-    """Grow ``tree`` from node ``near`` along the valid ``fraction`` of the way to ``target``.
-
-    A node every step; returns the node at ``target`` if reached.
-    """
-    if fraction == 0.0:
+    if relaxation is None:
+        return screen, None
+    relaxed_screen = screen_of(relaxation.valid)
+    if relaxed_screen is None:
         return None
-    origin = tree.nodes[near]
-    length = float(np.abs(target - origin) @ weights)
-    nodes = max(1, math.ceil(fraction * length / step_m))
-    parent = near
-    for k in range(1, nodes + 1):
-        parent = tree.add(origin + (fraction * k / nodes) * (target - origin), parent)
-    return parent if fraction == 1.0 else None
+    return screen, Relaxation(relaxed_screen, relaxation.after_samples)
